@@ -1,0 +1,63 @@
+"""``rtsgeom info | paths | export-mesh``: the setup's geometry."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..geometry import build_setup
+from ..info import format_info, scene_info
+from ..io import write_text
+from ..scene import load_scene
+from ._common import UsageError, print_json, scene_arg
+
+
+def cmd_info(args) -> int:
+    info = scene_info(build_setup(load_scene(args.scene)))
+    if args.json:
+        print_json(info)
+    else:
+        print(format_info(info))
+    return 0
+
+
+def cmd_paths(args) -> int:
+    setup = build_setup(load_scene(args.scene))
+    if args.method == "exact":
+        from ..paths import exact_paths
+        paths = exact_paths(setup)
+    else:
+        from ..paths.raytrace import raytrace_paths
+        paths = raytrace_paths(setup)
+    write_text(args.out, paths.to_csv())
+    print(f"wrote {len(paths)} paths ({paths.method}) to {args.out}")
+    return 0
+
+
+def cmd_export_mesh(args) -> int:
+    from ..geometry.export import export_setup
+    setup = build_setup(load_scene(args.scene))
+    try:
+        path = export_setup(setup, args.out)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    print(f"wrote {path}")
+    return 0
+
+
+def register(sub) -> None:
+    p = sub.add_parser("info", help="summary of a scene: elements, front ends, far-field figures")
+    scene_arg(p)
+    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    p.set_defaults(func=cmd_info)
+
+    p = sub.add_parser("paths", help="per-element propagation paths as CSV")
+    scene_arg(p)
+    p.add_argument("--out", type=Path, required=True, help="CSV file to write")
+    p.add_argument("--method", choices=("exact", "raytrace"), default="exact",
+                   help="exact line-of-sight distances (default) or Sionna RT ray tracing")
+    p.set_defaults(func=cmd_paths)
+
+    p = sub.add_parser("export-mesh", help="export the setup as GLB/PLY/OBJ/STL")
+    scene_arg(p)
+    p.add_argument("--out", type=Path, required=True, help="mesh file (.glb, .ply, .obj, .stl)")
+    p.set_defaults(func=cmd_export_mesh)

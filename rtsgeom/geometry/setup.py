@@ -1,0 +1,52 @@
+"""The whole physical setup: RuT array + front ends + sheet, built from a :class:`Scene`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import trimesh
+
+from .._util import frozen
+from ..scene import Scene
+from .arc import FrontEnds, antenna_positions, front_ends
+from .arrays import RutArray, rut_array
+from .sheet import sheet_mesh
+
+__all__ = ["Setup", "build_setup"]
+
+
+@dataclass(frozen=True)
+class Setup:
+    """Geometry of one scene (world frame, metres). The sheet mesh is built on first use."""
+
+    scene: Scene
+    rut: RutArray
+    fe: FrontEnds
+
+    @cached_property
+    def sheet(self) -> trimesh.Trimesh | None:
+        cfg = self.scene.sheet
+        if not cfg.enabled:
+            return None
+        return sheet_mesh(cfg, self.fe.arc_centre, self.fe.arc_radius_m, self.fe.angle_rad)
+
+    def fe_azimuth_rad(self) -> np.ndarray:
+        """Azimuth of each front end's module centre as seen from the RuT phase centre."""
+        return self.rut.azimuth_of(self.fe.module)
+
+
+def build_setup(scene: Scene, offsets_m: np.ndarray | None = None) -> Setup:
+    """Place the RuT and the front ends. ``offsets_m`` (F, 3) overrides the scene's mounting
+    errors (radial, tangential, height), e.g. for a tolerance draw."""
+    rut = rut_array(scene.radar)
+    centre = (np.asarray(scene.rts.arc_center_m, float) if scene.rts.arc_center_m is not None
+              else np.asarray(rut.position, float))
+    fe = front_ends(scene, centre)
+    if offsets_m is not None:
+        rx, tx, mod = antenna_positions(centre, scene.rts.arc_radius_m, fe.angle_rad,
+                                        fe.separation_m, offsets_m)
+        fe = FrontEnds(fe.angle_rad, frozen(rx), frozen(tx), frozen(mod), fe.separation_m,
+                       frozen(offsets_m), fe.arc_centre, fe.arc_radius_m)
+    return Setup(scene, rut, fe)
