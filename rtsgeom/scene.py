@@ -31,6 +31,7 @@ __all__ = [
     "RtsConfig",
     "SheetConfig",
     "TargetConfig",
+    "RaytraceConfig",
     "Scene",
     "load_scene",
     "parse_scene",
@@ -204,6 +205,19 @@ class SheetConfig:
 
 
 @dataclass(frozen=True)
+class RaytraceConfig:
+    """Sionna RT settings for ``--paths raytrace`` (see ``paths/raytrace.py``)."""
+
+    max_depth: int = 2  # reflections per path
+    samples_per_src: int = 10_000  # rays shot per source (memory grows with elements x this)
+    los: bool = True
+    specular_reflection: bool = True
+    diffuse_reflection: bool = False
+    refraction: bool = False
+    min_gain_db: float = -200.0  # drop paths weaker than this (amplitude, dB)
+
+
+@dataclass(frozen=True)
 class TargetConfig:
     """A virtual target as the RuT should see it: range, radial velocity, RCS and azimuth.
 
@@ -227,6 +241,7 @@ class Scene:
     rts: RtsConfig
     sheet: SheetConfig
     targets: tuple[TargetConfig, ...]
+    raytrace: RaytraceConfig = field(default_factory=RaytraceConfig)
     seed: int = 0
     source: str | None = None
     sha256: str = ""
@@ -467,6 +482,20 @@ def _parse_sheet(t: _Table) -> SheetConfig:
     return SheetConfig(enabled, off, thick, height, math.radians(a0), math.radians(a1), diam, mat)
 
 
+def _parse_raytrace(t: _Table) -> RaytraceConfig:
+    out = RaytraceConfig(
+        max_depth=t.integer("max_depth", default=2, lo=0, hi=10),
+        samples_per_src=t.integer("samples_per_src", default=10_000, lo=100, hi=10_000_000),
+        los=t.boolean("los", default=True),
+        specular_reflection=t.boolean("specular_reflection", default=True),
+        diffuse_reflection=t.boolean("diffuse_reflection", default=False),
+        refraction=t.boolean("refraction", default=False),
+        min_gain_db=t.num("min_gain_db", default=-200.0, lo=-400.0, hi=0.0, unit="dB"),
+    )
+    t.done()
+    return out
+
+
 def _parse_target(t: _Table) -> TargetConfig:
     rng = t.num("range_m", lo=0.0, hi=1e4, lo_open=True, unit="m")
     vel = t.num("velocity_mps", default=0.0, lo=-500.0, hi=500.0, unit="m/s")
@@ -537,6 +566,7 @@ def parse_scene(data: dict, source: str = "<scene>", base_dir: Path | None = Non
     rts = _parse_rts(top.table("rts", required=True))
     sheet = _parse_sheet(top.table("sheet"))
     targets = tuple(_parse_target(t) for t in top.tables("targets", required=False))
+    raytrace = _parse_raytrace(top.table("raytrace"))
     meshes = []
     for mt in top.tables("structure", required=False):
         rel = mt.string("mesh")
@@ -549,7 +579,8 @@ def parse_scene(data: dict, source: str = "<scene>", base_dir: Path | None = Non
             mt.fail(mt.path("mesh"), rel, f"an existing mesh file (resolved to {p})")
         meshes.append((str(p), mat))
     top.done()
-    scene = Scene(name, radar, rts, sheet, targets, seed, source, sha256, desc, tuple(meshes))
+    scene = Scene(name, radar, rts, sheet, targets, raytrace, seed, source, sha256, desc,
+                  tuple(meshes))
     _check_consistency(scene, source)
     return scene
 
