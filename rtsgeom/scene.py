@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import hashlib
 import math
+import reprlib
+import stat
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,6 +36,7 @@ __all__ = [
     "RaytraceConfig",
     "Scene",
     "load_scene",
+    "loads_scene",
     "parse_scene",
 ]
 
@@ -43,6 +46,16 @@ ANTENNA_PRESETS = ("awr1843boost",)
 WINDOWS = ("none", "hann", "hamming", "blackman")
 CFAR_KINDS = ("ca", "os")
 AOA_MODES = ("exact", "array-factor", "paper", "nearest")
+
+# Resource limits: a scene file is a few kB; these stop a hostile or mistyped file from asking
+# for gigabytes of memory or hours of work before anything is computed.
+MAX_SCENE_BYTES = 4 << 20  # size of a scene file
+MAX_NAME_CHARS = 200  # ``name`` (printed, may end up in file names)
+MAX_STRING_CHARS = 10_000  # any other string (description, mesh paths)
+MAX_FRONT_ENDS = 256
+MAX_TARGETS = 1024
+MAX_CALIBRATION_STEPS = 100_000  # calibration_span / calibration_step
+MAX_ADC_SAMPLES = 1 << 27  # samples_per_chirp * chirps_per_tx * virtual elements (2 GiB complex)
 
 
 class SceneError(ValueError):
@@ -254,8 +267,22 @@ class Scene:
 # --------------------------------------------------------------------------------------------
 
 
+_REPR = reprlib.Repr()
+_REPR.maxstring, _REPR.maxother, _REPR.maxlong = 60, 60, 40
+_REPR.maxlist, _REPR.maxdict, _REPR.maxlevel = 12, 8, 3
+
+
 def _fmt(v: Any) -> str:
-    return repr(v) if not isinstance(v, float) else f"{v:g}"
+    """The value as written in an error message: short even for huge or deeply nested input."""
+    return _REPR.repr(v) if not isinstance(v, float) else f"{v:g}"
+
+
+def _as_float(v: int | float) -> float | None:
+    """``float(v)``, or None for an integer too large for a float (TOML integers are unbounded)."""
+    try:
+        return float(v)
+    except OverflowError:
+        return None
 
 
 class _Table:
@@ -288,10 +315,11 @@ class _Table:
             return v
         if isinstance(v, bool) or not isinstance(v, (int, float)):
             self.fail(self.path(key), v, f"a number{' in ' + unit if unit else ''}")
-        v = float(v)
         rng = _range_text(lo, hi, lo_open, hi_open, unit)
-        if not math.isfinite(v):
+        f = _as_float(v)
+        if f is None or not math.isfinite(f):
             self.fail(self.path(key), v, f"a finite number {rng}".rstrip())
+        v = f
         if lo is not None and (v < lo or (lo_open and v == lo)):
             self.fail(self.path(key), v, rng)
         if hi is not None and (v > hi or (hi_open and v == hi)):
@@ -320,13 +348,26 @@ class _Table:
             self.fail(self.path(key), v, "true or false")
         return v
 
-    def string(self, key, default=_REQUIRED, choices=None) -> str:
+    def string(self, key, default=_REQUIRED, choices=None, max_chars=MAX_STRING_CHARS,
+               printable=False) -> str:
         v = self._get(key, default)
         if not isinstance(v, str):
             self.fail(self.path(key), v, "a string" + (f": one of {', '.join(choices)}" if choices else ""))
         if choices is not None and v not in choices:
             self.fail(self.path(key), v, f"one of {', '.join(choices)}")
+        if len(v) > max_chars:
+            self.fail(self.path(key), v, f"a string of at most {max_chars} characters "
+                                         f"(it has {len(v)})")
+        if printable and not v.isprintable():
+            self.fail(self.path(key), v, "a string of printable characters (no newlines, tabs "
+                                         "or control characters)")
         return v
+
+    def material(self, key) -> str:
+        mat = self.string(key, default="itu_metal", max_chars=MAX_NAME_CHARS)
+        if not mat.replace("_", "").isalnum():
+            self.fail(self.path(key), mat, "a radio material name such as itu_metal")
+        return mat
 
     def vector(self, key, n, default=_REQUIRED, unit="m", lo=-1e3, hi=1e3) -> tuple[float, ...]:
         v = self._get(key, default)
@@ -335,8 +376,8 @@ class _Table:
         if (not isinstance(v, list) or len(v) != n
                 or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in v)):
             self.fail(self.path(key), v, f"a list of {n} numbers in {unit}")
-        out = tuple(float(x) for x in v)
-        if not all(math.isfinite(x) and lo <= x <= hi for x in out):
+        out = tuple(_as_float(x) for x in v)
+        if not all(x is not None and math.isfinite(x) and lo <= x <= hi for x in out):
             self.fail(self.path(key), v, f"{n} finite numbers in [{lo:g}, {hi:g}] {unit}")
         return out
 
@@ -354,7 +395,10 @@ class _Table:
         unknown = sorted(set(self.data) - self.used)
         if unknown:
             allowed = ", ".join(sorted(self.used))
-            raise SceneError(f"{self.source}: {self.path(unknown[0])} is not a known field "
+            key = unknown[0]
+            if len(key) > 60 or not key.isprintable():  # show a hostile key abbreviated, quoted
+                key = _fmt(key)
+            raise SceneError(f"{self.source}: {self.path(key)} is not a known field "
                              f"(allowed here: {allowed})")
 
 
@@ -442,7 +486,11 @@ def _parse_front_end(t: _Table) -> FrontEndConfig:
 def _parse_rts(t: _Table) -> RtsConfig:
     radius = t.num("arc_radius_m", lo=0.05, hi=100.0, lo_open=False, unit="m")
     centre = t.vector("arc_center_m", 3, default=None)
-    fes = tuple(_parse_front_end(ft) for ft in t.tables("front_ends"))
+    fe_tables = t.tables("front_ends")
+    if len(fe_tables) > MAX_FRONT_ENDS:
+        t.fail(t.path("front_ends"), f"<{len(fe_tables)} front ends>",
+               f"a list of at most {MAX_FRONT_ENDS} front ends")
+    fes = tuple(_parse_front_end(ft) for ft in fe_tables)
     if not fes:
         t.fail(t.path("front_ends"), [], "a list of at least one front end")
     f_rts = t.num("f_rts_hz", lo=0.0, hi=100e9, unit="Hz")
@@ -475,9 +523,7 @@ def _parse_sheet(t: _Table) -> SheetConfig:
     if a1 <= a0:
         t.fail(t.path("angle_max_deg"), a1, f"> sheet.angle_min_deg ({a0:g} deg)")
     diam = t.num("cutout_diameter_m", default=0.05, lo=0.0, hi=2.0, lo_open=True, unit="m")
-    mat = t.string("material", default="itu_metal")
-    if not mat.replace("_", "").isalnum():
-        t.fail(t.path("material"), mat, "a radio material name such as itu_metal")
+    mat = t.material("material")
     t.done()
     return SheetConfig(enabled, off, thick, height, math.radians(a0), math.radians(a1), diam, mat)
 
@@ -505,12 +551,41 @@ def _parse_target(t: _Table) -> TargetConfig:
     return TargetConfig(rng, vel, rcs, ang)
 
 
+def front_end_module_m(centre, radius_m: float, fe: FrontEndConfig) -> tuple[float, float, float]:
+    """World position of a front end's module centre (mounting offsets applied).
+
+    The scalar twin of ``geometry.arc.antenna_positions`` for the checks below (this module
+    cannot import the geometry package, which imports it).
+    """
+    s, co = math.sin(fe.angle_rad), math.cos(fe.angle_rad)
+    r = radius_m + fe.radial_offset_m
+    t = fe.tangential_offset_m
+    return (centre[0] + r * s + t * co, centre[1] + r * co - t * s, centre[2] + fe.height_offset_m)
+
+
+def azimuth_from_radar_rad(radar: RadarConfig, point) -> float:
+    """Azimuth of a world point seen from the RuT's phase centre, in the radar frame."""
+    p = radar.position_m
+    return math.remainder(math.atan2(point[0] - p[0], point[1] - p[1]) - radar.yaw_rad,
+                          2.0 * math.pi)
+
+
+def arc_centre_m(scene: Scene) -> tuple[float, float, float]:
+    """The arc centre: ``rts.arc_center_m``, by default the RuT's phase centre."""
+    c0 = scene.rts.arc_center_m
+    return c0 if c0 is not None else scene.radar.position_m
+
+
 def _check_consistency(scene: Scene, source: str) -> None:
     """Physical consistency between sections; each error names the field it blames."""
     rts, sheet, radar = scene.rts, scene.sheet, scene.radar
 
     def fail(fieldname, value, allowed):
         raise SceneError(f"{source}: {fieldname} = {_fmt(value)}: must be {allowed}")
+
+    if sheet.enabled and sheet.cutout_diameter_m >= sheet.height_m:
+        fail("sheet.cutout_diameter_m", sheet.cutout_diameter_m,
+             f"< sheet.height_m ({sheet.height_m:g} m): the cutouts would cut the sheet in two")
 
     # Cutouts of neighbouring front ends must not overlap (the sheet would fall apart), and each
     # cutout must hold its front end's two antennas.
@@ -539,12 +614,69 @@ def _check_consistency(scene: Scene, source: str) -> None:
                      f">= {math.degrees(a.angle_rad) + min_deg:.4g} deg: front ends "
                      f"{i - 1} and {i} are closer ({chord * 1e3:.1f} mm) than their cutouts "
                      f"({sheet.cutout_diameter_m * 1e3:.1f} mm) allow")
-    # Targets must be inside the radar's unambiguous range and velocity.
+    # The RuT sits inside the arc (and inside the sheet), and every front end is in front of it.
+    centre = arc_centre_m(scene)
+    pos = radar.position_m
+    dist = math.dist(pos, centre)
+    r_in, what = rts.arc_radius_m, "rts.arc_radius_m"
+    if sheet.enabled and r_sheet < r_in:
+        r_in, what = r_sheet, "the sheet's inner radius rts.arc_radius_m + sheet.radius_offset_m"
+    if dist >= r_in:
+        fail("radar.position_m", list(pos),
+             f"inside the arc: less than {what} = {r_in:g} m from rts.arc_center_m "
+             f"{list(centre)} (it is {dist:.4g} m away)")
+    modules = [front_end_module_m(centre, rts.arc_radius_m, fe) for fe in rts.front_ends]
+    for i, (fe, mod) in enumerate(zip(rts.front_ends, modules)):
+        az = math.degrees(azimuth_from_radar_rad(radar, mod))
+        if not -90.0 < az < 90.0:
+            fail(f"rts.front_ends[{i}].angle_deg", math.degrees(fe.angle_rad),
+                 f"an angle that puts the front end in front of the radar: seen from "
+                 f"radar.position_m {list(pos)} with radar.yaw_deg = "
+                 f"{math.degrees(radar.yaw_rad):g} it is at azimuth {az:.4g} deg, outside "
+                 "(-90, 90) deg")
+    # The RTS delay must be able to take the calibration's steps, and the calibration sweep must
+    # cover one period of the phase it calibrates (paper: 1 / (f_rts + B/2) = 1 ns).
+    step = rts.calibration_step_s
+    if rts.delay_resolution_s > step * (1.0 + 1e-9):
+        how = (f"rts.fractional_delay = true with rts.fractional_delay_step_s = "
+               f"{rts.fractional_delay_step_s:g} s: use a finer fractional_delay_step_s"
+               if rts.fractional_delay else
+               f"rts.fractional_delay = false: the delay moves in whole back-end samples "
+               f"1/rts.f_s_hz; set rts.fractional_delay = true")
+        fail("rts.calibration_step_ps", step * 1e12,
+             f">= the RTS delay resolution {rts.delay_resolution_s * 1e12:g} ps ({how})")
+    span = rts.calibration_span_s[1] - rts.calibration_span_s[0]
+    period = 1.0 / (rts.f_rts_hz + 0.5 * radar.bandwidth_hz)
+    span_ns = [round(x * 1e9, 9) for x in rts.calibration_span_s]
+    if span < period * (1.0 - 1e-9):
+        fail("rts.calibration_span_ns", span_ns,
+             f"at least one period 1/(rts.f_rts_hz + radar.bandwidth_hz/2) = "
+             f"{period * 1e9:.4g} ns wide (it spans {span * 1e9:.4g} ns)")
+    if span / step > MAX_CALIBRATION_STEPS:
+        fail("rts.calibration_step_ps", step * 1e12,
+             f">= {span / MAX_CALIBRATION_STEPS * 1e12:.4g} ps: rts.calibration_span_ns "
+             f"{span_ns} would take {span / step:.4g} steps (at most {MAX_CALIBRATION_STEPS})")
+    n_adc = radar.samples_per_chirp * radar.chirps_per_tx * radar.num_tx_active * 4
+    if n_adc > MAX_ADC_SAMPLES:
+        fail("radar.chirps_per_tx", radar.chirps_per_tx,
+             f"<= {MAX_ADC_SAMPLES // (radar.samples_per_chirp * radar.num_tx_active * 4)}: "
+             f"samples_per_chirp x chirps_per_tx x virtual elements = {n_adc} ADC samples "
+             f"(at most {MAX_ADC_SAMPLES})")
+    # Targets must be inside the radar's unambiguous range (the beat of the echo includes any air
+    # path the RTS does not subtract) and velocity.
+    if len(scene.targets) > MAX_TARGETS:
+        fail("targets", f"<{len(scene.targets)} targets>", f"at most {MAX_TARGETS} targets")
+    d_air = max(math.dist(pos, m) for m in modules)
+    extra = max(0.0, d_air - rts.arc_radius_m) if rts.compensate_air_path else d_air
+    r_max = radar.max_range_m - extra
     for i, tg in enumerate(scene.targets):
-        if tg.range_m >= radar.max_range_m:
+        if tg.range_m >= r_max:
+            air = (f" minus the air path {extra:.4g} m the RTS does not subtract "
+                   f"(rts.compensate_air_path = {str(rts.compensate_air_path).lower()})"
+                   if extra > 0 else "")
             fail(f"targets[{i}].range_m", tg.range_m,
-                 f"< {radar.max_range_m:.4g} m, the radar's unambiguous range "
-                 "(adc_rate_hz * c / (2 * slope))")
+                 f"< {r_max:.4g} m, the radar's unambiguous range {radar.max_range_m:.4g} m "
+                 f"(adc_rate_hz * c / (2 * slope)){air}")
         if abs(tg.velocity_mps) >= radar.max_velocity_mps:
             fail(f"targets[{i}].velocity_mps", tg.velocity_mps,
                  f"in (-{radar.max_velocity_mps:.4g}, {radar.max_velocity_mps:.4g}) m/s, the "
@@ -559,7 +691,10 @@ def parse_scene(data: dict, source: str = "<scene>", base_dir: Path | None = Non
                 sha256: str = "") -> Scene:
     """Build a validated :class:`Scene` from a parsed TOML document."""
     top = _Table(data, "", source)
-    name = top.string("name", default=Path(source).stem if source != "<scene>" else "scene")
+    name = top.string("name", default=Path(source).stem if source != "<scene>" else "scene",
+                      max_chars=MAX_NAME_CHARS, printable=True)
+    if not name.strip():
+        top.fail("name", name, "a non-empty string")
     desc = top.string("description", default="")
     seed = top.integer("seed", default=0, lo=0, hi=2**63 - 1)
     radar = _parse_radar(top.table("radar", required=True))
@@ -570,13 +705,17 @@ def parse_scene(data: dict, source: str = "<scene>", base_dir: Path | None = Non
     meshes = []
     for mt in top.tables("structure", required=False):
         rel = mt.string("mesh")
-        mat = mt.string("material", default="itu_metal")
+        mat = mt.material("material")
         mt.done()
         p = Path(rel)
         if not p.is_absolute():
             p = (base_dir or Path.cwd()) / p
-        if not p.is_file():
-            mt.fail(mt.path("mesh"), rel, f"an existing mesh file (resolved to {p})")
+        try:
+            exists = p.is_file()
+        except (OSError, ValueError):  # e.g. a name too long for the file system
+            exists = False
+        if not exists:
+            mt.fail(mt.path("mesh"), rel, f"an existing mesh file (resolved to {_fmt(str(p))})")
         meshes.append((str(p), mat))
     top.done()
     scene = Scene(name, radar, rts, sheet, targets, raytrace, seed, source, sha256, desc,
@@ -585,18 +724,46 @@ def parse_scene(data: dict, source: str = "<scene>", base_dir: Path | None = Non
     return scene
 
 
+def loads_scene(raw: bytes | str, source: str = "<scene>", base_dir: Path | None = None
+                ) -> Scene:
+    """Parse and validate scene text (TOML). Every failure is a :class:`SceneError`.
+
+    ``base_dir`` is the folder relative mesh paths are resolved against (default: the current
+    directory). A UTF-8 byte-order mark is accepted.
+    """
+    if isinstance(raw, str):
+        raw = raw.encode("utf-8", "surrogatepass")
+    if len(raw) > MAX_SCENE_BYTES:
+        raise SceneError(f"{source}: scene file too large ({len(raw)} bytes; at most "
+                         f"{MAX_SCENE_BYTES})")
+    try:
+        data = tomllib.loads(raw.decode("utf-8-sig"))
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"{source}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+    except ValueError as exc:  # TOMLDecodeError, or an integer of more than 4300 digits
+        raise SceneError(f"{source}: not valid TOML ({str(exc)[:200]})") from None
+    except RecursionError:
+        raise SceneError(f"{source}: not valid TOML (arrays or tables nested too deeply)") from None
+    return parse_scene(data, source, base_dir, hashlib.sha256(raw).hexdigest())
+
+
 def load_scene(path: str | Path) -> Scene:
     """Load and validate a scene file (TOML, parsed with the standard library's safe loader)."""
     p = Path(path)
     try:
-        raw = p.read_bytes()
+        st = p.stat()
+        if stat.S_ISDIR(st.st_mode):
+            raise SceneError(f"{p}: cannot read scene file (it is a directory)")
+        if not stat.S_ISREG(st.st_mode):
+            raise SceneError(f"{p}: cannot read scene file (not a regular file)")
+        with p.open("rb") as fh:
+            raw = fh.read(MAX_SCENE_BYTES + 1)
+        base = p.resolve().parent
+    except SceneError:
+        raise
     except OSError as exc:
         raise SceneError(f"{p}: cannot read scene file ({exc.strerror or exc})") from None
-    try:
-        data = tomllib.loads(raw.decode("utf-8"))
-    except UnicodeDecodeError as exc:
-        raise SceneError(f"{p}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{p}: not valid TOML ({exc})") from None
-    return parse_scene(data, str(p), p.resolve().parent, hashlib.sha256(raw).hexdigest())
+    except (ValueError, RuntimeError) as exc:  # embedded NUL byte; symlink loop
+        raise SceneError(f"{_fmt(str(p))}: cannot read scene file ({exc})") from None
+    return loads_scene(raw, str(p), base)
 

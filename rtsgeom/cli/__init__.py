@@ -45,6 +45,10 @@ def main(argv: list[str] | None = None) -> int:
     except (SceneError, UsageError) as exc:
         print(f"rtsgeom: error: {exc}", file=sys.stderr)
         return 2
+    except OSError as exc:  # an output path that cannot be written, a missing input file
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"rtsgeom: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print("rtsgeom: interrupted", file=sys.stderr)
         return 130

@@ -5,9 +5,10 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from pathlib import Path
 
-__all__ = ["UsageError", "number", "scene_arg", "print_json"]
+__all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checked"]
 
 
 class UsageError(ValueError):
@@ -36,3 +37,15 @@ def scene_arg(p: argparse.ArgumentParser) -> None:
 
 def print_json(obj) -> None:
     print(json.dumps(obj, indent=2, allow_nan=False))
+
+
+def load_scene_checked(path):
+    """Load and validate a scene (errors raise :class:`~rtsgeom.scene.SceneError`, exit code 2)
+    and print its physical warnings (``rtsgeom.validate.scene_warnings``) to stderr as
+    ``rtsgeom: warning: ...``. Every subcommand that reads a scene should load it with this."""
+    from ..scene import load_scene
+    from ..validate import scene_warnings
+    scene = load_scene(path)
+    for line in scene_warnings(scene):
+        print(f"rtsgeom: warning: {line}", file=sys.stderr)
+    return scene

@@ -7,12 +7,11 @@ from pathlib import Path
 from ..geometry import build_setup
 from ..info import format_info, scene_info
 from ..io import write_text
-from ..scene import load_scene
-from ._common import UsageError, print_json, scene_arg
+from ._common import UsageError, load_scene_checked, print_json, scene_arg
 
 
 def cmd_info(args) -> int:
-    info = scene_info(build_setup(load_scene(args.scene)))
+    info = scene_info(build_setup(load_scene_checked(args.scene)))
     if args.json:
         print_json(info)
     else:
@@ -21,7 +20,7 @@ def cmd_info(args) -> int:
 
 
 def cmd_paths(args) -> int:
-    setup = build_setup(load_scene(args.scene))
+    setup = build_setup(load_scene_checked(args.scene))
     if args.method == "exact":
         from ..paths import exact_paths
         paths = exact_paths(setup)
@@ -35,7 +34,7 @@ def cmd_paths(args) -> int:
 
 def cmd_export_mesh(args) -> int:
     from ..geometry.export import export_setup
-    setup = build_setup(load_scene(args.scene))
+    setup = build_setup(load_scene_checked(args.scene))
     try:
         path = export_setup(setup, args.out)
     except ValueError as exc:

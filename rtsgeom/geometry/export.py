@@ -10,7 +10,7 @@ import trimesh
 from ..io import atomic_path
 from .setup import Setup
 
-__all__ = ["setup_scene", "export_setup"]
+__all__ = ["rut_board_mesh", "setup_scene", "export_setup"]
 
 _COLOURS = {"sheet": [170, 170, 180, 255], "rut_tx": [220, 60, 40, 255],
             "rut_rx": [40, 90, 220, 255], "fe_rx": [40, 160, 60, 255],
@@ -28,6 +28,27 @@ def _markers(points: np.ndarray, radius: float, colour) -> trimesh.Trimesh:
     return m
 
 
+def rut_board_mesh(setup: Setup) -> trimesh.Trimesh:
+    """The RuT's circuit board as a thin box (world frame): the elements' bounding box plus
+    3 lambda on each side in x and z, 1.6 mm thick, its front face 0.2 mm behind the elements.
+
+    Built in the radar frame and turned with the radar's yaw, so a yawed radar's elements stay
+    in front of its board (the ray tracer uses this box as a reflector).
+    """
+    rut = setup.rut
+    lam = rut.wavelength_m
+    pts = np.vstack([rut.tx_local, rut.rx_local])
+    lo, hi = pts.min(0), pts.max(0)
+    size = np.maximum(hi - lo, 0) + np.array([6 * lam, 0.0, 6 * lam])
+    board = trimesh.creation.box(extents=[size[0], 1.6e-3, size[2]])
+    board.apply_translation([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2 - 1e-3, (lo[2] + hi[2]) / 2])
+    pose = np.eye(4)
+    pose[:3, :3] = rut.rotation
+    pose[:3, 3] = rut.position
+    board.apply_transform(pose)
+    return board
+
+
 def setup_scene(setup: Setup) -> trimesh.Scene:
     """A trimesh scene with named geometry: sheet, RuT board, element and antenna markers."""
     sc = trimesh.Scene()
@@ -36,11 +57,7 @@ def setup_scene(setup: Setup) -> trimesh.Scene:
         sheet = setup.sheet.copy()
         sheet.visual.face_colors = _COLOURS["sheet"]
         sc.add_geometry(sheet, geom_name="sheet")
-    pts = np.vstack([setup.rut.tx_world, setup.rut.rx_world])
-    lo, hi = pts.min(0), pts.max(0)
-    size = np.maximum(hi - lo, 0) + np.array([6 * lam, 0.0, 6 * lam])
-    board = trimesh.creation.box(extents=[size[0], 1.6e-3, size[2]])
-    board.apply_translation([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2 - 1e-3, (lo[2] + hi[2]) / 2])
+    board = rut_board_mesh(setup)
     board.visual.face_colors = _COLOURS["board"]
     sc.add_geometry(board, geom_name="rut_board")
     r = lam / 4

@@ -14,7 +14,7 @@ from .arc import FrontEnds, antenna_positions, front_ends
 from .arrays import RutArray, rut_array
 from .sheet import sheet_mesh
 
-__all__ = ["Setup", "build_setup"]
+__all__ = ["Setup", "build_setup", "nominal_setup"]
 
 
 @dataclass(frozen=True)
@@ -50,3 +50,20 @@ def build_setup(scene: Scene, offsets_m: np.ndarray | None = None) -> Setup:
         fe = FrontEnds(fe.angle_rad, frozen(rx), frozen(tx), frozen(mod), fe.separation_m,
                        frozen(offsets_m), fe.arc_centre, fe.arc_radius_m)
     return Setup(scene, rut, fe)
+
+
+def nominal_setup(setup: Setup) -> Setup:
+    """The setup as designed: no mounting errors and no channel gain/phase errors.
+
+    This is what an RTS operator knows; the AoA design works on it, while the simulated RuT
+    sees the setup as built (``setup``), so calibration has to absorb the difference.
+    """
+    import dataclasses
+    scene = setup.scene
+    fes = tuple(dataclasses.replace(f, radial_offset_m=0.0, tangential_offset_m=0.0,
+                                    height_offset_m=0.0, gain_offset_db=0.0,
+                                    phase_offset_rad=0.0) for f in scene.rts.front_ends)
+    if fes == scene.rts.front_ends:
+        return setup
+    nominal = dataclasses.replace(scene, rts=dataclasses.replace(scene.rts, front_ends=fes))
+    return build_setup(nominal)

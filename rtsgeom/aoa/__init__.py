@@ -1,0 +1,9 @@
+"""Arbitrary angle of arrival: two-channel synthesis, calibration and linearity (on top of the
+signal chain)."""
+
+from .calibration import Calibration, calibrate_pair, probe_front_ends
+from .plan import plan_targets
+from .synthesis import MODES, PairModel
+
+__all__ = ["Calibration", "calibrate_pair", "probe_front_ends", "plan_targets", "MODES",
+           "PairModel"]

@@ -1,0 +1,232 @@
+"""Calibration of a front-end pair on the simulated RuT output (paper section "Calibration").
+
+1. Amplitude: each front end alone, its power at the RuT is measured (detections of the
+   simulated radar) and compared with the model; the ratio corrects its programmed gain.
+2. Phase: channel I keeps its delay, channel J's RTS delay is swept by Delta tau_rts over at
+   least one period ``1 / (f_rts + B/2)`` (eq. 27; paper: [-0.5, 1] ns in 25 ps steps) while two
+   probe targets synthesized at a quarter and three quarters of the span are detected; the
+   RMS angle error is minimised, then refined with decreasing steps down to the fractional-
+   delay resolution. The probes sit off mid-span on purpose: a target exactly between two
+   symmetric beams keeps its angle over about half a period of phase error (flat-bottomed
+   error curve), a quarter-span target gives a sharp V.
+
+The delay offset also moves channel J's echo in range ("Disadvantages"): the reported
+``range_offset_m`` is ``c0 / 2`` times the total delay mismatch of the two channels.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.constants import c
+
+from .._util import frozen
+from ..geometry import Setup
+from ..geometry.setup import nominal_setup
+from ..paths import Paths, exact_paths
+from ..radar import process
+from ..rts import RtsProgram, requested_delay
+from ..scene import TargetConfig
+from .synthesis import PairModel
+
+__all__ = ["Calibration", "FrontEndProbe", "probe_front_ends", "calibrate_pair", "probe_ranges"]
+
+
+@dataclass(frozen=True)
+class FrontEndProbe:
+    """Each front end alone, as the RuT detects it."""
+
+    angle_rad: np.ndarray  # (F,) detected azimuth
+    power_db: np.ndarray  # (F,) detected range-Doppler power
+    gain_correction: np.ndarray  # (F,) multiply the programmed amplitude by this
+
+
+@dataclass(frozen=True)
+class Calibration:
+    pair: tuple[int, int]
+    delta_tau_s: float  # delay offset of J relative to I
+    residual_error_deg: float
+    range_offset_m: float
+    sweep_delta_tau_s: np.ndarray
+    sweep_error_deg: np.ndarray
+    refine_delta_tau_s: np.ndarray
+    refine_error_deg: np.ndarray
+    probe_angles_deg: tuple[float, float]
+    period_s: float
+
+    def to_dict(self) -> dict:
+        def pts(t, e):
+            return [{"delta_tau_s": float(a), "angle_error_deg": (None if not np.isfinite(b)
+                                                                  else float(b))}
+                    for a, b in zip(t, e)]
+        return {
+            "pair": list(self.pair),
+            "delta_tau_s": self.delta_tau_s,
+            "residual_error_deg": self.residual_error_deg,
+            "range_offset_m": self.range_offset_m,
+            "period_s": self.period_s,
+            "probe_angles_deg": list(self.probe_angles_deg),
+            "sweep": pts(self.sweep_delta_tau_s, self.sweep_error_deg),
+            "refinement": pts(self.refine_delta_tau_s, self.refine_error_deg),
+        }
+
+
+def probe_ranges(setup: Setup, n: int) -> np.ndarray:
+    """Ranges for n simultaneous probe targets: distinct, away from the setup and ghosts."""
+    radar = setup.scene.radar
+    r0 = max(0.2 * radar.max_range_m, setup.scene.rts.arc_radius_m + 2.0)
+    step = max(8 * radar.range_resolution_m, 3.0)
+    return r0 + step * np.arange(n)
+
+
+def _simulate_detect(setup, paths, program, seed):
+    from ..run import simulate
+    _, cube = simulate(setup, paths, program, seed, setup.scene.radar.snr_db)
+    return process(cube)
+
+
+def _nearest(det, rd, range_m, velocity_mps=0.0):
+    """Index of the strongest detection within 2 range bins of range_m, or None."""
+    dr = rd.range_m[1] - rd.range_m[0]
+    dv = rd.velocity_mps[1] - rd.velocity_mps[0]
+    near = (np.abs(det.range_m - range_m) <= 2 * dr) & (np.abs(det.velocity_mps - velocity_mps) <= 2 * dv)
+    if not np.any(near):
+        return None
+    return int(np.flatnonzero(near)[np.argmax(det.power_db[near])])
+
+
+def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe:
+    """Each front end alone at its own probe range (one simulated frame): measured angle and
+    power; the gain correction equalises measured against modelled power."""
+    scene = setup.scene
+    n = setup.fe.count
+    ranges = probe_ranges(setup, n)
+    design, design_paths = nominal_model(setup, paths)
+    model_p = np.empty(n)
+    amps = np.empty(n)
+    for q in range(n):
+        j = (q + 1) % n if n > 1 else q
+        m = PairModel.build(design, design_paths, (q, j), TargetConfig(float(ranges[q])))
+        model_p[q] = np.max(np.sum(np.abs(m.responses[:, 0]) ** 2, axis=-1))
+        amps[q] = m.unit_gain
+    prog = RtsProgram.build(np.arange(n), np.arange(n), requested_delay(scene, ranges),
+                            np.zeros(n), amps)
+    rd, det = _simulate_detect(setup, paths, prog, seed)
+    ang = np.full(n, np.nan)
+    pw = np.full(n, np.nan)
+    for q in range(n):
+        k = _nearest(det, rd, ranges[q])
+        if k is not None:
+            ang[q], pw[q] = det.angle_rad[k], det.power_db[k]
+    meas = 10 ** (pw / 10) / amps ** 2
+    corr = np.sqrt(model_p / meas)
+    return FrontEndProbe(ang, pw, np.where(np.isfinite(corr), corr, 1.0))
+
+
+def _probe_program(design, pair, base, delta):
+    """Both probes on both channels; channel J delayed by ``delta`` more."""
+    tg, fe, dl, amp = [], [], [], []
+    for k, (a_i, a_j) in enumerate(design):
+        tg += [k, k]
+        fe += list(pair)
+        dl += [base[k][0], base[k][1] + delta]
+        amp += [a_i, a_j]
+    return RtsProgram.build(tg, fe, dl, np.zeros(len(tg)), amp)
+
+
+def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
+                   probe: FrontEndProbe | None = None, base_offsets=(0.0, 0.0),
+                   seed: int = 0, span_s=None, step_s=None) -> Calibration:
+    """Sweep channel J's delay offset and return the calibration of the pair (I, J)."""
+    scene = setup.scene
+    rts, radar = scene.rts, scene.radar
+    i, j = pair
+    probe = probe or probe_front_ends(setup, paths, seed)
+    th_i, th_j = probe.angle_rad[i], probe.angle_rad[j]
+    alphas = (th_i + 0.25 * (th_j - th_i), th_i + 0.75 * (th_j - th_i))
+    ranges = probe_ranges(setup, 2)
+    targets = [TargetConfig(float(r)) for r in ranges]
+    nom, nom_paths = nominal_model(setup, paths)
+    corr = (probe.gain_correction[i], probe.gain_correction[j])
+    base = [(float(requested_delay(scene, t.range_m)) + base_offsets[0],
+             float(requested_delay(scene, t.range_m)) + base_offsets[1]) for t in targets]
+
+    grid_s = 50e-12
+    nodes: dict[int, list] = {}
+
+    def node(k: int):
+        if k not in nodes:
+            out = []
+            for t, a in zip(targets, alphas):
+                m = PairModel.build(nom, nom_paths, pair, t,
+                                    (base_offsets[0], base_offsets[1] + k * grid_s))
+                a_i, a_j, _ = m.design(a)
+                out.append((a_i * corr[0], a_j * corr[1]))
+            nodes[k] = out
+        return np.asarray(nodes[k])
+
+    def design(delta: float):
+        """Probe amplitudes for coherent channels with J delayed by ``delta``: the design
+        knows the range offset the delay causes (interpolated on a 50 ps grid), so only the
+        phase is left to the sweep."""
+        k = int(np.floor(delta / grid_s))
+        w = delta / grid_s - k
+        return (1 - w) * node(k) + w * node(k + 1)
+
+    def error(delta: float) -> float:
+        prog = _probe_program(design(delta), pair, base, delta)
+        rd, det = _simulate_detect(setup, paths, prog, seed)
+        errs = []
+        for r, a in zip(ranges, alphas):
+            k = _nearest(det, rd, r)
+            errs.append(np.degrees(det.angle_rad[k] - a) if k is not None else np.nan)
+        errs = np.asarray(errs)
+        return float(np.sqrt(np.mean(errs ** 2))) if np.all(np.isfinite(errs)) else np.inf
+
+    span = span_s or rts.calibration_span_s
+    step = step_s or rts.calibration_step_s
+    grid = np.arange(span[0], span[1] + step / 2, step)
+    errs = np.array([error(d) for d in grid])
+    # Minima repeat every period; among those about as deep as the deepest, take the one with
+    # the smallest |delta tau|: it costs the least range offset ("Disadvantages").
+    inner = np.arange(len(errs))
+    is_min = (np.r_[True, errs[1:] <= errs[:-1]] & np.r_[errs[:-1] <= errs[1:], True])
+    good = inner[is_min & (errs <= 2 * np.min(errs) + 0.01)]
+    k = int(good[np.argmin(np.abs(grid[good]))])
+    best, best_err = float(grid[k]), float(errs[k])
+    ref_t, ref_e = [], []
+    resolution = rts.delay_resolution_s
+    cur = step
+    while cur > resolution * 1.0001:
+        cur = max(cur / 5.0, resolution)
+        fine = best + cur * np.arange(-4, 5)
+        fe_ = np.array([error(d) for d in fine])
+        ref_t += list(fine)
+        ref_e += list(fe_)
+        k = int(np.argmin(fe_))
+        if fe_[k] < best_err:
+            best, best_err = float(fine[k]), float(fe_[k])
+    air = _mean_air_delay(setup)
+    range_offset = 0.5 * c * ((air[j] + base_offsets[1] + best) - (air[i] + base_offsets[0]))
+    period = 1.0 / (rts.f_rts_hz + radar.bandwidth_hz / 2)
+    return Calibration(pair, best, best_err, float(range_offset), frozen(grid), frozen(errs),
+                       frozen(np.array(ref_t)), frozen(np.array(ref_e)),
+                       (float(np.degrees(alphas[0])), float(np.degrees(alphas[1]))), period)
+
+
+def nominal_model(setup: Setup, paths: Paths) -> tuple[Setup, Paths]:
+    """The nominal setup and its paths (the ones given when the setup has no errors)."""
+    nom = nominal_setup(setup)
+    if nom is setup:
+        return setup, paths
+    if paths.method == "exact":
+        return nom, exact_paths(nom)
+    from ..paths.raytrace import raytrace_paths
+    return nom, raytrace_paths(nom)
+
+
+def _mean_air_delay(setup: Setup) -> np.ndarray:
+    """Mean over virtual elements of each front end's two-way line-of-sight delay."""
+    from ..geometry.farfield import two_way_lengths
+    return two_way_lengths(setup.rut, setup.fe.rx, setup.fe.tx).mean(axis=1) / c

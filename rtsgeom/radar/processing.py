@@ -1,0 +1,218 @@
+"""RuT signal processing as a real radar does it (stage 5).
+
+ADC cube -> windowed range FFT (eq. 10) -> windowed Doppler FFT -> non-coherent integration over
+the virtual channels -> 2D CFAR (CA or OS) -> local maxima -> per detection: TDM-MIMO Doppler
+compensation and beamforming over the azimuth virtual array (eq. 14) with a zoomed grid search
+and parabolic refinement to well below 0.01 deg.
+
+Sign conventions: the beat signal is ``exp(+j phi_b)`` (eq. 8), so a delay tau gives a positive
+beat frequency ``S tau`` and a receding target (velocity > 0, tau growing) a positive slow-time
+frequency. The virtual element at ``x_v`` (``p_tx + p_rx`` in the radar frame) receives a source
+at azimuth theta with phase ``-k x_v sin theta``; the beamformer steers with ``+k x_v sin alpha``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage, signal
+from scipy.constants import c
+
+from .._util import frozen
+from ..geometry import RutArray
+from ..scene import CfarConfig, RadarConfig
+from .fmcw import AdcCube
+
+__all__ = ["RangeDoppler", "Detections", "range_doppler", "cfar_mask", "detect",
+           "angle_spectrum", "estimate_angles", "range_angle_map", "process", "window"]
+
+
+def window(name: str, n: int) -> np.ndarray:
+    if name == "none":
+        return np.ones(n)
+    return signal.get_window(name, n, fftbins=False)
+
+
+@dataclass(frozen=True)
+class RangeDoppler:
+    """Range-Doppler spectrum per virtual channel and its integrated power map."""
+
+    spectrum: np.ndarray  # (R, D, V) complex64, Doppler axis fftshifted
+    power: np.ndarray  # (R, D) sum over virtual channels of |X|^2
+    range_m: np.ndarray  # (R,)
+    velocity_mps: np.ndarray  # (D,)
+    doppler_hz: np.ndarray  # (D,) slow-time frequency per TDM cycle
+
+    @property
+    def power_db(self) -> np.ndarray:
+        return 10 * np.log10(np.maximum(self.power, 1e-30))
+
+
+@dataclass(frozen=True)
+class Detections:
+    """Detection list (SI units; ``angle_rad`` in the radar frame, from boresight to +x)."""
+
+    range_m: np.ndarray
+    velocity_mps: np.ndarray
+    angle_rad: np.ndarray
+    power_db: np.ndarray  # integrated range-Doppler power at the peak
+    snr_db: np.ndarray  # peak over the CFAR noise estimate
+    range_bin: np.ndarray
+    doppler_bin: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.range_m.size)
+
+    @property
+    def angle_deg(self) -> np.ndarray:
+        return np.degrees(self.angle_rad)
+
+
+def range_doppler(cube: AdcCube) -> RangeDoppler:
+    radar = cube.radar
+    n_l, _, n_s = cube.data.shape
+    w_r = window(radar.range_window, n_s).astype(np.float32)
+    w_d = window(radar.doppler_window, n_l).astype(np.float32)
+    x = np.fft.fft(cube.data * w_r, axis=2)
+    x = np.fft.fftshift(np.fft.fft(x * w_d[:, None, None], axis=0), axes=0)
+    spec = np.ascontiguousarray(x.transpose(2, 0, 1)).astype(np.complex64)  # (R, D, V)
+    power = np.sum(spec.real ** 2 + spec.imag ** 2, axis=2, dtype=np.float64)
+    f_beat = np.arange(n_s) * radar.adc_rate_hz / n_s
+    rng = f_beat * c / (2 * radar.slope_hz_per_s)
+    nu = np.fft.fftshift(np.fft.fftfreq(n_l, d=radar.tdm_cycle_s))
+    vel = nu * c / (2 * radar.f_c_hz)
+    return RangeDoppler(spec, power, frozen(rng), frozen(vel), frozen(nu))
+
+
+def cfar_mask(power: np.ndarray, cfg: CfarConfig) -> tuple[np.ndarray, np.ndarray]:
+    """2D CFAR on a (range, Doppler) power map: returns (detected mask, noise estimate).
+
+    Training cells form a ring around each cell under test (guard cells excluded); the range
+    axis is not cyclic (edge cells use the training cells that exist), the Doppler axis is.
+    CA averages the ring, OS takes its ``os_rank`` quantile.
+    """
+    gr, gd = cfg.guard_cells
+    tr, td = cfg.training_cells
+    ring = np.ones((2 * (gr + tr) + 1, 2 * (gd + td) + 1), bool)
+    ring[tr:tr + 2 * gr + 1, td:td + 2 * gd + 1] = False
+    pd = gd + td
+    padded = np.pad(power, ((0, 0), (pd, pd)), mode="wrap")  # Doppler is cyclic
+    crop = (slice(None), slice(pd, pd + power.shape[1]))
+    if cfg.kind == "ca":
+        k = ring.astype(float)
+        total = ndimage.convolve(padded, k, mode="constant")[crop]
+        count = ndimage.convolve(np.ones_like(padded), k, mode="constant")[crop]
+        noise = total / np.maximum(count, 1)
+    else:
+        noise = ndimage.percentile_filter(padded, 100 * cfg.os_rank, footprint=ring,
+                                          mode="nearest")[crop]
+    thr = noise * 10 ** (cfg.threshold_db / 10)
+    peak = power == ndimage.maximum_filter(np.pad(power, ((0, 0), (1, 1)), mode="wrap"),
+                                           size=3, mode="nearest")[:, 1:-1]
+    return (power > thr) & peak, noise
+
+
+def _steering(rut: RutArray, sin_alpha: np.ndarray) -> np.ndarray:
+    """Beamformer weights exp(+j k x_v sin alpha) for the azimuth virtual array, (..., V_az)."""
+    x = rut.virtual_local[rut.azimuth_mask, 0]
+    k = 2 * np.pi / rut.wavelength_m
+    return np.exp(1j * k * np.asarray(sin_alpha)[..., None] * x)
+
+
+def _angle_taper(radar: RadarConfig, rut: RutArray) -> np.ndarray:
+    x = rut.virtual_local[rut.azimuth_mask, 0]
+    w = np.empty_like(x)
+    w[np.argsort(x)] = window(radar.angle_window, x.size)
+    return w
+
+
+def angle_spectrum(snapshots: np.ndarray, rut: RutArray, radar: RadarConfig,
+                   angles_rad: np.ndarray) -> np.ndarray:
+    """Beamformer power |sum_v w_v x_v exp(j k x_v sin alpha)|^2 (eq. 14).
+
+    ``snapshots`` (..., V) over all virtual channels (the azimuth row is selected here);
+    returns (..., A).
+    """
+    x = snapshots[..., rut.azimuth_mask] * _angle_taper(radar, rut)
+    steer = _steering(rut, np.sin(angles_rad))  # (A, V_az)
+    return np.abs(x @ steer.T) ** 2
+
+
+def estimate_angles(snapshots: np.ndarray, rut: RutArray, radar: RadarConfig) -> np.ndarray:
+    """Peak of the beamformer per snapshot (..., V) -> (...,) radians.
+
+    Grid search at 0.25 deg, then two zoom levels (0.005 deg, 1e-4 deg) and a final parabolic
+    interpolation: precise to ~1e-6 deg on noise-free data, vectorised over snapshots.
+    """
+    snaps = np.atleast_2d(snapshots)
+    shape = snaps.shape[:-1]
+    snaps = snaps.reshape(-1, snaps.shape[-1])
+    grid = np.radians(np.arange(-90.0, 90.0001, 0.25))
+    p = angle_spectrum(snaps, rut, radar, grid)
+    best = grid[np.argmax(p, axis=1)]
+    for half, step in ((0.3, 0.005), (0.006, 1e-4)):
+        offs = np.radians(np.arange(-half, half + step / 2, step))
+        cand = np.clip(best[:, None] + offs[None, :], -np.pi / 2, np.pi / 2)
+        x = snaps[:, rut.azimuth_mask] * _angle_taper(radar, rut)
+        steer = _steering(rut, np.sin(cand))  # (D, O, V_az)
+        pw = np.abs(np.einsum("dv,dov->do", x, steer)) ** 2
+        i = np.clip(np.argmax(pw, axis=1), 1, offs.size - 2)
+        rows = np.arange(pw.shape[0])
+        y0, y1, y2 = pw[rows, i - 1], pw[rows, i], pw[rows, i + 1]
+        den = y0 - 2 * y1 + y2
+        frac = np.where(np.abs(den) > 0, 0.5 * (y0 - y2) / np.where(den == 0, 1, den), 0.0)
+        best = cand[rows, i] + np.clip(frac, -1, 1) * np.radians(step)
+    out = best.reshape(shape)
+    return out if np.ndim(snapshots) > 1 else out[0]
+
+
+def _parabolic(y0, y1, y2) -> np.ndarray:
+    """Sub-bin offset of a peak from three log-power samples."""
+    den = y0 - 2 * y1 + y2
+    return np.where(den < 0, 0.5 * (y0 - y2) / np.where(den == 0, -1, den), 0.0)
+
+
+def tdm_compensate(snapshots: np.ndarray, doppler_hz, rut: RutArray,
+                   radar: RadarConfig) -> np.ndarray:
+    """Remove the Tx-switching phase 2 pi f_D s T_rep of TDM slot s (snapshots (..., V))."""
+    ph = -2j * np.pi * np.asarray(doppler_hz)[..., None] * rut.virtual_slot * radar.chirp_repetition_s
+    return snapshots * np.exp(ph)
+
+
+def detect(rd: RangeDoppler, cube: AdcCube) -> Detections:
+    """CFAR detections with sub-bin range/velocity and a refined angle per detection."""
+    radar, rut = cube.radar, cube.rut
+    mask, noise = cfar_mask(rd.power, radar.cfar)
+    r_i, d_i = np.nonzero(mask)
+    n_r, n_d = rd.power.shape
+    logp = np.log(np.maximum(rd.power, 1e-300))
+    dr = _parabolic(logp[np.clip(r_i - 1, 0, n_r - 1), d_i], logp[r_i, d_i],
+                    logp[np.clip(r_i + 1, 0, n_r - 1), d_i])
+    dd = _parabolic(logp[r_i, (d_i - 1) % n_d], logp[r_i, d_i], logp[r_i, (d_i + 1) % n_d])
+    range_step = rd.range_m[1] - rd.range_m[0]
+    nu_step = rd.doppler_hz[1] - rd.doppler_hz[0]
+    nu = rd.doppler_hz[d_i] + dd * nu_step
+    snaps = tdm_compensate(rd.spectrum[r_i, d_i, :], nu, rut, radar)
+    ang = estimate_angles(snaps, rut, radar) if r_i.size else np.zeros(0)
+    return Detections(
+        range_m=frozen(rd.range_m[r_i] + dr * range_step),
+        velocity_mps=frozen(nu * c / (2 * radar.f_c_hz)),
+        angle_rad=frozen(ang),
+        power_db=frozen(10 * np.log10(rd.power[r_i, d_i])),
+        snr_db=frozen(10 * np.log10(rd.power[r_i, d_i] / noise[r_i, d_i])),
+        range_bin=frozen(r_i), doppler_bin=frozen(d_i),
+    )
+
+
+def range_angle_map(rd: RangeDoppler, cube: AdcCube, angles_rad: np.ndarray) -> np.ndarray:
+    """Beamformer power over (range, angle), each range bin at its strongest Doppler bin."""
+    d_best = np.argmax(rd.power, axis=1)
+    r = np.arange(rd.power.shape[0])
+    snaps = tdm_compensate(rd.spectrum[r, d_best, :], rd.doppler_hz[d_best], cube.rut, cube.radar)
+    return angle_spectrum(snaps, cube.rut, cube.radar, angles_rad)
+
+
+def process(cube: AdcCube) -> tuple[RangeDoppler, Detections]:
+    rd = range_doppler(cube)
+    return rd, detect(rd, cube)

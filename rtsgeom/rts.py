@@ -1,0 +1,296 @@
+"""RTS channel model: delay, Doppler, attenuation and cable ghosts per channel (stage 3).
+
+A channel q (one front end) receives the RuT's chirp, down-converts it to the IF ``f_rts``,
+delays it by ``tau_rts`` (eq. 1), shifts it by ``f_D,rts`` (eq. 2), scales it (eq. 3) and
+re-transmits it. The beat phase the RuT sees is (eq. 8)::
+
+    phi_b(t) = 2 pi [ f_c tau_c + f_rts tau_rts + S (tau t - tau^2 / 2) ],   tau = tau_c + tau_rts
+
+so the over-the-air delay ``tau_c`` acts at RF and the RTS delay at the IF: that difference is
+what the phase calibration exploits (eq. 27) and what costs the range offset ("Disadvantages").
+
+The output is an :class:`Echoes` table: per echo and per virtual channel the over-the-air delay
+(from the paths table, per element pair), the IF delay, the IF it acts at, the Doppler shift and
+the complex amplitude. The FMCW model turns it into an ADC cube.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.constants import c
+
+from ._util import frozen
+from .geometry import Setup
+from .paths.table import FE_TO_RX, RUT_TO_RUT, TX_TO_FE, Paths
+from .scene import Scene
+
+__all__ = ["RtsProgram", "Echoes", "realised_delay", "target_amplitude", "channel_echoes",
+           "setup_echoes", "cable_ghosts", "program_nearest", "build_echoes"]
+
+KIND_DIRECT, KIND_GHOST, KIND_SETUP = 0, 1, 2
+
+
+@dataclass(frozen=True)
+class RtsProgram:
+    """What the RTS back end is told to generate: one row per (target, channel).
+
+    ``delay_s`` is the requested RTS delay tau_rts (before the buffer/FIR quantisation),
+    ``doppler_hz`` the mixer frequency f_D,rts, ``amplitude`` the complex channel gain the RTS
+    applies (attenuation and AoA weight). Hardware offsets of the scene are *not* in here: they
+    belong to the channel, not to what the RTS is told.
+    """
+
+    target: np.ndarray  # (K,) int
+    front_end: np.ndarray  # (K,) int
+    delay_s: np.ndarray  # (K,)
+    doppler_hz: np.ndarray  # (K,)
+    amplitude: np.ndarray  # (K,) complex
+
+    @classmethod
+    def build(cls, target, front_end, delay_s, doppler_hz, amplitude) -> "RtsProgram":
+        return cls(frozen(np.atleast_1d(np.asarray(target, int))),
+                   frozen(np.atleast_1d(np.asarray(front_end, int))),
+                   frozen(np.atleast_1d(np.asarray(delay_s, float))),
+                   frozen(np.atleast_1d(np.asarray(doppler_hz, float))),
+                   frozen(np.atleast_1d(np.asarray(amplitude, complex))))
+
+    def __len__(self) -> int:
+        return int(self.target.size)
+
+
+@dataclass(frozen=True)
+class Echoes:
+    """Everything the RuT receives, as separable echoes (E echoes x V virtual channels)."""
+
+    tau_air_s: np.ndarray  # (E, V) over-the-air delay, acts at RF (f_c tau_c of eq. 8)
+    tau_if_s: np.ndarray  # (E,) delay applied inside the RTS, acts at f_if
+    f_if_hz: np.ndarray  # (E,) frequency at which tau_if acts on the phase (f_rts, eq. 7)
+    doppler_hz: np.ndarray  # (E,) frequency shift (f_D,rts, eq. 2)
+    amplitude: np.ndarray  # (E, V) complex amplitude at the RuT's receiver
+    target: np.ndarray  # (E,) target index, -1 for setup reflections
+    front_end: np.ndarray  # (E,) channel, -1 for setup reflections
+    kind: np.ndarray  # (E,) KIND_DIRECT | KIND_GHOST | KIND_SETUP
+    order: np.ndarray  # (E,) ghost order (0 for the direct echo)
+
+    @property
+    def tau_s(self) -> np.ndarray:
+        """Total delay tau = tau_c + tau_rts per echo and virtual channel."""
+        return self.tau_air_s + self.tau_if_s[:, None]
+
+    def __len__(self) -> int:
+        return int(self.tau_if_s.size)
+
+    @classmethod
+    def concat(cls, parts: list["Echoes"]) -> "Echoes":
+        names = ("tau_air_s", "tau_if_s", "f_if_hz", "doppler_hz", "amplitude", "target",
+                 "front_end", "kind", "order")
+        return cls(**{n: frozen(np.concatenate([getattr(p, n) for p in parts])) for n in names})
+
+    def select(self, mask) -> "Echoes":
+        m = np.asarray(mask, bool)
+        return Echoes(**{n: frozen(getattr(self, n)[m]) for n in self.__dataclass_fields__})
+
+    def scaled(self, gain) -> "Echoes":
+        """The same echoes with the amplitudes multiplied by ``gain`` (scalar or (E,))."""
+        g = np.asarray(gain)
+        amp = self.amplitude * (g[:, None] if g.ndim == 1 else g)
+        fields = {n: getattr(self, n) for n in self.__dataclass_fields__}
+        fields["amplitude"] = frozen(amp)
+        return Echoes(**fields)
+
+
+# ------------------------------------------------------------------------------------------
+# Back-end quantities
+# ------------------------------------------------------------------------------------------
+
+
+def realised_delay(delay_s, f_s_hz: float, fractional: bool, step_s: float) -> np.ndarray:
+    """The delay the back end actually applies: an integer buffer of ``1/f_s`` steps plus a
+    fractional-delay FIR whose setting is quantised to ``step_s`` (or nothing without one)."""
+    d = np.asarray(delay_s, float)
+    ts = 1.0 / f_s_hz
+    if not fractional:
+        return np.round(d / ts) * ts
+    n = np.floor(d / ts)
+    frac = np.round((d - n * ts) / step_s) * step_s
+    return n * ts + frac
+
+
+def target_amplitude(range_m, rcs_m2, wavelength_m: float) -> np.ndarray:
+    """Echo amplitude of a point target, sqrt of the radar equation with isotropic antennas:
+    ``sqrt(sigma) lambda / ((4 pi)^(3/2) R^2)`` (eq. 3 up to the constant)."""
+    return np.sqrt(rcs_m2) * wavelength_m / ((4 * np.pi) ** 1.5 * np.asarray(range_m) ** 2)
+
+
+def requested_delay(scene: Scene, range_m) -> np.ndarray:
+    """tau_rts = 2 R_t / c0 (eq. 1), minus the nominal over-the-air delay 2 R_c / c0 when the
+    RTS compensates it (so the RuT sees the target at its set range)."""
+    tau = 2.0 * np.asarray(range_m, float) / c
+    if scene.rts.compensate_air_path:
+        tau = tau - 2.0 * scene.rts.arc_radius_m / c
+    return tau
+
+
+def program_nearest(scene: Scene, setup: Setup) -> RtsProgram:
+    """Each target on the single front end nearest its set angle (no AoA synthesis)."""
+    if not scene.targets:
+        return RtsProgram.build([], [], [], [], [])
+    az = setup.fe_azimuth_rad()
+    tg = scene.targets
+    fe = np.array([int(np.argmin(np.abs(az - t.angle_rad))) for t in tg])
+    rng = np.array([t.range_m for t in tg])
+    rcs = np.array([t.rcs_m2 for t in tg])
+    vel = np.array([t.velocity_mps for t in tg])
+    lam = setup.rut.wavelength_m
+    amp = target_amplitude(rng, rcs, lam) / nominal_link_gain(scene, lam)
+    return RtsProgram.build(np.arange(len(tg)), fe, requested_delay(scene, rng),
+                            2.0 * scene.radar.f_c_hz * vel / c, amp)
+
+
+def nominal_link_gain(scene: Scene, wavelength_m: float) -> float:
+    """Free-space gain RuT -> front end -> RuT at the nominal arc radius, which the RTS
+    divides out so the echo has the target's radar-equation amplitude."""
+    g = wavelength_m / (4 * np.pi * scene.rts.arc_radius_m)
+    return g * g
+
+
+# ------------------------------------------------------------------------------------------
+# From paths + program to echoes
+# ------------------------------------------------------------------------------------------
+
+
+def _leg_table(paths: Paths, direction: int, n_fe: int, n_el: int):
+    """Rows of one direction as padded arrays (F, n_el, P): delay and gain (0 where absent)."""
+    sel = paths.direction == direction
+    fe = paths.front_end[sel]
+    el = (paths.rut_tx if direction == TX_TO_FE else paths.rut_rx)[sel]
+    delay, gain = paths.delay_s[sel], paths.gain[sel]
+    key = fe * n_el + el
+    order = np.argsort(key, kind="stable")
+    key, delay, gain = key[order], delay[order], gain[order]
+    counts = np.bincount(key, minlength=n_fe * n_el)
+    p = max(int(counts.max(initial=0)), 1)
+    slot = np.arange(key.size) - np.repeat(np.cumsum(counts) - counts, counts)
+    d = np.zeros((n_fe * n_el, p))
+    g = np.zeros((n_fe * n_el, p), complex)
+    d[key, slot] = delay
+    g[key, slot] = gain
+    if np.any(counts == 0):
+        missing = np.flatnonzero(counts == 0)[0]
+        raise ValueError(f"paths table has no {('tx_to_fe', 'fe_to_rx')[direction]} row for "
+                         f"front end {missing // n_el}, element {missing % n_el}")
+    return d.reshape(n_fe, n_el, p), g.reshape(n_fe, n_el, p)
+
+
+def channel_echoes(setup: Setup, paths: Paths, program: RtsProgram) -> Echoes:
+    """Echoes of programmed RTS channels through every path combination of both legs.
+
+    For channel (target, q) and virtual element v = (Tx m, Rx k) each pair of a path
+    RuT Tx m -> FE q Rx and a path FE q Tx -> RuT Rx k is one echo with
+    ``tau_c = tau_a + tau_b`` and amplitude ``g_a g_b G_q`` (G_q: programmed gain times the
+    channel's hardware gain/phase error).
+    """
+    scene, rut = setup.scene, setup.rut
+    n_fe = setup.fe.count
+    k = len(program)
+    v = rut.num_virtual
+    if k == 0:
+        return _empty(v)
+    d_a, g_a = _leg_table(paths, TX_TO_FE, n_fe, rut.tx_world.shape[0])
+    d_b, g_b = _leg_table(paths, FE_TO_RX, n_fe, rut.rx_world.shape[0])
+    q = program.front_end
+    # (K, V, Pa) and (K, V, Pb) -> (K, Pa, Pb, V)
+    da, ga = d_a[q][:, rut.virtual_tx], g_a[q][:, rut.virtual_tx]
+    db, gb = d_b[q][:, rut.virtual_rx], g_b[q][:, rut.virtual_rx]
+    tau_air = da[:, :, :, None] + db[:, :, None, :]  # (K, V, Pa, Pb)
+    gain = ga[:, :, :, None] * gb[:, :, None, :]
+    pa, pb = tau_air.shape[2], tau_air.shape[3]
+    tau_air = tau_air.transpose(0, 2, 3, 1).reshape(k * pa * pb, v)
+    gain = gain.transpose(0, 2, 3, 1).reshape(k * pa * pb, v)
+
+    fes = scene.rts.front_ends
+    hw = np.array([10 ** (f.gain_offset_db / 20) * np.exp(1j * f.phase_offset_rad) for f in fes])
+    tau_rts = realised_delay(program.delay_s, scene.rts.f_s_hz, scene.rts.fractional_delay,
+                             scene.rts.fractional_delay_step_s)
+    rep = pa * pb
+    amp = gain * np.repeat(program.amplitude * hw[q], rep)[:, None]
+    direct = Echoes(
+        tau_air_s=frozen(tau_air), tau_if_s=frozen(np.repeat(tau_rts, rep)),
+        f_if_hz=frozen(np.full(k * rep, scene.rts.f_rts_hz)),
+        doppler_hz=frozen(np.repeat(program.doppler_hz, rep)), amplitude=frozen(amp),
+        target=frozen(np.repeat(program.target, rep)), front_end=frozen(np.repeat(q, rep)),
+        kind=frozen(np.full(k * rep, KIND_DIRECT)), order=frozen(np.zeros(k * rep, int)),
+    )
+    ghosts = cable_ghosts(scene, direct)
+    keep = np.any(direct.amplitude != 0, axis=1)
+    return Echoes.concat([direct.select(keep), ghosts]) if len(ghosts) else direct.select(keep)
+
+
+def cable_ghosts(scene: Scene, direct: Echoes, min_level_db: float = -80.0) -> Echoes:
+    """Ghost echoes from the mismatched cables between front end and back end.
+
+    A signal reflected at the far end (Gamma_be) and again at the front end (Gamma_fe) runs the
+    cable twice more: extra delay ``2 L / (VF c0)`` (a range offset of ``L / VF``) and amplitude
+    ``Gamma_fe Gamma_be a^2`` with ``a`` the cable's one-way amplitude loss. Each front end has an
+    Rx and a Tx cable of the same kind, so the n-th ghost collects ``n + 1`` bounce combinations.
+    The cables carry the IF, so the extra delay acts at ``f_rts``. Ghost orders are added until
+    their level drops below ``min_level_db`` relative to the direct echo.
+    """
+    parts = []
+    for q, fe in enumerate(scene.rts.front_ends):
+        if fe.return_loss_fe_db is None or fe.return_loss_be_db is None:
+            continue
+        sel = (direct.front_end == q) & (direct.kind == KIND_DIRECT)
+        if not np.any(sel):
+            continue
+        base = direct.select(sel)
+        rho = (10 ** (-fe.return_loss_fe_db / 20) * 10 ** (-fe.return_loss_be_db / 20)
+               * 10 ** (-2 * fe.cable_loss_db / 20))
+        dt = 2.0 * fe.cable_length_m / (fe.cable_velocity_factor * c)
+        n = 1
+        while n < 64 and 20 * np.log10((n + 1) * rho ** n) > min_level_db:
+            fields = {name: getattr(base, name) for name in base.__dataclass_fields__}
+            fields["tau_if_s"] = frozen(base.tau_if_s + n * dt)
+            fields["amplitude"] = frozen(base.amplitude * ((n + 1) * rho ** n))
+            fields["kind"] = frozen(np.full(len(base), KIND_GHOST))
+            fields["order"] = frozen(np.full(len(base), n))
+            parts.append(Echoes(**fields))
+            n += 1
+    return Echoes.concat(parts) if parts else _empty(direct.amplitude.shape[1])
+
+
+def setup_echoes(setup: Setup, paths: Paths) -> Echoes:
+    """The RuT's own chirp reflected by the setup (``rut_to_rut`` rows): static echoes."""
+    rut = setup.rut
+    sel = paths.direction == RUT_TO_RUT
+    if not np.any(sel):
+        return _empty(rut.num_virtual)
+    p = paths.select(sel)
+    parts = []
+    for vi in range(rut.num_virtual):
+        m = (p.rut_tx == rut.virtual_tx[vi]) & (p.rut_rx == rut.virtual_rx[vi])
+        parts.append((vi, p.delay_s[m], p.gain[m]))
+    n = max(len(d) for _, d, _ in parts)
+    tau = np.zeros((n, rut.num_virtual))
+    amp = np.zeros((n, rut.num_virtual), complex)
+    for vi, d, g in parts:
+        tau[: len(d), vi] = d
+        amp[: len(d), vi] = g
+    zeros = np.zeros(n)
+    return Echoes(frozen(tau), frozen(zeros), frozen(zeros), frozen(zeros), frozen(amp),
+                  frozen(np.full(n, -1)), frozen(np.full(n, -1)), frozen(np.full(n, KIND_SETUP)),
+                  frozen(np.zeros(n, int)))
+
+
+def build_echoes(setup: Setup, paths: Paths, program: RtsProgram) -> Echoes:
+    """All echoes of a run: programmed channels with their ghosts, plus setup reflections."""
+    return Echoes.concat([channel_echoes(setup, paths, program), setup_echoes(setup, paths)])
+
+
+def _empty(v: int) -> Echoes:
+    z = np.zeros(0)
+    zi = np.zeros(0, int)
+    return Echoes(frozen(np.zeros((0, v))), frozen(z), frozen(z), frozen(z),
+                  frozen(np.zeros((0, v), complex)), frozen(zi), frozen(zi), frozen(zi), frozen(zi))

@@ -1,0 +1,145 @@
+"""The main job: a scene through the whole pipeline, and its matched results.
+
+Scene -> Setup -> Paths -> RTS program (AoA synthesis + calibration) -> Echoes -> ADC cube
+(+ noise) -> range-Doppler -> detections -> per-target match against the set-points.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import __version__
+from .geometry import Setup, build_setup
+from .paths import Paths, exact_paths
+from .radar import AdcCube, Detections, RangeDoppler, add_noise, process, synthesize
+from .rts import Echoes, RtsProgram, build_echoes, program_nearest
+from .scene import Scene
+
+__all__ = ["RunResult", "simulate", "run_scene", "match_targets", "noise_power"]
+
+
+@dataclass(frozen=True)
+class RunResult:
+    scene: Scene
+    setup: Setup
+    paths: Paths
+    program: RtsProgram
+    echoes: Echoes
+    cube: AdcCube
+    rd: RangeDoppler
+    detections: Detections
+    matches: list[dict]
+    calibration: dict = field(default_factory=dict)
+    warnings: tuple[str, ...] = ()
+
+
+def noise_power(echoes: Echoes, snr_db: float | None) -> float:
+    """Noise power per complex sample for a per-sample SNR of the strongest echo."""
+    if snr_db is None or len(echoes) == 0:
+        return 0.0
+    return float(np.max(np.abs(echoes.amplitude)) ** 2 / 10 ** (snr_db / 10))
+
+
+def simulate(setup: Setup, paths: Paths, program: RtsProgram, seed: int | None = None,
+             snr_db: float | None = None) -> tuple[Echoes, AdcCube]:
+    """Echoes and ADC cube of a programmed RTS (noise from ``seed`` when ``snr_db`` is set)."""
+    echoes = build_echoes(setup, paths, program)
+    cube = synthesize(echoes, setup.scene.radar, setup.rut)
+    if snr_db is not None:
+        rng = np.random.default_rng(seed)
+        cube = add_noise(cube, noise_power(echoes, snr_db), rng)
+    return echoes, cube
+
+
+def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angle_rad=None
+                  ) -> list[dict]:
+    """For each target, the strongest detection within 2 range and 2 Doppler bins."""
+    dr = rd.range_m[1] - rd.range_m[0]
+    dv = rd.velocity_mps[1] - rd.velocity_mps[0]
+    out = []
+    for i, t in enumerate(scene.targets):
+        near = (np.abs(det.range_m - t.range_m) <= 2 * dr) & \
+               (np.abs(det.velocity_mps - t.velocity_mps) <= 2 * dv)
+        entry = {"index": i, "set": {"range_m": t.range_m, "velocity_mps": t.velocity_mps,
+                                     "angle_deg": float(np.degrees(t.angle_rad)),
+                                     "rcs_dbsm": t.rcs_dbsm}}
+        if np.any(near):
+            j = int(np.flatnonzero(near)[np.argmax(det.power_db[near])])
+            d = {"range_m": float(det.range_m[j]), "velocity_mps": float(det.velocity_mps[j]),
+                 "angle_deg": float(det.angle_deg[j]), "power_db": float(det.power_db[j]),
+                 "snr_db": float(det.snr_db[j])}
+            entry["detection"] = d
+            entry["error"] = {
+                "range_m": d["range_m"] - t.range_m,
+                "velocity_mps": d["velocity_mps"] - t.velocity_mps,
+                "angle_deg": d["angle_deg"] - entry["set"]["angle_deg"],
+                "range_bins": (d["range_m"] - t.range_m) / dr,
+                "doppler_bins": (d["velocity_mps"] - t.velocity_mps) / dv,
+            }
+        else:
+            entry["detection"] = None
+            entry["error"] = None
+        out.append(entry)
+    return out
+
+
+def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = None,
+              progress=None) -> RunResult:
+    """Run the whole pipeline on ``scene``.
+
+    ``aoa_mode`` overrides the scene's ``rts.aoa_mode``: ``nearest`` puts each target on its
+    nearest front end; the synthesis modes calibrate the front-end pairs first.
+    """
+    setup = build_setup(scene)
+    if paths_method == "raytrace":
+        from .paths.raytrace import raytrace_paths
+        paths = raytrace_paths(setup)
+    else:
+        paths = exact_paths(setup)
+    mode = aoa_mode or scene.rts.aoa_mode
+    calibration: dict = {}
+    warnings: list[str] = []
+    if mode == "nearest" or not scene.targets:
+        program = program_nearest(scene, setup)
+    else:
+        from .aoa.plan import plan_targets
+        program, calibration, warnings = plan_targets(setup, paths, mode, progress=progress)
+    echoes, cube = simulate(setup, paths, program, scene.seed, scene.radar.snr_db)
+    rd, det = process(cube)
+    return RunResult(scene, setup, paths, program, echoes, cube, rd, det,
+                     match_targets(scene, det, rd), calibration, tuple(warnings))
+
+
+def summary(result: RunResult, paths_method: str) -> dict:
+    """The content of ``summary.json`` (no timestamps: same seed -> same bytes)."""
+    from .info import scene_info
+    s, r, rut = result.scene, result.scene.radar, result.setup.rut
+    info = scene_info(result.setup)
+    return {
+        "rtsgeom_version": __version__,
+        "scene": s.name,
+        "scene_sha256": s.sha256,
+        "seed": s.seed,
+        "paths": paths_method,
+        "aoa_mode": s.rts.aoa_mode,
+        "radar": {
+            "f_c_hz": r.f_c_hz, "bandwidth_hz": r.bandwidth_hz,
+            "slope_hz_per_s": r.slope_hz_per_s, "adc_rate_hz": r.adc_rate_hz,
+            "adc_start_s": r.adc_start_s, "samples_per_chirp": r.samples_per_chirp,
+            "chirps_per_tx": r.chirps_per_tx, "chirp_repetition_s": r.chirp_repetition_s,
+            "tx_order": list(rut.tx_order), "num_rx": rut.num_rx,
+            "cube_layout": "[chirp_loop, virtual_channel (tx_slot * num_rx + rx), sample]",
+            "range_resolution_m": r.range_resolution_m,
+            "velocity_resolution_mps": r.velocity_resolution_mps,
+            "snr_db": r.snr_db,
+        },
+        "far_field": info["far_field"],
+        "front_ends": info["front_ends"],
+        "calibration": result.calibration,
+        "targets": result.matches,
+        "num_detections": len(result.detections),
+        "num_echoes": len(result.echoes),
+        "warnings": list(result.warnings),
+    }

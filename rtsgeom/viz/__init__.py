@@ -1,0 +1,5 @@
+"""Visualisation: the setup in 3D (pyvista), result figures (matplotlib), HTML reports.
+
+Submodules are imported on use so that ``import rtsgeom.viz`` stays cheap; pyvista/VTK load only
+with :mod:`rtsgeom.viz.scene3d`.
+"""

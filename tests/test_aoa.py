@@ -1,0 +1,131 @@
+"""Arbitrary angle of arrival: synthesis modes and calibration (issue: AoA)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.constants import c
+
+from rtsgeom.aoa.calibration import calibrate_pair, probe_front_ends
+from rtsgeom.aoa.linearity import linearity
+from rtsgeom.aoa.synthesis import array_factor, g_paper, ratio_array_factor, ratio_paper
+from rtsgeom.geometry import build_setup
+from rtsgeom.paths import exact_paths
+
+from conftest import make_scene
+
+
+def far_field(doc):
+    doc["radar"].pop("snr_db", None)
+    doc["rts"]["arc_radius_m"] = 50.0
+    doc["sheet"]["enabled"] = False
+    for fe in doc["rts"]["front_ends"]:
+        fe["rx_tx_separation_m"] = 0.0
+        fe.pop("return_loss_fe_db", None)
+        fe.pop("return_loss_be_db", None)
+    doc["targets"] = []
+
+
+def test_closed_form_ratios_are_positive_between_the_beams():
+    th1, th2 = np.radians(3.4), np.radians(12.2)
+    alpha = np.radians(np.linspace(4, 11.5, 9))
+    assert np.all(ratio_paper(th1, th2, alpha) > 0)
+    assert np.all(ratio_array_factor(th1, th2, alpha, 8) > 0)
+    # as printed (without the minus sign) eq. (23) would be negative: A1 g1 + A2 g2 = 0
+    assert np.all(g_paper(th1, alpha) / g_paper(th2, alpha) < 0)
+    assert array_factor(0.0, 8) == 1.0
+    assert abs(array_factor(2 / 8, 8)) < 1e-12  # first null at u = 2/N
+
+
+@pytest.fixture(scope="module")
+def far_setup():
+    setup = build_setup(make_scene(far_field))
+    paths = exact_paths(setup)
+    return setup, paths, probe_front_ends(setup, paths)
+
+
+@pytest.mark.slow
+def test_modes_in_the_ideal_far_field(far_setup):
+    setup, paths, probe = far_setup
+    res = {m: linearity(setup, paths, (0, 1), m, probe, None, points=7) for m in
+           ("array-factor", "paper", "exact")}
+    assert res["array-factor"].max_abs_error_deg < 0.02  # exact in the far field
+    assert res["exact"].max_abs_error_deg < 0.02
+    # the paper's sinc is not the 8-element beam: exact only at the symmetric mid-point,
+    # ~0.3 deg off in between
+    assert 0.15 < res["paper"].max_abs_error_deg < 0.6
+    assert abs(res["paper"].error_deg[3]) < 0.05
+
+
+@pytest.fixture(scope="module")
+def default_cal():
+    setup = build_setup(make_scene())
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, 1)
+    cal = calibrate_pair(setup, paths, (0, 1), probe, seed=1, span_s=(-0.5e-9, 1.5e-9))
+    return setup, paths, probe, cal
+
+
+@pytest.mark.slow
+def test_calibration_sweep_period(default_cal):
+    setup, _, _, cal = default_cal
+    period = 1 / (setup.scene.rts.f_rts_hz + setup.scene.radar.bandwidth_hz / 2)
+    t, e = cal.sweep_delta_tau_s, cal.sweep_error_deg
+    step = t[1] - t[0]
+    interior = np.arange(1, len(e) - 1)
+    mins = interior[(e[interior] < e[interior - 1]) & (e[interior] <= e[interior + 1])]
+    maxs = interior[(e[interior] > e[interior - 1]) & (e[interior] >= e[interior + 1])]
+    deep = sorted(mins, key=lambda i: e[i])[:2]
+    # minima one period apart; the second is pulled by up to ~2 steps because the delay also
+    # moves channel J by c dtau / 2 = one range bin per period (the paper's range offset)
+    assert abs(abs(t[deep[1]] - t[deep[0]]) - period) <= 1.5 * step
+    top = sorted(maxs, key=lambda i: -e[i])[:2]
+    # maxima are broad and the later one sits 1.4 range bins off: looser
+    assert abs(abs(t[top[1]] - t[top[0]]) - period) <= 3 * step
+    assert cal.residual_error_deg < 0.02
+    assert abs(cal.range_offset_m) < 0.01
+
+
+@pytest.mark.slow
+def test_exact_linearity_after_calibration(default_cal):
+    setup, paths, probe, cal = default_cal
+    lin = linearity(setup, paths, (0, 1), "exact", probe, cal, points=9, seed=1)
+    assert lin.max_abs_error_deg <= 0.02
+
+
+@pytest.mark.slow
+def test_radial_offset_shifts_calibrated_delay(default_cal):
+    setup0, _, _, cal0 = default_cal
+    dr = 0.5e-3
+
+    def mutate(doc):
+        doc["rts"]["front_ends"][1]["radial_offset_mm"] = dr * 1e3
+    setup = build_setup(make_scene(mutate))
+    paths = exact_paths(setup)
+    cal = calibrate_pair(setup, paths, (0, 1), probe_front_ends(setup, paths, 1), seed=1)
+    r = setup.scene.radar
+    f_rts = setup.scene.rts.f_rts_hz
+    period = 1 / (f_rts + r.bandwidth_hz / 2)
+    predicted = -(r.f_c_hz + r.bandwidth_hz / 2) / (f_rts + r.bandwidth_hz / 2) * 2 * dr / c
+    assert predicted == pytest.approx(-0.26e-9, abs=0.01e-9)
+    shift = cal.delta_tau_s - cal0.delta_tau_s
+    wrapped = (shift - predicted + period / 2) % period - period / 2
+    # measured: ~35 ps (1.4 steps) more than the closed form; see the README's open findings
+    assert abs(wrapped) <= 2 * setup.scene.rts.calibration_step_s
+
+
+@pytest.mark.slow
+def test_quarter_wave_radial_error_breaks_uncalibrated_synthesis(default_cal):
+    _, _, _, cal0 = default_cal
+    lam = build_setup(make_scene()).rut.wavelength_m
+
+    def mutate(doc):
+        doc["rts"]["front_ends"][1]["radial_offset_mm"] = lam / 4 * 1e3
+    setup = build_setup(make_scene(mutate))
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, 1)
+    bad = linearity(setup, paths, (0, 1), "exact", probe, None, points=5, seed=1)
+    assert bad.max_abs_error_deg > 1.0  # destructive interference: the synthesis falls apart
+    cal = calibrate_pair(setup, paths, (0, 1), probe, seed=1)
+    good = linearity(setup, paths, (0, 1), "exact", probe, cal, points=5, seed=1)
+    assert good.max_abs_error_deg < 0.05

@@ -1,0 +1,454 @@
+"""Validation at every edge (issue 10): malformed scenes, hostile files, CLI exit codes, warnings.
+
+Every malformed scene is the default scene's TOML document with one mistake; the error must be a
+:class:`SceneError` whose message names the file, the field and (where there is one) the value.
+The same documents written to disk must make ``rtsgeom info`` exit 2 without a traceback.
+"""
+
+from __future__ import annotations
+
+import copy
+import datetime as dt
+import json
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from rtsgeom.cli import main
+from rtsgeom.cli._common import number
+from rtsgeom.scene import SceneError, load_scene, loads_scene, parse_scene
+from rtsgeom.validate import scene_warnings
+
+from conftest import DEFAULT_SCENE, ROOT, default_doc
+
+
+# --------------------------------------------------------------------------------------------
+# A minimal TOML writer (inline tables), enough to put any mutated document on disk
+# --------------------------------------------------------------------------------------------
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "nan"
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return repr(v)
+    if isinstance(v, str):
+        return json.dumps(v).replace("\x7f", "\\u007f")
+    if isinstance(v, (dt.datetime, dt.date, dt.time)):
+        return v.isoformat()
+    if isinstance(v, list):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{json.dumps(k)} = {_toml_value(x)}" for k, x in v.items()) + "}"
+    raise TypeError(type(v))
+
+
+def dump_toml(doc: dict) -> str:
+    """One ``key = value`` line per top-level key; tables and arrays of tables inline."""
+    return "".join(f"{json.dumps(k)} = {_toml_value(v)}\n" for k, v in doc.items())
+
+
+def test_dump_toml_round_trips_the_default_scene():
+    import tomllib
+    doc = default_doc()
+    assert tomllib.loads(dump_toml(doc)) == doc
+    odd = {"x": [math.inf, -0.0, 10**30, "a\x7f\n\"b", dt.date(2020, 1, 2)]}
+    back = tomllib.loads(dump_toml(odd))["x"]
+    assert back[0] == math.inf and math.copysign(1, back[1]) < 0 and back[2:] == odd["x"][2:]
+
+
+# --------------------------------------------------------------------------------------------
+# Malformed scenes: one mistake each, the message names the field
+# --------------------------------------------------------------------------------------------
+
+
+def _set(path: str, value):
+    """A mutation setting ``doc[a][b][i]...`` (dotted path; integers index arrays)."""
+    keys = [int(k) if k.isdigit() else k for k in path.split(".")]
+
+    def mutate(doc):
+        node = doc
+        for k in keys[:-1]:
+            node = node[k]
+        node[keys[-1]] = value
+    return mutate
+
+
+def _pop(path: str):
+    keys = [int(k) if k.isdigit() else k for k in path.split(".")]
+
+    def mutate(doc):
+        node = doc
+        for k in keys[:-1]:
+            node = node[k]
+        del node[keys[-1]]
+    return mutate
+
+
+def _all(*mutations):
+    def mutate(doc):
+        for m in mutations:
+            m(doc)
+    return mutate
+
+
+def _many_front_ends(doc):
+    doc["sheet"]["enabled"] = False
+    doc["targets"] = []
+    doc["rts"]["front_ends"] = [{"angle_deg": -80 + 0.5 * i} for i in range(300)]
+
+
+def _big_adc_cube(doc):
+    doc["radar"].update(samples_per_chirp=8192, adc_rate_hz=250e6, chirps_per_tx=4096)
+
+
+# (id, mutation, field named in the message, text of the value in the message or None)
+MALFORMED = [
+    ("string for a number", _set("radar.f_c_hz", "77e9"), "radar.f_c_hz", "'77e9'"),
+    ("nan", _set("radar.bandwidth_hz", math.nan), "radar.bandwidth_hz", "nan"),
+    ("inf", _set("radar.adc_rate_hz", math.inf), "radar.adc_rate_hz", "inf"),
+    ("huge integer", _set("radar.samples_per_chirp", 10**30), "radar.samples_per_chirp", "1000"),
+    ("integer beyond float", _set("radar.chirp_duration_s", 10**400), "radar.chirp_duration_s",
+     None),
+    ("date for a number", _set("radar.f_c_hz", dt.date(2022, 1, 1)), "radar.f_c_hz", "2022"),
+    ("bool for a number", _set("rts.front_ends.0.angle_deg", True),
+     "rts.front_ends[0].angle_deg", "True"),
+    ("vector of two", _set("radar.position_m", [0.0, 0.0]), "radar.position_m", "[0.0, 0.0]"),
+    ("yaw out of range", _set("radar.yaw_deg", 120.0), "radar.yaw_deg", "120"),
+    ("unknown CFAR", _set("radar.cfar.kind", "xx"), "radar.cfar.kind", "'xx'"),
+    ("fractional guard cells", _set("radar.cfar.guard_cells", [1.5, 2]),
+     "radar.cfar.guard_cells", "1.5"),
+    ("chirp repeats before it ends", _set("radar.chirp_repetition_s", 40e-6),
+     "radar.chirp_repetition_s", "4e-05"),
+    ("SNR as text", _set("radar.snr_db", "high"), "radar.snr_db", "'high'"),
+    ("negative zero radius", _set("rts.arc_radius_m", -0.0), "rts.arc_radius_m", "-0"),
+    ("no front ends", _set("rts.front_ends", []), "rts.front_ends", None),
+    ("too many front ends", _many_front_ends, "rts.front_ends", "300 front ends"),
+    ("front ends out of order", _set("rts.front_ends.1.angle_deg", 1.0), "rts.front_ends",
+     "[3.4, 1.0]"),
+    ("front end outside the sheet", _set("rts.front_ends.1.angle_deg", 29.0),
+     "rts.front_ends[1].angle_deg", "29"),
+    ("antennas wider than the cutout", _set("rts.front_ends.0.rx_tx_separation_m", 0.06),
+     "rts.front_ends[0].rx_tx_separation_m", "0.06"),
+    ("RuT outside the arc", _set("rts.arc_center_m", [0.0, -1.5, 0.0]), "radar.position_m",
+     "[0.0, 0.0, 0.0]"),
+    ("RuT looking away (yaw)", _set("radar.yaw_deg", -85.0), "rts.front_ends[1].angle_deg",
+     "12.2"),
+    ("front end behind the RuT", _all(
+        _set("sheet.enabled", False), _set("rts.arc_center_m", [0.0, 0.0, 0.0]),
+        _set("radar.position_m", [0.0, 0.5, 0.0]), _set("rts.front_ends.0.angle_deg", 40.0),
+        _set("rts.front_ends.1.angle_deg", 85.0)), "rts.front_ends[1].angle_deg", "85"),
+    ("sheet inside the RuT's position", _all(
+        _set("rts.arc_center_m", [0.0, -0.52, 0.0]), _set("sheet.radius_offset_m", -0.5)),
+     "radar.position_m", "inner radius"),
+    ("no fractional delay for 25 ps steps", _set("rts.fractional_delay", False),
+     "rts.calibration_step_ps", "25"),
+    ("fractional delay step coarser than the calibration step",
+     _set("rts.fractional_delay_step_s", 50e-12), "rts.calibration_step_ps", "25"),
+    ("calibration span shorter than a period", _set("rts.calibration_span_ns", [0.0, 0.5]),
+     "rts.calibration_span_ns", "[0.0, 0.5]"),
+    ("calibration span reversed", _set("rts.calibration_span_ns", [1.0, 0.0]),
+     "rts.calibration_span_ns", "[1.0, 0.0]"),
+    ("calibration with a million steps", _all(
+        _set("rts.calibration_span_ns", [-500.0, 500.0]), _set("rts.calibration_step_ps", 1.0)),
+     "rts.calibration_step_ps", "1"),
+    ("ADC cube of 268 M samples", _big_adc_cube, "radar.chirps_per_tx", "4096"),
+    ("target beyond the unambiguous range", _set("targets.3.range_m", 78.0),
+     "targets[3].range_m", "78"),
+    ("uncompensated air path pushes a target out", _all(
+        _set("rts.compensate_air_path", False), _set("targets.3.range_m", 77.0)),
+     "targets[3].range_m", "77"),
+    ("target faster than the unambiguous velocity", _set("targets.1.velocity_mps", 40.0),
+     "targets[1].velocity_mps", "40"),
+    ("target inside the arc", _set("targets.0.range_m", 0.5), "targets[0].range_m", "0.5"),
+    ("sheet extent reversed", _set("sheet.angle_max_deg", -20.0), "sheet.angle_max_deg", "-20"),
+    ("cutout taller than the sheet", _set("sheet.height_m", 0.04), "sheet.cutout_diameter_m",
+     "0.05"),
+    ("sheet radius below 5 cm", _all(_set("rts.arc_radius_m", 0.1),
+                                     _set("sheet.radius_offset_m", -0.06)),
+     "sheet.radius_offset_m", "-0.06"),
+    ("material with punctuation", _set("sheet.material", "metal; rm -rf /"), "sheet.material",
+     "'metal; rm -rf /'"),
+    ("name too long", _set("name", "x" * 5000), "name", "xxxx...xxxx"),
+    ("name with a newline", _set("name", "a\nb"), "name", "'a\\nb'"),
+    ("empty name", _set("name", "  "), "name", None),
+    ("description too long", _set("description", "y" * 20_000), "description", None),
+    ("unknown top-level key", _set("radr", {}), "radr", None),
+    ("misspelt field", _set("rts.arc_radius", 1.0), "rts.arc_radius", None),
+    ("missing required field", _pop("radar.f_c_hz"), "radar.f_c_hz", None),
+    ("missing section", _pop("rts"), "rts", None),
+    ("section is an array", _set("radar", [1, 2, 3]), "radar", "[1, 2, 3]"),
+    ("targets as one table", _set("targets", {"range_m": 10.0}), "targets", None),
+    ("nested garbage", _set("raytrace", {"max_depth": [[[[{"a": [1]}]]]]}), "raytrace.max_depth",
+     None),
+    ("raytrace depth", _set("raytrace.max_depth", 11), "raytrace.max_depth", "11"),
+    ("negative seed", _set("seed", -1), "seed", "-1"),
+    ("mesh that does not exist", _set("structure", [{"mesh": "nope.stl"}]), "structure[0].mesh",
+     "'nope.stl'"),
+    ("mesh path too long", _set("structure", [{"mesh": "a/" * 3000 + "m.stl"}]),
+     "structure[0].mesh", None),
+]
+
+
+def _mutated(mutate) -> dict:
+    doc = copy.deepcopy(default_doc())
+    mutate(doc)
+    return doc
+
+
+@pytest.mark.parametrize("label,mutate,field,value", MALFORMED, ids=[m[0] for m in MALFORMED])
+def test_malformed_scene_names_file_field_and_value(label, mutate, field, value):
+    with pytest.raises(SceneError) as err:
+        parse_scene(_mutated(mutate), "bad.toml", base_dir=ROOT)
+    msg = str(err.value)
+    assert msg.startswith("bad.toml: "), msg
+    assert field in msg, msg
+    if value is not None:
+        assert f"{field} = " in msg and value in msg, msg
+    assert len(msg) < 1000  # huge values are abbreviated
+    assert any(w in msg for w in ("must be", "is missing", "is not a known field")), msg
+
+
+def test_at_least_twenty_distinct_mistakes():
+    assert len({m[2] for m in MALFORMED}) >= 20
+
+
+def test_specific_messages_explain_what_is_allowed():
+    def msg(mutate):
+        with pytest.raises(SceneError) as err:
+            parse_scene(_mutated(mutate), "bad.toml")
+        return str(err.value)
+    m = msg(_set("rts.fractional_delay", False))
+    assert "rts.fractional_delay = false" in m and "250 ps" in m
+    m = msg(_set("rts.calibration_span_ns", [0.0, 0.5]))
+    assert "1 ns" in m and "rts.f_rts_hz" in m
+    m = msg(_set("rts.arc_center_m", [0.0, -1.5, 0.0]))
+    assert "rts.arc_center_m" in m and "rts.arc_radius_m = 1 m" in m and "1.5 m away" in m
+    m = msg(_set("radar.yaw_deg", -85.0))
+    assert "radar.yaw_deg = -85" in m and "(-90, 90)" in m
+    m = msg(_all(_set("rts.compensate_air_path", False), _set("targets.3.range_m", 77.0)))
+    assert "air path 1 m" in m and "rts.compensate_air_path = false" in m
+
+
+def test_relative_mesh_paths_resolve_against_the_scene_folder(tmp_path, monkeypatch):
+    folder = tmp_path / "scenes"
+    (folder / "meshes").mkdir(parents=True)
+    (folder / "meshes" / "wall.stl").write_text("solid wall\nendsolid wall\n")
+    doc = default_doc()
+    doc["structure"] = [{"mesh": "meshes/wall.stl", "material": "itu_concrete"}]
+    path = folder / "room.toml"
+    path.write_text(dump_toml(doc))
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)  # the working directory must not matter
+    scene = load_scene(os.path.relpath(path, elsewhere))
+    assert scene.extra_meshes == ((str((folder / "meshes" / "wall.stl").resolve()),
+                                   "itu_concrete"),)
+    # ...and the same relative path next to a scene in another folder is an error
+    other = tmp_path / "other.toml"
+    other.write_text(dump_toml(doc))
+    with pytest.raises(SceneError, match=r"structure\[0\]\.mesh = 'meshes/wall.stl'"):
+        load_scene(other)
+
+
+# --------------------------------------------------------------------------------------------
+# Hostile files
+# --------------------------------------------------------------------------------------------
+
+
+def _hostile_files(tmp_path: Path) -> dict[str, tuple[Path, str]]:
+    """name -> (path, text the error must contain)"""
+    text = DEFAULT_SCENE.read_text()
+    files = {
+        "directory": (tmp_path, "directory"),
+        "missing": (tmp_path / "nope.toml", "cannot read"),
+        "binary": (b"\x89PNG\r\n\x1a\n\x00\x00\xff\xfe", "not UTF-8"),
+        "NUL byte": (b"name = \"a\x00b\"\n", "not valid TOML"),
+        "empty": (b"", "radar is missing"),
+        "only a comment": (b"# nothing\n", "radar is missing"),
+        "top-level array": (b"[1, 2, 3]\n", "not valid TOML"),
+        "top-level value": (b"= 3\n", "not valid TOML"),
+        "4300+ digit integer": (text.replace("seed = 2022", "seed = " + "9" * 5000).encode(),
+                                "not valid TOML"),
+        "deeply nested array": (b"x = " + b"[" * 10_000 + b"]" * 10_000, "not valid TOML"),
+        "1e999": (text.replace("f_c_hz = 77e9", "f_c_hz = 1e999").encode(), "radar.f_c_hz"),
+        "nan": (text.replace("bandwidth_hz = 1e9", "bandwidth_hz = nan").encode(),
+                "radar.bandwidth_hz"),
+        "-inf": (text.replace("f_s_hz = 4e9", "f_s_hz = -inf").encode(), "rts.f_s_hz"),
+        "long string": (text.replace('name = "diewald2022"', 'name = "' + "z" * 200_000 + '"')
+                        .encode(), "name = 'zzz"),
+        "too large": (b"# " + b"x" * (5 << 20), "too large"),
+        "duplicate key": (text.replace("seed = 2022", "seed = 2022\nseed = 1").encode(),
+                          "not valid TOML"),
+        "table as value": (b"radar = 5\n" + text.split("[radar]", 1)[1].split("[rts]")[0]
+                           .encode(), "not valid TOML"),
+    }
+    out = {}
+    for name, (content, expect) in files.items():
+        if isinstance(content, bytes):
+            p = tmp_path / f"{name.replace(' ', '_')}.toml"
+            p.write_bytes(content)
+            content = p
+        out[name] = (content, expect)
+    return out
+
+
+def test_hostile_files_give_a_scene_error(tmp_path):
+    for name, (path, expect) in _hostile_files(tmp_path).items():
+        with pytest.raises(SceneError) as err:
+            load_scene(path)
+        assert expect in str(err.value), (name, str(err.value)[:300])
+        assert len(str(err.value)) < 1000, name
+
+
+def test_special_files_and_byte_order_mark(tmp_path):
+    with pytest.raises(SceneError, match="not a regular file"):
+        load_scene("/dev/null")
+    with pytest.raises(SceneError, match="cannot read"):
+        load_scene("a\x00b.toml")
+    bom = tmp_path / "bom.toml"
+    bom.write_bytes(b"\xef\xbb\xbf" + DEFAULT_SCENE.read_bytes())
+    assert load_scene(bom).name == "diewald2022"
+    with pytest.raises(SceneError, match="not UTF-8"):
+        loads_scene("name = '\udc80'")
+
+
+# --------------------------------------------------------------------------------------------
+# The CLI: exit code 2, one line, no traceback
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("label,mutate,field,value", MALFORMED, ids=[m[0] for m in MALFORMED])
+def test_cli_rejects_malformed_scene_with_exit_2(label, mutate, field, value, tmp_path, capsys):
+    path = tmp_path / "bad.toml"
+    path.write_text(dump_toml(_mutated(mutate)))
+    assert main(["info", str(path)]) == 2
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    assert cap.err.startswith(f"rtsgeom: error: {path}: ") and field in cap.err
+    assert "Traceback" not in cap.err
+
+
+def test_cli_rejects_hostile_files_with_exit_2(tmp_path, capsys):
+    for name, (path, _) in _hostile_files(tmp_path).items():
+        assert main(["info", str(path)]) == 2, name
+        err = capsys.readouterr().err
+        assert err.startswith("rtsgeom: error: ") and "Traceback" not in err, name
+
+
+def _run_cli(*args, cwd=None):
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    return subprocess.run([sys.executable, "-m", "rtsgeom", *args], capture_output=True,
+                          text=True, cwd=cwd, env=env, timeout=120)
+
+
+def test_cli_subprocess_exit_codes(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(dump_toml(_mutated(_set("rts.fractional_delay", False))))
+    binary = tmp_path / "binary.toml"
+    binary.write_bytes(bytes(range(256)))
+    for args, field in (((str(bad),), "rts.calibration_step_ps"),
+                        ((str(binary),), "not UTF-8"),
+                        ((str(tmp_path),), "directory")):
+        r = _run_cli("info", *args)
+        assert r.returncode == 2, r.stderr
+        assert "Traceback" not in r.stderr and field in r.stderr
+        assert r.stderr.count("\n") == 1  # one line
+    # an unwritable output path is bad input too
+    r = _run_cli("paths", str(DEFAULT_SCENE), "--out", str(binary / "x.csv"))
+    assert r.returncode == 2 and "Traceback" not in r.stderr and "x.csv" not in r.stdout
+    # argument errors: argparse's usage message, exit 2
+    r = _run_cli("info")
+    assert r.returncode == 2 and "Traceback" not in r.stderr and "usage:" in r.stderr
+
+
+def test_cli_prints_warnings_to_stderr_and_goes_on(tmp_path, capsys):
+    doc = default_doc()
+    del doc["radar"]["snr_db"]
+    doc["targets"][0]["angle_deg"] = 30.0
+    path = tmp_path / "doubtful.toml"
+    path.write_text(dump_toml(doc))
+    assert main(["info", str(path)]) == 0
+    cap = capsys.readouterr()
+    lines = cap.err.splitlines()
+    assert len(lines) == 2 and all(ln.startswith(f"rtsgeom: warning: {path}: ") for ln in lines)
+    assert "radar.snr_db" in cap.err and "targets[0].angle_deg = 30" in cap.err
+    assert cap.out.startswith("scene diewald2022")
+    assert main(["info", str(DEFAULT_SCENE)]) == 0
+    assert capsys.readouterr().err == ""  # the default scene is clean
+
+
+@pytest.mark.parametrize("argv", [
+    ["info"], ["info", "a.toml", "--jsn"], ["nope"], [], ["paths", "a.toml"],
+    ["paths", "a.toml", "--out", "x.csv", "--method", "magic"], ["--bogus"],
+])
+def test_cli_argument_errors_exit_2(argv, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    assert "Traceback" not in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("text", ["abc", "nan", "inf", "-inf", "1e999", "11", "-1", "",
+                                  "9" * 5000, "0x10", "1.5"])
+def test_bad_numbers_exit_2(text, capsys):
+    import argparse
+    ap = argparse.ArgumentParser(prog="t")
+    ap.add_argument("--x", type=number(0, 10))
+    ap.add_argument("--n", type=number(0, 10, integer=True))
+    for opt in ("--x", "--n"):
+        if opt == "--x" and text == "1.5":
+            continue  # a valid number
+        with pytest.raises(SystemExit) as exc:
+            ap.parse_args([opt, text])
+        assert exc.value.code == 2
+        err = capsys.readouterr().err
+        assert "usage:" in err and "Traceback" not in err
+
+
+# --------------------------------------------------------------------------------------------
+# Warnings
+# --------------------------------------------------------------------------------------------
+
+
+WARNINGS = [
+    ("front ends wider apart than the resolution", _set("rts.front_ends.1.angle_deg", 25.0),
+     "rts.front_ends[1].angle_deg = 25", "17.48 deg"),
+    ("arc inside the Fraunhofer distance", _all(
+        _set("rts.arc_radius_m", 0.1), _set("sheet.enabled", False), _set("targets", [])),
+     "rts.arc_radius_m = 0.1", "Fraunhofer"),
+    ("target outside the front ends' span", _set("targets.2.angle_deg", -5.0),
+     "targets[2].angle_deg = -5", "[3.4, 12.2]"),
+    ("mounting offset above lambda/4", _set("rts.front_ends.0.radial_offset_mm", 1.5),
+     "rts.front_ends[0].radial_offset_mm = 1.5", "lambda/4"),
+    ("antenna behind metal", _set("rts.front_ends.0.height_offset_mm", 30.0),
+     "rts.front_ends[0].height_offset_mm = 30", "through the sheet"),
+    ("noiseless", _pop("radar.snr_db"), "radar.snr_db is not set", "noiseless"),
+    ("grating lobes", _set("radar.element_spacing_m", 0.003), "radar.element_spacing_m = 0.003",
+     "grating lobes"),
+    ("IF above the back end's Nyquist", _set("rts.f_s_hz", 1.5e9), "rts.f_rts_hz = 5e+08",
+     "Nyquist"),
+    ("uneven calibration steps", _set("rts.calibration_step_ps", 2.5),
+     "rts.calibration_step_ps = 2.5", "whole multiple"),
+]
+
+
+@pytest.mark.parametrize("label,mutate,head,text", WARNINGS, ids=[w[0] for w in WARNINGS])
+def test_scene_warnings(label, mutate, head, text):
+    scene = parse_scene(_mutated(mutate), "w.toml")
+    found = [w for w in scene_warnings(scene) if w.startswith(f"w.toml: {head}") and text in w]
+    assert len(found) == 1, scene_warnings(scene)
+
+
+def test_default_scene_has_no_warnings(default_scene):
+    assert scene_warnings(default_scene) == []

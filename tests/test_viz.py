@@ -1,0 +1,261 @@
+"""Visualisation (issue 8): the 3D setup view, the result figures and the HTML report.
+
+Images are checked for content (not blank, the requested size), the report for being one
+self-contained file (no scripts, no links out, every image embedded) that a browser can load.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib.util
+import shutil
+import subprocess
+import sys
+from html.parser import HTMLParser
+
+import numpy as np
+import pytest
+from matplotlib.image import imread
+
+from rtsgeom.cli import main
+from rtsgeom.geometry import build_setup
+from rtsgeom.info import scene_info
+from rtsgeom.paths import Paths, exact_paths
+from rtsgeom.paths.table import FE_TO_RX, TX_TO_FE
+from rtsgeom.viz import figures as F
+from rtsgeom.viz.report import write_report
+from rtsgeom.viz.scene3d import (_html_requirements, _path_polylines, render_setup_png,
+                                  rut_scale_factor)
+
+from conftest import DEFAULT_SCENE, make_scene
+
+
+def _png_stats(path, background=None):
+    """(height, width), number of distinct colours, fraction of non-background pixels."""
+    img = imread(path)
+    rgb = np.round(img[..., :3] * 255).astype(np.uint8)
+    flat = rgb.reshape(-1, 3)
+    colours, counts = np.unique(flat, axis=0, return_counts=True)
+    bg = colours[np.argmax(counts)] if background is None else np.asarray(background)
+    non_bg = np.any(np.abs(flat.astype(int) - bg) > 8, axis=1).mean()
+    return img.shape[:2], len(colours), float(non_bg)
+
+
+# --------------------------------------------------------------------------------------------
+# 3D view
+# --------------------------------------------------------------------------------------------
+
+
+def test_show_writes_a_png_that_shows_the_setup(tmp_path, capsys):
+    out = tmp_path / "setup.png"
+    assert main(["show", str(DEFAULT_SCENE), "--png", str(out), "--paths", "exact"]) == 0
+    assert f"wrote {out}" in capsys.readouterr().out
+    shape, n_colours, non_bg = _png_stats(out)
+    assert shape == (1000, 1600)  # the default window size
+    assert n_colours > 500  # shaded sheet, board, markers, lines, text
+    assert non_bg > 0.1
+    assert not list(tmp_path.glob("*.part*"))  # atomic write left nothing behind
+
+
+def test_show_needs_an_output_without_a_display(tmp_path, monkeypatch, capsys):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    assert main(["show", str(DEFAULT_SCENE), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "--png" in err and "DISPLAY" in err
+
+
+def test_reflections_are_drawn_only_with_vertices():
+    setup = build_setup(make_scene())
+    fe = setup.fe
+
+    @dataclasses.dataclass(frozen=True)
+    class PathsWithVertices(Paths):
+        vertices: tuple = ()
+
+    base = dict(front_end=[0, 0, 1, 1], direction=[TX_TO_FE, TX_TO_FE, FE_TO_RX, FE_TO_RX],
+                rut_tx=[0, 0, -1, -1], rut_rx=[-1, -1, 2, 2], delay_s=[3.3e-9, 4e-9, 3.3e-9, 5e-9],
+                gain=[1e-3, 1e-4, 1e-3, 1e-4], bounces=[0, 1, 0, 2])
+    plain = Paths.build(**base)
+    los, refl = _path_polylines(setup, plain, scale=1.0)
+    assert len(los) == 2 and refl == []  # reflections without vertices: skipped silently
+
+    bounce = fe.module[1] + [0.0, 0.3, 0.0]
+    with_v = PathsWithVertices(*dataclasses.astuple(plain),
+                               vertices=(None, np.array([[0.1, 0.5, 0.0]]), None,
+                                         np.array([bounce, [0.0, 0.5, 0.1]])))
+    los, refl = _path_polylines(setup, with_v, scale=1.0)
+    assert len(los) == 2 and [len(p) for p in refl] == [3, 4]
+    assert np.allclose(los[0], [setup.rut.tx_world[0], fe.rx[0]])
+    assert np.allclose(refl[1][0], fe.tx[1]) and np.allclose(refl[1][-1], setup.rut.rx_world[2])
+
+
+def test_render_variants_without_sheet_or_targets(tmp_path):
+    def mutate(doc):
+        doc["sheet"]["enabled"] = False
+        doc["targets"] = []
+        doc["radar"]["yaw_deg"] = 5.0
+        doc["rts"]["front_ends"] = doc["rts"]["front_ends"][:1]
+
+    setup = build_setup(make_scene(mutate))
+    assert rut_scale_factor(setup) in (1, 2, 5, 10, 20, 50)
+    out = render_setup_png(setup, tmp_path / "bare.png", paths=exact_paths(setup),
+                           window_size=(640, 400))
+    shape, n_colours, non_bg = _png_stats(out)
+    assert shape == (400, 640) and n_colours > 100 and non_bg > 0.02
+
+
+_HTML_NEEDS = _html_requirements()
+_HTML_DEPS = all(importlib.util.find_spec(m) for m in _HTML_NEEDS)
+
+
+@pytest.mark.skipif(not _HTML_DEPS, reason="HTML export needs " + ", ".join(_HTML_NEEDS.values()))
+def test_show_writes_interactive_html(tmp_path):
+    out = tmp_path / "setup.html"
+    # a subprocess: the trame server and nest-asyncio2 patch asyncio for the whole process
+    run = subprocess.run([sys.executable, "-m", "rtsgeom", "show", str(DEFAULT_SCENE), "--html",
+                          str(out), "--quiet"], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    text = out.read_text()
+    assert text.lstrip().lower().startswith("<!doctype html") and len(text) > 100_000
+
+
+@pytest.mark.skipif(_HTML_DEPS, reason="the HTML export packages are installed")
+def test_html_export_names_the_missing_packages(tmp_path, capsys):
+    assert main(["show", str(DEFAULT_SCENE), "--html", str(tmp_path / "s.html")]) == 2
+    err = capsys.readouterr().err
+    assert all(pip in err for pip in _HTML_NEEDS.values())
+    assert not (tmp_path / "s.html").exists()
+
+
+# --------------------------------------------------------------------------------------------
+# Figures
+# --------------------------------------------------------------------------------------------
+
+
+def _figures():
+    rng = np.random.default_rng(8)
+    r, v, a = np.linspace(0, 77, 128), np.linspace(-9.7, 9.7, 64), np.linspace(-60, 60, 61)
+    rd = -100 + 3 * rng.standard_normal((r.size, v.size))
+    rd[55, 32] = -30
+    ra = -90 + 3 * rng.standard_normal((r.size, a.size))
+    ra[55, 34] = -35
+    tau = np.arange(-0.5e-9, 1.0e-9 + 1e-15, 25e-12)
+    s = np.linspace(3.4, 12.2, 12)
+    return {
+        "range_doppler": F.range_doppler_figure(rd, r, v, detections=[[33.5, 0.0]], title="rd"),
+        "range_angle": F.range_angle_figure(ra, r, a, detections=[[33.5, 7.2]],
+                                            set_points=[[33.5, 7.0]]),
+        "calibration": F.calibration_sweep_figure(tau, np.abs(np.sin(np.pi * (tau - 2e-10) / 1e-9)),
+                                                  2e-10, period_s=1e-9),
+        "linearity": F.linearity_figure(s, {"paper": s + 0.2 * np.sin(s), "exact": s + 0.01},
+                                        {"paper": np.stack([-(s - 3.4), -(12.2 - s)]),
+                                         "exact": np.stack([-(s - 3.4), -(12.2 - s)]) / 2}),
+        "linearity_no_amplitude": F.linearity_figure(s, {"exact": s}),
+        "tolerance": F.tolerance_histogram_figure({"1 mm": 0.2 * rng.standard_normal(400),
+                                                   "2 mm": 0.4 * rng.standard_normal(400)},
+                                                  spec_deg=0.5),
+        "design": F.design_heatmap_figure(np.linspace(0.5, 3, 6), np.linspace(2, 20, 5),
+                                          rng.random((5, 6)), "arc radius (m)",
+                                          "front-end spacing (deg)", "worst error (deg)", "design",
+                                          mask=np.eye(5, 6, dtype=bool)),
+    }
+
+
+def test_each_figure_saves_a_nonempty_png_without_pyplot(tmp_path):
+    import matplotlib.pyplot as plt
+    before = plt.get_fignums()
+    for name, fig in _figures().items():
+        out = F.save_figure(fig, tmp_path / f"{name}.png")
+        shape, n_colours, non_bg = _png_stats(out, background=(255, 255, 255))
+        assert shape[0] > 300 and shape[1] > 600, name
+        assert n_colours > 50 and non_bg > 0.05, name
+    assert plt.get_fignums() == before  # no figure leaked into pyplot's global state
+    assert not list(tmp_path.glob("*.part*"))
+
+
+def test_figure_inputs_are_checked():
+    r, v = np.arange(4.0), np.arange(3.0)
+    with pytest.raises(ValueError, match=r"power_db must have shape \(4, 3\)"):
+        F.range_doppler_figure(np.zeros((3, 4)), r, v)
+    with pytest.raises(ValueError, match="detections"):
+        F.range_doppler_figure(np.zeros((4, 3)), r, v, detections=[1.0, 2.0, 3.0])
+    with pytest.raises(ValueError, match=r"amplitude_db_by_mode\['paper'\]"):
+        F.linearity_figure(r, {"paper": r}, {"paper": r})
+
+
+# --------------------------------------------------------------------------------------------
+# Report
+# --------------------------------------------------------------------------------------------
+
+_VOID = {"meta", "img", "br", "hr", "link", "input", "col", "area", "base", "wbr", "source"}
+
+
+class _TagChecker(HTMLParser):
+    """Collects tags and checks that every non-void element is closed in order."""
+
+    def __init__(self):
+        super().__init__()
+        self.stack, self.errors, self.tags = [], [], []
+
+    def handle_starttag(self, tag, attrs):
+        self.tags.append((tag, dict(attrs)))
+        if tag not in _VOID:
+            self.stack.append(tag)
+
+    def handle_endtag(self, tag):
+        if not self.stack or self.stack.pop() != tag:
+            self.errors.append(f"unexpected </{tag}>")
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("report")
+    setup = build_setup(make_scene())
+    png = F.save_figure(_figures()["calibration"], tmp / "cal.png")
+    sections = [
+        {"heading": "Calibration <sweep>", "text": "First & only.\n\n<script>alert(1)</script>",
+         "images": [png, png.read_bytes()], "warnings": ["spacing > resolution"]},
+        {"heading": "Numbers", "table": {"columns": ["case", "error (deg)"],
+                                         "rows": [["a", 0.125], ["b", np.float64(1.5)]]}},
+    ]
+    path = write_report(tmp / "report.html", "rtsgeom <test>", scene_info(setup), sections)
+    return path, path.read_text(encoding="utf-8")
+
+
+def test_report_is_self_contained_and_escaped(report):
+    _, text = report
+    checker = _TagChecker()
+    checker.feed(text)
+    assert checker.errors == [] and checker.stack == []
+    imgs = [a for t, a in checker.tags if t == "img"]
+    assert len(imgs) == 2 and all(a["src"].startswith("data:image/png;base64,") for a in imgs)
+    assert 'src="http' not in text and "href=" not in text and "<script" not in text
+    assert "&lt;script&gt;alert(1)&lt;/script&gt;" in text and "rtsgeom &lt;test&gt;" in text
+    # the scene summary: radar, far field, RTS and the front ends as tables
+    for part in ("Radar under test", "Far field", "Radar target simulator", "Front ends"):
+        assert part in text
+    assert "77 GHz" in text and "arc_angle (deg)" in text and "spacing &gt; resolution" in text
+
+
+def test_report_rejects_non_png_images(tmp_path):
+    with pytest.raises(ValueError, match="not a PNG"):
+        write_report(tmp_path / "r.html", "t", {}, [{"heading": "h", "images": [b"GIF89a"]}])
+    assert not (tmp_path / "r.html").exists()
+
+
+_CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+
+
+@pytest.mark.skipif(_CHROMIUM is None, reason="Chromium (chromium or chromium-browser) is not on "
+                                               "PATH: the report is not loaded in a browser")
+def test_report_loads_in_headless_chromium(report, tmp_path):
+    path, _ = report
+    shot = tmp_path / "shot.png"
+    run = subprocess.run([_CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu",
+                          "--disable-background-networking", "--disable-component-update",
+                          "--disable-sync", "--no-first-run", f"--user-data-dir={tmp_path / 'u'}",
+                          f"--screenshot={shot}", "--window-size=1200,2000",
+                          path.resolve().as_uri()],
+                         capture_output=True, text=True, timeout=60)
+    assert run.returncode == 0, run.stderr
+    assert shot.is_file() and shot.stat().st_size > 10_000
