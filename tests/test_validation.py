@@ -311,6 +311,23 @@ def test_hostile_files_give_a_scene_error(tmp_path):
         assert len(str(err.value)) < 1000, name
 
 
+def test_documents_that_are_not_tables():
+    for data in ([1, 2, 3], "radar", 3.0, None):
+        with pytest.raises(SceneError, match=r"^x\.toml: <top level> = .*must be a table"):
+            parse_scene(data, "x.toml")
+
+
+def test_negative_zero_is_zero_where_legal(default_scene):
+    from rtsgeom.geometry import build_setup
+    doc = default_doc()
+    doc["radar"].update(yaw_deg=-0.0, position_m=[-0.0, -0.0, -0.0])
+    doc["targets"][0]["velocity_mps"] = -0.0
+    scene = parse_scene(doc, "z.toml")
+    assert scene.radar.yaw_rad == 0.0 and scene.targets[0].velocity_mps == 0.0
+    assert build_setup(scene).fe_azimuth_rad().tolist() == \
+        build_setup(default_scene).fe_azimuth_rad().tolist()
+
+
 def test_special_files_and_byte_order_mark(tmp_path):
     with pytest.raises(SceneError, match="not a regular file"):
         load_scene("/dev/null")
