@@ -15,7 +15,7 @@ from ._common import UsageError
 
 __all__ = ["main", "build_parser"]
 
-_GROUPS = ("geometry", "signal", "aoa", "analysis", "viz")
+_GROUPS = ("geometry", "signal", "aoa", "tolerance", "analysis", "viz")
 
 
 def build_parser() -> argparse.ArgumentParser:
