@@ -1,0 +1,530 @@
+"""Ray-traced paths with Sionna RT (``--paths raytrace``): the setup's reflections per element pair.
+
+This is the only module of rtsgeom that imports ``sionna``, ``mitsuba`` or ``drjit``, and it does
+so lazily, on the first :func:`raytrace_paths` call, after a pre-flight check of Dr.Jit's backend.
+
+Scene
+    The sheet mesh (``setup.sheet``, ITU material from ``sheet.material``), the RuT's circuit
+    board as a thin box (:func:`rtsgeom.geometry.export.rut_board_mesh`, ITU metal: the copper
+    ground plane under the patches; it carries the sheet <-> RuT multi-bounce paths) and the
+    ``[[structure]]`` meshes of the scene. One Sionna transmitter per RuT Tx element and per
+    front end's Tx antenna, one receiver per RuT Rx element and per front end's Rx antenna, each
+    an isotropic single-element array (``synthetic_array=False``), at the radar's centre
+    frequency ``c / setup.rut.wavelength_m``.
+
+Precision
+    Sionna computes in float32. Everything is translated by ``-setup.rut.position`` before it is
+    handed over (delays are translation invariant), so the radar sits at the origin where float32
+    is finest: line-of-sight delays agree with the exact model to about 0.0003 ps.
+
+Rows returned (a :class:`~rtsgeom.paths.table.Paths` table, ``method="raytrace"``)
+    ``tx_to_fe`` (RuT Tx m -> FE q Rx), ``fe_to_rx`` (FE q Tx -> RuT Rx k) and ``rut_to_rut``
+    (RuT Tx m -> setup -> RuT Rx k, at least one interaction off the RuT's own board: the direct
+    Tx -> Rx coupling, line of sight or its grazing bounce on the board, is not a setup echo).
+    Front end <-> front end paths are ignored. ``gain`` is Sionna's ``a`` (no propagation
+    phase), ``delay_s`` Sionna's ``tau`` in float64. Duplicate paths (same interaction types and
+    objects, hit points within 1 mm, delays within a few float32 ulps) are dropped, as are paths
+    weaker than ``raytrace.min_gain_db``.
+
+Backend: the ``cuda_ad_mono_polarized`` Mitsuba variant where Dr.Jit finds CUDA, else
+``llvm_ad_mono_polarized``; ``RTSGEOM_RAYTRACE_BACKEND=llvm`` (or ``cuda``) forces one. Dr.Jit's
+kernel cache goes to ``<repo>/.drjit_cache`` (source checkout) or ``~/.cache/rtsgeom/drjit``
+unless ``DRJIT_CACHE_DIR`` is set.
+
+Known limits (see RAYTRACE.md): Sionna drops every path segment shorter than 1 cm; its image
+method accepts a hit on another triangle whose image lies within 1 cm; geometric optics on a
+faceted cylinder seen from (near) its axis returns one glint per facet, so the coherent sheet echo
+depends on the tessellation.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy.constants import c
+
+from ..geometry import Setup
+from ..scene import RaytraceConfig, SceneError
+from .table import FE_TO_RX, RUT_TO_RUT, TX_TO_FE, Paths
+
+__all__ = ["RaytraceUnavailable", "RaytraceResult", "preflight", "ensure_available",
+           "backend_info", "itu_type", "trace", "raytrace_paths", "INSTALL_HINT"]
+
+INSTALL_HINT = ("install a recent LLVM for Dr.Jit's CPU backend (Debian/Ubuntu: `apt-get install -y "
+                "libllvm19`), or set DRJIT_LIBLLVM_PATH to such a libLLVM.so (LLVM 19 is tested; "
+                "15 crashes, 14 and older are refused)")
+
+# Slab thickness of the board's material (the box itself comes from geometry.export)
+BOARD_THICKNESS_M = 1.6e-3
+DUPLICATE_VERTEX_TOL_M = 1e-3  # two rows whose hit points all agree within this are one path
+DUPLICATE_DELAY_ULPS = 4  # ... and whose float32 delays agree within this many ulps
+
+_INTERACTION_NAMES = {1: "specular", 2: "diffuse", 4: "refraction", 8: "diffraction"}
+
+# A tiny kernel run in a subprocess: LLVM 15 passes Dr.Jit's version check but aborts the whole
+# process (SIGABRT, "LLVM ERROR: Cannot select ... fmaximum") at the first kernel it compiles.
+_SMOKE = r"""
+import drjit as dr
+from drjit.llvm import Float
+x = dr.arange(Float, 64) - 32
+y = dr.maximum(dr.sqrt(x * x + 1), 0.0) + dr.minimum(x, 0.0)
+dr.eval(y)
+print("OK", ".".join(map(str, dr.detail.llvm_version())))
+"""
+
+
+class RaytraceUnavailable(RuntimeError):
+    """Sionna RT cannot run here (package missing, no usable LLVM/CUDA backend). The message
+    says what to install."""
+
+
+@dataclass(frozen=True)
+class RaytraceResult:
+    """A ray-tracing run: the :class:`Paths` table plus per-row details for cross-checks.
+
+    ``vertices`` (P, D, 3) are the interaction points in the world frame (NaN past the last
+    interaction), ``primitives`` (P, D) the triangle index within ``objects`` (P, D) (object
+    names, ``""`` past the last interaction). Row ``i`` describes ``paths`` row ``i``.
+    """
+
+    paths: Paths
+    vertices: np.ndarray
+    primitives: np.ndarray
+    objects: np.ndarray
+    variant: str
+    timings_s: dict = field(default_factory=dict)
+    stats: dict = field(default_factory=dict)
+
+
+# ------------------------------------------------------------------------------------------
+# Backend pre-flight (runs once per process, before the first import of sionna)
+# ------------------------------------------------------------------------------------------
+
+_LOCK = threading.RLock()
+_PREFLIGHT: tuple[bool, str, str | None] | None = None
+
+
+def _default_cache_dir() -> Path:
+    """``<repo>/.drjit_cache`` in a writable source checkout, else the user's cache folder."""
+    repo = Path(__file__).resolve().parents[2]
+    if (repo / "pyproject.toml").is_file() and os.access(repo, os.W_OK):
+        return repo / ".drjit_cache"
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "rtsgeom" / "drjit"
+
+
+def _set_cache_dir() -> None:
+    """Point Dr.Jit's kernel cache to a project folder unless the user chose one
+    (``DRJIT_CACHE_DIR``). Must run before drjit is imported."""
+    if os.environ.get("DRJIT_CACHE_DIR") or "drjit" in sys.modules:
+        return
+    path = _default_cache_dir()
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        return  # Dr.Jit falls back to its own default ($HOME/.drjit)
+    os.environ["DRJIT_CACHE_DIR"] = str(path)
+
+
+def _run_preflight(timeout_s: float) -> tuple[bool, str, str | None]:
+    _set_cache_dir()
+    import importlib.util
+    missing = []
+    for mod in ("drjit", "mitsuba", "sionna"):  # top-level only: find_spec("sionna.rt")
+        try:                                    # would import sionna, i.e. sionna.rt
+            spec = importlib.util.find_spec(mod)
+        except (ImportError, ValueError):
+            spec = None
+        if spec is None:
+            missing.append(mod)
+        elif mod == "sionna" and not any((Path(p) / "rt").is_dir()
+                                         for p in spec.submodule_search_locations or ()):
+            missing.append("sionna.rt")
+    if missing:
+        return False, (f"Sionna RT is not installed ({', '.join(missing)} missing): "
+                       "pip install 'sionna-rt>=1.0'"), None
+    if "sionna.rt" in sys.modules:  # imported (and therefore working) already
+        import mitsuba as mi
+        return True, f"sionna.rt already imported (variant {mi.variant()})", mi.variant()
+    try:
+        import drjit as dr  # cheap, compiles nothing, never aborts
+    except ImportError as exc:
+        return False, f"drjit cannot be imported ({exc})", None
+    forced = os.environ.get("RTSGEOM_RAYTRACE_BACKEND", "").strip().lower()
+    if forced not in ("", "cuda", "llvm"):
+        return False, (f"RTSGEOM_RAYTRACE_BACKEND={forced!r}: must be 'cuda' or 'llvm' (or unset: "
+                       "CUDA where available, else LLVM)"), None
+    if forced != "llvm" and dr.has_backend(dr.JitBackend.CUDA):
+        return True, "CUDA backend available", "cuda_ad_mono_polarized"
+    if forced == "cuda":
+        return False, "RTSGEOM_RAYTRACE_BACKEND=cuda but Dr.Jit finds no CUDA backend", None
+    env_path = os.environ.get("DRJIT_LIBLLVM_PATH")
+    if not dr.has_backend(dr.JitBackend.LLVM):
+        try:
+            with open("/proc/self/maps") as fh:
+                libs = sorted({ln.split()[-1] for ln in fh if "libLLVM" in ln})
+        except OSError:
+            libs = []
+        why = (f"Dr.Jit cannot use {libs[0]} (LLVM older than 15?)" if libs
+               else "no libLLVM shared library was found")
+        where = f" (DRJIT_LIBLLVM_PATH={env_path})" if env_path else ""
+        return False, (f"Sionna RT needs Dr.Jit's LLVM backend on a machine without CUDA; "
+                       f"{why}{where}: {INSTALL_HINT}"), None
+    ver = ".".join(map(str, dr.detail.llvm_version()))
+    try:
+        r = subprocess.run([sys.executable, "-c", _SMOKE], capture_output=True, text=True,
+                           timeout=timeout_s, env=os.environ.copy())
+    except subprocess.TimeoutExpired:
+        return False, f"the LLVM {ver} smoke test timed out after {timeout_s:g} s: {INSTALL_HINT}", None
+    except OSError as exc:
+        return False, f"cannot start the LLVM smoke test ({exc})", None
+    if r.returncode != 0 or "OK" not in r.stdout:
+        lines = r.stderr.strip().splitlines()
+        err = [ln for ln in lines if "LLVM ERROR" in ln or "Error" in ln] or lines[-1:]
+        detail = re.sub(r"0x[0-9a-fA-F]+:? ?", "", err[0]) if err else "no output"  # addresses
+        return False, (f"LLVM {ver} is accepted by Dr.Jit but crashes when compiling a kernel "
+                       f"(exit code {r.returncode}: {detail[:120]}): {INSTALL_HINT}"), None
+    return True, f"LLVM {ver} OK", "llvm_ad_mono_polarized"
+
+
+def preflight(timeout_s: float = 120.0) -> tuple[bool, str]:
+    """Whether Sionna RT can run in this process, and why not. Cached; never crashes the caller
+    (the LLVM check compiles a kernel in a subprocess). Sets ``DRJIT_CACHE_DIR`` if unset."""
+    global _PREFLIGHT
+    with _LOCK:
+        if _PREFLIGHT is None:
+            _PREFLIGHT = _run_preflight(timeout_s)
+        return _PREFLIGHT[0], _PREFLIGHT[1]
+
+
+_RT = None  # (mitsuba, sionna.rt) once imported
+
+
+def ensure_available():
+    """Import Sionna RT (after the pre-flight) and return ``(mitsuba, sionna.rt)``; raises
+    :class:`RaytraceUnavailable` with installation advice."""
+    global _RT
+    with _LOCK:
+        if _RT is not None:
+            return _RT
+        ok, msg = preflight()
+        if not ok:
+            raise RaytraceUnavailable(msg)
+        variant = _PREFLIGHT[2]
+        try:
+            import mitsuba as mi
+            if "sionna.rt" not in sys.modules:
+                mi.set_variant(variant)  # must precede `import sionna.rt`
+            import sionna.rt as rt
+        except (ImportError, AttributeError, RuntimeError) as exc:
+            raise RaytraceUnavailable(f"cannot import Sionna RT ({exc}): {INSTALL_HINT}") from None
+        _RT = (mi, rt)
+        return _RT
+
+
+def backend_info() -> dict:
+    """Mitsuba variant, Dr.Jit thread count and Dr.Jit's allocation peak (MiB) of the backend in
+    use (device memory on CUDA); for benchmarks. Imports Sionna RT like :func:`trace`."""
+    mi, _ = ensure_available()
+    import drjit as dr
+    variant = mi.variant()
+    out = {"variant": variant, "drjit_threads": int(dr.thread_count())}
+    backend = dr.JitBackend.CUDA if variant.startswith("cuda") else dr.JitBackend.LLVM
+    try:
+        out["drjit_peak_mib"] = dr.detail.malloc_watermark(backend) / 2**20
+    except (AttributeError, RuntimeError, TypeError):  # not in every Dr.Jit version
+        pass
+    return out
+
+
+# ------------------------------------------------------------------------------------------
+# Scene
+# ------------------------------------------------------------------------------------------
+
+
+def itu_type(material: str, fieldname: str = "sheet.material") -> str:
+    """``itu_metal`` -> ``metal``: the ITU-R P.2040 material type of an rtsgeom material name.
+
+    Unknown names raise :class:`SceneError` naming ``fieldname``. Frequency validity is checked
+    when the material is evaluated at the radar frequency (:func:`trace`).
+    """
+    from sionna.rt.radio_materials.itu import ITU_MATERIALS_PROPERTIES  # after ensure_available
+    known = sorted(k for k in ITU_MATERIALS_PROPERTIES if k != "vacuum")
+    kind = material[4:] if material.startswith("itu_") else None
+    if kind not in known:
+        raise SceneError(f"{fieldname} = {material!r}: must be an ITU radio material, one of "
+                         + ", ".join("itu_" + k for k in known))
+    return kind
+
+
+def _mi_mesh(mi, mesh, name: str, offset: np.ndarray):
+    """trimesh -> mitsuba Mesh (float32, translated by ``offset``), faces in trimesh order so
+    Sionna's primitive index is the trimesh face index."""
+    v = np.asarray(mesh.vertices, float) + offset
+    f = np.asarray(mesh.faces, np.int64)
+    m = mi.Mesh(name, vertex_count=len(v), face_count=len(f), has_vertex_normals=False,
+                has_vertex_texcoords=False)
+    params = mi.traverse(m)
+    params["vertex_positions"] = mi.Float(np.ascontiguousarray(v, np.float32).ravel())
+    params["faces"] = mi.UInt32(np.ascontiguousarray(f, np.uint32).ravel())
+    params.update()
+    return m
+
+
+def _load_structure(path: str, index: int):
+    import trimesh
+    where = f"structure[{index}].mesh"
+    try:
+        mesh = trimesh.load(path, force="mesh", process=True)
+    except Exception as exc:  # trimesh raises many kinds for unreadable files
+        raise SceneError(f"{where} = {path!r}: cannot read the mesh ({exc})") from None
+    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
+        raise SceneError(f"{where} = {path!r}: must be a mesh with at least one triangle")
+    if not np.all(np.isfinite(mesh.vertices)):
+        raise SceneError(f"{where} = {path!r}: the mesh has non-finite vertices")
+    return mesh
+
+
+@dataclass
+class _Built:
+    scene: object
+    tx_names: list
+    rx_names: list
+    object_names: dict  # object_id -> name
+    meshes: dict  # name -> trimesh (world frame)
+
+
+def _build_scene(setup: Setup, mi, rt) -> _Built:
+    from sionna.rt.radio_materials.itu import ITU_MATERIALS_PROPERTIES
+    from ..geometry.export import rut_board_mesh
+    sc = setup.scene
+    origin = np.asarray(setup.rut.position, float)
+    off = -origin
+    freq = c / setup.rut.wavelength_m
+    scene = rt.load_scene()  # empty
+    scene.frequency = freq
+
+    materials: dict = {}
+
+    def material(name: str, fieldname: str, thickness: float):
+        kind = itu_type(name, fieldname)
+        key = (kind, round(float(thickness), 9))
+        if key not in materials:
+            label = f"{kind}_{len(materials)}"
+            try:
+                if kind == "metal":  # ITU's metal is frequency independent (eps_r 1, 1e7 S/m):
+                    eps, _, sigma, _ = next(iter(ITU_MATERIALS_PROPERTIES["metal"].values()))
+                    mat = rt.RadioMaterial(name=label, thickness=float(thickness),  # any band
+                                           relative_permittivity=eps, conductivity=sigma)
+                else:
+                    mat = rt.ITURadioMaterial(name=label, itu_type=kind, thickness=float(thickness))
+                scene.add(mat)  # evaluates the ITU model at the scene frequency
+            except ValueError as exc:
+                raise SceneError(f"{fieldname} = {name!r}: {exc} (the radar's centre frequency is "
+                                 f"{freq / 1e9:.3f} GHz)") from None
+            materials[key] = mat
+        return materials[key]
+
+    meshes = {}
+    objects = []
+    if setup.sheet is not None:
+        meshes["sheet"] = setup.sheet
+        objects.append(("sheet", material(sc.sheet.material, "sheet.material",
+                                          sc.sheet.thickness_m)))
+    meshes["rut_board"] = rut_board_mesh(setup)
+    objects.append(("rut_board", material("itu_metal", "rut board", BOARD_THICKNESS_M)))
+    for i, (path, mat) in enumerate(sc.extra_meshes):
+        name = f"structure_{i}"
+        meshes[name] = _load_structure(path, i)
+        objects.append((name, material(mat, f"structure[{i}].material", 0.1)))
+    scene.add([rt.SceneObject(mi_mesh=_mi_mesh(mi, meshes[n], n, off), name=n, radio_material=m)
+               for n, m in objects])
+
+    scene.tx_array = rt.PlanarArray(num_rows=1, num_cols=1, pattern="iso", polarization="V")
+    scene.rx_array = rt.PlanarArray(num_rows=1, num_cols=1, pattern="iso", polarization="V")
+    rut, fe = setup.rut, setup.fe
+    devices, tx_names, rx_names = [], [], []
+
+    def device(cls, name, p, names):
+        q = np.asarray(p, float) + off
+        devices.append(cls(name=name, position=mi.Point3f(*map(float, q))))
+        names.append(name)
+
+    for m, p in enumerate(rut.tx_world):
+        device(rt.Transmitter, f"rut_tx{m}", p, tx_names)
+    for q, p in enumerate(fe.tx):
+        device(rt.Transmitter, f"fe{q}_tx", p, tx_names)
+    for k, p in enumerate(rut.rx_world):
+        device(rt.Receiver, f"rut_rx{k}", p, rx_names)
+    for q, p in enumerate(fe.rx):
+        device(rt.Receiver, f"fe{q}_rx", p, rx_names)
+    scene.add(devices)
+    if list(scene.transmitters) != tx_names or list(scene.receivers) != rx_names:
+        raise RuntimeError("Sionna RT reordered the radio devices")  # index order = insertion
+    ids = {int(scene.objects[n].object_id): n for n, _ in objects}
+    return _Built(scene, tx_names, rx_names, ids, meshes)
+
+
+# ------------------------------------------------------------------------------------------
+# Solve and extract
+# ------------------------------------------------------------------------------------------
+
+
+def _dedupe(tau: np.ndarray, inter: np.ndarray, objs: np.ndarray, verts: np.ndarray) -> np.ndarray:
+    """Keep-mask over the paths of one element pair: drop rows that repeat an earlier one
+    (same interaction types and objects, every hit point within 1 mm, delay within a few ulps).
+    Arrays: tau (P,), inter/objs (P, D), verts (P, D, 3)."""
+    n = tau.size
+    keep = np.ones(n, bool)
+    if n < 2:
+        return keep
+    tol = DUPLICATE_DELAY_ULPS * np.spacing(np.abs(tau).astype(np.float32)).astype(float)
+    groups: dict = {}
+    for i in range(n):
+        groups.setdefault((inter[i].tobytes(), objs[i].tobytes()), []).append(i)
+    for idx in groups.values():
+        if len(idx) < 2:
+            continue
+        idx = np.asarray(idx)
+        idx = idx[np.argsort(tau[idx], kind="stable")]
+        kept: list[int] = []
+        for i in idx:
+            for j in reversed(kept):
+                if tau[i] - tau[j] > tol[i]:
+                    break
+                if np.all(np.linalg.norm(np.nan_to_num(verts[i] - verts[j]), axis=-1)
+                          <= DUPLICATE_VERTEX_TOL_M):
+                    keep[i] = False
+                    break
+            if keep[i]:
+                kept.append(i)
+    return keep
+
+
+def trace(setup: Setup, config: RaytraceConfig | None = None) -> RaytraceResult:
+    """Ray-trace ``setup`` with Sionna RT; the :class:`RaytraceResult` with the paths table."""
+    cfg = config or setup.scene.raytrace
+    timings = {}
+    t0 = time.perf_counter()
+    mi, rt = ensure_available()
+    timings["import_s"] = time.perf_counter() - t0
+    with _LOCK:
+        t0 = time.perf_counter()
+        built = _build_scene(setup, mi, rt)
+        timings["build_s"] = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        solver = rt.PathSolver(deterministic=True)
+        res = solver(built.scene, max_depth=int(cfg.max_depth),
+                     max_num_paths_per_src=int(cfg.samples_per_src) * max(1, int(cfg.max_depth)),
+                     samples_per_src=int(cfg.samples_per_src), synthetic_array=False,
+                     los=bool(cfg.los), specular_reflection=bool(cfg.specular_reflection),
+                     diffuse_reflection=bool(cfg.diffuse_reflection),
+                     refraction=bool(cfg.refraction), diffraction=False,
+                     seed=int(setup.scene.seed % (2**31 - 1)))
+        valid = np.asarray(res.valid.numpy(), bool)[:, 0, :, 0, :]  # (rx, tx, P)
+        timings["solve_s"] = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        tau = res.tau.numpy().astype(np.float64)[:, 0, :, 0, :]
+        a_re, a_im = res.a
+        a = (a_re.numpy().astype(np.float64)
+             + 1j * a_im.numpy().astype(np.float64))[:, 0, :, 0, :]
+        depth = int(cfg.max_depth)
+        if depth > 0:
+            inter = res.interactions.numpy()[:, :, 0, :, 0, :]  # (D, rx, tx, P)
+            objs = res.objects.numpy()[:, :, 0, :, 0, :]
+            prims = res.primitives.numpy()[:, :, 0, :, 0, :]
+            verts = res.vertices.numpy().astype(np.float64)[:, :, 0, :, 0, :, :]
+        else:
+            shape = (1,) + tau.shape
+            inter = np.zeros(shape, np.uint32)
+            objs = prims = np.full(shape, 0xFFFFFFFF, np.uint32)
+            verts = np.zeros(shape + (3,))
+        variant = mi.variant()
+    origin = np.asarray(setup.rut.position, float)
+    n_tx, n_rxel = setup.rut.tx_world.shape[0], setup.rut.rx_world.shape[0]
+    n_fe = setup.fe.count
+    board_id = next(i for i, name in built.object_names.items() if name == "rut_board")
+    cols = {k: [] for k in ("front_end", "direction", "rut_tx", "rut_rx", "delay_s", "gain",
+                            "bounces", "interactions")}
+    det_v, det_p, det_o = [], [], []
+    raw = dupes = weak = 0
+
+    def take(ti, ri, direction, fe_i, m, k, need_bounce):
+        nonlocal raw, dupes, weak
+        sel = np.flatnonzero(valid[ri, ti])
+        if sel.size == 0:
+            return
+        it = inter[:, ri, ti, sel].T  # (p, D)
+        nb = (it != 0).sum(axis=1)
+        if need_bounce:  # rut_to_rut: a setup echo must leave the radar
+            ob_all = objs[:, ri, ti, sel].T
+            off_board = np.any((it != 0) & (ob_all != board_id), axis=1)
+            sel, it, nb = sel[off_board], it[off_board], nb[off_board]
+            if sel.size == 0:
+                return
+        raw += sel.size
+        ob = objs[:, ri, ti, sel].T
+        pr = prims[:, ri, ti, sel].T
+        vt = verts[:, ri, ti, sel].transpose(1, 0, 2)
+        vt = np.where((it != 0)[..., None], vt, np.nan)
+        keep = _dedupe(tau[ri, ti, sel], it, np.where(it != 0, ob, 0), vt)
+        dupes += int((~keep).sum())
+        g = a[ri, ti, sel]
+        with np.errstate(divide="ignore"):
+            strong = 20 * np.log10(np.abs(g)) >= cfg.min_gain_db
+        weak += int((keep & ~strong).sum())
+        keep &= strong
+        for j in np.flatnonzero(keep):
+            cols["front_end"].append(fe_i)
+            cols["direction"].append(direction)
+            cols["rut_tx"].append(m)
+            cols["rut_rx"].append(k)
+            cols["delay_s"].append(tau[ri, ti, sel[j]])
+            cols["gain"].append(g[j])
+            cols["bounces"].append(int(nb[j]))
+            names = [_INTERACTION_NAMES.get(int(x), f"type{int(x)}") for x in it[j] if x != 0]
+            cols["interactions"].append("+".join(names) if names else "los")
+            det_v.append(vt[j] + origin)
+            det_p.append(np.where(it[j] != 0, pr[j].astype(np.int64), -1))
+            det_o.append([built.object_names.get(int(o), "?") if x != 0 else ""
+                          for o, x in zip(ob[j], it[j])])
+
+    for q in range(n_fe):
+        for m in range(n_tx):  # RuT Tx m -> FE q Rx
+            take(m, n_rxel + q, TX_TO_FE, q, m, -1, False)
+        for k in range(n_rxel):  # FE q Tx -> RuT Rx k
+            take(n_tx + q, k, FE_TO_RX, q, -1, k, False)
+    for m in range(n_tx):
+        for k in range(n_rxel):  # RuT Tx m -> setup -> RuT Rx k
+            take(m, k, RUT_TO_RUT, -1, m, k, True)
+
+    n = len(cols["delay_s"])
+    d = verts.shape[0]
+    order = np.lexsort((cols["delay_s"], cols["rut_rx"], cols["rut_tx"], cols["front_end"],
+                        cols["direction"])) if n else np.zeros(0, int)
+    paths = Paths.build(**{k: np.asarray(v)[order] if n else np.zeros(0) for k, v in cols.items()},
+                        method="raytrace")
+    vertices = np.asarray(det_v, float).reshape(n, d, 3)[order]
+    primitives = np.asarray(det_p, np.int64).reshape(n, d)[order]
+    objects = np.asarray(det_o, dtype=object).reshape(n, d)[order].astype(str)
+    timings["extract_s"] = time.perf_counter() - t0
+    stats = {"raw_paths": raw, "duplicates_dropped": dupes, "weak_dropped": weak,
+             "rows": n, "samples_per_src": int(cfg.samples_per_src), "max_depth": depth,
+             "frequency_hz": c / setup.rut.wavelength_m,
+             "faces": {k: int(len(v.faces)) for k, v in built.meshes.items()}}
+    return RaytraceResult(paths, vertices, primitives, objects, variant, timings, stats)
+
+
+def raytrace_paths(setup: Setup, config: RaytraceConfig | None = None) -> Paths:
+    """Ray-traced :class:`Paths` of ``setup`` (``method="raytrace"``); ``config`` defaults to the
+    scene's ``[raytrace]`` section. Raises :class:`RaytraceUnavailable` when Sionna RT cannot run
+    here and :class:`SceneError` for an unknown or out-of-band material."""
+    return trace(setup, config).paths
