@@ -177,10 +177,6 @@ def _leg_table(paths: Paths, direction: int, n_fe: int, n_el: int):
     g = np.zeros((n_fe * n_el, p), complex)
     d[key, slot] = delay
     g[key, slot] = gain
-    if np.any(counts == 0):
-        missing = np.flatnonzero(counts == 0)[0]
-        raise ValueError(f"paths table has no {('tx_to_fe', 'fe_to_rx')[direction]} row for "
-                         f"front end {missing // n_el}, element {missing % n_el}")
     return d.reshape(n_fe, n_el, p), g.reshape(n_fe, n_el, p)
 
 
@@ -189,8 +185,9 @@ def channel_echoes(setup: Setup, paths: Paths, program: RtsProgram) -> Echoes:
 
     For channel (target, q) and virtual element v = (Tx m, Rx k) each pair of a path
     RuT Tx m -> FE q Rx and a path FE q Tx -> RuT Rx k is one echo with
-    ``tau_c = tau_a + tau_b`` and amplitude ``g_a g_b G_q`` (G_q: programmed gain times the
-    channel's hardware gain/phase error).
+    ``tau_c = tau_a + tau_b`` and beat amplitude ``conj(g_a g_b G_q)`` (G_q: programmed gain
+    times the channel's hardware gain/phase error; conjugated because the beat signal is
+    tx * conj(rx)). A leg without any path (blocked) contributes nothing.
     """
     scene, rut = setup.scene, setup.rut
     n_fe = setup.fe.count
@@ -215,7 +212,9 @@ def channel_echoes(setup: Setup, paths: Paths, program: RtsProgram) -> Echoes:
     tau_rts = realised_delay(program.delay_s, scene.rts.f_s_hz, scene.rts.fractional_delay,
                              scene.rts.fractional_delay_step_s)
     rep = pa * pb
-    amp = gain * np.repeat(program.amplitude * hw[q], rep)[:, None]
+    # the beat signal is tx * conj(rx) (eq. 8): it carries the conjugate of the received
+    # complex gain (paths, RTS gain, hardware phase)
+    amp = np.conj(gain * np.repeat(program.amplitude * hw[q], rep)[:, None])
     direct = Echoes(
         tau_air_s=frozen(tau_air), tau_if_s=frozen(np.repeat(tau_rts, rep)),
         f_if_hz=frozen(np.full(k * rep, scene.rts.f_rts_hz)),
@@ -277,7 +276,7 @@ def setup_echoes(setup: Setup, paths: Paths) -> Echoes:
     amp = np.zeros((n, rut.num_virtual), complex)
     for vi, d, g in parts:
         tau[: len(d), vi] = d
-        amp[: len(d), vi] = g
+        amp[: len(d), vi] = np.conj(g)  # beat = tx * conj(rx)
     zeros = np.zeros(n)
     return Echoes(frozen(tau), frozen(zeros), frozen(zeros), frozen(zeros), frozen(amp),
                   frozen(np.full(n, -1)), frozen(np.full(n, -1)), frozen(np.full(n, KIND_SETUP)),

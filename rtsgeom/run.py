@@ -14,7 +14,7 @@ from . import __version__
 from .geometry import Setup, build_setup
 from .paths import Paths, exact_paths
 from .radar import AdcCube, Detections, RangeDoppler, add_noise, process, synthesize
-from .rts import Echoes, RtsProgram, build_echoes, program_nearest
+from .rts import KIND_DIRECT, Echoes, RtsProgram, build_echoes, program_nearest
 from .scene import Scene
 
 __all__ = ["RunResult", "simulate", "run_scene", "match_targets", "noise_power"]
@@ -36,10 +36,16 @@ class RunResult:
 
 
 def noise_power(echoes: Echoes, snr_db: float | None) -> float:
-    """Noise power per complex sample for a per-sample SNR of the strongest echo."""
+    """Noise power per complex sample for a per-sample SNR of the strongest target echo.
+
+    The reference is the RTS's direct echoes (not the setup's static reflections, which can be
+    far stronger than any target), so the targets keep their SNR whatever the paths method.
+    """
     if snr_db is None or len(echoes) == 0:
         return 0.0
-    return float(np.max(np.abs(echoes.amplitude)) ** 2 / 10 ** (snr_db / 10))
+    direct = echoes.kind == KIND_DIRECT
+    ref = echoes.amplitude[direct] if np.any(direct) else echoes.amplitude
+    return float(np.max(np.abs(ref)) ** 2 / 10 ** (snr_db / 10))
 
 
 def simulate(setup: Setup, paths: Paths, program: RtsProgram, seed: int | None = None,

@@ -76,6 +76,11 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
     seed = scene.seed
     probe: FrontEndProbe = probe_front_ends(setup, paths, seed)
     warnings = []
+    lost = np.flatnonzero(~np.isfinite(probe.angle_rad))
+    if lost.size:
+        raise SceneError(f"{scene.source}: rts.front_ends[{lost[0]}]: the RuT does not detect "
+                         "this front end alone (blocked line of sight, or an echo far weaker "
+                         "than the noise): cannot synthesize angles with it")
     res = angular_resolution_rad(setup.rut)
     pairs = {}
     for k, t in enumerate(scene.targets):

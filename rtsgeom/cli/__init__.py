@@ -37,12 +37,18 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
+def _raytrace_unavailable() -> type[Exception]:
+    """The ray tracer's 'no suitable LLVM/Sionna' error, without importing Sionna."""
+    from ..paths.raytrace import RaytraceUnavailable
+    return RaytraceUnavailable
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
         return int(args.func(args) or 0)
-    except (SceneError, UsageError) as exc:
+    except (SceneError, UsageError, _raytrace_unavailable()) as exc:
         print(f"rtsgeom: error: {exc}", file=sys.stderr)
         return 2
     except OSError as exc:  # an output path that cannot be written, a missing input file

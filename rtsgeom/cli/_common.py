@@ -8,7 +8,7 @@ import math
 import sys
 from pathlib import Path
 
-__all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checked"]
+__all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checked", "steps"]
 
 
 class UsageError(ValueError):
@@ -49,3 +49,44 @@ def load_scene_checked(path):
     for line in scene_warnings(scene):
         print(f"rtsgeom: warning: {line}", file=sys.stderr)
     return scene
+
+
+class steps:
+    """Progress of a multi-step command on stderr (a spinner per step; silent when quiet).
+
+    ``with steps(quiet) as step: step("calibrating"); ...`` prints each finished step with its
+    duration, so a user sees what takes time.
+    """
+
+    def __init__(self, quiet: bool = False):
+        self.quiet = quiet
+        self._status = None
+        self._label = None
+        self._t0 = 0.0
+
+    def __enter__(self):
+        if not self.quiet:
+            from rich.console import Console
+            self._console = Console(stderr=True)
+        return self
+
+    def __call__(self, label: str) -> None:
+        import time
+        self._finish()
+        if self.quiet:
+            return
+        self._label, self._t0 = label, time.perf_counter()
+        self._status = self._console.status(label + " ...")
+        self._status.start()
+
+    def _finish(self) -> None:
+        import time
+        if self._status is not None:
+            self._status.stop()
+            self._console.print(f"  {self._label}: {time.perf_counter() - self._t0:.1f} s",
+                                style="dim", highlight=False)
+            self._status = None
+
+    def __exit__(self, *exc):
+        self._finish()
+        return False

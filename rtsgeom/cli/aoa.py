@@ -11,8 +11,8 @@ from ..aoa.linearity import linearity
 from ..geometry import build_setup
 from ..io import write_json
 from ..paths import exact_paths
-from ..scene import load_scene
-from ._common import UsageError, number, print_json, scene_arg
+
+from ._common import UsageError, load_scene_checked, number, print_json, scene_arg
 
 
 def _pair(setup, pair):
@@ -24,7 +24,7 @@ def _pair(setup, pair):
 
 
 def cmd_calibrate(args) -> int:
-    scene = load_scene(args.scene)
+    scene = load_scene_checked(args.scene)
     setup = build_setup(scene)
     pair = _pair(setup, args.pair)
     paths = exact_paths(setup)
@@ -48,7 +48,7 @@ def cmd_calibrate(args) -> int:
 
 
 def cmd_linearity(args) -> int:
-    scene = load_scene(args.scene)
+    scene = load_scene_checked(args.scene)
     setup = build_setup(scene)
     pair = _pair(setup, args.pair)
     paths = exact_paths(setup)

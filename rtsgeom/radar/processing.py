@@ -89,16 +89,17 @@ def cfar_mask(power: np.ndarray, cfg: CfarConfig) -> tuple[np.ndarray, np.ndarra
     """2D CFAR on a (range, Doppler) power map: returns (detected mask, noise estimate).
 
     Training cells form a ring around each cell under test (guard cells excluded); the range
-    axis is not cyclic (edge cells use the training cells that exist), the Doppler axis is.
+    axis is cyclic too: with a complex ADC the beat frequencies wrap at f_adc, so the top
+    range bins neighbour the bottom ones.
     CA averages the ring, OS takes its ``os_rank`` quantile.
     """
     gr, gd = cfg.guard_cells
     tr, td = cfg.training_cells
     ring = np.ones((2 * (gr + tr) + 1, 2 * (gd + td) + 1), bool)
     ring[tr:tr + 2 * gr + 1, td:td + 2 * gd + 1] = False
-    pd = gd + td
-    padded = np.pad(power, ((0, 0), (pd, pd)), mode="wrap")  # Doppler is cyclic
-    crop = (slice(None), slice(pd, pd + power.shape[1]))
+    pr, pd = gr + tr, gd + td
+    padded = np.pad(power, ((pr, pr), (pd, pd)), mode="wrap")  # both axes are cyclic
+    crop = (slice(pr, pr + power.shape[0]), slice(pd, pd + power.shape[1]))
     if cfg.kind == "ca":
         k = ring.astype(float)
         total = ndimage.convolve(padded, k, mode="constant")[crop]
@@ -108,8 +109,7 @@ def cfar_mask(power: np.ndarray, cfg: CfarConfig) -> tuple[np.ndarray, np.ndarra
         noise = ndimage.percentile_filter(padded, 100 * cfg.os_rank, footprint=ring,
                                           mode="nearest")[crop]
     thr = noise * 10 ** (cfg.threshold_db / 10)
-    peak = power == ndimage.maximum_filter(np.pad(power, ((0, 0), (1, 1)), mode="wrap"),
-                                           size=3, mode="nearest")[:, 1:-1]
+    peak = power == ndimage.maximum_filter(power, size=3, mode="wrap")
     return (power > thr) & peak, noise
 
 
@@ -187,8 +187,7 @@ def detect(rd: RangeDoppler, cube: AdcCube) -> Detections:
     r_i, d_i = np.nonzero(mask)
     n_r, n_d = rd.power.shape
     logp = np.log(np.maximum(rd.power, 1e-300))
-    dr = _parabolic(logp[np.clip(r_i - 1, 0, n_r - 1), d_i], logp[r_i, d_i],
-                    logp[np.clip(r_i + 1, 0, n_r - 1), d_i])
+    dr = _parabolic(logp[(r_i - 1) % n_r, d_i], logp[r_i, d_i], logp[(r_i + 1) % n_r, d_i])
     dd = _parabolic(logp[r_i, (d_i - 1) % n_d], logp[r_i, d_i], logp[r_i, (d_i + 1) % n_d])
     range_step = rd.range_m[1] - rd.range_m[0]
     nu_step = rd.doppler_hz[1] - rd.doppler_hz[0]
