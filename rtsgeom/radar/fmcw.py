@@ -27,7 +27,8 @@ from ..geometry import RutArray
 from ..rts import Echoes
 from ..scene import RadarConfig
 
-__all__ = ["AdcCube", "fast_time_s", "chirp_start_s", "synthesize", "add_noise"]
+__all__ = ["AdcCube", "fast_time_s", "chirp_start_s", "synthesize", "synthesize_exact",
+           "add_noise"]
 
 
 @dataclass(frozen=True)
@@ -72,6 +73,33 @@ def synthesize(echoes: Echoes, radar: RadarConfig, rut: RutArray) -> AdcCube:
     f = np.exp(2j * np.pi * beat[:, :, None] * t_n[None, None, :]).astype(np.complex64)
     data = np.matmul(a, f)  # (V, L, N)
     return AdcCube(np.ascontiguousarray(data.transpose(1, 0, 2)), radar, rut)
+
+
+def synthesize_exact(echoes: Echoes, radar: RadarConfig, rut: RutArray,
+                     delay_rate=None) -> AdcCube:
+    """Reference synthesis: the full beat phase of every echo at every sample, one echo at a
+    time, optionally with range migration within the frame.
+
+    ``delay_rate`` (E,) in s/s lets each echo's IF delay drift, ``tau_if(t) = tau_if +
+    delay_rate * t`` with ``t`` the time since the frame start (an RTS that updates its delay
+    buffer continuously, 2 v / c0 for a target at v), which breaks the separability that
+    :func:`synthesize` relies on. With ``delay_rate = 0`` both agree to complex64 precision
+    (tested). Cost: one ``exp`` over the whole cube per echo; use it to validate, not to run.
+    """
+    s = radar.slope_hz_per_s
+    t_n = fast_time_s(radar)[None, None, :]  # (1, 1, N)
+    t_c = chirp_start_s(radar, rut)[:, :, None]  # (L, V, 1)
+    rate = np.zeros(len(echoes)) if delay_rate is None else np.asarray(delay_rate, float)
+    out = np.zeros((radar.chirps_per_tx, rut.num_virtual, radar.samples_per_chirp), np.complex64)
+    for e in range(len(echoes)):
+        tau_air = echoes.tau_air_s[e][None, :, None]  # (1, V, 1)
+        tau_if = echoes.tau_if_s[e] + rate[e] * (t_c + t_n)
+        tau = tau_air + tau_if
+        phase = 2 * np.pi * (radar.f_c_hz * tau_air + echoes.f_if_hz[e] * tau_if
+                             + s * tau * t_n - 0.5 * s * tau ** 2
+                             + echoes.doppler_hz[e] * (t_c + t_n))
+        out += (echoes.amplitude[e][None, :, None] * np.exp(1j * phase)).astype(np.complex64)
+    return AdcCube(out, radar, rut)
 
 
 def add_noise(cube: AdcCube, noise_power: float, rng: np.random.Generator) -> AdcCube:
