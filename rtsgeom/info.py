@@ -91,7 +91,7 @@ def format_info(info: dict) -> str:
         f"resolution {rts['delay_resolution_s'] * 1e12:.3g} ps, calibration period "
         f"1/(f_rts + B/2) = {rts['calibration_period_s'] * 1e9:.4f} ns",
         "front ends:",
-        "   #  arc deg  azimuth from RuT  apparent (Rx/Tx split)  distance m  curvature deg p-p",
+        "   #  arc deg  azimuth from RuT  apparent (Rx/Tx split)  distance m  array phase error deg p-p",
     ]
     for fe in info["front_ends"]:
         lines.append(f"  {fe['index']:2d} {fe['arc_angle_deg']:8.3f} {fe['azimuth_from_rut_deg']:17.4f}"

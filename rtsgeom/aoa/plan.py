@@ -47,7 +47,7 @@ def pair_amplitudes(setup: Setup, paths: Paths, pair, target: TargetConfig, mode
     if mode == "exact":
         rho = model.solve(alpha, phase)
     else:
-        th = setup.fe_azimuth_rad()[list(pair)]
+        th = nom.fe_azimuth_rad()[list(pair)]  # the design knows the nominal angles
         if mode == "paper":
             rho = float(ratio_paper(th[0], th[1], alpha))
         else:

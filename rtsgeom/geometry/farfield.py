@@ -3,9 +3,12 @@
 * aperture ``d_A = N_A * d`` of the azimuth virtual array (8 x lambda/2 = 4 lambda),
 * angular resolution ``1.22 lambda / d_A`` (paper eq. 24; 17.5 deg for the AWR1843),
 * Fraunhofer distance ``2 d_A^2 / lambda``,
-* per front end, the phase-front curvature error across the virtual array: the two-way exact
-  path of each azimuth virtual element minus its best linear fit over the element position
-  (what beamforming cannot absorb as a steering angle), peak to peak, in radians.
+* per front end, the phase error across the virtual array: the two-way exact path of each
+  azimuth virtual element minus its best linear fit over the element position (what
+  beamforming cannot absorb as a steering angle), peak to peak, in radians. At R_c = 1 m it is
+  almost all the *broken virtual array* (the front end's Rx/Tx split and the parallax of the
+  RuT's Tx and Rx groups; 22 deg p-p), not phase-front curvature (0.35 deg p-p); see
+  ``analysis.nearfield``.
 """
 
 from __future__ import annotations

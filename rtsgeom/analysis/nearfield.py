@@ -1,0 +1,421 @@
+"""Near-field violation: how far the arc radius R_c is from the far field the paper's signal
+model assumes (section "Disadvantages": "the far-field condition is not met, and the virtual
+array assumption is not fully accurate").
+
+For a sweep of arc radii (front-end angles kept) and per front end:
+
+(a) **Single front-end bias.** The angle the RuT detects one front end alone at, minus its
+    geometric angle (module centre seen from the RuT phase centre), at phasor level with the
+    exact geometry (``radar.phasors.bin_response`` through :class:`~rtsgeom.aoa.synthesis.PairModel`,
+    TDM compensation, ``estimate_angles``). It is split into closed-form parts:
+
+    * ``separation``: the front end's own Rx/Tx split, far-field closed form
+      ``geometry.farfield.apparent_azimuth_rad`` minus geometric (~ 0.52 s / (2 R));
+    * ``near_field`` = detected - that closed form, itself split into
+      ``parallax``: the RuT's Tx group and Rx group sit 9.5 d apart (AWR1843BOOST), so the Tx
+      see the front end's Rx antenna, and the Rx its Tx antenna, from their own centroids, not
+      from the virtual phase centre (the "virtual array assumption" of eq. 13 breaks down);
+      closed form :func:`group_azimuth_rad`, ~ 2.5 d cos^2(theta) / R;
+      ``beat_frequency``: an echo of total delay tau reaches the ADC window at
+      ``f_c + B/2 - S tau`` while the beamformer steers at ``f_c + B/2``, so sin(alpha) reads
+      ``1 - S tau / (f_c + B/2)`` too small (range-angle coupling; depends on the target's range,
+      not on R_c; ~1e-4 deg here);
+      ``curvature``: the rest, phase-front curvature within each group and the beamformer's
+      response to it; it falls about like 1/R^3 (a symmetric phase error does not move the
+      beam peak to first order): 5e-4 deg at 1 m.
+
+    Separation and parallax are both first order in 1/R: the bias falls like 1/R, and the
+    phase-centre far-field closed form explains only about half of it at *any* radius.
+
+(b) **Phase error across the virtual array**: the exact two-way phase minus its best-fit plane
+    wave over the azimuth virtual array (what beamforming cannot absorb as a steering angle),
+    peak to peak and RMS; mostly the non-planar virtual phase of (a) (Rx/Tx separation and
+    parallax, ~ 1/R), with the pure curvature part reported on its own.
+
+(c) **Synthesized angle.** For each adjacent pair, the worst |detected - set| over the pair's
+    span when the amplitude ratio comes from the ``array-factor`` closed form (far field,
+    geometric angles) versus ``exact`` (solved on the modelled RuT output of the nominal setup),
+    phasor level, phase-coherent channels (what the calibration establishes).
+
+The Fraunhofer distance ``2 d_A^2 / lambda`` of the virtual aperture is reported alongside: at
+0.12 m it is far below R_c = 1 m, yet the bias is 0.57 deg, because the bias is a first-order
+(1/R) angle effect of the antenna *offsets* (Rx/Tx split, Tx/Rx groups), not the second-order
+phase-front curvature the Fraunhofer criterion bounds.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.constants import c
+
+from ..aoa.calibration import nominal_model, probe_ranges
+from ..aoa.synthesis import AngleUnreachable, PairModel, ratio_array_factor
+from ..geometry import RutArray, Setup, build_setup
+from ..geometry.farfield import (aperture_m, apparent_azimuth_rad, fraunhofer_distance_m,
+                                 two_way_lengths)
+from ..paths import Paths, exact_paths
+from ..rts import requested_delay
+from ..scene import Scene, TargetConfig
+
+__all__ = ["DEFAULT_DECADES", "DEFAULT_POINTS", "default_radii", "with_arc_radius",
+           "group_azimuth_rad", "beat_frequency_azimuth_rad", "phase_error_deg",
+           "single_front_end_angles_rad", "synthesis_worst_errors_deg", "NearField",
+           "nearfield", "nearfield_figure"]
+
+DEFAULT_DECADES = (-0.5, 1.5)  # default sweep: R_c * 10^-0.5 ... R_c * 10^1.5 (0.32 m to 32 m)
+DEFAULT_POINTS = 13  # 6 per decade, so R_c itself is one of them
+
+
+def default_radii(scene: Scene, points: int = DEFAULT_POINTS) -> np.ndarray:
+    """Log-spaced arc radii around the scene's, the scene's radius included (odd ``points``
+    centred on it in log scale for the default decades)."""
+    return scene.rts.arc_radius_m * np.logspace(*DEFAULT_DECADES, points)
+
+
+def with_arc_radius(scene: Scene, radius_m: float) -> Scene:
+    """The scene with another arc radius (front-end angles, offsets and cables kept)."""
+    return dataclasses.replace(scene, rts=dataclasses.replace(scene.rts,
+                                                              arc_radius_m=float(radius_m)))
+
+
+# ------------------------------------------------------------------------------------------
+# Closed forms of the parts of the bias
+# ------------------------------------------------------------------------------------------
+
+
+def _azimuth_from(rut: RutArray, points: np.ndarray, origin: np.ndarray) -> np.ndarray:
+    """Azimuth (rad) of world ``points`` seen from world ``origin``, in the radar frame."""
+    p = (np.asarray(points) - origin) @ rut.rotation
+    return np.arctan2(p[..., 0], p[..., 1])
+
+
+def _slope_shares(rut: RutArray) -> tuple[float, float]:
+    """Shares of the Tx and of the Rx positions in the beamformer's least-squares slope over the
+    azimuth virtual array: ``sum_v w_v x_tx(v)`` and ``sum_v w_v x_rx(v)`` (they add up to 1)."""
+    m = rut.azimuth_mask
+    xt = rut.tx_local[rut.virtual_tx[m], 0]
+    xr = rut.rx_local[rut.virtual_rx[m], 0]
+    xv = xt + xr
+    w = (xv - xv.mean()) / np.sum((xv - xv.mean()) ** 2)
+    return float(np.sum(w * xt)), float(np.sum(w * xr))
+
+
+def group_azimuth_rad(rut: RutArray, fe_rx: np.ndarray, fe_tx: np.ndarray) -> np.ndarray:
+    """Far-field closed form of the detected azimuth with the RuT's Tx/Rx group parallax.
+
+    Like ``apparent_azimuth_rad`` (the Tx see the front end's Rx antenna at theta_a, the Rx its
+    Tx antenna at theta_b), but each angle is taken from the centroid of the RuT's azimuth Tx
+    (resp. Rx) group instead of the virtual phase centre: each group gets a locally plane wave
+    from its own direction. For the AWR1843BOOST the groups' centroids are -4.75 d and +4.75 d
+    from the phase centre and carry 0.76 and 0.24 of the beamformer slope, which adds
+    ~ 2.5 d cos^2(theta) / R to sin(alpha): as large as the Rx/Tx-separation term at R_c = 1 m
+    and of the same order in 1/R. Shapes (..., F, 3) -> (..., F).
+    """
+    m = rut.azimuth_mask
+    c_tx = rut.tx_world[rut.virtual_tx[m]].mean(axis=0)
+    c_rx = rut.rx_world[rut.virtual_rx[m]].mean(axis=0)
+    share_tx, share_rx = _slope_shares(rut)
+    s = (share_tx * np.sin(_azimuth_from(rut, fe_rx, c_tx))
+         + share_rx * np.sin(_azimuth_from(rut, fe_tx, c_rx)))
+    return np.arcsin(np.clip(s, -1.0, 1.0))
+
+
+def beat_frequency_azimuth_rad(angle_rad, radar, tau_s) -> np.ndarray:
+    """The azimuth the beamformer reads for a plane wave from ``angle_rad`` when the echo's
+    total delay is ``tau_s``: the air-path phase acts at ``f_c + B/2 - S tau`` (the frequency
+    the echo has in the middle of the ADC window, eq. 8), the steering vector at ``f_c + B/2``."""
+    scale = 1.0 - radar.slope_hz_per_s * np.asarray(tau_s) / radar.f_center_hz
+    return np.arcsin(np.clip(np.sin(angle_rad) * scale, -1.0, 1.0))
+
+
+def _residual_deg(rut: RutArray, lengths: np.ndarray) -> np.ndarray:
+    """Phase (deg) of path lengths (F, V_az) minus their best linear fit over x_v."""
+    x = rut.virtual_local[rut.azimuth_mask, 0]
+    fit = np.polynomial.polynomial.polyfit(x, lengths.T, 1)  # (2, F)
+    resid = lengths - np.polynomial.polynomial.polyval(x, fit)
+    return np.degrees(2 * np.pi * resid / rut.wavelength_m)
+
+
+def phase_error_deg(setup: Setup) -> dict[str, np.ndarray]:
+    """Per front end, the exact two-way phase across the azimuth virtual array minus the
+    best-fit plane wave: ``pp`` and ``rms`` (deg). ``curvature_pp``: the same for what is left
+    after each RuT group's locally plane wave to the antenna it sees (pure phase-front
+    curvature, what the Fraunhofer criterion is about)."""
+    rut, fe = setup.rut, setup.fe
+    m = rut.azimuth_mask
+    exact = two_way_lengths(rut, fe.rx, fe.tx)[:, m]  # (F, V_az)
+    total = _residual_deg(rut, exact)
+    # locally plane waves per group: |p - s| ~ |c - s| - (p - c) . u, u = (s - c)/|s - c|
+    tx, rx = rut.tx_world[rut.virtual_tx[m]], rut.rx_world[rut.virtual_rx[m]]
+    planar = np.zeros_like(exact)
+    for pts, src in ((tx, fe.rx), (rx, fe.tx)):
+        centre = pts.mean(axis=0)
+        d = src - centre  # (F, 3)
+        dist = np.linalg.norm(d, axis=-1)
+        planar += dist[:, None] - ((pts - centre) @ (d / dist[:, None]).T).T
+    curv = _residual_deg(rut, exact - planar)
+    return {"pp": np.ptp(total, axis=1), "rms": np.sqrt(np.mean(total ** 2, axis=1)),
+            "curvature_pp": np.ptp(curv, axis=1)}
+
+
+# ------------------------------------------------------------------------------------------
+# Phasor-level detection
+# ------------------------------------------------------------------------------------------
+
+
+def single_front_end_angles_rad(setup: Setup, paths: Paths, range_m: float) -> np.ndarray:
+    """Detected angle (rad) of each front end alone (unit amplitude, zero Doppler) at
+    ``range_m``: phasor level through the exact paths, TDM compensation and the RuT's
+    beamformer (``PairModel`` of the front end with itself, channel I alone)."""
+    target = TargetConfig(float(range_m))
+    return np.array([float(PairModel.build(setup, paths, (q, q), target).angle(0.0))
+                     for q in range(setup.fe.count)])
+
+
+def _echo_delay_s(setup: Setup, range_m: float) -> np.ndarray:
+    """Mean total delay (air + RTS) of each front end's echo over the virtual array."""
+    air = two_way_lengths(setup.rut, setup.fe.rx, setup.fe.tx).mean(axis=1) / c
+    return air + float(requested_delay(setup.scene, range_m))
+
+
+def synthesis_worst_errors_deg(setup: Setup, paths: Paths, pair: tuple[int, int],
+                               range_m: float, single_rad: np.ndarray, points: int = 11
+                               ) -> dict:
+    """Worst |detected - set| (deg) of a pair's synthesized target, ``array-factor`` vs
+    ``exact`` amplitudes, phasor level, phase-coherent channels.
+
+    The set-points span the intersection of the pair's measured span (``single_rad``: each
+    front end alone as detected) and its geometric span, ends excluded (as
+    ``aoa.linearity``). The design (ratio) is made on the nominal setup, the detection on the
+    setup as built; each channel pair is made coherent at the set angle.
+    """
+    i, j = pair
+    target = TargetConfig(float(range_m))
+    nom, nom_paths = nominal_model(setup, paths)
+    design = PairModel.build(nom, nom_paths, pair, target)
+    actual = design if nom is setup else PairModel.build(setup, paths, pair, target)
+    geo = nom.fe_azimuth_rad()[[i, j]]
+    meas = np.sort(single_rad[[i, j]])
+    lo, hi = max(meas[0], np.min(geo)), min(meas[1], np.max(geo))
+    out = {"pair": [i, j], "span_deg": [float(np.degrees(lo)), float(np.degrees(hi))],
+           "points": points}
+    if not hi > lo:
+        out.update({"array_factor_max_abs_error_deg": None, "exact_max_abs_error_deg": None,
+                    "note": "the measured and geometric spans do not overlap"})
+        return out
+    sets = lo + np.arange(1, points + 1) / (points + 1) * (hi - lo)
+    n_az = int(np.count_nonzero(setup.rut.azimuth_mask))
+    err = {"array-factor": [], "exact": []}
+    for a in sets:
+        rho_af = max(float(ratio_array_factor(geo[0], geo[1], a, n_az)), 0.0)
+        try:
+            rho_ex = design.solve(a, design.coherent_phase(a))
+        except AngleUnreachable:
+            rho_ex = np.nan
+        phase = actual.coherent_phase(a)
+        for mode, rho in (("array-factor", rho_af), ("exact", rho_ex)):
+            det = float(actual.angle(rho, phase)) if np.isfinite(rho) else np.nan
+            err[mode].append(np.degrees(det - a))
+    worst = {m: float(np.nanmax(np.abs(e))) if np.any(np.isfinite(e)) else None
+             for m, e in err.items()}
+    out["array_factor_max_abs_error_deg"] = worst["array-factor"]
+    out["exact_max_abs_error_deg"] = worst["exact"]
+    return out
+
+
+# ------------------------------------------------------------------------------------------
+# The sweep
+# ------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class NearField:
+    """Near-field figures of merit over arc radius (arrays (R, F) unless noted, degrees)."""
+
+    scene: Scene
+    radius_m: np.ndarray  # (R,)
+    range_m: np.ndarray  # (R,) target range of the phasor-level detection
+    geometric_deg: np.ndarray
+    detected_deg: np.ndarray
+    separation_deg: np.ndarray  # apparent_azimuth_rad - geometric
+    parallax_deg: np.ndarray  # group_azimuth_rad - apparent_azimuth_rad
+    beat_frequency_deg: np.ndarray  # range-dependent carrier of the echo
+    phase_pp_deg: np.ndarray
+    phase_rms_deg: np.ndarray
+    curvature_pp_deg: np.ndarray
+    synthesis: list  # per radius: list of per-pair dicts
+    fraunhofer_m: float
+    aperture_m: float
+    wavelength_m: float
+
+    @property
+    def bias_deg(self) -> np.ndarray:
+        return self.detected_deg - self.geometric_deg
+
+    @property
+    def near_field_deg(self) -> np.ndarray:
+        """Detected minus the far-field closed form (everything but the Rx/Tx separation)."""
+        return self.bias_deg - self.separation_deg
+
+    @property
+    def curvature_deg(self) -> np.ndarray:
+        """What the closed forms leave: phase-front curvature (and beamformer nonlinearity)."""
+        return self.near_field_deg - self.parallax_deg - self.beat_frequency_deg
+
+    def scene_index(self) -> int | None:
+        """Index of the scene's own radius in the sweep, if it is one of the radii."""
+        k = np.flatnonzero(np.isclose(self.radius_m, self.scene.rts.arc_radius_m, rtol=1e-9))
+        return int(k[0]) if k.size else None
+
+    def bias_times_radius_deg_m(self) -> np.ndarray:
+        """(F,) the 1/R coefficient of the bias: (separation + parallax) x R at the largest
+        radius (the closed forms; the detected bias x R agrees to ~1 % over the sweep)."""
+        return (self.separation_deg[-1] + self.parallax_deg[-1]) * self.radius_m[-1]
+
+    def to_dict(self) -> dict:
+        fl = lambda a: [float(x) for x in a]  # noqa: E731
+        k = self.scene_index()
+        coef = self.bias_times_radius_deg_m()
+        return {
+            "scene": self.scene.name,
+            "scene_arc_radius_m": self.scene.rts.arc_radius_m,
+            "wavelength_m": self.wavelength_m,
+            "aperture_m": self.aperture_m,
+            "fraunhofer_distance_m": self.fraunhofer_m,
+            "fraunhofer_note": "2 d_A^2 / lambda of the azimuth virtual aperture; it bounds the "
+                               "phase-front curvature, not the first-order (1/R) bias from the "
+                               "Rx/Tx separation and the RuT's Tx/Rx group parallax",
+            "bias_1_over_r_coefficient_deg_m": fl(coef),
+            "radius_for_bias_below_deg": {
+                str(lim): fl(np.abs(coef) / lim) for lim in (0.1, 0.01)},
+            "at_scene_radius": None if k is None else self._row(k),
+            "radii": [self._row(i) for i in range(self.radius_m.size)],
+        }
+
+    def _row(self, i: int) -> dict:
+        fes = []
+        for q in range(self.geometric_deg.shape[1]):
+            fes.append({
+                "index": q,
+                "geometric_deg": float(self.geometric_deg[i, q]),
+                "detected_deg": float(self.detected_deg[i, q]),
+                "bias_deg": float(self.bias_deg[i, q]),
+                "separation_part_deg": float(self.separation_deg[i, q]),
+                "near_field_part_deg": float(self.near_field_deg[i, q]),
+                "parallax_part_deg": float(self.parallax_deg[i, q]),
+                "beat_frequency_part_deg": float(self.beat_frequency_deg[i, q]),
+                "curvature_part_deg": float(self.curvature_deg[i, q]),
+                "phase_error_pp_deg": float(self.phase_pp_deg[i, q]),
+                "phase_error_rms_deg": float(self.phase_rms_deg[i, q]),
+                "curvature_phase_error_pp_deg": float(self.curvature_pp_deg[i, q]),
+            })
+        return {"radius_m": float(self.radius_m[i]), "target_range_m": float(self.range_m[i]),
+                "front_ends": fes, "synthesis": self.synthesis[i]}
+
+
+def _check_radii(scene: Scene, radii: np.ndarray) -> None:
+    r = np.asarray(radii, float)
+    limit = 0.8 * scene.radar.max_range_m - 2.0
+    if r.ndim != 1 or r.size == 0 or not np.all(np.isfinite(r)) or np.any(r < 0.05) \
+            or np.any(r > limit):
+        raise ValueError(f"arc radii must lie in [0.05, {limit:.4g}] m (the target must stay "
+                         f"within the radar's range), got {r}")
+
+
+def nearfield(scene: Scene, radii=None, points: int = 11) -> NearField:
+    """Run the near-field analysis over ``radii`` (default :func:`default_radii`).
+
+    ``points``: synthesized set-points per pair for (c).
+    """
+    radii = default_radii(scene) if radii is None else np.asarray(radii, float)
+    _check_radii(scene, radii)
+    cols = {k: [] for k in ("rng", "geo", "det", "sep", "par", "beat", "pp", "rms", "curv")}
+    synth = []
+    rut = None
+    for r in radii:
+        setup = build_setup(with_arc_radius(scene, r))
+        paths = exact_paths(setup)
+        rut, fe, radar = setup.rut, setup.fe, scene.radar
+        rng = float(probe_ranges(setup, 1)[0])
+        det = single_front_end_angles_rad(setup, paths, rng)
+        geo = setup.fe_azimuth_rad()
+        app = apparent_azimuth_rad(rut, fe.rx, fe.tx)
+        grp = group_azimuth_rad(rut, fe.rx, fe.tx)
+        beat = beat_frequency_azimuth_rad(grp, radar, _echo_delay_s(setup, rng))
+        ph = phase_error_deg(setup)
+        for key, val in (("rng", rng), ("geo", geo), ("det", det), ("sep", app - geo),
+                         ("par", grp - app), ("beat", beat - grp), ("pp", ph["pp"]),
+                         ("rms", ph["rms"]), ("curv", ph["curvature_pp"])):
+            cols[key].append(val)
+        synth.append([synthesis_worst_errors_deg(setup, paths, (k, k + 1), rng, det, points)
+                      for k in range(fe.count - 1)])
+    deg = {k: np.degrees(np.array(cols[k])) for k in ("geo", "det", "sep", "par", "beat")}
+    return NearField(
+        scene=scene, radius_m=radii, range_m=np.array(cols["rng"]),
+        geometric_deg=deg["geo"], detected_deg=deg["det"], separation_deg=deg["sep"],
+        parallax_deg=deg["par"], beat_frequency_deg=deg["beat"],
+        phase_pp_deg=np.array(cols["pp"]), phase_rms_deg=np.array(cols["rms"]),
+        curvature_pp_deg=np.array(cols["curv"]), synthesis=synth,
+        fraunhofer_m=fraunhofer_distance_m(rut), aperture_m=aperture_m(rut),
+        wavelength_m=rut.wavelength_m)
+
+
+# ------------------------------------------------------------------------------------------
+# Figure
+# ------------------------------------------------------------------------------------------
+
+
+def nearfield_figure(nf: NearField, title: str = ""):
+    """Three panels over arc radius (log x): the bias of each front end alone (log y when all
+    positive) with the far-field closed form (Rx/Tx separation only) and the closed form with
+    the RuT's Tx/Rx group parallax; the worst synthesized-angle error per pair (array-factor;
+    exact in the legend); the phase error across the virtual array (p-p, RMS, curvature only).
+    The scene's radius and the Fraunhofer distance are marked."""
+    import matplotlib as mpl
+    from ..viz.figures import STYLE, _new_figure
+    r = nf.radius_m
+    with mpl.rc_context(STYLE):
+        fig, (ax, ax2, ax3) = _new_figure(figsize=(6.4, 7.2), nrows=3, sharex=True)
+        for q in range(nf.geometric_deg.shape[1]):
+            col = f"C{q % 10}"
+            lab = f"FE {q} ({nf.geometric_deg[0, q]:.1f} deg)"
+            ax.plot(r, nf.bias_deg[:, q], "o", color=col, label=f"{lab}: detected - geometric")
+            ax.plot(r, nf.separation_deg[:, q], "-", color=col,
+                    label=f"{lab}: far-field closed form (Rx/Tx separation)")
+            ax.plot(r, (nf.separation_deg + nf.parallax_deg)[:, q], "--", color=col,
+                    label=f"{lab}: + RuT Tx/Rx group parallax")
+            ax3.plot(r, nf.phase_pp_deg[:, q], "-", color=col, label=f"{lab}: p-p")
+            ax3.plot(r, nf.phase_rms_deg[:, q], "--", color=col, label=f"{lab}: RMS")
+            ax3.plot(r, nf.curvature_pp_deg[:, q], ":", color=col,
+                     label=f"{lab}: curvature only, p-p")
+        for k in range(len(nf.synthesis[0]) if nf.synthesis else 0):
+            pick = lambda key: np.array([np.nan if row[k][key] is None else row[k][key]  # noqa: E731
+                                         for row in nf.synthesis])
+            af, ex = pick("array_factor_max_abs_error_deg"), pick("exact_max_abs_error_deg")
+            ex_max = np.nanmax(ex) if np.any(np.isfinite(ex)) else np.nan
+            ax2.plot(r, af, "s-", color=f"C{k % 10}", label=f"pair {k}-{k + 1}: array-factor "
+                     f"(exact: <= {ex_max:.1g} deg)")
+        for a in (ax, ax2, ax3):
+            a.set_xscale("log")
+            a.axvline(nf.scene.rts.arc_radius_m, color="C3", linewidth=0.9, linestyle="-.")
+            a.axvline(nf.fraunhofer_m, color="0.4", linewidth=0.9, linestyle="-.")
+        if np.all(nf.bias_deg > 0) and np.all(nf.separation_deg > 0):
+            ax.set_yscale("log")
+        ax2.set_yscale("log")
+        ax3.set_yscale("log")
+        ax.text(nf.scene.rts.arc_radius_m, 0.97, " scene R_c", color="C3", fontsize=7,
+                transform=ax.get_xaxis_transform(), va="top")
+        ax.text(nf.fraunhofer_m, 0.97, r" $2 d_A^2/\lambda$", color="0.3", fontsize=7,
+                transform=ax.get_xaxis_transform(), va="top")
+        ax.set_ylabel("single-FE bias (deg)")
+        ax.set_title(title or f"{nf.scene.name}: near-field bias vs arc radius")
+        ax2.set_ylabel("synthesized |error| (deg)")
+        ax3.set_ylabel("phase error (deg)")
+        ax3.set_xlabel("arc radius R_c (m)")
+        for a in (ax, ax2, ax3):
+            if a.get_legend_handles_labels()[0]:
+                a.legend(loc="lower left", fontsize=6, ncols=2 if a is ax3 else 1)
+    return fig

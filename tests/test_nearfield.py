@@ -1,0 +1,153 @@
+"""Near-field violation (issue 7, item 2): single front-end bias, phase error, synthesized angle
+over arc radius, against closed forms."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from rtsgeom.analysis.nearfield import default_radii, nearfield, phase_error_deg, with_arc_radius
+from rtsgeom.cli import main
+from rtsgeom.geometry import build_setup
+from rtsgeom.geometry.farfield import curvature_phase_error_rad, fraunhofer_distance_m
+
+from conftest import DEFAULT_SCENE, make_scene
+
+RADII = np.array([0.5, 1.0, 3.0, 10.0, 30.0])
+SCENE_K = 1  # index of R_c = 1 m in RADII
+
+
+def no_separation(doc):
+    for fe in doc["rts"]["front_ends"]:
+        fe["rx_tx_separation_m"] = 0.0
+
+
+@pytest.fixture(scope="module")
+def sweep():
+    return nearfield(make_scene(), RADII, points=5)
+
+
+@pytest.fixture(scope="module")
+def sweep_no_sep():
+    return nearfield(make_scene(no_separation), RADII, points=5)
+
+
+def geometric_part(nf):
+    """The bias without the (range-dependent, R_c-independent) beat-frequency term."""
+    return nf.bias_deg - nf.beat_frequency_deg
+
+
+def test_default_sweep_and_fraunhofer_distance():
+    scene = make_scene()
+    r = default_radii(scene)
+    assert r.size == 13 and r[0] == pytest.approx(0.316, abs=1e-3) and r[-1] == pytest.approx(31.6, abs=0.1)
+    assert np.any(np.isclose(r, scene.rts.arc_radius_m))
+    rut = build_setup(scene).rut
+    # 8 elements at lambda/2: d_A = 4 lambda, 2 d_A^2 / lambda = 32 lambda = 0.124 m << R_c
+    assert fraunhofer_distance_m(rut) == pytest.approx(32 * rut.wavelength_m)
+    scaled = build_setup(with_arc_radius(scene, 3.0))
+    assert np.linalg.norm(scaled.fe.module[0] - scaled.rut.position) == pytest.approx(3.0)
+    assert np.allclose(scaled.fe_azimuth_rad(), build_setup(scene).fe_azimuth_rad())
+
+
+def test_bias_shrinks_like_one_over_r(sweep):
+    b = sweep.bias_deg
+    assert np.all(b > 0) and np.all(np.diff(b, axis=0) < 0)
+    # at the paper's 1 m: ~0.57 deg, of which 0.30 deg from the 20 mm Rx/Tx separation
+    assert b[SCENE_K] == pytest.approx([0.574, 0.565], abs=0.005)
+    assert sweep.separation_deg[SCENE_K] == pytest.approx([0.300, 0.300], abs=0.002)
+    # 1/R law: bias x R constant to 2 % from 0.5 m to 30 m (0.3 % from 3 m on)
+    k = geometric_part(sweep) * RADII[:, None]
+    assert np.max(np.abs(k / k[-1] - 1)) < 0.02
+    assert np.max(np.abs(k[2:] / k[-1] - 1)) < 0.003
+
+
+def test_separation_closed_form_is_s_over_r(sweep):
+    # far-field closed form from the phase centre: the Tx carry 0.76 and the Rx 0.24 of the
+    # beamformer slope, so alpha - theta = (0.76 - 0.24) (s / 2) / R  (0.300 deg at s = 20 mm)
+    sep = sweep.separation_deg * RADII[:, None]
+    assert np.allclose(sep, np.degrees((4 / 5.25 - 1.25 / 5.25) * 0.01), rtol=0.005)
+
+
+def test_detected_approaches_closed_forms_faster_than_the_bias(sweep):
+    """Quantitatively: the phase-centre closed form (Rx/Tx separation only) leaves about half
+    of the bias at *every* radius -- the RuT's own Tx/Rx group parallax is also a 1/R term --
+    while separation + group parallax (+ the beat-frequency term) leave a residual that falls
+    faster than the bias: below 1e-3 of it at 1 m and shrinking about like 1/R^2 relative."""
+    left = sweep.near_field_deg / sweep.bias_deg  # detected - phase-centre closed form
+    assert np.all((left > 0.44) & (left < 0.50))
+    assert np.max(np.abs(left - left[-1])) < 0.03  # does NOT go to zero
+    rel = np.abs(sweep.curvature_deg / sweep.bias_deg)
+    assert np.all(rel[SCENE_K] < 2e-3) and np.all(rel[SCENE_K + 1] < 3e-4)  # 1 m, 3 m
+    assert np.all(rel[1] < rel[0] / 3) and np.all(rel[2] < rel[1] / 5)  # 0.5 -> 1 -> 3 m
+    assert np.all(np.abs(sweep.curvature_deg[SCENE_K:]) < 1e-3)
+
+
+def test_zero_separation_bias_falls_like_one_over_r(sweep_no_sep):
+    nf = sweep_no_sep
+    assert np.allclose(nf.separation_deg, 0.0, atol=1e-9)
+    b = geometric_part(nf)
+    k = b * RADII[:, None]
+    assert np.max(np.abs(k / k[-1] - 1)) < 0.02
+    assert np.max(np.abs(k[2:] / k[-1] - 1)) < 0.003
+    # the RuT's Tx/Rx group parallax alone: 2.5 d cos^2(theta) / R ~ 0.27 deg at 1 m
+    assert b[SCENE_K] == pytest.approx([0.275, 0.268], abs=0.003)
+    assert np.all(np.abs(nf.bias_deg[-1]) < 0.01)
+
+
+def test_phase_error_falls_like_one_over_r(sweep):
+    pp = sweep.phase_pp_deg
+    assert np.all(np.diff(pp, axis=0) < 0)
+    k = pp * RADII[:, None]
+    assert np.max(np.abs(k / k[-1] - 1)) < 0.005
+    assert np.all(sweep.phase_rms_deg < pp / 2)
+    # the same residual as `rtsgeom info` reports at R_c
+    setup = build_setup(make_scene())
+    assert pp[SCENE_K] == pytest.approx(np.degrees(curvature_phase_error_rad(setup)), rel=1e-9)
+    # it is the broken virtual array (Rx/Tx split, Tx/Rx groups), not phase-front curvature:
+    # 22 deg p-p at 1 m, of which the pure curvature is ~0.35 deg (also ~1/R)
+    assert pp[SCENE_K] == pytest.approx([22.3, 21.6], abs=0.2)
+    assert np.all(sweep.curvature_pp_deg[SCENE_K] < 0.5)
+    c = sweep.curvature_pp_deg * RADII[:, None]
+    assert np.max(np.abs(c / c[-1] - 1)) < 0.03
+
+
+def test_phase_error_vanishes_without_separation_and_groups():
+    # zero separation: the residual is the group parallax, still ~1/R and non-zero
+    s = build_setup(make_scene(no_separation))
+    pe = phase_error_deg(s)
+    assert np.all(pe["pp"] > 5) and np.all(pe["curvature_pp"] < 0.5)
+
+
+def test_synthesized_error_array_factor_vs_exact(sweep):
+    af = np.array([row[0]["array_factor_max_abs_error_deg"] for row in sweep.synthesis])
+    ex = np.array([row[0]["exact_max_abs_error_deg"] for row in sweep.synthesis])
+    assert af[SCENE_K] == pytest.approx(0.65, abs=0.05)  # README: 0.67 deg through the chain
+    assert np.all(np.diff(af) < 0)
+    k = af * RADII
+    assert np.max(np.abs(k / k[-1] - 1)) < 0.05  # ~1/R, like the bias it cannot see
+    assert np.all(ex < 1e-6)  # exact model = the RuT's phasor model here (no mounting errors)
+    lo, hi = sweep.synthesis[SCENE_K][0]["span_deg"]
+    # the span starts at the detected angle of FE 0, ends at the geometric angle of FE 1
+    assert lo == pytest.approx(sweep.detected_deg[SCENE_K, 0]) and hi == pytest.approx(12.2)
+
+
+def test_nearfield_cli(tmp_path):
+    out = tmp_path / "nf"
+    assert main(["nearfield", str(DEFAULT_SCENE), "--radius-m", "0.5:2:3", "--points", "3",
+                 "--out", str(out)]) == 0
+    d = json.loads((out / "nearfield.json").read_text())
+    assert [r["radius_m"] for r in d["radii"]] == pytest.approx([0.5, 1.0, 2.0])
+    assert d["at_scene_radius"]["radius_m"] == 1.0
+    fe = d["at_scene_radius"]["front_ends"][0]
+    parts = (fe["separation_part_deg"] + fe["parallax_part_deg"] + fe["beat_frequency_part_deg"]
+             + fe["curvature_part_deg"])
+    assert parts == pytest.approx(fe["bias_deg"], abs=1e-12)
+    assert d["fraunhofer_distance_m"] == pytest.approx(0.1238, abs=1e-3)
+    assert (out / "nearfield.png").stat().st_size > 0
+    with pytest.raises(SystemExit) as exc:
+        main(["nearfield", str(DEFAULT_SCENE), "--radius-m", "2:1:3"])
+    assert exc.value.code == 2
+    assert main(["nearfield", str(DEFAULT_SCENE), "--radius-m", "1:500:3"]) == 2
