@@ -23,12 +23,17 @@ def _pair(setup, pair):
     return (i, j)
 
 
-def cmd_calibrate(args) -> int:
+def _prepare(args):
+    """Scene, setup, pair, exact paths and each front end alone as the RuT detects it."""
     scene = load_scene_checked(args.scene)
     setup = build_setup(scene)
     pair = _pair(setup, args.pair)
     paths = exact_paths(setup)
-    probe = probe_front_ends(setup, paths, scene.seed)
+    return scene, setup, pair, paths, probe_front_ends(setup, paths, scene.seed)
+
+
+def cmd_calibrate(args) -> int:
+    scene, setup, pair, paths, probe = _prepare(args)
     cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
     out = cal.to_dict()
     out["front_end_angles_deg"] = [float(x) for x in np.degrees(probe.angle_rad)]
@@ -48,11 +53,7 @@ def cmd_calibrate(args) -> int:
 
 
 def cmd_linearity(args) -> int:
-    scene = load_scene_checked(args.scene)
-    setup = build_setup(scene)
-    pair = _pair(setup, args.pair)
-    paths = exact_paths(setup)
-    probe = probe_front_ends(setup, paths, scene.seed)
+    scene, setup, pair, paths, probe = _prepare(args)
     cal = None if args.uncalibrated else calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
     lin = linearity(setup, paths, pair, args.amplitudes, probe, cal, args.points, scene.seed)
     out = lin.to_dict()
