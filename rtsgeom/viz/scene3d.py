@@ -520,6 +520,23 @@ def _html_requirements() -> dict[str, str]:
     return {"trame": "trame", "trame_vtk": "trame-vtk", "nest_asyncio": "nest-asyncio"}
 
 
+class _OfflineWasmNoise:
+    """logging filter: drop asyncio's 'Task exception was never retrieved' for network errors
+    of trame-vtklocal's background WASM download, which the vtk.js export does not use and
+    which fails on offline machines."""
+
+    def filter(self, record) -> bool:
+        exc = record.exc_info[1] if record.exc_info else None
+        return not (exc is not None and type(exc).__module__.split(".")[0] == "aiohttp")
+
+
+def _quiet_offline_wasm_download() -> None:
+    import logging
+    log = logging.getLogger("asyncio")
+    if not any(isinstance(f, _OfflineWasmNoise) for f in log.filters):
+        log.addFilter(_OfflineWasmNoise())
+
+
 def export_setup_html(setup: Setup, path: str | Path, paths=None) -> Path:
     """Write an interactive, self-contained (vtk.js) HTML view of the setup; return its path.
 
@@ -535,6 +552,7 @@ def export_setup_html(setup: Setup, path: str | Path, paths=None) -> Path:
                        f"(missing: {', '.join(missing)}); install them with "
                        f"`pip install {' '.join(missing)}`")
     path = Path(path)
+    _quiet_offline_wasm_download()
     pl = build_plotter(setup, paths, off_screen=True, side_panels=False)
     try:
         component = getattr(pl, "trame", None)
