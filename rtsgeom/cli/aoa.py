@@ -12,7 +12,7 @@ from ..geometry import build_setup
 from ..io import write_json
 from ..paths import exact_paths
 
-from ._common import UsageError, load_scene_checked, number, print_json, scene_arg
+from ._common import UsageError, load_scene_checked, number, print_json, scene_arg, steps
 
 
 def _pair(setup, pair):
@@ -33,8 +33,11 @@ def _prepare(args):
 
 
 def cmd_calibrate(args) -> int:
-    scene, setup, pair, paths, probe = _prepare(args)
-    cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
+    with steps(args.quiet or args.json) as step:
+        step("measuring each front end alone")
+        scene, setup, pair, paths, probe = _prepare(args)
+        step(f"sweeping the delay of front end {pair[1]} on the simulated radar")
+        cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
     out = cal.to_dict()
     out["front_end_angles_deg"] = [float(x) for x in np.degrees(probe.angle_rad)]
     if args.out:
@@ -53,9 +56,15 @@ def cmd_calibrate(args) -> int:
 
 
 def cmd_linearity(args) -> int:
-    scene, setup, pair, paths, probe = _prepare(args)
-    cal = None if args.uncalibrated else calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
-    lin = linearity(setup, paths, pair, args.amplitudes, probe, cal, args.points, scene.seed)
+    with steps(args.quiet or args.json) as step:
+        step("measuring each front end alone")
+        scene, setup, pair, paths, probe = _prepare(args)
+        cal = None
+        if not args.uncalibrated:
+            step("calibrating the pair")
+            cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
+        step(f"sweeping {args.points} set-points ({args.amplitudes} amplitudes)")
+        lin = linearity(setup, paths, pair, args.amplitudes, probe, cal, args.points, scene.seed)
     out = lin.to_dict()
     if args.out:
         from ..viz.figures import linearity_figure, save_figure
@@ -81,6 +90,7 @@ def register(sub) -> None:
                        metavar=("I", "J"), default=[0, 1], help="adjacent front ends (default 0 1)")
         p.add_argument("--json", action="store_true", help="print the result as JSON")
         p.add_argument("--out", type=Path, default=None, help="folder for the plot and JSON")
+        p.add_argument("--quiet", action="store_true", help="no progress output")
         if name == "linearity":
             p.add_argument("--amplitudes", choices=("exact", "array-factor", "paper"),
                            default="exact", help="amplitude-ratio mode (default exact)")
