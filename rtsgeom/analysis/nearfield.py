@@ -51,7 +51,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.constants import c
 
-from ..aoa.calibration import nominal_model, probe_ranges
+from ..aoa.calibration import nominal_model, probe_angles, probe_ranges
 from ..aoa.synthesis import AngleUnreachable, PairModel, ratio_array_factor
 from ..geometry import RutArray, Setup, build_setup
 from ..geometry.farfield import (aperture_m, apparent_azimuth_rad, fraunhofer_distance_m,
@@ -209,13 +209,14 @@ def synthesis_worst_errors_deg(setup: Setup, paths: Paths, pair: tuple[int, int]
     sets = lo + np.arange(1, points + 1) / (points + 1) * (hi - lo)
     n_az = int(np.count_nonzero(setup.rut.azimuth_mask))
     err = {"array-factor": [], "exact": []}
+    probes = probe_angles(*single_rad[[i, j]])
+    design_phase, phase = design.coherent_phase(probes), actual.coherent_phase(probes)
     for a in sets:
         rho_af = max(float(ratio_array_factor(geo[0], geo[1], a, n_az)), 0.0)
         try:
-            rho_ex = design.solve(a, design.coherent_phase(a))
+            rho_ex = design.solve(a, design_phase)
         except AngleUnreachable:
             rho_ex = np.nan
-        phase = actual.coherent_phase(a)
         for mode, rho in (("array-factor", rho_af), ("exact", rho_ex)):
             det = float(actual.angle(rho, phase)) if np.isfinite(rho) else np.nan
             err[mode].append(np.degrees(det - a))

@@ -72,6 +72,11 @@ class Calibration:
         }
 
 
+def probe_angles(theta_i: float, theta_j: float) -> tuple[float, float]:
+    """Calibration probes at a quarter and three quarters of the span between two front ends."""
+    return theta_i + 0.25 * (theta_j - theta_i), theta_i + 0.75 * (theta_j - theta_i)
+
+
 def probe_ranges(setup: Setup, n: int) -> np.ndarray:
     """Ranges for n simultaneous probe targets: distinct, away from the setup and ghosts."""
     radar = setup.scene.radar
@@ -143,8 +148,7 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
     rts, radar = scene.rts, scene.radar
     i, j = pair
     probe = probe or probe_front_ends(setup, paths, seed)
-    th_i, th_j = probe.angle_rad[i], probe.angle_rad[j]
-    alphas = (th_i + 0.25 * (th_j - th_i), th_i + 0.75 * (th_j - th_i))
+    alphas = probe_angles(probe.angle_rad[i], probe.angle_rad[j])
     ranges = probe_ranges(setup, 2)
     targets = [TargetConfig(float(r)) for r in ranges]
     nom, nom_paths = nominal_model(setup, paths)
@@ -161,7 +165,7 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
             for t, a in zip(targets, alphas):
                 m = PairModel.build(nom, nom_paths, pair, t,
                                     (base_offsets[0], base_offsets[1] + k * grid_s))
-                a_i, a_j, _ = m.design(a)
+                a_i, a_j, _ = m.design(a, alphas)
                 out.append((a_i * corr[0], a_j * corr[1]))
             nodes[k] = out
         return np.asarray(nodes[k])

@@ -11,7 +11,8 @@ from ..geometry import Setup
 from ..paths import Paths
 from ..rts import RtsProgram, requested_delay
 from ..scene import TargetConfig
-from .calibration import Calibration, FrontEndProbe, _nearest, _simulate_detect, probe_ranges
+from .calibration import (Calibration, FrontEndProbe, _nearest, _simulate_detect, probe_angles,
+                          probe_ranges)
 from .plan import pair_amplitudes
 
 __all__ = ["Linearity", "linearity"]
@@ -68,7 +69,8 @@ def linearity(setup: Setup, paths: Paths, pair: tuple[int, int], mode: str,
     amp = np.zeros((2, points))
     for k, a in enumerate(sets):
         t = TargetConfig(rng, 0.0, 10.0, float(a))
-        a_i, a_j, _ = pair_amplitudes(setup, paths, pair, t, mode, off, corr)
+        a_i, a_j, _ = pair_amplitudes(setup, paths, pair, t, mode,
+                                      probe_angles(*probe.angle_rad[[i, j]]), off, corr)
         amp[:, k] = a_i, a_j
         prog = RtsProgram.build([0, 0], [i, j], [tau + off[0], tau + off[1]], [0.0, 0.0],
                                 [a_i, a_j])

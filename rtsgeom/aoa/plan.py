@@ -14,7 +14,8 @@ from ..paths import Paths
 from ..rts import RtsProgram, requested_delay
 from ..scene import SceneError, TargetConfig
 from scipy.constants import c
-from .calibration import Calibration, FrontEndProbe, calibrate_pair, probe_front_ends
+from .calibration import (Calibration, FrontEndProbe, calibrate_pair, probe_angles,
+                          probe_front_ends)
 from .synthesis import PairModel, ratio_array_factor, ratio_paper
 
 __all__ = ["bracketing_pair", "pair_amplitudes", "plan_targets", "channel_offsets"]
@@ -31,7 +32,8 @@ def bracketing_pair(angle_rad: float, fe_angles_rad: np.ndarray) -> tuple[int, i
 
 
 def pair_amplitudes(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str,
-                    offsets=(0.0, 0.0), gain_correction=(1.0, 1.0)) -> tuple[float, float, float]:
+                    probes_rad, offsets=(0.0, 0.0), gain_correction=(1.0, 1.0)
+                    ) -> tuple[float, float, float]:
     """Programmed amplitudes (A_I, A_J) and the ratio for a target synthesized by ``pair``.
 
     ``exact`` solves the ratio on the modelled RuT output of the nominal setup with the
@@ -43,7 +45,7 @@ def pair_amplitudes(setup: Setup, paths: Paths, pair, target: TargetConfig, mode
     nom, nom_paths = nominal_model(setup, paths)
     model = PairModel.build(nom, nom_paths, pair, target, offsets)
     alpha = target.angle_rad
-    phase = model.coherent_phase(alpha)
+    phase = model.coherent_phase(probes_rad)  # the phase the calibration establishes
     if mode == "exact":
         rho = model.solve(alpha, phase)
     else:
@@ -108,8 +110,9 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
     rows = []
     for k, t in enumerate(scene.targets):
         i, j = pairs[k]
-        a_i, a_j, _ = pair_amplitudes(setup, paths, (i, j), t, mode, (offsets[i], offsets[j]),
-                                      probe.gain_correction[[i, j]])
+        probes = probe_angles(probe.angle_rad[i], probe.angle_rad[j])
+        a_i, a_j, _ = pair_amplitudes(setup, paths, (i, j), t, mode, probes,
+                                      (offsets[i], offsets[j]), probe.gain_correction[[i, j]])
         tau = float(requested_delay(scene, t.range_m))
         f_d = 2 * scene.radar.f_c_hz * t.velocity_mps / c
         rows += [(k, i, tau + offsets[i], f_d, a_i), (k, j, tau + offsets[j], f_d, a_j)]

@@ -127,16 +127,18 @@ class PairModel:
         return estimate_angles(self.snapshot(rho, phase), self.setup.rut, self.setup.scene.radar)
 
     def coherent_phase(self, alpha) -> float:
-        """Phase to give channel J so both channels' beamformer outputs add in phase at alpha
-        (what a perfect phase calibration achieves in this model)."""
+        """Phase to give channel J so both channels' beamformer outputs add in phase at the
+        angle(s) ``alpha`` (the circular mean over several): what the phase calibration
+        establishes when its probes sit at those angles."""
         radar, rut = self.setup.scene.radar, self.setup.rut
         k = 1  # the set range's bin
         snaps = tdm_compensate(self.responses[k], self.doppler_hz, rut, radar)
         x = snaps[:, rut.azimuth_mask]
-        steer = np.exp(1j * 2 * np.pi / rut.wavelength_m * np.sin(alpha)
-                       * rut.virtual_local[rut.azimuth_mask, 0])
-        b = x @ steer
-        return float(np.angle(b[0]) - np.angle(b[1]))
+        steer = np.exp(1j * 2 * np.pi / rut.wavelength_m * np.outer(
+            rut.virtual_local[rut.azimuth_mask, 0], np.sin(np.atleast_1d(alpha))))
+        b = x @ steer  # (2, A)
+        z = b[0] * np.conj(b[1])
+        return float(np.angle(np.sum(z / np.maximum(np.abs(z), 1e-300))))
 
     def solve(self, alpha: float, phase: float = 0.0, log_span: float = 12.0) -> float:
         """The ratio rho = A_J / A_I that puts the detected angle at ``alpha`` (rad)."""
@@ -148,10 +150,14 @@ class PairModel:
         f = lambda x: float(self.angle(np.exp(x), phase)) - alpha  # noqa: E731
         return float(np.exp(brentq(f, -log_span, log_span, xtol=1e-10)))
 
-    def design(self, alpha: float) -> tuple[float, float, float]:
-        """Programmed amplitudes (A_I, A_J) and ratio for a target at ``alpha`` (rad), assuming
-        phase-coherent channels (what the calibration establishes)."""
-        phase = self.coherent_phase(alpha)
+    def design(self, alpha: float, probes_rad) -> tuple[float, float, float]:
+        """Programmed amplitudes (A_I, A_J) and ratio for a target at ``alpha`` (rad), for the
+        one channel phase the calibration establishes with its probes at ``probes_rad``.
+
+        Not the phase coherent at ``alpha`` itself: for a spacing beyond the beam's first null
+        (lambda / d_A) that phase flips by pi near the span's ends and the design fails there.
+        """
+        phase = self.coherent_phase(probes_rad)
         rho = self.solve(alpha, phase)
         a_i, a_j = self.amplitudes(rho, alpha, phase)
         return a_i, a_j, rho

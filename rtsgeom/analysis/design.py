@@ -1,0 +1,207 @@
+"""Arc design: how arc radius and front-end spacing trade synthesis accuracy, near-field bias,
+calibration cost and mounting tolerance (issue 7, item 4).
+
+For each (arc radius R_c, front-end spacing) a two-front-end variant of a scene is built: the
+pair's two front ends (their antenna separation, cables and so on kept, mounting and channel
+errors dropped) placed symmetrically about the pair's centre angle, targets dropped, the sheet
+kept, widened, or disabled where its cutouts would not fit. Per design, at phasor level
+(:class:`~rtsgeom.analysis.tolerance.PairPhasors`: exact geometry, exact amplitudes, no noise):
+
+``worst_error_deg``
+    worst |synthesized - set| angle over the span after the delay calibration, nominal setup;
+``near_field_bias_deg``
+    a single front end's detected minus geometric angle (module centre seen from the RuT), the
+    mean of the two (Rx/Tx separation and the RuT's Tx/Rx parallax, ~1/R_c);
+``range_offset_mm``
+    the calibration's range offset, c0/2 times the delay mismatch it leaves between the two
+    channels (nominal setup);
+``sigma_calibrated_mm``, ``sigma_uncalibrated_mm``
+    the mounting tolerance (one sigma, the same on the radial, tangential and height axes) that
+    keeps ``target_yield`` of the setups within ``spec_deg``: a small Monte Carlo
+    (:func:`~rtsgeom.analysis.tolerance.max_sigma_for_yield`);
+
+and ``exceeds_resolution``: the spacing seen from the RuT is larger than its angular
+resolution 1.22 lambda / d_A (paper eq. 24), where the composite splits into two peaks.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from .._util import frozen
+from ..geometry import build_setup
+from ..geometry.farfield import angular_resolution_rad
+from ..scene import Scene, SheetConfig, arc_centre_m, azimuth_from_radar_rad, front_end_module_m
+from .tolerance import CASES, PairPhasors, max_sigma_for_yield
+
+__all__ = ["METRICS", "DesignGrid", "two_front_end_scene", "evaluate_design", "design_grid"]
+
+# name -> (heat-map colour label, title)
+METRICS = {
+    "worst_error_deg": ("worst |angle error| (deg)", "Synthesized angle after calibration"),
+    "near_field_bias_deg": ("detected - geometric (deg)", "Near-field bias of one front end"),
+    "range_offset_mm": ("range offset (mm)", "Calibration range offset"),
+    "sigma_calibrated_mm": ("mounting sigma (mm)", "Tolerance for the spec, calibrated"),
+    "sigma_uncalibrated_mm": ("mounting sigma (mm)", "Tolerance for the spec, uncalibrated"),
+}
+SHEET_MARGIN_RAD = math.radians(2.0)  # sheet beyond the outer cutouts when it is widened
+
+
+def two_front_end_scene(scene: Scene, pair: tuple[int, int], radius_m: float,
+                        spacing_rad: float) -> tuple[Scene, str, str | None]:
+    """The scene with only the pair's front ends, ``spacing_rad`` apart on an arc of
+    ``radius_m`` symmetric about their centre angle; no targets, no mounting or channel errors.
+
+    Returns the scene, what happened to the sheet (``kept``, ``widened``, ``disabled``) and why
+    the design cannot be built (None when it can)."""
+    fes = scene.rts.front_ends
+    lo, hi = sorted((fes[pair[0]], fes[pair[1]]), key=lambda f: f.angle_rad)
+    centre = 0.5 * (lo.angle_rad + hi.angle_rad)
+    clean = dict(radial_offset_m=0.0, tangential_offset_m=0.0, height_offset_m=0.0,
+                 gain_offset_db=0.0, phase_offset_rad=0.0)
+    new = (dataclasses.replace(lo, angle_rad=centre - 0.5 * spacing_rad, **clean),
+           dataclasses.replace(hi, angle_rad=centre + 0.5 * spacing_rad, **clean))
+    rts = dataclasses.replace(scene.rts, arc_radius_m=float(radius_m), front_ends=new)
+    variant = dataclasses.replace(scene, rts=rts, targets=())
+    sheet, state = _fit_sheet(variant)
+    variant = dataclasses.replace(variant, sheet=sheet)
+    return variant, state, _problem(variant)
+
+
+def _fit_sheet(scene: Scene) -> tuple[SheetConfig, str]:
+    """The scene's sheet for the variant: kept if the cutouts fit, widened if the front ends
+    lie beyond it, disabled if cutouts would overlap, not hold both antennas, cut the sheet in
+    two, or the RuT would sit outside it."""
+    sheet, rts = scene.sheet, scene.rts
+    if not sheet.enabled:
+        return sheet, "disabled"
+    off = dataclasses.replace(sheet, enabled=False)
+    r_sheet = rts.arc_radius_m + sheet.radius_offset_m
+    d = sheet.cutout_diameter_m
+    a = [f.angle_rad for f in rts.front_ends]
+    dist = math.dist(scene.radar.position_m, arc_centre_m(scene))
+    if (r_sheet <= max(0.05, dist) or d >= sheet.height_m or d >= 2 * r_sheet
+            or any(f.rx_tx_separation_m >= d for f in rts.front_ends)
+            or 2 * r_sheet * math.sin(0.5 * abs(a[1] - a[0])) < d):
+        return off, "disabled"
+    half = math.asin(0.5 * d / r_sheet)
+    lo, hi = min(a) - half, max(a) + half
+    if lo >= sheet.angle_min_rad and hi <= sheet.angle_max_rad:
+        return sheet, "kept"
+    wide = dataclasses.replace(sheet, angle_min_rad=min(sheet.angle_min_rad, lo - SHEET_MARGIN_RAD),
+                               angle_max_rad=max(sheet.angle_max_rad, hi + SHEET_MARGIN_RAD))
+    return wide, "widened"
+
+
+def _problem(scene: Scene) -> str | None:
+    """Why the variant cannot be built: the RuT outside the arc, a front end behind it."""
+    rts, radar = scene.rts, scene.radar
+    centre = arc_centre_m(scene)
+    if math.dist(radar.position_m, centre) >= rts.arc_radius_m:
+        return "the RuT is not inside the arc"
+    for fe in rts.front_ends:
+        az = azimuth_from_radar_rad(radar, front_end_module_m(centre, rts.arc_radius_m, fe))
+        if not -0.5 * math.pi < az < 0.5 * math.pi:
+            return "a front end is not in front of the RuT"
+    return None
+
+
+def evaluate_design(scene: Scene, pair: tuple[int, int], radius_m: float, spacing_rad: float,
+                    spec_deg: float = 0.1, target_yield: float = 0.95, draws: int = 2000,
+                    seed: int = 0, points: int = 21, rel_tol: float = 0.02) -> dict:
+    """All metrics of one design (NaN where it cannot be built; ``problem`` says why)."""
+    variant, sheet_state, problem = two_front_end_scene(scene, pair, radius_m, spacing_rad)
+    out = {"radius_m": float(radius_m), "spacing_deg": round(math.degrees(spacing_rad), 9),
+           "sheet": sheet_state, "problem": problem, "exceeds_resolution": None}
+    out.update({name: float("nan") for name in METRICS})
+    if problem is not None:
+        return out
+    setup = build_setup(variant)
+    gap = abs(float(np.diff(setup.fe_azimuth_rad())[0]))
+    out["exceeds_resolution"] = bool(gap > angular_resolution_rad(setup.rut))
+    try:
+        model = PairPhasors.build(setup, (0, 1), points)
+    except ValueError as exc:  # no ratio reaches a set angle: the composite has split
+        out["problem"] = f"synthesis failed: {exc}"
+        return out
+    zero = np.zeros((2, 3))
+    out["worst_error_deg"] = float(np.max(np.abs(model.angle_errors(zero, "calibrated"))))
+    bias = np.degrees(model.fe_angle_rad - setup.fe_azimuth_rad())
+    out["near_field_bias_deg"] = float(np.mean(bias))
+    steps = model.calibration_steps(model.x_nominal)
+    out["range_offset_mm"] = float(model.range_offset_m(zero, steps)) * 1e3
+    out["delta_tau_ps"] = float(steps * model.delay_resolution_s * 1e12)
+    for case in CASES:
+        inv = max_sigma_for_yield(model, [1e-4] * 3, draws, seed, target_yield, spec_deg, case,
+                                  rel_tol=rel_tol)
+        out[f"sigma_{case}_mm"] = inv["sigma_mm"]["radial"]
+        out[f"sigma_{case}_capped"] = inv["capped"]
+    return out
+
+
+@dataclass(frozen=True)
+class DesignGrid:
+    """Metrics over radius (columns) x spacing (rows): each grid has shape (spacings, radii)."""
+
+    pair: tuple[int, int]
+    centre_deg: float
+    radius_m: np.ndarray
+    spacing_deg: np.ndarray
+    angular_resolution_deg: float
+    spec_deg: float
+    target_yield: float
+    draws: int
+    seed: int
+    metrics: dict  # name -> (S, R)
+    exceeds_resolution: np.ndarray  # (S, R) bool
+    designs: tuple  # per cell, row-major: evaluate_design's dict
+
+    def to_dict(self) -> dict:
+        def clean(v):
+            if isinstance(v, float) and not math.isfinite(v):
+                return None
+            return v
+        return {
+            "pair": list(self.pair),
+            "centre_deg": self.centre_deg,
+            "radius_m": [round(float(r), 9) for r in self.radius_m],
+            "spacing_deg": [round(float(s), 9) for s in self.spacing_deg],
+            "angular_resolution_deg": self.angular_resolution_deg,
+            "spec_deg": self.spec_deg,
+            "yield": self.target_yield,
+            "draws": self.draws,
+            "seed": self.seed,
+            "designs": [{k: clean(v) for k, v in d.items()} for d in self.designs],
+        }
+
+
+def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
+                spec_deg: float = 0.1, target_yield: float = 0.95, draws: int = 2000,
+                seed: int = 0, points: int = 21,
+                progress: Callable[[int, int], None] | None = None) -> DesignGrid:
+    """Evaluate every (spacing, radius) design; ``progress(done, total)`` after each."""
+    radii = np.asarray(radius_m, float).ravel()
+    spacings = np.asarray(spacing_deg, float).ravel()
+    fes = scene.rts.front_ends
+    centre = 0.5 * (fes[pair[0]].angle_rad + fes[pair[1]].angle_rad)
+    designs = []
+    total = radii.size * spacings.size
+    for s in spacings:
+        for r in radii:
+            designs.append(evaluate_design(scene, pair, float(r), math.radians(s), spec_deg,
+                                           target_yield, draws, seed, points))
+            if progress:
+                progress(len(designs), total)
+    shape = (spacings.size, radii.size)
+    metrics = {name: frozen(np.array([d[name] for d in designs], float).reshape(shape))
+               for name in METRICS}
+    exceeds = np.array([bool(d["exceeds_resolution"]) for d in designs]).reshape(shape)
+    res = math.degrees(angular_resolution_rad(build_setup(scene).rut))
+    return DesignGrid((int(pair[0]), int(pair[1])), math.degrees(centre), frozen(radii),
+                      frozen(spacings), res, float(spec_deg), float(target_yield), int(draws),
+                      int(seed), metrics, frozen(exceeds), tuple(designs))

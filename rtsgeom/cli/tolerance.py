@@ -1,0 +1,225 @@
+"""``rtsgeom tolerance | design``: mounting-tolerance Monte Carlo of a front-end pair, and the
+arc design map (radius x front-end spacing)."""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import sys
+import time
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis.tolerance import (AXES, CASES, DISTRIBUTIONS, NOMINAL_AMPLITUDES, PairPhasors,
+                                  max_sigma_for_yield, monte_carlo)
+from ..geometry import build_setup
+from ..io import write_json
+from ..parallel import dask_client, map_chunks
+from ._common import UsageError, load_scene_checked, number, print_json, scene_arg
+from .aoa import _pair
+
+MAX_SIGMA_MM = 10.0  # the phasor model is first order in the errors; checked to 0.3 mm
+
+
+@contextmanager
+def _progress(quiet: bool):
+    """A ``progress(label, done, total)`` callback drawing one rich bar on stderr, relabelled
+    at each stage (None when quiet or when stderr is not a terminal)."""
+    if quiet or not sys.stderr.isatty():
+        yield None
+        return
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                  TimeElapsedColumn(), console=Console(stderr=True), transient=True) as bar:
+        task = bar.add_task("", total=None)
+
+        def update(label: str, done: int, total: int) -> None:
+            bar.update(task, description=label, completed=done, total=total)
+        yield update
+
+
+def _grid_spec(lo: float, hi: float, unit: str, max_n: int = 50):
+    """argparse type for ``A:B:N``: N values from A to B (A <= B, both in [lo, hi])."""
+    def parse(text: str) -> np.ndarray:
+        parts = text.split(":")
+        try:
+            a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
+            if len(parts) != 3:
+                raise ValueError
+        except (ValueError, IndexError):
+            raise argparse.ArgumentTypeError(f"{text!r} is not A:B:N (from A to B {unit}, "
+                                             "N values, e.g. 0.5:2:4)") from None
+        if not (lo <= a <= hi and lo <= b <= hi) or a > b:
+            raise argparse.ArgumentTypeError(
+                f"{text}: A and B must lie in [{lo:g}, {hi:g}] {unit} with A <= B")
+        if not 1 <= n <= max_n or (n == 1 and a != b):
+            raise argparse.ArgumentTypeError(
+                f"{text}: N must be in [1, {max_n}] (1 only with A == B)")
+        return np.linspace(a, b, n)
+    return parse
+
+
+def _model(scene, pair_arg, points: int) -> PairPhasors:
+    setup = build_setup(scene)
+    pair = _pair(setup, pair_arg)
+    try:
+        return PairPhasors.build(setup, pair, points)
+    except ValueError as exc:  # the composite cannot reach a set angle
+        raise UsageError(f"--pair {pair[0]} {pair[1]}: the pair cannot synthesize its span "
+                         f"({exc})") from None
+
+
+def cmd_tolerance(args) -> int:
+    scene = load_scene_checked(args.scene)
+    model = _model(scene, args.pair, args.points)
+    seed = scene.seed if args.seed is None else args.seed
+    sigma = np.array([args.sigma_radial_mm, args.sigma_tangential_mm, args.sigma_height_mm]) * 1e-3
+    cases = CASES + ((NOMINAL_AMPLITUDES,) if args.nominal_amplitudes else ())
+    t0 = time.perf_counter()
+    with _progress(args.quiet) as progress, dask_client(args.dask, args.workers) as client:
+        mapper = None if client is None else functools.partial(map_chunks, client=client)
+        res = monte_carlo(model, sigma, args.draws, seed, args.distribution, args.spec_deg,
+                          cases, args.chunk, progress, "Monte Carlo", mapper)
+        out = res.to_dict()
+        if args.invert_yield is not None:
+            out["inversion"] = {
+                case: max_sigma_for_yield(model, sigma, args.draws, seed, args.invert_yield,
+                                          args.spec_deg, case, args.invert_axis,
+                                          args.distribution, chunk=args.chunk, progress=progress,
+                                          mapper=mapper)
+                for case in CASES}
+    elapsed = time.perf_counter() - t0
+    if args.out:
+        from ..viz.figures import save_figure, tolerance_histogram_figure
+        # The uncalibrated tail reaches degrees: errors beyond +-lim (above every case's 95th
+        # percentile, so the legend's stays exact) are piled into the outer bins.
+        p95 = max(out[case]["angle_error_deg"]["p95"] for case in cases)
+        lim = max(5 * args.spec_deg, 1.2 * p95)
+        fig = tolerance_histogram_figure(
+            {case: np.clip(res.worst_error_deg[case], -lim, lim) for case in cases},
+            args.spec_deg, f"Worst error per setup, pair {tuple(model.pair)} (clipped at "
+                           f"±{lim:.2g} deg)")
+        save_figure(fig, args.out / "tolerance.png")
+        write_json(args.out / "tolerance.json", out)
+    if args.json:
+        print_json(out)
+        return 0
+    scale = "sigma" if args.distribution == "normal" else "bound"
+    print(f"pair {tuple(model.pair)}, {args.draws} draws ({args.distribution}, {scale} "
+          + ", ".join(f"{a} {s * 1e3:g} mm" for a, s in zip(AXES, sigma))
+          + f"), {len(model.set_rad)} set-points, {elapsed:.2f} s")
+    for case in cases:
+        st = out[case]
+        p = st["angle_error_deg"]
+        print(f"  {case:>30}: |error| p50 {p['p50']:.4f}, p95 {p['p95']:.4f}, p99 "
+              f"{p['p99']:.4f}, max {p['max']:.4f} deg; yield {100 * st['yield']:.2f} % within "
+              f"{args.spec_deg:g} deg")
+    cal = out["calibration"]
+    print(f"  calibration |delta tau| p95 {cal['abs_delta_tau_ps']['p95']:.0f} ps, range offset "
+          f"p95 {cal['abs_range_offset_mm']['p95']:.1f} mm")
+    for case, inv in out.get("inversion", {}).items():
+        sig = ", ".join(f"{a} {inv['sigma_mm'][a]:.4g}" for a in AXES)
+        print(f"  {100 * args.invert_yield:g} % within {args.spec_deg:g} deg, {case}: {scale} "
+              f"{sig} mm{' (search cap)' if inv['capped'] else ''}")
+    return 0
+
+
+def cmd_design(args) -> int:
+    from ..analysis.design import METRICS, design_grid
+    scene = load_scene_checked(args.scene)
+    pair = _pair(build_setup(scene), args.pair)
+    seed = scene.seed if args.seed is None else args.seed
+    with _progress(args.quiet) as progress:
+        grid = design_grid(scene, pair, args.radius_m, args.spacing_deg, args.spec_deg,
+                           args.yield_, args.draws, seed, args.points,
+                           None if progress is None else
+                           (lambda done, total: progress("designs", done, total)))
+    out = grid.to_dict()
+    if args.out:
+        from ..viz.figures import design_heatmap_figure, save_figure
+        mask = grid.exceeds_resolution
+        for name, (zlabel, title) in METRICS.items():
+            fig = design_heatmap_figure(
+                grid.radius_m, grid.spacing_deg, grid.metrics[name], "arc radius R_c (m)",
+                "front-end spacing (deg)", zlabel,
+                f"{title} (hatched: spacing > {grid.angular_resolution_deg:.1f} deg, eq. 24)",
+                mask=mask)
+            save_figure(fig, args.out / f"design_{name}.png")
+        write_json(args.out / "design.json", out)
+    if args.json:
+        print_json(out)
+        return 0
+    print(f"pair {pair}, centre {grid.centre_deg:.2f} deg, angular resolution "
+          f"{grid.angular_resolution_deg:.2f} deg; tolerance: {100 * grid.target_yield:g} % "
+          f"within {grid.spec_deg:g} deg ({grid.draws} draws)")
+    print(f"{'R_c m':>6} {'sp deg':>7} {'worst deg':>10} {'bias deg':>9} {'offset mm':>10} "
+          f"{'sigma cal mm':>13} {'sigma unc mm':>13}  note")
+    for d in out["designs"]:
+        def f(key, fmt):
+            return format(d[key], fmt) if d[key] is not None else "-"
+        note = d["problem"] or ("> resolution" if d["exceeds_resolution"] else "")
+        print(f"{d['radius_m']:6.3g} {d['spacing_deg']:7.3g} {f('worst_error_deg', '10.4f')} "
+              f"{f('near_field_bias_deg', '9.4f')} {f('range_offset_mm', '10.2f')} "
+              f"{f('sigma_calibrated_mm', '13.4f')} {f('sigma_uncalibrated_mm', '13.4f')}  "
+              f"{note}")
+    return 0
+
+
+def _common(p, draws_default: int) -> None:
+    scene_arg(p)
+    p.add_argument("--pair", nargs=2, type=number(0, 10_000, integer=True), metavar=("I", "J"),
+                   default=[0, 1], help="adjacent front ends (default 0 1)")
+    p.add_argument("--spec-deg", type=number(1e-6, 90.0), default=0.1,
+                   help="angle-error spec in deg, in [1e-6, 90] (default 0.1)")
+    p.add_argument("--draws", type=number(1, 10_000_000, integer=True), default=draws_default,
+                   help=f"Monte-Carlo draws, in [1, 10000000] (default {draws_default})")
+    p.add_argument("--seed", type=number(0, 2 ** 63 - 1, integer=True), default=None,
+                   help="random seed (default: the scene's seed)")
+    p.add_argument("--points", type=number(3, 201, integer=True), default=21,
+                   help="set-points across the span, ends excluded, in [3, 201] (default 21)")
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.add_argument("--out", type=Path, default=None, help="folder for the plots and JSON")
+    p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
+
+
+def register(sub) -> None:
+    p = sub.add_parser("tolerance", help="mounting-tolerance Monte Carlo of a front-end pair")
+    _common(p, 10_000)
+    mm = number(0.0, MAX_SIGMA_MM)
+    for axis in AXES:
+        p.add_argument(f"--sigma-{axis}-mm", type=mm, default=0.1,
+                       help=f"{axis} mounting error per front end in mm, in [0, {MAX_SIGMA_MM:g}]: "
+                            "the standard deviation (normal) or the bound (uniform) (default 0.1)")
+    p.add_argument("--distribution", choices=DISTRIBUTIONS, default="normal",
+                   help="error distribution (default normal)")
+    p.add_argument("--invert-yield", type=number(1e-6, 1.0), default=None, metavar="Y",
+                   help="also find the largest sigma keeping the fraction Y, in (0, 1], of the "
+                        "setups within the spec (bisection, same seed)")
+    p.add_argument("--invert-axis", choices=("all",) + AXES, default="all",
+                   help="with --invert-yield: scale all three sigmas together (default) or vary "
+                        "one axis, the others held")
+    p.add_argument("--nominal-amplitudes", action="store_true",
+                   help=f"add the case '{NOMINAL_AMPLITUDES}': calibrated, but the amplitudes "
+                        "not designed for the calibration delay's range offset")
+    p.add_argument("--chunk", type=number(100, 1_000_000, integer=True), default=10_000,
+                   help="draws per chunk (memory), in [100, 1000000] (default 10000)")
+    p.add_argument("--dask", metavar="ADDRESS", default=None,
+                   help="run the chunks on an existing Dask scheduler (tcp://host:8786)")
+    p.add_argument("--workers", type=number(1, 1024, integer=True), default=None,
+                   help="run the chunks on a local Dask cluster of N worker processes")
+    p.set_defaults(func=cmd_tolerance)
+
+    p = sub.add_parser("design", help="arc radius x front-end spacing design map")
+    _common(p, 2000)
+    p.add_argument("--radius-m", type=_grid_spec(0.1, 100.0, "m"), default=np.linspace(0.5, 2.0, 4),
+                   metavar="A:B:N", help="arc radii, N from A to B m (default 0.5:2:4)")
+    p.add_argument("--spacing-deg", type=_grid_spec(0.1, 90.0, "deg"),
+                   default=np.linspace(4.0, 20.0, 5), metavar="A:B:N",
+                   help="front-end spacings, N from A to B deg (default 4:20:5)")
+    p.add_argument("--yield", dest="yield_", type=number(1e-6, 1.0), default=0.95, metavar="Y",
+                   help="fraction of setups within the spec for the tolerance, in (0, 1] "
+                        "(default 0.95)")
+    p.set_defaults(func=cmd_design)
