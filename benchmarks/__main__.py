@@ -78,18 +78,20 @@ def bench_synthesis(scene_path: Path, paths_method: str, repeat: int) -> dict:
 
 
 def bench_tolerance(scene_path: Path, draws: int) -> dict:
-    try:
-        from rtsgeom.analysis import tolerance
-    except ImportError as exc:  # pragma: no cover - depends on the analyses being installed
-        return {"skipped": f"rtsgeom.analysis.tolerance not available ({exc})"}
-    runner = getattr(tolerance, "benchmark", None)
-    if runner is None:
-        return {"skipped": "rtsgeom.analysis.tolerance has no benchmark() entry point"}
+    """Monte-Carlo tolerance draws (phasor level, 21 set-points, uncalibrated + calibrated)."""
+    from rtsgeom.analysis.tolerance import PairPhasors, monte_carlo
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.scene import load_scene
+    model = PairPhasors.build(build_setup(load_scene(scene_path)), (0, 1), points=21)
+    sigma = [1e-4, 1e-4, 1e-4]
+    monte_carlo(model, sigma, 1000, 0)  # warm-up
     t0 = time.perf_counter()
-    info = runner(scene_path, draws)
+    res = monte_carlo(model, sigma, draws, 0)
     wall = time.perf_counter() - t0
-    info.update({"draws": draws, "wall_s": wall, "draws_per_s": draws / wall})
-    return info
+    peak = _peak_mib(lambda: monte_carlo(model, sigma, min(draws, 20_000), 0))
+    return {"draws": draws, "set_points": int(model.set_rad.size), "wall_s": wall,
+            "draws_per_s": draws / wall, "peak_mib_per_20k_draws": peak,
+            "p95_calibrated_deg": float(res.stats("calibrated")["angle_error_deg"]["p95"])}
 
 
 def bench_raytrace(scene_path: Path) -> dict:
@@ -147,9 +149,9 @@ def main(argv=None) -> int:
         if "skipped" in t:
             print(f"tolerance: skipped ({t['skipped']})")
         else:
-            print(f"tolerance ({t['draws']} draws x {t.get('set_points', 21)} set-points): "
-                  f"{t['wall_s']:.2f} s, {t['draws_per_s']:.0f} draws/s"
-                  + (f", peak {t['peak_mib']:.0f} MiB" if "peak_mib" in t else ""))
+            print(f"tolerance ({t['draws']} draws x {t['set_points']} set-points): "
+                  f"{t['wall_s']:.2f} s, {t['draws_per_s']:.0f} draws/s, peak "
+                  f"{t['peak_mib_per_20k_draws']:.0f} MiB per 20k draws")
     r = results.get("raytrace")
     if r:
         if "skipped" in r:
