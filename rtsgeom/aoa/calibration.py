@@ -78,10 +78,19 @@ def probe_angles(theta_i: float, theta_j: float) -> tuple[float, float]:
 
 
 def probe_ranges(setup: Setup, n: int) -> np.ndarray:
-    """Ranges for n simultaneous probe targets: distinct, away from the setup and ghosts."""
-    radar = setup.scene.radar
-    r0 = max(0.2 * radar.max_range_m, setup.scene.rts.arc_radius_m + 2.0)
+    """Ranges for n simultaneous probe targets: distinct, away from the setup, and clear of
+    each other's cable ghosts (at multiples of L / VF behind each probe), which would otherwise
+    leak into a neighbour's bin and bias its angle."""
+    scene = setup.scene
+    radar = scene.radar
+    r0 = max(0.2 * radar.max_range_m, scene.rts.arc_radius_m + 2.0)
+    ghosts = [k * fe.cable_length_m / fe.cable_velocity_factor for fe in scene.rts.front_ends
+              if fe.return_loss_fe_db is not None and fe.return_loss_be_db is not None
+              for k in range(1, 6)]
+    clear = 4 * radar.range_resolution_m
     step = max(8 * radar.range_resolution_m, 3.0)
+    while any(abs(m * step - g) < clear for g in ghosts for m in range(1, n)):
+        step += radar.range_resolution_m
     return r0 + step * np.arange(n)
 
 
