@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy.constants import c
 
 from . import __version__
 from .geometry import Setup

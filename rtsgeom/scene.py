@@ -641,8 +641,8 @@ def _check_consistency(scene: Scene, source: str) -> None:
         how = (f"rts.fractional_delay = true with rts.fractional_delay_step_s = "
                f"{rts.fractional_delay_step_s:g} s: use a finer fractional_delay_step_s"
                if rts.fractional_delay else
-               f"rts.fractional_delay = false: the delay moves in whole back-end samples "
-               f"1/rts.f_s_hz; set rts.fractional_delay = true")
+               "rts.fractional_delay = false: the delay moves in whole back-end samples "
+               "1/rts.f_s_hz; set rts.fractional_delay = true")
         fail("rts.calibration_step_ps", step * 1e12,
              f">= the RTS delay resolution {rts.delay_resolution_s * 1e12:g} ps ({how})")
     span = rts.calibration_span_s[1] - rts.calibration_span_s[0]

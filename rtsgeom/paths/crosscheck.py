@@ -31,7 +31,7 @@ from scipy.optimize import brentq
 
 from ..geometry import Setup
 from .exact import exact_paths
-from .table import FE_TO_RX, RUT_TO_RUT, TX_TO_FE, Paths
+from .table import RUT_TO_RUT, TX_TO_FE, Paths
 
 __all__ = ["crosscheck", "format_crosscheck", "smooth_path_length", "stationary_points",
            "facet_image_length", "po_sheet_response"]
