@@ -37,8 +37,10 @@ class RtsProgram:
     """What the RTS back end is told to generate: one row per (target, channel).
 
     ``delay_s`` is the requested RTS delay tau_rts (before the buffer/FIR quantisation),
-    ``doppler_hz`` the mixer frequency f_D,rts, ``amplitude`` the complex channel gain the RTS
-    applies (attenuation and AoA weight). Hardware offsets of the scene are *not* in here: they
+    ``doppler_hz`` the Doppler shift f_D,rts = 2 f_c v / c0 of eq. (2) *as the RuT's beat
+    signal sees it* (positive for a receding target; the hardware mixer lowers the re-emitted
+    frequency by it, i.e. multiplies by exp(-j 2 pi f_D t)), ``amplitude`` the complex channel
+    gain the RTS applies (attenuation and AoA weight). Hardware offsets of the scene are *not* in here: they
     belong to the channel, not to what the RTS is told.
     """
 

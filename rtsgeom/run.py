@@ -13,8 +13,9 @@ import numpy as np
 from . import __version__
 from .geometry import Setup, build_setup
 from .paths import Paths, exact_paths
-from .radar import AdcCube, Detections, RangeDoppler, add_noise, process, synthesize
-from .rts import KIND_DIRECT, Echoes, RtsProgram, build_echoes, program_nearest
+from .radar import AdcCube, Detections, RangeDoppler, process
+from .radar.frame import noise_power, simulate
+from .rts import Echoes, RtsProgram, program_nearest
 from .scene import Scene
 
 __all__ = ["RunResult", "simulate", "run_scene", "match_targets", "noise_power"]
@@ -33,30 +34,7 @@ class RunResult:
     matches: list[dict]
     calibration: dict = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
-
-
-def noise_power(echoes: Echoes, snr_db: float | None) -> float:
-    """Noise power per complex sample for a per-sample SNR of the strongest target echo.
-
-    The reference is the RTS's direct echoes (not the setup's static reflections, which can be
-    far stronger than any target), so the targets keep their SNR whatever the paths method.
-    """
-    if snr_db is None or len(echoes) == 0:
-        return 0.0
-    direct = echoes.kind == KIND_DIRECT
-    ref = echoes.amplitude[direct] if np.any(direct) else echoes.amplitude
-    return float(np.max(np.abs(ref)) ** 2 / 10 ** (snr_db / 10))
-
-
-def simulate(setup: Setup, paths: Paths, program: RtsProgram, seed: int | None = None,
-             snr_db: float | None = None) -> tuple[Echoes, AdcCube]:
-    """Echoes and ADC cube of a programmed RTS (noise from ``seed`` when ``snr_db`` is set)."""
-    echoes = build_echoes(setup, paths, program)
-    cube = synthesize(echoes, setup.scene.radar, setup.rut)
-    if snr_db is not None:
-        rng = np.random.default_rng(seed)
-        cube = add_noise(cube, noise_power(echoes, snr_db), rng)
-    return echoes, cube
+    aoa_mode: str = "exact"  # the amplitude mode actually used
 
 
 def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angle_rad=None
@@ -115,7 +93,7 @@ def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = 
     echoes, cube = simulate(setup, paths, program, scene.seed, scene.radar.snr_db)
     rd, det = process(cube)
     return RunResult(scene, setup, paths, program, echoes, cube, rd, det,
-                     match_targets(scene, det, rd), calibration, tuple(warnings))
+                     match_targets(scene, det, rd), calibration, tuple(warnings), mode)
 
 
 def summary(result: RunResult, paths_method: str) -> dict:
@@ -129,7 +107,7 @@ def summary(result: RunResult, paths_method: str) -> dict:
         "scene_sha256": s.sha256,
         "seed": s.seed,
         "paths": paths_method,
-        "aoa_mode": s.rts.aoa_mode,
+        "aoa_mode": result.aoa_mode,
         "radar": {
             "f_c_hz": r.f_c_hz, "bandwidth_hz": r.bandwidth_hz,
             "slope_hz_per_s": r.slope_hz_per_s, "adc_rate_hz": r.adc_rate_hz,

@@ -128,3 +128,31 @@ def test_quarter_wave_radial_error_breaks_uncalibrated_synthesis(default_cal):
     cal = calibrate_pair(setup, paths, (0, 1), probe, seed=1)
     good = linearity(setup, paths, (0, 1), "exact", probe, cal, points=5, seed=1)
     assert good.max_abs_error_deg < 0.05
+
+
+def test_paper_g_is_accurate_near_zero():
+    # the series -u/6 + u^3/240 replaces the cancelling closed form near u = 0
+    for u in (1e-9, 1e-6, 1e-4, 2e-3):
+        ref = 2 * np.cos(np.float128(u) / 2) / np.float128(u) - 4 * np.sin(np.float128(u) / 2) / np.float128(u) ** 2 \
+            if u >= 1e-4 else -u / 6
+        got = float(g_paper(np.arcsin(u), 0.0))
+        assert got == pytest.approx(float(ref), rel=1e-6)
+
+
+def test_closed_form_modes_refuse_angles_outside_the_geometric_span():
+    from rtsgeom.aoa.plan import pair_amplitudes
+    from rtsgeom.aoa.synthesis import AngleUnreachable
+    from rtsgeom.scene import TargetConfig
+    setup = build_setup(make_scene())
+    paths = exact_paths(setup)
+    probes = np.radians([6.0, 10.0])
+    t = TargetConfig(37.0, 0.0, 10.0, np.radians(12.5))  # inside the measured, outside 3.4..12.2
+    for mode in ("paper", "array-factor"):
+        with pytest.raises(AngleUnreachable, match="geometric"):
+            pair_amplitudes(setup, paths, (0, 1), t, mode, probes)
+    end = TargetConfig(37.0, 0.0, 10.0, setup.fe_azimuth_rad()[1])  # exactly at front end 1
+    for mode in ("paper", "array-factor"):
+        a_i, a_j, _ = pair_amplitudes(setup, paths, (0, 1), end, mode, probes)
+        assert np.isfinite(a_i) and np.isfinite(a_j) and a_j > 1e3 * a_i
+    a_i, a_j, _ = pair_amplitudes(setup, paths, (0, 1), t, "exact", probes)
+    assert a_i > 0 and a_j > 0

@@ -14,7 +14,8 @@ from rtsgeom.radar.dca1000 import from_dca1000, to_dca1000
 from rtsgeom.radar.phasors import bin_response
 from rtsgeom.radar.processing import estimate_angles, tdm_compensate
 from rtsgeom.rts import Echoes, RtsProgram, build_echoes, program_nearest, realised_delay
-from rtsgeom.run import match_targets, simulate
+from rtsgeom.radar.frame import simulate
+from rtsgeom.run import match_targets
 
 from conftest import make_scene
 

@@ -17,7 +17,7 @@ from rtsgeom.paths import exact_paths
 from rtsgeom.radar import process
 from rtsgeom.radar.processing import estimate_angles, refine_angles, tdm_compensate
 from rtsgeom.rts import RtsProgram, requested_delay
-from rtsgeom.run import simulate
+from rtsgeom.radar.frame import simulate
 from rtsgeom.scene import TargetConfig
 
 from conftest import DEFAULT_SCENE, make_scene

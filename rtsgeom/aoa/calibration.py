@@ -26,6 +26,7 @@ from ..geometry import Setup
 from ..geometry.setup import nominal_setup
 from ..paths import Paths, exact_paths
 from ..radar import process
+from ..radar.frame import simulate
 from ..rts import RtsProgram, requested_delay
 from ..scene import TargetConfig
 from .synthesis import PairModel
@@ -95,7 +96,6 @@ def probe_ranges(setup: Setup, n: int) -> np.ndarray:
 
 
 def _simulate_detect(setup, paths, program, seed):
-    from ..run import simulate
     _, cube = simulate(setup, paths, program, seed, setup.scene.radar.snr_db)
     return process(cube)
 

@@ -16,7 +16,7 @@ from ..scene import SceneError, TargetConfig
 from scipy.constants import c
 from .calibration import (Calibration, FrontEndProbe, calibrate_pair, probe_angles,
                           probe_front_ends)
-from .synthesis import PairModel, ratio_array_factor, ratio_paper
+from .synthesis import AngleUnreachable, PairModel, ratio_array_factor, ratio_paper
 
 __all__ = ["bracketing_pair", "pair_amplitudes", "plan_targets", "channel_offsets"]
 
@@ -50,12 +50,23 @@ def pair_amplitudes(setup: Setup, paths: Paths, pair, target: TargetConfig, mode
         rho = model.solve(alpha, phase)
     else:
         th = nom.fe_azimuth_rad()[list(pair)]  # the design knows the nominal angles
-        if mode == "paper":
+        lo, hi = np.sort(th)
+        if not lo <= alpha <= hi:
+            raise AngleUnreachable(
+                f"angle {np.degrees(alpha):.4f} deg is outside the span the {mode} closed form "
+                f"can address: the front ends' geometric angles [{np.degrees(lo):.4f}, "
+                f"{np.degrees(hi):.4f}] deg (use the exact mode for the measured span)")
+        eps = 1e-9 * (hi - lo)
+        if abs(alpha - th[0]) <= eps:  # at a span end: that channel alone
+            rho = 0.0
+        elif abs(alpha - th[1]) <= eps:
+            rho = 1e12
+        elif mode == "paper":
             rho = float(ratio_paper(th[0], th[1], alpha))
         else:
             n = int(np.count_nonzero(setup.rut.azimuth_mask))
             rho = float(ratio_array_factor(th[0], th[1], alpha, n))
-        rho = max(rho, 0.0)
+        rho = float(np.clip(rho, 0.0, 1e12))
     a_i, a_j = model.amplitudes(rho, alpha, phase)
     return a_i * gain_correction[0], a_j * gain_correction[1], rho
 
@@ -111,8 +122,12 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
     for k, t in enumerate(scene.targets):
         i, j = pairs[k]
         probes = probe_angles(probe.angle_rad[i], probe.angle_rad[j])
-        a_i, a_j, _ = pair_amplitudes(setup, paths, (i, j), t, mode, probes,
-                                      (offsets[i], offsets[j]), probe.gain_correction[[i, j]])
+        try:
+            a_i, a_j, _ = pair_amplitudes(setup, paths, (i, j), t, mode, probes,
+                                          (offsets[i], offsets[j]), probe.gain_correction[[i, j]])
+        except AngleUnreachable as exc:
+            raise SceneError(f"{scene.source}: targets[{k}].angle_deg = "
+                             f"{np.degrees(t.angle_rad):g}: {exc}") from None
         tau = float(requested_delay(scene, t.range_m))
         f_d = 2 * scene.radar.f_c_hz * t.velocity_mps / c
         rows += [(k, i, tau + offsets[i], f_d, a_i), (k, j, tau + offsets[j], f_d, a_j)]

@@ -44,10 +44,15 @@ class AngleUnreachable(ValueError):
 
 
 def g_paper(theta, alpha):
-    """Paper eq. (22): derivative substitute of sinc((sin theta - sin alpha) / 2)."""
-    u = np.sin(theta) - np.sin(alpha)
-    u = np.where(np.abs(u) < 1e-12, 1e-12, u)
-    return 2 * np.cos(u / 2) / u - 4 * np.sin(u / 2) / u ** 2
+    """Paper eq. (22): derivative substitute of sinc((sin theta - sin alpha) / 2).
+
+    Near u = sin theta - sin alpha = 0 the two terms cancel catastrophically; there its series
+    -u/6 + u^3/240 is used."""
+    u = np.asarray(np.sin(theta) - np.sin(alpha), float)
+    small = np.abs(u) < 1e-3
+    us = np.where(small, 1.0, u)
+    exact = 2 * np.cos(us / 2) / us - 4 * np.sin(us / 2) / us ** 2
+    return np.where(small, -u / 6 + u ** 3 / 240, exact)
 
 
 def ratio_paper(theta_i, theta_j, alpha):
