@@ -16,7 +16,7 @@ the complex amplitude. The FMCW model turns it into an ADC cube.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.constants import c
@@ -97,10 +97,7 @@ class Echoes:
     def scaled(self, gain) -> "Echoes":
         """The same echoes with the amplitudes multiplied by ``gain`` (scalar or (E,))."""
         g = np.asarray(gain)
-        amp = self.amplitude * (g[:, None] if g.ndim == 1 else g)
-        fields = {n: getattr(self, n) for n in self.__dataclass_fields__}
-        fields["amplitude"] = frozen(amp)
-        return Echoes(**fields)
+        return replace(self, amplitude=frozen(self.amplitude * (g[:, None] if g.ndim == 1 else g)))
 
 
 # ------------------------------------------------------------------------------------------
@@ -252,12 +249,10 @@ def cable_ghosts(scene: Scene, direct: Echoes, min_level_db: float = -80.0) -> E
         dt = 2.0 * fe.cable_length_m / (fe.cable_velocity_factor * c)
         n = 1
         while n < 64 and 20 * np.log10((n + 1) * rho ** n) > min_level_db:
-            fields = {name: getattr(base, name) for name in base.__dataclass_fields__}
-            fields["tau_if_s"] = frozen(base.tau_if_s + n * dt)
-            fields["amplitude"] = frozen(base.amplitude * ((n + 1) * rho ** n))
-            fields["kind"] = frozen(np.full(len(base), KIND_GHOST))
-            fields["order"] = frozen(np.full(len(base), n))
-            parts.append(Echoes(**fields))
+            parts.append(replace(base, tau_if_s=frozen(base.tau_if_s + n * dt),
+                                 amplitude=frozen(base.amplitude * ((n + 1) * rho ** n)),
+                                 kind=frozen(np.full(len(base), KIND_GHOST)),
+                                 order=frozen(np.full(len(base), n))))
             n += 1
     return Echoes.concat(parts) if parts else _empty(direct.amplitude.shape[1])
 

@@ -15,6 +15,7 @@ from .geometry import Setup, build_setup
 from .paths import Paths, exact_paths
 from .radar import AdcCube, Detections, RangeDoppler, process
 from .radar.frame import noise_power, simulate
+from .radar.processing import nearest_detection
 from .rts import Echoes, RtsProgram, program_nearest
 from .scene import Scene
 
@@ -44,13 +45,11 @@ def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angl
     dv = rd.velocity_mps[1] - rd.velocity_mps[0]
     out = []
     for i, t in enumerate(scene.targets):
-        near = (np.abs(det.range_m - t.range_m) <= 2 * dr) & \
-               (np.abs(det.velocity_mps - t.velocity_mps) <= 2 * dv)
+        j = nearest_detection(det, rd, t.range_m, t.velocity_mps)
         entry = {"index": i, "set": {"range_m": t.range_m, "velocity_mps": t.velocity_mps,
                                      "angle_deg": float(np.degrees(t.angle_rad)),
                                      "rcs_dbsm": t.rcs_dbsm}}
-        if np.any(near):
-            j = int(np.flatnonzero(near)[np.argmax(det.power_db[near])])
+        if j is not None:
             d = {"range_m": float(det.range_m[j]), "velocity_mps": float(det.velocity_mps[j]),
                  "angle_deg": float(det.angle_deg[j]), "power_db": float(det.power_db[j]),
                  "snr_db": float(det.snr_db[j])}

@@ -48,19 +48,25 @@ def test_beat_frequency_is_slope_times_delay():
     assert det.range_m[0] == pytest.approx(c * tau / 2, abs=0.1 * r.range_resolution_m)
 
 
-def test_extra_rts_delay_moves_range_by_c_dtau_over_2():
+def first_target_delayed(extras_s):
+    """The quiet default scene's first target alone, its RTS delay increased by each extra:
+    yields (scene, range-Doppler, detections) per extra."""
     scene = make_scene(quiet)
     setup = build_setup(scene)
     paths = exact_paths(setup)
     base = program_nearest(scene, setup)
     keep = np.array([0])
-    dtau = 2.0e-9
-    ranges = []
-    for extra in (0.0, dtau):
+    for extra in extras_s:
         prog = RtsProgram.build(base.target[keep], base.front_end[keep], base.delay_s[keep] + extra,
                                 base.doppler_hz[keep], base.amplitude[keep])
         _, cube = simulate(setup, paths, prog)
-        _, det = process(cube)
+        yield (scene, *process(cube))
+
+
+def test_extra_rts_delay_moves_range_by_c_dtau_over_2():
+    dtau = 2.0e-9
+    ranges = []
+    for scene, _, det in first_target_delayed((0.0, dtau)):
         ranges.append(det.range_m[np.argmax(det.power_db)])
     assert ranges[1] - ranges[0] == pytest.approx(c * dtau / 2, abs=0.05 * scene.radar.range_resolution_m)
 
@@ -127,18 +133,9 @@ def test_single_front_end_bias_at_1m_matches_geometry(default_scene):
 
 def test_phase_slope_of_rts_delay_is_f_rts_plus_half_bandwidth():
     # eq. (27): d phi / d tau_rts = 2 pi (f_rts + B/2) -> calibration period 1 ns in the paper
-    scene = make_scene(quiet)
-    setup = build_setup(scene)
-    paths = exact_paths(setup)
-    base = program_nearest(scene, setup)
-    keep = np.array([0])
     d = 20e-12
     phases, bins = [], None
-    for extra in (0.0, d):
-        prog = RtsProgram.build(base.target[keep], base.front_end[keep], base.delay_s[keep] + extra,
-                                base.doppler_hz[keep], base.amplitude[keep])
-        ech, cube = simulate(setup, paths, prog)
-        rd, det = process(cube)
+    for scene, rd, det in first_target_delayed((0.0, d)):
         if bins is None:  # the same bin for both (adjacent bins differ by pi)
             k = np.argmax(det.power_db)
             bins = det.range_bin[k], det.doppler_bin[k]

@@ -23,9 +23,11 @@ from scipy.constants import c
 
 from .._util import frozen
 from ..geometry import Setup
+from ..geometry.farfield import two_way_lengths
 from ..geometry.setup import nominal_setup
 from ..paths import Paths, exact_paths
 from ..radar import process
+from ..radar.processing import nearest_detection
 from ..radar.frame import simulate
 from ..rts import RtsProgram, requested_delay
 from ..scene import TargetConfig
@@ -100,16 +102,6 @@ def _simulate_detect(setup, paths, program, seed):
     return process(cube)
 
 
-def _nearest(det, rd, range_m, velocity_mps=0.0):
-    """Index of the strongest detection within 2 range bins of range_m, or None."""
-    dr = rd.range_m[1] - rd.range_m[0]
-    dv = rd.velocity_mps[1] - rd.velocity_mps[0]
-    near = (np.abs(det.range_m - range_m) <= 2 * dr) & (np.abs(det.velocity_mps - velocity_mps) <= 2 * dv)
-    if not np.any(near):
-        return None
-    return int(np.flatnonzero(near)[np.argmax(det.power_db[near])])
-
-
 def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe:
     """Each front end alone at its own probe range (one simulated frame): measured angle and
     power; the gain correction equalises measured against modelled power."""
@@ -130,7 +122,7 @@ def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe
     ang = np.full(n, np.nan)
     pw = np.full(n, np.nan)
     for q in range(n):
-        k = _nearest(det, rd, ranges[q])
+        k = nearest_detection(det, rd, ranges[q])
         if k is not None:
             ang[q], pw[q] = det.angle_rad[k], det.power_db[k]
     meas = 10 ** (pw / 10) / amps ** 2
@@ -192,7 +184,7 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
         rd, det = _simulate_detect(setup, paths, prog, seed)
         errs = []
         for r, a in zip(ranges, alphas):
-            k = _nearest(det, rd, r)
+            k = nearest_detection(det, rd, r)
             errs.append(np.degrees(det.angle_rad[k] - a) if k is not None else np.nan)
         errs = np.asarray(errs)
         return float(np.sqrt(np.mean(errs ** 2))) if np.all(np.isfinite(errs)) else np.inf
@@ -241,5 +233,4 @@ def nominal_model(setup: Setup, paths: Paths) -> tuple[Setup, Paths]:
 
 def _mean_air_delay(setup: Setup) -> np.ndarray:
     """Mean over virtual elements of each front end's two-way line-of-sight delay."""
-    from ..geometry.farfield import two_way_lengths
     return two_way_lengths(setup.rut, setup.fe.rx, setup.fe.tx).mean(axis=1) / c

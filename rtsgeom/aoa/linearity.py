@@ -11,7 +11,8 @@ from ..geometry import Setup
 from ..paths import Paths
 from ..rts import RtsProgram, requested_delay
 from ..scene import TargetConfig
-from .calibration import (Calibration, FrontEndProbe, _nearest, _simulate_detect, probe_angles,
+from ..radar.processing import nearest_detection
+from .calibration import (Calibration, FrontEndProbe, _simulate_detect, probe_angles,
                           probe_ranges)
 from .plan import pair_amplitudes
 
@@ -75,7 +76,7 @@ def linearity(setup: Setup, paths: Paths, pair: tuple[int, int], mode: str,
         prog = RtsProgram.build([0, 0], [i, j], [tau + off[0], tau + off[1]], [0.0, 0.0],
                                 [a_i, a_j])
         rd, det = _simulate_detect(setup, paths, prog, seed)
-        n = _nearest(det, rd, rng)
+        n = nearest_detection(det, rd, rng)
         if n is not None:
             det_deg[k] = np.degrees(det.angle_rad[n])
     amp_db = 20 * np.log10(np.maximum(amp, 1e-300) / np.max(amp))

@@ -40,19 +40,29 @@ def cmd_calibrate(args) -> int:
         cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
     out = cal.to_dict()
     out["front_end_angles_deg"] = [float(x) for x in np.degrees(probe.angle_rad)]
+
+    def figure():
+        from ..viz.figures import calibration_sweep_figure
+        return calibration_sweep_figure(cal.sweep_delta_tau_s, cal.sweep_error_deg,
+                                        cal.delta_tau_s, cal.period_s)
+    _emit(args, "calibration_sweep.png", "calibration", out, figure,
+          f"pair {pair}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps, residual angle error "
+          f"{cal.residual_error_deg:.4f} deg, range offset {cal.range_offset_m * 1e3:.2f} mm "
+          f"(period {cal.period_s * 1e9:.4f} ns)")
+    return 0
+
+
+def _emit(args, png: str, name: str, out: dict, figure, summary_line: str) -> None:
+    """``--out DIR``: DIR/<png> (from ``figure()``) and DIR/<name>.json; then JSON or one
+    summary line on stdout."""
     if args.out:
-        from ..viz.figures import calibration_sweep_figure, save_figure
-        fig = calibration_sweep_figure(cal.sweep_delta_tau_s, cal.sweep_error_deg,
-                                       cal.delta_tau_s, cal.period_s)
-        save_figure(fig, args.out / "calibration_sweep.png")
-        write_json(args.out / "calibration.json", out)
+        from ..viz.figures import save_figure
+        save_figure(figure(), args.out / png)
+        write_json(args.out / f"{name}.json", out)
     if args.json:
         print_json(out)
     else:
-        print(f"pair {pair}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps, residual angle error "
-              f"{cal.residual_error_deg:.4f} deg, range offset {cal.range_offset_m * 1e3:.2f} mm "
-              f"(period {cal.period_s * 1e9:.4f} ns)")
-    return 0
+        print(summary_line)
 
 
 def cmd_linearity(args) -> int:
@@ -65,18 +75,13 @@ def cmd_linearity(args) -> int:
             cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
         step(f"sweeping {args.points} set-points ({args.amplitudes} amplitudes)")
         lin = linearity(setup, paths, pair, args.amplitudes, probe, cal, args.points, scene.seed)
-    out = lin.to_dict()
-    if args.out:
-        from ..viz.figures import linearity_figure, save_figure
-        fig = linearity_figure(lin.set_deg, {args.amplitudes: lin.detected_deg},
-                               {args.amplitudes: lin.amplitude_db})
-        save_figure(fig, args.out / "linearity.png")
-        write_json(args.out / "linearity.json", out)
-    if args.json:
-        print_json(out)
-    else:
-        print(f"{args.amplitudes} ({'calibrated' if cal else 'uncalibrated'}): max |error| "
-              f"{lin.max_abs_error_deg:.4f} deg over {len(lin.set_deg)} set-points")
+    def figure():
+        from ..viz.figures import linearity_figure
+        return linearity_figure(lin.set_deg, {args.amplitudes: lin.detected_deg},
+                                {args.amplitudes: lin.amplitude_db})
+    _emit(args, "linearity.png", "linearity", lin.to_dict(), figure,
+          f"{args.amplitudes} ({'calibrated' if cal else 'uncalibrated'}): max |error| "
+          f"{lin.max_abs_error_deg:.4f} deg over {len(lin.set_deg)} set-points")
     return 0
 
 

@@ -27,8 +27,8 @@ from ..geometry import RutArray
 from ..rts import Echoes
 from ..scene import RadarConfig
 
-__all__ = ["AdcCube", "fast_time_s", "chirp_start_s", "synthesize", "synthesize_exact",
-           "add_noise"]
+__all__ = ["AdcCube", "fast_time_s", "chirp_start_s", "beat_phase0", "synthesize",
+           "synthesize_exact", "add_noise"]
 
 
 @dataclass(frozen=True)
@@ -56,6 +56,15 @@ def chirp_start_s(radar: RadarConfig, rut: RutArray) -> np.ndarray:
     return (loops * n_tx + rut.virtual_slot[None, :]) * radar.chirp_repetition_s
 
 
+def beat_phase0(echoes: Echoes, radar: RadarConfig) -> np.ndarray:
+    """The part of the beat phase (eq. 8) that varies neither with fast nor slow time, (E, V):
+    ``2 pi [f_c tau_c + f_if tau_if - S tau^2 / 2]``."""
+    tau = echoes.tau_s
+    return 2 * np.pi * (radar.f_c_hz * echoes.tau_air_s
+                        + (echoes.f_if_hz * echoes.tau_if_s)[:, None]
+                        - 0.5 * radar.slope_hz_per_s * tau ** 2)
+
+
 def synthesize(echoes: Echoes, radar: RadarConfig, rut: RutArray) -> AdcCube:
     """Noise-free ADC cube of all echoes (batched GEMM over virtual channels)."""
     s = radar.slope_hz_per_s
@@ -63,8 +72,7 @@ def synthesize(echoes: Echoes, radar: RadarConfig, rut: RutArray) -> AdcCube:
     t_c = chirp_start_s(radar, rut)  # (L, V)
     tau = echoes.tau_s  # (E, V)
     f_d = echoes.doppler_hz  # (E,)
-    phi0 = 2 * np.pi * (radar.f_c_hz * echoes.tau_air_s
-                        + (echoes.f_if_hz * echoes.tau_if_s)[:, None] - 0.5 * s * tau ** 2)
+    phi0 = beat_phase0(echoes, radar)
     # slow time: A[v, l, e] = a[e, v] exp(j (phi0[e, v] + 2 pi f_D[e] t_c[l, v]))
     slow = phi0.T[:, None, :] + 2 * np.pi * f_d[None, None, :] * t_c.T[:, :, None]
     a = (echoes.amplitude.T[:, None, :] * np.exp(1j * slow)).astype(np.complex64)

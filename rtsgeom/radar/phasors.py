@@ -19,7 +19,7 @@ import numpy as np
 from ..geometry import RutArray
 from ..rts import Echoes
 from ..scene import RadarConfig
-from .fmcw import chirp_start_s, fast_time_s
+from .fmcw import beat_phase0, chirp_start_s, fast_time_s
 from .processing import window
 
 __all__ = ["bin_response"]
@@ -38,9 +38,7 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
     s = radar.slope_hz_per_s
     tau = echoes.tau_s  # (E, V)
     f_d = echoes.doppler_hz
-    phi0 = 2 * np.pi * (radar.f_c_hz * echoes.tau_air_s
-                        + (echoes.f_if_hz * echoes.tau_if_s)[:, None] - 0.5 * s * tau ** 2)
-    amp = echoes.amplitude * np.exp(1j * phi0)  # (E, V)
+    amp = echoes.amplitude * np.exp(1j * beat_phase0(echoes, radar))  # (E, V)
     # fast time: sum_n w_n exp(j 2 pi (S tau + f_D) t_n) exp(-j 2 pi r n / N)
     t_n = fast_time_s(radar)
     w_r = window(radar.range_window, n_s)

@@ -25,6 +25,7 @@ from ..scene import CfarConfig, RadarConfig
 from .fmcw import AdcCube
 
 __all__ = ["RangeDoppler", "Detections", "range_doppler", "cfar_mask", "detect",
+           "nearest_detection",
            "angle_spectrum", "estimate_angles", "range_angle_map", "process", "window"]
 
 
@@ -159,9 +160,7 @@ def estimate_angles(snapshots: np.ndarray, rut: RutArray, radar: RadarConfig) ->
         pw = np.abs(np.einsum("dv,dov->do", x, steer)) ** 2
         i = np.clip(np.argmax(pw, axis=1), 1, offs.size - 2)
         rows = np.arange(pw.shape[0])
-        y0, y1, y2 = pw[rows, i - 1], pw[rows, i], pw[rows, i + 1]
-        den = y0 - 2 * y1 + y2
-        frac = np.where(np.abs(den) > 0, 0.5 * (y0 - y2) / np.where(den == 0, 1, den), 0.0)
+        frac = _parabolic(pw[rows, i - 1], pw[rows, i], pw[rows, i + 1])
         best = cand[rows, i] + np.clip(frac, -1, 1) * np.radians(step)
     out = best.reshape(shape)
     return out if np.ndim(snapshots) > 1 else out[0]
@@ -202,6 +201,19 @@ def detect(rd: RangeDoppler, cube: AdcCube) -> Detections:
         snr_db=frozen(10 * np.log10(rd.power[r_i, d_i] / noise[r_i, d_i])),
         range_bin=frozen(r_i), doppler_bin=frozen(d_i),
     )
+
+
+def nearest_detection(det: Detections, rd: RangeDoppler, range_m: float,
+                      velocity_mps: float = 0.0, bins: int = 2) -> int | None:
+    """Index of the strongest detection within ``bins`` range and Doppler bins of a set-point,
+    or None."""
+    dr = rd.range_m[1] - rd.range_m[0]
+    dv = rd.velocity_mps[1] - rd.velocity_mps[0]
+    near = ((np.abs(det.range_m - range_m) <= bins * dr)
+            & (np.abs(det.velocity_mps - velocity_mps) <= bins * dv))
+    if not np.any(near):
+        return None
+    return int(np.flatnonzero(near)[np.argmax(det.power_db[near])])
 
 
 def range_angle_map(rd: RangeDoppler, cube: AdcCube, angles_rad: np.ndarray) -> np.ndarray:
