@@ -469,3 +469,15 @@ def test_scene_warnings(label, mutate, head, text):
 
 def test_default_scene_has_no_warnings(default_scene):
     assert scene_warnings(default_scene) == []
+
+
+def test_cli_output_into_a_closed_pipe_stops_quietly():
+    # `rtsgeom ... | head`: the reader closes the pipe before the CLI writes
+    import subprocess
+    import sys
+    p = subprocess.Popen([sys.executable, "-m", "rtsgeom", "info", str(DEFAULT_SCENE), "--json"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT)
+    p.stdout.close()
+    err = p.stderr.read().decode()
+    assert p.wait(timeout=60) == 0
+    assert "Broken pipe" not in err and "Traceback" not in err

@@ -51,6 +51,10 @@ def main(argv: list[str] | None = None) -> int:
     except (SceneError, UsageError, _raytrace_unavailable()) as exc:
         print(f"rtsgeom: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:  # the reader went away (`rtsgeom ... | head`): stop quietly
+        import os
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except OSError as exc:  # an output path that cannot be written, a missing input file
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"rtsgeom: error: {where}{exc.strerror or exc}", file=sys.stderr)
