@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from rtsgeom.aoa.synthesis import PairModel
-from rtsgeom.analysis.tolerance import (CASES, NOMINAL_AMPLITUDES, PairPhasors, _coherence_phase,
+from rtsgeom.analysis.tolerance import (CASES, NOMINAL_AMPLITUDES, PairPhasors,
                                         draw_offsets, max_sigma_for_yield, monte_carlo)
 from rtsgeom.cli import main
 from rtsgeom.geometry import build_setup
@@ -106,7 +106,7 @@ def test_redesign_for_the_delay_matches_pair_model(model):
         pm = PairModel.build(model.setup, pm_paths, (0, 1), TargetConfig(model.range_m),
                              (0.0, k * model.delay_resolution_s))
         delayed = tdm_compensate(pm.responses[1], 0.0, rut, radar)
-        phase = float(_coherence_phase(model.setup, delayed, model.probe_rad))
+        phase = float(model.coherence_phase(delayed))
         gain = 1 / abs(model.delay_factor[k + model.max_steps][rut.azimuth_mask].mean())
         assert gain > 1.0  # the echo left the bin centre
         for m in (0, 10, 20):
@@ -209,7 +209,7 @@ def test_radial_errors_are_calibrated_back_to_the_nominal(model):
     table_phase = np.angle(model.delay_factor[:, az].mean(axis=1))
 
     def eps(x, k):
-        need = _coherence_phase(model.setup, x, model.probe_rad)
+        need = model.coherence_phase(x)
         return np.angle(np.exp(1j * (table_phase[k + model.max_steps] - need)))
 
     x0 = model.x_nominal

@@ -52,11 +52,13 @@ import numpy as np
 from scipy.constants import c
 
 from ..aoa.calibration import nominal_model, probe_angles, probe_ranges
-from ..aoa.synthesis import AngleUnreachable, PairModel, ratio_array_factor
+from ..aoa.model import ChannelModel
+from ..aoa.synthesis import AngleUnreachable, PairModel
 from ..geometry import RutArray, Setup, build_setup
 from ..geometry.farfield import (aperture_m, apparent_azimuth_rad, fraunhofer_distance_m,
                                  two_way_lengths)
 from ..paths import Paths, exact_paths
+from ..radar.steering import Steering
 from ..rts import requested_delay
 from ..scene import Scene, TargetConfig
 
@@ -131,12 +133,13 @@ def beat_frequency_azimuth_rad(angle_rad, radar, tau_s) -> np.ndarray:
     return np.arcsin(np.clip(np.sin(angle_rad) * scale, -1.0, 1.0))
 
 
-def _residual_deg(rut: RutArray, lengths: np.ndarray) -> np.ndarray:
-    """Phase (deg) of path lengths (F, V_az) minus their best linear fit over x_v."""
-    x = rut.virtual_local[rut.azimuth_mask, 0]
+def _residual_deg(steering: Steering, lengths: np.ndarray) -> np.ndarray:
+    """Phase (deg) of path lengths (F, V_s) of the beamformer's elements minus their best
+    linear fit over the positions (azimuth: x_v)."""
+    x = steering.positions_m[:, 0]
     fit = np.polynomial.polynomial.polyfit(x, lengths.T, 1)  # (2, F)
     resid = lengths - np.polynomial.polynomial.polyval(x, fit)
-    return np.degrees(2 * np.pi * resid / rut.wavelength_m)
+    return np.degrees(2 * np.pi * resid / steering.wavelength_m)
 
 
 def phase_error_deg(setup: Setup) -> dict[str, np.ndarray]:
@@ -145,9 +148,10 @@ def phase_error_deg(setup: Setup) -> dict[str, np.ndarray]:
     after each RuT group's locally plane wave to the antenna it sees (pure phase-front
     curvature, what the Fraunhofer criterion is about)."""
     rut, fe = setup.rut, setup.fe
-    m = rut.azimuth_mask
+    steering = Steering.build(rut, setup.scene.radar)
+    m = steering.mask
     exact = two_way_lengths(rut, fe.rx, fe.tx)[:, m]  # (F, V_az)
-    total = _residual_deg(rut, exact)
+    total = _residual_deg(steering, exact)
     # locally plane waves per group: |p - s| ~ |c - s| - (p - c) . u, u = (s - c)/|s - c|
     tx, rx = rut.tx_world[rut.virtual_tx[m]], rut.rx_world[rut.virtual_rx[m]]
     planar = np.zeros_like(exact)
@@ -156,7 +160,7 @@ def phase_error_deg(setup: Setup) -> dict[str, np.ndarray]:
         d = src - centre  # (F, 3)
         dist = np.linalg.norm(d, axis=-1)
         planar += dist[:, None] - ((pts - centre) @ (d / dist[:, None]).T).T
-    curv = _residual_deg(rut, exact - planar)
+    curv = _residual_deg(steering, exact - planar)
     return {"pp": np.ptp(total, axis=1), "rms": np.sqrt(np.mean(total ** 2, axis=1)),
             "curvature_pp": np.ptp(curv, axis=1)}
 
@@ -169,10 +173,10 @@ def phase_error_deg(setup: Setup) -> dict[str, np.ndarray]:
 def single_front_end_angles_rad(setup: Setup, paths: Paths, range_m: float) -> np.ndarray:
     """Detected angle (rad) of each front end alone (unit amplitude, zero Doppler) at
     ``range_m``: phasor level through the exact paths, TDM compensation and the RuT's
-    beamformer (``PairModel`` of the front end with itself, channel I alone)."""
-    target = TargetConfig(float(range_m))
-    return np.array([float(PairModel.build(setup, paths, (q, q), target).angle(0.0))
-                     for q in range(setup.fe.count)])
+    beamformer (the :class:`~rtsgeom.aoa.model.ChannelModel` of all front ends, each alone)."""
+    n = setup.fe.count
+    model = ChannelModel.build(setup, paths, range(n), TargetConfig(float(range_m)))
+    return model.direction(np.eye(n))
 
 
 def _echo_delay_s(setup: Setup, range_m: float) -> np.ndarray:
@@ -207,12 +211,11 @@ def synthesis_worst_errors_deg(setup: Setup, paths: Paths, pair: tuple[int, int]
                     "note": "the measured and geometric spans do not overlap"})
         return out
     sets = lo + np.arange(1, points + 1) / (points + 1) * (hi - lo)
-    n_az = int(np.count_nonzero(setup.rut.azimuth_mask))
     err = {"array-factor": [], "exact": []}
     probes = probe_angles(*single_rad[[i, j]])
     design_phase, phase = design.coherent_phase(probes), actual.coherent_phase(probes)
     for a in sets:
-        rho_af = max(float(ratio_array_factor(geo[0], geo[1], a, n_az)), 0.0)
+        rho_af = design.solve(a, design_phase, mode="array-factor")
         try:
             rho_ex = design.solve(a, design_phase)
         except AngleUnreachable:

@@ -4,14 +4,15 @@ Angle of Arrival", "Constraints": a radial error of lambda/4 already cancels the
 Each draw moves both front ends of a pair radially, tangentially and in height (normal with
 given sigmas, or uniform within given bounds). The operator does not know the errors: the
 amplitudes of the set-points across the pair's span (21 by default, ends excluded as in
-``aoa.linearity``) are designed once on the nominal setup (:class:`PairModel`, its ``solve``
-and ``amplitudes`` for the phase the calibration establishes, see :func:`_coherence_phase`).
+``aoa.linearity``) are designed once on the nominal setup (:class:`~rtsgeom.aoa.model.ChannelModel`,
+its ``solve`` and ``amplitudes`` for the phase the calibration establishes, see
+:meth:`PairPhasors.coherence_phase`).
 For every draw the synthesized angle is evaluated uncalibrated (no delay offset) and after
 the calibration.
 
 Phasor level (the paper's eq. 15/16 with the exact geometry). The spectrum of channel q at the
 target's range/Doppler bin per virtual element v is the nominal one (``radar.phasors`` via
-:class:`PairModel`) times the changed two-way air delay's phase and free-space amplitude::
+:class:`~rtsgeom.aoa.model.ChannelModel`) times the changed two-way air delay's phase and free-space amplitude::
 
     x_qv(draw) = x_qv(nominal) * (a_qv b_qv / a'_qv b'_qv)
                  * exp(j 2 pi (f_c + S t_mid - S tau_t) (tau'_qv - tau_qv))
@@ -58,7 +59,6 @@ process pool or cluster can map it (``monte_carlo(..., mapper=...)``).
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import math
 from dataclasses import dataclass
@@ -69,14 +69,12 @@ from scipy.constants import c
 
 from .._util import frozen
 from ..aoa.calibration import probe_ranges
-from ..aoa.synthesis import PairModel
+from ..aoa.model import ChannelModel
 from ..geometry import Setup
-from ..geometry.arc import antenna_positions
 from ..geometry.setup import nominal_setup
 from ..paths import exact_paths
-from ..paths.exact import leg_delays
 from ..radar.phasors import bin_response
-from ..radar.processing import _angle_taper, estimate_angles, refine_angles, tdm_compensate
+from ..radar.processing import refine_angles
 from ..rts import KIND_DIRECT, RtsProgram, channel_echoes, requested_delay
 from ..scene import TargetConfig
 
@@ -100,11 +98,10 @@ Mapper = Callable[[Callable, list], Iterable]  # ordered map of a pure function 
 
 @dataclass(frozen=True)
 class PairPhasors:
-    """The nominal per-element phasors of one front-end pair at a target's bin, its design
-    (set-points, amplitudes) and what a draw needs to perturb them.
+    """The design (set-points, amplitudes) and the calibration of one front-end pair at a
+    target's bin, on its :class:`~rtsgeom.aoa.model.ChannelModel` (``channels``), which holds
+    the nominal per-element phasors, the beamformer and the mounting-error perturbation.
 
-    ``x_nominal[q, v]``: the spectrum of channel q (I, J) programmed with unit amplitude at the
-    target's range/Doppler bin, virtual element v, TDM-compensated (:class:`PairModel`).
     ``delay_factor[K + k, v]``: channel J's spectrum with its RTS delay offset by ``k`` steps of
     the delay resolution, relative to offset 0, for |k| <= K (a bit more than half a
     calibration period): the calibration delay's exact effect at the bin -- the phase of
@@ -112,19 +109,13 @@ class PairPhasors:
     and residual phase terms (``radar.phasors.bin_response``).
     """
 
-    setup: Setup  # nominal
-    pair: tuple[int, int]
-    range_m: float
+    channels: ChannelModel  # Q = 2, on the nominal setup
     fe_angle_rad: np.ndarray  # (2,) each front end alone, detected (nominal, phasor level)
     set_rad: np.ndarray  # (M,) set-points, ends of the span excluded
     probe_rad: np.ndarray  # (2,) calibration probes
     amplitudes: np.ndarray  # (M, 2) designed A_I, A_J
-    x_nominal: np.ndarray  # (2, V)
-    tau_nominal_s: np.ndarray  # (2, V) two-way air delay per virtual element
-    legs_nominal: np.ndarray  # (2, V) product of the two legs' delays (1/amplitude)
     delay_factor: np.ndarray  # (2K + 1, V) channel J's response to a delay offset
     delay_log_slope: np.ndarray  # (2K + 1, V) d ln|delay_factor| / d tau (1/s)
-    f_air_hz: float  # f_c + S (t_mid - tau): d phase / d tau_air at the bin / 2 pi
     cal_slope_hz: float  # f_rts + B/2: eq. (27)
     delay_resolution_s: float
 
@@ -138,34 +129,33 @@ class PairPhasors:
         the two front ends' detected angles into ``points + 1`` parts (ends excluded, as
         ``aoa.linearity``)."""
         nom = nominal_setup(setup)
-        scene, radar, rut = nom.scene, nom.scene.radar, nom.rut
+        scene, radar = nom.scene, nom.scene.radar
         pair = (int(pair[0]), int(pair[1]))
         bin_m = radar.range_resolution_m
         r0 = float(probe_ranges(nom, 1)[0]) if range_m is None else float(range_m)
         target = TargetConfig(max(round(r0 / bin_m), 1) * bin_m)
         paths = exact_paths(nom)
-        model = PairModel.build(nom, paths, pair, target)
-        x = tdm_compensate(model.responses[1], model.doppler_hz, rut, radar)  # (2, V)
-        th = estimate_angles(x, rut, radar)
+        model = ChannelModel.build(nom, paths, pair, target)
+        x = model.phasors  # (2, V)
+        th = model.steering.search(x)
         frac = np.arange(1, points + 1) / (points + 1)
         sets = th[0] + frac * (th[1] - th[0])
         probes = th[0] + np.asarray(PROBE_FRACTIONS) * (th[1] - th[0])
-        phase = _coherence_phase(nom, x, probes)
-        amps = np.array([model.amplitudes(model.solve(float(a), phase), float(a), phase)
-                         for a in sets])
+        phases = model.coherent_phases(probes)
+        amps = np.array([model.amplitudes(model.solve(float(a), phases), float(a))
+                         for a in sets])  # root finding per set-point
         rts = scene.rts
         slope = rts.f_rts_hz + 0.5 * radar.bandwidth_hz
         steps = int(np.ceil(0.5 / (slope * rts.delay_resolution_s))) + 4
         table = _delay_table(nom, paths, pair[1], target, rts.delay_resolution_s, steps)
-        zero = np.zeros_like(x, float)
         log_slope = np.gradient(np.log(np.abs(table)), rts.delay_resolution_s, axis=0)
-        out = cls(nom, pair, target.range_m, frozen(th), frozen(sets), frozen(probes),
-                  frozen(amps), frozen(x), zero, zero, frozen(table), frozen(log_slope),
-                  radar.f_center_hz - radar.slope_hz_per_s * 2 * target.range_m / c, slope,
-                  rts.delay_resolution_s)
-        t_a, t_b = out.air_legs(np.zeros((2, 3)))
-        return dataclasses.replace(out, tau_nominal_s=frozen(t_a + t_b),
-                                   legs_nominal=frozen(t_a * t_b))
+        return cls(model, frozen(th), frozen(sets), frozen(probes), frozen(amps),
+                   frozen(table), frozen(log_slope), slope, rts.delay_resolution_s)
+
+    setup = property(lambda self: self.channels.setup)  # nominal
+    pair = property(lambda self: self.channels.channels)
+    range_m = property(lambda self: self.channels.range_m)
+    x_nominal = property(lambda self: self.channels.phasors)  # (2, V)
 
     @property
     def max_steps(self) -> int:
@@ -174,38 +164,40 @@ class PairPhasors:
     # -- one draw's channels -------------------------------------------------------------
 
     def air_legs(self, offsets_m) -> tuple[np.ndarray, np.ndarray]:
-        """Delays of both legs (RuT Tx -> FE Rx, FE Tx -> RuT Rx) per virtual element,
-        (..., 2, V) each, for mounting errors ``offsets_m`` (..., 2, 3) (radial, tangential,
-        height) of the pair's front ends."""
-        fe, rut = self.setup.fe, self.setup.rut
-        q = list(self.pair)
-        rx, tx, _ = antenna_positions(fe.arc_centre, fe.arc_radius_m, fe.angle_rad[q],
-                                      fe.separation_m[q], offsets_m)
-        t_a, t_b = leg_delays(rut.tx_world, rut.rx_world, rx, tx)
-        return t_a[..., rut.virtual_tx], t_b[..., rut.virtual_rx]
+        """:meth:`ChannelModel.air_legs`: (..., 2, V) each for offsets (..., 2, 3)."""
+        return self.channels.air_legs(offsets_m)
 
     def channel_phasors(self, offsets_m, return_shift: bool = False):
-        """Per-element phasors of both channels at the bin for mounting errors (..., 2, 3):
-        the nominal ones with the changed air delay's phase and free-space amplitude.
-        ``return_shift``: also the air delay change (..., 2, V) (s)."""
-        t_a, t_b = self.air_legs(offsets_m)
-        d = t_a + t_b - self.tau_nominal_s
-        x = self.x_nominal * (self.legs_nominal / (t_a * t_b)) * np.exp(
-            2j * np.pi * self.f_air_hz * d)
-        return (x, d) if return_shift else x
+        """Per-element phasors of both channels at the bin for mounting errors (..., 2, 3)
+        (:meth:`ChannelModel.perturbed`). ``return_shift``: also the air delay change
+        (..., 2, V) (s)."""
+        return self.channels.perturbed(offsets_m, return_shift)
+
+    def coherence_phase(self, xq: np.ndarray) -> np.ndarray:
+        """The phase to give channel J so that both channels' beamformer outputs add in phase
+        at the probe angles (the circular mean over the probes), (...,) for phasors
+        (..., 2, V) (:meth:`ChannelModel.coherent_phases`).
+
+        The amplitudes are designed for this one phase, the one the calibration establishes,
+        not for the phase that is coherent at each set angle: the two agree to ~1e-6 relative
+        in the ratio while the spacing is below the first null lambda/d_A of the beam, but
+        beyond it the other front end's beam is in its first sidelobe at set angles near
+        either end, the per-angle coherent phase flips by pi and the design fails there
+        (``tests/test_design.py``)."""
+        return self.channels.coherent_phases(self.probe_rad, xq)[..., 1]
 
     def calibration_steps(self, xq: np.ndarray) -> np.ndarray:
         """The calibration of channel J, in delay-resolution steps (int, (...,)).
 
         The phase that makes both channels' beamformer outputs coherent at the probe angles
-        (:func:`_coherence_phase`) becomes a delay by eq. (27), wrapped to the smallest
+        (:meth:`coherence_phase`) becomes a delay by eq. (27), wrapped to the smallest
         |delay|, quantised, and refined by +-3 steps against the delay table's exact phase
         (what the calibration sweep, which measures the outcome, converges to)."""
-        phi = _coherence_phase(self.setup, xq, self.probe_rad)
+        phi = self.coherence_phase(xq)
         k0 = np.round(phi / (2 * np.pi * self.cal_slope_hz * self.delay_resolution_s))
         cand = np.clip(k0[..., None].astype(int) + np.arange(-3, 4), -self.max_steps,
                        self.max_steps)
-        table_phase = np.angle(self.delay_factor[:, self.setup.rut.azimuth_mask].mean(axis=1))
+        table_phase = np.angle(self.delay_factor[:, self.channels.steering.mask].mean(axis=1))
         miss = np.abs(np.angle(np.exp(1j * (phi[..., None] - table_phase[cand + self.max_steps]))))
         return np.take_along_axis(cand, np.argmin(miss, axis=-1)[..., None], axis=-1)[..., 0]
 
@@ -233,7 +225,7 @@ class PairPhasors:
             k = np.asarray(steps) + self.max_steps
             f = self.delay_factor[k]  # (..., V)
             if redesign:  # from the nominal model: the operator does not know the shift
-                g[..., 1] /= np.abs(f[..., self.setup.rut.azimuth_mask].mean(axis=-1))
+                g[..., 1] /= np.abs(f[..., self.channels.steering.mask].mean(axis=-1))
             if shift_s is not None:
                 f = f * np.exp(self.delay_log_slope[k] * shift_s[..., 1, :])
             x_j = x_j * f
@@ -248,8 +240,8 @@ class PairPhasors:
         return self._errors(snaps, return_converged)
 
     def _errors(self, snaps, return_converged=False):
-        rut, radar = self.setup.rut, self.setup.scene.radar
-        ang, ok = refine_angles(snaps, rut, radar, self.set_rad, return_converged=True)
+        ang, ok = refine_angles(snaps, self.channels.steering, None, self.set_rad,
+                                return_converged=True)
         err = np.degrees(ang - self.set_rad)
         return (err, ok) if return_converged else err
 
@@ -271,27 +263,6 @@ class PairPhasors:
             "nominal_delta_tau_s": k * self.delay_resolution_s,
             "delay_resolution_s": self.delay_resolution_s,
         }
-
-
-def _coherence_phase(setup: Setup, xq: np.ndarray, probes_rad: np.ndarray) -> np.ndarray:
-    """The phase to give channel J so that both channels' beamformer outputs add in phase at
-    the probe angles (the circular mean over the probes), (...,) for phasors (..., 2, V).
-
-    The amplitudes are designed for this one phase, the one the calibration establishes, not
-    for the phase that is coherent at each set angle (``PairModel.design``): the two agree to
-    ~1e-6 relative in the ratio while the spacing is below the first null lambda/d_A of the
-    beam, but beyond it the other front end's beam is in its first sidelobe at set angles near
-    either end, the per-angle coherent phase flips by pi and the design fails there
-    (``tests/test_design.py``)."""
-    rut, radar = setup.rut, setup.scene.radar
-    az = rut.azimuth_mask
-    kx = 2 * np.pi / rut.wavelength_m * rut.virtual_local[az, 0]
-    steer = np.exp(1j * kx[:, None] * np.sin(np.asarray(probes_rad))[None, :])  # (V, P)
-    w = xq[..., az] * _angle_taper(radar, rut)
-    b = np.sum(w[..., :, :, None] * steer, axis=-2)  # (..., 2, P); elementwise: bit-stable
-    z = b[..., 0, :] * np.conj(b[..., 1, :])
-    mag = np.abs(z)
-    return np.angle(np.sum(z / np.where(mag > 0, mag, 1.0), axis=-1))
 
 
 def _delay_table(setup: Setup, paths, channel: int, target: TargetConfig, resolution_s: float,

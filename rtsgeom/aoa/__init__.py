@@ -3,7 +3,8 @@ signal chain)."""
 
 from .calibration import Calibration, calibrate_pair, probe_front_ends
 from .plan import plan_targets
+from .model import ChannelModel
 from .synthesis import MODES, PairModel
 
 __all__ = ["Calibration", "calibrate_pair", "probe_front_ends", "plan_targets", "MODES",
-           "PairModel"]
+           "ChannelModel", "PairModel"]

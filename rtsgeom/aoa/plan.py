@@ -16,7 +16,7 @@ from ..scene import SceneError, TargetConfig
 from scipy.constants import c
 from .calibration import (Calibration, FrontEndProbe, calibrate_pair, probe_angles,
                           probe_front_ends)
-from .synthesis import AngleUnreachable, PairModel, ratio_array_factor, ratio_paper
+from .synthesis import PairModel
 
 __all__ = ["bracketing_pair", "pair_amplitudes", "plan_targets", "channel_offsets"]
 
@@ -46,27 +46,7 @@ def pair_amplitudes(setup: Setup, paths: Paths, pair, target: TargetConfig, mode
     model = PairModel.build(nom, nom_paths, pair, target, offsets)
     alpha = target.angle_rad
     phase = model.coherent_phase(probes_rad)  # the phase the calibration establishes
-    if mode == "exact":
-        rho = model.solve(alpha, phase)
-    else:
-        th = nom.fe_azimuth_rad()[list(pair)]  # the design knows the nominal angles
-        lo, hi = np.sort(th)
-        if not lo <= alpha <= hi:
-            raise AngleUnreachable(
-                f"angle {np.degrees(alpha):.4f} deg is outside the span the {mode} closed form "
-                f"can address: the front ends' geometric angles [{np.degrees(lo):.4f}, "
-                f"{np.degrees(hi):.4f}] deg (use the exact mode for the measured span)")
-        eps = 1e-9 * (hi - lo)
-        if abs(alpha - th[0]) <= eps:  # at a span end: that channel alone
-            rho = 0.0
-        elif abs(alpha - th[1]) <= eps:
-            rho = 1e12
-        elif mode == "paper":
-            rho = float(ratio_paper(th[0], th[1], alpha))
-        else:
-            n = int(np.count_nonzero(setup.rut.azimuth_mask))
-            rho = float(ratio_array_factor(th[0], th[1], alpha, n))
-        rho = float(np.clip(rho, 0.0, 1e12))
+    rho = model.solve(alpha, phase, mode=mode)  # exact: root finder; else closed forms
     a_i, a_j = model.amplitudes(rho, alpha, phase)
     return a_i * gain_correction[0], a_j * gain_correction[1], rho
 

@@ -20,12 +20,14 @@ echo. Phases are formed in float64; the cube is complex64.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
 from ..geometry import RutArray
 from ..rts import Echoes
 from ..scene import RadarConfig
+from .steering import Steering
 
 __all__ = ["AdcCube", "fast_time_s", "chirp_start_s", "beat_phase0", "synthesize",
            "synthesize_exact", "add_noise"]
@@ -42,6 +44,11 @@ class AdcCube:
     @property
     def shape(self) -> tuple[int, int, int]:
         return self.data.shape
+
+    @cached_property
+    def steering(self) -> Steering:
+        """The RuT's beamformer (built once per cube)."""
+        return Steering.build(self.rut, self.radar)
 
 
 def fast_time_s(radar: RadarConfig) -> np.ndarray:

@@ -20,7 +20,7 @@ from ..geometry import RutArray
 from ..rts import Echoes
 from ..scene import RadarConfig
 from .fmcw import beat_phase0, chirp_start_s, fast_time_s
-from .processing import window
+from .steering import window
 
 __all__ = ["bin_response"]
 

@@ -16,23 +16,18 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage, signal
+from scipy import ndimage
 from scipy.constants import c
 
 from .._util import frozen
 from ..geometry import RutArray
 from ..scene import CfarConfig, RadarConfig
 from .fmcw import AdcCube
+from .steering import Steering, parabolic as _parabolic, window
 
 __all__ = ["RangeDoppler", "Detections", "range_doppler", "cfar_mask", "detect",
            "nearest_detection",
            "angle_spectrum", "estimate_angles", "range_angle_map", "process", "window"]
-
-
-def window(name: str, n: int) -> np.ndarray:
-    if name == "none":
-        return np.ones(n)
-    return signal.get_window(name, n, fftbins=False)
 
 
 @dataclass(frozen=True)
@@ -114,62 +109,27 @@ def cfar_mask(power: np.ndarray, cfg: CfarConfig) -> tuple[np.ndarray, np.ndarra
     return (power > thr) & peak, noise
 
 
-def _steering(rut: RutArray, sin_alpha: np.ndarray) -> np.ndarray:
-    """Beamformer weights exp(+j k x_v sin alpha) for the azimuth virtual array, (..., V_az)."""
-    x = rut.virtual_local[rut.azimuth_mask, 0]
-    k = 2 * np.pi / rut.wavelength_m
-    return np.exp(1j * k * np.asarray(sin_alpha)[..., None] * x)
+def _steering_of(rut: RutArray | Steering, radar: RadarConfig | None) -> Steering:
+    return rut if isinstance(rut, Steering) else Steering.build(rut, radar)
 
 
-def _angle_taper(radar: RadarConfig, rut: RutArray) -> np.ndarray:
-    x = rut.virtual_local[rut.azimuth_mask, 0]
-    w = np.empty_like(x)
-    w[np.argsort(x)] = window(radar.angle_window, x.size)
-    return w
-
-
-def angle_spectrum(snapshots: np.ndarray, rut: RutArray, radar: RadarConfig,
+def angle_spectrum(snapshots: np.ndarray, rut: RutArray | Steering, radar: RadarConfig | None,
                    angles_rad: np.ndarray) -> np.ndarray:
-    """Beamformer power |sum_v w_v x_v exp(j k x_v sin alpha)|^2 (eq. 14).
+    """Beamformer power |sum_v w_v x_v exp(j k x_v sin alpha)|^2 (eq. 14):
+    :meth:`Steering.power` at azimuths ``angles_rad`` (A,).
 
     ``snapshots`` (..., V) over all virtual channels (the azimuth row is selected here);
-    returns (..., A).
+    returns (..., A). ``rut``: the RuT array (with ``radar``) or its :class:`Steering`.
     """
-    x = snapshots[..., rut.azimuth_mask] * _angle_taper(radar, rut)
-    steer = _steering(rut, np.sin(angles_rad))  # (A, V_az)
-    return np.abs(x @ steer.T) ** 2
+    st = _steering_of(rut, radar)
+    return st.power(snapshots, st.directions(np.asarray(angles_rad)))
 
 
-def estimate_angles(snapshots: np.ndarray, rut: RutArray, radar: RadarConfig) -> np.ndarray:
-    """Peak of the beamformer per snapshot (..., V) -> (...,) radians.
-
-    Grid search at 0.25 deg, then two zoom levels (0.005 deg, 1e-4 deg) and a final parabolic
-    interpolation: precise to ~1e-6 deg on noise-free data, vectorised over snapshots.
-    """
-    snaps = np.atleast_2d(snapshots)
-    shape = snaps.shape[:-1]
-    snaps = snaps.reshape(-1, snaps.shape[-1])
-    grid = np.radians(np.arange(-90.0, 90.0001, 0.25))
-    p = angle_spectrum(snaps, rut, radar, grid)
-    best = grid[np.argmax(p, axis=1)]
-    for half, step in ((0.3, 0.005), (0.006, 1e-4)):
-        offs = np.radians(np.arange(-half, half + step / 2, step))
-        cand = np.clip(best[:, None] + offs[None, :], -np.pi / 2, np.pi / 2)
-        x = snaps[:, rut.azimuth_mask] * _angle_taper(radar, rut)
-        steer = _steering(rut, np.sin(cand))  # (D, O, V_az)
-        pw = np.abs(np.einsum("dv,dov->do", x, steer)) ** 2
-        i = np.clip(np.argmax(pw, axis=1), 1, offs.size - 2)
-        rows = np.arange(pw.shape[0])
-        frac = _parabolic(pw[rows, i - 1], pw[rows, i], pw[rows, i + 1])
-        best = cand[rows, i] + np.clip(frac, -1, 1) * np.radians(step)
-    out = best.reshape(shape)
-    return out if np.ndim(snapshots) > 1 else out[0]
-
-
-def _parabolic(y0, y1, y2) -> np.ndarray:
-    """Sub-bin offset of a peak from three log-power samples."""
-    den = y0 - 2 * y1 + y2
-    return np.where(den < 0, 0.5 * (y0 - y2) / np.where(den == 0, -1, den), 0.0)
+def estimate_angles(snapshots: np.ndarray, rut: RutArray | Steering,
+                    radar: RadarConfig | None = None) -> np.ndarray:
+    """Peak of the beamformer per snapshot (..., V) -> (...,) radians (:meth:`Steering.search`:
+    grid search, zoom, parabolic interpolation; ~1e-6 deg on noise-free data)."""
+    return _steering_of(rut, radar).search(snapshots)
 
 
 def tdm_compensate(snapshots: np.ndarray, doppler_hz, rut: RutArray,
@@ -192,7 +152,7 @@ def detect(rd: RangeDoppler, cube: AdcCube) -> Detections:
     nu_step = rd.doppler_hz[1] - rd.doppler_hz[0]
     nu = rd.doppler_hz[d_i] + dd * nu_step
     snaps = tdm_compensate(rd.spectrum[r_i, d_i, :], nu, rut, radar)
-    ang = estimate_angles(snaps, rut, radar) if r_i.size else np.zeros(0)
+    ang = cube.steering.search(snaps) if r_i.size else np.zeros(0)
     return Detections(
         range_m=frozen(rd.range_m[r_i] + dr * range_step),
         velocity_mps=frozen(nu * c / (2 * radar.f_c_hz)),
@@ -221,7 +181,7 @@ def range_angle_map(rd: RangeDoppler, cube: AdcCube, angles_rad: np.ndarray) -> 
     d_best = np.argmax(rd.power, axis=1)
     r = np.arange(rd.power.shape[0])
     snaps = tdm_compensate(rd.spectrum[r, d_best, :], rd.doppler_hz[d_best], cube.rut, cube.radar)
-    return angle_spectrum(snaps, cube.rut, cube.radar, angles_rad)
+    return angle_spectrum(snaps, cube.steering, None, angles_rad)
 
 
 def process(cube: AdcCube) -> tuple[RangeDoppler, Detections]:
@@ -229,81 +189,16 @@ def process(cube: AdcCube) -> tuple[RangeDoppler, Detections]:
     return rd, detect(rd, cube)
 
 
-def refine_angles(snapshots: np.ndarray, rut: RutArray, radar: RadarConfig, start_rad,
-                  iterations: int = 4, *, return_converged: bool = False):
+def refine_angles(snapshots: np.ndarray, rut: RutArray | Steering, radar: RadarConfig | None,
+                  start_rad, iterations: int = 4, *, return_converged: bool = False):
     """Beamformer peak per snapshot (..., V) -> (...,) radians, by Newton's method from
     ``start_rad`` (broadcast to the snapshots): the fast path of :func:`estimate_angles` when
     the peak is known to lie near the start (e.g. a synthesized target near its set angle).
-
-    Up to ``iterations`` Newton steps on log P(u), u = sin(alpha), with P the beamformer power
-    of eq. (14) and its analytic derivatives (one pass over the elements per step, no grid).
-    A snapshot is accepted when its last step is below 1e-6 in u (quadratic convergence: the
-    next one would be ~1e-11), log P is concave there, and no point of a coarse grid over the
-    visible region (steps of lambda / (8 d_A) in u, at most ~1 % below the top of a lobe) has
-    more power, i.e. the peak found is the global one. The others are restarted from that
-    grid's maximum; what still fails goes to :func:`estimate_angles`. Elementwise arithmetic
-    in cache-sized blocks, so equal snapshots give bit-equal angles. ``return_converged`` also
-    returns a mask, False where :func:`estimate_angles` was used.
+    :meth:`Steering.peak` in azimuth (u = sin alpha): global check on a grid, restart from the
+    grid's maximum, and what still fails from :func:`estimate_angles`. ``return_converged``
+    also returns a mask, False where :func:`estimate_angles` was used.
     """
-    snaps = np.asarray(snapshots)
-    shape = snaps.shape[:-1]
-    flat = snaps.reshape(-1, snaps.shape[-1])
-    az = rut.azimuth_mask
-    kx = 2 * np.pi / rut.wavelength_m * rut.virtual_local[az, 0]
-    kx2 = kx ** 2
-    taper = _angle_taper(radar, rut)
-    grid = np.linspace(-1.0, 1.0, int(np.ceil(16 * kx.size * rut.spacing_m / rut.wavelength_m)) + 1)
-    steer = np.exp(1j * kx[:, None] * grid[None, :])  # (V, G)
-    u0 = np.sin(np.broadcast_to(np.asarray(start_rad, float), shape)).ravel()
-    u = np.empty(u0.size)
-    ok = np.zeros(u0.size, bool)
-
-    def newton(xr, xi, u, p_max, steps):
-        """Newton steps from ``u`` on snapshots (V, n) split in real and imaginary parts:
-        (u, accepted); accepted needs the power at the peak >= ``p_max`` (the grid's)."""
-        u = np.array(u, float)
-        ok = np.zeros(u.size, bool)
-        p_last = np.zeros(u.size)
-        act = np.arange(u.size)
-        for _ in range(steps):
-            if act.size == 0:
-                break
-            ar, ai, ua = xr[:, act], xi[:, act], u[act]
-            ph = kx[:, None] * ua
-            co, si = np.cos(ph), np.sin(ph)
-            y = np.stack([ar * co - ai * si, ar * si + ai * co])  # (2, V, n): Re, Im
-            # Re, Im of B = sum y, C = sum kx y, D = sum kx^2 y (row sums: bit-stable)
-            m = np.concatenate([y.sum(axis=1), (y * kx[:, None]).sum(axis=1),
-                                (y * kx2[:, None]).sum(axis=1)])
-            p = m[0] ** 2 + m[1] ** 2  # P = |B|^2 with B' = j C, B'' = -D
-            with np.errstate(divide="ignore", invalid="ignore"):
-                f1 = 2 * (m[1] * m[2] - m[0] * m[3]) / p
-                f2 = 2 * (m[2] ** 2 + m[3] ** 2 - m[0] * m[4] - m[1] * m[5]) / p - f1 ** 2
-                step = np.where(f2 < 0, -f1 / f2, np.nan)
-            fine = np.isfinite(step)
-            u[act] = ua + np.clip(np.where(fine, step, 0.0), -0.05, 0.05)
-            p_last[act] = p  # within ~1e-10 (relative) of the power at the final u
-            done = np.abs(step) < 1e-6
-            ok[act[done]] = True
-            act = act[fine & ~done]
-        return u, ok & (np.abs(u) < 1) & (p_last >= p_max * (1 - 1e-9))
-
-    for b in range(0, u0.size, 4096):
-        blk = slice(b, b + 4096)
-        x = flat[blk][:, az] * taper
-        y = x @ steer
-        p_grid = y.real ** 2 + y.imag ** 2  # (n, G)
-        p_max = p_grid.max(axis=1)
-        xr, xi = np.ascontiguousarray(x.real.T), np.ascontiguousarray(x.imag.T)
-        u[blk], ok[blk] = newton(xr, xi, u0[blk], p_max, iterations)
-        bad = np.flatnonzero(~ok[blk])
-        if bad.size:  # restart from the grid's maximum
-            u2, ok2 = newton(xr[:, bad], xi[:, bad], grid[np.argmax(p_grid[bad], axis=1)],
-                             p_max[bad], iterations + 4)
-            u[b + bad[ok2]] = u2[ok2]
-            ok[b + bad[ok2]] = True
-    out = np.arcsin(np.clip(u, -1.0, 1.0))
-    if not ok.all():
-        out[~ok] = estimate_angles(flat[~ok], rut, radar)
-    out = out.reshape(shape)
-    return (out, ok.reshape(shape)) if return_converged else out
+    st = _steering_of(rut, radar)
+    u, ok = st.peak(snapshots, st.directions(start_rad), iterations)
+    out = np.arcsin(np.clip(u[..., 0], -1.0, 1.0))
+    return (out, ok) if return_converged else out

@@ -1,0 +1,260 @@
+"""The RuT's beamformer (paper eq. 14): one steering model for every stage that forms a beam.
+
+A :class:`Steering` is built once from the RuT array and the radar configuration and carried by
+the ADC cube (``AdcCube.steering``) and by the channel models (``aoa.model.ChannelModel``):
+
+* which virtual elements take part (``mask``, (V,)), today the azimuth row;
+* their positions ``positions_m`` (V_s, D) in the radar frame along the direction-cosine axes:
+  D = 1 is azimuth (x, u = sin az); D = 2 adds elevation (x, z; u = (sin az cos el, sin el)).
+  A custom or sparse array only changes these positions;
+* the angle taper ``taper`` (V_s,) (the scene's ``radar.angle_window``).
+
+The virtual element at ``p_v`` receives a source in direction ``u`` with phase ``-k p_v . u``;
+the beamformer steers with ``+k p_v . u`` (sign conventions: ``radar.processing``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import signal
+
+from .._util import frozen
+from ..geometry import RutArray
+from ..scene import RadarConfig
+
+__all__ = ["Steering", "window"]
+
+BLOCK = 4096  # snapshots per block of the Newton refinement (cache-sized)
+
+
+def window(name: str, n: int) -> np.ndarray:
+    """Symmetric window ``name`` (scipy.signal names, or ``none``) of n points."""
+    if name == "none":
+        return np.ones(n)
+    return signal.get_window(name, n, fftbins=False)
+
+
+def _taper(name: str, positions: np.ndarray) -> np.ndarray:
+    """Window over the elements in position order, separable over the D axes (D = 1: the
+    window over the elements sorted by x)."""
+    w = np.ones(positions.shape[0])
+    for d in range(positions.shape[1]):
+        x = positions[:, d]
+        if positions.shape[1] == 1:
+            wd = np.empty_like(x)
+            wd[np.argsort(x)] = window(name, x.size)
+        else:  # one window value per distinct coordinate (a row or a column of a 2-D array)
+            vals, inv = np.unique(np.round(x, 12), return_inverse=True)
+            wd = window(name, vals.size)[inv]
+        w = w * wd
+    return w
+
+
+@dataclass(frozen=True)
+class Steering:
+    """Virtual positions, taper and element selection of the RuT's beamformer (eq. 14).
+
+    Directions are direction cosines ``u`` (..., D); angles (rad) only at :meth:`search` and in
+    the ``radar.processing`` wrappers.
+    """
+
+    mask: np.ndarray  # (V,) virtual elements that take part
+    positions_m: np.ndarray  # (V_s, D) radar frame, along the direction-cosine axes
+    taper: np.ndarray  # (V_s,)
+    wavelength_m: float
+    aperture_m: np.ndarray  # (D,) extent of the array per axis (elements times spacing)
+
+    @classmethod
+    def build(cls, rut: RutArray, radar: RadarConfig, elevation: bool = False) -> "Steering":
+        """The azimuth beamformer (D = 1, the azimuth row), or with ``elevation`` the 2-D one
+        over all virtual elements (D = 2: x and z)."""
+        if elevation:
+            mask = np.ones(rut.num_virtual, bool)
+            pos = rut.virtual_local[:, [0, 2]]
+            n = [np.unique(np.round(pos[:, d] / rut.spacing_m, 6)).size for d in range(2)]
+        else:
+            mask = np.asarray(rut.azimuth_mask, bool)
+            pos = rut.virtual_local[mask][:, [0]]
+            n = [int(np.count_nonzero(mask))]
+        return cls(frozen(mask), frozen(pos), frozen(_taper(radar.angle_window, pos)),
+                   float(rut.wavelength_m), frozen(np.asarray(n, float) * rut.spacing_m))
+
+    @property
+    def dims(self) -> int:
+        return int(self.positions_m.shape[1])
+
+    @property
+    def size(self) -> int:
+        return int(self.positions_m.shape[0])
+
+    @property
+    def wavevector(self) -> np.ndarray:
+        """``k p_v`` (V_s, D), k = 2 pi / lambda."""
+        return 2 * np.pi / self.wavelength_m * self.positions_m
+
+    def directions(self, angle_rad) -> np.ndarray:
+        """Direction cosines (..., D) of azimuth angles (...,) (D = 1) or of (az, el) pairs
+        (..., 2) (D = 2)."""
+        a = np.asarray(angle_rad, float)
+        if self.dims == 1:
+            return np.sin(a)[..., None]
+        return np.stack([np.sin(a[..., 0]) * np.cos(a[..., 1]), np.sin(a[..., 1])], axis=-1)
+
+    def weighted(self, snapshots) -> np.ndarray:
+        """The elements that take part, tapered: (..., V) -> (..., V_s)."""
+        return np.asarray(snapshots)[..., self.mask] * self.taper
+
+    def steer(self, u) -> np.ndarray:
+        """Steering vectors exp(+j k p_v . u) for directions ``u`` (..., D): (..., V_s)."""
+        u = np.asarray(u, float)
+        ph = np.sum(self.wavevector * u[..., None, :], axis=-1)
+        return np.exp(1j * ph)
+
+    def beam(self, snapshots, u) -> np.ndarray:
+        """Beamformer output sum_v w_v x_v exp(j k p_v . u) of snapshots (..., V) at directions
+        ``u`` (P, D): (..., P). Elementwise sums, so equal snapshots give equal bits whatever
+        the batch."""
+        w = self.weighted(snapshots)
+        return np.sum(w[..., :, None] * self.steer(u).T, axis=-2)
+
+    def power(self, snapshots, u) -> np.ndarray:
+        """Bartlett power |sum_v w_v x_v exp(j k p_v . u)|^2 (eq. 14) of snapshots (..., V) at
+        directions ``u`` (A, D): (..., A)."""
+        return np.abs(self.weighted(snapshots) @ self.steer(u).T) ** 2
+
+    def search(self, snapshots) -> np.ndarray:
+        """Beamformer peak per snapshot (..., V) -> azimuth (...,) rad, by grid search at
+        0.25 deg, two zoom levels (0.005 deg, 1e-4 deg) and a final parabolic interpolation:
+        precise to ~1e-6 deg on noise-free data. D = 1 only."""
+        if self.dims != 1:
+            raise NotImplementedError("the grid search is azimuth-only (D = 1); use peak()")
+        snaps = np.atleast_2d(snapshots)
+        shape = snaps.shape[:-1]
+        snaps = snaps.reshape(-1, snaps.shape[-1])
+        grid = np.radians(np.arange(-90.0, 90.0001, 0.25))
+        p = self.power(snaps, self.directions(grid))
+        best = grid[np.argmax(p, axis=1)]
+        x = self.weighted(snaps)
+        for half, step in ((0.3, 0.005), (0.006, 1e-4)):
+            offs = np.radians(np.arange(-half, half + step / 2, step))
+            cand = np.clip(best[:, None] + offs[None, :], -np.pi / 2, np.pi / 2)
+            pw = np.abs(np.einsum("dv,dov->do", x, self.steer(self.directions(cand)))) ** 2
+            i = np.clip(np.argmax(pw, axis=1), 1, offs.size - 2)
+            rows = np.arange(pw.shape[0])
+            frac = parabolic(pw[rows, i - 1], pw[rows, i], pw[rows, i + 1])
+            best = cand[rows, i] + np.clip(frac, -1, 1) * np.radians(step)
+        out = best.reshape(shape)
+        return out if np.ndim(snapshots) > 1 else out[0]
+
+    def grid(self) -> np.ndarray:
+        """Directions (G, D) of the global check: steps of lambda / (8 d_A) in u per axis
+        (at most ~1 % below the top of a lobe), inside the visible region."""
+        axes = [np.linspace(-1.0, 1.0, int(np.ceil(16 * a / self.wavelength_m)) + 1)
+                for a in self.aperture_m]
+        g = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, self.dims)
+        return g[np.sum(g ** 2, axis=-1) <= 1.0]
+
+    def peak(self, snapshots, u0, iterations: int = 4):
+        """Beamformer peak per snapshot (..., V) by Newton's method on log P(u) from ``u0``
+        (..., D) (broadcast): returns (u (..., D), converged (...,)).
+
+        Up to ``iterations`` Newton steps with P's analytic gradient and Hessian (one pass over
+        the elements per step, no grid; each component of a step clipped to 0.05). A snapshot
+        is accepted when its last step is below 1e-6 in u (quadratic convergence), log P is
+        concave there, |u| < 1, and no point of :meth:`grid` has more power, i.e. the peak
+        found is the global one. The others are restarted from the grid's maximum (with 4 more
+        steps); what still fails is not converged: its u is the grid search's
+        (:meth:`search`, D = 1) or the grid's maximum (D = 2). Elementwise arithmetic in
+        cache-sized blocks, so equal snapshots give bit-equal results."""
+        snaps = np.asarray(snapshots)
+        shape = snaps.shape[:-1]
+        flat = snaps.reshape(-1, snaps.shape[-1])
+        n_d = self.dims
+        kv = self.wavevector  # (V_s, D)
+        grid = self.grid()
+        steer = self.steer(grid).T  # (V_s, G)
+        u0 = np.broadcast_to(np.asarray(u0, float), shape + (n_d,)).reshape(-1, n_d)
+        u = np.empty_like(u0)
+        ok = np.zeros(u0.shape[0], bool)
+        best_grid = np.empty_like(u0)
+        for b in range(0, u0.shape[0], BLOCK):
+            blk = slice(b, b + BLOCK)
+            x = self.weighted(flat[blk])
+            y = x @ steer
+            p_grid = y.real ** 2 + y.imag ** 2  # (n, G)
+            p_max = p_grid.max(axis=1)
+            best_grid[blk] = grid[np.argmax(p_grid, axis=1)]
+            xr, xi = np.ascontiguousarray(x.real.T), np.ascontiguousarray(x.imag.T)
+            u[blk], ok[blk] = _newton(kv, xr, xi, u0[blk], p_max, iterations)
+            bad = np.flatnonzero(~ok[blk])
+            if bad.size:  # restart from the grid's maximum
+                u2, ok2 = _newton(kv, xr[:, bad], xi[:, bad], best_grid[blk][bad], p_max[bad],
+                                  iterations + 4)
+                u[b + bad[ok2]] = u2[ok2]
+                ok[b + bad[ok2]] = True
+        if not ok.all():
+            if n_d == 1:
+                u[~ok, 0] = np.sin(self.search(flat[~ok]))
+            else:
+                u[~ok] = best_grid[~ok]
+        return u.reshape(shape + (n_d,)), ok.reshape(shape)
+
+
+def _newton(kv, xr, xi, u, p_max, steps):
+    """Newton steps on log P from ``u`` (n, D) for tapered snapshots (V_s, n) split in real and
+    imaginary parts: (u, accepted); accepted needs the power at the peak >= ``p_max``.
+
+    With B = sum_v y_v (y_v = w_v x_v e^{j k p_v . u}), C_a = sum k_va y_v, D_ab = sum k_va
+    k_vb y_v: dB/du_a = j C_a, d2B/du_a du_b = -D_ab, so for P = |B|^2
+    g_a = 2 Im(B conj ... ) = 2 (Im B Re C_a - Re B Im C_a) / P and
+    H_ab = 2 (Re C_a Re C_b + Im C_a Im C_b - Re B Re D_ab - Im B Im D_ab) / P - g_a g_b."""
+    n_d = kv.shape[1]
+    u = np.array(u, float)
+    ok = np.zeros(u.shape[0], bool)
+    p_last = np.zeros(u.shape[0])
+    act = np.arange(u.shape[0])
+    pairs = [(a, b) for a in range(n_d) for b in range(a, n_d)]
+    for _ in range(steps):
+        if act.size == 0:
+            break
+        ar, ai, ua = xr[:, act], xi[:, act], u[act]
+        ph = np.sum(kv[:, :, None] * ua.T[None], axis=1)  # (V_s, n)
+        co, si = np.cos(ph), np.sin(ph)
+        y = np.stack([ar * co - ai * si, ar * si + ai * co])  # (2, V_s, n): Re, Im
+        # row sums: bit-stable
+        bb = y.sum(axis=1)
+        cc = [(y * kv[:, a, None]).sum(axis=1) for a in range(n_d)]
+        dd = {(a, b): (y * (kv[:, a] * kv[:, b])[:, None]).sum(axis=1) for a, b in pairs}
+        p = bb[0] ** 2 + bb[1] ** 2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            g = np.stack([2 * (bb[1] * cc[a][0] - bb[0] * cc[a][1]) / p for a in range(n_d)])
+            h = np.empty((n_d, n_d, act.size))
+            for a, b in pairs:
+                h[a, b] = h[b, a] = (2 * (cc[a][0] * cc[b][0] + cc[a][1] * cc[b][1]
+                                          - bb[0] * dd[a, b][0] - bb[1] * dd[a, b][1]) / p
+                                     - g[a] * g[b])
+            if n_d == 1:
+                step = np.where(h[0, 0] < 0, -g[0] / h[0, 0], np.nan)[:, None]
+            else:
+                hm, gm = np.moveaxis(h, -1, 0), g.T  # (n, D, D), (n, D)
+                concave = np.all(np.linalg.eigvalsh(np.where(np.isfinite(hm), hm, 0.0)) < 0,
+                                 axis=-1) & np.all(np.isfinite(hm), axis=(-2, -1))
+                safe = np.where(concave[:, None, None], hm, -np.eye(n_d))
+                step = np.where(concave[:, None], -np.linalg.solve(safe, gm[..., None])[..., 0],
+                                np.nan)
+        fine = np.all(np.isfinite(step), axis=-1)
+        u[act] = ua + np.clip(np.where(fine[:, None], step, 0.0), -0.05, 0.05)
+        p_last[act] = p  # within ~1e-10 (relative) of the power at the final u
+        done = fine & (np.max(np.abs(np.where(fine[:, None], step, 0.0)), axis=-1) < 1e-6)
+        ok[act[done]] = True
+        act = act[fine & ~done]
+    radius = np.sqrt(np.sum(u ** 2, axis=-1))
+    return u, ok & (radius < 1) & (p_last >= p_max * (1 - 1e-9))
+
+
+def parabolic(y0, y1, y2) -> np.ndarray:
+    """Sub-bin offset of a peak from three samples."""
+    den = y0 - 2 * y1 + y2
+    return np.where(den < 0, 0.5 * (y0 - y2) / np.where(den == 0, -1, den), 0.0)

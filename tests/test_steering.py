@@ -1,0 +1,133 @@
+"""One steering model (issue 21): the beamformer's closed forms on grids of directions, windows
+and arrays (1-D azimuth, 2-D azimuth + elevation, a custom planar array), and the one coherent
+phase that the tolerance study and the channel model share for every angle window."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rtsgeom.analysis.tolerance import PairPhasors
+from rtsgeom.aoa.synthesis import PairModel
+from rtsgeom.geometry import build_setup
+from rtsgeom.paths import exact_paths
+from rtsgeom.radar.processing import angle_spectrum, estimate_angles, refine_angles
+from rtsgeom.radar.steering import Steering
+from rtsgeom.scene import TargetConfig
+
+from conftest import make_scene
+
+WINDOWS = ("none", "hann", "hamming", "blackman")
+
+
+def plane_wave(st: Steering, u, n_virtual: int, mask=None) -> np.ndarray:
+    """Snapshot (..., V) of a unit plane wave from directions u (..., D): exp(-j k p . u) on
+    the elements that take part (zero elsewhere)."""
+    x = np.zeros(np.shape(u)[:-1] + (n_virtual,), complex)
+    x[..., st.mask] = np.exp(-1j * np.sum(st.wavevector * np.asarray(u)[..., None, :], axis=-1))
+    return x
+
+
+@pytest.mark.parametrize("window", WINDOWS)
+def test_azimuth_peak_power_and_search_on_plane_waves(window):
+    """Plane waves over the visible region: the Bartlett power at the source is (sum w)^2 and
+    no direction has more; ``peak`` (Newton) and ``search`` (grid) both find the source."""
+    scene = make_scene(angle_window=window)
+    rut = build_setup(scene).rut
+    st = Steering.build(rut, scene.radar)
+    az = np.radians(np.linspace(-60, 60, 25))
+    x = plane_wave(st, st.directions(az), rut.num_virtual)
+    p_src = np.diagonal(st.power(x, st.directions(az)))
+    assert np.allclose(p_src, np.sum(st.taper) ** 2, rtol=1e-12)
+    grid = st.directions(np.radians(np.linspace(-89, 89, 1001)))
+    assert np.all(st.power(x, grid) <= p_src[:, None] * (1 + 1e-12))
+    u, ok = st.peak(x, st.directions(az + np.radians(1.0)))
+    assert ok.all()
+    assert np.max(np.abs(np.degrees(np.arcsin(u[:, 0]) - az))) < 1e-8
+    assert np.max(np.abs(np.degrees(st.search(x) - az))) < 1e-5
+    # the processing wrappers are the same model
+    assert np.array_equal(angle_spectrum(x, rut, scene.radar, az), st.power(x, st.directions(az)))
+    assert np.array_equal(estimate_angles(x, rut, scene.radar), st.search(x))
+    assert np.array_equal(refine_angles(x, rut, scene.radar, az + np.radians(1.0)),
+                          np.arcsin(u[:, 0]))
+
+
+def test_taper_follows_the_window_over_sorted_positions():
+    for window in WINDOWS:
+        scene = make_scene(angle_window=window)
+        st = Steering.build(build_setup(scene).rut, scene.radar)
+        order = np.argsort(st.positions_m[:, 0])
+        w = st.taper[order]
+        assert np.allclose(w, w[::-1])  # symmetric windows
+        assert (window == "none") == np.allclose(w, 1.0)
+
+
+@pytest.mark.parametrize("elevation_deg", [-20.0, 0.0, 15.0])
+def test_two_dimensional_peak_on_the_radar_with_elevation(elevation_deg):
+    """D = 2 (azimuth + elevation over all virtual elements): Newton in two dimensions finds
+    plane waves over a grid of azimuths at the given elevation."""
+    scene = make_scene(use_elevation_tx=True)
+    rut = build_setup(scene).rut
+    st = Steering.build(rut, scene.radar, elevation=True)
+    assert st.dims == 2 and st.size == rut.num_virtual
+    ang = np.stack(np.broadcast_arrays(np.radians(np.linspace(-50, 50, 11)),
+                                       np.radians(elevation_deg)), axis=-1)
+    u_src = st.directions(ang)
+    x = plane_wave(st, u_src, rut.num_virtual)
+    u, ok = st.peak(x, u_src + 0.01)
+    assert ok.all()
+    assert np.max(np.abs(u - u_src)) < 1e-9
+
+
+def test_custom_planar_array_is_only_other_positions():
+    """A 4 x 4 uniform planar array at lambda/2 with a Hann taper: the same model, the same
+    closed forms (peak at the source, power (sum w)^2)."""
+    lam = 3.9e-3
+    gx, gz = np.meshgrid(np.arange(4) * lam / 2, np.arange(4) * lam / 2, indexing="ij")
+    pos = np.stack([gx.ravel(), gz.ravel()], axis=-1)
+    hann = np.hanning(6)[1:-1]
+    st = Steering(np.ones(16, bool), pos, np.outer(hann, hann).ravel(), lam,
+                  np.array([4, 4]) * lam / 2)
+    rng = np.random.default_rng(3)
+    r = np.sqrt(rng.uniform(0, 0.7 ** 2, 40))
+    phi = rng.uniform(0, 2 * np.pi, 40)
+    u_src = np.stack([r * np.cos(phi), r * np.sin(phi)], axis=-1)
+    x = plane_wave(st, u_src, 16)
+    assert np.allclose(np.einsum("nn->n", st.power(x, u_src)), np.sum(st.taper) ** 2)
+    u, ok = st.peak(x, np.clip(u_src + rng.normal(0, 0.02, u_src.shape), -0.99, 0.99))
+    assert ok.all()
+    assert np.max(np.abs(u - u_src)) < 1e-9
+
+
+@pytest.fixture(scope="module", params=WINDOWS)
+def windowed(request):
+    scene = make_scene(angle_window=request.param)
+    setup = build_setup(scene)
+    tol = PairPhasors.build(setup, (0, 1), points=3)
+    pm = PairModel.build(tol.setup, exact_paths(tol.setup), (0, 1), TargetConfig(tol.range_m))
+    return tol, pm
+
+
+def test_tolerance_and_channel_model_share_the_coherent_phase(windowed):
+    """The phase the tolerance study calibrates to and the one the channel model (PairModel,
+    used by the calibration and the exact mode) designs for are the same for every angle
+    window (before issue 21 only the tolerance model applied the taper: 0.030 deg apart with
+    hamming on the default scene)."""
+    tol, pm = windowed
+    a = float(tol.coherence_phase(tol.x_nominal))
+    b = pm.coherent_phase(tol.probe_rad)
+    assert abs(np.degrees(np.angle(np.exp(1j * (a - b))))) < 1e-9
+
+
+def test_coherent_phase_maximises_the_radars_own_beam(windowed):
+    """At a single probe the coherent phase maximises the power that the RuT's processing
+    (``angle_spectrum``, with its taper) sees of the two channels' sum: 1e-4 rad either side
+    has less."""
+    tol, pm = windowed
+    rut, radar = pm.setup.rut, pm.setup.scene.radar
+    x = tol.x_nominal
+    for probe in tol.probe_rad:
+        phi = pm.coherent_phase(np.array([probe]))
+        p = [angle_spectrum(x[0] + np.exp(1j * (phi + d)) * x[1], rut, radar,
+                            np.array([probe]))[0] for d in (-1e-4, 0.0, 1e-4)]
+        assert p[1] > p[0] and p[1] > p[2]
