@@ -12,7 +12,8 @@ the calibration.
 
 Phasor level (the paper's eq. 15/16 with the exact geometry). The spectrum of channel q at the
 target's range/Doppler bin per virtual element v is the nominal one (``radar.phasors`` via
-:class:`~rtsgeom.aoa.model.ChannelModel`) times the changed two-way air delay's phase and free-space amplitude::
+:class:`~rtsgeom.aoa.model.ChannelModel`) times the changed two-way air delay's phase and
+free-space amplitude (``ChannelModel.perturbed``)::
 
     x_qv(draw) = x_qv(nominal) * (a_qv b_qv / a'_qv b'_qv)
                  * exp(j 2 pi (f_c + S t_mid - S tau_t) (tau'_qv - tau_qv))
