@@ -3,7 +3,9 @@
 ADC cube -> windowed range FFT (eq. 10) -> windowed Doppler FFT -> non-coherent integration over
 the virtual channels -> 2D CFAR (CA or OS) -> local maxima -> per detection: TDM-MIMO Doppler
 compensation and beamforming over the azimuth virtual array (eq. 14) with a zoomed grid search
-and parabolic refinement to well below 0.01 deg.
+and parabolic refinement to well below 0.01 deg. The beamformer itself (positions, taper, which
+elements take part; power, grid search, Newton peak) is the one :class:`~.steering.Steering`
+the cube carries (``AdcCube.steering``); the functions here are its angle-valued wrappers.
 
 Sign conventions: the beat signal is ``exp(+j phi_b)`` (eq. 8), so a delay tau gives a positive
 beat frequency ``S tau`` and a receding target (velocity > 0, tau growing) a positive slow-time

@@ -207,8 +207,8 @@ def _newton(kv, xr, xi, u, p_max, steps):
     imaginary parts: (u, accepted); accepted needs the power at the peak >= ``p_max``.
 
     With B = sum_v y_v (y_v = w_v x_v e^{j k p_v . u}), C_a = sum k_va y_v, D_ab = sum k_va
-    k_vb y_v: dB/du_a = j C_a, d2B/du_a du_b = -D_ab, so for P = |B|^2
-    g_a = 2 Im(B conj ... ) = 2 (Im B Re C_a - Re B Im C_a) / P and
+    k_vb y_v: dB/du_a = j C_a, d2B/du_a du_b = -D_ab, so for log P, P = |B|^2,
+    g_a = 2 (Im B Re C_a - Re B Im C_a) / P and
     H_ab = 2 (Re C_a Re C_b + Im C_a Im C_b - Re B Re D_ab - Im B Im D_ab) / P - g_a g_b."""
     n_d = kv.shape[1]
     u = np.array(u, float)
