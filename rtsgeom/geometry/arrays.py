@@ -149,7 +149,9 @@ def array_spec(radar: RadarConfig, *, array: ArraySpec | None = None,
 
 def _grid_unit(x: np.ndarray, lam: float) -> float:
     """Smallest gap between distinct positions ``x``; lambda/2 for a single position."""
-    gaps = np.diff(np.unique(np.round(np.asarray(x) * _NM))) / _NM
+    x = np.asarray(x, float)
+    _, first = np.unique(np.round(x * _NM).astype(np.int64), return_index=True)
+    gaps = np.diff(np.sort(x[first]))
     return float(gaps.min()) if gaps.size else lam / 2.0
 
 

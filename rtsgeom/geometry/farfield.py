@@ -76,7 +76,8 @@ def grating_lobe_directions_rad(rut: RutArray, steer_rad: float = 0.0) -> np.nda
     step = rut.wavelength_m / g
     m = np.arange(-int(np.ceil(2 / step)) - 1, int(np.ceil(2 / step)) + 2)
     u = u0 + m[m != 0] * step
-    return np.sort(np.arcsin(u[np.abs(u) <= 1.0]))
+    u = u[np.abs(u) <= 1.0 + 1e-9]  # a lobe exactly at endfire (g = lambda) counts
+    return np.sort(np.arcsin(np.clip(u, -1.0, 1.0)))
 
 
 def unambiguous_half_width_rad(rut: RutArray) -> float:
