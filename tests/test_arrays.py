@@ -126,6 +126,10 @@ def test_array_spec_from_radar_fields():
     assert spec.name == "awr2944" and spec.tx_order == (0, 1, 2, 3)
     custom = ArraySpec.from_mm([[0, 0], [5, 0]], [[0, 0], [2, 0]], [1, 0])
     assert array_spec(radar, array=custom) is custom
+    cfg = dataclasses.make_dataclass("Cfg", ["tx_mm", "rx_mm", "tx_order"])(
+        [[0, 0], [5, 0]], [[0, 0], [2, 0]], [1, 0])
+    got = array_spec(dataclasses.replace(radar), array=cfg)
+    assert np.array_equal(got.tx_m, custom.tx_m) and got.tx_order == (1, 0)
     with pytest.raises(ValueError, match="antenna_preset"):
         array_spec(dataclasses.replace(scene.radar, antenna_preset="nope"))
 
@@ -216,7 +220,8 @@ def test_resolution_tracks_the_array_factor_main_lobe(name):
         assert ratio == pytest.approx(0.886, abs=0.01)
 
 
-@pytest.mark.parametrize("step_units,steer_deg", list(itertools.product([2, 3, 4], [0.0, 10.0, -25.0])))
+@pytest.mark.parametrize("step_units,steer_deg",
+                         list(itertools.product([2, 3, 4], [0.0, 10.0, -25.0])))
 def test_grating_lobes_of_sparse_arrays_are_where_the_array_factor_repeats(step_units, steer_deg):
     # Rx every step * lambda/2, one Tx: a sparse ULA with period step * d
     spec = ArraySpec(np.array([[0.0, 0.0]]), np.c_[np.arange(5) * step_units * D, np.zeros(5)],

@@ -98,7 +98,7 @@ class RutArray:
 
     @property
     def azimuth_unique(self) -> np.ndarray:
-        """Indices (into ``unique_local``) of the distinct azimuth virtual positions, sorted by x."""
+        """Indices into ``unique_local`` of the distinct azimuth virtual positions, by x."""
         idx = np.unique(self.virtual_unique[self.azimuth_mask])
         return idx[np.argsort(self.unique_local[idx, 0], kind="stable")]
 
@@ -134,11 +134,14 @@ class RutArray:
 
 def array_spec(radar: RadarConfig, *, array: ArraySpec | None = None,
                board_gap_m: float | None = None) -> ArraySpec:
-    """The :class:`ArraySpec` of ``radar``: ``array`` (or a ``radar.array`` field) if given, else
+    """The :class:`ArraySpec` of ``radar``: ``array`` (or a ``radar.array`` field: an ArraySpec,
+    or any object with ``tx_mm``, ``rx_mm``, ``tx_order``) if given, else
     its preset (``radar.antenna_preset``) at ``d = radar.element_spacing_m`` or lambda/2 at the
     centre frequency, azimuth Tx only unless ``radar.use_elevation_tx``; ``board_gap_m`` (or a
     ``radar.board_gap_m`` field) overrides the preset's board gap."""
     custom = array if array is not None else getattr(radar, "array", None)
+    if custom is not None and not isinstance(custom, ArraySpec):  # a config with mm fields
+        custom = ArraySpec.from_mm(custom.tx_mm, custom.rx_mm, custom.tx_order)
     if custom is not None:
         return custom
     lam = c / radar.f_center_hz

@@ -11,7 +11,7 @@ given; a path's amplitude is multiplied by the gains of both antennas of its leg
   half-power beamwidth (closed form ``q = ln(1/2) / ln cos(HPBW/2)``), zero behind the antenna;
   optionally separable with its own elevation beamwidth.
 * :class:`TablePattern` -- a measured or simulated table (azimuth, elevation, gain dB, phase
-  deg), interpolated linearly in the complex field with ``scipy.interpolate.RegularGridInterpolator``
+  deg), interpolated linearly in the complex field with scipy's ``RegularGridInterpolator``
   (complex interpolation keeps phase wraps harmless); zero outside the table.
 """
 
