@@ -1,0 +1,232 @@
+"""Antenna layouts of the radars people put in front of an RTS, and explicit custom arrays.
+
+A leaf module (numpy only) so the scene loader can read :data:`PRESETS` and build or validate
+an :class:`ArraySpec` without importing the geometry package.
+
+Board coordinates: ``x`` lateral (looking at the antenna side of the board, ``x`` grows towards
+larger azimuth in the radar frame), ``z`` up. Presets are stored in **units of d**, the
+half-wavelength at the board's design frequency (TI boards are laid out in lambda/2 steps at
+the band centre); :meth:`ArrayPreset.spec` scales them by the physical element spacing ``d``
+(by default lambda/2 at the radar's centre frequency, as ``radar.element_spacing_m = 0``
+always meant). A custom array (:class:`ArraySpec`) is given directly in metres.
+
+The virtual element ``(m, k)`` sits at ``p_tx(m) + p_rx(k)`` (the position whose projection on
+the arrival direction gives the two-way far-field phase, paper eq. 13), so the azimuth virtual
+array of a preset is a set of integer multiples of ``d``.
+
+Sources (TI document numbers) and what was checked is stated per preset; a layout that could
+not be verified from a readable source says so in its ``note``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["ArrayPreset", "ArraySpec", "PRESETS", "preset", "preset_names"]
+
+
+def _frozen(a) -> np.ndarray:
+    a = np.array(a, dtype=float)
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True)
+class ArraySpec:
+    """An explicit RuT antenna array in board coordinates, metres.
+
+    Parameters
+    ----------
+    tx_m : (N_tx, 2) ``[x, z]`` of every physical Tx antenna (metres).
+    rx_m : (N_rx, 2) ``[x, z]`` of every Rx antenna (metres).
+    tx_order : Tx index transmitting in each TDM slot (every slot a distinct Tx).
+    spacing_m : the array's grid unit ``d`` (for the resolution, the angle-search grid and the
+        grating-lobe check); ``None``: the smallest gap between distinct azimuth virtual
+        positions.
+    name : label for reports (the preset's name, or ``"custom"``).
+
+    Errors name the field and the allowed range (``ValueError``), so a scene loader can pass
+    them through.
+    """
+
+    tx_m: np.ndarray
+    rx_m: np.ndarray
+    tx_order: tuple[int, ...]
+    spacing_m: float | None = None
+    name: str = "custom"
+
+    def __post_init__(self):
+        for fname in ("tx_m", "rx_m"):
+            a = np.asarray(getattr(self, fname), dtype=float)
+            if a.ndim != 2 or a.shape[1] != 2 or a.shape[0] < 1:
+                raise ValueError(f"array.{fname}: expected a list of [x, z] pairs (at least one), "
+                                 f"got shape {a.shape}")
+            if not np.all(np.isfinite(a)) or np.any(np.abs(a) > 1.0):
+                raise ValueError(f"array.{fname}: coordinates must be finite and within +-1 m")
+            object.__setattr__(self, fname, _frozen(a))
+        order = tuple(int(i) for i in self.tx_order)
+        n_tx = self.tx_m.shape[0]
+        if not order or any(i < 0 or i >= n_tx for i in order) or len(set(order)) != len(order):
+            raise ValueError(f"array.tx_order: distinct Tx indices in [0, {n_tx - 1}] (at least "
+                             f"one), got {list(self.tx_order)}")
+        object.__setattr__(self, "tx_order", order)
+        if self.spacing_m is not None and not (0.0 < float(self.spacing_m) <= 0.1):
+            raise ValueError(f"array.spacing_m: must lie in (0, 0.1] m, got {self.spacing_m}")
+        for fname, a in (("tx_m", self.tx_m), ("rx_m", self.rx_m)):
+            u = np.unique(np.round(a * 1e9).astype(np.int64), axis=0)
+            if u.shape[0] != a.shape[0]:
+                raise ValueError(f"array.{fname}: two antennas at the same position")
+
+    @property
+    def num_tx(self) -> int:
+        return int(self.tx_m.shape[0])
+
+    @property
+    def num_rx(self) -> int:
+        return int(self.rx_m.shape[0])
+
+    @classmethod
+    def from_mm(cls, tx_mm, rx_mm, tx_order, name: str = "custom") -> "ArraySpec":
+        """The scene's ``[radar.array]`` form: ``tx_mm``/``rx_mm`` in millimetres."""
+        return cls(np.asarray(tx_mm, float) * 1e-3, np.asarray(rx_mm, float) * 1e-3,
+                   tuple(tx_order), name=name)
+
+
+@dataclass(frozen=True)
+class ArrayPreset:
+    """A documented radar board layout, positions in units of ``d`` (lambda/2 at the design
+    frequency).
+
+    ``rx_units`` of a board with separate Tx and Rx groups (``board_gap_units`` not None) are
+    relative to the Rx group's first element; :meth:`positions` places that element
+    ``board_gap`` to the right of the right-most Tx. The gap is the lateral distance between the
+    groups: it does not change the virtual array but it does change the near field, because the
+    Tx group sees a front end's Rx antenna and the Rx group its Tx antenna from different places
+    (the parallax of ``analysis.nearfield``: +0.27 deg at R_c = 1 m for the AWR1843BOOST with
+    3 lambda). Boards whose Tx and Rx interleave (the cascade) have ``board_gap_units = None``
+    and absolute ``rx_units``.
+    """
+
+    name: str
+    tx_units: np.ndarray  # (N_tx, 2) [x, z] in units of d
+    rx_units: np.ndarray  # (N_rx, 2)
+    tx_order: tuple[int, ...]  # default TDM slots: the azimuth Tx only
+    tx_order_elevation: tuple[int, ...]  # all Tx, elevated ones included
+    board_gap_units: float | None  # lateral Tx-group -> Rx-group gap, units of d
+    design_frequency_hz: float
+    source: str  # cited documents
+    note: str = ""  # what is verified, what is assumed
+    num_azimuth_unique: int = 0  # documented number of distinct azimuth virtual positions
+    labels: tuple[str, ...] = field(default=())  # Tx names in index order
+
+    def __post_init__(self):
+        object.__setattr__(self, "tx_units", _frozen(self.tx_units))
+        object.__setattr__(self, "rx_units", _frozen(self.rx_units))
+
+    def positions_m(self, spacing_m: float, board_gap_m: float | None = None
+                    ) -> tuple[np.ndarray, np.ndarray]:
+        """Tx and Rx ``[x, z]`` positions in metres for element spacing ``d = spacing_m``.
+
+        ``board_gap_m``: the lateral gap from the right-most Tx to the Rx group's first
+        element (``None``: the preset's documented or assumed gap, ``board_gap_units * d``).
+        """
+        d = float(spacing_m)
+        tx = self.tx_units * d
+        rx = self.rx_units * d
+        if self.board_gap_units is None:
+            if board_gap_m is not None:
+                raise ValueError(f"radar.board_gap_m: the {self.name} preset has interleaved Tx "
+                                 "and Rx antennas, so no board gap applies")
+            return tx, rx
+        gap = self.board_gap_units * d if board_gap_m is None else float(board_gap_m)
+        if not (0.0 <= gap <= 0.5):
+            raise ValueError(f"radar.board_gap_m: must lie in [0, 0.5] m, got {gap:g}")
+        rx[:, 0] += tx[:, 0].max() + gap  # same operations as the original AWR1843 layout
+        return tx, rx
+
+    def default_board_gap_m(self, spacing_m: float) -> float | None:
+        return None if self.board_gap_units is None else self.board_gap_units * spacing_m
+
+    def spec(self, spacing_m: float, use_elevation_tx: bool = False,
+             board_gap_m: float | None = None, tx_order=None) -> ArraySpec:
+        """The :class:`ArraySpec` of this board for element spacing ``d = spacing_m``.
+
+        ``board_gap_m`` (metres) overrides the preset's gap; ``tx_order`` overrides the TDM
+        slots (else the azimuth Tx, or all Tx with ``use_elevation_tx``).
+        """
+        tx, rx = self.positions_m(spacing_m, board_gap_m)
+        order = (tx_order if tx_order is not None
+                 else self.tx_order_elevation if use_elevation_tx else self.tx_order)
+        return ArraySpec(tx, rx, tuple(order), spacing_m=spacing_m, name=self.name)
+
+
+_RX4 = [[0, 0], [1, 0], [2, 0], [3, 0]]
+
+PRESETS: dict[str, ArrayPreset] = {p.name: p for p in (
+    ArrayPreset(
+        name="awr1843boost",
+        tx_units=[[0, 0], [2, 1], [4, 0]], rx_units=_RX4,
+        tx_order=(0, 2), tx_order_elevation=(0, 1, 2), board_gap_units=6.0,
+        design_frequency_hz=77e9, num_azimuth_unique=8, labels=("TX1", "TX2", "TX3"),
+        source="TI xWR1843BOOST EVM user's guide (SPRUIM4); TI mmWave SDK xWR18xx "
+               "out-of-box demo antenna geometry",
+        note="RX1..RX4 at lambda/2; TX1 and TX3 2 lambda apart in azimuth (8-element lambda/2 "
+             "azimuth virtual array with the 4 Rx); TX2 elevated by lambda/2, lambda right of "
+             "TX1 (4 elevated virtual elements). The Tx-Rx board gap (3 lambda, right edge of "
+             "TX3 to RX1) is an ASSUMPTION of this project, not a documented value."),
+    ArrayPreset(
+        name="iwr6843isk",
+        tx_units=[[0, 0], [2, 1], [4, 0]], rx_units=_RX4,
+        tx_order=(0, 2), tx_order_elevation=(0, 1, 2), board_gap_units=6.0,
+        design_frequency_hz=62e9, num_azimuth_unique=8, labels=("TX1", "TX2", "TX3"),
+        source="TI IWR6843ISK antenna module user's guide (SWRU546); the same 3 Tx x 4 Rx "
+               "pattern is written out in TI SWRU585 (IWR6843L EVM, sec. 4.1)",
+        note="Rx at D = lambda/2; TX1-TX2 lambda apart in azimuth and lambda/2 in elevation, "
+             "TX2-TX3 lambda in azimuth and lambda/2 in elevation (TX1, TX3 on one row, TX2 "
+             "elevated), lambda at 62 GHz. The board gap is ASSUMED (3 lambda), not documented."),
+    ArrayPreset(
+        name="awr2944",
+        tx_units=[[0, 0], [4, 0], [8, 0], [2, 1]], rx_units=_RX4,
+        tx_order=(0, 1, 2), tx_order_elevation=(0, 1, 2, 3), board_gap_units=6.0,
+        design_frequency_hz=77e9, num_azimuth_unique=12, labels=("TX1", "TX2", "TX3", "TX4"),
+        source="TI AWR2944EVM user's guide (SPRUJ22); TI TIDEP-01027 design guide (TIDUF01, "
+               "fig. 2-3); TI mmWave MCU+ SDK DDMA Doppler DPU (NUM_TXANT_AZIM 3, "
+               "NUM_TXANT_ELEV 1 for SOC_AWR2944)",
+        note="4 Tx x 4 Rx with 3 azimuth Tx and 1 elevated Tx is verified (SDK constants); the "
+             "positions are NOT verified (the user's guide gives them only as a figure): modelled "
+             "as Rx at lambda/2, the azimuth Tx 2 lambda apart (a filled 12-element lambda/2 "
+             "azimuth virtual array), the elevated Tx lambda/2 up and lambda right of TX1, and "
+             "a 3 lambda board gap (assumed). Use a custom [radar.array] for the real board."),
+    ArrayPreset(
+        name="awr2243-cascade",
+        tx_units=[[11, 6], [10, 4], [9, 1], [32, 0], [28, 0], [24, 0], [20, 0], [16, 0],
+                  [12, 0], [8, 0], [4, 0], [0, 0]],
+        rx_units=[[x, 0] for x in (*range(11, 15), *range(50, 54), *range(46, 50),
+                                   *range(0, 4))],
+        tx_order=tuple(range(3, 12)), tx_order_elevation=tuple(range(11, -1, -1)),
+        board_gap_units=None, design_frequency_hz=76.8e9, num_azimuth_unique=86,
+        labels=tuple(f"TX{i}" for i in range(1, 13)),
+        source="TI TIDEP-01012 imaging radar using cascaded mmWave sensors design guide "
+               "(TIDUEN5, figs. 5-7); MMWCAS-RF-EVM user's guide (SWRU553); TI mmWave Studio "
+               "cascade MATLAB processing (TI_Cascade_TX/RX_position_azi/_ele, 76.8 GHz)",
+        note="12 Tx x 16 Rx of four AWR2243. TX1..TX3 (master) elevated at 6, 4, 1 x lambda/2 "
+             "(minimum-redundancy elevation array); TX4..TX12 on the azimuth row 2 lambda apart; "
+             "Rx groups at 0-3, 11-14, 46-49 and 50-53 x lambda/2. The 9 x 16 = 144 azimuth "
+             "virtual elements cover 86 distinct lambda/2 positions (0..85; the rest overlap). "
+             "Verified against the cited numbers. Tx and Rx interleave: no board gap."),
+)}
+
+
+def preset_names() -> tuple[str, ...]:
+    return tuple(PRESETS)
+
+
+def preset(name: str) -> ArrayPreset:
+    """The preset called ``name``; a clear error listing the known ones otherwise."""
+    try:
+        return PRESETS[name]
+    except KeyError:
+        raise ValueError(f"radar.antenna_preset: unknown preset '{name}' (known: "
+                         f"{', '.join(PRESETS)})") from None
