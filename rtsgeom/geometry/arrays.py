@@ -13,6 +13,7 @@ import numpy as np
 from scipy.constants import c
 
 from .._util import frozen
+from ..registry import RADAR_PRESETS, awr1843boost_layout  # noqa: F401 (re-exported)
 from ..scene import RadarConfig
 
 __all__ = ["RutArray", "awr1843boost_layout", "rut_array", "yaw_matrix"]
@@ -22,20 +23,6 @@ def yaw_matrix(yaw_rad: float) -> np.ndarray:
     """Rotation local -> world for a yaw measured like azimuth (from +y towards +x)."""
     cy, sy = np.cos(yaw_rad), np.sin(yaw_rad)
     return np.array([[cy, sy, 0.0], [-sy, cy, 0.0], [0.0, 0.0, 1.0]])
-
-
-def awr1843boost_layout(d: float) -> tuple[np.ndarray, np.ndarray]:
-    """TI AWR1843BOOST antenna positions (Tx, Rx) in units of metres for element spacing ``d``.
-
-    Rx 0..3 at lambda/2 (``d``) in azimuth; TX1 and TX3 spaced 2 lambda (``4 d``) in azimuth; TX2
-    elevated by lambda/2 and offset lambda in azimuth. TX1+TX3 with the four Rx give the 8-element
-    lambda/2 azimuth virtual array of the paper; TX2 adds an elevated row of four.
-    The Rx row starts 3 lambda right of TX3 (assumed board gap; it only shifts the virtual array).
-    """
-    tx = np.array([[0.0, 0.0, 0.0], [2 * d, 0.0, d], [4 * d, 0.0, 0.0]])
-    rx0 = 4 * d + 6 * d
-    rx = np.array([[rx0 + k * d, 0.0, 0.0] for k in range(4)])
-    return tx, rx
 
 
 @dataclass(frozen=True)
@@ -84,8 +71,9 @@ def rut_array(radar: RadarConfig) -> RutArray:
     """Build the RuT array of ``radar`` (preset layout, active Tx, pose)."""
     lam = c / radar.f_center_hz
     d = radar.element_spacing_m or lam / 2.0
-    tx, rx = awr1843boost_layout(d)  # the only preset so far (validated by the scene loader)
-    order = (0, 1, 2) if radar.use_elevation_tx else (0, 2)
+    preset = RADAR_PRESETS[radar.antenna_preset]
+    tx, rx = preset.layout(d)
+    order = preset.tx_order(radar.use_elevation_tx)
     slot, vt, vr = np.meshgrid(np.arange(len(order)), 0, np.arange(len(rx)), indexing="ij")
     slot = slot.ravel()
     vt = np.asarray(order)[slot]
