@@ -73,6 +73,10 @@ def problems(scene: "Scene") -> list[str]:
 
 
 def _radar_rules(scene, fail) -> None:
+    """chirp_repetition_s >= chirp_duration_s; the ADC window samples_per_chirp / adc_rate_hz
+    (from adc_start_s) inside the ramp; each axis of the range-Doppler map (samples_per_chirp,
+    chirps_per_tx) holds 2 x (window main-lobe half width + CFAR guard + training cells) + 1
+    cells; the ADC cube within MAX_ADC_SAMPLES."""
     radar = scene.radar
     t_ramp, n_s, f_adc = radar.chirp_duration_s, radar.samples_per_chirp, radar.adc_rate_hz
     if radar.chirp_repetition_s < t_ramp:
@@ -114,6 +118,8 @@ def _radar_rules(scene, fail) -> None:
 
 
 def _rts_rules(scene, fail) -> None:
+    """Front ends ordered by strictly increasing angle_deg; fractional_delay_step_s <= 1/f_s_hz;
+    calibration_span_ns [start, stop] with stop > start."""
     rts = scene.rts
     angles = [fe.angle_rad for fe in rts.front_ends]
     if any(b <= a for a, b in zip(angles, angles[1:])):
@@ -129,6 +135,8 @@ def _rts_rules(scene, fail) -> None:
 
 
 def _sheet_rules(scene, fail) -> None:
+    """angle_max_deg > angle_min_deg; cutouts smaller than the sheet's height, holding both
+    antennas of their front end, inside the sheet's extent and not overlapping."""
     sheet, rts = scene.sheet, scene.rts
     a0, a1 = math.degrees(sheet.angle_min_rad), math.degrees(sheet.angle_max_rad)
     if a1 <= a0:

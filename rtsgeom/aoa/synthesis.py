@@ -29,6 +29,7 @@ from ..geometry import Setup
 from ..paths import Paths
 from ..radar.phasors import bin_response
 from ..radar.processing import angle_spectrum, estimate_angles, tdm_compensate
+from ..registry import SYNTHESIS_MODES
 from ..rts import RtsProgram, channel_echoes, nominal_link_gain, requested_delay, target_amplitude
 from ..scene import TargetConfig
 from scipy.constants import c
@@ -36,7 +37,7 @@ from scipy.constants import c
 __all__ = ["MODES", "g_paper", "array_factor", "ratio_paper", "ratio_array_factor", "PairModel",
            "AngleUnreachable"]
 
-MODES = ("exact", "array-factor", "paper")
+MODES = SYNTHESIS_MODES  # the registry (rtsgeom/registry.py) lists every AoA mode once
 
 
 class AngleUnreachable(ValueError):
