@@ -236,14 +236,18 @@ def _calibration_rules(scene, fail) -> None:
 def resolvable_limits(radar: "RadarConfig") -> tuple[float, float, str, str]:
     """(largest beat range, largest |velocity|) the processing resolves, and why.
 
-    The unambiguous range (velocity) less the bins the peak's main lobe and its CFAR ring
-    (guard + training cells) take: beyond them the peak and its ring wrap to the other edge of
-    the cyclic axis and the target comes out near 0 m (at the opposite velocity, with the TDM
-    phase compensation of the wrong sign)."""
+    Range: the unambiguous range less the bins of the range window's main lobe and the CFAR
+    ring (guard + training cells); beyond, the peak and its ring wrap to the near-range bins
+    and the target comes out near 0 m or is lost. Velocity: the unambiguous TDM-MIMO velocity
+    less the Doppler window's main lobe and the neighbour bin of the peak interpolation;
+    beyond, the peak wraps to the opposite velocity and the TDM phase compensation takes the
+    wrong sign (an angle error of degrees). The Doppler CFAR ring may wrap: the far edge of
+    the cyclic Doppler axis holds only noise (a target at 94 % of the maximum is found in its
+    bin, tests/test_signal.py)."""
     cfar = radar.cfar
-    k_r = WINDOWS[radar.range_window].mainlobe_half_bins + cfar.guard_cells[0] + cfar.training_cells[0]
-    k_d = (WINDOWS[radar.doppler_window].mainlobe_half_bins + cfar.guard_cells[1]
-           + cfar.training_cells[1])
+    k_r = (WINDOWS[radar.range_window].mainlobe_half_bins + cfar.guard_cells[0]
+           + cfar.training_cells[0])
+    k_d = WINDOWS[radar.doppler_window].mainlobe_half_bins + 1
     r_bin = radar.max_range_m / radar.samples_per_chirp
     v_bin = 2.0 * radar.max_velocity_mps / radar.chirps_per_tx
     why_r = (f"the radar's unambiguous range {radar.max_range_m:.4g} m (adc_rate_hz * c / "
@@ -251,7 +255,8 @@ def resolvable_limits(radar: "RadarConfig") -> tuple[float, float, str, str]:
              "lobe + radar.cfar guard and training cells)")
     why_v = (f"the radar's unambiguous TDM-MIMO velocity +-{radar.max_velocity_mps:.4g} m/s "
              f"less {k_d} Doppler bins of {v_bin:.3g} m/s (radar.doppler_window main lobe + "
-             "radar.cfar guard and training cells)")
+             "the peak's neighbour bin; beyond, the peak wraps to the opposite velocity and the "
+             "TDM compensation takes the wrong sign)")
     return (radar.max_range_m - k_r * r_bin, radar.max_velocity_mps - k_d * v_bin, why_r, why_v)
 
 
