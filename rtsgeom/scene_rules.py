@@ -75,8 +75,8 @@ def problems(scene: "Scene") -> list[str]:
 def _radar_rules(scene, fail) -> None:
     """chirp_repetition_s >= chirp_duration_s; the ADC window samples_per_chirp / adc_rate_hz
     (from adc_start_s) inside the ramp; each axis of the range-Doppler map (samples_per_chirp,
-    chirps_per_tx) holds 2 x (window main-lobe half width + CFAR guard + training cells) + 1
-    cells; the ADC cube within MAX_ADC_SAMPLES."""
+    chirps_per_tx) holds the CFAR window 2 x (guard + training cells) + 1 and room for a target
+    away from the edges (see the target limits); the ADC cube within MAX_ADC_SAMPLES."""
     radar = scene.radar
     t_ramp, n_s, f_adc = radar.chirp_duration_s, radar.samples_per_chirp, radar.adc_rate_hz
     if radar.chirp_repetition_s < t_ramp:
@@ -89,20 +89,23 @@ def _radar_rules(scene, fail) -> None:
              f"= {window:g} s exceeds chirp_duration_s = {t_ramp:g} s")
     elif radar.adc_start_s > t_ramp - window:
         fail("radar.adc_start_s", radar.adc_start_s, f"in [0, {t_ramp - window:g}] s")
-    # The CFAR ring around a cell, plus the main lobe of the target's peak, must fit in each
-    # axis of the range-Doppler map (both axes are cyclic; a bigger ring meets itself).
+    # The CFAR window (cell under test, guard and training cells on both sides) must fit in
+    # each axis of the range-Doppler map (both axes are cyclic: a bigger ring meets itself),
+    # and leave room for a target inside the limits of resolvable_limits (see there).
     cfar, default_cfar = radar.cfar, type(radar.cfar)()
     for ax, axis, size, key, win in ((0, "range", n_s, "samples_per_chirp", radar.range_window),
                                      (1, "Doppler", radar.chirps_per_tx, "chirps_per_tx",
                                       radar.doppler_window)):
-        ml = WINDOWS[win].mainlobe_half_bins
         g, t = cfar.guard_cells[ax], cfar.training_cells[ax]
-        need = 2 * (ml + g + t) + 1
+        ml = WINDOWS[win].mainlobe_half_bins
+        edge = ml + g + t + 1 if ax == 0 else 2 * (ml + 1) + 1
+        need = max(2 * (g + t) + 1, edge)
         if size < need:
-            why = (f"the {axis} axis must hold the CFAR window and a peak: 2 x (the {win} "
-                   f"window's main-lobe half width {ml} + radar.cfar.guard_cells[{ax}] {g} + "
-                   f"radar.cfar.training_cells[{ax}] {t}) + 1 = {need} cells")
-            if cfar == default_cfar:
+            why = (f"the {axis} axis must hold the CFAR window 2 x (radar.cfar.guard_cells[{ax}] "
+                   f"{g} + radar.cfar.training_cells[{ax}] {t}) + 1 cells and leave a target "
+                   f"room inside the {win} window's main lobe ({ml} bins) from the edge: "
+                   f"{need} cells")
+            if cfar == default_cfar or need == edge:
                 fail(f"radar.{key}", size, f">= {need}: {why}")
             else:
                 fail("radar.cfar.training_cells", list(cfar.training_cells),
