@@ -68,6 +68,9 @@ TOKENS = [
     b"1979-05-27T07:32:00Z", b"07:32:00", b"1979-05-27", b"[radar]", b"[rts]", b"[sheet]",
     b"[[rts.front_ends]]", b"[[targets]]", b"[[structure]]", b"[radar.cfar]", b",", b".",
     b"x = 1\n", b"[" * 3000, b"a" * 70000,
+    # keys tomllib takes seconds to minutes on (quadratic in the dotted parts): refused first
+    b"\n" + b".".join([b"k"] * 5000) + b" = 1\n", b"\n[" + b".".join([b'"q"'] * 5000) + b"]\n",
+    b"\n" + b"k" * 2000 + b" = 1\n",
 ]
 
 

@@ -36,7 +36,6 @@ def _rss_mib() -> float:
 
 def worker(scene_path: str, samples: int | None, depth: int | None, repeat: int) -> dict:
     """One process: import, then ``repeat`` full ``trace`` calls; times and memory as a dict."""
-    import dataclasses
     t0 = time.perf_counter()
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import raytrace
@@ -46,9 +45,9 @@ def worker(scene_path: str, samples: int | None, depth: int | None, repeat: int)
     _ = setup.sheet  # build the mesh outside the timed calls
     cfg = setup.scene.raytrace
     if samples is not None:
-        cfg = dataclasses.replace(cfg, samples_per_src=samples)
+        cfg = cfg.evolve(samples_per_src=samples)
     if depth is not None:
-        cfg = dataclasses.replace(cfg, max_depth=depth)
+        cfg = cfg.evolve(max_depth=depth)
     t0 = time.perf_counter()
     ok, msg = raytrace.preflight()
     t_pre = time.perf_counter() - t0

@@ -146,6 +146,29 @@ class ArrayPreset:
         rx[:, 0] += tx[:, 0].max() + gap  # same operations as the original AWR1843 layout
         return tx, rx
 
+    @property
+    def doc(self) -> str:
+        """One line for registries and generated docs."""
+        n_tx, n_rx = len(self.tx_units), len(self.rx_units)
+        return f"{n_tx} Tx x {n_rx} Rx ({self.source.split(';')[0]})"
+
+    @property
+    def num_rx(self) -> int:
+        return int(len(self.rx_units))
+
+    def active_tx_order(self, use_elevation_tx: bool = False) -> tuple[int, ...]:
+        """The TDM slots: the azimuth Tx, or all Tx with ``use_elevation_tx``."""
+        return self.tx_order_elevation if use_elevation_tx else self.tx_order
+
+    def azimuth_aperture_units(self, use_elevation_tx: bool = False) -> float:
+        """Aperture d_A / d of the azimuth virtual row (paper eq. 24): the span of the distinct
+        azimuth virtual positions plus one cell (N_A for a filled lambda/2 row)."""
+        order = self.active_tx_order(use_elevation_tx)
+        tx = self.tx_units[list(order)]
+        row = tx[:, 1] == tx[:, 1].min()  # the lowest (azimuth) Tx row
+        x = (tx[row, 0][:, None] + self.rx_units[:, 0][None, :]).ravel()
+        return float(x.max() - x.min() + 1.0)
+
     def default_board_gap_m(self, spacing_m: float) -> float | None:
         return None if self.board_gap_units is None else self.board_gap_units * spacing_m
 

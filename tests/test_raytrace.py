@@ -6,7 +6,6 @@ Skipped, with the pre-flight's reason, where Sionna RT or a usable LLVM backend 
 
 from __future__ import annotations
 
-import dataclasses
 import os
 import subprocess
 import sys
@@ -183,7 +182,7 @@ def test_extra_structure_reflects(rt, tmp_path):
     doc = default_doc()
     doc["structure"] = [{"mesh": "plate.ply", "material": "itu_concrete"}]
     s = build_setup(parse_scene(doc, "structure.toml", base_dir=tmp_path))
-    res = rt.trace(s, dataclasses.replace(s.scene.raytrace, max_depth=1))
+    res = rt.trace(s, s.scene.raytrace.evolve(max_depth=1))
     p = res.paths
     m = (p.direction == RUT_TO_RUT) & (res.objects[:, 0] == "structure_0")
     assert m.any()

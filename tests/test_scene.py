@@ -70,3 +70,130 @@ def test_cli_info_and_bad_scene(tmp_path, capsys):
     assert main(["info", str(bad)]) == 2
     err = capsys.readouterr().err
     assert "rts.arc_radius_m" in err and "Traceback" not in err
+
+
+# --------------------------------------------------------------------------------------------
+# The schema is written once (issue 21, section 3)
+# --------------------------------------------------------------------------------------------
+
+
+def test_scene_format_doc_is_generated_from_the_declarations():
+    """docs/scene-format.md is what ``python -m rtsgeom.scene_doc`` writes; every key is in it."""
+    from rtsgeom import scene as sc
+    from rtsgeom.scene_doc import DOC_PATH, render
+    from rtsgeom.schema import specs
+    text = render()
+    assert DOC_PATH.read_text() == text, "run `python -m rtsgeom.scene_doc` and commit the file"
+    for cls in (sc.Scene, sc.RadarConfig, sc.CfarConfig, sc.RtsConfig, sc.FrontEndConfig,
+                sc.SheetConfig, sc.TargetConfig, sc.RaytraceConfig, sc.StructureConfig):
+        for _, s in specs(cls):
+            assert f"| `{s.key}` |" in text, s.key
+
+
+def test_cli_choices_are_the_registries():
+    import argparse
+    from rtsgeom.cli import build_parser
+    from rtsgeom.registry import AOA_MODES, PATH_METHODS, SYNTHESIS_MODES
+    found = {}
+
+    def walk(p, name=""):
+        for a in p._actions:
+            if isinstance(a, argparse._SubParsersAction):
+                for sub, sp in a.choices.items():
+                    walk(sp, sub)
+            elif a.choices is not None:
+                found[(name, a.dest)] = tuple(a.choices)
+    walk(build_parser())
+    expect = {("run", "paths"): tuple(PATH_METHODS), ("show", "paths"): tuple(PATH_METHODS),
+              ("paths", "method"): tuple(PATH_METHODS), ("run", "amplitudes"): tuple(AOA_MODES),
+              ("adc", "amplitudes"): tuple(AOA_MODES),
+              ("linearity", "amplitudes"): SYNTHESIS_MODES}
+    for k, v in expect.items():
+        assert found[k] == v, (k, found[k])
+    from rtsgeom.aoa import MODES
+    assert MODES == SYNTHESIS_MODES
+
+
+def test_defaults_written_once_match_the_dataclasses(default_scene):
+    """A scene that sets only the required keys gets each declared default (converted to SI)."""
+    from rtsgeom.scene import CfarConfig, FrontEndConfig, RaytraceConfig, SheetConfig
+    doc = {"radar": {k: default_doc()["radar"][k] for k in (
+        "f_c_hz", "bandwidth_hz", "chirp_duration_s", "samples_per_chirp", "adc_rate_hz",
+        "chirps_per_tx")},
+           "rts": {"arc_radius_m": 1.0, "f_rts_hz": 5e8, "f_s_hz": 4e9,
+                   "front_ends": [{"angle_deg": 3.4}, {"angle_deg": 12.2}]}}
+    s = parse_scene(doc, "min.toml")
+    assert s.sheet == SheetConfig() and s.raytrace == RaytraceConfig()
+    assert s.radar.cfar == CfarConfig()
+    assert s.rts.front_ends[0] == FrontEndConfig(angle_rad=default_scene.rts.front_ends[0].angle_rad)
+    assert s.sheet.angle_min_rad == __import__("math").radians(-15.0)
+    assert s.radar.chirp_repetition_s == s.radar.chirp_duration_s
+    assert s.name == "min" and s.targets == () and s.rts.arc_center_m is None
+
+
+def test_evolve_validates_again(default_scene):
+    s = default_scene
+    v = s.evolve(rts=s.rts.evolve(arc_radius_m=1.5))
+    assert v.rts.arc_radius_m == 1.5 and v.targets == s.targets
+    with pytest.raises(SceneError, match=r"arc_radius_m = -1: must be in \[0.05, 100\] m"):
+        s.rts.evolve(arc_radius_m=-1.0)
+    with pytest.raises(SceneError, match=r"angle_deg = 95: must be in \[-90, 90\] deg"):
+        s.rts.front_ends[0].evolve(angle_rad=__import__("math").radians(95.0))
+    with pytest.raises(SceneError, match=r"diewald2022.toml: targets\[0\]\.range_m = 0.5: "
+                                         r"must be > rts.arc_radius_m"):
+        s.evolve(targets=(s.targets[0].evolve(range_m=0.5),))
+    with pytest.raises(SceneError, match=r"radar\.chirps_per_tx = 4: must be >= 13: "):
+        s.evolve(radar=s.radar.evolve(chirps_per_tx=4))
+
+
+def test_problems_lists_every_violated_rule(default_scene):
+    from rtsgeom.scene import problems
+    assert problems(default_scene) == []
+    s = dataclasses_replace(default_scene, targets=(
+        default_scene.targets[0].__class__(range_m=0.5), default_scene.targets[1].__class__(
+            range_m=30.0, velocity_mps=9.5)))
+    found = problems(s)
+    assert len(found) == 2 and "targets[0].range_m" in found[0] and "targets[1].velocity_mps" in found[1]
+    doc = copy.deepcopy(default_doc())
+    doc["targets"][0]["range_m"] = 0.5
+    doc["targets"][1]["velocity_mps"] = 9.5
+    with pytest.raises(SceneError) as err:
+        parse_scene(doc, "p.toml")
+    assert len(err.value.problems) == 2 and str(err.value) == err.value.problems[0]
+
+
+def dataclasses_replace(obj, **kw):
+    import dataclasses
+    return dataclasses.replace(obj, **kw)
+
+
+@pytest.mark.parametrize("radius", [0.3, 1.0, 4.0])
+@pytest.mark.parametrize("offsets_mm", [(0, 0, 0), (3, -2, 5), (-40, 30, -10)])
+def test_scene_module_positions_are_the_geometry_formula(radius, offsets_mm):
+    """One formula: the scene's rules see the modules where geometry builds them."""
+    import numpy as np
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.scene import arc_centre_m, front_end_module_m
+    doc = copy.deepcopy(default_doc())
+    doc["rts"]["arc_radius_m"] = radius
+    doc["sheet"]["enabled"] = False
+    doc["targets"] = []
+    for fe in doc["rts"]["front_ends"]:
+        fe.update(radial_offset_mm=offsets_mm[0], tangential_offset_mm=offsets_mm[1],
+                  height_offset_mm=offsets_mm[2])
+    s = parse_scene(doc, "g.toml")
+    setup = build_setup(s)
+    mods = [front_end_module_m(arc_centre_m(s), radius, fe) for fe in s.rts.front_ends]
+    np.testing.assert_allclose(mods, setup.fe.module, rtol=0, atol=1e-15)
+
+
+def test_design_filters_candidates_with_the_scene_rules(default_scene):
+    import math
+    from rtsgeom.analysis.design import two_front_end_scene
+    from rtsgeom.scene import problems
+    for radius, spacing in ((1.0, 8.0), (0.3, 8.0), (0.06, 60.0), (2.0, 179.0)):
+        variant, _, problem = two_front_end_scene(default_scene, (0, 1), radius,
+                                                  math.radians(spacing))
+        found = problems(variant)
+        assert problem == (found[0] if found else None)
+        assert problem is None or " must be " in problem

@@ -16,11 +16,12 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from rtsgeom.cli import main
 from rtsgeom.cli._common import number
-from rtsgeom.scene import SceneError, load_scene, loads_scene, parse_scene
+from rtsgeom.scene import SceneError, TargetConfig, load_scene, loads_scene, parse_scene
 from rtsgeom.validate import scene_warnings
 
 from conftest import DEFAULT_SCENE, ROOT, default_doc
@@ -439,7 +440,9 @@ def test_bad_numbers_exit_2(text, capsys):
 
 
 WARNINGS = [
-    ("front ends wider apart than the resolution", _set("rts.front_ends.1.angle_deg", 25.0),
+    # (forced: synthesis between front ends this far apart is refused, see test_scene_rules)
+    ("front ends wider apart than the resolution", _all(
+        _set("rts.front_ends.1.angle_deg", 25.0), _set("rts.allow_wide_spacing", True)),
      "rts.front_ends[1].angle_deg = 25", "17.48 deg"),
     ("arc inside the Fraunhofer distance", _all(
         _set("rts.arc_radius_m", 0.1), _set("sheet.enabled", False), _set("targets", [])),
@@ -481,3 +484,176 @@ def test_cli_output_into_a_closed_pipe_stops_quietly():
     err = p.stderr.read().decode()
     assert p.wait(timeout=60) == 0
     assert "Broken pipe" not in err and "Traceback" not in err
+
+
+# --------------------------------------------------------------------------------------------
+# Issue 18: no hang, the right field blamed, limits that the processing resolves
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("shape", ["{k} = 1\n", "[{k}]\nx = 1\n", "x = {{{k} = 1}}\n",
+                                   '{q} = 1\n'])
+def test_deeply_dotted_keys_are_refused_before_parsing(shape):
+    """tomllib is quadratic in a key's dotted parts (5000 parts: seconds; 200 000: minutes)."""
+    import time
+    parts = ["a"] * 5000
+    text = shape.format(k=".".join(parts), q=".".join(['"a"'] * 5000))
+    t0 = time.perf_counter()
+    with pytest.raises(SceneError, match=r"^k\.toml: line 1: a key of more than 16 dotted parts"):
+        loads_scene(text, "k.toml")
+    assert time.perf_counter() - t0 < 1.0
+
+
+def test_dotted_keys_of_a_legal_depth_and_floats_still_load(default_scene):
+    text = DEFAULT_SCENE.read_text().replace("[radar.cfar]\n", "[radar . cfar]\n")
+    assert loads_scene(text, "d.toml").radar.cfar == default_scene.radar.cfar
+    long = "x = [" + ", ".join(["1.5"] * 20000) + "]\n"  # many dots in values are not keys
+    with pytest.raises(SceneError, match="x is not a known field"):
+        loads_scene(DEFAULT_SCENE.read_text().replace("seed = 2022", "seed = 2022\n" + long))
+
+
+def test_integer_field_shows_the_float_as_written():
+    m = _msg(_set("radar.samples_per_chirp", 512.0))
+    assert "radar.samples_per_chirp = 512.0: must be an integer" in m, m
+
+
+def test_a_typo_names_the_unknown_key_and_the_missing_one():
+    def typo(d):
+        d["rts"]["arc_radus_m"] = d["rts"].pop("arc_radius_m")
+    m = _msg(typo)
+    assert "rts.arc_radus_m is not a known field" in m and "did you mean arc_radius_m?" in m, m
+    assert "rts.arc_radius_m is missing" in m, m
+
+
+def _msg(mutate) -> str:
+    with pytest.raises(SceneError) as err:
+        parse_scene(_mutated(mutate), "m.toml")
+    return str(err.value)
+
+
+@pytest.mark.parametrize("window", ["none", "hann", "blackman"])
+@pytest.mark.parametrize("guard,training", [((2, 2), (8, 4)), ((0, 1), (1, 1)), ((4, 3), (16, 9))])
+def test_map_axes_must_hold_the_cfar_window(window, guard, training):
+    """The smallest accepted samples_per_chirp / chirps_per_tx hold the CFAR window 2 (guard +
+    training) + 1 cells and room for a target away from the edges, and a target at 0 m/s in the middle of the map is found there; one
+    cell less is refused naming that field (not, later, 'blocked line of sight')."""
+    from rtsgeom.run import run_scene
+
+    def base(d):
+        d["radar"].update(range_window=window, doppler_window=window)
+        d["radar"]["cfar"].update(guard_cells=list(guard), training_cells=list(training))
+        d["targets"] = []
+    for ax, key in ((0, "samples_per_chirp"), (1, "chirps_per_tx")):
+        from rtsgeom.registry import WINDOWS
+        ml = WINDOWS[window].mainlobe_half_bins
+        edge = ml + guard[ax] + training[ax] + 1 if ax == 0 else 2 * (ml + 1) + 1
+        need = max(16 if ax == 0 else 2, 2 * (guard[ax] + training[ax]) + 1, edge)
+        ok = _mutated(_all(base, _set(f"radar.{key}", need)))
+        s = parse_scene(ok, "c.toml")
+        assert getattr(s.radar, key) == need
+        if ax == 1 and window == "hann" and guard == (2, 2):  # the chain works at the minimum
+            s = s.evolve(targets=(TargetConfig(20.0, 0.0, 10.0, s.rts.front_ends[0].angle_rad),),
+                         rts=s.rts.evolve(aoa_mode="nearest"))
+            det = run_scene(s, "exact", "nearest").detections
+            assert np.any(np.abs(det.range_m - 20.0) < 2 * s.radar.range_resolution_m), det
+        if need - 1 >= (16 if ax == 0 else 2):
+            m = _msg(_all(base, _set(f"radar.{key}", need - 1)))
+            assert ("radar.cfar.training_cells" in m or f"radar.{key} = {need - 1}: must be >= "
+                    f"{need}" in m), m
+            assert "CFAR window" in m
+
+
+@pytest.mark.parametrize("key,value", [("chirps_per_tx", 2), ("samples_per_chirp", 16)])
+def test_too_short_axes_blame_the_axis(key, value):
+    m = _msg(_set(f"radar.{key}", value))
+    assert m.startswith(f"m.toml: radar.{key} = {value}: must be >="), m
+
+
+def test_training_cells_bounded_by_the_map():
+    m = _msg(_set("radar.cfar.training_cells", [256, 4]))
+    assert m.startswith("m.toml: radar.cfar.training_cells = [256, 4]: must be smaller"), m
+
+
+def test_adc_size_limit_bounds_memory():
+    """2^25 complex64 samples pass (about 2 GiB peak), one chirp loop more does not."""
+    from rtsgeom.scene_rules import MAX_ADC_SAMPLES
+    big = dict(samples_per_chirp=8192, adc_rate_hz=250e6)
+    n_l = MAX_ADC_SAMPLES // (8192 * 8)
+    s = parse_scene(_mutated(lambda d: d["radar"].update(big, chirps_per_tx=n_l)), "a.toml")
+    assert s.radar.samples_per_chirp * s.radar.chirps_per_tx * 8 <= MAX_ADC_SAMPLES
+    m = _msg(lambda d: d["radar"].update(big, chirps_per_tx=n_l + 1))
+    assert f"radar.chirps_per_tx = {n_l + 1}: must be <= {n_l}" in m and "GiB" in m, m
+
+
+@pytest.mark.parametrize("window,training", [("hann", (8, 4)), ("none", (2, 1)),
+                                             ("blackman", (20, 10)), ("none", (20, 10)),
+                                             ("blackman", (2, 1))])
+def test_edge_targets_are_refused_or_resolved(window, training):
+    """Just inside the accepted range / velocity limits a target is detected where it was set;
+    just beyond them the loader refuses, naming the field and the limit (before the fix such
+    targets wrapped to ~0 m or to the negative maximum velocity, silently)."""
+    from rtsgeom.run import run_scene
+    from rtsgeom.scene_rules import resolvable_limits
+
+    def base(d):
+        d["radar"].update(range_window=window, doppler_window=window, snr_db=30.0)
+        d["radar"]["cfar"]["training_cells"] = list(training)
+        d["rts"]["aoa_mode"] = "nearest"
+        d["targets"] = [dict(range_m=20.0, velocity_mps=0.0, angle_deg=3.4)]
+    radar = parse_scene(_mutated(base), "e.toml").radar
+    r_lim, v_lim, _, _ = resolvable_limits(radar)
+    assert 0.8 * radar.max_range_m < r_lim < radar.max_range_m
+    assert 0.5 * radar.max_velocity_mps < v_lim < radar.max_velocity_mps
+    m = _msg(_all(base, _set("targets.0.range_m", r_lim + 0.01)))
+    assert "targets[0].range_m" in m and "unambiguous range" in m and "range bins" in m, m
+    m = _msg(_all(base, _set("targets.0.velocity_mps", -(v_lim + 0.01))))
+    assert "targets[0].velocity_mps" in m and "Doppler bins" in m, m
+    r_in = r_lim - radar.range_resolution_m  # the air path is compensated to ~0 here
+    v_in = 0.98 * v_lim
+    for rng, vel in ((r_in, 0.0), (20.0, v_in), (20.0, -v_in)):
+        s = parse_scene(_mutated(_all(base, _set("targets.0.range_m", rng),
+                                      _set("targets.0.velocity_mps", vel))), "e.toml")
+        det = run_scene(s, "exact", "nearest").detections
+        hit = (np.abs(det.range_m - rng) < 3 * radar.range_resolution_m) & (
+            np.abs(det.velocity_mps - vel) < 3 * radar.velocity_resolution_mps)
+        assert hit.any(), (rng, vel, det.range_m, det.velocity_mps)
+
+
+def test_wide_spacing_is_refused_for_synthesis_unless_forced():
+    wide = _set("rts.front_ends.1.angle_deg", 25.0)
+    m = _msg(wide)
+    assert m.startswith("m.toml: rts.front_ends[1].angle_deg = 25: must be within the RuT's "
+                        "angular resolution"), m
+    assert "eq. 24" in m and "targets[0].angle_deg = 7" in m and "allow_wide_spacing" in m
+    for ok in (_set("rts.allow_wide_spacing", True), _set("rts.aoa_mode", "nearest"),
+               _set("targets", [dict(range_m=30.0, angle_deg=-5.0)])):
+        parse_scene(_mutated(_all(wide, ok)), "ok.toml")
+    for mode in ("array-factor", "paper"):
+        with pytest.raises(SceneError, match="eq. 24"):
+            parse_scene(_mutated(_all(wide, _set("rts.aoa_mode", mode))), "m.toml")
+
+
+def test_mesh_paths_stay_in_the_scene_folder(tmp_path):
+    folder = tmp_path / "scenes"
+    folder.mkdir()
+    (tmp_path / "secret.stl").write_text("solid s\nendsolid s\n")
+    (folder / "in.stl").write_text("solid s\nendsolid s\n")
+    (folder / "link.stl").symlink_to(tmp_path / "secret.stl")
+    doc = default_doc()
+
+    def load(mesh, **kw):
+        d = copy.deepcopy(doc)
+        d["structure"] = [{"mesh": mesh}]
+        return parse_scene(d, "s.toml", base_dir=folder, **kw)
+    assert load("in.stl").extra_meshes[0][0] == str(folder / "in.stl")
+    msgs = {}
+    for mesh in (str(tmp_path / "secret.stl"), str(tmp_path / "nothing.stl"), "../secret.stl",
+                 "../nothing.stl"):
+        with pytest.raises(SceneError) as err:
+            load(mesh)
+        msgs[mesh] = str(err.value).split(": must be ", 1)[1]  # what follows the value
+        assert "inside the scene's folder" in msgs[mesh]
+    assert len(set(msgs.values())) == 1, msgs  # existence elsewhere is not revealed
+    with pytest.raises(SceneError, match="link leads out"):
+        load("link.stl")
+    assert load(str(tmp_path / "secret.stl"), allow_external_meshes=True).extra_meshes

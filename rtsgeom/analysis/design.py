@@ -36,7 +36,7 @@ import numpy as np
 from .._util import frozen
 from ..geometry import build_setup
 from ..geometry.farfield import angular_resolution_rad
-from ..scene import Scene, SheetConfig, arc_centre_m, azimuth_from_radar_rad, front_end_module_m
+from ..scene import Scene, SheetConfig, arc_centre_m, problems
 from .tolerance import CASES, PairPhasors, max_sigma_for_yield
 
 __all__ = ["METRICS", "DesignGrid", "two_front_end_scene", "evaluate_design", "design_grid"]
@@ -99,16 +99,9 @@ def _fit_sheet(scene: Scene) -> tuple[SheetConfig, str]:
 
 
 def _problem(scene: Scene) -> str | None:
-    """Why the variant cannot be built: the RuT outside the arc, a front end behind it."""
-    rts, radar = scene.rts, scene.radar
-    centre = arc_centre_m(scene)
-    if math.dist(radar.position_m, centre) >= rts.arc_radius_m:
-        return "the RuT is not inside the arc"
-    for fe in rts.front_ends:
-        az = azimuth_from_radar_rad(radar, front_end_module_m(centre, rts.arc_radius_m, fe))
-        if not -0.5 * math.pi < az < 0.5 * math.pi:
-            return "a front end is not in front of the RuT"
-    return None
+    """Why the variant cannot be built: the first rule of the scene schema it violates."""
+    found = problems(scene)
+    return found[0] if found else None
 
 
 def evaluate_design(scene: Scene, pair: tuple[int, int], radius_m: float, spacing_rad: float,

@@ -35,13 +35,14 @@ from ..paths.exact import leg_delays
 from ..radar.phasors import bin_response
 from ..radar.processing import tdm_compensate
 from ..radar.steering import Steering
+from ..registry import SYNTHESIS_MODES
 from ..rts import (KIND_DIRECT, RtsProgram, channel_echoes, nominal_link_gain, requested_delay,
                    target_amplitude)
 from ..scene import TargetConfig
 
 __all__ = ["ChannelModel", "AngleUnreachable", "SOLVERS"]
 
-SOLVERS = ("exact", "array-factor", "paper")
+SOLVERS = SYNTHESIS_MODES  # the registry lists every AoA mode once (rtsgeom/registry.py)
 
 
 class AngleUnreachable(ValueError):

@@ -12,6 +12,7 @@ from ..geometry import build_setup
 from ..io import write_json
 from ..paths import exact_paths
 
+from ..registry import SYNTHESIS_MODES
 from ._common import UsageError, load_scene_checked, number, print_json, scene_arg, steps
 
 
@@ -97,7 +98,7 @@ def register(sub) -> None:
         p.add_argument("--out", type=Path, default=None, help="folder for the plot and JSON")
         p.add_argument("--quiet", action="store_true", help="no progress output")
         if name == "linearity":
-            p.add_argument("--amplitudes", choices=("exact", "array-factor", "paper"),
+            p.add_argument("--amplitudes", choices=SYNTHESIS_MODES,
                            default="exact", help="amplitude-ratio mode (default exact)")
             p.add_argument("--uncalibrated", action="store_true",
                            help="no phase/amplitude calibration (delay offset 0)")

@@ -7,6 +7,7 @@ from pathlib import Path
 from ..geometry import build_setup
 from ..info import format_info, scene_info
 from ..io import write_text
+from ..registry import PATH_METHODS
 from ._common import UsageError, load_scene_checked, print_json, scene_arg
 
 
@@ -52,7 +53,7 @@ def register(sub) -> None:
     p = sub.add_parser("paths", help="per-element propagation paths as CSV")
     scene_arg(p)
     p.add_argument("--out", type=Path, required=True, help="CSV file to write")
-    p.add_argument("--method", choices=("exact", "raytrace"), default="exact",
+    p.add_argument("--method", choices=tuple(PATH_METHODS), default="exact",
                    help="exact line-of-sight distances (default) or Sionna RT ray tracing")
     p.set_defaults(func=cmd_paths)
 

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from ..io import atomic_path, write_bytes, write_json, write_text
+from ..registry import AOA_MODES, PATH_METHODS
 from ..run import RunResult, run_scene, summary
 from ._common import UsageError, load_scene_checked, scene_arg, steps
 
@@ -177,11 +178,11 @@ def cmd_adc(args) -> int:
 
 
 def register(sub) -> None:
-    modes = ("exact", "array-factor", "paper", "nearest")
+    modes = tuple(AOA_MODES)
     p = sub.add_parser("run", help="the main job: simulate the scene, detect, compare with set-points")
     scene_arg(p)
     p.add_argument("--out", type=Path, required=True, help="output folder")
-    p.add_argument("--paths", choices=("exact", "raytrace"), default="exact",
+    p.add_argument("--paths", choices=tuple(PATH_METHODS), default="exact",
                    help="exact line-of-sight paths (default) or Sionna RT ray tracing")
     p.add_argument("--amplitudes", choices=modes, default=None,
                    help="AoA amplitude mode (default: the scene's rts.aoa_mode)")

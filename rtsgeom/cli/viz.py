@@ -7,6 +7,7 @@ import os
 from pathlib import Path
 
 from ..geometry import build_setup
+from ..registry import PATH_METHODS
 from ._common import UsageError, load_scene_checked, scene_arg
 
 
@@ -64,7 +65,7 @@ def register(sub) -> None:
                                    "with its cutouts and the virtual targets. Without --png or "
                                    "--html a window opens (needs a display).")
     scene_arg(p)
-    p.add_argument("--paths", choices=("exact", "raytrace"), default=None,
+    p.add_argument("--paths", choices=tuple(PATH_METHODS), default=None,
                    help="also draw propagation paths: exact line of sight, or Sionna RT rays")
     p.add_argument("--png", type=Path, metavar="FILE", help="write an off-screen rendering (PNG)")
     p.add_argument("--html", type=Path, metavar="FILE",

@@ -18,103 +18,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._util import frozen
+from ..arcmath import (antenna_positions, layout_offsets, module_axes,  # noqa: F401 (re-exported)
+                       radial_tangent)  # the one formula (the scene's rules use it too)
 from ..scene import Scene
 
 __all__ = ["FrontEnds", "antenna_positions", "front_ends", "layout_offsets", "module_axes",
            "radial_tangent"]
-
-
-def radial_tangent(angle_rad: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Unit radial (outward) and tangential (towards larger azimuth) vectors, shape (..., 3)."""
-    a = np.asarray(angle_rad, dtype=float)
-    s, co, z = np.sin(a), np.cos(a), np.zeros_like(a)
-    return np.stack([s, co, z], -1), np.stack([co, -s, z], -1)
-
-
-def layout_offsets(separation_m) -> tuple[np.ndarray, np.ndarray]:
-    """The shorthand ``separation_m`` s (..., F) as signed offsets: rx (s/2, 0), tx (-s/2, 0)."""
-    half = 0.5 * np.asarray(separation_m, float)
-    z = np.zeros_like(half)
-    return np.stack([half, z], -1), np.stack([-half, z], -1)
-
-
-def module_axes(angle_rad, yaw_rad=None, pitch_rad=None
-                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Unit axes of each front-end module after its mounting rotations, (..., F, 3) each.
-
-    ``tangent`` (towards larger azimuth when not yawed), ``up`` and ``boresight`` (towards the arc
-    centre when not rotated). Pitch turns (boresight, up) about the tangent, then yaw turns all
-    three about the world vertical. ``yaw_rad``, ``pitch_rad``: (..., F), broadcast.
-    """
-    r_hat, t_hat = radial_tangent(angle_rad)
-    z_hat = np.array([0.0, 0.0, 1.0])
-    b, up, t = -r_hat, z_hat, t_hat
-    if pitch_rad is not None:
-        p = np.asarray(pitch_rad, float)[..., None]
-        b, up = np.cos(p) * b + np.sin(p) * z_hat, np.cos(p) * z_hat + np.sin(p) * r_hat
-    t, up, b = np.broadcast_arrays(t, up, b)
-    if yaw_rad is not None:
-        y = np.asarray(yaw_rad, float)
-        cy, sy = np.cos(y), np.sin(y)
-
-        def turn(v):
-            x = cy * v[..., 0] + sy * v[..., 1]
-            return np.stack([x, -sy * v[..., 0] + cy * v[..., 1],
-                             np.broadcast_to(v[..., 2], x.shape)], -1)
-
-        t, up, b = turn(t), turn(up), turn(b)
-    return t, up, b
-
-
-def antenna_positions(centre: np.ndarray, radius_m: float, angle_rad: np.ndarray,
-                      separation_m: np.ndarray | None = None,
-                      offsets_m: np.ndarray | None = None, *,
-                      rx_offset_m: np.ndarray | None = None,
-                      tx_offset_m: np.ndarray | None = None,
-                      yaw_rad: np.ndarray | None = None,
-                      pitch_rad: np.ndarray | None = None,
-                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Rx, Tx and module-centre positions of front ends on an arc.
-
-    Parameters
-    ----------
-    centre : (3,) arc centre (world).
-    radius_m : arc radius R_c.
-    angle_rad : (F,) nominal azimuths theta_q.
-    separation_m : (F,) shorthand for ``rx_offset_m = (s/2, 0)``, ``tx_offset_m = (-s/2, 0)``;
-        ignored where the offsets are given.
-    offsets_m : (..., F, 3) mounting errors (radial, tangential, height); broadcast over draws.
-    rx_offset_m, tx_offset_m : (..., F, 2) signed antenna offsets ``(t, h)`` in the module frame
-        (tangential, positive towards larger azimuth; height).
-    yaw_rad, pitch_rad : (..., F) mounting rotations of the module about its centre.
-
-    Returns
-    -------
-    rx, tx, module_centre : (..., F, 3)
-    """
-    r_hat, t_hat = radial_tangent(angle_rad)
-    z_hat = np.array([0.0, 0.0, 1.0])
-    nominal = np.asarray(centre, float) + radius_m * r_hat
-    if offsets_m is None:
-        offsets_m = np.zeros_like(nominal)
-    off = np.asarray(offsets_m, float)
-    mod = (nominal + off[..., 0:1] * r_hat + off[..., 1:2] * t_hat + off[..., 2:3] * z_hat)
-    simple = rx_offset_m is None and tx_offset_m is None and yaw_rad is None and pitch_rad is None
-    if simple:  # today's layout, same arithmetic (results stay bit-identical)
-        half = 0.5 * np.asarray(separation_m, float)[..., None] * t_hat
-        return mod + half, mod - half, mod
-    if rx_offset_m is None or tx_offset_m is None:
-        if separation_m is None:
-            raise ValueError("antenna_positions: give separation_m or both rx_offset_m and "
-                             "tx_offset_m")
-        rx_s, tx_s = layout_offsets(separation_m)
-        rx_offset_m = rx_s if rx_offset_m is None else rx_offset_m
-        tx_offset_m = tx_s if tx_offset_m is None else tx_offset_m
-    t, up, _ = module_axes(angle_rad, yaw_rad, pitch_rad)
-    ro, to = np.asarray(rx_offset_m, float), np.asarray(tx_offset_m, float)
-    rx = mod + ro[..., 0:1] * t + ro[..., 1:2] * up
-    tx = mod + to[..., 0:1] * t + to[..., 1:2] * up
-    return rx, tx, mod
 
 
 @dataclass(frozen=True)

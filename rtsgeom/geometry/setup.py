@@ -58,12 +58,10 @@ def nominal_setup(setup: Setup) -> Setup:
     This is what an RTS operator knows; the AoA design works on it, while the simulated RuT
     sees the setup as built (``setup``), so calibration has to absorb the difference.
     """
-    import dataclasses
     scene = setup.scene
-    fes = tuple(dataclasses.replace(f, radial_offset_m=0.0, tangential_offset_m=0.0,
-                                    height_offset_m=0.0, gain_offset_db=0.0,
-                                    phase_offset_rad=0.0) for f in scene.rts.front_ends)
+    fes = tuple(f.evolve(radial_offset_m=0.0, tangential_offset_m=0.0, height_offset_m=0.0,
+                         gain_offset_db=0.0, phase_offset_rad=0.0) for f in scene.rts.front_ends)
     if fes == scene.rts.front_ends:
         return setup
-    nominal = dataclasses.replace(scene, rts=dataclasses.replace(scene.rts, front_ends=fes))
+    nominal = scene.evolve(rts=scene.rts.evolve(front_ends=fes))  # validated again
     return build_setup(nominal)

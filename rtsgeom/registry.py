@@ -1,0 +1,64 @@
+"""Registries of the named choices a scene or the CLI can make: one entry per choice.
+
+Adding an AoA mode, a paths method, a radar preset, a window or a CFAR kind means adding ONE
+entry here; the scene schema (``scene.py``), the generated ``docs/scene-format.md`` and the
+CLI's ``choices=`` all read these dictionaries. This module imports only numpy so that every
+stage, the scene loader included, can import it (one-way imports).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+__all__ = ["AoaMode", "AOA_MODES", "SYNTHESIS_MODES", "PATH_METHODS",
+           "RADAR_PRESETS", "Window", "WINDOWS", "CFAR_KINDS"]
+
+
+@dataclass(frozen=True)
+class AoaMode:
+    """How the RTS sets a target's angle of arrival."""
+
+    doc: str
+    synthesis: bool  # True: interpolates between two front ends (amplitude ratio, eq. 18-23)
+
+
+AOA_MODES: dict[str, AoaMode] = {
+    "exact": AoaMode("amplitude ratio from the exact per-element model of the pair", True),
+    "array-factor": AoaMode("amplitude ratio from the array factor of the RuT (closed form)", True),
+    "paper": AoaMode("amplitude ratio from the paper's closed form g(theta) (eq. 23)", True),
+    "nearest": AoaMode("no synthesis: each target on the nearest front end", False),
+}
+SYNTHESIS_MODES: tuple[str, ...] = tuple(k for k, m in AOA_MODES.items() if m.synthesis)
+
+PATH_METHODS: dict[str, str] = {
+    "exact": "exact line-of-sight distances per element",
+    "raytrace": "Sionna RT ray tracing (reflections off the sheet and structures)",
+}
+
+
+# The radar boards: one registry, the documented layouts with their sources (a leaf module).
+from .radar_presets import PRESETS as RADAR_PRESETS  # noqa: E402
+
+
+@dataclass(frozen=True)
+class Window:
+    """A taper (scipy.signal.get_window name) and its main-lobe half width in FFT bins."""
+
+    doc: str
+    mainlobe_half_bins: int  # first null of the window's spectrum, in bins of the FFT
+
+
+WINDOWS: dict[str, Window] = {
+    "none": Window("rectangular", 1),
+    "hann": Window("Hann", 2),
+    "hamming": Window("Hamming", 2),
+    "blackman": Window("Blackman", 3),
+}
+
+CFAR_KINDS: dict[str, str] = {
+    "ca": "cell averaging: the mean of the training ring",
+    "os": "ordered statistic: the os_rank quantile of the training ring",
+}
