@@ -86,29 +86,76 @@ def range_doppler(cube: AdcCube) -> RangeDoppler:
     return RangeDoppler(spec, power, frozen(rng), frozen(vel), frozen(nu))
 
 
+#: OS-CFAR ranks at most this many training cells per cell under test (an evenly thinned ring
+#: beyond it), so that its cost stays O(map x OS_MAX_CELLS) whatever the ring the scene asks for.
+OS_MAX_CELLS = 512
+
+
+def _cyclic_box_sum(a: np.ndarray, half: int, axis: int) -> np.ndarray:
+    """Sum of a cyclic array over the centred window ``[i - half, i + half]`` along ``axis``,
+    for every ``i``, by cumulative sums: O(size) time and memory whatever ``half``. A window
+    longer than the axis wraps onto itself and counts cells more than once (as a wrapped
+    convolution does)."""
+    n = a.shape[axis]
+    full, rem = divmod(2 * half + 1, n)
+    a = np.moveaxis(a, axis, 0)
+    out = full * a.sum(axis=0, keepdims=True) if full else np.zeros((1,) + a.shape[1:])
+    if rem:
+        cs = np.concatenate([np.zeros((1,) + a.shape[1:]), np.cumsum(np.concatenate([a, a]), 0)])
+        start = (np.arange(n) - half) % n
+        out = out + (cs[start + rem] - cs[start])
+    else:
+        out = np.broadcast_to(out, a.shape).copy()
+    return np.moveaxis(out, 0, axis)
+
+
+def _box_sum(a: np.ndarray, half_r: int, half_d: int) -> np.ndarray:
+    return _cyclic_box_sum(_cyclic_box_sum(a, half_r, 0), half_d, 1)
+
+
+def _os_footprint(shape, gr: int, gd: int, tr: int, td: int) -> np.ndarray:
+    """The OS-CFAR training ring, clipped to the map (no cell twice) and thinned evenly to at
+    most :data:`OS_MAX_CELLS` cells."""
+    hr = min(gr + tr, (shape[0] - 1) // 2)
+    hd = min(gd + td, (shape[1] - 1) // 2)
+    ring = np.ones((2 * hr + 1, 2 * hd + 1), bool)
+    ring[max(hr - gr, 0):hr + gr + 1, max(hd - gd, 0):hd + gd + 1] = False
+    if not ring.any():  # the guard cells cover the whole map: train on every other cell
+        ring[:] = True
+        ring[hr, hd] = False
+    idx = np.flatnonzero(ring)
+    if idx.size > OS_MAX_CELLS:
+        keep = idx[np.linspace(0, idx.size - 1, OS_MAX_CELLS).round().astype(int)]
+        ring = np.zeros_like(ring)
+        ring.flat[keep] = True
+    return ring
+
+
 def cfar_mask(power: np.ndarray, cfg: CfarConfig) -> tuple[np.ndarray, np.ndarray]:
     """2D CFAR on a (range, Doppler) power map: returns (detected mask, noise estimate).
 
     Training cells form a ring around each cell under test (guard cells excluded); the range
     axis is cyclic too: with a complex ADC the beat frequencies wrap at f_adc, so the top
     range bins neighbour the bottom ones.
-    CA averages the ring, OS takes its ``os_rank`` quantile.
+
+    CA averages the ring: the sum over the outer window minus the sum over the guard window,
+    both by cyclic cumulative sums, so time and memory are O(map) whatever the ring size (a ring
+    larger than the map counts wrapped cells once per wrap, as a wrapped convolution does).
+    OS takes the ring's ``os_rank`` quantile; its ring is clipped to the map and thinned evenly
+    to at most :data:`OS_MAX_CELLS` cells, bounding the cost at O(map x OS_MAX_CELLS).
     """
     gr, gd = cfg.guard_cells
     tr, td = cfg.training_cells
-    ring = np.ones((2 * (gr + tr) + 1, 2 * (gd + td) + 1), bool)
-    ring[tr:tr + 2 * gr + 1, td:td + 2 * gd + 1] = False
-    pr, pd = gr + tr, gd + td
-    padded = np.pad(power, ((pr, pr), (pd, pd)), mode="wrap")  # both axes are cyclic
-    crop = (slice(pr, pr + power.shape[0]), slice(pd, pd + power.shape[1]))
+    power = np.asarray(power, dtype=np.float64)
     if cfg.kind == "ca":
-        k = ring.astype(float)
-        total = ndimage.convolve(padded, k, mode="constant")[crop]
-        count = ndimage.convolve(np.ones_like(padded), k, mode="constant")[crop]
-        noise = total / np.maximum(count, 1)
+        outer = _box_sum(power, gr + tr, gd + td)
+        inner = _box_sum(power, gr, gd)
+        count = (2 * (gr + tr) + 1) * (2 * (gd + td) + 1) - (2 * gr + 1) * (2 * gd + 1)
+        noise = np.maximum(outer - inner, 0.0) / count
     else:
-        noise = ndimage.percentile_filter(padded, 100 * cfg.os_rank, footprint=ring,
-                                          mode="nearest")[crop]
+        ring = _os_footprint(power.shape, gr, gd, tr, td)
+        noise = ndimage.percentile_filter(power, 100 * cfg.os_rank, footprint=ring,
+                                          mode="wrap")
     thr = noise * 10 ** (cfg.threshold_db / 10)
     peak = power == ndimage.maximum_filter(power, size=3, mode="wrap")
     return (power > thr) & peak, noise
