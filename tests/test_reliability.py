@@ -52,6 +52,17 @@ def staged_dir(*args, **kwargs):
     return impl(*args, **kwargs)
 
 
+def device_node(folder: Path) -> Path:
+    """A character device to aim --out at. As root, a private copy of /dev/full made with mknod
+    (code without the fix replaces the node: never risk the system's /dev/full); otherwise
+    /dev/full itself, which a normal user cannot replace."""
+    if os.geteuid() != 0:
+        return Path("/dev/full")
+    node = folder / "full"
+    os.mknod(node, stat.S_IFCHR | 0o666, os.makedev(1, 7))
+    return node
+
+
 def _old_folder(path: Path) -> None:
     path.mkdir()
     for name in ("detections.csv", "summary.json", "report.html", "range_doppler.png"):
@@ -209,7 +220,7 @@ def test_special_files_are_never_replaced(tmp_path, kind, capsys):
         target = tmp_path / "pipe"
         os.mkfifo(target)
     else:
-        target = Path("/dev/full")
+        target = device_node(tmp_path)
     before = os.stat(target)
     assert main(["paths", str(DEFAULT_SCENE), "--out", str(target)]) == 2
     after = os.stat(target)
