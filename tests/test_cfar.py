@@ -117,3 +117,16 @@ def test_os_cost_is_bounded_and_small_rings_are_exact():
     t0 = time.perf_counter()
     cfar_mask(p, CfarConfig("os", (64, 64), (256, 256)))
     assert time.perf_counter() - t0 < 10 * (OS_MAX_CELLS / 512)
+
+
+@pytest.mark.parametrize("g,t", WINDOWS)
+def test_ca_estimate_far_from_a_strong_peak_is_exact(g, t):
+    # a noise-free echo 120 dB above a quiet floor: the estimate away from the peak must be the
+    # floor itself, not the rounding residue of running sums over the peak
+    p = np.full((128, 32), 1e-3)
+    p[40, 10] = 1e9
+    noise = cfar_mask(p, CfarConfig("ca", g, t))[1]
+    ref = brute_ca(p, g, t)
+    far = ref < 1.0
+    np.testing.assert_allclose(noise[far], ref[far], rtol=1e-9)
+    np.testing.assert_allclose(noise, ref, rtol=1e-9)

@@ -412,6 +412,7 @@ def test_report_tables_are_readable(nearest_result):
     from rtsgeom.cli.signal import run_report_html
     html = run_report_html(nearest_result, {}, "exact", [])
     body = html.split("<style>")[0] + html.split("</style>")[1]
-    for raw in ("True", "False", "e-06", "e-07", "f_c_hz", "range_resolution", "arc_angle"):
+    for raw in ("True", "False", "e-06", "e-07", "f_c_hz", "range_resolution", "arc_angle",
+                "scene_sha256"):
         assert raw not in body, raw
     assert "yes" in body and "range resolution" in body

@@ -91,26 +91,34 @@ def range_doppler(cube: AdcCube) -> RangeDoppler:
 OS_MAX_CELLS = 512
 
 
-def _cyclic_box_sum(a: np.ndarray, half: int, axis: int) -> np.ndarray:
-    """Sum of a cyclic array over the centred window ``[i - half, i + half]`` along ``axis``,
-    for every ``i``, by cumulative sums: O(size) time and memory whatever ``half``. A window
-    longer than the axis wraps onto itself and counts cells more than once (as a wrapped
-    convolution does)."""
-    n = a.shape[axis]
-    full, rem = divmod(2 * half + 1, n)
+def _window_sums(a: np.ndarray, lo: int, hi: int, axis: int) -> np.ndarray:
+    """``out[i] = sum(a[(i + k) mod n] for k in lo..hi)`` along ``axis`` (cyclic), in O(size)
+    time and memory whatever the window, with additions only: blocks of the window's length,
+    each window the suffix of one block plus the prefix of the next (van Herk / Gil-Werman), so
+    the rounding error is relative to the window's own content (no difference of long running
+    sums, which would leave eps x the strongest peak in every quiet cell). A window longer than
+    the axis counts each wrap in full, as a wrapped convolution does."""
     a = np.moveaxis(a, axis, 0)
-    out = full * a.sum(axis=0, keepdims=True) if full else np.zeros((1,) + a.shape[1:])
-    if rem:
-        cs = np.concatenate([np.zeros((1,) + a.shape[1:]), np.cumsum(np.concatenate([a, a]), 0)])
-        start = (np.arange(n) - half) % n
-        out = out + (cs[start + rem] - cs[start])
-    else:
-        out = np.broadcast_to(out, a.shape).copy()
+    n = a.shape[0]
+    full, w = divmod(hi - lo + 1, n)
+    out = full * a.sum(axis=0, keepdims=True) if full else None
+    if w:
+        nb = -(-(n + w - 1) // w)  # blocks covering every window start 0..n-1
+        ext = np.take(a, np.arange(nb * w + w) % n, axis=0)  # cyclic extension
+        blocks = ext.reshape((nb + 1, w) + a.shape[1:])
+        pre = np.cumsum(blocks, axis=1).reshape(ext.shape)
+        suf = np.flip(np.cumsum(np.flip(blocks, 1), axis=1), 1).reshape(ext.shape)
+        s = np.arange(n)
+        part = np.where(((s % w) == 0).reshape((n,) + (1,) * (a.ndim - 1)),
+                        suf[s], suf[s] + pre[s + w - 1])
+        out = part if out is None else out + part
+    out = np.roll(np.broadcast_to(out, a.shape), -lo, axis=0)  # window starts at i + lo
     return np.moveaxis(out, 0, axis)
 
 
-def _box_sum(a: np.ndarray, half_r: int, half_d: int) -> np.ndarray:
-    return _cyclic_box_sum(_cyclic_box_sum(a, half_r, 0), half_d, 1)
+def _rect_sum(a: np.ndarray, r: tuple[int, int], d: tuple[int, int]) -> np.ndarray:
+    """Sum over the cyclic rectangle of range offsets ``r`` and Doppler offsets ``d``."""
+    return _window_sums(_window_sums(a, r[0], r[1], 0), d[0], d[1], 1)
 
 
 def _os_footprint(shape, gr: int, gd: int, tr: int, td: int) -> np.ndarray:
@@ -138,9 +146,10 @@ def cfar_mask(power: np.ndarray, cfg: CfarConfig) -> tuple[np.ndarray, np.ndarra
     axis is cyclic too: with a complex ADC the beat frequencies wrap at f_adc, so the top
     range bins neighbour the bottom ones.
 
-    CA averages the ring: the sum over the outer window minus the sum over the guard window,
-    both by cyclic cumulative sums, so time and memory are O(map) whatever the ring size (a ring
-    larger than the map counts wrapped cells once per wrap, as a wrapped convolution does).
+    CA averages the ring, summed as four rectangles with cyclic block prefix/suffix sums
+    (:func:`_window_sums`): time and memory O(map) whatever the ring size, rounding relative to
+    the ring's own content (a ring larger than the map counts wrapped cells once per wrap, as a
+    wrapped convolution does).
     OS takes the ring's ``os_rank`` quantile; its ring is clipped to the map and thinned evenly
     to at most :data:`OS_MAX_CELLS` cells, bounding the cost at O(map x OS_MAX_CELLS).
     """
@@ -148,10 +157,15 @@ def cfar_mask(power: np.ndarray, cfg: CfarConfig) -> tuple[np.ndarray, np.ndarra
     tr, td = cfg.training_cells
     power = np.asarray(power, dtype=np.float64)
     if cfg.kind == "ca":
-        outer = _box_sum(power, gr + tr, gd + td)
-        inner = _box_sum(power, gr, gd)
-        count = (2 * (gr + tr) + 1) * (2 * (gd + td) + 1) - (2 * gr + 1) * (2 * gd + 1)
-        noise = np.maximum(outer - inner, 0.0) / count
+        # the ring as four rectangles (bands above and below the guard window, over the full
+        # Doppler width; left and right of it): sums only, no outer-minus-inner cancellation
+        hr, hd = gr + tr, gd + td
+        total = (_rect_sum(power, (-hr, -gr - 1), (-hd, hd))
+                 + _rect_sum(power, (gr + 1, hr), (-hd, hd))
+                 + _rect_sum(power, (-gr, gr), (-hd, -gd - 1))
+                 + _rect_sum(power, (-gr, gr), (gd + 1, hd)))
+        count = (2 * hr + 1) * (2 * hd + 1) - (2 * gr + 1) * (2 * gd + 1)
+        noise = total / count
     else:
         ring = _os_footprint(power.shape, gr, gd, tr, td)
         noise = ndimage.percentile_filter(power, 100 * cfg.os_rank, footprint=ring,

@@ -195,7 +195,7 @@ def _scene_section(info: Mapping[str, Any]) -> str:
             if k in info]
     if meta:
         out.append("<p class=\"meta\">" + "<br>".join(
-            f"{_esc(k)}: <code>{_esc(v)}</code>" for k, v in meta) + "</p>")
+            f"{_esc(_label_unit(k)[0])}: <code>{_esc(v)}</code>" for k, v in meta) + "</p>")
     shown = {k for k, _ in meta}
     tables = []
     for key, heading in _INFO_PARTS:
