@@ -79,15 +79,22 @@ def interruption(tmp: Path, quick: bool) -> None:
     assert run(["run", old_scene, "--out", ref_old, "--quiet"]).returncode == 0
     old, new = snapshot(ref_old), snapshot(ref_new)
     assert old["detections.csv"] != new["detections.csv"]
-    fractions = (0.1, 0.6, 0.97) if quick else (0.05, 0.3, 0.6, 0.85, 0.95, 0.99, 1.02)
+    # fractions of the reference run's duration, and "swap": the moment the last file
+    # (report.html) appears in the staging folder, just before the folder is swapped in
+    points = (0.1, 0.6, "swap") if quick else (0.05, 0.3, 0.6, 0.95, 1.3, "swap")
     for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGKILL):
-        for frac in fractions:
+        for frac in points:
             out = tmp / "target"
             shutil.rmtree(out, ignore_errors=True)
             shutil.copytree(ref_old, out)
             proc = subprocess.Popen([*RTSGEOM, "run", SCENE, "--out", out, "--quiet"], env=ENV,
                                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-            time.sleep(frac * duration)
+            if frac == "swap":
+                while proc.poll() is None and not list(
+                        tmp.glob(".target.rtsgeom-staging-*/report.html")):
+                    time.sleep(0.002)
+            else:
+                time.sleep(frac * duration)
             if proc.poll() is None:
                 proc.send_signal(sig)
             _, err = proc.communicate()
@@ -98,8 +105,8 @@ def interruption(tmp: Path, quick: bool) -> None:
             if sig == signal.SIGKILL and left:  # the next run must clean up what KILL left
                 assert run(["run", SCENE, "--out", out, "--quiet"]).returncode == 0
                 clean = not leftovers(tmp) and snapshot(out) == new
-            check(f"interrupt run with {signal.Signals(sig).name} at {frac:.0%} of "
-                  f"{duration:.0f} s", state != "MIXED" and clean and "Traceback" not in err,
+            when = "the swap" if frac == "swap" else f"{frac:.0%} of {duration:.0f} s"
+            check(f"interrupt run with {signal.Signals(sig).name} at {when}", state != "MIXED" and clean and "Traceback" not in err,
                   folder=state, exit=proc.returncode, leftovers=left or "none")
 
 
