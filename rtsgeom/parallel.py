@@ -15,10 +15,28 @@ Running a study on an existing cluster::
 
 from __future__ import annotations
 
+import re
 from contextlib import contextmanager
 from typing import Callable, Sequence
 
-__all__ = ["map_chunks", "chunk_slices", "dask_client"]
+__all__ = ["map_chunks", "chunk_slices", "dask_client", "ClusterError", "check_address"]
+
+_ADDRESS = re.compile(r"(?:(tcp|tls|ws|wss|ucx|inproc)://)?(\[[0-9a-fA-F:]+\]|[A-Za-z0-9_.-]+)"
+                      r"(?::(\d{1,5}))?")
+
+
+class ClusterError(RuntimeError):
+    """A Dask scheduler address that is malformed or cannot be reached (one line, exit 2)."""
+
+
+def check_address(address: str) -> str:
+    """``address`` if it reads as a Dask scheduler address (``[PROTOCOL://]HOST[:PORT]``, e.g.
+    ``tcp://10.0.0.5:8786``), else :class:`ClusterError` saying what is expected."""
+    m = _ADDRESS.fullmatch(address.strip())
+    if not m or (m.group(3) is not None and not 0 < int(m.group(3)) < 65536):
+        raise ClusterError(f"--dask {address!r}: not a scheduler address; expected "
+                           "[tcp://]HOST[:PORT], e.g. tcp://10.0.0.5:8786")
+    return address.strip()
 
 
 def chunk_slices(n: int, size: int) -> list[slice]:
@@ -44,7 +62,16 @@ def dask_client(scheduler: str | None = None, workers: int | None = None):
     if scheduler is None:
         cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True,
                                dashboard_address=None)
-    client = Client(cluster if cluster is not None else scheduler)
+    if cluster is None:
+        scheduler = check_address(scheduler)
+        try:
+            client = Client(scheduler, timeout="10s")
+        except (OSError, ValueError, TypeError, TimeoutError) as exc:
+            raise ClusterError(f"--dask {scheduler}: cannot connect to a Dask scheduler there "
+                               f"({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''})"
+                               ) from None
+    else:
+        client = Client(cluster)
     try:
         yield client
     finally:

@@ -9,9 +9,7 @@ stage, the scene loader included, can import it (one-way imports).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
 
-import numpy as np
 
 __all__ = ["AoaMode", "AOA_MODES", "SYNTHESIS_MODES", "PATH_METHODS",
            "RADAR_PRESETS", "Window", "WINDOWS", "CFAR_KINDS"]

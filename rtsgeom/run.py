@@ -15,11 +15,11 @@ from .geometry import Setup, build_setup
 from .paths import Paths, exact_paths
 from .radar import AdcCube, Detections, RangeDoppler, process
 from .radar.frame import noise_power, simulate
-from .radar.processing import nearest_detection
 from .rts import Echoes, RtsProgram, program_nearest
 from .scene import Scene
 
-__all__ = ["RunResult", "simulate", "run_scene", "match_targets", "noise_power"]
+__all__ = ["RunResult", "simulate", "run_scene", "match_targets", "label_detections",
+           "noise_power"]
 
 
 @dataclass(frozen=True)
@@ -38,14 +38,33 @@ class RunResult:
     aoa_mode: str = "exact"  # the amplitude mode actually used
 
 
-def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angle_rad=None
-                  ) -> list[dict]:
-    """For each target, the strongest detection within 2 range and 2 Doppler bins."""
+def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angle_rad=None,
+                  bins: int = 2) -> list[dict]:
+    """For each target, the strongest detection within ``bins`` range and Doppler bins, each
+    detection matched to at most one target.
+
+    Two targets in one range-Doppler cell produce one detection: it goes to the target closest
+    to it (in bins; ties to the lower index) and the other target is reported not detected
+    (``detection`` None). Pairs are assigned greedily by (detection power, closeness), which
+    for well-separated targets is the strongest detection near each one.
+    """
     dr = rd.range_m[1] - rd.range_m[0]
     dv = rd.velocity_mps[1] - rd.velocity_mps[0]
+    pairs = []
+    for i, t in enumerate(scene.targets):
+        er = (det.range_m - t.range_m) / dr
+        ev = (det.velocity_mps - t.velocity_mps) / dv
+        for j in np.flatnonzero((np.abs(er) <= bins) & (np.abs(ev) <= bins)):
+            pairs.append((-float(det.power_db[j]), float(er[j] ** 2 + ev[j] ** 2), i, int(j)))
+    chosen: dict[int, int] = {}
+    used: set[int] = set()
+    for _, _, i, j in sorted(pairs):
+        if i not in chosen and j not in used:
+            chosen[i] = j
+            used.add(j)
     out = []
     for i, t in enumerate(scene.targets):
-        j = nearest_detection(det, rd, t.range_m, t.velocity_mps)
+        j = chosen.get(i)
         entry = {"index": i, "set": {"range_m": t.range_m, "velocity_mps": t.velocity_mps,
                                      "angle_deg": float(np.degrees(t.angle_rad)),
                                      "rcs_dbsm": t.rcs_dbsm}}
@@ -54,6 +73,7 @@ def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angl
                  "angle_deg": float(det.angle_deg[j]), "power_db": float(det.power_db[j]),
                  "snr_db": float(det.snr_db[j])}
             entry["detection"] = d
+            entry["detection_index"] = j
             entry["error"] = {
                 "range_m": d["range_m"] - t.range_m,
                 "velocity_mps": d["velocity_mps"] - t.velocity_mps,
@@ -66,6 +86,56 @@ def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angl
             entry["error"] = None
         out.append(entry)
     return out
+
+
+def label_detections(result: "RunResult", bins: float = 2.0) -> list[str]:
+    """What each detection is, from what the simulation knows about its echoes: ``target N``
+    (the detection matched to target N), ``cable ghost of target N`` (order k of its cable
+    reflections), ``setup reflection`` (the sheet, the board), or ``unmatched``.
+
+    Each echo's apparent position follows from the beat model (eq. 8): beat frequency
+    ``S tau + f_D`` (range, wrapped at the unambiguous range) and Doppler ``f_D`` (velocity,
+    wrapped at the unambiguous velocity). A detection takes the kind of the strongest echo
+    within ``bins`` range and Doppler bins of it (cyclic distances).
+    """
+    from scipy.constants import c
+
+    from .rts import KIND_GHOST, KIND_SETUP
+    det, rd, echoes, radar = result.detections, result.rd, result.echoes, result.scene.radar
+    labels = ["unmatched"] * len(det)
+    if len(det) and len(echoes):
+        dr = rd.range_m[1] - rd.range_m[0]
+        dv = rd.velocity_mps[1] - rd.velocity_mps[0]
+        span_r, span_v = dr * rd.range_m.size, dv * rd.velocity_mps.size
+        beat = radar.slope_hz_per_s * echoes.tau_s.mean(axis=1) + echoes.doppler_hz
+        e_r = beat * c / (2 * radar.slope_hz_per_s)
+        e_v = echoes.doppler_hz * c / (2 * radar.f_c_hz)
+        power = np.mean(np.abs(echoes.amplitude) ** 2, axis=1)
+
+        def cyc(a, span):
+            return np.abs((a + span / 2) % span - span / 2)
+        near = ((cyc(det.range_m[:, None] - e_r[None, :], span_r) <= bins * dr)
+                & (cyc(det.velocity_mps[:, None] - e_v[None, :], span_v) <= bins * dv))
+        for j in range(len(det)):
+            cand = np.flatnonzero(near[j])
+            if cand.size == 0:
+                continue
+            e = cand[np.argmax(power[cand])]
+            if echoes.kind[e] == KIND_SETUP:
+                labels[j] = "setup reflection"
+            elif echoes.kind[e] == KIND_GHOST:
+                labels[j] = f"cable ghost of target {int(echoes.target[e])}"
+            else:
+                labels[j] = f"target {int(echoes.target[e])}"
+    for m in result.matches:  # the matching decides which detection is the target itself
+        j = m.get("detection_index")
+        if j is not None:
+            labels[j] = f"target {m['index']}"
+    for j, lab in enumerate(labels):  # a target's second detection is not the target
+        if lab.startswith("target ") and not any(m.get("detection_index") == j
+                                                 for m in result.matches):
+            labels[j] = "unmatched"
+    return labels
 
 
 def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = None,
@@ -121,7 +191,8 @@ def summary(result: RunResult, paths_method: str) -> dict:
         "far_field": info["far_field"],
         "front_ends": info["front_ends"],
         "calibration": result.calibration,
-        "targets": result.matches,
+        "targets": [{k: v for k, v in m.items() if k != "detection_index"}
+                    for m in result.matches],
         "num_detections": len(result.detections),
         "num_echoes": len(result.echoes),
         "warnings": list(result.warnings),

@@ -234,7 +234,7 @@ def test_report_is_self_contained_and_escaped(report):
     # the scene summary: radar, far field, RTS and the front ends as tables
     for part in ("Radar under test", "Far field", "Radar target simulator", "Front ends"):
         assert part in text
-    assert "77 GHz" in text and "arc_angle (deg)" in text and "spacing &gt; resolution" in text
+    assert "77 GHz" in text and "arc angle (deg)" in text and "arc_angle" not in text and "spacing &gt; resolution" in text
 
 
 def test_report_rejects_non_png_images(tmp_path):

@@ -16,6 +16,7 @@ from ..scene import SceneError, TargetConfig
 from scipy.constants import c
 from .calibration import (Calibration, FrontEndProbe, calibrate_pair, probe_angles,
                           probe_front_ends)
+from .model import AngleUnreachable
 from .synthesis import PairModel
 
 __all__ = ["bracketing_pair", "pair_amplitudes", "plan_targets", "channel_offsets"]

@@ -6,9 +6,11 @@ import argparse
 import json
 import math
 import sys
+from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checked", "steps"]
+__all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checked", "steps",
+           "output_path", "output_folder", "output_file"]
 
 
 class UsageError(ValueError):
@@ -29,6 +31,34 @@ def number(lo=None, hi=None, integer=False):
             raise argparse.ArgumentTypeError(f"{text} is outside the allowed range [{lo}, {hi}]")
         return v
     return parse
+
+
+def output_path(text: str) -> Path:
+    """argparse type of ``--out`` (and ``--png``/``--html``): a non-empty path. (``Path('')`` is
+    ``'.'``, the current folder, which an output folder swap would replace.)"""
+    if text == "":
+        raise argparse.ArgumentTypeError("'' names no file or folder")
+    return Path(text)
+
+
+@contextmanager
+def output_folder(out, inputs=()):
+    """``--out DIR`` of a command: the staging folder to write into (see
+    :func:`rtsgeom.io.staged_dir`), or None without ``--out``. Enter it BEFORE computing: the
+    path is checked and the folder locked at once."""
+    if out is None:
+        yield None
+        return
+    from ..io import staged_dir
+    with staged_dir(out, [i for i in inputs if i is not None]) as stage:
+        yield stage
+
+
+def output_file(out, inputs=()) -> Path:
+    """Check an output file path before computing (exit 2 naming it); returns it."""
+    from ..io import check_output_file
+    check_output_file(out, [i for i in inputs if i is not None])
+    return Path(out)
 
 
 def scene_arg(p: argparse.ArgumentParser) -> None:

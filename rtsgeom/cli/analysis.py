@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import argparse
 import math
-from pathlib import Path
 
 import numpy as np
 
 from ..io import write_json
-from ._common import UsageError, load_scene_checked, number, print_json, scene_arg
+from ._common import (UsageError, load_scene_checked, number, output_folder, output_path,
+                      print_json, scene_arg)
 
 
 def radius_sweep(text: str) -> tuple[float, float, int]:
@@ -64,20 +64,27 @@ def cmd_nearfield(args) -> int:
     radii = (default_radii(scene) if args.radius_m is None
              else np.logspace(math.log10(args.radius_m[0]), math.log10(args.radius_m[1]),
                               args.radius_m[2]))
-    try:
-        nf = nearfield(scene, radii, points=args.points)
-    except ValueError as exc:
-        raise UsageError(f"--radius-m: {exc}") from None
-    return _emit(args, "nearfield", nf.to_dict(), lambda: nearfield_figure(nf), _nearfield_text)
+    with output_folder(args.out, [args.scene]) as stage:
+        try:
+            nf = nearfield(scene, radii, points=args.points)
+        except ValueError as exc:
+            raise UsageError(f"--radius-m: {exc}") from None
+        out = nf.to_dict()
+        _write(stage, "nearfield", out, lambda: nearfield_figure(nf))
+    return _emit(args, "nearfield", out, _nearfield_text)
 
 
-def _emit(args, name: str, out: dict, figure, text) -> int:
-    """Write ``NAME.json`` and ``NAME.png`` (``figure()``) under ``--out`` and print the JSON
-    (``--json``) or ``text(out)``."""
-    if args.out:
+def _write(stage, name: str, out: dict, figure) -> None:
+    """Write ``NAME.json`` and ``NAME.png`` (``figure()``) into the staging folder of
+    ``--out`` (None: nothing)."""
+    if stage is not None:
         from ..viz.figures import save_figure
-        write_json(args.out / f"{name}.json", out)
-        save_figure(figure(), args.out / f"{name}.png")
+        write_json(stage / f"{name}.json", out)
+        save_figure(figure(), stage / f"{name}.png")
+
+
+def _emit(args, name: str, out: dict, text) -> int:
+    """Print the JSON (``--json``) or ``text(out)`` once the output folder is in place."""
     if args.json:
         print_json(out)
     else:
@@ -122,8 +129,11 @@ def _ghosts_text(d: dict) -> str:
 def cmd_ghosts(args) -> int:
     from ..analysis.ghosts import ghost_analysis, ghosts_figure
     scene = load_scene_checked(args.scene)
-    rep = ghost_analysis(scene, args.floor_db, simulate=args.simulate)
-    return _emit(args, "ghosts", rep.to_dict(), lambda: ghosts_figure(rep), _ghosts_text)
+    with output_folder(args.out, [args.scene]) as stage:
+        rep = ghost_analysis(scene, args.floor_db, simulate=args.simulate)
+        out = rep.to_dict()
+        _write(stage, "ghosts", out, lambda: ghosts_figure(rep))
+    return _emit(args, "ghosts", out, _ghosts_text)
 
 
 def register(sub) -> None:
@@ -136,7 +146,7 @@ def register(sub) -> None:
     p.add_argument("--points", type=number(1, 201, integer=True), default=11,
                    help="synthesized set-points per pair (default 11)")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
-    p.add_argument("--out", type=Path, default=None,
+    p.add_argument("--out", type=output_path, default=None,
                    help="folder for nearfield.json and nearfield.png")
     p.set_defaults(func=cmd_nearfield)
 
@@ -149,5 +159,5 @@ def register(sub) -> None:
                    help="run the signal chain (targets on their nearest front ends) and read "
                         "each predicted ghost in the range-Doppler map")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
-    p.add_argument("--out", type=Path, default=None, help="folder for ghosts.json and ghosts.png")
+    p.add_argument("--out", type=output_path, default=None, help="folder for ghosts.json and ghosts.png")
     p.set_defaults(func=cmd_ghosts)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 
@@ -13,7 +12,8 @@ from ..io import write_json
 from ..paths import exact_paths
 
 from ..registry import SYNTHESIS_MODES
-from ._common import UsageError, load_scene_checked, number, print_json, scene_arg, steps
+from ._common import (UsageError, load_scene_checked, number, output_folder, output_path,
+                      print_json, scene_arg, steps)
 
 
 def _pair(setup, pair):
@@ -34,6 +34,11 @@ def _prepare(args):
 
 
 def cmd_calibrate(args) -> int:
+    with output_folder(args.out, [args.scene]) as stage:
+        return _calibrate(args, stage)
+
+
+def _calibrate(args, stage) -> int:
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
         scene, setup, pair, paths, probe = _prepare(args)
@@ -46,20 +51,21 @@ def cmd_calibrate(args) -> int:
         from ..viz.figures import calibration_sweep_figure
         return calibration_sweep_figure(cal.sweep_delta_tau_s, cal.sweep_error_deg,
                                         cal.delta_tau_s, cal.period_s)
-    _emit(args, "calibration_sweep.png", "calibration", out, figure,
+    _emit(args, stage, "calibration_sweep.png", "calibration", out, figure,
           f"pair {pair}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps, residual angle error "
           f"{cal.residual_error_deg:.4f} deg, range offset {cal.range_offset_m * 1e3:.2f} mm "
           f"(period {cal.period_s * 1e9:.4f} ns)")
     return 0
 
 
-def _emit(args, png: str, name: str, out: dict, figure, summary_line: str) -> None:
-    """``--out DIR``: DIR/<png> (from ``figure()``) and DIR/<name>.json; then JSON or one
-    summary line on stdout."""
-    if args.out:
+def _emit(args, stage, png: str, name: str, out: dict, figure, summary_line: str) -> None:
+    """``--out DIR``: <png> (from ``figure()``) and <name>.json into the staging folder
+    ``stage`` (swapped in as DIR when the command ends); then JSON or one summary line on
+    stdout."""
+    if stage is not None:
         from ..viz.figures import save_figure
-        save_figure(figure(), args.out / png)
-        write_json(args.out / f"{name}.json", out)
+        save_figure(figure(), stage / png)
+        write_json(stage / f"{name}.json", out)
     if args.json:
         print_json(out)
     else:
@@ -67,6 +73,11 @@ def _emit(args, png: str, name: str, out: dict, figure, summary_line: str) -> No
 
 
 def cmd_linearity(args) -> int:
+    with output_folder(args.out, [args.scene]) as stage:
+        return _linearity(args, stage)
+
+
+def _linearity(args, stage) -> int:
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
         scene, setup, pair, paths, probe = _prepare(args)
@@ -80,7 +91,7 @@ def cmd_linearity(args) -> int:
         from ..viz.figures import linearity_figure
         return linearity_figure(lin.set_deg, {args.amplitudes: lin.detected_deg},
                                 {args.amplitudes: lin.amplitude_db})
-    _emit(args, "linearity.png", "linearity", lin.to_dict(), figure,
+    _emit(args, stage, "linearity.png", "linearity", lin.to_dict(), figure,
           f"{args.amplitudes} ({'calibrated' if cal else 'uncalibrated'}): max |error| "
           f"{lin.max_abs_error_deg:.4f} deg over {len(lin.set_deg)} set-points")
     return 0
@@ -95,7 +106,7 @@ def register(sub) -> None:
         p.add_argument("--pair", nargs=2, type=number(0, 10_000, integer=True),
                        metavar=("I", "J"), default=[0, 1], help="adjacent front ends (default 0 1)")
         p.add_argument("--json", action="store_true", help="print the result as JSON")
-        p.add_argument("--out", type=Path, default=None, help="folder for the plot and JSON")
+        p.add_argument("--out", type=output_path, default=None, help="folder for the plot and JSON")
         p.add_argument("--quiet", action="store_true", help="no progress output")
         if name == "linearity":
             p.add_argument("--amplitudes", choices=SYNTHESIS_MODES,

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 
 from ..geometry import build_setup
 from ..info import format_info, scene_info
 from ..io import write_text
 from ..registry import PATH_METHODS
-from ._common import UsageError, load_scene_checked, print_json, scene_arg
+from ._common import (UsageError, load_scene_checked, output_file, output_path, print_json,
+                      scene_arg)
 
 
 def cmd_info(args) -> int:
@@ -21,6 +21,7 @@ def cmd_info(args) -> int:
 
 
 def cmd_paths(args) -> int:
+    output_file(args.out, [args.scene])
     setup = build_setup(load_scene_checked(args.scene))
     if args.method == "exact":
         from ..paths import exact_paths
@@ -35,6 +36,7 @@ def cmd_paths(args) -> int:
 
 def cmd_export_mesh(args) -> int:
     from ..geometry.export import export_setup
+    output_file(args.out, [args.scene])
     setup = build_setup(load_scene_checked(args.scene))
     try:
         path = export_setup(setup, args.out)
@@ -52,12 +54,12 @@ def register(sub) -> None:
 
     p = sub.add_parser("paths", help="per-element propagation paths as CSV")
     scene_arg(p)
-    p.add_argument("--out", type=Path, required=True, help="CSV file to write")
+    p.add_argument("--out", type=output_path, required=True, help="CSV file to write")
     p.add_argument("--method", choices=tuple(PATH_METHODS), default="exact",
                    help="exact line-of-sight distances (default) or Sionna RT ray tracing")
     p.set_defaults(func=cmd_paths)
 
     p = sub.add_parser("export-mesh", help="export the setup as GLB/PLY/OBJ/STL")
     scene_arg(p)
-    p.add_argument("--out", type=Path, required=True, help="mesh file (.glb, .ply, .obj, .stl)")
+    p.add_argument("--out", type=output_path, required=True, help="mesh file (.glb, .ply, .obj, .stl)")
     p.set_defaults(func=cmd_export_mesh)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import tempfile
 from pathlib import Path
 
@@ -11,27 +12,44 @@ import numpy as np
 
 from ..io import atomic_path, write_bytes, write_json, write_text
 from ..registry import AOA_MODES, PATH_METHODS
-from ..run import RunResult, run_scene, summary
-from ._common import UsageError, load_scene_checked, scene_arg, steps
+from ..run import RunResult, label_detections, run_scene, summary
+from ._common import (UsageError, load_scene_checked, output_file, output_folder, output_path,
+                      scene_arg, steps)
 
 
 def detections_csv(result: RunResult) -> str:
+    """One row per detection, sorted by range then velocity; the last column ``label`` says
+    what the simulation put there (:func:`rtsgeom.run.label_detections`)."""
     det = result.detections
+    labels = label_detections(result)
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(["range_m", "velocity_mps", "angle_deg", "power_db", "snr_db"])
+    w.writerow(["range_m", "velocity_mps", "angle_deg", "power_db", "snr_db", "label"])
     order = np.lexsort((det.velocity_mps, det.range_m))
     for i in order:
         w.writerow([f"{det.range_m[i]:.4f}", f"{det.velocity_mps[i]:.4f}",
-                    f"{det.angle_deg[i]:.4f}", f"{det.power_db[i]:.2f}", f"{det.snr_db[i]:.2f}"])
+                    f"{det.angle_deg[i]:.4f}", f"{det.power_db[i]:.2f}", f"{det.snr_db[i]:.2f}",
+                    labels[i]])
     return buf.getvalue()
 
 
-def write_maps(result: RunResult, out: Path) -> list[Path]:
-    """Range-Doppler and range-angle maps as PNG (paper Figs. "Range-Doppler map ..." and
-    "Range angle detections ...")."""
+def figure_png(fig) -> bytes:
+    """A figure as PNG bytes, in the style and resolution of
+    :func:`rtsgeom.viz.figures.save_figure` (kept in memory: the report embeds exactly these)."""
+    import matplotlib as mpl
+
+    from ..viz.figures import DPI, STYLE
+    buf = io.BytesIO()
+    with mpl.rc_context(STYLE):
+        fig.savefig(buf, format="png", dpi=DPI)
+    return buf.getvalue()
+
+
+def render_maps(result: RunResult) -> dict[str, bytes]:
+    """Range-Doppler and range-angle maps as PNG bytes (paper Figs. "Range-Doppler map ..." and
+    "Range angle detections ..."), by file name."""
     from ..radar.processing import range_angle_map
-    from ..viz.figures import range_angle_figure, range_doppler_figure, save_figure
+    from ..viz.figures import range_angle_figure, range_doppler_figure
     rd, det, scene = result.rd, result.detections, result.scene
     f1 = range_doppler_figure(rd.power_db, rd.range_m, rd.velocity_mps,
                               detections=np.c_[det.range_m, det.velocity_mps],
@@ -42,99 +60,125 @@ def write_maps(result: RunResult, out: Path) -> list[Path]:
     f2 = range_angle_figure(10 * np.log10(np.maximum(ra, 1e-30)), rd.range_m,
                             np.degrees(angles), detections=np.c_[det.range_m, det.angle_deg],
                             set_points=sets)
-    paths = [out / "range_doppler.png", out / "range_angle.png"]
-    save_figure(f1, paths[0])
-    save_figure(f2, paths[1])
+    return {"range_doppler.png": figure_png(f1), "range_angle.png": figure_png(f2)}
+
+
+def write_maps(result: RunResult, out: Path) -> list[Path]:
+    """Write :func:`render_maps` into ``out``; return the paths."""
+    paths = []
+    for name, data in render_maps(result).items():
+        write_bytes(out / name, data)
+        paths.append(out / name)
     return paths
 
 
-def _calibration_figures(result: RunResult, folder: Path) -> list[Path]:
-    from ..viz.figures import calibration_sweep_figure, save_figure
+def _calibration_figures(result: RunResult) -> list[bytes]:
+    from ..viz.figures import calibration_sweep_figure
     out = []
-    for k, cal in enumerate(result.calibration.get("pairs", [])):
+    for cal in result.calibration.get("pairs", []):
         t = np.array([p["delta_tau_s"] for p in cal["sweep"]])
         e = np.array([np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
                       for p in cal["sweep"]])
-        fig = calibration_sweep_figure(t, e, cal["delta_tau_s"], cal["period_s"])
-        path = folder / f"calibration_{k}.png"
-        save_figure(fig, path)
-        out.append(path)
+        out.append(figure_png(calibration_sweep_figure(t, e, cal["delta_tau_s"], cal["period_s"])))
     return out
 
 
-def write_run_report(result: RunResult, out: Path, maps: list[Path], paths_method: str,
-                     warnings: list[str]) -> Path:
-    """``DIR/report.html``: scene summary, 3D view, figures, detections vs set-points,
-    calibration, warnings; self-contained (images embedded)."""
-    from ..info import scene_info
-    from ..viz.report import write_report
+def _setup_png(result: RunResult) -> bytes:
     from ..viz.scene3d import render_setup_png
+    with tempfile.TemporaryDirectory(prefix="rtsgeom-3d-") as tmp:  # private to this run
+        return render_setup_png(result.setup, Path(tmp) / "setup.png",
+                                paths=result.paths).read_bytes()
+
+
+def run_report_html(result: RunResult, maps: dict[str, bytes], paths_method: str,
+                    warnings: list[str]) -> str:
+    """``report.html`` of a run: scene summary, 3D view, figures, detections vs set-points,
+    calibration, warnings; self-contained. Every image is bytes this run produced (``maps``
+    from :func:`render_maps`), never a file read back from the output folder."""
+    from ..info import scene_info
+    from ..viz.report import render_report
     sections = []
-    with tempfile.TemporaryDirectory() as tmp:
-        tmp = Path(tmp)
-        images = []
-        try:
-            images.append(render_setup_png(result.setup, tmp / "setup.png", paths=result.paths))
-        except Exception as exc:  # no off-screen OpenGL: the report still has everything else
-            warnings = warnings + [f"3D view not rendered: {exc}"]
-        sections.append({"heading": "Setup", "images": images,
-                         "text": f"Paths: {paths_method} ({len(result.paths)} rows)."})
-        rows = []
-        for m in result.matches:
-            s, d, e = m["set"], m["detection"], m["error"]
-            rows.append([m["index"], s["range_m"], s["velocity_mps"], s["angle_deg"],
-                         *(("-",) * 6 if d is None else
-                           (d["range_m"], d["velocity_mps"], d["angle_deg"], e["range_m"],
-                            e["velocity_mps"], e["angle_deg"]))])
-        sections.append({"heading": "Targets: set-points and detections",
-                         "table": {"columns": ["target", "set range m", "set velocity m/s",
-                                               "set angle deg", "range m", "velocity m/s",
-                                               "angle deg", "range error m",
-                                               "velocity error m/s", "angle error deg"],
-                                   "rows": rows},
-                         "images": [p.read_bytes() for p in maps]})
-        cal = result.calibration
-        if cal:
-            rows = [[str(tuple(p["pair"])), p["delta_tau_s"] * 1e12, p["residual_error_deg"],
-                     p["range_offset_m"] * 1e3] for p in cal["pairs"]]
-            sections.append({
-                "heading": "Calibration",
-                "text": (f"Amplitude mode {cal['mode']}. Front ends alone are detected at "
-                         + ", ".join(f"{a:.3f}" for a in cal["front_end_angles_deg"])
-                         + " deg; gain corrections "
-                         + ", ".join(f"{g:.4f}" for g in cal["gain_correction"]) + "."),
-                "table": {"columns": ["pair", "delta tau ps", "residual error deg",
-                                      "range offset mm"], "rows": rows},
-                "images": [p.read_bytes() for p in _calibration_figures(result, tmp)]})
-        det = result.detections
-        sections.append({"heading": "All detections",
-                         "table": {"columns": ["range m", "velocity m/s", "angle deg",
-                                               "power dB", "SNR dB"],
-                                   "rows": [[f"{a:.3f}", f"{b:.3f}", f"{c:.3f}", f"{d:.1f}",
-                                             f"{e:.1f}"] for a, b, c, d, e in
-                                            zip(det.range_m, det.velocity_mps, det.angle_deg,
-                                                det.power_db, det.snr_db)]}})
-        if warnings:
-            sections.append({"heading": "Warnings", "warnings": warnings})
-        return write_report(out / "report.html", f"rtsgeom run: {result.scene.name}",
-                            scene_info(result.setup), sections)
+    images = []
+    try:
+        images.append(_setup_png(result))
+    except Exception as exc:  # no off-screen OpenGL: the report still has everything else
+        warnings = warnings + [f"3D view not rendered: {exc}"]
+    sections.append({"heading": "Setup", "images": images,
+                     "text": f"Paths: {paths_method} ({len(result.paths)} rows)."})
+    rows = []
+    for m in result.matches:
+        s, d, e = m["set"], m["detection"], m["error"]
+        rows.append([m["index"], s["range_m"], s["velocity_mps"], s["angle_deg"],
+                     *(("not detected",) + ("-",) * 5 if d is None else
+                       (d["range_m"], d["velocity_mps"], d["angle_deg"], e["range_m"],
+                        e["velocity_mps"], e["angle_deg"]))])
+    sections.append({"heading": "Targets: set-points and detections",
+                     "table": {"columns": ["target", "set range (m)", "set velocity (m/s)",
+                                           "set angle (deg)", "range (m)", "velocity (m/s)",
+                                           "angle (deg)", "range error (m)",
+                                           "velocity error (m/s)", "angle error (deg)"],
+                               "rows": rows,
+                               "digits": [None, 4, 4, 3, 4, 4, 3, 4, 4, 3]},
+                     "images": list(maps.values())})
+    cal = result.calibration
+    if cal:
+        rows = [[f"{p['pair'][0]}-{p['pair'][1]}", p["delta_tau_s"] * 1e12,
+                 p["residual_error_deg"], p["range_offset_m"] * 1e3] for p in cal["pairs"]]
+        sections.append({
+            "heading": "Calibration",
+            "text": (f"Amplitude mode {cal['mode']}. Front ends alone are detected at "
+                     + ", ".join(f"{a:.3f}" for a in cal["front_end_angles_deg"])
+                     + " deg; gain corrections "
+                     + ", ".join(f"{g:.4f}" for g in cal["gain_correction"]) + "."),
+            "table": {"columns": ["front-end pair", "delay offset (ps)",
+                                  "residual angle error (deg)", "range offset (mm)"],
+                      "rows": rows, "digits": [None, 1, 4, 2]},
+            "images": _calibration_figures(result)})
+    det = result.detections
+    labels = label_detections(result)
+    sections.append({"heading": "All detections",
+                     "table": {"columns": ["range (m)", "velocity (m/s)", "angle (deg)",
+                                           "power (dB)", "SNR (dB)", "what it is"],
+                               "rows": [[a, b, c, d, e, lab] for a, b, c, d, e, lab in
+                                        zip(det.range_m, det.velocity_mps, det.angle_deg,
+                                            det.power_db, det.snr_db, labels)],
+                               "digits": [3, 3, 3, 1, 1, None]}})
+    if warnings:
+        sections.append({"heading": "Warnings", "warnings": warnings})
+    return render_report(f"rtsgeom run: {result.scene.name}", scene_info(result.setup), sections)
+
+
+def write_run_report(result: RunResult, out: Path, maps, paths_method: str,
+                     warnings: list[str]) -> Path:
+    """Write :func:`run_report_html` to ``out/report.html`` (``maps``: PNG bytes by name, or
+    the paths :func:`write_maps` returned)."""
+    if not isinstance(maps, dict):
+        maps = {Path(p).name: Path(p).read_bytes() for p in maps}
+    write_text(out / "report.html", run_report_html(result, maps, paths_method, warnings))
+    return out / "report.html"
 
 
 def cmd_run(args) -> int:
     from ..validate import scene_warnings
     scene = load_scene_checked(args.scene)
     out = args.out
-    with steps(args.quiet) as step:
+    with output_folder(out, [args.scene]) as stage, steps(args.quiet) as step:
         step(f"simulating {scene.name} ({args.paths} paths, calibration, ADC cube, detection)")
         result = run_scene(scene, args.paths, args.amplitudes)
         step("writing detections, summary and maps")
-        write_text(out / "detections.csv", detections_csv(result))
-        write_json(out / "summary.json", summary(result, args.paths))
-        maps = write_maps(result, out)
+        (stage / "detections.csv").write_text(detections_csv(result), encoding="utf-8")
+        (stage / "summary.json").write_text(
+            json.dumps(summary(result, args.paths), indent=2, allow_nan=False) + "\n",
+            encoding="utf-8")
+        maps = render_maps(result)
+        for name, data in maps.items():
+            (stage / name).write_bytes(data)
         if not args.no_report:
             step("writing report.html (3D view, figures)")
-            write_run_report(result, out, maps, args.paths,
-                             list(scene_warnings(scene)) + list(result.warnings))
+            (stage / "report.html").write_text(
+                run_report_html(result, maps, args.paths,
+                                list(scene_warnings(scene)) + list(result.warnings)),
+                encoding="utf-8")
     if not args.quiet:
         for m in result.matches:
             d, e = m["detection"], m["error"]
@@ -152,6 +196,9 @@ def cmd_run(args) -> int:
 
 
 def cmd_adc(args) -> int:
+    output_file(args.out, [args.scene])
+    if args.format == "dca1000":
+        output_file(Path(str(args.out) + ".json"), [args.scene])
     scene = load_scene_checked(args.scene)
     cube = run_scene(scene, "exact", args.amplitudes).cube
     if args.format == "npy":
@@ -181,7 +228,7 @@ def register(sub) -> None:
     modes = tuple(AOA_MODES)
     p = sub.add_parser("run", help="the main job: simulate the scene, detect, compare with set-points")
     scene_arg(p)
-    p.add_argument("--out", type=Path, required=True, help="output folder")
+    p.add_argument("--out", type=output_path, required=True, help="output folder")
     p.add_argument("--paths", choices=tuple(PATH_METHODS), default="exact",
                    help="exact line-of-sight paths (default) or Sionna RT ray tracing")
     p.add_argument("--amplitudes", choices=modes, default=None,
@@ -192,7 +239,7 @@ def register(sub) -> None:
 
     p = sub.add_parser("adc", help="save the raw ADC cube (.npy) or a DCA1000 capture")
     scene_arg(p)
-    p.add_argument("--out", type=Path, required=True, help="output file")
+    p.add_argument("--out", type=output_path, required=True, help="output file")
     p.add_argument("--format", choices=("npy", "dca1000"), default="npy")
     p.add_argument("--amplitudes", choices=modes, default=None,
                    help="AoA amplitude mode (default: the scene's rts.aoa_mode)")

@@ -8,7 +8,6 @@ import functools
 import sys
 import time
 from contextlib import contextmanager
-from pathlib import Path
 
 import numpy as np
 
@@ -16,11 +15,35 @@ from ..analysis.tolerance import (AXES, CASES, DISTRIBUTIONS, NOMINAL_AMPLITUDES
                                   max_sigma_for_yield, monte_carlo)
 from ..geometry import build_setup
 from ..io import write_json
-from ..parallel import dask_client, map_chunks
-from ._common import UsageError, load_scene_checked, number, print_json, scene_arg
+from ..parallel import ClusterError, check_address, dask_client, map_chunks
+from ._common import (UsageError, load_scene_checked, number, output_folder, output_path,
+                      print_json, scene_arg)
 from .aoa import _pair
 
 MAX_SIGMA_MM = 10.0  # the phasor model is first order in the errors; checked to 0.3 mm
+#: Peak memory of one Monte-Carlo chunk is about ``chunk * chunk_bytes_per_draw(points)``
+#: (measured with tracemalloc: 9.4 kB/draw at 21 set-points, 83 kB/draw at 201); ``--chunk`` is
+#: capped so that one chunk stays within this budget. The draws do not depend on the chunk size,
+#: so the cap changes no result.
+CHUNK_MEMORY_BYTES = 256 * 2 ** 20
+
+
+def chunk_bytes_per_draw(points: int) -> int:
+    """Upper bound of the peak bytes per draw of one tolerance chunk with ``points`` set-points
+    (all cases: ~420 B per set-point and draw, plus a fixed part)."""
+    return 450 * int(points) + 2000
+
+
+def capped_chunk(chunk: int, points: int) -> int:
+    """``chunk`` bounded so that one chunk's peak stays within :data:`CHUNK_MEMORY_BYTES`."""
+    return max(100, min(int(chunk), CHUNK_MEMORY_BYTES // chunk_bytes_per_draw(points)))
+
+
+def _dask_address(text: str) -> str:
+    try:
+        return check_address(text)
+    except ClusterError as exc:
+        raise argparse.ArgumentTypeError(str(exc).split(": ", 1)[1]) from None
 
 
 @contextmanager
@@ -74,7 +97,13 @@ def _model(scene, pair_arg, points: int) -> PairPhasors:
 
 def cmd_tolerance(args) -> int:
     scene = load_scene_checked(args.scene)
+    with output_folder(args.out, [args.scene]) as stage:
+        return _tolerance(args, scene, stage)
+
+
+def _tolerance(args, scene, stage) -> int:
     model = _model(scene, args.pair, args.points)
+    chunk = capped_chunk(args.chunk, len(model.set_rad))
     seed = scene.seed if args.seed is None else args.seed
     sigma = np.array([args.sigma_radial_mm, args.sigma_tangential_mm, args.sigma_height_mm]) * 1e-3
     cases = CASES + ((NOMINAL_AMPLITUDES,) if args.nominal_amplitudes else ())
@@ -82,17 +111,17 @@ def cmd_tolerance(args) -> int:
     with _progress(args.quiet) as progress, dask_client(args.dask, args.workers) as client:
         mapper = None if client is None else functools.partial(map_chunks, client=client)
         res = monte_carlo(model, sigma, args.draws, seed, args.distribution, args.spec_deg,
-                          cases, args.chunk, progress, "Monte Carlo", mapper)
+                          cases, chunk, progress, "Monte Carlo", mapper)
         out = res.to_dict()
         if args.invert_yield is not None:
             out["inversion"] = {
                 case: max_sigma_for_yield(model, sigma, args.draws, seed, args.invert_yield,
                                           args.spec_deg, case, args.invert_axis,
-                                          args.distribution, chunk=args.chunk, progress=progress,
+                                          args.distribution, chunk=chunk, progress=progress,
                                           mapper=mapper)
                 for case in CASES}
     elapsed = time.perf_counter() - t0
-    if args.out:
+    if stage is not None:
         from ..viz.figures import save_figure, tolerance_histogram_figure
         # The uncalibrated tail reaches degrees: errors beyond +-lim (above every case's 95th
         # percentile, so the legend's stays exact) are piled into the outer bins.
@@ -102,8 +131,8 @@ def cmd_tolerance(args) -> int:
             {case: np.clip(res.worst_error_deg[case], -lim, lim) for case in cases},
             args.spec_deg, f"Worst error per setup, pair {tuple(model.pair)} (clipped at "
                            f"±{lim:.2g} deg)")
-        save_figure(fig, args.out / "tolerance.png")
-        write_json(args.out / "tolerance.json", out)
+        save_figure(fig, stage / "tolerance.png")
+        write_json(stage / "tolerance.json", out)
     if args.json:
         print_json(out)
         return 0
@@ -128,8 +157,13 @@ def cmd_tolerance(args) -> int:
 
 
 def cmd_design(args) -> int:
-    from ..analysis.design import METRICS, design_grid
     scene = load_scene_checked(args.scene)
+    with output_folder(args.out, [args.scene]) as stage:
+        return _design(args, scene, stage)
+
+
+def _design(args, scene, stage) -> int:
+    from ..analysis.design import METRICS, design_grid
     pair = _pair(build_setup(scene), args.pair)
     seed = scene.seed if args.seed is None else args.seed
     with _progress(args.quiet) as progress:
@@ -138,7 +172,7 @@ def cmd_design(args) -> int:
                            None if progress is None else
                            (lambda done, total: progress("designs", done, total)))
     out = grid.to_dict()
-    if args.out:
+    if stage is not None:
         from ..viz.figures import design_heatmap_figure, save_figure
         mask = grid.exceeds_resolution
         for name, (zlabel, title) in METRICS.items():
@@ -147,8 +181,8 @@ def cmd_design(args) -> int:
                 "front-end spacing (deg)", zlabel,
                 f"{title} (hatched: spacing > {grid.angular_resolution_deg:.1f} deg, eq. 24)",
                 mask=mask)
-            save_figure(fig, args.out / f"design_{name}.png")
-        write_json(args.out / "design.json", out)
+            save_figure(fig, stage / f"design_{name}.png")
+        write_json(stage / "design.json", out)
     if args.json:
         print_json(out)
         return 0
@@ -181,7 +215,7 @@ def _common(p, draws_default: int) -> None:
     p.add_argument("--points", type=number(3, 201, integer=True), default=21,
                    help="set-points across the span, ends excluded, in [3, 201] (default 21)")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
-    p.add_argument("--out", type=Path, default=None, help="folder for the plots and JSON")
+    p.add_argument("--out", type=output_path, default=None, help="folder for the plots and JSON")
     p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
 
 
@@ -205,8 +239,10 @@ def register(sub) -> None:
                    help=f"add the case '{NOMINAL_AMPLITUDES}': calibrated, but the amplitudes "
                         "not designed for the calibration delay's range offset")
     p.add_argument("--chunk", type=number(100, 1_000_000, integer=True), default=10_000,
-                   help="draws per chunk (memory), in [100, 1000000] (default 10000)")
-    p.add_argument("--dask", metavar="ADDRESS", default=None,
+                   help="draws per chunk (memory), in [100, 1000000] (default 10000); capped "
+                        f"so that one chunk needs at most {CHUNK_MEMORY_BYTES >> 20} MiB "
+                        "(results do not depend on it)")
+    p.add_argument("--dask", metavar="ADDRESS", default=None, type=_dask_address,
                    help="run the chunks on an existing Dask scheduler (tcp://host:8786)")
     p.add_argument("--workers", type=number(1, 1024, integer=True), default=None,
                    help="run the chunks on a local Dask cluster of N worker processes")

@@ -4,11 +4,10 @@ from __future__ import annotations
 
 import argparse
 import os
-from pathlib import Path
 
 from ..geometry import build_setup
 from ..registry import PATH_METHODS
-from ._common import UsageError, load_scene_checked, scene_arg
+from ._common import UsageError, load_scene_checked, output_file, output_path, scene_arg
 
 
 def _window_size(text: str) -> tuple[int, int]:
@@ -40,6 +39,14 @@ def cmd_show(args) -> int:
     if not (args.png or args.html) and not os.environ.get("DISPLAY"):
         raise UsageError("no display to open a window on (DISPLAY is not set): write a file "
                          "with --png FILE and/or --html FILE")
+    if args.png and args.png.suffix.lower() != ".png":
+        raise UsageError(f"--png {args.png}: the file name must end in .png (the rendering is "
+                         "written as PNG)")
+    if args.html and args.html.suffix.lower() not in (".html", ".htm"):
+        raise UsageError(f"--html {args.html}: the file name must end in .html")
+    for out in (args.png, args.html):
+        if out is not None:
+            output_file(out, [args.scene])
     setup = build_setup(load_scene_checked(args.scene))
     paths = _load_paths(setup, args.paths)
     from ..viz.scene3d import VizError, export_setup_html, render_setup_png, show_setup
@@ -67,8 +74,8 @@ def register(sub) -> None:
     scene_arg(p)
     p.add_argument("--paths", choices=tuple(PATH_METHODS), default=None,
                    help="also draw propagation paths: exact line of sight, or Sionna RT rays")
-    p.add_argument("--png", type=Path, metavar="FILE", help="write an off-screen rendering (PNG)")
-    p.add_argument("--html", type=Path, metavar="FILE",
+    p.add_argument("--png", type=output_path, metavar="FILE", help="write an off-screen rendering (PNG)")
+    p.add_argument("--html", type=output_path, metavar="FILE",
                    help="write an interactive HTML view (needs trame-pyvista, nest-asyncio2)")
     p.add_argument("--size", type=_window_size, default=(1600, 1000), metavar="WxH",
                    help="image / window size in pixels (default 1600x1000)")

@@ -83,29 +83,90 @@ def range_doppler(cube: AdcCube) -> RangeDoppler:
     return RangeDoppler(spec, power, frozen(rng), frozen(vel), frozen(nu))
 
 
+#: OS-CFAR ranks at most this many training cells per cell under test (an evenly thinned ring
+#: beyond it), so that its cost stays O(map x OS_MAX_CELLS) whatever the ring the scene asks for.
+OS_MAX_CELLS = 512
+
+
+def _window_sums(a: np.ndarray, lo: int, hi: int, axis: int) -> np.ndarray:
+    """``out[i] = sum(a[(i + k) mod n] for k in lo..hi)`` along ``axis`` (cyclic), in O(size)
+    time and memory whatever the window, with additions only: blocks of the window's length,
+    each window the suffix of one block plus the prefix of the next (van Herk / Gil-Werman), so
+    the rounding error is relative to the window's own content (no difference of long running
+    sums, which would leave eps x the strongest peak in every quiet cell). A window longer than
+    the axis counts each wrap in full, as a wrapped convolution does."""
+    a = np.moveaxis(a, axis, 0)
+    n = a.shape[0]
+    full, w = divmod(hi - lo + 1, n)
+    out = full * a.sum(axis=0, keepdims=True) if full else None
+    if w:
+        nb = -(-(n + w - 1) // w)  # blocks covering every window start 0..n-1
+        ext = np.take(a, np.arange(nb * w + w) % n, axis=0)  # cyclic extension
+        blocks = ext.reshape((nb + 1, w) + a.shape[1:])
+        pre = np.cumsum(blocks, axis=1).reshape(ext.shape)
+        suf = np.flip(np.cumsum(np.flip(blocks, 1), axis=1), 1).reshape(ext.shape)
+        s = np.arange(n)
+        part = np.where(((s % w) == 0).reshape((n,) + (1,) * (a.ndim - 1)),
+                        suf[s], suf[s] + pre[s + w - 1])
+        out = part if out is None else out + part
+    out = np.roll(np.broadcast_to(out, a.shape), -lo, axis=0)  # window starts at i + lo
+    return np.moveaxis(out, 0, axis)
+
+
+def _rect_sum(a: np.ndarray, r: tuple[int, int], d: tuple[int, int]) -> np.ndarray:
+    """Sum over the cyclic rectangle of range offsets ``r`` and Doppler offsets ``d``."""
+    return _window_sums(_window_sums(a, r[0], r[1], 0), d[0], d[1], 1)
+
+
+def _os_footprint(shape, gr: int, gd: int, tr: int, td: int) -> np.ndarray:
+    """The OS-CFAR training ring, clipped to the map (no cell twice) and thinned evenly to at
+    most :data:`OS_MAX_CELLS` cells."""
+    hr = min(gr + tr, (shape[0] - 1) // 2)
+    hd = min(gd + td, (shape[1] - 1) // 2)
+    ring = np.ones((2 * hr + 1, 2 * hd + 1), bool)
+    ring[max(hr - gr, 0):hr + gr + 1, max(hd - gd, 0):hd + gd + 1] = False
+    if not ring.any():  # the guard cells cover the whole map: train on every other cell
+        ring[:] = True
+        ring[hr, hd] = False
+    idx = np.flatnonzero(ring)
+    if idx.size > OS_MAX_CELLS:
+        keep = idx[np.linspace(0, idx.size - 1, OS_MAX_CELLS).round().astype(int)]
+        ring = np.zeros_like(ring)
+        ring.flat[keep] = True
+    return ring
+
+
 def cfar_mask(power: np.ndarray, cfg: CfarConfig) -> tuple[np.ndarray, np.ndarray]:
     """2D CFAR on a (range, Doppler) power map: returns (detected mask, noise estimate).
 
     Training cells form a ring around each cell under test (guard cells excluded); the range
     axis is cyclic too: with a complex ADC the beat frequencies wrap at f_adc, so the top
     range bins neighbour the bottom ones.
-    CA averages the ring, OS takes its ``os_rank`` quantile.
+
+    CA averages the ring, summed as four rectangles with cyclic block prefix/suffix sums
+    (:func:`_window_sums`): time and memory O(map) whatever the ring size, rounding relative to
+    the ring's own content (a ring larger than the map counts wrapped cells once per wrap, as a
+    wrapped convolution does).
+    OS takes the ring's ``os_rank`` quantile; its ring is clipped to the map and thinned evenly
+    to at most :data:`OS_MAX_CELLS` cells, bounding the cost at O(map x OS_MAX_CELLS).
     """
     gr, gd = cfg.guard_cells
     tr, td = cfg.training_cells
-    ring = np.ones((2 * (gr + tr) + 1, 2 * (gd + td) + 1), bool)
-    ring[tr:tr + 2 * gr + 1, td:td + 2 * gd + 1] = False
-    pr, pd = gr + tr, gd + td
-    padded = np.pad(power, ((pr, pr), (pd, pd)), mode="wrap")  # both axes are cyclic
-    crop = (slice(pr, pr + power.shape[0]), slice(pd, pd + power.shape[1]))
+    power = np.asarray(power, dtype=np.float64)
     if cfg.kind == "ca":
-        k = ring.astype(float)
-        total = ndimage.convolve(padded, k, mode="constant")[crop]
-        count = ndimage.convolve(np.ones_like(padded), k, mode="constant")[crop]
-        noise = total / np.maximum(count, 1)
+        # the ring as four rectangles (bands above and below the guard window, over the full
+        # Doppler width; left and right of it): sums only, no outer-minus-inner cancellation
+        hr, hd = gr + tr, gd + td
+        total = (_rect_sum(power, (-hr, -gr - 1), (-hd, hd))
+                 + _rect_sum(power, (gr + 1, hr), (-hd, hd))
+                 + _rect_sum(power, (-gr, gr), (-hd, -gd - 1))
+                 + _rect_sum(power, (-gr, gr), (gd + 1, hd)))
+        count = (2 * hr + 1) * (2 * hd + 1) - (2 * gr + 1) * (2 * gd + 1)
+        noise = total / count
     else:
-        noise = ndimage.percentile_filter(padded, 100 * cfg.os_rank, footprint=ring,
-                                          mode="nearest")[crop]
+        ring = _os_footprint(power.shape, gr, gd, tr, td)
+        noise = ndimage.percentile_filter(power, 100 * cfg.os_rank, footprint=ring,
+                                          mode="wrap")
     thr = noise * 10 ** (cfg.threshold_db / 10)
     peak = power == ndimage.maximum_filter(power, size=3, mode="wrap")
     return (power > thr) & peak, noise

@@ -6,7 +6,8 @@ tables) and a list of sections. A section is a dict with
 * ``heading`` (str, required),
 * ``text`` (str; blank lines separate paragraphs),
 * ``images`` (list of PNG file paths or PNG bytes),
-* ``table`` (``{"columns": [...], "rows": [[...], ...]}``),
+* ``table`` (``{"columns": [...], "rows": [[...], ...]}``, optionally ``"digits": [...]``:
+  decimals per column, None for the automatic format),
 * ``warnings`` (list of str, shown highlighted).
 
 All text is HTML-escaped; the file is written atomically.
@@ -34,6 +35,26 @@ _SECTION_KEYS = {"heading", "text", "images", "table", "warnings"}
 _UNITS = (("_hz_per_s", "Hz/s"), ("_hz", "Hz"), ("_mps", "m/s"), ("_deg", "deg"), ("_mm", "mm"),
           ("_dbsm", "dBsm"), ("_db", "dB"), ("_m", "m"), ("_s", "s"))
 _PREFIXED = {"Hz", "Hz/s", "s", "m"}
+# Absolute precision of the quantities without SI prefixes: values are rounded to it, so that
+# numerical noise (-3.42094e-06 m/s) reads as 0.
+_PRECISION = {"m/s": 1e-4, "deg": 1e-4, "mm": 1e-4, "dB": 1e-3, "dBsm": 1e-3}
+# Readable names of the keys of scene_info and the summaries (the rest: underscores to spaces).
+_NAMES = {
+    "f_c": "start frequency f_c", "f_center": "centre frequency", "f_rts": "RTS IF f_rts",
+    "f_s": "RTS sampling rate f_s", "slope": "chirp slope S", "num_rx": "Rx antennas",
+    "num_virtual": "virtual channels", "num_virtual_azimuth": "azimuth virtual channels",
+    "tx_order": "Tx order", "antenna_preset": "antenna preset", "max_range": "maximum range",
+    "max_velocity": "maximum velocity", "aperture": "azimuth aperture d_A",
+    "fraunhofer_distance": "Fraunhofer distance 2 d_A^2 / lambda",
+    "arc_radius": "arc radius R_c", "delay_resolution": "delay resolution",
+    "calibration_period": "calibration period", "rcs": "RCS", "snr": "SNR",
+    "arc_angle": "arc angle", "azimuth_from_rut": "azimuth from the RuT",
+    "apparent_azimuth": "apparent azimuth", "rx_tx_separation": "Rx-Tx separation",
+    "mounting_offsets": "mounting offsets", "curvature_phase_error": "curvature phase error",
+    "front_end_spacing": "front-end spacing", "spacing_within_resolution":
+    "spacing within the angular resolution", "scene_sha256": "scene SHA-256",
+    "rtsgeom_version": "rtsgeom version",
+}
 
 _CSS = """
 body { font-family: system-ui, -apple-system, "Segoe UI", Roboto, sans-serif; margin: 2em auto;
@@ -61,20 +82,31 @@ def _esc(value: Any) -> str:
 
 
 def _label_unit(key: str) -> tuple[str, str | None]:
-    """``f_c_hz`` -> (``f_c``, ``Hz``); keys without a unit suffix stay as they are."""
-    for suffix, unit in _UNITS:
+    """``f_c_hz`` -> (``start frequency f_c``, ``Hz``): the readable name (:data:`_NAMES`, else
+    the key with spaces for underscores) and the unit of the key's suffix."""
+    label, unit = key, None
+    for suffix, u in _UNITS:
         if key.endswith(suffix) and len(key) > len(suffix):
-            return key[: -len(suffix)], unit
-    return key, None
+            label, unit = key[: -len(suffix)], u
+            break
+    return _NAMES.get(label, label.replace("_", " ")), unit
 
 
-def _format_number(value: float, unit: str | None) -> str:
+def _format_number(value: float, unit: str | None, digits: int | None = None) -> str:
     if not math.isfinite(value):
         return str(value)
+    if digits is not None:
+        text = f"{value:.{digits}f}"
+        if float(text) == 0.0:
+            text = text.lstrip("-")
+        return f"{text} {unit}" if unit else text
     if unit in _PREFIXED and value != 0.0:
         return EngFormatter(unit=unit, places=None, sep=" ", usetex=False,
-                            useMathText=False)(value).replace("\u2212", "-")
-    text = f"{value:.6g}"
+                            useMathText=False)(float(f"{value:.5g}")).replace("\u2212", "-")
+    if unit in _PRECISION:
+        q = _PRECISION[unit]
+        value = round(value / q) * q + 0.0
+    text = f"{value:.6g}" if value != 0 else "0"
     return f"{text} {unit}" if unit else text
 
 
@@ -83,16 +115,18 @@ def _plain(value: Any) -> Any:
     return value.tolist() if hasattr(value, "tolist") else value
 
 
-def _format_value(value: Any, unit: str | None = None) -> str:
+def _format_value(value: Any, unit: str | None = None, digits: int | None = None) -> str:
     value = _plain(value)
     if value is None:
         return "\u2013"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
     if isinstance(value, (list, tuple)):
-        return ", ".join(_format_value(v, unit) for v in value)
+        return ", ".join(_format_value(v, unit, digits) for v in value)
     if _is_number(value):
         if isinstance(value, int) and unit is None:
             return str(value)
-        return _format_number(float(value), unit)
+        return _format_number(float(value), unit, digits)
     return str(value)
 
 
@@ -100,14 +134,14 @@ def _is_number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
-def _cell(value: Any, unit: str | None = None) -> str:
+def _cell(value: Any, unit: str | None = None, digits: int | None = None) -> str:
     value = _plain(value)
     cls = ' class="num"' if _is_number(value) else ""
-    return f"<td{cls}>{_esc(_format_value(value, unit))}</td>"
+    return f"<td{cls}>{_esc(_format_value(value, unit, digits))}</td>"
 
 
 def _table(columns: Iterable[Any], rows: Iterable[Iterable[Any]],
-           units: list[str | None] | None = None) -> str:
+           units: list[str | None] | None = None, digits: list | None = None) -> str:
     columns = list(columns)
     head = "".join(f"<th>{_esc(c)}</th>" for c in columns)
     body = []
@@ -117,7 +151,8 @@ def _table(columns: Iterable[Any], rows: Iterable[Iterable[Any]],
             raise ValueError(f"report table row {row!r} has {len(row)} cells, the table has "
                              f"{len(columns)} columns")
         u = units or [None] * len(row)
-        body.append("<tr>" + "".join(_cell(v, un) for v, un in zip(row, u)) + "</tr>")
+        dg = digits or [None] * len(row)
+        body.append("<tr>" + "".join(_cell(v, un, d) for v, un, d in zip(row, u, dg)) + "</tr>")
     return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
 
 
@@ -135,8 +170,19 @@ def _records_table(records: list[Mapping[str, Any]]) -> str:
     labels, units = zip(*(_label_unit(str(k)) for k in keys)) if keys else ((), ())
     cols = [f"{lab} ({u})" if u else lab for lab, u in zip(labels, units)]
     # values in the body carry no unit: the header has it
-    rows = [[r.get(k, "") for k in keys] for r in records]
+    rows = [[_rounded(r.get(k, ""), u) for k, u in zip(keys, units)] for r in records]
     return _table(cols, rows)
+
+
+def _rounded(value: Any, unit: str | None) -> Any:
+    """``value`` rounded to the precision of its unit (:data:`_PRECISION`), lists elementwise."""
+    value = _plain(value)
+    if isinstance(value, list):
+        return [_rounded(v, unit) for v in value]
+    if _is_number(value) and isinstance(value, float) and unit in _PRECISION:
+        q = _PRECISION[unit]
+        return round(value / q) * q + 0.0
+    return value
 
 
 _INFO_PARTS = (("radar", "Radar under test"), ("far_field", "Far field"),
@@ -149,7 +195,7 @@ def _scene_section(info: Mapping[str, Any]) -> str:
             if k in info]
     if meta:
         out.append("<p class=\"meta\">" + "<br>".join(
-            f"{_esc(k)}: <code>{_esc(v)}</code>" for k, v in meta) + "</p>")
+            f"{_esc(_label_unit(k)[0])}: <code>{_esc(v)}</code>" for k, v in meta) + "</p>")
     shown = {k for k, _ in meta}
     tables = []
     for key, heading in _INFO_PARTS:
@@ -161,7 +207,7 @@ def _scene_section(info: Mapping[str, Any]) -> str:
     for key, value in info.items():  # front_ends, targets, and whatever scene_info adds later
         if key in shown:
             continue
-        heading = key.replace("_", " ").capitalize()
+        heading = _label_unit(key)[0].capitalize()
         if isinstance(value, list) and value and all(isinstance(v, Mapping) for v in value):
             out.append(f"<h3>{_esc(heading)}</h3>{_records_table(value)}")
         elif isinstance(value, Mapping):
@@ -170,7 +216,7 @@ def _scene_section(info: Mapping[str, Any]) -> str:
             continue
         else:
             label, unit = _label_unit(key)
-            out.append(f"<p><b>{_esc(label.replace('_', ' '))}</b>: "
+            out.append(f"<p><b>{_esc(label)}</b>: "
                        f"{_esc(_format_value(value, unit))}</p>")
     out.append("</section>")
     return "\n".join(out)
@@ -181,7 +227,7 @@ def _png_bytes(image: Any) -> tuple[bytes, str]:
     if isinstance(image, (bytes, bytearray, memoryview)):
         data, name = bytes(image), ""
     else:
-        p = Path(image)
+        p = Path(image)  # a file: prefer bytes, so a report shows what its run produced
         data, name = p.read_bytes(), p.name
     if not data.startswith(_PNG_MAGIC):
         raise ValueError(f"report image {name or '(bytes)'} is not a PNG file")
@@ -210,7 +256,8 @@ def _section(sec: Mapping[str, Any]) -> str:
         out.append(f'<figure><img src="{uri}" alt="{_esc(name or sec["heading"])}">{cap}</figure>')
     table = sec.get("table")
     if table:
-        out.append(_table(table.get("columns", []), table.get("rows", [])))
+        out.append(_table(table.get("columns", []), table.get("rows", []),
+                          digits=table.get("digits")))
     out.append("</section>")
     return "\n".join(out)
 
