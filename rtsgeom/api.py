@@ -226,8 +226,8 @@ def show(scene_or_setup, paths=None, png: str | Path | None = None,
             from .paths import exact_paths
             paths = exact_paths(setup)
         elif paths == "raytrace":
-            from .paths.raytrace import raytrace_paths
-            paths = raytrace_paths(setup)
+            from .paths.raytrace import trace
+            paths = trace(setup)  # with the reflections' hit points
         else:
             raise ValueError(f"paths {paths!r}: must be 'exact', 'raytrace', a Paths or None")
     if png is not None:

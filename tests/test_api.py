@@ -82,3 +82,20 @@ def test_bad_pair_names_field():
     s = rtsgeom.load_scene(SCENE)
     with pytest.raises(ValueError, match="pair"):
         rtsgeom.calibrate(s, pair=(0, 5))
+
+
+def test_raytrace_kernel_cache_is_outside_the_checkout(monkeypatch, tmp_path):
+    """Issue 16 defect 7: Dr.Jit's kernels went to <repo>/.drjit_cache."""
+    from pathlib import Path
+
+    from rtsgeom.paths import raytrace
+    repo = Path(rtsgeom.__file__).resolve().parents[1]
+    monkeypatch.delenv("RTSGEOM_CACHE_DIR", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    assert raytrace._default_cache_dir() == tmp_path / "xdg" / "rtsgeom" / "drjit"
+    monkeypatch.delenv("XDG_CACHE_HOME")
+    default = raytrace._default_cache_dir()
+    assert default == Path.home() / ".cache" / "rtsgeom" / "drjit"
+    assert repo not in default.parents
+    monkeypatch.setenv("RTSGEOM_CACHE_DIR", str(tmp_path / "mine"))
+    assert raytrace._default_cache_dir() == tmp_path / "mine" / "drjit"

@@ -77,7 +77,9 @@ def test_reflections_are_drawn_only_with_vertices():
                 gain=[1e-3, 1e-4, 1e-3, 1e-4], bounces=[0, 1, 0, 2])
     plain = Paths.build(**base)
     los, refl = _path_polylines(setup, plain, scale=1.0)
-    assert len(los) == 2 and refl == []  # reflections without vertices: skipped silently
+    assert len(los) == 2 and refl == []  # reflections without vertices cannot be drawn ...
+    from rtsgeom.viz.scene3d import undrawable_reflections
+    assert undrawable_reflections(plain) == 2  # ... but are counted (and noted in the view)
 
     bounce = fe.module[1] + [0.0, 0.3, 0.0]
     with_v = PathsWithVertices(*dataclasses.astuple(plain),
@@ -87,6 +89,58 @@ def test_reflections_are_drawn_only_with_vertices():
     assert len(los) == 2 and [len(p) for p in refl] == [3, 4]
     assert np.allclose(los[0], [setup.rut.tx_world[0], fe.rx[0]])
     assert np.allclose(refl[1][0], fe.tx[1]) and np.allclose(refl[1][-1], setup.rut.rx_world[2])
+    assert undrawable_reflections(with_v) == 0
+    # NaN rows past the last interaction (Sionna's layout) are dropped, not drawn to NaN
+    nan_v = PathsWithVertices(*dataclasses.astuple(plain),
+                              vertices=np.array([[[np.nan] * 3] * 2, [[0.1, 0.5, 0.0], [np.nan] * 3],
+                                                 [[np.nan] * 3] * 2, [bounce, [0.0, 0.5, 0.1]]]))
+    los, refl = _path_polylines(setup, nan_v, scale=1.0)
+    assert [len(p) for p in refl] == [3, 4] and all(np.isfinite(p).all() for p in refl)
+
+
+def test_plain_table_with_reflections_warns_in_the_view():
+    """A reflected path that cannot be drawn is never dropped silently."""
+    from rtsgeom.viz.scene3d import build_plotter
+    setup = build_setup(make_scene())
+    p = exact_paths(setup)
+    refl = Paths.build(p.front_end[:3], p.direction[:3], p.rut_tx[:3], p.rut_rx[:3],
+                       p.delay_s[:3] * 1.1, p.gain[:3], bounces=[1, 1, 1])
+    with pytest.warns(UserWarning, match="3 of 3 reflected paths"):
+        build_plotter(setup, Paths.concat([p, refl]), window_size=(320, 200)).close()
+
+
+@pytest.mark.raytrace
+def test_show_raytrace_draws_every_reflection(tmp_path):
+    """Issue 16 defect 2: ``show --paths raytrace`` drew only the line-of-sight rays."""
+    from rtsgeom.paths import raytrace
+    ok, msg = raytrace.preflight()
+    if not ok:
+        pytest.skip(f"Sionna RT unavailable: {msg}")
+    setup = build_setup(make_scene())
+    res = raytrace.trace(setup)
+    n_refl = int((res.paths.bounces > 0).sum())
+    assert n_refl > 100  # the sheet and the board reflect
+    los, refl = _path_polylines(setup, res, scale=1.0)
+    assert len(refl) == n_refl
+    for i, poly in zip(np.flatnonzero(res.paths.bounces > 0)[:50], refl):
+        assert len(res.hit_points(i)) == res.paths.bounces[i]
+        assert np.isfinite(poly).all() and len(poly) >= 2 + res.paths.bounces[i] - 1
+    # the CLI draws them: more reflection-coloured pixels than with exact paths
+    from rtsgeom.viz.scene3d import _REFLECTION
+    counts = {}
+    for method in ("exact", "raytrace"):
+        out = tmp_path / f"{method}.png"
+        assert main(["show", str(DEFAULT_SCENE), "--png", str(out), "--paths", method,
+                     "--size", "800x500", "--quiet"]) == 0
+        rgb = np.round(imread(out)[..., :3] * 255).astype(int)
+        target = np.array(_rgb_of(_REFLECTION))
+        counts[method] = int((np.abs(rgb - target).max(axis=-1) <= 40).sum())
+    assert counts["raytrace"] > counts["exact"] + 200
+
+
+def _rgb_of(colour):
+    from matplotlib.colors import to_rgb
+    return [round(255 * x) for x in to_rgb(colour)]
 
 
 def test_render_variants_without_sheet_or_targets(tmp_path):
