@@ -237,6 +237,124 @@ def test_figure_inputs_are_checked():
         F.linearity_figure(r, {"paper": r}, {"paper": r})
 
 
+def _legend_entries_without_artist(fig):
+    """Legend labels whose handle draws nothing (no data, no visible line)."""
+    bad = []
+    for ax in fig.axes:
+        leg = ax.get_legend()
+        if leg is None:
+            continue
+        for h, t in zip(leg.legend_handles, leg.get_texts()):
+            label = t.get_text()
+            owners = [a for a in ax.get_children() if getattr(a, "get_label", lambda: "")()
+                      == label and a is not h]
+            if not owners:
+                bad.append(label)
+                continue
+            a = owners[0]
+            if hasattr(a, "get_xdata") and not np.size(a.get_xdata()):
+                bad.append(label)
+    return bad
+
+
+def test_calibration_figure_shows_the_residual_of_the_json_and_no_empty_legend_entry():
+    """Issue 16 defect 6: the plot quoted the sweep interpolated at the chosen delay (0.008
+    deg) while the JSON's residual (0.0048 deg) comes from the refinement; and the legend
+    listed 'chosen + k periods' when no such line fell inside the sweep."""
+    tau = np.arange(-0.4e-9, 0.4e-9 + 1e-15, 50e-12)  # less than one period: no repeat line
+    err = np.abs(np.sin(np.pi * (tau - 0.21e-9) / 1e-9))
+    for residual in (0.0048, 0.0123, 1e-5):
+        fig = F.calibration_sweep_figure(tau, err, 0.2137e-9, period_s=1e-9,
+                                         residual_error_deg=residual,
+                                         refine_delta_tau_s=[0.2e-9, 0.2137e-9],
+                                         refine_error_deg=[0.03, residual])
+        labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+        chosen = [lab for lab in labels if lab.startswith("chosen:")]
+        assert chosen and f"{residual:.4f} deg" in chosen[0], labels
+        assert not any("periods" in lab for lab in labels), labels
+        assert _legend_entries_without_artist(fig) == []
+    # a sweep over two periods draws the repeat lines, and then lists them
+    tau = np.arange(-1.2e-9, 1.2e-9 + 1e-15, 50e-12)
+    fig = F.calibration_sweep_figure(tau, np.abs(np.sin(np.pi * tau / 1e-9)), 0.0, 1e-9)
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert any("periods" in lab for lab in labels)
+    assert _legend_entries_without_artist(fig) == []
+
+
+def test_linearity_figure_numbers_channels_like_the_cli():
+    """Issue 16 defect 6: the plot said channel 1/2 where the CLI's --pair says 0 1."""
+    s = np.linspace(3.4, 12.2, 5)
+    for pair in ((0, 1), (2, 3)):
+        fig = F.linearity_figure(s, {"exact": s}, {"exact": np.stack([-s, s])}, pair=pair)
+        labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+        assert labels == [f"exact: front end {pair[0]}", f"exact: front end {pair[1]}"]
+
+
+def test_tolerance_figure_resolves_both_cases():
+    """Issue 16 defect 6: a common-bin histogram put the calibrated case (errors ~1e-3 deg)
+    into one bin next to the uncalibrated one (~1 deg). The empirical CDF resolves both."""
+    rng = np.random.default_rng(0)
+    for scale_unc, scale_cal in ((1.0, 1e-3), (0.3, 1e-2), (5.0, 1e-4)):
+        cases = {"uncalibrated": scale_unc * rng.standard_normal(2000),
+                 "calibrated": scale_cal * rng.standard_normal(2000)}
+        fig = F.tolerance_cdf_figure(cases, spec_deg=0.1)
+        lines = [ln for ln in fig.axes[0].get_lines() if len(ln.get_xdata()) > 100]
+        assert len(lines) == 2
+        for ln, a in zip(lines, cases.values()):
+            x, y = np.asarray(ln.get_xdata()), np.asarray(ln.get_ydata())
+            # the curve climbs over the case's own range: >= 50 distinct steps below its p99
+            assert np.unique(y[x <= np.percentile(np.abs(a), 99)]).size > 50
+            np.testing.assert_allclose(np.interp(np.median(np.abs(a)), x, y), 0.5, atol=0.02)
+
+
+def test_design_with_one_radius_draws_lines_and_says_the_sheet_is_off(tmp_path, capsys,
+                                                                      monkeypatch):
+    """Issue 16 defect 3: ``--radius-m 0.5:0.5:1`` drew five empty heat maps, and the sheet
+    being disabled at small spacings was only in the JSON."""
+    saved = {}
+
+    def record(fig, path):
+        saved[path.name] = fig
+        return path
+    monkeypatch.setattr(F, "save_figure", record)
+    assert main(["design", str(DEFAULT_SCENE), "--radius-m", "0.5:0.5:1", "--spacing-deg",
+                 "1:8:2", "--draws", "20", "--out", str(tmp_path), "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "sheet disabled" in out and "note: sheet disabled in 1 of 2 designs" in out
+    pngs = [n for n in saved if n.startswith("design_")]
+    assert len(pngs) == 5
+    for name in pngs:
+        ax = saved[name].axes[0]
+        data = [np.asarray(ln.get_ydata(), float) for ln in ax.get_lines()]
+        assert sum(np.isfinite(d).sum() for d in data) >= 2, name  # a visible line
+    # JSON mode keeps stdout machine-readable and says it on stderr
+    assert main(["design", str(DEFAULT_SCENE), "--radius-m", "0.5:0.5:1", "--spacing-deg",
+                 "1:1:1", "--draws", "20", "--json"]) == 0
+    cap = capsys.readouterr()
+    import json
+    assert json.loads(cap.out)["designs"][0]["sheet"] == "disabled"
+    assert "sheet disabled" in cap.err
+
+
+@pytest.mark.parametrize("name", [r"$\undefinedcmd{x}$", "cost $5 and $", r"a_b^c $\frac{1}$"])
+def test_user_text_in_titles_never_crashes_a_figure(tmp_path, name):
+    """Issue 16 defect 6: a scene name with TeX in it crashed every figure."""
+    r, v = np.arange(4.0), np.arange(3.0)
+    fig = F.range_doppler_figure(np.zeros((4, 3)), r, v, title=f"{name}: range-Doppler map")
+    F.save_figure(fig, tmp_path / "rd.png")
+    assert fig.axes[0].get_title() == f"{name}: range-Doppler map"
+    # a title made outside figures.py (analysis modules set their own) is caught on saving
+    fig = F.range_doppler_figure(np.zeros((4, 3)), r, v)
+    fig.suptitle(name)
+    F.save_figure(fig, tmp_path / "rd2.png")
+    # the whole run with such a scene name writes its figures
+    scene = make_scene(lambda doc: doc.__setitem__("name", name))
+    from rtsgeom.cli.signal import write_maps
+    from rtsgeom.run import run_scene
+    paths = write_maps(run_scene(scene, aoa_mode="nearest"), tmp_path)
+    assert all(p.stat().st_size > 1000 for p in paths)
+
+
 # --------------------------------------------------------------------------------------------
 # Report
 # --------------------------------------------------------------------------------------------

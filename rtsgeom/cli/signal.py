@@ -54,7 +54,13 @@ def _calibration_figures(result: RunResult, folder: Path) -> list[Path]:
         t = np.array([p["delta_tau_s"] for p in cal["sweep"]])
         e = np.array([np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
                       for p in cal["sweep"]])
-        fig = calibration_sweep_figure(t, e, cal["delta_tau_s"], cal["period_s"])
+        rf = cal.get("refinement", [])
+        fig = calibration_sweep_figure(
+            t, e, cal["delta_tau_s"], cal["period_s"],
+            residual_error_deg=cal.get("residual_error_deg"),
+            refine_delta_tau_s=[p["delta_tau_s"] for p in rf],
+            refine_error_deg=[np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
+                              for p in rf])
         path = folder / f"calibration_{k}.png"
         save_figure(fig, path)
         out.append(path)
