@@ -11,7 +11,11 @@ from ._common import UsageError, load_scene_checked, print_json, scene_arg
 
 
 def cmd_info(args) -> int:
-    info = scene_info(build_setup(load_scene_checked(args.scene)))
+    import sys
+    from ..info import unreachable_warnings
+    info = scene_info(build_setup(load_scene_checked(args.scene)), reachable=True)
+    for w in unreachable_warnings(info):
+        print(f"rtsgeom: warning: {w}", file=sys.stderr)
     if args.json:
         print_json(info)
     else:
