@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..io import write_json
-from ._common import UsageError, load_scene_checked, number, print_json, scene_arg
+from ._common import UsageError, load_scene_checked, number, print_json, scene_arg, steps
 
 
 def radius_sweep(text: str) -> tuple[float, float, int]:
@@ -65,7 +65,9 @@ def cmd_nearfield(args) -> int:
              else np.logspace(math.log10(args.radius_m[0]), math.log10(args.radius_m[1]),
                               args.radius_m[2]))
     try:
-        nf = nearfield(scene, radii, points=args.points)
+        with steps(args.quiet or args.json) as step:
+            step(f"near field at {len(radii)} arc radii ({radii[0]:.3g} to {radii[-1]:.3g} m)")
+            nf = nearfield(scene, radii, points=args.points)
     except ValueError as exc:
         raise UsageError(f"--radius-m: {exc}") from None
     return _emit(args, "nearfield", nf.to_dict(), lambda: nearfield_figure(nf), _nearfield_text)
@@ -138,6 +140,7 @@ def register(sub) -> None:
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--out", type=Path, default=None,
                    help="folder for nearfield.json and nearfield.png")
+    p.add_argument("--quiet", action="store_true", help="no progress output on stderr")
     p.set_defaults(func=cmd_nearfield)
 
     p = sub.add_parser("ghosts", help="cable ghosts: predicted ranges and levels per front end "

@@ -158,7 +158,9 @@ def cmd_run(args) -> int:
 
 def cmd_adc(args) -> int:
     scene = load_scene_checked(args.scene)
-    cube = run_scene(scene, "exact", args.amplitudes).cube
+    with steps(args.quiet) as step:  # the calibration sweeps take about a minute
+        step(f"simulating {scene.name} (calibration, ADC cube)")
+        cube = run_scene(scene, "exact", args.amplitudes).cube
     if args.format == "npy":
         with atomic_path(args.out) as tmp:
             with open(tmp, "wb") as fh:
@@ -201,4 +203,5 @@ def register(sub) -> None:
     p.add_argument("--format", choices=("npy", "dca1000"), default="npy")
     p.add_argument("--amplitudes", choices=modes, default=None,
                    help="AoA amplitude mode (default: the scene's rts.aoa_mode)")
+    p.add_argument("--quiet", action="store_true", help="no progress output on stderr")
     p.set_defaults(func=cmd_adc)
