@@ -31,6 +31,7 @@ _LAZY = {
     "load_scene": (".scene", "load_scene"),
     "loads_scene": (".scene", "loads_scene"),
     "parse_scene": (".scene", "parse_scene"),
+    "replace": (".api", "replace"),
     "with_arc_radius": (".analysis.nearfield", "with_arc_radius"),
     # geometry and paths
     "Setup": (".geometry", "Setup"),

@@ -16,7 +16,32 @@ import numpy as np
 
 from .scene import Scene
 
-__all__ = ["calibrate", "linearity", "tolerance", "design", "nearfield", "ghosts", "show"]
+__all__ = ["replace", "calibrate", "linearity", "tolerance", "design", "nearfield", "ghosts",
+           "show"]
+
+
+def replace(obj, **changes):
+    """A copy of a scene (or of one of its sections) with ``changes`` applied.
+
+    Uses ``obj.evolve(**changes)`` where the object has it (a :class:`Scene` that validates the
+    variant again), else :func:`dataclasses.replace`.
+
+    Parameters
+    ----------
+    obj : Scene, RadarConfig, RtsConfig, FrontEndConfig, SheetConfig or TargetConfig
+    **changes
+        Fields to change, in SI units (``arc_radius_m``, ``angle_rad``, ...).
+
+    Examples
+    --------
+    >>> fes = tuple(replace(f, radial_offset_m=0.2e-3) for f in scene.rts.front_ends)
+    >>> scene = replace(scene, rts=replace(scene.rts, front_ends=fes))  # doctest: +SKIP
+    """
+    import dataclasses
+    evolve = getattr(obj, "evolve", None)
+    if callable(evolve):
+        return evolve(**changes)
+    return dataclasses.replace(obj, **changes)
 
 
 def _setup_paths(scene: Scene):
@@ -58,7 +83,7 @@ def calibrate(scene: Scene, pair=(0, 1)):
     return calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
 
 
-def linearity(scene: Scene, pair=(0, 1), amplitudes: str = "exact", calibrated: bool = True,
+def linearity(scene: Scene, pair=(0, 1), amplitudes: str = "exact", calibration=True,
               points: int = 21):
     """Synthesized-angle linearity across a pair's span on the simulated radar.
 
@@ -69,8 +94,10 @@ def linearity(scene: Scene, pair=(0, 1), amplitudes: str = "exact", calibrated: 
         Two adjacent front-end indices (0-based).
     amplitudes : {'exact', 'array-factor', 'paper'}
         How the amplitude ratio of the two channels is designed (eqs. 21-23, or the exact model).
-    calibrated : bool
-        Run the phase calibration first (:func:`calibrate`); otherwise delay offset 0.
+    calibration : bool or Calibration
+        ``True``: run the phase calibration first (:func:`calibrate`); a
+        :class:`~rtsgeom.aoa.calibration.Calibration` of this pair: use it (one calibration
+        for several modes); ``False``: uncalibrated, delay offset 0.
     points : int
         Set-points across the span (its ends excluded).
 
@@ -85,7 +112,14 @@ def linearity(scene: Scene, pair=(0, 1), amplitudes: str = "exact", calibrated: 
     setup, paths = _setup_paths(scene)
     pair = _check_pair(setup, pair)
     probe = probe_front_ends(setup, paths, scene.seed)
-    cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed) if calibrated else None
+    if calibration is True:
+        cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
+    elif calibration is False or calibration is None:
+        cal = None
+    else:
+        cal = calibration
+        if tuple(cal.pair) != pair:
+            raise ValueError(f"calibration is for pair {tuple(cal.pair)}, not {pair}")
     return _linearity(setup, paths, pair, amplitudes, probe, cal, points, scene.seed)
 
 
