@@ -295,7 +295,7 @@ def linearity_figure(set_deg, detected_deg_by_mode: Mapping[str, object],
 @_styled
 def tolerance_cdf_figure(errors_deg_by_case: Mapping[str, object],
                          spec_deg: float | None = None, title: str = "") -> Figure:
-    """Empirical CDFs of |angle error| (deg) per case (e.g. the worst error per drawn setup of
+    """Empirical CDFs of the absolute angle error (deg) per case (e.g. the worst error per drawn setup of
     the mounting-tolerance Monte Carlo) on a log axis, so that cases whose errors differ by
     orders of magnitude (uncalibrated: degrees; calibrated: thousandths) are both resolved (a
     histogram on common bins put the calibrated case into one bin). The legend gives each
