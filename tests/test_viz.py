@@ -355,6 +355,13 @@ def test_user_text_in_titles_never_crashes_a_figure(tmp_path, name):
     assert all(p.stat().st_size > 1000 for p in paths)
 
 
+def test_user_text_in_the_3d_title_is_plain(tmp_path, capfd):
+    """VTK hands "$...$" to matplotlib's mathtext: a TeX scene name is drawn literally."""
+    scene = make_scene(lambda doc: doc.__setitem__("name", r"$\undefinedcmd{x}$"))
+    render_setup_png(build_setup(scene), tmp_path / "s.png", window_size=(320, 200))
+    assert "MathText" not in capfd.readouterr().err
+
+
 # --------------------------------------------------------------------------------------------
 # Report
 # --------------------------------------------------------------------------------------------

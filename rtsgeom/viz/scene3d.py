@@ -503,6 +503,9 @@ def build_plotter(setup: Setup, paths=None, window_size=(1600, 1000), off_screen
     legend = _add_setup(pl, setup, paths, scale, labels="2d" if side_panels else "3d")
     s = setup.scene
     title = f"{s.name}" + (f": {s.description}" if s.description else "")
+    # user text is plain text: VTK hands "$...$" to matplotlib's mathtext; "\$" keeps a
+    # literal dollar (vtkTextRenderer strips the escape before FreeType draws it)
+    title = title.replace("$", "\\$")
     pl.add_text(title, position="upper_left", font_size=12, color="black")
     note = (f"RuT drawn x{scale:g} about its phase centre; front-end markers enlarged; "
             f"targets drawn at {TARGET_RADIUS_FACTOR:g} x arc radius")
