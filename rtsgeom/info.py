@@ -188,13 +188,19 @@ def format_info(info: dict) -> str:
     return "\n".join(lines)
 
 
-def unreachable_warnings(info: dict) -> list[str]:
-    """One line per target outside the reachable angles (empty without ``reachable``)."""
+def unreachable_warnings(info: dict, skip_outside_geometric: bool = False) -> list[str]:
+    """One line per target outside the reachable angles (empty without ``reachable``).
+
+    ``skip_outside_geometric``: leave out targets outside the front ends' geometric span,
+    which the scene check (``validate.scene_warnings``) has already warned about."""
     reach = info.get("reachable")
     if not reach:
         return []
+    geo = [fe["azimuth_from_rut_deg"] for fe in info["front_ends"]]
     spans = ", ".join(f"pair {p['pair'][0]}-{p['pair'][1]} [{p['lo_deg']:.4f}, "
                       f"{p['hi_deg']:.4f}] deg" for p in reach["pairs"])
     return [f"targets[{t['index']}].angle_deg = {t['angle_deg']:g}: outside the reachable "
             f"angles ({reach['mode']} amplitudes: {spans}); `run` refuses it"
-            for t in reach["targets"] if not t["reachable"]]
+            for t in reach["targets"] if not t["reachable"]
+            and not (skip_outside_geometric
+                     and not min(geo) - 1e-9 <= t["angle_deg"] <= max(geo) + 1e-9)]
