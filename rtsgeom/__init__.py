@@ -5,6 +5,87 @@ Pipeline (one direction)::
     Scene (scene.py) -> Setup (geometry/) -> Paths (paths/) -> Echoes (rts.py)
       -> AdcCube (radar/fmcw.py) -> RangeDoppler, Detections (radar/processing.py)
       -> AoA synthesis and calibration (aoa/) -> analyses (analysis/) -> figures, report (viz/)
+
+The public API is importable from the package itself; the names load on first use (module
+``__getattr__``, PEP 562), so ``import rtsgeom`` stays fast and Sionna or pyvista load only when
+ray tracing or the 3D view is used::
+
+    import rtsgeom
+    scene = rtsgeom.load_scene("scenes/diewald2022.toml")
+    result = rtsgeom.run_scene(scene)
+    result.detections.to_dataframe()     # pandas.DataFrame
+    result.rd.to_xarray()                # xarray.DataArray (range_m, velocity_mps)
 """
 
+from __future__ import annotations
+
+import importlib
+
 __version__ = "0.1.0"
+
+# public name -> (module, attribute)
+_LAZY = {
+    # scene file
+    "Scene": (".scene", "Scene"),
+    "SceneError": (".scene", "SceneError"),
+    "load_scene": (".scene", "load_scene"),
+    "loads_scene": (".scene", "loads_scene"),
+    "parse_scene": (".scene", "parse_scene"),
+    "replace": (".api", "replace"),
+    "with_arc_radius": (".analysis.nearfield", "with_arc_radius"),
+    # geometry and paths
+    "Setup": (".geometry", "Setup"),
+    "build_setup": (".geometry", "build_setup"),
+    "Paths": (".paths", "Paths"),
+    "exact_paths": (".paths", "exact_paths"),
+    "raytrace_paths": (".paths.raytrace", "raytrace_paths"),
+    "RaytraceUnavailable": (".paths.raytrace", "RaytraceUnavailable"),
+    # signal chain
+    "run_scene": (".run", "run_scene"),
+    "RunResult": (".run", "RunResult"),
+    "AdcCube": (".radar.fmcw", "AdcCube"),
+    "RangeDoppler": (".radar.processing", "RangeDoppler"),
+    "Detections": (".radar.processing", "Detections"),
+    "range_angle_map": (".radar.processing", "range_angle_map"),
+    "to_dca1000": (".radar.dca1000", "to_dca1000"),
+    "from_dca1000": (".radar.dca1000", "from_dca1000"),
+    # AoA synthesis
+    "calibrate": (".api", "calibrate"),
+    "calibrate_pair": (".aoa.calibration", "calibrate_pair"),
+    "probe_front_ends": (".aoa.calibration", "probe_front_ends"),
+    "Calibration": (".aoa.calibration", "Calibration"),
+    "linearity": (".api", "linearity"),
+    "Linearity": (".aoa.linearity", "Linearity"),
+    # analyses
+    "tolerance": (".api", "tolerance"),
+    "monte_carlo": (".analysis.tolerance", "monte_carlo"),
+    "PairPhasors": (".analysis.tolerance", "PairPhasors"),
+    "ToleranceResult": (".analysis.tolerance", "ToleranceResult"),
+    "design": (".api", "design"),
+    "design_grid": (".analysis.design", "design_grid"),
+    "DesignGrid": (".analysis.design", "DesignGrid"),
+    "nearfield": (".api", "nearfield"),
+    "NearField": (".analysis.nearfield", "NearField"),
+    "ghosts": (".api", "ghosts"),
+    "GhostReport": (".analysis.ghosts", "GhostReport"),
+    # views
+    "show": (".api", "show"),
+    "render_setup_png": (".viz.scene3d", "render_setup_png"),
+    "scene_info": (".info", "scene_info"),
+}
+
+__all__ = ["__version__", *_LAZY]
+
+
+def __getattr__(name: str):
+    try:
+        module, attr = _LAZY[name]
+    except KeyError:
+        raise AttributeError(f"module 'rtsgeom' has no attribute {name!r}") from None
+    value = getattr(importlib.import_module(module, __name__), attr)
+    globals()[name] = value  # later look-ups skip __getattr__
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

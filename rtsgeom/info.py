@@ -9,17 +9,78 @@ from .geometry import Setup
 from .geometry.farfield import (angular_resolution_rad, aperture_m, apparent_azimuth_rad,
                                 curvature_phase_error_rad, fraunhofer_distance_m)
 
-__all__ = ["scene_info", "format_info"]
+__all__ = ["scene_info", "format_info", "reachable_spans"]
+
+CLOSED_FORM_MODES = ("paper", "array-factor")
 
 
-def scene_info(setup: Setup) -> dict:
+def reachable_spans(setup: Setup, mode: str | None = None, paths=None) -> dict:
+    """The angles ``rtsgeom run`` can synthesize, per adjacent front-end pair.
+
+    The span is *measured* as ``run`` measures it (:func:`rtsgeom.aoa.calibration.
+    probe_front_ends`: each front end alone, detected by the simulated RuT with the scene's
+    seed and noise; the Rx/Tx separation and the near field move it off the geometric
+    angles), pairs adjacent in measured angle (:func:`rtsgeom.aoa.plan.bracketing_pair`). The
+    closed-form amplitude modes (``paper``, ``array-factor``) address only the front ends'
+    geometric angles, so for them the span is the intersection. ``nearest`` puts each target
+    on its nearest front end: every angle is accepted.
+
+    Parameters
+    ----------
+    setup : Setup
+    mode : str, optional
+        Amplitude mode (default: the scene's ``rts.aoa_mode``).
+    paths : Paths, optional
+        Default: exact paths (``run``'s default; ``run --paths raytrace`` measures on its own).
+
+    Returns
+    -------
+    dict
+        ``mode``, ``measured_angle_deg`` per front end, ``pairs`` (each ``pair``, ``lo_deg``,
+        ``hi_deg``) and ``targets`` (each ``index``, ``angle_deg``, ``pair`` or None,
+        ``reachable``).
+    """
+    from .aoa.calibration import probe_front_ends
+    from .aoa.plan import bracketing_pair
+    from .paths import exact_paths
+    scene = setup.scene
+    mode = mode or scene.rts.aoa_mode
+    probe = probe_front_ends(setup, exact_paths(setup) if paths is None else paths, scene.seed)
+    meas = probe.angle_rad
+    geo = setup.fe_azimuth_rad()
+    order = np.argsort(meas)
+    pairs = []
+    for i, j in zip(order[:-1], order[1:]):
+        lo, hi = float(meas[i]), float(meas[j])
+        if mode in CLOSED_FORM_MODES:
+            g_lo, g_hi = sorted((float(geo[i]), float(geo[j])))
+            lo, hi = max(lo, g_lo), min(hi, g_hi)
+        pairs.append({"pair": [int(i), int(j)], "lo_deg": float(np.degrees(lo)),
+                      "hi_deg": float(np.degrees(hi))})
+    targets = []
+    for k, t in enumerate(scene.targets):
+        pair = None if not np.all(np.isfinite(meas)) else bracketing_pair(t.angle_rad, meas)
+        ok = pair is not None
+        if ok and mode in CLOSED_FORM_MODES:
+            span = next(p for p in pairs if sorted(p["pair"]) == sorted(pair))
+            ok = span["lo_deg"] <= np.degrees(t.angle_rad) <= span["hi_deg"]
+        targets.append({"index": k, "angle_deg": float(np.degrees(t.angle_rad)),
+                        "pair": None if pair is None else [int(pair[0]), int(pair[1])],
+                        "reachable": bool(ok or mode == "nearest")})
+    return {"mode": mode, "measured_angle_deg": [float(x) for x in np.degrees(meas)],
+            "pairs": pairs, "targets": targets}
+
+
+def scene_info(setup: Setup, reachable: bool = False) -> dict:
+    """What a setup is, in numbers (``rtsgeom info --json``); with ``reachable`` also
+    :func:`reachable_spans` (one simulated frame)."""
     s, r, rut, fe = setup.scene, setup.scene.radar, setup.rut, setup.fe
     geo = np.degrees(setup.fe_azimuth_rad())
     app = np.degrees(apparent_azimuth_rad(rut, fe.rx, fe.tx))
     curv = np.degrees(curvature_phase_error_rad(setup))
     spacing = np.degrees(np.diff(fe.angle_rad))
     res = np.degrees(angular_resolution_rad(rut))
-    return {
+    out = {
         "rtsgeom_version": __version__,
         "scene": s.name,
         "source": s.source,
@@ -69,6 +130,9 @@ def scene_info(setup: Setup) -> dict:
             for t in s.targets
         ],
     }
+    if reachable:
+        out["reachable"] = reachable_spans(setup)
+    return out
 
 
 def format_info(info: dict) -> str:
@@ -100,9 +164,43 @@ def format_info(info: dict) -> str:
                                      info["spacing_within_resolution"])):
         lines.append(f"  spacing {i}-{i + 1}: {sp:.3f} deg "
                      f"({'within' if ok else 'EXCEEDS'} the angular resolution)")
+    reach = info.get("reachable")
+    if reach:
+        how = (" (intersected with the geometric angles: closed-form amplitudes)"
+               if reach["mode"] in CLOSED_FORM_MODES else "")
+        lines.append(f"reachable angles ({reach['mode']} amplitudes; each front end alone as "
+                     f"the simulated RuT detects it, as `run` measures it){how}:")
+        for p in reach["pairs"]:
+            lines.append(f"  pair {p['pair'][0]}-{p['pair'][1]}: [{p['lo_deg']:.4f}, "
+                         f"{p['hi_deg']:.4f}] deg")
     if info["targets"]:
         lines.append("targets:")
         for i, t in enumerate(info["targets"]):
-            lines.append(f"  {i}: {t['range_m']:.3f} m, {t['velocity_mps']:+.3f} m/s, "
-                         f"{t['angle_deg']:.3f} deg, {t['rcs_dbsm']:.1f} dBsm")
+            line = (f"  {i}: {t['range_m']:.3f} m, {t['velocity_mps']:+.3f} m/s, "
+                    f"{t['angle_deg']:.3f} deg, {t['rcs_dbsm']:.1f} dBsm")
+            if reach:
+                rt = reach["targets"][i]
+                if not rt["reachable"]:
+                    line += "  OUTSIDE the reachable angles: `run` refuses it"
+                elif rt["pair"] is not None and reach["mode"] != "nearest":
+                    line += f"  (pair {rt['pair'][0]}-{rt['pair'][1]})"
+            lines.append(line)
     return "\n".join(lines)
+
+
+def unreachable_warnings(info: dict, skip_outside_geometric: bool = False) -> list[str]:
+    """One line per target outside the reachable angles (empty without ``reachable``).
+
+    ``skip_outside_geometric``: leave out targets outside the front ends' geometric span,
+    which the scene check (``validate.scene_warnings``) has already warned about."""
+    reach = info.get("reachable")
+    if not reach:
+        return []
+    geo = [fe["azimuth_from_rut_deg"] for fe in info["front_ends"]]
+    spans = ", ".join(f"pair {p['pair'][0]}-{p['pair'][1]} [{p['lo_deg']:.4f}, "
+                      f"{p['hi_deg']:.4f}] deg" for p in reach["pairs"])
+    return [f"targets[{t['index']}].angle_deg = {t['angle_deg']:g}: outside the reachable "
+            f"angles ({reach['mode']} amplitudes: {spans}); `run` refuses it"
+            for t in reach["targets"] if not t["reachable"]
+            and not (skip_outside_geometric
+                     and not min(geo) - 1e-9 <= t["angle_deg"] <= max(geo) + 1e-9)]

@@ -77,7 +77,9 @@ def test_reflections_are_drawn_only_with_vertices():
                 gain=[1e-3, 1e-4, 1e-3, 1e-4], bounces=[0, 1, 0, 2])
     plain = Paths.build(**base)
     los, refl = _path_polylines(setup, plain, scale=1.0)
-    assert len(los) == 2 and refl == []  # reflections without vertices: skipped silently
+    assert len(los) == 2 and refl == []  # reflections without vertices cannot be drawn ...
+    from rtsgeom.viz.scene3d import undrawable_reflections
+    assert undrawable_reflections(plain) == 2  # ... but are counted (and noted in the view)
 
     bounce = fe.module[1] + [0.0, 0.3, 0.0]
     with_v = PathsWithVertices(*dataclasses.astuple(plain),
@@ -87,6 +89,58 @@ def test_reflections_are_drawn_only_with_vertices():
     assert len(los) == 2 and [len(p) for p in refl] == [3, 4]
     assert np.allclose(los[0], [setup.rut.tx_world[0], fe.rx[0]])
     assert np.allclose(refl[1][0], fe.tx[1]) and np.allclose(refl[1][-1], setup.rut.rx_world[2])
+    assert undrawable_reflections(with_v) == 0
+    # NaN rows past the last interaction (Sionna's layout) are dropped, not drawn to NaN
+    nan_v = PathsWithVertices(*dataclasses.astuple(plain),
+                              vertices=np.array([[[np.nan] * 3] * 2, [[0.1, 0.5, 0.0], [np.nan] * 3],
+                                                 [[np.nan] * 3] * 2, [bounce, [0.0, 0.5, 0.1]]]))
+    los, refl = _path_polylines(setup, nan_v, scale=1.0)
+    assert [len(p) for p in refl] == [3, 4] and all(np.isfinite(p).all() for p in refl)
+
+
+def test_plain_table_with_reflections_warns_in_the_view():
+    """A reflected path that cannot be drawn is never dropped silently."""
+    from rtsgeom.viz.scene3d import build_plotter
+    setup = build_setup(make_scene())
+    p = exact_paths(setup)
+    refl = Paths.build(p.front_end[:3], p.direction[:3], p.rut_tx[:3], p.rut_rx[:3],
+                       p.delay_s[:3] * 1.1, p.gain[:3], bounces=[1, 1, 1])
+    with pytest.warns(UserWarning, match="3 of 3 reflected paths"):
+        build_plotter(setup, Paths.concat([p, refl]), window_size=(320, 200)).close()
+
+
+@pytest.mark.raytrace
+def test_show_raytrace_draws_every_reflection(tmp_path):
+    """Issue 16 defect 2: ``show --paths raytrace`` drew only the line-of-sight rays."""
+    from rtsgeom.paths import raytrace
+    ok, msg = raytrace.preflight()
+    if not ok:
+        pytest.skip(f"Sionna RT unavailable: {msg}")
+    setup = build_setup(make_scene())
+    res = raytrace.trace(setup)
+    n_refl = int((res.paths.bounces > 0).sum())
+    assert n_refl > 100  # the sheet and the board reflect
+    los, refl = _path_polylines(setup, res, scale=1.0)
+    assert len(refl) == n_refl
+    for i, poly in zip(np.flatnonzero(res.paths.bounces > 0)[:50], refl):
+        assert len(res.hit_points(i)) == res.paths.bounces[i]
+        assert np.isfinite(poly).all() and len(poly) >= 2 + res.paths.bounces[i] - 1
+    # the CLI draws them: more reflection-coloured pixels than with exact paths
+    from rtsgeom.viz.scene3d import _REFLECTION
+    counts = {}
+    for method in ("exact", "raytrace"):
+        out = tmp_path / f"{method}.png"
+        assert main(["show", str(DEFAULT_SCENE), "--png", str(out), "--paths", method,
+                     "--size", "800x500", "--quiet"]) == 0
+        rgb = np.round(imread(out)[..., :3] * 255).astype(int)
+        target = np.array(_rgb_of(_REFLECTION))
+        counts[method] = int((np.abs(rgb - target).max(axis=-1) <= 40).sum())
+    assert counts["raytrace"] > counts["exact"] + 200
+
+
+def _rgb_of(colour):
+    from matplotlib.colors import to_rgb
+    return [round(255 * x) for x in to_rgb(colour)]
 
 
 def test_render_variants_without_sheet_or_targets(tmp_path):
@@ -181,6 +235,131 @@ def test_figure_inputs_are_checked():
         F.range_doppler_figure(np.zeros((4, 3)), r, v, detections=[1.0, 2.0, 3.0])
     with pytest.raises(ValueError, match=r"amplitude_db_by_mode\['paper'\]"):
         F.linearity_figure(r, {"paper": r}, {"paper": r})
+
+
+def _legend_entries_without_artist(fig):
+    """Legend labels whose handle draws nothing (no data, no visible line)."""
+    bad = []
+    for ax in fig.axes:
+        leg = ax.get_legend()
+        if leg is None:
+            continue
+        for h, t in zip(leg.legend_handles, leg.get_texts()):
+            label = t.get_text()
+            owners = [a for a in ax.get_children() if getattr(a, "get_label", lambda: "")()
+                      == label and a is not h]
+            if not owners:
+                bad.append(label)
+                continue
+            a = owners[0]
+            if hasattr(a, "get_xdata") and not np.size(a.get_xdata()):
+                bad.append(label)
+    return bad
+
+
+def test_calibration_figure_shows_the_residual_of_the_json_and_no_empty_legend_entry():
+    """Issue 16 defect 6: the plot quoted the sweep interpolated at the chosen delay (0.008
+    deg) while the JSON's residual (0.0048 deg) comes from the refinement; and the legend
+    listed 'chosen + k periods' when no such line fell inside the sweep."""
+    tau = np.arange(-0.4e-9, 0.4e-9 + 1e-15, 50e-12)  # less than one period: no repeat line
+    err = np.abs(np.sin(np.pi * (tau - 0.21e-9) / 1e-9))
+    for residual in (0.0048, 0.0123, 1e-5):
+        fig = F.calibration_sweep_figure(tau, err, 0.2137e-9, period_s=1e-9,
+                                         residual_error_deg=residual,
+                                         refine_delta_tau_s=[0.2e-9, 0.2137e-9],
+                                         refine_error_deg=[0.03, residual])
+        labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+        chosen = [lab for lab in labels if lab.startswith("chosen:")]
+        assert chosen and f"{residual:.4f} deg" in chosen[0], labels
+        assert not any("periods" in lab for lab in labels), labels
+        assert _legend_entries_without_artist(fig) == []
+    # a sweep over two periods draws the repeat lines, and then lists them
+    tau = np.arange(-1.2e-9, 1.2e-9 + 1e-15, 50e-12)
+    fig = F.calibration_sweep_figure(tau, np.abs(np.sin(np.pi * tau / 1e-9)), 0.0, 1e-9)
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert any("periods" in lab for lab in labels)
+    assert _legend_entries_without_artist(fig) == []
+
+
+def test_linearity_figure_numbers_channels_like_the_cli():
+    """Issue 16 defect 6: the plot said channel 1/2 where the CLI's --pair says 0 1."""
+    s = np.linspace(3.4, 12.2, 5)
+    for pair in ((0, 1), (2, 3)):
+        fig = F.linearity_figure(s, {"exact": s}, {"exact": np.stack([-s, s])}, pair=pair)
+        labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+        assert labels == [f"exact: front end {pair[0]}", f"exact: front end {pair[1]}"]
+
+
+def test_tolerance_figure_resolves_both_cases():
+    """Issue 16 defect 6: a common-bin histogram put the calibrated case (errors ~1e-3 deg)
+    into one bin next to the uncalibrated one (~1 deg). The empirical CDF resolves both."""
+    rng = np.random.default_rng(0)
+    for scale_unc, scale_cal in ((1.0, 1e-3), (0.3, 1e-2), (5.0, 1e-4)):
+        cases = {"uncalibrated": scale_unc * rng.standard_normal(2000),
+                 "calibrated": scale_cal * rng.standard_normal(2000)}
+        fig = F.tolerance_cdf_figure(cases, spec_deg=0.1)
+        lines = [ln for ln in fig.axes[0].get_lines() if len(ln.get_xdata()) > 100]
+        assert len(lines) == 2
+        for ln, a in zip(lines, cases.values()):
+            x, y = np.asarray(ln.get_xdata()), np.asarray(ln.get_ydata())
+            # the curve climbs over the case's own range: >= 50 distinct steps below its p99
+            assert np.unique(y[x <= np.percentile(np.abs(a), 99)]).size > 50
+            np.testing.assert_allclose(np.interp(np.median(np.abs(a)), x, y), 0.5, atol=0.02)
+
+
+def test_design_with_one_radius_draws_lines_and_says_the_sheet_is_off(tmp_path, capsys,
+                                                                      monkeypatch):
+    """Issue 16 defect 3: ``--radius-m 0.5:0.5:1`` drew five empty heat maps, and the sheet
+    being disabled at small spacings was only in the JSON."""
+    saved = {}
+
+    def record(fig, path):
+        saved[path.name] = fig
+        return path
+    monkeypatch.setattr(F, "save_figure", record)
+    assert main(["design", str(DEFAULT_SCENE), "--radius-m", "0.5:0.5:1", "--spacing-deg",
+                 "1:8:2", "--draws", "20", "--out", str(tmp_path), "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "sheet disabled" in out and "note: sheet disabled in 1 of 2 designs" in out
+    pngs = [n for n in saved if n.startswith("design_")]
+    assert len(pngs) == 5
+    for name in pngs:
+        ax = saved[name].axes[0]
+        data = [np.asarray(ln.get_ydata(), float) for ln in ax.get_lines()]
+        assert sum(np.isfinite(d).sum() for d in data) >= 2, name  # a visible line
+    # JSON mode keeps stdout machine-readable and says it on stderr
+    assert main(["design", str(DEFAULT_SCENE), "--radius-m", "0.5:0.5:1", "--spacing-deg",
+                 "1:1:1", "--draws", "20", "--json"]) == 0
+    cap = capsys.readouterr()
+    import json
+    assert json.loads(cap.out)["designs"][0]["sheet"] == "disabled"
+    assert "sheet disabled" in cap.err
+
+
+@pytest.mark.parametrize("name", [r"$\undefinedcmd{x}$", "cost $5 and $", r"a_b^c $\frac{1}$"])
+def test_user_text_in_titles_never_crashes_a_figure(tmp_path, name):
+    """Issue 16 defect 6: a scene name with TeX in it crashed every figure."""
+    r, v = np.arange(4.0), np.arange(3.0)
+    fig = F.range_doppler_figure(np.zeros((4, 3)), r, v, title=f"{name}: range-Doppler map")
+    F.save_figure(fig, tmp_path / "rd.png")
+    assert fig.axes[0].get_title() == f"{name}: range-Doppler map"
+    # a title made outside figures.py (analysis modules set their own) is caught on saving
+    fig = F.range_doppler_figure(np.zeros((4, 3)), r, v)
+    fig.suptitle(name)
+    F.save_figure(fig, tmp_path / "rd2.png")
+    # the whole run with such a scene name writes its figures
+    scene = make_scene(lambda doc: doc.__setitem__("name", name))
+    from rtsgeom.cli.signal import write_maps
+    from rtsgeom.run import run_scene
+    paths = write_maps(run_scene(scene, aoa_mode="nearest"), tmp_path)
+    assert all(p.stat().st_size > 1000 for p in paths)
+
+
+def test_user_text_in_the_3d_title_is_plain(tmp_path, capfd):
+    """VTK hands "$...$" to matplotlib's mathtext: a TeX scene name is drawn literally."""
+    scene = make_scene(lambda doc: doc.__setitem__("name", r"$\undefinedcmd{x}$"))
+    render_setup_png(build_setup(scene), tmp_path / "s.png", window_size=(320, 200))
+    assert "MathText" not in capfd.readouterr().err
 
 
 # --------------------------------------------------------------------------------------------

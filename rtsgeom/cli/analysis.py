@@ -9,7 +9,7 @@ import numpy as np
 
 from ..io import write_json
 from ._common import (UsageError, load_scene_checked, number, output_folder, output_path,
-                      print_json, scene_arg)
+                      print_json, scene_arg, steps)
 
 
 def radius_sweep(text: str) -> tuple[float, float, int]:
@@ -66,7 +66,9 @@ def cmd_nearfield(args) -> int:
                               args.radius_m[2]))
     with output_folder(args.out, [args.scene]) as stage:
         try:
-            nf = nearfield(scene, radii, points=args.points)
+            with steps(args.quiet or args.json) as step:
+                step(f"near field at {len(radii)} arc radii ({radii[0]:.3g} to {radii[-1]:.3g} m)")
+                nf = nearfield(scene, radii, points=args.points)
         except ValueError as exc:
             raise UsageError(f"--radius-m: {exc}") from None
         out = nf.to_dict()
@@ -148,6 +150,7 @@ def register(sub) -> None:
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--out", type=output_path, default=None,
                    help="folder for nearfield.json and nearfield.png")
+    p.add_argument("--quiet", action="store_true", help="no progress output on stderr")
     p.set_defaults(func=cmd_nearfield)
 
     p = sub.add_parser("ghosts", help="cable ghosts: predicted ranges and levels per front end "

@@ -50,7 +50,10 @@ def _calibrate(args, stage) -> int:
     def figure():
         from ..viz.figures import calibration_sweep_figure
         return calibration_sweep_figure(cal.sweep_delta_tau_s, cal.sweep_error_deg,
-                                        cal.delta_tau_s, cal.period_s)
+                                        cal.delta_tau_s, cal.period_s,
+                                        residual_error_deg=cal.residual_error_deg,
+                                        refine_delta_tau_s=cal.refine_delta_tau_s,
+                                        refine_error_deg=cal.refine_error_deg)
     _emit(args, stage, "calibration_sweep.png", "calibration", out, figure,
           f"pair {pair}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps, residual angle error "
           f"{cal.residual_error_deg:.4f} deg, range offset {cal.range_offset_m * 1e3:.2f} mm "
@@ -90,7 +93,7 @@ def _linearity(args, stage) -> int:
     def figure():
         from ..viz.figures import linearity_figure
         return linearity_figure(lin.set_deg, {args.amplitudes: lin.detected_deg},
-                                {args.amplitudes: lin.amplitude_db})
+                                {args.amplitudes: lin.amplitude_db}, pair=pair)
     _emit(args, stage, "linearity.png", "linearity", lin.to_dict(), figure,
           f"{args.amplitudes} ({'calibrated' if cal else 'uncalibrated'}): max |error| "
           f"{lin.max_abs_error_deg:.4f} deg over {len(lin.set_deg)} set-points")

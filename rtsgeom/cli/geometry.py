@@ -12,7 +12,11 @@ from ._common import (UsageError, load_scene_checked, output_file, output_path, 
 
 
 def cmd_info(args) -> int:
-    info = scene_info(build_setup(load_scene_checked(args.scene)))
+    import sys
+    from ..info import unreachable_warnings
+    info = scene_info(build_setup(load_scene_checked(args.scene)), reachable=True)
+    for w in unreachable_warnings(info, skip_outside_geometric=True):  # those: validate's
+        print(f"rtsgeom: warning: {args.scene}: {w}", file=sys.stderr)
     if args.json:
         print_json(info)
     else:

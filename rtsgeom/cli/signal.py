@@ -79,7 +79,14 @@ def _calibration_figures(result: RunResult) -> list[bytes]:
         t = np.array([p["delta_tau_s"] for p in cal["sweep"]])
         e = np.array([np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
                       for p in cal["sweep"]])
-        out.append(figure_png(calibration_sweep_figure(t, e, cal["delta_tau_s"], cal["period_s"])))
+        rf = cal.get("refinement", [])
+        fig = calibration_sweep_figure(
+            t, e, cal["delta_tau_s"], cal["period_s"],
+            residual_error_deg=cal.get("residual_error_deg"),
+            refine_delta_tau_s=[p["delta_tau_s"] for p in rf],
+            refine_error_deg=[np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
+                              for p in rf])
+        out.append(figure_png(fig))
     return out
 
 
@@ -200,7 +207,9 @@ def cmd_adc(args) -> int:
     if args.format == "dca1000":
         output_file(Path(str(args.out) + ".json"), [args.scene])
     scene = load_scene_checked(args.scene)
-    cube = run_scene(scene, "exact", args.amplitudes).cube
+    with steps(args.quiet) as step:  # the calibration sweeps take about a minute
+        step(f"simulating {scene.name} (calibration, ADC cube)")
+        cube = run_scene(scene, "exact", args.amplitudes).cube
     if args.format == "npy":
         with atomic_path(args.out) as tmp:
             with open(tmp, "wb") as fh:
@@ -243,4 +252,5 @@ def register(sub) -> None:
     p.add_argument("--format", choices=("npy", "dca1000"), default="npy")
     p.add_argument("--amplitudes", choices=modes, default=None,
                    help="AoA amplitude mode (default: the scene's rts.aoa_mode)")
+    p.add_argument("--quiet", action="store_true", help="no progress output on stderr")
     p.set_defaults(func=cmd_adc)

@@ -122,15 +122,12 @@ def _tolerance(args, scene, stage) -> int:
                 for case in CASES}
     elapsed = time.perf_counter() - t0
     if stage is not None:
-        from ..viz.figures import save_figure, tolerance_histogram_figure
-        # The uncalibrated tail reaches degrees: errors beyond +-lim (above every case's 95th
-        # percentile, so the legend's stays exact) are piled into the outer bins.
-        p95 = max(out[case]["angle_error_deg"]["p95"] for case in cases)
-        lim = max(5 * args.spec_deg, 1.2 * p95)
-        fig = tolerance_histogram_figure(
-            {case: np.clip(res.worst_error_deg[case], -lim, lim) for case in cases},
-            args.spec_deg, f"Worst error per setup, pair {tuple(model.pair)} (clipped at "
-                           f"±{lim:.2g} deg)")
+        from ..viz.figures import save_figure, tolerance_cdf_figure
+        # Empirical CDFs on a log axis: the uncalibrated tail (degrees) and the calibrated
+        # case (thousandths of a degree) are both resolved; nothing is clipped.
+        fig = tolerance_cdf_figure({case: res.worst_error_deg[case] for case in cases},
+                                   args.spec_deg,
+                                   f"Worst |error| per setup, pair {tuple(model.pair)}")
         save_figure(fig, stage / "tolerance.png")
         write_json(stage / "tolerance.json", out)
     if args.json:
@@ -173,18 +170,24 @@ def _design(args, scene, stage) -> int:
                            (lambda done, total: progress("designs", done, total)))
     out = grid.to_dict()
     if stage is not None:
-        from ..viz.figures import design_heatmap_figure, save_figure
+        from ..viz.figures import design_heatmap_figure, design_lines_figure, save_figure
         mask = grid.exceeds_resolution
+        # a single radius or spacing is a 1-D sweep: lines, not a heat map of one row/column
+        draw = (design_lines_figure if min(grid.radius_m.size, grid.spacing_deg.size) == 1
+                else design_heatmap_figure)
         for name, (zlabel, title) in METRICS.items():
-            fig = design_heatmap_figure(
+            fig = draw(
                 grid.radius_m, grid.spacing_deg, grid.metrics[name], "arc radius R_c (m)",
                 "front-end spacing (deg)", zlabel,
-                f"{title} (hatched: spacing > {grid.angular_resolution_deg:.1f} deg, eq. 24)",
-                mask=mask)
+                f"{title} ({'hatched' if draw is design_heatmap_figure else 'hollow'}: spacing > "
+                f"{grid.angular_resolution_deg:.1f} deg, eq. 24)", mask=mask)
             save_figure(fig, stage / f"design_{name}.png")
         write_json(stage / "design.json", out)
+    sheet_note = _sheet_note(out["designs"])
     if args.json:
         print_json(out)
+        if sheet_note and not args.quiet:
+            print(f"rtsgeom: {sheet_note}", file=sys.stderr)
         return 0
     print(f"pair {pair}, centre {grid.centre_deg:.2f} deg, angular resolution "
           f"{grid.angular_resolution_deg:.2f} deg; tolerance: {100 * grid.target_yield:g} % "
@@ -194,12 +197,31 @@ def _design(args, scene, stage) -> int:
     for d in out["designs"]:
         def f(key, fmt):
             return format(d[key], fmt) if d[key] is not None else "-"
-        note = d["problem"] or ("> resolution" if d["exceeds_resolution"] else "")
+        note = d["problem"] or ", ".join(
+            ([] if d["sheet"] == "kept" else [f"sheet {d['sheet']}"])
+            + (["> resolution"] if d["exceeds_resolution"] else []))
         print(f"{d['radius_m']:6.3g} {d['spacing_deg']:7.3g} {f('worst_error_deg', '10.4f')} "
               f"{f('near_field_bias_deg', '9.4f')} {f('range_offset_mm', '10.2f')} "
               f"{f('sigma_calibrated_mm', '13.4f')} {f('sigma_uncalibrated_mm', '13.4f')}  "
               f"{note}")
+    if sheet_note:
+        print(sheet_note)
     return 0
+
+
+def _sheet_note(designs: list[dict]) -> str:
+    """One line saying where the design disabled or widened the sheet (else empty)."""
+    parts = []
+    for state, why in (("disabled", "its cutouts do not fit (they would overlap or not hold "
+                                    "both antennas); no sheet is modelled there"),
+                       ("widened", "the front ends lie beyond it")):
+        hit = [d for d in designs if d["sheet"] == state]
+        if hit:
+            cells = ", ".join(f"{d['radius_m']:g} m/{d['spacing_deg']:g} deg" for d in hit[:6])
+            more = f" and {len(hit) - 6} more" if len(hit) > 6 else ""
+            parts.append(f"sheet {state} in {len(hit)} of {len(designs)} designs "
+                         f"(R_c/spacing {cells}{more}): {why}")
+    return "note: " + "; ".join(parts) if parts else ""
 
 
 def _common(p, draws_default: int) -> None:

@@ -27,12 +27,12 @@ def _load_paths(setup, method: str | None):
         from ..paths import exact_paths
         return exact_paths(setup)
     try:
-        from ..paths.raytrace import raytrace_paths
+        from ..paths.raytrace import trace
     except ModuleNotFoundError as exc:
         if exc.name not in ("rtsgeom.paths.raytrace", "sionna", "sionna.rt"):
             raise
         raise UsageError(f"--paths raytrace is not available here ({exc})") from None
-    return raytrace_paths(setup)
+    return trace(setup)  # the table plus each reflection's hit points, which the view draws
 
 
 def cmd_show(args) -> int:

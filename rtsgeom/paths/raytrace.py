@@ -28,8 +28,8 @@ Rows returned (a :class:`~rtsgeom.paths.table.Paths` table, ``method="raytrace"`
 
 Backend: the ``cuda_ad_mono_polarized`` Mitsuba variant where Dr.Jit finds CUDA, else
 ``llvm_ad_mono_polarized``; ``RTSGEOM_RAYTRACE_BACKEND=llvm`` (or ``cuda``) forces one. Dr.Jit's
-kernel cache goes to ``<repo>/.drjit_cache`` (source checkout) or ``~/.cache/rtsgeom/drjit``
-unless ``DRJIT_CACHE_DIR`` is set.
+kernel cache goes to the user's cache folder, ``$XDG_CACHE_HOME/rtsgeom/drjit`` (default
+``~/.cache/rtsgeom/drjit``), or ``$RTSGEOM_CACHE_DIR/drjit``; ``DRJIT_CACHE_DIR`` overrides both.
 
 Known limits (see RAYTRACE.md): Sionna drops every path segment shorter than 1 cm; its image
 method accepts a hit on another triangle whose image lies within 1 cm; geometric optics on a
@@ -103,6 +103,12 @@ class RaytraceResult:
     timings_s: dict = field(default_factory=dict)
     stats: dict = field(default_factory=dict)
 
+    def hit_points(self, i: int) -> np.ndarray:
+        """The interaction points (world frame, in order from transmitter to receiver) of
+        ``paths`` row ``i``: (bounces, 3); empty for line of sight."""
+        v = self.vertices[i]
+        return v[np.all(np.isfinite(v), axis=-1)]
+
 
 # ------------------------------------------------------------------------------------------
 # Backend pre-flight (runs once per process, before the first import of sionna)
@@ -113,12 +119,14 @@ _PREFLIGHT: tuple[bool, str, str | None] | None = None
 
 
 def _default_cache_dir() -> Path:
-    """``<repo>/.drjit_cache`` in a writable source checkout, else the user's cache folder."""
-    repo = Path(__file__).resolve().parents[2]
-    if (repo / "pyproject.toml").is_file() and os.access(repo, os.W_OK):
-        return repo / ".drjit_cache"
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "rtsgeom" / "drjit"
+    """Dr.Jit's kernel cache: ``$RTSGEOM_CACHE_DIR/drjit`` if set, else the user's cache folder
+    ``$XDG_CACHE_HOME/rtsgeom/drjit`` (``~/.cache/rtsgeom/drjit``); never inside the source
+    checkout, which may be read-only, shared or under version control."""
+    base = os.environ.get("RTSGEOM_CACHE_DIR")
+    if base:
+        return Path(base).expanduser() / "drjit"
+    xdg = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(xdg) / "rtsgeom" / "drjit"
 
 
 def _set_cache_dir() -> None:

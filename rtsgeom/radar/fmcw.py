@@ -55,6 +55,20 @@ class AdcCube:
         """The RuT's beamformer (built once per cube)."""
         return Steering.build(self.rut, self.radar)
 
+    def to_xarray(self):
+        """The cube as an ``xarray.DataArray`` with dims ``chirp_loop``, ``virtual_channel``
+        and ``sample``; coordinates ``fast_time_s`` (since ramp start) on the samples and
+        ``tx_slot``, ``rx`` on the virtual channels (v = tx_slot * num_rx + rx)."""
+        import xarray as xr
+        n_l, n_v, _ = self.data.shape
+        v = np.arange(n_v)
+        return xr.DataArray(self.data, dims=("chirp_loop", "virtual_channel", "sample"),
+                            coords={"chirp_loop": np.arange(n_l), "virtual_channel": v,
+                                    "tx_slot": ("virtual_channel", v // self.rut.num_rx),
+                                    "rx": ("virtual_channel", v % self.rut.num_rx),
+                                    "fast_time_s": ("sample", fast_time_s(self.radar))},
+                            name="adc", attrs={"long_name": "complex IF samples"})
+
 
 def fast_time_s(radar: RadarConfig) -> np.ndarray:
     """Sample instants since the start of the ramp, (N,)."""

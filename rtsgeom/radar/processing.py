@@ -46,6 +46,34 @@ class RangeDoppler:
     def power_db(self) -> np.ndarray:
         return 10 * np.log10(np.maximum(self.power, 1e-30))
 
+    def to_xarray(self):
+        """The integrated power map as an ``xarray.DataArray`` (linear power, dims ``range_m``
+        and ``velocity_mps``, with ``doppler_hz`` as a second coordinate on the Doppler axis).
+
+        ``10 * numpy.log10(da)`` gives dB; ``da.sel(range_m=33.5, method="nearest")`` a cut.
+        """
+        import xarray as xr
+        return xr.DataArray(self.power, dims=("range_m", "velocity_mps"),
+                            coords={"range_m": self.range_m, "velocity_mps": self.velocity_mps,
+                                    "doppler_hz": ("velocity_mps", self.doppler_hz)},
+                            name="power", attrs={"long_name": "range-Doppler power",
+                                                 "description": "sum over virtual channels of "
+                                                                "|X|^2"})
+
+    def range_angle_to_xarray(self, cube: AdcCube, angle_deg=None):
+        """The range-angle map (:func:`range_angle_map`, each range bin at its strongest
+        Doppler bin) as an ``xarray.DataArray`` with dims ``range_m`` and ``angle_deg``.
+
+        ``angle_deg`` defaults to -60..60 deg in 0.25 deg steps.
+        """
+        import xarray as xr
+        angle_deg = np.arange(-60.0, 60.0 + 1e-9, 0.25) if angle_deg is None else (
+            np.asarray(angle_deg, float))
+        power = range_angle_map(self, cube, np.radians(angle_deg))
+        return xr.DataArray(power, dims=("range_m", "angle_deg"),
+                            coords={"range_m": self.range_m, "angle_deg": angle_deg},
+                            name="power", attrs={"long_name": "beamformer power"})
+
 
 @dataclass(frozen=True)
 class Detections:
@@ -65,6 +93,16 @@ class Detections:
     @property
     def angle_deg(self) -> np.ndarray:
         return np.degrees(self.angle_rad)
+
+    def to_dataframe(self):
+        """One row per detection as a ``pandas.DataFrame`` (columns ``range_m``,
+        ``velocity_mps``, ``angle_deg``, ``power_db``, ``snr_db``, ``range_bin``,
+        ``doppler_bin``)."""
+        import pandas as pd
+        return pd.DataFrame({"range_m": self.range_m, "velocity_mps": self.velocity_mps,
+                             "angle_deg": self.angle_deg, "power_db": self.power_db,
+                             "snr_db": self.snr_db, "range_bin": self.range_bin,
+                             "doppler_bin": self.doppler_bin})
 
 
 def range_doppler(cube: AdcCube) -> RangeDoppler:

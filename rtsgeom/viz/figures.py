@@ -24,8 +24,8 @@ from matplotlib.patches import Rectangle
 from ..io import atomic_path
 
 __all__ = ["STYLE", "save_figure", "range_doppler_figure", "range_angle_figure",
-           "calibration_sweep_figure", "linearity_figure", "tolerance_histogram_figure",
-           "design_heatmap_figure"]
+           "calibration_sweep_figure", "linearity_figure", "tolerance_cdf_figure",
+           "tolerance_histogram_figure", "design_heatmap_figure", "design_lines_figure"]
 
 STYLE = {
     "font.size": 9,
@@ -66,9 +66,33 @@ def _new_figure(figsize=(6.4, 4.4), nrows=1, ncols=1, **subplot_kw) -> tuple[Fig
     return fig, axes
 
 
+def _plain_text_if_not_math(fig: Figure) -> None:
+    """Show every text that mathtext cannot parse literally instead of failing the whole
+    figure: a title made elsewhere from a user's string (a scene name with ``$\\x$`` in it)
+    must never crash a figure."""
+    from matplotlib.cbook import is_math_text
+    from matplotlib.mathtext import MathTextParser
+    from matplotlib.text import Text
+    parser = MathTextParser("path")
+    for t in fig.findobj(Text):
+        s = t.get_text()
+        if not (t.get_parse_math() and is_math_text(s)):
+            continue
+        try:
+            parser.parse(s, 72, t.get_fontproperties())
+        except ValueError:
+            t.set_parse_math(False)
+
+
+def _title(ax, text: str) -> None:
+    """A title that may carry a user's string (a scene name): plain text, never mathtext."""
+    ax.set_title(text, parse_math=False)
+
+
 def save_figure(fig: Figure, path: str | Path) -> Path:
     """Write ``fig`` as PNG (dpi 120) atomically; return the path."""
     path = Path(path)
+    _plain_text_if_not_math(fig)
     with mpl.rc_context(STYLE), atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", dpi=DPI)
     return path
@@ -112,7 +136,7 @@ def _power_map(ax, fig, x, y, power_db, xlabel: str, ylabel: str, title: str) ->
     ax.set_ylabel(ylabel)
     ax.grid(False)
     if title:
-        ax.set_title(title)
+        _title(ax, title)
 
 
 @_styled
@@ -155,11 +179,17 @@ def range_angle_figure(power_db, range_m, angle_deg, detections=None, set_points
 
 @_styled
 def calibration_sweep_figure(delta_tau_s, angle_error_deg, chosen_delta_tau_s: float,
-                             period_s: float | None = None, title: str = "") -> Figure:
+                             period_s: float | None = None, title: str = "",
+                             residual_error_deg: float | None = None,
+                             refine_delta_tau_s=None, refine_error_deg=None) -> Figure:
     """Phase-coherency calibration: angle error (deg) over the swept RTS delay offset (ns).
 
-    The chosen offset is marked; with ``period_s`` (the phase period 1/(f_rts + B/2)) the
-    offsets one period apart, where the same minimum repeats, are marked as well.
+    The chosen offset is marked at ``residual_error_deg`` (the calibration's own residual, as
+    in its JSON; it comes from the refinement around the sweep's best grid point, drawn when
+    ``refine_delta_tau_s`` and ``refine_error_deg`` are given). Without it the marker sits on
+    the sweep, interpolated, and says so. With ``period_s`` (the phase period
+    1/(f_rts + B/2), eq. 27) the offsets whole periods away, where the same minimum repeats,
+    are marked where they fall inside the sweep.
     """
     tau = _vector("delta_tau_s", delta_tau_s)
     err = _vector("angle_error_deg", angle_error_deg)
@@ -169,22 +199,35 @@ def calibration_sweep_figure(delta_tau_s, angle_error_deg, chosen_delta_tau_s: f
     t_ns, err = tau[order] * 1e9, err[order]
     chosen_ns = float(chosen_delta_tau_s) * 1e9
     fig, ax = _new_figure(figsize=(6.4, 3.8))
-    ax.plot(t_ns, err, marker=".", label="angle error")
+    ax.plot(t_ns, err, marker=".", label="sweep: angle error")
     ax.axhline(0.0, color="0.4", linewidth=0.8)
+    if refine_delta_tau_s is not None and refine_error_deg is not None:
+        rt = np.asarray(refine_delta_tau_s, float).ravel()
+        re = np.asarray(refine_error_deg, float).ravel()
+        if rt.size != re.size:
+            raise ValueError(f"refine_error_deg has {re.size} values, refine_delta_tau_s "
+                             f"{rt.size}")
+        if rt.size:
+            ax.plot(rt * 1e9, re, marker="+", linestyle="none", color="C1",
+                    label="refinement")
     if period_s is not None and period_s > 0:
         p_ns = float(period_s) * 1e9
         k = np.arange(np.ceil((t_ns[0] - chosen_ns) / p_ns),
                       np.floor((t_ns[-1] - chosen_ns) / p_ns) + 1)
-        for x in chosen_ns + p_ns * k[k != 0]:
-            ax.axvline(x, color="C2", linestyle=":", linewidth=1.2)
-        ax.plot([], [], color="C2", linestyle=":", label=f"chosen + k periods ({p_ns:.4f} ns)")
-    y_chosen = float(np.interp(chosen_ns, t_ns, err))
+        k = k[k != 0]
+        for n, x in enumerate(chosen_ns + p_ns * k):  # the legend entry only with a line
+            ax.axvline(x, color="C2", linestyle=":", linewidth=1.2,
+                       label=f"chosen + k periods ({p_ns:.4f} ns)" if n == 0 else None)
+    if residual_error_deg is not None:
+        y_chosen, how = float(residual_error_deg), "residual"
+    else:
+        y_chosen, how = float(np.interp(chosen_ns, t_ns, err)), "sweep, interpolated"
     ax.axvline(chosen_ns, color="C3", linestyle="--", linewidth=1.2)
     ax.plot([chosen_ns], [y_chosen], marker="o", markersize=7, color="C3", linestyle="none",
-            label=f"chosen: {chosen_ns * 1e3:.1f} ps ({y_chosen:.3f} deg)")
+            label=f"chosen: {chosen_ns * 1e3:.1f} ps ({how} {y_chosen:.4f} deg)")
     ax.set_xlabel("RTS delay offset $\\Delta\\tau_{rts}$ (ns)")
     ax.set_ylabel("angle error (deg)")
-    ax.set_title(title or "Phase coherency calibration")
+    _title(ax, title or "Phase coherency calibration")
     ax.legend(loc="best")
     return fig
 
@@ -212,11 +255,12 @@ def _mode_arrays(name: str, by_mode: Mapping[str, object], n: int, rows: int | N
 @_styled
 def linearity_figure(set_deg, detected_deg_by_mode: Mapping[str, object],
                      amplitude_db_by_mode: Mapping[str, object] | None = None,
-                     title: str = "") -> Figure:
+                     title: str = "", pair: tuple[int, int] | None = None) -> Figure:
     """Amplitude attenuation and angle linearity and error (paper figure), stacked over the set
     angle: the two channels' attenuation in dB (only with ``amplitude_db_by_mode``, each (2, n)),
     the detected angle against the ideal line, and the error detected - set. One colour per
-    synthesis mode; NaN marks a set angle without a detection."""
+    synthesis mode; NaN marks a set angle without a detection. The channels are named by their
+    front-end indices ``pair`` (0-based, as the CLI's ``--pair``), else "channel I" and "J"."""
     s = _vector("set_deg", set_deg)
     det = _mode_arrays("detected_deg_by_mode", detected_deg_by_mode, s.size)
     amp = (None if amplitude_db_by_mode is None
@@ -225,15 +269,17 @@ def linearity_figure(set_deg, detected_deg_by_mode: Mapping[str, object],
     fig, axes = _new_figure(figsize=(6.4, 2.4 * n_panels + 0.4), nrows=n_panels, sharex=True)
     ax_amp, ax_lin, ax_err = (None, *axes) if amp is None else axes
     colour = {m: f"C{i % 10}" for i, m in enumerate(dict.fromkeys([*det, *(amp or {})]))}
+    names = (("channel I", "channel J") if pair is None
+             else tuple(f"front end {int(q)}" for q in pair))
     if ax_amp is not None:
         for mode, a in amp.items():
-            ax_amp.plot(s, a[0], color=colour[mode], label=f"{mode}: channel 1")
-            ax_amp.plot(s, a[1], color=colour[mode], linestyle="--", label=f"{mode}: channel 2")
+            ax_amp.plot(s, a[0], color=colour[mode], label=f"{mode}: {names[0]}")
+            ax_amp.plot(s, a[1], color=colour[mode], linestyle="--", label=f"{mode}: {names[1]}")
         ax_amp.set_ylabel("attenuation (dB)")
         ax_amp.legend(loc="best", ncols=2 if len(amp) > 1 else 1)
-        ax_amp.set_title(title or "Amplitude attenuation and angle linearity and error")
+        _title(ax_amp, title or "Amplitude attenuation and angle linearity and error")
     else:
-        ax_lin.set_title(title or "Angle linearity and error")
+        _title(ax_lin, title or "Angle linearity and error")
     ax_lin.plot(s, s, color="0.5", linestyle=":", label="ideal")
     for mode, d in det.items():
         ax_lin.plot(s, d, color=colour[mode], marker=".", label=mode)
@@ -247,38 +293,52 @@ def linearity_figure(set_deg, detected_deg_by_mode: Mapping[str, object],
 
 
 @_styled
-def tolerance_histogram_figure(errors_deg_by_case: Mapping[str, object],
-                               spec_deg: float | None = None, title: str = "") -> Figure:
-    """Histograms of angle errors (deg) per case (e.g. mounting-tolerance Monte Carlo draws) on
-    common bins; the legend gives each case's count and 95th percentile of |error|; ``spec_deg``
-    draws the ±spec limits."""
+def tolerance_cdf_figure(errors_deg_by_case: Mapping[str, object],
+                         spec_deg: float | None = None, title: str = "") -> Figure:
+    """Empirical CDFs of the absolute angle error (deg) per case (e.g. the worst error per drawn setup of
+    the mounting-tolerance Monte Carlo) on a log axis, so that cases whose errors differ by
+    orders of magnitude (uncalibrated: degrees; calibrated: thousandths) are both resolved (a
+    histogram on common bins put the calibrated case into one bin). The legend gives each
+    case's count, 95th percentile and the fraction within ``spec_deg`` (the vertical line)."""
     cases = {}
     for name, values in errors_deg_by_case.items():
-        a = np.asarray(values, dtype=float).ravel()
-        cases[str(name)] = a[np.isfinite(a)]
+        a = np.abs(np.asarray(values, dtype=float).ravel())
+        cases[str(name)] = np.sort(a[np.isfinite(a)])
     if not cases:
         raise ValueError("errors_deg_by_case is empty")
     every = np.concatenate(list(cases.values()))
-    lo, hi = (float(every.min()), float(every.max())) if every.size else (-1.0, 1.0)
+    positive = every[every > 0]
+    floor = float(positive.min()) if positive.size else 1e-6
     if spec_deg is not None:
-        lo, hi = min(lo, -abs(spec_deg)), max(hi, abs(spec_deg))
-    if hi - lo < 1e-12:
-        lo, hi = lo - 0.5, hi + 0.5
-    bins = np.linspace(lo, hi, int(np.clip(np.sqrt(max(every.size, 1)), 10, 60)) + 1)
+        floor = min(floor, abs(spec_deg))
     fig, ax = _new_figure(figsize=(6.4, 3.8))
     for name, a in cases.items():
-        p95 = float(np.percentile(np.abs(a), 95)) if a.size else np.nan
-        ax.hist(a, bins=bins, histtype="step", linewidth=1.5,
-                label=f"{name} (n={a.size}, |err| 95 %: {p95:.3f} deg)")
+        if not a.size:
+            continue
+        p95 = float(np.percentile(a, 95))
+        label = f"{name} (n={a.size}, 95 %: {p95:.3g} deg"
+        if spec_deg is not None:
+            label += f", {100 * np.mean(a <= abs(spec_deg)):.1f} % within spec"
+        # the ECDF as a step function; zeros are drawn at the axis' left end
+        x = np.maximum(a, 0.5 * floor)
+        ax.step(np.r_[x[0], x], np.r_[0.0, np.arange(1, a.size + 1) / a.size], where="post",
+                linewidth=1.5, label=label + ")")
     if spec_deg is not None:
-        for sign in (-1, 1):
-            ax.axvline(sign * abs(spec_deg), color="red", linestyle="--", linewidth=1.2,
-                       label=f"spec ±{abs(spec_deg):g} deg" if sign > 0 else None)
-    ax.set_xlabel("angle error (deg)")
-    ax.set_ylabel("count")
-    ax.set_title(title or "Angle error distribution")
+        ax.axvline(abs(spec_deg), color="red", linestyle="--", linewidth=1.2,
+                   label=f"spec {abs(spec_deg):g} deg")
+    ax.set_xscale("log")
+    ax.set_ylim(0, 1.02)
+    ax.set_xlabel("|angle error| (deg)")
+    ax.set_ylabel("fraction of setups")
+    _title(ax, title or "Angle error distribution (empirical CDF)")
     ax.legend(loc="best")
     return fig
+
+
+def tolerance_histogram_figure(errors_deg_by_case: Mapping[str, object],
+                               spec_deg: float | None = None, title: str = "") -> Figure:
+    """Kept for earlier callers: the empirical CDFs of :func:`tolerance_cdf_figure`."""
+    return tolerance_cdf_figure(errors_deg_by_case, spec_deg, title)
 
 
 @_styled
@@ -311,6 +371,41 @@ def design_heatmap_figure(x, y, z, xlabel: str, ylabel: str, zlabel: str, title:
         ax.clabel(cs, fontsize=7, fmt="%.3g")
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
-    ax.set_title(title)
+    _title(ax, title)
     ax.grid(False)
+    return fig
+
+
+@_styled
+def design_lines_figure(x, y, z, xlabel: str, ylabel: str, zlabel: str, title: str,
+                        mask=None) -> Figure:
+    """A 1-D design sweep as lines: ``z`` (shape (len(y), len(x))) over whichever of ``x``
+    and ``y`` has more than one value, one line per value of the other (a heat map of a
+    single row or column shows nothing readable). ``mask`` (True = excluded) is drawn hollow."""
+    xv = _vector("x", x)
+    yv = _vector("y", y)
+    zv = _grid("z", z, (yv.size, xv.size), "len(y), len(x)")
+    m = np.zeros(zv.shape, bool) if mask is None else np.asarray(mask, bool)
+    if m.shape != zv.shape:
+        raise ValueError(f"mask must have shape {zv.shape}, got {m.shape}")
+    if xv.size >= yv.size:  # lines over x, one per y
+        axis, other, other_label, zz, mm = xv, yv, ylabel, zv, m
+        axis_label = xlabel
+    else:
+        axis, other, other_label, zz, mm = yv, xv, xlabel, zv.T, m.T
+        axis_label = ylabel
+    fig, ax = _new_figure()
+    for k, val in enumerate(other):
+        line, = ax.plot(axis, np.where(mm[k], np.nan, zz[k]), marker="o",
+                        label=f"{other_label} = {val:g}", linestyle="-")
+        if mm[k].any():
+            ax.plot(axis[mm[k]], zz[k][mm[k]], marker="o", linestyle="none",
+                    markerfacecolor="none", color=line.get_color(), label="excluded")
+    if not np.isfinite(zz).any():
+        ax.text(0.5, 0.5, "no finite values", transform=ax.transAxes, ha="center",
+                va="center", color="0.4")
+    ax.set_xlabel(axis_label)
+    ax.set_ylabel(zlabel)
+    _title(ax, title)
+    ax.legend(loc="best")
     return fig

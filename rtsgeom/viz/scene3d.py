@@ -233,13 +233,44 @@ def _target_positions(setup: Setup) -> tuple[np.ndarray, np.ndarray]:
     return rut.position + TARGET_RADIUS_FACTOR * setup.fe.arc_radius_m * direction, direction
 
 
+def _split_paths(paths):
+    """``(Paths, vertices or None)`` from a :class:`~rtsgeom.paths.Paths` table or a ray-tracing
+    result (:class:`~rtsgeom.paths.raytrace.RaytraceResult`, which carries the hit points)."""
+    if paths is None:
+        return None, None
+    if hasattr(paths, "paths") and hasattr(paths, "vertices"):
+        return paths.paths, paths.vertices
+    return paths, getattr(paths, "vertices", None)
+
+
+def _hit_points(vertices, i: int) -> np.ndarray:
+    """Row ``i``'s finite hit points, (n, 3) (none without ``vertices``)."""
+    v = None if vertices is None else vertices[i]
+    if v is None:
+        return np.zeros((0, 3))
+    v = np.atleast_2d(np.asarray(v, float))
+    return v[np.all(np.isfinite(v), axis=-1)] if v.size else np.zeros((0, 3))
+
+
+def undrawable_reflections(paths) -> int:
+    """How many reflected rows of ``paths`` carry no hit points (they cannot be drawn)."""
+    table, vertices = _split_paths(paths)
+    if table is None:
+        return 0
+    refl = np.flatnonzero(np.asarray(table.bounces) > 0)
+    return int(sum(len(_hit_points(vertices, i)) == 0 for i in refl))
+
+
 def _path_polylines(setup: Setup, paths, scale: float) -> tuple[list[np.ndarray], list[np.ndarray]]:
-    """Line-of-sight and reflected path polylines; RuT ends at the drawn (scaled) elements."""
+    """Line-of-sight and reflected path polylines; RuT ends at the drawn (scaled) elements.
+
+    ``paths``: a :class:`Paths` table or a ray-tracing result; a reflection is drawn through
+    its hit points (``vertices``, NaN rows past the last interaction are dropped)."""
     from ..paths.table import FE_TO_RX, RUT_TO_RUT, TX_TO_FE
     rut, fe = setup.rut, setup.fe
     tx = _scaled(rut.tx_world, rut.position, scale)
     rx = _scaled(rut.rx_world, rut.position, scale)
-    vertices = getattr(paths, "vertices", None)
+    paths, vertices = _split_paths(paths)
     los, refl = [], []
     for i in range(len(paths)):
         d, f = int(paths.direction[i]), int(paths.front_end[i])
@@ -255,10 +286,9 @@ def _path_polylines(setup: Setup, paths, scale: float) -> tuple[list[np.ndarray]
             if d != RUT_TO_RUT:  # direct Tx -> Rx coupling on the board: nothing to see
                 los.append(np.array([start, end]))
             continue
-        v = None if vertices is None else vertices[i]
-        if v is None or len(v) == 0:
-            continue  # a reflection without its interaction points cannot be drawn
-        v = np.atleast_2d(np.asarray(v, float))
+        v = _hit_points(vertices, i)
+        if len(v) == 0:
+            continue  # no hit points: counted by undrawable_reflections and noted in the view
         pts = [start] + [p for p in v if not (np.allclose(p, start) or np.allclose(p, end))] + [end]
         refl.append(np.array(pts))
     return los, refl
@@ -315,7 +345,7 @@ def _add_setup(pl, setup: Setup, paths, scale: float, labels: str) -> list:
         legend.append([f"targets (drawn at {TARGET_RADIUS_FACTOR:g} R_c)", _TARGET])
 
     # propagation paths
-    if paths is not None and len(paths):
+    if paths is not None and len(_split_paths(paths)[0]):
         los, refl = _path_polylines(setup, paths, scale)
         if los:
             pl.add_mesh(_merge_lines(los), color=_LOS, line_width=2, opacity=0.8)
@@ -473,11 +503,23 @@ def build_plotter(setup: Setup, paths=None, window_size=(1600, 1000), off_screen
     legend = _add_setup(pl, setup, paths, scale, labels="2d" if side_panels else "3d")
     s = setup.scene
     title = f"{s.name}" + (f": {s.description}" if s.description else "")
+    # user text is plain text: VTK hands "$...$" to matplotlib's mathtext; "\$" keeps a
+    # literal dollar (vtkTextRenderer strips the escape before FreeType draws it)
+    title = title.replace("$", "\\$")
     pl.add_text(title, position="upper_left", font_size=12, color="black")
     note = (f"RuT drawn x{scale:g} about its phase centre; front-end markers enlarged; "
             f"targets drawn at {TARGET_RADIUS_FACTOR:g} x arc radius")
     if paths is not None:
-        note += f"; paths: {paths.method}"
+        table = _split_paths(paths)[0]
+        n_refl = int((np.asarray(table.bounces) > 0).sum())
+        note += f"; paths: {table.method} ({len(table) - n_refl} direct, {n_refl} reflected)"
+        missing = undrawable_reflections(paths)
+        if missing:
+            import warnings
+            msg = (f"{missing} of {n_refl} reflected paths carry no hit points and are not "
+                   "drawn (pass the ray-tracing result, paths.raytrace.trace(setup))")
+            warnings.warn(msg, stacklevel=2)
+            note += f"; {missing} reflected paths not drawn (no hit points)"
     pl.add_text(note, position="lower_left", font_size=9, color="#333333")
     pl.add_legend(legend, bcolor="white", background_opacity=0.8, border=True, size=(0.25, 0.22),
                   loc="upper right", face="rectangle")

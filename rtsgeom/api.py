@@ -1,0 +1,269 @@
+"""Scene-level conveniences for notebooks and scripts: each wraps one CLI job.
+
+The functions here take a :class:`~rtsgeom.scene.Scene` (and a front-end pair) and return the
+library's own result objects; they add no physics. Import them from the package::
+
+    import rtsgeom
+    scene = rtsgeom.load_scene("scenes/diewald2022.toml")
+    cal = rtsgeom.calibrate(scene, pair=(0, 1))
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .scene import Scene
+
+__all__ = ["replace", "calibrate", "linearity", "tolerance", "design", "nearfield", "ghosts",
+           "show"]
+
+
+def replace(obj, **changes):
+    """A copy of a scene (or of one of its sections) with ``changes`` applied.
+
+    Uses ``obj.evolve(**changes)`` where the object has it (a :class:`Scene` that validates the
+    variant again), else :func:`dataclasses.replace`.
+
+    Parameters
+    ----------
+    obj : Scene, RadarConfig, RtsConfig, FrontEndConfig, SheetConfig or TargetConfig
+    **changes
+        Fields to change, in SI units (``arc_radius_m``, ``angle_rad``, ...).
+
+    Examples
+    --------
+    >>> fes = tuple(replace(f, radial_offset_m=0.2e-3) for f in scene.rts.front_ends)
+    >>> scene = replace(scene, rts=replace(scene.rts, front_ends=fes))  # doctest: +SKIP
+    """
+    import dataclasses
+    evolve = getattr(obj, "evolve", None)
+    if callable(evolve):
+        return evolve(**changes)
+    return dataclasses.replace(obj, **changes)
+
+
+def _setup_paths(scene: Scene):
+    from .geometry import build_setup
+    from .paths import exact_paths
+    setup = build_setup(scene)
+    return setup, exact_paths(setup)
+
+
+def _check_pair(setup, pair) -> tuple[int, int]:
+    i, j = (int(p) for p in pair)
+    n = setup.fe.count
+    if not (0 <= i < n and 0 <= j < n) or abs(i - j) != 1:
+        raise ValueError(f"pair {pair}: must be two adjacent front-end indices in [0, {n - 1}]")
+    return i, j
+
+
+def calibrate(scene: Scene, pair=(0, 1)):
+    """Calibrate a front-end pair by the paper's delay sweep on the simulated radar.
+
+    Parameters
+    ----------
+    scene : Scene
+        The setup; its seed drives the noise.
+    pair : tuple of int
+        Two adjacent front-end indices (0-based), channel J's delay is swept.
+
+    Returns
+    -------
+    Calibration
+        ``delta_tau_s``, ``residual_error_deg``, ``range_offset_m``, ``period_s`` (eq. 27) and
+        the sweep (``sweep_delta_tau_s``, ``sweep_error_deg``); ``to_dict()`` gives the JSON of
+        ``rtsgeom calibrate``.
+    """
+    from .aoa.calibration import calibrate_pair, probe_front_ends
+    setup, paths = _setup_paths(scene)
+    pair = _check_pair(setup, pair)
+    probe = probe_front_ends(setup, paths, scene.seed)
+    return calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
+
+
+def linearity(scene: Scene, pair=(0, 1), amplitudes: str = "exact", calibration=True,
+              points: int = 21):
+    """Synthesized-angle linearity across a pair's span on the simulated radar.
+
+    Parameters
+    ----------
+    scene : Scene
+    pair : tuple of int
+        Two adjacent front-end indices (0-based).
+    amplitudes : {'exact', 'array-factor', 'paper'}
+        How the amplitude ratio of the two channels is designed (eqs. 21-23, or the exact model).
+    calibration : bool or Calibration
+        ``True``: run the phase calibration first (:func:`calibrate`); a
+        :class:`~rtsgeom.aoa.calibration.Calibration` of this pair: use it (one calibration
+        for several modes); ``False``: uncalibrated, delay offset 0.
+    points : int
+        Set-points across the span (its ends excluded).
+
+    Returns
+    -------
+    Linearity
+        ``set_deg``, ``detected_deg``, ``error_deg``, ``amplitude_db`` (2, points) and
+        ``max_abs_error_deg``.
+    """
+    from .aoa.calibration import calibrate_pair, probe_front_ends
+    from .aoa.linearity import linearity as _linearity
+    setup, paths = _setup_paths(scene)
+    pair = _check_pair(setup, pair)
+    probe = probe_front_ends(setup, paths, scene.seed)
+    if calibration is True:
+        cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
+    elif calibration is False or calibration is None:
+        cal = None
+    else:
+        cal = calibration
+        if tuple(cal.pair) != pair:
+            raise ValueError(f"calibration is for pair {tuple(cal.pair)}, not {pair}")
+    return _linearity(setup, paths, pair, amplitudes, probe, cal, points, scene.seed)
+
+
+def tolerance(scene: Scene, pair=(0, 1), sigma_mm=(0.1, 0.1, 0.1), draws: int = 10_000,
+              seed: int | None = None, distribution: str = "normal", spec_deg: float = 0.1,
+              points: int = 21):
+    """Mounting-tolerance Monte Carlo of a front-end pair (phasor level).
+
+    Parameters
+    ----------
+    scene : Scene
+    pair : tuple of int
+        Two adjacent front-end indices (0-based).
+    sigma_mm : sequence of 3 float
+        Radial, tangential and height mounting error per front end in mm: the standard
+        deviation (``normal``) or the bound (``uniform``).
+    draws : int
+        Number of drawn setups.
+    seed : int, optional
+        Random seed (default: the scene's seed); the same seed gives the same draws.
+    distribution : {'normal', 'uniform'}
+    spec_deg : float
+        Angle-error spec for the yield.
+    points : int
+        Set-points across the span.
+
+    Returns
+    -------
+    ToleranceResult
+        ``worst_error_deg[case]`` per draw for ``'uncalibrated'`` and ``'calibrated'``,
+        ``yield_(case)``, ``stats(case)`` and ``to_dict()``.
+    """
+    from .analysis.tolerance import PairPhasors, monte_carlo
+    from .geometry import build_setup
+    setup = build_setup(scene)
+    pair = _check_pair(setup, pair)
+    model = PairPhasors.build(setup, pair, points)
+    sigma = np.asarray(sigma_mm, float).reshape(3) * 1e-3
+    return monte_carlo(model, sigma, draws, scene.seed if seed is None else seed, distribution,
+                       spec_deg)
+
+
+def design(scene: Scene, radius_m, spacing_deg, pair=(0, 1), spec_deg: float = 0.1,
+           target_yield: float = 0.95, draws: int = 2000, seed: int | None = None,
+           points: int = 21):
+    """Arc design map: every (front-end spacing, arc radius) as a two-front-end variant.
+
+    Parameters
+    ----------
+    scene : Scene
+        The template (radar, sheet, RTS); the pair's centre angle is kept.
+    radius_m : array_like
+        Arc radii (m).
+    spacing_deg : array_like
+        Front-end spacings (deg).
+    pair : tuple of int
+        The front-end pair whose centre angle the designs keep.
+    spec_deg, target_yield, draws, seed, points
+        As for :func:`tolerance`; the tolerance per design is the sigma that keeps
+        ``target_yield`` of the setups within ``spec_deg``.
+
+    Returns
+    -------
+    DesignGrid
+        ``metrics[name]`` (spacings, radii) arrays for each name in
+        :data:`rtsgeom.analysis.design.METRICS`, ``exceeds_resolution`` and ``to_dict()``.
+    """
+    from .analysis.design import design_grid
+    from .geometry import build_setup
+    pair = _check_pair(build_setup(scene), pair)
+    return design_grid(scene, pair, np.atleast_1d(radius_m), np.atleast_1d(spacing_deg),
+                       spec_deg, target_yield, draws, scene.seed if seed is None else seed,
+                       points)
+
+
+def nearfield(scene: Scene, radius_m=None, points: int = 11):
+    """Near-field analysis versus arc radius (single-front-end bias, phase error, synthesis).
+
+    Parameters
+    ----------
+    scene : Scene
+    radius_m : array_like, optional
+        Arc radii (m); default 13 radii over two decades around the scene's radius.
+    points : int
+        Synthesized set-points per pair.
+
+    Returns
+    -------
+    NearField
+    """
+    from .analysis.nearfield import nearfield as _nearfield
+    return _nearfield(scene, radius_m, points)
+
+
+def ghosts(scene: Scene, floor_db: float = -80.0, simulate: bool = False):
+    """Predicted (and, with ``simulate``, simulated) cable-ghost ranges and levels.
+
+    Parameters
+    ----------
+    scene : Scene
+    floor_db : float
+        Lowest ghost level relative to its target that is listed.
+    simulate : bool
+        Also run the signal chain and read each ghost in the range-Doppler map.
+
+    Returns
+    -------
+    GhostReport
+    """
+    from .analysis.ghosts import ghost_analysis
+    return ghost_analysis(scene, floor_db, simulate)
+
+
+def show(scene_or_setup, paths=None, png: str | Path | None = None,
+         window_size=(1600, 1000)):
+    """Draw the setup in 3D (pyvista): to a PNG file, or as an image array.
+
+    Parameters
+    ----------
+    scene_or_setup : Scene or Setup
+    paths : Paths, {'exact', 'raytrace'} or None
+        Propagation paths to draw (line of sight, and the reflections of ray tracing).
+    png : path, optional
+        Write an off-screen rendering there and return its path.
+    window_size : (int, int)
+        Image size in pixels.
+
+    Returns
+    -------
+    pathlib.Path or numpy.ndarray
+        The PNG's path, or the image (H, W, 3) uint8 when ``png`` is None.
+    """
+    from .geometry import Setup, build_setup
+    from .viz.scene3d import render_setup_png, show_setup
+    setup = scene_or_setup if isinstance(scene_or_setup, Setup) else build_setup(scene_or_setup)
+    if isinstance(paths, str):
+        if paths == "exact":
+            from .paths import exact_paths
+            paths = exact_paths(setup)
+        elif paths == "raytrace":
+            from .paths.raytrace import trace
+            paths = trace(setup)  # with the reflections' hit points
+        else:
+            raise ValueError(f"paths {paths!r}: must be 'exact', 'raytrace', a Paths or None")
+    if png is not None:
+        return render_setup_png(setup, png, paths=paths, window_size=window_size)
+    return show_setup(setup, paths=paths, interactive=False, window_size=window_size)
