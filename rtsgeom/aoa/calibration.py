@@ -33,7 +33,8 @@ from ..rts import RtsProgram, requested_delay
 from ..scene import TargetConfig
 from .synthesis import PairModel
 
-__all__ = ["Calibration", "FrontEndProbe", "probe_front_ends", "calibrate_pair", "probe_ranges"]
+__all__ = ["Calibration", "FrontEndProbe", "probe_front_ends", "calibrate_pair", "probe_ranges",
+           "if_phase_slope_hz", "air_phase_slope_hz", "coherence_delay"]
 
 
 @dataclass(frozen=True)
@@ -73,6 +74,53 @@ class Calibration:
             "sweep": pts(self.sweep_delta_tau_s, self.sweep_error_deg),
             "refinement": pts(self.refine_delta_tau_s, self.refine_error_deg),
         }
+
+
+def if_phase_slope_hz(scene, tau_s) -> np.ndarray:
+    """d(phase)/d(tau_rts) / 2 pi of an echo of total delay ``tau_s`` at the ADC window's
+    centre: ``f_rts + S t_mid - S tau`` (eq. 8 at t = t_mid; eq. 27 is its approximation
+    f_rts + B/2). Its inverse is the exact period of the calibration sweep."""
+    radar = scene.radar
+    return (scene.rts.f_rts_hz + (radar.f_center_hz - radar.f_c_hz)
+            - radar.slope_hz_per_s * np.asarray(tau_s, float))
+
+
+def air_phase_slope_hz(scene, tau_s) -> np.ndarray:
+    """d(phase)/d(tau_c) / 2 pi of the same echo: ``f_c + S t_mid - S tau`` (the over-the-air
+    delay acts at RF). A radial offset dr moves the coherence point by
+    ``-air_phase_slope_hz / if_phase_slope_hz * 2 dr / c0``."""
+    radar = scene.radar
+    return radar.f_center_hz - radar.slope_hz_per_s * np.asarray(tau_s, float)
+
+
+def coherence_delay(setup: Setup, paths: Paths, pair: tuple[int, int], alphas,
+                    near_s: float = 0.0, base_offsets=(0.0, 0.0), iterations: int = 4) -> float:
+    """The delay offset of channel J that makes both channels coherent at the probe angles
+    ``alphas`` on the setup *as built* (phasor model of both probe targets, with the range
+    offset the delay causes), the one nearest ``near_s``: the point the sweep should find.
+
+    Newton on the circular mean of the two probes' coherent phases, slope
+    ``2 pi if_phase_slope_hz``.
+    """
+    scene = setup.scene
+    targets = [TargetConfig(float(r)) for r in probe_ranges(setup, 2)]
+    tau = np.mean([2 * t.range_m / c for t in targets])
+    f_if = float(if_phase_slope_hz(scene, tau))
+    period = 1.0 / f_if
+
+    def phase(d):
+        z = 0j
+        for t in targets:
+            m = PairModel.build(setup, paths, pair, t, (base_offsets[0], base_offsets[1] + d))
+            z += np.exp(1j * m.coherent_phase(alphas))
+        return float(np.angle(z))
+
+    d = float(near_s)
+    for _ in range(2):  # Newton, then move to the period nearest near_s and polish there
+        for _ in range(iterations):
+            d += phase(d) / (2 * np.pi * f_if)
+        d += np.round((near_s - d) / period) * period
+    return float(d)
 
 
 def probe_angles(theta_i: float, theta_j: float) -> tuple[float, float]:
