@@ -34,7 +34,8 @@ from ..scene import TargetConfig
 from .synthesis import PairModel
 
 __all__ = ["Calibration", "FrontEndProbe", "probe_front_ends", "calibrate_pair", "probe_ranges",
-           "if_phase_slope_hz", "air_phase_slope_hz", "coherence_delay"]
+           "if_phase_slope_hz", "air_phase_slope_hz", "coherence_delay", "probe_total_delay",
+           "frames_per_step", "TARGET_BIAS_PS"]
 
 
 @dataclass(frozen=True)
@@ -57,7 +58,9 @@ class Calibration:
     refine_delta_tau_s: np.ndarray
     refine_error_deg: np.ndarray
     probe_angles_deg: tuple[float, float]
-    period_s: float
+    period_s: float  # exact: 1 / (f_rts + S t_mid - S tau) at the probes (eq. 27 refined)
+    frames_per_step: int = 1  # frames averaged (coherently) per sweep step
+    frame_noise_deg: float = 0.0  # predicted 1-sigma probe-angle noise of one frame
 
     def to_dict(self) -> dict:
         def pts(t, e):
@@ -70,6 +73,8 @@ class Calibration:
             "residual_error_deg": self.residual_error_deg,
             "range_offset_m": self.range_offset_m,
             "period_s": self.period_s,
+            "frames_per_step": self.frames_per_step,
+            "frame_noise_deg": self.frame_noise_deg,
             "probe_angles_deg": list(self.probe_angles_deg),
             "sweep": pts(self.sweep_delta_tau_s, self.sweep_error_deg),
             "refinement": pts(self.refine_delta_tau_s, self.refine_error_deg),
@@ -93,6 +98,13 @@ def air_phase_slope_hz(scene, tau_s) -> np.ndarray:
     return radar.f_center_hz - radar.slope_hz_per_s * np.asarray(tau_s, float)
 
 
+def probe_total_delay(setup: Setup, ranges) -> float:
+    """Mean total delay tau = tau_c + tau_rts of probe targets at ``ranges`` (what sets the
+    beat frequency S tau)."""
+    return float(np.mean(requested_delay(setup.scene, np.asarray(ranges, float)))
+                 + np.mean(_mean_air_delay(setup)))
+
+
 def coherence_delay(setup: Setup, paths: Paths, pair: tuple[int, int], alphas,
                     near_s: float = 0.0, base_offsets=(0.0, 0.0), iterations: int = 4) -> float:
     """The delay offset of channel J that makes both channels coherent at the probe angles
@@ -103,9 +115,9 @@ def coherence_delay(setup: Setup, paths: Paths, pair: tuple[int, int], alphas,
     ``2 pi if_phase_slope_hz``.
     """
     scene = setup.scene
-    targets = [TargetConfig(float(r)) for r in probe_ranges(setup, 2)]
-    tau = np.mean([2 * t.range_m / c for t in targets])
-    f_if = float(if_phase_slope_hz(scene, tau))
+    ranges = probe_ranges(setup, 2)
+    targets = [TargetConfig(float(r)) for r in ranges]
+    f_if = float(if_phase_slope_hz(scene, probe_total_delay(setup, ranges)))
     period = 1.0 / f_if
 
     def phase(d):
@@ -145,9 +157,67 @@ def probe_ranges(setup: Setup, n: int) -> np.ndarray:
     return r0 + step * np.arange(n)
 
 
-def _simulate_detect(setup, paths, program, seed):
-    _, cube = simulate(setup, paths, program, seed, setup.scene.radar.snr_db)
+def _simulate_detect(setup, paths, program, seed, frames: int = 1):
+    """One radar output: the coherent average of ``frames`` frames of a static RTS program.
+
+    The K frames carry the same noise-free cube and independent receiver noise, so their
+    average is that cube plus noise of power N0 / K: simulated as one frame at an SNR
+    10 log10(K) dB higher, which has exactly the distribution of the average and costs one
+    frame."""
+    snr = setup.scene.radar.snr_db
+    if snr is not None and frames > 1:
+        snr = snr + 10 * np.log10(frames)
+    _, cube = simulate(setup, paths, program, seed, snr)
     return process(cube)
+
+
+TARGET_BIAS_PS = 2.0  # the averaging keeps the noise's pull on the chosen delay below this
+MAX_FRAMES = 1 << 20
+
+
+def _processing_gain(name: str, n: int) -> float:
+    """SNR gain of an n-point windowed DFT: (sum w)^2 / sum w^2 (n for no window)."""
+    from ..radar.processing import window
+    w = window(name, n)
+    return float(np.sum(w) ** 2 / np.sum(w ** 2))
+
+
+def frames_per_step(setup: Setup, models, designs, alphas, f_if_hz: float,
+                    bias_s: float = TARGET_BIAS_PS * 1e-12) -> tuple[int, float]:
+    """Frames to average coherently per sweep step so that receiver noise cannot pull the
+    chosen delay by ``bias_s``; returns (frames, per-frame angle noise in deg).
+
+    Near the coherence point each probe's angle error is *quadratic* in the phase error (the
+    two beams' cross term goes with cos(phi)): ``e_p = c_p phi^2``, so the RMS criterion rises
+    by only ``kappa d^2`` at a delay ``d`` from it, ``kappa = rms(c_p) (2 pi f_if)^2`` (c_p from
+    the nominal model). One frame's angle noise (beamformer peak of an N-element lambda/2
+    array at high SNR) is ``sigma_u = sqrt(6 / (SNR N (N^2 - 1))) / pi``, u = sin(alpha), with
+    SNR the per-element SNR after the windowed range and Doppler DFTs (per-sample SNR of the
+    strongest echo, scaled by the probe's amplitude, times both DFTs' processing gains). Each
+    step is a fresh measurement, so a step ``bias_s`` off wins over the right one when the
+    difference of two noises (sqrt 2 sigma / sqrt K) exceeds ``kappa bias_s^2``; K frames make
+    that a 2-sigma event: ``K = 8 sigma^2 / (kappa bias_s^2)^2``.
+    """
+    radar, rut = setup.scene.radar, setup.rut
+    if radar.snr_db is None:
+        return 1, 0.0
+    n = int(np.count_nonzero(rut.azimuth_mask))
+    snr = (10 ** (radar.snr_db / 10) * _processing_gain(radar.range_window, radar.samples_per_chirp)
+           * _processing_gain(radar.doppler_window, radar.chirps_per_tx))
+    amps = np.abs(np.asarray(designs))  # (P, 2): the composite carries both channels
+    rel = np.minimum(amps.sum(axis=1) / amps.max(), 1.0)
+    h = 0.05  # rad: inside the quadratic region (checked against h/2 in the tests)
+    curv = []
+    for m, (a_i, a_j) in zip(models, designs):
+        rho = a_j / a_i
+        phase = m.coherent_phase(alphas)
+        e = [float(m.angle(rho, phase + x)) for x in (-h, 0.0, h)]
+        curv.append((e[0] + e[2] - 2 * e[1]) / (2 * h * h))
+    kappa = float(np.sqrt(np.mean(np.square(curv)))) * (2 * np.pi * f_if_hz) ** 2  # rad / s^2
+    sigma_u = np.sqrt(6.0 / (snr * rel ** 2 * n * (n * n - 1.0))) / np.pi
+    sigma_a = float(np.sqrt(np.mean((sigma_u / np.cos(np.asarray(alphas))) ** 2)))
+    frames = int(min(MAX_FRAMES, max(1, np.ceil(8 * sigma_a ** 2 / (kappa * bias_s ** 2) ** 2))))
+    return frames, float(np.degrees(sigma_a))
 
 
 def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe:
@@ -227,9 +297,16 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
         w = delta / grid_s - k
         return (1 - w) * node(k) + w * node(k + 1)
 
+    period = 1.0 / float(if_phase_slope_hz(scene, probe_total_delay(setup, ranges)))
+    models = [PairModel.build(nom, nom_paths, pair, t, base_offsets) for t in targets]
+    frames, frame_noise = frames_per_step(setup, models, node(0), alphas, 1.0 / period)
+
     def error(delta: float) -> float:
         prog = _probe_program(design(delta), pair, base, delta)
-        rd, det = _simulate_detect(setup, paths, prog, seed)
+        # fresh noise at every step (a new measurement), reproducible from the seed
+        step_seed = np.random.SeedSequence([int(seed) % 2 ** 32,
+                                            int(round(delta * 1e15)) + 2 ** 40])
+        rd, det = _simulate_detect(setup, paths, prog, step_seed, frames)
         errs = []
         for r, a in zip(ranges, alphas):
             k = nearest_detection(det, rd, r)
@@ -262,10 +339,10 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
             best, best_err = float(fine[k]), float(fe_[k])
     air = _mean_air_delay(setup)
     range_offset = 0.5 * c * ((air[j] + base_offsets[1] + best) - (air[i] + base_offsets[0]))
-    period = 1.0 / (rts.f_rts_hz + radar.bandwidth_hz / 2)
     return Calibration(pair, best, best_err, float(range_offset), frozen(grid), frozen(errs),
                        frozen(np.array(ref_t)), frozen(np.array(ref_e)),
-                       (float(np.degrees(alphas[0])), float(np.degrees(alphas[1]))), period)
+                       (float(np.degrees(alphas[0])), float(np.degrees(alphas[1]))), period,
+                       frames, frame_noise)
 
 
 def nominal_model(setup: Setup, paths: Paths) -> tuple[Setup, Paths]:
