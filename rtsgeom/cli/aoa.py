@@ -16,11 +16,14 @@ from ._common import UsageError, load_scene_checked, number, print_json, scene_a
 
 
 def _pair(setup, pair):
+    """The pair in its canonical order, the lower index first (I keeps its delay, J is
+    swept): ``--pair 1 0`` and ``--pair 0 1`` are the same measurement and give the same
+    numbers (the front ends are ordered by angle in the scene)."""
     i, j = pair
     n = setup.fe.count
     if not (0 <= i < n and 0 <= j < n) or abs(i - j) != 1:
         raise UsageError(f"--pair {i} {j}: must be two adjacent front-end indices in [0, {n - 1}]")
-    return (i, j)
+    return (min(i, j), max(i, j))
 
 
 def _prepare(args):
