@@ -197,6 +197,9 @@ class RtsConfig:
     aoa_mode: str = "exact"
     calibration_span_s: tuple[float, float] = (-0.5e-9, 1.0e-9)
     calibration_step_s: float = 25e-12
+    # the fractional-delay filter's model: "windowed-sinc" (its real frequency response over
+    # the IF sweep, rts.fir_if_gain) or "ideal" (a pure delay)
+    fractional_delay_filter: str = "windowed-sinc"
 
     @property
     def delay_resolution_s(self) -> float:
@@ -498,6 +501,8 @@ def _parse_rts(t: _Table) -> RtsConfig:
     frac = t.boolean("fractional_delay", default=True)
     step = t.num("fractional_delay_step_s", default=1e-12, lo=1e-15, hi=1.0 / f_s, unit="s")
     taps = t.integer("fractional_delay_taps", default=33, lo=3, hi=1025)
+    fir = t.string("fractional_delay_filter", default="windowed-sinc",
+                   choices=("windowed-sinc", "ideal"))
     comp = t.boolean("compensate_air_path", default=True)
     mode = t.string("aoa_mode", default="exact", choices=AOA_MODES)
     span = t.vector("calibration_span_ns", 2, default=(-0.5, 1.0), unit="ns", lo=-1e3, hi=1e3)
@@ -510,7 +515,8 @@ def _parse_rts(t: _Table) -> RtsConfig:
         t.fail(t.path("front_ends"), [round(math.degrees(a), 6) for a in angles],
                "ordered by strictly increasing angle_deg")
     return RtsConfig(radius, centre, fes, f_rts, f_s, frac, step, taps, comp, mode,
-                     (span[0] * 1e-9, span[1] * 1e-9), cal_step * 1e-12)
+                     (span[0] * 1e-9, span[1] * 1e-9), cal_step * 1e-12,
+                     fractional_delay_filter=fir)
 
 
 def _parse_sheet(t: _Table) -> SheetConfig:
