@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
 
-from ..aoa.calibration import calibrate_pair, probe_front_ends
+from ..aoa.calibration import calibrate_pair, calibrate_pair_paper, probe_front_ends
 from ..aoa.linearity import linearity
 from ..geometry import build_setup
 from ..io import write_json
@@ -29,6 +30,9 @@ def _pair(setup, pair):
 def _prepare(args):
     """Scene, setup, pair, exact paths and each front end alone as the RuT detects it."""
     scene = load_scene_checked(args.scene)
+    if getattr(args, "fir", None):  # override the scene's fractional-delay filter model
+        scene = dataclasses.replace(scene, rts=dataclasses.replace(
+            scene.rts, fractional_delay_filter=args.fir))
     setup = build_setup(scene)
     pair = _pair(setup, args.pair)
     paths = exact_paths(setup)
@@ -39,10 +43,16 @@ def cmd_calibrate(args) -> int:
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
         scene, setup, pair, paths, probe = _prepare(args)
-        step(f"sweeping the delay of front end {pair[1]} on the simulated radar")
-        cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
+        step(f"sweeping the delay of front end {pair[1]} on the simulated radar "
+             f"({args.procedure} procedure)")
+        if args.procedure == "paper":
+            cal = calibrate_pair_paper(setup, paths, pair, probe, seed=scene.seed)
+        else:
+            cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
     out = cal.to_dict()
+    out["procedure"] = args.procedure
     out["front_end_angles_deg"] = [float(x) for x in np.degrees(probe.angle_rad)]
+    out["fractional_delay_filter"] = _fir_effect(setup, pair, cal)
 
     def figure():
         from ..viz.figures import calibration_sweep_figure
@@ -51,8 +61,36 @@ def cmd_calibrate(args) -> int:
     _emit(args, "calibration_sweep.png", "calibration", out, figure,
           f"pair {pair}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps, residual angle error "
           f"{cal.residual_error_deg:.4f} deg, range offset {cal.range_offset_m * 1e3:.2f} mm "
-          f"(period {cal.period_s * 1e9:.4f} ns)")
+          f"(period {cal.period_s * 1e9:.4f} ns); fractional-delay filter "
+          f"{out['fractional_delay_filter']['model']}: phase ripple over the IF sweep "
+          f"{out['fractional_delay_filter']['phase_ripple_deg']:.3f} deg p-p, moves the "
+          f"coherence point by {out['fractional_delay_filter']['predicted_shift_ps']:+.2f} ps")
     return 0
+
+
+def _fir_effect(setup, pair, cal) -> dict:
+    """The fractional-delay FIR at the calibrated settings of both channels: its gain and
+    phase ripple along the chirp's IF sweep and the shift of the coherence point it causes,
+    ``(phi_J - phi_I) / (2 pi f_if)`` with phi the window-weighted phase of each channel's
+    beat-signal gain (``rts.fir_if_gain``)."""
+    from ..aoa.calibration import probe_ranges, probe_total_delay
+    from ..radar.processing import window
+    from ..rts import fir_if_gain, requested_delay
+    scene = setup.scene
+    model = scene.rts.fractional_delay_filter if scene.rts.fractional_delay else "none"
+    base = float(requested_delay(scene, probe_ranges(setup, 1)[0]))
+    tau = probe_total_delay(setup, probe_ranges(setup, 1))
+    g = fir_if_gain(scene, np.array([base, base + cal.delta_tau_s]), np.full(2, tau))
+    if g is None:
+        return {"model": model, "gain_ripple_db": 0.0, "phase_ripple_deg": 0.0,
+                "predicted_shift_ps": 0.0}
+    w = window(scene.radar.range_window, scene.radar.samples_per_chirp)
+    phi = np.angle(g @ w)  # (2,) beat-signal phase of channels I, J
+    shift = float((phi[0] - phi[1]) / (2 * np.pi) * cal.period_s)
+    return {"model": model,
+            "gain_ripple_db": float(np.ptp(20 * np.log10(np.abs(g)))),
+            "phase_ripple_deg": float(np.ptp(np.degrees(np.angle(g)))),
+            "predicted_shift_ps": shift * 1e12}
 
 
 def _emit(args, png: str, name: str, out: dict, figure, summary_line: str) -> None:
@@ -77,13 +115,15 @@ def cmd_linearity(args) -> int:
             step("calibrating the pair")
             cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
         step(f"sweeping {args.points} set-points ({args.amplitudes} amplitudes)")
-        lin = linearity(setup, paths, pair, args.amplitudes, probe, cal, args.points, scene.seed)
+        lin = linearity(setup, paths, pair, args.amplitudes, probe, cal, args.points, scene.seed,
+                        args.end_angles)
     def figure():
         from ..viz.figures import linearity_figure
         return linearity_figure(lin.set_deg, {args.amplitudes: lin.detected_deg},
                                 {args.amplitudes: lin.amplitude_db})
     _emit(args, "linearity.png", "linearity", lin.to_dict(), figure,
-          f"{args.amplitudes} ({'calibrated' if cal else 'uncalibrated'}): max |error| "
+          f"{args.amplitudes} ({'calibrated' if cal else 'uncalibrated'}, "
+          f"{args.end_angles} end angles): max |error| "
           f"{lin.max_abs_error_deg:.4f} deg over {len(lin.set_deg)} set-points")
     return 0
 
@@ -99,7 +139,21 @@ def register(sub) -> None:
         p.add_argument("--json", action="store_true", help="print the result as JSON")
         p.add_argument("--out", type=Path, default=None, help="folder for the plot and JSON")
         p.add_argument("--quiet", action="store_true", help="no progress output")
+        p.add_argument("--fir", choices=("windowed-sinc", "ideal"), default=None,
+                       help="fractional-delay filter model (default: the scene's "
+                            "rts.fractional_delay_filter)")
+        if name == "calibrate":
+            p.add_argument("--procedure", choices=("exact", "paper"), default="exact",
+                           help="exact: two probes, amplitudes re-designed at every step, "
+                                "refined to the delay resolution (default); paper: the "
+                                "paper's sweep as written (fixed eq. 23 amplitudes, one set "
+                                "angle, 25 ps steps)")
         if name == "linearity":
+            p.add_argument("--end-angles", choices=("geometric", "measured"),
+                           default="geometric",
+                           help="front-end angles in the paper/array-factor closed forms: "
+                                "geometric (default) or measured (each alone, as the RuT "
+                                "detects it)")
             p.add_argument("--amplitudes", choices=("exact", "array-factor", "paper"),
                            default="exact", help="amplitude-ratio mode (default exact)")
             p.add_argument("--uncalibrated", action="store_true",
