@@ -157,3 +157,82 @@ def test_minima_are_one_exact_period_apart(radius, f_rts):
                             span_s=(near - 0.1e-9, near + 0.1e-9))
     spacing = second.delta_tau_s - first.delta_tau_s
     assert spacing == pytest.approx(p, abs=2e-12)
+
+
+# ---------------------------------------------------------------- fractional-delay FIR (item 4)
+
+def _fir_scene(taps, model, snr=False):
+    def mutate(doc):
+        if not snr:
+            doc["radar"].pop("snr_db", None)
+        doc["rts"]["fractional_delay_taps"] = taps
+        doc["rts"]["fractional_delay_filter"] = model
+    return make_scene(mutate)
+
+
+@pytest.mark.parametrize("taps", [3, 9, 33, 129])
+def test_fir_is_the_delay_it_is_set_to_at_low_frequency_and_exact_at_integer_settings(taps):
+    from rtsgeom.rts import fir_error_response, fractional_delay_fir
+    mu = np.array([0.0, 0.13, 0.5, 0.87])
+    h = fractional_delay_fir(mu, taps)
+    assert np.allclose(h.sum(1), 1.0)
+    assert np.allclose(h[0], np.eye(taps)[(taps - 1) // 2])  # integer setting: a pure delay
+    f = np.linspace(0.0, 1.5e9, 31)[None].repeat(4, 0)
+    e = fir_error_response(mu, taps, 4e9, f)
+    assert np.allclose(e[0], 1.0)
+    assert np.allclose(e[:, 0], 1.0)  # DC: unit gain, no phase error
+    assert np.abs(e[1:] - 1).max() > 1e-6  # fractional settings are not ideal
+
+
+def test_fir_ripple_falls_with_the_number_of_taps():
+    from rtsgeom.rts import fir_error_response
+    f = np.linspace(0.5e9, 1.5e9, 101)[None]
+    worst = [np.abs(np.angle(fir_error_response([0.5], t, 4e9, f))).max() for t in (5, 17, 65)]
+    assert worst[0] > worst[1] > worst[2]
+
+
+def test_ideal_filter_reproduces_the_pure_delay_and_integer_settings_match_it():
+    from rtsgeom.radar.fmcw import synthesize
+    from rtsgeom.rts import build_echoes
+    ideal, fir = build_setup(_fir_scene(33, "ideal")), build_setup(_fir_scene(33, "windowed-sinc"))
+    paths = exact_paths(ideal)
+    ts = 1 / ideal.scene.rts.f_s_hz
+    whole = RtsProgram.build([0, 0], [0, 1], [400 * ts, 401 * ts], [0.0, 0.0], [1.0, 0.5])
+    e_i, e_f = build_echoes(ideal, paths, whole), build_echoes(fir, paths, whole)
+    assert e_i.fast_gain is None
+    r, rut = ideal.scene.radar, ideal.rut
+    assert np.allclose(synthesize(e_i, r, rut).data, synthesize(e_f, r, rut).data, atol=1e-7)
+    frac = RtsProgram.build([0, 0], [0, 1], [400.3 * ts, 401.6 * ts], [0.0, 0.0], [1.0, 0.5])
+    e_i, e_f = build_echoes(ideal, paths, frac), build_echoes(fir, paths, frac)
+    x_i, x_f = synthesize(e_i, r, rut).data, synthesize(e_f, r, rut).data
+    assert not np.allclose(x_i, x_f, atol=1e-7)  # a fractional setting has ripple
+    # ... and the cube differs from the ideal one by exactly the FIR's gain along the chirp
+    assert np.abs(x_f - x_i).max() <= np.abs(e_f.fast_gain - 1).max() * np.abs(x_i).max() * 1.01
+
+
+@pytest.mark.parametrize("taps", [5, 9, 33])
+def test_fir_moves_the_coherence_point_by_its_phase_ripple(taps):
+    """The channels' coherent phase with the FIR minus without it, at programmed delays
+    across a period, equals -2 pi f_if times the shift `fir_effect` predicts from the
+    filter's own response (window-weighted phase at each probe's bin)."""
+    from rtsgeom.aoa.calibration import fir_effect
+    from rtsgeom.aoa.synthesis import PairModel
+    from rtsgeom.scene import TargetConfig
+    ideal, fir = build_setup(_fir_scene(taps, "ideal")), build_setup(_fir_scene(taps, "windowed-sinc"))
+    paths = exact_paths(ideal)
+    ranges = probe_ranges(ideal, 2)
+    for d in (0.0, 0.1e-9, 0.37e-9, 0.81e-9):
+        z = 0j
+        for r in ranges:
+            m0 = PairModel.build(ideal, paths, (0, 1), TargetConfig(float(r)), (0.0, d))
+            m1 = PairModel.build(fir, paths, (0, 1), TargetConfig(float(r)), (0.0, d))
+            z += np.exp(1j * (m1.coherent_phase([0.1]) - m0.coherent_phase([0.1])))
+        measured = np.degrees(np.angle(z))
+        f_if = if_phase_slope_hz(fir.scene, probe_total_delay(fir, ranges))
+        eff = fir_effect(fir, d)
+        predicted = eff["predicted_shift_ps"] * 1e-12 * 360 * f_if
+        # first order in the filter's phase ripple: measured 10 % off with 5 taps (14 deg
+        # ripple), 0.03 deg off with 33 taps (0.2 deg ripple): within a quarter of the ripple
+        assert abs(measured - predicted) <= 0.25 * eff["phase_ripple_deg"]
+        assert abs(measured) <= eff["phase_ripple_deg"]
+    assert fir_effect(ideal, 0.1e-9)["predicted_shift_ps"] == 0.0

@@ -35,7 +35,7 @@ from .synthesis import PairModel
 
 __all__ = ["Calibration", "FrontEndProbe", "probe_front_ends", "calibrate_pair", "probe_ranges",
            "if_phase_slope_hz", "air_phase_slope_hz", "coherence_delay", "probe_total_delay",
-           "frames_per_step", "TARGET_BIAS_PS", "calibrate_pair_paper"]
+           "frames_per_step", "TARGET_BIAS_PS", "calibrate_pair_paper", "fir_effect"]
 
 
 @dataclass(frozen=True)
@@ -410,3 +410,38 @@ def calibrate_pair_paper(setup: Setup, paths: Paths, pair: tuple[int, int],
     return Calibration(pair, best, float(errs[k]), float(range_offset), frozen(grid),
                        frozen(errs), frozen(np.zeros(0)), frozen(np.zeros(0)), (deg, deg), period,
                        1, 0.0)
+
+
+def fir_effect(setup: Setup, delta_tau_s: float, base_offsets=(0.0, 0.0)) -> dict:
+    """The fractional-delay FIR at the settings the calibration's two probe targets program
+    on channels I (delay ``base``) and J (``base + delta_tau_s``): its gain and phase ripple
+    along the chirp's IF sweep (``rts.fir_if_gain``) and the shift of the coherence point it
+    predicts, the mean over the probes of ``(phi_I - phi_J) / (2 pi f_if)``, phi the
+    range-window-weighted phase of each channel's beat-signal gain (what the range DFT sees
+    at the target's bin), f_if = 1 / period."""
+    from ..radar.processing import window
+    from ..rts import fir_if_gain
+    scene = setup.scene
+    model = scene.rts.fractional_delay_filter if scene.rts.fractional_delay else "none"
+    rng = probe_ranges(setup, 2)
+    base = requested_delay(scene, rng)  # (2,) one per probe
+    delays = np.concatenate([base + base_offsets[0], base + base_offsets[1] + delta_tau_s])
+    tau = np.concatenate([requested_delay(scene, rng)] * 2) + np.mean(_mean_air_delay(setup))
+    g = fir_if_gain(scene, delays, tau)  # (4, N): I of both probes, then J of both
+    if g is None:
+        return {"model": model, "gain_ripple_db": 0.0, "phase_ripple_deg": 0.0,
+                "predicted_shift_ps": 0.0}
+    radar = scene.radar
+    n_s = radar.samples_per_chirp
+    t_n = radar.adc_start_s + np.arange(n_s) / radar.adc_rate_hz
+    beat = radar.slope_hz_per_s * tau  # (4,)
+    r0 = np.round(beat * n_s / radar.adc_rate_hz)  # the target's range bin
+    kern = window(radar.range_window, n_s) * np.exp(
+        2j * np.pi * (beat[:, None] * t_n - r0[:, None] * np.arange(n_s) / n_s))
+    phi = np.angle(np.sum(kern * g, 1) / np.sum(kern, 1)).reshape(2, 2)  # [channel, probe]
+    period = 1.0 / float(if_phase_slope_hz(scene, probe_total_delay(setup, rng)))
+    shift = float(np.angle(np.mean(np.exp(1j * (phi[0] - phi[1])))) / (2 * np.pi) * period)
+    return {"model": model,
+            "gain_ripple_db": float(np.ptp(20 * np.log10(np.abs(g)))),
+            "phase_ripple_deg": float(np.ptp(np.degrees(np.angle(g)))),
+            "predicted_shift_ps": shift * 1e12}

@@ -7,7 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..aoa.calibration import calibrate_pair, calibrate_pair_paper, probe_front_ends
+from ..aoa.calibration import (calibrate_pair, calibrate_pair_paper, fir_effect,
+                               probe_front_ends)
 from ..aoa.linearity import linearity
 from ..geometry import build_setup
 from ..io import write_json
@@ -52,7 +53,7 @@ def cmd_calibrate(args) -> int:
     out = cal.to_dict()
     out["procedure"] = args.procedure
     out["front_end_angles_deg"] = [float(x) for x in np.degrees(probe.angle_rad)]
-    out["fractional_delay_filter"] = _fir_effect(setup, pair, cal)
+    out["fractional_delay_filter"] = fir_effect(setup, cal.delta_tau_s)
 
     def figure():
         from ..viz.figures import calibration_sweep_figure
@@ -66,31 +67,6 @@ def cmd_calibrate(args) -> int:
           f"{out['fractional_delay_filter']['phase_ripple_deg']:.3f} deg p-p, moves the "
           f"coherence point by {out['fractional_delay_filter']['predicted_shift_ps']:+.2f} ps")
     return 0
-
-
-def _fir_effect(setup, pair, cal) -> dict:
-    """The fractional-delay FIR at the calibrated settings of both channels: its gain and
-    phase ripple along the chirp's IF sweep and the shift of the coherence point it causes,
-    ``(phi_J - phi_I) / (2 pi f_if)`` with phi the window-weighted phase of each channel's
-    beat-signal gain (``rts.fir_if_gain``)."""
-    from ..aoa.calibration import probe_ranges, probe_total_delay
-    from ..radar.processing import window
-    from ..rts import fir_if_gain, requested_delay
-    scene = setup.scene
-    model = scene.rts.fractional_delay_filter if scene.rts.fractional_delay else "none"
-    base = float(requested_delay(scene, probe_ranges(setup, 1)[0]))
-    tau = probe_total_delay(setup, probe_ranges(setup, 1))
-    g = fir_if_gain(scene, np.array([base, base + cal.delta_tau_s]), np.full(2, tau))
-    if g is None:
-        return {"model": model, "gain_ripple_db": 0.0, "phase_ripple_deg": 0.0,
-                "predicted_shift_ps": 0.0}
-    w = window(scene.radar.range_window, scene.radar.samples_per_chirp)
-    phi = np.angle(g @ w)  # (2,) beat-signal phase of channels I, J
-    shift = float((phi[0] - phi[1]) / (2 * np.pi) * cal.period_s)
-    return {"model": model,
-            "gain_ripple_db": float(np.ptp(20 * np.log10(np.abs(g)))),
-            "phase_ripple_deg": float(np.ptp(np.degrees(np.angle(g)))),
-            "predicted_shift_ps": shift * 1e12}
 
 
 def _emit(args, png: str, name: str, out: dict, figure, summary_line: str) -> None:
