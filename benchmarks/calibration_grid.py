@@ -124,14 +124,23 @@ def main(argv=None) -> int:
     cases = [(a.scene, r, fe, float(dr), a.noiseless, noms[r]) for r in a.radii for fe in PAIR
              for dr in offsets_m]
     rows = []
+    partial = open(str(stem) + ".partial.csv", "w", newline="")  # rows as they come
+    writer = None
     for row in mapper(one_case, cases):
         rows.append(row)
+        if writer is None:
+            writer = csv.DictWriter(partial, fieldnames=list(row))
+            writer.writeheader()
+        writer.writerow(row)
+        partial.flush()
         print(f"R_c {row['radius_m']:.2f} m  fe {row['front_end']}  dr {row['radial_offset_mm']:+.2f}"
               f" mm: delta_tau {row['delta_tau_ps']:+8.1f} ps, from coherence (closed form) "
               f"{row['dist_closed_ps']:+6.1f} ps, (phasor) {row['dist_phasor_ps']:+6.1f} ps, "
               f"residual {row['residual_deg']:.4f} deg", flush=True)
     if pool:
         pool.shutdown()
+    partial.close()
+    Path(str(stem) + ".partial.csv").unlink()
     d = np.array([abs(r["dist_closed_ps"]) for r in rows])
     worst = sorted(rows, key=lambda r: -abs(r["dist_closed_ps"]))[:10]
     summary = {
