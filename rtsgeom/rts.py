@@ -149,13 +149,15 @@ def fir_error_response(mu, taps: int, f_s_hz: float, f_hz) -> np.ndarray:
     """The FIR's response relative to the ideal delay it is set to, ``H(f) exp(j 2 pi f D /
     f_s)`` (magnitude and phase ripple), for settings ``mu`` (M,) at frequencies ``f_hz``
     (M, N) -> (M, N)."""
+    mu = np.atleast_1d(np.asarray(mu, float))
     h = fractional_delay_fir(mu, taps)
-    f = np.asarray(f_hz, float)
-    d = (taps - 1) / 2 + np.atleast_1d(np.asarray(mu, float))
-    n = np.arange(taps)
-    w = 2 * np.pi * f / f_s_hz  # (M, N)
-    resp = np.einsum("mk,mnk->mn", h, np.exp(-1j * w[..., None] * n))
-    return resp * np.exp(1j * w * d[:, None])
+    w = 2 * np.pi * np.asarray(f_hz, float) / f_s_hz  # (M, N)
+    z = np.exp(-1j * w)
+    # H(z) = sum_k h_k z^k by Horner (memory M x N whatever the number of taps)
+    resp = np.zeros(w.shape, complex)
+    for k in range(taps - 1, -1, -1):
+        resp = resp * z + h[:, k:k + 1]
+    return resp * np.exp(1j * w * ((taps - 1) / 2 + mu)[:, None])
 
 
 def fir_if_gain(scene: Scene, delay_s, tau_total_s) -> np.ndarray | None:
@@ -180,10 +182,8 @@ def fir_if_gain(scene: Scene, delay_s, tau_total_s) -> np.ndarray | None:
     out = np.empty(f.shape, complex)
     for k, m in enumerate(uniq):  # loop over distinct settings, vectorised over samples
         sel = inv.ravel() == k
-        h = fractional_delay_fir([m], rts.fractional_delay_taps)[0]
-        w = 2 * np.pi * f[sel] / rts.f_s_hz  # (S, N)
-        d = (rts.fractional_delay_taps - 1) / 2 + m
-        out[sel] = np.exp(-1j * w[..., None] * np.arange(h.size)) @ h * np.exp(1j * w * d)
+        out[sel] = fir_error_response(np.full(int(sel.sum()), m), rts.fractional_delay_taps,
+                                      rts.f_s_hz, f[sel])
     return np.conj(out)
 
 
