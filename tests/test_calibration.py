@@ -205,7 +205,7 @@ def test_ideal_filter_reproduces_the_pure_delay_and_integer_settings_match_it():
     frac = RtsProgram.build([0, 0], [0, 1], [400.3 * ts, 401.6 * ts], [0.0, 0.0], [1.0, 0.5])
     e_i, e_f = build_echoes(ideal, paths, frac), build_echoes(fir, paths, frac)
     x_i, x_f = synthesize(e_i, r, rut).data, synthesize(e_f, r, rut).data
-    assert not np.allclose(x_i, x_f, atol=1e-7)  # a fractional setting has ripple
+    assert np.abs(x_f - x_i).max() > 1e-4 * np.abs(x_i).max()  # fractional: ripple
     # ... and the cube differs from the ideal one by exactly the FIR's gain along the chirp
     assert np.abs(x_f - x_i).max() <= np.abs(e_f.fast_gain - 1).max() * np.abs(x_i).max() * 1.01
 
@@ -236,3 +236,29 @@ def test_fir_moves_the_coherence_point_by_its_phase_ripple(taps):
         assert abs(measured - predicted) <= 0.25 * eff["phase_ripple_deg"]
         assert abs(measured) <= eff["phase_ripple_deg"]
     assert fir_effect(ideal, 0.1e-9)["predicted_shift_ps"] == 0.0
+
+
+# ---------------------------------------------------------------- paper procedure (item 6)
+
+@pytest.mark.slow
+def test_paper_procedure_minima_are_one_period_apart_and_its_optimum_is_off_coherence():
+    """The paper's sweep as written (fixed eq. 23 amplitudes, one set angle, 25 ps steps) on
+    the perfect default setup: its minima repeat about every period_s, the second pulled
+    late because a period of delay moves J's echo by 1.3 range bins and the fixed amplitudes
+    do not know it (measured: 1.10 ns apart); its optimum is not the coherence point (the
+    fixed design's own error is traded against phase)."""
+    from rtsgeom.aoa.calibration import calibrate_pair_paper
+    setup = build_setup(make_scene())
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, 1)
+    cal = calibrate_pair_paper(setup, paths, (0, 1), probe, seed=1, span_s=(-0.5e-9, 1.5e-9))
+    t, e = cal.sweep_delta_tau_s, cal.sweep_error_deg
+    inner = np.arange(1, len(e) - 1)
+    mins = inner[(e[inner] < e[inner - 1]) & (e[inner] <= e[inner + 1])]
+    deep = sorted(mins, key=lambda k: e[k])[:2]
+    step = t[1] - t[0]
+    spacing = abs(t[deep[1]] - t[deep[0]])
+    assert cal.period_s - step <= spacing <= cal.period_s + 0.15e-9
+    coherent = coherence_delay(setup, paths, (0, 1), probe_angles(*probe.angle_rad[[0, 1]]),
+                               cal.delta_tau_s)
+    assert abs(cal.delta_tau_s - coherent) > 2 * step  # measured: about 200 ps
