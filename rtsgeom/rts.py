@@ -27,9 +27,11 @@ from .paths.table import FE_TO_RX, RUT_TO_RUT, TX_TO_FE, Paths
 from .scene import Scene
 
 __all__ = ["RtsProgram", "Echoes", "realised_delay", "target_amplitude", "channel_echoes",
-           "setup_echoes", "cable_ghosts", "program_nearest", "build_echoes"]
+           "setup_echoes", "cable_ghosts", "program_nearest", "build_echoes",
+           "fractional_delay_fir", "fir_error_response", "fir_if_gain"]
 
 KIND_DIRECT, KIND_GHOST, KIND_SETUP = 0, 1, 2
+FIR_KAISER_BETA = 4.0  # [assumed] fractional-delay FIR window (about 40 dB stop band)
 
 
 @dataclass(frozen=True)
@@ -75,6 +77,9 @@ class Echoes:
     front_end: np.ndarray  # (E,) channel, -1 for setup reflections
     kind: np.ndarray  # (E,) KIND_DIRECT | KIND_GHOST | KIND_SETUP
     order: np.ndarray  # (E,) ghost order (0 for the direct echo)
+    # (E, N) complex gain per fast-time sample (the fractional-delay FIR's response along the
+    # IF sweep, rts.fir_if_gain); None: 1 everywhere (an ideal delay)
+    fast_gain: np.ndarray | None = None
 
     @property
     def tau_s(self) -> np.ndarray:
@@ -88,11 +93,19 @@ class Echoes:
     def concat(cls, parts: list["Echoes"]) -> "Echoes":
         names = ("tau_air_s", "tau_if_s", "f_if_hz", "doppler_hz", "amplitude", "target",
                  "front_end", "kind", "order")
-        return cls(**{n: frozen(np.concatenate([getattr(p, n) for p in parts])) for n in names})
+        out = {n: frozen(np.concatenate([getattr(p, n) for p in parts])) for n in names}
+        gains = [p.fast_gain for p in parts if p.fast_gain is not None and len(p)]
+        if gains:
+            n_s = gains[0].shape[1]
+            out["fast_gain"] = frozen(np.concatenate(
+                [p.fast_gain if p.fast_gain is not None else np.ones((len(p), n_s), complex)
+                 for p in parts]))
+        return cls(**out)
 
     def select(self, mask) -> "Echoes":
         m = np.asarray(mask, bool)
-        return Echoes(**{n: frozen(getattr(self, n)[m]) for n in self.__dataclass_fields__})
+        return Echoes(**{n: (None if getattr(self, n) is None else frozen(getattr(self, n)[m]))
+                         for n in self.__dataclass_fields__})
 
     def scaled(self, gain) -> "Echoes":
         """The same echoes with the amplitudes multiplied by ``gain`` (scalar or (E,))."""
@@ -115,6 +128,63 @@ def realised_delay(delay_s, f_s_hz: float, fractional: bool, step_s: float) -> n
     n = np.floor(d / ts)
     frac = np.round((d - n * ts) / step_s) * step_s
     return n * ts + frac
+
+
+def fractional_delay_fir(mu, taps: int, beta: float = FIR_KAISER_BETA) -> np.ndarray:
+    """Coefficients (M, taps) of a Kaiser-windowed-sinc fractional-delay FIR for fractional
+    delays ``mu`` (M,) in samples, [0, 1): ``h[n] = sinc(n - D) w(n - D)``, D = (taps - 1)/2
+    + mu, with the Kaiser window centred on D (the standard shifted-window design, Laakso et
+    al. 1996), normalised to unit gain at DC. The bulk (taps - 1)/2 samples are part of the
+    delay buffer. Hand-written: scipy's ``firwin`` only delays by whole or half samples."""
+    from scipy.special import i0
+    mu = np.atleast_1d(np.asarray(mu, float))
+    n = np.arange(taps)
+    x = n[None, :] - (taps - 1) / 2 - mu[:, None]
+    arg = np.clip(1.0 - (2.0 * x / (taps - 1)) ** 2, 0.0, None)
+    h = np.sinc(x) * i0(beta * np.sqrt(arg)) / i0(beta)
+    return h / h.sum(axis=1, keepdims=True)
+
+
+def fir_error_response(mu, taps: int, f_s_hz: float, f_hz) -> np.ndarray:
+    """The FIR's response relative to the ideal delay it is set to, ``H(f) exp(j 2 pi f D /
+    f_s)`` (magnitude and phase ripple), for settings ``mu`` (M,) at frequencies ``f_hz``
+    (M, N) -> (M, N)."""
+    mu = np.atleast_1d(np.asarray(mu, float))
+    h = fractional_delay_fir(mu, taps)
+    w = 2 * np.pi * np.asarray(f_hz, float) / f_s_hz  # (M, N)
+    z = np.exp(-1j * w)
+    # H(z) = sum_k h_k z^k by Horner (memory M x N whatever the number of taps)
+    resp = np.zeros(w.shape, complex)
+    for k in range(taps - 1, -1, -1):
+        resp = resp * z + h[:, k:k + 1]
+    return resp * np.exp(1j * w * ((taps - 1) / 2 + mu)[:, None])
+
+
+def fir_if_gain(scene: Scene, delay_s, tau_total_s) -> np.ndarray | None:
+    """Fast-time gain (E, N) of the fractional-delay FIR on each echo's beat signal.
+
+    The RTS processes the RuT's chirp at the IF ``f_rts + S (t - tau)`` (t: the RuT's fast
+    time, tau the echo's total delay), so the FIR's magnitude and phase ripple at its
+    setting becomes a gain/phase that changes along the chirp. The beat signal carries the
+    conjugate of the RTS's complex gain (eq. 8: tx * conj(rx)). None for an ideal delay
+    (``fractional_delay_filter = "ideal"`` or no fractional delay)."""
+    rts, radar = scene.rts, scene.radar
+    if not rts.fractional_delay or rts.fractional_delay_filter == "ideal":
+        return None
+    ts = 1.0 / rts.f_s_hz
+    d = np.asarray(delay_s, float)
+    mu = (d - np.floor(d / ts) * ts) / ts
+    mu = np.where(mu >= 1.0 - 1e-9, 0.0, mu)
+    t_n = radar.adc_start_s + np.arange(radar.samples_per_chirp) / radar.adc_rate_hz
+    f = rts.f_rts_hz + radar.slope_hz_per_s * (t_n[None, :] - np.asarray(tau_total_s)[:, None])
+    # one design per distinct setting (channels of one program share few settings)
+    uniq, inv = np.unique(np.round(mu, 9), return_inverse=True)
+    out = np.empty(f.shape, complex)
+    for k, m in enumerate(uniq):  # loop over distinct settings, vectorised over samples
+        sel = inv.ravel() == k
+        out[sel] = fir_error_response(np.full(int(sel.sum()), m), rts.fractional_delay_taps,
+                                      rts.f_s_hz, f[sel])
+    return np.conj(out)
 
 
 def target_amplitude(range_m, rcs_m2, wavelength_m: float) -> np.ndarray:
@@ -214,12 +284,15 @@ def channel_echoes(setup: Setup, paths: Paths, program: RtsProgram) -> Echoes:
     # the beat signal is tx * conj(rx) (eq. 8): it carries the conjugate of the received
     # complex gain (paths, RTS gain, hardware phase)
     amp = np.conj(gain * np.repeat(program.amplitude * hw[q], rep)[:, None])
+    tau_if = np.repeat(tau_rts, rep)
+    fir = fir_if_gain(scene, tau_if, tau_if + tau_air.mean(axis=1))
     direct = Echoes(
-        tau_air_s=frozen(tau_air), tau_if_s=frozen(np.repeat(tau_rts, rep)),
+        tau_air_s=frozen(tau_air), tau_if_s=frozen(tau_if),
         f_if_hz=frozen(np.full(k * rep, scene.rts.f_rts_hz)),
         doppler_hz=frozen(np.repeat(program.doppler_hz, rep)), amplitude=frozen(amp),
         target=frozen(np.repeat(program.target, rep)), front_end=frozen(np.repeat(q, rep)),
         kind=frozen(np.full(k * rep, KIND_DIRECT)), order=frozen(np.zeros(k * rep, int)),
+        fast_gain=None if fir is None else frozen(fir),
     )
     ghosts = cable_ghosts(scene, direct)
     keep = np.any(direct.amplitude != 0, axis=1)

@@ -262,6 +262,10 @@ class RtsConfig(Evolvable):
     allow_wide_spacing: bool = spec(
         "allow_wide_spacing", "bool", "force synthesis modes with targets between front ends "
         "wider apart than the RuT's angular resolution (paper eq. 24 violated)", False)
+    fractional_delay_filter: str = spec(
+        "fractional_delay_filter", "str", "model of the fractional-delay FIR: windowed-sinc (its "
+        "real response along the IF sweep, rts.fir_if_gain) or ideal (a pure delay)",
+        "windowed-sinc", choices=("windowed-sinc", "ideal"))
 
     @property
     def delay_resolution_s(self) -> float:

@@ -18,9 +18,15 @@ from .geometry import build_setup
 from .geometry.farfield import angular_resolution_rad, fraunhofer_distance_m
 from .scene import Scene, _fmt
 
-__all__ = ["scene_warnings"]
+__all__ = ["scene_warnings", "height_phase_deg"]
 
 _OFFSETS = ("radial_offset_mm", "tangential_offset_mm", "height_offset_mm")
+
+
+def height_phase_deg(dz_m: float, range_m: float, wavelength_m: float) -> float:
+    """Two-way phase (deg) a height offset ``dz_m`` adds at distance ``range_m``: each leg
+    grows by sqrt(R^2 + dz^2) - R ~ dz^2 / 2R (second order), both legs by dz^2 / R."""
+    return float(np.degrees(2 * np.pi * (2 * (np.hypot(range_m, dz_m) - range_m)) / wavelength_m))
 
 
 def scene_warnings(scene: Scene) -> list[str]:
@@ -68,12 +74,23 @@ def scene_warnings(scene: Scene) -> list[str]:
 
     # Mounting errors: lambda/4 radially is already half a wavelength of two-way path.
     for i, f in enumerate(rts.front_ends):
-        offs = (f.radial_offset_m, f.tangential_offset_m, f.height_offset_m)
+        offs = (f.radial_offset_m, f.tangential_offset_m)
         for name, v in zip(_OFFSETS, offs):
             if abs(v) > lam / 4.0:
                 warn(f"rts.front_ends[{i}].{name}", v * 1e3,
                      f"larger than lambda/4 = {lam / 4.0 * 1e3:.3g} mm: a mounting error of "
                      "this size costs up to 180 deg of two-way phase unless calibrated away")
+        # A height offset lengthens each leg only in second order, dz^2 / 2R: two-way
+        # dz^2 / R, a phase of 2 pi dz^2 / (R lambda); warn where that reaches the radial
+        # warning's 180 deg.
+        dz = f.height_offset_m
+        r_flat = float(np.sqrt(max(dist[i] ** 2 - dz * dz, 0.0)))  # dist includes dz
+        phase_deg = height_phase_deg(dz, r_flat, lam)
+        if phase_deg >= 180.0:
+            warn(f"rts.front_ends[{i}].height_offset_mm", dz * 1e3,
+                 f"lengthens both legs by dz^2 / 2R = {dz * dz / (2 * r_flat) * 1e3:.3g} mm at "
+                 f"R = {r_flat:.4g} m: {phase_deg:.4g} deg of two-way phase unless calibrated "
+                 "away")
 
     # Each antenna should look at the RuT through its cutout, not through metal.
     if scene.sheet.enabled:

@@ -33,7 +33,9 @@ from ..rts import RtsProgram, requested_delay
 from ..scene import TargetConfig
 from .synthesis import PairModel
 
-__all__ = ["Calibration", "FrontEndProbe", "probe_front_ends", "calibrate_pair", "probe_ranges"]
+__all__ = ["Calibration", "FrontEndProbe", "probe_front_ends", "calibrate_pair", "probe_ranges",
+           "if_phase_slope_hz", "air_phase_slope_hz", "coherence_delay", "probe_total_delay",
+           "frames_per_step", "TARGET_BIAS_PS", "calibrate_pair_paper", "fir_effect"]
 
 
 @dataclass(frozen=True)
@@ -56,7 +58,9 @@ class Calibration:
     refine_delta_tau_s: np.ndarray
     refine_error_deg: np.ndarray
     probe_angles_deg: tuple[float, float]
-    period_s: float
+    period_s: float  # exact: 1 / (f_rts + S t_mid - S tau) at the probes (eq. 27 refined)
+    frames_per_step: int = 1  # frames averaged (coherently) per sweep step
+    frame_noise_deg: float = 0.0  # predicted 1-sigma probe-angle noise of one frame
 
     def to_dict(self) -> dict:
         def pts(t, e):
@@ -69,10 +73,66 @@ class Calibration:
             "residual_error_deg": self.residual_error_deg,
             "range_offset_m": self.range_offset_m,
             "period_s": self.period_s,
+            "frames_per_step": self.frames_per_step,
+            "frame_noise_deg": self.frame_noise_deg,
             "probe_angles_deg": list(self.probe_angles_deg),
             "sweep": pts(self.sweep_delta_tau_s, self.sweep_error_deg),
             "refinement": pts(self.refine_delta_tau_s, self.refine_error_deg),
         }
+
+
+def if_phase_slope_hz(scene, tau_s) -> np.ndarray:
+    """d(phase)/d(tau_rts) / 2 pi of an echo of total delay ``tau_s`` at the ADC window's
+    centre: ``f_rts + S t_mid - S tau`` (eq. 8 at t = t_mid; eq. 27 is its approximation
+    f_rts + B/2). Its inverse is the exact period of the calibration sweep."""
+    radar = scene.radar
+    return (scene.rts.f_rts_hz + (radar.f_center_hz - radar.f_c_hz)
+            - radar.slope_hz_per_s * np.asarray(tau_s, float))
+
+
+def air_phase_slope_hz(scene, tau_s) -> np.ndarray:
+    """d(phase)/d(tau_c) / 2 pi of the same echo: ``f_c + S t_mid - S tau`` (the over-the-air
+    delay acts at RF). A radial offset dr moves the coherence point by
+    ``-air_phase_slope_hz / if_phase_slope_hz * 2 dr / c0``."""
+    radar = scene.radar
+    return radar.f_center_hz - radar.slope_hz_per_s * np.asarray(tau_s, float)
+
+
+def probe_total_delay(setup: Setup, ranges) -> float:
+    """Mean total delay tau = tau_c + tau_rts of probe targets at ``ranges`` (what sets the
+    beat frequency S tau)."""
+    return float(np.mean(requested_delay(setup.scene, np.asarray(ranges, float)))
+                 + np.mean(_mean_air_delay(setup)))
+
+
+def coherence_delay(setup: Setup, paths: Paths, pair: tuple[int, int], alphas,
+                    near_s: float = 0.0, base_offsets=(0.0, 0.0), iterations: int = 4) -> float:
+    """The delay offset of channel J that makes both channels coherent at the probe angles
+    ``alphas`` on the setup *as built* (phasor model of both probe targets, with the range
+    offset the delay causes), the one nearest ``near_s``: the point the sweep should find.
+
+    Newton on the circular mean of the two probes' coherent phases, slope
+    ``2 pi if_phase_slope_hz``.
+    """
+    scene = setup.scene
+    ranges = probe_ranges(setup, 2)
+    targets = [TargetConfig(float(r)) for r in ranges]
+    f_if = float(if_phase_slope_hz(scene, probe_total_delay(setup, ranges)))
+    period = 1.0 / f_if
+
+    def phase(d):
+        z = 0j
+        for t in targets:
+            m = PairModel.build(setup, paths, pair, t, (base_offsets[0], base_offsets[1] + d))
+            z += np.exp(1j * m.coherent_phase(alphas))
+        return float(np.angle(z))
+
+    d = float(near_s)
+    for _ in range(2):  # Newton, then move to the period nearest near_s and polish there
+        for _ in range(iterations):
+            d += phase(d) / (2 * np.pi * f_if)
+        d += np.round((near_s - d) / period) * period
+    return float(d)
 
 
 def probe_angles(theta_i: float, theta_j: float) -> tuple[float, float]:
@@ -97,9 +157,67 @@ def probe_ranges(setup: Setup, n: int) -> np.ndarray:
     return r0 + step * np.arange(n)
 
 
-def _simulate_detect(setup, paths, program, seed):
-    _, cube = simulate(setup, paths, program, seed, setup.scene.radar.snr_db)
+def _simulate_detect(setup, paths, program, seed, frames: int = 1):
+    """One radar output: the coherent average of ``frames`` frames of a static RTS program.
+
+    The K frames carry the same noise-free cube and independent receiver noise, so their
+    average is that cube plus noise of power N0 / K: simulated as one frame at an SNR
+    10 log10(K) dB higher, which has exactly the distribution of the average and costs one
+    frame."""
+    snr = setup.scene.radar.snr_db
+    if snr is not None and frames > 1:
+        snr = snr + 10 * np.log10(frames)
+    _, cube = simulate(setup, paths, program, seed, snr)
     return process(cube)
+
+
+TARGET_BIAS_PS = 2.0  # the averaging keeps the noise's pull on the chosen delay below this
+MAX_FRAMES = 1 << 20
+
+
+def _processing_gain(name: str, n: int) -> float:
+    """SNR gain of an n-point windowed DFT: (sum w)^2 / sum w^2 (n for no window)."""
+    from ..radar.processing import window
+    w = window(name, n)
+    return float(np.sum(w) ** 2 / np.sum(w ** 2))
+
+
+def frames_per_step(setup: Setup, models, designs, alphas, f_if_hz: float,
+                    bias_s: float = TARGET_BIAS_PS * 1e-12) -> tuple[int, float]:
+    """Frames to average coherently per sweep step so that receiver noise cannot pull the
+    chosen delay by ``bias_s``; returns (frames, per-frame angle noise in deg).
+
+    Near the coherence point each probe's angle error is *quadratic* in the phase error (the
+    two beams' cross term goes with cos(phi)): ``e_p = c_p phi^2``, so the RMS criterion rises
+    by only ``kappa d^2`` at a delay ``d`` from it, ``kappa = rms(c_p) (2 pi f_if)^2`` (c_p from
+    the nominal model). One frame's angle noise (beamformer peak of an N-element lambda/2
+    array at high SNR) is ``sigma_u = sqrt(6 / (SNR N (N^2 - 1))) / pi``, u = sin(alpha), with
+    SNR the per-element SNR after the windowed range and Doppler DFTs (per-sample SNR of the
+    strongest echo, scaled by the probe's amplitude, times both DFTs' processing gains). Each
+    step is a fresh measurement, so a step ``bias_s`` off wins over the right one when the
+    difference of two noises (sqrt 2 sigma / sqrt K) exceeds ``kappa bias_s^2``; K frames make
+    that a 2-sigma event: ``K = 8 sigma^2 / (kappa bias_s^2)^2``.
+    """
+    radar, rut = setup.scene.radar, setup.rut
+    if radar.snr_db is None:
+        return 1, 0.0
+    n = int(np.count_nonzero(rut.azimuth_mask))
+    snr = (10 ** (radar.snr_db / 10) * _processing_gain(radar.range_window, radar.samples_per_chirp)
+           * _processing_gain(radar.doppler_window, radar.chirps_per_tx))
+    amps = np.abs(np.asarray(designs))  # (P, 2): the composite carries both channels
+    rel = np.minimum(amps.sum(axis=1) / amps.max(), 1.0)
+    h = 0.05  # rad: inside the quadratic region (checked against h/2 in the tests)
+    curv = []
+    for m, (a_i, a_j) in zip(models, designs):
+        rho = a_j / a_i
+        phase = m.coherent_phase(alphas)
+        e = [float(m.angle(rho, phase + x)) for x in (-h, 0.0, h)]
+        curv.append((e[0] + e[2] - 2 * e[1]) / (2 * h * h))
+    kappa = float(np.sqrt(np.mean(np.square(curv)))) * (2 * np.pi * f_if_hz) ** 2  # rad / s^2
+    sigma_u = np.sqrt(6.0 / (snr * rel ** 2 * n * (n * n - 1.0))) / np.pi
+    sigma_a = float(np.sqrt(np.mean((sigma_u / np.cos(np.asarray(alphas))) ** 2)))
+    frames = int(min(MAX_FRAMES, max(1, np.ceil(8 * sigma_a ** 2 / (kappa * bias_s ** 2) ** 2))))
+    return frames, float(np.degrees(sigma_a))
 
 
 def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe:
@@ -179,9 +297,16 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
         w = delta / grid_s - k
         return (1 - w) * node(k) + w * node(k + 1)
 
+    period = 1.0 / float(if_phase_slope_hz(scene, probe_total_delay(setup, ranges)))
+    models = [PairModel.build(nom, nom_paths, pair, t, base_offsets) for t in targets]
+    frames, frame_noise = frames_per_step(setup, models, node(0), alphas, 1.0 / period)
+
     def error(delta: float) -> float:
         prog = _probe_program(design(delta), pair, base, delta)
-        rd, det = _simulate_detect(setup, paths, prog, seed)
+        # fresh noise at every step (a new measurement), reproducible from the seed
+        step_seed = np.random.SeedSequence([int(seed) % 2 ** 32,
+                                            int(round(delta * 1e15)) + 2 ** 40])
+        rd, det = _simulate_detect(setup, paths, prog, step_seed, frames)
         errs = []
         for r, a in zip(ranges, alphas):
             k = nearest_detection(det, rd, r)
@@ -214,10 +339,10 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
             best, best_err = float(fine[k]), float(fe_[k])
     air = _mean_air_delay(setup)
     range_offset = 0.5 * c * ((air[j] + base_offsets[1] + best) - (air[i] + base_offsets[0]))
-    period = 1.0 / (rts.f_rts_hz + radar.bandwidth_hz / 2)
     return Calibration(pair, best, best_err, float(range_offset), frozen(grid), frozen(errs),
                        frozen(np.array(ref_t)), frozen(np.array(ref_e)),
-                       (float(np.degrees(alphas[0])), float(np.degrees(alphas[1]))), period)
+                       (float(np.degrees(alphas[0])), float(np.degrees(alphas[1]))), period,
+                       frames, frame_noise)
 
 
 def nominal_model(setup: Setup, paths: Paths) -> tuple[Setup, Paths]:
@@ -234,3 +359,89 @@ def nominal_model(setup: Setup, paths: Paths) -> tuple[Setup, Paths]:
 def _mean_air_delay(setup: Setup) -> np.ndarray:
     """Mean over virtual elements of each front end's two-way line-of-sight delay."""
     return two_way_lengths(setup.rut, setup.fe.rx, setup.fe.tx).mean(axis=1) / c
+
+
+def calibrate_pair_paper(setup: Setup, paths: Paths, pair: tuple[int, int],
+                         probe: FrontEndProbe | None = None, seed: int = 0,
+                         set_angle_rad: float | None = None, span_s=None,
+                         step_s=None) -> Calibration:
+    """The paper's calibration procedure as written (section "Measurement"): one target at
+    one set angle (default: the middle of the pair's geometric span), its amplitudes fixed
+    from eq. (23) with the nominal geometric front-end angles (times the amplitude
+    calibration's gain correction) and never re-designed, channel J's delay swept over the
+    scene's span (paper: [-0.5, 1] ns in 25 ps steps, one frame per step, no refinement),
+    the delay with the smallest |angle error| kept.
+
+    rtsgeom's own procedure (:func:`calibrate_pair`) instead re-designs the amplitudes with
+    the exact model at every step and uses two probes; with fixed amplitudes the optimum
+    is where the *fixed* design happens to hit the set angle, which need not be the
+    coherence point (docs/paper-comparison.md)."""
+    from .synthesis import ratio_paper
+    scene = setup.scene
+    rts = scene.rts
+    i, j = pair
+    probe = probe or probe_front_ends(setup, paths, seed)
+    nom, nom_paths = nominal_model(setup, paths)
+    th = nom.fe_azimuth_rad()[[i, j]]
+    alpha = float(np.mean(th)) if set_angle_rad is None else float(set_angle_rad)
+    rng = float(probe_ranges(setup, 1)[0])
+    target = TargetConfig(rng, 0.0, 10.0, alpha)
+    unit = PairModel.build(nom, nom_paths, pair, target).unit_gain
+    rho = float(ratio_paper(th[0], th[1], alpha))
+    amp = (unit * probe.gain_correction[i], unit * rho * probe.gain_correction[j])
+    tau = float(requested_delay(scene, rng))
+    span = span_s or rts.calibration_span_s
+    step = step_s or rts.calibration_step_s
+    grid = np.arange(span[0], span[1] + step / 2, step)
+    errs = np.full(grid.size, np.inf)
+    for k, d in enumerate(grid):
+        prog = RtsProgram.build([0, 0], [i, j], [tau, tau + d], [0.0, 0.0], list(amp))
+        step_seed = np.random.SeedSequence([int(seed) % 2 ** 32, int(round(d * 1e15)) + 2 ** 40])
+        rd, det = _simulate_detect(setup, paths, prog, step_seed)
+        n = nearest_detection(det, rd, rng)
+        if n is not None:
+            errs[k] = abs(np.degrees(det.angle_rad[n] - alpha))
+    k = int(np.argmin(errs))
+    best = float(grid[k])
+    air = _mean_air_delay(setup)
+    range_offset = 0.5 * c * ((air[j] + best) - air[i])
+    period = 1.0 / float(if_phase_slope_hz(scene, probe_total_delay(setup, [rng])))
+    deg = float(np.degrees(alpha))
+    return Calibration(pair, best, float(errs[k]), float(range_offset), frozen(grid),
+                       frozen(errs), frozen(np.zeros(0)), frozen(np.zeros(0)), (deg, deg), period,
+                       1, 0.0)
+
+
+def fir_effect(setup: Setup, delta_tau_s: float, base_offsets=(0.0, 0.0)) -> dict:
+    """The fractional-delay FIR at the settings the calibration's two probe targets program
+    on channels I (delay ``base``) and J (``base + delta_tau_s``): its gain and phase ripple
+    along the chirp's IF sweep (``rts.fir_if_gain``) and the shift of the coherence point it
+    predicts, the mean over the probes of ``(phi_I - phi_J) / (2 pi f_if)``, phi the
+    range-window-weighted phase of each channel's beat-signal gain (what the range DFT sees
+    at the target's bin), f_if = 1 / period."""
+    from ..radar.processing import window
+    from ..rts import fir_if_gain
+    scene = setup.scene
+    model = scene.rts.fractional_delay_filter if scene.rts.fractional_delay else "none"
+    rng = probe_ranges(setup, 2)
+    base = requested_delay(scene, rng)  # (2,) one per probe
+    delays = np.concatenate([base + base_offsets[0], base + base_offsets[1] + delta_tau_s])
+    tau = np.concatenate([requested_delay(scene, rng)] * 2) + np.mean(_mean_air_delay(setup))
+    g = fir_if_gain(scene, delays, tau)  # (4, N): I of both probes, then J of both
+    if g is None:
+        return {"model": model, "gain_ripple_db": 0.0, "phase_ripple_deg": 0.0,
+                "predicted_shift_ps": 0.0}
+    radar = scene.radar
+    n_s = radar.samples_per_chirp
+    t_n = radar.adc_start_s + np.arange(n_s) / radar.adc_rate_hz
+    beat = radar.slope_hz_per_s * tau  # (4,)
+    r0 = np.round(beat * n_s / radar.adc_rate_hz)  # the target's range bin
+    kern = window(radar.range_window, n_s) * np.exp(
+        2j * np.pi * (beat[:, None] * t_n - r0[:, None] * np.arange(n_s) / n_s))
+    phi = np.angle(np.sum(kern * g, 1) / np.sum(kern, 1)).reshape(2, 2)  # [channel, probe]
+    period = 1.0 / float(if_phase_slope_hz(scene, probe_total_delay(setup, rng)))
+    shift = float(np.angle(np.mean(np.exp(1j * (phi[0] - phi[1])))) / (2 * np.pi) * period)
+    return {"model": model,
+            "gain_ripple_db": float(np.ptp(20 * np.log10(np.abs(g)))),
+            "phase_ripple_deg": float(np.ptp(np.degrees(np.angle(g)))),
+            "predicted_shift_ps": shift * 1e12}

@@ -26,6 +26,7 @@ class Linearity:
     set_deg: np.ndarray
     detected_deg: np.ndarray
     amplitude_db: np.ndarray  # (2, n) programmed attenuation of channels I and J
+    end_angles: str = "geometric"  # front-end angles the closed forms used
 
     @property
     def error_deg(self) -> np.ndarray:
@@ -37,16 +38,41 @@ class Linearity:
 
     def to_dict(self) -> dict:
         return {
-            "mode": self.mode, "calibrated": self.calibrated,
+            "mode": self.mode, "calibrated": self.calibrated, "end_angles": self.end_angles,
             "points": [{"set_deg": float(s), "detected_deg": float(d), "error_deg": float(d - s)}
                        for s, d in zip(self.set_deg, self.detected_deg)],
             "max_abs_error_deg": self.max_abs_error_deg,
         }
 
 
+END_ANGLES = ("geometric", "measured")
+
+
+def _closed_form_measured(setup, paths, pair, target, mode, probe, offsets, corr):
+    """``paper`` / ``array-factor`` amplitudes with the front ends' *measured* angles (each
+    alone as the RuT detects it, as the paper's angles were "determined by measurement")
+    in the closed form, instead of their geometric azimuths."""
+    from .calibration import nominal_model
+    from .synthesis import PairModel, ratio_array_factor, ratio_paper
+    i, j = pair
+    th = probe.angle_rad[[i, j]]
+    alpha = target.angle_rad
+    if mode == "paper":
+        rho = float(ratio_paper(th[0], th[1], alpha))
+    else:
+        rho = float(ratio_array_factor(th[0], th[1], alpha,
+                                       int(np.count_nonzero(setup.rut.azimuth_mask))))
+    rho = float(np.clip(rho, 0.0, 1e12))
+    nom, nom_paths = nominal_model(setup, paths)
+    model = PairModel.build(nom, nom_paths, pair, target, offsets)
+    phase = model.coherent_phase(probe_angles(*th))
+    a_i, a_j = model.amplitudes(rho, alpha, phase)
+    return a_i * corr[0], a_j * corr[1], rho
+
+
 def linearity(setup: Setup, paths: Paths, pair: tuple[int, int], mode: str,
               probe: FrontEndProbe, calibration: Calibration | None, points: int = 21,
-              seed: int = 0) -> Linearity:
+              seed: int = 0, end_angles: str = "geometric") -> Linearity:
     """Sweep the set angle across ``pair`` and detect each synthesized target on the simulated
     RuT.
 
@@ -54,7 +80,13 @@ def linearity(setup: Setup, paths: Paths, pair: tuple[int, int], mode: str,
     end alone as the RuT detects it; near field and Rx/Tx separation move it) and the
     geometric span (the closed forms only reach between the front ends' geometric angles);
     its ends are excluded, where one channel would be off.
+
+    ``end_angles``: which front-end angles the closed forms (``paper``, ``array-factor``)
+    use: ``geometric`` (module azimuths of the nominal setup) or ``measured`` (each front
+    end alone as the RuT detects it); ``exact`` ignores it.
     """
+    if end_angles not in END_ANGLES:
+        raise ValueError(f"end_angles = {end_angles!r}: must be one of {END_ANGLES}")
     scene = setup.scene
     i, j = pair
     meas = np.sort(probe.angle_rad[[i, j]])
@@ -70,8 +102,11 @@ def linearity(setup: Setup, paths: Paths, pair: tuple[int, int], mode: str,
     amp = np.zeros((2, points))
     for k, a in enumerate(sets):
         t = TargetConfig(rng, 0.0, 10.0, float(a))
-        a_i, a_j, _ = pair_amplitudes(setup, paths, pair, t, mode,
-                                      probe_angles(*probe.angle_rad[[i, j]]), off, corr)
+        if end_angles == "measured" and mode != "exact":
+            a_i, a_j, _ = _closed_form_measured(setup, paths, pair, t, mode, probe, off, corr)
+        else:
+            a_i, a_j, _ = pair_amplitudes(setup, paths, pair, t, mode,
+                                          probe_angles(*probe.angle_rad[[i, j]]), off, corr)
         amp[:, k] = a_i, a_j
         prog = RtsProgram.build([0, 0], [i, j], [tau + off[0], tau + off[1]], [0.0, 0.0],
                                 [a_i, a_j])
@@ -80,4 +115,5 @@ def linearity(setup: Setup, paths: Paths, pair: tuple[int, int], mode: str,
         if n is not None:
             det_deg[k] = np.degrees(det.angle_rad[n])
     amp_db = 20 * np.log10(np.maximum(amp, 1e-300) / np.max(amp))
-    return Linearity(mode, calibration is not None, np.degrees(sets), det_deg, amp_db)
+    return Linearity(mode, calibration is not None, np.degrees(sets), det_deg, amp_db,
+                     end_angles)

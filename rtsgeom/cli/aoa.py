@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..aoa.calibration import calibrate_pair, probe_front_ends
+from ..aoa.calibration import (calibrate_pair, calibrate_pair_paper, fir_effect,
+                               probe_front_ends)
 from ..aoa.linearity import linearity
 from ..geometry import build_setup
 from ..io import write_json
@@ -17,16 +18,21 @@ from ._common import (UsageError, load_scene_checked, number, output_folder, out
 
 
 def _pair(setup, pair):
+    """The pair in its canonical order, the lower index first (I keeps its delay, J is
+    swept): ``--pair 1 0`` and ``--pair 0 1`` are the same measurement and give the same
+    numbers (the front ends are ordered by angle in the scene)."""
     i, j = pair
     n = setup.fe.count
     if not (0 <= i < n and 0 <= j < n) or abs(i - j) != 1:
         raise UsageError(f"--pair {i} {j}: must be two adjacent front-end indices in [0, {n - 1}]")
-    return (i, j)
+    return (min(i, j), max(i, j))
 
 
 def _prepare(args):
     """Scene, setup, pair, exact paths and each front end alone as the RuT detects it."""
     scene = load_scene_checked(args.scene)
+    if getattr(args, "fir", None):  # override the scene's fractional-delay filter model
+        scene = scene.evolve(rts=scene.rts.evolve(fractional_delay_filter=args.fir))
     setup = build_setup(scene)
     pair = _pair(setup, args.pair)
     paths = exact_paths(setup)
@@ -42,10 +48,16 @@ def _calibrate(args, stage) -> int:
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
         scene, setup, pair, paths, probe = _prepare(args)
-        step(f"sweeping the delay of front end {pair[1]} on the simulated radar")
-        cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
+        step(f"sweeping the delay of front end {pair[1]} on the simulated radar "
+             f"({args.procedure} procedure)")
+        if args.procedure == "paper":
+            cal = calibrate_pair_paper(setup, paths, pair, probe, seed=scene.seed)
+        else:
+            cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
     out = cal.to_dict()
+    out["procedure"] = args.procedure
     out["front_end_angles_deg"] = [float(x) for x in np.degrees(probe.angle_rad)]
+    out["fractional_delay_filter"] = fir_effect(setup, cal.delta_tau_s)
 
     def figure():
         from ..viz.figures import calibration_sweep_figure
@@ -57,7 +69,10 @@ def _calibrate(args, stage) -> int:
     _emit(args, stage, "calibration_sweep.png", "calibration", out, figure,
           f"pair {pair}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps, residual angle error "
           f"{cal.residual_error_deg:.4f} deg, range offset {cal.range_offset_m * 1e3:.2f} mm "
-          f"(period {cal.period_s * 1e9:.4f} ns)")
+          f"(period {cal.period_s * 1e9:.4f} ns); fractional-delay filter "
+          f"{out['fractional_delay_filter']['model']}: phase ripple over the IF sweep "
+          f"{out['fractional_delay_filter']['phase_ripple_deg']:.3f} deg p-p, moves the "
+          f"coherence point by {out['fractional_delay_filter']['predicted_shift_ps']:+.2f} ps")
     return 0
 
 
@@ -89,13 +104,15 @@ def _linearity(args, stage) -> int:
             step("calibrating the pair")
             cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
         step(f"sweeping {args.points} set-points ({args.amplitudes} amplitudes)")
-        lin = linearity(setup, paths, pair, args.amplitudes, probe, cal, args.points, scene.seed)
+        lin = linearity(setup, paths, pair, args.amplitudes, probe, cal, args.points, scene.seed,
+                        args.end_angles)
     def figure():
         from ..viz.figures import linearity_figure
         return linearity_figure(lin.set_deg, {args.amplitudes: lin.detected_deg},
                                 {args.amplitudes: lin.amplitude_db}, pair=pair)
     _emit(args, stage, "linearity.png", "linearity", lin.to_dict(), figure,
-          f"{args.amplitudes} ({'calibrated' if cal else 'uncalibrated'}): max |error| "
+          f"{args.amplitudes} ({'calibrated' if cal else 'uncalibrated'}, "
+          f"{args.end_angles} end angles): max |error| "
           f"{lin.max_abs_error_deg:.4f} deg over {len(lin.set_deg)} set-points")
     return 0
 
@@ -111,7 +128,21 @@ def register(sub) -> None:
         p.add_argument("--json", action="store_true", help="print the result as JSON")
         p.add_argument("--out", type=output_path, default=None, help="folder for the plot and JSON")
         p.add_argument("--quiet", action="store_true", help="no progress output")
+        p.add_argument("--fir", choices=("windowed-sinc", "ideal"), default=None,
+                       help="fractional-delay filter model (default: the scene's "
+                            "rts.fractional_delay_filter)")
+        if name == "calibrate":
+            p.add_argument("--procedure", choices=("exact", "paper"), default="exact",
+                           help="exact: two probes, amplitudes re-designed at every step, "
+                                "refined to the delay resolution (default); paper: the "
+                                "paper's sweep as written (fixed eq. 23 amplitudes, one set "
+                                "angle, 25 ps steps)")
         if name == "linearity":
+            p.add_argument("--end-angles", choices=("geometric", "measured"),
+                           default="geometric",
+                           help="front-end angles in the paper/array-factor closed forms: "
+                                "geometric (default) or measured (each alone, as the RuT "
+                                "detects it)")
             p.add_argument("--amplitudes", choices=SYNTHESIS_MODES,
                            default="exact", help="amplitude-ratio mode (default exact)")
             p.add_argument("--uncalibrated", action="store_true",

@@ -3,12 +3,13 @@
 For echo e on virtual channel v = (Tx slot s, Rx k), chirp loop l and fast-time sample n the
 beat signal is (paper eq. 8, with the RTS Doppler mixer added)::
 
-    x[l, v, n] = sum_e a[e, v] exp{ j 2 pi [ f_c tau_c[e, v] + f_if[e] tau_if[e]
+    x[l, v, n] = sum_e a[e, v] g[e, n] exp{ j 2 pi [ f_c tau_c[e, v] + f_if[e] tau_if[e]
                                             + S tau[e, v] t_n - S tau[e, v]^2 / 2
                                             + f_D[e] (t_c[l, s] + t_n) ] }
 
 with ``tau = tau_c + tau_if``, ``t_n = t_adc + n / f_adc`` (time since ramp start),
-``t_c = (l N_tx + s) T_rep`` (TDM: the Tx take turns chirp by chirp, so a moving target carries
+``t_c = (l N_tx + s) T_rep``, ``g`` the fractional-delay FIR's gain along the chirp
+(``Echoes.fast_gain``, 1 for an ideal delay) (TDM: the Tx take turns chirp by chirp, so a moving target carries
 the Tx-switching phase 2 pi f_D s T_rep) and ``S = B / T``.
 
 Every echo is separable into a slow-time factor and a fast-time factor, so for each virtual
@@ -117,7 +118,10 @@ def synthesize(echoes: Echoes, radar: RadarConfig, rut: RutArray) -> AdcCube:
     a = (echoes.amplitude.T[:, None, :] * np.exp(1j * slow)).astype(np.complex64)
     # fast time: F[v, e, n] = exp(j 2 pi (S tau[e, v] + f_D[e]) t_n)
     beat = s * tau.T + f_d[None, :]  # (V, E)
-    f = np.exp(2j * np.pi * beat[:, :, None] * t_n[None, None, :]).astype(np.complex64)
+    f = np.exp(2j * np.pi * beat[:, :, None] * t_n[None, None, :])
+    if echoes.fast_gain is not None:  # the fractional-delay FIR's ripple along the chirp
+        f = f * echoes.fast_gain[None]
+    f = f.astype(np.complex64)
     with _single_threaded_blas():  # fixed reduction order: bytes independent of thread count
         data = np.matmul(a, f)  # (V, L, N)
     return AdcCube(np.ascontiguousarray(data.transpose(1, 0, 2)), radar, rut)
@@ -146,7 +150,8 @@ def synthesize_exact(echoes: Echoes, radar: RadarConfig, rut: RutArray,
         phase = 2 * np.pi * (radar.f_c_hz * tau_air + echoes.f_if_hz[e] * tau_if
                              + s * tau * t_n - 0.5 * s * tau ** 2
                              + echoes.doppler_hz[e] * (t_c + t_n))
-        out += (echoes.amplitude[e][None, :, None] * np.exp(1j * phase)).astype(np.complex64)
+        g = 1.0 if echoes.fast_gain is None else echoes.fast_gain[e][None, None, :]
+        out += (echoes.amplitude[e][None, :, None] * g * np.exp(1j * phase)).astype(np.complex64)
     return AdcCube(out, radar, rut)
 
 

@@ -46,6 +46,8 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
     kern_r = w_r * np.exp(-2j * np.pi * np.outer(r, n) / n_s)  # (K, N)
     beat = s * tau + f_d[:, None]  # (E, V)
     fast = np.exp(2j * np.pi * beat[..., None] * t_n)  # (E, V, N)
+    if echoes.fast_gain is not None:  # fractional-delay FIR ripple along the chirp
+        fast = fast * echoes.fast_gain[:, None, :]
     rr = np.einsum("kn,evn->kev", kern_r, fast)
     # slow time (Doppler bin d of the fftshifted spectrum is DFT index d - L/2)
     t_c = chirp_start_s(radar, rut)  # (L, V)
