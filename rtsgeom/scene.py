@@ -38,7 +38,7 @@ from .scene_rules import (MAX_ADC_SAMPLES, MAX_CALIBRATION_STEPS, arc_centre_m, 
 
 __all__ = [
     "SceneError", "RadarConfig", "CfarConfig", "FrontEndConfig", "RtsConfig", "SheetConfig",
-    "TargetConfig", "RaytraceConfig", "StructureConfig", "Scene", "load_scene", "loads_scene",
+    "TargetConfig", "RaytraceConfig", "PatternConfig", "ArrayConfig", "StructureConfig", "Scene", "load_scene", "loads_scene",
     "parse_scene", "problems", "arc_centre_m", "azimuth_from_radar_rad", "front_end_module_m",
 ]
 
@@ -82,6 +82,44 @@ class CfarConfig(Evolvable):
                           0.75, lo=0.0, hi=1.0, lo_open=True)
 
 
+@dataclass(frozen=True)
+class PatternConfig(Evolvable):
+    """An antenna pattern (``geometry.patterns``): ``isotropic``, ``cos`` (power cos^q off
+    boresight with half-power beamwidth ``hpbw_deg``, optionally its own ``hpbw_el_deg``) or a
+    ``table`` (CSV inside the scene's folder: azimuth_deg, elevation_deg, gain_db, phase_deg).
+    It multiplies the exact paths' amplitudes, and so the amplitude calibration and synthesis."""
+
+    kind: str = spec("kind", "str", "pattern model", "isotropic",
+                     choices=tuple(registry.PATTERN_KINDS))
+    hpbw_deg: float | None = spec("hpbw_deg", "float", "half-power beamwidth (kind cos)", None,
+                                  unit="deg", lo=0.0, hi=180.0, lo_open=True, hi_open=True)
+    hpbw_el_deg: float | None = spec("hpbw_el_deg", "float", "elevation half-power beamwidth "
+                                     "(kind cos; unset = hpbw_deg, rotationally symmetric)",
+                                     None, unit="deg", lo=0.0, hi=180.0, lo_open=True,
+                                     hi_open=True)
+    peak_gain_db: float = spec("peak_gain_db", "float", "boresight gain (kind cos)", 0.0,
+                               unit="dB", lo=-100.0, hi=100.0)
+    table: str | None = spec("table", "str", "CSV file relative to the scene's folder and "
+                             "inside it (kind table)", None)
+
+
+@dataclass(frozen=True)
+class ArrayConfig(Evolvable):
+    """A custom RuT array in board coordinates (x lateral towards larger azimuth, z up), in
+    millimetres; replaces the preset. Virtual element (slot, rx) sits at p_tx + p_rx; sparse and
+    non-uniform arrays work, duplicate virtual positions are combined."""
+
+    tx_mm: tuple[tuple[float, float], ...] = spec(
+        "tx_mm", "points", "every Tx antenna [x, z]", n=2, unit="mm", lo=-1000.0, hi=1000.0,
+        min_items=1, max_items=64)
+    rx_mm: tuple[tuple[float, float], ...] = spec(
+        "rx_mm", "points", "every Rx antenna [x, z]", n=2, unit="mm", lo=-1000.0, hi=1000.0,
+        min_items=1, max_items=64)
+    tx_order: tuple[int, ...] = spec(
+        "tx_order", "ints", "Tx index (0-based, into tx_mm) transmitting in each TDM slot, each "
+        "Tx at most once", lo=0, hi=63, min_items=1, max_items=64)
+
+
 def _centred_adc_start(v: dict) -> float:
     return 0.5 * (v["chirp_duration_s"] - v["samples_per_chirp"] / v["adc_rate_hz"])
 
@@ -120,6 +158,23 @@ class RadarConfig(Evolvable):
                                "awr1843boost", choices=tuple(registry.RADAR_PRESETS))
     use_elevation_tx: bool = spec("use_elevation_tx", "bool", "also transmit on the elevated "
                                   "Tx (3 TDM slots instead of 2)", False)
+    board_gap_m: float | None = spec(
+        "board_gap_mm", "float", "lateral gap from the right-most Tx to the first Rx of a preset "
+        "with separate Tx and Rx groups; unset = the preset's default, 3 lambda (6 d) for the "
+        "single-chip boards (an assumption, it moves the near-field parallax); not for "
+        "awr2243-cascade (interleaved) nor a custom array", None, unit="mm", lo=0.0, hi=500.0,
+        scale=1e-3)
+    array: ArrayConfig | None = spec("array", "table", "[radar.array] a custom array "
+                                     "(replaces antenna_preset)", None, cls=ArrayConfig)
+    pattern: PatternConfig = spec("pattern", "table", "[radar.pattern] pattern of every RuT "
+                                  "element (Tx and Rx)", {}, cls=PatternConfig)
+    position_offset_m: tuple[float, float, float] = spec(
+        "position_offset_mm", "vec", "pose error of the RuT (world x, y, z): the arc stays "
+        "centred on position_m", (0.0, 0.0, 0.0), n=3, unit="mm", lo=-100.0, hi=100.0,
+        scale=1e-3)
+    yaw_offset_rad: float = spec("yaw_offset_deg", "float", "yaw error of the RuT (it measures "
+                                 "in its own, turned frame)", 0.0, unit="deg", lo=-30.0,
+                                 hi=30.0, scale=_DEG)
     element_spacing_m: float = spec("element_spacing_m", "float", "element spacing d; 0 = "
                                     "lambda/2 at the centre frequency", 0.0, unit="m",
                                     lo=0.0, hi=0.1)
@@ -169,7 +224,16 @@ class RadarConfig(Evolvable):
 
     @property
     def num_tx_active(self) -> int:
+        """TDM slots: the custom array's ``tx_order``, else the preset's."""
+        if self.array is not None:
+            return len(self.array.tx_order)
         return len(registry.RADAR_PRESETS[self.antenna_preset].active_tx_order(self.use_elevation_tx))
+
+    @property
+    def num_rx(self) -> int:
+        if self.array is not None:
+            return len(self.array.rx_mm)
+        return registry.RADAR_PRESETS[self.antenna_preset].num_rx
 
     @property
     def tdm_cycle_s(self) -> float:
@@ -189,14 +253,28 @@ class RadarConfig(Evolvable):
 class FrontEndConfig(Evolvable):
     """One RTS front end on the arc: an Rx and a Tx antenna on a module tangent to the arc.
 
-    The Rx antenna sits ``rx_tx_separation_m/2`` along the tangent towards larger azimuth, the
-    Tx antenna the same distance towards smaller azimuth. Mounting errors move the whole module.
+    The antennas sit at signed offsets ``rx_offset_mm``/``tx_offset_mm`` = [t, h] in the
+    module's frame (t along the tangent, positive towards larger azimuth; h up); the shorthand
+    ``rx_tx_separation_m = s`` means rx [s/2, 0], tx [-s/2, 0] (Rx at the larger azimuth).
+    Mounting errors move the whole module and turn it (yaw, pitch) about its centre.
     """
 
     angle_rad: float = spec("angle_deg", "float", "azimuth theta_q on the arc", unit="deg",
                             lo=-90.0, hi=90.0, scale=_DEG)
     rx_tx_separation_m: float = spec("rx_tx_separation_m", "float", "Rx/Tx antenna separation "
                                      "along the tangent", 0.02, unit="m", lo=0.0, hi=0.5)
+    rx_offset_m: tuple[float, float] | None = spec(
+        "rx_offset_mm", "vec", "Rx antenna [t, h] on the module (signed; with tx_offset_mm, "
+        "instead of rx_tx_separation_m)", None, n=2, unit="mm", lo=-250.0, hi=250.0, scale=1e-3)
+    tx_offset_m: tuple[float, float] | None = spec(
+        "tx_offset_mm", "vec", "Tx antenna [t, h] on the module (signed; with rx_offset_mm)",
+        None, n=2, unit="mm", lo=-250.0, hi=250.0, scale=1e-3)
+    yaw_offset_rad: float = spec("yaw_offset_deg", "float", "mounting rotation about the "
+                                 "vertical (azimuth sense)", 0.0, unit="deg", lo=-30.0, hi=30.0,
+                                 scale=_DEG)
+    pitch_offset_rad: float = spec("pitch_offset_deg", "float", "mounting rotation about the "
+                                   "tangent (positive: boresight up)", 0.0, unit="deg",
+                                   lo=-30.0, hi=30.0, scale=_DEG)
     radial_offset_m: float = spec("radial_offset_mm", "float", "mounting error, radial",
                                   0.0, unit="mm", lo=-50.0, hi=50.0, scale=1e-3)
     tangential_offset_m: float = spec("tangential_offset_mm", "float", "mounting error, "
@@ -219,6 +297,14 @@ class FrontEndConfig(Evolvable):
     return_loss_be_db: float | None = spec("return_loss_be_db", "float", "mismatch at the back "
                                            "end; unset = no cable ghosts", None, unit="dB",
                                            lo=0.0, hi=100.0, lo_open=True)
+
+    def antenna_offsets_m(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """Signed (t, h) of the Rx and the Tx antenna on the module (m): the explicit offsets,
+        else the shorthand rx (s/2, 0), tx (-s/2, 0)."""
+        if self.rx_offset_m is not None and self.tx_offset_m is not None:
+            return tuple(self.rx_offset_m), tuple(self.tx_offset_m)
+        half = 0.5 * self.rx_tx_separation_m
+        return (half, 0.0), (-half, 0.0)
 
 
 @dataclass(frozen=True)
@@ -262,6 +348,9 @@ class RtsConfig(Evolvable):
     allow_wide_spacing: bool = spec(
         "allow_wide_spacing", "bool", "force synthesis modes with targets between front ends "
         "wider apart than the RuT's angular resolution (paper eq. 24 violated)", False)
+    pattern: PatternConfig = spec("pattern", "table", "[rts.pattern] pattern of every "
+                                  "front-end antenna (Rx and Tx; boresight at the arc centre)",
+                                  {}, cls=PatternConfig)
 
     @property
     def delay_resolution_s(self) -> float:
@@ -406,6 +495,65 @@ def _resolve_meshes(scene: Scene, source: str, base_dir: Path | None,
     return tuple(out)
 
 
+def _check_layout_keys(data: dict, source: str) -> None:
+    """A front end's layout is either the shorthand rx_tx_separation_m or both signed offsets."""
+    fes = data.get("rts", {}).get("front_ends", []) if isinstance(data.get("rts"), dict) else []
+    if not isinstance(fes, list):
+        return
+    for i, fe in enumerate(fes):
+        if not isinstance(fe, dict):
+            continue
+        given = [k for k in ("rx_offset_mm", "tx_offset_mm") if k in fe]
+        if given and "rx_tx_separation_m" in fe:
+            raise SceneError(f"{source}: rts.front_ends[{i}].rx_tx_separation_m = "
+                             f"{_fmt(fe['rx_tx_separation_m'])}: must be left out when "
+                             f"{' and '.join(given)} is given (the separation is the shorthand "
+                             "for rx_offset_mm = [s/2, 0], tx_offset_mm = [-s/2, 0])")
+        if len(given) == 1:
+            other = ({"rx_offset_mm", "tx_offset_mm"} - set(given)).pop()
+            raise SceneError(f"{source}: rts.front_ends[{i}].{other} is missing: must be given "
+                             f"together with {given[0]} (both antennas' [t, h] in mm)")
+
+
+def _resolve_pattern_tables(scene: Scene, source: str, base_dir: Path | None) -> Scene:
+    """Pattern CSV paths resolved against the scene's folder and kept inside it (as meshes)."""
+    base = base_dir or Path.cwd()
+
+    def resolve(cfg, where):
+        if cfg.kind != "table":
+            return cfg
+        rel = cfg.table
+        if rel is None:
+            raise SceneError(f"{source}: {where}.table is missing: must be a CSV path when "
+                             f"{where}.kind = \"table\"")
+        p = Path(rel)
+        if p.is_absolute() or ".." in p.parts or "\0" in rel:
+            raise SceneError(f"{source}: {where}.table = {_fmt(rel)}: must be a relative path "
+                             "inside the scene's folder (no absolute path, no '..')")
+        p = base / p
+        try:
+            ok = p.is_file() and p.resolve().is_relative_to(base.resolve())
+        except (OSError, ValueError, RuntimeError):
+            ok = False
+        if not ok:
+            raise SceneError(f"{source}: {where}.table = {_fmt(rel)}: must be an existing CSV "
+                             "file inside the scene's folder")
+        from .geometry.patterns import TablePattern  # validates the table's contents
+        try:
+            TablePattern.from_csv(p)
+        except ValueError as exc:
+            raise SceneError(f"{source}: {where}.table = {_fmt(rel)}: {exc}") from None
+        return dataclasses.replace(cfg, table=str(p.resolve()))
+
+    for cfg, where in ((scene.radar.pattern, "radar.pattern"), (scene.rts.pattern, "rts.pattern")):
+        if cfg.kind == "cos" and cfg.hpbw_deg is None:
+            raise SceneError(f"{source}: {where}.hpbw_deg is missing: must be in (0, 180) deg "
+                             f"when {where}.kind = \"cos\"")
+    radar = dataclasses.replace(scene.radar, pattern=resolve(scene.radar.pattern, "radar.pattern"))
+    rts = dataclasses.replace(scene.rts, pattern=resolve(scene.rts.pattern, "rts.pattern"))
+    return dataclasses.replace(scene, radar=radar, rts=rts)
+
+
 def parse_scene(data: dict, source: str = "<scene>", base_dir: Path | None = None,
                 sha256: str = "", allow_external_meshes: bool = False) -> Scene:
     """Build a validated :class:`Scene` from a parsed TOML document.
@@ -414,8 +562,10 @@ def parse_scene(data: dict, source: str = "<scene>", base_dir: Path | None = Non
     violated cross-field rules (:func:`problems`)."""
     stem = Path(source).stem if source != "<scene>" else "scene"
     scene = read(Scene, data, source, "", {"_stem": stem, "source": source, "sha256": sha256})
+    _check_layout_keys(data, source)  # the file's keys (a read scene cannot tell them apart)
     meshes = _resolve_meshes(scene, source, base_dir, allow_external_meshes)
     scene = dataclasses.replace(scene, extra_meshes=meshes)
+    scene = _resolve_pattern_tables(scene, source, base_dir)
     found = problems(scene)
     if found:
         raise SceneError(found[0], found)

@@ -80,15 +80,17 @@ def scene_warnings(scene: Scene) -> list[str]:
         r_cut = 0.5 * scene.sheet.cutout_diameter_m
         for i, f in enumerate(rts.front_ends):
             t, h = f.tangential_offset_m, f.height_offset_m
-            off = {label: math.hypot(t + sign * 0.5 * f.rx_tx_separation_m, h)
-                   for label, sign in (("Rx", 1.0), ("Tx", -1.0))}
+            off = {label: math.hypot(t + at, h + ah)
+                   for label, (at, ah) in zip(("Rx", "Tx"), f.antenna_offsets_m())}
             outside = [label for label, v in off.items() if v > r_cut]
             if outside:
                 name, v = (("height_offset_mm", h) if abs(h) >= abs(t)
                            else ("tangential_offset_mm", t))
                 warn(f"rts.front_ends[{i}].{name}", v * 1e3,
                      f"with tangential_offset_mm = {t * 1e3:g}, height_offset_mm = "
-                     f"{h * 1e3:g} and rx_tx_separation_m = {f.rx_tx_separation_m:g} the "
+                     f"{h * 1e3:g} and the antennas at rx/tx [t, h] = "
+                     f"{[round(x * 1e3, 3) for x in f.antenna_offsets_m()[0]]}/"
+                     f"{[round(x * 1e3, 3) for x in f.antenna_offsets_m()[1]]} mm the "
                      f"{' and '.join(outside)} antenna{'s are' if len(outside) > 1 else ' is'} "
                      f"up to {max(off[k] for k in outside) * 1e3:.3g} mm from the centre of the "
                      f"cutout (radius {r_cut * 1e3:.3g} mm): looking at the RuT through the sheet")
