@@ -56,7 +56,7 @@ def _allowed(s: Spec) -> str:
     if s.kind == "int":
         return f"integer in [{s.lo}, {s.hi}]"
     if s.kind == "points":
-        return (f"{s.min_items} to {s.max_items} [{', '.join('xyzw'[:s.n])}] pairs, each number "
+        return (f"{s.min_items} to {s.max_items} [{'x, z' if s.n == 2 else ', '.join('xyz'[:s.n])}] pairs, each number "
                 f"in [{s.lo:g}, {s.hi:g}]")
     if s.kind == "ints":
         return f"{s.min_items} to {s.max_items} integers in [{s.lo}, {s.hi}]"

@@ -322,7 +322,7 @@ def _check_list(s: Spec, v: Any, ctx: _Ctx, path: str) -> tuple:
     unit = f" {s.unit}" if s.unit else ""
     count = (f"at least {s.min_items}" + (f" and at most {s.max_items}" if s.max_items else ""))
     if s.kind == "points":
-        what = f"a list ({count} entries) of [{', '.join('xyzw'[:s.n])}] pairs of numbers in " \
+        what = f"a list ({count} entries) of [{'x, z' if s.n == 2 else ', '.join('xyz'[:s.n])}] pairs of numbers in " \
                f"[{s.lo:g}, {s.hi:g}]{unit}"
         if (not isinstance(v, (list, tuple)) or len(v) < s.min_items
                 or (s.max_items and len(v) > s.max_items)

@@ -136,7 +136,9 @@ def _scale(unit: dict, b: Bounds) -> dict:
 
 
 def _pair_pose(err: dict, pair: tuple[int, int]) -> tuple[np.ndarray, dict]:
-    q = list(pair)
+    # an adjacent pair as a slice (a view: with two front ends the very array the pair study
+    # evaluates, so the sums round alike and the results agree bit for bit)
+    q = slice(pair[0], pair[0] + 2) if pair[1] == pair[0] + 1 else list(pair)
     pose = {"yaw_rad": None if err["yaw_rad"] is None else err["yaw_rad"][:, q],
             "pitch_rad": None if err["pitch_rad"] is None else err["pitch_rad"][:, q],
             "rut_offset_m": err["rut_offset_m"], "rut_yaw_rad": err["rut_yaw_rad"]}
@@ -224,6 +226,7 @@ class ArcResult:
         arrays.update(pairs=np.array(self.pairs), delay_s=self.delay_s,
                       range_offset_m=self.range_offset_m, spec_deg=np.float64(self.spec_deg))
         path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_name(path.name + ".part")
         with open(tmp, "wb") as fh:
             np.savez_compressed(fh, **arrays)

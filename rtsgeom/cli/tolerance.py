@@ -18,7 +18,7 @@ from ..geometry import build_setup
 from ..io import write_json
 from ..parallel import dask_client, map_chunks
 from ._common import UsageError, load_scene_checked, number, print_json, scene_arg
-from .aoa import _pair
+from .aoa import _pair, _pair_arg, _pairs
 
 MAX_SIGMA_MM = 10.0  # the phasor model is first order in the errors; checked to 0.3 mm
 
@@ -72,11 +72,33 @@ def _model(scene, pair_arg, points: int) -> PairPhasors:
                          f"({exc})") from None
 
 
+def _scales(args) -> tuple[np.ndarray, dict]:
+    """The per-axis scales (m: the sigma, or the uniform bound) from the old ``--sigma-*-mm``
+    flags or the new tolerance flags (``--radial-mm 0.2 --sigma-level 3``: +-0.2 mm at 3
+    sigma), and the rotation / RuT-pose tolerances (SI) of the new flags."""
+    k = 1.0 / args.sigma_level if args.distribution == "normal" else 1.0
+    sigma = []
+    for axis in AXES:
+        old, new = getattr(args, f"sigma_{axis}_mm"), getattr(args, f"{axis}_mm")
+        if old is not None and new is not None:
+            raise UsageError(f"--sigma-{axis}-mm and --{axis}-mm: give one of them (the first is "
+                             "the scale itself, the second a tolerance at --sigma-level)")
+        sigma.append(old if old is not None else (k * new if new is not None else 0.1))
+    extra = {"yaw_rad": np.radians(args.yaw_deg), "pitch_rad": np.radians(args.pitch_deg),
+             "rut_position_m": (args.rut_position_mm * 1e-3,) * 3,
+             "rut_yaw_rad": np.radians(args.rut_yaw_deg)}
+    return np.array(sigma) * 1e-3, extra
+
+
 def cmd_tolerance(args) -> int:
     scene = load_scene_checked(args.scene)
+    sigma, extra = _scales(args)
+    arc = (list(args.pair) == ["all"] or any(v for v in (args.yaw_deg, args.pitch_deg,
+                                                          args.rut_position_mm, args.rut_yaw_deg)))
+    if arc:
+        return _tolerance_arc(args, scene, sigma, extra)
     model = _model(scene, args.pair, args.points)
     seed = scene.seed if args.seed is None else args.seed
-    sigma = np.array([args.sigma_radial_mm, args.sigma_tangential_mm, args.sigma_height_mm]) * 1e-3
     cases = CASES + ((NOMINAL_AMPLITUDES,) if args.nominal_amplitudes else ())
     t0 = time.perf_counter()
     with _progress(args.quiet) as progress, dask_client(args.dask, args.workers) as client:
@@ -104,6 +126,7 @@ def cmd_tolerance(args) -> int:
                            f"±{lim:.2g} deg)")
         save_figure(fig, args.out / "tolerance.png")
         write_json(args.out / "tolerance.json", out)
+        _save_pair_npz(args.out / "tolerance_draws.npz", res, seed)
     if args.json:
         print_json(out)
         return 0
@@ -124,6 +147,82 @@ def cmd_tolerance(args) -> int:
         sig = ", ".join(f"{a} {inv['sigma_mm'][a]:.4g}" for a in AXES)
         print(f"  {100 * args.invert_yield:g} % within {args.spec_deg:g} deg, {case}: {scale} "
               f"{sig} mm{' (search cap)' if inv['capped'] else ''}")
+    return 0
+
+
+def _save_pair_npz(path: Path, res, seed: int) -> None:
+    """Per-draw offsets (draws, 2, 3) m and worst errors (deg) of a pair study (NPZ)."""
+    from ..analysis.tolerance import draw_offsets
+    off = draw_offsets(seed, res.draws, res.sigma_m, res.distribution)
+    arrays = {"offsets_m": off, "pairs": np.array([res.model.pair]),
+              "delay_s": res.delay_s[:, None], "range_offset_m": res.range_offset_m[:, None]}
+    arrays.update({f"{case}_deg": v[:, None] for case, v in res.worst_error_deg.items()})
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".part")
+    with open(tmp, "wb") as fh:
+        np.savez_compressed(fh, **arrays)
+    tmp.replace(path)
+
+
+def _tolerance_arc(args, scene, sigma, extra) -> int:
+    """``--pair all`` (or rotation / RuT-pose errors): every pair on shared per-front-end
+    draws (``analysis.arc``); one JSON entry per pair plus the arc's yield."""
+    from ..analysis.arc import Bounds, arc_models, arc_monte_carlo
+    setup = build_setup(scene)
+    pairs = _pairs(setup, args.pair)
+    seed = scene.seed if args.seed is None else args.seed
+    cases = CASES + ((NOMINAL_AMPLITUDES,) if args.nominal_amplitudes else ())
+    k = 1.0 / args.sigma_level if args.distribution == "normal" else 1.0
+    bounds = Bounds(tuple(float(x) for x in sigma), k * extra["yaw_rad"],
+                    k * extra["pitch_rad"], tuple(k * x for x in extra["rut_position_m"]),
+                    k * extra["rut_yaw_rad"])
+    if args.invert_yield is not None:
+        raise UsageError("--invert-yield: only for one pair without rotation or RuT-pose errors "
+                         "so far (rtsgeom design --coverage-deg finds the arc's tolerance)")
+    t0 = time.perf_counter()
+    try:
+        models = arc_models(setup, pairs, args.points)
+    except ValueError as exc:
+        raise UsageError(f"--pair: a pair cannot synthesize its span ({exc})") from None
+    with _progress(args.quiet) as progress, dask_client(args.dask, args.workers) as client:
+        mapper = None if client is None else functools.partial(map_chunks, client=client)
+        res = arc_monte_carlo(models, setup.fe.count, bounds, args.draws, seed,
+                              args.distribution, args.spec_deg, cases, args.chunk,
+                              keep_errors=bool(args.out), progress=progress,
+                              label="Monte Carlo (arc)", mapper=mapper)
+    out = res.to_dict()
+    out["sigma_level"] = args.sigma_level if args.distribution == "normal" else None
+    elapsed = time.perf_counter() - t0
+    if args.out:
+        from ..viz.figures import save_figure, tolerance_histogram_figure
+        p95 = max(out["arc"][case]["angle_error_deg"]["p95"] for case in cases)
+        lim = max(5 * args.spec_deg, 1.2 * p95)
+        fig = tolerance_histogram_figure(
+            {case: np.clip(res.arc_worst(case), -lim, lim) for case in cases}, args.spec_deg,
+            f"Worst error per arc ({len(pairs)} pairs, clipped at ±{lim:.2g} deg)")
+        save_figure(fig, args.out / "tolerance.png")
+        write_json(args.out / "tolerance.json", out)
+        res.save_npz(args.out / "tolerance_draws.npz")
+    if args.json:
+        print_json(out)
+        return 0
+    sc = out["scales"]
+    kind = "sigma" if args.distribution == "normal" else "bound"
+    print(f"arc of {setup.fe.count} front ends, {len(pairs)} pair(s), {args.draws} draws "
+          f"({args.distribution}, {kind}: radial {sc['radial_mm']:.4g}, tangential "
+          f"{sc['tangential_mm']:.4g}, height {sc['height_mm']:.4g} mm, yaw {sc['yaw_deg']:.4g}, "
+          f"pitch {sc['pitch_deg']:.4g} deg per front end; RuT position "
+          f"{sc['rut_position_mm'][0]:.4g} mm, yaw {sc['rut_yaw_deg']:.4g} deg), "
+          f"{elapsed:.2f} s")
+    for entry in out["pairs"]:
+        print(f"  pair {tuple(entry['pair'])}: " + "; ".join(
+            f"{case} p95 {entry[case]['angle_error_deg']['p95']:.4f} deg, yield "
+            f"{100 * entry[case]['yield']:.2f} %" for case in cases))
+    for case in cases:
+        a = out["arc"][case]
+        print(f"  ARC {case:>28}: |worst error| p50 {a['angle_error_deg']['p50']:.4f}, p95 "
+              f"{a['angle_error_deg']['p95']:.4f}, max {a['angle_error_deg']['max']:.4f} deg; "
+              f"yield {100 * a['yield']:.2f} % (every pair within {args.spec_deg:g} deg)")
     return 0
 
 
@@ -168,10 +267,15 @@ def cmd_design(args) -> int:
     return 0
 
 
-def _common(p, draws_default: int) -> None:
+def _common(p, draws_default: int, allow_all: bool = False) -> None:
     scene_arg(p)
-    p.add_argument("--pair", nargs=2, type=number(0, 10_000, integer=True), metavar=("I", "J"),
-                   default=[0, 1], help="adjacent front ends (default 0 1)")
+    if allow_all:
+        p.add_argument("--pair", nargs="+", type=_pair_arg, metavar="I J | all",
+                       default=[0, 1], help="adjacent front ends (default 0 1), or all: every "
+                                            "adjacent pair on shared per-front-end draws")
+    else:
+        p.add_argument("--pair", nargs=2, type=number(0, 10_000, integer=True),
+                       metavar=("I", "J"), default=[0, 1], help="adjacent front ends (default 0 1)")
     p.add_argument("--spec-deg", type=number(1e-6, 90.0), default=0.1,
                    help="angle-error spec in deg, in [1e-6, 90] (default 0.1)")
     p.add_argument("--draws", type=number(1, 10_000_000, integer=True), default=draws_default,
@@ -186,13 +290,30 @@ def _common(p, draws_default: int) -> None:
 
 
 def register(sub) -> None:
-    p = sub.add_parser("tolerance", help="mounting-tolerance Monte Carlo of a front-end pair")
-    _common(p, 10_000)
+    p = sub.add_parser("tolerance", help="mounting-tolerance Monte Carlo of a front-end pair "
+                                         "or a whole arc")
+    _common(p, 10_000, allow_all=True)
     mm = number(0.0, MAX_SIGMA_MM)
     for axis in AXES:
-        p.add_argument(f"--sigma-{axis}-mm", type=mm, default=0.1,
+        p.add_argument(f"--sigma-{axis}-mm", type=mm, default=None,
                        help=f"{axis} mounting error per front end in mm, in [0, {MAX_SIGMA_MM:g}]: "
                             "the standard deviation (normal) or the bound (uniform) (default 0.1)")
+    for axis in AXES:
+        p.add_argument(f"--{axis}-mm", type=mm, default=None, metavar="TOL",
+                       help=f"{axis} mounting tolerance +-TOL mm at --sigma-level sigmas (normal; "
+                            "uniform: the bound), instead of --sigma-" + axis + "-mm")
+    deg = number(0.0, 10.0)
+    p.add_argument("--yaw-deg", type=deg, default=0.0, metavar="TOL",
+                   help="front-end yaw tolerance, deg, in [0, 10], drawn per front end (default 0)")
+    p.add_argument("--pitch-deg", type=deg, default=0.0, metavar="TOL",
+                   help="front-end pitch tolerance, deg, in [0, 10] (default 0)")
+    p.add_argument("--rut-position-mm", type=mm, default=0.0, metavar="TOL",
+                   help="RuT position tolerance (each of x, y, z), mm (default 0)")
+    p.add_argument("--rut-yaw-deg", type=deg, default=0.0, metavar="TOL",
+                   help="RuT yaw tolerance, deg (default 0)")
+    p.add_argument("--sigma-level", type=number(0.1, 10.0), default=3.0,
+                   help="the tolerances above are this many sigmas of a normal distribution "
+                        "(default 3: '+-0.2 mm at 3 sigma'); ignored for uniform")
     p.add_argument("--distribution", choices=DISTRIBUTIONS, default="normal",
                    help="error distribution (default normal)")
     p.add_argument("--invert-yield", type=number(1e-6, 1.0), default=None, metavar="Y",
