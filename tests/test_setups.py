@@ -342,3 +342,40 @@ def test_nearfield_bias_sign_follows_the_front_end_layout():
     # the rest of the bias (RuT parallax, beat frequency) does not depend on the FE layout's sign
     shift = b.bias_deg - a.bias_deg
     assert np.allclose(shift, 2 * b.separation_deg, rtol=0.15)
+
+
+# ------------------------------------------------------------------------------------------
+# Arc design for N front ends
+# ------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("radius_m", [0.2, 1.0])
+def test_coverage_plan_respects_resolution_bias_and_cutouts(radius_m):
+    """The planned arc: spacing within the resolution (eq. 24), the outer front ends' detected
+    angles reach the coverage (bias compensated), and the sheet removed exactly when the
+    cutouts cannot fit the spacing."""
+    from rtsgeom.analysis.coverage import plan_arc, _bias_rad
+    scene = load_scene(DEFAULT)
+    cov = (math.radians(-10.0), math.radians(10.0))
+    for extra in (0, 1):
+        plan = plan_arc(scene, cov, radius_m, extra)
+        assert plan["spacing_deg"] <= plan["resolution_deg"] * (1 + 1e-9)
+        detected = np.degrees(np.radians(plan["angles_deg"]) + _bias_rad(plan["scene"]))
+        assert detected[0] <= -10.0 + 0.02 and detected[-1] >= 10.0 - 0.02
+        fits = plan["spacing_deg"] >= plan["min_cutout_spacing_deg"]
+        assert (plan["sheet"] == "disabled") == (not fits)
+        assert ("cutout fit" in plan["binding"]) == (not fits)
+        assert plan["front_ends"] == math.ceil(
+            (plan["angles_deg"][-1] - plan["angles_deg"][0]) / plan["resolution_deg"]
+            - 1e-9) + 1 + extra
+
+
+def test_design_coverage_cli_prints_the_sheet_change(tmp_path, capsys):
+    rc = main(["design", str(DEFAULT), "--coverage-deg", "-10:10", "--radius-m", "0.2:0.2:1",
+               "--draws", "20", "--points", "3", "--quiet", "--out", str(tmp_path)])
+    assert rc == 0
+    text = capsys.readouterr().out
+    assert "sheet REMOVED" in text and "cutout fit" in text and "best per radius" in text
+    out = json.loads((tmp_path / "coverage.json").read_text())
+    assert out["best"][0]["front_ends"] >= 3
+    assert (tmp_path / "coverage_worst_calibrated_deg.png").is_file()
