@@ -379,3 +379,26 @@ def test_design_coverage_cli_prints_the_sheet_change(tmp_path, capsys):
     out = json.loads((tmp_path / "coverage.json").read_text())
     assert out["best"][0]["front_ends"] >= 3
     assert (tmp_path / "coverage_worst_calibrated_deg.png").is_file()
+
+
+@pytest.mark.slow
+def test_calibrate_and_linearity_pair_all(tmp_path, capsys):
+    """``--pair all``: one entry per adjacent pair plus the arc's summary, each entry the same
+    as the single-pair command gives (same seed)."""
+    text = _small(_with_front_ends([0.0, 8.0, 16.0]))
+    text = text[:text.index("[[targets]]")]
+    p = tmp_path / "arc3.toml"
+    p.write_text(text)
+    assert main(["calibrate", str(p), "--pair", "all", "--json", "--quiet"]) == 0
+    arc = json.loads(capsys.readouterr().out)
+    assert [e["pair"] for e in arc["pairs"]] == [[0, 1], [1, 2]]
+    assert main(["calibrate", str(p), "--pair", "1", "2", "--json", "--quiet"]) == 0
+    one = json.loads(capsys.readouterr().out)
+    assert arc["pairs"][1]["delta_tau_s"] == one["delta_tau_s"]
+    assert arc["arc"]["worst_residual_error_deg"] == max(
+        abs(e["residual_error_deg"]) for e in arc["pairs"])
+    assert main(["linearity", str(p), "--pair", "all", "--points", "3", "--uncalibrated",
+                 "--json", "--quiet"]) == 0
+    lin = json.loads(capsys.readouterr().out)
+    assert len(lin["pairs"]) == 2 and lin["arc"]["calibrated"] is False
+    assert main(["calibrate", str(p), "--pair", "0", "2", "--quiet"]) == 2
