@@ -99,8 +99,11 @@ def scene_warnings(scene: Scene) -> list[str]:
     d = rut.spacing_m
     if d > 0.5 * lam * (1.0 + 1e-9):
         fov = math.degrees(math.asin(min(1.0, lam / (2.0 * d))))
-        warn("radar.element_spacing_m", radar.element_spacing_m,
-             f"more than lambda/2 = {0.5 * lam:.4g} m: angles beyond +-{fov:.3g} deg are "
+        custom = getattr(radar, "array", None) is not None
+        warn("radar.array.rx_mm" if custom else "radar.element_spacing_m",
+             d if custom else radar.element_spacing_m,
+             f"{'the grid unit (smallest virtual gap) ' if custom else ''}more than lambda/2 = "
+             f"{0.5 * lam:.4g} m: angles beyond +-{fov:.3g} deg are "
              "ambiguous (grating lobes)")
 
     # The RTS back end samples the IF band [f_rts - B/2, f_rts + B/2] at f_s.

@@ -402,3 +402,22 @@ def test_calibrate_and_linearity_pair_all(tmp_path, capsys):
     lin = json.loads(capsys.readouterr().out)
     assert len(lin["pairs"]) == 2 and lin["arc"]["calibrated"] is False
     assert main(["calibrate", str(p), "--pair", "0", "2", "--quiet"]) == 2
+
+
+@pytest.mark.parametrize("name", ["awr1843boost", "awr2243-cascade"])
+def test_array_factor_closed_form_counts_distinct_positions(name):
+    """The array-factor mode's closed form is sized from the distinct azimuth positions (86 for
+    the cascade's 144 elements), and the position form equals the lambda/2 closed form."""
+    from rtsgeom.aoa.model import _af_size
+    from rtsgeom.aoa.synthesis import array_factor
+    scene = load_scene(DEFAULT)
+    scene = scene.evolve(radar=scene.radar.evolve(antenna_preset=name))
+    rut = build_setup(scene).rut
+    n, _, pos = _af_size(rut)
+    assert pos is None and n == PRESETS[name].num_azimuth_unique
+    u = np.linspace(-0.3, 0.3, 41)
+    x = rut.azimuth_positions_m / rut.wavelength_m
+    assert np.allclose(array_factor(u, n), array_factor(u, positions_wl=x), atol=1e-12)
+    custom = build_setup(load_scene(CUSTOM)).rut
+    n, _, pos = _af_size(custom)
+    assert n == 0 and pos.size == 10
