@@ -411,7 +411,7 @@ def test_array_factor_closed_form_counts_distinct_positions(name):
     from rtsgeom.aoa.model import _af_size
     from rtsgeom.aoa.synthesis import array_factor
     scene = load_scene(DEFAULT)
-    scene = scene.evolve(radar=scene.radar.evolve(antenna_preset=name))
+    scene = scene.evolve(radar=scene.radar.evolve(antenna_preset=name), targets=())
     rut = build_setup(scene).rut
     n, _, pos = _af_size(rut)
     assert pos is None and n == PRESETS[name].num_azimuth_unique
