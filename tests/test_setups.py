@@ -421,3 +421,63 @@ def test_array_factor_closed_form_counts_distinct_positions(name):
     custom = build_setup(load_scene(CUSTOM)).rut
     n, _, pos = _af_size(custom)
     assert n == 0 and pos.size == 10
+
+
+def test_rut_pattern_enters_the_synthesis_design():
+    """A cos pattern on the RuT's elements weights front end q by its two-way field gain
+    g(theta_q)^2 (Tx element towards its Rx antenna, Rx element towards its Tx antenna): the
+    exact design's amplitude ratio A_J / A_I changes by (g_I / g_J)^2 and the synthesized
+    angles stay on target."""
+    from rtsgeom.geometry.patterns import CosinePattern
+    iso_scene = load_scene(DEFAULT)
+    s = _text().replace("[radar.cfar]", '[radar.pattern]\nkind = "cos"\nhpbw_deg = 30.0\n\n'
+                                        "[radar.cfar]")
+    pat_scene = loads_scene(s, "x.toml")
+    iso = PairPhasors.build(build_setup(iso_scene), (0, 1), 3)
+    pat = PairPhasors.build(build_setup(pat_scene), (0, 1), 3)
+    g = CosinePattern(math.radians(30.0)).field(
+        np.stack([np.sin(iso.setup.fe_azimuth_rad()), np.cos(iso.setup.fe_azimuth_rad()),
+                  np.zeros(2)], -1)).real
+    r_iso = iso.amplitudes[:, 1] / iso.amplitudes[:, 0]
+    r_pat = pat.amplitudes[:, 1] / pat.amplitudes[:, 0]
+    assert np.allclose(r_pat / r_iso, (g[0] / g[1]) ** 2, rtol=0.02)
+    assert np.max(np.abs(pat.angle_errors(np.zeros((2, 3)), "calibrated"))) < 0.01
+
+
+def test_front_end_pattern_table_from_the_scene_folder(tmp_path):
+    az = np.arange(-90, 91, 10.0)
+    el = np.array([-45.0, 0.0, 45.0])
+    rows = ["azimuth_deg,elevation_deg,gain_db,phase_deg"]
+    rows += [f"{a},{e},{-0.01 * a * a},{0.5 * a}" for a in az for e in el]
+    (tmp_path / "fe.csv").write_text("\n".join(rows) + "\n")
+    text = _text().replace("[sheet]", '[rts.pattern]\nkind = "table"\ntable = "fe.csv"\n\n[sheet]')
+    (tmp_path / "s.toml").write_text(text)
+    scene = load_scene(tmp_path / "s.toml")
+    assert Path(scene.rts.pattern.table) == (tmp_path / "fe.csv").resolve()
+    from rtsgeom.geometry.patterns import AntennaPatterns, TablePattern
+    setup = build_setup(scene)
+    table = TablePattern.from_csv(tmp_path / "fe.csv")
+    a = exact_paths(setup)
+    b = exact_paths(setup, AntennaPatterns(fe_rx=table, fe_tx=table))
+    assert np.array_equal(a.gain, b.gain)
+    assert not np.allclose(a.gain, exact_paths(setup, AntennaPatterns()).gain)
+
+
+def test_raytrace_refuses_patterns_it_cannot_take():
+    from rtsgeom.paths.raytrace import raytrace_paths
+    s = _text().replace("[sheet]", '[rts.pattern]\nkind = "cos"\nhpbw_deg = 60.0\n\n[sheet]')
+    with pytest.raises(SceneError, match=r"rts\.pattern\.kind.*isotropic with --paths raytrace"):
+        raytrace_paths(build_setup(loads_scene(s, "x.toml")))
+
+
+def test_rut_yaw_error_shifts_every_synthesized_angle():
+    """A RuT yaw error turns the frame it measures in: every detected angle moves by -yaw,
+    which no calibration of the RTS removes (closed form, per draw)."""
+    setup = build_setup(load_scene(DEFAULT))
+    model = PairPhasors.build(setup, (0, 1), 3)
+    yaw = math.radians(0.05)
+    res = arc_monte_carlo([model], 2, Bounds(rut_yaw_rad=yaw), 40, 5, "uniform", 0.1,
+                          keep_errors=True)
+    drawn = np.degrees(res.errors["rut_yaw_rad"])
+    for case in ("uncalibrated", "calibrated"):
+        assert np.allclose(res.worst_error_deg[case][:, 0], -drawn, atol=2e-3)
