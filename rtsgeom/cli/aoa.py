@@ -16,6 +16,14 @@ from ..registry import SYNTHESIS_MODES
 from ._common import UsageError, load_scene_checked, number, print_json, scene_arg, steps
 
 
+def _folder(out):
+    """``--out DIR`` for the whole-arc commands (``cli/arc.py``): the folder, or None."""
+    if out is None:
+        return None
+    out.mkdir(parents=True, exist_ok=True)
+    return out
+
+
 def _pair_arg(text: str):
     """argparse type of one ``--pair`` word: an index in [0, 10000] or ``all``."""
     if text == "all":
@@ -55,7 +63,8 @@ def _prepare(args):
 
 def cmd_calibrate(args) -> int:
     if list(args.pair) == ["all"]:
-        return _calibrate_all(args)
+        from .arc import calibrate_all
+        return calibrate_all(args, _folder(args.out))
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
         scene, setup, pair, paths, probe = _prepare(args)
@@ -75,48 +84,6 @@ def cmd_calibrate(args) -> int:
     return 0
 
 
-def _prepare_all(args):
-    """``--pair all``: scene, setup, every adjacent pair, paths, each front end alone."""
-    scene = load_scene_checked(args.scene)
-    setup = build_setup(scene)
-    pairs = _pairs(setup, args.pair)
-    paths = exact_paths(setup)
-    return scene, setup, pairs, paths, probe_front_ends(setup, paths, scene.seed)
-
-
-def _calibrate_all(args) -> int:
-    """Every adjacent pair calibrated in one run; one JSON entry per pair plus the arc's."""
-    with steps(args.quiet or args.json) as step:
-        step("measuring each front end alone")
-        scene, setup, pairs, paths, probe = _prepare_all(args)
-        cals = []
-        for pair in pairs:
-            step(f"sweeping the delay of front end {pair[1]} (pair {pair})")
-            cals.append(calibrate_pair(setup, paths, pair, probe, seed=scene.seed))
-    res = [abs(c.residual_error_deg) for c in cals]
-    out = {"pairs": [c.to_dict() for c in cals],
-           "front_end_angles_deg": [float(x) for x in np.degrees(probe.angle_rad)],
-           "arc": {"pairs": [list(p) for p in pairs], "worst_residual_error_deg": max(res),
-                   "worst_pair": list(pairs[int(np.argmax(res))]),
-                   "max_abs_range_offset_mm": max(abs(c.range_offset_m) for c in cals) * 1e3}}
-    if args.out:
-        from ..viz.figures import calibration_sweep_figure, save_figure
-        for pair, cal in zip(pairs, cals):
-            save_figure(calibration_sweep_figure(cal.sweep_delta_tau_s, cal.sweep_error_deg,
-                                                 cal.delta_tau_s, cal.period_s),
-                        args.out / f"calibration_sweep_{pair[0]}_{pair[1]}.png")
-        write_json(args.out / "calibration.json", out)
-    if args.json:
-        print_json(out)
-        return 0
-    for pair, cal in zip(pairs, cals):
-        print(f"pair {pair}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps, residual angle error "
-              f"{cal.residual_error_deg:.4f} deg, range offset {cal.range_offset_m * 1e3:.2f} mm")
-    print(f"arc ({len(pairs)} pairs): worst residual {out['arc']['worst_residual_error_deg']:.4f} "
-          f"deg (pair {tuple(out['arc']['worst_pair'])})")
-    return 0
-
-
 def _emit(args, png: str, name: str, out: dict, figure, summary_line: str) -> None:
     """``--out DIR``: DIR/<png> (from ``figure()``) and DIR/<name>.json; then JSON or one
     summary line on stdout."""
@@ -132,7 +99,8 @@ def _emit(args, png: str, name: str, out: dict, figure, summary_line: str) -> No
 
 def cmd_linearity(args) -> int:
     if list(args.pair) == ["all"]:
-        return _linearity_all(args)
+        from .arc import linearity_all
+        return linearity_all(args, _folder(args.out))
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
         scene, setup, pair, paths, probe = _prepare(args)
@@ -149,44 +117,6 @@ def cmd_linearity(args) -> int:
     _emit(args, "linearity.png", "linearity", lin.to_dict(), figure,
           f"{args.amplitudes} ({'calibrated' if cal else 'uncalibrated'}): max |error| "
           f"{lin.max_abs_error_deg:.4f} deg over {len(lin.set_deg)} set-points")
-    return 0
-
-
-def _linearity_all(args) -> int:
-    """Every adjacent pair's linearity in one run; one JSON entry per pair plus the arc's."""
-    with steps(args.quiet or args.json) as step:
-        step("measuring each front end alone")
-        scene, setup, pairs, paths, probe = _prepare_all(args)
-        lins = []
-        for pair in pairs:
-            cal = None
-            if not args.uncalibrated:
-                step(f"calibrating pair {pair}")
-                cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
-            step(f"pair {pair}: sweeping {args.points} set-points ({args.amplitudes} amplitudes)")
-            lins.append(linearity(setup, paths, pair, args.amplitudes, probe, cal, args.points,
-                                  scene.seed))
-    worst = [lin.max_abs_error_deg for lin in lins]
-    out = {"pairs": [lin.to_dict() for lin in lins],
-           "arc": {"pairs": [list(p) for p in pairs], "max_abs_error_deg": max(worst),
-                   "worst_pair": list(pairs[int(np.argmax(worst))]),
-                   "calibrated": not args.uncalibrated, "amplitudes": args.amplitudes}}
-    if args.out:
-        from ..viz.figures import linearity_figure, save_figure
-        for pair, lin in zip(pairs, lins):
-            save_figure(linearity_figure(lin.set_deg, {args.amplitudes: lin.detected_deg},
-                                         {args.amplitudes: lin.amplitude_db}),
-                        args.out / f"linearity_{pair[0]}_{pair[1]}.png")
-        write_json(args.out / "linearity.json", out)
-    if args.json:
-        print_json(out)
-        return 0
-    state = "uncalibrated" if args.uncalibrated else "calibrated"
-    for pair, lin in zip(pairs, lins):
-        print(f"pair {pair}: {args.amplitudes} ({state}): max |error| "
-              f"{lin.max_abs_error_deg:.4f} deg over {len(lin.set_deg)} set-points")
-    print(f"arc ({len(pairs)} pairs): max |error| {max(worst):.4f} deg (pair "
-          f"{tuple(out['arc']['worst_pair'])})")
     return 0
 
 

@@ -18,7 +18,8 @@ from ..geometry import build_setup
 from ..io import write_json
 from ..parallel import dask_client, map_chunks
 from ._common import UsageError, load_scene_checked, number, print_json, scene_arg
-from .aoa import _pair, _pair_arg, _pairs
+from .aoa import _pair, _pair_arg
+from .arc import coverage_spec
 
 MAX_SIGMA_MM = 10.0  # the phasor model is first order in the errors; checked to 0.3 mm
 
@@ -72,31 +73,13 @@ def _model(scene, pair_arg, points: int) -> PairPhasors:
                          f"({exc})") from None
 
 
-def _scales(args) -> tuple[np.ndarray, dict]:
-    """The per-axis scales (m: the sigma, or the uniform bound) from the old ``--sigma-*-mm``
-    flags or the new tolerance flags (``--radial-mm 0.2 --sigma-level 3``: +-0.2 mm at 3
-    sigma), and the rotation / RuT-pose tolerances (SI) of the new flags."""
-    k = 1.0 / args.sigma_level if args.distribution == "normal" else 1.0
-    sigma = []
-    for axis in AXES:
-        old, new = getattr(args, f"sigma_{axis}_mm"), getattr(args, f"{axis}_mm")
-        if old is not None and new is not None:
-            raise UsageError(f"--sigma-{axis}-mm and --{axis}-mm: give one of them (the first is "
-                             "the scale itself, the second a tolerance at --sigma-level)")
-        sigma.append(old if old is not None else (k * new if new is not None else 0.1))
-    extra = {"yaw_rad": np.radians(args.yaw_deg), "pitch_rad": np.radians(args.pitch_deg),
-             "rut_position_m": (args.rut_position_mm * 1e-3,) * 3,
-             "rut_yaw_rad": np.radians(args.rut_yaw_deg)}
-    return np.array(sigma) * 1e-3, extra
-
-
 def cmd_tolerance(args) -> int:
     scene = load_scene_checked(args.scene)
-    sigma, extra = _scales(args)
-    arc = (list(args.pair) == ["all"] or any(v for v in (args.yaw_deg, args.pitch_deg,
-                                                          args.rut_position_mm, args.rut_yaw_deg)))
-    if arc:
-        return _tolerance_arc(args, scene, sigma, extra)
+    from .arc import save_pair_npz, scales, tolerance_arc, wants_arc
+    sigma, extra = scales(args)
+    if wants_arc(args):
+        from .aoa import _folder
+        return tolerance_arc(args, scene, sigma, extra, _folder(args.out))
     model = _model(scene, args.pair, args.points)
     seed = scene.seed if args.seed is None else args.seed
     cases = CASES + ((NOMINAL_AMPLITUDES,) if args.nominal_amplitudes else ())
@@ -126,7 +109,7 @@ def cmd_tolerance(args) -> int:
                            f"±{lim:.2g} deg)")
         save_figure(fig, args.out / "tolerance.png")
         write_json(args.out / "tolerance.json", out)
-        _save_pair_npz(args.out / "tolerance_draws.npz", res, seed)
+        save_pair_npz(args.out / "tolerance_draws.npz", res, seed)
     if args.json:
         print_json(out)
         return 0
@@ -150,164 +133,13 @@ def cmd_tolerance(args) -> int:
     return 0
 
 
-def _save_pair_npz(path: Path, res, seed: int) -> None:
-    """Per-draw offsets (draws, 2, 3) m and worst errors (deg) of a pair study (NPZ)."""
-    from ..analysis.tolerance import draw_offsets
-    off = draw_offsets(seed, res.draws, res.sigma_m, res.distribution)
-    arrays = {"offsets_m": off, "pairs": np.array([res.model.pair]),
-              "delay_s": res.delay_s[:, None], "range_offset_m": res.range_offset_m[:, None]}
-    arrays.update({f"{case}_deg": v[:, None] for case, v in res.worst_error_deg.items()})
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".part")
-    with open(tmp, "wb") as fh:
-        np.savez_compressed(fh, **arrays)
-    tmp.replace(path)
-
-
-def _tolerance_arc(args, scene, sigma, extra) -> int:
-    """``--pair all`` (or rotation / RuT-pose errors): every pair on shared per-front-end
-    draws (``analysis.arc``); one JSON entry per pair plus the arc's yield."""
-    from ..analysis.arc import Bounds, arc_models, arc_monte_carlo
-    setup = build_setup(scene)
-    pairs = _pairs(setup, args.pair)
-    seed = scene.seed if args.seed is None else args.seed
-    cases = CASES + ((NOMINAL_AMPLITUDES,) if args.nominal_amplitudes else ())
-    k = 1.0 / args.sigma_level if args.distribution == "normal" else 1.0
-    bounds = Bounds(tuple(float(x) for x in sigma), k * extra["yaw_rad"],
-                    k * extra["pitch_rad"], tuple(k * x for x in extra["rut_position_m"]),
-                    k * extra["rut_yaw_rad"])
-    if args.invert_yield is not None:
-        raise UsageError("--invert-yield: only for one pair without rotation or RuT-pose errors "
-                         "so far (rtsgeom design --coverage-deg finds the arc's tolerance)")
-    t0 = time.perf_counter()
-    try:
-        models = arc_models(setup, pairs, args.points)
-    except ValueError as exc:
-        raise UsageError(f"--pair: a pair cannot synthesize its span ({exc})") from None
-    with _progress(args.quiet) as progress, dask_client(args.dask, args.workers) as client:
-        mapper = None if client is None else functools.partial(map_chunks, client=client)
-        res = arc_monte_carlo(models, setup.fe.count, bounds, args.draws, seed,
-                              args.distribution, args.spec_deg, cases, args.chunk,
-                              keep_errors=bool(args.out), progress=progress,
-                              label="Monte Carlo (arc)", mapper=mapper)
-    out = res.to_dict()
-    out["sigma_level"] = args.sigma_level if args.distribution == "normal" else None
-    elapsed = time.perf_counter() - t0
-    if args.out:
-        from ..viz.figures import save_figure, tolerance_histogram_figure
-        p95 = max(out["arc"][case]["angle_error_deg"]["p95"] for case in cases)
-        lim = max(5 * args.spec_deg, 1.2 * p95)
-        fig = tolerance_histogram_figure(
-            {case: np.clip(res.arc_worst(case), -lim, lim) for case in cases}, args.spec_deg,
-            f"Worst error per arc ({len(pairs)} pairs, clipped at ±{lim:.2g} deg)")
-        save_figure(fig, args.out / "tolerance.png")
-        write_json(args.out / "tolerance.json", out)
-        res.save_npz(args.out / "tolerance_draws.npz")
-    if args.json:
-        print_json(out)
-        return 0
-    sc = out["scales"]
-    kind = "sigma" if args.distribution == "normal" else "bound"
-    print(f"arc of {setup.fe.count} front ends, {len(pairs)} pair(s), {args.draws} draws "
-          f"({args.distribution}, {kind}: radial {sc['radial_mm']:.4g}, tangential "
-          f"{sc['tangential_mm']:.4g}, height {sc['height_mm']:.4g} mm, yaw {sc['yaw_deg']:.4g}, "
-          f"pitch {sc['pitch_deg']:.4g} deg per front end; RuT position "
-          f"{sc['rut_position_mm'][0]:.4g} mm, yaw {sc['rut_yaw_deg']:.4g} deg), "
-          f"{elapsed:.2f} s")
-    for entry in out["pairs"]:
-        print(f"  pair {tuple(entry['pair'])}: " + "; ".join(
-            f"{case} p95 {entry[case]['angle_error_deg']['p95']:.4f} deg, yield "
-            f"{100 * entry[case]['yield']:.2f} %" for case in cases))
-    for case in cases:
-        a = out["arc"][case]
-        print(f"  ARC {case:>28}: |worst error| p50 {a['angle_error_deg']['p50']:.4f}, p95 "
-              f"{a['angle_error_deg']['p95']:.4f}, max {a['angle_error_deg']['max']:.4f} deg; "
-              f"yield {100 * a['yield']:.2f} % (every pair within {args.spec_deg:g} deg)")
-    return 0
-
-
-def _coverage_spec(text: str) -> tuple[float, float]:
-    """argparse type for ``--coverage-deg A:B`` (A < B, both in [-80, 80] deg)."""
-    try:
-        a, b = (float(x) for x in text.split(":"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not A:B (azimuths in deg, e.g. "
-                                         "-10:10)") from None
-    if not (-80.0 <= a < b <= 80.0):
-        raise argparse.ArgumentTypeError(f"{text}: need -80 <= A < B <= 80 deg")
-    return a, b
-
-
-COVERAGE_MAPS = {
-    "worst_calibrated_deg": ("worst |angle error| (deg)", "Calibrated, over the coverage"),
-    "worst_uncalibrated_deg": ("worst |angle error| (deg)", "Uncalibrated, over the coverage"),
-    "sigma_mm": ("mounting sigma (mm)", "Tolerance for the yield (whole arc)"),
-    "front_ends": ("front ends", "Number of front ends"),
-}
-
-
-def _cmd_coverage(args, scene) -> int:
-    """``design --coverage-deg A:B``: N front ends per radius (``analysis.coverage``)."""
-    from ..analysis.coverage import best_per_radius, coverage_designs
-    seed = scene.seed if args.seed is None else args.seed
-    draws = args.draws if args.draws is not None else 300
-    with _progress(args.quiet) as progress:
-        grid = coverage_designs(scene, args.coverage_deg, args.radius_m, args.spec_deg,
-                                args.yield_, draws, seed, min(args.points, 11),
-                                progress=None if progress is None else
-                                (lambda done, total: progress("designs", done, total)))
-    out = grid.to_dict()
-    if args.out:
-        from ..viz.figures import design_heatmap_figure, save_figure
-        extras = sorted({d["extra"] for d in grid.designs})
-        for name, (zlabel, title) in COVERAGE_MAPS.items():
-            z = np.full((len(extras), grid.radius_m.size), np.nan)
-            for d in grid.designs:
-                i = int(np.argmin(np.abs(grid.radius_m - d["radius_m"])))
-                v = d.get(name)
-                z[extras.index(d["extra"]), i] = np.nan if v is None else float(v)
-            fig = design_heatmap_figure(
-                grid.radius_m, np.array(extras, float), z, "arc radius R_c (m)",
-                "front ends beyond the fewest", zlabel,
-                f"{title}, coverage {args.coverage_deg[0]:g}..{args.coverage_deg[1]:g} deg")
-            save_figure(fig, args.out / f"coverage_{name}.png")
-        write_json(args.out / "coverage.json", out)
-    if args.json:
-        print_json(out)
-        return 0
-    a, b = args.coverage_deg
-    print(f"coverage {a:g}..{b:g} deg; spec {grid.spec_deg:g} deg; tolerance: "
-          f"{100 * grid.target_yield:g} % of whole arcs within the spec ({draws} draws)")
-    print("worst |angle error| over the coverage (deg): on the nominal arc, and p95 over arcs "
-          "with 0.1 mm sigma mounting errors")
-    print(f"{'R_c m':>6} {'N':>3} {'sp deg':>7} {'res deg':>8} {'cal':>7} {'uncal':>7} "
-          f"{'cal p95':>8} {'unc p95':>8} {'sigma mm':>9}  binding; sheet")
-    best = {id(d) for d in best_per_radius(grid)}
-    for d in grid.designs:
-        def f(key, fmt):
-            v = d.get(key)
-            return format(v, fmt) if v is not None and np.isfinite(v) else "-"
-        mark = "*" if id(d) in best else " "
-        why = ", ".join(d["binding"]) or "-"
-        print(f"{d['radius_m']:6.3g}{mark}{d['front_ends']:3d} {d['spacing_deg']:7.3f} "
-              f"{d['resolution_deg']:8.3f} {f('worst_calibrated_deg', '7.4f')} "
-              f"{f('worst_uncalibrated_deg', '7.4f')} {f('p95_calibrated_at_0.1mm_deg', '8.4f')} "
-              f"{f('p95_uncalibrated_at_0.1mm_deg', '8.4f')} {f('sigma_mm', '9.4f')}"
-              f"{'+' if d.get('sigma_capped') else ' '} {why}; {d['sheet_change']}"
-              + (f"; PROBLEM: {d['problem']}" if d["problem"] else ""))
-    print("best per radius (*): the fewest front ends within the spec after calibration")
-    for d in best_per_radius(grid):
-        print(f"  R_c {d['radius_m']:g} m: {d['front_ends']} front ends at "
-              + ", ".join(f"{x:.2f}" for x in d["angles_deg"])
-              + f" deg; {d['sheet_change']}")
-    return 0
-
-
 def cmd_design(args) -> int:
     from ..analysis.design import METRICS, design_grid
     scene = load_scene_checked(args.scene)
     if args.coverage_deg is not None:
-        return _cmd_coverage(args, scene)
+        from .aoa import _folder
+        from .arc import design_coverage
+        return design_coverage(args, scene, _folder(args.out))
     if args.draws is None:
         args.draws = 2000
     pair = _pair(build_setup(scene), args.pair)
@@ -421,7 +253,7 @@ def register(sub) -> None:
     p.add_argument("--spacing-deg", type=_grid_spec(0.1, 90.0, "deg"),
                    default=np.linspace(4.0, 20.0, 5), metavar="A:B:N",
                    help="front-end spacings, N from A to B deg (default 4:20:5)")
-    p.add_argument("--coverage-deg", type=_coverage_spec, default=None, metavar="A:B",
+    p.add_argument("--coverage-deg", type=coverage_spec, default=None, metavar="A:B",
                    help="design an arc of N front ends covering A..B deg for each --radius-m "
                         "(number of front ends and spacing chosen; --spacing-deg and --pair "
                         "unused)")

@@ -8,7 +8,6 @@ from functools import cached_property
 import numpy as np
 import trimesh
 
-from .._util import frozen
 from ..scene import Scene, arc_centre_m
 from .arc import FrontEnds, front_ends
 from .arrays import RutArray, rut_array
