@@ -7,7 +7,9 @@ import numpy as np
 from . import __version__
 from .geometry import Setup
 from .geometry.farfield import (angular_resolution_rad, aperture_m, apparent_azimuth_rad,
-                                curvature_phase_error_rad, fraunhofer_distance_m)
+                                coarray_period_m, curvature_phase_error_rad,
+                                fraunhofer_distance_m, grating_lobe_directions_rad,
+                                smallest_spacing_m, unambiguous_half_width_rad)
 
 __all__ = ["scene_info", "format_info", "reachable_spans"]
 
@@ -86,7 +88,8 @@ def scene_info(setup: Setup, reachable: bool = False) -> dict:
         "source": s.source,
         "scene_sha256": s.sha256,
         "radar": {
-            "antenna_preset": r.antenna_preset,
+            "antenna_preset": r.antenna_preset if r.array is None else "custom",
+            "array": rut.name,
             "f_c_hz": r.f_c_hz, "bandwidth_hz": r.bandwidth_hz,
             "f_center_hz": r.f_center_hz, "wavelength_m": rut.wavelength_m,
             "slope_hz_per_s": r.slope_hz_per_s,
@@ -104,6 +107,7 @@ def scene_info(setup: Setup, reachable: bool = False) -> dict:
             "fraunhofer_distance_m": fraunhofer_distance_m(rut),
             "arc_radius_m": s.rts.arc_radius_m,
         },
+        "virtual_array": _virtual_array(rut),
         "rts": {
             "f_rts_hz": s.rts.f_rts_hz, "f_s_hz": s.rts.f_s_hz,
             "delay_resolution_s": s.rts.delay_resolution_s,
@@ -135,6 +139,27 @@ def scene_info(setup: Setup, reachable: bool = False) -> dict:
     return out
 
 
+def _virtual_array(rut) -> dict:
+    """The azimuth virtual array as the beamformer sees it: distinct positions (duplicates
+    combined), smallest gap, co-array period, grating lobes at boresight, unambiguous field."""
+    x = rut.azimuth_positions_m
+    period = coarray_period_m(rut)
+    gl = np.degrees(grating_lobe_directions_rad(rut))
+    return {
+        "tx_local_mm": [[float(v) for v in p] for p in rut.tx_local[:, [0, 2]] * 1e3],
+        "rx_local_mm": [[float(v) for v in p] for p in rut.rx_local[:, [0, 2]] * 1e3],
+        "num_azimuth_elements": int(np.count_nonzero(rut.azimuth_mask)),
+        "num_azimuth_unique": int(x.size),
+        "azimuth_positions_mm": [float(v) for v in x * 1e3],
+        "azimuth_positions_wavelengths": [float(v) for v in x / rut.wavelength_m],
+        "smallest_spacing_m": smallest_spacing_m(rut),
+        "coarray_period_m": period,
+        "uniform": bool(x.size > 1 and np.allclose(np.diff(x), np.diff(x)[0], atol=1e-9)),
+        "grating_lobes_deg": [float(v) for v in gl if abs(v) > 1e-9],
+        "unambiguous_half_width_deg": float(np.degrees(unambiguous_half_width_rad(rut))),
+    }
+
+
 def format_info(info: dict) -> str:
     r, ff, rts = info["radar"], info["far_field"], info["rts"]
     lines = [
@@ -150,6 +175,7 @@ def format_info(info: dict) -> str:
         f"far field  aperture d_A {ff['aperture_m'] * 1e3:.2f} mm, angular resolution "
         f"1.22 lambda/d_A = {ff['angular_resolution_deg']:.2f} deg, Fraunhofer distance "
         f"{ff['fraunhofer_distance_m']:.3f} m (arc radius {ff['arc_radius_m']:.3f} m)",
+        _format_virtual(info["virtual_array"], r["wavelength_m"]),
         f"RTS  f_rts {rts['f_rts_hz'] / 1e6:.1f} MHz, f_s {rts['f_s_hz'] / 1e9:.3f} GS/s, delay "
         f"resolution {rts['delay_resolution_s'] * 1e12:.3g} ps, calibration period "
         f"1/(f_rts + B/2) = {rts['calibration_period_s'] * 1e9:.4f} ns",
@@ -204,3 +230,18 @@ def unreachable_warnings(info: dict, skip_outside_geometric: bool = False) -> li
             for t in reach["targets"] if not t["reachable"]
             and not (skip_outside_geometric
                      and not min(geo) - 1e-9 <= t["angle_deg"] <= max(geo) + 1e-9)]
+
+
+def _format_virtual(va: dict, lam: float) -> str:
+    gl = va["grating_lobes_deg"]
+    pos = ", ".join(f"{v:g}" for v in np.round(va["azimuth_positions_wavelengths"], 3))
+    if len(va["azimuth_positions_wavelengths"]) > 24:
+        first = va["azimuth_positions_wavelengths"]
+        pos = (", ".join(f"{v:g}" for v in np.round(first[:10], 3)) + ", ..., "
+               + ", ".join(f"{v:g}" for v in np.round(first[-4:], 3)))
+    return (f"virtual array  {va['num_azimuth_elements']} azimuth elements on "
+            f"{va['num_azimuth_unique']} distinct positions "
+            f"({'uniform' if va['uniform'] else 'NON-UNIFORM'}), at x/lambda = [{pos}]; "
+            f"smallest gap {va['smallest_spacing_m'] * 1e3:.3f} mm; grating lobes at boresight: "
+            + (", ".join(f"{v:+.2f}" for v in gl) + " deg" if gl else "none")
+            + f"; unambiguous +-{va['unambiguous_half_width_deg']:.1f} deg")

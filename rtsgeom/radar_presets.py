@@ -87,6 +87,25 @@ class ArraySpec:
     def num_rx(self) -> int:
         return int(self.rx_m.shape[0])
 
+    def azimuth_virtual_x_m(self) -> np.ndarray:
+        """Distinct azimuth virtual positions x (board frame, m, ascending): the fullest virtual
+        row (ties: the lowest |z|), as ``geometry.arrays.array_from_spec`` chooses it."""
+        order = np.asarray(self.tx_order)
+        vx = (self.tx_m[order, 0][:, None] + self.rx_m[None, :, 0]).ravel()
+        vz = np.round((self.tx_m[order, 1][:, None] + self.rx_m[None, :, 1]).ravel() * 1e9)
+        rows, counts = np.unique(vz, return_counts=True)
+        best = rows[counts == counts.max()]
+        row = vz == best[np.argmin(np.abs(best))]
+        return np.unique(np.round(vx[row] * 1e9)) * 1e-9
+
+    def azimuth_aperture_m(self) -> float:
+        """Azimuth aperture d_A: span of the distinct azimuth virtual positions plus one grid
+        cell d (``spacing_m``, else the smallest gap; paper eq. 24 convention)."""
+        x = self.azimuth_virtual_x_m()
+        gaps = np.diff(x)
+        d = float(self.spacing_m) if self.spacing_m else (float(gaps.min()) if gaps.size else 0.0)
+        return float(np.ptp(x) + d) if d > 0 else 0.0
+
     @classmethod
     def from_mm(cls, tx_mm, rx_mm, tx_order, name: str = "custom") -> "ArraySpec":
         """The scene's ``[radar.array]`` form: ``tx_mm``/``rx_mm`` in millimetres."""

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 
 __all__ = ["AoaMode", "AOA_MODES", "SYNTHESIS_MODES", "PATH_METHODS",
-           "RADAR_PRESETS", "Window", "WINDOWS", "CFAR_KINDS"]
+           "RADAR_PRESETS", "Window", "WINDOWS", "CFAR_KINDS", "PATTERN_KINDS"]
 
 
 @dataclass(frozen=True)
@@ -54,6 +54,12 @@ WINDOWS: dict[str, Window] = {
     "hann": Window("Hann", 2),
     "hamming": Window("Hamming", 2),
     "blackman": Window("Blackman", 3),
+}
+
+PATTERN_KINDS: dict[str, str] = {
+    "isotropic": "field gain 1 in every direction",
+    "cos": "power cos^q of the angle off boresight, q from the half-power beamwidth hpbw_deg",
+    "table": "a CSV of azimuth_deg, elevation_deg, gain_db, phase_deg (a full regular grid)",
 }
 
 CFAR_KINDS: dict[str, str] = {

@@ -33,12 +33,14 @@ from scipy.constants import c
 from . import registry
 from .schema import Derived, Evolvable, SceneError, check_fields, read, spec
 from .schema import fmt as _fmt
+from .scene_hardware import (ArrayConfig, PatternConfig, check_layout_keys,  # noqa: F401
+                             resolve_pattern_tables)
 from .scene_rules import (MAX_ADC_SAMPLES, MAX_CALIBRATION_STEPS, arc_centre_m,  # noqa: F401
                           azimuth_from_radar_rad, front_end_module_m, problems)
 
 __all__ = [
     "SceneError", "RadarConfig", "CfarConfig", "FrontEndConfig", "RtsConfig", "SheetConfig",
-    "TargetConfig", "RaytraceConfig", "StructureConfig", "Scene", "load_scene", "loads_scene",
+    "TargetConfig", "RaytraceConfig", "PatternConfig", "ArrayConfig", "StructureConfig", "Scene", "load_scene", "loads_scene",
     "parse_scene", "problems", "arc_centre_m", "azimuth_from_radar_rad", "front_end_module_m",
 ]
 
@@ -120,6 +122,23 @@ class RadarConfig(Evolvable):
                                "awr1843boost", choices=tuple(registry.RADAR_PRESETS))
     use_elevation_tx: bool = spec("use_elevation_tx", "bool", "also transmit on the elevated "
                                   "Tx (3 TDM slots instead of 2)", False)
+    board_gap_m: float | None = spec(
+        "board_gap_mm", "float", "lateral gap from the right-most Tx to the first Rx of a preset "
+        "with separate Tx and Rx groups; unset = the preset's default, 3 lambda (6 d) for the "
+        "single-chip boards (an assumption, it moves the near-field parallax); not for "
+        "awr2243-cascade (interleaved) nor a custom array", None, unit="mm", lo=0.0, hi=500.0,
+        scale=1e-3)
+    array: ArrayConfig | None = spec("array", "table", "[radar.array] a custom array "
+                                     "(replaces antenna_preset)", None, cls=ArrayConfig)
+    pattern: PatternConfig = spec("pattern", "table", "[radar.pattern] pattern of every RuT "
+                                  "element (Tx and Rx)", {}, cls=PatternConfig)
+    position_offset_m: tuple[float, float, float] = spec(
+        "position_offset_mm", "vec", "pose error of the RuT (world x, y, z): the arc stays "
+        "centred on position_m", (0.0, 0.0, 0.0), n=3, unit="mm", lo=-100.0, hi=100.0,
+        scale=1e-3)
+    yaw_offset_rad: float = spec("yaw_offset_deg", "float", "yaw error of the RuT (it measures "
+                                 "in its own, turned frame)", 0.0, unit="deg", lo=-30.0,
+                                 hi=30.0, scale=_DEG)
     element_spacing_m: float = spec("element_spacing_m", "float", "element spacing d; 0 = "
                                     "lambda/2 at the centre frequency", 0.0, unit="m",
                                     lo=0.0, hi=0.1)
@@ -169,7 +188,16 @@ class RadarConfig(Evolvable):
 
     @property
     def num_tx_active(self) -> int:
+        """TDM slots: the custom array's ``tx_order``, else the preset's."""
+        if self.array is not None:
+            return len(self.array.tx_order)
         return len(registry.RADAR_PRESETS[self.antenna_preset].active_tx_order(self.use_elevation_tx))
+
+    @property
+    def num_rx(self) -> int:
+        if self.array is not None:
+            return len(self.array.rx_mm)
+        return registry.RADAR_PRESETS[self.antenna_preset].num_rx
 
     @property
     def tdm_cycle_s(self) -> float:
@@ -189,14 +217,28 @@ class RadarConfig(Evolvable):
 class FrontEndConfig(Evolvable):
     """One RTS front end on the arc: an Rx and a Tx antenna on a module tangent to the arc.
 
-    The Rx antenna sits ``rx_tx_separation_m/2`` along the tangent towards larger azimuth, the
-    Tx antenna the same distance towards smaller azimuth. Mounting errors move the whole module.
+    The antennas sit at signed offsets ``rx_offset_mm``/``tx_offset_mm`` = [t, h] in the
+    module's frame (t along the tangent, positive towards larger azimuth; h up); the shorthand
+    ``rx_tx_separation_m = s`` means rx [s/2, 0], tx [-s/2, 0] (Rx at the larger azimuth).
+    Mounting errors move the whole module and turn it (yaw, pitch) about its centre.
     """
 
     angle_rad: float = spec("angle_deg", "float", "azimuth theta_q on the arc", unit="deg",
                             lo=-90.0, hi=90.0, scale=_DEG)
     rx_tx_separation_m: float = spec("rx_tx_separation_m", "float", "Rx/Tx antenna separation "
                                      "along the tangent", 0.02, unit="m", lo=0.0, hi=0.5)
+    rx_offset_m: tuple[float, float] | None = spec(
+        "rx_offset_mm", "vec", "Rx antenna [t, h] on the module (signed; with tx_offset_mm, "
+        "instead of rx_tx_separation_m)", None, n=2, unit="mm", lo=-250.0, hi=250.0, scale=1e-3)
+    tx_offset_m: tuple[float, float] | None = spec(
+        "tx_offset_mm", "vec", "Tx antenna [t, h] on the module (signed; with rx_offset_mm)",
+        None, n=2, unit="mm", lo=-250.0, hi=250.0, scale=1e-3)
+    yaw_offset_rad: float = spec("yaw_offset_deg", "float", "mounting rotation about the "
+                                 "vertical (azimuth sense)", 0.0, unit="deg", lo=-30.0, hi=30.0,
+                                 scale=_DEG)
+    pitch_offset_rad: float = spec("pitch_offset_deg", "float", "mounting rotation about the "
+                                   "tangent (positive: boresight up)", 0.0, unit="deg",
+                                   lo=-30.0, hi=30.0, scale=_DEG)
     radial_offset_m: float = spec("radial_offset_mm", "float", "mounting error, radial",
                                   0.0, unit="mm", lo=-50.0, hi=50.0, scale=1e-3)
     tangential_offset_m: float = spec("tangential_offset_mm", "float", "mounting error, "
@@ -219,6 +261,14 @@ class FrontEndConfig(Evolvable):
     return_loss_be_db: float | None = spec("return_loss_be_db", "float", "mismatch at the back "
                                            "end; unset = no cable ghosts", None, unit="dB",
                                            lo=0.0, hi=100.0, lo_open=True)
+
+    def antenna_offsets_m(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """Signed (t, h) of the Rx and the Tx antenna on the module (m): the explicit offsets,
+        else the shorthand rx (s/2, 0), tx (-s/2, 0)."""
+        if self.rx_offset_m is not None and self.tx_offset_m is not None:
+            return tuple(self.rx_offset_m), tuple(self.tx_offset_m)
+        half = 0.5 * self.rx_tx_separation_m
+        return (half, 0.0), (-half, 0.0)
 
 
 @dataclass(frozen=True)
@@ -266,6 +316,9 @@ class RtsConfig(Evolvable):
         "fractional_delay_filter", "str", "model of the fractional-delay FIR: windowed-sinc (its "
         "real response along the IF sweep, rts.fir_if_gain) or ideal (a pure delay)",
         "windowed-sinc", choices=("windowed-sinc", "ideal"))
+    pattern: PatternConfig = spec("pattern", "table", "[rts.pattern] pattern of every "
+                                  "front-end antenna (Rx and Tx; boresight at the arc centre)",
+                                  {}, cls=PatternConfig)
 
     @property
     def delay_resolution_s(self) -> float:
@@ -418,8 +471,10 @@ def parse_scene(data: dict, source: str = "<scene>", base_dir: Path | None = Non
     violated cross-field rules (:func:`problems`)."""
     stem = Path(source).stem if source != "<scene>" else "scene"
     scene = read(Scene, data, source, "", {"_stem": stem, "source": source, "sha256": sha256})
+    check_layout_keys(data, source)  # the file's keys (a read scene cannot tell them apart)
     meshes = _resolve_meshes(scene, source, base_dir, allow_external_meshes)
     scene = dataclasses.replace(scene, extra_meshes=meshes)
+    scene = resolve_pattern_tables(scene, source, base_dir)
     found = problems(scene)
     if found:
         raise SceneError(found[0], found)

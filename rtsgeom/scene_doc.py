@@ -31,7 +31,7 @@ def _default(s: Spec) -> str:
     if isinstance(d, Derived):
         return f"*{d.doc}*"
     if d is None:
-        return "*unset*"
+        return "*unset*" if s.kind != "table" else "*none*"
     if isinstance(d, bool):
         return f"`{str(d).lower()}`"
     if isinstance(d, str):
@@ -55,6 +55,11 @@ def _allowed(s: Spec) -> str:
         return f"{s.n} {what}, each in [{s.lo:g}, {s.hi:g}]"
     if s.kind == "int":
         return f"integer in [{s.lo}, {s.hi}]"
+    if s.kind == "points":
+        return (f"{s.min_items} to {s.max_items} [{'x, z' if s.n == 2 else ', '.join('xyz'[:s.n])}] pairs, each number "
+                f"in [{s.lo:g}, {s.hi:g}]")
+    if s.kind == "ints":
+        return f"{s.min_items} to {s.max_items} integers in [{s.lo}, {s.hi}]"
     if s.kind == "float":
         r = s.range_text().removeprefix("in ")
         return r.replace(f" {s.unit}", "") if s.unit else r
@@ -94,7 +99,7 @@ def render() -> str:
     out += ["## Rules between fields", "",
             "Checked on load and by `Scene.evolve` (`rtsgeom.scene.problems(scene)` lists all "
             "of them a scene violates):", ""]
-    for name in ("_radar_rules", "_rts_rules", "_sheet_rules", "_placement_rules",
+    for name in ("_array_rules", "_radar_rules", "_rts_rules", "_sheet_rules", "_placement_rules",
                  "_calibration_rules", "_target_rules", "_spacing_rules"):
         fn = getattr(scene_rules, name)
         doc = " ".join((inspect.getdoc(fn) or "").split())
@@ -107,6 +112,12 @@ def render() -> str:
     out += [f"- `{k}`: {v}" for k, v in registry.PATH_METHODS.items()]
     out += ["", "Radar presets (`radar.antenna_preset`):"]
     out += [f"- `{k}`: {p.doc}" for k, p in registry.RADAR_PRESETS.items()]
+    out += ["", "Antenna patterns (`radar.pattern.kind`, `rts.pattern.kind`):"]
+    out += [f"- `{k}`: {v}" for k, v in registry.PATTERN_KINDS.items()]
+    out += ["", "Front-end layout: `rx_tx_separation_m = s` is the shorthand for "
+            "`rx_offset_mm = [s/2, 0]`, `tx_offset_mm = [-s/2, 0]` (in mm) (the Rx at the larger "
+            "azimuth); giving both forms, or only one of the two offsets, is an error. "
+            "A pattern `table` is a CSV inside the scene's folder (like `[[structure]] mesh`)."]
     out += ["", "Windows (`radar.range_window`, `doppler_window`, `angle_window`):"]
     out += [f"- `{k}`: {w.doc}, main-lobe half width {w.mainlobe_half_bins} bins"
             for k, w in registry.WINDOWS.items()]

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .arcmath import antenna_positions
+from .radar_presets import ArraySpec
 from .registry import RADAR_PRESETS, WINDOWS, AOA_MODES
 from .schema import fmt
 
@@ -66,7 +67,7 @@ def problems(scene: "Scene") -> list[str]:
     def fail(fieldname: str, value: Any, allowed: str) -> None:
         out.append(f"{src}: {fieldname} = {fmt(value)}: must be {allowed}")
 
-    for rule in (_radar_rules, _rts_rules, _sheet_rules, _placement_rules, _calibration_rules,
+    for rule in (_array_rules, _radar_rules, _rts_rules, _sheet_rules, _placement_rules, _calibration_rules,
                  _target_rules, _spacing_rules):
         rule(scene, fail)
     return out
@@ -110,7 +111,7 @@ def _radar_rules(scene, fail) -> None:
             else:
                 fail("radar.cfar.training_cells", list(cfar.training_cells),
                      f"smaller: with radar.{key} = {size}, {why}")
-    n_rx = RADAR_PRESETS[radar.antenna_preset].num_rx
+    n_rx = radar.num_rx
     per_loop = n_s * radar.num_tx_active * n_rx
     n_adc = per_loop * radar.chirps_per_tx
     if n_adc > MAX_ADC_SAMPLES:
@@ -118,6 +119,39 @@ def _radar_rules(scene, fail) -> None:
              f"<= {MAX_ADC_SAMPLES // per_loop}: samples_per_chirp x chirps_per_tx x virtual "
              f"elements = {n_adc} ADC samples (at most {MAX_ADC_SAMPLES}, about 2 GiB peak "
              "memory in complex64 processing)")
+
+
+def _array_rules(scene, fail) -> None:
+    """A custom [radar.array]: tx_order indexes tx_mm, each Tx at most once; no two antennas at
+    one place; use_elevation_tx and board_gap_mm belong to presets. A preset's board gap only
+    where it has separate Tx and Rx groups."""
+    radar = scene.radar
+    arr = radar.array
+    if arr is None:
+        p = RADAR_PRESETS[radar.antenna_preset]
+        if radar.board_gap_m is not None and p.board_gap_units is None:
+            fail("radar.board_gap_mm", radar.board_gap_m * 1e3,
+                 f"left out: the {p.name} preset interleaves its Tx and Rx antennas, so no "
+                 "board gap applies")
+        return
+    n_tx = len(arr.tx_mm)
+    bad = [i for i in arr.tx_order if i >= n_tx]
+    if bad:
+        fail("radar.array.tx_order", list(arr.tx_order),
+             f"indices into radar.array.tx_mm, in [0, {n_tx - 1}] ({bad[0]} is not)")
+    if len(set(arr.tx_order)) != len(arr.tx_order):
+        fail("radar.array.tx_order", list(arr.tx_order), "distinct: each Tx in one TDM slot")
+    for key, pts in (("tx_mm", arr.tx_mm), ("rx_mm", arr.rx_mm)):
+        q = {(round(x * 1e6), round(z * 1e6)) for x, z in pts}
+        if len(q) != len(pts):
+            fail(f"radar.array.{key}", [list(p) for p in pts], "distinct positions (two "
+                 "antennas at one place)")
+    if radar.use_elevation_tx:
+        fail("radar.use_elevation_tx", True, "false with [radar.array] (its tx_order sets the "
+             "TDM slots)")
+    if radar.board_gap_m is not None:
+        fail("radar.board_gap_mm", radar.board_gap_m * 1e3, "left out with [radar.array] (the "
+             "custom positions include any gap)")
 
 
 def _rts_rules(scene, fail) -> None:
@@ -157,10 +191,17 @@ def _sheet_rules(scene, fail) -> None:
              f"> {0.05 - rts.arc_radius_m:g} m (the sheet radius must stay positive)")
         return
     for i, fe in enumerate(rts.front_ends):
-        if fe.rx_tx_separation_m >= sheet.cutout_diameter_m:
-            fail(f"rts.front_ends[{i}].rx_tx_separation_m", fe.rx_tx_separation_m,
-                 f"< sheet.cutout_diameter_m ({sheet.cutout_diameter_m:g} m) so both "
-                 "antennas look through the cutout")
+        if fe.rx_offset_m is None or fe.tx_offset_m is None:
+            if fe.rx_tx_separation_m >= sheet.cutout_diameter_m:
+                fail(f"rts.front_ends[{i}].rx_tx_separation_m", fe.rx_tx_separation_m,
+                     f"< sheet.cutout_diameter_m ({sheet.cutout_diameter_m:g} m) so both "
+                     "antennas look through the cutout")
+        else:
+            for key, (t, h) in zip(("rx_offset_mm", "tx_offset_mm"), fe.antenna_offsets_m()):
+                if math.hypot(t, h) >= 0.5 * sheet.cutout_diameter_m:
+                    fail(f"rts.front_ends[{i}].{key}", [t * 1e3, h * 1e3],
+                         f"within the cutout: |[t, h]| < sheet.cutout_diameter_m / 2 = "
+                         f"{sheet.cutout_diameter_m * 500:g} mm so the antenna looks through it")
         half = math.asin(min(1.0, 0.5 * sheet.cutout_diameter_m / r_sheet))
         if fe.angle_rad - half < sheet.angle_min_rad or fe.angle_rad + half > sheet.angle_max_rad:
             fail(f"rts.front_ends[{i}].angle_deg", math.degrees(fe.angle_rad),
@@ -289,8 +330,16 @@ def _target_rules(scene, fail) -> None:
 
 
 def angular_resolution_rad(radar: "RadarConfig") -> float:
-    """1.22 lambda / d_A of the RuT's azimuth virtual array (paper eq. 24), from the preset."""
+    """1.22 lambda / d_A of the RuT's azimuth virtual array (paper eq. 24), from the preset or
+    the custom array (inf for a single azimuth position)."""
     lam = radar.wavelength_m
+    if radar.array is not None:
+        arr = radar.array
+        try:
+            d_a = ArraySpec.from_mm(arr.tx_mm, arr.rx_mm, arr.tx_order).azimuth_aperture_m()
+        except ValueError:  # reported by _array_rules
+            return math.inf
+        return 1.22 * lam / d_a if d_a > 0 else math.inf
     d = radar.element_spacing_m or lam / 2.0
     n_a = RADAR_PRESETS[radar.antenna_preset].azimuth_aperture_units(radar.use_elevation_tx)
     return 1.22 * lam / (n_a * d)

@@ -56,7 +56,7 @@ class Spec:
     """One field's declaration (see :func:`spec`)."""
 
     key: str
-    kind: str  # float, int, bool, str, material, vec, table, tables
+    kind: str  # float, int, bool, str, material, vec, points, ints, table, tables
     doc: str
     unit: str = ""
     lo: float | None = None
@@ -79,7 +79,8 @@ class Spec:
         if v is None or self.scale == 1.0:
             return v
         if isinstance(v, tuple):
-            return tuple(x * self.scale for x in v)
+            return tuple(tuple(y * self.scale for y in x) if isinstance(x, tuple)
+                         else x * self.scale for x in v)
         return v * self.scale
 
     def range_text(self) -> str:
@@ -95,6 +96,8 @@ def spec(key: str, kind: str, doc: str, default: Any = REQUIRED, **kw) -> datacl
     if default is REQUIRED or isinstance(default, Derived):
         return dataclasses.field(metadata=meta)
     if kind == "table":
+        if default is None:  # an optional table: absent = None
+            return dataclasses.field(default=None, metadata=meta)
         return dataclasses.field(default_factory=s.cls, metadata=meta)
     if kind == "tables":
         return dataclasses.field(default=(), metadata=meta)
@@ -220,7 +223,7 @@ def _read_field(s: Spec, data: dict, ctx: _Ctx, values: dict, context: dict) -> 
         if isinstance(s.default, Derived):
             return s.default.fn({**context, **values})
         if s.kind == "table":
-            return read(s.cls, {}, ctx.source, path, context)
+            return None if s.default is None else read(s.cls, {}, ctx.source, path, context)
         if s.kind == "tables":
             v = []
         elif s.kind == "vec" and s.default is not None:
@@ -288,6 +291,8 @@ def check_value(s: Spec, v: Any, ctx: _Ctx, path: str, context: dict | None = No
                 ctx.fail(path, list(out), f"{s.n} whole numbers of {unit}")
             return tuple(int(x) for x in out)
         return out
+    if k in ("points", "ints"):
+        return _check_list(s, v, ctx, path)
     if k == "table":
         if isinstance(v, s.cls):
             return v
@@ -311,6 +316,36 @@ def check_value(s: Spec, v: Any, ctx: _Ctx, path: str, context: dict | None = No
     raise AssertionError(f"unknown kind {k}")  # a declaration error, not input
 
 
+def _check_list(s: Spec, v: Any, ctx: _Ctx, path: str) -> tuple:
+    """``points``: a list of [a, b, ...] (``s.n`` numbers each); ``ints``: a list of integers;
+    both with ``s.min_items``..``s.max_items`` entries and every number in [lo, hi]."""
+    unit = f" {s.unit}" if s.unit else ""
+    count = (f"at least {s.min_items}" + (f" and at most {s.max_items}" if s.max_items else ""))
+    if s.kind == "points":
+        what = f"a list ({count} entries) of [{'x, z' if s.n == 2 else ', '.join('xyz'[:s.n])}] pairs of numbers in " \
+               f"[{s.lo:g}, {s.hi:g}]{unit}"
+        if (not isinstance(v, (list, tuple)) or len(v) < s.min_items
+                or (s.max_items and len(v) > s.max_items)
+                or any(not isinstance(p, (list, tuple)) or len(p) != s.n
+                       or any(not _is_num(x) for x in p) for p in v)):
+            ctx.fail(path, v, what)
+        out = tuple(tuple(_as_float(x) for x in p) for p in v)
+        for i, p in enumerate(out):
+            if not all(x is not None and math.isfinite(x) and s.lo <= x <= s.hi for x in p):
+                ctx.fail(f"{path}[{i}]", list(v[i]), f"{s.n} finite numbers in "
+                                                     f"[{s.lo:g}, {s.hi:g}]{unit}")
+        return out
+    what = f"a list ({count} entries) of integers in [{s.lo:g}, {s.hi:g}]"
+    if (not isinstance(v, (list, tuple)) or len(v) < s.min_items
+            or (s.max_items and len(v) > s.max_items)
+            or any(isinstance(x, bool) or not isinstance(x, int) for x in v)):
+        ctx.fail(path, v, what)
+    for i, x in enumerate(v):
+        if not s.lo <= x <= s.hi:
+            ctx.fail(f"{path}[{i}]", x, f"in [{s.lo:g}, {s.hi:g}]")
+    return tuple(int(x) for x in v)
+
+
 # --------------------------------------------------------------------------------------------
 # Re-checking values set in code (evolve)
 # --------------------------------------------------------------------------------------------
@@ -325,7 +360,8 @@ def check_fields(obj: Any, source: str, where: str = "") -> None:
         if v is None and (s.default is None or isinstance(s.default, Derived)):
             continue
         if s.kind == "table":
-            check_fields(v, source, path)
+            if v is not None:
+                check_fields(v, source, path)
             continue
         if s.kind == "tables":
             check_value(s, v, ctx, path)

@@ -97,15 +97,17 @@ def scene_warnings(scene: Scene) -> list[str]:
         r_cut = 0.5 * scene.sheet.cutout_diameter_m
         for i, f in enumerate(rts.front_ends):
             t, h = f.tangential_offset_m, f.height_offset_m
-            off = {label: math.hypot(t + sign * 0.5 * f.rx_tx_separation_m, h)
-                   for label, sign in (("Rx", 1.0), ("Tx", -1.0))}
+            off = {label: math.hypot(t + at, h + ah)
+                   for label, (at, ah) in zip(("Rx", "Tx"), f.antenna_offsets_m())}
             outside = [label for label, v in off.items() if v > r_cut]
             if outside:
                 name, v = (("height_offset_mm", h) if abs(h) >= abs(t)
                            else ("tangential_offset_mm", t))
                 warn(f"rts.front_ends[{i}].{name}", v * 1e3,
                      f"with tangential_offset_mm = {t * 1e3:g}, height_offset_mm = "
-                     f"{h * 1e3:g} and rx_tx_separation_m = {f.rx_tx_separation_m:g} the "
+                     f"{h * 1e3:g} and the antennas at rx/tx [t, h] = "
+                     f"{[round(x * 1e3, 3) for x in f.antenna_offsets_m()[0]]}/"
+                     f"{[round(x * 1e3, 3) for x in f.antenna_offsets_m()[1]]} mm the "
                      f"{' and '.join(outside)} antenna{'s are' if len(outside) > 1 else ' is'} "
                      f"up to {max(off[k] for k in outside) * 1e3:.3g} mm from the centre of the "
                      f"cutout (radius {r_cut * 1e3:.3g} mm): looking at the RuT through the sheet")
@@ -114,8 +116,11 @@ def scene_warnings(scene: Scene) -> list[str]:
     d = rut.spacing_m
     if d > 0.5 * lam * (1.0 + 1e-9):
         fov = math.degrees(math.asin(min(1.0, lam / (2.0 * d))))
-        warn("radar.element_spacing_m", radar.element_spacing_m,
-             f"more than lambda/2 = {0.5 * lam:.4g} m: angles beyond +-{fov:.3g} deg are "
+        custom = getattr(radar, "array", None) is not None
+        warn("radar.array.rx_mm" if custom else "radar.element_spacing_m",
+             d if custom else radar.element_spacing_m,
+             f"{'the grid unit (smallest virtual gap) ' if custom else ''}more than lambda/2 = "
+             f"{0.5 * lam:.4g} m: angles beyond +-{fov:.3g} deg are "
              "ambiguous (grating lobes)")
 
     # The RTS back end samples the IF band [f_rts - B/2, f_rts + B/2] at f_s.

@@ -63,6 +63,7 @@ def two_front_end_scene(scene: Scene, pair: tuple[int, int], radius_m: float,
     lo, hi = sorted((fes[pair[0]], fes[pair[1]]), key=lambda f: f.angle_rad)
     centre = 0.5 * (lo.angle_rad + hi.angle_rad)
     clean = dict(radial_offset_m=0.0, tangential_offset_m=0.0, height_offset_m=0.0,
+                 yaw_offset_rad=0.0, pitch_offset_rad=0.0,
                  gain_offset_db=0.0, phase_offset_rad=0.0)
     new = (dataclasses.replace(lo, angle_rad=centre - 0.5 * spacing_rad, **clean),
            dataclasses.replace(hi, angle_rad=centre + 0.5 * spacing_rad, **clean))
@@ -86,7 +87,8 @@ def _fit_sheet(scene: Scene) -> tuple[SheetConfig, str]:
     a = [f.angle_rad for f in rts.front_ends]
     dist = math.dist(scene.radar.position_m, arc_centre_m(scene))
     if (r_sheet <= max(0.05, dist) or d >= sheet.height_m or d >= 2 * r_sheet
-            or any(f.rx_tx_separation_m >= d for f in rts.front_ends)
+            or any(max(math.hypot(*o) for o in f.antenna_offsets_m()) >= 0.5 * d
+                   for f in rts.front_ends)
             or 2 * r_sheet * math.sin(0.5 * abs(a[1] - a[0])) < d):
         return off, "disabled"
     half = math.asin(0.5 * d / r_sheet)

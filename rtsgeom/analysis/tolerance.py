@@ -164,15 +164,17 @@ class PairPhasors:
 
     # -- one draw's channels -------------------------------------------------------------
 
-    def air_legs(self, offsets_m) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`ChannelModel.air_legs`: (..., 2, V) each for offsets (..., 2, 3)."""
-        return self.channels.air_legs(offsets_m)
+    def air_legs(self, offsets_m, pose: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`ChannelModel.air_legs`: (..., 2, V) each for offsets (..., 2, 3); ``pose``:
+        its rotation and RuT-pose keywords (``yaw_rad``, ``pitch_rad`` (..., 2),
+        ``rut_offset_m`` (..., 3), ``rut_yaw_rad`` (...,))."""
+        return self.channels.air_legs(offsets_m, **(pose or {}))
 
-    def channel_phasors(self, offsets_m, return_shift: bool = False):
+    def channel_phasors(self, offsets_m, return_shift: bool = False, pose: dict | None = None):
         """Per-element phasors of both channels at the bin for mounting errors (..., 2, 3)
-        (:meth:`ChannelModel.perturbed`). ``return_shift``: also the air delay change
-        (..., 2, V) (s)."""
-        return self.channels.perturbed(offsets_m, return_shift)
+        and ``pose`` (:meth:`air_legs`) (:meth:`ChannelModel.perturbed`). ``return_shift``:
+        also the air delay change (..., 2, V) (s)."""
+        return self.channels.perturbed(offsets_m, return_shift, **(pose or {}))
 
     def coherence_phase(self, xq: np.ndarray) -> np.ndarray:
         """The phase to give channel J so that both channels' beamformer outputs add in phase
@@ -246,11 +248,11 @@ class PairPhasors:
         err = np.degrees(ang - self.set_rad)
         return (err, ok) if return_converged else err
 
-    def range_offset_m(self, offsets_m, steps) -> np.ndarray:
+    def range_offset_m(self, offsets_m, steps, pose: dict | None = None) -> np.ndarray:
         """Range offset between the two channels' echoes after calibration: c0/2 times the
         total delay mismatch (element-mean air delay plus J's delay offset), as
         ``calibrate_pair`` reports it."""
-        air = sum(self.air_legs(offsets_m)).mean(axis=-1)
+        air = sum(self.air_legs(offsets_m, pose)).mean(axis=-1)
         return 0.5 * c * (air[..., 1] + np.asarray(steps) * self.delay_resolution_s - air[..., 0])
 
     def to_dict(self) -> dict:
@@ -314,14 +316,16 @@ def draw_offsets(seed: int, draws: int, sigma_m, distribution: str = "normal") -
     return z * np.asarray(sigma_m, float)
 
 
-def evaluate_chunk(model: PairPhasors, offsets_m: np.ndarray, cases=CASES) -> dict:
-    """Per draw of ``offsets_m`` (k, 2, 3): for each case the signed angle error of the worst
+def evaluate_chunk(model: PairPhasors, offsets_m: np.ndarray, cases=CASES,
+                   pose: dict | None = None) -> dict:
+    """Per draw of ``offsets_m`` (k, 2, 3) (and ``pose``: rotations (k, 2) and RuT pose
+    errors, :meth:`PairPhasors.air_legs`): for each case the signed angle error of the worst
     set-point (deg) and the number of snapshots ``refine_angles`` left to ``estimate_angles``;
     the calibration (delay steps of channel J) and the range offset it causes (m). Pure: the
     same offsets give the same bits."""
-    xq, shift = model.channel_phasors(offsets_m, return_shift=True)
+    xq, shift = model.channel_phasors(offsets_m, return_shift=True, pose=pose)
     steps = model.calibration_steps(xq)
-    out = {"steps": steps, "range_offset_m": model.range_offset_m(offsets_m, steps)}
+    out = {"steps": steps, "range_offset_m": model.range_offset_m(offsets_m, steps, pose)}
     for case in cases:
         if case not in ALL_CASES:
             raise ValueError(f"case {case!r}: must be one of {', '.join(ALL_CASES)}")

@@ -45,6 +45,17 @@ __all__ = ["ChannelModel", "AngleUnreachable", "SOLVERS"]
 SOLVERS = SYNTHESIS_MODES  # the registry lists every AoA mode once (rtsgeom/registry.py)
 
 
+def _af_size(rut) -> tuple[int, float, np.ndarray | None]:
+    """(n, h, positions) for ``ratio_array_factor``: the distinct azimuth virtual positions
+    (duplicates combined: 86 for the cascade, not its 144 elements); a filled lambda/2 row
+    uses the closed form with n, anything else the positions in wavelengths."""
+    x = rut.azimuth_positions_m
+    lam = rut.wavelength_m
+    if x.size > 1 and np.allclose(np.diff(x), 0.5 * lam, rtol=1e-9, atol=1e-12):
+        return int(x.size), 1e-6, None
+    return 0, 1e-6, x / lam
+
+
 class AngleUnreachable(ValueError):
     """The set angle lies outside what the front-end pair can synthesize."""
 
@@ -191,7 +202,7 @@ class ChannelModel:
         elif mode == "paper":
             rho = float(ratio_paper(th[0], th[1], alpha))
         else:
-            rho = float(ratio_array_factor(th[0], th[1], alpha, self.steering.size))
+            rho = float(ratio_array_factor(th[0], th[1], alpha, *_af_size(self.setup.rut)))
         return float(np.clip(rho, 0.0, 1e12))
 
     def scale(self, w, direction: float) -> float:
@@ -210,15 +221,34 @@ class ChannelModel:
 
     # -- mounting errors --------------------------------------------------------------------
 
-    def air_legs(self, offsets_m) -> tuple[np.ndarray, np.ndarray]:
+    def air_legs(self, offsets_m, yaw_rad=None, pitch_rad=None, rut_offset_m=None,
+                 rut_yaw_rad=None) -> tuple[np.ndarray, np.ndarray]:
         """Delays of both legs (RuT Tx -> FE Rx, FE Tx -> RuT Rx) per virtual element,
         (..., Q, V) each, for mounting errors ``offsets_m`` (..., Q, 3) (radial, tangential,
-        height) of the channels' front ends."""
+        height) of the channels' front ends, their mounting rotations ``yaw_rad``/``pitch_rad``
+        (..., Q) (added to the setup's own) and the RuT's pose errors ``rut_offset_m`` (..., 3),
+        ``rut_yaw_rad`` (...,) (the same leading shape as ``offsets_m``'s draws). The front ends keep their signed antenna layout."""
         fe, rut = self.setup.fe, self.setup.rut
         q = list(self.channels)
+
+        def pick(a, extra):
+            base = None if a is None else a[q]
+            if extra is None:
+                return base
+            return np.asarray(extra, float) + (0.0 if base is None else base)
+
+        ro = None if fe.rx_offset_m is None else fe.rx_offset_m[q]
+        to = None if fe.tx_offset_m is None else fe.tx_offset_m[q]
         rx, tx, _ = antenna_positions(fe.arc_centre, fe.arc_radius_m, fe.angle_rad[q],
-                                      fe.separation_m[q], offsets_m)
-        t_a, t_b = leg_delays(rut.tx_world, rut.rx_world, rx, tx)
+                                      fe.separation_m[q], offsets_m, rx_offset_m=ro,
+                                      tx_offset_m=to, yaw_rad=pick(fe.yaw_rad, yaw_rad),
+                                      pitch_rad=pick(fe.pitch_rad, pitch_rad))
+        if rut_offset_m is None and rut_yaw_rad is None:
+            rut_tx, rut_rx = rut.tx_world, rut.rx_world
+        else:
+            from ..geometry.arrays import posed_positions
+            rut_tx, rut_rx = posed_positions(rut, rut_offset_m, rut_yaw_rad)
+        t_a, t_b = leg_delays(rut_tx, rut_rx, rx, tx)
         return t_a[..., rut.virtual_tx], t_b[..., rut.virtual_rx]
 
     @cached_property
@@ -233,17 +263,22 @@ class ChannelModel:
         radar = self.setup.scene.radar
         return radar.f_center_hz - radar.slope_hz_per_s * 2 * self.range_m / c
 
-    def perturbed(self, offsets_m, return_shift: bool = False):
-        """:attr:`phasors` for mounting errors ``offsets_m`` (..., Q, 3) of the front ends::
+    def perturbed(self, offsets_m, return_shift: bool = False, yaw_rad=None, pitch_rad=None,
+                  rut_offset_m=None, rut_yaw_rad=None):
+        """:attr:`phasors` for mounting errors ``offsets_m`` (..., Q, 3) of the front ends (and
+        the rotations and RuT pose errors of :meth:`air_legs`)::
 
             x_qv(draw) = x_qv * (a_qv b_qv / a'_qv b'_qv) exp(j 2 pi f_air (tau'_qv - tau_qv))
 
         (eq. 15/16 with the exact legs a, b, tau = a + b; primed: the draw). Neglected:
         -S dtau^2 / 2 and the beat-frequency shift S dtau against the range bin (3e-3 bins
-        per mm of path; quadratic in the magnitude at the bin centre). ``return_shift``: also
-        the air delay change (..., Q, V) (s)."""
+        per mm of path; quadratic in the magnitude at the bin centre), and the change of the
+        antenna patterns' gains with the rotations (none for isotropic patterns). A RuT yaw
+        error turns the frame the RuT measures in: it shows up as an angle error of the
+        detections, as on a real bench. ``return_shift``: also the air delay change
+        (..., Q, V) (s)."""
         tau0, legs0 = self._nominal_legs
-        t_a, t_b = self.air_legs(offsets_m)
+        t_a, t_b = self.air_legs(offsets_m, yaw_rad, pitch_rad, rut_offset_m, rut_yaw_rad)
         d = t_a + t_b - tau0
         x = self.phasors * (legs0 / (t_a * t_b)) * np.exp(2j * np.pi * self.f_air_hz * d)
         return (x, d) if return_shift else x

@@ -52,19 +52,28 @@ def ratio_paper(theta_i, theta_j, alpha):
     return -g_paper(theta_i, alpha) / g_paper(theta_j, alpha)
 
 
-def array_factor(u, n: int):
-    """Normalised array factor of n elements at lambda/2: sin(n pi u/2) / (n sin(pi u/2))."""
+def array_factor(u, n: int = 0, positions_wl=None):
+    """Normalised array factor: of ``n`` elements at lambda/2, sin(n pi u/2) / (n sin(pi u/2));
+    or, with ``positions_wl`` (distinct element positions in wavelengths, any spacing, sparse or
+    non-uniform), the real part of the mean of exp(j 2 pi x_k u) about their centroid (the
+    same Dirichlet kernel for a filled lambda/2 array; exact for a symmetric array)."""
     u = np.asarray(u, float)
+    if positions_wl is not None:
+        x = np.asarray(positions_wl, float)
+        x = x - x.mean()
+        return np.mean(np.cos(2 * np.pi * u[..., None] * x), axis=-1)
     den = n * np.sin(np.pi * u / 2)
     small = np.abs(den) < 1e-12
     return np.where(small, 1.0, np.sin(n * np.pi * u / 2) / np.where(small, 1.0, den))
 
 
-def ratio_array_factor(theta_i, theta_j, alpha, n: int, h: float = 1e-6):
-    """A_J / A_I with the true array factor: A_I AF_I'(alpha) + A_J AF_J'(alpha) = 0."""
+def ratio_array_factor(theta_i, theta_j, alpha, n: int = 0, h: float = 1e-6,
+                       positions_wl=None):
+    """A_J / A_I with the true array factor: A_I AF_I'(alpha) + A_J AF_J'(alpha) = 0
+    (``n`` lambda/2 elements, or the distinct positions ``positions_wl`` of :func:`array_factor`)."""
     def d_af(theta):
-        return (array_factor(np.sin(theta) - np.sin(alpha + h), n)
-                - array_factor(np.sin(theta) - np.sin(alpha - h), n)) / (2 * h)
+        return (array_factor(np.sin(theta) - np.sin(alpha + h), n, positions_wl)
+                - array_factor(np.sin(theta) - np.sin(alpha - h), n, positions_wl)) / (2 * h)
     return -d_af(theta_i) / d_af(theta_j)
 
 

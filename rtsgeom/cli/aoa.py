@@ -17,10 +17,30 @@ from ._common import (UsageError, load_scene_checked, number, output_folder, out
                       print_json, scene_arg, steps)
 
 
+def _pair_arg(text: str):
+    """argparse type of one ``--pair`` word: an index in [0, 10000] or ``all``."""
+    if text == "all":
+        return text
+    return number(0, 10_000, integer=True)(text)
+
+
+def _pairs(setup, pair) -> list[tuple[int, int]]:
+    """``--pair I J`` as one pair, or ``--pair all``: every adjacent pair of the arc."""
+    if list(pair) == ["all"]:
+        n = setup.fe.count
+        if n < 2:
+            raise UsageError("--pair all: the arc needs at least two front ends")
+        return [(i, i + 1) for i in range(n - 1)]
+    return [_pair(setup, pair)]
+
+
 def _pair(setup, pair):
     """The pair in its canonical order, the lower index first (I keeps its delay, J is
     swept): ``--pair 1 0`` and ``--pair 0 1`` are the same measurement and give the same
     numbers (the front ends are ordered by angle in the scene)."""
+    if len(pair) != 2 or "all" in pair:
+        raise UsageError(f"--pair {' '.join(map(str, pair))}: must be two adjacent front-end "
+                         "indices I J, or all")
     i, j = pair
     n = setup.fe.count
     if not (0 <= i < n and 0 <= j < n) or abs(i - j) != 1:
@@ -45,6 +65,9 @@ def cmd_calibrate(args) -> int:
 
 
 def _calibrate(args, stage) -> int:
+    if list(args.pair) == ["all"]:
+        from .arc import calibrate_all
+        return calibrate_all(args, stage)
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
         scene, setup, pair, paths, probe = _prepare(args)
@@ -96,6 +119,9 @@ def cmd_linearity(args) -> int:
 
 
 def _linearity(args, stage) -> int:
+    if list(args.pair) == ["all"]:
+        from .arc import linearity_all
+        return linearity_all(args, stage)
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
         scene, setup, pair, paths, probe = _prepare(args)
@@ -123,8 +149,9 @@ def register(sub) -> None:
             ("linearity", cmd_linearity, "synthesized-angle linearity across a pair's span")):
         p = sub.add_parser(name, help=helptext)
         scene_arg(p)
-        p.add_argument("--pair", nargs=2, type=number(0, 10_000, integer=True),
-                       metavar=("I", "J"), default=[0, 1], help="adjacent front ends (default 0 1)")
+        p.add_argument("--pair", nargs="+", type=_pair_arg, metavar="I J | all",
+                       default=[0, 1], help="adjacent front ends (default 0 1), or all: every "
+                                            "adjacent pair of the arc in one run")
         p.add_argument("--json", action="store_true", help="print the result as JSON")
         p.add_argument("--out", type=output_path, default=None, help="folder for the plot and JSON")
         p.add_argument("--quiet", action="store_true", help="no progress output")

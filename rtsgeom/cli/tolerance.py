@@ -18,7 +18,8 @@ from ..io import write_json
 from ..parallel import ClusterError, check_address, dask_client, map_chunks
 from ._common import (UsageError, load_scene_checked, number, output_folder, output_path,
                       print_json, scene_arg)
-from .aoa import _pair
+from .aoa import _pair, _pair_arg
+from .arc import coverage_spec
 
 MAX_SIGMA_MM = 10.0  # the phasor model is first order in the errors; checked to 0.3 mm
 #: Peak memory of one Monte-Carlo chunk is about ``chunk * chunk_bytes_per_draw(points)``
@@ -102,10 +103,13 @@ def cmd_tolerance(args) -> int:
 
 
 def _tolerance(args, scene, stage) -> int:
+    from .arc import save_pair_npz, scales, tolerance_arc, wants_arc
+    sigma, extra = scales(args)
+    if wants_arc(args):
+        return tolerance_arc(args, scene, sigma, extra, stage)
     model = _model(scene, args.pair, args.points)
     chunk = capped_chunk(args.chunk, len(model.set_rad))
     seed = scene.seed if args.seed is None else args.seed
-    sigma = np.array([args.sigma_radial_mm, args.sigma_tangential_mm, args.sigma_height_mm]) * 1e-3
     cases = CASES + ((NOMINAL_AMPLITUDES,) if args.nominal_amplitudes else ())
     t0 = time.perf_counter()
     with _progress(args.quiet) as progress, dask_client(args.dask, args.workers) as client:
@@ -130,6 +134,7 @@ def _tolerance(args, scene, stage) -> int:
                                    f"Worst |error| per setup, pair {tuple(model.pair)}")
         save_figure(fig, stage / "tolerance.png")
         write_json(stage / "tolerance.json", out)
+        save_pair_npz(stage / "tolerance_draws.npz", res, seed)
     if args.json:
         print_json(out)
         return 0
@@ -160,6 +165,11 @@ def cmd_design(args) -> int:
 
 
 def _design(args, scene, stage) -> int:
+    if args.coverage_deg is not None:
+        from .arc import design_coverage
+        return design_coverage(args, scene, stage)
+    if args.draws is None:
+        args.draws = 2000
     from ..analysis.design import METRICS, design_grid
     pair = _pair(build_setup(scene), args.pair)
     seed = scene.seed if args.seed is None else args.seed
@@ -224,10 +234,15 @@ def _sheet_note(designs: list[dict]) -> str:
     return "note: " + "; ".join(parts) if parts else ""
 
 
-def _common(p, draws_default: int) -> None:
+def _common(p, draws_default: int, allow_all: bool = False) -> None:
     scene_arg(p)
-    p.add_argument("--pair", nargs=2, type=number(0, 10_000, integer=True), metavar=("I", "J"),
-                   default=[0, 1], help="adjacent front ends (default 0 1)")
+    if allow_all:
+        p.add_argument("--pair", nargs="+", type=_pair_arg, metavar="I J | all",
+                       default=[0, 1], help="adjacent front ends (default 0 1), or all: every "
+                                            "adjacent pair on shared per-front-end draws")
+    else:
+        p.add_argument("--pair", nargs=2, type=number(0, 10_000, integer=True),
+                       metavar=("I", "J"), default=[0, 1], help="adjacent front ends (default 0 1)")
     p.add_argument("--spec-deg", type=number(1e-6, 90.0), default=0.1,
                    help="angle-error spec in deg, in [1e-6, 90] (default 0.1)")
     p.add_argument("--draws", type=number(1, 10_000_000, integer=True), default=draws_default,
@@ -242,13 +257,30 @@ def _common(p, draws_default: int) -> None:
 
 
 def register(sub) -> None:
-    p = sub.add_parser("tolerance", help="mounting-tolerance Monte Carlo of a front-end pair")
-    _common(p, 10_000)
+    p = sub.add_parser("tolerance", help="mounting-tolerance Monte Carlo of a front-end pair "
+                                         "or a whole arc")
+    _common(p, 10_000, allow_all=True)
     mm = number(0.0, MAX_SIGMA_MM)
     for axis in AXES:
-        p.add_argument(f"--sigma-{axis}-mm", type=mm, default=0.1,
+        p.add_argument(f"--sigma-{axis}-mm", type=mm, default=None,
                        help=f"{axis} mounting error per front end in mm, in [0, {MAX_SIGMA_MM:g}]: "
                             "the standard deviation (normal) or the bound (uniform) (default 0.1)")
+    for axis in AXES:
+        p.add_argument(f"--{axis}-mm", type=mm, default=None, metavar="TOL",
+                       help=f"{axis} mounting tolerance +-TOL mm at --sigma-level sigmas (normal; "
+                            "uniform: the bound), instead of --sigma-" + axis + "-mm")
+    deg = number(0.0, 10.0)
+    p.add_argument("--yaw-deg", type=deg, default=0.0, metavar="TOL",
+                   help="front-end yaw tolerance, deg, in [0, 10], drawn per front end (default 0)")
+    p.add_argument("--pitch-deg", type=deg, default=0.0, metavar="TOL",
+                   help="front-end pitch tolerance, deg, in [0, 10] (default 0)")
+    p.add_argument("--rut-position-mm", type=mm, default=0.0, metavar="TOL",
+                   help="RuT position tolerance (each of x, y, z), mm (default 0)")
+    p.add_argument("--rut-yaw-deg", type=deg, default=0.0, metavar="TOL",
+                   help="RuT yaw tolerance, deg (default 0)")
+    p.add_argument("--sigma-level", type=number(0.1, 10.0), default=3.0,
+                   help="the tolerances above are this many sigmas of a normal distribution "
+                        "(default 3: '+-0.2 mm at 3 sigma'); ignored for uniform")
     p.add_argument("--distribution", choices=DISTRIBUTIONS, default="normal",
                    help="error distribution (default normal)")
     p.add_argument("--invert-yield", type=number(1e-6, 1.0), default=None, metavar="Y",
@@ -277,7 +309,15 @@ def register(sub) -> None:
     p.add_argument("--spacing-deg", type=_grid_spec(0.1, 90.0, "deg"),
                    default=np.linspace(4.0, 20.0, 5), metavar="A:B:N",
                    help="front-end spacings, N from A to B deg (default 4:20:5)")
+    p.add_argument("--coverage-deg", type=coverage_spec, default=None, metavar="A:B",
+                   help="design an arc of N front ends covering A..B deg for each --radius-m "
+                        "(number of front ends and spacing chosen; --spacing-deg and --pair "
+                        "unused)")
     p.add_argument("--yield", dest="yield_", type=number(1e-6, 1.0), default=0.95, metavar="Y",
                    help="fraction of setups within the spec for the tolerance, in (0, 1] "
                         "(default 0.95)")
-    p.set_defaults(func=cmd_design)
+    # "--coverage-deg -10:10": argparse takes a word starting with "-" for an option unless it
+    # looks like a negative number; teach this parser that A:B ranges are numbers too.
+    import re
+    p._negative_number_matcher = re.compile(r"^-\d+$|^-\d*\.\d+$|^-?[\d.]+(:-?[\d.]+)+$")
+    p.set_defaults(func=cmd_design, draws=None)  # 2000 for the grid, 300 with --coverage-deg

@@ -66,18 +66,20 @@ class FrontEnds:
 
 
 def front_ends(scene: Scene, arc_centre: np.ndarray, *, rx_offset_m=None, tx_offset_m=None,
-               yaw_rad=None, pitch_rad=None) -> FrontEnds:
+               yaw_rad=None, pitch_rad=None, offsets_m=None) -> FrontEnds:
     """The front ends of ``scene`` around ``arc_centre``.
 
     The layout and rotations come from the explicit arguments ((F, 2) and (F,) arrays), else
     from the front-end configs' ``rx_offset_m``/``tx_offset_m`` ((t, h) pairs) and
     ``yaw_offset_rad``/``pitch_offset_rad`` fields where the scene has them, else today's
-    shorthand ``rx_tx_separation_m`` with no rotation.
+    shorthand ``rx_tx_separation_m`` with no rotation. ``offsets_m`` (F, 3) overrides the
+    mounting errors (radial, tangential, height), e.g. for a tolerance draw.
     """
     fes = scene.rts.front_ends
     ang = np.array([f.angle_rad for f in fes])
     sep = np.array([f.rx_tx_separation_m for f in fes])
-    off = np.array([[f.radial_offset_m, f.tangential_offset_m, f.height_offset_m] for f in fes])
+    off = (np.array([[f.radial_offset_m, f.tangential_offset_m, f.height_offset_m] for f in fes])
+           if offsets_m is None else np.asarray(offsets_m, float))
 
     def field(explicit, name, shape):
         if explicit is not None:
@@ -97,6 +99,9 @@ def front_ends(scene: Scene, arc_centre: np.ndarray, *, rx_offset_m=None, tx_off
     to = field(tx_offset_m, "tx_offset_m", (n, 2))
     yaw = field(yaw_rad, "yaw_offset_rad", (n,))
     pitch = field(pitch_rad, "pitch_offset_rad", (n,))
+    # no rotation at all keeps today's arithmetic (bit-identical positions)
+    yaw = None if yaw is not None and yaw_rad is None and not np.any(yaw) else yaw
+    pitch = None if pitch is not None and pitch_rad is None and not np.any(pitch) else pitch
     if ro is not None or to is not None:
         rs, ts = layout_offsets(sep)
         ro = rs if ro is None else ro

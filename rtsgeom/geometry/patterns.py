@@ -18,6 +18,7 @@ given; a path's amplitude is multiplied by the gains of both antennas of its leg
 from __future__ import annotations
 
 import csv
+import functools
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -25,7 +26,8 @@ import numpy as np
 from scipy.interpolate import RegularGridInterpolator
 
 __all__ = ["AntennaPatterns", "CosinePattern", "ISOTROPIC", "Isotropic", "Pattern",
-           "TablePattern", "cos_power_exponent", "direction_angles", "pattern_from_config"]
+           "TablePattern", "cos_power_exponent", "direction_angles", "pattern_from_config",
+           "scene_patterns"]
 
 
 def direction_angles(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -226,3 +228,20 @@ def pattern_from_config(kind: str, hpbw_deg: float | None = None,
             raise ValueError("pattern.table: a CSV path is required for a 'table' pattern")
         return TablePattern.from_csv(table)
     raise ValueError(f"pattern.kind: one of isotropic, cos, table; got '{kind}'")
+
+
+@functools.lru_cache(maxsize=32)
+def _from_scene_config(cfg) -> Pattern:
+    return pattern_from_config(cfg.kind, cfg.hpbw_deg, cfg.hpbw_el_deg, cfg.table,
+                               cfg.peak_gain_db)
+
+
+def scene_patterns(scene) -> AntennaPatterns:
+    """The patterns a scene declares: ``[radar.pattern]`` for every RuT element (Tx and Rx),
+    ``[rts.pattern]`` for every front-end antenna (Rx and Tx). Isotropic where unset (a scene
+    without pattern keys gives :attr:`AntennaPatterns.isotropic`, so nothing is multiplied)."""
+    radar = getattr(scene.radar, "pattern", None)
+    fe = getattr(scene.rts, "pattern", None)
+    rut_p = ISOTROPIC if radar is None else _from_scene_config(radar)
+    fe_p = ISOTROPIC if fe is None else _from_scene_config(fe)
+    return AntennaPatterns(rut_tx=rut_p, rut_rx=rut_p, fe_rx=fe_p, fe_tx=fe_p)

@@ -8,9 +8,8 @@ from functools import cached_property
 import numpy as np
 import trimesh
 
-from .._util import frozen
-from ..scene import Scene
-from .arc import FrontEnds, antenna_positions, front_ends
+from ..scene import Scene, arc_centre_m
+from .arc import FrontEnds, front_ends
 from .arrays import RutArray, rut_array
 from .sheet import sheet_mesh
 
@@ -37,31 +36,33 @@ class Setup:
         return self.rut.azimuth_of(self.fe.module)
 
 
-def build_setup(scene: Scene, offsets_m: np.ndarray | None = None) -> Setup:
+def build_setup(scene: Scene, offsets_m: np.ndarray | None = None, *, yaw_rad=None,
+                pitch_rad=None, rut_offset_m=None, rut_yaw_rad=None) -> Setup:
     """Place the RuT and the front ends. ``offsets_m`` (F, 3) overrides the scene's mounting
-    errors (radial, tangential, height), e.g. for a tolerance draw."""
-    rut = rut_array(scene.radar)
-    centre = (np.asarray(scene.rts.arc_center_m, float) if scene.rts.arc_center_m is not None
-              else np.asarray(rut.position, float))
-    fe = front_ends(scene, centre)
-    if offsets_m is not None:
-        rx, tx, mod = antenna_positions(centre, scene.rts.arc_radius_m, fe.angle_rad,
-                                        fe.separation_m, offsets_m)
-        fe = FrontEnds(fe.angle_rad, frozen(rx), frozen(tx), frozen(mod), fe.separation_m,
-                       frozen(offsets_m), fe.arc_centre, fe.arc_radius_m)
+    errors (radial, tangential, height), ``yaw_rad``/``pitch_rad`` (F,) its mounting rotations,
+    ``rut_offset_m`` (3,)/``rut_yaw_rad`` the RuT's pose errors, e.g. for a tolerance draw; the
+    antenna layouts (signed offsets) are kept. The arc stays centred on the RuT's nominal
+    position (``radar.position_m``) when ``rts.arc_center_m`` is unset."""
+    rut = rut_array(scene.radar, position_offset_m=rut_offset_m, yaw_offset_rad=rut_yaw_rad)
+    centre = np.asarray(arc_centre_m(scene), float)
+    fe = front_ends(scene, centre, yaw_rad=yaw_rad, pitch_rad=pitch_rad, offsets_m=offsets_m)
     return Setup(scene, rut, fe)
 
 
 def nominal_setup(setup: Setup) -> Setup:
     """The setup as designed: no mounting errors and no channel gain/phase errors.
 
-    This is what an RTS operator knows; the AoA design works on it, while the simulated RuT
+    The RuT's pose errors are dropped too. This is what an RTS operator knows; the AoA design works on it, while the simulated RuT
     sees the setup as built (``setup``), so calibration has to absorb the difference.
     """
     scene = setup.scene
     fes = tuple(f.evolve(radial_offset_m=0.0, tangential_offset_m=0.0, height_offset_m=0.0,
+                         yaw_offset_rad=0.0, pitch_offset_rad=0.0,
                          gain_offset_db=0.0, phase_offset_rad=0.0) for f in scene.rts.front_ends)
-    if fes == scene.rts.front_ends:
+    radar = scene.radar
+    if radar.yaw_offset_rad != 0.0 or any(radar.position_offset_m):
+        radar = radar.evolve(position_offset_m=(0.0, 0.0, 0.0), yaw_offset_rad=0.0)
+    if fes == scene.rts.front_ends and radar is scene.radar:
         return setup
-    nominal = scene.evolve(rts=scene.rts.evolve(front_ends=fes))  # validated again
+    nominal = scene.evolve(rts=scene.rts.evolve(front_ends=fes), radar=radar)  # validated again
     return build_setup(nominal)

@@ -65,9 +65,15 @@ def leg_pattern_gains(setup: Setup, patterns: AntennaPatterns) -> tuple[np.ndarr
 def exact_paths(setup: Setup, patterns: AntennaPatterns | None = None) -> Paths:
     """Line-of-sight :class:`Paths` of a setup: one row per (front end, direction, element).
 
-    ``patterns``: antenna patterns of the RuT's elements and the front ends' antennas (default
-    isotropic, bit-identical to the pattern-free model).
+    ``patterns``: antenna patterns of the RuT's elements and the front ends' antennas (default:
+    the scene's ``[radar.pattern]`` / ``[rts.pattern]``, isotropic where unset, which is
+    bit-identical to the pattern-free model). Every caller (the run, the calibration, the
+    synthesis design, the tolerance model) takes its paths from here, so the patterns reach
+    the amplitude calibration and the synthesis.
     """
+    if patterns is None:
+        from ..geometry.patterns import scene_patterns
+        patterns = scene_patterns(setup.scene)
     rut, fe = setup.rut, setup.fe
     tau_tx, tau_rx = leg_delays(rut.tx_world, rut.rx_world, fe.rx, fe.tx)
     lam = rut.wavelength_m

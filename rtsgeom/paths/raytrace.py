@@ -534,5 +534,13 @@ def trace(setup: Setup, config: RaytraceConfig | None = None) -> RaytraceResult:
 def raytrace_paths(setup: Setup, config: RaytraceConfig | None = None) -> Paths:
     """Ray-traced :class:`Paths` of ``setup`` (``method="raytrace"``); ``config`` defaults to the
     scene's ``[raytrace]`` section. Raises :class:`RaytraceUnavailable` when Sionna RT cannot run
-    here and :class:`SceneError` for an unknown or out-of-band material."""
+    here and :class:`SceneError` for an unknown or out-of-band material, or for antenna
+    patterns (``[radar.pattern]``/``[rts.pattern]`` other than isotropic: not yet handed to
+    Sionna RT, so they are refused rather than silently dropped)."""
+    for cfg, where in ((setup.scene.radar.pattern, "radar.pattern.kind"),
+                       (setup.scene.rts.pattern, "rts.pattern.kind")):
+        if cfg.kind != "isotropic":
+            raise SceneError(f"{setup.scene.source or '<scene>'}: {where} = \"{cfg.kind}\": "
+                             "must be isotropic with --paths raytrace (antenna patterns enter "
+                             "the exact paths only so far)")
     return trace(setup, config).paths

@@ -77,7 +77,10 @@ class Steering:
         else:
             mask = np.asarray(rut.azimuth_mask, bool)
             pos = rut.virtual_local[mask][:, [0]]
-            n = [int(np.count_nonzero(mask))]
+            # the distinct positions' span plus one cell (duplicates and gaps counted right:
+            # the cascade's 144 elements span 86 cells)
+            return cls(frozen(mask), frozen(pos), frozen(_taper(radar.angle_window, pos)),
+                       float(rut.wavelength_m), frozen(np.array([rut.aperture_m])))
         return cls(frozen(mask), frozen(pos), frozen(_taper(radar.angle_window, pos)),
                    float(rut.wavelength_m), frozen(np.asarray(n, float) * rut.spacing_m))
 

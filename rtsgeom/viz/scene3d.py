@@ -216,7 +216,7 @@ def _modules(setup: Setup):
     boxes = []
     for i in range(fe.count):
         r_hat, t_hat = radial_tangent(fe.angle_rad[i])
-        size_t = fe.separation_m[i] + 0.012  # smaller than the cutout: the hole stays visible
+        size_t = abs(fe.separation_m[i]) + 0.012  # smaller than the cutout: the hole stays visible
         box = pv.Box(bounds=(-size_t / 2, size_t / 2, 0.012, 0.024, -0.01, 0.01))
         rot = np.stack([t_hat, r_hat, [0.0, 0.0, 1.0]], axis=1)  # local (t, r, z) -> world
         box.points = box.points @ rot.T + fe.module[i]
@@ -328,7 +328,7 @@ def _add_setup(pl, setup: Setup, paths, scale: float, labels: str) -> list:
 
     # front ends: module body and enlarged antenna markers
     pl.add_mesh(_modules(setup), color=_MODULE, opacity=0.9)
-    ant_r = max(min(0.006, 0.3 * float(np.min(fe.separation_m))), 0.5 * lam)
+    ant_r = max(min(0.006, 0.3 * float(np.min(np.abs(fe.separation_m)))), 0.5 * lam)
     pl.add_mesh(_spheres(fe.rx, ant_r), color=_rgb("fe_rx"))
     pl.add_mesh(_spheres(fe.tx, ant_r), color=_rgb("fe_tx"))
     legend += [["front-end Rx antennas", _rgb("fe_rx")], ["front-end Tx antennas", _rgb("fe_tx")]]

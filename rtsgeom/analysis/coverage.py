@@ -1,0 +1,213 @@
+"""Arc design for N front ends: "a 0.5 m arc covering -10..+10 deg" (issue 14, item 5).
+
+For each arc radius the design chooses the number of front ends N and their (uniform) spacing:
+
+1. **Near-field bias.** A front end alone is detected ``bias`` off its module angle (Rx/Tx
+   split, the RuT's Tx/Rx parallax, ~1/R_c; ``analysis.nearfield``). The synthesizable span
+   runs between the *detected* angles of the outer front ends, so they are placed at
+   ``A - bias_0`` and ``B - bias_last`` (two passes: the bias is measured on the placed arc).
+2. **Resolution** (paper eq. 24). Neighbouring front ends at most 1.22 lambda / d_A apart seen
+   from the RuT: ``N_min = ceil(span / resolution) + 1``; the candidates are ``N_min`` and
+   ``N_min + 1`` (closer spacing, more hardware).
+3. **Cutout fit.** With the sheet, neighbouring cutouts must not overlap:
+   ``spacing >= 2 asin(d_cutout / (2 R_sheet))``, and each must hold its antennas. Where they do
+   not fit the sheet is removed (``design._fit_sheet``), widened where the front ends lie
+   beyond it; the output says so.
+
+Per design (phasor level, exact geometry, no noise; ``analysis.tolerance``/``analysis.arc``):
+the worst |synthesized - set| over every pair's span (the whole coverage), calibrated and
+uncalibrated, on the nominal arc and as the 95th percentile over arcs built with 0.1 mm
+mounting errors (one sigma per axis; without calibration the path differences of the
+errors are what the synthesis sees); the mounting tolerance (one sigma, the same on the radial, tangential and height
+axes) that keeps ``target_yield`` of the *arcs* within the spec (shared per-front-end draws);
+and the binding constraint: ``resolution`` (N is the fewest the resolution allows),
+``near-field bias`` (the bias of the outer front ends costs a front end more than the bare
+coverage would), ``cutout fit`` (the sheet had to be removed).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ..geometry import build_setup
+from ..geometry.farfield import angular_resolution_rad
+from ..paths import exact_paths
+from ..scene import Scene
+from .arc import Bounds, adjacent_pairs, arc_models, arc_monte_carlo, max_scale_for_yield
+from .design import _fit_sheet, _problem
+
+__all__ = ["CoverageDesign", "arc_scene", "plan_arc", "evaluate_arc", "coverage_designs",
+           "best_per_radius"]
+
+BASE_SIGMA_M = 1e-4  # the tolerance search scales 0.1 mm sigmas
+
+
+def arc_scene(scene: Scene, radius_m: float, angles_rad) -> tuple[Scene, str]:
+    """``scene`` with N front ends (copies of its first: layout, cables; no mounting or channel
+    errors) at ``angles_rad`` on an arc of ``radius_m``, no targets; the sheet kept, widened or
+    removed so its cutouts fit (``design._fit_sheet``). Returns the scene and the sheet's fate."""
+    tmpl = scene.rts.front_ends[0]
+    clean = dict(radial_offset_m=0.0, tangential_offset_m=0.0, height_offset_m=0.0,
+                 yaw_offset_rad=0.0, pitch_offset_rad=0.0, gain_offset_db=0.0,
+                 phase_offset_rad=0.0)
+    fes = tuple(dataclasses.replace(tmpl, angle_rad=float(a), **clean) for a in angles_rad)
+    rts = dataclasses.replace(scene.rts, arc_radius_m=float(radius_m), front_ends=fes)
+    variant = dataclasses.replace(scene, rts=rts, targets=())
+    sheet, state = _fit_sheet(variant)
+    return dataclasses.replace(variant, sheet=sheet), state
+
+
+def _min_cutout_spacing_rad(scene: Scene, radius_m: float) -> float:
+    sh = scene.sheet
+    if not sh.enabled:
+        return 0.0
+    r = radius_m + sh.radius_offset_m
+    return 2 * math.asin(min(1.0, 0.5 * sh.cutout_diameter_m / r)) if r > 0 else math.inf
+
+
+def _bias_rad(variant: Scene) -> np.ndarray:
+    """Detected minus module angle of each front end alone (near-field bias), radians."""
+    from ..aoa.calibration import probe_ranges
+    from .nearfield import single_front_end_angles_rad
+    setup = build_setup(variant)
+    rng = float(probe_ranges(setup, 1)[0])
+    return single_front_end_angles_rad(setup, exact_paths(setup), rng) - setup.fe_azimuth_rad()
+
+
+def plan_arc(scene: Scene, coverage_rad: tuple[float, float], radius_m: float,
+             extra: int = 0) -> dict:
+    """Number of front ends and spacing for one radius (steps 1-3 of the module docstring);
+    ``extra`` front ends beyond the fewest the resolution allows."""
+    a, b = sorted(coverage_rad)
+    rut = build_setup(scene).rut
+    res = angular_resolution_rad(rut)
+    n_bare = max(2, math.ceil((b - a) / res * (1 - 1e-12)) + 1)
+    lo, hi = a, b
+    bias = np.zeros(2)
+    for _ in range(2):  # place, measure the bias of the outer front ends, place again
+        n = max(2, math.ceil((hi - lo) / res * (1 - 1e-12)) + 1) + extra
+        angles = np.linspace(lo, hi, n)
+        variant, _ = arc_scene(scene, radius_m, angles)
+        bias_all = _bias_rad(variant)
+        bias = bias_all[[0, -1]]
+        lo, hi = a - bias[0], b - bias[1]
+    n = max(2, math.ceil((hi - lo) / res * (1 - 1e-12)) + 1) + extra
+    angles = np.linspace(lo, hi, n)
+    variant, sheet = arc_scene(scene, radius_m, angles)
+    spacing = (hi - lo) / (n - 1)
+    cut = _min_cutout_spacing_rad(scene, radius_m)
+    binding = []
+    if extra == 0:
+        binding.append("near-field bias" if n > n_bare else "resolution")
+    if scene.sheet.enabled and sheet == "disabled":
+        binding.append("cutout fit")
+    sh = variant.sheet
+    sheet_text = {
+        "kept": "sheet kept",
+        "widened": f"sheet widened to [{math.degrees(sh.angle_min_rad):.2f}, "
+                   f"{math.degrees(sh.angle_max_rad):.2f}] deg",
+        "disabled": (f"sheet REMOVED: cutouts of {scene.sheet.cutout_diameter_m * 1e3:g} mm need "
+                     f"{math.degrees(cut):.2f} deg spacing, the design has "
+                     f"{math.degrees(spacing):.2f} deg" if scene.sheet.enabled and spacing < cut
+                     else "sheet REMOVED (its cutouts cannot hold the antennas or it would not "
+                          "enclose the RuT)" if scene.sheet.enabled else "no sheet in the scene"),
+    }[sheet]
+    return {"scene": variant, "radius_m": float(radius_m), "front_ends": int(n),
+            "angles_deg": [float(x) for x in np.degrees(angles)],
+            "spacing_deg": math.degrees(spacing), "resolution_deg": math.degrees(res),
+            "min_cutout_spacing_deg": math.degrees(cut),
+            "outer_bias_deg": [float(x) for x in np.degrees(bias)],
+            "sheet": sheet, "sheet_change": sheet_text, "binding": binding, "extra": extra}
+
+
+def evaluate_arc(plan: dict, spec_deg: float = 0.1, target_yield: float = 0.95,
+                 draws: int = 200, seed: int = 0, points: int = 11) -> dict:
+    """Worst calibrated / uncalibrated angle error over the coverage and the mounting tolerance
+    for the yield of one planned arc (NaN and ``problem`` where it cannot be built)."""
+    variant = plan["scene"]
+    out = {k: v for k, v in plan.items() if k != "scene"}
+    out.update(worst_calibrated_deg=math.nan, worst_uncalibrated_deg=math.nan,
+               sigma_mm=math.nan, sigma_capped=False, problem=_problem(variant))
+    if out["problem"] is not None:
+        return out
+    setup = build_setup(variant)
+    pairs = adjacent_pairs(setup.fe.count)
+    try:
+        models = arc_models(setup, pairs, points)
+    except ValueError as exc:
+        out["problem"] = f"synthesis failed: {exc}"
+        return out
+    zero = np.zeros((2, 3))
+    out["worst_calibrated_deg"] = max(float(np.max(np.abs(m.angle_errors(zero, "calibrated"))))
+                                      for m in models)
+    out["worst_uncalibrated_deg"] = max(
+        float(np.max(np.abs(m.angle_errors(zero, "uncalibrated")))) for m in models)
+    ref = arc_monte_carlo(models, setup.fe.count, Bounds((BASE_SIGMA_M,) * 3), draws, seed,
+                          "normal", spec_deg)
+    for case in ("calibrated", "uncalibrated"):
+        out[f"p95_{case}_at_0.1mm_deg"] = float(np.percentile(np.abs(ref.arc_worst(case)), 95))
+        out[f"yield_{case}_at_0.1mm"] = ref.yield_(case)
+    inv = max_scale_for_yield(models, setup.fe.count, Bounds((BASE_SIGMA_M,) * 3), draws, seed,
+                              target_yield, spec_deg, "calibrated", rel_tol=0.05)
+    out["sigma_mm"] = inv["factor"] * BASE_SIGMA_M * 1e3
+    out["sigma_capped"] = inv["capped"]
+    out["tolerance_yield"] = inv["yield"]
+    return out
+
+
+@dataclass(frozen=True)
+class CoverageDesign:
+    coverage_deg: tuple[float, float]
+    radius_m: np.ndarray
+    spec_deg: float
+    target_yield: float
+    draws: int
+    designs: tuple  # evaluate_arc dicts, radius-major, candidates N_min, N_min + 1
+
+    def to_dict(self) -> dict:
+        def clean(v):
+            return None if isinstance(v, float) and not math.isfinite(v) else v
+        return {"coverage_deg": list(self.coverage_deg),
+                "radius_m": [float(r) for r in self.radius_m], "spec_deg": self.spec_deg,
+                "yield": self.target_yield, "draws": self.draws,
+                "designs": [{k: clean(v) for k, v in d.items()} for d in self.designs],
+                "best": [{k: clean(v) for k, v in d.items()} for d in best_per_radius(self)]}
+
+
+def best_per_radius(grid: CoverageDesign) -> list[dict]:
+    """Per radius: the fewest front ends meeting the spec after calibration (largest
+    tolerance among equals), else the smallest worst error."""
+    out = []
+    for r in grid.radius_m:
+        cand = [d for d in grid.designs if d["radius_m"] == float(r) and d["problem"] is None
+                and math.isfinite(d["worst_calibrated_deg"])]
+        if not cand:
+            continue
+        ok = [d for d in cand if d["worst_calibrated_deg"] <= grid.spec_deg]
+        pick = (min(ok, key=lambda d: (d["front_ends"], -d["sigma_mm"])) if ok
+                else min(cand, key=lambda d: d["worst_calibrated_deg"]))
+        out.append(pick)
+    return out
+
+
+def coverage_designs(scene: Scene, coverage_deg: tuple[float, float], radius_m,
+                     spec_deg: float = 0.1, target_yield: float = 0.95, draws: int = 200,
+                     seed: int = 0, points: int = 11, extras=(0, 1),
+                     progress: Callable[[int, int], None] | None = None) -> CoverageDesign:
+    """Plan and evaluate the candidate arcs for every radius."""
+    cov = tuple(math.radians(x) for x in coverage_deg)
+    radii = np.asarray(radius_m, float).ravel()
+    designs, total = [], radii.size * len(extras)
+    for r in radii:
+        for e in extras:
+            designs.append(evaluate_arc(plan_arc(scene, cov, float(r), e), spec_deg,
+                                        target_yield, draws, seed, points))
+            if progress:
+                progress(len(designs), total)
+    return CoverageDesign(tuple(float(x) for x in coverage_deg), radii, float(spec_deg),
+                          float(target_yield), int(draws), tuple(designs))

@@ -1,0 +1,285 @@
+"""``--pair all`` (``calibrate``, ``linearity``, ``tolerance``) and ``design --coverage-deg``:
+whole arcs (issue 14). The commands in ``cli/aoa.py`` and ``cli/tolerance.py`` hand over to
+these functions; ``folder`` is where ``--out`` files go (None: no ``--out``)."""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis.tolerance import AXES, CASES, NOMINAL_AMPLITUDES
+from ..aoa.calibration import calibrate_pair, probe_front_ends
+from ..aoa.linearity import linearity
+from ..geometry import build_setup
+from ..io import write_json
+from ..parallel import dask_client, map_chunks
+from ..paths import exact_paths
+from ._common import UsageError, load_scene_checked, print_json, steps
+from .aoa import _pairs
+
+__all__ = ["prepare_all", "calibrate_all", "linearity_all", "scales", "wants_arc",
+           "save_pair_npz", "tolerance_arc", "coverage_spec", "design_coverage"]
+
+
+def wants_arc(args) -> bool:
+    """``tolerance`` goes through the arc study for ``--pair all`` or rotation / RuT-pose
+    errors (the pair study draws only the three offsets)."""
+    return list(args.pair) == ["all"] or any(
+        v for v in (args.yaw_deg, args.pitch_deg, args.rut_position_mm, args.rut_yaw_deg))
+
+
+def prepare_all(args):
+    """``--pair all``: scene, setup, every adjacent pair, paths, each front end alone."""
+    scene = load_scene_checked(args.scene)
+    setup = build_setup(scene)
+    pairs = _pairs(setup, args.pair)
+    paths = exact_paths(setup)
+    return scene, setup, pairs, paths, probe_front_ends(setup, paths, scene.seed)
+
+
+def calibrate_all(args, folder) -> int:
+    """Every adjacent pair calibrated in one run; one JSON entry per pair plus the arc's."""
+    with steps(args.quiet or args.json) as step:
+        step("measuring each front end alone")
+        scene, setup, pairs, paths, probe = prepare_all(args)
+        cals = []
+        for pair in pairs:
+            step(f"sweeping the delay of front end {pair[1]} (pair {pair})")
+            cals.append(calibrate_pair(setup, paths, pair, probe, seed=scene.seed))
+    res = [abs(c.residual_error_deg) for c in cals]
+    out = {"pairs": [c.to_dict() for c in cals],
+           "front_end_angles_deg": [float(x) for x in np.degrees(probe.angle_rad)],
+           "arc": {"pairs": [list(p) for p in pairs], "worst_residual_error_deg": max(res),
+                   "worst_pair": list(pairs[int(np.argmax(res))]),
+                   "max_abs_range_offset_mm": max(abs(c.range_offset_m) for c in cals) * 1e3}}
+    if folder is not None:
+        from ..viz.figures import calibration_sweep_figure, save_figure
+        for pair, cal in zip(pairs, cals):
+            save_figure(calibration_sweep_figure(cal.sweep_delta_tau_s, cal.sweep_error_deg,
+                                                 cal.delta_tau_s, cal.period_s),
+                        folder / f"calibration_sweep_{pair[0]}_{pair[1]}.png")
+        write_json(folder / "calibration.json", out)
+    if args.json:
+        print_json(out)
+        return 0
+    for pair, cal in zip(pairs, cals):
+        print(f"pair {pair}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps, residual angle error "
+              f"{cal.residual_error_deg:.4f} deg, range offset {cal.range_offset_m * 1e3:.2f} mm")
+    print(f"arc ({len(pairs)} pairs): worst residual {out['arc']['worst_residual_error_deg']:.4f} "
+          f"deg (pair {tuple(out['arc']['worst_pair'])})")
+    return 0
+
+
+def linearity_all(args, folder) -> int:
+    """Every adjacent pair's linearity in one run; one JSON entry per pair plus the arc's."""
+    with steps(args.quiet or args.json) as step:
+        step("measuring each front end alone")
+        scene, setup, pairs, paths, probe = prepare_all(args)
+        lins = []
+        for pair in pairs:
+            cal = None
+            if not args.uncalibrated:
+                step(f"calibrating pair {pair}")
+                cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
+            step(f"pair {pair}: sweeping {args.points} set-points ({args.amplitudes} amplitudes)")
+            lins.append(linearity(setup, paths, pair, args.amplitudes, probe, cal, args.points,
+                                  scene.seed))
+    worst = [lin.max_abs_error_deg for lin in lins]
+    out = {"pairs": [lin.to_dict() for lin in lins],
+           "arc": {"pairs": [list(p) for p in pairs], "max_abs_error_deg": max(worst),
+                   "worst_pair": list(pairs[int(np.argmax(worst))]),
+                   "calibrated": not args.uncalibrated, "amplitudes": args.amplitudes}}
+    if folder is not None:
+        from ..viz.figures import linearity_figure, save_figure
+        for pair, lin in zip(pairs, lins):
+            save_figure(linearity_figure(lin.set_deg, {args.amplitudes: lin.detected_deg},
+                                         {args.amplitudes: lin.amplitude_db}),
+                        folder / f"linearity_{pair[0]}_{pair[1]}.png")
+        write_json(folder / "linearity.json", out)
+    if args.json:
+        print_json(out)
+        return 0
+    state = "uncalibrated" if args.uncalibrated else "calibrated"
+    for pair, lin in zip(pairs, lins):
+        print(f"pair {pair}: {args.amplitudes} ({state}): max |error| "
+              f"{lin.max_abs_error_deg:.4f} deg over {len(lin.set_deg)} set-points")
+    print(f"arc ({len(pairs)} pairs): max |error| {max(worst):.4f} deg (pair "
+          f"{tuple(out['arc']['worst_pair'])})")
+    return 0
+
+
+def scales(args) -> tuple[np.ndarray, dict]:
+    """The per-axis scales (m: the sigma, or the uniform bound) from the old ``--sigma-*-mm``
+    flags or the new tolerance flags (``--radial-mm 0.2 --sigma-level 3``: +-0.2 mm at 3
+    sigma), and the rotation / RuT-pose tolerances (SI) of the new flags."""
+    k = 1.0 / args.sigma_level if args.distribution == "normal" else 1.0
+    sigma = []
+    for axis in AXES:
+        old, new = getattr(args, f"sigma_{axis}_mm"), getattr(args, f"{axis}_mm")
+        if old is not None and new is not None:
+            raise UsageError(f"--sigma-{axis}-mm and --{axis}-mm: give one of them (the first is "
+                             "the scale itself, the second a tolerance at --sigma-level)")
+        sigma.append(old if old is not None else (k * new if new is not None else 0.1))
+    extra = {"yaw_rad": np.radians(args.yaw_deg), "pitch_rad": np.radians(args.pitch_deg),
+             "rut_position_m": (args.rut_position_mm * 1e-3,) * 3,
+             "rut_yaw_rad": np.radians(args.rut_yaw_deg)}
+    return np.array(sigma) * 1e-3, extra
+
+
+def save_pair_npz(path: Path, res, seed: int) -> None:
+    """Per-draw offsets (draws, 2, 3) m and worst errors (deg) of a pair study (NPZ)."""
+    from ..analysis.tolerance import draw_offsets
+    off = draw_offsets(seed, res.draws, res.sigma_m, res.distribution)
+    arrays = {"offsets_m": off, "pairs": np.array([res.model.pair]),
+              "delay_s": res.delay_s[:, None], "range_offset_m": res.range_offset_m[:, None]}
+    arrays.update({f"{case}_deg": v[:, None] for case, v in res.worst_error_deg.items()})
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".part")
+    with open(tmp, "wb") as fh:
+        np.savez_compressed(fh, **arrays)
+    tmp.replace(path)
+
+
+def tolerance_arc(args, scene, sigma, extra, folder) -> int:
+    """``--pair all`` (or rotation / RuT-pose errors): every pair on shared per-front-end
+    draws (``analysis.arc``); one JSON entry per pair plus the arc's yield."""
+    from ..analysis.arc import Bounds, arc_models, arc_monte_carlo
+    setup = build_setup(scene)
+    pairs = _pairs(setup, args.pair)
+    seed = scene.seed if args.seed is None else args.seed
+    cases = CASES + ((NOMINAL_AMPLITUDES,) if args.nominal_amplitudes else ())
+    k = 1.0 / args.sigma_level if args.distribution == "normal" else 1.0
+    bounds = Bounds(tuple(float(x) for x in sigma), k * extra["yaw_rad"],
+                    k * extra["pitch_rad"], tuple(k * x for x in extra["rut_position_m"]),
+                    k * extra["rut_yaw_rad"])
+    if args.invert_yield is not None:
+        raise UsageError("--invert-yield: only for one pair without rotation or RuT-pose errors "
+                         "so far (rtsgeom design --coverage-deg finds the arc's tolerance)")
+    t0 = time.perf_counter()
+    try:
+        models = arc_models(setup, pairs, args.points)
+    except ValueError as exc:
+        raise UsageError(f"--pair: a pair cannot synthesize its span ({exc})") from None
+    from .tolerance import _progress
+    with _progress(args.quiet) as progress, dask_client(args.dask, args.workers) as client:
+        mapper = None if client is None else functools.partial(map_chunks, client=client)
+        res = arc_monte_carlo(models, setup.fe.count, bounds, args.draws, seed,
+                              args.distribution, args.spec_deg, cases, args.chunk,
+                              keep_errors=folder is not None, progress=progress,
+                              label="Monte Carlo (arc)", mapper=mapper)
+    out = res.to_dict()
+    out["sigma_level"] = args.sigma_level if args.distribution == "normal" else None
+    elapsed = time.perf_counter() - t0
+    if folder is not None:
+        from ..viz.figures import save_figure, tolerance_histogram_figure
+        p95 = max(out["arc"][case]["angle_error_deg"]["p95"] for case in cases)
+        lim = max(5 * args.spec_deg, 1.2 * p95)
+        fig = tolerance_histogram_figure(
+            {case: np.clip(res.arc_worst(case), -lim, lim) for case in cases}, args.spec_deg,
+            f"Worst error per arc ({len(pairs)} pairs, clipped at ±{lim:.2g} deg)")
+        save_figure(fig, folder / "tolerance.png")
+        write_json(folder / "tolerance.json", out)
+        res.save_npz(folder / "tolerance_draws.npz")
+    if args.json:
+        print_json(out)
+        return 0
+    sc = out["scales"]
+    kind = "sigma" if args.distribution == "normal" else "bound"
+    print(f"arc of {setup.fe.count} front ends, {len(pairs)} pair(s), {args.draws} draws "
+          f"({args.distribution}, {kind}: radial {sc['radial_mm']:.4g}, tangential "
+          f"{sc['tangential_mm']:.4g}, height {sc['height_mm']:.4g} mm, yaw {sc['yaw_deg']:.4g}, "
+          f"pitch {sc['pitch_deg']:.4g} deg per front end; RuT position "
+          f"{sc['rut_position_mm'][0]:.4g} mm, yaw {sc['rut_yaw_deg']:.4g} deg), "
+          f"{elapsed:.2f} s")
+    for entry in out["pairs"]:
+        print(f"  pair {tuple(entry['pair'])}: " + "; ".join(
+            f"{case} p95 {entry[case]['angle_error_deg']['p95']:.4f} deg, yield "
+            f"{100 * entry[case]['yield']:.2f} %" for case in cases))
+    for case in cases:
+        a = out["arc"][case]
+        print(f"  ARC {case:>28}: |worst error| p50 {a['angle_error_deg']['p50']:.4f}, p95 "
+              f"{a['angle_error_deg']['p95']:.4f}, max {a['angle_error_deg']['max']:.4f} deg; "
+              f"yield {100 * a['yield']:.2f} % (every pair within {args.spec_deg:g} deg)")
+    return 0
+
+
+def coverage_spec(text: str) -> tuple[float, float]:
+    """argparse type for ``--coverage-deg A:B`` (A < B, both in [-80, 80] deg)."""
+    try:
+        a, b = (float(x) for x in text.split(":"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not A:B (azimuths in deg, e.g. "
+                                         "-10:10)") from None
+    if not (-80.0 <= a < b <= 80.0):
+        raise argparse.ArgumentTypeError(f"{text}: need -80 <= A < B <= 80 deg")
+    return a, b
+
+
+COVERAGE_MAPS = {
+    "worst_calibrated_deg": ("worst |angle error| (deg)", "Calibrated, over the coverage"),
+    "worst_uncalibrated_deg": ("worst |angle error| (deg)", "Uncalibrated, over the coverage"),
+    "sigma_mm": ("mounting sigma (mm)", "Tolerance for the yield (whole arc)"),
+    "front_ends": ("front ends", "Number of front ends"),
+}
+
+
+def design_coverage(args, scene, folder) -> int:
+    """``design --coverage-deg A:B``: N front ends per radius (``analysis.coverage``)."""
+    from ..analysis.coverage import best_per_radius, coverage_designs
+    seed = scene.seed if args.seed is None else args.seed
+    draws = args.draws if args.draws is not None else 300
+    from .tolerance import _progress
+    with _progress(args.quiet) as progress:
+        grid = coverage_designs(scene, args.coverage_deg, args.radius_m, args.spec_deg,
+                                args.yield_, draws, seed, min(args.points, 11),
+                                progress=None if progress is None else
+                                (lambda done, total: progress("designs", done, total)))
+    out = grid.to_dict()
+    if folder is not None:
+        from ..viz.figures import design_heatmap_figure, save_figure
+        extras = sorted({d["extra"] for d in grid.designs})
+        for name, (zlabel, title) in COVERAGE_MAPS.items():
+            z = np.full((len(extras), grid.radius_m.size), np.nan)
+            for d in grid.designs:
+                i = int(np.argmin(np.abs(grid.radius_m - d["radius_m"])))
+                v = d.get(name)
+                z[extras.index(d["extra"]), i] = np.nan if v is None else float(v)
+            fig = design_heatmap_figure(
+                grid.radius_m, np.array(extras, float), z, "arc radius R_c (m)",
+                "front ends beyond the fewest", zlabel,
+                f"{title}, coverage {args.coverage_deg[0]:g}..{args.coverage_deg[1]:g} deg")
+            save_figure(fig, folder / f"coverage_{name}.png")
+        write_json(folder / "coverage.json", out)
+    if args.json:
+        print_json(out)
+        return 0
+    a, b = args.coverage_deg
+    print(f"coverage {a:g}..{b:g} deg; spec {grid.spec_deg:g} deg; tolerance: "
+          f"{100 * grid.target_yield:g} % of whole arcs within the spec ({draws} draws)")
+    print("worst |angle error| over the coverage (deg): on the nominal arc, and p95 over arcs "
+          "with 0.1 mm sigma mounting errors")
+    print(f"{'R_c m':>6} {'N':>3} {'sp deg':>7} {'res deg':>8} {'cal':>7} {'uncal':>7} "
+          f"{'cal p95':>8} {'unc p95':>8} {'sigma mm':>9}  binding; sheet")
+    best = {id(d) for d in best_per_radius(grid)}
+    for d in grid.designs:
+        def f(key, fmt):
+            v = d.get(key)
+            return format(v, fmt) if v is not None and np.isfinite(v) else "-"
+        mark = "*" if id(d) in best else " "
+        why = ", ".join(d["binding"]) or "-"
+        print(f"{d['radius_m']:6.3g}{mark}{d['front_ends']:3d} {d['spacing_deg']:7.3f} "
+              f"{d['resolution_deg']:8.3f} {f('worst_calibrated_deg', '7.4f')} "
+              f"{f('worst_uncalibrated_deg', '7.4f')} {f('p95_calibrated_at_0.1mm_deg', '8.4f')} "
+              f"{f('p95_uncalibrated_at_0.1mm_deg', '8.4f')} {f('sigma_mm', '9.4f')}"
+              f"{'+' if d.get('sigma_capped') else ' '} {why}; {d['sheet_change']}"
+              + (f"; PROBLEM: {d['problem']}" if d["problem"] else ""))
+    print("best per radius (*): the fewest front ends within the spec after calibration")
+    for d in best_per_radius(grid):
+        print(f"  R_c {d['radius_m']:g} m: {d['front_ends']} front ends at "
+              + ", ".join(f"{x:.2f}" for x in d["angles_deg"])
+              + f" deg; {d['sheet_change']}")
+    return 0
