@@ -6,7 +6,6 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-import trimesh
 
 from .._util import frozen
 from ..scene import Scene
@@ -26,7 +25,7 @@ class Setup:
     fe: FrontEnds
 
     @cached_property
-    def sheet(self) -> trimesh.Trimesh | None:
+    def sheet(self) -> "trimesh.Trimesh | None":  # noqa: F821 (trimesh loads with the mesh)
         cfg = self.scene.sheet
         if not cfg.enabled:
             return None
