@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -12,6 +13,9 @@ from ..scene import Scene
 from .arc import FrontEnds, antenna_positions, front_ends
 from .arrays import RutArray, rut_array
 from .sheet import sheet_mesh
+
+if TYPE_CHECKING:  # trimesh loads where the mesh is built (geometry.sheet)
+    import trimesh
 
 __all__ = ["Setup", "build_setup", "nominal_setup"]
 
@@ -25,7 +29,7 @@ class Setup:
     fe: FrontEnds
 
     @cached_property
-    def sheet(self) -> "trimesh.Trimesh | None":  # noqa: F821 (trimesh loads with the mesh)
+    def sheet(self) -> trimesh.Trimesh | None:
         cfg = self.scene.sheet
         if not cfg.enabled:
             return None

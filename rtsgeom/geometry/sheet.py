@@ -8,10 +8,15 @@ subtracted with manifold3d so the result is watertight with outward normals.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..scene import SheetConfig
 from .arc import radial_tangent
+
+if TYPE_CHECKING:  # trimesh itself loads where a mesh is built (1 s of imports)
+    import trimesh
 
 __all__ = ["segments_blocked", "shell_sector", "sheet_mesh"]
 

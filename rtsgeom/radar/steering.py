@@ -20,7 +20,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .._util import frozen
+from .._util import frozen, single_threaded_blas
 from ..geometry import RutArray
 from ..scene import RadarConfig
 
@@ -214,6 +214,18 @@ class Steering:
         u = np.empty_like(u0)
         ok = np.zeros(u0.shape[0], bool)
         best_grid = np.empty_like(u0)
+        with single_threaded_blas():  # (BLOCK x V_s) @ (V_s x G) is too small to share out
+            self._peak_blocks(flat, u0, u, ok, best_grid, kv, grid, steer, iterations)
+        if not ok.all():
+            if n_d == 1:
+                u[~ok, 0] = np.sin(self.search(flat[~ok]))
+            else:
+                u[~ok] = best_grid[~ok]
+        return u.reshape(shape + (n_d,)), ok.reshape(shape)
+
+    def _peak_blocks(self, flat, u0, u, ok, best_grid, kv, grid, steer, iterations):
+        """:meth:`peak`'s Newton steps and global check, block by block (fills ``u``,
+        ``ok`` and ``best_grid`` in place)."""
         for b in range(0, u0.shape[0], BLOCK):
             blk = slice(b, b + BLOCK)
             x = self.weighted(flat[blk])
@@ -229,12 +241,6 @@ class Steering:
                                   iterations + 4)
                 u[b + bad[ok2]] = u2[ok2]
                 ok[b + bad[ok2]] = True
-        if not ok.all():
-            if n_d == 1:
-                u[~ok, 0] = np.sin(self.search(flat[~ok]))
-            else:
-                u[~ok] = best_grid[~ok]
-        return u.reshape(shape + (n_d,)), ok.reshape(shape)
 
 
 def _newton(kv, xr, xi, u, p_max, steps):
