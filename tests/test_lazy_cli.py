@@ -68,9 +68,8 @@ def test_commands_import_only_what_they_use(tmp_path, args):
 
 
 def test_unknown_command_is_a_one_line_error(tmp_path):
-    code, mods = _imported(["no-such-command"], tmp_path)
+    code, _mods = _imported(["no-such-command"], tmp_path)
     assert code == 2
-    assert _loaded(mods, ("numpy",)) == []
 
 
 def _subparsers(parser):

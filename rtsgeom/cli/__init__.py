@@ -60,9 +60,10 @@ def _on_sigterm(signum, frame):
 
 def build_parser(command: str | None = None, *, lazy: bool = False) -> argparse.ArgumentParser:
     """The CLI's parser. By default every group registers its subcommands (the complete
-    parser). ``lazy``: only the group that owns ``command`` does (none for ``None``); the
-    other commands appear with their help line (enough for ``rtsgeom --help`` and for
-    argparse's choice check) and nothing of their group is imported."""
+    parser). ``lazy``: only the group that owns ``command`` does (none for ``None``; all for a
+    word not in :data:`COMMANDS`, so a command a group registers but the table misses still
+    runs); the other commands appear with their help line (enough for ``rtsgeom --help`` and
+    for argparse's choice check) and nothing of their group is imported."""
     ap = _Parser(
         prog="rtsgeom",
         description="Radar target simulator setups as geometry: per-element paths, FMCW "
@@ -70,8 +71,10 @@ def build_parser(command: str | None = None, *, lazy: bool = False) -> argparse.
     ap.add_argument("--version", action="version", version=f"rtsgeom {__version__}")
     sub = ap.add_subparsers(dest="command", metavar="COMMAND", required=True)
     import importlib
-    groups = _GROUPS if not lazy else (
-        (COMMANDS[command][0],) if command in COMMANDS else ())
+    if not lazy or (command is not None and command not in COMMANDS):
+        groups = _GROUPS  # complete, or a word the table does not know: let every group try
+    else:
+        groups = (COMMANDS[command][0],) if command is not None else ()
     for name in groups:
         try:
             mod = importlib.import_module(f".{name}", __name__)
