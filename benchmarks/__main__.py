@@ -1,5 +1,17 @@
-"""``python -m benchmarks``: performance of the heavy stages, as ratios so a noisy machine does
-not matter. Not part of the test suite.
+"""``python -m benchmarks``: performance of the heavy stages and of every command, as absolute
+times (wall and CPU) and as ratios to a reference measured in the same run, so a noisy machine
+matters less. Not part of the test suite.
+
+* Every command of issue 17 (``commands``): the simulation phase of ``run`` (``run_scene`` on
+  the default scene), one full-chain frame (synthesis + range-Doppler + CFAR + angle),
+  ``calibrate --pair 0 1``, ``adc --format dca1000``, ``design`` (default grid),
+  ``nearfield``, ``tolerance`` (1e6 draws x 21 set-points; 1e5 with ``--quick``; also on a
+  2-worker Dask LocalCluster), ``info`` and ``--help``. Each: wall time, CPU time (this
+  process's ``time.process_time`` in process, the child's user + system time for a
+  subprocess) and wall / reference, the reference being the per-echo ADC synthesis
+  (``synthesize_exact``) of the default scene timed in the same run: a machine-speed unit.
+  ``--help`` and ``info`` are also compared with importing every command group (what the CLI
+  did before it imported lazily).
 
 * ADC-cube synthesis of the default scene (targets on two channels each, cable ghosts and, when
   Sionna RT works here, the ray-traced reflections): the batched-GEMM path against the
@@ -111,17 +123,182 @@ def bench_raytrace(scene_path: Path) -> dict:
             "process_wall_s": time.perf_counter() - t0}
 
 
+def _cpu_children() -> float:
+    import resource
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def _time_cli(args: list[str], repeat: int = 1, python_args: tuple = ()) -> dict:
+    """Best wall time of ``python -m rtsgeom ARGS`` in a subprocess, and its CPU time."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    best = {"wall_s": np.inf, "cpu_s": np.inf}
+    for _ in range(repeat):
+        c0, t0 = _cpu_children(), time.perf_counter()
+        r = subprocess.run([sys.executable, *python_args, "-m", "rtsgeom", *args], cwd=ROOT,
+                           env=env, capture_output=True, text=True)
+        wall, cpu = time.perf_counter() - t0, _cpu_children() - c0
+        if r.returncode != 0:
+            return {"failed": f"exit {r.returncode}: {r.stderr.strip()[-300:]}"}
+        best = {"wall_s": min(best["wall_s"], wall), "cpu_s": min(best["cpu_s"], cpu)}
+    return best
+
+
+def _time_python(code: str, repeat: int = 1) -> dict:
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    best = {"wall_s": np.inf, "cpu_s": np.inf}
+    for _ in range(repeat):
+        c0, t0 = _cpu_children(), time.perf_counter()
+        subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, check=True)
+        best = {"wall_s": min(best["wall_s"], time.perf_counter() - t0),
+                "cpu_s": min(best["cpu_s"], _cpu_children() - c0)}
+    return best
+
+
+def _time_inproc(f, repeat: int = 1) -> tuple[dict, object]:
+    best, out = {"wall_s": np.inf, "cpu_s": np.inf}, None
+    for _ in range(repeat):
+        c0, t0 = time.process_time(), time.perf_counter()
+        out = f()
+        best = {"wall_s": min(best["wall_s"], time.perf_counter() - t0),
+                "cpu_s": min(best["cpu_s"], time.process_time() - c0)}
+    return best, out
+
+
+#: issue 17's targets (quiet 2-core machine), seconds
+TARGETS = {"run_simulation": 1.0, "frame": 0.030, "calibrate": 1.0, "adc_dca1000": 2.0,
+           "design_default_grid": 5.0, "nearfield": 2.0, "tolerance": 20.0, "help": 0.5}
+
+
+def bench_commands(scene_path: Path, quick: bool, repeat: int, workers: int) -> dict:
+    """Every command of the issue's table: wall, CPU and wall / reference."""
+    import tempfile
+    from rtsgeom.radar.fmcw import synthesize, synthesize_exact
+    from rtsgeom.radar.processing import cfar_mask, detect, range_doppler
+    from rtsgeom.run import run_scene
+    from rtsgeom.scene import load_scene
+    scene_arg = str(scene_path)
+    scene = load_scene(scene_path)
+    out: dict = {}
+    t_sim, result = _time_inproc(lambda: run_scene(scene), 1 if quick else 2)
+    out["run_simulation"] = t_sim
+    ech, radar, rut = result.echoes, result.scene.radar, result.setup.rut
+    ref, _ = _time_inproc(lambda: synthesize_exact(ech, radar, rut), max(1, repeat // 2))
+    reference = {"what": "per-echo ADC synthesis (synthesize_exact) of the default scene, "
+                         f"{len(ech)} echoes, exact paths", **ref}
+
+    def frame():
+        cube = synthesize(ech, radar, rut)
+        rd = range_doppler(cube)
+        return detect(rd, cube)
+    out["frame"], _ = _time_inproc(frame, 5 * repeat)
+    rd = range_doppler(result.cube)
+    out["frame"]["parts"] = {
+        "synthesis": _time_inproc(lambda: synthesize(ech, radar, rut), 5 * repeat)[0],
+        "range_doppler": _time_inproc(lambda: range_doppler(result.cube), 5 * repeat)[0],
+        "cfar": _time_inproc(lambda: cfar_mask(rd.power, radar.cfar), 5 * repeat)[0],
+        "detect": _time_inproc(lambda: detect(rd, result.cube), 5 * repeat)[0]}
+    out["help"] = _time_cli(["--help"], 3)
+    out["help_all_groups_imported"] = _time_python(
+        "from rtsgeom.cli import build_parser; build_parser()", 3)
+    out["info"] = _time_cli(["info", scene_arg], 3)
+    out["calibrate"] = _time_cli(["calibrate", scene_arg, "--pair", "0", "1", "--json",
+                                  "--quiet"])
+    with tempfile.TemporaryDirectory() as tmp:
+        out["adc_dca1000"] = _time_cli(["adc", scene_arg, "--format", "dca1000", "--out",
+                                        str(Path(tmp) / "adc.bin"), "--quiet"])
+    design = ["design", scene_arg, "--json", "--quiet"]
+    if quick:  # a 2 x 2 corner of the default 4 x 5 grid
+        design += ["--radius-m", "0.5:2:2", "--spacing-deg", "4:20:2"]
+    out["design_default_grid" if not quick else "design_2x2"] = _time_cli(design)
+    out["nearfield"] = _time_cli(["nearfield", scene_arg, "--json", "--quiet"])
+    draws = 100_000 if quick else 1_000_000
+    tol = ["tolerance", scene_arg, "--pair", "0", "1", "--sigma-radial-mm", "0.1",
+           "--sigma-tangential-mm", "0.1", "--sigma-height-mm", "0.1", "--seed", "1",
+           "--json", "--quiet"]
+    out["tolerance"] = {"draws": draws, **_time_cli(tol + ["--draws", str(draws)])}
+    dask_draws = 100_000 if quick else 400_000
+    out["tolerance_dask"] = bench_dask_scaling(scene_path, dask_draws, workers)
+    for name, v in out.items():
+        if isinstance(v, dict) and "wall_s" in v:
+            v["over_reference"] = v["wall_s"] / reference["wall_s"]
+            if name in TARGETS:
+                v["target_s"] = TARGETS[name]
+    out["reference"] = reference
+    return out
+
+
+def bench_dask_scaling(scene_path: Path, draws: int, workers: int) -> dict:
+    """Tolerance draws on a warm LocalCluster of 1 and of ``workers`` single-threaded worker
+    processes (cluster start and the first chunk excluded: the scaling of the study itself).
+    The CLI's ``--workers N`` adds the cluster start (about 10 s here) to this."""
+    from rtsgeom.analysis.tolerance import PairPhasors, monte_carlo
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.parallel import dask_client, map_chunks
+    from rtsgeom.scene import load_scene
+    model = PairPhasors.build(build_setup(load_scene(scene_path)), (0, 1), points=21)
+    sigma = [1e-4, 1e-4, 1e-4]
+    out = {"draws": draws, "workers": workers}
+    p95 = {}
+    for n in (1, workers):
+        with dask_client(workers=n) as client:
+            def mapper(func, chunks):
+                return map_chunks(func, chunks, client)
+            monte_carlo(model, sigma, 4 * 10_000, 0, mapper=mapper)  # warm: imports, model
+            c0, t0 = time.process_time(), time.perf_counter()
+            res = monte_carlo(model, sigma, draws, 0, mapper=mapper)
+            out[f"{n}_workers"] = {"wall_s": time.perf_counter() - t0,
+                                   "client_cpu_s": time.process_time() - c0}
+            p95[n] = res.worst_error_deg["calibrated"]
+    out["speedup"] = out["1_workers"]["wall_s"] / out[f"{workers}_workers"]["wall_s"]
+    out["bit_identical"] = bool(np.array_equal(p95[1], p95[workers]))
+    return out
+
+
+def _print_commands(cmds: dict) -> None:
+    ref = cmds["reference"]
+    print(f"commands (reference: {ref['what']}: {ref['wall_s']:.3f} s wall, "
+          f"{ref['cpu_s']:.3f} s CPU)")
+    print(f"  {'what':28s} {'wall':>10s} {'CPU':>10s} {'/ ref':>8s} {'target':>8s}")
+    for name, v in cmds.items():
+        if name == "reference" or not isinstance(v, dict):
+            continue
+        if "failed" in v:
+            print(f"  {name:28s} failed: {v['failed']}")
+            continue
+        if "wall_s" not in v:
+            continue
+        tgt = f"{v['target_s']:.3g} s" if "target_s" in v else ""
+        print(f"  {name:28s} {v['wall_s']:9.3f}s {v['cpu_s']:9.3f}s {v['over_reference']:8.3f} "
+              f"{tgt:>8s}")
+    d = cmds["tolerance_dask"]
+    print(f"  tolerance {d['draws']} draws on a warm LocalCluster: 1 worker "
+          f"{d['1_workers']['wall_s']:.2f} s, {d['workers']} workers "
+          f"{d[str(d['workers']) + '_workers']['wall_s']:.2f} s: {d['speedup']:.2f}x "
+          f"(results bit-identical: {d['bit_identical']})")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m benchmarks", description=__doc__.split("\n")[0])
     ap.add_argument("--scene", type=Path, default=DEFAULT_SCENE)
     ap.add_argument("--draws", type=int, default=100_000, help="tolerance draws (default 1e5)")
     ap.add_argument("--repeat", type=int, default=5, help="timing repeats (best of)")
-    ap.add_argument("--skip", nargs="*", default=[], choices=["synthesis", "tolerance", "raytrace"])
+    ap.add_argument("--skip", nargs="*", default=[],
+                    choices=["synthesis", "tolerance", "raytrace", "commands"])
+    ap.add_argument("--quick", action="store_true",
+                    help="fewer repeats and draws, a 2 x 2 design grid, no ray tracing")
+    ap.add_argument("--workers", type=int, default=2, help="Dask workers to compare with one")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results.json")
     args = ap.parse_args(argv)
+    if args.quick:
+        args.repeat = min(args.repeat, 2)
+        args.draws = min(args.draws, 20_000)
+        args.skip = sorted(set(args.skip) | {"raytrace"})
 
     results = {"machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
-                           "numpy": np.__version__, "platform": platform.platform()}}
+                           "numpy": np.__version__, "platform": platform.platform(),
+                           "load_average_before": list(os.getloadavg())},
+               "quick": bool(args.quick)}
     rt_ok = "raytrace" not in args.skip
     if "raytrace" not in args.skip:
         results["raytrace"] = bench_raytrace(args.scene)
@@ -131,6 +308,9 @@ def main(argv=None) -> int:
                                                args.repeat)
     if "tolerance" not in args.skip:
         results["tolerance"] = bench_tolerance(args.scene, args.draws)
+    if "commands" not in args.skip:
+        results["commands"] = bench_commands(args.scene, args.quick, args.repeat, args.workers)
+    results["machine"]["load_average_after"] = list(os.getloadavg())
 
     print("benchmark                     result")
     s = results.get("synthesis")
@@ -160,6 +340,11 @@ def main(argv=None) -> int:
             print(f"ray tracing ({r['variant']}, {r['rows']} rows): first solve "
                   f"{r['first_solve_s']:.2f} s, warm {r['warm_solve_s']:.3f} s, peak RSS "
                   f"{r['peak_rss_mib']:.0f} MiB")
+    if "commands" in results:
+        _print_commands(results["commands"])
+    m = results["machine"]
+    print(f"load average before/after: {m['load_average_before'][0]:.1f} / "
+          f"{m['load_average_after'][0]:.1f} on {m['cpus']} CPUs")
     from rtsgeom.io import write_json
     write_json(args.out, results)
     print(f"wrote {args.out}")

@@ -26,7 +26,6 @@ from functools import cached_property
 
 import numpy as np
 from scipy.constants import c
-from scipy.optimize import brentq
 
 from ..geometry import Setup
 from ..geometry.arc import antenna_positions
@@ -183,6 +182,7 @@ class ChannelModel:
             raise AngleUnreachable(
                 f"angle {np.degrees(alpha):.4f} deg is outside the span this front-end pair "
                 f"can synthesize [{np.degrees(min(lo, hi)):.4f}, {np.degrees(max(lo, hi)):.4f}] deg")
+        from scipy.optimize import brentq  # here: scipy.optimize costs ~0.3 s of imports
         return float(np.exp(brentq(lambda x: angle(x) - alpha, -log_span, log_span, xtol=1e-10)))
 
     def _closed_form(self, alpha: float, mode: str) -> float:

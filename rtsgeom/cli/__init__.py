@@ -11,14 +11,32 @@ import signal as _sig
 import sys
 
 from .. import __version__
-from ..io import OutputError
-from ..parallel import ClusterError
-from ..scene import SceneError
-from ._common import UsageError
 
 __all__ = ["main", "build_parser"]
 
 _GROUPS = ("geometry", "signal", "aoa", "tolerance", "analysis", "viz")
+
+#: Every subcommand: (group module that registers it, its one-line help). ``main`` imports only
+#: the group of the command it runs (the groups import numpy, scipy, the signal chain), so
+#: ``rtsgeom --help`` and ``rtsgeom info`` start without the heavy libraries; the other
+#: commands are listed from this table. ``tests/test_lazy_cli.py`` checks it against what the
+#: groups register.
+COMMANDS: dict[str, tuple[str, str]] = {
+    "info": ("geometry", "summary of a scene: elements, front ends, far-field figures"),
+    "paths": ("geometry", "per-element propagation paths as CSV"),
+    "export-mesh": ("geometry", "export the setup as GLB/PLY/OBJ/STL"),
+    "run": ("signal", "the main job: simulate the scene, detect, compare with set-points"),
+    "adc": ("signal", "save the raw ADC cube (.npy) or a DCA1000 capture"),
+    "calibrate": ("aoa", "phase calibration sweep of a front-end pair"),
+    "linearity": ("aoa", "synthesized-angle linearity across a pair's span"),
+    "tolerance": ("tolerance", "mounting-tolerance Monte Carlo of a front-end pair or a whole arc"),
+    "design": ("tolerance", "arc radius x front-end spacing design map"),
+    "nearfield": ("analysis", "near-field violation: single front-end bias, phase error and "
+                              "synthesized-angle error vs arc radius"),
+    "ghosts": ("analysis", "cable ghosts: predicted ranges and levels per front end and "
+                           "target (and simulated with --simulate)"),
+    "show": ("viz", "3D view of the setup: PNG, interactive HTML or a window"),
+}
 
 
 class _Parser(argparse.ArgumentParser):
@@ -40,7 +58,12 @@ def _on_sigterm(signum, frame):
     raise Terminated()
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None, *, lazy: bool = False) -> argparse.ArgumentParser:
+    """The CLI's parser. By default every group registers its subcommands (the complete
+    parser). ``lazy``: only the group that owns ``command`` does (none for ``None``; all for a
+    word not in :data:`COMMANDS`, so a command a group registers but the table misses still
+    runs); the other commands appear with their help line (enough for ``rtsgeom --help`` and
+    for argparse's choice check) and nothing of their group is imported."""
     ap = _Parser(
         prog="rtsgeom",
         description="Radar target simulator setups as geometry: per-element paths, FMCW "
@@ -48,7 +71,11 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--version", action="version", version=f"rtsgeom {__version__}")
     sub = ap.add_subparsers(dest="command", metavar="COMMAND", required=True)
     import importlib
-    for name in _GROUPS:
+    if not lazy or (command is not None and command not in COMMANDS):
+        groups = _GROUPS  # complete, or a word the table does not know: let every group try
+    else:
+        groups = (COMMANDS[command][0],) if command is not None else ()
+    for name in groups:
         try:
             mod = importlib.import_module(f".{name}", __name__)
         except ModuleNotFoundError as exc:  # a group not written yet
@@ -56,7 +83,24 @@ def build_parser() -> argparse.ArgumentParser:
                 raise
             continue
         mod.register(sub)
+    for cmd, (_group, helptext) in COMMANDS.items():  # the commands not registered above
+        if cmd not in sub.choices:
+            sub.add_parser(cmd, help=helptext, add_help=False)
+    # list the commands in the table's order whichever group registered first (argparse keeps
+    # the help lines in registration order; no public API reorders them)
+    order = list(COMMANDS)
+    sub._choices_actions.sort(key=lambda a: order.index(a.dest)  # noqa: SLF001
+                              if a.dest in order else len(order))
     return ap
+
+
+def _command_of(argv: list[str]) -> str | None:
+    """The subcommand named on a command line: the first word that is not an option (the
+    top-level parser takes no option with a value)."""
+    for word in argv:
+        if not word.startswith("-"):
+            return word
+    return None
 
 
 def _raytrace_unavailable() -> type[Exception]:
@@ -66,7 +110,8 @@ def _raytrace_unavailable() -> type[Exception]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(_command_of(argv), lazy=True)
     args = parser.parse_args(argv)
     import threading
     old = None
@@ -80,6 +125,10 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _dispatch(args) -> int:
+    from ..io import OutputError
+    from ..parallel import ClusterError
+    from ..scene import SceneError
+    from ._common import UsageError
     try:
         return int(args.func(args) or 0)
     except (SceneError, UsageError, OutputError, ClusterError, _raytrace_unavailable()) as exc:

@@ -23,7 +23,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy.interpolate import RegularGridInterpolator
 
 __all__ = ["AntennaPatterns", "CosinePattern", "ISOTROPIC", "Isotropic", "Pattern",
            "TablePattern", "cos_power_exponent", "direction_angles", "pattern_from_config",
@@ -125,7 +124,8 @@ class TablePattern(Pattern):
     elevation_rad: np.ndarray
     gain_db: np.ndarray
     phase_rad: np.ndarray
-    _interp: RegularGridInterpolator = field(init=False, repr=False, compare=False)
+    # scipy's RegularGridInterpolator (imported where it is built)
+    _interp: object = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         az = np.asarray(self.azimuth_rad, float)
@@ -144,6 +144,8 @@ class TablePattern(Pattern):
         if not (np.all(np.isfinite(g)) and np.all(np.isfinite(ph))):
             raise ValueError("pattern table: gain_db and phase_deg must be finite")
         values = 10.0 ** (g / 20.0) * np.exp(1j * ph)
+        # imported here: scipy.interpolate costs ~0.5 s of imports that only tables need
+        from scipy.interpolate import RegularGridInterpolator
         interp = RegularGridInterpolator((az, el), values, method="linear", bounds_error=False,
                                          fill_value=0.0)
         object.__setattr__(self, "_interp", interp)

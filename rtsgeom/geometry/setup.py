@@ -4,14 +4,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
-import trimesh
 
 from ..scene import Scene, arc_centre_m
 from .arc import FrontEnds, front_ends
 from .arrays import RutArray, rut_array
 from .sheet import sheet_mesh
+
+if TYPE_CHECKING:  # trimesh loads where the mesh is built (geometry.sheet)
+    import trimesh
 
 __all__ = ["Setup", "build_setup", "nominal_setup"]
 

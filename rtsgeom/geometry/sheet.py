@@ -8,11 +8,15 @@ subtracted with manifold3d so the result is watertight with outward normals.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import trimesh
 
 from ..scene import SheetConfig
 from .arc import radial_tangent
+
+if TYPE_CHECKING:  # trimesh itself loads where a mesh is built (1 s of imports)
+    import trimesh
 
 __all__ = ["segments_blocked", "shell_sector", "sheet_mesh"]
 
@@ -21,6 +25,7 @@ def shell_sector(r_inner: float, thickness: float, angle_min: float, angle_max: 
                  z_min: float, z_max: float, max_step_rad: float = np.radians(0.5)
                  ) -> trimesh.Trimesh:
     """Watertight cylindrical shell sector about the z axis (azimuth from +y towards +x)."""
+    import trimesh  # here, not at the top: 1 s of imports that `rtsgeom info` does not need
     n = max(2, int(np.ceil((angle_max - angle_min) / max_step_rad)) + 1)
     a = np.linspace(angle_min, angle_max, n)
     r_hat, _ = radial_tangent(a)  # (n, 3)
@@ -59,6 +64,7 @@ def shell_sector(r_inner: float, thickness: float, angle_min: float, angle_max: 
 def sheet_mesh(cfg: SheetConfig, arc_centre: np.ndarray, arc_radius_m: float,
                cutout_angles_rad: np.ndarray) -> trimesh.Trimesh:
     """The sheet with its cutouts, in world coordinates."""
+    import trimesh
     r0 = arc_radius_m + cfg.radius_offset_m
     h = 0.5 * cfg.height_m
     shell = shell_sector(r0, cfg.thickness_m, cfg.angle_min_rad, cfg.angle_max_rad, -h, h)

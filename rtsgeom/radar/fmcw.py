@@ -30,6 +30,7 @@ from functools import cached_property
 
 import numpy as np
 
+from .._util import single_threaded_blas
 from ..geometry import RutArray
 from ..rts import Echoes
 from ..scene import RadarConfig
@@ -92,17 +93,9 @@ def beat_phase0(echoes: Echoes, radar: RadarConfig) -> np.ndarray:
                         - 0.5 * radar.slope_hz_per_s * tau ** 2)
 
 
-_CONTROLLER = None
-
-
 def _single_threaded_blas():
-    """Context manager limiting BLAS to one thread (the controller is built once: inspecting
-    the loaded libraries takes milliseconds)."""
-    global _CONTROLLER
-    from threadpoolctl import ThreadpoolController
-    if _CONTROLLER is None:
-        _CONTROLLER = ThreadpoolController()
-    return _CONTROLLER.limit(limits=1, user_api="blas")
+    """BLAS limited to one thread (:func:`rtsgeom._util.single_threaded_blas`)."""
+    return single_threaded_blas()
 
 
 def synthesize(echoes: Echoes, radar: RadarConfig, rut: RutArray) -> AdcCube:

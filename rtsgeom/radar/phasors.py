@@ -19,10 +19,26 @@ import numpy as np
 from ..geometry import RutArray
 from ..rts import Echoes
 from ..scene import RadarConfig
-from .fmcw import beat_phase0, chirp_start_s, fast_time_s
+from .fmcw import beat_phase0, chirp_start_s
 from .steering import window
 
 __all__ = ["bin_response"]
+
+
+def _tones(freq_hz: np.ndarray, t0_s: float, dt_s: float, n: int) -> np.ndarray:
+    """``exp(2 pi j f (t0 + i dt))`` for i = 0..n-1: (..., n) for frequencies (...).
+
+    Factored as ``exp(2 pi j f (t0 + a B dt)) exp(2 pi j f b dt)``, i = a B + b with
+    B ~ sqrt(n): 2 sqrt(n) complex exponentials and n products per frequency instead of n
+    exponentials (numpy's complex ``exp`` dominated the model construction: 0.2 s for the
+    delay table of ~1000 echoes). Agrees with the direct form to ~1e-15 (tested); each
+    phase is a product of two exact-to-rounding factors, no recursion that accumulates."""
+    f = np.asarray(freq_hz, float)[..., None]
+    block = max(1, int(np.ceil(np.sqrt(n))))
+    outer = np.exp(2j * np.pi * f * (t0_s + np.arange(-(-n // block)) * block * dt_s))
+    inner = np.exp(2j * np.pi * f * (np.arange(block) * dt_s))
+    out = outer[..., :, None] * inner[..., None, :]
+    return out.reshape(out.shape[:-2] + (-1,))[..., :n]
 
 
 def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, doppler_bin
@@ -40,12 +56,11 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
     f_d = echoes.doppler_hz
     amp = echoes.amplitude * np.exp(1j * beat_phase0(echoes, radar))  # (E, V)
     # fast time: sum_n w_n exp(j 2 pi (S tau + f_D) t_n) exp(-j 2 pi r n / N)
-    t_n = fast_time_s(radar)
     w_r = window(radar.range_window, n_s)
     n = np.arange(n_s)
     kern_r = w_r * np.exp(-2j * np.pi * np.outer(r, n) / n_s)  # (K, N)
     beat = s * tau + f_d[:, None]  # (E, V)
-    fast = np.exp(2j * np.pi * beat[..., None] * t_n)  # (E, V, N)
+    fast = _tones(beat, radar.adc_start_s, 1.0 / radar.adc_rate_hz, n_s)  # (E, V, N) at t_n
     if echoes.fast_gain is not None:  # fractional-delay FIR ripple along the chirp
         fast = fast * echoes.fast_gain[:, None, :]
     rr = np.einsum("kn,evn->kev", kern_r, fast)

@@ -16,11 +16,11 @@ the beamformer steers with ``+k p_v . u`` (sign conventions: ``radar.processing`
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
-from scipy import signal
 
-from .._util import frozen
+from .._util import frozen, single_threaded_blas
 from ..geometry import RutArray
 from ..scene import RadarConfig
 
@@ -29,11 +29,31 @@ __all__ = ["Steering", "window"]
 BLOCK = 4096  # snapshots per block of the Newton refinement (cache-sized)
 
 
+#: The cosine-sum coefficients of the registry's windows (``registry.WINDOWS``), as in
+#: ``scipy.signal.windows``.
+_COSINE_SUMS = {"hann": (0.5, 1.0 - 0.5), "hamming": (0.54, 1.0 - 0.54),  # scipy: (a, 1 - a)
+                "blackman": (0.42, 0.50, 0.08)}
+
+
 def window(name: str, n: int) -> np.ndarray:
-    """Symmetric window ``name`` (scipy.signal names, or ``none``) of n points."""
-    if name == "none":
+    """Symmetric window ``name`` (scipy.signal names, or ``none``) of n points.
+
+    The registry's cosine-sum windows are formed here with scipy's own arithmetic
+    (``scipy.signal.windows.general_cosine``: ``sum_k a_k cos(k x)``, x = linspace(-pi, pi, n)),
+    bit for bit (tested), because importing ``scipy.signal`` costs about half a second (it
+    loads ``scipy.stats``), more than the rest of ``rtsgeom info``; other names go to
+    ``scipy.signal.get_window``."""
+    if name == "none" or n <= 1:
         return np.ones(n)
-    return signal.get_window(name, n, fftbins=False)
+    coeffs = _COSINE_SUMS.get(name)
+    if coeffs is None:
+        from scipy import signal
+        return signal.get_window(name, n, fftbins=False)
+    x = np.linspace(-np.pi, np.pi, n, dtype=np.float64)
+    w = np.zeros(n, dtype=np.float64)
+    for k, a in enumerate(coeffs):
+        w += a * np.cos(k * x)
+    return w
 
 
 def _taper(name: str, positions: np.ndarray) -> np.ndarray:
@@ -125,7 +145,22 @@ class Steering:
     def power(self, snapshots, u) -> np.ndarray:
         """Bartlett power |sum_v w_v x_v exp(j k p_v . u)|^2 (eq. 14) of snapshots (..., V) at
         directions ``u`` (A, D): (..., A)."""
-        return np.abs(self.weighted(snapshots) @ self.steer(u).T) ** 2
+        return self._power(self.weighted(snapshots), self.steer(u))
+
+    @staticmethod
+    def _power(weighted: np.ndarray, steer: np.ndarray) -> np.ndarray:
+        """|weighted @ steer.T|^2. ``einsum`` (numpy's own loops), not BLAS: these products are
+        small (a few snapshots x V_s x a grid), where a multi-threaded BLAS call costs 10x
+        its arithmetic in thread hand-offs on a busy machine (measured: 1.1 ms instead of
+        0.1 ms per call, which made the `exact` amplitude design of `nearfield` take 20 s)."""
+        return np.abs(np.einsum("...v,av->...a", weighted, steer)) ** 2
+
+    @cached_property
+    def _search_grid(self) -> tuple[np.ndarray, np.ndarray]:
+        """The coarse grid of :meth:`search` (0.25 deg over +-90 deg) and its steering vectors
+        (built once per beamformer, not per call)."""
+        grid = np.radians(np.arange(-90.0, 90.0001, 0.25))
+        return grid, self.steer(self.directions(grid))
 
     def search(self, snapshots) -> np.ndarray:
         """Beamformer peak per snapshot (..., V) -> azimuth (...,) rad, by grid search at
@@ -136,10 +171,10 @@ class Steering:
         snaps = np.atleast_2d(snapshots)
         shape = snaps.shape[:-1]
         snaps = snaps.reshape(-1, snaps.shape[-1])
-        grid = np.radians(np.arange(-90.0, 90.0001, 0.25))
-        p = self.power(snaps, self.directions(grid))
-        best = grid[np.argmax(p, axis=1)]
+        grid, steer = self._search_grid
         x = self.weighted(snaps)
+        p = self._power(x, steer)
+        best = grid[np.argmax(p, axis=1)]
         for half, step in ((0.3, 0.005), (0.006, 1e-4)):
             offs = np.radians(np.arange(-half, half + step / 2, step))
             cand = np.clip(best[:, None] + offs[None, :], -np.pi / 2, np.pi / 2)
@@ -182,6 +217,18 @@ class Steering:
         u = np.empty_like(u0)
         ok = np.zeros(u0.shape[0], bool)
         best_grid = np.empty_like(u0)
+        with single_threaded_blas():  # (BLOCK x V_s) @ (V_s x G) is too small to share out
+            self._peak_blocks(flat, u0, u, ok, best_grid, kv, grid, steer, iterations)
+        if not ok.all():
+            if n_d == 1:
+                u[~ok, 0] = np.sin(self.search(flat[~ok]))
+            else:
+                u[~ok] = best_grid[~ok]
+        return u.reshape(shape + (n_d,)), ok.reshape(shape)
+
+    def _peak_blocks(self, flat, u0, u, ok, best_grid, kv, grid, steer, iterations):
+        """:meth:`peak`'s Newton steps and global check, block by block (fills ``u``,
+        ``ok`` and ``best_grid`` in place)."""
         for b in range(0, u0.shape[0], BLOCK):
             blk = slice(b, b + BLOCK)
             x = self.weighted(flat[blk])
@@ -197,12 +244,6 @@ class Steering:
                                   iterations + 4)
                 u[b + bad[ok2]] = u2[ok2]
                 ok[b + bad[ok2]] = True
-        if not ok.all():
-            if n_d == 1:
-                u[~ok, 0] = np.sin(self.search(flat[~ok]))
-            else:
-                u[~ok] = best_grid[~ok]
-        return u.reshape(shape + (n_d,)), ok.reshape(shape)
 
 
 def _newton(kv, xr, xi, u, p_max, steps):
