@@ -18,7 +18,7 @@ from ._common import UsageError
 
 __all__ = ["main", "build_parser"]
 
-_GROUPS = ("geometry", "signal", "aoa", "tolerance", "analysis", "viz")
+_GROUPS = ("geometry", "signal", "aoa", "tolerance", "analysis", "viz", "identify")
 
 
 class _Parser(argparse.ArgumentParser):
