@@ -537,11 +537,11 @@ def predicted_calibration(setup: Setup, pair: tuple[int, int], alphas=None) -> d
 def crb_grid(scene: Scene, snr_db, radii_m, active: int = 0) -> np.ndarray:
     """Cramer-Rao std of radial, tangential, height offset (m) and yaw (rad), (R, S, 4), for
     one capture of front end ``active`` at each arc radius ``radii_m`` (R,) and per-sample SNR
-    ``snr_db`` (S,); the channel's gain and phase are unknown, its delay known (it is
-    inseparable otherwise). inf where the Fisher matrix is singular."""
+    ``snr_db`` (S,). Each parameter is estimated together with what a capture always fits
+    (tangential and height offsets, the channel's gain and phase); the channel delay is known
+    (it is inseparable otherwise). inf where the parameter does not act."""
     snr = np.atleast_1d(np.asarray(snr_db, float))
     out = np.empty((np.size(radii_m), snr.size, 4))
-    free = [0, 1, 2, 3, 5, 6]
     for k, r in enumerate(np.atleast_1d(radii_m)):
         sc = scene.evolve(rts=scene.rts.evolve(arc_radius_m=float(r)))
         setup = build_setup(sc)
@@ -549,7 +549,7 @@ def crb_grid(scene: Scene, snr_db, radii_m, active: int = 0) -> np.ndarray:
         m = ProbeModel.of(setup, Capture(np.zeros((0, 0, 0), complex), active, rng, 0.0, amp))
         th = m.nominal()
         s2 = m.noise_variance(th, 0.0)  # SNR 0 dB; the bound scales with 10^(-SNR / 20)
-        std = cramer_rao([m], th, s2, free)[[0, 1, 2, 3]]
+        std = np.array([cramer_rao([m], th, s2, sorted({1, 2, 5, 6, p}))[p] for p in range(4)])
         out[k] = std[None, :] * 10 ** (-snr[:, None] / 20)
     return out
 
