@@ -70,12 +70,15 @@ MIN_EIGENVALUE = 1e-4
 
 SEPARATE_BY = {
     0: ("a capture of this front end at another RF start frequency (radar.f_c_hz moved by about "
-        "1 GHz): the air path's phase turns with f_c, the channel's delay with f_rts and its "
-        "phase not at all"),
+        "1 GHz; the air path's phase turns with f_c, the channel's delay with f_rts and its "
+        "phase not at all; identify does not take such captures yet: every capture is read "
+        "with the scene's radar)"),
     4: ("a capture of this front end through another RTS channel, or at another RF start "
-        "frequency (the channel delay acts at f_rts, a radial offset at f_c)"),
-    3: ("front-end antenna patterns in the model, or a second probe in another RuT (the yaw "
-        "only moves the Rx and Tx antennas by +-s/2 sin(yaw) in opposite radial directions)"),
+        "frequency (the channel delay acts at f_rts, a radial offset at f_c; neither is an "
+        "input of identify yet)"),
+    3: ("directive front-end antenna patterns in the model (not in identify's model yet; "
+        "without them the yaw only moves the Rx and Tx antennas by +-s/2 sin(yaw) in opposite "
+        "radial directions, which cancels in the two-way path)"),
     2: "a RuT with elevation elements (radar.use_elevation_tx = true)",
     1: "a higher SNR (more frames averaged)",
 }

@@ -215,3 +215,16 @@ def test_identify_rejects_a_capture_without_sidecar(tmp_path, capsys):
     np.save(bad, np.zeros((2, 2, 2), np.complex64))
     assert main(["identify", str(DEFAULT_SCENE), str(bad)]) == 2
     assert "sidecar" in capsys.readouterr().err
+
+
+def test_captures_of_one_front_end_are_fitted_jointly():
+    """Two captures of the same front end (two probe ranges, independent noise) are one fit:
+    the tangential std falls by about sqrt(2) and the estimate stays within 3 std."""
+    scene = _scene()
+    setup, truth = _built(scene, 11)
+    one = ident_mod.identify(scene, [ident_mod.simulate_capture(setup, 0, seed=1)]).fit(0)
+    two = ident_mod.identify(scene, [ident_mod.simulate_capture(setup, 0, seed=1),
+                                     ident_mod.simulate_capture(setup, 0, 20.0, seed=2)]).fit(0)
+    assert two.captures == 2 and one.captures == 1
+    assert 1.2 < one.std[1] / two.std[1] < 1.7
+    assert abs(two.estimate[1] - truth[0, 1]) < 3 * two.std[1]
