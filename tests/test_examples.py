@@ -25,6 +25,7 @@ OUTPUTS = {
     "plot_cable_ghosts.py": ["cable_ghosts.png"],
     "plot_nearfield.py": ["nearfield.png"],
     "plot_dca1000_capture.py": ["adc.bin", "adc.bin.json", "dca1000_range_profile.png"],
+    "plot_identify.py": ["identify_crb.png"],
 }
 
 

@@ -14,7 +14,7 @@ from .. import __version__
 
 __all__ = ["main", "build_parser"]
 
-_GROUPS = ("geometry", "signal", "aoa", "tolerance", "analysis", "viz")
+_GROUPS = ("geometry", "signal", "aoa", "tolerance", "analysis", "viz", "identify")
 
 #: Every subcommand: (group module that registers it, its one-line help). ``main`` imports only
 #: the group of the command it runs (the groups import numpy, scipy, the signal chain), so

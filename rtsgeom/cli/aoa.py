@@ -60,7 +60,19 @@ def _prepare(args):
 
 
 def cmd_calibrate(args) -> int:
-    with output_folder(args.out, [args.scene]) as stage:
+    with output_folder(args.out, [args.scene, getattr(args, "from_identified", None)]) as stage:
+        if getattr(args, "from_identified", None) is not None:  # no sweep (rtsgeom.identify)
+            from ..identify import calibrate_from_identified
+            scene = load_scene_checked(args.from_identified)
+            out = calibrate_from_identified(scene, _pair(build_setup(scene), args.pair))
+            if stage is not None:
+                write_json(stage / "calibration.json", out)
+            if args.json:
+                print_json(out)
+            else:
+                print(f"pair {tuple(out['pair'])}: delta_tau {out['delta_tau_s'] * 1e12:.1f} ps "
+                      f"(predicted from {args.from_identified}, no sweep)")
+            return 0
         return _calibrate(args, stage)
 
 
@@ -164,6 +176,9 @@ def register(sub) -> None:
                                 "refined to the delay resolution (default); paper: the "
                                 "paper's sweep as written (fixed eq. 23 amplitudes, one set "
                                 "angle, 25 ps steps)")
+            p.add_argument("--from-identified", type=output_path, default=None, metavar="FILE",
+                           help="no sweep: predict the delay from a scene as identified "
+                                "(rtsgeom identify --out DIR writes DIR/identified.toml)")
         if name == "linearity":
             p.add_argument("--end-angles", choices=("geometric", "measured"),
                            default="geometric",

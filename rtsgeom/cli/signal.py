@@ -13,8 +13,8 @@ import numpy as np
 from ..io import atomic_path, write_bytes, write_json, write_text
 from ..registry import AOA_MODES, PATH_METHODS
 from ..run import RunResult, label_detections, run_scene, summary
-from ._common import (UsageError, load_scene_checked, output_file, output_folder, output_path,
-                      scene_arg, steps)
+from ._common import (UsageError, load_scene_checked, number, output_file, output_folder,
+                      output_path, scene_arg, steps)
 
 
 def detections_csv(result: RunResult) -> str:
@@ -204,9 +204,12 @@ def cmd_run(args) -> int:
 
 def cmd_adc(args) -> int:
     output_file(args.out, [args.scene])
-    if args.format == "dca1000":
+    if args.format == "dca1000" or args.active is not None:
         output_file(Path(str(args.out) + ".json"), [args.scene])
     scene = load_scene_checked(args.scene)
+    if args.active is not None:  # one front end alone on a probe target (rtsgeom identify)
+        from .identify import adc_probe_capture
+        return adc_probe_capture(scene, args)
     with steps(args.quiet) as step:  # the calibration sweeps take about a minute
         step(f"simulating {scene.name} (calibration, ADC cube)")
         cube = run_scene(scene, "exact", args.amplitudes).cube
@@ -253,4 +256,13 @@ def register(sub) -> None:
     p.add_argument("--amplitudes", choices=modes, default=None,
                    help="AoA amplitude mode (default: the scene's rts.aoa_mode)")
     p.add_argument("--quiet", action="store_true", help="no progress output on stderr")
+    p.add_argument("--active", type=number(0, 10_000, integer=True), default=None, metavar="I",
+                   help="capture front end I alone with a probe target (for rtsgeom identify; "
+                        "the sidecar OUT.json records the probe)")
+    p.add_argument("--probe-range-m", type=number(0.01, 1e4), default=None, metavar="R",
+                   help="probe range with --active (default: the calibration's probe range)")
+    p.add_argument("--probe-velocity-mps", type=number(-1e3, 1e3), default=0.0,
+                   help="probe velocity with --active (default 0)")
+    p.add_argument("--seed", type=number(0, 2**32 - 1, integer=True), default=None,
+                   help="receiver-noise seed with --active (default: the scene's seed + I)")
     p.set_defaults(func=cmd_adc)

@@ -1,0 +1,100 @@
+"""``rtsgeom identify`` and ``rtsgeom adc --active``: measure a built setup from probe captures
+(``rtsgeom.identify``)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ._common import (UsageError, load_scene_checked, output_folder, output_path, print_json,
+                      scene_arg, steps)
+
+
+def adc_probe_capture(scene, args) -> int:
+    """``rtsgeom adc SCENE --active I``: front end I alone with a probe target, on the setup as
+    built (the scene's mounting errors), receiver noise at the scene's SNR."""
+    from ..identify import setup_of, simulate_capture, write_capture
+    setup = setup_of(scene)
+    seed = (scene.seed or 0) + args.active if args.seed is None else args.seed
+    try:
+        with steps(args.quiet) as step:
+            step(f"simulating front end {args.active} alone with a probe target")
+            cap = simulate_capture(setup, args.active, args.probe_range_m,
+                                   args.probe_velocity_mps, seed)
+            meta = write_capture(cap, setup.rut, args.out, args.format)
+    except ValueError as exc:
+        raise UsageError(f"--active/--probe-range-m: {exc}") from None
+    if not args.quiet:
+        print(f"wrote {args.out} and {args.out}.json: front end {cap.active} alone, probe at "
+              f"{cap.range_m:.3f} m, {cap.velocity_mps:+.3f} m/s ({meta['format']})")
+    return 0
+
+
+def _text(d: dict) -> str:
+    lines = []
+
+    def val(x, unit, digits=4):
+        return "not identifiable" if x is None else f"{x['value']:+.{digits}f} +- {x['std']:.{digits}f} {unit}"
+
+    for fe, ch in zip(d["front_ends"], d["channels"]):
+        lines.append(f"front end {fe['index']} ({fe['captures']} capture(s), residual "
+                     f"{fe['residual_rms']:.2f} x noise):")
+        for key, unit in (("radial_offset_mm", "mm"), ("tangential_offset_mm", "mm"),
+                          ("height_offset_mm", "mm"), ("yaw_offset_deg", "deg")):
+            lines.append(f"  {key:22s} {val(fe[key], unit)}")
+        lines.append(f"  {'channel delay_offset_s':22s} "
+                     + ("not identifiable" if ch["delay_offset_s"] is None else
+                        f"{ch['delay_offset_s']['value']:+.4g} +- {ch['delay_offset_s']['std']:.2g} s"))
+        lines.append(f"  {'channel gain_db':22s} {val(ch['gain_db'], 'dB')}")
+        lines.append(f"  {'channel phase_deg':22s} {val(ch['phase_deg'], 'deg', 3)}")
+        for key, why in list(fe["not_identifiable"].items()) + list(ch["not_identifiable"].items()):
+            lines.append(f"  why not {key}: {why}")
+    return "\n".join(lines)
+
+
+def cmd_identify(args) -> int:
+    from ..identify import identified_scene_toml, identify, read_capture
+    with output_folder(args.out, [args.scene, *args.captures]) as stage:
+        scene = load_scene_checked(args.scene)
+        try:
+            caps = [read_capture(p) for p in args.captures]
+        except (OSError, ValueError, KeyError) as exc:
+            raise UsageError(f"CAPTURE: {exc}") from None
+        with steps(args.quiet or args.json) as step:
+            step(f"fitting {len(caps)} capture(s) of front end(s) "
+                 f"{sorted({c.active for c in caps})}")
+            try:
+                ident = identify(scene, caps)
+            except ValueError as exc:
+                raise UsageError(f"CAPTURE: {exc}") from None
+        d = ident.to_dict()
+        if stage is not None:
+            import json
+            text = Path(args.scene).read_text(encoding="utf-8")
+            (stage / "identified.toml").write_text(identified_scene_toml(text, ident),
+                                                   encoding="utf-8")
+            (stage / "identified.json").write_text(json.dumps(d, indent=2, allow_nan=False)
+                                                   + "\n", encoding="utf-8")
+    if args.json:
+        print_json(d)
+    elif not args.quiet:
+        print(_text(d))
+        if args.out is not None:
+            print(f"wrote {args.out}/identified.toml (the scene as built) and identified.json")
+    return 0
+
+
+def register(sub) -> None:
+    p = sub.add_parser("identify", help="estimate each front end's mounting errors and each "
+                                        "channel's gain/phase/delay from probe captures")
+    scene_arg(p)
+    p.add_argument("captures", nargs="+", type=Path, metavar="CAPTURE",
+                   help="probe captures (.bin or .npy with its .json sidecar, as rtsgeom adc "
+                        "--active I writes them)")
+    p.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    p.add_argument("--out", type=output_path, default=None,
+                   help="folder for identified.toml (the corrected scene) and identified.json")
+    p.add_argument("--quiet", action="store_true", help="no progress output")
+    p.set_defaults(func=cmd_identify)
+
+
+__all__ = ["adc_probe_capture", "cmd_identify", "register"]
