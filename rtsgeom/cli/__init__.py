@@ -36,6 +36,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "ghosts": ("analysis", "cable ghosts: predicted ranges and levels per front end and "
                            "target (and simulated with --simulate)"),
     "show": ("viz", "3D view of the setup: PNG, interactive HTML or a window"),
+    "identify": ("identify", "estimate each front end's mounting errors and each channel's "
+                             "gain/phase/delay from probe captures"),
 }
 
 
