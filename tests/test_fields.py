@@ -246,7 +246,7 @@ def test_cfar_fields_reach_the_detector(guard, train):
     """radar.cfar.guard_cells / training_cells / threshold_db: the scene's CA-CFAR noise
     estimate is the mean of its ring, and a detection is a local maximum above noise x
     10^(threshold/10) -- checked on the detector the chain calls (``detect``)."""
-    scene = scene_with(radar=dict(cfar={"kind": "ca", "guard_cells": guard,
+    scene = scene_with(radar=dict(chirps_per_tx=48, cfar={"kind": "ca", "guard_cells": guard,
                                         "training_cells": train, "threshold_db": 12.0}),
                        targets=[{"range_m": 30.0, "angle_deg": 3.4},
                                 {"range_m": 41.0, "velocity_mps": -3.0, "angle_deg": 12.2}],
@@ -289,16 +289,17 @@ def test_os_cfar_noise_is_the_ring_quantile(rank):
     assert not np.allclose(cfar_mask(power, ca)[1], noise)
 
 
-@pytest.mark.parametrize("snr_db", [0.0, 10.0, 25.0])
+@pytest.mark.parametrize("snr_db", [0.0, 25.0])
 def test_snr_sets_the_noise_power_and_the_seed_the_realisation(snr_db):
     """radar.snr_db and seed: run_scene adds noise of power max|a|^2 / 10^(snr/10) per sample,
     drawn from the scene's seed (same seed: same bits; another seed: other noise)."""
     from rtsgeom.run import run_scene
     tg = [{"range_m": 30.0, "angle_deg": 3.4}]
-    runs = {seed: run_scene(scene_with(radar=dict(snr_db=snr_db), targets=tg, top=dict(seed=seed),
-                                       noisy=True), aoa_mode="nearest") for seed in (1, 1, 2)}
-    res = run_scene(scene_with(radar=dict(snr_db=snr_db), targets=tg, top=dict(seed=1),
-                               noisy=True), aoa_mode="nearest")
+    radar = dict(snr_db=snr_db, chirps_per_tx=32)
+    runs = {seed: run_scene(scene_with(radar=radar, targets=tg, top=dict(seed=seed), noisy=True),
+                            aoa_mode="nearest") for seed in (1, 2)}
+    res = run_scene(scene_with(radar=radar, targets=tg, top=dict(seed=1), noisy=True),
+                    aoa_mode="nearest")
     clean = synthesize(res.echoes, res.scene.radar, res.setup.rut).data
     noise = res.cube.data - clean
     direct = res.echoes.kind == 0
@@ -412,7 +413,8 @@ def test_the_scenes_aoa_mode_is_the_one_run(mode, monkeypatch):
         seen.append(m)
         return program_nearest(setup.scene, setup), {}, []
     monkeypatch.setattr(plan, "plan_targets", fake_plan)
-    s = scene_with(rts=dict(aoa_mode=mode), targets=[{"range_m": 30.0, "angle_deg": 7.0}])
+    s = scene_with(radar=dict(chirps_per_tx=32), rts=dict(aoa_mode=mode),
+                   targets=[{"range_m": 30.0, "angle_deg": 7.0}])
     res = run_mod.run_scene(s)
     assert res.aoa_mode == mode
     assert seen == ([] if mode == "nearest" else [mode])
