@@ -313,6 +313,17 @@ def test_linearity_sweeps_the_inner_span_and_reports_relative_amplitudes(cal_set
     assert lin.max_abs_error_deg < 0.05
     amp_db = np.asarray(lin.amplitude_db)
     assert amp_db.max() == 0.0 and np.all(amp_db <= 0.0)
+    # 20 log10 of the programmed amplitudes relative to the largest
+    from rtsgeom.aoa.calibration import probe_angles
+    from rtsgeom.aoa.plan import pair_amplitudes
+    from rtsgeom.aoa.calibration import probe_ranges
+    from rtsgeom.scene import TargetConfig
+    rng = float(probe_ranges(setup, 1)[0])
+    amps = np.array([pair_amplitudes(setup, paths, (0, 1), TargetConfig(rng, 0.0, 10.0, float(a)),
+                                     "exact", probe_angles(*probe.angle_rad[[0, 1]]),
+                                     (0.0, cal.delta_tau_s), probe.gain_correction[[0, 1]])[:2]
+                     for a in np.radians(lin.set_deg)]).T
+    np.testing.assert_allclose(amp_db, 20 * np.log10(amps / amps.max()), atol=1e-9)
     # the channels trade amplitude across the span: A_J grows, A_I falls
     assert np.all(np.diff(amp_db[1]) > 0) and np.all(np.diff(amp_db[0]) < 0)
 
@@ -331,10 +342,18 @@ def test_probe_ranges_keep_clear_of_every_cable_ghost(length):
             assert all(abs((r[b] - r[a]) - g) >= clear - 1e-12 for g in ghosts)
 
 
-def test_closed_forms_put_a_span_end_on_one_channel_alone():
+@pytest.mark.parametrize("angles", [(3.4, 12.2), (-5.0, 5.0), (-12.0, -2.0)])
+def test_closed_forms_put_a_span_end_on_one_channel_alone(angles):
     from rtsgeom.aoa.model import ChannelModel
     from rtsgeom.scene import TargetConfig
-    setup = build_setup(small_quiet([]))
+
+    def mutate(doc):
+        doc["radar"].update(SMALL)
+        for fe, a in zip(doc["rts"]["front_ends"], angles):
+            fe["angle_deg"] = a
+        doc["sheet"]["enabled"] = False
+        doc["targets"] = []
+    setup = build_setup(make_scene(mutate))
     cm = ChannelModel.build(setup, exact_paths(setup), (0, 1), TargetConfig(20.0))
     th = setup.fe_azimuth_rad()
     for mode in ("array-factor", "paper"):
