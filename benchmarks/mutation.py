@@ -271,7 +271,8 @@ def summarise(results: dict, meta: dict) -> dict:
     counted = sum(len(v) for s, v in by.items() if s not in ("equivalent", "not checked"))
     per_module: dict[str, dict[str, int]] = defaultdict(lambda: defaultdict(int))
     for k, r in results.items():
-        per_module[module_of(r["file"]) or "?"][r["status"]] += 1
+        status = "equivalent" if k in EQUIVALENT and r["status"] == "survived" else r["status"]
+        per_module[module_of(r["file"]) or "?"][status] += 1
     first = defaultdict(int)
     for r in results.values():
         first[r.get("first_status", r["status"])] += 1
@@ -299,9 +300,10 @@ def write_report(s: dict) -> None:
         f"(seed {s['seed']}, stratified per module)",
         f"* wall time: {s['wall_s']:.0f} s on {os.cpu_count()} cores ({s['children']} workers)",
         f"* excluded from the population (not physics): {', '.join(EXCLUDE)}",
-        *([f"* re-run after new tests: the {len(s['rerun'])} survivors and no-test mutants of "
-           f"the first pass ({s['first_pass']}); {s.get('rerun_wall_s', 0):.0f} s"]
-          if s.get("rerun") else []),
+        *([f"* first pass: {s['first_pass']}; then the survivors (and no-test mutants) were run "
+           f"again after new tests: " + ", ".join(f"{r['mutants']} mutants in {r['wall_s']:.0f} s"
+                                                  for r in s["reruns"])]
+          if s.get("reruns") else []),
         "", f"**Kill rate: {rate}** = (killed + timed out) / (sampled - equivalent)", "",
         "| status | mutants |", "| --- | --- |",
         *[f"| {k} | {v} |" for k, v in c.items()], "",
@@ -354,18 +356,19 @@ def main(argv: list[str] | None = None) -> int:
         prepare(a.workdir, meta["modules"])
         all_mutants(a.workdir)
         print(f"re-running {len(rerun)} survivors", flush=True)
-        meta["rerun_wall_s"] = run(a.workdir, rerun, a.children, a.timeout_s)
-        meta["rerun"] = rerun
+        wall = run(a.workdir, rerun, a.children, a.timeout_s)
+        meta.setdefault("reruns", []).append({"mutants": len(rerun), "wall_s": round(wall, 1)})
         names = meta["names"]
         state.write_text(json.dumps(meta))
         new = collect(a.workdir, rerun)
         for k, r in new.items():
-            r["first_status"] = previous[k]["status"]
+            r["first_status"] = previous[k].get("first_status", previous[k]["status"])
         previous.update(new)
         (a.workdir / "results.json").write_text(json.dumps(previous, indent=1))
-    elif a.report_only:
+    elif a.report_only:  # from the merged results the last run left
         meta = json.loads(state.read_text())
         names = meta["names"]
+        previous = json.loads((a.workdir / "results.json").read_text())
     else:
         prepare(a.workdir, a.modules)
         population = all_mutants(a.workdir)
