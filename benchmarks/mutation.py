@@ -284,6 +284,10 @@ def summarise(results: dict, meta: dict) -> dict:
                           + by["suspicious"]},
             "equivalent": {k: {"reason": EQUIVALENT[k], "diff": results[k]["diff"]}
                            for k in by["equivalent"]},
+            "killed_later": {k: {"first_status": r["first_status"], "diff": r.get("first_diff", "")}
+                             for k, r in sorted(results.items())
+                             if r.get("first_status", r["status"]) != r["status"]
+                             and r["status"] == "killed"},
             "timed_out": by["timeout"], "killed": by["killed"]}
 
 
@@ -315,6 +319,13 @@ def write_report(s: dict) -> None:
         lines += ["## Survivors", ""]
         for k, d in s["survivors"].items():
             lines += [f"### `{k}`", "", "```diff", d.strip(), "```", ""]
+    if s["killed_later"]:
+        lines += ["## First-pass survivors killed by later tests", "",
+                  "Each was killed by a test added after the first pass (`tests/test_mutants.py` "
+                  "unless noted there).", ""]
+        for k, d in s["killed_later"].items():
+            lines += [f"### `{k}` (first pass: {d['first_status']})", "", "```diff",
+                      d["diff"].strip(), "```", ""]
     if s["equivalent"]:
         lines += ["## Equivalent mutants (no observable change)", ""]
         for k, e in s["equivalent"].items():
@@ -363,6 +374,7 @@ def main(argv: list[str] | None = None) -> int:
         new = collect(a.workdir, rerun)
         for k, r in new.items():
             r["first_status"] = previous[k].get("first_status", previous[k]["status"])
+            r["first_diff"] = previous[k].get("first_diff") or previous[k]["diff"]
         previous.update(new)
         (a.workdir / "results.json").write_text(json.dumps(previous, indent=1))
     elif a.report_only:  # from the merged results the last run left
