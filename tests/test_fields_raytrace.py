@@ -16,7 +16,7 @@ from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.paths.table import RUT_TO_RUT
 
-pytestmark = pytest.mark.raytrace
+pytestmark = [pytest.mark.raytrace, pytest.mark.slow]  # ~20 s idle (Sionna solves)
 
 
 @pytest.fixture(scope="module")
