@@ -1,0 +1,405 @@
+"""``python -m benchmarks.mutation``: mutation testing of the physics core with mutmut (issue 22).
+
+Not part of the test suite (minutes to hours). mutmut 3 rewrites every function of the mutated
+modules into a trampoline that dispatches to the original or to one of its mutants (an operator,
+a constant, a keyword argument changed), runs the test selection once to learn which tests reach
+which function, and then runs, per mutant, only the tests that reach its function. A mutant
+*survives* when those tests still pass: a change of the code that no test notices.
+
+What this driver adds to ``mutmut run``:
+
+* **the physics core only** (``MODULES``): geometry/, paths/exact.py, rts.py, radar/, aoa/,
+  analysis/; ``--modules`` picks some of them (names as in ``MODULES``);
+* **targeted fast tests**: each module maps to the test files that exercise it
+  (``MODULES``); the selection is their union for the chosen modules, without the ``slow``
+  marker, the ray tracer, and the tests that run a subprocess or a dask cluster (a mutant is
+  switched by an environment variable inside the forked test process, so a subprocess or a
+  dask worker would run the unmutated code anyway, and they are slow);
+* **a reproducible sample**: ``--sample N --seed K`` runs N mutants drawn with
+  ``numpy.random.default_rng(K)``, stratified per module (each module's share of the sample is
+  its share of all mutants, at least one); without ``--sample`` every mutant runs;
+* **a report**: ``benchmarks/mutation-report.md`` and ``.json`` with the killed, survived (each
+  survivor's diff) and timed-out mutants and the kill rate (killed + timed out) / (run).
+
+mutmut copies the project into ``mutants/`` in the folder it runs in; this driver runs it in a
+scratch copy (``--workdir``, default ``/tmp/rtsgeom-mutation``) whose ``pyproject.toml`` holds the
+``[tool.mutmut]`` section of this project's pyproject with the module and test selection filled
+in, so the worktree stays clean. ``mutmut run`` in the repository itself uses the same section
+(all core modules, the union of their tests).
+
+Equivalent mutants (no observable change, e.g. a changed default that every caller overrides)
+are listed in ``EQUIVALENT`` with the reason; they are reported apart and left out of the rate.
+
+    python -m benchmarks.mutation --sample 150 --seed 1
+    python -m benchmarks.mutation --modules rts radar --sample 40 --seed 2
+    python -m benchmarks.mutation --report-only          # rewrite the report from the last run
+"""
+
+from __future__ import annotations
+
+import argparse
+import fnmatch
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+import tomllib
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+REPORT_MD = ROOT / "benchmarks" / "mutation-report.md"
+REPORT_JSON = ROOT / "benchmarks" / "mutation-report.json"
+
+# module (source glob, relative to the repository) -> the fast test files that exercise it
+MODULES: dict[str, tuple[str, tuple[str, ...]]] = {
+    "geometry": ("rtsgeom/geometry/*", (
+        "tests/test_geometry.py", "tests/test_frontends.py", "tests/test_arrays.py",
+        "tests/test_patterns.py", "tests/test_properties.py", "tests/test_warnings_geometry.py",
+        "tests/test_fields.py", "tests/test_mutants.py")),
+    "paths.exact": ("rtsgeom/paths/exact.py", (
+        "tests/test_geometry.py", "tests/test_patterns.py", "tests/test_properties.py",
+        "tests/test_frontends.py", "tests/test_mutants.py")),
+    "rts": ("rtsgeom/rts.py", (
+        "tests/test_signal.py", "tests/test_signal_properties.py", "tests/test_ghosts.py",
+        "tests/test_fields.py", "tests/test_mutants.py")),
+    "radar": ("rtsgeom/radar/*", (
+        "tests/test_signal.py", "tests/test_signal_properties.py", "tests/test_steering.py",
+        "tests/test_windows.py", "tests/test_fields.py", "tests/test_mutants.py",
+        "tests/test_cfar.py")),
+    "aoa": ("rtsgeom/aoa/*", (
+        "tests/test_aoa.py", "tests/test_steering.py", "tests/test_windows.py",
+        "tests/test_fields.py", "tests/test_mutants.py", "tests/test_calibration.py")),
+    "analysis": ("rtsgeom/analysis/*", (
+        "tests/test_tolerance.py", "tests/test_nearfield.py", "tests/test_ghosts.py",
+        "tests/test_design.py", "tests/test_mutants.py")),
+}
+
+# Functions outside the physics core although they sit in its modules: plotting, mesh export
+# and JSON serialisation (their contracts are the CLI tests', which run subprocesses and are
+# left out here). fnmatch patterns on the mutant name.
+EXCLUDE = ("*figure*", "rtsgeom.geometry.export.*", "*to_dict*")
+
+# mutant name -> why it is equivalent (no observable change); filled in from the survivors
+EQUIVALENT: dict[str, str] = {
+    "rtsgeom.geometry.arrays.x__grid_unit__mutmut_5":
+        "np.asarray(x) instead of np.asarray(x, float): every caller passes float positions "
+        "(metres), so the array is the same.",
+    "rtsgeom.geometry.arrays.x_posed_positions__mutmut_3":
+        "np.asarray(yaw, None) instead of float: a yaw offset is a float or a float array, the "
+        "array is the same (and cos/sin make floats of any integer).",
+    "rtsgeom.geometry.sheet.x_sheet_mesh__mutmut_29":
+        "np.asarray(angles) without float: the cutout angles are floats (radians) already.",
+    "rtsgeom.geometry.farfield.x_coarray_period_m__mutmut_1":
+        "the default search depth 64 -> 65 differs only for an array whose co-array period is "
+        "d_min/65; the scene selects presets only (periods d_min or d_min/2), custom arrays "
+        "are not wired to the scene.",
+    "rtsgeom.geometry.patterns.x_direction_angles__mutmut_16":
+        "no lower clip for arcsin(v_z / |v|): the ratio of a component to the norm lies in "
+        "[-1, 1] (exactly -1 straight down); only a rounding past -1 could differ.",
+    "rtsgeom.radar.dca1000.x_to_dca1000__mutmut_48":
+        "the I part rounded to float64 instead of int16 before `.astype('<i2')`: the values "
+        "are whole numbers within int16, so the bytes are the same.",
+    "rtsgeom.radar.steering.xǁSteeringǁsearch__mutmut_60":
+        "the zoom grid loses its last point (+half): the coarse peak is within half a coarse "
+        "step (0.125 deg < 0.3 deg; 0.0025 deg < 0.006 deg) of the grid centre, so the "
+        "argmax never falls on that point.",
+    "rtsgeom.radar.steering.xǁSteeringǁsearch__mutmut_4":
+        "the error message gains 'XX' around the same text (the test matches the text).",
+    "rtsgeom.analysis.tolerance.x_evaluate_chunk__mutmut_59":
+        "np.take_along_axis without axis= uses axis=-1 in numpy 2, the axis given.",
+}
+
+
+def _toml_list(xs) -> str:
+    return "[" + ", ".join(json.dumps(str(x)) for x in xs) + "]"
+
+
+def selection(modules: list[str]) -> tuple[list[str], list[str]]:
+    """(source globs, existing test files) of the chosen modules."""
+    globs = [MODULES[m][0] for m in modules]
+    tests = sorted({t for m in modules for t in MODULES[m][1] if (ROOT / t).exists()})
+    return globs, tests
+
+
+def prepare(workdir: Path, modules: list[str]) -> None:
+    """A scratch copy of the project whose [tool.mutmut] names the chosen modules and tests."""
+    if workdir.exists():
+        shutil.rmtree(workdir)
+    workdir.mkdir(parents=True)
+    ignore = shutil.ignore_patterns("__pycache__", "*.pyc", ".hypothesis", ".pytest_cache")
+    for d in ("rtsgeom", "tests", "scenes", "docs"):
+        shutil.copytree(ROOT / d, workdir / d, ignore=ignore)
+    base = tomllib.loads((ROOT / "pyproject.toml").read_text()).get("tool", {})
+    cfg = dict(base.get("mutmut", {}))
+    globs, tests = selection(modules)
+    cfg["only_mutate"] = globs
+    cfg["pytest_add_cli_args_test_selection"] = tests
+    lines = ["[tool.pytest.ini_options]", 'testpaths = ["tests"]',
+             "markers = " + _toml_list(base.get("pytest", {}).get("ini_options", {})
+                                       .get("markers", [])), "", "[tool.mutmut]"]
+    for k, v in cfg.items():
+        if isinstance(v, list):
+            lines.append(f"{k} = {_toml_list(v)}")
+        elif isinstance(v, bool):
+            lines.append(f"{k} = {'true' if v else 'false'}")
+        elif isinstance(v, (int, float)):
+            lines.append(f"{k} = {v}")
+        else:
+            lines.append(f"{k} = {json.dumps(v)}")
+    (workdir / "pyproject.toml").write_text("\n".join(lines) + "\n")
+
+
+def _env() -> dict:
+    env = dict(os.environ)
+    env.pop("PYTHONPATH", None)  # the tests must import the mutated copy, never the worktree
+    for k in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        env[k] = "1"
+    env["RTSGEOM_FUZZ_EXAMPLES"] = env.get("RTSGEOM_FUZZ_EXAMPLES", "50")
+    env["RTSGEOM_PROPERTY_EXAMPLES"] = env.get("RTSGEOM_PROPERTY_EXAMPLES", "15")
+    return env
+
+
+_GENERATE = """
+from mutmut.__main__ import (copy_src_dir, copy_also_copy_files, setup_source_paths,
+                             store_lines_covered_by_tests, create_mutants)
+from mutmut.mutation.trampoline import set_mutant_under_test
+import os
+os.makedirs("mutants", exist_ok=True)
+set_mutant_under_test("mutant_generation")
+copy_src_dir(); copy_also_copy_files(); setup_source_paths(); store_lines_covered_by_tests()
+create_mutants(2)
+"""
+
+_MUTMUT = [sys.executable, "-c", "import sys; from mutmut.__main__ import cli; "
+           "sys.argv[0] = 'mutmut'; cli()"]
+
+
+def all_mutants(workdir: Path) -> dict[str, list[str]]:
+    """Generate the mutants (no tests run) and list their names per module of ``MODULES``."""
+    subprocess.run([sys.executable, "-c", _GENERATE], cwd=workdir, env=_env(), check=True,
+                   stdout=subprocess.DEVNULL)
+    out: dict[str, list[str]] = defaultdict(list)
+    for meta in sorted((workdir / "mutants").rglob("*.py.meta")):
+        data = json.loads(meta.read_text())
+        rel = str(meta.relative_to(workdir / "mutants"))[:-len(".meta")]
+        mod = module_of(rel)
+        if mod:
+            out[mod].extend(k for k in sorted(data.get("exit_code_by_key", {}))
+                            if not any(fnmatch.fnmatch(k, pat) for pat in EXCLUDE))
+    return dict(out)
+
+
+def module_of(path: str) -> str | None:
+    import fnmatch
+    for m, (glob, _) in MODULES.items():
+        if fnmatch.fnmatch(path, glob):
+            return m
+    return None
+
+
+def sample(names: dict[str, list[str]], n: int | None, seed: int) -> list[str]:
+    """``n`` names, stratified per module (proportional, at least one each), reproducible."""
+    total = sum(len(v) for v in names.values())
+    if n is None or n >= total:
+        return sorted(x for v in names.values() for x in v)
+    rng = np.random.default_rng(seed)
+    mods = sorted(names)
+    share = np.array([len(names[m]) for m in mods], float) / total * n
+    k = np.maximum(1, np.floor(share)).astype(int)
+    # hand out what the floors left, largest remainders first (deterministic)
+    for i in np.argsort(-(share - np.floor(share)), kind="stable")[:max(0, n - k.sum())]:
+        k[i] += 1
+    picked = []
+    for m, km in zip(mods, k):
+        pool = sorted(names[m])
+        picked += [pool[i] for i in rng.choice(len(pool), size=min(km, len(pool)), replace=False)]
+    return sorted(picked)
+
+
+def run(workdir: Path, names: list[str], children: int, timeout_s: float) -> float:
+    t0 = time.perf_counter()
+    # pass the names through a file-free argv: mutmut matches each name exactly
+    proc = subprocess.run(_MUTMUT + ["run", "--max-children", str(children), *names],
+                          cwd=workdir, env=_env(), timeout=timeout_s,
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    (workdir / "mutmut-run.log").write_text(proc.stdout)
+    if proc.returncode != 0:
+        print(proc.stdout[-3000:], file=sys.stderr)
+        raise SystemExit(f"mutmut run failed (exit {proc.returncode}); log: "
+                         f"{workdir / 'mutmut-run.log'}")
+    return time.perf_counter() - t0
+
+
+_COLLECT = """
+import json, sys
+from mutmut.__main__ import SourceFileMutationData, walk_mutatable_files, get_diff_for_mutant
+from mutmut.stats import status_by_exit_code
+names = set(json.load(open(sys.argv[1])))
+out = {}
+for path in walk_mutatable_files():
+    m = SourceFileMutationData(path=path)
+    m.load()
+    for k, code in m.exit_code_by_key.items():
+        if k not in names:
+            continue
+        status = status_by_exit_code[code]
+        diff = get_diff_for_mutant(k, path=path) if status not in ("killed",) else ""
+        out[k] = {"status": status, "exit_code": code, "file": str(path),
+                  "duration_s": m.durations_by_key.get(k), "diff": diff}
+json.dump(out, open(sys.argv[2], "w"), indent=1)
+"""
+
+
+def collect(workdir: Path, names: list[str]) -> dict:
+    (workdir / "sample.json").write_text(json.dumps(names))
+    subprocess.run([sys.executable, "-c", _COLLECT, "sample.json", "results.json"], cwd=workdir,
+                   env=_env(), check=True)
+    return json.loads((workdir / "results.json").read_text())
+
+
+def summarise(results: dict, meta: dict) -> dict:
+    by: dict[str, list[str]] = defaultdict(list)
+    for k, r in sorted(results.items()):
+        status = "equivalent" if k in EQUIVALENT and r["status"] == "survived" else r["status"]
+        by[status].append(k)
+    killed = len(by["killed"]) + len(by["timeout"])
+    counted = sum(len(v) for s, v in by.items() if s not in ("equivalent", "not checked"))
+    per_module: dict[str, dict[str, int]] = defaultdict(lambda: defaultdict(int))
+    for k, r in results.items():
+        status = "equivalent" if k in EQUIVALENT and r["status"] == "survived" else r["status"]
+        per_module[module_of(r["file"]) or "?"][status] += 1
+    first = defaultdict(int)
+    for r in results.values():
+        first[r.get("first_status", r["status"])] += 1
+    return {**meta, "counts": {s: len(v) for s, v in sorted(by.items())},
+            "first_pass": dict(first),
+            "kill_rate": killed / counted if counted else None,
+            "per_module": {m: dict(v) for m, v in sorted(per_module.items())},
+            "survivors": {k: results[k]["diff"] for k in by["survived"] + by["no tests"]
+                          + by["suspicious"]},
+            "equivalent": {k: {"reason": EQUIVALENT[k], "diff": results[k]["diff"]}
+                           for k in by["equivalent"]},
+            "killed_later": {k: {"first_status": r["first_status"], "diff": r.get("first_diff", "")}
+                             for k, r in sorted(results.items())
+                             if r.get("first_status", r["status"]) != r["status"]
+                             and r["status"] == "killed"},
+            "timed_out": by["timeout"], "killed": by["killed"]}
+
+
+def write_report(s: dict) -> None:
+    REPORT_JSON.write_text(json.dumps(s, indent=1) + "\n")
+    c = s["counts"]
+    rate = "n/a" if s["kill_rate"] is None else f"{100 * s['kill_rate']:.1f} %"
+    lines = [
+        "# Mutation testing of the physics core (mutmut)", "",
+        "Written by `python -m benchmarks.mutation` (see its docstring); not part of CI.", "",
+        f"* command: `{s['command']}`",
+        f"* mutmut {s['mutmut']}, modules: {', '.join(s['modules'])}",
+        f"* mutants in these modules: {s['population']}; sampled: {s['sampled']} "
+        f"(seed {s['seed']}, stratified per module)",
+        f"* wall time: {s['wall_s']:.0f} s on {os.cpu_count()} cores ({s['children']} workers)",
+        f"* excluded from the population (not physics): {', '.join(EXCLUDE)}",
+        *([f"* first pass: {s['first_pass']}; then the survivors (and no-test mutants) were run "
+           f"again after new tests: " + ", ".join(f"{r['mutants']} mutants in {r['wall_s']:.0f} s"
+                                                  for r in s["reruns"])]
+          if s.get("reruns") else []),
+        "", f"**Kill rate: {rate}** = (killed + timed out) / (sampled - equivalent)", "",
+        "| status | mutants |", "| --- | --- |",
+        *[f"| {k} | {v} |" for k, v in c.items()], "",
+        "Per module:", "", "| module | " + " | ".join(sorted(c)) + " |",
+        "| --- |" + " --- |" * len(c),
+        *[f"| {m} | " + " | ".join(str(v.get(k, 0)) for k in sorted(c)) + " |"
+          for m, v in s["per_module"].items()], ""]
+    if s["survivors"]:
+        lines += ["## Survivors", ""]
+        for k, d in s["survivors"].items():
+            lines += [f"### `{k}`", "", "```diff", d.strip(), "```", ""]
+    if s["killed_later"]:
+        lines += ["## First-pass survivors killed by later tests", "",
+                  "Each was killed by a test added after the first pass (`tests/test_mutants.py` "
+                  "unless noted there).", ""]
+        for k, d in s["killed_later"].items():
+            lines += [f"### `{k}` (first pass: {d['first_status']})", "", "```diff",
+                      d["diff"].strip(), "```", ""]
+    if s["equivalent"]:
+        lines += ["## Equivalent mutants (no observable change)", ""]
+        for k, e in s["equivalent"].items():
+            lines += [f"### `{k}`", "", e["reason"], "", "```diff", e["diff"].strip(), "```", ""]
+    if s["timed_out"]:
+        lines += ["## Timed out (counted as killed)", "", *[f"* `{k}`" for k in s["timed_out"]],
+                  ""]
+    REPORT_MD.write_text("\n".join(lines))
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m benchmarks.mutation", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--modules", nargs="+", choices=sorted(MODULES), default=sorted(MODULES))
+    ap.add_argument("--sample", type=int, default=None, help="mutants to run (default: all)")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--children", type=int, default=2, help="parallel mutmut workers")
+    ap.add_argument("--workdir", type=Path, default=Path("/tmp/rtsgeom-mutation"))
+    ap.add_argument("--timeout-s", type=float, default=6 * 3600.0)
+    ap.add_argument("--report-only", action="store_true",
+                    help="rewrite the report from the run left in --workdir")
+    ap.add_argument("--names", nargs="*", default=None,
+                    help="run exactly these mutants (e.g. the survivors of a report)")
+    ap.add_argument("--rerun-survivors", action="store_true",
+                    help="run the last run's survivors again (after new tests) and merge")
+    a = ap.parse_args(argv)
+    from importlib.metadata import version
+    meta = {"command": "python -m benchmarks.mutation " + " ".join(argv if argv is not None
+                                                                   else sys.argv[1:]),
+            "mutmut": version("mutmut"), "modules": a.modules, "seed": a.seed,
+            "children": a.children}
+    state = a.workdir / "driver.json"
+    previous: dict = {}
+    if a.rerun_survivors:
+        meta = json.loads(state.read_text())
+        previous = json.loads((a.workdir / "results.json").read_text())
+        rerun = sorted(k for k, r in previous.items()
+                       if r["status"] in ("survived", "no tests", "suspicious"))
+        prepare(a.workdir, meta["modules"])
+        all_mutants(a.workdir)
+        print(f"re-running {len(rerun)} survivors", flush=True)
+        wall = run(a.workdir, rerun, a.children, a.timeout_s)
+        meta.setdefault("reruns", []).append({"mutants": len(rerun), "wall_s": round(wall, 1)})
+        names = meta["names"]
+        state.write_text(json.dumps(meta))
+        new = collect(a.workdir, rerun)
+        for k, r in new.items():
+            r["first_status"] = previous[k].get("first_status", previous[k]["status"])
+            r["first_diff"] = previous[k].get("first_diff") or previous[k]["diff"]
+        previous.update(new)
+        (a.workdir / "results.json").write_text(json.dumps(previous, indent=1))
+    elif a.report_only:  # from the merged results the last run left
+        meta = json.loads(state.read_text())
+        names = meta["names"]
+        previous = json.loads((a.workdir / "results.json").read_text())
+    else:
+        prepare(a.workdir, a.modules)
+        population = all_mutants(a.workdir)
+        names = a.names or sample(population, a.sample, a.seed)
+        meta.update(population=sum(len(v) for v in population.values()), sampled=len(names),
+                    population_per_module={m: len(v) for m, v in population.items()})
+        print(f"{meta['population']} mutants in {', '.join(a.modules)}; running {len(names)}",
+              flush=True)
+        meta["wall_s"] = run(a.workdir, names, a.children, a.timeout_s)
+        meta["names"] = names
+        state.write_text(json.dumps(meta))
+    results = previous or collect(a.workdir, names)
+    s = summarise(results, {k: v for k, v in meta.items() if k != "names"})
+    write_report(s)
+    rate = s["kill_rate"]
+    print(f"kill rate {'n/a' if rate is None else f'{100 * rate:.1f} %'}; {s['counts']}; "
+          f"report: {REPORT_MD.relative_to(ROOT)}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
