@@ -256,14 +256,8 @@ def show(scene_or_setup, paths=None, png: str | Path | None = None,
     from .viz.scene3d import render_setup_png, show_setup
     setup = scene_or_setup if isinstance(scene_or_setup, Setup) else build_setup(scene_or_setup)
     if isinstance(paths, str):
-        if paths == "exact":
-            from .paths import exact_paths
-            paths = exact_paths(setup)
-        elif paths == "raytrace":
-            from .paths.raytrace import trace
-            paths = trace(setup)  # with the reflections' hit points
-        else:
-            raise ValueError(f"paths {paths!r}: must be 'exact', 'raytrace', a Paths or None")
+        from .paths import compute_paths
+        paths = compute_paths(setup, paths, for_drawing=True)  # reflections with hit points
     if png is not None:
         return render_setup_png(setup, png, paths=paths, window_size=window_size)
     return show_setup(setup, paths=paths, interactive=False, window_size=window_size)

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 
-__all__ = ["AoaMode", "AOA_MODES", "SYNTHESIS_MODES", "PATH_METHODS",
+__all__ = ["AoaMode", "AOA_MODES", "SYNTHESIS_MODES", "PathMethod", "PATH_METHODS",
            "RADAR_PRESETS", "Window", "WINDOWS", "CFAR_KINDS", "PATTERN_KINDS"]
 
 
@@ -31,9 +31,23 @@ AOA_MODES: dict[str, AoaMode] = {
 }
 SYNTHESIS_MODES: tuple[str, ...] = tuple(k for k, m in AOA_MODES.items() if m.synthesis)
 
-PATH_METHODS: dict[str, str] = {
-    "exact": "exact line-of-sight distances per element",
-    "raytrace": "Sionna RT ray tracing (reflections off the sheet and structures)",
+@dataclass(frozen=True)
+class PathMethod:
+    """How the propagation paths are computed: ``compute`` returns the :class:`Paths` table,
+    ``draw`` what the 3D view draws (the table plus each reflection's hit points). Both are
+    ``"module:function"`` names, imported only when used (Sionna loads only for ray tracing)."""
+
+    doc: str
+    compute: str
+    draw: str
+
+
+PATH_METHODS: dict[str, PathMethod] = {
+    "exact": PathMethod("exact line-of-sight distances per element",
+                        "rtsgeom.paths.exact:exact_paths", "rtsgeom.paths.exact:exact_paths"),
+    "raytrace": PathMethod("Sionna RT ray tracing (reflections off the sheet and structures)",
+                           "rtsgeom.paths.raytrace:raytrace_paths",
+                           "rtsgeom.paths.raytrace:trace"),
 }
 
 

@@ -12,7 +12,7 @@ import numpy as np
 
 from . import __version__
 from .geometry import Setup, build_setup
-from .paths import Paths, exact_paths
+from .paths import Paths, compute_paths
 from .radar import AdcCube, Detections, RangeDoppler, process
 from .radar.frame import noise_power, simulate
 from .rts import Echoes, RtsProgram, program_nearest
@@ -146,11 +146,7 @@ def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = 
     nearest front end; the synthesis modes calibrate the front-end pairs first.
     """
     setup = build_setup(scene)
-    if paths_method == "raytrace":
-        from .paths.raytrace import raytrace_paths
-        paths = raytrace_paths(setup)
-    else:
-        paths = exact_paths(setup)
+    paths = compute_paths(setup, paths_method)
     mode = aoa_mode or scene.rts.aoa_mode
     calibration: dict = {}
     warnings: list[str] = []

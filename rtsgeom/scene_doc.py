@@ -109,7 +109,7 @@ def render() -> str:
     out += [f"- `{k}`: {m.doc}{' (synthesis)' if m.synthesis else ''}"
             for k, m in registry.AOA_MODES.items()]
     out += ["", "Paths methods (`--paths`, `--method`):"]
-    out += [f"- `{k}`: {v}" for k, v in registry.PATH_METHODS.items()]
+    out += [f"- `{k}`: {v.doc}" for k, v in registry.PATH_METHODS.items()]
     out += ["", "Radar presets (`radar.antenna_preset`):"]
     out += [f"- `{k}`: {p.doc}" for k, p in registry.RADAR_PRESETS.items()]
     out += ["", "Antenna patterns (`radar.pattern.kind`, `rts.pattern.kind`):"]

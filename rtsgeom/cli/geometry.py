@@ -27,12 +27,8 @@ def cmd_info(args) -> int:
 def cmd_paths(args) -> int:
     output_file(args.out, [args.scene])
     setup = build_setup(load_scene_checked(args.scene))
-    if args.method == "exact":
-        from ..paths import exact_paths
-        paths = exact_paths(setup)
-    else:
-        from ..paths.raytrace import raytrace_paths
-        paths = raytrace_paths(setup)
+    from ..paths import compute_paths
+    paths = compute_paths(setup, args.method)
     write_text(args.out, paths.to_csv())
     print(f"wrote {len(paths)} paths ({paths.method}) to {args.out}")
     return 0

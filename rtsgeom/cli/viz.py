@@ -23,16 +23,13 @@ def _window_size(text: str) -> tuple[int, int]:
 def _load_paths(setup, method: str | None):
     if method is None:
         return None
-    if method == "exact":
-        from ..paths import exact_paths
-        return exact_paths(setup)
-    try:
-        from ..paths.raytrace import trace
+    from ..paths import compute_paths
+    try:  # for ray tracing: the table plus each reflection's hit points, which the view draws
+        return compute_paths(setup, method, for_drawing=True)
     except ModuleNotFoundError as exc:
         if exc.name not in ("rtsgeom.paths.raytrace", "sionna", "sionna.rt"):
             raise
-        raise UsageError(f"--paths raytrace is not available here ({exc})") from None
-    return trace(setup)  # the table plus each reflection's hit points, which the view draws
+        raise UsageError(f"--paths {method} is not available here ({exc})") from None
 
 
 def cmd_show(args) -> int:

@@ -1,6 +1,26 @@
 """Propagation paths per antenna-element pair (stage 2): exact distances or ray tracing."""
 
+from importlib import import_module
+
 from .table import DIRECTIONS, Paths
 from .exact import exact_paths
 
-__all__ = ["DIRECTIONS", "Paths", "exact_paths"]
+__all__ = ["DIRECTIONS", "Paths", "exact_paths", "compute_paths"]
+
+
+def compute_paths(setup, method: str = "exact", *, for_drawing: bool = False):
+    """The paths of ``setup`` by a method of the registry (``registry.PATH_METHODS``).
+
+    ``for_drawing``: what the 3D view draws (for ray tracing the table plus each reflection's
+    hit points, :func:`rtsgeom.paths.raytrace.trace`). The method's module is imported only
+    here, so Sionna loads only when ray tracing is asked for. Adding a method is one registry
+    entry.
+    """
+    from ..registry import PATH_METHODS
+    try:
+        m = PATH_METHODS[method]
+    except KeyError:
+        raise ValueError(f"paths method {method!r}: must be one of "
+                         f"{', '.join(PATH_METHODS)}") from None
+    module, func = (m.draw if for_drawing else m.compute).split(":")
+    return getattr(import_module(module), func)(setup)
