@@ -219,6 +219,11 @@ class FrontEndConfig(Evolvable):
     return_loss_be_db: float | None = spec("return_loss_be_db", "float", "mismatch at the back "
                                            "end; unset = no cable ghosts", None, unit="dB",
                                            lo=0.0, hi=100.0, lo_open=True)
+    # -- front ends on a sphere (issue 15): elevation on the sphere about the arc centre ------
+    elevation_rad: float = spec("elevation_deg", "float", "elevation epsilon_q on the sphere "
+                                "about the arc centre (0: on the arc; any non-zero one makes "
+                                "the sheet a spherical cap)", 0.0, unit="deg", lo=-60.0,
+                                hi=60.0, scale=_DEG)
 
 
 @dataclass(frozen=True)
@@ -237,7 +242,8 @@ class RtsConfig(Evolvable):
         Derived("the RuT's phase centre radar.position_m", lambda v: None), n=3, unit="m",
         lo=-1e3, hi=1e3)
     front_ends: tuple[FrontEndConfig, ...] = spec(
-        "front_ends", "tables", "[[rts.front_ends]], ordered by strictly increasing angle_deg",
+        "front_ends", "tables", "[[rts.front_ends]], ordered by strictly increasing angle_deg "
+        "(by (angle_deg, elevation_deg) where elevations differ)",
         cls=FrontEndConfig, max_items=MAX_FRONT_ENDS, min_items=1, item="front end")
     f_rts_hz: float = spec("f_rts_hz", "float", "IF at which the RTS delay acts (eq. 7)",
                            unit="Hz", lo=0.0, hi=100e9)

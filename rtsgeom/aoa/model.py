@@ -216,8 +216,9 @@ class ChannelModel:
         height) of the channels' front ends."""
         fe, rut = self.setup.fe, self.setup.rut
         q = list(self.channels)
+        el = None if fe.elevation_rad is None else fe.elevation_rad[q]
         rx, tx, _ = antenna_positions(fe.arc_centre, fe.arc_radius_m, fe.angle_rad[q],
-                                      fe.separation_m[q], offsets_m)
+                                      fe.separation_m[q], offsets_m, elevation_rad=el)
         t_a, t_b = leg_delays(rut.tx_world, rut.rx_world, rx, tx)
         return t_a[..., rut.virtual_tx], t_b[..., rut.virtual_rx]
 
