@@ -19,17 +19,21 @@ from ._common import (UsageError, load_scene_checked, output_file, output_folder
 
 def detections_csv(result: RunResult) -> str:
     """One row per detection, sorted by range then velocity; the last column ``label`` says
-    what the simulation put there (:func:`rtsgeom.run.label_detections`)."""
+    what the simulation put there (:func:`rtsgeom.run.label_detections`); ``elevation_deg``
+    (0 for an azimuth-only array) sits after ``snr_db``, so the earlier columns keep their
+    places."""
     det = result.detections
     labels = label_detections(result)
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(["range_m", "velocity_mps", "angle_deg", "power_db", "snr_db", "label"])
+    w.writerow(["range_m", "velocity_mps", "angle_deg", "power_db", "snr_db", "elevation_deg",
+                "label"])
     order = np.lexsort((det.velocity_mps, det.range_m))
+    el = det.elevation_deg
     for i in order:
         w.writerow([f"{det.range_m[i]:.4f}", f"{det.velocity_mps[i]:.4f}",
                     f"{det.angle_deg[i]:.4f}", f"{det.power_db[i]:.2f}", f"{det.snr_db[i]:.2f}",
-                    labels[i]])
+                    f"{el[i]:.4f}", labels[i]])
     return buf.getvalue()
 
 
