@@ -329,6 +329,10 @@ class TargetConfig(Evolvable):
                            lo=-100.0, hi=100.0)
     angle_rad: float = spec("angle_deg", "float", "azimuth seen from the RuT", 0.0, unit="deg",
                             lo=-90.0, hi=90.0, scale=_DEG)
+    # -- targets in elevation (issue 15): synthesized by a cell of front ends on a sphere -----
+    elevation_rad: float = spec("elevation_deg", "float", "elevation seen from the RuT (needs "
+                                "front ends at elevations and a RuT with elevation)", 0.0,
+                                unit="deg", lo=-60.0, hi=60.0, scale=_DEG)
 
     @property
     def rcs_m2(self) -> float:

@@ -196,9 +196,11 @@ def cmd_run(args) -> int:
             if d is None:
                 print(f"target {m['index']}: NOT DETECTED")
                 continue
+            el = (f" el {d['elevation_deg']:7.3f} deg" if "elevation_deg" in d else "")
+            el_e = (f", el {e['elevation_deg']:+.3f} deg" if "elevation_deg" in e else "")
             print(f"target {m['index']}: {d['range_m']:7.3f} m {d['velocity_mps']:+7.3f} m/s "
-                  f"{d['angle_deg']:8.3f} deg  (errors {e['range_m']:+.3f} m, "
-                  f"{e['velocity_mps']:+.3f} m/s, {e['angle_deg']:+.3f} deg)")
+                  f"{d['angle_deg']:8.3f} deg{el}  (errors {e['range_m']:+.3f} m, "
+                  f"{e['velocity_mps']:+.3f} m/s, {e['angle_deg']:+.3f} deg{el_e})")
         for w in result.warnings:
             print(f"warning: {w}")
         print(f"{len(result.detections)} detections; wrote {out}/detections.csv, summary.json, "

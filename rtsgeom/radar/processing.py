@@ -230,10 +230,14 @@ def angle_spectrum(snapshots: np.ndarray, rut: RutArray | Steering, radar: Radar
     :meth:`Steering.power` at azimuths ``angles_rad`` (A,).
 
     ``snapshots`` (..., V) over all virtual channels (the azimuth row is selected here);
-    returns (..., A). ``rut``: the RuT array (with ``radar``) or its :class:`Steering`.
+    returns (..., A). ``rut``: the RuT array (with ``radar``) or its :class:`Steering`. A 2-D
+    steering (D = 2) is cut at elevation 0.
     """
     st = _steering_of(rut, radar)
-    return st.power(snapshots, st.directions(np.asarray(angles_rad)))
+    a = np.asarray(angles_rad, float)
+    if st.dims == 2:
+        a = np.stack([a, np.zeros_like(a)], axis=-1)
+    return st.power(snapshots, st.directions(a))
 
 
 def estimate_angles(snapshots: np.ndarray, rut: RutArray | Steering,
