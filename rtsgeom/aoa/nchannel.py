@@ -56,7 +56,8 @@ def target_direction(steering: Steering, target: TargetConfig) -> np.ndarray:
 def closed_form_amplitudes(steering: Steering, u_fe, u_set, phases=None) -> np.ndarray:
     """The ``array-factor`` amplitudes a (Q,) (the largest 1) of channels at direction cosines
     ``u_fe`` (Q, D) synthesizing ``u_set`` (D,) (module docstring); ``phases`` (Q,): the
-    channels' phases, default coherent at ``u_set``."""
+    channels' programmed phases, default coherent at ``u_set`` (given ones are taken as making
+    the channels coherent there: B(u*) is rotated real by channel 0's phase)."""
     u_fe = np.asarray(u_fe, float)
     du = np.asarray(u_set, float)[None, :] - u_fe  # (Q, D)
     t = steering.taper
@@ -64,8 +65,9 @@ def closed_form_amplitudes(steering: Steering, u_fe, u_set, phases=None) -> np.n
     af = e.sum(-1) / t.sum()
     d_af = 1j * (e @ steering.wavevector) / t.sum()  # (Q, D)
     phi = -np.angle(af) if phases is None else np.asarray(phases, float)
-    g = np.real(np.exp(1j * phi)[:, None] * d_af).T  # (D, Q)
-    f = np.real(np.exp(1j * phi) * af)
+    rot = np.exp(1j * (phi - np.angle(np.exp(1j * phi[0]) * af[0])))  # B(u*) real, channel 0
+    g = np.real(rot[:, None] * d_af).T  # (D, Q)
+    f = np.real(rot * af)
     a = f - g.T @ np.linalg.lstsq(g @ g.T, g @ f, rcond=None)[0]  # P_null(G) f
     if np.any(a < 0) and a.size > g.shape[0] + 1:
         # more channels than conditions and P_null f not all positive (near a corner of a
@@ -92,6 +94,8 @@ class ChannelSet:
     (``model.steering`` = ``Steering.auto``)."""
 
     model: ChannelModel
+    fe_u: np.ndarray | None = None  # (Q, D) front-end directions for the closed form (None:
+    #                                  the geometric ones seen from the RuT)
 
     @classmethod
     def build(cls, setup: Setup, paths: Paths, channels, target: TargetConfig,
@@ -114,6 +118,8 @@ class ChannelSet:
 
     def fe_directions(self) -> np.ndarray:
         """The channels' front ends' direction cosines (Q, D) seen from the RuT (geometric)."""
+        if self.fe_u is not None:
+            return np.asarray(self.fe_u, float)
         u = self.model.setup.fe_direction_cosines()[list(self.model.channels)]
         return u[:, :1] if self.dims == 1 else u
 
@@ -155,7 +161,7 @@ class ChannelSet:
         if mode == "paper":
             raise ValueError("mode 'paper': eq. 23 is defined for a pair of front ends in "
                              "azimuth only; use exact or array-factor")
-        a0 = closed_form_amplitudes(self.steering, self.fe_directions(), u_set)
+        a0 = closed_form_amplitudes(self.steering, self.fe_directions(), u_set, phases)
         if mode == "array-factor":
             return self.weights(a0, phases)
         return self.weights(self._peak_match(u_set, a0, phases, tol, max_iter), phases)
