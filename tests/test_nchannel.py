@@ -140,8 +140,18 @@ def test_sphere4_run_within_0_05_deg():
     moved = tuple(t.evolve(angle_rad=np.radians(a), elevation_rad=np.radians(e))
                   for t, a, e in zip(scene.targets, (4.0, 11.5, 8.0, 6.0),
                                      (-3.5, 1.0, 2.0, -1.0)))
-    for sc in (scene, scene.evolve(targets=moved)):
+    fes = list(scene.rts.front_ends)  # hardware errors the calibration has to find
+    fes[1] = fes[1].evolve(phase_offset_rad=np.radians(30.0))
+    fes[3] = fes[3].evolve(phase_offset_rad=np.radians(-50.0), gain_offset_db=1.0)
+    wrong = scene.evolve(targets=moved, rts=scene.rts.evolve(front_ends=tuple(fes)))
+    for sc in (scene, wrong):
         result = run_scene(sc)
+        ch = result.calibration["channels"]
+        assert len(ch["spanning_tree"]) == 3 and len(ch["loop_closure_s"]) == 2
+        # loops close within a few of the 25 ps sweep steps (noise on a flat-bottomed minimum)
+        assert max(abs(x) for x in ch["loop_closure_s"]) < 50e-12
+        assert abs(ch["residual_deg"]["azimuth"]) < 0.05
+        assert abs(ch["residual_deg"]["elevation"]) < 0.05
         for m in result.matches:
             e = m["error"]
             assert e is not None, m

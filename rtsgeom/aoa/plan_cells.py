@@ -4,8 +4,10 @@ channels, solve one weight per channel (issue 15; the N-channel counterpart of `
 Used by ``run`` when any front end has a non-zero elevation. The cells come from the front
 ends' geometric direction cosines seen from the RuT (``aoa.cells``); the weights from
 :class:`~rtsgeom.aoa.nchannel.ChannelSet` on the nominal setup with the channels' calibrated
-delay offsets and their natural phases (the phases those delays give, which is what the RuT
-sees), amplitudes times each channel's measured gain correction.
+delay offsets and their natural phases (what the RuT sees of a nominal setup) when
+uncalibrated, or the phases the calibration establishes (each measured pair
+coherent where its probes sat, ``ncal.tree_phases``), amplitudes times each channel's measured
+gain correction.
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ def plan_cells(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, pr
 
     Returns the program, the calibration record (for summary.json) and warnings."""
     from .calibration import nominal_model, probe_front_ends
-    from .ncal import calibrate_channels
+    from .ncal import calibrate_channels, tree_phases
     scene = setup.scene
     nom, nom_paths = nominal_model(setup, paths)
     probe = probe_front_ends(setup, paths, scene.seed)
@@ -64,18 +66,23 @@ def plan_cells(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, pr
                              f"{exc}") from None
     offsets = np.zeros(setup.fe.count)
     cal_record: dict = {}
+    used = sorted({q for cell in cells.values() for q in cell})
+    tree = None
     if calibrate:
-        used = sorted({q for cell in cells.values() for q in cell})
         cal = calibrate_channels(setup, paths, used, probe, progress=progress)
-        offsets = cal.offsets_s
+        offsets, tree = cal.offsets_s, cal.tree
         cal_record = cal.to_dict()
     rows = []
     for k, t in enumerate(scene.targets):
         cell = cells[k]
-        cs = ChannelSet.build(nom, nom_paths, cell, t, offsets[list(cell)])
         u = target_direction(st, t)
+        phases = None  # uncalibrated: the phases the channels' delays give
+        if tree is not None:  # calibrated: coherent pairwise where the probes sat
+            cs_all = ChannelSet.build(nom, nom_paths, used, t, offsets[used])
+            phases = tree_phases(cs_all, tree)[[used.index(q) for q in cell]]
+        cs = ChannelSet.build(nom, nom_paths, cell, t, offsets[list(cell)])
         try:
-            w = cs.solve(u, mode=mode)
+            w = cs.solve(u, phases, mode=mode)
         except AngleUnreachable as exc:
             raise SceneError(f"{scene.source}: targets[{k}]: {exc}") from None
         amps = cs.amplitudes(w, u) * probe.gain_correction[list(cell)]
