@@ -31,10 +31,10 @@ what a calibration establishes); the amplitudes ``a`` (the strongest 1) are solv
 from __future__ import annotations
 
 import dataclasses
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import lsq_linear
 
 from ..geometry import Setup
 from ..paths import Paths
@@ -69,16 +69,19 @@ def closed_form_amplitudes(steering: Steering, u_fe, u_set, phases=None) -> np.n
     g = np.real(rot[:, None] * d_af).T  # (D, Q)
     f = np.real(rot * af)
     a = f - g.T @ np.linalg.lstsq(g @ g.T, g @ f, rcond=None)[0]  # P_null(G) f
-    if np.any(a < 0) and a.size > g.shape[0] + 1:
+    if np.any(a < -1e-12 * np.abs(a).max()) and a.size > g.shape[0] + 1:
         # more channels than conditions and P_null f not all positive (near a corner of a
-        # quadrilateral): the non-negative a with G a = 0 nearest f (bounded least squares,
-        # the condition weighted 1e6 above the closeness)
-        scale = 1e6 / max(np.abs(g).max(), 1e-300)
-        sol = lsq_linear(np.vstack([scale * g, np.eye(a.size)]),
-                         np.concatenate([np.zeros(g.shape[0]), f]), bounds=(0.0, np.inf),
-                         tol=1e-14, lsmr_tol="auto")
-        if np.max(np.abs(g @ sol.x)) <= 1e-9 * np.max(np.abs(g)) * np.abs(sol.x).sum():
-            a = sol.x
+        # quadrilateral): of the sub-cells of D + 1 channels (its triangles) whose one
+        # solution is non-negative, the one with the largest peak power per unit norm
+        best, score = None, -np.inf
+        for sub in itertools.combinations(range(a.size), g.shape[0] + 1):
+            null = np.linalg.svd(g[:, sub])[2][-1]
+            null = null * np.sign(null @ f[list(sub)] or 1.0)
+            if np.all(null >= -1e-12) and null @ f[list(sub)] / np.linalg.norm(null) > score:
+                best, score = (sub, null), null @ f[list(sub)] / np.linalg.norm(null)
+        if best is not None:
+            a = np.zeros(a.size)
+            a[list(best[0])] = best[1]
     if np.max(a) <= 0:
         raise AngleUnreachable("the array-factor closed form gives no channel a weight here")
     a = a / np.max(a)
