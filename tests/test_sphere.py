@@ -99,3 +99,41 @@ def test_rules_for_the_sphere():
         corners(scene, (5.0, 6.0), (-1.0, 1.0))  # cutouts overlap
     ok = corners(scene, (5.0, 9.0), (-3.0, 3.0))
     assert [round(np.degrees(f.elevation_rad), 9) for f in ok.rts.front_ends] == [-3, 3, -3, 3]
+
+
+def test_all_elevations_zero_keeps_the_1d_pipeline():
+    """The default scene: no N-channel planner, the azimuth-only beamformer, the arc, and a
+    scene with every elevation written out as 0 builds the same bits."""
+    from rtsgeom.aoa.plan_cells import uses_cells
+    from rtsgeom.radar.steering import Steering
+    scene = load_scene(SCENE)
+    assert not uses_cells(scene)
+    setup = build_setup(scene)
+    auto = Steering.auto(setup.rut, scene.radar)
+    ref = Steering.build(setup.rut, scene.radar)
+    assert auto.dims == 1 and np.array_equal(auto.positions_m, ref.positions_m)
+    assert np.array_equal(auto.taper, ref.taper)
+    zero = scene.evolve(rts=scene.rts.evolve(front_ends=tuple(
+        f.evolve(elevation_rad=0.0) for f in scene.rts.front_ends)),
+        targets=tuple(t.evolve(elevation_rad=0.0) for t in scene.targets))
+    s0 = build_setup(zero)
+    for a, b in ((setup.fe.rx, s0.fe.rx), (setup.fe.tx, s0.fe.tx),
+                 (setup.fe.module, s0.fe.module), (setup.sheet.vertices, s0.sheet.vertices)):
+        assert np.array_equal(a, b)
+
+
+@pytest.mark.slow
+def test_default_scene_run_unchanged_with_explicit_zero_elevations():
+    """The whole run (pair calibration, synthesis, detection) with every elevation written out
+    as 0 gives the same detections and calibration as the scene without the keys."""
+    from rtsgeom.run import run_scene
+    scene = load_scene(SCENE)
+    zero = scene.evolve(rts=scene.rts.evolve(front_ends=tuple(
+        f.evolve(elevation_rad=0.0) for f in scene.rts.front_ends)),
+        targets=tuple(t.evolve(elevation_rad=0.0) for t in scene.targets))
+    a, b = run_scene(scene), run_scene(zero)
+    assert a.detections.elevation_rad is None and b.detections.elevation_rad is None
+    for name in ("range_m", "velocity_mps", "angle_rad", "power_db"):
+        assert np.array_equal(getattr(a.detections, name), getattr(b.detections, name))
+    assert a.calibration == b.calibration
+    assert all("elevation_deg" not in m["set"] for m in a.matches)
