@@ -230,7 +230,8 @@ def _target_positions(setup: Setup) -> tuple[np.ndarray, np.ndarray]:
     """Drawn positions (T, 3) and outward directions (T, 3) of the virtual targets."""
     rut = setup.rut
     ang = np.array([t.angle_rad for t in setup.scene.targets], float)
-    local = np.stack([np.sin(ang), np.cos(ang), np.zeros_like(ang)], -1)
+    el = np.array([getattr(t, "elevation_rad", 0.0) for t in setup.scene.targets], float)
+    local = sphere_frame(ang, el if np.any(el) else None)[0]
     direction = local @ rut.rotation.T
     return rut.position + TARGET_RADIUS_FACTOR * setup.fe.arc_radius_m * direction, direction
 
@@ -388,8 +389,10 @@ def _add_labels(pl, setup: Setup, scale: float, text3d: bool = False) -> None:
             a = pos[j] + (0.06 + 0.045 * k) * z_hat
             anchors.append(a)
             leaders.append(np.array([pos[j], a]))
-            texts.append(f"T{j}: {t.range_m:g} m, {np.degrees(t.angle_rad):g} deg, "
-                         f"{t.velocity_mps:+g} m/s")
+            el = getattr(t, "elevation_rad", 0.0)
+            texts.append(f"T{j}: {t.range_m:g} m, {np.degrees(t.angle_rad):g} deg"
+                         + (f" el {np.degrees(el):g} deg" if el else "")
+                         + f", {t.velocity_mps:+g} m/s")
     pl.add_mesh(_merge_lines(leaders), color="#444444", line_width=1)
     if text3d:
         normal = -_overview_direction(setup)  # towards the camera
