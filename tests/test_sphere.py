@@ -55,7 +55,7 @@ def test_positions_on_the_sphere(radius, el_deg):
     assert np.allclose(np.einsum("fk,fk->f", rx - tx, r), 0)
     assert np.allclose(np.einsum("fk,fk->f", t, up), 0) and np.allclose(np.einsum(
         "fk,fk->f", r, up), 0)
-    tt, uu, bb = module_axes(az, elevation_rad=el)
+    _, uu, bb = module_axes(az, elevation_rad=el)
     assert np.allclose(bb, -r) and np.allclose(uu, up)
 
 

@@ -11,6 +11,7 @@ from scipy.spatial import Delaunay
 from ..geometry import Setup
 from ..paths import Paths
 from ..radar.processing import nearest_detection
+from ..radar.steering import Steering
 from ..rts import RtsProgram, requested_delay
 from ..scene import TargetConfig
 from .calibration import _simulate_detect, nominal_model, probe_front_ends, probe_ranges
@@ -62,7 +63,7 @@ def linearity_grid(setup: Setup, paths: Paths, mode: str = "exact", n: int = 5,
     probe = probe_front_ends(setup, paths, seed)
     rng = float(probe_ranges(setup, 1)[0])
     target0 = TargetConfig(rng)
-    st = ChannelSet.build(nom, nom_paths, cell, target0).steering
+    st = Steering.auto(nom.rut, setup.scene.radar)
     if st.dims != 2:
         raise ValueError("linearity --grid needs a RuT with elevation (an array with "
                          "elevation extent, e.g. radar.use_elevation_tx = true)")

@@ -27,6 +27,7 @@ from scipy.sparse.csgraph import breadth_first_order, minimum_spanning_tree
 from scipy.spatial import Delaunay
 
 from ..radar.processing import nearest_detection
+from ..radar.steering import Steering
 from ..rts import RtsProgram, requested_delay
 from ..scene import TargetConfig
 from .nchannel import ChannelSet
@@ -163,7 +164,7 @@ def calibrate_channels(setup, paths, channels, probe, seed=None, progress=None,
     scene = setup.scene
     seed = scene.seed if seed is None else seed
     nom, nom_paths = nominal_model(setup, paths)
-    st = ChannelSet.build(nom, nom_paths, (0,), TargetConfig(10.0)).steering
+    st = Steering.auto(nom.rut, scene.radar)
     u_fe = nom.fe_direction_cosines()
     u_fe = np.sin(nom.fe_azimuth_rad())[:, None] if st.dims == 1 else u_fe
     ch = sorted(int(q) for q in channels)

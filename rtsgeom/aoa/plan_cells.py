@@ -17,6 +17,7 @@ from scipy.constants import c
 
 from ..geometry import Setup
 from ..paths import Paths
+from ..radar.steering import Steering
 from ..rts import RtsProgram, requested_delay
 from ..scene import SceneError
 from .cells import CellUnreachable, enclosing_cell
@@ -44,8 +45,7 @@ def plan_cells(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, pr
     nom, nom_paths = nominal_model(setup, paths)
     probe = probe_front_ends(setup, paths, scene.seed)
     warnings: list[str] = []
-    ref = ChannelSet.build(nom, nom_paths, (0,), scene.targets[0])
-    st = ref.steering
+    st = Steering.auto(nom.rut, scene.radar)  # the beamformer the RuT runs
     u_fe = nom.fe_direction_cosines()
     u_fe = np.sin(nom.fe_azimuth_rad())[:, None] if st.dims == 1 else u_fe
     cells = {}
