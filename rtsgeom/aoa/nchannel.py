@@ -164,9 +164,16 @@ class ChannelSet:
         if mode == "paper":
             raise ValueError("mode 'paper': eq. 23 is defined for a pair of front ends in "
                              "azimuth only; use exact or array-factor")
-        a0 = closed_form_amplitudes(self.steering, self.fe_directions(), u_set, phases)
         if mode == "array-factor":
+            a0 = closed_form_amplitudes(self.steering, self.fe_directions(), u_set, phases)
             return self.weights(a0, phases)
+        try:  # the start of the peak matching: the closed form, else equal amplitudes
+            a0 = closed_form_amplitudes(self.steering, self.fe_directions(), u_set, phases)
+        except AngleUnreachable:
+            try:
+                a0 = closed_form_amplitudes(self.steering, self.fe_directions(), u_set)
+            except AngleUnreachable:
+                a0 = np.ones(self.count)
         return self.weights(self._peak_match(u_set, a0, phases, tol, max_iter), phases)
 
     def _peak_match(self, u_set, a0, phases, tol, max_iter) -> np.ndarray:
