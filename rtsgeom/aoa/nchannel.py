@@ -183,7 +183,7 @@ class ChannelSet:
 
         def amps(xx):
             a = np.ones(a0.size)
-            a[free] = np.exp(xx)
+            a[free] = np.exp(np.clip(xx, -40.0, 40.0))  # beyond: a diverging (unreachable) fit
             return a
 
         def resid(xx):
