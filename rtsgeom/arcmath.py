@@ -1,4 +1,10 @@
-"""Front-end positions on an arc: the one formula, shared by the scene's rules and ``geometry``.
+"""Front-end positions on an arc or a sphere: the one formula, shared by the scene's rules and
+``geometry``.
+
+A front end sits at azimuth theta and elevation epsilon (default 0: on the arc) on the sphere of
+radius R_c about the arc centre, radial unit vector ``(sin th cos el, cos th cos el, sin el)``
+(its x and z components are the direction cosines ``u`` of ``radar.steering``). Elevation 0 (or
+None) takes exactly today's arithmetic, so positions on the arc stay bit-identical.
 
 Each front end is a module tangent to the arc carrying an Rx and a Tx antenna at signed offsets
 (by default the Rx towards larger azimuth, the Tx towards smaller). Mounting errors move the
@@ -11,7 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["radial_tangent", "layout_offsets", "module_axes", "antenna_positions"]
+__all__ = ["radial_tangent", "sphere_frame", "layout_offsets", "module_axes",
+           "antenna_positions"]
 
 
 def radial_tangent(angle_rad: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -21,6 +28,22 @@ def radial_tangent(angle_rad: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.stack([s, co, z], -1), np.stack([co, -s, z], -1)
 
 
+def sphere_frame(angle_rad, elevation_rad=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Radial (outward), tangential (towards larger azimuth, horizontal) and up (towards larger
+    elevation) unit vectors at (azimuth, elevation) on the sphere, (..., 3) each. Without an
+    elevation (None): :func:`radial_tangent` and the world vertical, the same bits."""
+    r_hat, t_hat = radial_tangent(angle_rad)
+    if elevation_rad is None:
+        return r_hat, t_hat, np.broadcast_to(np.array([0.0, 0.0, 1.0]), r_hat.shape)
+    e = np.asarray(elevation_rad, float)[..., None]
+    z_hat = np.array([0.0, 0.0, 1.0])
+    horiz = r_hat  # (sin th, cos th, 0)
+    r = np.cos(e) * horiz + np.sin(e) * z_hat
+    up = np.cos(e) * z_hat - np.sin(e) * horiz
+    r, t_hat, up = np.broadcast_arrays(r, t_hat, up)
+    return r, t_hat, up
+
+
 def layout_offsets(separation_m) -> tuple[np.ndarray, np.ndarray]:
     """The shorthand ``separation_m`` s (..., F) as signed offsets: rx (s/2, 0), tx (-s/2, 0)."""
     half = 0.5 * np.asarray(separation_m, float)
@@ -28,16 +51,21 @@ def layout_offsets(separation_m) -> tuple[np.ndarray, np.ndarray]:
     return np.stack([half, z], -1), np.stack([-half, z], -1)
 
 
-def module_axes(angle_rad, yaw_rad=None, pitch_rad=None
+def module_axes(angle_rad, yaw_rad=None, pitch_rad=None, elevation_rad=None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Unit axes of each front-end module after its mounting rotations, (..., F, 3) each.
 
     ``tangent`` (towards larger azimuth when not yawed), ``up`` and ``boresight`` (towards the arc
     centre when not rotated). Pitch turns (boresight, up) about the tangent, then yaw turns all
-    three about the world vertical. ``yaw_rad``, ``pitch_rad``: (..., F), broadcast.
+    three about the world vertical. ``yaw_rad``, ``pitch_rad``: (..., F), broadcast. A module at
+    ``elevation_rad`` (..., F) looks down/up at the centre: its ``up`` is the sphere's
+    elevation direction (:func:`sphere_frame`).
     """
-    r_hat, t_hat = radial_tangent(angle_rad)
-    z_hat = np.array([0.0, 0.0, 1.0])
+    if elevation_rad is None:
+        r_hat, t_hat = radial_tangent(angle_rad)
+        z_hat = np.array([0.0, 0.0, 1.0])
+    else:
+        r_hat, t_hat, z_hat = sphere_frame(angle_rad, elevation_rad)
     b, up, t = -r_hat, z_hat, t_hat
     if pitch_rad is not None:
         p = np.asarray(pitch_rad, float)[..., None]
@@ -63,8 +91,9 @@ def antenna_positions(centre: np.ndarray, radius_m: float, angle_rad: np.ndarray
                       tx_offset_m: np.ndarray | None = None,
                       yaw_rad: np.ndarray | None = None,
                       pitch_rad: np.ndarray | None = None,
+                      elevation_rad: np.ndarray | None = None,
                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Rx, Tx and module-centre positions of front ends on an arc.
+    """Rx, Tx and module-centre positions of front ends on an arc (or a sphere).
 
     Parameters
     ----------
@@ -77,19 +106,28 @@ def antenna_positions(centre: np.ndarray, radius_m: float, angle_rad: np.ndarray
     rx_offset_m, tx_offset_m : (..., F, 2) signed antenna offsets ``(t, h)`` in the module frame
         (tangential, positive towards larger azimuth; height).
     yaw_rad, pitch_rad : (..., F) mounting rotations of the module about its centre.
+    elevation_rad : (F,) nominal elevations epsilon_q on the sphere (None or all 0: the arc,
+        today's arithmetic). The height offset and the antennas' ``h`` then run along the
+        sphere's elevation direction, the radial offset along the sphere's radius.
 
     Returns
     -------
     rx, tx, module_centre : (..., F, 3)
     """
-    r_hat, t_hat = radial_tangent(angle_rad)
-    z_hat = np.array([0.0, 0.0, 1.0])
+    if elevation_rad is not None and not np.any(np.asarray(elevation_rad, float)):
+        elevation_rad = None  # all on the arc: today's arithmetic, bit-identical
+    if elevation_rad is None:
+        r_hat, t_hat = radial_tangent(angle_rad)
+        z_hat = np.array([0.0, 0.0, 1.0])
+    else:
+        r_hat, t_hat, z_hat = sphere_frame(angle_rad, elevation_rad)
     nominal = np.asarray(centre, float) + radius_m * r_hat
     if offsets_m is None:
         offsets_m = np.zeros_like(nominal)
     off = np.asarray(offsets_m, float)
     mod = (nominal + off[..., 0:1] * r_hat + off[..., 1:2] * t_hat + off[..., 2:3] * z_hat)
-    simple = rx_offset_m is None and tx_offset_m is None and yaw_rad is None and pitch_rad is None
+    simple = (rx_offset_m is None and tx_offset_m is None and yaw_rad is None
+              and pitch_rad is None)
     if simple:  # today's layout, same arithmetic (results stay bit-identical)
         half = 0.5 * np.asarray(separation_m, float)[..., None] * t_hat
         return mod + half, mod - half, mod
@@ -100,7 +138,7 @@ def antenna_positions(centre: np.ndarray, radius_m: float, angle_rad: np.ndarray
         rx_s, tx_s = layout_offsets(separation_m)
         rx_offset_m = rx_s if rx_offset_m is None else rx_offset_m
         tx_offset_m = tx_s if tx_offset_m is None else tx_offset_m
-    t, up, _ = module_axes(angle_rad, yaw_rad, pitch_rad)
+    t, up, _ = module_axes(angle_rad, yaw_rad, pitch_rad, elevation_rad)
     ro, to = np.asarray(rx_offset_m, float), np.asarray(tx_offset_m, float)
     rx = mod + ro[..., 0:1] * t + ro[..., 1:2] * up
     tx = mod + to[..., 0:1] * t + to[..., 1:2] * up

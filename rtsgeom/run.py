@@ -68,6 +68,8 @@ def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angl
         entry = {"index": i, "set": {"range_m": t.range_m, "velocity_mps": t.velocity_mps,
                                      "angle_deg": float(np.degrees(t.angle_rad)),
                                      "rcs_dbsm": t.rcs_dbsm}}
+        if det.elevation_rad is not None:
+            entry["set"]["elevation_deg"] = float(np.degrees(t.elevation_rad))
         if j is not None:
             d = {"range_m": float(det.range_m[j]), "velocity_mps": float(det.velocity_mps[j]),
                  "angle_deg": float(det.angle_deg[j]), "power_db": float(det.power_db[j]),
@@ -81,6 +83,10 @@ def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angl
                 "range_bins": (d["range_m"] - t.range_m) / dr,
                 "doppler_bins": (d["velocity_mps"] - t.velocity_mps) / dv,
             }
+            if det.elevation_rad is not None:  # a RuT with elevation: both angles
+                d["elevation_deg"] = float(det.elevation_deg[j])
+                entry["error"]["elevation_deg"] = d["elevation_deg"] - entry["set"][
+                    "elevation_deg"]
         else:
             entry["detection"] = None
             entry["error"] = None
@@ -153,8 +159,13 @@ def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = 
     if mode == "nearest" or not scene.targets:
         program = program_nearest(scene, setup)
     else:
-        from .aoa.plan import plan_targets
-        program, calibration, warnings = plan_targets(setup, paths, mode, progress=progress)
+        from .aoa.plan_cells import plan_cells, uses_cells
+        if uses_cells(scene):  # front ends on a sphere / targets in elevation: N channels
+            program, calibration, warnings = plan_cells(setup, paths, mode, progress=progress)
+        else:
+            from .aoa.plan import plan_targets
+            program, calibration, warnings = plan_targets(setup, paths, mode,
+                                                          progress=progress)
     echoes, cube = simulate(setup, paths, program, scene.seed, scene.radar.snr_db)
     rd, det = process(cube)
     return RunResult(scene, setup, paths, program, echoes, cube, rd, det,

@@ -122,6 +122,10 @@ class RadarConfig(Evolvable):
                                "awr1843boost", choices=tuple(registry.RADAR_PRESETS))
     use_elevation_tx: bool = spec("use_elevation_tx", "bool", "also transmit on the elevated "
                                   "Tx (3 TDM slots instead of 2)", False)
+    elevation_processing: bool = spec(
+        "elevation_processing", "bool", "the RuT beamforms in azimuth and elevation (2-D, all "
+        "virtual elements) when its virtual array has elevation extent; false: the azimuth row "
+        "only (eq. 14). Front ends or targets off the horizontal plane need it", False)
     board_gap_m: float | None = spec(
         "board_gap_mm", "float", "lateral gap from the right-most Tx to the first Rx of a preset "
         "with separate Tx and Rx groups; unset = the preset's default, 3 lambda (6 d) for the "
@@ -261,6 +265,11 @@ class FrontEndConfig(Evolvable):
     return_loss_be_db: float | None = spec("return_loss_be_db", "float", "mismatch at the back "
                                            "end; unset = no cable ghosts", None, unit="dB",
                                            lo=0.0, hi=100.0, lo_open=True)
+    # -- front ends on a sphere (issue 15): elevation on the sphere about the arc centre ------
+    elevation_rad: float = spec("elevation_deg", "float", "elevation epsilon_q on the sphere "
+                                "about the arc centre (0: on the arc; any non-zero one makes "
+                                "the sheet a spherical cap)", 0.0, unit="deg", lo=-60.0,
+                                hi=60.0, scale=_DEG)
 
     def antenna_offsets_m(self) -> tuple[tuple[float, float], tuple[float, float]]:
         """Signed (t, h) of the Rx and the Tx antenna on the module (m): the explicit offsets,
@@ -287,7 +296,8 @@ class RtsConfig(Evolvable):
         Derived("the RuT's phase centre radar.position_m", lambda v: None), n=3, unit="m",
         lo=-1e3, hi=1e3)
     front_ends: tuple[FrontEndConfig, ...] = spec(
-        "front_ends", "tables", "[[rts.front_ends]], ordered by strictly increasing angle_deg",
+        "front_ends", "tables", "[[rts.front_ends]], ordered by strictly increasing angle_deg "
+        "(by (angle_deg, elevation_deg) where elevations differ)",
         cls=FrontEndConfig, max_items=MAX_FRONT_ENDS, min_items=1, item="front end")
     f_rts_hz: float = spec("f_rts_hz", "float", "IF at which the RTS delay acts (eq. 7)",
                            unit="Hz", lo=0.0, hi=100e9)
@@ -376,6 +386,10 @@ class TargetConfig(Evolvable):
                            lo=-100.0, hi=100.0)
     angle_rad: float = spec("angle_deg", "float", "azimuth seen from the RuT", 0.0, unit="deg",
                             lo=-90.0, hi=90.0, scale=_DEG)
+    # -- targets in elevation (issue 15): synthesized by a cell of front ends on a sphere -----
+    elevation_rad: float = spec("elevation_deg", "float", "elevation seen from the RuT (needs "
+                                "front ends at elevations and a RuT with elevation)", 0.0,
+                                unit="deg", lo=-60.0, hi=60.0, scale=_DEG)
 
     @property
     def rcs_m2(self) -> float:

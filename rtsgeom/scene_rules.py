@@ -42,7 +42,8 @@ def front_end_module_m(centre, radius_m: float, fe: "FrontEndConfig") -> tuple[f
     """World position of a front end's module centre (mounting offsets applied)."""
     off = (fe.radial_offset_m, fe.tangential_offset_m, fe.height_offset_m)
     _, _, mod = antenna_positions(np.asarray(centre, float), radius_m, fe.angle_rad,
-                                  fe.rx_tx_separation_m, off)
+                                  fe.rx_tx_separation_m, off,
+                                  elevation_rad=getattr(fe, "elevation_rad", 0.0) or None)
     return tuple(float(x) for x in mod)
 
 
@@ -68,9 +69,20 @@ def problems(scene: "Scene") -> list[str]:
         out.append(f"{src}: {fieldname} = {fmt(value)}: must be {allowed}")
 
     for rule in (_array_rules, _radar_rules, _rts_rules, _sheet_rules, _placement_rules, _calibration_rules,
-                 _target_rules, _spacing_rules):
+                 _target_rules, _spacing_rules, _elevation_rules):
         rule(scene, fail)
     return out
+
+
+def _elevation_rules(scene, fail) -> None:
+    """Front ends or targets off the horizontal plane need the RuT's 2-D beamforming."""
+    off_plane = (any(fe.elevation_rad for fe in scene.rts.front_ends)
+                 or any(t.elevation_rad for t in scene.targets))
+    if off_plane and not scene.radar.elevation_processing:
+        fail("radar.elevation_processing", False,
+             "true: front ends or targets off the horizontal plane (elevation_deg != 0) need the "
+             "RuT's 2-D (azimuth x elevation) beamforming, with an array that has elevation "
+             "extent (e.g. use_elevation_tx = true)")
 
 
 def _radar_rules(scene, fail) -> None:
@@ -159,9 +171,17 @@ def _rts_rules(scene, fail) -> None:
     calibration_span_ns [start, stop] with stop > start."""
     rts = scene.rts
     angles = [fe.angle_rad for fe in rts.front_ends]
-    if any(b <= a for a, b in zip(angles, angles[1:])):
-        fail("rts.front_ends", [round(math.degrees(a), 6) for a in angles],
-             "ordered by strictly increasing angle_deg")
+    elev = [fe.elevation_rad for fe in rts.front_ends]
+    if not any(elev):
+        if any(b <= a for a, b in zip(angles, angles[1:])):
+            fail("rts.front_ends", [round(math.degrees(a), 6) for a in angles],
+                 "ordered by strictly increasing angle_deg")
+    else:
+        keys = list(zip(angles, elev))
+        if any(b <= a for a, b in zip(keys, keys[1:])):
+            fail("rts.front_ends", [[round(math.degrees(a), 6), round(math.degrees(e), 6)]
+                                    for a, e in keys],
+                 "ordered by strictly increasing (angle_deg, elevation_deg)")
     if rts.fractional_delay_step_s > 1.0 / rts.f_s_hz:
         fail("rts.fractional_delay_step_s", rts.fractional_delay_step_s,
              f"in [1e-15, {1.0 / rts.f_s_hz:g}] s")
@@ -208,6 +228,9 @@ def _sheet_rules(scene, fail) -> None:
                  f"within the sheet [{math.degrees(sheet.angle_min_rad + half):g}, "
                  f"{math.degrees(sheet.angle_max_rad - half):g}] deg (sheet extent minus "
                  "half a cutout)")
+    if any(fe.elevation_rad for fe in rts.front_ends):
+        _cap_rules(scene, r_sheet, fail)
+        return
     for i in range(1, len(rts.front_ends)):
         a, b = rts.front_ends[i - 1], rts.front_ends[i]
         chord = 2.0 * r_sheet * math.sin(0.5 * (b.angle_rad - a.angle_rad))
@@ -218,6 +241,32 @@ def _sheet_rules(scene, fail) -> None:
                  f">= {math.degrees(a.angle_rad) + min_deg:.4g} deg: front ends "
                  f"{i - 1} and {i} are closer ({chord * 1e3:.1f} mm) than their cutouts "
                  f"({sheet.cutout_diameter_m * 1e3:.1f} mm) allow")
+
+
+def _cap_rules(scene, r_sheet: float, fail) -> None:
+    """Front ends on a sphere: each cutout inside the cap's elevation extent (sheet.height_m
+    as a chord, +-asin(height / 2 r)), and no two cutouts overlapping (chord between any two
+    front ends' directions on the sheet >= the cutout diameter)."""
+    sheet, fes = scene.sheet, scene.rts.front_ends
+    half = math.asin(min(1.0, 0.5 * sheet.cutout_diameter_m / r_sheet))
+    top = math.asin(min(1.0, 0.5 * sheet.height_m / r_sheet))
+    for i, fe in enumerate(fes):
+        if abs(fe.elevation_rad) + half > top:
+            fail(f"rts.front_ends[{i}].elevation_deg", math.degrees(fe.elevation_rad),
+                 f"within +-{math.degrees(top - half):.4g} deg (the spherical cap's extent "
+                 "+-asin(sheet.height_m / 2 r_sheet) minus half a cutout)")
+    for i in range(len(fes)):
+        for j in range(i):
+            a, b = fes[j], fes[i]
+            cos_g = (math.sin(a.elevation_rad) * math.sin(b.elevation_rad)
+                     + math.cos(a.elevation_rad) * math.cos(b.elevation_rad)
+                     * math.cos(b.angle_rad - a.angle_rad))
+            chord = 2.0 * r_sheet * math.sin(0.5 * math.acos(max(-1.0, min(1.0, cos_g))))
+            if chord < sheet.cutout_diameter_m:
+                fail(f"rts.front_ends[{i}].angle_deg", math.degrees(b.angle_rad),
+                     f"further from front end {j}: front ends {j} and {i} are closer "
+                     f"({chord * 1e3:.1f} mm) than their cutouts "
+                     f"({sheet.cutout_diameter_m * 1e3:.1f} mm) allow")
 
 
 def _modules(scene) -> list[tuple[float, ...]]:

@@ -239,10 +239,11 @@ class ChannelModel:
 
         ro = None if fe.rx_offset_m is None else fe.rx_offset_m[q]
         to = None if fe.tx_offset_m is None else fe.tx_offset_m[q]
+        el = None if fe.elevation_rad is None else fe.elevation_rad[q]
         rx, tx, _ = antenna_positions(fe.arc_centre, fe.arc_radius_m, fe.angle_rad[q],
                                       fe.separation_m[q], offsets_m, rx_offset_m=ro,
                                       tx_offset_m=to, yaw_rad=pick(fe.yaw_rad, yaw_rad),
-                                      pitch_rad=pick(fe.pitch_rad, pitch_rad))
+                                      pitch_rad=pick(fe.pitch_rad, pitch_rad), elevation_rad=el)
         if rut_offset_m is None and rut_yaw_rad is None:
             rut_tx, rut_rx = rut.tx_world, rut.rx_world
         else:

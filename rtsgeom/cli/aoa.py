@@ -134,6 +134,8 @@ def _linearity(args, stage) -> int:
     if list(args.pair) == ["all"]:
         from .arc import linearity_all
         return linearity_all(args, stage)
+    if getattr(args, "grid", None):  # 2-D: an error map over one cell (issue 15)
+        return _linearity_grid(args, stage)
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
         scene, setup, pair, paths, probe = _prepare(args)
@@ -152,6 +154,29 @@ def _linearity(args, stage) -> int:
           f"{args.amplitudes} ({'calibrated' if cal else 'uncalibrated'}, "
           f"{args.end_angles} end angles): max |error| "
           f"{lin.max_abs_error_deg:.4f} deg over {len(lin.set_deg)} set-points")
+    return 0
+
+
+def _linearity_grid(args, stage) -> int:
+    from ..aoa.linearity2d import error_map_figure, linearity_grid
+    with steps(args.quiet or args.json) as step:
+        step("measuring each front end alone")
+        scene = load_scene_checked(args.scene)
+        setup = build_setup(scene)
+        paths = exact_paths(setup)
+        step(f"{'calibrating the channels, then ' if not args.uncalibrated else ''}"
+             f"synthesizing a {args.grid} x {args.grid} grid ({args.amplitudes} amplitudes)")
+        try:
+            em = linearity_grid(setup, paths, args.amplitudes, args.grid,
+                                not args.uncalibrated, scene.seed)
+        except ValueError as exc:
+            raise UsageError(f"{args.scene}: {exc}") from None
+    mx = em.max_abs_error_deg()
+    _emit(args, stage, "linearity_grid.png", "linearity_grid", em.to_dict(),
+          lambda: error_map_figure(em),
+          f"{args.amplitudes} ({'calibrated' if em.calibrated else 'uncalibrated'}): max "
+          f"|error| azimuth {mx[0]:.4f} deg, elevation {mx[1]:.4f} deg over "
+          f"{em.set_deg.shape[0]} set-points")
     return 0
 
 
@@ -189,6 +214,10 @@ def register(sub) -> None:
                            default="exact", help="amplitude-ratio mode (default exact)")
             p.add_argument("--uncalibrated", action="store_true",
                            help="no phase/amplitude calibration (delay offset 0)")
+            p.add_argument("--grid", type=number(2, 50, integer=True), default=None,
+                           metavar="N", help="2-D: an N x N azimuth/elevation error map over "
+                                             "the cell of the scene's 3 or 4 front ends "
+                                             "(writes linearity_grid.png and .json)")
             p.add_argument("--points", type=number(3, 1001, integer=True), default=21,
                            help="set-points across the span (default 21)")
         p.set_defaults(func=func)

@@ -19,17 +19,21 @@ from ._common import (UsageError, load_scene_checked, number, output_file, outpu
 
 def detections_csv(result: RunResult) -> str:
     """One row per detection, sorted by range then velocity; the last column ``label`` says
-    what the simulation put there (:func:`rtsgeom.run.label_detections`)."""
+    what the simulation put there (:func:`rtsgeom.run.label_detections`); ``elevation_deg``
+    (0 for an azimuth-only array) sits after ``snr_db``, so the earlier columns keep their
+    places."""
     det = result.detections
     labels = label_detections(result)
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(["range_m", "velocity_mps", "angle_deg", "power_db", "snr_db", "label"])
+    w.writerow(["range_m", "velocity_mps", "angle_deg", "power_db", "snr_db", "elevation_deg",
+                "label"])
     order = np.lexsort((det.velocity_mps, det.range_m))
+    el = det.elevation_deg
     for i in order:
         w.writerow([f"{det.range_m[i]:.4f}", f"{det.velocity_mps[i]:.4f}",
                     f"{det.angle_deg[i]:.4f}", f"{det.power_db[i]:.2f}", f"{det.snr_db[i]:.2f}",
-                    labels[i]])
+                    f"{el[i]:.4f}", labels[i]])
     return buf.getvalue()
 
 
@@ -192,9 +196,11 @@ def cmd_run(args) -> int:
             if d is None:
                 print(f"target {m['index']}: NOT DETECTED")
                 continue
+            el = (f" el {d['elevation_deg']:7.3f} deg" if "elevation_deg" in d else "")
+            el_e = (f", el {e['elevation_deg']:+.3f} deg" if "elevation_deg" in e else "")
             print(f"target {m['index']}: {d['range_m']:7.3f} m {d['velocity_mps']:+7.3f} m/s "
-                  f"{d['angle_deg']:8.3f} deg  (errors {e['range_m']:+.3f} m, "
-                  f"{e['velocity_mps']:+.3f} m/s, {e['angle_deg']:+.3f} deg)")
+                  f"{d['angle_deg']:8.3f} deg{el}  (errors {e['range_m']:+.3f} m, "
+                  f"{e['velocity_mps']:+.3f} m/s, {e['angle_deg']:+.3f} deg{el_e})")
         for w in result.warnings:
             print(f"warning: {w}")
         print(f"{len(result.detections)} detections; wrote {out}/detections.csv, summary.json, "

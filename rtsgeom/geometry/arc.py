@@ -47,6 +47,7 @@ class FrontEnds:
     tx_offset_m: np.ndarray | None = None  # (F, 2)
     yaw_rad: np.ndarray | None = None  # (F,)
     pitch_rad: np.ndarray | None = None  # (F,)
+    elevation_rad: np.ndarray | None = None  # (F,) on the sphere; None: all on the arc
 
     @property
     def count(self) -> int:
@@ -54,7 +55,7 @@ class FrontEnds:
 
     def axes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(tangent, up, boresight) unit vectors per module, (F, 3) each (:func:`module_axes`)."""
-        return module_axes(self.angle_rad, self.yaw_rad, self.pitch_rad)
+        return module_axes(self.angle_rad, self.yaw_rad, self.pitch_rad, self.elevation_rad)
 
     def antenna_frame(self) -> np.ndarray:
         """Rotation antenna frame -> world per module, (F, 3, 3), columns (x, y, z): ``y`` the
@@ -77,6 +78,8 @@ def front_ends(scene: Scene, arc_centre: np.ndarray, *, rx_offset_m=None, tx_off
     """
     fes = scene.rts.front_ends
     ang = np.array([f.angle_rad for f in fes])
+    elev = np.array([getattr(f, "elevation_rad", 0.0) for f in fes], float)
+    elev = elev if np.any(elev) else None  # all on the arc: today's arithmetic
     sep = np.array([f.rx_tx_separation_m for f in fes])
     off = (np.array([[f.radial_offset_m, f.tangential_offset_m, f.height_offset_m] for f in fes])
            if offsets_m is None else np.asarray(offsets_m, float))
@@ -108,7 +111,8 @@ def front_ends(scene: Scene, arc_centre: np.ndarray, *, rx_offset_m=None, tx_off
         to = ts if to is None else to
         sep = ro[:, 0] - to[:, 0]
     rx, tx, mod = antenna_positions(arc_centre, scene.rts.arc_radius_m, ang, sep, off,
-                                    rx_offset_m=ro, tx_offset_m=to, yaw_rad=yaw, pitch_rad=pitch)
-    opt = [None if a is None else frozen(a) for a in (ro, to, yaw, pitch)]
+                                    rx_offset_m=ro, tx_offset_m=to, yaw_rad=yaw, pitch_rad=pitch,
+                                    elevation_rad=elev)
+    opt = [None if a is None else frozen(a) for a in (ro, to, yaw, pitch, elev)]
     return FrontEnds(frozen(ang), frozen(rx), frozen(tx), frozen(mod), frozen(sep), frozen(off),
                      frozen(arc_centre), scene.rts.arc_radius_m, *opt)

@@ -32,11 +32,18 @@ class Setup:
         cfg = self.scene.sheet
         if not cfg.enabled:
             return None
-        return sheet_mesh(cfg, self.fe.arc_centre, self.fe.arc_radius_m, self.fe.angle_rad)
+        return sheet_mesh(cfg, self.fe.arc_centre, self.fe.arc_radius_m, self.fe.angle_rad,
+                          self.fe.elevation_rad)
 
     def fe_azimuth_rad(self) -> np.ndarray:
         """Azimuth of each front end's module centre as seen from the RuT phase centre."""
         return self.rut.azimuth_of(self.fe.module)
+
+    def fe_direction_cosines(self) -> np.ndarray:
+        """Direction cosines u = (sin az cos el, sin el) (F, 2) of each front end's module
+        centre seen from the RuT phase centre, in the radar frame (``radar.steering``)."""
+        p = self.rut.to_local(self.fe.module)
+        return p[:, [0, 2]] / np.linalg.norm(p, axis=-1, keepdims=True)
 
 
 def build_setup(scene: Scene, offsets_m: np.ndarray | None = None, *, yaw_rad=None,

@@ -2,8 +2,10 @@
 
 The sheet is a cylindrical shell sector coaxial with the arc (vertical axis through the arc
 centre): inner face at ``R_c + radius_offset_m``, ``thickness_m`` thick, ``height_m`` tall,
-centred on the arc's height. Cutouts are cylinders along each front end's radial direction,
-subtracted with manifold3d so the result is watertight with outward normals.
+centred on the arc's height. With front ends on a sphere (any non-zero elevation) it is a
+spherical-cap section about the arc centre instead: the same azimuth extent, elevations within
++-asin(height_m / 2 r) (``height_m`` as the chord). Cutouts are cylinders along each front end's
+radial direction, subtracted with manifold3d so the result is watertight with outward normals.
 """
 
 from __future__ import annotations
@@ -14,11 +16,12 @@ import numpy as np
 
 from ..scene import SheetConfig
 from .arc import radial_tangent
+from ..arcmath import sphere_frame
 
 if TYPE_CHECKING:  # trimesh itself loads where a mesh is built (1 s of imports)
     import trimesh
 
-__all__ = ["segments_blocked", "shell_sector", "sheet_mesh"]
+__all__ = ["segments_blocked", "shell_sector", "cap_sector", "sheet_mesh"]
 
 
 def shell_sector(r_inner: float, thickness: float, angle_min: float, angle_max: float,
@@ -61,19 +64,58 @@ def shell_sector(r_inner: float, thickness: float, angle_min: float, angle_max: 
     return mesh
 
 
+def cap_sector(r_inner: float, thickness: float, angle_min: float, angle_max: float,
+               el_min: float, el_max: float, max_step_rad: float = np.radians(0.5)
+               ) -> trimesh.Trimesh:
+    """Watertight spherical shell section about the origin: azimuth in [angle_min, angle_max]
+    (from +y towards +x), elevation in [el_min, el_max]; inner radius ``r_inner``.
+
+    A grid of (azimuth, elevation) directions on two radii, closed by four side walls; the
+    outline of the (n_a x n_e) grid is walked once so each wall is one strip of quads."""
+    import trimesh  # here, not at the top (see shell_sector)
+    n_a = max(2, int(np.ceil((angle_max - angle_min) / max_step_rad)) + 1)
+    n_e = max(2, int(np.ceil((el_max - el_min) / max_step_rad)) + 1)
+    az, el = np.meshgrid(np.linspace(angle_min, angle_max, n_a),
+                         np.linspace(el_min, el_max, n_e), indexing="ij")
+    r_hat, _, _ = sphere_frame(az, el)  # (n_a, n_e, 3)
+    n = n_a * n_e
+    v = np.concatenate([(r * r_hat).reshape(-1, 3) for r in (r_inner, r_inner + thickness)])
+    idx = np.arange(n).reshape(n_a, n_e)
+    a, b, cc, d = idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]
+    quads = [np.stack([a, b, cc, d], -1).reshape(-1, 4)]  # inner face
+    quads.append(quads[0][:, ::-1] + n)  # outer face
+    ring = np.concatenate([idx[:, 0], idx[-1, 1:], idx[-2::-1, -1], idx[0, -2:0:-1]])
+    nxt = np.roll(ring, -1)
+    quads.append(np.stack([ring, nxt, nxt + n, ring + n], -1))  # side walls
+    q = np.concatenate(quads)
+    mesh = trimesh.Trimesh(v, np.concatenate([q[:, [0, 1, 2]], q[:, [0, 2, 3]]]), process=True)
+    trimesh.repair.fix_normals(mesh)
+    return mesh
+
+
 def sheet_mesh(cfg: SheetConfig, arc_centre: np.ndarray, arc_radius_m: float,
-               cutout_angles_rad: np.ndarray) -> trimesh.Trimesh:
-    """The sheet with its cutouts, in world coordinates."""
+               cutout_angles_rad: np.ndarray, cutout_elevations_rad: np.ndarray | None = None
+               ) -> trimesh.Trimesh:
+    """The sheet with its cutouts, in world coordinates: a cylinder section, or a
+    spherical-cap section where ``cutout_elevations_rad`` has a non-zero elevation."""
     import trimesh
     r0 = arc_radius_m + cfg.radius_offset_m
     h = 0.5 * cfg.height_m
-    shell = shell_sector(r0, cfg.thickness_m, cfg.angle_min_rad, cfg.angle_max_rad, -h, h)
+    ang_all = np.asarray(cutout_angles_rad, float)
+    cap = cutout_elevations_rad is not None and np.any(cutout_elevations_rad)
+    if cap:
+        top = float(np.arcsin(min(1.0, h / r0)))
+        shell = cap_sector(r0, cfg.thickness_m, cfg.angle_min_rad, cfg.angle_max_rad, -top, top)
+        elev = np.asarray(cutout_elevations_rad, float)
+    else:
+        shell = shell_sector(r0, cfg.thickness_m, cfg.angle_min_rad, cfg.angle_max_rad, -h, h)
+        elev = np.zeros_like(ang_all)
     cutters = []
     length = 4.0 * cfg.thickness_m + 0.02
-    for ang in np.asarray(cutout_angles_rad, float):
+    for ang, el in zip(ang_all, elev):
         cyl = trimesh.creation.cylinder(radius=0.5 * cfg.cutout_diameter_m, height=length,
                                         sections=64)
-        r_hat, _ = radial_tangent(ang)
+        r_hat = sphere_frame(ang, el)[0] if cap else radial_tangent(ang)[0]
         align = trimesh.geometry.align_vectors([0.0, 0.0, 1.0], r_hat)
         align[:3, 3] = (r0 + 0.5 * cfg.thickness_m) * r_hat
         cyl.apply_transform(align)

@@ -54,8 +54,9 @@ class AdcCube:
 
     @cached_property
     def steering(self) -> Steering:
-        """The RuT's beamformer (built once per cube)."""
-        return Steering.build(self.rut, self.radar)
+        """The RuT's beamformer (built once per cube): 2-D when the virtual array has
+        elevation extent (:meth:`Steering.auto`)."""
+        return Steering.auto(self.rut, self.radar)
 
     def to_xarray(self):
         """The cube as an ``xarray.DataArray`` with dims ``chirp_loop``, ``virtual_channel``

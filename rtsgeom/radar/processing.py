@@ -85,6 +85,8 @@ class Detections:
     snr_db: np.ndarray  # peak over the CFAR noise estimate
     range_bin: np.ndarray
     doppler_bin: np.ndarray
+    # elevation of the 2-D beamformer's peak (arrays with elevation extent); None: azimuth-only
+    elevation_rad: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.range_m.size)
@@ -93,13 +95,21 @@ class Detections:
     def angle_deg(self) -> np.ndarray:
         return np.degrees(self.angle_rad)
 
+    @property
+    def elevation_deg(self) -> np.ndarray:
+        """Elevation (deg) per detection; 0 for an azimuth-only array."""
+        if self.elevation_rad is None:
+            return np.zeros_like(np.asarray(self.range_m, float))
+        return np.degrees(self.elevation_rad)
+
     def to_dataframe(self):
         """One row per detection as a ``pandas.DataFrame`` (columns ``range_m``,
-        ``velocity_mps``, ``angle_deg``, ``power_db``, ``snr_db``, ``range_bin``,
-        ``doppler_bin``)."""
+        ``velocity_mps``, ``angle_deg``, ``elevation_deg``, ``power_db``, ``snr_db``,
+        ``range_bin``, ``doppler_bin``)."""
         import pandas as pd
         return pd.DataFrame({"range_m": self.range_m, "velocity_mps": self.velocity_mps,
-                             "angle_deg": self.angle_deg, "power_db": self.power_db,
+                             "angle_deg": self.angle_deg, "elevation_deg": self.elevation_deg,
+                             "power_db": self.power_db,
                              "snr_db": self.snr_db, "range_bin": self.range_bin,
                              "doppler_bin": self.doppler_bin})
 
@@ -249,10 +259,14 @@ def angle_spectrum(snapshots: np.ndarray, rut: RutArray | Steering, radar: Radar
     :meth:`Steering.power` at azimuths ``angles_rad`` (A,).
 
     ``snapshots`` (..., V) over all virtual channels (the azimuth row is selected here);
-    returns (..., A). ``rut``: the RuT array (with ``radar``) or its :class:`Steering`.
+    returns (..., A). ``rut``: the RuT array (with ``radar``) or its :class:`Steering`. A 2-D
+    steering (D = 2) is cut at elevation 0.
     """
     st = _steering_of(rut, radar)
-    return st.power(snapshots, st.directions(np.asarray(angles_rad)))
+    a = np.asarray(angles_rad, float)
+    if st.dims == 2:
+        a = np.stack([a, np.zeros_like(a)], axis=-1)
+    return st.power(snapshots, st.directions(a))
 
 
 def estimate_angles(snapshots: np.ndarray, rut: RutArray | Steering,
@@ -282,14 +296,18 @@ def detect(rd: RangeDoppler, cube: AdcCube) -> Detections:
     nu_step = rd.doppler_hz[1] - rd.doppler_hz[0]
     nu = rd.doppler_hz[d_i] + dd * nu_step
     snaps = tdm_compensate(rd.spectrum[r_i, d_i, :], nu, rut, radar)
-    ang = cube.steering.search(snaps) if r_i.size else np.zeros(0)
+    st = cube.steering
+    ang = st.search(snaps) if r_i.size else (np.zeros((0, 2)) if st.dims == 2 else np.zeros(0))
+    elev = None
+    if st.dims == 2:  # 2-D beamforming (array with elevation extent)
+        ang, elev = ang[..., 0], frozen(ang[..., 1])
     return Detections(
         range_m=frozen(rd.range_m[r_i] + dr * range_step),
         velocity_mps=frozen(nu * c / (2 * radar.f_c_hz)),
         angle_rad=frozen(ang),
         power_db=frozen(10 * np.log10(rd.power[r_i, d_i])),
         snr_db=frozen(10 * np.log10(rd.power[r_i, d_i] / noise[r_i, d_i])),
-        range_bin=frozen(r_i), doppler_bin=frozen(d_i),
+        range_bin=frozen(r_i), doppler_bin=frozen(d_i), elevation_rad=elev,
     )
 
 

@@ -67,7 +67,10 @@ def _taper(name: str, positions: np.ndarray) -> np.ndarray:
             wd[np.argsort(x)] = window(name, x.size)
         else:  # one window value per distinct coordinate (a row or a column of a 2-D array)
             vals, inv = np.unique(np.round(x, 12), return_inverse=True)
-            wd = window(name, vals.size)[inv]
+            wv = window(name, vals.size)
+            if not np.all(wv > 0):  # e.g. hann over 2 rows is (0, 0): drop the zero ends
+                wv = window(name, vals.size + 2)[1:-1]
+            wd = wv[inv]
         w = w * wd
     return w
 
@@ -103,6 +106,21 @@ class Steering:
                        float(rut.wavelength_m), frozen(np.array([rut.aperture_m])))
         return cls(frozen(mask), frozen(pos), frozen(_taper(radar.angle_window, pos)),
                    float(rut.wavelength_m), frozen(np.asarray(n, float) * rut.spacing_m))
+
+    @staticmethod
+    def has_elevation(rut: RutArray) -> bool:
+        """Whether the virtual array has elevation extent (more than one distinct height)."""
+        z = np.round(np.asarray(rut.virtual_local)[:, 2] / rut.spacing_m, 6)
+        return bool(np.unique(z).size > 1)
+
+    @classmethod
+    def auto(cls, rut: RutArray, radar: RadarConfig) -> "Steering":
+        """The RuT's beamformer as it processes: 2-D (azimuth x elevation, D = 2, all virtual
+        elements) when ``radar.elevation_processing`` is on and the virtual array has elevation
+        extent, else the azimuth row (D = 1). (Opt-in: the pair designs of a flat arc solve on
+        the azimuth row, so a 2-D RuT would see them ~0.2 deg off; see README.)"""
+        on = bool(getattr(radar, "elevation_processing", False))
+        return cls.build(rut, radar, elevation=on and cls.has_elevation(rut))
 
     @property
     def dims(self) -> int:
@@ -162,12 +180,33 @@ class Steering:
         grid = np.radians(np.arange(-90.0, 90.0001, 0.25))
         return grid, self.steer(self.directions(grid))
 
+    @staticmethod
+    def angles(u) -> np.ndarray:
+        """(azimuth, elevation) (..., 2) rad of direction cosines u (..., 2):
+        el = asin u_el, az = asin(u_az / cos el)."""
+        u = np.asarray(u, float)
+        el = np.arcsin(np.clip(u[..., 1], -1.0, 1.0))
+        ce = np.cos(el)
+        az = np.arcsin(np.clip(u[..., 0] / np.where(ce > 0, ce, 1.0), -1.0, 1.0))
+        return np.stack([az, el], axis=-1)
+
+    def azimuth(self, snapshots) -> np.ndarray:
+        """The detected azimuth (...,) rad of snapshots (..., V), whatever D (D = 2: the
+        azimuth of the 2-D peak)."""
+        a = self.search(snapshots)
+        return a if self.dims == 1 else a[..., 0]
+
     def search(self, snapshots) -> np.ndarray:
-        """Beamformer peak per snapshot (..., V) -> azimuth (...,) rad, by grid search at
-        0.25 deg, two zoom levels (0.005 deg, 1e-4 deg) and a final parabolic interpolation:
-        precise to ~1e-6 deg on noise-free data. D = 1 only."""
+        """Beamformer peak per snapshot (..., V) -> azimuth (...,) rad (D = 1) or
+        (azimuth, elevation) (..., 2) rad (D = 2).
+
+        D = 1: grid search at 0.25 deg, two zoom levels (0.005 deg, 1e-4 deg) and a final
+        parabolic interpolation: precise to ~1e-6 deg on noise-free data. D = 2: the global
+        maximum on the coarse 2-D grid of :meth:`grid` (lambda / (8 d_A) per axis over the
+        visible region, which holds the unambiguous one), then :meth:`peak` (2-D Newton on
+        log P with the global check) from there."""
         if self.dims != 1:
-            raise NotImplementedError("the grid search is azimuth-only (D = 1); use peak()")
+            return self._search_2d(snapshots)
         snaps = np.atleast_2d(snapshots)
         shape = snaps.shape[:-1]
         snaps = snaps.reshape(-1, snaps.shape[-1])
@@ -185,6 +224,19 @@ class Steering:
             best = cand[rows, i] + np.clip(frac, -1, 1) * np.radians(step)
         out = best.reshape(shape)
         return out if np.ndim(snapshots) > 1 else out[0]
+
+    def _search_2d(self, snapshots) -> np.ndarray:
+        snaps = np.asarray(snapshots)
+        shape = snaps.shape[:-1]
+        flat = snaps.reshape(-1, snaps.shape[-1])
+        grid = self.grid()
+        steer = self.steer(grid).T
+        start = np.empty((flat.shape[0], 2))
+        for b in range(0, flat.shape[0], BLOCK):
+            y = self.weighted(flat[b:b + BLOCK]) @ steer
+            start[b:b + BLOCK] = grid[np.argmax(y.real ** 2 + y.imag ** 2, axis=1)]
+        u, _ = self.peak(flat, start, iterations=8)
+        return self.angles(u).reshape(shape + (2,))
 
     def grid(self) -> np.ndarray:
         """Directions (G, D) of the global check: steps of lambda / (8 d_A) in u per axis

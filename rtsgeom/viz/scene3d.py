@@ -28,7 +28,7 @@ import numpy as np
 import pyvista as pv
 
 from ..geometry import Setup
-from ..geometry.arc import radial_tangent
+from ..arcmath import radial_tangent, sphere_frame
 from ..geometry.export import _COLOURS
 from ..io import atomic_path, write_text
 
@@ -201,11 +201,12 @@ def _cutout_rims(setup: Setup):
     r0 = setup.fe.arc_radius_m + cfg.radius_offset_m
     t = np.linspace(0.0, 2 * np.pi, 73)
     rims = []
-    for ang in setup.fe.angle_rad:
-        r_hat, t_hat = radial_tangent(ang)
+    for i, ang in enumerate(setup.fe.angle_rad):
+        el = None if setup.fe.elevation_rad is None else setup.fe.elevation_rad[i]
+        r_hat, t_hat, up = sphere_frame(ang, el)
         circle = (setup.fe.arc_centre + (r0 - 1e-4) * r_hat
                   + 0.5 * cfg.cutout_diameter_m * (np.cos(t)[:, None] * t_hat
-                                                   + np.sin(t)[:, None] * np.array([0, 0, 1.0])))
+                                                   + np.sin(t)[:, None] * up))
         rims.append(_polyline(circle))
     return _merge(rims)
 
@@ -215,10 +216,11 @@ def _modules(setup: Setup):
     fe = setup.fe
     boxes = []
     for i in range(fe.count):
-        r_hat, t_hat = radial_tangent(fe.angle_rad[i])
+        el = None if fe.elevation_rad is None else fe.elevation_rad[i]
+        r_hat, t_hat, up = sphere_frame(fe.angle_rad[i], el)
         size_t = abs(fe.separation_m[i]) + 0.012  # smaller than the cutout: the hole stays visible
         box = pv.Box(bounds=(-size_t / 2, size_t / 2, 0.012, 0.024, -0.01, 0.01))
-        rot = np.stack([t_hat, r_hat, [0.0, 0.0, 1.0]], axis=1)  # local (t, r, z) -> world
+        rot = np.stack([t_hat, r_hat, up], axis=1)  # local (t, r, up) -> world
         box.points = box.points @ rot.T + fe.module[i]
         boxes.append(box)
     return _merge(boxes)
@@ -228,7 +230,8 @@ def _target_positions(setup: Setup) -> tuple[np.ndarray, np.ndarray]:
     """Drawn positions (T, 3) and outward directions (T, 3) of the virtual targets."""
     rut = setup.rut
     ang = np.array([t.angle_rad for t in setup.scene.targets], float)
-    local = np.stack([np.sin(ang), np.cos(ang), np.zeros_like(ang)], -1)
+    el = np.array([getattr(t, "elevation_rad", 0.0) for t in setup.scene.targets], float)
+    local = sphere_frame(ang, el if np.any(el) else None)[0]
     direction = local @ rut.rotation.T
     return rut.position + TARGET_RADIUS_FACTOR * setup.fe.arc_radius_m * direction, direction
 
@@ -386,8 +389,10 @@ def _add_labels(pl, setup: Setup, scale: float, text3d: bool = False) -> None:
             a = pos[j] + (0.06 + 0.045 * k) * z_hat
             anchors.append(a)
             leaders.append(np.array([pos[j], a]))
-            texts.append(f"T{j}: {t.range_m:g} m, {np.degrees(t.angle_rad):g} deg, "
-                         f"{t.velocity_mps:+g} m/s")
+            el = getattr(t, "elevation_rad", 0.0)
+            texts.append(f"T{j}: {t.range_m:g} m, {np.degrees(t.angle_rad):g} deg"
+                         + (f" el {np.degrees(el):g} deg" if el else "")
+                         + f", {t.velocity_mps:+g} m/s")
     pl.add_mesh(_merge_lines(leaders), color="#444444", line_width=1)
     if text3d:
         normal = -_overview_direction(setup)  # towards the camera

@@ -1,0 +1,103 @@
+"""Targets in azimuth and elevation: pick the enclosing cell of front ends, calibrate its
+channels, solve one weight per channel (issue 15; the N-channel counterpart of ``aoa.plan``).
+
+Used by ``run`` when any front end has a non-zero elevation. The cells come from the front
+ends' geometric direction cosines seen from the RuT (``aoa.cells``); the weights from
+:class:`~rtsgeom.aoa.nchannel.ChannelSet` on the nominal setup with the channels' calibrated
+delay offsets and their natural phases (what the RuT sees of a nominal setup) when
+uncalibrated, or the phases the calibration establishes (each measured pair
+coherent where its probes sat, ``ncal.tree_phases``), amplitudes times each channel's measured
+gain correction.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.constants import c
+
+from ..geometry import Setup
+from ..paths import Paths
+from ..radar.steering import Steering
+from ..rts import RtsProgram, requested_delay
+from ..scene import SceneError
+from .cells import CellUnreachable, enclosing_cell
+from .model import AngleUnreachable
+from .nchannel import ChannelSet, target_direction
+
+__all__ = ["plan_cells", "uses_cells"]
+
+
+def uses_cells(scene) -> bool:
+    """Whether the scene needs the N-channel planner: a front end off the arc, or a target
+    with an elevation."""
+    return (any(fe.elevation_rad for fe in scene.rts.front_ends)
+            or any(getattr(t, "elevation_rad", 0.0) for t in scene.targets))
+
+
+def plan_cells(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, progress=None
+               ) -> tuple[RtsProgram, dict, list[str]]:
+    """The RTS program for the scene's targets at their set (azimuth, elevation).
+
+    Returns the program, the calibration record (for summary.json) and warnings."""
+    from .calibration import nominal_model, probe_front_ends
+    from .ncal import calibrate_channels, tree_phases
+    scene = setup.scene
+    nom, nom_paths = nominal_model(setup, paths)
+    probe = probe_front_ends(setup, paths, scene.seed)
+    warnings: list[str] = []
+    st = Steering.auto(nom.rut, scene.radar)  # the beamformer the RuT runs
+    u_fe = nom.fe_direction_cosines()
+    u_fe = np.sin(nom.fe_azimuth_rad())[:, None] if st.dims == 1 else u_fe
+    cells = {}
+    for k, t in enumerate(scene.targets):
+        if st.dims == 1 and getattr(t, "elevation_rad", 0.0):
+            raise SceneError(f"{scene.source}: targets[{k}].elevation_deg = "
+                             f"{np.degrees(t.elevation_rad):g}: must be 0: the RuT's array "
+                             f"({scene.radar.antenna_preset}, use_elevation_tx = "
+                             f"{str(scene.radar.use_elevation_tx).lower()}) has no elevation "
+                             "extent, it cannot see a target's elevation")
+        u = target_direction(st, t)
+        try:
+            cells[k] = enclosing_cell(u, u_fe)
+        except CellUnreachable as exc:
+            raise SceneError(f"{scene.source}: targets[{k}] (angle_deg = "
+                             f"{np.degrees(t.angle_rad):g}, elevation_deg = "
+                             f"{np.degrees(getattr(t, 'elevation_rad', 0.0)):g}): unreachable: "
+                             f"{exc}") from None
+    offsets = np.zeros(setup.fe.count)
+    cal_record: dict = {}
+    used = sorted({q for cell in cells.values() for q in cell})
+    tree = None
+    if calibrate:
+        cal = calibrate_channels(setup, paths, used, probe, progress=progress)
+        offsets, tree = cal.offsets_s, cal.tree
+        cal_record = cal.to_dict()
+    rows = []
+    for k, t in enumerate(scene.targets):
+        cell = cells[k]
+        u = target_direction(st, t)
+        phases = None  # uncalibrated: the phases the channels' delays give
+        if tree is not None:  # calibrated: coherent pairwise where the probes sat
+            cs_all = ChannelSet.build(nom, nom_paths, used, t, offsets[used])
+            phases = tree_phases(cs_all, tree)[[used.index(q) for q in cell]]
+        cs = ChannelSet.build(nom, nom_paths, cell, t, offsets[list(cell)])
+        try:
+            w = cs.solve(u, phases, mode=mode)
+        except AngleUnreachable as exc:
+            raise SceneError(f"{scene.source}: targets[{k}]: {exc}") from None
+        amps = cs.amplitudes(w, u) * probe.gain_correction[list(cell)]
+        tau = float(requested_delay(scene, t.range_m))
+        f_d = 2 * scene.radar.f_c_hz * t.velocity_mps / c
+        rows += [(k, q, tau + offsets[q], f_d, float(a)) for q, a in zip(cell, amps)]
+    program = RtsProgram.build(*zip(*rows)) if rows else RtsProgram.build([], [], [], [], [])
+    record = {
+        "mode": mode,
+        "cells": {str(k): list(v) for k, v in cells.items()},
+        "front_end_angles_deg": [float(x) for x in np.degrees(probe.angle_rad)],
+        "front_end_direction_cosines": [[float(x) for x in row] for row in u_fe],
+        "gain_correction": [float(x) for x in probe.gain_correction],
+        "channel_delay_offsets_s": [float(x) for x in offsets],
+        "pairs": cal_record.get("pairs", []),
+        "channels": cal_record,
+    }
+    return program, record, warnings

@@ -1,0 +1,158 @@
+"""N-channel synthesis in azimuth and elevation (issue 15): cells, closed form vs exact,
+the pair as the N = 2 case, and the bundled sphere4 scene end to end."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from rtsgeom.aoa.cells import CellUnreachable, enclosing_cell
+from rtsgeom.aoa.model import AngleUnreachable, ChannelModel
+from rtsgeom.aoa.nchannel import ChannelSet, closed_form_amplitudes
+from rtsgeom.geometry import build_setup
+from rtsgeom.paths import exact_paths
+from rtsgeom.scene import TargetConfig, load_scene
+
+SPHERE = "scenes/sphere4.toml"
+
+
+@pytest.fixture(scope="module")
+def sphere():
+    scene = load_scene(SPHERE)
+    setup = build_setup(scene)
+    return scene, setup, exact_paths(setup)
+
+
+# -- cells ------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("du", [(0.05, 0.03), (0.1, 0.2), (0.02, 0.01)])
+def test_cells_grid(du):
+    """On an az x el grid of front ends every interior point lies in the quad whose corners
+    bracket it in both axes; outside the hull is unreachable."""
+    ux, uz = np.arange(4) * du[0], np.arange(3) * du[1]
+    pts = np.stack(np.meshgrid(ux, uz, indexing="ij"), -1).reshape(-1, 2)
+    rng = np.random.default_rng(0)
+    for p in rng.uniform([0, 0], [ux[-1], uz[-1]], (50, 2)):
+        cell = enclosing_cell(p, pts)
+        c = pts[list(cell)]
+        assert len(cell) == 4
+        assert c[:, 0].min() <= p[0] <= c[:, 0].max() and c[:, 1].min() <= p[1] <= c[:, 1].max()
+        assert np.isclose(np.ptp(c[:, 0]), du[0]) and np.isclose(np.ptp(c[:, 1]), du[1])
+        tri = enclosing_cell(p, pts, quads=False)
+        assert len(tri) == 3 and set(tri) <= set(cell)
+    with pytest.raises(CellUnreachable):
+        enclosing_cell((ux[-1] + 0.01, 0.0), pts)
+    # 1-D: sorted intervals
+    x = np.array([0.3, -0.1, 0.1])[:, None]
+    assert enclosing_cell([0.0], x) == (1, 2) and enclosing_cell([0.2], x) == (2, 0)
+    with pytest.raises(CellUnreachable):
+        enclosing_cell([0.31], x)
+
+
+# -- the ideal far field: closed form against exact --------------------------------------------
+
+def ideal(cs: ChannelSet, u_fe):
+    """The channel set with ideal far-field responses: plane waves from ``u_fe`` (Q, D), all
+    in the centre candidate bin, no Doppler."""
+    st = cs.steering
+    v = cs.model.responses.shape[-1]
+    x = np.zeros((3, len(u_fe), v), complex)
+    x[1][:, st.mask] = np.exp(-1j * (st.wavevector @ np.asarray(u_fe).T)).T
+    return ChannelSet(dataclasses.replace(cs.model, responses=x, doppler_hz=0.0), np.asarray(u_fe))
+
+
+@pytest.mark.parametrize("cell", [(0, 1, 2, 3), (0, 1, 2), (0, 2, 3), (1, 2, 3)])
+@pytest.mark.parametrize("spread", [(0.08, 0.08), (0.15, 0.12), (0.05, 0.2)])
+def test_closed_form_equals_exact_in_ideal_far_field(sphere, cell, spread):
+    scene, setup, paths = sphere
+    cs = ChannelSet.build(setup, paths, cell, scene.targets[0])
+    corners = np.array([[0.0, 0.0], [0.0, 1.0], [1.0, 0.0], [1.0, 1.0]]) * spread + [0.05, -0.04]
+    u_fe = corners[list(cell)]
+    cs = ideal(cs, u_fe)
+    rng = np.random.default_rng(len(cell))
+    for _ in range(4):
+        b = rng.dirichlet(np.ones(len(cell)) * 3)  # a point inside the cell
+        u = b @ u_fe
+        ph = cs.coherent_phases(u)  # what a calibration establishes
+        w_cf = cs.solve(u, ph, mode="array-factor")
+        got = cs.direction_cosines(w_cf, u)
+        assert np.abs(got - u).max() < 1e-9  # the closed form is exact here
+        w_ex = cs.solve(u, ph, mode="exact")
+        assert np.abs(cs.direction_cosines(w_ex, u) - u).max() < 1e-9
+        if len(cell) == 3:  # one solution: both modes find it
+            assert np.allclose(np.abs(w_ex), np.abs(w_cf), rtol=1e-5, atol=1e-8)
+
+
+def test_closed_form_pair_is_paper_array_factor():
+    """D = 1, Q = 2: the null-space closed form is eq. 23 with the true array factor."""
+    from rtsgeom.aoa.synthesis import ratio_array_factor
+    from rtsgeom.radar.steering import Steering
+    scene = load_scene("scenes/diewald2022.toml")
+    setup = build_setup(scene)
+    st = Steering.auto(setup.rut, scene.radar)
+    for th_i, th_j in ((0.05, 0.2), (-0.1, 0.05), (0.3, 0.4)):
+        for f in (0.2, 0.5, 0.8):
+            alpha = th_i + f * (th_j - th_i)
+            a = closed_form_amplitudes(st, np.sin([[th_i], [th_j]]), [np.sin(alpha)])
+            rho = ratio_array_factor(th_i, th_j, alpha, st.size)
+            assert np.isclose(a[1] / a[0], rho, rtol=1e-5)
+
+
+def test_pair_is_the_n2_case():
+    """The 1-D pair through ChannelSet is ChannelModel's solve, bit for bit."""
+    scene = load_scene("scenes/diewald2022.toml")
+    setup = build_setup(scene)
+    paths = exact_paths(setup)
+    t = scene.targets[0]
+    cs = ChannelSet.build(setup, paths, (0, 1), t)
+    m = ChannelModel.build(setup, paths, (0, 1), t)
+    for mode in ("exact", "array-factor", "paper"):
+        assert np.array_equal(cs.solve([np.sin(t.angle_rad)], mode=mode),
+                              m.solve(t.angle_rad, None, mode))
+
+
+# -- the bundled scene ------------------------------------------------------------------------
+
+def test_exact_model_hits_cell_points(sphere):
+    """Exact mode on the real (near-field) geometry: the modelled peak at the set point, over
+    a grid of points inside the cell; outside the cell unreachable."""
+    scene, setup, paths = sphere
+    u_fe = setup.fe_direction_cosines()
+    t = TargetConfig(25.0)
+    cs = ChannelSet.build(setup, paths, (0, 1, 2, 3), t)
+    lo, hi = u_fe.min(0), u_fe.max(0)
+    for fx in (0.2, 0.5, 0.8):
+        for fz in (0.15, 0.5, 0.85):
+            u = lo + np.array([fx, fz]) * (hi - lo)
+            w = cs.solve(u)
+            assert np.abs(cs.direction_cosines(w, u) - u).max() < 1e-9
+            assert np.all(np.abs(w) > 0)
+    with pytest.raises(AngleUnreachable):
+        cs.solve(hi + 0.2 * (hi - lo))
+
+
+@pytest.mark.slow
+def test_sphere4_run_within_0_05_deg():
+    """Done-when: targets at several (az, el) inside the cell, detected within 0.05 deg in both
+    angles after calibration (exact mode), for the bundled targets and a second set."""
+    from rtsgeom.run import run_scene
+    scene = load_scene(SPHERE)
+    moved = tuple(t.evolve(angle_rad=np.radians(a), elevation_rad=np.radians(e))
+                  for t, a, e in zip(scene.targets, (4.0, 11.5, 8.0, 6.0),
+                                     (-3.5, 1.0, 2.0, -1.0)))
+    fes = list(scene.rts.front_ends)  # hardware errors the calibration has to find
+    fes[1] = fes[1].evolve(phase_offset_rad=np.radians(30.0))
+    fes[3] = fes[3].evolve(phase_offset_rad=np.radians(-50.0), gain_offset_db=1.0)
+    wrong = scene.evolve(targets=moved, rts=scene.rts.evolve(front_ends=tuple(fes)))
+    for sc in (scene, wrong):
+        result = run_scene(sc)
+        ch = result.calibration["channels"]
+        assert len(ch["spanning_tree"]) == 3 and len(ch["loop_closure_s"]) == 2
+        # loops close within a few of the 25 ps sweep steps (noise on a flat-bottomed minimum)
+        assert max(abs(x) for x in ch["loop_closure_s"]) < 50e-12
+        assert abs(ch["residual_deg"]["azimuth"]) < 0.05
+        assert abs(ch["residual_deg"]["elevation"]) < 0.05
+        for m in result.matches:
+            e = m["error"]
+            assert e is not None, m
+            assert abs(e["angle_deg"]) < 0.05 and abs(e["elevation_deg"]) < 0.05, m
