@@ -166,7 +166,9 @@ def test_sigma_zero_reproduces_the_nominal_error_exactly(model):
         nominal = model.angle_errors(ZERO, case)
         w = res.worst_error_deg[case]
         assert np.all(w == w[0])  # bit-equal across draws (and chunks)
-        assert w[0] == worst(nominal)
+        # the drawn path goes through the general geometry (signed offsets, rotations, RuT
+        # pose) and the nominal one through the shorthand: equal to rounding, not bit for bit
+        assert w[0] == pytest.approx(worst(nominal), rel=1e-9, abs=1e-15)
         # the nominal error itself, with the grid-search estimator
         steps = None if case == "uncalibrated" else model.calibration_steps(model.x_nominal)
         snaps = model.snapshots(model.x_nominal, steps)
