@@ -149,8 +149,12 @@ def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = 
     """Run the whole pipeline on ``scene``.
 
     ``aoa_mode`` overrides the scene's ``rts.aoa_mode``: ``nearest`` puts each target on its
-    nearest front end; the synthesis modes calibrate the front-end pairs first.
+    nearest front end; the synthesis modes calibrate the front-end pairs first. The override
+    is validated like the scene's own mode (``Scene.evolve``: e.g. paper eq. 24's spacing rule
+    for the synthesis modes), so it cannot bypass a rule the scene file would have to meet.
     """
+    if aoa_mode is not None and aoa_mode != scene.rts.aoa_mode:
+        scene = scene.evolve(rts=scene.rts.evolve(aoa_mode=aoa_mode))
     setup = build_setup(scene)
     paths = compute_paths(setup, paths_method)
     mode = aoa_mode or scene.rts.aoa_mode

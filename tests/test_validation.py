@@ -658,3 +658,13 @@ def test_mesh_paths_stay_in_the_scene_folder(tmp_path):
     with pytest.raises(SceneError, match="link leads out"):
         load("link.stl")
     assert load(str(tmp_path / "secret.stl"), allow_external_meshes=True).extra_meshes
+
+
+def test_amplitudes_override_cannot_bypass_the_spacing_rule():
+    """`run --amplitudes exact` on a `nearest` scene with front ends wider apart than the
+    resolution is refused like the same mode written in the scene (eq. 24), before computing."""
+    from rtsgeom.run import run_scene
+    s = parse_scene(_mutated(_all(_set("rts.front_ends.1.angle_deg", 25.0),
+                                  _set("rts.aoa_mode", "nearest"))), "n.toml")
+    with pytest.raises(SceneError, match="eq. 24"):
+        run_scene(s, "exact", "exact")
