@@ -96,6 +96,8 @@ def one_case(args: tuple) -> dict:
             "closed_minus_phasor_ps": wrap(closed - phasor) * 1e12,
             "residual_deg": cal.residual_error_deg, "period_s": cal.period_s,
             "exact_period_s": period, "range_offset_mm": cal.range_offset_m * 1e3,
+            "frames_per_step": cal.frames_per_step,
+            "one_frame_scatter_ps": cal.one_frame_scatter_ps,
             "seconds": time.perf_counter() - t0}
 
 
@@ -150,6 +152,8 @@ def main(argv=None) -> int:
         "p95_abs_dist_closed_ps": float(np.percentile(d, 95)),
         "within_10ps": float(np.mean(d <= 10.0)),
         "max_residual_deg": float(max(r["residual_deg"] for r in rows)),
+        "max_frames_per_step": int(max(r["frames_per_step"] for r in rows)),
+        "max_one_frame_scatter_ps": float(max(r["one_frame_scatter_ps"] for r in rows)),
         "max_abs_closed_minus_phasor_ps": float(max(abs(r["closed_minus_phasor_ps"]) for r in rows)),
         "per_radius": {str(r): {"max_abs_dist_closed_ps": float(max(
             abs(x["dist_closed_ps"]) for x in rows if x["radius_m"] == r)),

@@ -67,8 +67,10 @@ class ChannelModel:
 
     @classmethod
     def build(cls, setup: Setup, paths: Paths, channels, target: TargetConfig,
-              delta_tau_s=None) -> "ChannelModel":
-        """``delta_tau_s`` (Q,): the channels' calibration delay offsets (default zeros)."""
+              delta_tau_s=None, half_bins: int = 1) -> "ChannelModel":
+        """``delta_tau_s`` (Q,): the channels' calibration delay offsets (default zeros);
+        ``half_bins``: candidate range bins on either side of the set range's bin (the
+        calibration sweep moves channel J by up to ~2 bins: it asks for more)."""
         scene, radar = setup.scene, setup.scene.radar
         ch = tuple(int(q) for q in channels)
         n_q = len(ch)
@@ -83,11 +85,12 @@ class ChannelModel:
         rbin = (target.range_m * 2 * radar.slope_hz_per_s / c * radar.samples_per_chirp
                 / radar.adc_rate_hz)
         r0 = int(np.round(rbin))
-        rbins = np.array([r0 - 1, r0, r0 + 1]) % radar.samples_per_chirp
+        h = int(half_bins)
+        rbins = np.arange(r0 - h, r0 + h + 1) % radar.samples_per_chirp
         nu = f_d  # slow-time frequency per TDM cycle equals f_D
         dbin = int(np.round(nu * radar.tdm_cycle_s * radar.chirps_per_tx)) + radar.chirps_per_tx // 2
         dbin %= radar.chirps_per_tx
-        resp = bin_response(ech, radar, setup.rut, rbins, np.full(3, dbin))  # (K, E, V)
+        resp = bin_response(ech, radar, setup.rut, rbins, np.full(rbins.size, dbin))  # (K, E, V)
         per_q = np.stack([resp[:, ech.target == q].sum(1) for q in range(n_q)], 1)
         amp = target_amplitude(target.range_m, target.rcs_m2, lam) / nominal_link_gain(scene, lam)
         return cls(setup, ch, per_q, f_d, float(amp), float(target.range_m),
@@ -100,7 +103,8 @@ class ChannelModel:
     @cached_property
     def phasors(self) -> np.ndarray:
         """Each channel's TDM-compensated spectrum at the set range's bin, (Q, V)."""
-        return tdm_compensate(self.responses[1], self.doppler_hz, self.setup.rut,
+        return tdm_compensate(self.responses[self.responses.shape[0] // 2], self.doppler_hz,
+                              self.setup.rut,
                               self.setup.scene.radar)
 
     # -- the synthesized target -------------------------------------------------------------
