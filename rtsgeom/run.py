@@ -139,11 +139,12 @@ def label_detections(result: "RunResult", bins: float = 2.0) -> list[str]:
 
 
 def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = None,
-              progress=None) -> RunResult:
+              progress=None, calibration: dict | None = None) -> RunResult:
     """Run the whole pipeline on ``scene``.
 
     ``aoa_mode`` overrides the scene's ``rts.aoa_mode``: ``nearest`` puts each target on its
-    nearest front end; the synthesis modes calibrate the front-end pairs first.
+    nearest front end; the synthesis modes calibrate the front-end pairs first, or take
+    them from ``calibration`` (a calibration file's content, ``aoa.plan.load_calibration``).
     """
     setup = build_setup(scene)
     if paths_method == "raytrace":
@@ -152,13 +153,14 @@ def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = 
     else:
         paths = exact_paths(setup)
     mode = aoa_mode or scene.rts.aoa_mode
-    calibration: dict = {}
+    cal_file, calibration = calibration, {}
     warnings: list[str] = []
     if mode == "nearest" or not scene.targets:
         program = program_nearest(scene, setup)
     else:
         from .aoa.plan import plan_targets
-        program, calibration, warnings = plan_targets(setup, paths, mode, progress=progress)
+        program, calibration, warnings = plan_targets(setup, paths, mode, progress=progress,
+                                                       calibration=cal_file)
     echoes, cube = simulate(setup, paths, program, scene.seed, scene.radar.snr_db)
     rd, det = process(cube)
     return RunResult(scene, setup, paths, program, echoes, cube, rd, det,

@@ -86,6 +86,21 @@ class Calibration:
             "refinement": pts(self.refine_delta_tau_s, self.refine_error_deg),
         }
 
+    @classmethod
+    def from_dict(cls, d: dict) -> "Calibration":
+        """Inverse of :meth:`to_dict` (a calibration file written by ``rtsgeom calibrate``)."""
+        def arr(key, field):
+            return frozen(np.array([np.nan if p[field] is None else p[field]
+                                    for p in d.get(key, [])], float))
+        return cls((int(d["pair"][0]), int(d["pair"][1])), float(d["delta_tau_s"]),
+                   float(d.get("residual_error_deg", np.nan)), float(d.get("range_offset_m", 0.0)),
+                   arr("sweep", "delta_tau_s"), arr("sweep", "angle_error_deg"),
+                   arr("refinement", "delta_tau_s"), arr("refinement", "angle_error_deg"),
+                   tuple(float(x) for x in d.get("probe_angles_deg", (np.nan, np.nan))),
+                   float(d.get("period_s", np.nan)), int(d.get("frames_per_step", 1)),
+                   float(d.get("frame_noise_deg", 0.0)), str(d.get("method", "phasor")),
+                   tuple(d.get("probe_ranges_m", ())), float(d.get("one_frame_scatter_ps", 0.0)))
+
 
 def if_phase_slope_hz(scene, tau_s) -> np.ndarray:
     """d(phase)/d(tau_rts) / 2 pi of an echo of total delay ``tau_s`` at the ADC window's

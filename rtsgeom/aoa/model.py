@@ -165,10 +165,37 @@ class ChannelModel:
         if mode not in SOLVERS:
             raise ValueError(f"mode {mode!r}: must be one of {', '.join(SOLVERS)}")
         if mode == "exact":
-            return self._solve_pair(direction, phases, log_span)
+            rho = self._solve_pair_closed(direction, phases)
+            return rho if rho is not None else self._solve_pair(direction, phases, log_span)
         return self._closed_form(direction, mode)
 
+    def _solve_pair_closed(self, alpha: float, phases) -> float | None:
+        """The exact ratio in closed form (``aoa.sweep.design_ratio``) at each candidate bin;
+        the one whose design the RuT detects at that same bin (design and detection agree on
+        the bin; nearest the set range's bin first). Where none is (two bins of nearly equal
+        power, each design moving the peak to the other bin), the bin's design whose
+        detected angle is nearest ``alpha``. None where no bin has a design (the root finder
+        decides, and reports an unreachable angle)."""
+        from .sweep import design_ratio
+        ph = np.zeros(2) if phases is None else np.asarray(phases, float)
+        x = tdm_compensate(self.responses, self.doppler_hz, self.setup.rut,
+                           self.setup.scene.radar)  # (K, 2, V)
+        rho = design_ratio(self.steering, x[:, 0], x[:, 1], alpha, ph[1] - ph[0])  # (K,)
+        n_k = rho.size
+        ks = [k for k in sorted(range(n_k), key=lambda k: abs(k - n_k // 2))
+              if np.isfinite(rho[k]) and rho[k] > 0]
+        for k in ks:
+            w = self.weights([rho[k]], phases)
+            y = self.responses[:, 0] * w[0] + self.responses[:, 1] * w[1]
+            if int(np.argmax(np.sum(np.abs(y) ** 2, -1))) == k:
+                return float(rho[k])
+        if not ks:
+            return None
+        miss = [abs(float(self.direction(self.weights([rho[k]], phases))) - alpha) for k in ks]
+        return float(rho[ks[int(np.argmin(miss))]])
+
     def _solve_pair(self, alpha: float, phases, log_span: float) -> float:
+        """Reference: brentq on the searched beamformer peak of the strongest bin."""
         def angle(log_rho):
             return float(self.direction(self.weights([np.exp(log_rho)], phases)))
         lo, hi = angle(-log_span), angle(log_span)

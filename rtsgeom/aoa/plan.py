@@ -19,7 +19,40 @@ from .calibration import (Calibration, FrontEndProbe, calibrate_pair, probe_angl
 from .model import AngleUnreachable
 from .synthesis import PairModel
 
-__all__ = ["bracketing_pair", "pair_amplitudes", "plan_targets", "channel_offsets"]
+__all__ = ["bracketing_pair", "pair_amplitudes", "plan_targets", "channel_offsets",
+           "load_calibration", "CALIBRATION_FORMAT"]
+
+CALIBRATION_FORMAT = "rtsgeom-calibration"
+
+
+def load_calibration(doc: dict, setup: Setup) -> tuple[FrontEndProbe, dict]:
+    """The front-end probe and pair calibrations of a calibration file (``rtsgeom calibrate
+    --out DIR`` writes DIR/calibration.json): what a lab measures once and reuses for every
+    scenario on the same setup. Raises ``SceneError`` naming the field when the file does
+    not fit the setup."""
+    n = setup.fe.count
+    where = "calibration file"
+    try:
+        ang = np.radians(np.asarray(doc["front_end_angles_deg"], float))
+        gain = np.asarray(doc.get("gain_correction", np.ones(n)), float)
+        pairs = doc["pairs"] if "pairs" in doc else [doc]
+        cals = {}
+        for k, p in enumerate(pairs):
+            cal = Calibration.from_dict(p)
+            cals[cal.pair] = cal
+    except (KeyError, TypeError, ValueError) as exc:
+        raise SceneError(f"{where}: not an rtsgeom calibration ({exc!s}): write one with "
+                         "`rtsgeom calibrate SCENE --out DIR`") from None
+    if ang.shape != (n,) or gain.shape != (n,):
+        raise SceneError(f"{where}: front_end_angles_deg has {ang.size} entries, gain_correction "
+                         f"{gain.size}: the scene has {n} front ends (calibrated on another "
+                         "setup?)")
+    for (i, j) in cals:
+        if not (0 <= i < n and 0 <= j < n):
+            raise SceneError(f"{where}: pair ({i}, {j}): must be front-end indices in "
+                             f"[0, {n - 1}]")
+    probe = FrontEndProbe(ang, np.full(n, np.nan), gain)
+    return probe, cals
 
 
 def bracketing_pair(angle_rad: float, fe_angles_rad: np.ndarray) -> tuple[int, int] | None:
@@ -60,15 +93,21 @@ def channel_offsets(n_fe: int, cals: dict[tuple[int, int], Calibration]) -> np.n
     return off
 
 
-def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, progress=None
-                 ) -> tuple[RtsProgram, dict, list[str]]:
+def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, progress=None,
+                 calibration: dict | None = None) -> tuple[RtsProgram, dict, list[str]]:
     """The RTS program for the scene's targets at their set angles.
 
+    ``calibration``: a calibration file's content (:func:`load_calibration`): its front-end
+    angles, gain corrections and pair delays are used instead of measuring them again.
     Returns the program, the calibration record (for summary.json) and warnings.
     """
     scene = setup.scene
     seed = scene.seed
-    probe: FrontEndProbe = probe_front_ends(setup, paths, seed)
+    loaded: dict = {}
+    if calibration is not None:
+        probe, loaded = load_calibration(calibration, setup)
+    else:
+        probe = probe_front_ends(setup, paths, seed)
     warnings = []
     lost = np.flatnonzero(~np.isfinite(probe.angle_rad))
     if lost.size:
@@ -94,6 +133,13 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
     if calibrate:
         for pair in sorted(set(pairs.values())):
             base = channel_offsets(setup.fe.count, cals)
+            if calibration is not None:
+                if pair not in loaded:
+                    raise SceneError(f"calibration file: has no pair {pair} (it has "
+                                     f"{sorted(loaded)}): run `rtsgeom calibrate SCENE --pair "
+                                     f"{pair[0]} {pair[1]} --out DIR`")
+                cals[pair] = loaded[pair]
+                continue
             cals[pair] = calibrate_pair(setup, paths, pair, probe, (base[pair[0]], base[pair[0]]),
                                         seed)
             if progress:
@@ -115,6 +161,7 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
     program = RtsProgram.build(*zip(*rows)) if rows else RtsProgram.build([], [], [], [], [])
     record = {
         "mode": mode,
+        "source": "file" if calibration is not None else "measured",
         "front_end_angles_deg": [float(x) for x in np.degrees(probe.angle_rad)],
         "gain_correction": [float(x) for x in probe.gain_correction],
         "channel_delay_offsets_s": [float(x) for x in offsets],

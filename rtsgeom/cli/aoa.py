@@ -53,10 +53,13 @@ def _calibrate(args, stage) -> int:
         if args.procedure == "paper":
             cal = calibrate_pair_paper(setup, paths, pair, probe, seed=scene.seed)
         else:
-            cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
+            cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed,
+                                 full_chain=args.full_chain)
     out = cal.to_dict()
     out["procedure"] = args.procedure
     out["front_end_angles_deg"] = [float(x) for x in np.degrees(probe.angle_rad)]
+    out["gain_correction"] = [float(x) for x in probe.gain_correction]
+    out["format"] = "rtsgeom-calibration"  # `run/adc --calibration DIR/calibration.json`
     out["fractional_delay_filter"] = fir_effect(setup, cal.delta_tau_s)
 
     def figure():
@@ -137,6 +140,9 @@ def register(sub) -> None:
                                 "refined to the delay resolution (default); paper: the "
                                 "paper's sweep as written (fixed eq. 23 amplitudes, one set "
                                 "angle, 25 ps steps)")
+            p.add_argument("--full-chain", action="store_true",
+                           help="evaluate every sweep step through the full ADC-cube chain "
+                                "instead of the phasor model (validation; about a minute)")
         if name == "linearity":
             p.add_argument("--end-angles", choices=("geometric", "measured"),
                            default="geometric",

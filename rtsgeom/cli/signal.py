@@ -165,13 +165,29 @@ def write_run_report(result: RunResult, out: Path, maps, paths_method: str,
     return out / "report.html"
 
 
+def _read_calibration(path) -> dict | None:
+    """``--calibration FILE``: the JSON ``rtsgeom calibrate --out DIR`` wrote
+    (DIR/calibration.json), or None."""
+    if path is None:
+        return None
+    try:
+        doc = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise UsageError(f"--calibration {path}: cannot read it as JSON ({exc})") from None
+    if not isinstance(doc, dict):
+        raise UsageError(f"--calibration {path}: not a calibration file (a JSON object from "
+                         "`rtsgeom calibrate SCENE --out DIR`)")
+    return doc
+
+
 def cmd_run(args) -> int:
     from ..validate import scene_warnings
     scene = load_scene_checked(args.scene)
     out = args.out
     with output_folder(out, [args.scene]) as stage, steps(args.quiet) as step:
         step(f"simulating {scene.name} ({args.paths} paths, calibration, ADC cube, detection)")
-        result = run_scene(scene, args.paths, args.amplitudes)
+        result = run_scene(scene, args.paths, args.amplitudes,
+                           calibration=_read_calibration(args.calibration))
         step("writing detections, summary and maps")
         (stage / "detections.csv").write_text(detections_csv(result), encoding="utf-8")
         (stage / "summary.json").write_text(
@@ -209,7 +225,8 @@ def cmd_adc(args) -> int:
     scene = load_scene_checked(args.scene)
     with steps(args.quiet) as step:  # the calibration sweeps take about a minute
         step(f"simulating {scene.name} (calibration, ADC cube)")
-        cube = run_scene(scene, "exact", args.amplitudes).cube
+        cube = run_scene(scene, "exact", args.amplitudes,
+                         calibration=_read_calibration(args.calibration)).cube
     if args.format == "npy":
         with atomic_path(args.out) as tmp:
             with open(tmp, "wb") as fh:
@@ -244,6 +261,9 @@ def register(sub) -> None:
                    help="AoA amplitude mode (default: the scene's rts.aoa_mode)")
     p.add_argument("--no-report", action="store_true", help="skip report.html")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    p.add_argument("--calibration", default=None, metavar="FILE",
+                   help="use this calibration (DIR/calibration.json from `rtsgeom calibrate "
+                        "--out DIR`) instead of calibrating again")
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("adc", help="save the raw ADC cube (.npy) or a DCA1000 capture")
@@ -253,4 +273,7 @@ def register(sub) -> None:
     p.add_argument("--amplitudes", choices=modes, default=None,
                    help="AoA amplitude mode (default: the scene's rts.aoa_mode)")
     p.add_argument("--quiet", action="store_true", help="no progress output on stderr")
+    p.add_argument("--calibration", default=None, metavar="FILE",
+                   help="use this calibration (DIR/calibration.json from `rtsgeom calibrate "
+                        "--out DIR`) instead of calibrating again")
     p.set_defaults(func=cmd_adc)
