@@ -176,6 +176,11 @@ class ChannelModel:
         power, each design moving the peak to the other bin), the bin's design whose
         detected angle is nearest ``alpha``. None where no bin has a design (the root finder
         decides, and reports an unreachable angle)."""
+        return self.solve_checked(alpha, phases)[0]
+
+    def solve_checked(self, alpha: float, phases) -> tuple[float | None, bool, float]:
+        """:meth:`_solve_pair_closed` with whether design and detection agree on the bin and
+        the detected bin's power over the next strongest (1 where they do not agree)."""
         from .sweep import design_ratio
         ph = np.zeros(2) if phases is None else np.asarray(phases, float)
         x = tdm_compensate(self.responses, self.doppler_hz, self.setup.rut,
@@ -187,12 +192,13 @@ class ChannelModel:
         for k in ks:
             w = self.weights([rho[k]], phases)
             y = self.responses[:, 0] * w[0] + self.responses[:, 1] * w[1]
-            if int(np.argmax(np.sum(np.abs(y) ** 2, -1))) == k:
-                return float(rho[k])
+            pw = np.sum(np.abs(y) ** 2, -1)
+            if int(np.argmax(pw)) == k:
+                return float(rho[k]), True, float(pw[k] / max(np.sort(pw)[-2], 1e-300))
         if not ks:
-            return None
+            return None, False, 1.0
         miss = [abs(float(self.direction(self.weights([rho[k]], phases))) - alpha) for k in ks]
-        return float(rho[ks[int(np.argmin(miss))]])
+        return float(rho[ks[int(np.argmin(miss))]]), False, 1.0
 
     def _solve_pair(self, alpha: float, phases, log_span: float) -> float:
         """Reference: brentq on the searched beamformer peak of the strongest bin."""

@@ -85,6 +85,44 @@ def pair_amplitudes(setup: Setup, paths: Paths, pair, target: TargetConfig, mode
     return a_i * gain_correction[0], a_j * gain_correction[1], rho
 
 
+def pair_design(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str, probes_rad,
+                offsets=(0.0, 0.0), gain_correction=(1.0, 1.0), period_s: float | None = None
+                ) -> tuple[float, float, float, float]:
+    """:func:`pair_amplitudes` with channel J's delay offset chosen among the calibrated one
+    and one period of the target's IF phase either side (``offsets[1] + m period``,
+    m = 0, -1, 1: the same phase, J's echo a period's range further): the first whose exact
+    design the RuT detects at the bin it was designed for, with the largest power margin.
+    Where J's echo straddles a range-bin boundary no design is consistent (each moves the
+    peak to the other bin) and the angle misses by up to a degree (issue 13 item 1).
+    Returns (A_I, A_J, rho, offset of J)."""
+    from .calibration import if_phase_slope_hz, nominal_model
+    if mode != "exact":
+        return (*pair_amplitudes(setup, paths, pair, target, mode, probes_rad, offsets,
+                                 gain_correction), float(offsets[1]))
+    scene = setup.scene
+    nom, nom_paths = nominal_model(setup, paths)
+    period = period_s or 1.0 / float(if_phase_slope_hz(scene, 2 * target.range_m / c))
+    best = None
+    for m in (0, -1, 1):
+        off = (offsets[0], offsets[1] + m * period)
+        model = PairModel.build(nom, nom_paths, pair, target, off)
+        phase = model.coherent_phase(probes_rad)
+        rho, ok, margin = model.model.solve_checked(target.angle_rad, (0.0, phase))
+        if rho is None:
+            continue
+        score = (ok, margin if ok else 0.0, -abs(m))
+        if best is None or score > best[0]:
+            best = (score, model, rho, phase, off)
+        if ok and margin > 2.0:
+            break
+    if best is None:
+        return (*pair_amplitudes(setup, paths, pair, target, mode, probes_rad, offsets,
+                                 gain_correction), float(offsets[1]))
+    _, model, rho, phase, off = best
+    a_i, a_j = model.amplitudes(rho, target.angle_rad, phase)
+    return (a_i * gain_correction[0], a_j * gain_correction[1], float(rho), float(off[1]))
+
+
 def channel_offsets(n_fe: int, cals: dict[tuple[int, int], Calibration]) -> np.ndarray:
     """Per-channel delay offsets from pair calibrations chained along the arc."""
     off = np.zeros(n_fe)
@@ -150,14 +188,15 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
         i, j = pairs[k]
         probes = probe_angles(probe.angle_rad[i], probe.angle_rad[j])
         try:
-            a_i, a_j, _ = pair_amplitudes(setup, paths, (i, j), t, mode, probes,
-                                          (offsets[i], offsets[j]), probe.gain_correction[[i, j]])
+            a_i, a_j, _, off_j = pair_design(setup, paths, (i, j), t, mode, probes,
+                                             (offsets[i], offsets[j]),
+                                             probe.gain_correction[[i, j]])
         except AngleUnreachable as exc:
             raise SceneError(f"{scene.source}: targets[{k}].angle_deg = "
                              f"{np.degrees(t.angle_rad):g}: {exc}") from None
         tau = float(requested_delay(scene, t.range_m))
         f_d = 2 * scene.radar.f_c_hz * t.velocity_mps / c
-        rows += [(k, i, tau + offsets[i], f_d, a_i), (k, j, tau + offsets[j], f_d, a_j)]
+        rows += [(k, i, tau + offsets[i], f_d, a_i), (k, j, tau + off_j, f_d, a_j)]
     program = RtsProgram.build(*zip(*rows)) if rows else RtsProgram.build([], [], [], [], [])
     record = {
         "mode": mode,
