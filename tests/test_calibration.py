@@ -384,3 +384,21 @@ def test_calibration_file_round_trip(tmp_path, capsys):
     assert main(["run", str(DEFAULT_SCENE), "--out", str(tmp_path / "d"), "--quiet",
                  "--calibration", str(bad)]) == 2
     assert "calibration" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_one_frame_per_step_keeps_the_noise_pull_below_2_ps():
+    """The fitted minimum takes receiver noise linearly: with the frames the calibration
+    chooses (one on the default scene), sweeps with different noise land within 2 ps of the
+    noiseless sweep (same front-end probe, so only the sweep's noise differs)."""
+    setup = build_setup(make_scene())
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, 1)
+    quiet = build_setup(_noiseless())
+    ref = calibrate_pair(quiet, exact_paths(quiet), (0, 1), probe, seed=1).delta_tau_s
+    got = []
+    for seed in range(5):
+        cal = calibrate_pair(setup, paths, (0, 1), probe, seed=seed)
+        assert (2 * cal.one_frame_scatter_ps / np.sqrt(cal.frames_per_step)) <= 2.0
+        got.append(cal.delta_tau_s)
+    assert np.max(np.abs(np.array(got) - ref)) < 2e-12
