@@ -16,7 +16,8 @@ from ..scene import SceneError, TargetConfig
 from scipy.constants import c
 from .calibration import (Calibration, FrontEndProbe, calibrate_pair, probe_angles,
                           probe_front_ends)
-from .model import AngleUnreachable
+from .model import AngleUnreachable, ChannelModel
+from .sweep import HALF_BINS
 from .synthesis import PairModel
 
 __all__ = ["bracketing_pair", "pair_amplitudes", "plan_targets", "channel_offsets",
@@ -85,6 +86,9 @@ def pair_amplitudes(setup: Setup, paths: Paths, pair, target: TargetConfig, mode
     return a_i * gain_correction[0], a_j * gain_correction[1], rho
 
 
+MIN_BIN_MARGIN = 1.2  # detected bin's power over the next strongest that counts as unambiguous
+
+
 def pair_design(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str, probes_rad,
                 offsets=(0.0, 0.0), gain_correction=(1.0, 1.0), period_s: float | None = None
                 ) -> tuple[float, float, float, float]:
@@ -105,7 +109,8 @@ def pair_design(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: st
     best = None
     for m in (0, -1, 1):
         off = (offsets[0], offsets[1] + m * period)
-        model = PairModel.build(nom, nom_paths, pair, target, off)
+        # candidate bins +-3: a period moves J's echo by about a bin
+        model = PairModel(ChannelModel.build(nom, nom_paths, pair, target, off, HALF_BINS))
         phase = model.coherent_phase(probes_rad)
         rho, ok, margin = model.model.solve_checked(target.angle_rad, (0.0, phase))
         if rho is None:
@@ -113,7 +118,7 @@ def pair_design(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: st
         score = (ok, margin if ok else 0.0, -abs(m))
         if best is None or score > best[0]:
             best = (score, model, rho, phase, off)
-        if ok and margin > 2.0:
+        if ok and margin > MIN_BIN_MARGIN:  # the calibrated offset unless it is ambiguous
             break
     if best is None:
         return (*pair_amplitudes(setup, paths, pair, target, mode, probes_rad, offsets,
