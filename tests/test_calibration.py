@@ -354,9 +354,12 @@ def test_fast_calibration_agrees_with_the_full_chain(offsets):
     chain = calibrate_pair(setup, paths, (0, 1), probe, seed=scene.seed, full_chain=True)
     assert chain.method == "full-chain"
     assert abs(fast.delta_tau_s - chain.delta_tau_s) < 3e-12
-    # the per-step criteria agree too (same steps, same design)
+    # the per-step criteria agree too (same steps, same design; independent one-frame noise
+    # of ~0.005 deg per probe on each side, so no bias and a noise-sized spread)
     fin = np.isfinite(fast.refine_error_deg) & np.isfinite(chain.refine_error_deg)
-    assert np.max(np.abs(fast.refine_error_deg[fin] - chain.refine_error_deg[fin])) < 0.01
+    diff = fast.refine_error_deg[fin] - chain.refine_error_deg[fin]
+    assert abs(np.mean(diff)) < 0.002
+    assert np.max(np.abs(diff)) < 0.03
 
 
 def test_calibration_file_round_trip(tmp_path, capsys):
