@@ -180,14 +180,20 @@ def _read_calibration(path) -> dict | None:
     return doc
 
 
+def _calibration_kw(args) -> dict:
+    """``run_scene``'s calibration argument, only when ``--calibration`` was given (the
+    call without it stays as it was)."""
+    doc = _read_calibration(getattr(args, "calibration", None))
+    return {} if doc is None else {"calibration": doc}
+
+
 def cmd_run(args) -> int:
     from ..validate import scene_warnings
     scene = load_scene_checked(args.scene)
     out = args.out
     with output_folder(out, [args.scene]) as stage, steps(args.quiet) as step:
         step(f"simulating {scene.name} ({args.paths} paths, calibration, ADC cube, detection)")
-        result = run_scene(scene, args.paths, args.amplitudes,
-                           calibration=_read_calibration(args.calibration))
+        result = run_scene(scene, args.paths, args.amplitudes, **_calibration_kw(args))
         step("writing detections, summary and maps")
         (stage / "detections.csv").write_text(detections_csv(result), encoding="utf-8")
         (stage / "summary.json").write_text(
@@ -225,8 +231,7 @@ def cmd_adc(args) -> int:
     scene = load_scene_checked(args.scene)
     with steps(args.quiet) as step:  # the calibration sweeps take about a minute
         step(f"simulating {scene.name} (calibration, ADC cube)")
-        cube = run_scene(scene, "exact", args.amplitudes,
-                         calibration=_read_calibration(args.calibration)).cube
+        cube = run_scene(scene, "exact", args.amplitudes, **_calibration_kw(args)).cube
     if args.format == "npy":
         with atomic_path(args.out) as tmp:
             with open(tmp, "wb") as fh:
