@@ -16,7 +16,8 @@ pair (0, 1), at arc radii R_c = 0.5, 1 and 3 m, run the full-chain calibration
 * ``period_s``: the sweep period the calibration reports.
 
 Writes ``benchmarks/calibration_grid[_quick].json`` and ``.csv``; prints the worst cases.
-``--quick``: 0.25 mm steps instead of 0.05 mm. ``--noiseless``: no receiver noise (isolates
+``--quick``: 0.25 mm steps instead of 0.05 mm. ``--linearity N``: also the exact-mode
+linearity (N set-points, calibrated) per case. ``--noiseless``: no receiver noise (isolates
 the systematic part from the per-frame noise bias). ``--workers N``: a process pool.
 """
 
@@ -65,7 +66,7 @@ def nominal_point(scene_path: str, radius_m: float, noiseless: bool) -> dict:
 
 
 def one_case(args: tuple) -> dict:
-    scene_path, radius_m, fe, dr_m, noiseless, nominal_s = args
+    scene_path, radius_m, fe, dr_m, noiseless, nominal_s, lin_points = args
     from rtsgeom.aoa.calibration import (air_phase_slope_hz, calibrate_pair, coherence_delay,
                                          if_phase_slope_hz, probe_angles, probe_front_ends,
                                          probe_ranges)
@@ -88,7 +89,12 @@ def one_case(args: tuple) -> dict:
 
     def wrap(x):
         return float((x + period / 2) % period - period / 2)
-    return {"radius_m": radius_m, "front_end": fe, "radial_offset_mm": round(dr_m * 1e3, 6),
+    lin = {}
+    if lin_points:
+        from rtsgeom.aoa.linearity import linearity
+        res = linearity(setup, paths, PAIR, "exact", probe, cal, lin_points, scene.seed)
+        lin = {"linearity_max_abs_deg": res.max_abs_error_deg}
+    return {**lin, "radius_m": radius_m, "front_end": fe, "radial_offset_mm": round(dr_m * 1e3, 6),
             "delta_tau_ps": cal.delta_tau_s * 1e12, "closed_form_ps": closed * 1e12,
             "phasor_ps": phasor * 1e12,
             "dist_closed_ps": wrap(cal.delta_tau_s - closed) * 1e12,
@@ -96,6 +102,8 @@ def one_case(args: tuple) -> dict:
             "closed_minus_phasor_ps": wrap(closed - phasor) * 1e12,
             "residual_deg": cal.residual_error_deg, "period_s": cal.period_s,
             "exact_period_s": period, "range_offset_mm": cal.range_offset_m * 1e3,
+            "frames_per_step": cal.frames_per_step,
+            "one_frame_scatter_ps": cal.one_frame_scatter_ps,
             "seconds": time.perf_counter() - t0}
 
 
@@ -109,6 +117,8 @@ def main(argv=None) -> int:
     ap.add_argument("--step-mm", type=float, default=None)
     ap.add_argument("--noiseless", action="store_true")
     ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--linearity", type=int, default=0, metavar="N",
+                    help="also exact-mode linearity with N set-points per case (0: off)")
     ap.add_argument("--out", type=Path, default=None, help="file stem (default benchmarks/"
                     "calibration_grid[_quick])")
     a = ap.parse_args(argv)
@@ -121,8 +131,8 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     noms = {r["radius_m"]: r["coherence_s"] for r in
             mapper(nominal_point, [a.scene] * len(a.radii), a.radii, [a.noiseless] * len(a.radii))}
-    cases = [(a.scene, r, fe, float(dr), a.noiseless, noms[r]) for r in a.radii for fe in PAIR
-             for dr in offsets_m]
+    cases = [(a.scene, r, fe, float(dr), a.noiseless, noms[r], a.linearity) for r in a.radii
+             for fe in PAIR for dr in offsets_m]
     rows = []
     partial = open(str(stem) + ".partial.csv", "w", newline="")  # rows as they come
     writer = None
@@ -136,7 +146,9 @@ def main(argv=None) -> int:
         print(f"R_c {row['radius_m']:.2f} m  fe {row['front_end']}  dr {row['radial_offset_mm']:+.2f}"
               f" mm: delta_tau {row['delta_tau_ps']:+8.1f} ps, from coherence (closed form) "
               f"{row['dist_closed_ps']:+6.1f} ps, (phasor) {row['dist_phasor_ps']:+6.1f} ps, "
-              f"residual {row['residual_deg']:.4f} deg", flush=True)
+              f"residual {row['residual_deg']:.4f} deg"
+              + (f", linearity {row['linearity_max_abs_deg']:.4f} deg" if a.linearity else ""),
+              flush=True)
     if pool:
         pool.shutdown()
     partial.close()
@@ -150,6 +162,10 @@ def main(argv=None) -> int:
         "p95_abs_dist_closed_ps": float(np.percentile(d, 95)),
         "within_10ps": float(np.mean(d <= 10.0)),
         "max_residual_deg": float(max(r["residual_deg"] for r in rows)),
+        "max_frames_per_step": int(max(r["frames_per_step"] for r in rows)),
+        "max_linearity_deg": (float(max(r["linearity_max_abs_deg"] for r in rows))
+                              if a.linearity else None),
+        "max_one_frame_scatter_ps": float(max(r["one_frame_scatter_ps"] for r in rows)),
         "max_abs_closed_minus_phasor_ps": float(max(abs(r["closed_minus_phasor_ps"]) for r in rows)),
         "per_radius": {str(r): {"max_abs_dist_closed_ps": float(max(
             abs(x["dist_closed_ps"]) for x in rows if x["radius_m"] == r)),

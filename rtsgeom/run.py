@@ -16,7 +16,7 @@ from .paths import Paths, compute_paths
 from .radar import AdcCube, Detections, RangeDoppler, process
 from .radar.frame import noise_power, simulate
 from .rts import Echoes, RtsProgram, program_nearest
-from .scene import Scene
+from .scene import Scene, SceneError
 
 __all__ = ["RunResult", "simulate", "run_scene", "match_targets", "label_detections",
            "noise_power"]
@@ -145,31 +145,36 @@ def label_detections(result: "RunResult", bins: float = 2.0) -> list[str]:
 
 
 def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = None,
-              progress=None) -> RunResult:
+              progress=None, calibration: dict | None = None) -> RunResult:
     """Run the whole pipeline on ``scene``.
 
     ``aoa_mode`` overrides the scene's ``rts.aoa_mode``: ``nearest`` puts each target on its
-    nearest front end; the synthesis modes calibrate the front-end pairs first. The override
-    is validated like the scene's own mode (``Scene.evolve``: e.g. paper eq. 24's spacing rule
-    for the synthesis modes), so it cannot bypass a rule the scene file would have to meet.
+    nearest front end; the synthesis modes calibrate the front-end pairs first, or take
+    them from ``calibration`` (a calibration file's content, ``aoa.plan.load_calibration``).
+    The override is validated like the scene's own mode (``Scene.evolve``: e.g. paper eq. 24's
+    spacing rule for the synthesis modes), so it cannot bypass a rule the scene file must meet.
     """
     if aoa_mode is not None and aoa_mode != scene.rts.aoa_mode:
         scene = scene.evolve(rts=scene.rts.evolve(aoa_mode=aoa_mode))
     setup = build_setup(scene)
     paths = compute_paths(setup, paths_method)
     mode = aoa_mode or scene.rts.aoa_mode
-    calibration: dict = {}
+    cal_file, calibration = calibration, {}
     warnings: list[str] = []
     if mode == "nearest" or not scene.targets:
         program = program_nearest(scene, setup)
     else:
         from .aoa.plan_cells import plan_cells, uses_cells
         if uses_cells(scene):  # front ends on a sphere / targets in elevation: N channels
+            if cal_file is not None:
+                raise SceneError(f"{scene.source}: --calibration: a calibration file holds pair "
+                                 "calibrations; front ends on a "
+                                 "sphere are calibrated per channel by the run itself")
             program, calibration, warnings = plan_cells(setup, paths, mode, progress=progress)
         else:
             from .aoa.plan import plan_targets
-            program, calibration, warnings = plan_targets(setup, paths, mode,
-                                                          progress=progress)
+            program, calibration, warnings = plan_targets(setup, paths, mode, progress=progress,
+                                                           calibration=cal_file)
     echoes, cube = simulate(setup, paths, program, scene.seed, scene.radar.snr_db)
     rd, det = process(cube)
     return RunResult(scene, setup, paths, program, echoes, cube, rd, det,

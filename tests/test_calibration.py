@@ -262,3 +262,153 @@ def test_paper_procedure_minima_are_one_period_apart_and_its_optimum_is_off_cohe
     coherent = coherence_delay(setup, paths, (0, 1), probe_angles(*probe.angle_rad[[0, 1]]),
                                cal.delta_tau_s)
     assert abs(cal.delta_tau_s - coherent) > 2 * step  # measured: about 200 ps
+
+
+# ---------------------------------------------------- calibration at the detected bin (13.1, 17)
+
+def _offset_scene(radius_m, fe, dr_mm, tangential_mm=0.0, snr=True):
+    def mutate(doc):
+        if not snr:
+            doc["radar"].pop("snr_db", None)
+        doc["rts"]["arc_radius_m"] = radius_m
+        doc["rts"]["front_ends"][fe]["radial_offset_mm"] = dr_mm
+        if tangential_mm:
+            doc["rts"]["front_ends"][1 - fe]["tangential_offset_mm"] = tangential_mm
+    return make_scene(mutate)
+
+
+def _closed_form_point(radius_m, fe, dr_mm, probe, snr=True):
+    """The coherence point of the nominal setup (phasor model) moved by the closed form
+    -(f_c + S t_mid - S tau) / (f_rts + S t_mid - S tau) * 2 dr / c0 (J; opposite for I)."""
+    nom = build_setup(_offset_scene(radius_m, fe, 0.0, snr=snr))
+    paths = exact_paths(nom)
+    alphas = probe_angles(*probe.angle_rad[[0, 1]])
+    d0 = coherence_delay(nom, paths, (0, 1), alphas)
+    tau = probe_total_delay(nom, probe_ranges(nom, 2))
+    ratio = air_phase_slope_hz(nom.scene, tau) / if_phase_slope_hz(nom.scene, tau)
+    sign = 1.0 if fe == 1 else -1.0
+    return d0 - sign * ratio * 2 * dr_mm * 1e-3 / c, 1 / if_phase_slope_hz(nom.scene, tau)
+
+
+# the grid's worst cases before the fix (benchmarks/calibration_grid_quick_partial.txt: 75 ps
+# off at +-0.75 mm on 0.5 and 1 m) and a 3 m arc; the full grid: python -m
+# benchmarks.calibration_grid
+@pytest.mark.slow
+@pytest.mark.parametrize("radius, fe, dr_mm", [(0.5, 0, 0.75), (0.5, 1, -0.75), (1.0, 0, 0.75),
+                                               (1.0, 1, -0.75), (3.0, 0, -0.6), (3.0, 1, 1.0)])
+def test_calibration_lands_on_the_coherence_point(radius, fe, dr_mm):
+    setup = build_setup(_offset_scene(radius, fe, dr_mm))
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, setup.scene.seed)
+    cal = calibrate_pair(setup, paths, (0, 1), probe, seed=setup.scene.seed)
+    point, period = _closed_form_point(radius, fe, dr_mm, probe)
+    dist = (cal.delta_tau_s - point + period / 2) % period - period / 2
+    assert abs(dist) < 10e-12
+    assert cal.residual_error_deg < 0.02  # the full-chain confirmation at the chosen delay
+    assert cal.frames_per_step >= 1 and cal.method == "phasor"
+
+
+def test_closed_form_design_matches_the_root_finder():
+    """The exact ratio in closed form (dP/du = 0 at the set angle, a quadratic in rho) is
+    the root finder's on the searched beamformer peak, on a grid of radii, delays and
+    angles."""
+    from rtsgeom.aoa.model import ChannelModel
+    from rtsgeom.scene import TargetConfig
+    for radius in (0.5, 1.0, 3.0):
+        setup = build_setup(_noiseless(radius))
+        paths = exact_paths(setup)
+        th = np.sort(probe_front_ends(setup, paths, 1).angle_rad[[0, 1]])
+        for delay in (0.0, 150e-12):
+            for a in th[0] + np.array([0.1, 0.35, 0.6, 0.9]) * (th[1] - th[0]):
+                m = ChannelModel.build(setup, paths, (0, 1), TargetConfig(20.0, 0.0, 10.0, a),
+                                       (0.0, delay))
+                ph = m.coherent_phases(probe_angles(*th))
+                fast = m._solve_pair_closed(a, ph)
+                ref = m._solve_pair(a, ph, 12.0)
+                assert fast == pytest.approx(ref, rel=1e-6)
+                assert float(m.direction(m.weights([fast], ph))) == pytest.approx(a, abs=1e-8)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("radius, fe, dr_mm", [(0.5, 0, 0.75), (1.0, 1, -0.75)])
+def test_exact_linearity_after_calibration_on_straddling_setups(radius, fe, dr_mm):
+    from rtsgeom.aoa.linearity import linearity
+    setup = build_setup(_offset_scene(radius, fe, dr_mm))
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, setup.scene.seed)
+    cal = calibrate_pair(setup, paths, (0, 1), probe, seed=setup.scene.seed)
+    lin = linearity(setup, paths, (0, 1), "exact", probe, cal, 11, setup.scene.seed)
+    assert lin.max_abs_error_deg <= 0.02
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("offsets", [None, (0, 0.75, 0.5)])
+def test_fast_calibration_agrees_with_the_full_chain(offsets):
+    """Issue 17: the phasor-model sweep and every step through the ADC-cube chain choose
+    the same delay (default scene, and one with radial and tangential mounting offsets)."""
+    scene = make_scene() if offsets is None else _offset_scene(1.0, *offsets)
+    setup = build_setup(scene)
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, scene.seed)
+    fast = calibrate_pair(setup, paths, (0, 1), probe, seed=scene.seed)
+    chain = calibrate_pair(setup, paths, (0, 1), probe, seed=scene.seed, full_chain=True)
+    assert chain.method == "full-chain"
+    assert abs(fast.delta_tau_s - chain.delta_tau_s) < 3e-12
+    # the per-step criteria agree too (same design; independent one-frame noise of ~0.005 deg
+    # per probe on each side, so no bias and a noise-sized spread). The fine windows are
+    # centred on each sweep's own coarse minimum: compare on the common delays, near the
+    # chosen one (+-period/8)
+    t_f, t_c = fast.refine_delta_tau_s, chain.refine_delta_tau_s
+    common = np.intersect1d(np.round(t_f * 1e15), np.round(t_c * 1e15))
+    near = np.abs(common * 1e-15 - fast.delta_tau_s) < fast.period_s / 8
+    ef = fast.refine_error_deg[np.isin(np.round(t_f * 1e15), common[near])]
+    ec = chain.refine_error_deg[np.isin(np.round(t_c * 1e15), common[near])]
+    assert ef.size >= 10
+    diff = ef - ec
+    assert abs(np.mean(diff)) < 0.002
+    assert np.max(np.abs(diff)) < 0.03
+
+
+def test_calibration_file_round_trip(tmp_path, capsys):
+    """calibrate --out DIR writes DIR/calibration.json; run --calibration FILE uses it and
+    gives what a run that calibrates itself gives; a foreign file is a clean exit 2."""
+    out = tmp_path / "cal"
+    assert main(["calibrate", str(DEFAULT_SCENE), "--out", str(out), "--quiet"]) == 0
+    f = out / "calibration.json"
+    doc = json.loads(f.read_text())
+    assert doc["format"] == "rtsgeom-calibration" and len(doc["gain_correction"]) == 2
+    assert main(["run", str(DEFAULT_SCENE), "--out", str(tmp_path / "a"), "--quiet",
+                 "--no-report"]) == 0
+    assert main(["run", str(DEFAULT_SCENE), "--out", str(tmp_path / "b"), "--quiet",
+                 "--no-report", "--calibration", str(f)]) == 0
+    a = json.loads((tmp_path / "a" / "summary.json").read_text())
+    b = json.loads((tmp_path / "b" / "summary.json").read_text())
+    assert b["calibration"]["source"] == "file"
+    assert a["calibration"]["channel_delay_offsets_s"] == b["calibration"]["channel_delay_offsets_s"]
+    assert a["targets"] == b["targets"]
+    assert main(["adc", str(DEFAULT_SCENE), "--out", str(tmp_path / "c.npy"), "--quiet",
+                 "--calibration", str(f)]) == 0
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps({"pair": [0, 1]}))
+    capsys.readouterr()
+    assert main(["run", str(DEFAULT_SCENE), "--out", str(tmp_path / "d"), "--quiet",
+                 "--calibration", str(bad)]) == 2
+    assert "calibration" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_one_frame_per_step_keeps_the_noise_pull_below_2_ps():
+    """The fitted minimum takes receiver noise linearly: with the frames the calibration
+    chooses (one on the default scene), sweeps with different noise land within 2 ps of the
+    noiseless sweep (same front-end probe, so only the sweep's noise differs)."""
+    setup = build_setup(make_scene())
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, 1)
+    quiet = build_setup(_noiseless())
+    ref = calibrate_pair(quiet, exact_paths(quiet), (0, 1), probe, seed=1).delta_tau_s
+    got = []
+    for seed in range(5):
+        cal = calibrate_pair(setup, paths, (0, 1), probe, seed=seed)
+        assert (2 * cal.one_frame_scatter_ps / np.sqrt(cal.frames_per_step)) <= 2.0
+        got.append(cal.delta_tau_s)
+    assert np.max(np.abs(np.array(got) - ref)) < 2e-12

@@ -61,6 +61,9 @@ class Calibration:
     period_s: float  # exact: 1 / (f_rts + S t_mid - S tau) at the probes (eq. 27 refined)
     frames_per_step: int = 1  # frames averaged (coherently) per sweep step
     frame_noise_deg: float = 0.0  # predicted 1-sigma probe-angle noise of one frame
+    method: str = "phasor"  # what evaluated the sweep: phasor model or full-chain
+    probe_ranges_m: tuple = ()  # the probes' set ranges (moved within a bin, sweep.place_probes)
+    one_frame_scatter_ps: float = 0.0  # 1-sigma of the chosen delay with one frame per step
 
     def to_dict(self) -> dict:
         def pts(t, e):
@@ -75,10 +78,28 @@ class Calibration:
             "period_s": self.period_s,
             "frames_per_step": self.frames_per_step,
             "frame_noise_deg": self.frame_noise_deg,
+            "method": self.method,
+            "probe_ranges_m": list(self.probe_ranges_m),
+            "one_frame_scatter_ps": self.one_frame_scatter_ps,
             "probe_angles_deg": list(self.probe_angles_deg),
             "sweep": pts(self.sweep_delta_tau_s, self.sweep_error_deg),
             "refinement": pts(self.refine_delta_tau_s, self.refine_error_deg),
         }
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Calibration":
+        """Inverse of :meth:`to_dict` (a calibration file written by ``rtsgeom calibrate``)."""
+        def arr(key, field):
+            return frozen(np.array([np.nan if p[field] is None else p[field]
+                                    for p in d.get(key, [])], float))
+        return cls((int(d["pair"][0]), int(d["pair"][1])), float(d["delta_tau_s"]),
+                   float(d.get("residual_error_deg", np.nan)), float(d.get("range_offset_m", 0.0)),
+                   arr("sweep", "delta_tau_s"), arr("sweep", "angle_error_deg"),
+                   arr("refinement", "delta_tau_s"), arr("refinement", "angle_error_deg"),
+                   tuple(float(x) for x in d.get("probe_angles_deg", (np.nan, np.nan))),
+                   float(d.get("period_s", np.nan)), int(d.get("frames_per_step", 1)),
+                   float(d.get("frame_noise_deg", 0.0)), str(d.get("method", "phasor")),
+                   tuple(d.get("probe_ranges_m", ())), float(d.get("one_frame_scatter_ps", 0.0)))
 
 
 def if_phase_slope_hz(scene, tau_s) -> np.ndarray:
@@ -261,88 +282,97 @@ def _probe_program(design, pair, base, delta):
 
 def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
                    probe: FrontEndProbe | None = None, base_offsets=(0.0, 0.0),
-                   seed: int = 0, span_s=None, step_s=None) -> Calibration:
-    """Sweep channel J's delay offset and return the calibration of the pair (I, J)."""
+                   seed: int = 0, span_s=None, step_s=None, full_chain: bool = False,
+                   frames: int | None = None) -> Calibration:
+    """Sweep channel J's delay offset and return the calibration of the pair (I, J).
+
+    1. Coarse sweep over the scene's span (``calibration_step_ps``) with the probes at their
+       ranges; each step's amplitudes designed for the bin the RuT detects
+       (``aoa.sweep``); the deepest minimum nearest zero delay.
+    2. The probes moved within their range bin so that design and detection agree on one bin
+       over a window of +-period/4 around it (``sweep.place_probes``).
+    3. Fine sweep over that window (``FINE_STEP_S``) with ``frames`` coherently averaged
+       frames per step (default: as many as keep the chosen delay's 2-sigma scatter below
+       ``TARGET_BIAS_PS``, from a Monte-Carlo of the phasor model); the minimum from a
+       least-squares fit of the criterion's periodic shape over the window
+       (``sweep.fit_minimum``), so every step's information counts.
+    4. The chosen delay confirmed through the full ADC-cube chain (``residual_error_deg``).
+
+    Steps 1-3 evaluate the phasor model (``radar.phasors``, batched over all steps); with
+    ``full_chain`` every step runs through the ADC-cube chain instead (validation; minutes).
+    """
+    from .sweep import chain_errors, fit_minimum, phasor_sweep, place_probes
     scene = setup.scene
-    rts, radar = scene.rts, scene.radar
+    rts = scene.rts
     i, j = pair
     probe = probe or probe_front_ends(setup, paths, seed)
-    alphas = probe_angles(probe.angle_rad[i], probe.angle_rad[j])
-    ranges = probe_ranges(setup, 2)
-    targets = [TargetConfig(float(r)) for r in ranges]
-    nom, nom_paths = nominal_model(setup, paths)
+    alphas = np.asarray(probe_angles(probe.angle_rad[i], probe.angle_rad[j]))
+    nominal = nominal_model(setup, paths)
     corr = (probe.gain_correction[i], probe.gain_correction[j])
-    base = [(float(requested_delay(scene, t.range_m)) + base_offsets[0],
-             float(requested_delay(scene, t.range_m)) + base_offsets[1]) for t in targets]
-
-    grid_s = 50e-12
-    nodes: dict[int, list] = {}
-
-    def node(k: int):
-        if k not in nodes:
-            out = []
-            for t, a in zip(targets, alphas):
-                m = PairModel.build(nom, nom_paths, pair, t,
-                                    (base_offsets[0], base_offsets[1] + k * grid_s))
-                a_i, a_j, _ = m.design(a, alphas)
-                out.append((a_i * corr[0], a_j * corr[1]))
-            nodes[k] = out
-        return np.asarray(nodes[k])
-
-    def design(delta: float):
-        """Probe amplitudes for coherent channels with J delayed by ``delta``: the design
-        knows the range offset the delay causes (interpolated on a 50 ps grid), so only the
-        phase is left to the sweep."""
-        k = int(np.floor(delta / grid_s))
-        w = delta / grid_s - k
-        return (1 - w) * node(k) + w * node(k + 1)
-
+    ranges = probe_ranges(setup, 2)
     period = 1.0 / float(if_phase_slope_hz(scene, probe_total_delay(setup, ranges)))
-    models = [PairModel.build(nom, nom_paths, pair, t, base_offsets) for t in targets]
-    frames, frame_noise = frames_per_step(setup, models, node(0), alphas, 1.0 / period)
-
-    def error(delta: float) -> float:
-        prog = _probe_program(design(delta), pair, base, delta)
-        # fresh noise at every step (a new measurement), reproducible from the seed
-        step_seed = np.random.SeedSequence([int(seed) % 2 ** 32,
-                                            int(round(delta * 1e15)) + 2 ** 40])
-        rd, det = _simulate_detect(setup, paths, prog, step_seed, frames)
-        errs = []
-        for r, a in zip(ranges, alphas):
-            k = nearest_detection(det, rd, r)
-            errs.append(np.degrees(det.angle_rad[k] - a) if k is not None else np.nan)
-        errs = np.asarray(errs)
-        return float(np.sqrt(np.mean(errs ** 2))) if np.all(np.isfinite(errs)) else np.inf
-
     span = span_s or rts.calibration_span_s
     step = step_s or rts.calibration_step_s
     grid = np.arange(span[0], span[1] + step / 2, step)
-    errs = np.array([error(d) for d in grid])
+    rng = np.random.default_rng(np.random.SeedSequence([int(seed) % 2 ** 32, 1713]))
+    noisy = scene.radar.snr_db is not None
+
+    def measure(targets, res, k_frames):
+        if full_chain:
+            return chain_errors(setup, paths, pair, targets, res, base_offsets, k_frames,
+                                seed)[0]
+        return res.errors(k_frames, rng if noisy else None)
+
+    def rms_deg(e):
+        out = np.degrees(np.sqrt(np.mean(e ** 2, axis=-1)))
+        return np.where(np.isfinite(out), out, np.inf)
+
+    targets = [TargetConfig(float(r)) for r in ranges]
+    coarse = phasor_sweep(setup, paths, nominal, pair, targets, alphas, grid, base_offsets, corr)
+    k_coarse = 1 if frames is None else frames
+    errs = rms_deg(measure(targets, coarse, k_coarse))
     # Minima repeat every period; among those about as deep as the deepest, take the one with
     # the smallest |delta tau|: it costs the least range offset ("Disadvantages").
     inner = np.arange(len(errs))
     is_min = (np.r_[True, errs[1:] <= errs[:-1]] & np.r_[errs[:-1] <= errs[1:], True])
     good = inner[is_min & (errs <= 2 * np.min(errs) + 0.01)]
-    k = int(good[np.argmin(np.abs(grid[good]))])
-    best, best_err = float(grid[k]), float(errs[k])
-    ref_t, ref_e = [], []
-    resolution = rts.delay_resolution_s
-    cur = step
-    while cur > resolution * 1.0001:
-        cur = max(cur / 5.0, resolution)
-        fine = best + cur * np.arange(-4, 5)
-        fe_ = np.array([error(d) for d in fine])
-        ref_t += list(fine)
-        ref_e += list(fe_)
-        k = int(np.argmin(fe_))
-        if fe_[k] < best_err:
-            best, best_err = float(fine[k]), float(fe_[k])
+    near = float(grid[int(good[np.argmin(np.abs(grid[good]))])])
+    if grid.size < 3:  # no sweep to speak of (e.g. only the period asked for)
+        fine_t, fine_e, best, n_frames, noise = grid, errs, near, k_coarse, 0.0
+    else:
+        half = period / 4
+        ranges = place_probes(setup, paths, nominal, pair, ranges, alphas,
+                              near + np.arange(-half, half + 1e-15, step), base_offsets, corr)
+        targets = [TargetConfig(float(r)) for r in ranges]
+        fine_t = near + np.arange(-half, half + 1e-15, FINE_STEP_S)
+        fine = phasor_sweep(setup, paths, nominal, pair, targets, alphas, fine_t,
+                            base_offsets, corr)
+        noise = 0.0
+        n_frames = 1 if frames is None else int(frames)
+        if noisy and frames is None:  # scatter of the fitted minimum with one frame per step
+            draws = fine.errors(1, rng, MC_DRAWS)
+            est = [fit_minimum(fine_t, e, period, near, search_s=half / 2) for e in draws]
+            noise = float(np.std(est))
+            n_frames = int(min(MAX_FRAMES, max(1, np.ceil((2 * noise / (TARGET_BIAS_PS
+                                                                          * 1e-12)) ** 2))))
+        e_fine = measure(targets, fine, n_frames)
+        best = fit_minimum(fine_t, e_fine, period, near, search_s=half / 2)
+        fine_e = rms_deg(e_fine)
+    confirm = phasor_sweep(setup, paths, nominal, pair, targets, alphas, [best], base_offsets,
+                           corr)
+    e_conf = chain_errors(setup, paths, pair, targets, confirm, base_offsets, n_frames, seed)[0]
+    best_err = float(rms_deg(e_conf)[0])
     air = _mean_air_delay(setup)
     range_offset = 0.5 * c * ((air[j] + base_offsets[1] + best) - (air[i] + base_offsets[0]))
-    return Calibration(pair, best, best_err, float(range_offset), frozen(grid), frozen(errs),
-                       frozen(np.array(ref_t)), frozen(np.array(ref_e)),
+    return Calibration(pair, float(best), best_err, float(range_offset), frozen(grid),
+                       frozen(errs), frozen(np.asarray(fine_t)), frozen(np.asarray(fine_e)),
                        (float(np.degrees(alphas[0])), float(np.degrees(alphas[1]))), period,
-                       frames, frame_noise)
+                       n_frames, 0.0, "full-chain" if full_chain else "phasor",
+                       tuple(float(r) for r in ranges), noise * 1e12)
+
+
+FINE_STEP_S = 5e-12  # step of the fitted fine sweep
+MC_DRAWS = 32  # noise realisations that size the frames per step
 
 
 def nominal_model(setup: Setup, paths: Paths) -> tuple[Setup, Paths]:

@@ -14,7 +14,7 @@ from ..scene import TargetConfig
 from ..radar.processing import nearest_detection
 from .calibration import (Calibration, FrontEndProbe, _simulate_detect, probe_angles,
                           probe_ranges)
-from .plan import pair_amplitudes
+from .plan import pair_design
 
 __all__ = ["Linearity", "linearity"]
 
@@ -105,10 +105,11 @@ def linearity(setup: Setup, paths: Paths, pair: tuple[int, int], mode: str,
         if end_angles == "measured" and mode != "exact":
             a_i, a_j, _ = _closed_form_measured(setup, paths, pair, t, mode, probe, off, corr)
         else:
-            a_i, a_j, _ = pair_amplitudes(setup, paths, pair, t, mode,
-                                          probe_angles(*probe.angle_rad[[i, j]]), off, corr)
+            a_i, a_j, _, off_j = pair_design(setup, paths, pair, t, mode,
+                                             probe_angles(*probe.angle_rad[[i, j]]), off, corr)
         amp[:, k] = a_i, a_j
-        prog = RtsProgram.build([0, 0], [i, j], [tau + off[0], tau + off[1]], [0.0, 0.0],
+        off_j = off[1] if end_angles == "measured" and mode != "exact" else off_j
+        prog = RtsProgram.build([0, 0], [i, j], [tau + off[0], tau + off_j], [0.0, 0.0],
                                 [a_i, a_j])
         rd, det = _simulate_detect(setup, paths, prog, seed)
         n = nearest_detection(det, rd, rng)

@@ -77,8 +77,10 @@ class ChannelModel:
 
     @classmethod
     def build(cls, setup: Setup, paths: Paths, channels, target: TargetConfig,
-              delta_tau_s=None) -> "ChannelModel":
-        """``delta_tau_s`` (Q,): the channels' calibration delay offsets (default zeros)."""
+              delta_tau_s=None, half_bins: int = 1) -> "ChannelModel":
+        """``delta_tau_s`` (Q,): the channels' calibration delay offsets (default zeros);
+        ``half_bins``: candidate range bins on either side of the set range's bin (the
+        calibration sweep moves channel J by up to ~2 bins: it asks for more)."""
         scene, radar = setup.scene, setup.scene.radar
         ch = tuple(int(q) for q in channels)
         n_q = len(ch)
@@ -93,11 +95,12 @@ class ChannelModel:
         rbin = (target.range_m * 2 * radar.slope_hz_per_s / c * radar.samples_per_chirp
                 / radar.adc_rate_hz)
         r0 = int(np.round(rbin))
-        rbins = np.array([r0 - 1, r0, r0 + 1]) % radar.samples_per_chirp
+        h = int(half_bins)
+        rbins = np.arange(r0 - h, r0 + h + 1) % radar.samples_per_chirp
         nu = f_d  # slow-time frequency per TDM cycle equals f_D
         dbin = int(np.round(nu * radar.tdm_cycle_s * radar.chirps_per_tx)) + radar.chirps_per_tx // 2
         dbin %= radar.chirps_per_tx
-        resp = bin_response(ech, radar, setup.rut, rbins, np.full(3, dbin))  # (K, E, V)
+        resp = bin_response(ech, radar, setup.rut, rbins, np.full(rbins.size, dbin))  # (K, E, V)
         per_q = np.stack([resp[:, ech.target == q].sum(1) for q in range(n_q)], 1)
         amp = target_amplitude(target.range_m, target.rcs_m2, lam) / nominal_link_gain(scene, lam)
         return cls(setup, ch, per_q, f_d, float(amp), float(target.range_m),
@@ -110,7 +113,8 @@ class ChannelModel:
     @cached_property
     def phasors(self) -> np.ndarray:
         """Each channel's TDM-compensated spectrum at the set range's bin, (Q, V)."""
-        return tdm_compensate(self.responses[1], self.doppler_hz, self.setup.rut,
+        return tdm_compensate(self.responses[self.responses.shape[0] // 2], self.doppler_hz,
+                              self.setup.rut,
                               self.setup.scene.radar)
 
     # -- the synthesized target -------------------------------------------------------------
@@ -171,10 +175,43 @@ class ChannelModel:
         if mode not in SOLVERS:
             raise ValueError(f"mode {mode!r}: must be one of {', '.join(SOLVERS)}")
         if mode == "exact":
-            return self._solve_pair(direction, phases, log_span)
+            rho = self._solve_pair_closed(direction, phases)
+            return rho if rho is not None else self._solve_pair(direction, phases, log_span)
         return self._closed_form(direction, mode)
 
+    def _solve_pair_closed(self, alpha: float, phases) -> float | None:
+        """The exact ratio in closed form (``aoa.sweep.design_ratio``) at each candidate bin;
+        the one whose design the RuT detects at that same bin (design and detection agree on
+        the bin; nearest the set range's bin first). Where none is (two bins of nearly equal
+        power, each design moving the peak to the other bin), the bin's design whose
+        detected angle is nearest ``alpha``. None where no bin has a design (the root finder
+        decides, and reports an unreachable angle)."""
+        return self.solve_checked(alpha, phases)[0]
+
+    def solve_checked(self, alpha: float, phases) -> tuple[float | None, bool, float]:
+        """:meth:`_solve_pair_closed` with whether design and detection agree on the bin and
+        the detected bin's power over the next strongest (1 where they do not agree)."""
+        from .sweep import design_ratio
+        ph = np.zeros(2) if phases is None else np.asarray(phases, float)
+        x = tdm_compensate(self.responses, self.doppler_hz, self.setup.rut,
+                           self.setup.scene.radar)  # (K, 2, V)
+        rho = design_ratio(self.steering, x[:, 0], x[:, 1], alpha, ph[1] - ph[0])  # (K,)
+        n_k = rho.size
+        ks = [k for k in sorted(range(n_k), key=lambda k: abs(k - n_k // 2))
+              if np.isfinite(rho[k]) and rho[k] > 0]
+        for k in ks:
+            w = self.weights([rho[k]], phases)
+            y = self.responses[:, 0] * w[0] + self.responses[:, 1] * w[1]
+            pw = np.sum(np.abs(y) ** 2, -1)
+            if int(np.argmax(pw)) == k:
+                return float(rho[k]), True, float(pw[k] / max(np.sort(pw)[-2], 1e-300))
+        if not ks:
+            return None, False, 1.0
+        miss = [abs(float(self.direction(self.weights([rho[k]], phases))) - alpha) for k in ks]
+        return float(rho[ks[int(np.argmin(miss))]]), False, 1.0
+
     def _solve_pair(self, alpha: float, phases, log_span: float) -> float:
+        """Reference: brentq on the searched beamformer peak of the strongest bin."""
         def angle(log_rho):
             return float(self.direction(self.weights([np.exp(log_rho)], phases)))
         lo, hi = angle(-log_span), angle(log_span)

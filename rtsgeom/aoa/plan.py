@@ -16,10 +16,44 @@ from ..scene import SceneError, TargetConfig
 from scipy.constants import c
 from .calibration import (Calibration, FrontEndProbe, calibrate_pair, probe_angles,
                           probe_front_ends)
-from .model import AngleUnreachable
+from .model import AngleUnreachable, ChannelModel
+from .sweep import HALF_BINS
 from .synthesis import PairModel
 
-__all__ = ["bracketing_pair", "pair_amplitudes", "plan_targets", "channel_offsets"]
+__all__ = ["bracketing_pair", "pair_amplitudes", "plan_targets", "channel_offsets",
+           "load_calibration", "CALIBRATION_FORMAT"]
+
+CALIBRATION_FORMAT = "rtsgeom-calibration"
+
+
+def load_calibration(doc: dict, setup: Setup) -> tuple[FrontEndProbe, dict]:
+    """The front-end probe and pair calibrations of a calibration file (``rtsgeom calibrate
+    --out DIR`` writes DIR/calibration.json): what a lab measures once and reuses for every
+    scenario on the same setup. Raises ``SceneError`` naming the field when the file does
+    not fit the setup."""
+    n = setup.fe.count
+    where = "calibration file"
+    try:
+        ang = np.radians(np.asarray(doc["front_end_angles_deg"], float))
+        gain = np.asarray(doc.get("gain_correction", np.ones(n)), float)
+        pairs = doc["pairs"] if "pairs" in doc else [doc]
+        cals = {}
+        for k, p in enumerate(pairs):
+            cal = Calibration.from_dict(p)
+            cals[cal.pair] = cal
+    except (KeyError, TypeError, ValueError) as exc:
+        raise SceneError(f"{where}: not an rtsgeom calibration ({exc!s}): write one with "
+                         "`rtsgeom calibrate SCENE --out DIR`") from None
+    if ang.shape != (n,) or gain.shape != (n,):
+        raise SceneError(f"{where}: front_end_angles_deg has {ang.size} entries, gain_correction "
+                         f"{gain.size}: the scene has {n} front ends (calibrated on another "
+                         "setup?)")
+    for (i, j) in cals:
+        if not (0 <= i < n and 0 <= j < n):
+            raise SceneError(f"{where}: pair ({i}, {j}): must be front-end indices in "
+                             f"[0, {n - 1}]")
+    probe = FrontEndProbe(ang, np.full(n, np.nan), gain)
+    return probe, cals
 
 
 def bracketing_pair(angle_rad: float, fe_angles_rad: np.ndarray) -> tuple[int, int] | None:
@@ -52,6 +86,48 @@ def pair_amplitudes(setup: Setup, paths: Paths, pair, target: TargetConfig, mode
     return a_i * gain_correction[0], a_j * gain_correction[1], rho
 
 
+MIN_BIN_MARGIN = 1.2  # detected bin's power over the next strongest that counts as unambiguous
+
+
+def pair_design(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str, probes_rad,
+                offsets=(0.0, 0.0), gain_correction=(1.0, 1.0), period_s: float | None = None
+                ) -> tuple[float, float, float, float]:
+    """:func:`pair_amplitudes` with channel J's delay offset chosen among the calibrated one
+    and one period of the target's IF phase either side (``offsets[1] + m period``,
+    m = 0, -1, 1: the same phase, J's echo a period's range further): the first whose exact
+    design the RuT detects at the bin it was designed for, with the largest power margin.
+    Where J's echo straddles a range-bin boundary no design is consistent (each moves the
+    peak to the other bin) and the angle misses by up to a degree (issue 13 item 1).
+    Returns (A_I, A_J, rho, offset of J)."""
+    from .calibration import if_phase_slope_hz, nominal_model
+    if mode != "exact":
+        return (*pair_amplitudes(setup, paths, pair, target, mode, probes_rad, offsets,
+                                 gain_correction), float(offsets[1]))
+    scene = setup.scene
+    nom, nom_paths = nominal_model(setup, paths)
+    period = period_s or 1.0 / float(if_phase_slope_hz(scene, 2 * target.range_m / c))
+    best = None
+    for m in (0, -1, 1):
+        off = (offsets[0], offsets[1] + m * period)
+        # candidate bins +-3: a period moves J's echo by about a bin
+        model = PairModel(ChannelModel.build(nom, nom_paths, pair, target, off, HALF_BINS))
+        phase = model.coherent_phase(probes_rad)
+        rho, ok, margin = model.model.solve_checked(target.angle_rad, (0.0, phase))
+        if rho is None:
+            continue
+        score = (ok, margin if ok else 0.0, -abs(m))
+        if best is None or score > best[0]:
+            best = (score, model, rho, phase, off)
+        if ok and margin > MIN_BIN_MARGIN:  # the calibrated offset unless it is ambiguous
+            break
+    if best is None:
+        return (*pair_amplitudes(setup, paths, pair, target, mode, probes_rad, offsets,
+                                 gain_correction), float(offsets[1]))
+    _, model, rho, phase, off = best
+    a_i, a_j = model.amplitudes(rho, target.angle_rad, phase)
+    return (a_i * gain_correction[0], a_j * gain_correction[1], float(rho), float(off[1]))
+
+
 def channel_offsets(n_fe: int, cals: dict[tuple[int, int], Calibration]) -> np.ndarray:
     """Per-channel delay offsets from pair calibrations chained along the arc."""
     off = np.zeros(n_fe)
@@ -60,15 +136,21 @@ def channel_offsets(n_fe: int, cals: dict[tuple[int, int], Calibration]) -> np.n
     return off
 
 
-def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, progress=None
-                 ) -> tuple[RtsProgram, dict, list[str]]:
+def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, progress=None,
+                 calibration: dict | None = None) -> tuple[RtsProgram, dict, list[str]]:
     """The RTS program for the scene's targets at their set angles.
 
+    ``calibration``: a calibration file's content (:func:`load_calibration`): its front-end
+    angles, gain corrections and pair delays are used instead of measuring them again.
     Returns the program, the calibration record (for summary.json) and warnings.
     """
     scene = setup.scene
     seed = scene.seed
-    probe: FrontEndProbe = probe_front_ends(setup, paths, seed)
+    loaded: dict = {}
+    if calibration is not None:
+        probe, loaded = load_calibration(calibration, setup)
+    else:
+        probe = probe_front_ends(setup, paths, seed)
     warnings = []
     lost = np.flatnonzero(~np.isfinite(probe.angle_rad))
     if lost.size:
@@ -94,6 +176,13 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
     if calibrate:
         for pair in sorted(set(pairs.values())):
             base = channel_offsets(setup.fe.count, cals)
+            if calibration is not None:
+                if pair not in loaded:
+                    raise SceneError(f"calibration file: has no pair {pair} (it has "
+                                     f"{sorted(loaded)}): run `rtsgeom calibrate SCENE --pair "
+                                     f"{pair[0]} {pair[1]} --out DIR`")
+                cals[pair] = loaded[pair]
+                continue
             cals[pair] = calibrate_pair(setup, paths, pair, probe, (base[pair[0]], base[pair[0]]),
                                         seed)
             if progress:
@@ -104,17 +193,19 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
         i, j = pairs[k]
         probes = probe_angles(probe.angle_rad[i], probe.angle_rad[j])
         try:
-            a_i, a_j, _ = pair_amplitudes(setup, paths, (i, j), t, mode, probes,
-                                          (offsets[i], offsets[j]), probe.gain_correction[[i, j]])
+            a_i, a_j, _, off_j = pair_design(setup, paths, (i, j), t, mode, probes,
+                                             (offsets[i], offsets[j]),
+                                             probe.gain_correction[[i, j]])
         except AngleUnreachable as exc:
             raise SceneError(f"{scene.source}: targets[{k}].angle_deg = "
                              f"{np.degrees(t.angle_rad):g}: {exc}") from None
         tau = float(requested_delay(scene, t.range_m))
         f_d = 2 * scene.radar.f_c_hz * t.velocity_mps / c
-        rows += [(k, i, tau + offsets[i], f_d, a_i), (k, j, tau + offsets[j], f_d, a_j)]
+        rows += [(k, i, tau + offsets[i], f_d, a_i), (k, j, tau + off_j, f_d, a_j)]
     program = RtsProgram.build(*zip(*rows)) if rows else RtsProgram.build([], [], [], [], [])
     record = {
         "mode": mode,
+        "source": "file" if calibration is not None else "measured",
         "front_end_angles_deg": [float(x) for x in np.degrees(probe.angle_rad)],
         "gain_correction": [float(x) for x in probe.gain_correction],
         "channel_delay_offsets_s": [float(x) for x in offsets],

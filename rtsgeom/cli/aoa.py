@@ -88,10 +88,13 @@ def _calibrate(args, stage) -> int:
         if args.procedure == "paper":
             cal = calibrate_pair_paper(setup, paths, pair, probe, seed=scene.seed)
         else:
-            cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
+            cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed,
+                                 full_chain=args.full_chain)
     out = cal.to_dict()
     out["procedure"] = args.procedure
     out["front_end_angles_deg"] = [float(x) for x in np.degrees(probe.angle_rad)]
+    out["gain_correction"] = [float(x) for x in probe.gain_correction]
+    out["format"] = "rtsgeom-calibration"  # `run/adc --calibration DIR/calibration.json`
     out["fractional_delay_filter"] = fir_effect(setup, cal.delta_tau_s)
 
     def figure():
@@ -204,6 +207,9 @@ def register(sub) -> None:
             p.add_argument("--from-identified", type=output_path, default=None, metavar="FILE",
                            help="no sweep: predict the delay from a scene as identified "
                                 "(rtsgeom identify --out DIR writes DIR/identified.toml)")
+            p.add_argument("--full-chain", action="store_true",
+                           help="evaluate every sweep step through the full ADC-cube chain "
+                                "instead of the phasor model (validation; about a minute)")
         if name == "linearity":
             p.add_argument("--end-angles", choices=("geometric", "measured"),
                            default="geometric",

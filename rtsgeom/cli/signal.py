@@ -169,13 +169,35 @@ def write_run_report(result: RunResult, out: Path, maps, paths_method: str,
     return out / "report.html"
 
 
+def _read_calibration(path) -> dict | None:
+    """``--calibration FILE``: the JSON ``rtsgeom calibrate --out DIR`` wrote
+    (DIR/calibration.json), or None."""
+    if path is None:
+        return None
+    try:
+        doc = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise UsageError(f"--calibration {path}: cannot read it as JSON ({exc})") from None
+    if not isinstance(doc, dict):
+        raise UsageError(f"--calibration {path}: not a calibration file (a JSON object from "
+                         "`rtsgeom calibrate SCENE --out DIR`)")
+    return doc
+
+
+def _calibration_kw(args) -> dict:
+    """``run_scene``'s calibration argument, only when ``--calibration`` was given (the
+    call without it stays as it was)."""
+    doc = _read_calibration(getattr(args, "calibration", None))
+    return {} if doc is None else {"calibration": doc}
+
+
 def cmd_run(args) -> int:
     from ..validate import scene_warnings
     scene = load_scene_checked(args.scene)
     out = args.out
     with output_folder(out, [args.scene]) as stage, steps(args.quiet) as step:
         step(f"simulating {scene.name} ({args.paths} paths, calibration, ADC cube, detection)")
-        result = run_scene(scene, args.paths, args.amplitudes)
+        result = run_scene(scene, args.paths, args.amplitudes, **_calibration_kw(args))
         step("writing detections, summary and maps")
         (stage / "detections.csv").write_text(detections_csv(result), encoding="utf-8")
         (stage / "summary.json").write_text(
@@ -218,7 +240,7 @@ def cmd_adc(args) -> int:
         return adc_probe_capture(scene, args)
     with steps(args.quiet) as step:  # the calibration sweeps take about a minute
         step(f"simulating {scene.name} (calibration, ADC cube)")
-        cube = run_scene(scene, "exact", args.amplitudes).cube
+        cube = run_scene(scene, "exact", args.amplitudes, **_calibration_kw(args)).cube
     if args.format == "npy":
         with atomic_path(args.out) as tmp:
             with open(tmp, "wb") as fh:
@@ -253,6 +275,9 @@ def register(sub) -> None:
                    help="AoA amplitude mode (default: the scene's rts.aoa_mode)")
     p.add_argument("--no-report", action="store_true", help="skip report.html")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    p.add_argument("--calibration", default=None, metavar="FILE",
+                   help="use this calibration (DIR/calibration.json from `rtsgeom calibrate "
+                        "--out DIR`) instead of calibrating again")
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("adc", help="save the raw ADC cube (.npy) or a DCA1000 capture")
@@ -271,4 +296,7 @@ def register(sub) -> None:
                    help="probe velocity with --active (default 0)")
     p.add_argument("--seed", type=number(0, 2**32 - 1, integer=True), default=None,
                    help="receiver-noise seed with --active (default: the scene's seed + I)")
+    p.add_argument("--calibration", default=None, metavar="FILE",
+                   help="use this calibration (DIR/calibration.json from `rtsgeom calibrate "
+                        "--out DIR`) instead of calibrating again")
     p.set_defaults(func=cmd_adc)
