@@ -94,7 +94,9 @@ def spec(key: str, kind: str, doc: str, default: Any = REQUIRED, **kw) -> datacl
     meta = {"spec": s}
     if default is REQUIRED or isinstance(default, Derived):
         return dataclasses.field(metadata=meta)
-    if kind == "table":
+    if kind == "table":  # default None: an optional table (absent = None)
+        if default is None:
+            return dataclasses.field(default=None, metadata=meta)
         return dataclasses.field(default_factory=s.cls, metadata=meta)
     if kind == "tables":
         return dataclasses.field(default=(), metadata=meta)
@@ -220,7 +222,7 @@ def _read_field(s: Spec, data: dict, ctx: _Ctx, values: dict, context: dict) -> 
         if isinstance(s.default, Derived):
             return s.default.fn({**context, **values})
         if s.kind == "table":
-            return read(s.cls, {}, ctx.source, path, context)
+            return None if s.default is None else read(s.cls, {}, ctx.source, path, context)
         if s.kind == "tables":
             v = []
         elif s.kind == "vec" and s.default is not None:
