@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.constants import c, k as K_BOLTZMANN
 
+from .link_config import RADAR_LINK_PRESETS
 from .rts import KIND_DIRECT, KIND_SETUP, Echoes, RtsProgram
 from .schema import SceneError
 
@@ -41,73 +42,6 @@ __all__ = ["RADAR_LINK_PRESETS", "RadarLink", "LinkError", "LinkBudget", "radar_
            "if_response", "apply_radar_link", "thermal_noise_w", "shaped_noise", "adc_convert",
            "channel_table", "check_channels", "channel_noise_w", "window_snr_loss",
            "link_budget", "dbm", "link_warnings"]
-
-_AWR_DS = "TI AWR1843 datasheet (SWRS222)"
-_HPF = ("HPF1 corner, one of 175/235/350/700 kHz in the device's profile configuration "
-        "(TI mmWave DFP, rlProfileCfg hpfCornerFreq1); the lowest is taken")
-_FS = ("[assumed] receiver-input power of a full-scale tone at a mid Rx gain (~30 dB of the "
-       "24-48 dB range): not in the datasheet; check with the device's Rx saturation monitor")
-_LPF_ORDER = "[assumed] 4th-order Butterworth anti-alias response"
-
-# One entry per antenna preset: the values and where each comes from.
-RADAR_LINK_PRESETS: dict[str, dict] = {
-    "awr1843boost": {
-        "values": {"tx_power_dbm": 12.0, "tx_antenna_gain_dbi": 10.5,
-                   "rx_antenna_gain_dbi": 10.5, "noise_figure_db": 15.0,
-                   "if_highpass_hz": 175e3, "if_lowpass_hz": 10e6, "if_lowpass_order": 4,
-                   "adc_bits": 12, "adc_full_scale_dbm": -25.0},
-        "sources": {"tx_power_dbm": f"{_AWR_DS}: TX power 12 dBm",
-                    "tx_antenna_gain_dbi": "TI xWR1843BOOST user's guide (SPRUIM4): antenna peak "
-                                           "gain > 10.5 dBi (76-81 GHz)",
-                    "rx_antenna_gain_dbi": "as tx_antenna_gain_dbi",
-                    "noise_figure_db": f"{_AWR_DS}: RX noise figure 14 dB (76-77 GHz), 15 dB "
-                                       "(77-81 GHz); 15 dB taken",
-                    "if_highpass_hz": _HPF,
-                    "if_lowpass_hz": f"{_AWR_DS}: IF bandwidth 10 MHz",
-                    "if_lowpass_order": _LPF_ORDER,
-                    "adc_bits": f"{_AWR_DS}: 12-bit ADC samples (adcCfg also offers 14/16-bit "
-                                "output formats)",
-                    "adc_full_scale_dbm": _FS}},
-    "iwr6843isk": {
-        "values": {"tx_power_dbm": 12.0, "tx_antenna_gain_dbi": 7.0, "rx_antenna_gain_dbi": 7.0,
-                   "noise_figure_db": 12.0, "if_highpass_hz": 175e3, "if_lowpass_hz": 10e6,
-                   "if_lowpass_order": 4, "adc_bits": 12, "adc_full_scale_dbm": -25.0},
-        "sources": {"tx_power_dbm": "TI IWR6843 datasheet (SWRS219): TX power 12 dBm",
-                    "tx_antenna_gain_dbi": "[assumed] ~7 dBi patch array of the ISK module",
-                    "rx_antenna_gain_dbi": "[assumed] as tx_antenna_gain_dbi",
-                    "noise_figure_db": "TI IWR6843 datasheet (SWRS219): RX noise figure 12 dB",
-                    "if_highpass_hz": _HPF, "if_lowpass_hz": "TI IWR6843 datasheet: IF bandwidth "
-                                                         "10 MHz",
-                    "if_lowpass_order": _LPF_ORDER, "adc_bits": "as the AWR1843",
-                    "adc_full_scale_dbm": _FS}},
-    "awr2944": {
-        "values": {"tx_power_dbm": 13.0, "tx_antenna_gain_dbi": 10.0,
-                   "rx_antenna_gain_dbi": 10.0, "noise_figure_db": 12.0,
-                   "if_highpass_hz": 175e3, "if_lowpass_hz": 15e6, "if_lowpass_order": 4,
-                   "adc_bits": 12, "adc_full_scale_dbm": -25.0},
-        "sources": {"tx_power_dbm": "TI AWR2944 datasheet (SWRS273): TX power 13 dBm",
-                    "tx_antenna_gain_dbi": "[assumed]", "rx_antenna_gain_dbi": "[assumed]",
-                    "noise_figure_db": "TI AWR2944 datasheet (SWRS273): RX noise figure 12 dB "
-                                       "[re-check]",
-                    "if_highpass_hz": _HPF, "if_lowpass_hz": "TI AWR2944 datasheet: IF bandwidth "
-                                                         "15 MHz [re-check]",
-                    "if_lowpass_order": _LPF_ORDER, "adc_bits": "[assumed] as the AWR1843",
-                    "adc_full_scale_dbm": _FS}},
-    "awr2243-cascade": {
-        "values": {"tx_power_dbm": 13.0, "tx_antenna_gain_dbi": 10.0,
-                   "rx_antenna_gain_dbi": 10.0, "noise_figure_db": 14.0,
-                   "if_highpass_hz": 175e3, "if_lowpass_hz": 20e6, "if_lowpass_order": 4,
-                   "adc_bits": 12, "adc_full_scale_dbm": -25.0},
-        "sources": {"tx_power_dbm": "TI AWR2243 datasheet (SWRS223): TX power 13 dBm",
-                    "tx_antenna_gain_dbi": "[assumed]", "rx_antenna_gain_dbi": "[assumed]",
-                    "noise_figure_db": "TI AWR2243 datasheet (SWRS223): RX noise figure "
-                                       "12-14 dB; 14 dB taken [re-check]",
-                    "if_highpass_hz": _HPF, "if_lowpass_hz": "TI AWR2243 datasheet: IF bandwidth "
-                                                         "20 MHz",
-                    "if_lowpass_order": _LPF_ORDER, "adc_bits": "[assumed] as the AWR1843",
-                    "adc_full_scale_dbm": _FS}},
-}
-
 
 class LinkError(SceneError):
     """A target the RTS cannot produce with its gains and dynamic range (names the field)."""
@@ -369,14 +303,16 @@ def _entry(p_in_w, h2, noise_w, nq, fs_w, gain_db) -> dict:
 
 def link_budget(scene, echoes: Echoes, program: RtsProgram, linked: bool,
                 noise_override_w: float | None = None,
-                estimated_setup: Echoes | None = None) -> LinkBudget:
+                estimated_setup: Echoes | None = None, predict: bool = False) -> LinkBudget:
     """The budget per target (its direct echoes, summed coherently over its channels per
     virtual channel, power averaged over the virtual channels), per setup echo and per front
     end. ``echoes`` are the run's: already through :func:`apply_radar_link` when ``linked``
     (the scene has ``[radar.link]``), else relative ones that are taken through the preset's
     link here, so the budget is shown either way. ``noise_override_w``: ``snr_db``'s noise.
     ``estimated_setup``: relative setup echoes not in the signal (the sheet by
-    :func:`sheet_paths` under ``--paths exact``), listed with ``"in_signal": false``."""
+    :func:`sheet_paths` under ``--paths exact``), listed with ``"in_signal": false``.
+    ``predict``: what a real RuT with these values would show (thermal noise and the ADC's
+    quantisation even where the signal model has neither)."""
     radar = scene.radar
     link = radar_link(radar)
     raw = echoes
@@ -393,9 +329,11 @@ def link_budget(scene, echoes: Echoes, program: RtsProgram, linked: bool,
                                         "target echo (not the physical noise)")
     else:
         noise = n_th + n_ch
-        src = ("thermal k T0 F f_adc + RTS channel noise" if linked else
-               "none in the signal (no [radar.link], no snr_db); budget with the preset's link")
-    nq = link.quantisation_noise_w if linked else 0.0  # no ADC in the relative model
+        src = "thermal k T0 F f_adc + RTS channel noise"
+        if not linked:
+            src += (" (prediction: the scene has no [radar.link])" if predict else
+                    "; not in the signal (no [radar.link], no snr_db)")
+    nq = link.quantisation_noise_w if linked or predict else 0.0  # no ADC in the relative model
     gain_db = float(10 * np.log10(radar.samples_per_chirp * radar.chirps_per_tx
                                   * window_snr_loss(radar.range_window, radar.samples_per_chirp)
                                   * window_snr_loss(radar.doppler_window, radar.chirps_per_tx)))
@@ -496,3 +434,43 @@ def sheet_paths(setup, step_m: float | None = None):
     return Paths.build(front_end=np.full(m.size, -1), direction=np.full(m.size, RUT_TO_RUT),
                        rut_tx=m, rut_rx=k, delay_s=tau, gain=g, bounces=np.ones(m.size, int),
                        method="po")
+
+
+def static_budget(setup) -> LinkBudget:
+    """The budget without a run (``rtsgeom info``): each target on its nearest front end over
+    the exact paths, the sheet by physical optics, thermal noise (``snr_db`` ignored)."""
+    from .paths import exact_paths
+    from .rts import build_echoes, program_nearest, setup_echoes
+    scene = setup.scene
+    program = program_nearest(scene, setup)
+    echoes = build_echoes(setup, exact_paths(setup), program)
+    sp = sheet_paths(setup)
+    est = setup_echoes(setup, sp) if sp is not None else None
+    return link_budget(scene, echoes, program, False, None, est, predict=True)
+
+
+def format_budget(b: dict) -> list[str]:
+    """Text lines of a budget dict (:meth:`LinkBudget.to_dict`) for ``rtsgeom info``."""
+    r = b["radar"]
+    lines = [f"link budget ({'modelled in the signal' if b['modelled'] else 'not modelled in the signal: no [radar.link]'}):",
+             f"  RuT Tx {r['tx_power_dbm']:.1f} dBm, antennas {r['tx_antenna_gain_dbi']:.1f}/"
+             f"{r['rx_antenna_gain_dbi']:.1f} dBi, NF {r['noise_figure_db']:.1f} dB, IF "
+             f"HPF {r['if_highpass_hz'] / 1e3:.0f} kHz / LPF {r['if_lowpass_hz'] / 1e6:.2f} MHz, "
+             f"ADC {r['adc_bits']} bit, full scale {r['adc_full_scale_dbm']:.1f} dBm",
+             f"  noise {b['noise_dbm_per_sample']:.1f} dBm per sample ({b['noise_source']}), "
+             f"quantisation {b['quantisation_noise_dbm']:.1f} dBm, FFT gain "
+             f"{b['fft_gain_db']:.1f} dB"]
+    for fe in b["front_ends"]:
+        att = ", ".join(f"{a:.1f}" for a in fe["attenuation_db"]) or "-"
+        lines.append(f"  front end {fe['index']}: RuT chirp at the back end's ADC "
+                     f"{fe['rut_chirp_at_adc_dbm']:.1f} dBm ({fe['adc_level_dbfs']:.1f} dBFS), "
+                     f"attenuation {att} dB of at most {fe['max_attenuation_db']:.1f} dB")
+    for kind, rows in (("target", b["targets"]), ("setup echo", b["setup_echoes"])):
+        for t in rows:
+            if t.get("adc_power_dbm") is None:
+                continue
+            lines.append(f"  {kind} {t['index']} ({t['range_m']:.2f} m): {t['adc_power_dbm']:.1f} "
+                         f"dBm at the ADC (IF {t['if_response_db']:+.1f} dB), SNR after the FFTs "
+                         f"{t['snr_after_fft_db']:.1f} dB, clip margin {t['clip_margin_db']:.1f} dB"
+                         + ("  CLIPS" if t["clip_margin_db"] < 0 else ""))
+    return lines

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 from .schema import Derived, Evolvable, spec
 
-__all__ = ["RadarLinkConfig", "RtsLinkConfig"]
+__all__ = ["RadarLinkConfig", "RtsLinkConfig", "RADAR_LINK_PRESETS"]
 
 _PRESET = Derived("the antenna preset's value (rtsgeom.link.RADAR_LINK_PRESETS)", lambda v: None)
 
@@ -79,3 +79,73 @@ class RtsLinkConfig(Evolvable):
                                      "of a full-scale tone", 0.0, unit="dBm", lo=-60.0, hi=40.0)
     dac_bits: int = spec("dac_bits", "int", "DAC resolution (sets the attenuation range: the "
                          "echo must stay above the DAC's quantisation floor)", 14, lo=2, hi=24)
+
+
+# The RuT presets' link values and where each comes from (rtsgeom.link.radar_link fills the
+# unset [radar.link] fields from them). Datasheet values are as quoted from the TI datasheets
+# (the project's search corpus did not hold them: re-check against the current revision).
+_AWR_DS = "TI AWR1843 datasheet (SWRS222)"
+_HPF = ("HPF1 corner, one of 175/235/350/700 kHz in the device's profile configuration "
+        "(TI mmWave DFP, rlProfileCfg hpfCornerFreq1); the lowest is taken")
+_FS = ("[assumed] receiver-input power of a full-scale tone at a mid Rx gain (~30 dB of the "
+       "24-48 dB range): not in the datasheet; check with the device's Rx saturation monitor")
+_LPF_ORDER = "[assumed] 4th-order Butterworth anti-alias response"
+
+# One entry per antenna preset: the values and where each comes from.
+RADAR_LINK_PRESETS: dict[str, dict] = {
+    "awr1843boost": {
+        "values": {"tx_power_dbm": 12.0, "tx_antenna_gain_dbi": 10.5,
+                   "rx_antenna_gain_dbi": 10.5, "noise_figure_db": 15.0,
+                   "if_highpass_hz": 175e3, "if_lowpass_hz": 10e6, "if_lowpass_order": 4,
+                   "adc_bits": 12, "adc_full_scale_dbm": -25.0},
+        "sources": {"tx_power_dbm": f"{_AWR_DS}: TX power 12 dBm",
+                    "tx_antenna_gain_dbi": "TI xWR1843BOOST user's guide (SPRUIM4): antenna peak "
+                                           "gain > 10.5 dBi (76-81 GHz)",
+                    "rx_antenna_gain_dbi": "as tx_antenna_gain_dbi",
+                    "noise_figure_db": f"{_AWR_DS}: RX noise figure 14 dB (76-77 GHz), 15 dB "
+                                       "(77-81 GHz); 15 dB taken",
+                    "if_highpass_hz": _HPF,
+                    "if_lowpass_hz": f"{_AWR_DS}: IF bandwidth 10 MHz",
+                    "if_lowpass_order": _LPF_ORDER,
+                    "adc_bits": f"{_AWR_DS}: 12-bit ADC samples (adcCfg also offers 14/16-bit "
+                                "output formats)",
+                    "adc_full_scale_dbm": _FS}},
+    "iwr6843isk": {
+        "values": {"tx_power_dbm": 12.0, "tx_antenna_gain_dbi": 7.0, "rx_antenna_gain_dbi": 7.0,
+                   "noise_figure_db": 12.0, "if_highpass_hz": 175e3, "if_lowpass_hz": 10e6,
+                   "if_lowpass_order": 4, "adc_bits": 12, "adc_full_scale_dbm": -25.0},
+        "sources": {"tx_power_dbm": "TI IWR6843 datasheet (SWRS219): TX power 12 dBm",
+                    "tx_antenna_gain_dbi": "[assumed] ~7 dBi patch array of the ISK module",
+                    "rx_antenna_gain_dbi": "[assumed] as tx_antenna_gain_dbi",
+                    "noise_figure_db": "TI IWR6843 datasheet (SWRS219): RX noise figure 12 dB",
+                    "if_highpass_hz": _HPF, "if_lowpass_hz": "TI IWR6843 datasheet: IF bandwidth "
+                                                         "10 MHz",
+                    "if_lowpass_order": _LPF_ORDER, "adc_bits": "as the AWR1843",
+                    "adc_full_scale_dbm": _FS}},
+    "awr2944": {
+        "values": {"tx_power_dbm": 13.0, "tx_antenna_gain_dbi": 10.0,
+                   "rx_antenna_gain_dbi": 10.0, "noise_figure_db": 12.0,
+                   "if_highpass_hz": 175e3, "if_lowpass_hz": 15e6, "if_lowpass_order": 4,
+                   "adc_bits": 12, "adc_full_scale_dbm": -25.0},
+        "sources": {"tx_power_dbm": "TI AWR2944 datasheet (SWRS273): TX power 13 dBm",
+                    "tx_antenna_gain_dbi": "[assumed]", "rx_antenna_gain_dbi": "[assumed]",
+                    "noise_figure_db": "TI AWR2944 datasheet (SWRS273): RX noise figure 12 dB "
+                                       "[re-check]",
+                    "if_highpass_hz": _HPF, "if_lowpass_hz": "TI AWR2944 datasheet: IF bandwidth "
+                                                         "15 MHz [re-check]",
+                    "if_lowpass_order": _LPF_ORDER, "adc_bits": "[assumed] as the AWR1843",
+                    "adc_full_scale_dbm": _FS}},
+    "awr2243-cascade": {
+        "values": {"tx_power_dbm": 13.0, "tx_antenna_gain_dbi": 10.0,
+                   "rx_antenna_gain_dbi": 10.0, "noise_figure_db": 14.0,
+                   "if_highpass_hz": 175e3, "if_lowpass_hz": 20e6, "if_lowpass_order": 4,
+                   "adc_bits": 12, "adc_full_scale_dbm": -25.0},
+        "sources": {"tx_power_dbm": "TI AWR2243 datasheet (SWRS223): TX power 13 dBm",
+                    "tx_antenna_gain_dbi": "[assumed]", "rx_antenna_gain_dbi": "[assumed]",
+                    "noise_figure_db": "TI AWR2243 datasheet (SWRS223): RX noise figure "
+                                       "12-14 dB; 14 dB taken [re-check]",
+                    "if_highpass_hz": _HPF, "if_lowpass_hz": "TI AWR2243 datasheet: IF bandwidth "
+                                                         "20 MHz",
+                    "if_lowpass_order": _LPF_ORDER, "adc_bits": "[assumed] as the AWR1843",
+                    "adc_full_scale_dbm": _FS}},
+}

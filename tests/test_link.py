@@ -58,10 +58,10 @@ def test_post_fft_snr_is_the_radar_equation_through_the_rts(range_m, rcs_dbsm):
     x_s = _tone(sig, f_b, radar)
     p_noise = lk.thermal_noise_w(radar, rl) + lk.channel_noise_w(scene, program, rl)
     rng = np.random.default_rng(1)
-    noise = lk.shaped_noise((512,) + sig.shape[1:], p_noise, rl, radar, rng)
+    noise = lk.shaped_noise((4096,) + sig.shape[1:], p_noise, rl, radar, rng)
     noise_q, _ = lk.adc_convert(noise, rl)
     x_n = np.concatenate([_tone(noise_q[i:i + radar.chirps_per_tx], f_b, radar)
-                          for i in range(0, 512, radar.chirps_per_tx)])
+                          for i in range(0, 4096, radar.chirps_per_tx)])
     measured = 10 * np.log10(np.mean(np.abs(x_s) ** 2) / np.mean(np.abs(x_n) ** 2))
     # closed form
     lam = c / radar.f_center_hz
@@ -73,7 +73,6 @@ def test_post_fft_snr_is_the_radar_equation_through_the_rts(range_m, rcs_dbsm):
             * lk.window_snr_loss(radar.range_window, radar.samples_per_chirp)
             * lk.window_snr_loss(radar.doppler_window, radar.chirps_per_tx))
     closed = 10 * np.log10(p_r * h2 / (n0 * h2 + rl.quantisation_noise_w) * gain)
-    print(f"SNR R={range_m} rcs={rcs_dbsm}: measured {measured:.2f} closed {closed:.2f}")
     assert measured == pytest.approx(closed, abs=0.5)
     # and the budget reports the same
     b = lk.link_budget(scene, echoes, program, linked=True)
@@ -141,7 +140,7 @@ def test_uncovered_sheet_at_1m_on_an_awr1843():
     below the 175 kHz HPF corner (about 3 dB suppression reported); at the highest Rx gain
     (48 dB: full scale 18 dB lower than the preset's 30-dB point) it clips the ADC, and with
     a 20 dB absorber it does not."""
-    rows, scene, _, _ = _sheet_budget({}, 0.0)
+    rows, _, _, _ = _sheet_budget({}, 0.0)
     assert rows and all(r["beat_hz"] < 175e3 for r in rows)
     assert all(-4.0 < r["if_response_db"] < -2.5 for r in rows)
     hi_gain = {"adc_full_scale_dbm": -25.0 - 18.0}
@@ -203,3 +202,17 @@ def test_default_scene_unchanged_and_budget_states_the_override(default_scene):
                                      "clip_margin_db"}
     assert lb["setup_echoes"] and lb["setup_echoes"][0]["in_signal"] is False
     assert s["adc_clipped_samples"] == 0
+
+
+def test_linked_run_warns_on_clipping_and_reports_the_budget():
+    """run_scene with [radar.link]: the budget is 'modelled', thermal noise is named, the
+    sheet (estimated) clips at the highest Rx gain and run warns; same seed, same bytes."""
+    from rtsgeom.run import run_scene, summary
+    scene = make_scene(lambda d: linked_doc(d, link={"adc_full_scale_dbm": -43.0}))
+    r = run_scene(scene, aoa_mode="nearest")
+    lb = summary(r, "exact")["link_budget"]
+    assert lb["modelled"] is True and lb["noise_source"].startswith("thermal")
+    assert any("setup echo 0 clips" in w for w in r.warnings)
+    assert r.matches[0]["detection"] is not None
+    r2 = run_scene(scene, aoa_mode="nearest")
+    assert r.cube.data.tobytes() == r2.cube.data.tobytes()
