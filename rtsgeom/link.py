@@ -282,12 +282,26 @@ class LinkBudget:
     setup_echoes: list
 
     def to_dict(self) -> dict:
+        """Plain JSON: a level that is not finite (no noise, no echo: -inf dBm) is None."""
+        return _json_safe(self._raw_dict())
+
+    def _raw_dict(self) -> dict:
         return {"modelled": self.modelled, "noise_source": self.noise_source,
                 "noise_dbm_per_sample": float(dbm(self.noise_w)),
                 "quantisation_noise_dbm": float(dbm(self.quantisation_noise_w)),
                 "fft_gain_db": self.fft_gain_db, "radar": self.radar,
                 "front_ends": self.front_ends, "targets": self.targets,
                 "setup_echoes": self.setup_echoes}
+
+
+def _json_safe(x):
+    if isinstance(x, dict):
+        return {k: _json_safe(v) for k, v in x.items()}
+    if isinstance(x, list):
+        return [_json_safe(v) for v in x]
+    if isinstance(x, float) and not np.isfinite(x):
+        return None
+    return x
 
 
 def _entry(p_in_w, h2, noise_w, nq, fs_w, gain_db) -> dict:
@@ -449,28 +463,32 @@ def static_budget(setup) -> LinkBudget:
     return link_budget(scene, echoes, program, False, None, est, predict=True)
 
 
+def _f1(x) -> str:
+    return "-" if x is None else f"{x:.1f}"
+
+
 def format_budget(b: dict) -> list[str]:
     """Text lines of a budget dict (:meth:`LinkBudget.to_dict`) for ``rtsgeom info``."""
     r = b["radar"]
     lines = [f"link budget ({'modelled in the signal' if b['modelled'] else 'not modelled in the signal: no [radar.link]'}):",
-             f"  RuT Tx {r['tx_power_dbm']:.1f} dBm, antennas {r['tx_antenna_gain_dbi']:.1f}/"
-             f"{r['rx_antenna_gain_dbi']:.1f} dBi, NF {r['noise_figure_db']:.1f} dB, IF "
+             f"  RuT Tx {_f1(r['tx_power_dbm'])} dBm, antennas {_f1(r['tx_antenna_gain_dbi'])}/"
+             f"{_f1(r['rx_antenna_gain_dbi'])} dBi, NF {_f1(r['noise_figure_db'])} dB, IF "
              f"HPF {r['if_highpass_hz'] / 1e3:.0f} kHz / LPF {r['if_lowpass_hz'] / 1e6:.2f} MHz, "
-             f"ADC {r['adc_bits']} bit, full scale {r['adc_full_scale_dbm']:.1f} dBm",
-             f"  noise {b['noise_dbm_per_sample']:.1f} dBm per sample ({b['noise_source']}), "
-             f"quantisation {b['quantisation_noise_dbm']:.1f} dBm, FFT gain "
-             f"{b['fft_gain_db']:.1f} dB"]
+             f"ADC {r['adc_bits']} bit, full scale {_f1(r['adc_full_scale_dbm'])} dBm",
+             f"  noise {_f1(b['noise_dbm_per_sample'])} dBm per sample ({b['noise_source']}), "
+             f"quantisation {_f1(b['quantisation_noise_dbm'])} dBm, FFT gain "
+             f"{_f1(b['fft_gain_db'])} dB"]
     for fe in b["front_ends"]:
-        att = ", ".join(f"{a:.1f}" for a in fe["attenuation_db"]) or "-"
+        att = ", ".join(_f1(a) for a in fe["attenuation_db"]) or "-"
         lines.append(f"  front end {fe['index']}: RuT chirp at the back end's ADC "
-                     f"{fe['rut_chirp_at_adc_dbm']:.1f} dBm ({fe['adc_level_dbfs']:.1f} dBFS), "
-                     f"attenuation {att} dB of at most {fe['max_attenuation_db']:.1f} dB")
+                     f"{_f1(fe['rut_chirp_at_adc_dbm'])} dBm ({_f1(fe['adc_level_dbfs'])} dBFS), "
+                     f"attenuation {att} dB of at most {_f1(fe['max_attenuation_db'])} dB")
     for kind, rows in (("target", b["targets"]), ("setup echo", b["setup_echoes"])):
         for t in rows:
             if t.get("adc_power_dbm") is None:
                 continue
-            lines.append(f"  {kind} {t['index']} ({t['range_m']:.2f} m): {t['adc_power_dbm']:.1f} "
-                         f"dBm at the ADC (IF {t['if_response_db']:+.1f} dB), SNR after the FFTs "
-                         f"{t['snr_after_fft_db']:.1f} dB, clip margin {t['clip_margin_db']:.1f} dB"
-                         + ("  CLIPS" if t["clip_margin_db"] < 0 else ""))
+            lines.append(f"  {kind} {t['index']} ({t['range_m']:.2f} m): {_f1(t['adc_power_dbm'])} "
+                         f"dBm at the ADC (IF {_f1(t['if_response_db'])} dB), SNR after the FFTs "
+                         f"{_f1(t['snr_after_fft_db'])} dB, clip margin {_f1(t['clip_margin_db'])} dB"
+                         + ("  CLIPS" if (t["clip_margin_db"] or 0) < 0 else ""))
     return lines

@@ -202,6 +202,8 @@ def test_default_scene_unchanged_and_budget_states_the_override(default_scene):
                                      "clip_margin_db"}
     assert lb["setup_echoes"] and lb["setup_echoes"][0]["in_signal"] is False
     assert s["adc_clipped_samples"] == 0
+    import json
+    json.dumps(s, allow_nan=False)  # summary.json is strict JSON (no -inf dBm)
 
 
 def test_linked_run_warns_on_clipping_and_reports_the_budget():
