@@ -211,6 +211,9 @@ def format_info(info: dict) -> str:
                 elif rt["pair"] is not None and reach["mode"] != "nearest":
                     line += f"  (pair {rt['pair'][0]}-{rt['pair'][1]})"
             lines.append(line)
+    if info.get("link_budget"):
+        from .link import format_budget
+        lines += format_budget(info["link_budget"])
     return "\n".join(lines)
 
 

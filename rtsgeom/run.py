@@ -36,6 +36,7 @@ class RunResult:
     calibration: dict = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
     aoa_mode: str = "exact"  # the amplitude mode actually used
+    link_budget: object = None  # rtsgeom.link.LinkBudget
 
 
 def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angle_rad=None,
@@ -177,8 +178,36 @@ def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = 
                                                            calibration=cal_file)
     echoes, cube = simulate(setup, paths, program, scene.seed, scene.radar.snr_db)
     rd, det = process(cube)
+    budget = _budget(scene, setup, echoes, program)
+    if scene.radar.link is not None:
+        from .link import link_warnings
+        warnings = list(warnings) + link_warnings(budget, scene.radar.cfar.threshold_db)
+        if cube.clipped:
+            warnings.append(f"link: the ADC clipped {cube.clipped} of {cube.data.size} samples "
+                            "of this frame")
     return RunResult(scene, setup, paths, program, echoes, cube, rd, det,
-                     match_targets(scene, det, rd), calibration, tuple(warnings), mode)
+                     match_targets(scene, det, rd), calibration, tuple(warnings), mode, budget)
+
+
+def _budget(scene: Scene, setup: Setup, echoes: Echoes, program: RtsProgram):
+    """The run's link budget (rtsgeom.link); the snr_db override's noise where it is set; with
+    ``[radar.link]``, the sheet's echo estimated by physical optics where the paths carry no
+    setup reflection."""
+    from .link import link_budget, sheet_paths
+    from .rts import KIND_SETUP, setup_echoes
+    est = None
+    # the physical-optics sheet estimate costs ~1 s: only for a physical budget ([radar.link])
+    if scene.radar.link is not None and not np.any(echoes.kind == KIND_SETUP):
+        sp = sheet_paths(setup)
+        est = setup_echoes(setup, sp) if sp is not None else None
+    override = None
+    if scene.radar.snr_db is not None:
+        override = noise_power(echoes, scene.radar.snr_db)
+        if scene.radar.link is None:  # relative echoes: scale the override like the link would
+            from .link import radar_link
+            rl = radar_link(scene.radar)
+            override *= rl.tx_power_w * rl.tx_gain * rl.rx_gain
+    return link_budget(scene, echoes, program, scene.radar.link is not None, override, est)
 
 
 def summary(result: RunResult, paths_method: str) -> dict:
@@ -209,6 +238,9 @@ def summary(result: RunResult, paths_method: str) -> dict:
         "calibration": result.calibration,
         "targets": [{k: v for k, v in m.items() if k != "detection_index"}
                     for m in result.matches],
+        "link_budget": (result.link_budget.to_dict() if result.link_budget is not None
+                        else None),
+        "adc_clipped_samples": result.cube.clipped,
         "num_detections": len(result.detections),
         "num_echoes": len(result.echoes),
         "warnings": list(result.warnings),

@@ -31,6 +31,7 @@ from pathlib import Path
 from scipy.constants import c
 
 from . import registry
+from .link_config import RadarLinkConfig, RtsLinkConfig
 from .schema import Derived, Evolvable, SceneError, check_fields, read, spec
 from .schema import fmt as _fmt
 from .scene_hardware import (ArrayConfig, PatternConfig, check_layout_keys,  # noqa: F401
@@ -160,7 +161,12 @@ class RadarConfig(Evolvable):
     cfar: CfarConfig = spec("cfar", "table", "[radar.cfar] detection settings", {},
                             cls=CfarConfig)
     snr_db: float | None = spec("snr_db", "float", "per-sample SNR of the strongest echo; "
-                                "unset = noiseless", None, unit="dB", lo=-60.0, hi=200.0)
+                                "unset = noiseless (or thermal noise with [radar.link]); an "
+                                "override of the link's noise when both are given", None,
+                                unit="dB", lo=-60.0, hi=200.0)
+    link: RadarLinkConfig | None = spec(
+        "link", "table", "[radar.link] physical link budget (optional: absent = relative "
+        "amplitudes, noise from snr_db)", None, cls=RadarLinkConfig)
 
     @property
     def slope_hz_per_s(self) -> float:
@@ -329,6 +335,9 @@ class RtsConfig(Evolvable):
     pattern: PatternConfig = spec("pattern", "table", "[rts.pattern] pattern of every "
                                   "front-end antenna (Rx and Tx; boresight at the arc centre)",
                                   {}, cls=PatternConfig)
+    link: RtsLinkConfig = spec("link", "table", "[rts.link] each channel's gains, noise figure "
+                               "and back-end full scale (used with [radar.link])", {},
+                               cls=RtsLinkConfig)
 
     @property
     def delay_resolution_s(self) -> float:
@@ -353,6 +362,10 @@ class SheetConfig(Evolvable):
                                     unit="m", lo=0.0, hi=2.0, lo_open=True)
     material: str = spec("material", "material", "radio material (Sionna RT)", "itu_metal",
                          max_chars=MAX_NAME_CHARS)
+    reflection_loss_db: float = spec("reflection_loss_db", "float", "extra loss per reflection "
+                                     "off the sheet (an absorber covering it); applied to the "
+                                     "setup echoes with [radar.link]", 0.0, unit="dB",
+                                     lo=0.0, hi=100.0)
 
 
 @dataclass(frozen=True)

@@ -137,6 +137,9 @@ def scene_warnings(scene: Scene) -> list[str]:
              f"not a whole multiple of the RTS delay resolution "
              f"{rts.delay_resolution_s * 1e12:g} ps: the steps will be uneven")
 
-    if radar.snr_db is None:
+    if radar.snr_db is None and radar.link is None:
         out.append(f"{src}: radar.snr_db is not set: the simulation is noiseless")
+    if radar.snr_db is not None and radar.link is not None:
+        out.append(f"{src}: radar.snr_db = {radar.snr_db:g} overrides the thermal noise of "
+                   "[radar.link] (a fixed per-sample SNR of the strongest target echo)")
     return out

@@ -14,7 +14,10 @@ from ._common import (UsageError, load_scene_checked, output_file, output_path, 
 def cmd_info(args) -> int:
     import sys
     from ..info import unreachable_warnings
-    info = scene_info(build_setup(load_scene_checked(args.scene)), reachable=True)
+    setup = build_setup(load_scene_checked(args.scene))
+    info = scene_info(setup, reachable=True)
+    from ..link import static_budget
+    info["link_budget"] = static_budget(setup).to_dict()
     for w in unreachable_warnings(info, skip_outside_geometric=True):  # those: validate's
         print(f"rtsgeom: warning: {args.scene}: {w}", file=sys.stderr)
     if args.json:

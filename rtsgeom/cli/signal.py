@@ -57,7 +57,9 @@ def render_maps(result: RunResult) -> dict[str, bytes]:
     rd, det, scene = result.rd, result.detections, result.scene
     f1 = range_doppler_figure(rd.power_db, rd.range_m, rd.velocity_mps,
                               detections=np.c_[det.range_m, det.velocity_mps],
-                              title=f"{scene.name}: range-Doppler map")
+                              title=f"{scene.name}: range-Doppler map"
+                              + (f" (ADC CLIPPED: {result.cube.clipped} samples)"
+                                 if result.cube.clipped else ""))
     angles = np.radians(np.arange(-60.0, 60.01, 0.25))
     ra = range_angle_map(rd, result.cube, angles)
     sets = np.array([[t.range_m, np.degrees(t.angle_rad)] for t in scene.targets]).reshape(-1, 2)

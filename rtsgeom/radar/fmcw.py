@@ -47,6 +47,7 @@ class AdcCube:
     data: np.ndarray
     radar: RadarConfig
     rut: RutArray
+    clipped: int = 0  # samples the ADC clipped (with [radar.link]; rtsgeom.link.adc_convert)
 
     @property
     def shape(self) -> tuple[int, int, int]:

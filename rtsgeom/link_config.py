@@ -1,0 +1,151 @@
+"""Scene fields of the physical link budget: ``[radar.link]`` and ``[rts.link]``.
+
+Declared once (:func:`rtsgeom.schema.spec`) like every scene field; the physics that uses them
+is :mod:`rtsgeom.link`. Kept apart from ``scene.py`` so that module stays small and the link's
+fields sit in one place. ``[radar.link]`` is optional: absent, the signal model keeps its
+relative amplitudes (transmit power 1, isotropic RuT) and its noise from ``snr_db``; present
+(even empty), the echoes are powers at the RuT's receiver input, filtered by the IF chain,
+with thermal noise and an ADC that clips and quantises. Unset values come from the antenna
+preset's datasheet values (``rtsgeom.link.RADAR_LINK_PRESETS``, with their sources).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .schema import Derived, Evolvable, spec
+
+__all__ = ["RadarLinkConfig", "RtsLinkConfig", "RADAR_LINK_PRESETS"]
+
+_PRESET = Derived("the antenna preset's value (rtsgeom.link.RADAR_LINK_PRESETS)", lambda v: None)
+
+
+@dataclass(frozen=True)
+class RadarLinkConfig(Evolvable):
+    """The RuT's transmitter, receiver, IF chain and ADC (radar equation and thermal noise).
+
+    Powers are referred to the antenna ports (the receiver input); the ADC's full scale is the
+    power of a tone at the receiver input that just reaches full scale (at the Rx gain set)."""
+
+    tx_power_dbm: float | None = spec("tx_power_dbm", "float", "transmit power per Tx at the "
+                                      "antenna port", _PRESET, unit="dBm", lo=-50.0, hi=50.0)
+    tx_antenna_gain_dbi: float | None = spec("tx_antenna_gain_dbi", "float", "peak gain of a Tx "
+                                             "antenna (the paths carry the pattern's shape)",
+                                             _PRESET, unit="dBi", lo=-20.0, hi=50.0)
+    rx_antenna_gain_dbi: float | None = spec("rx_antenna_gain_dbi", "float", "peak gain of an Rx "
+                                             "antenna", _PRESET, unit="dBi", lo=-20.0, hi=50.0)
+    noise_figure_db: float | None = spec("noise_figure_db", "float", "receiver noise figure",
+                                         _PRESET, unit="dB", lo=0.0, hi=50.0)
+    if_highpass_hz: float | None = spec("if_highpass_hz", "float", "IF high-pass corner "
+                                        "(first order); 0 = none", _PRESET, unit="Hz",
+                                        lo=0.0, hi=1e9)
+    if_lowpass_hz: float | None = spec("if_lowpass_hz", "float", "IF low-pass / anti-alias "
+                                       "corner", _PRESET, unit="Hz", lo=1e3, hi=1e10)
+    if_lowpass_order: int | None = spec("if_lowpass_order", "int", "order of the Butterworth "
+                                        "IF low-pass", _PRESET, lo=1, hi=12)
+    adc_bits: int | None = spec("adc_bits", "int", "ADC resolution per I and Q rail", _PRESET,
+                                lo=2, hi=24)
+    adc_full_scale_dbm: float | None = spec("adc_full_scale_dbm", "float", "receiver-input "
+                                            "power of a tone at ADC full scale", _PRESET,
+                                            unit="dBm", lo=-100.0, hi=50.0)
+    temperature_k: float = spec("temperature_k", "float", "noise reference temperature T0",
+                                290.0, unit="K", lo=1.0, hi=1000.0)
+
+
+@dataclass(frozen=True)
+class RtsLinkConfig(Evolvable):
+    """One RTS channel's link: front-end antennas, receive and transmit gain, noise figure and
+    the back end's ADC/DAC full scale (used when ``[radar.link]`` is given).
+
+    Defaults are assumptions for a front end like the paper's with an RFSoC back end
+    (ADC full scale +1 dBm, 14-bit DAC: Xilinx DS926 class); set them from your hardware."""
+
+    fe_rx_antenna_gain_dbi: float = spec("fe_rx_antenna_gain_dbi", "float", "front-end Rx "
+                                         "antenna peak gain", 10.0, unit="dBi", lo=-20.0, hi=50.0)
+    fe_tx_antenna_gain_dbi: float = spec("fe_tx_antenna_gain_dbi", "float", "front-end Tx "
+                                         "antenna peak gain", 10.0, unit="dBi", lo=-20.0, hi=50.0)
+    rx_gain_db: float = spec("rx_gain_db", "float", "gain from the Rx antenna port to the back "
+                             "end's ADC input (LNA, down-conversion, cable)", 30.0, unit="dB",
+                             lo=-50.0, hi=150.0)
+    tx_gain_db: float = spec("tx_gain_db", "float", "gain from the DAC output to the Tx antenna "
+                             "port (up-conversion, PA, cable)", 20.0, unit="dB", lo=-50.0,
+                             hi=150.0)
+    noise_figure_db: float = spec("noise_figure_db", "float", "channel noise figure at the Rx "
+                                  "antenna port", 12.0, unit="dB", lo=0.0, hi=50.0)
+    adc_full_scale_dbm: float = spec("adc_full_scale_dbm", "float", "back-end ADC full scale "
+                                     "(input power of a full-scale tone)", 1.0, unit="dBm",
+                                     lo=-60.0, hi=40.0)
+    dac_full_scale_dbm: float = spec("dac_full_scale_dbm", "float", "back-end DAC output power "
+                                     "of a full-scale tone", 0.0, unit="dBm", lo=-60.0, hi=40.0)
+    dac_bits: int = spec("dac_bits", "int", "DAC resolution (sets the attenuation range: the "
+                         "echo must stay above the DAC's quantisation floor)", 14, lo=2, hi=24)
+
+
+# The RuT presets' link values and where each comes from (rtsgeom.link.radar_link fills the
+# unset [radar.link] fields from them). Datasheet values are as quoted from the TI datasheets
+# (the project's search corpus did not hold them: re-check against the current revision).
+_AWR_DS = "TI AWR1843 datasheet (SWRS222)"
+_HPF = ("HPF1 corner, one of 175/235/350/700 kHz in the device's profile configuration "
+        "(TI mmWave DFP, rlProfileCfg hpfCornerFreq1); the lowest is taken")
+_FS = ("[assumed] receiver-input power of a full-scale tone at a mid Rx gain (~30 dB of the "
+       "24-48 dB range): not in the datasheet; check with the device's Rx saturation monitor")
+_LPF_ORDER = "[assumed] 4th-order Butterworth anti-alias response"
+
+# One entry per antenna preset: the values and where each comes from.
+RADAR_LINK_PRESETS: dict[str, dict] = {
+    "awr1843boost": {
+        "values": {"tx_power_dbm": 12.0, "tx_antenna_gain_dbi": 10.5,
+                   "rx_antenna_gain_dbi": 10.5, "noise_figure_db": 15.0,
+                   "if_highpass_hz": 175e3, "if_lowpass_hz": 10e6, "if_lowpass_order": 4,
+                   "adc_bits": 12, "adc_full_scale_dbm": -25.0},
+        "sources": {"tx_power_dbm": f"{_AWR_DS}: TX power 12 dBm",
+                    "tx_antenna_gain_dbi": "TI xWR1843BOOST user's guide (SPRUIM4): antenna peak "
+                                           "gain > 10.5 dBi (76-81 GHz)",
+                    "rx_antenna_gain_dbi": "as tx_antenna_gain_dbi",
+                    "noise_figure_db": f"{_AWR_DS}: RX noise figure 14 dB (76-77 GHz), 15 dB "
+                                       "(77-81 GHz); 15 dB taken",
+                    "if_highpass_hz": _HPF,
+                    "if_lowpass_hz": f"{_AWR_DS}: IF bandwidth 10 MHz",
+                    "if_lowpass_order": _LPF_ORDER,
+                    "adc_bits": f"{_AWR_DS}: 12-bit ADC samples (adcCfg also offers 14/16-bit "
+                                "output formats)",
+                    "adc_full_scale_dbm": _FS}},
+    "iwr6843isk": {
+        "values": {"tx_power_dbm": 12.0, "tx_antenna_gain_dbi": 7.0, "rx_antenna_gain_dbi": 7.0,
+                   "noise_figure_db": 12.0, "if_highpass_hz": 175e3, "if_lowpass_hz": 10e6,
+                   "if_lowpass_order": 4, "adc_bits": 12, "adc_full_scale_dbm": -25.0},
+        "sources": {"tx_power_dbm": "TI IWR6843 datasheet (SWRS219): TX power 12 dBm",
+                    "tx_antenna_gain_dbi": "[assumed] ~7 dBi patch array of the ISK module",
+                    "rx_antenna_gain_dbi": "[assumed] as tx_antenna_gain_dbi",
+                    "noise_figure_db": "TI IWR6843 datasheet (SWRS219): RX noise figure 12 dB",
+                    "if_highpass_hz": _HPF, "if_lowpass_hz": "TI IWR6843 datasheet: IF bandwidth "
+                                                         "10 MHz",
+                    "if_lowpass_order": _LPF_ORDER, "adc_bits": "as the AWR1843",
+                    "adc_full_scale_dbm": _FS}},
+    "awr2944": {
+        "values": {"tx_power_dbm": 13.0, "tx_antenna_gain_dbi": 10.0,
+                   "rx_antenna_gain_dbi": 10.0, "noise_figure_db": 12.0,
+                   "if_highpass_hz": 175e3, "if_lowpass_hz": 15e6, "if_lowpass_order": 4,
+                   "adc_bits": 12, "adc_full_scale_dbm": -25.0},
+        "sources": {"tx_power_dbm": "TI AWR2944 datasheet (SWRS273): TX power 13 dBm",
+                    "tx_antenna_gain_dbi": "[assumed]", "rx_antenna_gain_dbi": "[assumed]",
+                    "noise_figure_db": "TI AWR2944 datasheet (SWRS273): RX noise figure 12 dB "
+                                       "[re-check]",
+                    "if_highpass_hz": _HPF, "if_lowpass_hz": "TI AWR2944 datasheet: IF bandwidth "
+                                                         "15 MHz [re-check]",
+                    "if_lowpass_order": _LPF_ORDER, "adc_bits": "[assumed] as the AWR1843",
+                    "adc_full_scale_dbm": _FS}},
+    "awr2243-cascade": {
+        "values": {"tx_power_dbm": 13.0, "tx_antenna_gain_dbi": 10.0,
+                   "rx_antenna_gain_dbi": 10.0, "noise_figure_db": 14.0,
+                   "if_highpass_hz": 175e3, "if_lowpass_hz": 20e6, "if_lowpass_order": 4,
+                   "adc_bits": 12, "adc_full_scale_dbm": -25.0},
+        "sources": {"tx_power_dbm": "TI AWR2243 datasheet (SWRS223): TX power 13 dBm",
+                    "tx_antenna_gain_dbi": "[assumed]", "rx_antenna_gain_dbi": "[assumed]",
+                    "noise_figure_db": "TI AWR2243 datasheet (SWRS223): RX noise figure "
+                                       "12-14 dB; 14 dB taken [re-check]",
+                    "if_highpass_hz": _HPF, "if_lowpass_hz": "TI AWR2243 datasheet: IF bandwidth "
+                                                         "20 MHz",
+                    "if_lowpass_order": _LPF_ORDER, "adc_bits": "[assumed] as the AWR1843",
+                    "adc_full_scale_dbm": _FS}},
+}
