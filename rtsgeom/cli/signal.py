@@ -96,11 +96,15 @@ def _calibration_figures(result: RunResult) -> list[bytes]:
     return out
 
 
-def _setup_png(result: RunResult) -> bytes:
+def _setup_png(result: RunResult, paths_method: str) -> bytes:
     from ..viz.scene3d import render_setup_png
+    paths = result.paths
+    if paths_method != "exact":  # the view draws reflections through their hit points,
+        from ..paths import compute_paths  # which the table alone does not carry
+        paths = compute_paths(result.setup, paths_method, for_drawing=True)
     with tempfile.TemporaryDirectory(prefix="rtsgeom-3d-") as tmp:  # private to this run
         return render_setup_png(result.setup, Path(tmp) / "setup.png",
-                                paths=result.paths).read_bytes()
+                                paths=paths).read_bytes()
 
 
 def run_report_html(result: RunResult, maps: dict[str, bytes], paths_method: str,
@@ -113,7 +117,7 @@ def run_report_html(result: RunResult, maps: dict[str, bytes], paths_method: str
     sections = []
     images = []
     try:
-        images.append(_setup_png(result))
+        images.append(_setup_png(result, paths_method))
     except Exception as exc:  # no off-screen OpenGL: the report still has everything else
         warnings = warnings + [f"3D view not rendered: {exc}"]
     sections.append({"heading": "Setup", "images": images,
@@ -233,6 +237,8 @@ def cmd_run(args) -> int:
 
 
 def cmd_adc(args) -> int:
+    if args.format is None:  # from the file name: a .bin is a DCA1000 capture, else .npy
+        args.format = "dca1000" if args.out.suffix.lower() == ".bin" else "npy"
     output_file(args.out, [args.scene])
     if args.format == "dca1000" or args.active is not None:
         output_file(Path(str(args.out) + ".json"), [args.scene])
@@ -285,7 +291,9 @@ def register(sub) -> None:
     p = sub.add_parser("adc", help="save the raw ADC cube (.npy) or a DCA1000 capture")
     scene_arg(p)
     p.add_argument("--out", type=output_path, required=True, help="output file")
-    p.add_argument("--format", choices=("npy", "dca1000"), default="npy")
+    p.add_argument("--format", choices=("npy", "dca1000"), default=None,
+                   help="npy (complex64 cube) or dca1000 (TI's raw int16 capture + sidecar "
+                        "JSON); default: dca1000 for a .bin file, else npy")
     p.add_argument("--amplitudes", choices=modes, default=None,
                    help="AoA amplitude mode (default: the scene's rts.aoa_mode)")
     p.add_argument("--quiet", action="store_true", help="no progress output on stderr")
