@@ -219,3 +219,15 @@ def test_linked_run_warns_on_clipping_and_reports_the_budget():
     assert r.matches[0]["detection"] is not None
     r2 = run_scene(scene, aoa_mode="nearest")
     assert r.cube.data.tobytes() == r2.cube.data.tobytes()
+
+
+@pytest.mark.parametrize("order", [1, 2, 3, 4, 6])
+def test_if_lowpass_is_scipys_butterworth(order):
+    """The written-out Butterworth equals scipy.signal.butter(analog=True) via freqs_zpk."""
+    from scipy.signal import butter, freqs_zpk
+    rl = lk.radar_link(make_scene(lambda d: linked_doc(d, link={"if_lowpass_order": order,
+                                                                "if_highpass_hz": 0.0})).radar)
+    f = np.linspace(-3, 3, 61) * rl.if_lowpass_hz
+    z, p, k = butter(order, 2 * np.pi * rl.if_lowpass_hz, analog=True, output="zpk")
+    _, ref = freqs_zpk(z, p, k, worN=2 * np.pi * f)
+    np.testing.assert_allclose(lk.if_response(rl, f), ref, rtol=1e-10, atol=1e-12)
