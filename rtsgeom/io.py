@@ -42,7 +42,7 @@ __all__ = ["OutputError", "atomic_path", "write_text", "write_bytes", "write_jso
 #: replaced only when it holds nothing else (or carries the marker file): ``--out ~`` must never
 #: swap a user's home folder away.
 OUTPUT_NAMES = re.compile(
-    r"(detections\.csv|summary\.json|report\.html|range_(doppler|angle)\.png|"
+    r"(detections\.csv|summary\.json|report\.html|range_(doppler|angle)\.png|maps\.(npz|mat|nc)|"
     r"calibration(_\d+|_sweep)?\.(png|json)|linearity\.(png|json)|tolerance\.(png|json)|"
     r"design(_\w+)?\.(png|json)|nearfield\.(png|json)|ghosts\.(png|json)|"
     r"\.rtsgeom-output)")

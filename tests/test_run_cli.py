@@ -28,7 +28,7 @@ def two_runs(tmp_path_factory):
 def test_run_writes_the_contract(two_runs):
     out = two_runs[0]
     for name in ("detections.csv", "summary.json", "range_doppler.png", "range_angle.png",
-                 "report.html"):
+                 "maps.npz", "maps.mat", "maps.nc", "report.html"):
         assert (out / name).stat().st_size > 0, name
     rows = list(csv.DictReader((out / "detections.csv").open()))
     assert list(rows[0])[:4] == ["range_m", "velocity_mps", "angle_deg", "power_db"]

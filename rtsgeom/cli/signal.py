@@ -49,23 +49,60 @@ def figure_png(fig) -> bytes:
     return buf.getvalue()
 
 
-def render_maps(result: RunResult) -> dict[str, bytes]:
+def map_dataset(result: RunResult):
+    """The two maps of a run as one ``xarray.Dataset``, in dB: ``range_doppler_db`` (dims
+    ``range_m``, ``velocity_mps``; ``doppler_hz`` a second coordinate on the Doppler axis) and
+    ``range_angle_db`` (dims ``range_m``, ``angle_deg``, -60..60 deg in 0.25 deg steps), from
+    :meth:`RangeDoppler.to_xarray <rtsgeom.radar.processing.RangeDoppler.to_xarray>` and
+    :meth:`~rtsgeom.radar.processing.RangeDoppler.range_angle_to_xarray`. Every variable and
+    coordinate carries ``units``. The PNGs and ``maps.npz|mat|nc`` are drawn from this."""
+    import xarray as xr
+    rd = result.rd
+
+    def to_db(da):  # as RangeDoppler.power_db
+        return 10 * np.log10(np.maximum(da, 1e-30))
+    rdm = to_db(rd.to_xarray()).assign_attrs(
+        units="dB", long_name="range-Doppler power, sum over virtual channels of |X|^2")
+    ram = to_db(rd.range_angle_to_xarray(result.cube)).assign_attrs(
+        units="dB", long_name="beamformer power, each range bin at its strongest Doppler bin")
+    ds = xr.Dataset({"range_doppler_db": rdm, "range_angle_db": ram},
+                    attrs={"scene": result.scene.name, "source": "rtsgeom run"})
+    for name, unit in (("range_m", "m"), ("velocity_mps", "m/s"), ("doppler_hz", "Hz"),
+                       ("angle_deg", "deg")):
+        ds[name].attrs["units"] = unit
+    return ds
+
+
+def maps_arrays(ds) -> dict[str, bytes]:
+    """:func:`map_dataset` as ``maps.npz`` (numpy), ``maps.mat`` (MATLAB: the same variable
+    names, axes as column vectors, a ``units`` struct) and ``maps.nc`` (NetCDF-3 via xarray's
+    scipy engine), as bytes by file name."""
+    import scipy.io
+    arrays = {k: np.asarray(v.values) for k, v in {**ds.coords, **ds.data_vars}.items()}
+    units = {k: (ds[k].attrs["units"]) for k in arrays}
+    npz = io.BytesIO()
+    np.savez(npz, **arrays, units=json.dumps(units))
+    mat = io.BytesIO()
+    scipy.io.savemat(mat, {**arrays, "units": units}, oned_as="column")
+    return {"maps.npz": npz.getvalue(), "maps.mat": mat.getvalue(),
+            "maps.nc": ds.to_netcdf(engine="scipy")}
+
+
+def render_maps(result: RunResult, ds=None) -> dict[str, bytes]:
     """Range-Doppler and range-angle maps as PNG bytes (paper Figs. "Range-Doppler map ..." and
-    "Range angle detections ..."), by file name."""
-    from ..radar.processing import range_angle_map
+    "Range angle detections ..."), by file name; ``ds``: :func:`map_dataset` (computed when
+    not given)."""
     from ..viz.figures import range_angle_figure, range_doppler_figure
+    ds = map_dataset(result) if ds is None else ds
     rd, det, scene = result.rd, result.detections, result.scene
-    f1 = range_doppler_figure(rd.power_db, rd.range_m, rd.velocity_mps,
+    f1 = range_doppler_figure(ds.range_doppler_db.values, rd.range_m, rd.velocity_mps,
                               detections=np.c_[det.range_m, det.velocity_mps],
                               title=f"{scene.name}: range-Doppler map"
                               + (f" (ADC CLIPPED: {result.cube.clipped} samples)"
                                  if result.cube.clipped else ""))
-    angles = np.radians(np.arange(-60.0, 60.01, 0.25))
-    ra = range_angle_map(rd, result.cube, angles)
     sets = np.array([[t.range_m, np.degrees(t.angle_rad)] for t in scene.targets]).reshape(-1, 2)
-    f2 = range_angle_figure(10 * np.log10(np.maximum(ra, 1e-30)), rd.range_m,
-                            np.degrees(angles), detections=np.c_[det.range_m, det.angle_deg],
-                            set_points=sets)
+    f2 = range_angle_figure(ds.range_angle_db.values, rd.range_m, ds.angle_deg.values,
+                            detections=np.c_[det.range_m, det.angle_deg], set_points=sets)
     return {"range_doppler.png": figure_png(f1), "range_angle.png": figure_png(f2)}
 
 
@@ -209,9 +246,10 @@ def cmd_run(args) -> int:
         (stage / "summary.json").write_text(
             json.dumps(summary(result, args.paths), indent=2, allow_nan=False) + "\n",
             encoding="utf-8")
-        maps = render_maps(result)
-        for name, data in maps.items():
-            (stage / name).write_bytes(data)
+        ds = map_dataset(result)
+        maps = render_maps(result, ds)
+        for name, data in {**maps, **maps_arrays(ds)}.items():
+            write_bytes(stage / name, data)
         if not args.no_report:
             step("writing report.html (3D view, figures)")
             (stage / "report.html").write_text(
@@ -232,7 +270,7 @@ def cmd_run(args) -> int:
         for w in result.warnings:
             print(f"warning: {w}")
         print(f"{len(result.detections)} detections; wrote {out}/detections.csv, summary.json, "
-              "range_doppler.png, range_angle.png" + ("" if args.no_report else ", report.html"))
+              "range_doppler.png, range_angle.png, maps.npz|mat|nc" + ("" if args.no_report else ", report.html"))
     return 0
 
 
