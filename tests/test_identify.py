@@ -228,3 +228,12 @@ def test_captures_of_one_front_end_are_fitted_jointly():
     assert two.captures == 2 and one.captures == 1
     assert 1.2 < one.std[1] / two.std[1] < 1.7
     assert abs(two.estimate[1] - truth[0, 1]) < 3 * two.std[1]
+
+
+def test_from_identified_with_pair_all_says_what_to_give(capsys):
+    """--from-identified predicts one pair: with --pair all the error says so (it used to say
+    '--pair all: must be ... or all')."""
+    from rtsgeom.cli import main
+    scene = "scenes/diewald2022.toml"
+    assert main(["calibrate", scene, "--pair", "all", "--from-identified", scene]) == 2
+    assert "give --pair I J" in capsys.readouterr().err

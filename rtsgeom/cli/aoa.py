@@ -62,6 +62,8 @@ def _prepare(args):
 def cmd_calibrate(args) -> int:
     with output_folder(args.out, [args.scene, getattr(args, "from_identified", None)]) as stage:
         if getattr(args, "from_identified", None) is not None:  # no sweep (rtsgeom.identify)
+            if list(args.pair) == ["all"]:
+                raise UsageError("--from-identified predicts one pair's delay: give --pair I J")
             from ..identify import calibrate_from_identified
             scene = load_scene_checked(args.from_identified)
             out = calibrate_from_identified(scene, _pair(build_setup(scene), args.pair))
