@@ -76,11 +76,17 @@ def calibrate(scene: Scene, pair=(0, 1)):
         the sweep (``sweep_delta_tau_s``, ``sweep_error_deg``); ``to_dict()`` gives the JSON of
         ``rtsgeom calibrate``.
     """
-    from .aoa.calibration import calibrate_pair, probe_front_ends
+    from .aoa.calibration import calibrate_pair
+    setup, paths, pair, probe = _pair_setup(scene, pair)
+    return calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
+
+
+def _pair_setup(scene: Scene, pair):
+    """Setup, exact paths, the checked pair and each front end alone as the RuT detects it."""
+    from .aoa.calibration import probe_front_ends
     setup, paths = _setup_paths(scene)
     pair = _check_pair(setup, pair)
-    probe = probe_front_ends(setup, paths, scene.seed)
-    return calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
+    return setup, paths, pair, probe_front_ends(setup, paths, scene.seed)
 
 
 def linearity(scene: Scene, pair=(0, 1), amplitudes: str = "exact", calibration=True,
@@ -107,11 +113,9 @@ def linearity(scene: Scene, pair=(0, 1), amplitudes: str = "exact", calibration=
         ``set_deg``, ``detected_deg``, ``error_deg``, ``amplitude_db`` (2, points) and
         ``max_abs_error_deg``.
     """
-    from .aoa.calibration import calibrate_pair, probe_front_ends
+    from .aoa.calibration import calibrate_pair
     from .aoa.linearity import linearity as _linearity
-    setup, paths = _setup_paths(scene)
-    pair = _check_pair(setup, pair)
-    probe = probe_front_ends(setup, paths, scene.seed)
+    setup, paths, pair, probe = _pair_setup(scene, pair)
     if calibration is True:
         cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
     elif calibration is False or calibration is None:

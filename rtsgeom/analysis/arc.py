@@ -31,7 +31,8 @@ from typing import Callable, Iterator
 import numpy as np
 
 from .._util import frozen
-from .tolerance import CASES, DISTRIBUTIONS, PairPhasors, evaluate_chunk, percentiles
+from .tolerance import (CASES, DISTRIBUTIONS, PairPhasors, evaluate_chunk, largest_passing_scale,
+                        percentiles)
 
 __all__ = ["Bounds", "ArcResult", "arc_draws", "arc_monte_carlo", "arc_models",
            "adjacent_pairs", "max_scale_for_yield"]
@@ -309,20 +310,4 @@ def max_scale_for_yield(models, count: int, bounds: Bounds, draws: int, seed: in
     y0 = yield_at(0.0)
     if y0 < target_yield:
         return result(0.0, y0)
-    lo, y_lo, hi = 0.0, y0, 1.0
-    y_hi = yield_at(hi)
-    while y_hi >= target_yield:
-        if hi >= cap:
-            return result(hi, y_hi, capped=True)
-        lo, y_lo, hi = hi, y_hi, min(2 * hi, cap)
-        y_hi = yield_at(hi)
-    while hi - lo > rel_tol * hi:
-        mid = math.sqrt(lo * hi) if lo > 0 else 0.5 * hi
-        y = yield_at(mid)
-        if y >= target_yield:
-            lo, y_lo = mid, y
-        else:
-            hi = mid
-        if len(history) > 40:
-            break
-    return result(lo, y_lo)
+    return result(*largest_passing_scale(yield_at, y0, target_yield, 1.0, cap, rel_tol))

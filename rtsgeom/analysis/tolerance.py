@@ -471,17 +471,25 @@ def max_sigma_for_yield(model: PairPhasors, sigma_m, draws: int, seed: int, targ
     y0 = yield_at(0.0)
     if y0 < target_yield:
         return result(0.0, y0, note="the setup misses the spec even without the varied errors")
-    lo, y_lo = 0.0, y0
-    hi = float(np.max(base * direction)) or 1e-4
-    hi = min(hi, cap_m)
+    start = min(float(np.max(base * direction)) or 1e-4, cap_m)
+    return result(*largest_passing_scale(yield_at, y0, target_yield, start, cap_m, rel_tol))
+
+
+def largest_passing_scale(yield_at, y0: float, target_yield: float, start: float, cap: float,
+                          rel_tol: float, max_bisections: int = 60) -> tuple[float, float, bool]:
+    """The largest scale t in [0, cap] with ``yield_at(t) >= target_yield`` (``y0`` the yield
+    at 0, which passes): double from ``start`` until the yield drops (or ``cap``: then
+    ``capped``), then bisect geometrically to ``rel_tol``. Common random numbers (the same
+    seed in every evaluation) keep the yield monotone in t. Returns (t, yield, capped)."""
+    lo, y_lo, hi = 0.0, y0, start
     y_hi = yield_at(hi)
     while y_hi >= target_yield:
-        if hi >= cap_m:
-            return result(hi, y_hi, capped=True)
+        if hi >= cap:
+            return hi, y_hi, True
         lo, y_lo = hi, y_hi
-        hi = min(2 * hi, cap_m)
+        hi = min(2 * hi, cap)
         y_hi = yield_at(hi)
-    for _ in range(60):
+    for _ in range(max_bisections):
         if hi - lo <= rel_tol * hi:
             break
         mid = math.sqrt(lo * hi) if lo > 0 else 0.5 * hi
@@ -490,4 +498,4 @@ def max_sigma_for_yield(model: PairPhasors, sigma_m, draws: int, seed: int, targ
             lo, y_lo = mid, y
         else:
             hi = mid
-    return result(lo, y_lo)
+    return lo, y_lo, False
