@@ -341,18 +341,25 @@ def tolerance_histogram_figure(errors_deg_by_case: Mapping[str, object],
     return tolerance_cdf_figure(errors_deg_by_case, spec_deg, title)
 
 
-@_styled
-def design_heatmap_figure(x, y, z, xlabel: str, ylabel: str, zlabel: str, title: str,
-                          mask=None) -> Figure:
-    """Heat map of a figure of merit ``z`` (shape (len(y), len(x))) over two design parameters,
-    e.g. arc radius vs front-end spacing with colour = worst angle error. ``mask`` (same shape,
-    True = excluded, e.g. infeasible) greys out and hatches cells. Labels should carry units."""
+def _design_arrays(x, y, z, mask):
+    """The checked inputs of the design figures: x, y vectors, z (len(y), len(x)) and the
+    exclusion mask of the same shape (all False when None)."""
     xv = _vector("x", x)
     yv = _vector("y", y)
     zv = _grid("z", z, (yv.size, xv.size), "len(y), len(x)")
     m = np.zeros(zv.shape, bool) if mask is None else np.asarray(mask, bool)
     if m.shape != zv.shape:
         raise ValueError(f"mask must have shape {zv.shape}, got {m.shape}")
+    return xv, yv, zv, m
+
+
+@_styled
+def design_heatmap_figure(x, y, z, xlabel: str, ylabel: str, zlabel: str, title: str,
+                          mask=None) -> Figure:
+    """Heat map of a figure of merit ``z`` (shape (len(y), len(x))) over two design parameters,
+    e.g. arc radius vs front-end spacing with colour = worst angle error. ``mask`` (same shape,
+    True = excluded, e.g. infeasible) greys out and hatches cells. Labels should carry units."""
+    xv, yv, zv, m = _design_arrays(x, y, z, mask)
     shown = np.ma.masked_array(zv, mask=m | ~np.isfinite(zv))
     fig, ax = _new_figure()
     ax.set_facecolor("0.85")
@@ -382,12 +389,7 @@ def design_lines_figure(x, y, z, xlabel: str, ylabel: str, zlabel: str, title: s
     """A 1-D design sweep as lines: ``z`` (shape (len(y), len(x))) over whichever of ``x``
     and ``y`` has more than one value, one line per value of the other (a heat map of a
     single row or column shows nothing readable). ``mask`` (True = excluded) is drawn hollow."""
-    xv = _vector("x", x)
-    yv = _vector("y", y)
-    zv = _grid("z", z, (yv.size, xv.size), "len(y), len(x)")
-    m = np.zeros(zv.shape, bool) if mask is None else np.asarray(mask, bool)
-    if m.shape != zv.shape:
-        raise ValueError(f"mask must have shape {zv.shape}, got {m.shape}")
+    xv, yv, zv, m = _design_arrays(x, y, z, mask)
     if xv.size >= yv.size:  # lines over x, one per y
         axis, other, other_label, zz, mm = xv, yv, ylabel, zv, m
         axis_label = xlabel
