@@ -20,11 +20,7 @@ are rejected so a typo never silently falls back to a default.
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import math
-import re
-import stat
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -33,7 +29,8 @@ from scipy.constants import c
 from . import registry
 from .link_config import RadarLinkConfig, RtsLinkConfig
 from .schema import Derived, Evolvable, SceneError, check_fields, read, spec
-from .schema import fmt as _fmt
+from .scene_file import (MAX_KEY_CHARS, MAX_KEY_PARTS, MAX_SCENE_BYTES,  # noqa: F401
+                         decode_toml, read_scene_bytes, resolve_meshes)
 from .scene_hardware import (ArrayConfig, PatternConfig, check_layout_keys,  # noqa: F401
                              resolve_pattern_tables)
 from .scene_rules import (MAX_ADC_SAMPLES, MAX_CALIBRATION_STEPS, arc_centre_m,  # noqa: F401
@@ -51,11 +48,7 @@ WINDOWS = tuple(registry.WINDOWS)
 CFAR_KINDS = tuple(registry.CFAR_KINDS)
 AOA_MODES = tuple(registry.AOA_MODES)
 
-# Resource limits: a scene file is a few kB; these stop a hostile or mistyped file from asking
-# for gigabytes of memory or hours of work before anything is computed.
-MAX_SCENE_BYTES = 4 << 20  # size of a scene file
-MAX_KEY_PARTS = 16  # dotted parts of one TOML key (tomllib is quadratic in them)
-MAX_KEY_CHARS = 1000  # characters of one bare key
+# Resource limits (the file-level ones live in scene_file.py).
 MAX_NAME_CHARS = 200  # ``name`` (printed, may end up in file names)
 MAX_FRONT_ENDS = 256
 MAX_TARGETS = 1024
@@ -457,39 +450,6 @@ class Scene(Evolvable):
 # --------------------------------------------------------------------------------------------
 
 
-def _resolve_meshes(scene: Scene, source: str, base_dir: Path | None,
-                    allow_external_meshes: bool) -> tuple[tuple[str, str], ...]:
-    """Mesh paths, resolved against the scene's folder and (unless allowed) kept inside it.
-
-    A path outside the folder is refused before the file system is asked anything, so the
-    error cannot reveal whether some file elsewhere exists."""
-    base = (base_dir or Path.cwd())
-    out = []
-    for i, st in enumerate(scene.extra_meshes):
-        rel, where = st.mesh, f"structure[{i}].mesh"
-        p = Path(rel)
-        if not allow_external_meshes:
-            if p.is_absolute() or ".." in p.parts or "\0" in rel:
-                raise SceneError(f"{source}: {where} = {_fmt(rel)}: must be a relative path "
-                                 "inside the scene's folder (no absolute path, no '..'; "
-                                 "pass allow_external_meshes to load one from elsewhere)")
-        if not p.is_absolute():
-            p = base / p
-        try:
-            exists = p.is_file()
-            inside = allow_external_meshes or p.resolve().is_relative_to(base.resolve())
-        except (OSError, ValueError, RuntimeError):  # a name too long, a symlink loop
-            exists = inside = False
-        if not inside:
-            raise SceneError(f"{source}: {where} = {_fmt(rel)}: must be a file inside the "
-                             "scene's folder (a link leads out of it)")
-        if not exists:
-            raise SceneError(f"{source}: {where} = {_fmt(rel)}: must be an existing mesh file "
-                             f"in the scene's folder (resolved to {_fmt(str(p))})")
-        out.append((str(p), st.material))
-    return tuple(out)
-
-
 def parse_scene(data: dict, source: str = "<scene>", base_dir: Path | None = None,
                 sha256: str = "", allow_external_meshes: bool = False) -> Scene:
     """Build a validated :class:`Scene` from a parsed TOML document.
@@ -499,37 +459,13 @@ def parse_scene(data: dict, source: str = "<scene>", base_dir: Path | None = Non
     stem = Path(source).stem if source != "<scene>" else "scene"
     scene = read(Scene, data, source, "", {"_stem": stem, "source": source, "sha256": sha256})
     check_layout_keys(data, source)  # the file's keys (a read scene cannot tell them apart)
-    meshes = _resolve_meshes(scene, source, base_dir, allow_external_meshes)
+    meshes = resolve_meshes(scene.extra_meshes, source, base_dir, allow_external_meshes)
     scene = dataclasses.replace(scene, extra_meshes=meshes)
     scene = resolve_pattern_tables(scene, source, base_dir)
     found = problems(scene)
     if found:
         raise SceneError(found[0], found)
     return scene
-
-
-# A dotted key of many parts (``a.a.a. ... = 1``, also in table headers and inline tables):
-# tomllib takes time quadratic in the parts, minutes for a 400 kB line, so they are counted
-# first. The lookbehind anchors the search at the start of a key and the possessive
-# quantifiers keep the scan linear.
-_DOTTED = re.compile(r"""(?<![\w"'-])(?:(?:[\w-]++|"[^"\\\n]*+"|'[^'\n]*+')[ \t]*+\.[ \t]*+)"""
-                     + "{%d}" % MAX_KEY_PARTS)
-_LONG_KEY = re.compile(r"^[ \t]*+\[*+[ \t]*+[\w-]{%d}" % (MAX_KEY_CHARS + 1), re.MULTILINE)
-
-
-def _prescan(text: str, source: str) -> None:
-    """Refuse keys TOML would take minutes to parse: too many dotted parts, too long."""
-    m = _DOTTED.search(text)
-    if m:
-        line = text.count("\n", 0, m.start()) + 1
-        raise SceneError(f"{source}: line {line}: a key of more than {MAX_KEY_PARTS} dotted "
-                         f"parts ({_fmt(m.group(0))}...): scene keys are at most "
-                         f"{MAX_KEY_PARTS} deep")
-    m = _LONG_KEY.search(text)
-    if m:
-        line = text.count("\n", 0, m.start()) + 1
-        raise SceneError(f"{source}: line {line}: a key of more than {MAX_KEY_CHARS} "
-                         f"characters ({_fmt(m.group(0).strip())}...): no scene key is that long")
 
 
 def loads_scene(raw: bytes | str, source: str = "<scene>", base_dir: Path | None = None,
@@ -540,44 +476,11 @@ def loads_scene(raw: bytes | str, source: str = "<scene>", base_dir: Path | None
     directory); meshes must lie inside it unless ``allow_external_meshes``. A UTF-8 byte-order
     mark is accepted.
     """
-    if isinstance(raw, str):
-        raw = raw.encode("utf-8", "surrogatepass")
-    if len(raw) > MAX_SCENE_BYTES:
-        raise SceneError(f"{source}: scene file too large ({len(raw)} bytes; at most "
-                         f"{MAX_SCENE_BYTES})")
-    try:
-        text = raw.decode("utf-8-sig")
-        _prescan(text, source)
-        data = tomllib.loads(text)
-    except UnicodeDecodeError as exc:
-        raise SceneError(f"{source}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
-    except SceneError:
-        raise
-    except ValueError as exc:  # TOMLDecodeError, or an integer of more than 4300 digits
-        raise SceneError(f"{source}: not valid TOML ({str(exc)[:200]})") from None
-    except RecursionError:
-        raise SceneError(f"{source}: not valid TOML (arrays or tables nested too deeply)") from None
-    return parse_scene(data, source, base_dir, hashlib.sha256(raw).hexdigest(),
-                       allow_external_meshes)
+    data, sha256 = decode_toml(raw, source)
+    return parse_scene(data, source, base_dir, sha256, allow_external_meshes)
 
 
 def load_scene(path: str | Path, allow_external_meshes: bool = False) -> Scene:
     """Load and validate a scene file (TOML, parsed with the standard library's safe loader)."""
-    p = Path(path)
-    try:
-        st = p.stat()
-        if stat.S_ISDIR(st.st_mode):
-            raise SceneError(f"{p}: cannot read scene file (it is a directory)")
-        if not stat.S_ISREG(st.st_mode):
-            raise SceneError(f"{p}: cannot read scene file (not a regular file)")
-        with p.open("rb") as fh:
-            raw = fh.read(MAX_SCENE_BYTES + 1)
-        base = p.resolve().parent
-    except SceneError:
-        raise
-    except OSError as exc:
-        raise SceneError(f"{p}: cannot read scene file ({exc.strerror or exc})") from None
-    except (ValueError, RuntimeError) as exc:  # embedded NUL byte; symlink loop
-        raise SceneError(f"{_fmt(str(p))}: cannot read scene file ({exc})") from None
-    return loads_scene(raw, str(p), base, allow_external_meshes)
-
+    raw, base = read_scene_bytes(path)
+    return loads_scene(raw, str(Path(path)), base, allow_external_meshes)

@@ -16,7 +16,8 @@ import numpy as np
 
 from .geometry import build_setup
 from .geometry.farfield import angular_resolution_rad, fraunhofer_distance_m
-from .scene import Scene, _fmt
+from .scene import Scene
+from .schema import fmt as _fmt
 
 __all__ = ["scene_warnings", "height_phase_deg"]
 
