@@ -22,9 +22,9 @@ channels' own output noise, re-radiated to the RuT, :func:`channel_noise_w`) is 
 IF chain, so it is shaped by the same response (:func:`shaped_noise`); the ADC then clips each
 rail at full scale and quantises (:func:`adc_convert`).
 
-Values of the presets are datasheet values where a source is named and assumptions where
-marked ``[assumed]``; the search corpus of this project did not hold the TI datasheets, so the
-datasheet values are as quoted from them and should be re-checked against the current revision.
+Values of the presets are datasheet values where a source (document and section) is named,
+assumptions where marked ``[assumed]``, and values not yet verified against the datasheet's text
+where marked ``[re-check]`` (:data:`rtsgeom.link_config.RADAR_LINK_PRESETS` says what was tried).
 """
 
 from __future__ import annotations
