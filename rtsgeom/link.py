@@ -134,14 +134,15 @@ def beat_hz(echoes: Echoes, radar) -> np.ndarray:
 
 def apply_radar_link(echoes: Echoes, scene, link: RadarLink | None = None) -> Echoes:
     """Echoes as amplitudes (sqrt W) after the RuT's IF chain, referred to the receiver input:
-    times ``sqrt(P_t G_t G_r)``, the sheet's reflection loss per setup echo, and the IF
-    response at each echo's beat frequency."""
+    times ``sqrt(P_t G_t G_r)`` and the IF response at each echo's beat frequency. Absorbers
+    (``sheet.reflection_loss_db``, ``[[structure]] reflection_loss_db``) are already in the
+    path gains, per bounce off the surface that carries them (the ray tracer, the sheet's
+    physical-optics echo)."""
     link = link or radar_link(scene.radar)
     if len(echoes) == 0:
         return echoes
     g = np.sqrt(link.tx_power_w * link.tx_gain * link.rx_gain)
-    loss = np.where(echoes.kind == KIND_SETUP, 10 ** (-scene.sheet.reflection_loss_db / 20), 1.0)
-    return echoes.scaled(g * loss[:, None] * if_response(link, beat_hz(echoes, scene.radar)))
+    return echoes.scaled(g * if_response(link, beat_hz(echoes, scene.radar)))
 
 
 def thermal_noise_w(radar, link: RadarLink | None = None) -> float:

@@ -363,9 +363,9 @@ class SheetConfig(Evolvable):
     material: str = spec("material", "material", "radio material (Sionna RT)", "itu_metal",
                          max_chars=MAX_NAME_CHARS)
     reflection_loss_db: float = spec("reflection_loss_db", "float", "extra loss per reflection "
-                                     "off the sheet (an absorber covering it); applied to the "
-                                     "setup echoes with [radar.link]", 0.0, unit="dB",
-                                     lo=0.0, hi=100.0)
+                                     "off the sheet (an absorber covering it), on every "
+                                     "ray-traced path that bounces off it and on the sheet's "
+                                     "physical-optics echo", 0.0, unit="dB", lo=0.0, hi=100.0)
 
 
 @dataclass(frozen=True)
@@ -416,6 +416,10 @@ class StructureConfig:
     mesh: str = spec("mesh", "str", "mesh file, relative to the scene's folder and inside it")
     material: str = spec("material", "material", "radio material (Sionna RT)", "itu_metal",
                          max_chars=MAX_NAME_CHARS)
+    reflection_loss_db: float = spec("reflection_loss_db", "float", "extra loss per reflection "
+                                     "off this structure (an absorber covering it), on every "
+                                     "ray-traced path that bounces off it", 0.0, unit="dB",
+                                     lo=0.0, hi=100.0)
 
 
 @dataclass(frozen=True)
@@ -437,7 +441,7 @@ class Scene(Evolvable):
     source: str | None = None
     sha256: str = ""
     description: str = spec("description", "str", "free text", "")
-    extra_meshes: tuple[tuple[str, str], ...] = spec(  # (absolute path, material)
+    extra_meshes: tuple[tuple[str, str, float], ...] = spec(  # (absolute path, material, loss dB)
         "structure", "tables", "[[structure]] extra meshes for ray tracing", [],
         cls=StructureConfig, max_items=MAX_TARGETS, item="structure")
 
@@ -458,7 +462,7 @@ class Scene(Evolvable):
 
 
 def _resolve_meshes(scene: Scene, source: str, base_dir: Path | None,
-                    allow_external_meshes: bool) -> tuple[tuple[str, str], ...]:
+                    allow_external_meshes: bool) -> tuple[tuple[str, str, float], ...]:
     """Mesh paths, resolved against the scene's folder and (unless allowed) kept inside it.
 
     A path outside the folder is refused before the file system is asked anything, so the
@@ -486,7 +490,7 @@ def _resolve_meshes(scene: Scene, source: str, base_dir: Path | None,
         if not exists:
             raise SceneError(f"{source}: {where} = {_fmt(rel)}: must be an existing mesh file "
                              f"in the scene's folder (resolved to {_fmt(str(p))})")
-        out.append((str(p), st.material))
+        out.append((str(p), st.material, float(st.reflection_loss_db)))
     return tuple(out)
 
 
