@@ -41,7 +41,7 @@ from .schema import SceneError
 __all__ = ["RADAR_LINK_PRESETS", "RadarLink", "LinkError", "LinkBudget", "radar_link",
            "if_response", "apply_radar_link", "thermal_noise_w", "shaped_noise", "adc_convert",
            "channel_table", "check_channels", "channel_noise_w", "window_snr_loss",
-           "link_budget", "dbm", "link_warnings"]
+           "link_budget", "dbm", "link_warnings", "relative_noise_power"]
 
 class LinkError(SceneError):
     """A target the RTS cannot produce with its gains and dynamic range (names the field)."""
@@ -149,6 +149,29 @@ def thermal_noise_w(radar, link: RadarLink | None = None) -> float:
     """Receiver noise per complex sample at the receiver input: ``k T0 F f_adc``."""
     link = link or radar_link(radar)
     return float(K_BOLTZMANN * link.temperature_k * link.noise_figure * radar.adc_rate_hz)
+
+
+def relative_noise_power(scene, amp_power, beat_hz) -> np.ndarray:
+    """The link's noise per complex sample in the signal model's *relative* units (transmit
+    power 1, isotropic RuT, before the IF chain): what ``snr_db`` would otherwise set, for the
+    models that work in those units (the calibration's phasor sweep).
+
+    An echo of relative amplitude ``a`` reaches the ADC as ``a sqrt(P_t G_t G_r) H(f_b)``; the
+    noise there is ``(N_th + N_ch) |H(f_b)|^2 + N_q`` (thermal and RTS channel noise shaped by
+    the IF chain, quantisation after it). Referred back::
+
+        N_rel = (N_th + N_ch) / (P_t G_t G_r) + N_q / (P_t G_t G_r |H(f_b)|^2)
+
+    ``amp_power``: the sum of the programmed RTS rows' squared amplitudes (any shape; the
+    channels' re-radiated noise :func:`channel_noise_w` is linear in it); ``beat_hz``: the
+    echo's beat frequency (broadcast against ``amp_power``)."""
+    link = radar_link(scene.radar)
+    g = link.tx_power_w * link.tx_gain * link.rx_gain
+    unit = RtsProgram.build([0], [0], [0.0], [0.0], [1.0])
+    n_ch = channel_noise_w(scene, unit, link) * np.asarray(amp_power, float)
+    h2 = np.abs(if_response(link, beat_hz)) ** 2
+    with np.errstate(divide="ignore"):
+        return (thermal_noise_w(scene.radar, link) + n_ch) / g + link.quantisation_noise_w / (g * h2)
 
 
 def shaped_noise(shape, power_w: float, link: RadarLink, radar, rng: np.random.Generator
