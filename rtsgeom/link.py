@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.constants import c, k as K_BOLTZMANN
 
-from .link_config import RADAR_LINK_PRESETS
+from .link_config import FE_ANTENNA_GAIN_DBI, RADAR_LINK_PRESETS
 from .rts import KIND_DIRECT, KIND_SETUP, Echoes, RtsProgram
 from .schema import SceneError
 
@@ -94,6 +94,10 @@ def radar_link(radar) -> RadarLink:
     cfg = radar.link
     v = dict(preset["values"])
     src = dict(preset["sources"])
+    if _has_pattern(radar):  # the paths carry the pattern's gain toward each front end
+        for name in ("tx_antenna_gain_dbi", "rx_antenna_gain_dbi"):
+            v[name], src[name] = 0.0, ("[radar.pattern]: its gain toward each front end (in the "
+                                       "paths, its dB read as dBi) is the antenna's; 0 dBi on top")
     if cfg is not None:
         for name in v:
             x = getattr(cfg, name)
@@ -106,6 +110,48 @@ def radar_link(radar) -> RadarLink:
         if_lowpass_order=int(v["if_lowpass_order"]), adc_bits=int(v["adc_bits"]),
         adc_full_scale_w=_w(v["adc_full_scale_dbm"]),
         temperature_k=cfg.temperature_k if cfg is not None else 290.0, sources=src)
+
+
+def _has_pattern(section) -> bool:
+    """A ``[radar.pattern]`` / ``[rts.pattern]`` other than isotropic."""
+    p = getattr(section, "pattern", None)
+    return p is not None and p.kind != "isotropic"
+
+
+def fe_gain_db(scene) -> tuple[float, float]:
+    """The front ends' scalar antenna gains (Rx, Tx) in dBi, on top of ``[rts.pattern]`` (which
+    the paths carry): the scene's ``[rts.link]`` values, else 10 dBi, or 0 dBi with a pattern
+    (the pattern's gain toward the RuT is then the antenna's)."""
+    rl = scene.rts.link
+    dflt = 0.0 if _has_pattern(scene.rts) else FE_ANTENNA_GAIN_DBI
+    return (dflt if rl.fe_rx_antenna_gain_dbi is None else float(rl.fe_rx_antenna_gain_dbi),
+            dflt if rl.fe_tx_antenna_gain_dbi is None else float(rl.fe_tx_antenna_gain_dbi))
+
+
+def pattern_gains(scene, setup=None) -> dict:
+    """Per front end (F,): the patterns' power gains ``|f|^2`` that the exact paths carry (the
+    same :func:`rtsgeom.paths.exact.leg_pattern_gains`), each antenna toward the other, averaged
+    over the RuT's elements: ``rut_tx``/``rut_rx`` (the RuT's pattern toward front end q),
+    ``fe_rx``/``fe_tx`` (front end q's pattern toward the RuT). Ones where isotropic (no setup
+    is built then); ``setup`` defaults to ``build_setup(scene)``."""
+    from .geometry.patterns import ISOTROPIC, AntennaPatterns, scene_patterns
+    n = len(scene.rts.front_ends)
+    pats = scene_patterns(scene)
+    out = {k: np.ones(n) for k in ("rut_tx", "rut_rx", "fe_rx", "fe_tx")}
+    if pats.isotropic:
+        return out
+    if setup is None:
+        from .geometry import build_setup
+        setup = build_setup(scene)
+    from .paths.exact import leg_pattern_gains
+    rut_only = AntennaPatterns(rut_tx=pats.rut_tx, rut_rx=pats.rut_rx)
+    fe_only = AntennaPatterns(fe_rx=pats.fe_rx, fe_tx=pats.fe_tx, rut_tx=ISOTROPIC,
+                              rut_rx=ISOTROPIC)
+    for (tx_key, rx_key), p in ((("rut_tx", "rut_rx"), rut_only), (("fe_rx", "fe_tx"), fe_only)):
+        g_tx, g_rx = leg_pattern_gains(setup, p)
+        out[tx_key] = np.mean(np.abs(g_tx) ** 2, axis=1)
+        out[rx_key] = np.mean(np.abs(g_rx) ** 2, axis=1)
+    return out
 
 
 def if_response(link: RadarLink, f_hz) -> np.ndarray:
@@ -168,7 +214,7 @@ def relative_noise_power(scene, amp_power, beat_hz) -> np.ndarray:
     link = radar_link(scene.radar)
     g = link.tx_power_w * link.tx_gain * link.rx_gain
     unit = RtsProgram.build([0], [0], [0.0], [0.0], [1.0])
-    n_ch = channel_noise_w(scene, unit, link) * np.asarray(amp_power, float)
+    n_ch = channel_noise_w(scene, unit, link) * np.asarray(amp_power, float)  # front end 0's patterns
     h2 = np.abs(if_response(link, beat_hz)) ** 2
     with np.errstate(divide="ignore"):
         return (thermal_noise_w(scene.radar, link) + n_ch) / g + link.quantisation_noise_w / (g * h2)
@@ -202,47 +248,60 @@ def adc_convert(data: np.ndarray, link: RadarLink) -> tuple[np.ndarray, int]:
 # ------------------------------------------------------------------------------------------
 
 
-def channel_table(scene, program: RtsProgram, link: RadarLink | None = None) -> dict:
-    """Per program row: the RTS channel's levels and the attenuation realising eq. (3).
+def channel_table(scene, program: RtsProgram, link: RadarLink | None = None,
+                  setup=None) -> dict:
+    """Per front end and per program row: the RTS channel's levels and the attenuation
+    realising eq. (3).
 
-    ``input_dbm``: the RuT's chirp at the back end's ADC (RuT Tx peak EIRP over the nominal
-    arc radius, FE Rx antenna, receive gain); ``electronic_gain_db``: the programmed field gain
-    without the FE antennas; ``attenuation_db``: what the back end applies, ``rx + tx gain +
-    DAC FS - ADC FS - electronic gain``; ``max_attenuation_db``: down to the DAC's
-    quantisation floor (``6.02 bits + 1.76`` dB below full scale) from the level the ADC
-    delivers, counted in the RuT's IF bandwidth (the DAC's noise spreads over ``f_s / 2``, the
-    RuT samples ``f_adc`` of it: ``+ 10 log10(f_s / (2 f_adc))``). Feasible when ``0 <= attenuation_db <= max_attenuation_db``.
+    ``input_dbm`` (F,): the RuT's chirp at each back end's ADC (RuT Tx EIRP toward front end q
+    over the nominal arc radius, FE Rx antenna toward the RuT, receive gain; the antennas' gains
+    are the scalars times the patterns' :func:`pattern_gains`); ``level_dbfs`` (F,) that over
+    the ADC's full scale; per row ``electronic_gain_db``: the programmed field gain without the
+    FE antennas' scalar gains (their patterns are in the paths, so not in the program);
+    ``attenuation_db``: what the back end applies, ``rx + tx gain + DAC FS - ADC FS -
+    electronic gain``; ``max_attenuation_db`` (per row; ``max_attenuation_fe_db`` per front
+    end): down to the DAC's quantisation floor (``6.02 bits + 1.76`` dB below full scale) from
+    the level the ADC delivers, counted in the RuT's IF bandwidth (the DAC's noise spreads over
+    ``f_s / 2``, the RuT samples ``f_adc`` of it: ``+ 10 log10(f_s / (2 f_adc))``). Feasible
+    when ``0 <= attenuation_db <= max_attenuation_db``.
     """
     link = link or radar_link(scene.radar)
     rl = scene.rts.link
+    fe_rx_db, fe_tx_db = fe_gain_db(scene)
+    pg = pattern_gains(scene, setup)
     lam = c / scene.radar.f_center_hz
     path_db = 20 * np.log10(lam / (4 * np.pi * scene.rts.arc_radius_m))
-    eirp_dbm = float(dbm(link.tx_power_w * link.tx_gain))
-    input_dbm = eirp_dbm + path_db + rl.fe_rx_antenna_gain_dbi + rl.rx_gain_db
+    eirp_dbm = dbm(link.tx_power_w * link.tx_gain * pg["rut_tx"])  # (F,) toward each FE
+    input_dbm = eirp_dbm + path_db + fe_rx_db + 10 * np.log10(pg["fe_rx"]) + rl.rx_gain_db
     level_dbfs = input_dbm - rl.adc_full_scale_dbm
     with np.errstate(divide="ignore"):
         amp_db = 20 * np.log10(np.abs(program.amplitude))
-    elec = amp_db - rl.fe_rx_antenna_gain_dbi - rl.fe_tx_antenna_gain_dbi
+    elec = amp_db - fe_rx_db - fe_tx_db
     max_gain = rl.rx_gain_db + rl.tx_gain_db + rl.dac_full_scale_dbm - rl.adc_full_scale_dbm
     # the echo must stay above the DAC's quantisation noise inside the RuT's IF bandwidth: the
     # noise (6.02 b + 1.76 dB below full scale) spreads over f_s/2; the RuT sees f_adc of it
     dr = (6.02 * rl.dac_bits + 1.76
           + 10 * np.log10(scene.rts.f_s_hz / (2 * scene.radar.adc_rate_hz)))
+    mx_fe = dr + np.minimum(level_dbfs, 0.0)
     return {"input_dbm": input_dbm, "level_dbfs": level_dbfs, "electronic_gain_db": elec,
-            "attenuation_db": max_gain - elec, "max_attenuation_db": dr + min(level_dbfs, 0.0),
-            "max_gain_db": max_gain}
+            "attenuation_db": max_gain - elec,
+            "max_attenuation_db": mx_fe[np.asarray(program.front_end, int)],
+            "max_attenuation_fe_db": mx_fe, "max_gain_db": max_gain,
+            "fe_antenna_gain_dbi": (fe_rx_db, fe_tx_db), "pattern_gains": pg}
 
 
-def check_channels(scene, program: RtsProgram, link: RadarLink | None = None) -> dict:
+def check_channels(scene, program: RtsProgram, link: RadarLink | None = None,
+                   setup=None) -> dict:
     """:func:`channel_table`, raising :class:`LinkError` where the back end clips on the RuT's
     chirp or a target's RCS at its range is beyond the channel's gain range."""
-    t = channel_table(scene, program, link)
+    t = channel_table(scene, program, link, setup)
     src = scene.source or "<scene>"
-    if t["level_dbfs"] > 0:
+    if np.any(t["level_dbfs"] > 0):
+        q = int(np.argmax(t["level_dbfs"]))
         raise LinkError(f"{src}: rts.link.rx_gain_db = {scene.rts.link.rx_gain_db:g}: must be "
-                        f"<= {scene.rts.link.rx_gain_db - t['level_dbfs']:.1f} dB: the RuT's "
-                        f"chirp reaches the back end's ADC at {t['input_dbm']:.1f} dBm, above its "
-                        f"full scale rts.link.adc_full_scale_dbm")
+                        f"<= {scene.rts.link.rx_gain_db - t['level_dbfs'][q]:.1f} dB: the RuT's "
+                        f"chirp reaches front end {q}'s back-end ADC at {t['input_dbm'][q]:.1f} "
+                        f"dBm, above its full scale rts.link.adc_full_scale_dbm")
     att, mx = t["attenuation_db"], t["max_attenuation_db"]
     # too little attenuation on any row: the RCS is too large; too much on a target's
     # strongest row: too small (a weak AoA-weight row below the DAC floor is only imprecise)
@@ -254,30 +313,36 @@ def check_channels(scene, program: RtsProgram, link: RadarLink | None = None) ->
         i = int(program.target[row])
         tg = scene.targets[i] if i < len(scene.targets) else None
         rcs = tg.rcs_dbsm if tg is not None else float("nan")
-        lo, hi = rcs - (mx - att[row]), rcs + att[row]  # amplitude ~ sqrt(sigma): dB for dB
+        lo, hi = rcs - (mx[row] - att[row]), rcs + att[row]  # amplitude ~ sqrt(sigma): dB for dB
         rng = tg.range_m if tg is not None else float("nan")
         raise LinkError(f"{src}: targets[{i}].rcs_dbsm = {rcs:g}: must be in [{lo:.1f}, "
                         f"{hi:.1f}] dBsm at range_m = {rng:g} on RTS channel "
                         f"{int(program.front_end[row])} (attenuation {att[row]:.1f} dB needed; "
-                        f"the back end offers [0, {mx:.1f}] dB with rts.link gains, full scales "
+                        f"the back end offers [0, {mx[row]:.1f}] dB with rts.link gains, full scales "
                         f"and dac_bits)")
     return t
 
 
-def channel_noise_w(scene, program: RtsProgram, link: RadarLink | None = None) -> float:
+def channel_noise_w(scene, program: RtsProgram, link: RadarLink | None = None,
+                    setup=None) -> float:
     """Output noise of the programmed RTS channels at the RuT's receiver input, per sample:
-    ``k T0 F_ch f_adc`` at the FE Rx port, times each row's channel gain (field gain incl. FE
-    antennas, as programmed) squared, the nominal FE -> RuT path and the RuT's Rx antenna.
-    Rows are independent noise (different delays), so powers add."""
+    ``k T0 F_ch f_adc`` at the FE Rx port, times each row's electronic gain squared, the FE Tx
+    antenna, the nominal FE -> RuT path and the RuT's Rx antenna (scalars times the patterns'
+    :func:`pattern_gains` of the row's front end). Rows are independent noise (different
+    delays), so powers add."""
     link = link or radar_link(scene.radar)
     if len(program) == 0:
         return 0.0
     rl = scene.rts.link
+    fe_rx_db, _ = fe_gain_db(scene)
+    pg = pattern_gains(scene, setup)
     lam = c / scene.radar.f_center_hz
     leg = (lam / (4 * np.pi * scene.rts.arc_radius_m)) ** 2
     n_in = K_BOLTZMANN * link.temperature_k * 10 ** (rl.noise_figure_db / 10) * scene.radar.adc_rate_hz
-    # programmed gain includes both FE antennas; the noise enters at the Rx port (no Rx antenna)
-    g2 = np.abs(program.amplitude) ** 2 / 10 ** (rl.fe_rx_antenna_gain_dbi / 10)
+    # |electronic gain|^2 x FE Tx scalar = |programmed amplitude|^2 / FE Rx scalar
+    q = np.asarray(program.front_end, int)
+    g2 = (np.abs(program.amplitude) ** 2 / 10 ** (fe_rx_db / 10)
+          * pg["fe_tx"][q] * pg["rut_rx"][q])
     return float(n_in * np.sum(g2) * leg * link.rx_gain)
 
 
@@ -343,7 +408,8 @@ def _entry(p_in_w, h2, noise_w, nq, fs_w, gain_db) -> dict:
 
 def link_budget(scene, echoes: Echoes, program: RtsProgram, linked: bool,
                 noise_override_w: float | None = None,
-                estimated_setup: Echoes | None = None, predict: bool = False) -> LinkBudget:
+                estimated_setup: Echoes | None = None, predict: bool = False,
+                setup=None) -> LinkBudget:
     """The budget per target (its direct echoes, summed coherently over its channels per
     virtual channel, power averaged over the virtual channels), per setup echo and per front
     end. ``echoes`` are the run's: already through :func:`apply_radar_link` when ``linked``
@@ -363,7 +429,7 @@ def link_budget(scene, echoes: Echoes, program: RtsProgram, linked: bool,
     with np.errstate(invalid="ignore", divide="ignore"):
         p_in = np.mean(np.abs(e.amplitude) ** 2, axis=1) / np.where(h2 > 0, h2, 1.0)
     n_th = thermal_noise_w(radar, link)
-    n_ch = channel_noise_w(scene, program, link) if len(program) else 0.0
+    n_ch = channel_noise_w(scene, program, link, setup) if len(program) else 0.0
     if noise_override_w is not None:
         noise, src = noise_override_w, ("snr_db override: fixed per-sample SNR of the strongest "
                                         "target echo (not the physical noise)")
@@ -390,10 +456,10 @@ def link_budget(scene, echoes: Echoes, program: RtsProgram, linked: bool,
                      link.adc_full_scale_w, gain_db)
         targets.append({"index": i, "range_m": t.range_m, "rcs_dbsm": t.rcs_dbsm,
                         "beat_hz": float(np.mean(f_b[sel])), **ent})
-    setup = []
+    rows_setup = []
     for j in np.flatnonzero(raw.kind == KIND_SETUP):
         ent = _entry(float(p_in[j]), float(h2[j]), noise, nq, link.adc_full_scale_w, gain_db)
-        setup.append({"index": len(setup), "range_m": float(np.mean(raw.tau_s[j]) * c / 2),
+        rows_setup.append({"index": len(rows_setup), "range_m": float(np.mean(raw.tau_s[j]) * c / 2),
                       "beat_hz": float(np.mean(f_b[j])), "in_signal": True, **ent})
     if estimated_setup is not None and len(estimated_setup):
         est = apply_radar_link(estimated_setup, scene, link)
@@ -402,18 +468,24 @@ def link_budget(scene, echoes: Echoes, program: RtsProgram, linked: bool,
         for j in range(len(est)):
             p = float(np.mean(np.abs(est.amplitude[j]) ** 2)) / hh[j]
             ent = _entry(p, float(hh[j]), noise, nq, link.adc_full_scale_w, gain_db)
-            setup.append({"index": len(setup), "range_m": float(np.mean(
+            rows_setup.append({"index": len(rows_setup), "range_m": float(np.mean(
                 estimated_setup.tau_s[j]) * c / 2), "beat_hz": float(np.mean(fe_b[j])),
                 "in_signal": False, "source": "sheet, physical-optics estimate", **ent})
     fes = []
     if len(scene.rts.front_ends):
-        tab = channel_table(scene, program, link)
+        tab = channel_table(scene, program, link, setup)
+        pg, (fe_rx_db, fe_tx_db) = tab["pattern_gains"], tab["fe_antenna_gain_dbi"]
         for q in range(len(scene.rts.front_ends)):
             rows = program.front_end == q
-            fes.append({"index": q, "rut_chirp_at_adc_dbm": tab["input_dbm"],
-                        "adc_level_dbfs": tab["level_dbfs"],
-                        "max_attenuation_db": tab["max_attenuation_db"],
-                        "attenuation_db": [float(a) for a in tab["attenuation_db"][rows]]})
+            fes.append({"index": q, "rut_chirp_at_adc_dbm": float(tab["input_dbm"][q]),
+                        "adc_level_dbfs": float(tab["level_dbfs"][q]),
+                        "max_attenuation_db": float(tab["max_attenuation_fe_db"][q]),
+                        "attenuation_db": [float(a) for a in tab["attenuation_db"][rows]],
+                        # each antenna's gain toward the other (scalar x pattern), dBi
+                        "rut_tx_gain_dbi": float(10 * np.log10(link.tx_gain * pg["rut_tx"][q])),
+                        "rut_rx_gain_dbi": float(10 * np.log10(link.rx_gain * pg["rut_rx"][q])),
+                        "fe_rx_gain_dbi": float(fe_rx_db + 10 * np.log10(pg["fe_rx"][q])),
+                        "fe_tx_gain_dbi": float(fe_tx_db + 10 * np.log10(pg["fe_tx"][q]))})
     rad = {"tx_power_dbm": float(dbm(link.tx_power_w)),
            "tx_antenna_gain_dbi": float(10 * np.log10(link.tx_gain)),
            "rx_antenna_gain_dbi": float(10 * np.log10(link.rx_gain)),
@@ -422,7 +494,7 @@ def link_budget(scene, echoes: Echoes, program: RtsProgram, linked: bool,
            "adc_bits": link.adc_bits, "adc_full_scale_dbm": float(dbm(link.adc_full_scale_w)),
            "thermal_noise_dbm_per_sample": float(dbm(n_th)),
            "rts_noise_dbm_per_sample": float(dbm(n_ch)), "sources": link.sources}
-    return LinkBudget(linked, src, float(noise), nq, gain_db, rad, fes, targets, setup)
+    return LinkBudget(linked, src, float(noise), nq, gain_db, rad, fes, targets, rows_setup)
 
 
 def link_warnings(budget: LinkBudget, threshold_db: float) -> list[str]:
@@ -488,7 +560,7 @@ def static_budget(setup) -> LinkBudget:
     if scene.radar.link is not None:  # the sheet's physical-optics estimate costs ~1 s
         sp = sheet_paths(setup)
         est = setup_echoes(setup, sp) if sp is not None else None
-    return link_budget(scene, echoes, program, False, None, est, predict=True)
+    return link_budget(scene, echoes, program, False, None, est, predict=True, setup=setup)
 
 
 def _f1(x) -> str:
@@ -510,7 +582,10 @@ def format_budget(b: dict) -> list[str]:
         att = ", ".join(_f1(a) for a in fe["attenuation_db"]) or "-"
         lines.append(f"  front end {fe['index']}: RuT chirp at the back end's ADC "
                      f"{_f1(fe['rut_chirp_at_adc_dbm'])} dBm ({_f1(fe['adc_level_dbfs'])} dBFS), "
-                     f"attenuation {att} dB of at most {_f1(fe['max_attenuation_db'])} dB")
+                     f"attenuation {att} dB of at most {_f1(fe['max_attenuation_db'])} dB; "
+                     f"antennas toward each other: RuT {_f1(fe.get('rut_tx_gain_dbi'))}/"
+                     f"{_f1(fe.get('rut_rx_gain_dbi'))} dBi, front end "
+                     f"{_f1(fe.get('fe_rx_gain_dbi'))}/{_f1(fe.get('fe_tx_gain_dbi'))} dBi")
     for kind, rows in (("target", b["targets"]), ("setup echo", b["setup_echoes"])):
         for t in rows:
             if t.get("adc_power_dbm") is None:

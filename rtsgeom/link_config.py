@@ -15,9 +15,14 @@ from dataclasses import dataclass
 
 from .schema import Derived, Evolvable, spec
 
-__all__ = ["RadarLinkConfig", "RtsLinkConfig", "RADAR_LINK_PRESETS"]
+__all__ = ["RadarLinkConfig", "RtsLinkConfig", "RADAR_LINK_PRESETS", "FE_ANTENNA_GAIN_DBI"]
 
 _PRESET = Derived("the antenna preset's value (rtsgeom.link.RADAR_LINK_PRESETS)", lambda v: None)
+_RUT_GAIN = Derived("the preset's peak gain; 0 with a [radar.pattern]: the pattern's gain toward "
+                    "each front end (its dB read as dBi) is the antenna's", lambda v: None)
+_FE_GAIN = Derived("10; 0 with a [rts.pattern]: the pattern's gain toward the RuT (its dB read "
+                   "as dBi) is the antenna's", lambda v: None)
+FE_ANTENNA_GAIN_DBI = 10.0  # the scalar default without a front-end pattern
 
 
 @dataclass(frozen=True)
@@ -29,11 +34,13 @@ class RadarLinkConfig(Evolvable):
 
     tx_power_dbm: float | None = spec("tx_power_dbm", "float", "transmit power per Tx at the "
                                       "antenna port", _PRESET, unit="dBm", lo=-50.0, hi=50.0)
-    tx_antenna_gain_dbi: float | None = spec("tx_antenna_gain_dbi", "float", "peak gain of a Tx "
-                                             "antenna (the paths carry the pattern's shape)",
-                                             _PRESET, unit="dBi", lo=-20.0, hi=50.0)
-    rx_antenna_gain_dbi: float | None = spec("rx_antenna_gain_dbi", "float", "peak gain of an Rx "
-                                             "antenna", _PRESET, unit="dBi", lo=-20.0, hi=50.0)
+    tx_antenna_gain_dbi: float | None = spec("tx_antenna_gain_dbi", "float", "gain of a Tx "
+                                             "antenna on top of [radar.pattern] (which the "
+                                             "paths carry toward each front end)", _RUT_GAIN,
+                                             unit="dBi", lo=-20.0, hi=50.0)
+    rx_antenna_gain_dbi: float | None = spec("rx_antenna_gain_dbi", "float", "gain of an Rx "
+                                             "antenna on top of [radar.pattern]", _RUT_GAIN,
+                                             unit="dBi", lo=-20.0, hi=50.0)
     noise_figure_db: float | None = spec("noise_figure_db", "float", "receiver noise figure",
                                          _PRESET, unit="dB", lo=0.0, hi=50.0)
     if_highpass_hz: float | None = spec("if_highpass_hz", "float", "IF high-pass corner "
@@ -60,10 +67,12 @@ class RtsLinkConfig(Evolvable):
     Defaults are assumptions for a front end like the paper's with an RFSoC back end
     (ADC full scale +1 dBm, 14-bit DAC: Xilinx DS926 class); set them from your hardware."""
 
-    fe_rx_antenna_gain_dbi: float = spec("fe_rx_antenna_gain_dbi", "float", "front-end Rx "
-                                         "antenna peak gain", 10.0, unit="dBi", lo=-20.0, hi=50.0)
-    fe_tx_antenna_gain_dbi: float = spec("fe_tx_antenna_gain_dbi", "float", "front-end Tx "
-                                         "antenna peak gain", 10.0, unit="dBi", lo=-20.0, hi=50.0)
+    fe_rx_antenna_gain_dbi: float | None = spec("fe_rx_antenna_gain_dbi", "float", "front-end "
+                                                "Rx antenna gain on top of [rts.pattern]",
+                                                _FE_GAIN, unit="dBi", lo=-20.0, hi=50.0)
+    fe_tx_antenna_gain_dbi: float | None = spec("fe_tx_antenna_gain_dbi", "float", "front-end "
+                                                "Tx antenna gain on top of [rts.pattern]",
+                                                _FE_GAIN, unit="dBi", lo=-20.0, hi=50.0)
     rx_gain_db: float = spec("rx_gain_db", "float", "gain from the Rx antenna port to the back "
                              "end's ADC input (LNA, down-conversion, cable)", 30.0, unit="dB",
                              lo=-50.0, hi=150.0)

@@ -51,7 +51,7 @@ def _simulate_linked(setup: Setup, echoes: Echoes, program: RtsProgram, seed, sn
     from .. import link as lk
     scene = setup.scene
     rl = lk.radar_link(scene.radar)
-    lk.check_channels(scene, program, rl)
+    lk.check_channels(scene, program, rl, setup)
     echoes = lk.apply_radar_link(echoes, scene, rl)
     cube = synthesize(echoes, scene.radar, setup.rut)
     rng = np.random.default_rng(seed)
@@ -59,7 +59,7 @@ def _simulate_linked(setup: Setup, echoes: Echoes, program: RtsProgram, seed, sn
         cube = add_noise(cube, noise_power(echoes, snr_db), rng)
     else:
         p = (lk.thermal_noise_w(scene.radar, rl)
-             + lk.channel_noise_w(scene, program, rl)) / max(1, int(noise_frames))
+             + lk.channel_noise_w(scene, program, rl, setup)) / max(1, int(noise_frames))
         cube = AdcCube(cube.data + lk.shaped_noise(cube.shape, p, rl, scene.radar, rng),
                        cube.radar, cube.rut)
     data, clipped = lk.adc_convert(cube.data, rl)
