@@ -15,9 +15,14 @@ from dataclasses import dataclass
 
 from .schema import Derived, Evolvable, spec
 
-__all__ = ["RadarLinkConfig", "RtsLinkConfig", "RADAR_LINK_PRESETS"]
+__all__ = ["RadarLinkConfig", "RtsLinkConfig", "RADAR_LINK_PRESETS", "FE_ANTENNA_GAIN_DBI"]
 
 _PRESET = Derived("the antenna preset's value (rtsgeom.link.RADAR_LINK_PRESETS)", lambda v: None)
+_RUT_GAIN = Derived("the preset's peak gain; 0 with a [radar.pattern]: the pattern's gain toward "
+                    "each front end (its dB read as dBi) is the antenna's", lambda v: None)
+_FE_GAIN = Derived("10; 0 with a [rts.pattern]: the pattern's gain toward the RuT (its dB read "
+                   "as dBi) is the antenna's", lambda v: None)
+FE_ANTENNA_GAIN_DBI = 10.0  # the scalar default without a front-end pattern
 
 
 @dataclass(frozen=True)
@@ -29,11 +34,13 @@ class RadarLinkConfig(Evolvable):
 
     tx_power_dbm: float | None = spec("tx_power_dbm", "float", "transmit power per Tx at the "
                                       "antenna port", _PRESET, unit="dBm", lo=-50.0, hi=50.0)
-    tx_antenna_gain_dbi: float | None = spec("tx_antenna_gain_dbi", "float", "peak gain of a Tx "
-                                             "antenna (the paths carry the pattern's shape)",
-                                             _PRESET, unit="dBi", lo=-20.0, hi=50.0)
-    rx_antenna_gain_dbi: float | None = spec("rx_antenna_gain_dbi", "float", "peak gain of an Rx "
-                                             "antenna", _PRESET, unit="dBi", lo=-20.0, hi=50.0)
+    tx_antenna_gain_dbi: float | None = spec("tx_antenna_gain_dbi", "float", "gain of a Tx "
+                                             "antenna on top of [radar.pattern] (which the "
+                                             "paths carry toward each front end)", _RUT_GAIN,
+                                             unit="dBi", lo=-20.0, hi=50.0)
+    rx_antenna_gain_dbi: float | None = spec("rx_antenna_gain_dbi", "float", "gain of an Rx "
+                                             "antenna on top of [radar.pattern]", _RUT_GAIN,
+                                             unit="dBi", lo=-20.0, hi=50.0)
     noise_figure_db: float | None = spec("noise_figure_db", "float", "receiver noise figure",
                                          _PRESET, unit="dB", lo=0.0, hi=50.0)
     if_highpass_hz: float | None = spec("if_highpass_hz", "float", "IF high-pass corner "
@@ -60,10 +67,12 @@ class RtsLinkConfig(Evolvable):
     Defaults are assumptions for a front end like the paper's with an RFSoC back end
     (ADC full scale +1 dBm, 14-bit DAC: Xilinx DS926 class); set them from your hardware."""
 
-    fe_rx_antenna_gain_dbi: float = spec("fe_rx_antenna_gain_dbi", "float", "front-end Rx "
-                                         "antenna peak gain", 10.0, unit="dBi", lo=-20.0, hi=50.0)
-    fe_tx_antenna_gain_dbi: float = spec("fe_tx_antenna_gain_dbi", "float", "front-end Tx "
-                                         "antenna peak gain", 10.0, unit="dBi", lo=-20.0, hi=50.0)
+    fe_rx_antenna_gain_dbi: float | None = spec("fe_rx_antenna_gain_dbi", "float", "front-end "
+                                                "Rx antenna gain on top of [rts.pattern]",
+                                                _FE_GAIN, unit="dBi", lo=-20.0, hi=50.0)
+    fe_tx_antenna_gain_dbi: float | None = spec("fe_tx_antenna_gain_dbi", "float", "front-end "
+                                                "Tx antenna gain on top of [rts.pattern]",
+                                                _FE_GAIN, unit="dBi", lo=-20.0, hi=50.0)
     rx_gain_db: float = spec("rx_gain_db", "float", "gain from the Rx antenna port to the back "
                              "end's ADC input (LNA, down-conversion, cable)", 30.0, unit="dB",
                              lo=-50.0, hi=150.0)
@@ -82,14 +91,25 @@ class RtsLinkConfig(Evolvable):
 
 
 # The RuT presets' link values and where each comes from (rtsgeom.link.radar_link fills the
-# unset [radar.link] fields from them). Datasheet values are as quoted from the TI datasheets
-# (the project's search corpus did not hold them: re-check against the current revision).
-_AWR_DS = "TI AWR1843 datasheet (SWRS222)"
-_HPF = ("HPF1 corner, one of 175/235/350/700 kHz in the device's profile configuration "
-        "(TI mmWave DFP, rlProfileCfg hpfCornerFreq1); the lowest is taken")
+# unset [radar.link] fields from them). Checked against the TI datasheets' HTML editions in the
+# project's search corpus (ti.com document viewer) on 2026-11-23: a value with a document and
+# section is verified there; "[re-check]" marks one that could not be (what was tried is said);
+# "[assumed]" one that no datasheet states. The RF specification tables of the AWR1843
+# (SWRS222D), IWR6843 (SWRS219E/F), AWR2243 (SWRS223D) and AWR2944 (SWRS273D) were listed in the
+# corpus but their table text was not retrievable (only the contents came back, queries on the
+# table rows included), so those devices' Tx power and noise figure stay [re-check].
+_RECHECK_RF = ("[re-check]: the device's RF Specification table was not retrievable from the "
+               "search corpus (only its table of contents)")
+_HPF = ("HPF1 corner, one of 175/235/350/700 kHz (hpfCornerFreq1 of rlProfileCfg_t, TI mmWave "
+        "DFP; the codes 0-3 as listed in TI mmWave Studio's cascade Lua scripts); the "
+        "datasheets' receive-subsystem section: 'configurable lower cutoff frequencies above "
+        "175 kHz'; the lowest is taken. Modelled as one first-order stage (HPF2, 350 kHz and "
+        "up, is not modelled)")
 _FS = ("[assumed] receiver-input power of a full-scale tone at a mid Rx gain (~30 dB of the "
        "24-48 dB range): not in the datasheet; check with the device's Rx saturation monitor")
 _LPF_ORDER = "[assumed] 4th-order Butterworth anti-alias response"
+_ADC_CFG = ("[re-check] 12 bits: the mmWave SDK's adcCfg numADCBits (0 = 12, 1 = 14, 2 = 16 "
+            "bit output formats); the datasheet's ADC resolution row was not retrievable")
 
 # One entry per antenna preset: the values and where each comes from.
 RADAR_LINK_PRESETS: dict[str, dict] = {
@@ -98,54 +118,76 @@ RADAR_LINK_PRESETS: dict[str, dict] = {
                    "rx_antenna_gain_dbi": 10.5, "noise_figure_db": 15.0,
                    "if_highpass_hz": 175e3, "if_lowpass_hz": 10e6, "if_lowpass_order": 4,
                    "adc_bits": 12, "adc_full_scale_dbm": -25.0},
-        "sources": {"tx_power_dbm": f"{_AWR_DS}: TX power 12 dBm",
+        "sources": {"tx_power_dbm": "TI AWR1843 datasheet (SWRS222), RF Specification: TX "
+                                    f"power 12 dBm {_RECHECK_RF}",
                     "tx_antenna_gain_dbi": "TI xWR1843BOOST user's guide (SPRUIM4): antenna peak "
-                                           "gain > 10.5 dBi (76-81 GHz)",
+                                           "gain > 10.5 dBi (76-81 GHz) [re-check: not in the "
+                                           "corpus]",
                     "rx_antenna_gain_dbi": "as tx_antenna_gain_dbi",
-                    "noise_figure_db": f"{_AWR_DS}: RX noise figure 14 dB (76-77 GHz), 15 dB "
-                                       "(77-81 GHz); 15 dB taken",
+                    "noise_figure_db": "TI AWR1843 datasheet (SWRS222), RF Specification: RX "
+                                       "noise figure 14 dB (76-77 GHz), 15 dB (77-81 GHz); 15 "
+                                       f"dB taken {_RECHECK_RF}",
                     "if_highpass_hz": _HPF,
-                    "if_lowpass_hz": f"{_AWR_DS}: IF bandwidth 10 MHz",
+                    "if_lowpass_hz": "10 MHz: TI IWR1843AOP datasheet (JAJSRC0), Receive "
+                                     "Subsystem: 'bandwidths up to 10 MHz' (the AWR1843's own "
+                                     "section was not retrievable [re-check])",
                     "if_lowpass_order": _LPF_ORDER,
-                    "adc_bits": f"{_AWR_DS}: 12-bit ADC samples (adcCfg also offers 14/16-bit "
-                                "output formats)",
+                    "adc_bits": _ADC_CFG,
                     "adc_full_scale_dbm": _FS}},
     "iwr6843isk": {
         "values": {"tx_power_dbm": 12.0, "tx_antenna_gain_dbi": 7.0, "rx_antenna_gain_dbi": 7.0,
                    "noise_figure_db": 12.0, "if_highpass_hz": 175e3, "if_lowpass_hz": 10e6,
                    "if_lowpass_order": 4, "adc_bits": 12, "adc_full_scale_dbm": -25.0},
-        "sources": {"tx_power_dbm": "TI IWR6843 datasheet (SWRS219): TX power 12 dBm",
+        "sources": {"tx_power_dbm": f"TI IWR6843 datasheet (SWRS219): TX power 12 dBm {_RECHECK_RF}",
                     "tx_antenna_gain_dbi": "[assumed] ~7 dBi patch array of the ISK module",
                     "rx_antenna_gain_dbi": "[assumed] as tx_antenna_gain_dbi",
-                    "noise_figure_db": "TI IWR6843 datasheet (SWRS219): RX noise figure 12 dB",
-                    "if_highpass_hz": _HPF, "if_lowpass_hz": "TI IWR6843 datasheet: IF bandwidth "
-                                                         "10 MHz",
-                    "if_lowpass_order": _LPF_ORDER, "adc_bits": "as the AWR1843",
+                    "noise_figure_db": "TI IWR6843 datasheet (SWRS219): RX noise figure 12 dB "
+                                       + _RECHECK_RF,
+                    "if_highpass_hz": _HPF + "; TI IWR6843 datasheet (SWRS219E), Receive "
+                                             "Subsystem: 'lower cutoff frequencies above 175 kHz'",
+                    "if_lowpass_hz": "TI IWR6843 datasheet (SWRS219E), Receive Subsystem: "
+                                     "'bandwidths up to 10 MHz'",
+                    "if_lowpass_order": _LPF_ORDER, "adc_bits": _ADC_CFG,
                     "adc_full_scale_dbm": _FS}},
     "awr2944": {
-        "values": {"tx_power_dbm": 13.0, "tx_antenna_gain_dbi": 10.0,
+        # A real-only receiver (SWRS273/JAJSNB2A, Receive Subsystem): the signal model's complex
+        # baseband is an approximation for it (no image band, the noise of one rail).
+        "values": {"tx_power_dbm": 13.5, "tx_antenna_gain_dbi": 10.0,
                    "rx_antenna_gain_dbi": 10.0, "noise_figure_db": 12.0,
-                   "if_highpass_hz": 175e3, "if_lowpass_hz": 15e6, "if_lowpass_order": 4,
-                   "adc_bits": 12, "adc_full_scale_dbm": -25.0},
-        "sources": {"tx_power_dbm": "TI AWR2944 datasheet (SWRS273): TX power 13 dBm",
+                   "if_highpass_hz": 350e3, "if_lowpass_hz": 15e6, "if_lowpass_order": 4,
+                   "adc_bits": 16, "adc_full_scale_dbm": -25.0},
+        "sources": {"tx_power_dbm": "13.5 dBm: TI IWR2944 datasheet (SWRS330), RF "
+                                    "Specifications table, Transmitter output power (the "
+                                    "industrial variant; the AWR2944's own table, SWRS273D "
+                                    "6.8, was not retrievable [re-check])",
                     "tx_antenna_gain_dbi": "[assumed]", "rx_antenna_gain_dbi": "[assumed]",
-                    "noise_figure_db": "TI AWR2944 datasheet (SWRS273): RX noise figure 12 dB "
-                                       "[re-check]",
-                    "if_highpass_hz": _HPF, "if_lowpass_hz": "TI AWR2944 datasheet: IF bandwidth "
-                                                         "15 MHz [re-check]",
-                    "if_lowpass_order": _LPF_ORDER, "adc_bits": "[assumed] as the AWR1843",
+                    "noise_figure_db": "12 dB: TI IWR2944 datasheet (SWRS330), RF Specifications "
+                                       "table, Receiver noise figure (as tx_power_dbm "
+                                       "[re-check] for the AWR2944)",
+                    "if_highpass_hz": "350 kHz: TI AWR2944 datasheet (JAJSNB2A), Receive "
+                                      "Subsystem: 'configurable cutoff frequencies above 350 "
+                                      "kHz' (the IWR2944's table, SWRS330, note 2: a "
+                                      "second-order HPF, -6 dB corners 300/350/700/1400 kHz; "
+                                      "modelled as one first-order stage)",
+                    "if_lowpass_hz": "TI AWR2944 datasheet (JAJSNB2A), Receive Subsystem: "
+                                     "'bandwidths up to 15 MHz'",
+                    "if_lowpass_order": _LPF_ORDER,
+                    "adc_bits": "16 bits: TI IWR2944 datasheet (SWRS330), RF Specifications "
+                                "table, ADC resolution [re-check] for the AWR2944",
                     "adc_full_scale_dbm": _FS}},
     "awr2243-cascade": {
         "values": {"tx_power_dbm": 13.0, "tx_antenna_gain_dbi": 10.0,
                    "rx_antenna_gain_dbi": 10.0, "noise_figure_db": 14.0,
                    "if_highpass_hz": 175e3, "if_lowpass_hz": 20e6, "if_lowpass_order": 4,
                    "adc_bits": 12, "adc_full_scale_dbm": -25.0},
-        "sources": {"tx_power_dbm": "TI AWR2243 datasheet (SWRS223): TX power 13 dBm",
+        "sources": {"tx_power_dbm": f"TI AWR2243 datasheet (SWRS223): TX power 13 dBm {_RECHECK_RF}",
                     "tx_antenna_gain_dbi": "[assumed]", "rx_antenna_gain_dbi": "[assumed]",
                     "noise_figure_db": "TI AWR2243 datasheet (SWRS223): RX noise figure "
-                                       "12-14 dB; 14 dB taken [re-check]",
-                    "if_highpass_hz": _HPF, "if_lowpass_hz": "TI AWR2243 datasheet: IF bandwidth "
-                                                         "20 MHz",
-                    "if_lowpass_order": _LPF_ORDER, "adc_bits": "[assumed] as the AWR1843",
+                                       f"12-14 dB; 14 dB taken {_RECHECK_RF}",
+                    "if_highpass_hz": _HPF + "; TI AWR2243 datasheet (SWRS223D), Receive "
+                                             "Subsystem: 'lower cutoff frequencies above 175 kHz'",
+                    "if_lowpass_hz": "TI AWR2243 datasheet (SWRS223D), Receive Subsystem: "
+                                     "'bandwidths up to 20 MHz'",
+                    "if_lowpass_order": _LPF_ORDER, "adc_bits": _ADC_CFG,
                     "adc_full_scale_dbm": _FS}},
 }

@@ -356,9 +356,9 @@ class SheetConfig(Evolvable):
     material: str = spec("material", "material", "radio material (Sionna RT)", "itu_metal",
                          max_chars=MAX_NAME_CHARS)
     reflection_loss_db: float = spec("reflection_loss_db", "float", "extra loss per reflection "
-                                     "off the sheet (an absorber covering it); applied to the "
-                                     "setup echoes with [radar.link]", 0.0, unit="dB",
-                                     lo=0.0, hi=100.0)
+                                     "off the sheet (an absorber covering it), on every "
+                                     "ray-traced path that bounces off it and on the sheet's "
+                                     "physical-optics echo", 0.0, unit="dB", lo=0.0, hi=100.0)
 
 
 @dataclass(frozen=True)
@@ -409,6 +409,10 @@ class StructureConfig:
     mesh: str = spec("mesh", "str", "mesh file, relative to the scene's folder and inside it")
     material: str = spec("material", "material", "radio material (Sionna RT)", "itu_metal",
                          max_chars=MAX_NAME_CHARS)
+    reflection_loss_db: float = spec("reflection_loss_db", "float", "extra loss per reflection "
+                                     "off this structure (an absorber covering it), on every "
+                                     "ray-traced path that bounces off it", 0.0, unit="dB",
+                                     lo=0.0, hi=100.0)
 
 
 @dataclass(frozen=True)
@@ -430,7 +434,7 @@ class Scene(Evolvable):
     source: str | None = None
     sha256: str = ""
     description: str = spec("description", "str", "free text", "")
-    extra_meshes: tuple[tuple[str, str], ...] = spec(  # (absolute path, material)
+    extra_meshes: tuple[tuple[str, str, float], ...] = spec(  # (absolute path, material, loss dB)
         "structure", "tables", "[[structure]] extra meshes for ray tracing", [],
         cls=StructureConfig, max_items=MAX_TARGETS, item="structure")
 

@@ -94,7 +94,7 @@ def read_scene_bytes(path: str | Path) -> tuple[bytes, Path]:
 
 
 def resolve_meshes(structures, source: str, base_dir: Path | None,
-                   allow_external_meshes: bool) -> tuple[tuple[str, str], ...]:
+                   allow_external_meshes: bool) -> tuple[tuple[str, str, float], ...]:
     """Mesh paths, resolved against the scene's folder and (unless allowed) kept inside it.
 
     A path outside the folder is refused before the file system is asked anything, so the
@@ -122,5 +122,5 @@ def resolve_meshes(structures, source: str, base_dir: Path | None,
         if not exists:
             raise SceneError(f"{source}: {where} = {_fmt(rel)}: must be an existing mesh file "
                              f"in the scene's folder (resolved to {_fmt(str(p))})")
-        out.append((str(p), st.material))
+        out.append((str(p), st.material, float(st.reflection_loss_db)))
     return tuple(out)

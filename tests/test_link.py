@@ -93,8 +93,11 @@ def _setup_paths(setup, tau_s, gain):
                                                     (1.0, 700e3, 10.0), (3.0, 235e3, 20.0),
                                                     (20.0, 0.0, 0.0)])
 def test_setup_reflection_follows_path_gain_and_if_response(dist_m, hpf_hz, loss_db):
-    """A setup echo's level at the ADC = P_t G_t G_r |g|^2 |H(S tau)|^2 (minus the absorber),
-    in the budget and in the synthesised samples (tone projection)."""
+    """A setup echo's level at the ADC = P_t G_t G_r |g|^2 |H(S tau)|^2, in the budget and in
+    the synthesised samples (tone projection). The path gain g carries any absorber (the path
+    producers apply it: test_sheet_absorber_scales_the_po_echo, tests/test_absorbers.py), so
+    the link must not apply the sheet's loss a second time: a hand-made path keeps its level
+    whatever sheet.reflection_loss_db says."""
     def mut(d):
         linked_doc(d, link={"if_highpass_hz": hpf_hz})
         d["sheet"]["reflection_loss_db"] = loss_db
@@ -110,7 +113,7 @@ def test_setup_reflection_follows_path_gain_and_if_response(dist_m, hpf_hz, loss
         x = f_b / hpf_hz
         assert abs(h) ** 2 == pytest.approx(x * x / (1 + x * x) / (1 + (f_b / rl.if_lowpass_hz) ** 8),
                                             rel=1e-9)
-    expect = rl.tx_power_w * rl.tx_gain * rl.rx_gain * g ** 2 * abs(h) ** 2 * 10 ** (-loss_db / 10)
+    expect = rl.tx_power_w * rl.tx_gain * rl.rx_gain * g ** 2 * abs(h) ** 2
     e = lk.apply_radar_link(raw, scene, rl)
     assert np.allclose(np.abs(e.amplitude) ** 2, expect, rtol=1e-9)
     cube = synthesize(e, radar, setup.rut).data
@@ -133,6 +136,32 @@ def _sheet_budget(link, loss_db):
     program = program_nearest(scene, setup)
     raw = setup_echoes(setup, lk.sheet_paths(setup))
     return lk.link_budget(scene, raw, program, linked=False).setup_echoes, scene, setup, raw
+
+
+@pytest.mark.parametrize("radius_m,offset_m", [(1.0, 0.0), (2.0, 0.05)])
+def test_sheet_absorber_scales_the_po_echo(radius_m, offset_m):
+    """sheet.reflection_loss_db = L: the sheet's physical-optics echo (sheet_paths, the budget's
+    estimate) is 10^(-L/20) of the uncovered one per element pair, phase unchanged; through
+    the link the power drops by exactly L dB."""
+    def scene_with(loss):
+        def mut(d):
+            linked_doc(d)
+            d["rts"]["arc_radius_m"] = radius_m
+            d["sheet"]["radius_offset_m"] = offset_m
+            d["sheet"]["reflection_loss_db"] = loss
+        return make_scene(mut)
+    lam = c / scene_with(0.0).radar.f_center_hz
+    ref = lk.sheet_paths(build_setup(scene_with(0.0)), step_m=lam)
+    for loss in (7.0, 20.0, 43.0):
+        scene = scene_with(loss)
+        setup = build_setup(scene)
+        p = lk.sheet_paths(setup, step_m=lam)
+        np.testing.assert_allclose(p.delay_s, ref.delay_s, rtol=0, atol=0)
+        np.testing.assert_allclose(p.gain, ref.gain * 10 ** (-loss / 20), rtol=1e-12)
+        e0 = lk.apply_radar_link(setup_echoes(setup, ref), scene)
+        e1 = lk.apply_radar_link(setup_echoes(setup, p), scene)
+        drop = 10 * np.log10(np.abs(e0.amplitude) ** 2 / np.abs(e1.amplitude) ** 2)
+        np.testing.assert_allclose(drop, loss, atol=1e-9)
 
 
 def test_uncovered_sheet_at_1m_on_an_awr1843():

@@ -254,7 +254,7 @@ def test_relative_mesh_paths_resolve_against_the_scene_folder(tmp_path, monkeypa
     monkeypatch.chdir(elsewhere)  # the working directory must not matter
     scene = load_scene(os.path.relpath(path, elsewhere))
     assert scene.extra_meshes == ((str((folder / "meshes" / "wall.stl").resolve()),
-                                   "itu_concrete"),)
+                                   "itu_concrete", 0.0),)  # (path, material, reflection loss dB)
     # ...and the same relative path next to a scene in another folder is an error
     other = tmp_path / "other.toml"
     other.write_text(dump_toml(doc))

@@ -184,11 +184,11 @@ def _simulate_detect(setup, paths, program, seed, frames: int = 1):
     The K frames carry the same noise-free cube and independent receiver noise, so their
     average is that cube plus noise of power N0 / K: simulated as one frame at an SNR
     10 log10(K) dB higher, which has exactly the distribution of the average and costs one
-    frame."""
+    frame. With ``[radar.link]`` (no ``snr_db``) the same: the link's noise power / K."""
     snr = setup.scene.radar.snr_db
     if snr is not None and frames > 1:
         snr = snr + 10 * np.log10(frames)
-    _, cube = simulate(setup, paths, program, seed, snr)
+    _, cube = simulate(setup, paths, program, seed, snr, noise_frames=frames)
     return process(cube)
 
 
@@ -315,7 +315,7 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
     step = step_s or rts.calibration_step_s
     grid = np.arange(span[0], span[1] + step / 2, step)
     rng = np.random.default_rng(np.random.SeedSequence([int(seed) % 2 ** 32, 1713]))
-    noisy = scene.radar.snr_db is not None
+    noisy = scene.radar.snr_db is not None or scene.radar.link is not None  # link: kTBF noise
 
     def measure(targets, res, k_frames):
         if full_chain:

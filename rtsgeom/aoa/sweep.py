@@ -157,6 +157,21 @@ def _noise_sigma(setup, paths, pair, targets, amps, snr_db) -> np.ndarray:
     return np.sqrt(n0 * g)
 
 
+def _linked_noise_sigma(setup, targets, amps) -> np.ndarray:
+    """As :func:`_noise_sigma` with ``[radar.link]`` and no ``snr_db``: the per-sample noise
+    from the link budget, referred to the model's relative amplitudes
+    (:func:`rtsgeom.link.relative_noise_power`; the RTS channels' noise from every programmed
+    row ``amps`` (S, P, 2), the quantisation at the weakest probe's IF response)."""
+    from ..link import relative_noise_power
+    scene, radar = setup.scene, setup.scene.radar
+    beat = radar.slope_hz_per_s * 2.0 * np.array([t.range_m for t in targets]) / c  # (P,)
+    n0 = np.max(relative_noise_power(scene, np.nansum(np.abs(amps) ** 2, axis=(1, 2))[:, None],
+                                     beat[None, :]), axis=1)  # (S,)
+    g = (np.sum(window(radar.range_window, radar.samples_per_chirp) ** 2)
+         * np.sum(window(radar.doppler_window, radar.chirps_per_tx) ** 2))
+    return np.sqrt(n0 * g)
+
+
 def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair, targets,
                  alphas, deltas, base_offsets=(0.0, 0.0), gain_correction=(1.0, 1.0),
                  bins=None) -> SweepResult:
@@ -209,8 +224,12 @@ def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair,
         amps[:, p] = np.stack([a_i[k, steps], a_j[k, steps]], -1)
         snaps.append(x[k, steps])  # (S, K_bins, V)
     x = np.stack(snaps, 1)  # (S, P, K_bins, V)
-    sigma = (np.zeros(n_s) if radar.snr_db is None
-             else _noise_sigma(setup, paths, pair, targets, amps, radar.snr_db))
+    if radar.snr_db is not None:
+        sigma = _noise_sigma(setup, paths, pair, targets, amps, radar.snr_db)
+    elif radar.link is not None:  # the link budget's thermal noise (kTBF, RTS, ADC)
+        sigma = _linked_noise_sigma(setup, targets, amps)
+    else:
+        sigma = np.zeros(n_s)
     r0 = np.array([_range_bin(setup.scene, t.range_m) for t in targets])
     return SweepResult(deltas, x, kbin, amps, r0, consistent, margin, sigma,
                        np.asarray(alphas, float), st)

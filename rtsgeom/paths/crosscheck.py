@@ -154,7 +154,8 @@ def _on_sheet(setup: Setup, az: float, z: float) -> bool:
 def po_sheet_response(setup: Setup, a, b, freq_hz: float, step_m: float | None = None) -> complex:
     """Physical-optics echo a -> smooth sheet -> b as a path response ``sum g exp(-j 2 pi f tau)``.
 
-    Scalar PO of a perfect conductor (Gamma = -1) over the inner cylinder face, cutouts removed::
+    Scalar PO of a perfect conductor (Gamma = -1, times the absorber's amplitude factor
+    ``10^(-sheet.reflection_loss_db / 20)``) over the inner cylinder face, cutouts removed::
 
         u(b) = (j k / 2 pi) Gamma  INT exp(-j k (r1 + r2)) / (r1 r2) cos(theta_i) dS
 
@@ -188,7 +189,8 @@ def po_sheet_response(setup: Setup, a, b, freq_hz: float, step_m: float | None =
             mask &= (r0 * np.sin(AZ - th)) ** 2 + Z ** 2 >= (0.5 * cfg.cutout_diameter_m) ** 2
         integrand = np.exp(-1j * k * (r1 + r2)) / (r1 * r2) * cos_i * mask
         total += integrand.sum() * r0 * daz * dz
-    u = (1j * k / (2 * np.pi)) * (-1.0) * total
+    gamma = -(10.0 ** (-cfg.reflection_loss_db / 20.0))
+    u = (1j * k / (2 * np.pi)) * gamma * total
     return complex(lam / (4 * np.pi) * u)
 
 

@@ -23,7 +23,9 @@ Rows returned (a :class:`~rtsgeom.paths.table.Paths` table, ``method="raytrace"`
     (RuT Tx m -> setup -> RuT Rx k, at least one interaction off the RuT's own board: the direct
     Tx -> Rx coupling, line of sight or its grazing bounce on the board, is not a setup echo).
     Front end <-> front end paths are ignored. ``gain`` is Sionna's ``a`` (no propagation
-    phase), ``delay_s`` Sionna's ``tau`` in float64. Duplicate paths (same interaction types and
+    phase) times ``10^(-L/20)`` per bounce off a surface with an absorber of L dB
+    (``sheet.reflection_loss_db``, ``[[structure]] reflection_loss_db``), ``delay_s`` Sionna's
+    ``tau`` in float64. Duplicate paths (same interaction types and
     objects, hit points within 1 mm, delays within a few float32 ulps) are dropped, as are paths
     weaker than ``raytrace.min_gain_db``.
 
@@ -141,6 +143,7 @@ class _Built:
     rx_names: list
     object_names: dict  # object_id -> name
     meshes: dict  # name -> trimesh (world frame)
+    absorber: dict = field(default_factory=dict)  # object_id -> amplitude factor per bounce
 
 
 def _build_scene(setup: Setup, mi, rt) -> _Built:
@@ -182,10 +185,12 @@ def _build_scene(setup: Setup, mi, rt) -> _Built:
                                           sc.sheet.thickness_m)))
     meshes["rut_board"] = rut_board_mesh(setup)
     objects.append(("rut_board", material("itu_metal", "rut board", BOARD_THICKNESS_M)))
-    for i, (path, mat) in enumerate(sc.extra_meshes):
+    loss_db = {"sheet": sc.sheet.reflection_loss_db}
+    for i, (path, mat, loss) in enumerate(sc.extra_meshes):
         name = f"structure_{i}"
         meshes[name] = _load_structure(path, i)
         objects.append((name, material(mat, f"structure[{i}].material", 0.1)))
+        loss_db[name] = loss
     scene.add([rt.SceneObject(mi_mesh=_mi_mesh(mi, meshes[n], n, off), name=n, radio_material=m)
                for n, m in objects])
 
@@ -211,7 +216,8 @@ def _build_scene(setup: Setup, mi, rt) -> _Built:
     if list(scene.transmitters) != tx_names or list(scene.receivers) != rx_names:
         raise RuntimeError("Sionna RT reordered the radio devices")  # index order = insertion
     ids = {int(scene.objects[n].object_id): n for n, _ in objects}
-    return _Built(scene, tx_names, rx_names, ids, meshes)
+    absorber = {i: 10.0 ** (-loss_db[n] / 20.0) for i, n in ids.items() if loss_db.get(n, 0.0)}
+    return _Built(scene, tx_names, rx_names, ids, meshes, absorber)
 
 
 # ------------------------------------------------------------------------------------------
@@ -319,6 +325,8 @@ def trace(setup: Setup, config: RaytraceConfig | None = None) -> RaytraceResult:
         keep = _dedupe(tau[ri, ti, sel], it, np.where(it != 0, ob, 0), vt)
         dupes += int((~keep).sum())
         g = a[ri, ti, sel]
+        for oid, f in built.absorber.items():  # an absorber's loss once per bounce off it
+            g = g * f ** np.sum((it != 0) & (ob == oid), axis=1)
         with np.errstate(divide="ignore"):
             strong = 20 * np.log10(np.abs(g)) >= cfg.min_gain_db
         weak += int((keep & ~strong).sum())

@@ -26,15 +26,19 @@ def noise_power(echoes: Echoes, snr_db: float | None) -> float:
 
 
 def simulate(setup: Setup, paths: Paths, program: RtsProgram, seed: int | None = None,
-             snr_db: float | None = None) -> tuple[Echoes, AdcCube]:
+             snr_db: float | None = None, noise_frames: int = 1) -> tuple[Echoes, AdcCube]:
     """Echoes and ADC cube of a programmed RTS (noise from ``seed`` when ``snr_db`` is set).
 
     With ``[radar.link]`` the chain is physical (:mod:`rtsgeom.link`): echoes in sqrt(W) at the
     receiver input through the IF chain, thermal + RTS channel noise shaped by it (``snr_db``,
-    when given, overrides that noise), then the ADC's clipping and quantisation."""
+    when given, overrides that noise), then the ADC's clipping and quantisation.
+    ``noise_frames`` K: the coherent average of K frames of a static program, simulated as
+    one frame with the link's noise power / K (the quantisation, once, is not divided: a
+    slight overestimate of the average's noise); ignored without ``[radar.link]`` or with
+    ``snr_db`` (the caller raises ``snr_db`` by 10 log10 K)."""
     echoes = build_echoes(setup, paths, program)
     if setup.scene.radar.link is not None:
-        return _simulate_linked(setup, echoes, program, seed, snr_db)
+        return _simulate_linked(setup, echoes, program, seed, snr_db, noise_frames)
     cube = synthesize(echoes, setup.scene.radar, setup.rut)
     if snr_db is not None:
         rng = np.random.default_rng(seed)
@@ -42,18 +46,20 @@ def simulate(setup: Setup, paths: Paths, program: RtsProgram, seed: int | None =
     return echoes, cube
 
 
-def _simulate_linked(setup: Setup, echoes: Echoes, program: RtsProgram, seed, snr_db):
+def _simulate_linked(setup: Setup, echoes: Echoes, program: RtsProgram, seed, snr_db,
+                     noise_frames: int = 1):
     from .. import link as lk
     scene = setup.scene
     rl = lk.radar_link(scene.radar)
-    lk.check_channels(scene, program, rl)
+    lk.check_channels(scene, program, rl, setup)
     echoes = lk.apply_radar_link(echoes, scene, rl)
     cube = synthesize(echoes, scene.radar, setup.rut)
     rng = np.random.default_rng(seed)
     if snr_db is not None:
         cube = add_noise(cube, noise_power(echoes, snr_db), rng)
     else:
-        p = lk.thermal_noise_w(scene.radar, rl) + lk.channel_noise_w(scene, program, rl)
+        p = (lk.thermal_noise_w(scene.radar, rl)
+             + lk.channel_noise_w(scene, program, rl, setup)) / max(1, int(noise_frames))
         cube = AdcCube(cube.data + lk.shaped_noise(cube.shape, p, rl, scene.radar, rng),
                        cube.radar, cube.rut)
     data, clipped = lk.adc_convert(cube.data, rl)
