@@ -26,7 +26,7 @@ from scipy.constants import c
 
 from ..geometry import build_setup
 from ..radar.processing import window
-from ..rts import KIND_DIRECT, Echoes, cable_ghosts, program_nearest
+from ..rts import EchoKind, Echoes, cable_ghosts, program_nearest
 from ..scene import Scene
 
 __all__ = ["DEFAULT_FLOOR_DB", "ghost_orders", "predict_ghosts", "measure_ghosts",
@@ -39,10 +39,9 @@ ZOOM_POINTS = 401  # range zoom: +-1 bin in 1/200 bin steps (scalloping < 1e-4 d
 def _unit_echoes(scene: Scene) -> Echoes:
     """One unit-amplitude direct echo per front end (one virtual channel, zero delay)."""
     n = len(scene.rts.front_ends)
-    z = np.zeros(n)
-    return Echoes(tau_air_s=np.zeros((n, 1)), tau_if_s=z, f_if_hz=np.full(n, scene.rts.f_rts_hz),
-                  doppler_hz=z, amplitude=np.ones((n, 1), complex), target=np.zeros(n, int),
-                  front_end=np.arange(n), kind=np.full(n, KIND_DIRECT), order=np.zeros(n, int))
+    return Echoes.build(tau_air_s=np.zeros((n, 1)), amplitude=np.ones((n, 1), complex),
+                        f_if_hz=scene.rts.f_rts_hz, target=0, front_end=np.arange(n),
+                        kind=EchoKind.DIRECT)
 
 
 def ghost_orders(scene: Scene, floor_db: float = DEFAULT_FLOOR_DB) -> list[dict]:
@@ -218,13 +217,13 @@ def ghosts_figure(report: GhostReport, title: str = ""):
     """Per target, the range profile at its Doppler bin (dB relative to the target, when
     simulated) with the predicted ghost positions and levels marked (and the simulated ones)."""
     import matplotlib as mpl
-    from ..viz.figures import STYLE, _new_figure
+    from ..viz.figures import STYLE, new_figure
     tg = report.targets
     n = max(len(tg), 1)
     ncols = 1 if n == 1 else 2
     nrows = int(np.ceil(n / ncols))
     with mpl.rc_context(STYLE):
-        fig, axes = _new_figure(figsize=(6.4, 1.9 * nrows + 0.6), nrows=nrows, ncols=ncols)
+        fig, axes = new_figure(figsize=(6.4, 1.9 * nrows + 0.6), nrows=nrows, ncols=ncols)
         axes = np.atleast_1d(axes).ravel()
         for ax in axes[len(tg):]:
             ax.set_visible(False)

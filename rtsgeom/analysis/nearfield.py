@@ -379,10 +379,10 @@ def nearfield_figure(nf: NearField, title: str = ""):
     exact in the legend); the phase error across the virtual array (p-p, RMS, curvature only).
     The scene's radius and the Fraunhofer distance are marked."""
     import matplotlib as mpl
-    from ..viz.figures import STYLE, _new_figure
+    from ..viz.figures import STYLE, new_figure
     r = nf.radius_m
     with mpl.rc_context(STYLE):
-        fig, (ax, ax2, ax3) = _new_figure(figsize=(6.4, 7.2), nrows=3, sharex=True)
+        fig, (ax, ax2, ax3) = new_figure(figsize=(6.4, 7.2), nrows=3, sharex=True)
         for q in range(nf.geometric_deg.shape[1]):
             col = f"C{q % 10}"
             lab = f"FE {q} ({nf.geometric_deg[0, q]:.1f} deg)"

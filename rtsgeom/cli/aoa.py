@@ -66,7 +66,7 @@ def cmd_calibrate(args) -> int:
                 raise UsageError("--from-identified predicts one pair's delay: give --pair I J")
             from ..identify import calibrate_from_identified
             scene = load_scene_checked(args.from_identified)
-            out = calibrate_from_identified(scene, _pair(build_setup(scene), args.pair))
+            out = calibrate_from_identified(scene, _pair(build_setup(scene), args.pair)).to_dict()
             if stage is not None:
                 write_json(stage / "calibration.json", out)
             if args.json:

@@ -29,7 +29,7 @@ import pyvista as pv
 
 from ..geometry import Setup
 from ..arcmath import radial_tangent, sphere_frame
-from ..geometry.export import _COLOURS
+from ..geometry.export import COLOURS
 from ..io import atomic_path, write_text
 
 __all__ = ["VizError", "ensure_render_backend", "build_plotter", "render_setup_png",
@@ -51,7 +51,7 @@ _MODULE = "#5c6670"
 
 def _rgb(key: str) -> tuple[float, float, float]:
     """A colour of the mesh export (same palette in the GLB and in the 3D view)."""
-    return tuple(v / 255.0 for v in _COLOURS[key][:3])
+    return tuple(v / 255.0 for v in COLOURS[key][:3])
 
 
 class VizError(RuntimeError):
