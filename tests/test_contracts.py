@@ -143,3 +143,87 @@ def test_no_private_name_is_imported_from_another_package():
                 if re.match(r"_[a-zA-Z]", a.name) and target_pkg != pkg:
                     bad.append(f"{path.relative_to(ROOT)}: {a.name} from {'.'.join(target)}")
     assert not bad, bad
+
+
+# ------------------------------------------------------------------------------------------
+# Specific exceptions: a user's bad input is a named error (exit 2), never a masked bug
+# ------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def capture_files(tmp_path_factory):
+    from rtsgeom.cli import main
+    from conftest import DEFAULT_SCENE
+    d = tmp_path_factory.mktemp("caps")
+    for name in ("c.bin", "c.npy"):
+        assert main(["adc", str(DEFAULT_SCENE), "--active", "0", "--out", str(d / name),
+                     "--quiet"]) == 0
+    return d
+
+
+def _corrupt(kind, path):
+    side = path.with_name(path.name + ".json")
+    if kind == "truncated":
+        path.write_bytes(path.read_bytes()[:1001])
+    elif kind == "not-json":
+        side.write_text("{not json")
+    elif kind == "not-object":
+        side.write_text("[1, 2]")
+    elif kind == "missing-key":
+        import json
+        meta = json.loads(side.read_text())
+        del meta["probe_range_m" if path.suffix == ".npy" else "num_rx"]
+        side.write_text(json.dumps(meta))
+    elif kind == "bad-value":
+        import json
+        meta = json.loads(side.read_text())
+        meta["active_front_end"] = "first"
+        side.write_text(json.dumps(meta))
+    elif kind == "no-sidecar":
+        side.unlink()
+
+
+@pytest.mark.parametrize("name", ["c.bin", "c.npy"])
+@pytest.mark.parametrize("kind", ["truncated", "not-json", "not-object", "missing-key",
+                                  "bad-value", "no-sidecar"])
+def test_a_broken_capture_is_a_capture_error_and_exit_2(capture_files, tmp_path, name, kind,
+                                                        capsys):
+    import shutil
+
+    from rtsgeom.cli import main
+    from rtsgeom.errors import CaptureError
+    from rtsgeom.identify import read_capture
+    from conftest import DEFAULT_SCENE
+    path = tmp_path / name
+    shutil.copy(capture_files / name, path)
+    shutil.copy(capture_files / (name + ".json"), tmp_path / (name + ".json"))
+    assert read_capture(path).data.ndim == 3  # intact: reads
+    _corrupt(kind, path)
+    with pytest.raises(CaptureError, match=re.escape(str(tmp_path))):
+        read_capture(path)
+    assert main(["identify", str(DEFAULT_SCENE), str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("rtsgeom: error: CAPTURE: ") and "Traceback" not in err
+
+
+def test_odd_samples_cannot_be_dca1000(tmp_path, capsys):
+    from rtsgeom.cli import main
+    from rtsgeom.errors import ParameterError
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.radar.dca1000 import to_dca1000
+    from rtsgeom.radar.fmcw import AdcCube
+    from conftest import make_scene
+    scene = make_scene(samples_per_chirp=63)
+    setup = build_setup(scene)
+    cube = AdcCube(np.zeros((2, setup.rut.num_virtual, 63), np.complex64), scene.radar, setup.rut)
+    with pytest.raises(ParameterError, match="samples_per_chirp = 63: must be even"):
+        to_dca1000(cube)
+
+
+@pytest.mark.parametrize("suffix", [".xyz", ".png", ".glb2"])
+def test_unknown_mesh_format_is_an_output_error(tmp_path, suffix, capsys):
+    from rtsgeom.cli import main
+    from conftest import DEFAULT_SCENE
+    assert main(["export-mesh", str(DEFAULT_SCENE), "--out", str(tmp_path / f"m{suffix}")]) == 2
+    err = capsys.readouterr().err
+    assert "unsupported mesh format" in err and "Traceback" not in err

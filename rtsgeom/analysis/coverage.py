@@ -34,6 +34,7 @@ from typing import Callable
 
 import numpy as np
 
+from ..aoa.model import AngleUnreachable
 from ..geometry import build_setup
 from ..geometry.farfield import angular_resolution_rad
 from ..paths import exact_paths
@@ -139,7 +140,7 @@ def evaluate_arc(plan: dict, spec_deg: float = 0.1, target_yield: float = 0.95,
     pairs = adjacent_pairs(setup.fe.count)
     try:
         models = arc_models(setup, pairs, points)
-    except ValueError as exc:
+    except AngleUnreachable as exc:
         out["problem"] = f"synthesis failed: {exc}"
         return out
     zero = np.zeros((2, 3))

@@ -54,6 +54,7 @@ from scipy.constants import c
 from ..aoa.calibration import nominal_model, probe_angles, probe_ranges
 from ..aoa.model import ChannelModel
 from ..aoa.synthesis import AngleUnreachable, PairModel
+from ..errors import ParameterError
 from ..geometry import RutArray, Setup, build_setup
 from ..geometry.farfield import (aperture_m, apparent_azimuth_rad, fraunhofer_distance_m,
                                  two_way_lengths)
@@ -325,7 +326,7 @@ def _check_radii(scene: Scene, radii: np.ndarray) -> None:
     limit = 0.8 * scene.radar.max_range_m - 2.0
     if r.ndim != 1 or r.size == 0 or not np.all(np.isfinite(r)) or np.any(r < 0.05) \
             or np.any(r > limit):
-        raise ValueError(f"arc radii must lie in [0.05, {limit:.4g}] m (the target must stay "
+        raise ParameterError(f"arc radii must lie in [0.05, {limit:.4g}] m (the target must stay "
                          f"within the radar's range), got {r}")
 
 

@@ -13,6 +13,7 @@ import numpy as np
 
 from ..analysis.tolerance import AXES, CASES, NOMINAL_AMPLITUDES
 from ..aoa.calibration import calibrate_pair, probe_front_ends
+from ..aoa.model import AngleUnreachable
 from ..aoa.linearity import linearity
 from ..geometry import build_setup
 from ..io import write_json
@@ -162,7 +163,7 @@ def tolerance_arc(args, scene, sigma, extra, folder) -> int:
     t0 = time.perf_counter()
     try:
         models = arc_models(setup, pairs, args.points)
-    except ValueError as exc:
+    except AngleUnreachable as exc:
         raise UsageError(f"--pair: a pair cannot synthesize its span ({exc})") from None
     from .tolerance import _progress
     with _progress(args.quiet) as progress, dask_client(args.dask, args.workers) as client:

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from ..io import atomic_path
+from ..io import OutputError, atomic_path
 from .setup import Setup
 
 __all__ = ["COLOURS", "rut_board_mesh", "setup_scene", "export_setup"]
@@ -74,7 +74,7 @@ def export_setup(setup: Setup, path: str | Path) -> Path:
     path = Path(path)
     fmt = path.suffix.lower().lstrip(".")
     if fmt not in ("glb", "gltf", "ply", "obj", "stl"):
-        raise ValueError(f"--out {path}: unsupported mesh format '{fmt}' (use .glb, .ply, .obj "
+        raise OutputError(f"--out {path}: unsupported mesh format '{fmt}' (use .glb, .ply, .obj "
                          "or .stl)")
     sc = setup_scene(setup)
     data = (sc.export(file_type=fmt) if fmt in ("glb", "gltf", "obj")

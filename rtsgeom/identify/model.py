@@ -10,6 +10,7 @@ import numpy as np
 from scipy.constants import c
 
 from ..arcmath import antenna_positions, layout_offsets
+from ..errors import CaptureError
 from ..geometry import Setup
 from ..paths.exact import leg_delays
 from ..radar.capture import Capture
@@ -123,11 +124,11 @@ def measure(setup: Setup, cap: Capture) -> tuple[np.ndarray, float, ProbeModel]:
     radar = setup.scene.radar
     want = (radar.chirps_per_tx, setup.rut.num_virtual, radar.samples_per_chirp)
     if cap.data.shape != want:
-        raise ValueError(f"capture of front end {cap.active}: shape {list(cap.data.shape)} does "
-                         f"not match the scene's radar {list(want)} [loop, virtual, sample]")
+        raise CaptureError(f"capture of front end {cap.active}: shape {list(cap.data.shape)} "
+                           f"does not match the scene's radar {list(want)} [loop, virtual, sample]")
     if not 0 <= cap.active < setup.fe.count:
-        raise ValueError(f"capture: active front end {cap.active} not in the scene "
-                         f"(0..{setup.fe.count - 1})")
+        raise CaptureError(f"capture: active front end {cap.active} not in the scene "
+                           f"(0..{setup.fe.count - 1})")
     rd = range_doppler(AdcCube(cap.data.astype(np.complex64), radar, setup.rut))
     model = ProbeModel.of(setup, cap)
     rbs = (model.range_bin + np.arange(-1, 2)) % radar.samples_per_chirp
