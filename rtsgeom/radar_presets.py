@@ -26,7 +26,7 @@ import numpy as np
 
 from .schema import SceneError
 
-__all__ = ["ArrayPreset", "ArraySpec", "PRESETS", "preset", "preset_names"]
+__all__ = ["ArrayPreset", "ArraySpec", "PRESETS", "preset"]
 
 
 def _frozen(a) -> np.ndarray:
@@ -261,10 +261,6 @@ PRESETS: dict[str, ArrayPreset] = {p.name: p for p in (
              "virtual elements cover 86 distinct lambda/2 positions (0..85; the rest overlap). "
              "Verified against the cited numbers. Tx and Rx interleave: no board gap."),
 )}
-
-
-def preset_names() -> tuple[str, ...]:
-    return tuple(PRESETS)
 
 
 def preset(name: str) -> ArrayPreset:

@@ -119,12 +119,13 @@ def test_every_all_lists_existing_public_names(name):
         assert not n.startswith("_") or n == "__version__", f"{name}.__all__ lists private {n!r}"
 
 
-def test_top_level_names_resolve_and_are_public():
-    for n in rtsgeom.__all__:
-        assert not n.startswith("_") or n == "__version__"
-        if n in ("render_setup_png", "raytrace_paths", "RaytraceUnavailable"):
-            continue  # pyvista / Sionna: loaded on use
-        assert getattr(rtsgeom, n) is not None
+def test_top_level_lists_each_name_once_and_only_public_ones():
+    assert len(set(rtsgeom.__all__)) == len(rtsgeom.__all__)
+    assert all(not n.startswith("_") for n in rtsgeom.__all__ if n != "__version__")
+    assert set(rtsgeom.__all__) == {"__version__", *rtsgeom._LAZY}
+    # the API reference documents exactly the top level
+    text = (ROOT / "docs" / "api.rst").read_text(encoding="utf-8").split("Figures (")[0]
+    assert set(re.findall(r"^   ([A-Za-z_0-9]+)$", text, re.M)) == set(rtsgeom._LAZY)
 
 
 def test_no_private_name_is_imported_from_another_package():
