@@ -114,7 +114,18 @@ def _zoom_power(cube, doppler_bin: int, range_bins: np.ndarray) -> np.ndarray:
     return np.sum(np.abs(kern @ y.T) ** 2, axis=1)
 
 
-def _peak(rd, cube, range_m: float, velocity_mps: float) -> dict:
+@dataclass(frozen=True)
+class MapPeak:
+    """A peak in a run's range-Doppler map (:func:`_peak`)."""
+
+    range_bin: int  # the strongest map cell within +-1 bin of the looked-up point
+    doppler_bin: int
+    peak_db: float  # that cell's power (dB)
+    range_m: float  # the peak of the range spectrum zoomed around it at that Doppler bin
+    level_db: float  # the zoomed peak's power (dB, no scalloping loss)
+
+
+def _peak(rd, cube, range_m: float, velocity_mps: float) -> MapPeak:
     """The strongest map cell within +-1 bin of (range, Doppler) (``peak_db``), and the peak
     of the range spectrum zoomed around it at that Doppler bin (``range_m``, ``level_db``)."""
     n_r, n_d = rd.power.shape
@@ -129,9 +140,8 @@ def _peak(rd, cube, range_m: float, velocity_mps: float) -> dict:
     fine = r + np.linspace(-1.0, 1.0, ZOOM_POINTS)
     zp = _zoom_power(cube, d, fine)
     k = int(np.argmax(zp))
-    return {"range_bin": r, "doppler_bin": d, "peak_db": float(rd.power_db[r, d]),
-            "range_m": float(rd.range_m[0] + fine[k] * dr),
-            "level_db": float(10 * np.log10(max(zp[k], 1e-300)))}
+    return MapPeak(r, d, float(rd.power_db[r, d]), float(rd.range_m[0] + fine[k] * dr),
+                   float(10 * np.log10(max(zp[k], 1e-300))))
 
 
 def measure_ghosts(result, predicted: list[dict]) -> list[dict]:
@@ -146,30 +156,30 @@ def measure_ghosts(result, predicted: list[dict]) -> list[dict]:
     out = []
     for tgt in predicted:
         t = _peak(rd, result.cube, tgt["range_m"], tgt["velocity_mps"])
-        entry = {"index": tgt["index"], "target_range_m": t["range_m"],
-                 "target_power_db": t["peak_db"], "target_level_db": t["level_db"],
-                 "map_median_db": median - t["level_db"],
+        entry = {"index": tgt["index"], "target_range_m": t.range_m,
+                 "target_power_db": t.peak_db, "target_level_db": t.level_db,
+                 "map_median_db": median - t.level_db,
                  "ghosts": []}
         for g in tgt["ghosts"]:
             if g["range_m"] > rd.range_m[-1]:
                 entry["ghosts"].append({"order": g["order"], "beyond_max_range": True})
                 continue
             m = _peak(rd, result.cube, g["range_m"], tgt["velocity_mps"])
-            offset = m["range_m"] - t["range_m"]
-            hit = (np.abs(det.range_bin - m["range_bin"]) <= 1) & \
-                  (np.abs((det.doppler_bin - m["doppler_bin"] + rd.power.shape[1] // 2)
+            offset = m.range_m - t.range_m
+            hit = (np.abs(det.range_bin - m.range_bin) <= 1) & \
+                  (np.abs((det.doppler_bin - m.doppler_bin + rd.power.shape[1] // 2)
                           % rd.power.shape[1] - rd.power.shape[1] // 2) <= 1)
             entry["ghosts"].append({
                 "order": g["order"],
                 "predicted_range_m": g["range_m"], "predicted_level_db": g["level_db"],
-                "range_m": m["range_m"], "offset_from_target_m": offset,
+                "range_m": m.range_m, "offset_from_target_m": offset,
                 "offset_error_bins": (offset - g["range_offset_m"]) / dr,
-                "level_db_bin": m["peak_db"] - t["peak_db"],
-                "level_db": m["level_db"] - t["level_db"],
-                "level_error_db": m["level_db"] - t["level_db"] - g["level_db"],
-                "above_map_median_db": m["peak_db"] - median,
-                "predicted_above_map_median_db": g["level_db"] + t["level_db"] - median,
-                "within_cfar_window_of_target": bool(abs(m["range_bin"] - t["range_bin"]) <= ring),
+                "level_db_bin": m.peak_db - t.peak_db,
+                "level_db": m.level_db - t.level_db,
+                "level_error_db": m.level_db - t.level_db - g["level_db"],
+                "above_map_median_db": m.peak_db - median,
+                "predicted_above_map_median_db": g["level_db"] + t.level_db - median,
+                "within_cfar_window_of_target": bool(abs(m.range_bin - t.range_bin) <= ring),
                 "cfar_detected": bool(np.any(hit)),
             })
         out.append(entry)
