@@ -63,8 +63,8 @@ for q, fe in enumerate(result["front_ends"]):
 ident = identify(nominal, captures)
 pred = predicted_calibration(setup_of(identified_scene(ident)), (0, 1))
 true = predicted_calibration(built_setup, (0, 1))
-print(f"calibration delay: predicted {pred['delta_tau_s'] * 1e12:.1f} ps, "
-      f"setup as built {true['delta_tau_s'] * 1e12:.1f} ps")
+print(f"calibration delay: predicted {pred.delta_tau_s * 1e12:.1f} ps, "
+      f"setup as built {true.delta_tau_s * 1e12:.1f} ps")
 
 # %%
 # Cramer-Rao bound of one capture versus SNR and arc radius.

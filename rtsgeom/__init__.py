@@ -23,33 +23,37 @@ import importlib
 
 __version__ = "0.1.0"
 
-# public name -> (module, attribute)
+# public name -> (module, attribute), in pipeline order. Only what a script needs: the scene,
+# each stage's typed result, the CLI jobs as functions (api.py) and the errors a user's input
+# can cause; everything else is imported from its module.
 _LAZY = {
     # scene file
     "Scene": (".scene", "Scene"),
-    "SceneError": (".scene", "SceneError"),
     "load_scene": (".scene", "load_scene"),
     "loads_scene": (".scene", "loads_scene"),
     "parse_scene": (".scene", "parse_scene"),
     "replace": (".api", "replace"),
-    "with_arc_radius": (".analysis.nearfield", "with_arc_radius"),
     # geometry and paths
     "Setup": (".geometry", "Setup"),
     "build_setup": (".geometry", "build_setup"),
     "Paths": (".paths", "Paths"),
     "exact_paths": (".paths", "exact_paths"),
     "raytrace_paths": (".paths.raytrace", "raytrace_paths"),
-    "RaytraceUnavailable": (".paths.raytrace", "RaytraceUnavailable"),
-    # signal chain
+    # RTS channels and the signal chain
+    "RtsProgram": (".rts", "RtsProgram"),
+    "Echoes": (".rts", "Echoes"),
+    "EchoKind": (".rts", "EchoKind"),
     "run_scene": (".run", "run_scene"),
     "RunResult": (".run", "RunResult"),
     "AdcCube": (".radar.fmcw", "AdcCube"),
     "RangeDoppler": (".radar.processing", "RangeDoppler"),
     "Detections": (".radar.processing", "Detections"),
+    "Steering": (".radar.steering", "Steering"),
     "range_angle_map": (".radar.processing", "range_angle_map"),
     "to_dca1000": (".radar.dca1000", "to_dca1000"),
     "from_dca1000": (".radar.dca1000", "from_dca1000"),
     # AoA synthesis
+    "ChannelModel": (".aoa.model", "ChannelModel"),
     "calibrate": (".api", "calibrate"),
     "calibrate_pair": (".aoa.calibration", "calibrate_pair"),
     "probe_front_ends": (".aoa.calibration", "probe_front_ends"),
@@ -68,10 +72,19 @@ _LAZY = {
     "NearField": (".analysis.nearfield", "NearField"),
     "ghosts": (".api", "ghosts"),
     "GhostReport": (".analysis.ghosts", "GhostReport"),
+    "Identification": (".identify", "Identification"),
     # views
     "show": (".api", "show"),
     "render_setup_png": (".viz.scene3d", "render_setup_png"),
     "scene_info": (".info", "scene_info"),
+    # errors a user's input can cause (rtsgeom.errors lists them all)
+    "SceneError": (".scene", "SceneError"),
+    "ParameterError": (".errors", "ParameterError"),
+    "CaptureError": (".errors", "CaptureError"),
+    "OutputError": (".io", "OutputError"),
+    "AngleUnreachable": (".aoa.model", "AngleUnreachable"),
+    "RaytraceUnavailable": (".paths.raytrace", "RaytraceUnavailable"),
+    "VizError": (".viz.render_backend", "VizError"),
 }
 
 __all__ = ["__version__", *_LAZY]

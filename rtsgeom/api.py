@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .errors import ParameterError
 from .scene import Scene
 
 __all__ = ["replace", "calibrate", "linearity", "tolerance", "design", "nearfield", "ghosts",
@@ -55,7 +56,7 @@ def _check_pair(setup, pair) -> tuple[int, int]:
     i, j = (int(p) for p in pair)
     n = setup.fe.count
     if not (0 <= i < n and 0 <= j < n) or abs(i - j) != 1:
-        raise ValueError(f"pair {pair}: must be two adjacent front-end indices in [0, {n - 1}]")
+        raise ParameterError(f"pair {pair}: must be two adjacent front-end indices in [0, {n - 1}]")
     return i, j
 
 
@@ -123,7 +124,7 @@ def linearity(scene: Scene, pair=(0, 1), amplitudes: str = "exact", calibration=
     else:
         cal = calibration
         if tuple(cal.pair) != pair:
-            raise ValueError(f"calibration is for pair {tuple(cal.pair)}, not {pair}")
+            raise ParameterError(f"calibration is for pair {tuple(cal.pair)}, not {pair}")
     return _linearity(setup, paths, pair, amplitudes, probe, cal, points, scene.seed)
 
 

@@ -19,7 +19,7 @@ import re
 from contextlib import contextmanager
 from typing import Callable, Sequence
 
-__all__ = ["map_chunks", "chunk_slices", "dask_client", "ClusterError", "check_address"]
+__all__ = ["map_chunks", "dask_client", "ClusterError", "check_address"]
 
 _ADDRESS = re.compile(r"(?:(tcp|tls|ws|wss|ucx|inproc)://)?(\[[0-9a-fA-F:]+\]|[A-Za-z0-9_.-]+)"
                       r"(?::(\d{1,5}))?")
@@ -37,12 +37,6 @@ def check_address(address: str) -> str:
         raise ClusterError(f"--dask {address!r}: not a scheduler address; expected "
                            "[tcp://]HOST[:PORT], e.g. tcp://10.0.0.5:8786")
     return address.strip()
-
-
-def chunk_slices(n: int, size: int) -> list[slice]:
-    """``slice`` objects covering ``range(n)`` in chunks of at most ``size``."""
-    size = max(1, int(size))
-    return [slice(i, min(i + size, n)) for i in range(0, n, size)]
 
 
 @contextmanager

@@ -24,7 +24,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["ArrayPreset", "ArraySpec", "PRESETS", "preset", "preset_names"]
+from .schema import SceneError
+
+__all__ = ["ArrayPreset", "ArraySpec", "PRESETS", "preset"]
 
 
 def _frozen(a) -> np.ndarray:
@@ -61,23 +63,23 @@ class ArraySpec:
         for fname in ("tx_m", "rx_m"):
             a = np.asarray(getattr(self, fname), dtype=float)
             if a.ndim != 2 or a.shape[1] != 2 or a.shape[0] < 1:
-                raise ValueError(f"array.{fname}: expected a list of [x, z] pairs (at least one), "
-                                 f"got shape {a.shape}")
+                raise SceneError(f"array.{fname}: expected a list of [x, z] pairs (at least "
+                                 f"one), got shape {a.shape}")
             if not np.all(np.isfinite(a)) or np.any(np.abs(a) > 1.0):
-                raise ValueError(f"array.{fname}: coordinates must be finite and within +-1 m")
+                raise SceneError(f"array.{fname}: coordinates must be finite and within +-1 m")
             object.__setattr__(self, fname, _frozen(a))
         order = tuple(int(i) for i in self.tx_order)
         n_tx = self.tx_m.shape[0]
         if not order or any(i < 0 or i >= n_tx for i in order) or len(set(order)) != len(order):
-            raise ValueError(f"array.tx_order: distinct Tx indices in [0, {n_tx - 1}] (at least "
+            raise SceneError(f"array.tx_order: distinct Tx indices in [0, {n_tx - 1}] (at least "
                              f"one), got {list(self.tx_order)}")
         object.__setattr__(self, "tx_order", order)
         if self.spacing_m is not None and not (0.0 < float(self.spacing_m) <= 0.1):
-            raise ValueError(f"array.spacing_m: must lie in (0, 0.1] m, got {self.spacing_m}")
+            raise SceneError(f"array.spacing_m: must lie in (0, 0.1] m, got {self.spacing_m}")
         for fname, a in (("tx_m", self.tx_m), ("rx_m", self.rx_m)):
             u = np.unique(np.round(a * 1e9).astype(np.int64), axis=0)
             if u.shape[0] != a.shape[0]:
-                raise ValueError(f"array.{fname}: two antennas at the same position")
+                raise SceneError(f"array.{fname}: two antennas at the same position")
 
     @property
     def num_tx(self) -> int:
@@ -156,12 +158,12 @@ class ArrayPreset:
         rx = self.rx_units * d
         if self.board_gap_units is None:
             if board_gap_m is not None:
-                raise ValueError(f"radar.board_gap_m: the {self.name} preset has interleaved Tx "
+                raise SceneError(f"radar.board_gap_m: the {self.name} preset has interleaved Tx "
                                  "and Rx antennas, so no board gap applies")
             return tx, rx
         gap = self.board_gap_units * d if board_gap_m is None else float(board_gap_m)
         if not (0.0 <= gap <= 0.5):
-            raise ValueError(f"radar.board_gap_m: must lie in [0, 0.5] m, got {gap:g}")
+            raise SceneError(f"radar.board_gap_m: must lie in [0, 0.5] m, got {gap:g}")
         rx[:, 0] += tx[:, 0].max() + gap  # same operations as the original AWR1843 layout
         return tx, rx
 
@@ -261,14 +263,10 @@ PRESETS: dict[str, ArrayPreset] = {p.name: p for p in (
 )}
 
 
-def preset_names() -> tuple[str, ...]:
-    return tuple(PRESETS)
-
-
 def preset(name: str) -> ArrayPreset:
     """The preset called ``name``; a clear error listing the known ones otherwise."""
     try:
         return PRESETS[name]
     except KeyError:
-        raise ValueError(f"radar.antenna_preset: unknown preset '{name}' (known: "
+        raise SceneError(f"radar.antenna_preset: unknown preset '{name}' (known: "
                          f"{', '.join(PRESETS)})") from None

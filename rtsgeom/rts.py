@@ -16,7 +16,8 @@ the complex amplitude. The FMCW model turns it into an ADC cube.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
+from enum import IntEnum
 
 import numpy as np
 from scipy.constants import c
@@ -26,11 +27,22 @@ from .geometry import Setup
 from .paths.table import FE_TO_RX, RUT_TO_RUT, TX_TO_FE, Paths
 from .scene import Scene
 
-__all__ = ["RtsProgram", "Echoes", "realised_delay", "target_amplitude", "channel_echoes",
-           "setup_echoes", "cable_ghosts", "program_nearest", "build_echoes",
+__all__ = ["RtsProgram", "EchoKind", "Echoes", "realised_delay", "target_amplitude",
+           "channel_echoes", "setup_echoes", "cable_ghosts", "program_nearest", "build_echoes",
            "fractional_delay_fir", "fir_error_response", "fir_if_gain"]
 
-KIND_DIRECT, KIND_GHOST, KIND_SETUP = 0, 1, 2
+
+class EchoKind(IntEnum):
+    """What an echo is (``Echoes.kind``; an ``int`` subclass, so ``echoes.kind == EchoKind.GHOST``
+    compares the stored integers)."""
+
+    DIRECT = 0  # a target's echo through its RTS channel
+    GHOST = 1  # a cable ghost of a direct echo (``cable_ghosts``)
+    SETUP = 2  # the RuT's own chirp reflected by the setup (``setup_echoes``)
+
+
+#: the earlier names of the echo kinds (aliases of the members)
+KIND_DIRECT, KIND_GHOST, KIND_SETUP = EchoKind.DIRECT, EchoKind.GHOST, EchoKind.SETUP
 FIR_KAISER_BETA = 4.0  # [assumed] fractional-delay FIR window (about 40 dB stop band)
 
 
@@ -64,9 +76,21 @@ class RtsProgram:
         return int(self.target.size)
 
 
+#: the shape of each ``Echoes`` field in echoes E, virtual channels V and fast-time samples N
+_ECHO_SHAPES = {"tau_air_s": "EV", "tau_if_s": "E", "f_if_hz": "E", "doppler_hz": "E",
+                "amplitude": "EV", "target": "E", "front_end": "E", "kind": "E", "order": "E",
+                "fast_gain": "EN"}
+_ECHO_INTS = ("target", "front_end", "kind", "order")
+
+
 @dataclass(frozen=True)
 class Echoes:
-    """Everything the RuT receives, as separable echoes (E echoes x V virtual channels)."""
+    """Everything the RuT receives, as separable echoes (E echoes x V virtual channels).
+
+    Construct it with every field (positional or keyword) or with :meth:`build` (keywords,
+    per-echo fields broadcast from scalars). The shapes are checked on construction (a
+    ``ValueError`` names the field and the shape it must have) and the arrays stored read-only.
+    """
 
     tau_air_s: np.ndarray  # (E, V) over-the-air delay, acts at RF (f_c tau_c of eq. 8)
     tau_if_s: np.ndarray  # (E,) delay applied inside the RTS, acts at f_if
@@ -75,11 +99,55 @@ class Echoes:
     amplitude: np.ndarray  # (E, V) complex amplitude at the RuT's receiver
     target: np.ndarray  # (E,) target index, -1 for setup reflections
     front_end: np.ndarray  # (E,) channel, -1 for setup reflections
-    kind: np.ndarray  # (E,) KIND_DIRECT | KIND_GHOST | KIND_SETUP
+    kind: np.ndarray  # (E,) int, an EchoKind
     order: np.ndarray  # (E,) ghost order (0 for the direct echo)
     # (E, N) complex gain per fast-time sample (the fractional-delay FIR's response along the
     # IF sweep, rts.fir_if_gain); None: 1 everywhere (an ideal delay)
     fast_gain: np.ndarray | None = None
+
+    def __post_init__(self):
+        tau = np.asarray(self.tau_air_s)
+        if tau.ndim != 2:
+            raise ValueError(f"Echoes.tau_air_s: shape {tau.shape} must be (E, V) (echoes, "
+                             "virtual channels)")
+        dims = {"E": tau.shape[0], "V": tau.shape[1]}
+        if np.ndim(self.fast_gain) == 2:
+            dims["N"] = np.shape(self.fast_gain)[1]
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if v is None and f.name == "fast_gain":
+                continue
+            a = np.asarray(v)
+            want = tuple(dims.get(d, d) for d in _ECHO_SHAPES[f.name])
+            kind = np.integer if f.name in _ECHO_INTS else np.number
+            if a.shape != want or not np.issubdtype(a.dtype, kind):
+                names = ", ".join(_ECHO_SHAPES[f.name]) + ("," if len(want) == 1 else "")
+                size = ", ".join(map(str, want)) + ("," if len(want) == 1 else "")
+                what = "integers" if f.name in _ECHO_INTS else "numbers"
+                raise ValueError(f"Echoes.{f.name}: got shape {a.shape} of {a.dtype}, must be "
+                                 f"({names}) = ({size}) {what} (E echoes and V virtual "
+                                 "channels as in tau_air_s, N fast-time samples)")
+            if a.flags.writeable:
+                a = frozen(a)
+            object.__setattr__(self, f.name, a)
+
+    @classmethod
+    def build(cls, *, tau_air_s, amplitude, tau_if_s=0.0, f_if_hz=0.0, doppler_hz=0.0,
+              target=-1, front_end=-1, kind=EchoKind.DIRECT, order=0,
+              fast_gain=None) -> "Echoes":
+        """Echoes from keyword arguments: ``tau_air_s`` and ``amplitude`` (E, V); the per-echo
+        fields (E,) or a scalar for every echo (defaults: no IF delay, no Doppler, a direct
+        echo of no target or channel)."""
+        e = np.shape(tau_air_s)[0] if np.ndim(tau_air_s) else 0
+
+        def per_echo(v):
+            a = np.asarray(v)
+            return np.full(e, a) if a.ndim == 0 else a
+
+        return cls(tau_air_s=tau_air_s, tau_if_s=per_echo(tau_if_s), f_if_hz=per_echo(f_if_hz),
+                   doppler_hz=per_echo(doppler_hz), amplitude=amplitude,
+                   target=per_echo(target), front_end=per_echo(front_end), kind=per_echo(kind),
+                   order=per_echo(order), fast_gain=fast_gain)
 
     @property
     def tau_s(self) -> np.ndarray:

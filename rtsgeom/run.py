@@ -107,7 +107,7 @@ def label_detections(result: "RunResult", bins: float = 2.0) -> list[str]:
     """
     from scipy.constants import c
 
-    from .rts import KIND_GHOST, KIND_SETUP
+    from .rts import EchoKind
     det, rd, echoes, radar = result.detections, result.rd, result.echoes, result.scene.radar
     labels = ["unmatched"] * len(det)
     if len(det) and len(echoes):
@@ -128,9 +128,9 @@ def label_detections(result: "RunResult", bins: float = 2.0) -> list[str]:
             if cand.size == 0:
                 continue
             e = cand[np.argmax(power[cand])]
-            if echoes.kind[e] == KIND_SETUP:
+            if echoes.kind[e] == EchoKind.SETUP:
                 labels[j] = "setup reflection"
-            elif echoes.kind[e] == KIND_GHOST:
+            elif echoes.kind[e] == EchoKind.GHOST:
                 labels[j] = f"cable ghost of target {int(echoes.target[e])}"
             else:
                 labels[j] = f"target {int(echoes.target[e])}"
@@ -194,10 +194,10 @@ def _budget(scene: Scene, setup: Setup, echoes: Echoes, program: RtsProgram):
     ``[radar.link]``, the sheet's echo estimated by physical optics where the paths carry no
     setup reflection."""
     from .link import link_budget, sheet_paths
-    from .rts import KIND_SETUP, setup_echoes
+    from .rts import EchoKind, setup_echoes
     est = None
     # the physical-optics sheet estimate costs ~1 s: only for a physical budget ([radar.link])
-    if scene.radar.link is not None and not np.any(echoes.kind == KIND_SETUP):
+    if scene.radar.link is not None and not np.any(echoes.kind == EchoKind.SETUP):
         sp = sheet_paths(setup)
         est = setup_echoes(setup, sp) if sp is not None else None
     override = None

@@ -23,7 +23,7 @@ import numpy as np
 from .arcmath import antenna_positions
 from .radar_presets import ArraySpec
 from .registry import RADAR_PRESETS, WINDOWS, AOA_MODES
-from .schema import fmt
+from .schema import SceneError, fmt
 
 if TYPE_CHECKING:
     from .scene import FrontEndConfig, RadarConfig, Scene
@@ -386,7 +386,7 @@ def angular_resolution_rad(radar: "RadarConfig") -> float:
         arr = radar.array
         try:
             d_a = ArraySpec.from_mm(arr.tx_mm, arr.rx_mm, arr.tx_order).azimuth_aperture_m()
-        except ValueError:  # reported by _array_rules
+        except SceneError:  # reported by _array_rules
             return math.inf
         return 1.22 * lam / d_a if d_a > 0 else math.inf
     d = radar.element_spacing_m or lam / 2.0

@@ -92,8 +92,8 @@ def test_no_mismatch_no_ghosts(base):
     # nothing where the ghost would be: more than 60 dB below the target (window sidelobes)
     t = _peak(rep.result.rd, rep.result.cube, 30.0, 0.0)
     g = _peak(rep.result.rd, rep.result.cube, 30.0 + 1.0 / 0.7, 0.0)
-    assert g["level_db"] - t["level_db"] < -60.0
-    assert g["level_db"] - t["level_db"] < first(base)[1]["level_db"] - 30.0
+    assert g.level_db - t.level_db < -60.0
+    assert g.level_db - t.level_db < first(base)[1]["level_db"] - 30.0
     # one end matched is enough: no round trip
     assert ghost_orders(one_target(rl_be=None))[0]["ghosts"] == []
 

@@ -134,7 +134,7 @@ def test_monte_carlo_offsets_within_3_sigma_std_at_crb_and_calibration_without_s
                 assert abs(f.estimate[i] - truth[q, i]) < 3 * f.std[i], (seed, q, i)
                 assert 1 / 1.5 < f.std[i] / crb[i] < 1.5, (seed, q, i)
         built = ident_mod.setup_of(ident_mod.identified_scene(ident))
-        pred = ident_mod.predicted_calibration(built, (0, 1))["delta_tau_s"]
+        pred = ident_mod.predicted_calibration(built, (0, 1)).delta_tau_s
         probe = probe_front_ends(setup, paths, seed)
         truth_d = coherence_delay(setup, paths, (0, 1),
                                   probe_angles(probe.angle_rad[0], probe.angle_rad[1]))

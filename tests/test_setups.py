@@ -358,14 +358,14 @@ def test_coverage_plan_respects_resolution_bias_and_cutouts(radius_m):
     cov = (math.radians(-10.0), math.radians(10.0))
     for extra in (0, 1):
         plan = plan_arc(scene, cov, radius_m, extra)
-        assert plan["spacing_deg"] <= plan["resolution_deg"] * (1 + 1e-9)
-        detected = np.degrees(np.radians(plan["angles_deg"]) + _bias_rad(plan["scene"]))
+        assert plan.spacing_deg <= plan.resolution_deg * (1 + 1e-9)
+        detected = np.degrees(np.radians(plan.angles_deg) + _bias_rad(plan.scene))
         assert detected[0] <= -10.0 + 0.02 and detected[-1] >= 10.0 - 0.02
-        fits = plan["spacing_deg"] >= plan["min_cutout_spacing_deg"]
-        assert (plan["sheet"] == "disabled") == (not fits)
-        assert ("cutout fit" in plan["binding"]) == (not fits)
-        assert plan["front_ends"] == math.ceil(
-            (plan["angles_deg"][-1] - plan["angles_deg"][0]) / plan["resolution_deg"]
+        fits = plan.spacing_deg >= plan.min_cutout_spacing_deg
+        assert (plan.sheet == "disabled") == (not fits)
+        assert ("cutout fit" in plan.binding) == (not fits)
+        assert plan.front_ends == math.ceil(
+            (plan.angles_deg[-1] - plan.angles_deg[0]) / plan.resolution_deg
             - 1e-9) + 1 + extra
 
 

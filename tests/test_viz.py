@@ -24,8 +24,8 @@ from rtsgeom.paths import Paths, exact_paths
 from rtsgeom.paths.table import FE_TO_RX, TX_TO_FE
 from rtsgeom.viz import figures as F
 from rtsgeom.viz.report import write_report
-from rtsgeom.viz.scene3d import (_html_requirements, _path_polylines, render_setup_png,
-                                  rut_scale_factor)
+from rtsgeom.viz.meshes import path_polylines
+from rtsgeom.viz.scene3d import _html_requirements, render_setup_png, rut_scale_factor
 
 from conftest import DEFAULT_SCENE, make_scene
 
@@ -76,7 +76,7 @@ def test_reflections_are_drawn_only_with_vertices():
                 rut_tx=[0, 0, -1, -1], rut_rx=[-1, -1, 2, 2], delay_s=[3.3e-9, 4e-9, 3.3e-9, 5e-9],
                 gain=[1e-3, 1e-4, 1e-3, 1e-4], bounces=[0, 1, 0, 2])
     plain = Paths.build(**base)
-    los, refl = _path_polylines(setup, plain, scale=1.0)
+    los, refl = path_polylines(setup, plain, scale=1.0)
     assert len(los) == 2 and refl == []  # reflections without vertices cannot be drawn ...
     from rtsgeom.viz.scene3d import undrawable_reflections
     assert undrawable_reflections(plain) == 2  # ... but are counted (and noted in the view)
@@ -85,7 +85,7 @@ def test_reflections_are_drawn_only_with_vertices():
     with_v = PathsWithVertices(*dataclasses.astuple(plain),
                                vertices=(None, np.array([[0.1, 0.5, 0.0]]), None,
                                          np.array([bounce, [0.0, 0.5, 0.1]])))
-    los, refl = _path_polylines(setup, with_v, scale=1.0)
+    los, refl = path_polylines(setup, with_v, scale=1.0)
     assert len(los) == 2 and [len(p) for p in refl] == [3, 4]
     assert np.allclose(los[0], [setup.rut.tx_world[0], fe.rx[0]])
     assert np.allclose(refl[1][0], fe.tx[1]) and np.allclose(refl[1][-1], setup.rut.rx_world[2])
@@ -94,7 +94,7 @@ def test_reflections_are_drawn_only_with_vertices():
     nan_v = PathsWithVertices(*dataclasses.astuple(plain),
                               vertices=np.array([[[np.nan] * 3] * 2, [[0.1, 0.5, 0.0], [np.nan] * 3],
                                                  [[np.nan] * 3] * 2, [bounce, [0.0, 0.5, 0.1]]]))
-    los, refl = _path_polylines(setup, nan_v, scale=1.0)
+    los, refl = path_polylines(setup, nan_v, scale=1.0)
     assert [len(p) for p in refl] == [3, 4] and all(np.isfinite(p).all() for p in refl)
 
 
@@ -120,20 +120,20 @@ def test_show_raytrace_draws_every_reflection(tmp_path):
     res = raytrace.trace(setup)
     n_refl = int((res.paths.bounces > 0).sum())
     assert n_refl > 100  # the sheet and the board reflect
-    los, refl = _path_polylines(setup, res, scale=1.0)
+    los, refl = path_polylines(setup, res, scale=1.0)
     assert len(refl) == n_refl
     for i, poly in zip(np.flatnonzero(res.paths.bounces > 0)[:50], refl):
         assert len(res.hit_points(i)) == res.paths.bounces[i]
         assert np.isfinite(poly).all() and len(poly) >= 2 + res.paths.bounces[i] - 1
     # the CLI draws them: more reflection-coloured pixels than with exact paths
-    from rtsgeom.viz.scene3d import _REFLECTION
+    from rtsgeom.viz.meshes import REFLECTION
     counts = {}
     for method in ("exact", "raytrace"):
         out = tmp_path / f"{method}.png"
         assert main(["show", str(DEFAULT_SCENE), "--png", str(out), "--paths", method,
                      "--size", "800x500", "--quiet"]) == 0
         rgb = np.round(imread(out)[..., :3] * 255).astype(int)
-        target = np.array(_rgb_of(_REFLECTION))
+        target = np.array(_rgb_of(REFLECTION))
         counts[method] = int((np.abs(rgb - target).max(axis=-1) <= 40).sum())
     assert counts["raytrace"] > counts["exact"] + 200
 

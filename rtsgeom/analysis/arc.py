@@ -31,6 +31,7 @@ from typing import Callable, Iterator
 import numpy as np
 
 from .._util import frozen
+from ..errors import ParameterError
 from .tolerance import (CASES, DISTRIBUTIONS, PairPhasors, evaluate_chunk, largest_passing_scale,
                         percentiles)
 
@@ -86,7 +87,7 @@ class Bounds:
         vals = [*self.offsets_m, self.yaw_rad, self.pitch_rad, *self.rut_position_m,
                 self.rut_yaw_rad]
         if not all(math.isfinite(v) and v >= 0 for v in vals):
-            raise ValueError(f"tolerance bounds {vals}: must be finite and >= 0")
+            raise ParameterError(f"tolerance bounds {vals}: must be finite and >= 0")
 
     def to_dict(self) -> dict:
         return {"radial_mm": self.offsets_m[0] * 1e3, "tangential_mm": self.offsets_m[1] * 1e3,
@@ -108,7 +109,7 @@ def arc_draws(seed: int, draws: int, count: int, distribution: str = "normal",
     pitch) and ``rut`` (k, 4) (x, y, z, yaw), each from its own generator (see the module
     docstring); none depends on ``chunk``."""
     if distribution not in DISTRIBUTIONS:
-        raise ValueError(f"distribution {distribution!r}: must be one of "
+        raise ParameterError(f"distribution {distribution!r}: must be one of "
                          f"{', '.join(DISTRIBUTIONS)}")
     g_off = np.random.default_rng(seed)
     g_rot = np.random.default_rng([seed, 1])

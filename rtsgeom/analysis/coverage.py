@@ -34,6 +34,7 @@ from typing import Callable
 
 import numpy as np
 
+from ..aoa.model import AngleUnreachable
 from ..geometry import build_setup
 from ..geometry.farfield import angular_resolution_rad
 from ..paths import exact_paths
@@ -41,10 +42,71 @@ from ..scene import Scene
 from .arc import Bounds, adjacent_pairs, arc_models, arc_monte_carlo, max_scale_for_yield
 from .design import _fit_sheet, _problem
 
-__all__ = ["CoverageDesign", "arc_scene", "plan_arc", "evaluate_arc", "coverage_designs",
-           "best_per_radius"]
+__all__ = ["ArcPlan", "ArcDesign", "CoverageDesign", "arc_scene", "plan_arc", "evaluate_arc",
+           "coverage_designs", "best_per_radius"]
 
 BASE_SIGMA_M = 1e-4  # the tolerance search scales 0.1 mm sigmas
+
+
+@dataclass(frozen=True)
+class ArcPlan:
+    """One radius's candidate arc (steps 1-3 of the module docstring)."""
+
+    scene: Scene  # the arc as a scene: N front ends, the sheet kept, widened or removed
+    radius_m: float
+    front_ends: int
+    angles_deg: tuple[float, ...]  # module angles, bias compensated
+    spacing_deg: float
+    resolution_deg: float  # 1.22 lambda / d_A (paper eq. 24)
+    min_cutout_spacing_deg: float
+    outer_bias_deg: tuple[float, float]  # near-field bias of the outer front ends
+    sheet: str  # "kept" | "widened" | "disabled"
+    sheet_change: str  # what happened to the sheet, in words
+    binding: tuple[str, ...]  # the binding constraints
+    extra: int  # front ends beyond the fewest the resolution allows
+
+    def to_dict(self) -> dict:
+        """The plan's JSON keys (the scene left out)."""
+        return {"radius_m": self.radius_m, "front_ends": self.front_ends,
+                "angles_deg": list(self.angles_deg), "spacing_deg": self.spacing_deg,
+                "resolution_deg": self.resolution_deg,
+                "min_cutout_spacing_deg": self.min_cutout_spacing_deg,
+                "outer_bias_deg": list(self.outer_bias_deg), "sheet": self.sheet,
+                "sheet_change": self.sheet_change, "binding": list(self.binding),
+                "extra": self.extra}
+
+
+@dataclass(frozen=True)
+class ArcDesign:
+    """A planned arc evaluated (:func:`evaluate_arc`); NaN and ``problem`` where it cannot be
+    built or synthesize its span, the Monte-Carlo fields None then."""
+
+    plan: ArcPlan
+    worst_calibrated_deg: float = math.nan  # worst |error| over the coverage, nominal arc
+    worst_uncalibrated_deg: float = math.nan
+    sigma_mm: float = math.nan  # mounting sigma that keeps the target yield of whole arcs
+    sigma_capped: bool = False  # the tolerance search hit its cap
+    problem: str | None = None
+    p95_calibrated_deg: float | None = None  # p95 over arcs with 0.1 mm sigma errors
+    yield_calibrated: float | None = None  # and the fraction of them within the spec
+    p95_uncalibrated_deg: float | None = None
+    yield_uncalibrated: float | None = None
+    tolerance_yield: float | None = None  # the yield reached at sigma_mm
+
+    def to_dict(self) -> dict:
+        """``design --coverage-deg --json``: one entry of ``designs`` (keys as before)."""
+        out = self.plan.to_dict()
+        out.update(worst_calibrated_deg=self.worst_calibrated_deg,
+                   worst_uncalibrated_deg=self.worst_uncalibrated_deg, sigma_mm=self.sigma_mm,
+                   sigma_capped=self.sigma_capped, problem=self.problem)
+        if self.p95_calibrated_deg is None:  # not evaluated (see problem)
+            return out
+        out.update({"p95_calibrated_at_0.1mm_deg": self.p95_calibrated_deg,
+                    "yield_calibrated_at_0.1mm": self.yield_calibrated,
+                    "p95_uncalibrated_at_0.1mm_deg": self.p95_uncalibrated_deg,
+                    "yield_uncalibrated_at_0.1mm": self.yield_uncalibrated,
+                    "tolerance_yield": self.tolerance_yield})
+        return out
 
 
 def arc_scene(scene: Scene, radius_m: float, angles_rad) -> tuple[Scene, str]:
@@ -80,7 +142,7 @@ def _bias_rad(variant: Scene) -> np.ndarray:
 
 
 def plan_arc(scene: Scene, coverage_rad: tuple[float, float], radius_m: float,
-             extra: int = 0) -> dict:
+             extra: int = 0) -> ArcPlan:
     """Number of front ends and spacing for one radius (steps 1-3 of the module docstring);
     ``extra`` front ends beyond the fewest the resolution allows."""
     a, b = sorted(coverage_rad)
@@ -117,47 +179,38 @@ def plan_arc(scene: Scene, coverage_rad: tuple[float, float], radius_m: float,
                      else "sheet REMOVED (its cutouts cannot hold the antennas or it would not "
                           "enclose the RuT)" if scene.sheet.enabled else "no sheet in the scene"),
     }[sheet]
-    return {"scene": variant, "radius_m": float(radius_m), "front_ends": int(n),
-            "angles_deg": [float(x) for x in np.degrees(angles)],
-            "spacing_deg": math.degrees(spacing), "resolution_deg": math.degrees(res),
-            "min_cutout_spacing_deg": math.degrees(cut),
-            "outer_bias_deg": [float(x) for x in np.degrees(bias)],
-            "sheet": sheet, "sheet_change": sheet_text, "binding": binding, "extra": extra}
+    return ArcPlan(variant, float(radius_m), int(n), tuple(float(x) for x in np.degrees(angles)),
+                   math.degrees(spacing), math.degrees(res), math.degrees(cut),
+                   tuple(float(x) for x in np.degrees(bias)), sheet, sheet_text,
+                   tuple(binding), extra)
 
 
-def evaluate_arc(plan: dict, spec_deg: float = 0.1, target_yield: float = 0.95,
-                 draws: int = 200, seed: int = 0, points: int = 11) -> dict:
+def evaluate_arc(plan: ArcPlan, spec_deg: float = 0.1, target_yield: float = 0.95,
+                 draws: int = 200, seed: int = 0, points: int = 11) -> ArcDesign:
     """Worst calibrated / uncalibrated angle error over the coverage and the mounting tolerance
     for the yield of one planned arc (NaN and ``problem`` where it cannot be built)."""
-    variant = plan["scene"]
-    out = {k: v for k, v in plan.items() if k != "scene"}
-    out.update(worst_calibrated_deg=math.nan, worst_uncalibrated_deg=math.nan,
-               sigma_mm=math.nan, sigma_capped=False, problem=_problem(variant))
-    if out["problem"] is not None:
-        return out
-    setup = build_setup(variant)
+    problem = _problem(plan.scene)
+    if problem is not None:
+        return ArcDesign(plan, problem=problem)
+    setup = build_setup(plan.scene)
     pairs = adjacent_pairs(setup.fe.count)
     try:
         models = arc_models(setup, pairs, points)
-    except ValueError as exc:
-        out["problem"] = f"synthesis failed: {exc}"
-        return out
+    except AngleUnreachable as exc:
+        return ArcDesign(plan, problem=f"synthesis failed: {exc}")
     zero = np.zeros((2, 3))
-    out["worst_calibrated_deg"] = max(float(np.max(np.abs(m.angle_errors(zero, "calibrated"))))
-                                      for m in models)
-    out["worst_uncalibrated_deg"] = max(
-        float(np.max(np.abs(m.angle_errors(zero, "uncalibrated")))) for m in models)
+    worst = {case: max(float(np.max(np.abs(m.angle_errors(zero, case)))) for m in models)
+             for case in ("calibrated", "uncalibrated")}
     ref = arc_monte_carlo(models, setup.fe.count, Bounds((BASE_SIGMA_M,) * 3), draws, seed,
                           "normal", spec_deg)
-    for case in ("calibrated", "uncalibrated"):
-        out[f"p95_{case}_at_0.1mm_deg"] = float(np.percentile(np.abs(ref.arc_worst(case)), 95))
-        out[f"yield_{case}_at_0.1mm"] = ref.yield_(case)
+    p95 = {case: float(np.percentile(np.abs(ref.arc_worst(case)), 95))
+           for case in ("calibrated", "uncalibrated")}
     inv = max_scale_for_yield(models, setup.fe.count, Bounds((BASE_SIGMA_M,) * 3), draws, seed,
                               target_yield, spec_deg, "calibrated", rel_tol=0.05)
-    out["sigma_mm"] = inv["factor"] * BASE_SIGMA_M * 1e3
-    out["sigma_capped"] = inv["capped"]
-    out["tolerance_yield"] = inv["yield"]
-    return out
+    return ArcDesign(plan, worst["calibrated"], worst["uncalibrated"],
+                     inv["factor"] * BASE_SIGMA_M * 1e3, inv["capped"], None,
+                     p95["calibrated"], ref.yield_("calibrated"), p95["uncalibrated"],
+                     ref.yield_("uncalibrated"), inv["yield"])
 
 
 @dataclass(frozen=True)
@@ -167,7 +220,7 @@ class CoverageDesign:
     spec_deg: float
     target_yield: float
     draws: int
-    designs: tuple  # evaluate_arc dicts, radius-major, candidates N_min, N_min + 1
+    designs: tuple[ArcDesign, ...]  # radius-major, candidates N_min, N_min + 1
 
     def to_dict(self) -> dict:
         def clean(v):
@@ -175,22 +228,23 @@ class CoverageDesign:
         return {"coverage_deg": list(self.coverage_deg),
                 "radius_m": [float(r) for r in self.radius_m], "spec_deg": self.spec_deg,
                 "yield": self.target_yield, "draws": self.draws,
-                "designs": [{k: clean(v) for k, v in d.items()} for d in self.designs],
-                "best": [{k: clean(v) for k, v in d.items()} for d in best_per_radius(self)]}
+                "designs": [{k: clean(v) for k, v in d.to_dict().items()} for d in self.designs],
+                "best": [{k: clean(v) for k, v in d.to_dict().items()}
+                         for d in best_per_radius(self)]}
 
 
-def best_per_radius(grid: CoverageDesign) -> list[dict]:
+def best_per_radius(grid: CoverageDesign) -> list[ArcDesign]:
     """Per radius: the fewest front ends meeting the spec after calibration (largest
     tolerance among equals), else the smallest worst error."""
     out = []
     for r in grid.radius_m:
-        cand = [d for d in grid.designs if d["radius_m"] == float(r) and d["problem"] is None
-                and math.isfinite(d["worst_calibrated_deg"])]
+        cand = [d for d in grid.designs if d.plan.radius_m == float(r) and d.problem is None
+                and math.isfinite(d.worst_calibrated_deg)]
         if not cand:
             continue
-        ok = [d for d in cand if d["worst_calibrated_deg"] <= grid.spec_deg]
-        pick = (min(ok, key=lambda d: (d["front_ends"], -d["sigma_mm"])) if ok
-                else min(cand, key=lambda d: d["worst_calibrated_deg"]))
+        ok = [d for d in cand if d.worst_calibrated_deg <= grid.spec_deg]
+        pick = (min(ok, key=lambda d: (d.plan.front_ends, -d.sigma_mm)) if ok
+                else min(cand, key=lambda d: d.worst_calibrated_deg))
         out.append(pick)
     return out
 

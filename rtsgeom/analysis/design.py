@@ -34,6 +34,7 @@ from typing import Callable
 import numpy as np
 
 from .._util import frozen
+from ..aoa.model import AngleUnreachable
 from ..geometry import build_setup
 from ..geometry.farfield import angular_resolution_rad
 from ..scene import Scene, SheetConfig, arc_centre_m, problems
@@ -121,7 +122,7 @@ def evaluate_design(scene: Scene, pair: tuple[int, int], radius_m: float, spacin
     out["exceeds_resolution"] = bool(gap > angular_resolution_rad(setup.rut))
     try:
         model = PairPhasors.build(setup, (0, 1), points)
-    except ValueError as exc:  # no ratio reaches a set angle: the composite has split
+    except AngleUnreachable as exc:  # no ratio reaches a set angle: the composite has split
         out["problem"] = f"synthesis failed: {exc}"
         return out
     zero = np.zeros((2, 3))

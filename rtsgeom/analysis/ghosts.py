@@ -26,7 +26,7 @@ from scipy.constants import c
 
 from ..geometry import build_setup
 from ..radar.processing import window
-from ..rts import KIND_DIRECT, Echoes, cable_ghosts, program_nearest
+from ..rts import EchoKind, Echoes, cable_ghosts, program_nearest
 from ..scene import Scene
 
 __all__ = ["DEFAULT_FLOOR_DB", "ghost_orders", "predict_ghosts", "measure_ghosts",
@@ -39,10 +39,9 @@ ZOOM_POINTS = 401  # range zoom: +-1 bin in 1/200 bin steps (scalloping < 1e-4 d
 def _unit_echoes(scene: Scene) -> Echoes:
     """One unit-amplitude direct echo per front end (one virtual channel, zero delay)."""
     n = len(scene.rts.front_ends)
-    z = np.zeros(n)
-    return Echoes(tau_air_s=np.zeros((n, 1)), tau_if_s=z, f_if_hz=np.full(n, scene.rts.f_rts_hz),
-                  doppler_hz=z, amplitude=np.ones((n, 1), complex), target=np.zeros(n, int),
-                  front_end=np.arange(n), kind=np.full(n, KIND_DIRECT), order=np.zeros(n, int))
+    return Echoes.build(tau_air_s=np.zeros((n, 1)), amplitude=np.ones((n, 1), complex),
+                        f_if_hz=scene.rts.f_rts_hz, target=0, front_end=np.arange(n),
+                        kind=EchoKind.DIRECT)
 
 
 def ghost_orders(scene: Scene, floor_db: float = DEFAULT_FLOOR_DB) -> list[dict]:
@@ -115,7 +114,18 @@ def _zoom_power(cube, doppler_bin: int, range_bins: np.ndarray) -> np.ndarray:
     return np.sum(np.abs(kern @ y.T) ** 2, axis=1)
 
 
-def _peak(rd, cube, range_m: float, velocity_mps: float) -> dict:
+@dataclass(frozen=True)
+class MapPeak:
+    """A peak in a run's range-Doppler map (:func:`_peak`)."""
+
+    range_bin: int  # the strongest map cell within +-1 bin of the looked-up point
+    doppler_bin: int
+    peak_db: float  # that cell's power (dB)
+    range_m: float  # the peak of the range spectrum zoomed around it at that Doppler bin
+    level_db: float  # the zoomed peak's power (dB, no scalloping loss)
+
+
+def _peak(rd, cube, range_m: float, velocity_mps: float) -> MapPeak:
     """The strongest map cell within +-1 bin of (range, Doppler) (``peak_db``), and the peak
     of the range spectrum zoomed around it at that Doppler bin (``range_m``, ``level_db``)."""
     n_r, n_d = rd.power.shape
@@ -130,9 +140,8 @@ def _peak(rd, cube, range_m: float, velocity_mps: float) -> dict:
     fine = r + np.linspace(-1.0, 1.0, ZOOM_POINTS)
     zp = _zoom_power(cube, d, fine)
     k = int(np.argmax(zp))
-    return {"range_bin": r, "doppler_bin": d, "peak_db": float(rd.power_db[r, d]),
-            "range_m": float(rd.range_m[0] + fine[k] * dr),
-            "level_db": float(10 * np.log10(max(zp[k], 1e-300)))}
+    return MapPeak(r, d, float(rd.power_db[r, d]), float(rd.range_m[0] + fine[k] * dr),
+                   float(10 * np.log10(max(zp[k], 1e-300))))
 
 
 def measure_ghosts(result, predicted: list[dict]) -> list[dict]:
@@ -147,30 +156,30 @@ def measure_ghosts(result, predicted: list[dict]) -> list[dict]:
     out = []
     for tgt in predicted:
         t = _peak(rd, result.cube, tgt["range_m"], tgt["velocity_mps"])
-        entry = {"index": tgt["index"], "target_range_m": t["range_m"],
-                 "target_power_db": t["peak_db"], "target_level_db": t["level_db"],
-                 "map_median_db": median - t["level_db"],
+        entry = {"index": tgt["index"], "target_range_m": t.range_m,
+                 "target_power_db": t.peak_db, "target_level_db": t.level_db,
+                 "map_median_db": median - t.level_db,
                  "ghosts": []}
         for g in tgt["ghosts"]:
             if g["range_m"] > rd.range_m[-1]:
                 entry["ghosts"].append({"order": g["order"], "beyond_max_range": True})
                 continue
             m = _peak(rd, result.cube, g["range_m"], tgt["velocity_mps"])
-            offset = m["range_m"] - t["range_m"]
-            hit = (np.abs(det.range_bin - m["range_bin"]) <= 1) & \
-                  (np.abs((det.doppler_bin - m["doppler_bin"] + rd.power.shape[1] // 2)
+            offset = m.range_m - t.range_m
+            hit = (np.abs(det.range_bin - m.range_bin) <= 1) & \
+                  (np.abs((det.doppler_bin - m.doppler_bin + rd.power.shape[1] // 2)
                           % rd.power.shape[1] - rd.power.shape[1] // 2) <= 1)
             entry["ghosts"].append({
                 "order": g["order"],
                 "predicted_range_m": g["range_m"], "predicted_level_db": g["level_db"],
-                "range_m": m["range_m"], "offset_from_target_m": offset,
+                "range_m": m.range_m, "offset_from_target_m": offset,
                 "offset_error_bins": (offset - g["range_offset_m"]) / dr,
-                "level_db_bin": m["peak_db"] - t["peak_db"],
-                "level_db": m["level_db"] - t["level_db"],
-                "level_error_db": m["level_db"] - t["level_db"] - g["level_db"],
-                "above_map_median_db": m["peak_db"] - median,
-                "predicted_above_map_median_db": g["level_db"] + t["level_db"] - median,
-                "within_cfar_window_of_target": bool(abs(m["range_bin"] - t["range_bin"]) <= ring),
+                "level_db_bin": m.peak_db - t.peak_db,
+                "level_db": m.level_db - t.level_db,
+                "level_error_db": m.level_db - t.level_db - g["level_db"],
+                "above_map_median_db": m.peak_db - median,
+                "predicted_above_map_median_db": g["level_db"] + t.level_db - median,
+                "within_cfar_window_of_target": bool(abs(m.range_bin - t.range_bin) <= ring),
                 "cfar_detected": bool(np.any(hit)),
             })
         out.append(entry)
@@ -218,13 +227,13 @@ def ghosts_figure(report: GhostReport, title: str = ""):
     """Per target, the range profile at its Doppler bin (dB relative to the target, when
     simulated) with the predicted ghost positions and levels marked (and the simulated ones)."""
     import matplotlib as mpl
-    from ..viz.figures import STYLE, _new_figure
+    from ..viz.figures import STYLE, new_figure
     tg = report.targets
     n = max(len(tg), 1)
     ncols = 1 if n == 1 else 2
     nrows = int(np.ceil(n / ncols))
     with mpl.rc_context(STYLE):
-        fig, axes = _new_figure(figsize=(6.4, 1.9 * nrows + 0.6), nrows=nrows, ncols=ncols)
+        fig, axes = new_figure(figsize=(6.4, 1.9 * nrows + 0.6), nrows=nrows, ncols=ncols)
         axes = np.atleast_1d(axes).ravel()
         for ax in axes[len(tg):]:
             ax.set_visible(False)

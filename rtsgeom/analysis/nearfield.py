@@ -54,6 +54,7 @@ from scipy.constants import c
 from ..aoa.calibration import nominal_model, probe_angles, probe_ranges
 from ..aoa.model import ChannelModel
 from ..aoa.synthesis import AngleUnreachable, PairModel
+from ..errors import ParameterError
 from ..geometry import RutArray, Setup, build_setup
 from ..geometry.farfield import (aperture_m, apparent_azimuth_rad, fraunhofer_distance_m,
                                  two_way_lengths)
@@ -325,7 +326,7 @@ def _check_radii(scene: Scene, radii: np.ndarray) -> None:
     limit = 0.8 * scene.radar.max_range_m - 2.0
     if r.ndim != 1 or r.size == 0 or not np.all(np.isfinite(r)) or np.any(r < 0.05) \
             or np.any(r > limit):
-        raise ValueError(f"arc radii must lie in [0.05, {limit:.4g}] m (the target must stay "
+        raise ParameterError(f"arc radii must lie in [0.05, {limit:.4g}] m (the target must stay "
                          f"within the radar's range), got {r}")
 
 
@@ -379,10 +380,10 @@ def nearfield_figure(nf: NearField, title: str = ""):
     exact in the legend); the phase error across the virtual array (p-p, RMS, curvature only).
     The scene's radius and the Fraunhofer distance are marked."""
     import matplotlib as mpl
-    from ..viz.figures import STYLE, _new_figure
+    from ..viz.figures import STYLE, new_figure
     r = nf.radius_m
     with mpl.rc_context(STYLE):
-        fig, (ax, ax2, ax3) = _new_figure(figsize=(6.4, 7.2), nrows=3, sharex=True)
+        fig, (ax, ax2, ax3) = new_figure(figsize=(6.4, 7.2), nrows=3, sharex=True)
         for q in range(nf.geometric_deg.shape[1]):
             col = f"C{q % 10}"
             lab = f"FE {q} ({nf.geometric_deg[0, q]:.1f} deg)"

@@ -35,7 +35,7 @@ from .synthesis import PairModel
 
 __all__ = ["Calibration", "FrontEndProbe", "probe_front_ends", "calibrate_pair", "probe_ranges",
            "if_phase_slope_hz", "air_phase_slope_hz", "coherence_delay", "probe_total_delay",
-           "frames_per_step", "TARGET_BIAS_PS", "calibrate_pair_paper", "fir_effect"]
+           "TARGET_BIAS_PS", "calibrate_pair_paper", "fir_effect"]
 
 
 @dataclass(frozen=True)
@@ -194,51 +194,6 @@ def _simulate_detect(setup, paths, program, seed, frames: int = 1):
 
 TARGET_BIAS_PS = 2.0  # the averaging keeps the noise's pull on the chosen delay below this
 MAX_FRAMES = 1 << 20
-
-
-def _processing_gain(name: str, n: int) -> float:
-    """SNR gain of an n-point windowed DFT: (sum w)^2 / sum w^2 (n for no window)."""
-    from ..radar.processing import window
-    w = window(name, n)
-    return float(np.sum(w) ** 2 / np.sum(w ** 2))
-
-
-def frames_per_step(setup: Setup, models, designs, alphas, f_if_hz: float,
-                    bias_s: float = TARGET_BIAS_PS * 1e-12) -> tuple[int, float]:
-    """Frames to average coherently per sweep step so that receiver noise cannot pull the
-    chosen delay by ``bias_s``; returns (frames, per-frame angle noise in deg).
-
-    Near the coherence point each probe's angle error is *quadratic* in the phase error (the
-    two beams' cross term goes with cos(phi)): ``e_p = c_p phi^2``, so the RMS criterion rises
-    by only ``kappa d^2`` at a delay ``d`` from it, ``kappa = rms(c_p) (2 pi f_if)^2`` (c_p from
-    the nominal model). One frame's angle noise (beamformer peak of an N-element lambda/2
-    array at high SNR) is ``sigma_u = sqrt(6 / (SNR N (N^2 - 1))) / pi``, u = sin(alpha), with
-    SNR the per-element SNR after the windowed range and Doppler DFTs (per-sample SNR of the
-    strongest echo, scaled by the probe's amplitude, times both DFTs' processing gains). Each
-    step is a fresh measurement, so a step ``bias_s`` off wins over the right one when the
-    difference of two noises (sqrt 2 sigma / sqrt K) exceeds ``kappa bias_s^2``; K frames make
-    that a 2-sigma event: ``K = 8 sigma^2 / (kappa bias_s^2)^2``.
-    """
-    radar, rut = setup.scene.radar, setup.rut
-    if radar.snr_db is None:
-        return 1, 0.0
-    n = int(np.count_nonzero(rut.azimuth_mask))
-    snr = (10 ** (radar.snr_db / 10) * _processing_gain(radar.range_window, radar.samples_per_chirp)
-           * _processing_gain(radar.doppler_window, radar.chirps_per_tx))
-    amps = np.abs(np.asarray(designs))  # (P, 2): the composite carries both channels
-    rel = np.minimum(amps.sum(axis=1) / amps.max(), 1.0)
-    h = 0.05  # rad: inside the quadratic region (checked against h/2 in the tests)
-    curv = []
-    for m, (a_i, a_j) in zip(models, designs):
-        rho = a_j / a_i
-        phase = m.coherent_phase(alphas)
-        e = [float(m.angle(rho, phase + x)) for x in (-h, 0.0, h)]
-        curv.append((e[0] + e[2] - 2 * e[1]) / (2 * h * h))
-    kappa = float(np.sqrt(np.mean(np.square(curv)))) * (2 * np.pi * f_if_hz) ** 2  # rad / s^2
-    sigma_u = np.sqrt(6.0 / (snr * rel ** 2 * n * (n * n - 1.0))) / np.pi
-    sigma_a = float(np.sqrt(np.mean((sigma_u / np.cos(np.asarray(alphas))) ** 2)))
-    frames = int(min(MAX_FRAMES, max(1, np.ceil(8 * sigma_a ** 2 / (kappa * bias_s ** 2) ** 2))))
-    return frames, float(np.degrees(sigma_a))
 
 
 def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe:

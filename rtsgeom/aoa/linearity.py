@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..geometry import Setup
 from ..paths import Paths
 from ..rts import RtsProgram, requested_delay
@@ -86,7 +87,7 @@ def linearity(setup: Setup, paths: Paths, pair: tuple[int, int], mode: str,
     end alone as the RuT detects it); ``exact`` ignores it.
     """
     if end_angles not in END_ANGLES:
-        raise ValueError(f"end_angles = {end_angles!r}: must be one of {END_ANGLES}")
+        raise ParameterError(f"end_angles = {end_angles!r}: must be one of {END_ANGLES}")
     scene = setup.scene
     i, j = pair
     meas = np.sort(probe.angle_rad[[i, j]])

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay
 
+from ..errors import ParameterError
 from ..geometry import Setup
 from ..paths import Paths
 from ..radar.processing import nearest_detection
@@ -56,7 +57,7 @@ def linearity_grid(setup: Setup, paths: Paths, mode: str = "exact", n: int = 5,
     the calibrated offsets and phases and detected by the simulated RuT."""
     from .ncal import calibrate_channels, tree_phases
     if setup.fe.count > 4:
-        raise ValueError(f"linearity --grid: the scene has {setup.fe.count} front ends; the "
+        raise ParameterError(f"linearity --grid: the scene has {setup.fe.count} front ends; the "
                          "error map covers one cell of 3 or 4")
     cell = tuple(range(setup.fe.count))
     nom, nom_paths = nominal_model(setup, paths)
@@ -65,7 +66,7 @@ def linearity_grid(setup: Setup, paths: Paths, mode: str = "exact", n: int = 5,
     target0 = TargetConfig(rng)
     st = Steering.auto(nom.rut, setup.scene.radar)
     if st.dims != 2:
-        raise ValueError("linearity --grid needs a RuT with elevation (an array with "
+        raise ParameterError("linearity --grid needs a RuT with elevation (an array with "
                          "elevation extent, e.g. radar.use_elevation_tx = true)")
     offsets, tree = np.zeros(setup.fe.count), None
     if calibrate:

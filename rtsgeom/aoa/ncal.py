@@ -228,12 +228,13 @@ def _residual(setup, paths, nom, nom_paths, ch, offsets, probe, st, seed, tree):
     """(azimuth, elevation) error (deg) of one target at the channels' centre, synthesized by
     all of them with the calibrated offsets (exact mode)."""
     from .calibration import probe_ranges
+    from .model import AngleUnreachable
     r = float(probe_ranges(setup, 1)[0])
     cs = ChannelSet.build(nom, nom_paths, tuple(ch), TargetConfig(r), offsets[ch])
     u = cs.fe_directions().mean(axis=0)
     try:
         w = cs.solve(u, tree_phases(cs, tree))
-    except ValueError:
+    except AngleUnreachable:  # the centre is outside what the channels reach: no error to show
         return (np.nan, np.nan)
     amps = cs.amplitudes(w, u) * probe.gain_correction[ch]
     tau = float(requested_delay(setup.scene, r))

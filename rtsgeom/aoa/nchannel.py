@@ -36,6 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..geometry import Setup
 from ..paths import Paths
 from ..radar.steering import Steering
@@ -157,12 +158,12 @@ class ChannelSet:
         """Weights w (Q,) whose beamformer peak is at ``u_set`` (D,) (the pair: w_0 = 1; else
         the strongest channel's amplitude 1)."""
         if mode not in SOLVERS:
-            raise ValueError(f"mode {mode!r}: must be one of {', '.join(SOLVERS)}")
+            raise ParameterError(f"mode {mode!r}: must be one of {', '.join(SOLVERS)}")
         u_set = np.atleast_1d(np.asarray(u_set, float))
         if self.count == 2 and self.dims == 1:  # the pair: ChannelModel's fast path
             return self.model.solve(float(np.arcsin(u_set[0])), phases, mode)
         if mode == "paper":
-            raise ValueError("mode 'paper': eq. 23 is defined for a pair of front ends in "
+            raise ParameterError("mode 'paper': eq. 23 is defined for a pair of front ends in "
                              "azimuth only; use exact or array-factor")
         if mode == "array-factor":
             a0 = closed_form_amplitudes(self.steering, self.fe_directions(), u_set, phases)

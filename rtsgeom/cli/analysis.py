@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..io import write_json
 from ._common import (UsageError, load_scene_checked, number, output_folder, output_path,
                       print_json, scene_arg, steps)
@@ -69,7 +70,7 @@ def cmd_nearfield(args) -> int:
             with steps(args.quiet or args.json) as step:
                 step(f"near field at {len(radii)} arc radii ({radii[0]:.3g} to {radii[-1]:.3g} m)")
                 nf = nearfield(scene, radii, points=args.points)
-        except ValueError as exc:
+        except ParameterError as exc:
             raise UsageError(f"--radius-m: {exc}") from None
         out = nf.to_dict()
         _write(stage, "nearfield", out, lambda: nearfield_figure(nf))

@@ -8,6 +8,8 @@ import numpy as np
 from ..aoa.calibration import (calibrate_pair, calibrate_pair_paper, fir_effect,
                                probe_front_ends)
 from ..aoa.linearity import linearity
+from ..aoa.model import AngleUnreachable
+from ..errors import ParameterError
 from ..geometry import build_setup
 from ..io import write_json
 from ..paths import exact_paths
@@ -66,7 +68,7 @@ def cmd_calibrate(args) -> int:
                 raise UsageError("--from-identified predicts one pair's delay: give --pair I J")
             from ..identify import calibrate_from_identified
             scene = load_scene_checked(args.from_identified)
-            out = calibrate_from_identified(scene, _pair(build_setup(scene), args.pair))
+            out = calibrate_from_identified(scene, _pair(build_setup(scene), args.pair)).to_dict()
             if stage is not None:
                 write_json(stage / "calibration.json", out)
             if args.json:
@@ -174,7 +176,7 @@ def _linearity_grid(args, stage) -> int:
         try:
             em = linearity_grid(setup, paths, args.amplitudes, args.grid,
                                 not args.uncalibrated, scene.seed)
-        except ValueError as exc:
+        except (ParameterError, AngleUnreachable) as exc:
             raise UsageError(f"{args.scene}: {exc}") from None
     mx = em.max_abs_error_deg()
     _emit(args, stage, "linearity_grid.png", "linearity_grid", em.to_dict(),

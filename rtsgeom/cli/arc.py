@@ -13,6 +13,7 @@ import numpy as np
 
 from ..analysis.tolerance import AXES, CASES, NOMINAL_AMPLITUDES
 from ..aoa.calibration import calibrate_pair, probe_front_ends
+from ..aoa.model import AngleUnreachable
 from ..aoa.linearity import linearity
 from ..geometry import build_setup
 from ..io import write_json
@@ -162,7 +163,7 @@ def tolerance_arc(args, scene, sigma, extra, folder) -> int:
     t0 = time.perf_counter()
     try:
         models = arc_models(setup, pairs, args.points)
-    except ValueError as exc:
+    except AngleUnreachable as exc:
         raise UsageError(f"--pair: a pair cannot synthesize its span ({exc})") from None
     from .tolerance import _progress
     with _progress(args.quiet) as progress, dask_client(args.dask, args.workers) as client:
@@ -241,10 +242,10 @@ def design_coverage(args, scene, folder) -> int:
     out = grid.to_dict()
     if folder is not None:
         from ..viz.figures import design_heatmap_figure, save_figure
-        extras = sorted({d["extra"] for d in grid.designs})
+        extras = sorted({d.plan.extra for d in grid.designs})
         for name, (zlabel, title) in COVERAGE_MAPS.items():
             z = np.full((len(extras), grid.radius_m.size), np.nan)
-            for d in grid.designs:
+            for d in (design.to_dict() for design in grid.designs):
                 i = int(np.argmin(np.abs(grid.radius_m - d["radius_m"])))
                 v = d.get(name)
                 z[extras.index(d["extra"]), i] = np.nan if v is None else float(v)
@@ -265,11 +266,13 @@ def design_coverage(args, scene, folder) -> int:
     print(f"{'R_c m':>6} {'N':>3} {'sp deg':>7} {'res deg':>8} {'cal':>7} {'uncal':>7} "
           f"{'cal p95':>8} {'unc p95':>8} {'sigma mm':>9}  binding; sheet")
     best = {id(d) for d in best_per_radius(grid)}
-    for d in grid.designs:
+    for design in grid.designs:
+        d = design.to_dict()
+
         def f(key, fmt):
             v = d.get(key)
             return format(v, fmt) if v is not None and np.isfinite(v) else "-"
-        mark = "*" if id(d) in best else " "
+        mark = "*" if id(design) in best else " "
         why = ", ".join(d["binding"]) or "-"
         print(f"{d['radius_m']:6.3g}{mark}{d['front_ends']:3d} {d['spacing_deg']:7.3f} "
               f"{d['resolution_deg']:8.3f} {f('worst_calibrated_deg', '7.4f')} "
@@ -278,8 +281,7 @@ def design_coverage(args, scene, folder) -> int:
               f"{'+' if d.get('sigma_capped') else ' '} {why}; {d['sheet_change']}"
               + (f"; PROBLEM: {d['problem']}" if d["problem"] else ""))
     print("best per radius (*): the fewest front ends within the spec after calibration")
-    for d in best_per_radius(grid):
-        print(f"  R_c {d['radius_m']:g} m: {d['front_ends']} front ends at "
-              + ", ".join(f"{x:.2f}" for x in d["angles_deg"])
-              + f" deg; {d['sheet_change']}")
+    for p in (d.plan for d in best_per_radius(grid)):
+        print(f"  R_c {p.radius_m:g} m: {p.front_ends} front ends at "
+              + ", ".join(f"{x:.2f}" for x in p.angles_deg) + f" deg; {p.sheet_change}")
     return 0

@@ -7,8 +7,7 @@ from ..geometry import build_setup
 from ..info import format_info, scene_info
 from ..io import write_text
 from ..registry import PATH_METHODS
-from ._common import (UsageError, load_scene_checked, output_file, output_path, print_json,
-                      scene_arg)
+from ._common import load_scene_checked, output_file, output_path, print_json, scene_arg
 
 
 def cmd_info(args) -> int:
@@ -41,10 +40,7 @@ def cmd_export_mesh(args) -> int:
     from ..geometry.export import export_setup
     output_file(args.out, [args.scene])
     setup = build_setup(load_scene_checked(args.scene))
-    try:
-        path = export_setup(setup, args.out)
-    except ValueError as exc:
-        raise UsageError(str(exc)) from None
+    path = export_setup(setup, args.out)  # OutputError for an unknown format: exit 2
     print(f"wrote {path}")
     return 0
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..errors import CaptureError, ParameterError
 from ._common import (UsageError, load_scene_checked, output_folder, output_path, print_json,
                       scene_arg, steps)
 
@@ -21,8 +22,10 @@ def adc_probe_capture(scene, args) -> int:
             cap = simulate_capture(setup, args.active, args.probe_range_m,
                                    args.probe_velocity_mps, seed)
             meta = write_capture(cap, setup.rut, args.out, args.format)
-    except ValueError as exc:
+    except CaptureError as exc:
         raise UsageError(f"--active/--probe-range-m: {exc}") from None
+    except ParameterError as exc:
+        raise UsageError(f"--format {args.format}: {exc}") from None
     if not args.quiet:
         print(f"wrote {args.out} and {args.out}.json: front end {cap.active} alone, probe at "
               f"{cap.range_m:.3f} m, {cap.velocity_mps:+.3f} m/s ({meta['format']})")
@@ -57,14 +60,14 @@ def cmd_identify(args) -> int:
         scene = load_scene_checked(args.scene)
         try:
             caps = [read_capture(p) for p in args.captures]
-        except (OSError, ValueError, KeyError) as exc:
+        except (OSError, CaptureError) as exc:
             raise UsageError(f"CAPTURE: {exc}") from None
         with steps(args.quiet or args.json) as step:
             step(f"fitting {len(caps)} capture(s) of front end(s) "
                  f"{sorted({c.active for c in caps})}")
             try:
                 ident = identify(scene, caps)
-            except ValueError as exc:
+            except CaptureError as exc:
                 raise UsageError(f"CAPTURE: {exc}") from None
         d = ident.to_dict()
         if stage is not None:

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..io import atomic_path, write_bytes, write_json, write_text
 from ..registry import AOA_MODES, PATH_METHODS
 from ..run import RunResult, label_detections, run_scene, summary
@@ -155,7 +156,8 @@ def run_report_html(result: RunResult, maps: dict[str, bytes], paths_method: str
     images = []
     try:
         images.append(_setup_png(result, paths_method))
-    except Exception as exc:  # no off-screen OpenGL: the report still has everything else
+    except (ImportError, RuntimeError) as exc:  # no pyvista, no off-screen OpenGL (VizError),
+        # no ray tracing for the drawn paths (RaytraceUnavailable): the report has the rest
         warnings = warnings + [f"3D view not rendered: {exc}"]
     sections.append({"heading": "Setup", "images": images,
                      "text": f"Paths: {paths_method} ({len(result.paths)} rows)."})
@@ -219,7 +221,7 @@ def _read_calibration(path) -> dict | None:
         return None
     try:
         doc = json.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise UsageError(f"--calibration {path}: cannot read it as JSON ({exc})") from None
     if not isinstance(doc, dict):
         raise UsageError(f"--calibration {path}: not a calibration file (a JSON object from "
@@ -297,8 +299,8 @@ def cmd_adc(args) -> int:
         from ..radar.dca1000 import to_dca1000
         try:
             raw, scale = to_dca1000(cube)
-        except ValueError as exc:
-            raise UsageError(str(exc)) from None
+        except ParameterError as exc:
+            raise UsageError(f"--format dca1000: {exc}") from None
         write_bytes(args.out, raw)
         n_l, n_v, n_s = cube.shape
         meta = {"format": "dca1000-xwr18xx-complex-2lane", "scale": scale,

@@ -13,6 +13,7 @@ import numpy as np
 
 from ..analysis.tolerance import (AXES, CASES, DISTRIBUTIONS, NOMINAL_AMPLITUDES, PairPhasors,
                                   max_sigma_for_yield, monte_carlo)
+from ..aoa.model import AngleUnreachable
 from ..geometry import build_setup
 from ..io import write_json
 from ..parallel import ClusterError, check_address, dask_client, map_chunks
@@ -91,7 +92,7 @@ def _model(scene, pair_arg, points: int) -> PairPhasors:
     pair = _pair(setup, pair_arg)
     try:
         return PairPhasors.build(setup, pair, points)
-    except ValueError as exc:  # the composite cannot reach a set angle
+    except AngleUnreachable as exc:  # the composite cannot reach a set angle
         raise UsageError(f"--pair {pair[0]} {pair[1]}: the pair cannot synthesize its span "
                          f"({exc})") from None
 

@@ -7,14 +7,15 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from ..io import atomic_path
+from ..io import OutputError, atomic_path
 from .setup import Setup
 
-__all__ = ["rut_board_mesh", "setup_scene", "export_setup"]
+__all__ = ["COLOURS", "rut_board_mesh", "setup_scene", "export_setup"]
 
-_COLOURS = {"sheet": [170, 170, 180, 255], "rut_tx": [220, 60, 40, 255],
-            "rut_rx": [40, 90, 220, 255], "fe_rx": [40, 160, 60, 255],
-            "fe_tx": [230, 150, 20, 255], "board": [30, 110, 60, 255]}
+#: RGBA colours of the setup's parts (the mesh export and the 3D view, ``viz.scene3d``)
+COLOURS = {"sheet": [170, 170, 180, 255], "rut_tx": [220, 60, 40, 255],
+           "rut_rx": [40, 90, 220, 255], "fe_rx": [40, 160, 60, 255],
+           "fe_tx": [230, 150, 20, 255], "board": [30, 110, 60, 255]}
 
 
 def _markers(points: np.ndarray, radius: float, colour) -> trimesh.Trimesh:
@@ -55,16 +56,16 @@ def setup_scene(setup: Setup) -> trimesh.Scene:
     lam = setup.rut.wavelength_m
     if setup.sheet is not None:
         sheet = setup.sheet.copy()
-        sheet.visual.face_colors = _COLOURS["sheet"]
+        sheet.visual.face_colors = COLOURS["sheet"]
         sc.add_geometry(sheet, geom_name="sheet")
     board = rut_board_mesh(setup)
-    board.visual.face_colors = _COLOURS["board"]
+    board.visual.face_colors = COLOURS["board"]
     sc.add_geometry(board, geom_name="rut_board")
     r = lam / 4
-    sc.add_geometry(_markers(setup.rut.tx_world, r, _COLOURS["rut_tx"]), geom_name="rut_tx")
-    sc.add_geometry(_markers(setup.rut.rx_world, r, _COLOURS["rut_rx"]), geom_name="rut_rx")
-    sc.add_geometry(_markers(setup.fe.rx, 2 * r, _COLOURS["fe_rx"]), geom_name="fe_rx")
-    sc.add_geometry(_markers(setup.fe.tx, 2 * r, _COLOURS["fe_tx"]), geom_name="fe_tx")
+    sc.add_geometry(_markers(setup.rut.tx_world, r, COLOURS["rut_tx"]), geom_name="rut_tx")
+    sc.add_geometry(_markers(setup.rut.rx_world, r, COLOURS["rut_rx"]), geom_name="rut_rx")
+    sc.add_geometry(_markers(setup.fe.rx, 2 * r, COLOURS["fe_rx"]), geom_name="fe_rx")
+    sc.add_geometry(_markers(setup.fe.tx, 2 * r, COLOURS["fe_tx"]), geom_name="fe_tx")
     return sc
 
 
@@ -73,7 +74,7 @@ def export_setup(setup: Setup, path: str | Path) -> Path:
     path = Path(path)
     fmt = path.suffix.lower().lstrip(".")
     if fmt not in ("glb", "gltf", "ply", "obj", "stl"):
-        raise ValueError(f"--out {path}: unsupported mesh format '{fmt}' (use .glb, .ply, .obj "
+        raise OutputError(f"--out {path}: unsupported mesh format '{fmt}' (use .glb, .ply, .obj "
                          "or .stl)")
     sc = setup_scene(setup)
     data = (sc.export(file_type=fmt) if fmt in ("glb", "gltf", "obj")

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 from scipy.constants import c
 
+from ..errors import CaptureError
 from ..geometry import Setup
 from ..paths import exact_paths
 from ..rts import RtsProgram, nominal_link_gain, requested_delay, target_amplitude
@@ -53,11 +54,11 @@ def simulate_capture(setup: Setup, active: int, range_m: float | None = None,
     noise at the scene's SNR from ``seed``), on the setup *as built*."""
     n = setup.fe.count
     if not 0 <= active < n:
-        raise ValueError(f"active front end {active}: must be in 0..{n - 1}")
+        raise CaptureError(f"active front end {active}: must be in 0..{n - 1}")
     scene = setup.scene
     r, amp = capture_probe(setup, range_m)
     if not 0 < r < scene.radar.max_range_m:
-        raise ValueError(f"probe range {r:g} m: must be in (0, {scene.radar.max_range_m:g}) m")
+        raise CaptureError(f"probe range {r:g} m: must be in (0, {scene.radar.max_range_m:g}) m")
     paths = exact_paths(setup) if paths is None else paths
     f_d = 2 * scene.radar.f_c_hz * velocity_mps / c
     prog = RtsProgram.build([0], [active], [float(requested_delay(scene, r))], [f_d], [amp])
@@ -95,21 +96,38 @@ def read_capture(path) -> Capture:
     path = Path(path)
     side = Path(str(path) + ".json")
     if not side.is_file():
-        raise ValueError(f"{path}: no sidecar {side.name} (write captures with rtsgeom adc "
-                         "--active I)")
-    meta = json.loads(side.read_text(encoding="utf-8"))
-    for key in ("active_front_end", "probe_range_m", "probe_velocity_mps", "probe_amplitude"):
+        raise CaptureError(f"{path}: no sidecar {side.name} (write captures with rtsgeom adc "
+                           "--active I)")
+    try:
+        meta = json.loads(side.read_text(encoding="utf-8"))
+    except json.JSONDecodeError as exc:
+        raise CaptureError(f"{side}: not JSON ({exc})") from None
+    if not isinstance(meta, dict):
+        raise CaptureError(f"{side}: not a probe capture's sidecar (a JSON object)")
+    keys = ["active_front_end", "probe_range_m", "probe_velocity_mps", "probe_amplitude"]
+    npy = meta.get("format") == "npy" or path.suffix == ".npy"
+    for key in keys + ([] if npy else ["num_rx", "samples_per_chirp", "chirps", "tx_order",
+                                       "scale"]):
         if key not in meta:
-            raise ValueError(f"{side}: no {key!r}: not a probe capture (rtsgeom adc --active I)")
-    if meta.get("format") == "npy" or path.suffix == ".npy":
-        data = np.load(path, allow_pickle=False)
-    else:
-        n_rx, n_s, chirps = int(meta["num_rx"]), int(meta["samples_per_chirp"]), int(meta["chirps"])
-        raw = from_dca1000(path.read_bytes(), chirps, n_rx, n_s)
-        n_tx = len(meta["tx_order"])
-        data = raw.reshape(chirps // n_tx, n_tx * n_rx, n_s) / float(meta["scale"])
+            raise CaptureError(f"{side}: no {key!r}: not a probe capture (rtsgeom adc "
+                               "--active I)")
+    # numpy's own errors for a file that is no .npy / a .bin of the wrong size (ValueError,
+    # EOFError) and a sidecar value of the wrong type become the capture's error
+    try:
+        probe = (int(meta["active_front_end"]), float(meta["probe_range_m"]),
+                 float(meta["probe_velocity_mps"]), float(meta["probe_amplitude"]))
+        if npy:
+            data = np.load(path, allow_pickle=False)
+        else:
+            n_rx, n_s, chirps = (int(meta["num_rx"]), int(meta["samples_per_chirp"]),
+                                 int(meta["chirps"]))
+            raw = from_dca1000(path.read_bytes(), chirps, n_rx, n_s)
+            n_tx = len(meta["tx_order"])
+            data = raw.reshape(chirps // n_tx, n_tx * n_rx, n_s) / float(meta["scale"])
+    except (ValueError, TypeError, EOFError) as exc:
+        raise CaptureError(f"{path}: cannot read the capture its sidecar describes ({exc})") \
+            from None
     if data.ndim != 3 or not np.iscomplexobj(data):
-        raise ValueError(f"{path}: expected a complex [loop, virtual, sample] cube, got "
-                         f"{data.dtype} {list(data.shape)}")
-    return Capture(np.asarray(data), int(meta["active_front_end"]), float(meta["probe_range_m"]),
-                   float(meta["probe_velocity_mps"]), float(meta["probe_amplitude"]))
+        raise CaptureError(f"{path}: expected a complex [loop, virtual, sample] cube, got "
+                           f"{data.dtype} {list(data.shape)}")
+    return Capture(np.asarray(data), *probe)

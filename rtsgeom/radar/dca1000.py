@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import ParameterError
 from .fmcw import AdcCube
 
 __all__ = ["to_dca1000", "from_dca1000"]
@@ -24,7 +25,8 @@ def to_dca1000(cube: AdcCube) -> tuple[bytes, float]:
     data = cube.data
     n_l, n_v, n_s = data.shape
     if n_s % 2:
-        raise ValueError("samples_per_chirp must be even for the 2-lane I/Q pair layout")
+        raise ParameterError(f"radar.samples_per_chirp = {n_s}: must be even for the DCA1000 "
+                             "format (2-lane I/Q pair layout)")
     n_rx = cube.rut.num_rx
     n_tx = n_v // n_rx
     peak = float(max(np.max(np.abs(data.real)), np.max(np.abs(data.imag)), 1e-30))

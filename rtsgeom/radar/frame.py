@@ -6,7 +6,7 @@ import numpy as np
 
 from ..geometry import Setup
 from ..paths import Paths
-from ..rts import KIND_DIRECT, Echoes, RtsProgram, build_echoes
+from ..rts import EchoKind, Echoes, RtsProgram, build_echoes
 from .fmcw import AdcCube, add_noise, synthesize
 
 __all__ = ["noise_power", "simulate"]
@@ -20,7 +20,7 @@ def noise_power(echoes: Echoes, snr_db: float | None) -> float:
     """
     if snr_db is None or len(echoes) == 0:
         return 0.0
-    direct = echoes.kind == KIND_DIRECT
+    direct = echoes.kind == EchoKind.DIRECT
     ref = echoes.amplitude[direct] if np.any(direct) else echoes.amplitude
     return float(np.max(np.abs(ref)) ** 2 / 10 ** (snr_db / 10))
 

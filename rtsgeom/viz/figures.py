@@ -23,7 +23,7 @@ from matplotlib.patches import Rectangle
 
 from ..io import atomic_path
 
-__all__ = ["STYLE", "save_figure", "range_doppler_figure", "range_angle_figure",
+__all__ = ["STYLE", "new_figure", "save_figure", "range_doppler_figure", "range_angle_figure",
            "calibration_sweep_figure", "linearity_figure", "tolerance_cdf_figure",
            "tolerance_histogram_figure", "design_heatmap_figure", "design_lines_figure"]
 
@@ -59,7 +59,9 @@ def _styled(func):
     return wrapper
 
 
-def _new_figure(figsize=(6.4, 4.4), nrows=1, ncols=1, **subplot_kw) -> tuple[Figure, object]:
+def new_figure(figsize=(6.4, 4.4), nrows=1, ncols=1, **subplot_kw) -> tuple[Figure, object]:
+    """A figure of the house style (``DPI``, constrained layout) on the Agg canvas, without
+    pyplot's global state, and its axes (``nrows`` x ``ncols``, squeezed)."""
     fig = Figure(figsize=figsize, dpi=DPI, layout="constrained")
     FigureCanvasAgg(fig)
     axes = fig.subplots(nrows, ncols, squeeze=True, **subplot_kw)
@@ -148,7 +150,7 @@ def range_doppler_figure(power_db, range_m, velocity_mps, detections=None,
     v = _vector("velocity_mps", velocity_mps)
     p = _grid("power_db", power_db, (r.size, v.size), "n_range, n_doppler")
     det = _points("detections", detections)
-    fig, ax = _new_figure()
+    fig, ax = new_figure()
     _power_map(ax, fig, v, r, p, "radial velocity (m/s)", "range (m)", title or "Range-Doppler map")
     if det is not None:
         ax.scatter(det[:, 1], det[:, 0], label=f"detections ({len(det)})", **_DETECTION)
@@ -166,7 +168,7 @@ def range_angle_figure(power_db, range_m, angle_deg, detections=None, set_points
     p = _grid("power_db", power_db, (r.size, a.size), "n_range, n_angle")
     det = _points("detections", detections)
     sp = _points("set_points", set_points)
-    fig, ax = _new_figure()
+    fig, ax = new_figure()
     _power_map(ax, fig, a, r, p, "azimuth (deg)", "range (m)", title or "Range-angle map")
     if sp is not None:
         ax.scatter(sp[:, 1], sp[:, 0], label="set points", **_SET_POINT)
@@ -198,7 +200,7 @@ def calibration_sweep_figure(delta_tau_s, angle_error_deg, chosen_delta_tau_s: f
     order = np.argsort(tau)
     t_ns, err = tau[order] * 1e9, err[order]
     chosen_ns = float(chosen_delta_tau_s) * 1e9
-    fig, ax = _new_figure(figsize=(6.4, 3.8))
+    fig, ax = new_figure(figsize=(6.4, 3.8))
     ax.plot(t_ns, err, marker=".", label="sweep: angle error")
     ax.axhline(0.0, color="0.4", linewidth=0.8)
     if refine_delta_tau_s is not None and refine_error_deg is not None:
@@ -266,7 +268,7 @@ def linearity_figure(set_deg, detected_deg_by_mode: Mapping[str, object],
     amp = (None if amplitude_db_by_mode is None
            else _mode_arrays("amplitude_db_by_mode", amplitude_db_by_mode, s.size, rows=2))
     n_panels = 2 if amp is None else 3
-    fig, axes = _new_figure(figsize=(6.4, 2.4 * n_panels + 0.4), nrows=n_panels, sharex=True)
+    fig, axes = new_figure(figsize=(6.4, 2.4 * n_panels + 0.4), nrows=n_panels, sharex=True)
     ax_amp, ax_lin, ax_err = (None, *axes) if amp is None else axes
     colour = {m: f"C{i % 10}" for i, m in enumerate(dict.fromkeys([*det, *(amp or {})]))}
     names = (("channel I", "channel J") if pair is None
@@ -311,7 +313,7 @@ def tolerance_cdf_figure(errors_deg_by_case: Mapping[str, object],
     floor = float(positive.min()) if positive.size else 1e-6
     if spec_deg is not None:
         floor = min(floor, abs(spec_deg))
-    fig, ax = _new_figure(figsize=(6.4, 3.8))
+    fig, ax = new_figure(figsize=(6.4, 3.8))
     for name, a in cases.items():
         if not a.size:
             continue
@@ -361,7 +363,7 @@ def design_heatmap_figure(x, y, z, xlabel: str, ylabel: str, zlabel: str, title:
     True = excluded, e.g. infeasible) greys out and hatches cells. Labels should carry units."""
     xv, yv, zv, m = _design_arrays(x, y, z, mask)
     shown = np.ma.masked_array(zv, mask=m | ~np.isfinite(zv))
-    fig, ax = _new_figure()
+    fig, ax = new_figure()
     ax.set_facecolor("0.85")
     mesh = ax.pcolormesh(xv, yv, shown, shading="nearest", rasterized=True)
     fig.colorbar(mesh, ax=ax, label=zlabel)
@@ -396,7 +398,7 @@ def design_lines_figure(x, y, z, xlabel: str, ylabel: str, zlabel: str, title: s
     else:
         axis, other, other_label, zz, mm = yv, xv, xlabel, zv.T, m.T
         axis_label = ylabel
-    fig, ax = _new_figure()
+    fig, ax = new_figure()
     for k, val in enumerate(other):
         line, = ax.plot(axis, np.where(mm[k], np.nan, zz[k]), marker="o",
                         label=f"{other_label} = {val:g}", linestyle="-")

@@ -18,287 +18,24 @@ started only as a last resort (see :func:`ensure_render_backend`).
 
 from __future__ import annotations
 
-import atexit
 import os
-import shutil
-import subprocess
 from pathlib import Path
 
 import numpy as np
 import pyvista as pv
 
 from ..geometry import Setup
-from ..arcmath import radial_tangent, sphere_frame
-from ..geometry.export import _COLOURS
 from ..io import atomic_path, write_text
+from .meshes import (ARC, BACKGROUND, LOS, MODULE, PANEL_BACKGROUND, REFLECTION, RIM, SHEET,
+                     SHEET_LEGEND, TARGET, TARGET_RADIUS_FACTOR, angle_span, arc_points, board,
+                     cutout_rims, merge, merge_lines, modules, path_polylines, polyline, rgb,
+                     rut_scale_factor, scaled, spheres, split_paths, target_positions,
+                     undrawable_reflections)
+from .render_backend import VizError, ensure_render_backend
 
 __all__ = ["VizError", "ensure_render_backend", "build_plotter", "render_setup_png",
-           "export_setup_html", "show_setup", "TARGET_RADIUS_FACTOR"]
-
-TARGET_RADIUS_FACTOR = 1.5  # targets are drawn at this multiple of the arc radius
-
-_BACKGROUND = "#f4f5f7"  # light: the cutouts show as bright holes in the grey sheet
-_PANEL_BACKGROUND = "#e8eaee"
-_SHEET = "#aab1ba"
-_SHEET_LEGEND = "#6b7280"  # the legend writes its text in the entry colour
-_RIM = "#2b2f36"
-_ARC = "#1f6fb4"
-_LOS = "#12a150"
-_REFLECTION = "#d62f8c"
-_TARGET = "#7b3fb8"
-_MODULE = "#5c6670"
-
-
-def _rgb(key: str) -> tuple[float, float, float]:
-    """A colour of the mesh export (same palette in the GLB and in the 3D view)."""
-    return tuple(v / 255.0 for v in _COLOURS[key][:3])
-
-
-class VizError(RuntimeError):
-    """Rendering is not possible here (no OpenGL context, no display, a missing package)."""
-
-
-# --------------------------------------------------------------------------------------------
-# Render backend
-# --------------------------------------------------------------------------------------------
-
-_BACKEND: str | None = None
-
-
-def _probe_window(class_name: str) -> bool:
-    """Whether an off-screen render window of VTK class ``class_name`` gets an OpenGL context."""
-    try:
-        from vtkmodules import vtkRenderingOpenGL2 as gl
-        win = getattr(gl, class_name)()
-        win.SetOffScreenRendering(1)
-        ok = bool(win.SupportsOpenGL())
-        win.Finalize()
-        return ok
-    except (AttributeError, ImportError, RuntimeError, TypeError):
-        return False
-
-
-def _start_xvfb() -> str | None:
-    """Start ``Xvfb`` on a free display number (stopped at exit); return ``:N`` or None."""
-    exe = shutil.which("Xvfb")
-    if exe is None:
-        return None
-    read_fd, write_fd = os.pipe()
-    try:
-        proc = subprocess.Popen([exe, "-displayfd", str(write_fd), "-screen", "0", "1920x1080x24",
-                                 "-nolisten", "tcp"], pass_fds=(write_fd,),
-                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    except OSError:
-        os.close(read_fd)
-        os.close(write_fd)
-        return None
-    os.close(write_fd)
-    with os.fdopen(read_fd) as f:
-        number = f.readline().strip()
-    if not number.isdigit():
-        proc.terminate()
-        return None
-    atexit.register(proc.terminate)
-    return f":{number}"
-
-
-def ensure_render_backend() -> str:
-    """Make sure VTK can render here; return the backend used.
-
-    With ``DISPLAY`` set, VTK's X window is used. Without it, VTK would first try X (and log a
-    warning) before its EGL fallback, so the EGL window (Mesa's llvmpipe works without a GPU) and
-    then OSMesa are selected explicitly through ``VTK_DEFAULT_OPENGL_WINDOW`` (unless the user set
-    that variable). Only if neither gets an OpenGL context is an ``Xvfb`` server started (when the
-    program exists). Otherwise :class:`VizError` says which system packages are missing.
-    """
-    global _BACKEND
-    if _BACKEND is not None:
-        return _BACKEND
-    if os.environ.get("DISPLAY"):
-        _BACKEND = "x11"
-        return _BACKEND
-    chosen = os.environ.get("VTK_DEFAULT_OPENGL_WINDOW")
-    candidates = [chosen] if chosen else ["vtkEGLRenderWindow", "vtkOSOpenGLRenderWindow"]
-    for name in candidates:
-        if _probe_window(name):
-            os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = name
-            _BACKEND = name
-            return _BACKEND
-    display = _start_xvfb()
-    if display is not None:
-        os.environ["DISPLAY"] = display
-        os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = "vtkXOpenGLRenderWindow"
-        if _probe_window("vtkXOpenGLRenderWindow"):
-            _BACKEND = f"xvfb {display}"
-            return _BACKEND
-    raise VizError("cannot create an off-screen OpenGL context for VTK: install Mesa's EGL "
-                   "(apt: libegl1 libgl1-mesa-dri) or OSMesa (apt: libosmesa6), or Xvfb "
-                   "(apt: xvfb), or run with a DISPLAY")
-
-
-# --------------------------------------------------------------------------------------------
-# Scene content
-# --------------------------------------------------------------------------------------------
-
-
-def rut_scale_factor(setup: Setup) -> float:
-    """How much the RuT is enlarged in the overview: a round factor (1, 2, 5, 10, 20, ...) that
-    makes its board about a fifth of the arc radius wide."""
-    width = np.ptp(_board(setup, 1.0).points[:, 0])
-    want = max(0.2 * setup.fe.arc_radius_m / width, 1.0)
-    nice = 10.0 ** np.floor(np.log10(want)) * np.array([1.0, 2.0, 5.0, 10.0])
-    return float(nice[np.argmin(np.abs(np.log(nice / want)))])
-
-
-def _scaled(points: np.ndarray, centre: np.ndarray, scale: float) -> np.ndarray:
-    return centre + scale * (np.asarray(points, float) - centre)
-
-
-def _board(setup: Setup, scale: float):
-    """The RuT board (a thin box behind the elements), as in the mesh export, scaled."""
-    rut = setup.rut
-    pts = np.vstack([rut.tx_world, rut.rx_world])
-    lo, hi = pts.min(0), pts.max(0)
-    margin = 3 * rut.wavelength_m
-    box = pv.Box(bounds=(lo[0] - margin, hi[0] + margin, lo[1] - 1.8e-3, lo[1] - 0.2e-3,
-                         lo[2] - margin, hi[2] + margin))
-    box.points = _scaled(box.points, rut.position, scale)
-    return box
-
-
-def _merge(meshes: list):
-    """One mesh of several (pyvista PolyData), so each group is a single actor."""
-    return meshes[0].merge(meshes[1:]) if len(meshes) > 1 else meshes[0]
-
-
-def _spheres(points: np.ndarray, radius: float):
-    return _merge([pv.Sphere(radius=radius, center=p, theta_resolution=16, phi_resolution=12)
-                   for p in np.atleast_2d(points)])
-
-
-def _polyline(points: np.ndarray):
-    return pv.lines_from_points(np.asarray(points, float))
-
-
-def _arc_points(setup: Setup, a_min: float, a_max: float) -> np.ndarray:
-    """The front-end arc (module centres at zero mounting error) between two azimuths."""
-    r_hat, _ = radial_tangent(np.linspace(a_min, a_max, 181))
-    return setup.fe.arc_centre + setup.fe.arc_radius_m * r_hat
-
-
-def _angle_span(setup: Setup) -> tuple[float, float]:
-    """Azimuth span of the drawing: the sheet, or the front ends with a margin."""
-    cfg = setup.scene.sheet
-    if cfg.enabled:
-        return cfg.angle_min_rad, cfg.angle_max_rad
-    a = setup.fe.angle_rad
-    return float(a.min()) - np.radians(10), float(a.max()) + np.radians(10)
-
-
-def _cutout_rims(setup: Setup):
-    """A circle at each cutout on the sheet's inner face, to show where the holes are."""
-    cfg = setup.scene.sheet
-    r0 = setup.fe.arc_radius_m + cfg.radius_offset_m
-    t = np.linspace(0.0, 2 * np.pi, 73)
-    rims = []
-    for i, ang in enumerate(setup.fe.angle_rad):
-        el = None if setup.fe.elevation_rad is None else setup.fe.elevation_rad[i]
-        r_hat, t_hat, up = sphere_frame(ang, el)
-        circle = (setup.fe.arc_centre + (r0 - 1e-4) * r_hat
-                  + 0.5 * cfg.cutout_diameter_m * (np.cos(t)[:, None] * t_hat
-                                                   + np.sin(t)[:, None] * up))
-        rims.append(_polyline(circle))
-    return _merge(rims)
-
-
-def _modules(setup: Setup):
-    """Front-end module bodies: a box behind each antenna pair (radially outward)."""
-    fe = setup.fe
-    boxes = []
-    for i in range(fe.count):
-        el = None if fe.elevation_rad is None else fe.elevation_rad[i]
-        r_hat, t_hat, up = sphere_frame(fe.angle_rad[i], el)
-        size_t = abs(fe.separation_m[i]) + 0.012  # smaller than the cutout: the hole stays visible
-        box = pv.Box(bounds=(-size_t / 2, size_t / 2, 0.012, 0.024, -0.01, 0.01))
-        rot = np.stack([t_hat, r_hat, up], axis=1)  # local (t, r, up) -> world
-        box.points = box.points @ rot.T + fe.module[i]
-        boxes.append(box)
-    return _merge(boxes)
-
-
-def _target_positions(setup: Setup) -> tuple[np.ndarray, np.ndarray]:
-    """Drawn positions (T, 3) and outward directions (T, 3) of the virtual targets."""
-    rut = setup.rut
-    ang = np.array([t.angle_rad for t in setup.scene.targets], float)
-    el = np.array([getattr(t, "elevation_rad", 0.0) for t in setup.scene.targets], float)
-    local = sphere_frame(ang, el if np.any(el) else None)[0]
-    direction = local @ rut.rotation.T
-    return rut.position + TARGET_RADIUS_FACTOR * setup.fe.arc_radius_m * direction, direction
-
-
-def _split_paths(paths):
-    """``(Paths, vertices or None)`` from a :class:`~rtsgeom.paths.Paths` table or a ray-tracing
-    result (:class:`~rtsgeom.paths.raytrace.RaytraceResult`, which carries the hit points)."""
-    if paths is None:
-        return None, None
-    if hasattr(paths, "paths") and hasattr(paths, "vertices"):
-        return paths.paths, paths.vertices
-    return paths, getattr(paths, "vertices", None)
-
-
-def _hit_points(vertices, i: int) -> np.ndarray:
-    """Row ``i``'s finite hit points, (n, 3) (none without ``vertices``)."""
-    v = None if vertices is None else vertices[i]
-    if v is None:
-        return np.zeros((0, 3))
-    v = np.atleast_2d(np.asarray(v, float))
-    return v[np.all(np.isfinite(v), axis=-1)] if v.size else np.zeros((0, 3))
-
-
-def undrawable_reflections(paths) -> int:
-    """How many reflected rows of ``paths`` carry no hit points (they cannot be drawn)."""
-    table, vertices = _split_paths(paths)
-    if table is None:
-        return 0
-    refl = np.flatnonzero(np.asarray(table.bounces) > 0)
-    return int(sum(len(_hit_points(vertices, i)) == 0 for i in refl))
-
-
-def _path_polylines(setup: Setup, paths, scale: float) -> tuple[list[np.ndarray], list[np.ndarray]]:
-    """Line-of-sight and reflected path polylines; RuT ends at the drawn (scaled) elements.
-
-    ``paths``: a :class:`Paths` table or a ray-tracing result; a reflection is drawn through
-    its hit points (``vertices``, NaN rows past the last interaction are dropped)."""
-    from ..paths.table import FE_TO_RX, RUT_TO_RUT, TX_TO_FE
-    rut, fe = setup.rut, setup.fe
-    tx = _scaled(rut.tx_world, rut.position, scale)
-    rx = _scaled(rut.rx_world, rut.position, scale)
-    paths, vertices = _split_paths(paths)
-    los, refl = [], []
-    for i in range(len(paths)):
-        d, f = int(paths.direction[i]), int(paths.front_end[i])
-        if d == TX_TO_FE:
-            start, end = tx[paths.rut_tx[i]], fe.rx[f]
-        elif d == FE_TO_RX:
-            start, end = fe.tx[f], rx[paths.rut_rx[i]]
-        elif d == RUT_TO_RUT:
-            start, end = tx[paths.rut_tx[i]], rx[paths.rut_rx[i]]
-        else:
-            continue
-        if int(paths.bounces[i]) == 0:
-            if d != RUT_TO_RUT:  # direct Tx -> Rx coupling on the board: nothing to see
-                los.append(np.array([start, end]))
-            continue
-        v = _hit_points(vertices, i)
-        if len(v) == 0:
-            continue  # no hit points: counted by undrawable_reflections and noted in the view
-        pts = [start] + [p for p in v if not (np.allclose(p, start) or np.allclose(p, end))] + [end]
-        refl.append(np.array(pts))
-    return los, refl
-
-
-def _merge_lines(polylines: list[np.ndarray]):
-    return _merge([_polyline(p) for p in polylines])
+           "export_setup_html", "show_setup", "TARGET_RADIUS_FACTOR", "rut_scale_factor",
+           "undrawable_reflections"]
 
 
 def _add_setup(pl, setup: Setup, paths, scale: float, labels: str) -> list:
@@ -311,51 +48,51 @@ def _add_setup(pl, setup: Setup, paths, scale: float, labels: str) -> list:
     legend = []
 
     # RuT, enlarged about its phase centre
-    pl.add_mesh(_board(setup, scale), color=_rgb("board"), opacity=0.4)
+    pl.add_mesh(board(setup, scale), color=rgb("board"), opacity=0.4)
     el_r = 0.22 * lam * scale
-    pl.add_mesh(_spheres(_scaled(rut.tx_world, rut.position, scale), el_r), color=_rgb("rut_tx"))
-    pl.add_mesh(_spheres(_scaled(rut.rx_world, rut.position, scale), el_r), color=_rgb("rut_rx"))
-    legend += [[f"RuT Tx (drawn x{scale:g})", _rgb("rut_tx")], ["RuT Rx", _rgb("rut_rx")]]
+    pl.add_mesh(spheres(scaled(rut.tx_world, rut.position, scale), el_r), color=rgb("rut_tx"))
+    pl.add_mesh(spheres(scaled(rut.rx_world, rut.position, scale), el_r), color=rgb("rut_rx"))
+    legend += [[f"RuT Tx (drawn x{scale:g})", rgb("rut_tx")], ["RuT Rx", rgb("rut_rx")]]
 
     # arc through the module centres
-    a_min, a_max = _angle_span(setup)
-    pl.add_mesh(_polyline(_arc_points(setup, a_min, a_max)), color=_ARC, line_width=2)
-    legend.append([f"front-end arc, R_c = {fe.arc_radius_m:g} m", _ARC])
+    a_min, a_max = angle_span(setup)
+    pl.add_mesh(polyline(arc_points(setup, a_min, a_max)), color=ARC, line_width=2)
+    legend.append([f"front-end arc, R_c = {fe.arc_radius_m:g} m", ARC])
 
     # sheet with cutouts
     if setup.sheet is not None:
-        pl.add_mesh(pv.wrap(setup.sheet), color=_SHEET, opacity=0.5, specular=0.5,
+        pl.add_mesh(pv.wrap(setup.sheet), color=SHEET, opacity=0.5, specular=0.5,
                     specular_power=15, ambient=0.25)
-        pl.add_mesh(_cutout_rims(setup), color=_RIM, line_width=3)
-        legend.append(["metal sheet with cutouts", _SHEET_LEGEND])
+        pl.add_mesh(cutout_rims(setup), color=RIM, line_width=3)
+        legend.append(["metal sheet with cutouts", SHEET_LEGEND])
 
     # front ends: module body and enlarged antenna markers
-    pl.add_mesh(_modules(setup), color=_MODULE, opacity=0.9)
+    pl.add_mesh(modules(setup), color=MODULE, opacity=0.9)
     ant_r = max(min(0.006, 0.3 * float(np.min(np.abs(fe.separation_m)))), 0.5 * lam)
-    pl.add_mesh(_spheres(fe.rx, ant_r), color=_rgb("fe_rx"))
-    pl.add_mesh(_spheres(fe.tx, ant_r), color=_rgb("fe_tx"))
-    legend += [["front-end Rx antennas", _rgb("fe_rx")], ["front-end Tx antennas", _rgb("fe_tx")]]
+    pl.add_mesh(spheres(fe.rx, ant_r), color=rgb("fe_rx"))
+    pl.add_mesh(spheres(fe.tx, ant_r), color=rgb("fe_tx"))
+    legend += [["front-end Rx antennas", rgb("fe_rx")], ["front-end Tx antennas", rgb("fe_tx")]]
 
     # virtual targets
     if setup.scene.targets:
-        pos, direction = _target_positions(setup)
+        pos, direction = target_positions(setup)
         cone_h = 0.05 * fe.arc_radius_m
         cones = [pv.Cone(center=p + 0.5 * cone_h * d, direction=d, height=cone_h,
                          radius=0.35 * cone_h, resolution=24) for p, d in zip(pos, direction)]
-        pl.add_mesh(_merge(cones), color=_TARGET)
+        pl.add_mesh(merge(cones), color=TARGET)
         rays = [np.array([rut.position, p]) for p in pos]
-        pl.add_mesh(_merge_lines(rays), color=_TARGET, opacity=0.35, line_width=1)
-        legend.append([f"targets (drawn at {TARGET_RADIUS_FACTOR:g} R_c)", _TARGET])
+        pl.add_mesh(merge_lines(rays), color=TARGET, opacity=0.35, line_width=1)
+        legend.append([f"targets (drawn at {TARGET_RADIUS_FACTOR:g} R_c)", TARGET])
 
     # propagation paths
-    if paths is not None and len(_split_paths(paths)[0]):
-        los, refl = _path_polylines(setup, paths, scale)
+    if paths is not None and len(split_paths(paths)[0]):
+        los, refl = path_polylines(setup, paths, scale)
         if los:
-            pl.add_mesh(_merge_lines(los), color=_LOS, line_width=2, opacity=0.8)
-            legend.append(["line of sight", _LOS])
+            pl.add_mesh(merge_lines(los), color=LOS, line_width=2, opacity=0.8)
+            legend.append(["line of sight", LOS])
         if refl:
-            pl.add_mesh(_merge_lines(refl), color=_REFLECTION, line_width=2, opacity=0.8)
-            legend.append(["reflections", _REFLECTION])
+            pl.add_mesh(merge_lines(refl), color=REFLECTION, line_width=2, opacity=0.8)
+            legend.append(["reflections", REFLECTION])
 
     if labels != "none":
         _add_labels(pl, setup, scale, text3d=labels == "3d")
@@ -378,11 +115,11 @@ def _add_labels(pl, setup: Setup, scale: float, text3d: bool = False) -> None:
             anchors.append(a)
             texts.append(f"FE{i} {name}")
             leaders.append(np.array([p, a]))
-    board_top = _board(setup, scale).bounds
+    board_top = board(setup, scale).bounds
     anchors.append(np.array([rut.position[0], rut.position[1], board_top[5] + 0.04]))
     texts.append(f"RuT (x{scale:g})")
     if setup.scene.targets:
-        pos, _ = _target_positions(setup)
+        pos, _ = target_positions(setup)
         order = np.argsort([t.angle_rad for t in setup.scene.targets])
         for k, j in enumerate(order):
             t = setup.scene.targets[j]
@@ -393,7 +130,7 @@ def _add_labels(pl, setup: Setup, scale: float, text3d: bool = False) -> None:
             texts.append(f"T{j}: {t.range_m:g} m, {np.degrees(t.angle_rad):g} deg"
                          + (f" el {np.degrees(el):g} deg" if el else "")
                          + f", {t.velocity_mps:+g} m/s")
-    pl.add_mesh(_merge_lines(leaders), color="#444444", line_width=1)
+    pl.add_mesh(merge_lines(leaders), color="#444444", line_width=1)
     if text3d:
         normal = -_overview_direction(setup)  # towards the camera
         up = np.cross(normal, np.cross(z_hat, normal))
@@ -405,7 +142,7 @@ def _add_labels(pl, setup: Setup, scale: float, text3d: bool = False) -> None:
             m = pv.Text3D(t, depth=0.0, height=size)  # in the xy plane, centred on the origin
             m.points = m.points @ rot.T + a + 0.7 * size * up + 2 * size * normal
             meshes.append(m)
-        pl.add_mesh(_merge(meshes), color="black")
+        pl.add_mesh(merge(meshes), color="black")
         return
     pl.add_point_labels(np.array(anchors), texts, font_size=14, bold=False, text_color="black",
                         shape_color="white", shape_opacity=0.75, show_points=False,
@@ -414,11 +151,11 @@ def _add_labels(pl, setup: Setup, scale: float, text3d: bool = False) -> None:
 
 def _drawn_points(setup: Setup, scale: float) -> np.ndarray:
     """Points spanning what is drawn: the enlarged RuT, the antennas, the sheet, the targets."""
-    pts = [_board(setup, scale).points, setup.fe.rx, setup.fe.tx]
+    pts = [board(setup, scale).points, setup.fe.rx, setup.fe.tx]
     if setup.sheet is not None:
         pts.append(setup.sheet.bounds)
     if setup.scene.targets:
-        pts.append(_target_positions(setup)[0])
+        pts.append(target_positions(setup)[0])
     return np.vstack(pts)
 
 
@@ -448,10 +185,10 @@ def _add_rut_panel(pl, setup: Setup) -> None:
     rut = setup.rut
     lam = rut.wavelength_m
     lateral, boresight = rut.rotation[:, 0], rut.rotation[:, 1]
-    pl.set_background(_PANEL_BACKGROUND)
-    pl.add_mesh(_board(setup, 1.0), color=_rgb("board"), opacity=0.35)
-    pl.add_mesh(_spheres(rut.tx_world, 0.3 * lam), color=_rgb("rut_tx"))
-    pl.add_mesh(_spheres(rut.rx_world, 0.3 * lam), color=_rgb("rut_rx"))
+    pl.set_background(PANEL_BACKGROUND)
+    pl.add_mesh(board(setup, 1.0), color=rgb("board"), opacity=0.35)
+    pl.add_mesh(spheres(rut.tx_world, 0.3 * lam), color=rgb("rut_tx"))
+    pl.add_mesh(spheres(rut.rx_world, 0.3 * lam), color=rgb("rut_rx"))
     active = set(rut.tx_order)
     texts = [f"Tx{i}" + ("" if i in active else " (off)") for i in range(len(rut.tx_world))]
     texts += [f"Rx{k}" for k in range(len(rut.rx_world))]
@@ -465,7 +202,7 @@ def _add_rut_panel(pl, setup: Setup) -> None:
                 position="upper_left", font_size=10, color="black")
     lo = rut.to_local(np.vstack([rut.tx_world, rut.rx_world])).min(0)
     start = rut.position + rut.rotation @ [lo[0], -2e-3, lo[2] - 4 * lam]
-    pl.add_mesh(_polyline(np.array([start, start + 0.01 * lateral])), color="black", line_width=2)
+    pl.add_mesh(polyline(np.array([start, start + 0.01 * lateral])), color="black", line_width=2)
     pl.add_point_labels((start + 0.005 * lateral - [0.0, 0.0, 0.6 * lam])[None], ["1 cm"],
                         font_size=11, bold=False, text_color="black", shape_opacity=0.0,
                         show_points=False, always_visible=True)
@@ -478,7 +215,7 @@ def _add_rut_panel(pl, setup: Setup) -> None:
 def _add_plan_panel(pl, setup: Setup, paths, scale: float, aspect: float) -> None:
     """Top-down view of the same scene, the RuT's boresight up; ``aspect`` of the panel (w/h)."""
     rut = setup.rut
-    pl.set_background(_PANEL_BACKGROUND)
+    pl.set_background(PANEL_BACKGROUND)
     _add_setup(pl, setup, paths, scale, labels="none")
     pl.add_text("plan view (top down, RuT boresight up)", position="upper_left", font_size=10,
                 color="black")
@@ -504,7 +241,7 @@ def build_plotter(setup: Setup, paths=None, window_size=(1600, 1000), off_screen
         pl.subplot(0, 0)
     else:
         pl = pv.Plotter(**kw)
-    pl.set_background(_BACKGROUND)
+    pl.set_background(BACKGROUND)
     legend = _add_setup(pl, setup, paths, scale, labels="2d" if side_panels else "3d")
     s = setup.scene
     title = f"{s.name}" + (f": {s.description}" if s.description else "")
@@ -515,7 +252,7 @@ def build_plotter(setup: Setup, paths=None, window_size=(1600, 1000), off_screen
     note = (f"RuT drawn x{scale:g} about its phase centre; front-end markers enlarged; "
             f"targets drawn at {TARGET_RADIUS_FACTOR:g} x arc radius")
     if paths is not None:
-        table = _split_paths(paths)[0]
+        table = split_paths(paths)[0]
         n_refl = int((np.asarray(table.bounces) > 0).sum())
         note += f"; paths: {table.method} ({len(table) - n_refl} direct, {n_refl} reflected)"
         missing = undrawable_reflections(paths)

@@ -1,0 +1,139 @@
+"""The probe's forward model: the RuT's spectrum at the probe's range-Doppler bin per virtual
+element as a function of one front end's mounting and channel parameters (:data:`PARAMS`), and
+:func:`measure`, the same quantity read off a capture (see :mod:`rtsgeom.identify`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.constants import c
+
+from ..arcmath import antenna_positions, layout_offsets
+from ..errors import CaptureError
+from ..geometry import Setup
+from ..paths.exact import leg_delays
+from ..radar.capture import Capture
+from ..radar.frame import noise_power
+from ..radar.phasors import bin_response
+from ..radar.processing import range_doppler, window
+from ..rts import EchoKind, Echoes, fir_if_gain, realised_delay, requested_delay
+
+__all__ = ["PARAMS", "ProbeModel", "measure"]
+
+#: the fitted parameters per front end / channel, SI inside (m, rad, s; gain as ln|G|)
+PARAMS = ("radial_offset", "tangential_offset", "height_offset", "yaw_offset", "delay_offset",
+          "log_gain", "phase")
+# central-difference steps (SI), per parameter
+_STEP = np.array([1e-6, 1e-6, 1e-6, 1e-5, 1e-14, 1e-6, 1e-6])
+
+
+
+@dataclass(frozen=True)
+class ProbeModel:
+    """The probe's spectrum at its bin per virtual element, for a batch of parameter vectors
+    (:data:`PARAMS`, SI) of front end ``active`` on the nominal ``setup``."""
+
+    setup: Setup
+    active: int
+    range_m: float
+    velocity_mps: float
+    amplitude: float
+    range_bin: int
+    doppler_bin: int
+
+    @classmethod
+    def of(cls, setup: Setup, cap: Capture, range_bin: int | None = None) -> "ProbeModel":
+        radar = setup.scene.radar
+        f_d = 2 * radar.f_c_hz * cap.velocity_mps / c
+        rb = (int(np.round(cap.range_m * 2 * radar.slope_hz_per_s / c * radar.samples_per_chirp
+                           / radar.adc_rate_hz)) if range_bin is None else int(range_bin))
+        n_l = radar.chirps_per_tx
+        db = (int(np.round(f_d * radar.tdm_cycle_s * n_l)) + n_l // 2) % n_l
+        return cls(setup, cap.active, cap.range_m, cap.velocity_mps, cap.amplitude, rb, db)
+
+    def nominal(self) -> np.ndarray:
+        """The scene's own values of the parameters (its offsets, gain and phase errors)."""
+        f = self.setup.scene.rts.front_ends[self.active]
+        yaw = getattr(f, "yaw_offset_rad", None) or 0.0
+        return np.array([f.radial_offset_m, f.tangential_offset_m, f.height_offset_m, yaw, 0.0,
+                         f.gain_offset_db * np.log(10) / 20, f.phase_offset_rad])
+
+    def echoes(self, theta) -> Echoes:
+        """One direct echo per parameter vector ``theta`` (B, 7)."""
+        th = np.atleast_2d(np.asarray(theta, float))
+        scene, rut, fe = self.setup.scene, self.setup.rut, self.setup.fe
+        q = slice(self.active, self.active + 1)
+        ro = fe.rx_offset_m[q] if fe.rx_offset_m is not None else layout_offsets(fe.separation_m[q])[0]
+        to = fe.tx_offset_m[q] if fe.tx_offset_m is not None else layout_offsets(fe.separation_m[q])[1]
+        pitch = None if fe.pitch_rad is None else fe.pitch_rad[q]
+        rx, tx, _ = antenna_positions(fe.arc_centre, fe.arc_radius_m, fe.angle_rad[q],
+                                      fe.separation_m[q], th[:, None, 0:3], rx_offset_m=ro,
+                                      tx_offset_m=to, yaw_rad=th[:, 3:4], pitch_rad=pitch)
+        t_a, t_b = leg_delays(rut.tx_world, rut.rx_world, rx, tx)  # (B, 1, Ntx), (B, 1, Nrx)
+        t_a, t_b = t_a[:, 0, rut.virtual_tx], t_b[:, 0, rut.virtual_rx]  # (B, V)
+        lam = rut.wavelength_m
+        g = (lam / (4 * np.pi * c * t_a)) * (lam / (4 * np.pi * c * t_b))
+        gain = np.exp(th[:, 5] + 1j * th[:, 6]) * self.amplitude
+        rts = scene.rts
+        tau0 = realised_delay(requested_delay(scene, self.range_m), rts.f_s_hz,
+                              rts.fractional_delay, rts.fractional_delay_step_s)
+        tau_if = tau0 + th[:, 4]
+        tau_air = t_a + t_b
+        fir = fir_if_gain(scene, tau_if, tau_if + tau_air.mean(axis=1))
+        f_d = 2 * scene.radar.f_c_hz * self.velocity_mps / c
+        return Echoes.build(tau_air_s=tau_air, amplitude=np.conj(g * gain[:, None]),
+                            tau_if_s=tau_if, f_if_hz=rts.f_rts_hz, doppler_hz=f_d, target=0,
+                            front_end=self.active, kind=EchoKind.DIRECT, fast_gain=fir)
+
+    def response(self, theta) -> np.ndarray:
+        """Spectrum at the probe's bin per virtual element, (B, V) complex128."""
+        ech = self.echoes(theta)
+        return bin_response(ech, self.setup.scene.radar, self.setup.rut, [self.range_bin],
+                            [self.doppler_bin])[0]
+
+    def jacobian(self, theta, free) -> tuple[np.ndarray, np.ndarray]:
+        """Response (V,) at ``theta`` and its derivatives (V, P) along the ``free`` parameters
+        (central differences, all columns in one batched call)."""
+        th = np.asarray(theta, float)
+        free = list(free)
+        h = _STEP[free]
+        batch = np.repeat(th[None], 2 * len(free) + 1, axis=0)
+        k = np.arange(len(free))
+        batch[1 + k, free] += h
+        batch[1 + len(free) + k, free] -= h
+        y = self.response(batch)
+        return y[0], ((y[1:1 + len(free)] - y[1 + len(free):]) / (2 * h[:, None])).T
+
+    def noise_variance(self, theta, snr_db: float) -> float:
+        """Noise variance of one complex spectrum value at the bin for the scene's per-sample
+        SNR ``snr_db`` of this echo (``radar.frame.noise_power``) after both windowed DFTs."""
+        radar = self.setup.scene.radar
+        p = noise_power(self.echoes(theta), snr_db)
+        return float(p * np.sum(window(radar.range_window, radar.samples_per_chirp) ** 2)
+                     * np.sum(window(radar.doppler_window, radar.chirps_per_tx) ** 2))
+
+
+def measure(setup: Setup, cap: Capture) -> tuple[np.ndarray, float, ProbeModel]:
+    """The RuT's processing of a capture: the range-Doppler spectrum (``radar.processing``) at
+    the probe's bin per virtual element (V,), the noise variance of one spectrum value (median
+    of |X|^2 over the whole map / ln 2: the median of an exponential, untouched by the few
+    target cells), and the probe's model at that bin (the strongest of the three range bins
+    around the set range)."""
+    from ..radar.fmcw import AdcCube
+    radar = setup.scene.radar
+    want = (radar.chirps_per_tx, setup.rut.num_virtual, radar.samples_per_chirp)
+    if cap.data.shape != want:
+        raise CaptureError(f"capture of front end {cap.active}: shape {list(cap.data.shape)} "
+                           f"does not match the scene's radar {list(want)} [loop, virtual, sample]")
+    if not 0 <= cap.active < setup.fe.count:
+        raise CaptureError(f"capture: active front end {cap.active} not in the scene "
+                           f"(0..{setup.fe.count - 1})")
+    rd = range_doppler(AdcCube(cap.data.astype(np.complex64), radar, setup.rut))
+    model = ProbeModel.of(setup, cap)
+    rbs = (model.range_bin + np.arange(-1, 2)) % radar.samples_per_chirp
+    best = int(rbs[np.argmax(rd.power[rbs, model.doppler_bin])])
+    model = ProbeModel.of(setup, cap, best)
+    x = rd.spectrum
+    sigma2 = float(np.median(x.real.astype(float) ** 2 + x.imag.astype(float) ** 2) / np.log(2))
+    return rd.spectrum[best, model.doppler_bin].astype(complex), sigma2, model
