@@ -145,6 +145,16 @@ def _array_rules(scene, fail) -> None:
             fail("radar.board_gap_mm", radar.board_gap_m * 1e3,
                  f"left out: the {p.name} preset interleaves its Tx and Rx antennas, so no "
                  "board gap applies")
+        elif radar.board_gap_m is None and p.board_gap_units is not None:
+            # the preset's own gap scales with the element spacing (board_gap_units * d) and
+            # must stay in the board gap's range, [0, 0.5] m, as an explicit one does
+            d_max = 0.5 / p.board_gap_units
+            d = radar.element_spacing_m or radar.wavelength_m / 2.0
+            if d > d_max:
+                fail("radar.element_spacing_m", radar.element_spacing_m,
+                     f"at most {d_max:g} m for the {p.name} preset (its Tx-Rx board gap, "
+                     f"{p.board_gap_units:g} element spacings, must stay within 0.5 m; or give "
+                     "radar.board_gap_mm)")
         return
     n_tx = len(arr.tx_mm)
     bad = [i for i in arr.tx_order if i >= n_tx]

@@ -668,3 +668,27 @@ def test_amplitudes_override_cannot_bypass_the_spacing_rule():
                                   _set("rts.aoa_mode", "nearest"))), "n.toml")
     with pytest.raises(SceneError, match="eq. 24"):
         run_scene(s, "exact", "exact")
+
+
+@pytest.mark.parametrize("preset", [p for p in __import__("rtsgeom.registry", fromlist=["x"])
+                                    .RADAR_PRESETS.values() if p.board_gap_units is not None],
+                         ids=lambda p: p.name)
+def test_preset_board_gap_bounds_the_element_spacing(preset):
+    """A preset's own Tx-Rx gap is board_gap_units * d: a spacing that pushes it past 0.5 m is
+    refused on load, naming the field and its limit (found by the fuzzer: it used to pass
+    loading and fail in build_setup)."""
+    from conftest import make_scene
+    d_max = 0.5 / preset.board_gap_units
+    for d, ok in ((0.999 * d_max, True), (1.001 * d_max, False)):
+        if d > 0.1:  # beyond the field's own range
+            continue
+        def edit(doc, d=d):
+            doc["radar"]["antenna_preset"] = preset.name
+            doc["radar"]["element_spacing_m"] = d
+            doc["radar"].pop("use_elevation_tx", None)
+            doc["rts"]["allow_wide_spacing"] = True  # a wide d narrows the beam (eq. 24)
+        if ok:
+            make_scene(edit)
+        else:
+            with pytest.raises(SceneError, match=r"radar\.element_spacing_m.*at most"):
+                make_scene(edit)
