@@ -55,6 +55,11 @@ def _af_size(rut) -> tuple[int, float, np.ndarray | None]:
     return 0, 1e-6, x / lam
 
 
+#: How far the root finder's angle may miss the set angle before it counts as a jump (a
+#: smoothed Capon or MUSIC resolving the front ends); continuous peaks meet it to ~1e-8 rad.
+JUMP_RAD = np.radians(1e-3)
+
+
 class AngleUnreachable(ValueError):
     """The set angle lies outside what the front-end pair can synthesize."""
 
@@ -175,6 +180,8 @@ class ChannelModel:
         if mode not in SOLVERS:
             raise ValueError(f"mode {mode!r}: must be one of {', '.join(SOLVERS)}")
         if mode == "exact":
+            if self.steering.smoothing:  # the closed form is Bartlett's peak condition
+                return self._solve_pair(direction, phases, log_span)
             rho = self._solve_pair_closed(direction, phases)
             return rho if rho is not None else self._solve_pair(direction, phases, log_span)
         return self._closed_form(direction, mode)
@@ -193,6 +200,16 @@ class ChannelModel:
         the detected bin's power over the next strongest (1 where they do not agree)."""
         from .sweep import design_ratio
         ph = np.zeros(2) if phases is None else np.asarray(phases, float)
+        if self.steering.smoothing:  # a smoothed Capon/MUSIC: its own peak, by the root finder
+            try:
+                rho = self._solve_pair(alpha, phases, 12.0)
+            except AngleUnreachable:
+                return None, False, 1.0
+            w = self.weights([rho], phases)
+            pw = np.sum(np.abs(self.responses[:, 0] * w[0] + self.responses[:, 1] * w[1]) ** 2,
+                        -1)
+            k = int(np.argmax(pw))
+            return float(rho), True, float(pw[k] / max(np.sort(pw)[-2], 1e-300))
         x = tdm_compensate(self.responses, self.doppler_hz, self.setup.rut,
                            self.setup.scene.radar)  # (K, 2, V)
         rho = design_ratio(self.steering, x[:, 0], x[:, 1], alpha, ph[1] - ph[0])  # (K,)
@@ -220,7 +237,17 @@ class ChannelModel:
                 f"angle {np.degrees(alpha):.4f} deg is outside the span this front-end pair "
                 f"can synthesize [{np.degrees(min(lo, hi)):.4f}, {np.degrees(max(lo, hi)):.4f}] deg")
         from scipy.optimize import brentq  # here: scipy.optimize costs ~0.3 s of imports
-        return float(np.exp(brentq(lambda x: angle(x) - alpha, -log_span, log_span, xtol=1e-10)))
+        x = brentq(lambda x: angle(x) - alpha, -log_span, log_span, xtol=1e-10)
+        got = angle(x)
+        if abs(got - alpha) > JUMP_RAD:  # brentq closed in on a jump of the detected angle
+            st = self.steering
+            raise AngleUnreachable(
+                f"angle {np.degrees(alpha):.4f} deg: the {st.estimator} estimator's detected "
+                f"angle jumps across it (to {np.degrees(got):.4f} deg at amplitude ratio "
+                f"{np.exp(x):.4g}): with radar.angle_subarray = {st.subarray} it resolves the "
+                "two front ends instead of one synthesized direction (front ends too far apart "
+                "for this estimator; see README, \"The RuT's direction estimator\")")
+        return float(np.exp(x))
 
     def _closed_form(self, alpha: float, mode: str) -> float:
         from .synthesis import ratio_array_factor, ratio_paper
