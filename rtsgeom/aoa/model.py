@@ -245,8 +245,9 @@ class ChannelModel:
                 f"angle {np.degrees(alpha):.4f} deg: the {st.estimator} estimator's detected "
                 f"angle jumps across it (to {np.degrees(got):.4f} deg at amplitude ratio "
                 f"{np.exp(x):.4g}): with radar.angle_subarray = {st.subarray} it resolves the "
-                "two front ends instead of one synthesized direction (front ends too far apart "
-                "for this estimator; see README, \"The RuT's direction estimator\")")
+                "two front ends (or a spurious direction) instead of one synthesized direction "
+                "(front ends too far apart for this estimator; see README, \"The RuT's "
+                "direction estimator\")")
         return float(np.exp(x))
 
     def _closed_form(self, alpha: float, mode: str) -> float:

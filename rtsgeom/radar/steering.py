@@ -250,6 +250,13 @@ class Steering:
         snaps = np.atleast_2d(snapshots)
         shape = snaps.shape[:-1]
         snaps = snaps.reshape(-1, snaps.shape[-1])
+        fine = np.all(np.isfinite(snaps[:, self.mask]), axis=-1)
+        if not fine.all():  # a snapshot with NaN (e.g. a design that has none): NaN angle
+            out = np.full(snaps.shape[0], np.nan)
+            if fine.any():
+                out[fine] = self._search_smoothed(snaps[fine])
+            out = out.reshape(shape)
+            return out if np.ndim(snapshots) > 1 else out[0]
         k = est.kernel(self.covariance(snaps), self.estimator)  # (n, L, L)
         grid = self._search_grid[0]
         q = est.quadratic(k, self.manifold(self.directions(grid)))
