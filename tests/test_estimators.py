@@ -17,7 +17,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from conftest import make_scene
+from conftest import ROOT, make_scene
 from rtsgeom.analysis.estimators import pair_snapshots, pair_sweep
 from rtsgeom.aoa.model import AngleUnreachable, ChannelModel
 from rtsgeom.geometry import build_setup
@@ -319,3 +319,29 @@ def test_near_field_parallax_keeps_smoothing_from_resolving_the_front_ends(kind)
         a = np.degrees(m.direction(m.weights(rho[:, None], ph)))
         steps[radius] = float(np.max(np.abs(np.diff(a))))
     assert steps[1.0] < 0.2 < 2.0 < steps[5.0], steps
+
+
+def test_smoothed_search_gives_nan_for_a_nan_snapshot():
+    """A snapshot with NaN (the calibration sweep's steps that have no design) gives a NaN
+    angle, the others theirs."""
+    st, nv = steering(estimator="capon", subarray=5)
+    x = plane_waves(st, np.array([[0.1], [0.2]]), nv)
+    x[0, st.mask.nonzero()[0][0]] = np.nan
+    a = st.search(x)
+    assert np.isnan(a[0]) and abs(np.sin(a[1]) - 0.2) < 1e-9
+
+
+def test_run_cli_offers_the_registry_estimators(tmp_path, capsys):
+    """``run --estimator`` takes its choices from ``registry.ANGLE_ESTIMATORS``; the override
+    is validated like the scene file (exit 2 naming the field)."""
+    from rtsgeom.cli import main
+    from rtsgeom.registry import ANGLE_ESTIMATORS
+    scene = str(ROOT / "scenes" / "diewald2022.toml")
+    with pytest.raises(SystemExit) as exc:
+        main(["run", scene, "--out", str(tmp_path / "a"), "--estimator", "esprit"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert all(k in err for k in ANGLE_ESTIMATORS)
+    rc = main(["run", scene, "--out", str(tmp_path / "b"), "--estimator", "bartlett",
+               "--subarray", "4", "--quiet"])
+    assert rc == 2 and "radar.angle_subarray = 4" in capsys.readouterr().err
