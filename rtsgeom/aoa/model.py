@@ -203,9 +203,12 @@ class ChannelModel:
         phases ``phases`` (Q,) (e.g. :meth:`coherent_phases`).
 
         Q = 2 only (peak matching with more channels has free parameters left, see
-        ``channel-sets.md``). ``exact``: the ratio rho = |w_1 / w_0| by a bracketing root
-        finder on the modelled beamformer (its fast path; AngleUnreachable outside the span the
-        pair reaches); ``paper``, ``array-factor``: their closed forms (``aoa.synthesis``) with
+        ``channel-sets.md``). ``exact``: the ratio rho = |w_1 / w_0| on the modelled RuT
+        output read by the RuT's own direction estimator (``steering.estimator``): Bartlett's
+        peak condition in closed form (``sweep.design_ratio``), for a smoothed Capon or MUSIC
+        a bisection on its peak (:func:`estimator_ratio`), else a bracketing root finder
+        (AngleUnreachable outside the span the pair reaches, or across a jump of a smoothed
+        estimator's angle); ``paper``, ``array-factor``: their closed forms (``aoa.synthesis``) with
         the front ends' geometric azimuths, span ends included exactly."""
         return self.weights([self.solve_ratio(direction, phases, mode, log_span)], phases)
 
