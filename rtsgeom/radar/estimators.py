@@ -49,7 +49,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["CAPON_LOADING", "SIGNAL_EIGEN_DB", "smoothed_covariance", "rank_one_covariance",
-           "kernel", "quadratic", "uniform_cells"]
+           "kernel", "quadratic", "lag_sums", "uniform_cells"]
 
 #: Capon's diagonal loading relative to the mean eigenvalue tr(R)/L (-30 dB: a noise-free
 #: rank-deficient R stays invertible; much smaller than any source's share of the power).
@@ -121,3 +121,13 @@ def kernel(cov, estimator: str) -> np.ndarray:
 def quadratic(k, a) -> np.ndarray:
     """Re(a^H K a) for kernels K (..., L, L) and manifold vectors a (..., A, L): (..., A)."""
     return np.real(np.einsum("...al,...lm,...am->...a", np.conj(a), k, a))
+
+
+def lag_sums(k) -> np.ndarray:
+    """On a uniform subarray (a_l = e^{-j l phi}) a^H K a = Re sum_delta r_delta e^{j delta
+    phi} with r_delta = sum_m K_{m + delta, m}: the 2L - 1 lag sums (..., 2L - 1), delta =
+    -(L-1) .. L-1, so a direction costs 2L - 1 products instead of L^2."""
+    k = np.asarray(k)
+    n = k.shape[-1]
+    return np.stack([np.trace(k, offset=-d, axis1=-2, axis2=-1) for d in range(-n + 1, n)],
+                    axis=-1)

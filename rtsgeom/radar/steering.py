@@ -257,20 +257,47 @@ class Steering:
                 out[fine] = self._search_smoothed(snaps[fine])
             out = out.reshape(shape)
             return out if np.ndim(snapshots) > 1 else out[0]
-        k = est.kernel(self.covariance(snaps), self.estimator)  # (n, L, L)
+        with single_threaded_blas():  # many small products: threads cost more than they give
+            return self._search_smoothed_blocks(snaps, shape, np.ndim(snapshots))
+
+    def _search_smoothed_blocks(self, snaps, shape, ndim) -> np.ndarray:
+        """MUSIC's nulls are all unbounded peaks on noise-free data: of the coarse grid's
+        local minima of a^H K a within 0.05 L of the deepest (the resolved sources), the one
+        with the most power a^H R a, the strongest source, is reported (what a radar reports
+        for one detection); Capon's peaks are ordered by power already."""
+        cov = self.covariance(snaps)
+        r = est.lag_sums(est.kernel(cov, self.estimator))  # (n, 2L - 1)
+        lags = np.arange(-self.subarray + 1, self.subarray)
+        kd = 2 * np.pi / self.wavelength_m * self.pitch_m
+
+        def quad(angles, lag=r):  # a^H K a at azimuths (n, A) or (A,): Re sum r_d z^d
+            z = np.exp(1j * kd * np.sin(angles))[..., None, :]  # (..., 1, A), z = e^{j k d u}
+            pos = np.cumprod(np.broadcast_to(z, z.shape[:-2] + (lags.size // 2, z.shape[-1])),
+                             axis=-2)  # z^1 .. z^(L-1): products, not exponentials
+            e = np.concatenate([np.conj(pos[..., ::-1, :]), np.ones_like(z), pos], axis=-2)
+            return np.real(lag @ e if e.ndim == 2 else np.einsum("nd,nda->na", lag, e))
+
         grid = self._search_grid[0]
-        q = est.quadratic(k, self.manifold(self.directions(grid)))
-        best = grid[np.argmin(q, axis=1)]
+        q = quad(grid)
+        pick = np.argmin(q, axis=1)
+        if self.estimator == "music":
+            low = np.zeros(q.shape, bool)
+            low[:, 1:-1] = (q[:, 1:-1] <= q[:, :-2]) & (q[:, 1:-1] <= q[:, 2:])
+            low &= q <= q.min(axis=1, keepdims=True) + 0.05 * self.subarray
+            power = quad(grid, est.lag_sums(cov))
+            pick = np.where(low.any(axis=1), np.argmax(np.where(low, power, -np.inf), axis=1),
+                            pick)
+        best = grid[pick]
         for half, step in ((0.3, 0.005), (0.006, 1e-4)):
             offs = np.radians(np.arange(-half, half + step / 2, step))
             cand = np.clip(best[:, None] + offs[None, :], -np.pi / 2, np.pi / 2)
-            pw = -est.quadratic(k, self.manifold(self.directions(cand)))
+            pw = -quad(cand)
             i = np.clip(np.argmax(pw, axis=1), 1, offs.size - 2)
             rows = np.arange(pw.shape[0])
             frac = parabolic(pw[rows, i - 1], pw[rows, i], pw[rows, i + 1])
             best = cand[rows, i] + np.clip(frac, -1, 1) * np.radians(step)
         out = best.reshape(shape)
-        return out if np.ndim(snapshots) > 1 else out[0]
+        return out if ndim > 1 else out[0]
 
     @cached_property
     def _search_grid(self) -> tuple[np.ndarray, np.ndarray]:
