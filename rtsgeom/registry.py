@@ -12,7 +12,8 @@ from dataclasses import dataclass
 
 
 __all__ = ["AoaMode", "AOA_MODES", "SYNTHESIS_MODES", "PathMethod", "PATH_METHODS",
-           "RADAR_PRESETS", "Window", "WINDOWS", "CFAR_KINDS", "PATTERN_KINDS"]
+           "RADAR_PRESETS", "Window", "WINDOWS", "CFAR_KINDS", "PATTERN_KINDS",
+           "ANGLE_ESTIMATORS"]
 
 
 @dataclass(frozen=True)
@@ -74,6 +75,15 @@ PATTERN_KINDS: dict[str, str] = {
     "isotropic": "field gain 1 in every direction",
     "cos": "power cos^q of the angle off boresight, q from the half-power beamwidth hpbw_deg",
     "table": "a CSV of azimuth_deg, elevation_deg, gain_db, phase_deg (a full regular grid)",
+}
+
+#: The RuT's direction estimators (``radar.angle_estimator``; ``radar.estimators``). Capon and
+#: MUSIC differ from Bartlett only with spatial smoothing (``radar.angle_subarray``): on one
+#: snapshot the covariance is rank 1 and all three peak at the same direction.
+ANGLE_ESTIMATORS: dict[str, str] = {
+    "bartlett": "the beamformer |sum_v w_v x_v e^{j k p_v . u}|^2 (eq. 14)",
+    "capon": "minimum variance (MVDR) 1 / a^H (R + delta I)^-1 a, diagonal loading delta",
+    "music": "MUSIC 1 / a^H E_n E_n^H a on the noise subspace of R",
 }
 
 CFAR_KINDS: dict[str, str] = {

@@ -16,7 +16,7 @@ from .paths import Paths, compute_paths
 from .radar import AdcCube, Detections, RangeDoppler, process
 from .radar.frame import noise_power, simulate
 from .rts import Echoes, RtsProgram, program_nearest
-from .scene import Scene, SceneError
+from .scene import Scene
 
 __all__ = ["RunResult", "simulate", "run_scene", "match_targets", "label_detections",
            "noise_power"]
@@ -165,17 +165,9 @@ def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = 
     if mode == "nearest" or not scene.targets:
         program = program_nearest(scene, setup)
     else:
-        from .aoa.plan_cells import plan_cells, uses_cells
-        if uses_cells(scene):  # front ends on a sphere / targets in elevation: N channels
-            if cal_file is not None:
-                raise SceneError(f"{scene.source}: --calibration: a calibration file holds pair "
-                                 "calibrations; front ends on a "
-                                 "sphere are calibrated per channel by the run itself")
-            program, calibration, warnings = plan_cells(setup, paths, mode, progress=progress)
-        else:
-            from .aoa.plan import plan_targets
-            program, calibration, warnings = plan_targets(setup, paths, mode, progress=progress,
-                                                           calibration=cal_file)
+        from .aoa.plan import plan_targets  # pairs on an arc, or cells on a sphere
+        program, calibration, warnings = plan_targets(setup, paths, mode, progress=progress,
+                                                       calibration=cal_file)
     echoes, cube = simulate(setup, paths, program, scene.seed, scene.radar.snr_db)
     rd, det = process(cube)
     budget = _budget(scene, setup, echoes, program)

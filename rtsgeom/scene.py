@@ -151,6 +151,15 @@ class RadarConfig(Evolvable):
                                choices=tuple(registry.WINDOWS))
     angle_window: str = spec("angle_window", "str", "taper of the angle beamformer", "none",
                              choices=tuple(registry.WINDOWS))
+    angle_estimator: str = spec(
+        "angle_estimator", "str", "the RuT's direction estimator per detection (bartlett: eq. "
+        "14; capon, music: differ from it only with angle_subarray > 0, see "
+        "radar/estimators.py)", "bartlett", choices=tuple(registry.ANGLE_ESTIMATORS))
+    angle_subarray: int = spec(
+        "angle_subarray", "int", "forward-backward spatial smoothing over subarrays of this "
+        "many elements of the azimuth row (capon, music; 1-D uniform arrays); 0 = none (one "
+        "snapshot, rank-1 covariance); about 2/3 of the row's elements is the usual choice",
+        0, unit="", lo=0, hi=4096)
     cfar: CfarConfig = spec("cfar", "table", "[radar.cfar] detection settings", {},
                             cls=CfarConfig)
     snr_db: float | None = spec("snr_db", "float", "per-sample SNR of the strongest echo; "

@@ -69,7 +69,7 @@ def problems(scene: "Scene") -> list[str]:
         out.append(f"{src}: {fieldname} = {fmt(value)}: must be {allowed}")
 
     for rule in (_array_rules, _radar_rules, _rts_rules, _sheet_rules, _placement_rules, _calibration_rules,
-                 _target_rules, _spacing_rules, _elevation_rules):
+                 _target_rules, _spacing_rules, _elevation_rules, _estimator_rules):
         rule(scene, fail)
     return out
 
@@ -83,6 +83,26 @@ def _elevation_rules(scene, fail) -> None:
              "true: front ends or targets off the horizontal plane (elevation_deg != 0) need the "
              "RuT's 2-D (azimuth x elevation) beamforming, with an array that has elevation "
              "extent (e.g. use_elevation_tx = true)")
+
+
+def _estimator_rules(scene, fail) -> None:
+    """Spatial smoothing is for the super-resolution estimators and the azimuth row: eq. 14's
+    Bartlett beamformer uses the whole array (a smoothed Bartlett would be another estimator),
+    and smoothing a 2-D array is not implemented (the array's length is checked where the
+    array is built, ``Steering.build``)."""
+    radar = scene.radar
+    if radar.angle_subarray and radar.angle_estimator == "bartlett":
+        fail("radar.angle_subarray", radar.angle_subarray,
+             "0 with radar.angle_estimator = \"bartlett\" (eq. 14 beamforms the whole array; "
+             "spatial smoothing is for capon and music)")
+    if radar.angle_subarray and radar.elevation_processing:
+        fail("radar.angle_subarray", radar.angle_subarray,
+             "0 with radar.elevation_processing = true: spatial smoothing is implemented for "
+             "the 1-D azimuth row only (2-D arrays need 2-D subarrays, not implemented); "
+             "without smoothing capon and music peak where bartlett does")
+    if radar.angle_subarray == 1:
+        fail("radar.angle_subarray", 1, "0 (no smoothing) or >= 2 (a subarray of one "
+             "element has no direction)")
 
 
 def _radar_rules(scene, fail) -> None:

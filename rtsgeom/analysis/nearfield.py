@@ -37,6 +37,17 @@ For a sweep of arc radii (front-end angles kept) and per front end:
     geometric angles) versus ``exact`` (solved on the modelled RuT output of the nominal setup),
     phasor level, phase-coherent channels (what the calibration establishes).
 
+**2-D cells** (a RuT that beamforms in azimuth and elevation, ``Steering.auto`` with D = 2,
+e.g. ``scenes/sphere4.toml``): (a) each front end alone is detected by the 2-D beamformer, and
+its bias is reported in both angles (the azimuth part split into the same closed forms as in
+1-D, which are those of the azimuth row; the elevation bias as detected, no closed form);
+(b) the phase error is the residual after the best-fit *plane* over the 2-D virtual positions
+(x, z); (c) the synthesized angle is checked over a grid of set directions inside each cell
+of front ends (the one cell of 3 or 4 front ends, else the Delaunay triangles of their
+direction cosines) with the ``array-factor`` closed form in 2-D and ``exact`` peak matching
+(``aoa.nchannel.ChannelSet``), errors in both angles. The 1-D analysis is the D = 1 case: the
+cells are the adjacent pairs and the fit a line.
+
 The Fraunhofer distance ``2 d_A^2 / lambda`` of the virtual aperture is reported alongside: at
 0.12 m it is far below R_c = 1 m, yet the bias is 0.57 deg, because the bias is a first-order
 (1/R) angle effect of the antenna *offsets* (Rx/Tx split, Tx/Rx groups), not the second-order
@@ -62,10 +73,12 @@ from ..paths import Paths, exact_paths
 from ..radar.steering import Steering
 from ..rts import requested_delay
 from ..scene import Scene, TargetConfig
+from .nearfield2d import _cells, cell_synthesis_errors_deg, single_front_end_directions_rad
 
 __all__ = ["DEFAULT_DECADES", "DEFAULT_POINTS", "default_radii", "with_arc_radius",
            "group_azimuth_rad", "beat_frequency_azimuth_rad", "phase_error_deg",
-           "single_front_end_angles_rad", "synthesis_worst_errors_deg", "NearField",
+           "single_front_end_angles_rad", "single_front_end_directions_rad",
+           "synthesis_worst_errors_deg", "cell_synthesis_errors_deg", "NearField",
            "nearfield", "nearfield_figure"]
 
 DEFAULT_DECADES = (-0.5, 1.5)  # default sweep: R_c * 10^-0.5 ... R_c * 10^1.5 (0.32 m to 32 m)
@@ -95,18 +108,25 @@ def _azimuth_from(rut: RutArray, points: np.ndarray, origin: np.ndarray) -> np.n
     return np.arctan2(p[..., 0], p[..., 1])
 
 
-def _slope_shares(rut: RutArray) -> tuple[float, float]:
+def _slope_shares(rut: RutArray, mask=None) -> tuple[float, float]:
     """Shares of the Tx and of the Rx positions in the beamformer's least-squares slope over the
-    azimuth virtual array: ``sum_v w_v x_tx(v)`` and ``sum_v w_v x_rx(v)`` (they add up to 1)."""
-    m = rut.azimuth_mask
+    azimuth virtual array: ``sum_v w_v x_tx(v)`` and ``sum_v w_v x_rx(v)`` (they add up to 1).
+    ``mask``: the elements of a 2-D beamformer (all); the slope in x is then the x coefficient
+    of the least-squares plane over (x, z)."""
+    m = rut.azimuth_mask if mask is None else np.asarray(mask, bool)
     xt = rut.tx_local[rut.virtual_tx[m], 0]
     xr = rut.rx_local[rut.virtual_rx[m], 0]
     xv = xt + xr
-    w = (xv - xv.mean()) / np.sum((xv - xv.mean()) ** 2)
+    if mask is None:
+        w = (xv - xv.mean()) / np.sum((xv - xv.mean()) ** 2)
+    else:
+        zv = rut.tx_local[rut.virtual_tx[m], 2] + rut.rx_local[rut.virtual_rx[m], 2]
+        w = np.linalg.pinv(np.stack([np.ones_like(xv), xv, zv], axis=1))[1]
     return float(np.sum(w * xt)), float(np.sum(w * xr))
 
 
-def group_azimuth_rad(rut: RutArray, fe_rx: np.ndarray, fe_tx: np.ndarray) -> np.ndarray:
+def group_azimuth_rad(rut: RutArray, fe_rx: np.ndarray, fe_tx: np.ndarray,
+                      mask=None) -> np.ndarray:
     """Far-field closed form of the detected azimuth with the RuT's Tx/Rx group parallax.
 
     Like ``apparent_azimuth_rad`` (the Tx see the front end's Rx antenna at theta_a, the Rx its
@@ -115,12 +135,13 @@ def group_azimuth_rad(rut: RutArray, fe_rx: np.ndarray, fe_tx: np.ndarray) -> np
     from its own direction. For the AWR1843BOOST the groups' centroids are -4.75 d and +4.75 d
     from the phase centre and carry 0.76 and 0.24 of the beamformer slope, which adds
     ~ 2.5 d cos^2(theta) / R to sin(alpha): as large as the Rx/Tx-separation term at R_c = 1 m
-    and of the same order in 1/R. Shapes (..., F, 3) -> (..., F).
+    and of the same order in 1/R. Shapes (..., F, 3) -> (..., F). ``mask``: the elements of
+    a 2-D beamformer (``Steering.mask``), whose groups and slope are taken over them.
     """
-    m = rut.azimuth_mask
+    m = rut.azimuth_mask if mask is None else np.asarray(mask, bool)
     c_tx = rut.tx_world[rut.virtual_tx[m]].mean(axis=0)
     c_rx = rut.rx_world[rut.virtual_rx[m]].mean(axis=0)
-    share_tx, share_rx = _slope_shares(rut)
+    share_tx, share_rx = _slope_shares(rut, mask)
     s = (share_tx * np.sin(_azimuth_from(rut, fe_rx, c_tx))
          + share_rx * np.sin(_azimuth_from(rut, fe_tx, c_rx)))
     return np.arcsin(np.clip(s, -1.0, 1.0))
@@ -136,20 +157,27 @@ def beat_frequency_azimuth_rad(angle_rad, radar, tau_s) -> np.ndarray:
 
 def _residual_deg(steering: Steering, lengths: np.ndarray) -> np.ndarray:
     """Phase (deg) of path lengths (F, V_s) of the beamformer's elements minus their best
-    linear fit over the positions (azimuth: x_v)."""
-    x = steering.positions_m[:, 0]
-    fit = np.polynomial.polynomial.polyfit(x, lengths.T, 1)  # (2, F)
-    resid = lengths - np.polynomial.polynomial.polyval(x, fit)
+    linear fit over the positions (azimuth: a line in x_v; D = 2: a plane in (x_v, z_v))."""
+    pos = steering.positions_m
+    if pos.shape[1] == 1:
+        x = pos[:, 0]
+        fit = np.polynomial.polynomial.polyfit(x, lengths.T, 1)  # (2, F)
+        resid = lengths - np.polynomial.polynomial.polyval(x, fit)
+    else:  # the same least squares with one slope per axis
+        design = np.concatenate([np.ones((pos.shape[0], 1)), pos], axis=1)
+        coef, *_ = np.linalg.lstsq(design, lengths.T, rcond=None)
+        resid = lengths - (design @ coef).T
     return np.degrees(2 * np.pi * resid / steering.wavelength_m)
 
 
-def phase_error_deg(setup: Setup) -> dict[str, np.ndarray]:
-    """Per front end, the exact two-way phase across the azimuth virtual array minus the
-    best-fit plane wave: ``pp`` and ``rms`` (deg). ``curvature_pp``: the same for what is left
-    after each RuT group's locally plane wave to the antenna it sees (pure phase-front
-    curvature, what the Fraunhofer criterion is about)."""
+def phase_error_deg(setup: Setup, steering: Steering | None = None) -> dict[str, np.ndarray]:
+    """Per front end, the exact two-way phase across the beamformer's virtual array (default
+    the azimuth row; a 2-D ``steering``: all elements, fit over x and z) minus the best-fit
+    plane wave: ``pp`` and ``rms`` (deg). ``curvature_pp``: the same for what is left after
+    each RuT group's locally plane wave to the antenna it sees (pure phase-front curvature,
+    what the Fraunhofer criterion is about)."""
     rut, fe = setup.rut, setup.fe
-    steering = Steering.build(rut, setup.scene.radar)
+    steering = steering or Steering.build(rut, setup.scene.radar)
     m = steering.mask
     exact = two_way_lengths(rut, fe.rx, fe.tx)[:, m]  # (F, V_az)
     total = _residual_deg(steering, exact)
@@ -251,10 +279,20 @@ class NearField:
     phase_pp_deg: np.ndarray
     phase_rms_deg: np.ndarray
     curvature_pp_deg: np.ndarray
-    synthesis: list  # per radius: list of per-pair dicts
+    synthesis: list  # per radius: list of per-pair (1-D) or per-cell (2-D) dicts
     fraunhofer_m: float
     aperture_m: float
     wavelength_m: float
+    # 2-D beamformer (D = 2): each front end's geometric and detected elevation (R, F)
+    geometric_el_deg: np.ndarray | None = None
+    detected_el_deg: np.ndarray | None = None
+
+    @property
+    def elevation_bias_deg(self) -> np.ndarray | None:
+        """Detected minus geometric elevation (R, F); None for an azimuth-only RuT."""
+        if self.detected_el_deg is None:
+            return None
+        return self.detected_el_deg - self.geometric_el_deg
 
     @property
     def bias_deg(self) -> np.ndarray:
@@ -317,6 +355,11 @@ class NearField:
                 "phase_error_rms_deg": float(self.phase_rms_deg[i, q]),
                 "curvature_phase_error_pp_deg": float(self.curvature_pp_deg[i, q]),
             })
+            if self.detected_el_deg is not None:
+                fes[-1].update({
+                    "geometric_elevation_deg": float(self.geometric_el_deg[i, q]),
+                    "detected_elevation_deg": float(self.detected_el_deg[i, q]),
+                    "elevation_bias_deg": float(self.elevation_bias_deg[i, q])})
         return {"radius_m": float(self.radius_m[i]), "target_range_m": float(self.range_m[i]),
                 "front_ends": fes, "synthesis": self.synthesis[i]}
 
@@ -337,27 +380,45 @@ def nearfield(scene: Scene, radii=None, points: int = 11) -> NearField:
     """
     radii = default_radii(scene) if radii is None else np.asarray(radii, float)
     _check_radii(scene, radii)
-    cols = {k: [] for k in ("rng", "geo", "det", "sep", "par", "beat", "pp", "rms", "curv")}
+    cols = {k: [] for k in ("rng", "geo", "det", "sep", "par", "beat", "pp", "rms", "curv",
+                            "geo_el", "det_el")}
     synth = []
     rut = None
+    two_d = False
     for r in radii:
         setup = build_setup(with_arc_radius(scene, r))
         paths = exact_paths(setup)
         rut, fe, radar = setup.rut, setup.fe, scene.radar
         rng = float(probe_ranges(setup, 1)[0])
-        det = single_front_end_angles_rad(setup, paths, rng)
+        st = Steering.auto(rut, radar)  # the beamformer the RuT runs
+        two_d = st.dims == 2
         geo = setup.fe_azimuth_rad()
+        if two_d:  # (azimuth, elevation) of each front end alone, by the 2-D beamformer
+            both = single_front_end_directions_rad(setup, paths, rng, st)
+            det = both[:, 0]
+            geo_both = st.angles(setup.fe_direction_cosines())
+            geo = geo_both[:, 0]
+            cols["geo_el"].append(geo_both[:, 1])
+            cols["det_el"].append(both[:, 1])
+        else:
+            det = single_front_end_angles_rad(setup, paths, rng)
         app = apparent_azimuth_rad(rut, fe.rx, fe.tx)
-        grp = group_azimuth_rad(rut, fe.rx, fe.tx)
+        grp = group_azimuth_rad(rut, fe.rx, fe.tx, st.mask if two_d else None)
         beat = beat_frequency_azimuth_rad(grp, radar, _echo_delay_s(setup, rng))
-        ph = phase_error_deg(setup)
+        ph = phase_error_deg(setup, st if two_d else None)
         for key, val in (("rng", rng), ("geo", geo), ("det", det), ("sep", app - geo),
                          ("par", grp - app), ("beat", beat - grp), ("pp", ph["pp"]),
                          ("rms", ph["rms"]), ("curv", ph["curvature_pp"])):
             cols[key].append(val)
-        synth.append([synthesis_worst_errors_deg(setup, paths, (k, k + 1), rng, det, points)
-                      for k in range(fe.count - 1)])
+        if two_d:
+            synth.append([cell_synthesis_errors_deg(setup, paths, cell, rng, points)
+                          for cell in _cells(setup.fe_direction_cosines())])
+        else:
+            synth.append([synthesis_worst_errors_deg(setup, paths, (k, k + 1), rng, det,
+                                                     points) for k in range(fe.count - 1)])
     deg = {k: np.degrees(np.array(cols[k])) for k in ("geo", "det", "sep", "par", "beat")}
+    el = ({"geometric_el_deg": np.degrees(np.array(cols["geo_el"])),
+           "detected_el_deg": np.degrees(np.array(cols["det_el"]))} if two_d else {})
     return NearField(
         scene=scene, radius_m=radii, range_m=np.array(cols["rng"]),
         geometric_deg=deg["geo"], detected_deg=deg["det"], separation_deg=deg["sep"],
@@ -365,7 +426,7 @@ def nearfield(scene: Scene, radii=None, points: int = 11) -> NearField:
         phase_pp_deg=np.array(cols["pp"]), phase_rms_deg=np.array(cols["rms"]),
         curvature_pp_deg=np.array(cols["curv"]), synthesis=synth,
         fraunhofer_m=fraunhofer_distance_m(rut), aperture_m=aperture_m(rut),
-        wavelength_m=rut.wavelength_m)
+        wavelength_m=rut.wavelength_m, **el)
 
 
 # ------------------------------------------------------------------------------------------
@@ -388,6 +449,9 @@ def nearfield_figure(nf: NearField, title: str = ""):
             col = f"C{q % 10}"
             lab = f"FE {q} ({nf.geometric_deg[0, q]:.1f} deg)"
             ax.plot(r, nf.bias_deg[:, q], "o", color=col, label=f"{lab}: detected - geometric")
+            if nf.elevation_bias_deg is not None:
+                ax.plot(r, np.abs(nf.elevation_bias_deg[:, q]), "x", color=col,
+                        label=f"{lab}: |elevation bias|")
             ax.plot(r, nf.separation_deg[:, q], "-", color=col,
                     label=f"{lab}: far-field closed form (Rx/Tx separation)")
             ax.plot(r, (nf.separation_deg + nf.parallax_deg)[:, q], "--", color=col,
@@ -401,7 +465,10 @@ def nearfield_figure(nf: NearField, title: str = ""):
                                          for row in nf.synthesis])
             af, ex = pick("array_factor_max_abs_error_deg"), pick("exact_max_abs_error_deg")
             ex_max = np.nanmax(ex) if np.any(np.isfinite(ex)) else np.nan
-            ax2.plot(r, af, "s-", color=f"C{k % 10}", label=f"pair {k}-{k + 1}: array-factor "
+            first = nf.synthesis[0][k]
+            name = ("cell " + "-".join(str(q) for q in first["cell"]) if "cell" in first
+                    else f"pair {k}-{k + 1}")
+            ax2.plot(r, af, "s-", color=f"C{k % 10}", label=f"{name}: array-factor "
                      f"(exact: <= {ex_max:.1g} deg)")
         for a in (ax, ax2, ax3):
             a.set_xscale("log")

@@ -39,7 +39,7 @@ from ..rts import (KIND_DIRECT, RtsProgram, channel_echoes, nominal_link_gain, r
                    target_amplitude)
 from ..scene import TargetConfig
 
-__all__ = ["ChannelModel", "AngleUnreachable", "SOLVERS"]
+__all__ = ["ChannelModel", "AngleUnreachable", "SOLVERS", "estimator_ratio"]
 
 SOLVERS = SYNTHESIS_MODES  # the registry lists every AoA mode once (rtsgeom/registry.py)
 
@@ -53,6 +53,48 @@ def _af_size(rut) -> tuple[int, float, np.ndarray | None]:
     if x.size > 1 and np.allclose(np.diff(x), 0.5 * lam, rtol=1e-9, atol=1e-12):
         return int(x.size), 1e-6, None
     return 0, 1e-6, x / lam
+
+
+#: How far the root finder's angle may miss the set angle before it counts as a jump (a
+#: smoothed Capon or MUSIC resolving the front ends); continuous peaks meet it to ~1e-8 rad.
+JUMP_RAD = np.radians(1e-3)
+
+
+def estimator_ratio(st: Steering, x_i, x_j, alpha_rad: float, phase=0.0,
+                    log_span: float = 12.0, grid: int = 13, iterations: int = 40
+                    ) -> np.ndarray:
+    """The ratio rho >= 0 (...,) for which the estimator's detected angle of
+    ``x_i + rho e^{j phase} x_j`` (snapshots (..., V)) is ``alpha_rad``, by bisection on
+    log rho, batched over all snapshots: what ``aoa.sweep.design_ratio`` (Bartlett's peak
+    condition in closed form) is for an estimator without one (a smoothed Capon or MUSIC,
+    ``Steering.smoothing``). The bracket is the first sign change of (angle - alpha) on
+    ``grid`` log-spaced ratios over e^{+-log_span}; NaN where there is none, or where the
+    bisection closes in on a jump of the detected angle (the estimator resolves the
+    channels, :data:`JUMP_RAD`). Bisection, not a faster root finder: the detected angle of
+    such an estimator can jump, and bisection stays inside its bracket."""
+    x_i, x_j = np.broadcast_arrays(np.asarray(x_i), np.asarray(x_j))
+    shape, n_v = x_i.shape[:-1], x_i.shape[-1]
+    ph = np.broadcast_to(np.exp(1j * np.asarray(phase, float)), shape)
+    xi = x_i.reshape(-1, n_v)
+    xj = (x_j * ph[..., None]).reshape(-1, n_v)
+    n = xi.shape[0]
+    lr = np.linspace(-log_span, log_span, grid)
+    f = st.search(xi[:, None, :] + np.exp(lr)[None, :, None] * xj[:, None, :]) - alpha_rad
+    change = (np.sign(f[:, :-1]) * np.sign(f[:, 1:]) <= 0) & np.isfinite(f[:, :-1] + f[:, 1:])
+    has = change.any(axis=1)
+    k = np.argmax(change, axis=1)
+    rows = np.arange(n)
+    lo, hi, f_lo = lr[k], lr[k + 1], f[rows, k]
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        f_mid = st.search(xi + np.exp(mid)[:, None] * xj) - alpha_rad
+        left = np.sign(f_mid) == np.sign(f_lo)
+        lo, f_lo = np.where(left, mid, lo), np.where(left, f_mid, f_lo)
+        hi = np.where(left, hi, mid)
+    x = 0.5 * (lo + hi)
+    got = st.search(xi + np.exp(x)[:, None] * xj)
+    ok = has & (np.abs(got - alpha_rad) < JUMP_RAD)
+    return np.where(ok, np.exp(x), np.nan).reshape(shape)
 
 
 class AngleUnreachable(ValueError):
@@ -161,9 +203,12 @@ class ChannelModel:
         phases ``phases`` (Q,) (e.g. :meth:`coherent_phases`).
 
         Q = 2 only (peak matching with more channels has free parameters left, see
-        ``channel-sets.md``). ``exact``: the ratio rho = |w_1 / w_0| by a bracketing root
-        finder on the modelled beamformer (its fast path; AngleUnreachable outside the span the
-        pair reaches); ``paper``, ``array-factor``: their closed forms (``aoa.synthesis``) with
+        ``channel-sets.md``). ``exact``: the ratio rho = |w_1 / w_0| on the modelled RuT
+        output read by the RuT's own direction estimator (``steering.estimator``): Bartlett's
+        peak condition in closed form (``sweep.design_ratio``), for a smoothed Capon or MUSIC
+        a bisection on its peak (:func:`estimator_ratio`), else a bracketing root finder
+        (AngleUnreachable outside the span the pair reaches, or across a jump of a smoothed
+        estimator's angle); ``paper``, ``array-factor``: their closed forms (``aoa.synthesis``) with
         the front ends' geometric azimuths, span ends included exactly."""
         return self.weights([self.solve_ratio(direction, phases, mode, log_span)], phases)
 
@@ -220,7 +265,21 @@ class ChannelModel:
                 f"angle {np.degrees(alpha):.4f} deg is outside the span this front-end pair "
                 f"can synthesize [{np.degrees(min(lo, hi)):.4f}, {np.degrees(max(lo, hi)):.4f}] deg")
         from scipy.optimize import brentq  # here: scipy.optimize costs ~0.3 s of imports
-        return float(np.exp(brentq(lambda x: angle(x) - alpha, -log_span, log_span, xtol=1e-10)))
+        x = brentq(lambda x: angle(x) - alpha, -log_span, log_span, xtol=1e-10)
+        got = angle(x)
+        # brentq closed in on a jump of the detected angle. Only for a smoothed estimator:
+        # Bartlett's jump (front ends beyond the resolution) is what the design map's
+        # worst_error_deg measures, its ratio kept as before.
+        if self.steering.smoothing and abs(got - alpha) > JUMP_RAD:
+            st = self.steering
+            raise AngleUnreachable(
+                f"angle {np.degrees(alpha):.4f} deg: the {st.estimator} estimator's detected "
+                f"angle jumps across it (to {np.degrees(got):.4f} deg at amplitude ratio "
+                f"{np.exp(x):.4g}): with radar.angle_subarray = {st.subarray} it resolves the "
+                "two front ends (or a spurious direction) instead of one synthesized direction "
+                "(front ends too far apart for this estimator; see README, \"The RuT's "
+                "direction estimator\")")
+        return float(np.exp(x))
 
     def _closed_form(self, alpha: float, mode: str) -> float:
         from .synthesis import ratio_array_factor, ratio_paper

@@ -88,12 +88,27 @@ def _detect(setup, paths, program, seed):
 
 
 def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=None) -> dict:
-    """Delay offset of channel j relative to channel i of ``pair`` by a sweep (module doc)."""
-    from .calibration import (if_phase_slope_hz, nominal_model, probe_ranges,
+    """Delay offset of channel j relative to channel i of ``pair`` (a row of
+    :attr:`ChannelCalibration.pairs`).
+
+    In the RuT's own beamformer: when it is the azimuth row (D = 1) this is the pair
+    calibration of the arc, ``calibration.calibrate_pair`` (phasor-model sweep, periodic
+    least-squares fit, full-chain confirmation), as a dict; the pair on an arc is the N = 2,
+    D = 1 case of the channel calibration, not a second sweep. With a 2-D beamformer (D = 2:
+    pairs side by side or stacked in elevation) the sweep of the module doc, through the
+    full ADC-cube chain, comparing the probes' detected direction cosines in both axes (the
+    phasor sweep's closed-form design and Newton reading are 1-D so far)."""
+    from .calibration import (calibrate_pair, if_phase_slope_hz, nominal_model, probe_ranges,
                               probe_total_delay)
     scene = setup.scene
     rts = scene.rts
     nom, nom_paths = nominal_model(setup, paths)
+    if Steering.auto(nom.rut, scene.radar).dims == 1:
+        cal = calibrate_pair(setup, paths, tuple(int(q) for q in pair), probe, (0.0, 0.0),
+                             seed, span_s, step_s)
+        row = cal.to_dict()
+        row["residual_error_deg"] = float(cal.residual_error_deg)
+        return row
     ranges = probe_ranges(setup, 2)
     corr = probe.gain_correction[list(pair)]
     designs, predicted = [], []

@@ -20,7 +20,7 @@ from .model import AngleUnreachable, ChannelModel
 from .sweep import HALF_BINS
 from .synthesis import PairModel
 
-__all__ = ["bracketing_pair", "pair_amplitudes", "plan_targets", "channel_offsets",
+__all__ = ["bracketing_pair", "pair_amplitudes", "plan_targets", "uses_cells", "channel_offsets",
            "load_calibration", "CALIBRATION_FORMAT"]
 
 CALIBRATION_FORMAT = "rtsgeom-calibration"
@@ -136,15 +136,35 @@ def channel_offsets(n_fe: int, cals: dict[tuple[int, int], Calibration]) -> np.n
     return off
 
 
+def uses_cells(scene) -> bool:
+    """Whether the scene needs cells of N front ends in (azimuth, elevation): a front end off
+    the arc, or a target with an elevation. Otherwise the cells are pairs on the arc."""
+    return (any(fe.elevation_rad for fe in scene.rts.front_ends)
+            or any(getattr(t, "elevation_rad", 0.0) for t in scene.targets))
+
+
 def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, progress=None,
                  calibration: dict | None = None) -> tuple[RtsProgram, dict, list[str]]:
-    """The RTS program for the scene's targets at their set angles.
+    """The RTS program for the scene's targets at their set directions: the one planner.
+
+    Targets on an arc (every elevation 0): each in the pair of front ends whose *measured*
+    span holds it (the N = 2, D = 1 cell), the pairs calibrated along the arc
+    (``calibrate_pair``), the ratio by :func:`pair_design`. Front ends on a sphere or targets
+    in elevation: the enclosing cell of 3 or 4 front ends and one weight per channel
+    (``aoa.plan_cells``; a calibration file, which holds pair calibrations, is refused there).
 
     ``calibration``: a calibration file's content (:func:`load_calibration`): its front-end
     angles, gain corrections and pair delays are used instead of measuring them again.
     Returns the program, the calibration record (for summary.json) and warnings.
     """
     scene = setup.scene
+    if uses_cells(scene):
+        if calibration is not None:
+            raise SceneError(f"{scene.source}: --calibration: a calibration file holds pair "
+                             "calibrations; front ends on a sphere are calibrated per channel "
+                             "by the run itself")
+        from .plan_cells import plan_cells
+        return plan_cells(setup, paths, mode, calibrate, progress)
     seed = scene.seed
     loaded: dict = {}
     if calibration is not None:

@@ -1,7 +1,8 @@
 """Targets in azimuth and elevation: pick the enclosing cell of front ends, calibrate its
-channels, solve one weight per channel (issue 15; the N-channel counterpart of ``aoa.plan``).
+channels, solve one weight per channel (issue 15): the cell branch of the one planner,
+``aoa.plan.plan_targets``.
 
-Used by ``run`` when any front end has a non-zero elevation. The cells come from the front
+Taken when any front end or target has a non-zero elevation (``plan.uses_cells``). The cells come from the front
 ends' geometric direction cosines seen from the RuT (``aoa.cells``); the weights from
 :class:`~rtsgeom.aoa.nchannel.ChannelSet` on the nominal setup with the channels' calibrated
 delay offsets and their natural phases (what the RuT sees of a nominal setup) when
@@ -23,15 +24,9 @@ from ..scene import SceneError
 from .cells import CellUnreachable, enclosing_cell
 from .model import AngleUnreachable
 from .nchannel import ChannelSet, target_direction
+from .plan import uses_cells  # noqa: F401  (re-exported: the planner decides with it)
 
 __all__ = ["plan_cells", "uses_cells"]
-
-
-def uses_cells(scene) -> bool:
-    """Whether the scene needs the N-channel planner: a front end off the arc, or a target
-    with an elevation."""
-    return (any(fe.elevation_rad for fe in scene.rts.front_ends)
-            or any(getattr(t, "elevation_rad", 0.0) for t in scene.targets))
 
 
 def plan_cells(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, progress=None

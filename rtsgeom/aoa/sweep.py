@@ -61,7 +61,12 @@ def design_ratio(st: Steering, x_i, x_j, alpha_rad, phase=0.0):
     ``Re(b_I* b_I') + rho Re(b_I* y' + y* b_I') + rho^2 Re(y* y') = 0``; of its non-negative
     roots the one where P is a maximum (P'' < 0) with the larger P. NaN where none is (the
     angle is outside the pair's span). Agrees with the root finder on the searched peak
-    (``ChannelModel.solve``) to its tolerance (tested)."""
+    (``ChannelModel.solve``) to its tolerance (tested). A smoothed Capon or MUSIC
+    (``Steering.smoothing``) has no such closed form: ``model.estimator_ratio`` solves it on
+    the estimator's own peak."""
+    if st.smoothing:
+        from .model import estimator_ratio
+        return estimator_ratio(st, x_i, x_j, float(alpha_rad), phase)
     u = np.sin(np.asarray(alpha_rad, float))
     bi, bi1, bi2 = _beam_derivatives(st, x_i, u)
     ph = np.exp(1j * np.asarray(phase, float))

@@ -38,7 +38,7 @@ def _nearfield_text(d: dict) -> str:
              "  R (m)  FE  geometric   bias   = separation + parallax + beat-f + curvature"
              "   phase p-p   rms  | pair  array-factor  exact"]
     for row in d["radii"]:
-        syn = {s["pair"][0]: s for s in row["synthesis"]}
+        syn = {s["pair"][0]: s for s in row["synthesis"] if "pair" in s}
         for fe in row["front_ends"]:
             s = syn.get(fe["index"])
             tail = ""
@@ -47,12 +47,26 @@ def _nearfield_text(d: dict) -> str:
                 tail = (f" | {s['pair'][0]}-{s['pair'][1]}  "
                         f"{'n/a' if af is None else f'{af:11.4f}'}  "
                         f"{'n/a' if ex is None else f'{ex:.1e}'}")
+            if "elevation_bias_deg" in fe:
+                tail += (f" | el {fe['geometric_elevation_deg']:+.3f} bias "
+                         f"{fe['elevation_bias_deg']:+.4f}")
             lines.append(
                 f"{row['radius_m']:7.3f} {fe['index']:3d} {fe['geometric_deg']:9.4f} "
                 f"{fe['bias_deg']:+8.4f}   {fe['separation_part_deg']:+9.4f}  "
                 f"{fe['parallax_part_deg']:+8.4f}  {fe['beat_frequency_part_deg']:+7.4f}  "
                 f"{fe['curvature_part_deg']:+9.5f}  {fe['phase_error_pp_deg']:9.3f} "
                 f"{fe['phase_error_rms_deg']:6.3f}{tail}")
+        for s in row["synthesis"]:
+            if "cell" not in s:
+                continue
+            fmt2 = lambda v: "n/a" if v is None else f"{v:.4f}"  # noqa: E731
+            lines.append(
+                f"{row['radius_m']:7.3f} cell {'-'.join(str(q) for q in s['cell'])} "
+                f"({s['points']} set directions): worst |error| az / el, deg: array-factor "
+                f"{fmt2(s['array_factor_max_abs_error_azimuth_deg'])} / "
+                f"{fmt2(s['array_factor_max_abs_error_elevation_deg'])}, exact "
+                f"{fmt2(s['exact_max_abs_error_azimuth_deg'])} / "
+                f"{fmt2(s['exact_max_abs_error_elevation_deg'])}")
     coef = ", ".join(f"{x:.4f}" for x in d["bias_1_over_r_coefficient_deg_m"])
     need = ", ".join(f"{x:.2f}" for x in d["radius_for_bias_below_deg"]["0.1"])
     lines.append(f"bias x R (deg m) per front end: {coef}; bias < 0.1 deg needs R >= {need} m")

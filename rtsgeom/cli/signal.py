@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..io import atomic_path, write_bytes, write_json, write_text
-from ..registry import AOA_MODES, PATH_METHODS
+from ..registry import ANGLE_ESTIMATORS, AOA_MODES, PATH_METHODS
 from ..run import RunResult, label_detections, run_scene, summary
 from ._common import (UsageError, load_scene_checked, number, output_file, output_folder,
                       output_path, scene_arg, steps)
@@ -236,9 +236,20 @@ def _calibration_kw(args) -> dict:
     return {} if doc is None else {"calibration": doc}
 
 
+def _with_estimator(scene, args):
+    """The scene with ``--estimator``/``--subarray`` applied (validated again, like the file:
+    e.g. smoothing needs capon or music)."""
+    est, sub = getattr(args, "estimator", None), getattr(args, "subarray", None)
+    if est is None and sub is None:
+        return scene
+    radar = scene.radar.evolve(**{k: v for k, v in (("angle_estimator", est),
+                                                     ("angle_subarray", sub)) if v is not None})
+    return scene.evolve(radar=radar)
+
+
 def cmd_run(args) -> int:
     from ..validate import scene_warnings
-    scene = load_scene_checked(args.scene)
+    scene = _with_estimator(load_scene_checked(args.scene), args)
     out = args.out
     with output_folder(out, [args.scene]) as stage, steps(args.quiet) as step:
         step(f"simulating {scene.name} ({args.paths} paths, calibration, ADC cube, detection)")
@@ -321,6 +332,12 @@ def register(sub) -> None:
                    help="exact line-of-sight paths (default) or Sionna RT ray tracing")
     p.add_argument("--amplitudes", choices=modes, default=None,
                    help="AoA amplitude mode (default: the scene's rts.aoa_mode)")
+    p.add_argument("--estimator", choices=tuple(ANGLE_ESTIMATORS), default=None,
+                   help="the RuT's direction estimator (default: the scene's "
+                        "radar.angle_estimator); `exact` designs against it")
+    p.add_argument("--subarray", type=number(0, 4096, integer=True), default=None,
+                   metavar="L", help="spatial smoothing subarray length for capon/music "
+                                     "(default: the scene's radar.angle_subarray; 0 = none)")
     p.add_argument("--no-report", action="store_true", help="skip report.html")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.add_argument("--calibration", default=None, metavar="FILE",

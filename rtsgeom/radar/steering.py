@@ -7,7 +7,10 @@ the ADC cube (``AdcCube.steering``) and by the channel models (``aoa.model.Chann
 * their positions ``positions_m`` (V_s, D) in the radar frame along the direction-cosine axes:
   D = 1 is azimuth (x, u = sin az); D = 2 adds elevation (x, z; u = (sin az cos el, sin el)).
   A custom or sparse array only changes these positions;
-* the angle taper ``taper`` (V_s,) (the scene's ``radar.angle_window``).
+* the angle taper ``taper`` (V_s,) (the scene's ``radar.angle_window``);
+* the direction estimator ``estimator`` (``radar.angle_estimator``: bartlett, eq. 14, capon or
+  music) and its spatial smoothing ``subarray`` (``radar.angle_subarray``, 0 = none); the
+  estimators and why they equal Bartlett on one unsmoothed snapshot: ``radar.estimators``.
 
 The virtual element at ``p_v`` receives a source in direction ``u`` with phase ``-k p_v . u``;
 the beamformer steers with ``+k p_v . u`` (sign conventions: ``radar.processing``).
@@ -22,7 +25,8 @@ import numpy as np
 
 from .._util import frozen, single_threaded_blas
 from ..geometry import RutArray
-from ..scene import RadarConfig
+from ..scene import RadarConfig, SceneError
+from . import estimators as est
 
 __all__ = ["Steering", "window"]
 
@@ -88,24 +92,59 @@ class Steering:
     taper: np.ndarray  # (V_s,)
     wavelength_m: float
     aperture_m: np.ndarray  # (D,) extent of the array per axis (elements times spacing)
+    estimator: str = "bartlett"  # radar.angle_estimator (registry.ANGLE_ESTIMATORS)
+    subarray: int = 0  # radar.angle_subarray: smoothing subarray length, 0 = none
+    pitch_m: float = 0.0  # grid pitch of the azimuth row (smoothing only)
 
     @classmethod
     def build(cls, rut: RutArray, radar: RadarConfig, elevation: bool = False) -> "Steering":
         """The azimuth beamformer (D = 1, the azimuth row), or with ``elevation`` the 2-D one
-        over all virtual elements (D = 2: x and z)."""
+        over all virtual elements (D = 2: x and z), with the scene's direction estimator."""
+        kind = str(getattr(radar, "angle_estimator", "bartlett"))
+        sub = int(getattr(radar, "angle_subarray", 0))
         if elevation:
             mask = np.ones(rut.num_virtual, bool)
             pos = rut.virtual_local[:, [0, 2]]
             n = [np.unique(np.round(pos[:, d] / rut.spacing_m, 6)).size for d in range(2)]
+            aperture = np.asarray(n, float) * rut.spacing_m
         else:
             mask = np.asarray(rut.azimuth_mask, bool)
             pos = rut.virtual_local[mask][:, [0]]
             # the distinct positions' span plus one cell (duplicates and gaps counted right:
             # the cascade's 144 elements span 86 cells)
-            return cls(frozen(mask), frozen(pos), frozen(_taper(radar.angle_window, pos)),
-                       float(rut.wavelength_m), frozen(np.array([rut.aperture_m])))
-        return cls(frozen(mask), frozen(pos), frozen(_taper(radar.angle_window, pos)),
-                   float(rut.wavelength_m), frozen(np.asarray(n, float) * rut.spacing_m))
+            aperture = np.array([rut.aperture_m])
+        out = cls(frozen(mask), frozen(pos), frozen(_taper(radar.angle_window, pos)),
+                  float(rut.wavelength_m), frozen(aperture), kind, sub, float(rut.spacing_m))
+        if out.smoothing:
+            out._check_smoothing()
+        return out
+
+    @property
+    def smoothing(self) -> bool:
+        """Whether the estimator differs from Bartlett's peak: Capon or MUSIC with spatial
+        smoothing. Without smoothing the covariance of one snapshot is rank 1 and both peak
+        exactly where Bartlett does (``radar.estimators``): the Bartlett search is used."""
+        return self.estimator != "bartlett" and self.subarray > 0
+
+    def _check_smoothing(self) -> None:
+        field = f"radar.angle_subarray = {self.subarray}"
+        if self.dims != 1:
+            raise SceneError(f"{field}: must be 0 with 2-D (azimuth x elevation) processing: "
+                             "spatial smoothing is implemented for the 1-D azimuth row only")
+        try:
+            _, n = self._cells
+        except ValueError as exc:
+            raise SceneError(f"{field}: must be 0 for this array: {exc} (spatial smoothing "
+                             "needs a filled uniform row; a sparse row has no shifted "
+                             "subarrays)") from None
+        if not 2 <= self.subarray <= n:
+            raise SceneError(f"{field}: must be in [2, {n}] (the azimuth row has {n} distinct "
+                             "positions), or 0 for no smoothing")
+
+    @cached_property
+    def _cells(self) -> tuple[np.ndarray, int]:
+        """Grid cell per azimuth element and the number of cells (smoothing)."""
+        return est.uniform_cells(self.positions_m[:, 0], self.pitch_m)
 
     @staticmethod
     def has_elevation(rut: RutArray) -> bool:
@@ -173,6 +212,93 @@ class Steering:
         0.1 ms per call, which made the `exact` amplitude design of `nearfield` take 20 s)."""
         return np.abs(np.einsum("...v,av->...a", weighted, steer)) ** 2
 
+    # -- the direction estimator (radar.estimators) ------------------------------------------
+
+    def covariance(self, snapshots) -> np.ndarray:
+        """The estimator's covariance of snapshots (..., V): with smoothing the forward-backward
+        smoothed (..., L, L) over the row's grid cells (untapered), else the rank-1
+        x x^H (..., V_s, V_s) of the tapered snapshot."""
+        if self.smoothing:
+            cell, n = self._cells
+            x = est.cell_snapshots(np.asarray(snapshots)[..., self.mask], cell, n)
+            return est.smoothed_covariance(x, self.subarray)
+        return est.rank_one_covariance(self.weighted(snapshots))
+
+    def manifold(self, u) -> np.ndarray:
+        """Array manifold a(u) = e^{-j k p . u} (..., L) for directions ``u`` (..., D): over
+        one subarray's grid with smoothing, else over the elements that take part."""
+        if self.smoothing:
+            kx = 2 * np.pi / self.wavelength_m * self.pitch_m * np.arange(self.subarray)
+            return np.exp(-1j * kx * np.asarray(u, float)[..., :1])
+        return np.conj(self.steer(u))
+
+    def spectrum(self, snapshots, u) -> np.ndarray:
+        """The estimator's spectrum of snapshots (..., V) at directions ``u`` (A, D): (..., A).
+        Bartlett: :meth:`power`; Capon, MUSIC: 1 / a^H K a (``radar.estimators``), from the
+        covariance of :meth:`covariance` whether or not it is smoothed."""
+        if self.estimator == "bartlett":
+            return self.power(snapshots, u)
+        k = est.kernel(self.covariance(snapshots), self.estimator)
+        q = est.quadratic(k, self.manifold(u))
+        return 1.0 / np.maximum(q, np.finfo(float).tiny)
+
+    def _search_smoothed(self, snapshots) -> np.ndarray:
+        """:meth:`search` for a smoothed Capon or MUSIC (D = 1): the largest peak of the
+        estimator's spectrum (the smallest a^H K a) on the 0.25 deg grid, two zoom levels
+        (0.005, 1e-4 deg) and a parabola through -a^H K a (smooth where 1 / a^H K a is
+        sharp)."""
+        snaps = np.atleast_2d(snapshots)
+        shape = snaps.shape[:-1]
+        snaps = snaps.reshape(-1, snaps.shape[-1])
+        fine = np.all(np.isfinite(snaps[:, self.mask]), axis=-1)
+        if not fine.all():  # a snapshot with NaN (e.g. a design that has none): NaN angle
+            out = np.full(snaps.shape[0], np.nan)
+            if fine.any():
+                out[fine] = self._search_smoothed(snaps[fine])
+            out = out.reshape(shape)
+            return out if np.ndim(snapshots) > 1 else out[0]
+        with single_threaded_blas():  # many small products: threads cost more than they give
+            return self._search_smoothed_blocks(snaps, shape, np.ndim(snapshots))
+
+    def _search_smoothed_blocks(self, snaps, shape, ndim) -> np.ndarray:
+        """MUSIC's nulls are all unbounded peaks on noise-free data: of the coarse grid's
+        local minima of a^H K a within 0.05 L of the deepest (the resolved sources), the one
+        with the most power a^H R a, the strongest source, is reported (what a radar reports
+        for one detection); Capon's peaks are ordered by power already."""
+        cov = self.covariance(snaps)
+        r = est.lag_sums(est.kernel(cov, self.estimator))  # (n, 2L - 1)
+        lags = np.arange(-self.subarray + 1, self.subarray)
+        kd = 2 * np.pi / self.wavelength_m * self.pitch_m
+
+        def quad(angles, lag=r):  # a^H K a at azimuths (n, A) or (A,): Re sum r_d z^d
+            z = np.exp(1j * kd * np.sin(angles))[..., None, :]  # (..., 1, A), z = e^{j k d u}
+            pos = np.cumprod(np.broadcast_to(z, z.shape[:-2] + (lags.size // 2, z.shape[-1])),
+                             axis=-2)  # z^1 .. z^(L-1): products, not exponentials
+            e = np.concatenate([np.conj(pos[..., ::-1, :]), np.ones_like(z), pos], axis=-2)
+            return np.real(lag @ e if e.ndim == 2 else np.einsum("nd,nda->na", lag, e))
+
+        grid = self._search_grid[0]
+        q = quad(grid)
+        pick = np.argmin(q, axis=1)
+        if self.estimator == "music":
+            low = np.zeros(q.shape, bool)
+            low[:, 1:-1] = (q[:, 1:-1] <= q[:, :-2]) & (q[:, 1:-1] <= q[:, 2:])
+            low &= q <= q.min(axis=1, keepdims=True) + 0.05 * self.subarray
+            power = quad(grid, est.lag_sums(cov))
+            pick = np.where(low.any(axis=1), np.argmax(np.where(low, power, -np.inf), axis=1),
+                            pick)
+        best = grid[pick]
+        for half, step in ((0.3, 0.005), (0.006, 1e-4)):
+            offs = np.radians(np.arange(-half, half + step / 2, step))
+            cand = np.clip(best[:, None] + offs[None, :], -np.pi / 2, np.pi / 2)
+            pw = -quad(cand)
+            i = np.clip(np.argmax(pw, axis=1), 1, offs.size - 2)
+            rows = np.arange(pw.shape[0])
+            frac = parabolic(pw[rows, i - 1], pw[rows, i], pw[rows, i + 1])
+            best = cand[rows, i] + np.clip(frac, -1, 1) * np.radians(step)
+        out = best.reshape(shape)
+        return out if ndim > 1 else out[0]
+
     @cached_property
     def _search_grid(self) -> tuple[np.ndarray, np.ndarray]:
         """The coarse grid of :meth:`search` (0.25 deg over +-90 deg) and its steering vectors
@@ -197,14 +323,18 @@ class Steering:
         return a if self.dims == 1 else a[..., 0]
 
     def search(self, snapshots) -> np.ndarray:
-        """Beamformer peak per snapshot (..., V) -> azimuth (...,) rad (D = 1) or
-        (azimuth, elevation) (..., 2) rad (D = 2).
+        """The estimator's peak per snapshot (..., V) -> azimuth (...,) rad (D = 1) or
+        (azimuth, elevation) (..., 2) rad (D = 2). A smoothed Capon or MUSIC
+        (:attr:`smoothing`) searches its own spectrum (:meth:`_search_smoothed`); every other
+        case is Bartlett's peak (the same peak for all three estimators on one snapshot):
 
         D = 1: grid search at 0.25 deg, two zoom levels (0.005 deg, 1e-4 deg) and a final
         parabolic interpolation: precise to ~1e-6 deg on noise-free data. D = 2: the global
         maximum on the coarse 2-D grid of :meth:`grid` (lambda / (8 d_A) per axis over the
         visible region, which holds the unambiguous one), then :meth:`peak` (2-D Newton on
         log P with the global check) from there."""
+        if self.smoothing:
+            return self._search_smoothed(snapshots)
         if self.dims != 1:
             return self._search_2d(snapshots)
         snaps = np.atleast_2d(snapshots)
@@ -257,9 +387,13 @@ class Steering:
         found is the global one. The others are restarted from the grid's maximum (with 4 more
         steps); what still fails is not converged: its u is the grid search's
         (:meth:`search`, D = 1) or the grid's maximum (D = 2). Elementwise arithmetic in
-        cache-sized blocks, so equal snapshots give bit-equal results."""
+        cache-sized blocks, so equal snapshots give bit-equal results. A smoothed Capon or
+        MUSIC (:attr:`smoothing`) returns its :meth:`search` (``u0`` unused), all converged."""
         snaps = np.asarray(snapshots)
         shape = snaps.shape[:-1]
+        if self.smoothing:  # no Newton on Bartlett's power: the estimator's own search
+            u = np.sin(self.search(snaps.reshape(-1, snaps.shape[-1])))[:, None]
+            return u.reshape(shape + (1,)), np.ones(shape, bool)
         flat = snaps.reshape(-1, snaps.shape[-1])
         n_d = self.dims
         kv = self.wavevector  # (V_s, D)
