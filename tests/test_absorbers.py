@@ -68,7 +68,8 @@ def test_absorber_lowers_each_bounce_off_its_surface(rt, tmp_path, dist_m, az_de
         assert np.array_equal(got.objects, ref.objects)
         np.testing.assert_array_equal(got.paths.delay_s, ref.paths.delay_s)
         expect = ref.paths.gain * 10 ** (-(n_sheet * sheet_db + n_plate * plate_db) / 20)
-        np.testing.assert_allclose(got.paths.gain, expect, rtol=1e-12, atol=0)
+        # Sionna traces in float32: a re-trace may round a row differently (seen: 1e-7)
+        np.testing.assert_allclose(got.paths.gain, expect, rtol=1e-6, atol=0)
         level = 20 * np.log10(np.abs(got.paths.gain[echo]) / np.abs(ref.paths.gain[echo]))
         np.testing.assert_allclose(level, -plate_db, atol=1e-9)
 
