@@ -57,20 +57,24 @@ def test_modes_in_the_ideal_far_field(far_setup):
     assert abs(res["paper"].error_deg[3]) < 0.05
 
 
-@pytest.mark.parametrize("window", ["hann", "hamming", "blackman"])
-def test_tapered_angle_window_in_the_ideal_far_field(window):
-    """``exact`` solves on the tapered beamformer and stays exact; ``array-factor``'s closed form
-    is the untapered array factor, so a taper moves its set-points (README: 0.14 to 0.23 deg)."""
-    def tapered(doc):
-        far_field(doc)
-        doc["radar"]["angle_window"] = window
-    setup = build_setup(make_scene(tapered))
-    paths = exact_paths(setup)
-    probe = probe_front_ends(setup, paths)
-    res = {m: linearity(setup, paths, (0, 1), m, probe, None, points=7)
-           for m in ("array-factor", "exact")}
-    assert res["exact"].max_abs_error_deg < 0.02
-    assert 0.1 < res["array-factor"].max_abs_error_deg < 0.3
+def test_array_factor_of_positions_and_weights():
+    """The weighted array factor is the beamformer output for one plane wave: equal to
+    |sum w e^{j 2 pi x u}| / sum w on symmetric arrays (the filled row's Dirichlet kernel
+    when untapered), and repeated positions count as often as they occur."""
+    u = np.linspace(-0.6, 0.6, 41)
+    x = np.arange(8) * 0.5
+    np.testing.assert_allclose(array_factor(u, positions_wl=x), array_factor(u, 8), atol=1e-12)
+    w = np.hanning(10)[1:-1]
+    direct = np.abs(np.exp(2j * np.pi * u[:, None] * (x - x.mean())) @ w) / w.sum()
+    np.testing.assert_allclose(np.abs(array_factor(u, positions_wl=x, weights=w)), direct,
+                               atol=1e-12)
+    # a repeated element: the same as weight 2 on one copy
+    xr = np.r_[x, x[3]]
+    wr = np.r_[np.ones(8), 1.0]
+    w2 = np.ones(8)
+    w2[3] = 2.0
+    np.testing.assert_allclose(array_factor(u, positions_wl=xr, weights=wr),
+                               array_factor(u, positions_wl=x, weights=w2), atol=1e-12)
 
 
 @pytest.fixture(scope="module")

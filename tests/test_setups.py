@@ -403,23 +403,37 @@ def test_calibrate_and_linearity_pair_all(tmp_path, capsys):
     assert main(["calibrate", str(p), "--pair", "0", "2", "--quiet"]) == 2
 
 
-@pytest.mark.parametrize("name", ["awr1843boost", "awr2243-cascade"])
-def test_array_factor_closed_form_counts_distinct_positions(name):
-    """The array-factor mode's closed form is sized from the distinct azimuth positions (86 for
-    the cascade's 144 elements), and the position form equals the lambda/2 closed form."""
-    from rtsgeom.aoa.model import _af_size
-    from rtsgeom.aoa.synthesis import array_factor
+@pytest.mark.parametrize("window", ["none", "hamming"])
+@pytest.mark.parametrize("name", sorted(PRESETS))
+def test_array_factor_closed_form_is_the_rut_beamformer(name, window):
+    """The array-factor mode's closed form (``synthesis.array_factor_args``) is the RuT's own
+    beamformer for one plane wave: its taper and every virtual element (the cascade's 144 on 86
+    positions count with their multiplicity). Symmetric arrays: |AF| = |beam| / sum w to
+    1e-12; the cascade's row is asymmetric, so the real part about the weighted centroid is
+    an approximation there -- still closer than the distinct-position kernel it replaced."""
+    from rtsgeom.aoa.synthesis import array_factor, array_factor_args
+    from rtsgeom.radar.steering import Steering
     scene = load_scene(DEFAULT)
-    scene = scene.evolve(radar=scene.radar.evolve(antenna_preset=name), targets=())
-    rut = build_setup(scene).rut
-    n, _, pos = _af_size(rut)
-    assert pos is None and n == PRESETS[name].num_azimuth_unique
-    u = np.linspace(-0.3, 0.3, 41)
-    x = rut.azimuth_positions_m / rut.wavelength_m
-    assert np.allclose(array_factor(u, n), array_factor(u, positions_wl=x), atol=1e-12)
-    custom = build_setup(load_scene(CUSTOM)).rut
-    n, _, pos = _af_size(custom)
-    assert n == 0 and pos.size == 10
+    scene = scene.evolve(radar=scene.radar.evolve(antenna_preset=name, angle_window=window),
+                         targets=())
+    setup = build_setup(scene)
+    st = Steering.build(setup.rut, scene.radar)
+    u0, u = 0.05, np.linspace(-0.3, 0.3, 41)
+    x = np.zeros(st.mask.size, complex)
+    x[st.mask] = np.conj(st.steer(np.array([u0])))
+    beam = np.sqrt(st.power(x, u[:, None])) / np.sum(st.taper)
+    af = array_factor(u - u0, **array_factor_args(st))
+    if name != "awr2243-cascade":
+        np.testing.assert_allclose(np.abs(af), beam, atol=1e-12)
+    else:
+        old = array_factor(u - u0, setup.rut.azimuth_positions_m.size)
+        assert np.max(np.abs(np.abs(af) - beam)) < 0.6 * np.max(np.abs(np.abs(old) - beam))
+    if window == "none" and name != "awr2243-cascade":  # a filled untapered row: the n form
+        assert array_factor_args(st) == {"n": PRESETS[name].num_azimuth_unique}
+    custom = build_setup(load_scene(CUSTOM))  # a sparse row: its positions, with repeats
+    c_st = Steering.build(custom.rut, custom.scene.radar)
+    args = array_factor_args(c_st)
+    assert args["positions_wl"].size == int(np.count_nonzero(c_st.mask))
 
 
 def test_rut_pattern_enters_the_synthesis_design():

@@ -54,18 +54,18 @@ def _closed_form_measured(setup, paths, pair, target, mode, probe, offsets, corr
     alone as the RuT detects it, as the paper's angles were "determined by measurement")
     in the closed form, instead of their geometric azimuths."""
     from .calibration import nominal_model
-    from .synthesis import PairModel, ratio_array_factor, ratio_paper
+    from .synthesis import PairModel, array_factor_args, ratio_array_factor, ratio_paper
     i, j = pair
     th = probe.angle_rad[[i, j]]
     alpha = target.angle_rad
-    if mode == "paper":
-        rho = float(ratio_paper(th[0], th[1], alpha))
-    else:
-        rho = float(ratio_array_factor(th[0], th[1], alpha,
-                                       int(np.count_nonzero(setup.rut.azimuth_mask))))
-    rho = float(np.clip(rho, 0.0, 1e12))
     nom, nom_paths = nominal_model(setup, paths)
     model = PairModel.build(nom, nom_paths, pair, target, offsets)
+    if mode == "paper":
+        rho = float(ratio_paper(th[0], th[1], alpha))
+    else:  # the RuT's own beamformer (taper, repeated elements), as the geometric reading
+        rho = float(ratio_array_factor(th[0], th[1], alpha,
+                                       **array_factor_args(model.model.steering)))
+    rho = float(np.clip(rho, 0.0, 1e12))
     phase = model.coherent_phase(probe_angles(*th))
     a_i, a_j = model.amplitudes(rho, alpha, phase)
     return a_i * corr[0], a_j * corr[1], rho

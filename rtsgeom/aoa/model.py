@@ -44,17 +44,6 @@ __all__ = ["ChannelModel", "AngleUnreachable", "SOLVERS", "estimator_ratio"]
 SOLVERS = SYNTHESIS_MODES  # the registry lists every AoA mode once (rtsgeom/registry.py)
 
 
-def _af_size(rut) -> tuple[int, float, np.ndarray | None]:
-    """(n, h, positions) for ``ratio_array_factor``: the distinct azimuth virtual positions
-    (duplicates combined: 86 for the cascade, not its 144 elements); a filled lambda/2 row
-    uses the closed form with n, anything else the positions in wavelengths."""
-    x = rut.azimuth_positions_m
-    lam = rut.wavelength_m
-    if x.size > 1 and np.allclose(np.diff(x), 0.5 * lam, rtol=1e-9, atol=1e-12):
-        return int(x.size), 1e-6, None
-    return 0, 1e-6, x / lam
-
-
 #: How far the root finder's angle may miss the set angle before it counts as a jump (a
 #: smoothed Capon or MUSIC resolving the front ends); continuous peaks meet it to ~1e-8 rad.
 JUMP_RAD = np.radians(1e-3)
@@ -282,7 +271,7 @@ class ChannelModel:
         return float(np.exp(x))
 
     def _closed_form(self, alpha: float, mode: str) -> float:
-        from .synthesis import ratio_array_factor, ratio_paper
+        from .synthesis import array_factor_args, ratio_array_factor, ratio_paper
         th = self.setup.fe_azimuth_rad()[list(self.channels)]  # the nominal angles
         lo, hi = np.sort(th)
         if not lo <= alpha <= hi:
@@ -298,7 +287,8 @@ class ChannelModel:
         elif mode == "paper":
             rho = float(ratio_paper(th[0], th[1], alpha))
         else:
-            rho = float(ratio_array_factor(th[0], th[1], alpha, *_af_size(self.setup.rut)))
+            rho = float(ratio_array_factor(th[0], th[1], alpha,
+                                           **array_factor_args(self.steering)))
         return float(np.clip(rho, 0.0, 1e12))
 
     def scale(self, w, direction: float) -> float:

@@ -29,7 +29,7 @@ from ..paths import Paths
 from ..scene import TargetConfig
 from .model import SOLVERS, AngleUnreachable, ChannelModel
 
-__all__ = ["MODES", "g_paper", "array_factor", "ratio_paper", "ratio_array_factor", "PairModel",
+__all__ = ["MODES", "g_paper", "array_factor", "ratio_paper", "ratio_array_factor", "array_factor_args", "PairModel",
            "AngleUnreachable"]
 
 MODES = SOLVERS
@@ -52,29 +52,50 @@ def ratio_paper(theta_i, theta_j, alpha):
     return -g_paper(theta_i, alpha) / g_paper(theta_j, alpha)
 
 
-def array_factor(u, n: int = 0, positions_wl=None):
+def array_factor(u, n: int = 0, positions_wl=None, weights=None):
     """Normalised array factor: of ``n`` elements at lambda/2, sin(n pi u/2) / (n sin(pi u/2));
-    or, with ``positions_wl`` (distinct element positions in wavelengths, any spacing, sparse or
-    non-uniform), the real part of the mean of exp(j 2 pi x_k u) about their centroid (the
-    same Dirichlet kernel for a filled lambda/2 array; exact for a symmetric array)."""
+    or, with ``positions_wl`` (element positions in wavelengths, any spacing, sparse,
+    non-uniform or repeated) and optional ``weights`` (the beamformer's taper per element),
+    the real part of sum_k w_k exp(j 2 pi x_k u) / sum_k w_k about the weighted centroid (the
+    same Dirichlet kernel for a filled untapered lambda/2 array; exact for a symmetric array
+    and taper). This is the beamformer output of eq. (14) for one plane wave, u = sin theta -
+    sin alpha."""
     u = np.asarray(u, float)
     if positions_wl is not None:
         x = np.asarray(positions_wl, float)
-        x = x - x.mean()
-        return np.mean(np.cos(2 * np.pi * u[..., None] * x), axis=-1)
+        w = np.ones_like(x) if weights is None else np.asarray(weights, float)
+        x = x - np.sum(w * x) / np.sum(w)
+        return np.cos(2 * np.pi * u[..., None] * x) @ w / np.sum(w)
     den = n * np.sin(np.pi * u / 2)
     small = np.abs(den) < 1e-12
     return np.where(small, 1.0, np.sin(n * np.pi * u / 2) / np.where(small, 1.0, den))
 
 
 def ratio_array_factor(theta_i, theta_j, alpha, n: int = 0, h: float = 1e-6,
-                       positions_wl=None):
+                       positions_wl=None, weights=None):
     """A_J / A_I with the true array factor: A_I AF_I'(alpha) + A_J AF_J'(alpha) = 0
-    (``n`` lambda/2 elements, or the distinct positions ``positions_wl`` of :func:`array_factor`)."""
+    (``n`` lambda/2 elements, or the positions ``positions_wl`` and taper ``weights`` of
+    :func:`array_factor`)."""
     def d_af(theta):
-        return (array_factor(np.sin(theta) - np.sin(alpha + h), n, positions_wl)
-                - array_factor(np.sin(theta) - np.sin(alpha - h), n, positions_wl)) / (2 * h)
+        return (array_factor(np.sin(theta) - np.sin(alpha + h), n, positions_wl, weights)
+                - array_factor(np.sin(theta) - np.sin(alpha - h), n, positions_wl,
+                               weights)) / (2 * h)
     return -d_af(theta_i) / d_af(theta_j)
+
+
+def array_factor_args(steering) -> dict:
+    """The keyword arguments of :func:`ratio_array_factor` that make its array factor the RuT's
+    own azimuth beamformer (:class:`~rtsgeom.radar.steering.Steering`, D = 1): a filled,
+    untapered lambda/2 row without repeated elements is the closed form in ``n``; anything
+    else (a taper, repeated virtual elements such as the cascade's 144 on 86 positions, gaps,
+    another spacing) its element positions and taper weights."""
+    x = np.asarray(steering.positions_m)[:, 0] / steering.wavelength_m
+    w = np.asarray(steering.taper, float)
+    xs = np.sort(x)
+    if (x.size > 1 and np.all(w == w[0])
+            and np.allclose(np.diff(xs), 0.5, rtol=1e-9, atol=1e-12)):
+        return {"n": int(x.size)}
+    return {"positions_wl": x, "weights": w}
 
 
 @dataclass(frozen=True)
