@@ -412,3 +412,53 @@ def test_one_frame_per_step_keeps_the_noise_pull_below_2_ps():
         assert (2 * cal.one_frame_scatter_ps / np.sqrt(cal.frames_per_step)) <= 2.0
         got.append(cal.delta_tau_s)
     assert np.max(np.abs(np.array(got) - ref)) < 2e-12
+
+
+# ------------------------------------------- the chosen delay is one the RTS can set (13.4)
+
+@pytest.mark.parametrize("res_ps, fractional", [(1.0, True), (5.0, True), (25.0, True),
+                                                (50.0, True), (250.0, False)])
+def test_calibrated_delay_is_realisable_and_the_residual_is_reported(res_ps, fractional):
+    """On a grid of RTS delay resolutions (fractional-delay steps of 1 to 50 ps, and whole
+    4 GSPS samples without the FIR): every fine-sweep step and the chosen delay are whole
+    multiples of the resolution, the RTS realises the chosen offset exactly on both probes'
+    delays, the reported residual is the fit's optimum minus the chosen delay (at most half
+    a step), and the chosen delay is the realisable one nearest the coherence point."""
+    from rtsgeom.aoa.calibration import realisable
+    from rtsgeom.rts import realised_delay, requested_delay
+
+    def mutate(doc):
+        doc["radar"].pop("snr_db", None)
+        doc["rts"]["fractional_delay"] = fractional
+        doc["rts"]["fractional_delay_step_s"] = res_ps * 1e-12 if fractional else 1e-12
+        doc["rts"]["calibration_step_ps"] = max(25.0, res_ps)
+    setup = build_setup(make_scene(mutate))
+    rts = setup.scene.rts
+    res = rts.delay_resolution_s
+    assert res == pytest.approx(res_ps * 1e-12)
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, 1)
+    cal = calibrate_pair(setup, paths, (0, 1), probe, seed=1)
+    assert cal.delay_resolution_s == res
+    steps = np.concatenate([[cal.delta_tau_s], cal.refine_delta_tau_s]) / res
+    assert np.allclose(steps, np.round(steps), rtol=0, atol=1e-6)
+    assert abs(cal.quantisation_residual_s) <= res / 2 * (1 + 1e-9)
+    tau = requested_delay(setup.scene, np.asarray(cal.probe_ranges_m))
+    moved = (realised_delay(tau + cal.delta_tau_s, rts.f_s_hz, rts.fractional_delay,
+                            rts.fractional_delay_step_s)
+             - realised_delay(tau, rts.f_s_hz, rts.fractional_delay, rts.fractional_delay_step_s))
+    assert np.allclose(moved, cal.delta_tau_s, rtol=0, atol=1e-16)
+    # the coherence point on the same geometry with a (near) continuous delay: the model of a
+    # coarse RTS rounds every delay it is given, which makes its phase a staircase
+    fine = build_setup(make_scene(lambda doc: doc["rts"].update(fractional_delay_step_s=1e-15)))
+    point = coherence_delay(fine, exact_paths(fine), (0, 1),
+                            probe_angles(*probe.angle_rad[[0, 1]]), cal.delta_tau_s)
+    fitted = cal.delta_tau_s + cal.quantisation_residual_s
+    assert cal.delta_tau_s == pytest.approx(float(realisable(fitted, res)), abs=1e-18)
+    # the fit finds the coherence point to a few ps whatever the step; at 250 ps (3 fine
+    # points) the chosen delay is the sweep's realisable point nearest it
+    assert abs(fitted - point) <= (5e-12 if res < 100e-12 else res / 2)
+    assert abs(cal.delta_tau_s - point) <= res / 2 + 5e-12
+    round_trip = type(cal).from_dict(json.loads(json.dumps(cal.to_dict())))
+    assert round_trip.quantisation_residual_s == cal.quantisation_residual_s
+    assert round_trip.delay_resolution_s == res
