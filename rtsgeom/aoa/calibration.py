@@ -35,7 +35,7 @@ from .synthesis import PairModel
 
 __all__ = ["Calibration", "FrontEndProbe", "probe_front_ends", "calibrate_pair", "probe_ranges",
            "if_phase_slope_hz", "air_phase_slope_hz", "coherence_delay", "probe_total_delay",
-           "frames_per_step", "TARGET_BIAS_PS", "calibrate_pair_paper", "fir_effect", "fir_bin_gain", "fir_matched_delay", "realisable"]
+           "frames_per_step", "TARGET_BIAS_PS", "calibrate_pair_paper", "fir_effect", "fir_bin_gain", "realisable"]
 
 
 @dataclass(frozen=True)
@@ -514,25 +514,6 @@ def fir_bin_gain(scene, delays_s, tau_total_s) -> np.ndarray:
     kern = window(radar.range_window, n_s) * np.exp(
         2j * np.pi * (beat[:, None] * t_n - r0[:, None] * np.arange(n_s) / n_s))
     return np.sum(kern * g, 1) / np.sum(kern, 1)
-
-
-def fir_matched_delay(scene, ref_delay_s: float, delay_s: float, air_s: float,
-                      period_s: float, iterations: int = 4) -> float:
-    """The delay near ``delay_s`` (a whole number of periods from ``ref_delay_s``) at which a
-    channel's beat phase is the one it has at ``ref_delay_s`` *with* the fractional-delay
-    FIR: ``2 pi (d - ref) / period + psi(d) - psi(ref)`` a multiple of 2 pi, psi the filter's
-    phase at the echo's bin (:func:`fir_bin_gain`; ``air_s`` the echo's air delay). The
-    filter's phase cycles with its setting every 1/f_s, so a period later is not the same
-    phase (up to +-3.7 deg with 5 taps). Fixed-point iteration (psi changes ~4x slower with
-    the setting than the delay's own phase). ``delay_s`` itself for an ideal delay."""
-    if not scene.rts.fractional_delay or scene.rts.fractional_delay_filter == "ideal":
-        return float(delay_s)
-    g_ref = fir_bin_gain(scene, [ref_delay_s], [ref_delay_s + air_s])[0]
-    d = float(delay_s)
-    for _ in range(iterations):
-        g = fir_bin_gain(scene, [d], [d + air_s])[0]
-        d = float(delay_s) + float(np.angle(g / g_ref)) / (2 * np.pi) * period_s
-    return d
 
 
 def fir_effect(setup: Setup, delta_tau_s: float, base_offsets=(0.0, 0.0), ranges=None) -> dict:

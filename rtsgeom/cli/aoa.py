@@ -97,7 +97,8 @@ def _calibrate(args, stage) -> int:
     out["front_end_angles_deg"] = [float(x) for x in np.degrees(probe.angle_rad)]
     out["gain_correction"] = [float(x) for x in probe.gain_correction]
     out["format"] = "rtsgeom-calibration"  # `run/adc --calibration DIR/calibration.json`
-    out["fractional_delay_filter"] = fir_effect(setup, cal.delta_tau_s)
+    out["fractional_delay_filter"] = fir_effect(setup, cal.delta_tau_s,
+                                                ranges=cal.probe_ranges_m)
 
     def figure():
         from ..viz.figures import calibration_sweep_figure
