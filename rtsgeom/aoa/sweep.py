@@ -232,7 +232,7 @@ def fit_minimum(deltas, error_rad, period_s: float, near_s: float, harmonics: in
 
     ``extra_phase_rad`` (S, P): a phase each step adds to channel J of each probe beyond the
     delay's own ``2 pi delta / period`` and known in advance -- the fractional-delay FIR's
-    phase at the step's setting (``calibration.fir_bin_gain``), which cycles with the
+    phase at the step's setting (``aoa.fir.fir_bin_gain``), which cycles with the
     setting every 1/f_s (+-3.7 deg with 5 taps) and would otherwise bend the periodic shape
     (a 33 ps bias with 5 taps). The shape is then fitted on each probe's phase axis
     ``2 pi (delta - near) / period + extra`` and searched with the extra phase interpolated
