@@ -4,7 +4,8 @@ matters less. Not part of the test suite.
 
 * Every command of issue 17 (``commands``): the simulation phase of ``run`` (``run_scene`` on
   the default scene), one full-chain frame (synthesis + range-Doppler + CFAR + angle),
-  ``calibrate --pair 0 1``, ``adc --format dca1000``, ``design`` (default grid),
+  ``calibrate --pair 0 1``, ``adc --format dca1000``, ``design`` (default grid; also with
+  ``--workers 2``, and its CPU split into model builds and tolerance searches),
   ``nearfield``, ``tolerance`` (1e6 draws x 21 set-points; 1e5 with ``--quick``; also on a
   2-worker Dask LocalCluster), ``info`` and ``--help``. Each: wall time, CPU time (this
   process's ``time.process_time`` in process, the child's user + system time for a
@@ -167,7 +168,8 @@ def _time_inproc(f, repeat: int = 1) -> tuple[dict, object]:
 
 #: issue 17's targets (quiet 2-core machine), seconds
 TARGETS = {"run_simulation": 1.0, "frame": 0.030, "calibrate": 1.0, "adc_dca1000": 2.0,
-           "design_default_grid": 5.0, "nearfield": 2.0, "tolerance": 20.0, "help": 0.5}
+           "design_default_grid": 5.0, "design_default_grid_2_workers": 5.0, "nearfield": 2.0,
+           "tolerance": 20.0, "help": 0.5}
 
 
 def bench_commands(scene_path: Path, quick: bool, repeat: int, workers: int) -> dict:
@@ -210,7 +212,10 @@ def bench_commands(scene_path: Path, quick: bool, repeat: int, workers: int) -> 
     design = ["design", scene_arg, "--json", "--quiet"]
     if quick:  # a 2 x 2 corner of the default 4 x 5 grid
         design += ["--radius-m", "0.5:2:2", "--spacing-deg", "4:20:2"]
-    out["design_default_grid" if not quick else "design_2x2"] = _time_cli(design)
+    name = "design_default_grid" if not quick else "design_2x2"
+    out[name] = _time_cli(design)
+    out[name + "_2_workers"] = _time_cli(design + ["--workers", "2"])
+    out[name + "_parts"] = bench_design_parts(scene, quick)
     out["nearfield"] = _time_cli(["nearfield", scene_arg, "--json", "--quiet"])
     draws = 100_000 if quick else 1_000_000
     tol = ["tolerance", scene_arg, "--pair", "0", "1", "--sigma-radial-mm", "0.1",
@@ -226,6 +231,45 @@ def bench_commands(scene_path: Path, quick: bool, repeat: int, workers: int) -> 
                 v["target_s"] = TARGETS[name]
     out["reference"] = reference
     return out
+
+
+def bench_design_parts(scene, quick: bool) -> dict:
+    """What ``design`` spends its CPU on, design by design as ``evaluate_design`` does it: the
+    pair model (``PairPhasors.build``) and the two tolerance searches
+    (``max_sigma_for_yield``, uncalibrated and calibrated: Monte Carlos of 2000 draws x 21
+    set-points each, counted)."""
+    import math
+    from rtsgeom.analysis.design import two_front_end_scene
+    from rtsgeom.analysis.tolerance import CASES, PairPhasors, max_sigma_for_yield
+    from rtsgeom.geometry import build_setup
+    radii = np.linspace(0.5, 2.0, 2 if quick else 4)
+    spacings = np.linspace(4.0, 20.0, 2 if quick else 5)
+    cpu = {"build_s": 0.0, **{f"tolerance_{c}_s": 0.0 for c in CASES}}
+    evaluations, designs = 0, 0
+    c_all = time.process_time()
+    for sp in spacings:
+        for r in radii:
+            variant, _, problem = two_front_end_scene(scene, (0, 1), float(r), math.radians(sp))
+            if problem is not None:
+                continue
+            setup = build_setup(variant)
+            c0 = time.process_time()
+            try:
+                model = PairPhasors.build(setup, (0, 1), 21)
+            except ValueError:
+                continue
+            cpu["build_s"] += time.process_time() - c0
+            designs += 1
+            for case in CASES:
+                c0 = time.process_time()
+                res = max_sigma_for_yield(model, [1e-4] * 3, 2000, scene.seed, 0.95, 0.1, case,
+                                          rel_tol=0.02)
+                cpu[f"tolerance_{case}_s"] += time.process_time() - c0
+                evaluations += len(res["evaluations"])
+    total = time.process_time() - c_all
+    tol = sum(cpu[f"tolerance_{c}_s"] for c in CASES)
+    return {**cpu, "designs": designs, "total_cpu_s": total, "tolerance_share": tol / total,
+            "monte_carlos": evaluations, "cpu_s_per_monte_carlo": tol / max(evaluations, 1)}
 
 
 def bench_dask_scaling(scene_path: Path, draws: int, workers: int) -> dict:
@@ -271,6 +315,12 @@ def _print_commands(cmds: dict) -> None:
         tgt = f"{v['target_s']:.3g} s" if "target_s" in v else ""
         print(f"  {name:28s} {v['wall_s']:9.3f}s {v['cpu_s']:9.3f}s {v['over_reference']:8.3f} "
               f"{tgt:>8s}")
+    for name, v in cmds.items():
+        if name.endswith("_parts"):
+            print(f"  {name}: {v['designs']} designs, {v['total_cpu_s']:.2f} s CPU: model "
+                  f"builds {v['build_s']:.2f} s, tolerance searches {v['tolerance_share']:.0%} "
+                  f"({v['monte_carlos']} Monte Carlos, {v['cpu_s_per_monte_carlo'] * 1e3:.1f} ms "
+                  "each)")
     d = cmds["tolerance_dask"]
     print(f"  tolerance {d['draws']} draws on a warm LocalCluster: 1 worker "
           f"{d['1_workers']['wall_s']:.2f} s, {d['workers']} workers "

@@ -101,3 +101,14 @@ def test_cli_rejects_bad_grids(arg, capsys):
         main(["design", str(DEFAULT_SCENE), "--radius-m", arg, "--quiet"])
     assert exc.value.code == 2
     assert "--radius-m" in capsys.readouterr().err
+
+
+def test_design_grid_in_processes_is_the_same_grid(scene, grid):
+    """``workers=2`` spreads the designs over two processes: the same designs, in the same
+    order, bit for bit, and the progress still counts every design once, in order."""
+    seen = []
+    par = design_grid(scene, (0, 1), [0.5, 1.0, 2.0], [8.8, 19.0], draws=200, seed=1,
+                      points=11, progress=lambda done, total: seen.append((done, total)),
+                      workers=2)
+    assert json.dumps(par.to_dict()) == json.dumps(grid.to_dict())
+    assert seen == [(k, 6) for k in range(1, 7)]

@@ -31,11 +31,13 @@ from ..radar.processing import nearest_detection
 from ..radar.frame import simulate
 from ..rts import RtsProgram, requested_delay
 from ..scene import TargetConfig
+from .fir import fir_bin_gain, fir_effect, fir_sweep_phase  # noqa: F401 (re-exported)
 from .synthesis import PairModel
 
 __all__ = ["Calibration", "FrontEndProbe", "probe_front_ends", "calibrate_pair", "probe_ranges",
            "if_phase_slope_hz", "air_phase_slope_hz", "coherence_delay", "probe_total_delay",
-           "TARGET_BIAS_PS", "calibrate_pair_paper", "fir_effect"]
+           "TARGET_BIAS_PS", "calibrate_pair_paper", "fir_effect",
+           "fir_bin_gain", "realisable"]
 
 
 @dataclass(frozen=True)
@@ -64,6 +66,10 @@ class Calibration:
     method: str = "phasor"  # what evaluated the sweep: phasor model or full-chain
     probe_ranges_m: tuple = ()  # the probes' set ranges (moved within a bin, sweep.place_probes)
     one_frame_scatter_ps: float = 0.0  # 1-sigma of the chosen delay with one frame per step
+    # the fitted optimum minus delta_tau_s, which is quantised to what the RTS can set
+    # (rts.delay_resolution_s); |residual| <= resolution / 2
+    quantisation_residual_s: float = 0.0
+    delay_resolution_s: float = 0.0  # the RTS's delay step the chosen delay is a multiple of
 
     def to_dict(self) -> dict:
         def pts(t, e):
@@ -81,6 +87,8 @@ class Calibration:
             "method": self.method,
             "probe_ranges_m": list(self.probe_ranges_m),
             "one_frame_scatter_ps": self.one_frame_scatter_ps,
+            "quantisation_residual_s": self.quantisation_residual_s,
+            "delay_resolution_s": self.delay_resolution_s,
             "probe_angles_deg": list(self.probe_angles_deg),
             "sweep": pts(self.sweep_delta_tau_s, self.sweep_error_deg),
             "refinement": pts(self.refine_delta_tau_s, self.refine_error_deg),
@@ -99,7 +107,9 @@ class Calibration:
                    tuple(float(x) for x in d.get("probe_angles_deg", (np.nan, np.nan))),
                    float(d.get("period_s", np.nan)), int(d.get("frames_per_step", 1)),
                    float(d.get("frame_noise_deg", 0.0)), str(d.get("method", "phasor")),
-                   tuple(d.get("probe_ranges_m", ())), float(d.get("one_frame_scatter_ps", 0.0)))
+                   tuple(d.get("probe_ranges_m", ())), float(d.get("one_frame_scatter_ps", 0.0)),
+                   float(d.get("quantisation_residual_s", 0.0)),
+                   float(d.get("delay_resolution_s", 0.0)))
 
 
 def if_phase_slope_hz(scene, tau_s) -> np.ndarray:
@@ -246,12 +256,15 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
        (``aoa.sweep``); the deepest minimum nearest zero delay.
     2. The probes moved within their range bin so that design and detection agree on one bin
        over a window of +-period/4 around it (``sweep.place_probes``).
-    3. Fine sweep over that window (``FINE_STEP_S``) with ``frames`` coherently averaged
+    3. Fine sweep over that window (``FINE_STEP_S`` rounded to whole steps of the RTS's
+       delay resolution ``rts.delay_resolution_s``) with ``frames`` coherently averaged
        frames per step (default: as many as keep the chosen delay's 2-sigma scatter below
        ``TARGET_BIAS_PS``, from a Monte-Carlo of the phasor model); the minimum from a
        least-squares fit of the criterion's periodic shape over the window
        (``sweep.fit_minimum``), so every step's information counts.
-    4. The chosen delay confirmed through the full ADC-cube chain (``residual_error_deg``).
+    4. The fitted optimum rounded to a delay the RTS can set (a whole number of
+       ``rts.delay_resolution_s``; the difference is ``quantisation_residual_s``), confirmed
+       through the full ADC-cube chain (``residual_error_deg``).
 
     Steps 1-3 evaluate the phasor model (``radar.phasors``, batched over all steps); with
     ``full_chain`` every step runs through the ADC-cube chain instead (validation; minutes).
@@ -291,28 +304,38 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
     inner = np.arange(len(errs))
     is_min = (np.r_[True, errs[1:] <= errs[:-1]] & np.r_[errs[:-1] <= errs[1:], True])
     good = inner[is_min & (errs <= 2 * np.min(errs) + 0.01)]
-    near = float(grid[int(good[np.argmin(np.abs(grid[good]))])])
+    res = rts.delay_resolution_s  # every delay the sweep sets and reports is a multiple
+    near = float(realisable(grid[int(good[np.argmin(np.abs(grid[good]))])], res))
+    best_fit = near
     if grid.size < 3:  # no sweep to speak of (e.g. only the period asked for)
-        fine_t, fine_e, best, n_frames, noise = grid, errs, near, k_coarse, 0.0
+        fine_t, fine_e, n_frames, noise = grid, errs, k_coarse, 0.0
     else:
         half = period / 4
         ranges = place_probes(setup, paths, nominal, pair, ranges, alphas,
                               near + np.arange(-half, half + 1e-15, step), base_offsets, corr)
         targets = [TargetConfig(float(r)) for r in ranges]
-        fine_t = near + np.arange(-half, half + 1e-15, FINE_STEP_S)
+        # fine steps the RTS can set: FINE_STEP_S rounded to whole resolution steps (an RTS
+        # whose delay moves in 25 ps cannot take 5 ps steps; the model would round them)
+        fine_step = res * max(1, round(FINE_STEP_S / res))
+        k_half = int(np.floor(half / fine_step + 1e-9))
+        fine_t = near + np.arange(-k_half, k_half + 1) * fine_step
         fine = phasor_sweep(setup, paths, nominal, pair, targets, alphas, fine_t,
                             base_offsets, corr)
         noise = 0.0
         n_frames = 1 if frames is None else int(frames)
+        extra = fir_sweep_phase(setup, ranges, fine_t, base_offsets)
         if noisy and frames is None:  # scatter of the fitted minimum with one frame per step
             draws = fine.errors(1, rng, MC_DRAWS)
-            est = [fit_minimum(fine_t, e, period, near, search_s=half / 2) for e in draws]
+            est = [fit_minimum(fine_t, e, period, near, search_s=half / 2,
+                               extra_phase_rad=extra) for e in draws]
             noise = float(np.std(est))
             n_frames = int(min(MAX_FRAMES, max(1, np.ceil((2 * noise / (TARGET_BIAS_PS
                                                                           * 1e-12)) ** 2))))
         e_fine = measure(targets, fine, n_frames)
-        best = fit_minimum(fine_t, e_fine, period, near, search_s=half / 2)
+        best_fit = fit_minimum(fine_t, e_fine, period, near, search_s=half / 2,
+                               extra_phase_rad=extra)
         fine_e = rms_deg(e_fine)
+    best = float(realisable(best_fit, res))  # what the RTS can set; the fit's optimum is between
     confirm = phasor_sweep(setup, paths, nominal, pair, targets, alphas, [best], base_offsets,
                            corr)
     e_conf = chain_errors(setup, paths, pair, targets, confirm, base_offsets, n_frames, seed)[0]
@@ -323,7 +346,16 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
                        frozen(errs), frozen(np.asarray(fine_t)), frozen(np.asarray(fine_e)),
                        (float(np.degrees(alphas[0])), float(np.degrees(alphas[1]))), period,
                        n_frames, 0.0, "full-chain" if full_chain else "phasor",
-                       tuple(float(r) for r in ranges), noise * 1e12)
+                       tuple(float(r) for r in ranges), noise * 1e12, float(best_fit - best),
+                       float(res))
+
+
+def realisable(delay_s, resolution_s: float):
+    """``delay_s`` rounded to a whole number of the RTS's delay steps ``resolution_s``
+    (``rts.delay_resolution_s``: the fractional-delay FIR's step, or 1/f_s without one).
+    An offset that is a multiple of the step moves every channel's realised delay
+    (``rts.realised_delay``) by exactly that offset when 1/f_s is a multiple of the step."""
+    return np.round(np.asarray(delay_s, float) / resolution_s) * resolution_s
 
 
 FINE_STEP_S = 5e-12  # step of the fitted fine sweep
@@ -387,46 +419,14 @@ def calibrate_pair_paper(setup: Setup, paths: Paths, pair: tuple[int, int],
         if n is not None:
             errs[k] = abs(np.degrees(det.angle_rad[n] - alpha))
     k = int(np.argmin(errs))
-    best = float(grid[k])
+    res = rts.delay_resolution_s
+    best = float(realisable(grid[k], res))  # the grid's steps are multiples unless the
+    # scene's calibration_step_ps is not (validate warns)
     air = _mean_air_delay(setup)
     range_offset = 0.5 * c * ((air[j] + best) - air[i])
     period = 1.0 / float(if_phase_slope_hz(scene, probe_total_delay(setup, [rng])))
     deg = float(np.degrees(alpha))
     return Calibration(pair, best, float(errs[k]), float(range_offset), frozen(grid),
                        frozen(errs), frozen(np.zeros(0)), frozen(np.zeros(0)), (deg, deg), period,
-                       1, 0.0)
-
-
-def fir_effect(setup: Setup, delta_tau_s: float, base_offsets=(0.0, 0.0)) -> dict:
-    """The fractional-delay FIR at the settings the calibration's two probe targets program
-    on channels I (delay ``base``) and J (``base + delta_tau_s``): its gain and phase ripple
-    along the chirp's IF sweep (``rts.fir_if_gain``) and the shift of the coherence point it
-    predicts, the mean over the probes of ``(phi_I - phi_J) / (2 pi f_if)``, phi the
-    range-window-weighted phase of each channel's beat-signal gain (what the range DFT sees
-    at the target's bin), f_if = 1 / period."""
-    from ..radar.processing import window
-    from ..rts import fir_if_gain
-    scene = setup.scene
-    model = scene.rts.fractional_delay_filter if scene.rts.fractional_delay else "none"
-    rng = probe_ranges(setup, 2)
-    base = requested_delay(scene, rng)  # (2,) one per probe
-    delays = np.concatenate([base + base_offsets[0], base + base_offsets[1] + delta_tau_s])
-    tau = np.concatenate([requested_delay(scene, rng)] * 2) + np.mean(_mean_air_delay(setup))
-    g = fir_if_gain(scene, delays, tau)  # (4, N): I of both probes, then J of both
-    if g is None:
-        return {"model": model, "gain_ripple_db": 0.0, "phase_ripple_deg": 0.0,
-                "predicted_shift_ps": 0.0}
-    radar = scene.radar
-    n_s = radar.samples_per_chirp
-    t_n = radar.adc_start_s + np.arange(n_s) / radar.adc_rate_hz
-    beat = radar.slope_hz_per_s * tau  # (4,)
-    r0 = np.round(beat * n_s / radar.adc_rate_hz)  # the target's range bin
-    kern = window(radar.range_window, n_s) * np.exp(
-        2j * np.pi * (beat[:, None] * t_n - r0[:, None] * np.arange(n_s) / n_s))
-    phi = np.angle(np.sum(kern * g, 1) / np.sum(kern, 1)).reshape(2, 2)  # [channel, probe]
-    period = 1.0 / float(if_phase_slope_hz(scene, probe_total_delay(setup, rng)))
-    shift = float(np.angle(np.mean(np.exp(1j * (phi[0] - phi[1])))) / (2 * np.pi) * period)
-    return {"model": model,
-            "gain_ripple_db": float(np.ptp(20 * np.log10(np.abs(g)))),
-            "phase_ripple_deg": float(np.ptp(np.degrees(np.angle(g)))),
-            "predicted_shift_ps": shift * 1e12}
+                       1, 0.0, quantisation_residual_s=float(grid[k] - best),
+                       delay_resolution_s=float(res))

@@ -107,11 +107,22 @@ def pair_design(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: st
     nom, nom_paths = nominal_model(setup, paths)
     period = period_s or 1.0 / float(if_phase_slope_hz(scene, 2 * target.range_m / c))
     best = None
+    fir = scene.rts.fractional_delay and scene.rts.fractional_delay_filter != "ideal"
     for m in (0, -1, 1):
         off = (offsets[0], offsets[1] + m * period)
         # candidate bins +-3: a period moves J's echo by about a bin
         model = PairModel(ChannelModel.build(nom, nom_paths, pair, target, off, HALF_BINS))
         phase = model.coherent_phase(probes_rad)
+        if m == 0:
+            phase0 = phase
+        for _ in range(2 if m and fir else 0):
+            # the fractional-delay FIR's response cycles with its setting every 1/f_s: a
+            # period later J's phase at the bin is not the calibrated one (up to 4 deg with 5
+            # taps, 0.003 deg of angle); Newton on the modelled phase back to it
+            miss = np.angle(np.exp(1j * (phase - phase0)))
+            off = (off[0], off[1] + miss / (2 * np.pi) * period)
+            model = PairModel(ChannelModel.build(nom, nom_paths, pair, target, off, HALF_BINS))
+            phase = model.coherent_phase(probes_rad)
         rho, ok, margin = model.model.solve_checked(target.angle_rad, (0.0, phase))
         if rho is None:
             continue

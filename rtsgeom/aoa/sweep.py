@@ -241,7 +241,7 @@ def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair,
 
 
 def fit_minimum(deltas, error_rad, period_s: float, near_s: float, harmonics: int = 2,
-                search_s: float | None = None) -> float:
+                search_s: float | None = None, extra_phase_rad=None) -> float:
     """The delay where the probes' fitted signed angle errors are jointly smallest, from a
     least-squares fit of the criterion's known periodic shape over one period of steps
     centred at ``near_s`` (the sweep's coarse minimum).
@@ -252,24 +252,42 @@ def fit_minimum(deltas, error_rad, period_s: float, near_s: float, harmonics: in
     period, so receiver noise enters the chosen delay linearly through the fit, not through
     one step's quadratically flat neighbourhood (what makes the step-minimum need ~2e4
     frames per step). The minimum of sum_p e_p^2 on the fitted curves within one sweep step
-    of ``near_s`` (0.05 ps grid; ``search_s``: that half-width instead)."""
+    of ``near_s`` (0.05 ps grid; ``search_s``: that half-width instead).
+
+    ``extra_phase_rad`` (S, P): a phase each step adds to channel J of each probe beyond the
+    delay's own ``2 pi delta / period`` and known in advance -- the fractional-delay FIR's
+    phase at the step's setting (``aoa.fir.fir_bin_gain``), which cycles with the
+    setting every 1/f_s (+-3.7 deg with 5 taps) and would otherwise bend the periodic shape
+    (a 33 ps bias with 5 taps). The shape is then fitted on each probe's phase axis
+    ``2 pi (delta - near) / period + extra`` and searched with the extra phase interpolated
+    between the steps."""
     d = np.asarray(deltas, float)
     e = np.asarray(error_rad, float)
     sel = (np.abs(d - near_s) <= period_s / 2) & np.all(np.isfinite(e), axis=1)
     th = 2 * np.pi * (d[sel] - near_s) / period_s
     h = np.arange(1, harmonics + 1)
-    design = np.concatenate([np.ones((th.size, 1)), np.cos(np.outer(th, h)),
-                             np.sin(np.outer(th, h))], axis=1)
-    if th.size < design.shape[1] + 2:
+
+    def basis(theta):
+        return np.concatenate([np.ones((theta.size, 1)), np.cos(np.outer(theta, h)),
+                               np.sin(np.outer(theta, h))], axis=1)
+    if th.size < 2 * harmonics + 3:
         return float(near_s)
-    coef, *_ = np.linalg.lstsq(design, e[sel], rcond=None)  # (1 + 2H, P)
     step = np.median(np.diff(np.sort(d))) if d.size > 1 else period_s / 40
     half = 1.5 * step if search_s is None else search_s
     fine = near_s + np.arange(-half, half + 1e-15, 0.05e-12)
     tf = 2 * np.pi * (fine - near_s) / period_s
-    basis = np.concatenate([np.ones((tf.size, 1)), np.cos(np.outer(tf, h)),
-                            np.sin(np.outer(tf, h))], axis=1)
-    crit = np.sum((basis @ coef) ** 2, axis=1)
+    if extra_phase_rad is None:
+        coef, *_ = np.linalg.lstsq(basis(th), e[sel], rcond=None)  # (1 + 2H, P)
+        crit = np.sum((basis(tf) @ coef) ** 2, axis=1)
+        return float(fine[np.argmin(crit)])
+    extra = np.asarray(extra_phase_rad, float).reshape(d.size, -1)
+    order = np.argsort(d[sel])
+    crit = np.zeros(fine.size)
+    for p in range(e.shape[1]):  # each probe on its own phase axis
+        x = extra[sel, p]
+        coef, *_ = np.linalg.lstsq(basis(th + x), e[sel, p], rcond=None)
+        x_f = np.interp(fine, d[sel][order], x[order])  # smooth in the setting: 5 ps steps
+        crit += (basis(tf + x_f) @ coef) ** 2
     return float(fine[np.argmin(crit)])
 
 

@@ -99,7 +99,8 @@ def _calibrate(args, stage) -> int:
     out["front_end_angles_deg"] = [float(x) for x in np.degrees(probe.angle_rad)]
     out["gain_correction"] = [float(x) for x in probe.gain_correction]
     out["format"] = "rtsgeom-calibration"  # `run/adc --calibration DIR/calibration.json`
-    out["fractional_delay_filter"] = fir_effect(setup, cal.delta_tau_s)
+    out["fractional_delay_filter"] = fir_effect(setup, cal.delta_tau_s,
+                                                ranges=cal.probe_ranges_m)
 
     def figure():
         from ..viz.figures import calibration_sweep_figure
@@ -109,7 +110,9 @@ def _calibrate(args, stage) -> int:
                                         refine_delta_tau_s=cal.refine_delta_tau_s,
                                         refine_error_deg=cal.refine_error_deg)
     _emit(args, stage, "calibration_sweep.png", "calibration", out, figure,
-          f"pair {pair}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps, residual angle error "
+          f"pair {pair}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps (set in "
+          f"{cal.delay_resolution_s * 1e12:g} ps steps; the fit's optimum "
+          f"{cal.quantisation_residual_s * 1e12:+.2f} ps from it), residual angle error "
           f"{cal.residual_error_deg:.4f} deg, range offset {cal.range_offset_m * 1e3:.2f} mm "
           f"(period {cal.period_s * 1e9:.4f} ns); fractional-delay filter "
           f"{out['fractional_delay_filter']['model']}: phase ripple over the IF sweep "

@@ -178,7 +178,8 @@ def _design(args, scene, stage) -> int:
         grid = design_grid(scene, pair, args.radius_m, args.spacing_deg, args.spec_deg,
                            args.yield_, args.draws, seed, args.points,
                            None if progress is None else
-                           (lambda done, total: progress("designs", done, total)))
+                           (lambda done, total: progress("designs", done, total)),
+                           workers=args.workers or 1)
     out = grid.to_dict()
     if stage is not None:
         from ..viz.figures import design_heatmap_figure, design_lines_figure, save_figure
@@ -317,6 +318,8 @@ def register(sub) -> None:
     p.add_argument("--yield", dest="yield_", type=number(1e-6, 1.0), default=0.95, metavar="Y",
                    help="fraction of setups within the spec for the tolerance, in (0, 1] "
                         "(default 0.95)")
+    p.add_argument("--workers", type=number(1, 1024, integer=True), default=None,
+                   help="evaluate the grid's designs in N processes (same result; default 1)")
     # "--coverage-deg -10:10": argparse takes a word starting with "-" for an option unless it
     # looks like a negative number; teach this parser that A:B ranges are numbers too.
     import re
