@@ -106,6 +106,9 @@ def _tolerance(args, scene, stage) -> int:
     from .arc import save_pair_npz, scales, tolerance_arc, wants_arc
     sigma, extra = scales(args)
     if wants_arc(args):
+        if args.verify:
+            raise UsageError("--verify: only for one pair with offsets (not --pair all, "
+                             "rotations or RuT-pose errors)")
         return tolerance_arc(args, scene, sigma, extra, stage)
     model = _model(scene, args.pair, args.points)
     chunk = capped_chunk(args.chunk, len(model.set_rad))
@@ -117,6 +120,10 @@ def _tolerance(args, scene, stage) -> int:
         res = monte_carlo(model, sigma, args.draws, seed, args.distribution, args.spec_deg,
                           cases, chunk, progress, "Monte Carlo", mapper)
         out = res.to_dict()
+        if args.verify:
+            from ..analysis.tolerance_verify import verify_draws
+            out["verify"] = verify_draws(model, sigma, min(args.verify, args.draws), seed,
+                                         args.distribution, cases, progress=progress).to_dict()
         if args.invert_yield is not None:
             out["inversion"] = {
                 case: max_sigma_for_yield(model, sigma, args.draws, seed, args.invert_yield,
@@ -148,6 +155,10 @@ def _tolerance(args, scene, stage) -> int:
         print(f"  {case:>30}: |error| p50 {p['p50']:.4f}, p95 {p['p95']:.4f}, p99 "
               f"{p['p99']:.4f}, max {p['max']:.4f} deg; yield {100 * st['yield']:.2f} % within "
               f"{args.spec_deg:g} deg")
+    if "verify" in out:
+        v = out["verify"]
+        print(f"  verify: {v['draws']} draws through the ADC-cube chain, largest |chain - model| "
+              f"{v['max_abs_difference_deg']:.2e} deg (at each draw's worst set-point)")
     cal = out["calibration"]
     print(f"  calibration |delta tau| p95 {cal['abs_delta_tau_ps']['p95']:.0f} ps, range offset "
           f"p95 {cal['abs_range_offset_mm']['p95']:.1f} mm")
@@ -292,6 +303,10 @@ def register(sub) -> None:
     p.add_argument("--nominal-amplitudes", action="store_true",
                    help=f"add the case '{NOMINAL_AMPLITUDES}': calibrated, but the amplitudes "
                         "not designed for the calibration delay's range offset")
+    p.add_argument("--verify", type=number(0, 10_000, integer=True), default=0, metavar="N",
+                   help="push the first N draws (same seed) through the full ADC-cube chain "
+                        "(synthesis, range-Doppler, CFAR, angle) and report the largest "
+                        "difference from the fast model, in [0, 10000] (default 0)")
     p.add_argument("--chunk", type=number(100, 1_000_000, integer=True), default=10_000,
                    help="draws per chunk (memory), in [100, 1000000] (default 10000); capped "
                         f"so that one chunk needs at most {CHUNK_MEMORY_BYTES >> 20} MiB "
