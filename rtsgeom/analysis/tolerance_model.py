@@ -64,7 +64,7 @@ from ..scene import TargetConfig
 
 __all__ = ["PairPhasors", "HALF_BINS", "PROBE_FRACTIONS", "response_table"]
 
-HALF_BINS = 2  # candidate bins either side of the set range's: target +-1/2, J +-1/2 more
+HALF_BINS = 2  # candidate bins either side of the set range's (default scene; see build)
 PROBE_FRACTIONS = (0.25, 0.75)  # calibrate_pair's probe angles across the span
 _TABLE_BYTES = 64 * 2 ** 20  # peak of one block of bin_response's fast-time tones
 
@@ -110,6 +110,7 @@ class _Design:
     p_one: np.ndarray
     probe_beams: np.ndarray  # (2, D, P) beam responses at the probes, the set range's bin
     unit_gain: float
+    reach: int  # design bins either side of the set range's (the table has one more)
 
     def phase(self, row_i, row_j) -> np.ndarray:
         """J's phase the calibration establishes, (n,), as the operator's nominal model sees it
@@ -123,13 +124,17 @@ class _Design:
         """Programme amplitudes (n, M, 2), the design bin (n, M) and whether design and
         detection agree (n, M) for channel I at table row ``row_i`` (n,), J at ``row_j`` (n,),
         sub-bin position index ``sub`` (n,)."""
+        n_k = self.beams.shape[-1]
+        kd = slice(n_k // 2 - self.reach, n_k // 2 + self.reach + 1)  # where J's echo can be
         b_i = self.beams[0][:, row_i]  # (3, n, M, K)
         b_j = self.beams[1][:, row_j]
         phase = self.phase(row_i, row_j)[:, None, None]  # (n, 1, 1)
-        rho = ratio_from_beams(tuple(b_i), tuple(b_j), phase)  # (n, M, K)
+        rho = np.full(b_i.shape[1:], np.nan)  # (n, M, K): no design in the outermost bins
+        rho[..., kd] = ratio_from_beams(tuple(b_i[..., kd]), tuple(b_j[..., kd]), phase)
         c_ij = np.sum(np.conj(table[0, row_i]) * table[1, row_j], -1)[:, None]  # (n, 1, K)
         rho, k, ok, _ = detected_bin_choice(rho, phase, self.power[0, row_i][:, None],
-                                            self.power[1, row_j][:, None], c_ij)
+                                            self.power[1, row_j][:, None], c_ij,
+                                            margin=False)
         pick = k[None, ..., None]
         bi = np.take_along_axis(b_i[0], pick[0], -1)[..., 0]
         bj = np.take_along_axis(b_j[0], pick[0], -1)[..., 0]
@@ -196,7 +201,19 @@ class PairPhasors:
         sub = np.arange(n_bin) - n_bin // 2
         half = n_bin // 2 + max_steps + 2
         d = np.arange(-half, half + 1)
-        table = np.stack([response_table(nom, paths, q, target, res, d) for q in pair])
+        # J's echo lies at most (n_bin // 2 + max_steps) / n_bin bins from the set range's
+        # (sub-bin position plus the calibration delay): its nearest bin, `reach`, bounds
+        # where the combined peak (between the echoes) is detected; the designs there, the
+        # detection compared one bin further
+        reach = max(1, int(np.floor((n_bin // 2 + max_steps) / n_bin + 0.5)))
+        nb = reach + 1
+        t_j = response_table(nom, paths, pair[1], target, res, d, nb)
+        # I only ever sits at the sub-bin positions (+-1 row for the slope): the rows beyond
+        # are never read (edge copies keep the array rectangular)
+        near = np.clip(d, -(n_bin // 2) - 1, n_bin // 2 + 1)
+        lo = int(near.min())
+        t_i = response_table(nom, paths, pair[0], target, res, np.arange(lo, -lo + 1), nb)
+        table = np.stack([t_i[near - lo], t_j])
         with np.errstate(divide="ignore"):
             log_slope = np.gradient(np.log(np.abs(table)), res, axis=1)
         z = half
@@ -214,9 +231,9 @@ class PairPhasors:
         u_one, _ = st.peak(one, st.directions(np.full(sub.size, th[0])))
         b_one, _, _ = _beam_derivatives(st, one, u_one[:, 0])
         p_one = np.abs(b_one) ** 2  # (U,)
-        probe_beams = st.beam(table[:, :, HALF_BINS], st.directions(probes))  # (2, D, P)
+        probe_beams = st.beam(table[:, :, nb], st.directions(probes))  # (2, D, P)
         design = _Design(frozen(beams), frozen(power), frozen(p_one), frozen(probe_beams),
-                         model.unit_gain)
+                         model.unit_gain, reach)
         amps, kbin, ok = design(table, z + sub, z + sub, np.arange(sub.size))
         c0 = int(np.flatnonzero(sub == 0)[0])
         # no closed-form design at the bin centre (spacings beyond the beam's resolution):
@@ -226,7 +243,7 @@ class PairPhasors:
             phases = model.coherent_phases(probes)
             amps[c0, m] = model.amplitudes(model.solve(float(sets[m]), phases), float(sets[m]))
         ks = slice(z - max_steps, z + max_steps + 1)
-        centre = HALF_BINS
+        centre = nb
         factor = table[1, ks, centre] / table[1, z, centre]
         return cls(model, frozen(th), frozen(sets), frozen(probes), frozen(amps[c0]),
                    frozen(factor), frozen(log_slope[1, ks, centre]), slope, res,
@@ -362,7 +379,7 @@ class PairPhasors:
                                     return_converged=True)
             out[case] = ang - self.set_rad
             detail["converged"][case] = ok
-            detail["bin"][case] = det - HALF_BINS
+            detail["bin"][case] = det - self.table.shape[2] // 2
             detail["amplitudes"][case] = np.stack([a_i, a_j], -1)
         return (out, detail) if return_detail else out
 

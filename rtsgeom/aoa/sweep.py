@@ -119,17 +119,22 @@ def design_at_detected_bin(st: Steering, h, alpha_rad, phase=0.0):
     return detected_bin_choice(rho, ph, p_ii, p_jj, c_ij)
 
 
-def detected_bin_choice(rho, phase, p_ii, p_jj, c_ij):
+def detected_bin_choice(rho, phase, p_ii, p_jj, c_ij, margin: bool = True):
     """The bin logic of :func:`design_at_detected_bin` from the ratios per design bin ``rho``
     (..., K), J's phase (broadcast) and the channels' power sums over the virtual elements at
-    each candidate bin: ``p_ii``, ``p_jj`` (..., K) and ``c_ij = sum conj(x_i) x_j``."""
-    ph = np.asarray(phase, float)
-    # power of each design (..., K_design) at every bin (K_bins)
-    w = rho * np.exp(1j * np.broadcast_to(ph, rho.shape))  # (..., K_design)
-    power = (p_ii[..., None, :] + np.abs(w[..., :, None]) ** 2 * p_jj[..., None, :]
-             + 2 * np.real(w[..., :, None] * c_ij[..., None, :]))
+    each candidate bin: ``p_ii``, ``p_jj`` (..., K) and ``c_ij = sum conj(x_i) x_j``.
+    ``margin=False``: the fourth result is None (saves a sort in Monte-Carlo loops)."""
+    ph = np.broadcast_to(np.asarray(phase, float), rho.shape)
     finite = np.isfinite(rho) & (rho > 0)
-    det = np.argmax(np.where(np.isfinite(power), power, -1.0), -1)  # (..., K_design)
+    r = np.where(finite, rho, 0.0)
+    # power of each design (..., K_design) at every bin (K_bins), in real arithmetic:
+    # |I + r e^{j ph} J|^2 = p_ii + r^2 p_jj + 2 r Re(e^{j ph} c_ij)
+    q = (np.cos(ph)[..., :, None] * c_ij.real[..., None, :]
+         - np.sin(ph)[..., :, None] * c_ij.imag[..., None, :])
+    power = (p_ii[..., None, :] + (r * r)[..., :, None] * p_jj[..., None, :]
+             + 2 * r[..., :, None] * q)
+    # a design that does not exist detects nothing (its row never agrees)
+    det = np.where(finite, np.argmax(power, -1), 0)  # (..., K_design)
     n_k = rho.shape[-1]
     ks = np.arange(n_k)
     agree = finite & (det == ks)
@@ -137,14 +142,18 @@ def detected_bin_choice(rho, phase, p_ii, p_jj, c_ij):
     rank = np.abs(ks - n_k // 2) * 2 + (ks > n_k // 2)
     best = np.argmin(np.where(agree, rank, n_k * 4), -1)
     consistent = np.take_along_axis(agree, best[..., None], -1)[..., 0]
-    k = np.broadcast_to(det[..., n_k // 2], consistent.shape).copy()
-    for _ in range(4):  # none agrees: redesign at the reported bin
-        k = np.take_along_axis(det, k[..., None], -1)[..., 0]
-    k = np.where(consistent, best, k)
-    pw = np.sort(np.take_along_axis(power, k[..., None, None], -2)[..., 0, :], -1)
-    margin = np.where(consistent, pw[..., -1] / np.maximum(pw[..., -2], 1e-300), 1.0)
+    k = best
+    if not np.all(consistent):  # none agrees: redesign at the reported bin
+        k0 = np.broadcast_to(det[..., n_k // 2], consistent.shape).copy()
+        for _ in range(4):
+            k0 = np.take_along_axis(det, k0[..., None], -1)[..., 0]
+        k = np.where(consistent, best, k0)
     out = np.take_along_axis(rho, k[..., None], -1)[..., 0]
-    return out, k, consistent, margin
+    if not margin:
+        return out, k, consistent, None
+    pw = np.sort(np.take_along_axis(power, k[..., None, None], -2)[..., 0, :], -1)
+    mg = np.where(consistent, pw[..., -1] / np.maximum(pw[..., -2], 1e-300), 1.0)
+    return out, k, consistent, mg
 
 
 @dataclass(frozen=True)
