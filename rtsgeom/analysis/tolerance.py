@@ -252,7 +252,8 @@ def max_sigma_for_yield(model: PairPhasors, sigma_m, draws: int, seed: int, targ
                         spec_deg: float = 0.1, case: str = "calibrated", axis: str = "all",
                         distribution: str = "normal", rel_tol: float = 0.01,
                         cap_m: float = 0.01, chunk: int = DEFAULT_CHUNK,
-                        progress: Progress | None = None, mapper: Mapper | None = None) -> dict:
+                        progress: Progress | None = None, mapper: Mapper | None = None,
+                        subbin: bool = True) -> dict:
     """The largest mounting tolerance that keeps ``target_yield`` of the setups within
     ``spec_deg`` for ``case``, by bisection on the scale with the same seed (the same unit
     draws scaled: common random numbers, so the yield curve is smooth and, up to the rare
@@ -275,7 +276,8 @@ def max_sigma_for_yield(model: PairPhasors, sigma_m, draws: int, seed: int, targ
 
     def yield_at(t: float) -> float:
         res = monte_carlo(model, fixed + t * direction, draws, seed, distribution, spec_deg,
-                          (case,), chunk, progress, f"{case}: sigma {t * 1e3:.4g} mm", mapper)
+                          (case,), chunk, progress, f"{case}: sigma {t * 1e3:.4g} mm", mapper,
+                          subbin)
         y = res.yield_(case)
         history.append({"scale_mm": t * 1e3, "yield": y})
         return y

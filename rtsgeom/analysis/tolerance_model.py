@@ -51,7 +51,7 @@ import numpy as np
 from scipy.constants import c
 
 from .._util import frozen
-from ..aoa.calibration import probe_ranges
+from ..aoa.calibration import if_phase_slope_hz, probe_ranges
 from ..aoa.model import ChannelModel
 from ..aoa.sweep import _beam_derivatives, detected_bin_choice, ratio_from_beams
 from ..geometry import Setup
@@ -120,27 +120,58 @@ class _Design:
         mag = np.abs(z)
         return np.angle(np.sum(z / np.where(mag > 0, mag, 1.0), axis=-1))
 
-    def __call__(self, table, row_i, row_j, sub):
-        """Programme amplitudes (n, M, 2), the design bin (n, M) and whether design and
-        detection agree (n, M) for channel I at table row ``row_i`` (n,), J at ``row_j`` (n,),
-        sub-bin position index ``sub`` (n,)."""
+    def __call__(self, table, row_i, row_j, sub, reach: int | None = None):
+        """Programme amplitudes (n, M, 2), the design bin (n, M), whether design and
+        detection agree (n, M) and the detected bin's power over the next strongest (n, M)
+        for channel I at table row ``row_i`` (n,), J at ``row_j`` (n,), sub-bin position index
+        ``sub`` (n,); designs in the ``reach`` bins either side of the set range's (default
+        :attr:`reach`)."""
         n_k = self.beams.shape[-1]
-        kd = slice(n_k // 2 - self.reach, n_k // 2 + self.reach + 1)  # where J's echo can be
+        r = self.reach if reach is None else reach
+        kd = slice(n_k // 2 - r, n_k // 2 + r + 1)  # where J's echo can be
         b_i = self.beams[0][:, row_i]  # (3, n, M, K)
         b_j = self.beams[1][:, row_j]
         phase = self.phase(row_i, row_j)[:, None, None]  # (n, 1, 1)
         rho = np.full(b_i.shape[1:], np.nan)  # (n, M, K): no design in the outermost bins
         rho[..., kd] = ratio_from_beams(tuple(b_i[..., kd]), tuple(b_j[..., kd]), phase)
         c_ij = np.sum(np.conj(table[0, row_i]) * table[1, row_j], -1)[:, None]  # (n, 1, K)
-        rho, k, ok, _ = detected_bin_choice(rho, phase, self.power[0, row_i][:, None],
-                                            self.power[1, row_j][:, None], c_ij,
-                                            margin=False)
+        rho, k, ok, margin = detected_bin_choice(rho, phase, self.power[0, row_i][:, None],
+                                                 self.power[1, row_j][:, None], c_ij)
         pick = k[None, ..., None]
         bi = np.take_along_axis(b_i[0], pick[0], -1)[..., 0]
         bj = np.take_along_axis(b_j[0], pick[0], -1)[..., 0]
         p_sum = np.abs(bi + rho * np.exp(1j * phase[..., 0]) * bj) ** 2  # (n, M)
         scale = self.unit_gain * np.sqrt(self.p_one[sub][:, None] / np.maximum(p_sum, 1e-300))
-        return np.stack([scale, scale * rho], -1), k, ok
+        return np.stack([scale, scale * rho], -1), k, ok, margin
+
+    def planned(self, table, row_i, row_j, sub, period_steps: int, reach_far: int):
+        """``aoa.plan.pair_design``'s choice of J's delay, per set-point: the calibrated one
+        (row ``row_j``) or one period of the IF phase either side (m = 0, -1, 1: the same
+        phase, J's echo about a bin further), the first whose design the RuT detects at the
+        bin it was designed for with a power margin above ``plan.MIN_BIN_MARGIN``, else the
+        best (consistent, margin, smallest |m|). Returns amplitudes (n, M, 2) and m (n, M)."""
+        from ..aoa.plan import MIN_BIN_MARGIN
+        amps, _, ok, mg = self(table, row_i, row_j, sub)
+        m_best = np.zeros(ok.shape, int)
+        s_ok, s_mg = ok.copy(), np.where(ok, mg, 0.0)
+        done = ok & (mg > MIN_BIN_MARGIN)
+        rows = np.flatnonzero(~done.all(-1))
+        for m in (-1, 1):
+            if rows.size == 0:
+                break
+            a2, _, ok2, mg2 = self(table, row_i[rows], row_j[rows] + m * period_steps,
+                                   sub[rows], reach_far)
+            mg2 = np.where(ok2, mg2, 0.0)
+            # score (ok, margin if ok, -|m|) against the best so far; m = 0 ranks first on a tie
+            better = ~done[rows] & ((ok2 > s_ok[rows]) | ((ok2 == s_ok[rows]) & (mg2 > s_mg[rows])))
+            idx = np.nonzero(better)
+            r_abs = rows[idx[0]]
+            amps[r_abs, idx[1]] = a2[idx]
+            m_best[r_abs, idx[1]] = m
+            s_ok[r_abs, idx[1]], s_mg[r_abs, idx[1]] = ok2[idx], mg2[idx]
+            done[rows] |= ok2 & (mg2 > MIN_BIN_MARGIN)
+            rows = rows[~done[rows].all(-1)]
+        return amps, m_best
 
 
 @dataclass(frozen=True)
@@ -171,6 +202,8 @@ class PairPhasors:
     design_bin: np.ndarray  # (U, M) index into K
     design_consistent: np.ndarray  # (U, M) design and detection agree on the bin
     design: "_Design"  # the exact design for any (sub-bin, J delay) row pair
+    period_steps: int = 0  # J's IF phase period in delay steps (plan's alternative delays)
+    reach_far: int = 1  # bins J's echo can reach with a period's shift
 
     @classmethod
     def build(cls, setup: Setup, pair: tuple[int, int], points: int = 21,
@@ -199,14 +232,18 @@ class PairPhasors:
         max_steps = int(np.ceil(0.5 / (slope * res))) + 4
         n_bin = max(1, int(round(2 * bin_m / c / res)))  # delay steps per range bin
         sub = np.arange(n_bin) - n_bin // 2
-        half = n_bin // 2 + max_steps + 2
+        # the exact period of J's IF phase at the target (eq. 27 refined), as aoa.plan uses it
+        period = 1.0 / float(if_phase_slope_hz(nom.scene, 2 * target.range_m / c))
+        p_steps = int(round(period / res))
+        half = n_bin // 2 + max_steps + p_steps + 2
         d = np.arange(-half, half + 1)
-        # J's echo lies at most (n_bin // 2 + max_steps) / n_bin bins from the set range's
-        # (sub-bin position plus the calibration delay): its nearest bin, `reach`, bounds
-        # where the combined peak (between the echoes) is detected; the designs there, the
-        # detection compared one bin further
+        # J's echo lies at most (n_bin // 2 + max_steps [+ a period]) / n_bin bins from the set
+        # range's (sub-bin position plus the calibration delay [plus plan's period shift]):
+        # its nearest bin, `reach`, bounds where the combined peak (between the echoes) is
+        # detected; the designs there, the detection compared one bin further
         reach = max(1, int(np.floor((n_bin // 2 + max_steps) / n_bin + 0.5)))
-        nb = reach + 1
+        reach_far = max(1, int(np.floor((n_bin // 2 + max_steps + p_steps) / n_bin + 0.5)))
+        nb = reach_far + 1
         t_j = response_table(nom, paths, pair[1], target, res, d, nb)
         # I only ever sits at the sub-bin positions (+-1 row for the slope): the rows beyond
         # are never read (edge copies keep the array rectangular)
@@ -234,7 +271,7 @@ class PairPhasors:
         probe_beams = st.beam(table[:, :, nb], st.directions(probes))  # (2, D, P)
         design = _Design(frozen(beams), frozen(power), frozen(p_one), frozen(probe_beams),
                          model.unit_gain, reach)
-        amps, kbin, ok = design(table, z + sub, z + sub, np.arange(sub.size))
+        amps, kbin, ok, _ = design(table, z + sub, z + sub, np.arange(sub.size))
         c0 = int(np.flatnonzero(sub == 0)[0])
         # no closed-form design at the bin centre (spacings beyond the beam's resolution):
         # ChannelModel.solve's root finder on the searched peak, AngleUnreachable where even
@@ -248,7 +285,7 @@ class PairPhasors:
         return cls(model, frozen(th), frozen(sets), frozen(probes), frozen(amps[c0]),
                    frozen(factor), frozen(log_slope[1, ks, centre]), slope, res,
                    frozen(table), frozen(log_slope), z, frozen(sub), frozen(amps),
-                   frozen(kbin), frozen(ok), design)
+                   frozen(kbin), frozen(ok), design, p_steps, reach_far)
 
     setup = property(lambda self: self.channels.setup)  # nominal
     pair = property(lambda self: self.channels.channels)
@@ -356,31 +393,38 @@ class PairPhasors:
         x_i = spectrum(0, z + d_u)
         p_ii = np.sum(x_i.real ** 2 + x_i.imag ** 2, -1)  # (n, K)
         amps0 = self.design_amplitudes[u]  # (n, M, 2)
-        out, detail = {}, {"steps": steps, "converged": {}, "bin": {}, "amplitudes": {}}
+        out, detail = {}, {"steps": steps, "converged": {}, "bin": {}, "amplitudes": {},
+                           "j_steps": {}}
         for case in cases:
             cal = case != "uncalibrated"
             j = z + d_u + (steps if cal else 0)
-            x_j = spectrum(1, j)
+            m = np.zeros((n, self.set_rad.size), int)
             if case == "calibrated":  # designed for the known delay, for the RuT's bin
-                amps, _, _ = self.design(self.table, z + d_u, j, u)
+                amps, m = self.design.planned(self.table, z + d_u, j, u, self.period_steps,
+                                              self.reach_far)
                 a_i, a_j = amps[..., 0], amps[..., 1]
             else:
                 a_i, a_j = amps0[..., 0], amps0[..., 1]
             if cal:
                 a_i, a_j = a_i * g[:, 0, None], a_j * g[:, 1, None]
-            p_jj = np.sum(x_j.real ** 2 + x_j.imag ** 2, -1)
-            c_ij = np.sum(np.conj(x_i) * x_j, -1)  # (n, K)
-            power = (a_i[..., None] ** 2 * p_ii[:, None] + a_j[..., None] ** 2 * p_jj[:, None]
-                     + 2 * a_i[..., None] * a_j[..., None] * c_ij.real[:, None])  # (n, M, K)
+            shifts = (0, -1, 1) if np.any(m) else (0,)  # J's alternative delays (plan)
+            x_j = np.stack([spectrum(1, j + s_ * self.period_steps) for s_ in shifts])
+            p_jj = np.sum(x_j.real ** 2 + x_j.imag ** 2, -1)  # (S, n, K)
+            c_ij = np.sum(np.conj(x_i)[None] * x_j, -1).real
+            sel = np.where(m == -1, 1, np.where(m == 1, 2, 0))  # (n, M) index into shifts
+            p_jj, c_ij = p_jj[sel, ar[:, None]], c_ij[sel, ar[:, None]]  # (n, M, K)
+            power = (a_i[..., None] ** 2 * p_ii[:, None] + a_j[..., None] ** 2 * p_jj
+                     + 2 * a_i[..., None] * a_j[..., None] * c_ij)  # (n, M, K)
             det = np.argmax(power, -1)  # (n, M): the RuT's bin
             snaps = (a_i[..., None] * x_i[ar[:, None], det]
-                     + a_j[..., None] * x_j[ar[:, None], det])  # (n, M, V)
+                     + a_j[..., None] * x_j[sel, ar[:, None], det])  # (n, M, V)
             ang, ok = refine_angles(snaps, self.channels.steering, None, self.set_rad,
                                     return_converged=True)
             out[case] = ang - self.set_rad
             detail["converged"][case] = ok
             detail["bin"][case] = det - self.table.shape[2] // 2
             detail["amplitudes"][case] = np.stack([a_i, a_j], -1)
+            detail["j_steps"][case] = (j - z - d_u)[:, None] + m * self.period_steps
         return (out, detail) if return_detail else out
 
     def angle_errors(self, offsets_m, case: str = "calibrated", return_converged: bool = False,

@@ -90,7 +90,7 @@ def verify_draws(model: PairPhasors, sigma_m, n: int, seed: int, distribution: s
             m = int(np.argmax(np.abs(e)))
             index[case][i] = m
             out["model"][case][i] = e[m]
-            k = int(det["steps"][i]) if case != "uncalibrated" else 0
+            k = int(det["j_steps"][case][i, m])  # J's delay (steps), as planned per set-point
             a_i, a_j = det["amplitudes"][case][i, m]
             prog = RtsProgram.build([0, 0], pair, [tau0 + d_u * res, tau0 + (d_u + k) * res],
                                     [0.0, 0.0], [a_i, a_j])
