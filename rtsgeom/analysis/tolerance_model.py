@@ -120,29 +120,34 @@ class _Design:
         mag = np.abs(z)
         return np.angle(np.sum(z / np.where(mag > 0, mag, 1.0), axis=-1))
 
-    def __call__(self, table, row_i, row_j, sub, reach: int | None = None):
-        """Programme amplitudes (n, M, 2), the design bin (n, M), whether design and
-        detection agree (n, M) and the detected bin's power over the next strongest (n, M)
-        for channel I at table row ``row_i`` (n,), J at ``row_j`` (n,), sub-bin position index
-        ``sub`` (n,); designs in the ``reach`` bins either side of the set range's (default
-        :attr:`reach`)."""
+    def __call__(self, table, row_i, row_j, sub, reach: int | None = None, sp=None):
+        """Programme amplitudes (n, M, 2), the design bin (n, M, index into the table's K),
+        whether design and detection agree (n, M) and the detected bin's power over the next
+        strongest (n, M) for channel I at table row ``row_i`` (n,), J at ``row_j`` (n,), sub-bin
+        position index ``sub`` (n,); designs in the ``reach`` bins either side of the set
+        range's (default :attr:`reach`), the detection compared one bin further. ``sp`` (n,):
+        one set-point per row instead of all (M = 1)."""
         n_k = self.beams.shape[-1]
         r = self.reach if reach is None else reach
-        kd = slice(n_k // 2 - r, n_k // 2 + r + 1)  # where J's echo can be
-        b_i = self.beams[0][:, row_i]  # (3, n, M, K)
-        b_j = self.beams[1][:, row_j]
+        lo = n_k // 2 - r - 1
+        kk = slice(lo, n_k // 2 + r + 2)  # the bins compared
+        pts = slice(None) if sp is None else np.asarray(sp)[:, None]
+        rows_i = row_i if sp is None else row_i[:, None]
+        rows_j = row_j if sp is None else row_j[:, None]
+        b_i = self.beams[0][:, rows_i, pts, kk]  # (3, n, M, K')
+        b_j = self.beams[1][:, rows_j, pts, kk]
         phase = self.phase(row_i, row_j)[:, None, None]  # (n, 1, 1)
-        rho = np.full(b_i.shape[1:], np.nan)  # (n, M, K): no design in the outermost bins
-        rho[..., kd] = ratio_from_beams(tuple(b_i[..., kd]), tuple(b_j[..., kd]), phase)
-        c_ij = np.sum(np.conj(table[0, row_i]) * table[1, row_j], -1)[:, None]  # (n, 1, K)
-        rho, k, ok, margin = detected_bin_choice(rho, phase, self.power[0, row_i][:, None],
-                                                 self.power[1, row_j][:, None], c_ij)
-        pick = k[None, ..., None]
-        bi = np.take_along_axis(b_i[0], pick[0], -1)[..., 0]
-        bj = np.take_along_axis(b_j[0], pick[0], -1)[..., 0]
+        rho = np.full(b_i.shape[1:], np.nan)  # (n, M, K'): no design in the outermost bins
+        rho[..., 1:-1] = ratio_from_beams(tuple(b_i[..., 1:-1]), tuple(b_j[..., 1:-1]), phase)
+        c_ij = np.sum(np.conj(table[0, row_i, kk]) * table[1, row_j, kk], -1)[:, None]
+        rho, k, ok, margin = detected_bin_choice(rho, phase, self.power[0, row_i, kk][:, None],
+                                                 self.power[1, row_j, kk][:, None], c_ij)
+        pick = k[..., None]
+        bi = np.take_along_axis(b_i[0], pick, -1)[..., 0]
+        bj = np.take_along_axis(b_j[0], pick, -1)[..., 0]
         p_sum = np.abs(bi + rho * np.exp(1j * phase[..., 0]) * bj) ** 2  # (n, M)
         scale = self.unit_gain * np.sqrt(self.p_one[sub][:, None] / np.maximum(p_sum, 1e-300))
-        return np.stack([scale, scale * rho], -1), k, ok, margin
+        return np.stack([scale, scale * rho], -1), k + lo, ok, margin
 
     def planned(self, table, row_i, row_j, sub, period_steps: int, reach_far: int):
         """``aoa.plan.pair_design``'s choice of J's delay, per set-point: the calibrated one
@@ -155,22 +160,22 @@ class _Design:
         m_best = np.zeros(ok.shape, int)
         s_ok, s_mg = ok.copy(), np.where(ok, mg, 0.0)
         done = ok & (mg > MIN_BIN_MARGIN)
-        rows = np.flatnonzero(~done.all(-1))
+        d_idx, p_idx = np.nonzero(~done)  # (draw, set-point) pairs still open
         for m in (-1, 1):
-            if rows.size == 0:
+            if d_idx.size == 0:
                 break
-            a2, _, ok2, mg2 = self(table, row_i[rows], row_j[rows] + m * period_steps,
-                                   sub[rows], reach_far)
-            mg2 = np.where(ok2, mg2, 0.0)
+            a2, _, ok2, mg2 = self(table, row_i[d_idx], row_j[d_idx] + m * period_steps,
+                                   sub[d_idx], reach_far, p_idx)
+            a2, ok2, mg2 = a2[:, 0], ok2[:, 0], np.where(ok2[:, 0], mg2[:, 0], 0.0)
             # score (ok, margin if ok, -|m|) against the best so far; m = 0 ranks first on a tie
-            better = ~done[rows] & ((ok2 > s_ok[rows]) | ((ok2 == s_ok[rows]) & (mg2 > s_mg[rows])))
-            idx = np.nonzero(better)
-            r_abs = rows[idx[0]]
-            amps[r_abs, idx[1]] = a2[idx]
-            m_best[r_abs, idx[1]] = m
-            s_ok[r_abs, idx[1]], s_mg[r_abs, idx[1]] = ok2[idx], mg2[idx]
-            done[rows] |= ok2 & (mg2 > MIN_BIN_MARGIN)
-            rows = rows[~done[rows].all(-1)]
+            better = (ok2 > s_ok[d_idx, p_idx]) | ((ok2 == s_ok[d_idx, p_idx])
+                                                   & (mg2 > s_mg[d_idx, p_idx]))
+            bd, bp = d_idx[better], p_idx[better]
+            amps[bd, bp] = a2[better]
+            m_best[bd, bp] = m
+            s_ok[bd, bp], s_mg[bd, bp] = ok2[better], mg2[better]
+            keep = ~(ok2 & (mg2 > MIN_BIN_MARGIN))
+            d_idx, p_idx = d_idx[keep], p_idx[keep]
         return amps, m_best
 
 
