@@ -51,3 +51,28 @@ def test_verify_200_on_the_default_study():
     model = PairPhasors.build(build_setup(scene), (0, 1))
     res = verify_draws(model, [1e-4] * 3, 200, scene.seed)
     assert res.max_difference_deg < REQUIRED_DEG, res.to_dict()
+
+
+def test_cli_verify_reports_the_difference(tmp_path, capsys):
+    """``--verify N``: the JSON key (stdout and tolerance.json) and the human line; earlier
+    keys kept; bad N and an arc study rejected with exit 2."""
+    import json
+
+    from rtsgeom.cli import main
+    base = ["tolerance", "scenes/diewald2022.toml", "--draws", "300", "--points", "5", "--quiet"]
+    assert main(base + ["--verify", "2", "--json", "--out", str(tmp_path / "o")]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for key in ("draws", "seed", "uncalibrated", "calibrated", "calibration", "pair", "verify"):
+        assert key in out
+    v = out["verify"]
+    assert v["draws"] == 2 and 0 <= v["max_abs_difference_deg"] < REQUIRED_DEG
+    assert json.loads((tmp_path / "o" / "tolerance.json").read_text())["verify"] == v
+    assert main(base + ["--verify", "1"]) == 0
+    assert "largest |chain - model|" in capsys.readouterr().out
+    for bad in (["--verify", "-1"], ["--verify", "x"], ["--verify", "1", "--yaw-deg", "0.1"]):
+        try:
+            code = main(base + bad)
+        except SystemExit as e:
+            code = e.code
+        assert code == 2
+        assert "--verify" in capsys.readouterr().err

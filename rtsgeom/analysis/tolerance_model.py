@@ -37,10 +37,14 @@ ADC-cube chain.
 Calibration at phasor level, as the paper's two steps: amplitude (each channel's power over
 the virtual channels against the model's, ``probe_front_ends``) and delay (channel J's offset
 that makes both channels' beamformer outputs coherent at the probe angles, eq. (27), quantised
-and refined on the table's exact phase: :meth:`PairPhasors.calibration_steps`). The operator
-designs J's amplitude for the known delay (case ``calibrated``, first order of the redesign:
-J's amplitude divided by the delay's loss at the design bin);
-``calibrated_nominal_amplitudes`` keeps the nominal design.
+and refined on the table's exact phase: :meth:`PairPhasors.calibration_steps`). In the case
+``calibrated`` the operator then plans each set-point as ``rtsgeom run`` does
+(``aoa.plan.pair_design``): the exact design on the nominal model with J at the calibrated
+delay, for the bin the RuT detects; where that bin is ambiguous (J's echo straddles a bin
+boundary: no consistent design, or a power margin below ``plan.MIN_BIN_MARGIN``) J's delay one
+IF period either side (the same phase, the echo about a bin further) is tried
+(:meth:`_Design.planned`). ``calibrated_nominal_amplitudes`` keeps the design made without the
+delay (J at the target's own delay), which is also the ``uncalibrated`` design.
 """
 
 from __future__ import annotations
