@@ -105,7 +105,7 @@ class _Design:
     """The exact closed-form design (``aoa.sweep.ratio_from_beams``) for the bin the RuT
     detects (``aoa.sweep.detected_bin_choice``), from tables of the channels' beam responses
     at the set angles, so that a draw's redesign for its calibration delay is a lookup and a
-    quadratic: ``beams`` (2, 3, D, M, K) (b, b', b'' per table row), ``power`` (2, D, K) each
+    quadratic: ``beams`` (2, D, 3, M, K) (b, b', b'' per table row), ``power`` (2, D, K) each
     channel's power over the elements, ``p_one`` (U,) channel I alone at its peak per sub-bin
     position (the power normalisation, ``ChannelModel.scale``)."""
 
@@ -135,11 +135,12 @@ class _Design:
         r = self.reach if reach is None else reach
         lo = n_k // 2 - r - 1
         kk = slice(lo, n_k // 2 + r + 2)  # the bins compared
-        pts = slice(None) if sp is None else np.asarray(sp)[:, None]
-        rows_i = row_i if sp is None else row_i[:, None]
-        rows_j = row_j if sp is None else row_j[:, None]
-        b_i = self.beams[0][:, rows_i, pts, kk]  # (3, n, M, K')
-        b_j = self.beams[1][:, rows_j, pts, kk]
+        if sp is None:  # whole rows: contiguous copies
+            b_i = np.moveaxis(self.beams[0][row_i][..., kk], 1, 0)  # (3, n, M, K')
+            b_j = np.moveaxis(self.beams[1][row_j][..., kk], 1, 0)
+        else:
+            b_i = np.moveaxis(self.beams[0][row_i, :, sp][..., None, kk], 1, 0)
+            b_j = np.moveaxis(self.beams[1][row_j, :, sp][..., None, kk], 1, 0)
         phase = self.phase(row_i, row_j)[:, None, None]  # (n, 1, 1)
         rho = np.full(b_i.shape[1:], np.nan)  # (n, M, K'): no design in the outermost bins
         rho[..., 1:-1] = ratio_from_beams(tuple(b_i[..., 1:-1]), tuple(b_j[..., 1:-1]), phase)
@@ -268,8 +269,8 @@ class PairPhasors:
         kv = st.wavevector[:, 0]
         e = np.exp(1j * kv * np.sin(sets)[:, None])  # (M, V_s)
         y = w * e
-        beams = np.stack([y.sum(-1), (1j * kv * y).sum(-1), (-(kv * kv) * y).sum(-1)], 1)
-        beams = np.swapaxes(beams, -1, -2)
+        beams = np.stack([y.sum(-1), (1j * kv * y).sum(-1), (-(kv * kv) * y).sum(-1)], 2)
+        beams = np.ascontiguousarray(np.swapaxes(beams, -1, -2))  # (2, D, 3, M, K)
         power = np.sum(table.real ** 2 + table.imag ** 2, -1)  # (2, D, K)
         x_i = table[0, z + sub]  # (U, K, V)
         k_one = np.argmax(power[0, z + sub], -1)  # (U,) I alone: its strongest bin

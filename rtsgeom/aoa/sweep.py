@@ -68,25 +68,31 @@ def design_ratio(st: Steering, x_i, x_j, alpha_rad, phase=0.0):
 
 def ratio_from_beams(beam_i, beam_j, phase=0.0):
     """:func:`design_ratio` from the channels' beam responses and their first two derivatives
-    in u at the set direction, ``(b, b', b'')`` each (...,) (e.g. gathered from a table)."""
+    in u at the set direction, ``(b, b', b'')`` each (...,) (e.g. gathered from a table).
+
+    P, dP/du and d2P/du2 of ``b_I + rho y`` are quadratics in rho with real coefficients
+    (``Re(conj(f) g)`` of the beams), formed once; the roots and the maximum test are then
+    real arithmetic (the Monte-Carlo studies call this for millions of set-points)."""
     bi, bi1, bi2 = beam_i
-    bj, bj1, bj2 = beam_j
     ph = np.exp(1j * np.asarray(phase, float))
-    y, y1, y2 = ph * bj, ph * bj1, ph * bj2
-    a0 = np.real(np.conj(bi) * bi1)
-    a1 = np.real(np.conj(bi) * y1 + np.conj(y) * bi1)
-    a2 = np.real(np.conj(y) * y1)
+    y, y1, y2 = (ph * b for b in beam_j)
+
+    def re(f, g):  # Re(conj(f) g)
+        return f.real * g.real + f.imag * g.imag
+
+    a0 = re(bi, bi1)
+    a1 = re(bi, y1) + re(y, bi1)
+    a2 = re(y, y1)
     disc = a1 * a1 - 4 * a0 * a2
     sq = np.sqrt(np.where(disc >= 0, disc, np.nan))
     with np.errstate(divide="ignore", invalid="ignore"):
         lin = -a0 / a1
         roots = np.stack([np.where(a2 != 0, (-a1 + sq) / (2 * a2), lin),
                           np.where(a2 != 0, (-a1 - sq) / (2 * a2), lin)])
-    s = bi[None] + roots * y[None]
-    s1 = bi1[None] + roots * y1[None]
-    s2 = bi2[None] + roots * y2[None]
-    p = np.abs(s) ** 2
-    p2 = 2 * np.real(np.conj(s) * s2) + 2 * np.abs(s1) ** 2
+    # P = |s|^2 and P'' = 2 Re(conj(s) s'') + 2 |s'|^2, s = b_I + rho y, as quadratics in rho
+    p = re(bi, bi) + roots * (2 * re(bi, y) + roots * re(y, y))
+    p2 = 2 * (re(bi, bi2) + roots * (re(bi, y2) + re(y, bi2)) + roots ** 2 * re(y, y2)) \
+        + 2 * (re(bi1, bi1) + roots * (2 * re(bi1, y1)) + roots ** 2 * re(y1, y1))
     ok = np.isfinite(roots) & (roots >= 0) & (p2 < 0)
     score = np.where(ok, p, -np.inf)
     k = np.argmax(score, axis=0)
