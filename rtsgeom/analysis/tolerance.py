@@ -115,7 +115,7 @@ def evaluate_chunk(model: PairPhasors, offsets_m: np.ndarray, cases=CASES,
     for case in cases:
         if case not in ALL_CASES:
             raise ValueError(f"case {case!r}: must be one of {', '.join(ALL_CASES)}")
-    err, det = model.draw_errors(offsets_m, subbin, tuple(cases), pose, return_detail=True)
+    err, det = _blocked(model, offsets_m, subbin, tuple(cases), pose)
     steps = det["steps"]
     out = {"steps": steps, "range_offset_m": model.range_offset_m(offsets_m, steps, pose)}
     for case in cases:
@@ -125,6 +125,35 @@ def evaluate_chunk(model: PairPhasors, offsets_m: np.ndarray, cases=CASES,
         out[case + "_fallbacks"] = int(np.count_nonzero(~det["converged"][case]))
         out[case + "_off_bin"] = int(np.count_nonzero(det["bin"][case]))
     return out
+
+
+#: draws per block inside a chunk: the temporaries (draws x set-points x bins) stay below
+#: glibc's mmap threshold, which saves the page-fault system time of 10 000-draw blocks
+#: (measured: 0.4-0.6 s of system time per 20 000 draws at 10 000, none at 1000; user time
+#: the same). Elementwise and row-wise arithmetic only, so the bits do not depend on it.
+BLOCK_DRAWS = 1000
+
+
+def _blocked(model: PairPhasors, offsets_m, subbin, cases, pose):
+    """``model.draw_errors`` in blocks of :data:`BLOCK_DRAWS` draws, joined."""
+    n = len(offsets_m)
+    if n <= BLOCK_DRAWS:
+        return model.draw_errors(offsets_m, subbin, cases, pose, return_detail=True)
+    parts = []
+    for b in range(0, n, BLOCK_DRAWS):
+        sl = slice(b, b + BLOCK_DRAWS)
+        sub_pose = None if pose is None else {
+            k: (None if v is None else np.asarray(v)[sl]) for k, v in pose.items()}
+        parts.append(model.draw_errors(offsets_m[sl], None if subbin is None else subbin[sl],
+                                       cases, sub_pose, return_detail=True))
+
+    def join(items):
+        first = items[0]
+        if isinstance(first, dict):
+            return {k: join([i[k] for i in items]) for k in first}
+        return np.concatenate(items)
+
+    return join([p[0] for p in parts]), join([p[1] for p in parts])
 
 
 def _evaluate_part(model: PairPhasors, part: tuple, cases) -> dict:

@@ -148,7 +148,8 @@ def _tolerance(args, scene, stage) -> int:
     scale = "sigma" if args.distribution == "normal" else "bound"
     print(f"pair {tuple(model.pair)}, {args.draws} draws ({args.distribution}, {scale} "
           + ", ".join(f"{a} {s * 1e3:g} mm" for a, s in zip(AXES, sigma))
-          + f"), {len(model.set_rad)} set-points, {elapsed:.2f} s")
+          + f"), {len(model.set_rad)} set-points, {elapsed:.2f} s ({res.cpu_s:.2f} s CPU in "
+             "the Monte Carlo)")
     for case in cases:
         st = out[case]
         p = st["angle_error_deg"]
