@@ -37,8 +37,7 @@ def _scene(radius_m: float):
 
 
 def run(draws: int, verify: int, inversion_draws: int) -> list[dict]:
-    from rtsgeom.analysis.tolerance import (PairPhasors, draw_subbins, max_sigma_for_yield,
-                                            monte_carlo)
+    from rtsgeom.analysis.tolerance import PairPhasors, max_sigma_for_yield, monte_carlo
     from rtsgeom.analysis.tolerance_verify import verify_draws
     from rtsgeom.geometry import build_setup
     rows = []

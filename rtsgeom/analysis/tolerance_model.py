@@ -393,7 +393,7 @@ class PairPhasors:
         steps = self.calibration_steps(xq)
         g = self.gain_correction(xq)
         d_u = self.subbin_steps[u]  # (n,)
-        z, mask = self.table_zero, self.channels.steering.mask
+        z = self.table_zero
         ar = np.arange(n)
 
         def spectrum(q, j):  # (n, K, V)
