@@ -22,17 +22,18 @@ from .aoa import _pair, _pair_arg
 from .arc import coverage_spec
 
 MAX_SIGMA_MM = 10.0  # the phasor model is first order in the errors; checked to 0.3 mm
-#: Peak memory of one Monte-Carlo chunk is about ``chunk * chunk_bytes_per_draw(points)``
-#: (measured with tracemalloc: 9.4 kB/draw at 21 set-points, 83 kB/draw at 201); ``--chunk`` is
-#: capped so that one chunk stays within this budget. The draws do not depend on the chunk size,
-#: so the cap changes no result.
+#: Peak memory of one Monte-Carlo chunk is at most about ``chunk * chunk_bytes_per_draw(points)``
+#: (measured with tracemalloc, all three cases, the issue-13 model: 17 kB/draw at 5 set-points,
+#: 40 kB at 21, 112 kB at 61; a chunk is evaluated in blocks of ``tolerance.BLOCK_DRAWS``, so
+#: past that the peak stops growing); ``--chunk`` is capped so that one chunk stays within this
+#: budget. The draws do not depend on the chunk size, so the cap changes no result.
 CHUNK_MEMORY_BYTES = 256 * 2 ** 20
 
 
 def chunk_bytes_per_draw(points: int) -> int:
     """Upper bound of the peak bytes per draw of one tolerance chunk with ``points`` set-points
-    (all cases: ~420 B per set-point and draw, plus a fixed part)."""
-    return 450 * int(points) + 2000
+    (all cases: ~1.9 kB per set-point and draw, plus a fixed part)."""
+    return 2000 * int(points) + 10000
 
 
 def capped_chunk(chunk: int, points: int) -> int:
