@@ -28,6 +28,18 @@ def test_fast_model_agrees_with_the_adc_cube_chain(radius_m, sigma_mm):
     assert max(np.max(np.abs(v)) for v in res.model_deg.values()) > 20 * res.max_difference_deg
 
 
+def test_every_set_point_and_the_worst_agree_with_the_chain():
+    """``all_points``: every set-point of a draw through the chain, and the study's per-draw
+    statistic (the worst error over the set-points) from both."""
+    model = PairPhasors.build(build_setup(make_scene()), (0, 1), 5)
+    res = verify_draws(model, [2e-4] * 3, 2, 7, all_points=True)
+    for case in CASES:
+        assert res.model_deg[case].shape == (2, 5)
+        assert np.max(res.difference_deg(case)) < REQUIRED_DEG
+        assert np.max(res.worst_difference_deg(case)) < REQUIRED_DEG
+    assert res.to_dict()["set_point"] == "every set-point"
+
+
 def test_subbin_positions_cover_one_bin_uniformly():
     scene = make_scene()
     model = PairPhasors.build(build_setup(scene), (0, 1), 5)
