@@ -100,16 +100,29 @@ def response_table(setup: Setup, paths, channel: int, target: TargetConfig, reso
     return tdm_compensate(out, 0.0, rut, radar)
 
 
+def _set_beams(st, rows: np.ndarray, sets: np.ndarray) -> np.ndarray:
+    """Beam responses and their first two derivatives in u at the set angles of table rows
+    (R, K, V): (R, 3, M, K), contiguous per row (a draw's lookup copies one block)."""
+    w = st.weighted(rows)[..., None, :]  # (R, K, 1, V_s)
+    kv = st.wavevector[:, 0]
+    y = w * np.exp(1j * kv * np.sin(sets)[:, None])  # (R, K, M, V_s)
+    beams = np.stack([y.sum(-1), (1j * kv * y).sum(-1), (-(kv * kv) * y).sum(-1)], 1)
+    return np.ascontiguousarray(np.swapaxes(beams, -1, -2))
+
+
 @dataclass(frozen=True)
 class _Design:
     """The exact closed-form design (``aoa.sweep.ratio_from_beams``) for the bin the RuT
     detects (``aoa.sweep.detected_bin_choice``), from tables of the channels' beam responses
     at the set angles, so that a draw's redesign for its calibration delay is a lookup and a
-    quadratic: ``beams`` (2, D, 3, M, K) (b, b', b'' per table row), ``power`` (2, D, K) each
+    quadratic: ``beams_i``, ``beams_j`` (rows, 3, M, K) (b, b', b'' per table row; I's from
+    row ``i0`` on, the rows it can sit at), ``power`` (2, D, K) each
     channel's power over the elements, ``p_one`` (U,) channel I alone at its peak per sub-bin
     position (the power normalisation, ``ChannelModel.scale``)."""
 
-    beams: np.ndarray
+    beams_i: np.ndarray  # (D_i, 3, M, K) channel I from table row i0 on
+    beams_j: np.ndarray  # (D, 3, M, K) channel J
+    i0: int
     power: np.ndarray
     p_one: np.ndarray
     probe_beams: np.ndarray  # (2, D, P) beam responses at the probes, the set range's bin
@@ -131,16 +144,16 @@ class _Design:
         position index ``sub`` (n,); designs in the ``reach`` bins either side of the set
         range's (default :attr:`reach`), the detection compared one bin further. ``sp`` (n,):
         one set-point per row instead of all (M = 1)."""
-        n_k = self.beams.shape[-1]
+        n_k = self.beams_j.shape[-1]
         r = self.reach if reach is None else reach
         lo = n_k // 2 - r - 1
         kk = slice(lo, n_k // 2 + r + 2)  # the bins compared
         if sp is None:  # whole rows: contiguous copies
-            b_i = np.moveaxis(self.beams[0][row_i][..., kk], 1, 0)  # (3, n, M, K')
-            b_j = np.moveaxis(self.beams[1][row_j][..., kk], 1, 0)
+            b_i = np.moveaxis(self.beams_i[row_i - self.i0][..., kk], 1, 0)  # (3, n, M, K')
+            b_j = np.moveaxis(self.beams_j[row_j][..., kk], 1, 0)
         else:
-            b_i = np.moveaxis(self.beams[0][row_i, :, sp][..., None, kk], 1, 0)
-            b_j = np.moveaxis(self.beams[1][row_j, :, sp][..., None, kk], 1, 0)
+            b_i = np.moveaxis(self.beams_i[row_i - self.i0, :, sp][..., None, kk], 1, 0)
+            b_j = np.moveaxis(self.beams_j[row_j, :, sp][..., None, kk], 1, 0)
         phase = self.phase(row_i, row_j)[:, None, None]  # (n, 1, 1)
         rho = np.full(b_i.shape[1:], np.nan)  # (n, M, K'): no design in the outermost bins
         rho[..., 1:-1] = ratio_from_beams(tuple(b_i[..., 1:-1]), tuple(b_j[..., 1:-1]), phase)
@@ -264,13 +277,11 @@ class PairPhasors:
         with np.errstate(divide="ignore"):
             log_slope = np.gradient(np.log(np.abs(table)), res, axis=1)
         z = half
-        # beam responses and derivatives at the set angles of every table row: (2, 3, D, M, K)
-        w = st.weighted(table)[..., None, :]  # (2, D, K, 1, V_s)
-        kv = st.wavevector[:, 0]
-        e = np.exp(1j * kv * np.sin(sets)[:, None])  # (M, V_s)
-        y = w * e
-        beams = np.stack([y.sum(-1), (1j * kv * y).sum(-1), (-(kv * kv) * y).sum(-1)], 2)
-        beams = np.ascontiguousarray(np.swapaxes(beams, -1, -2))  # (2, D, 3, M, K)
+        # beam responses and derivatives at the set angles: J on every table row, I on the
+        # rows it can sit at (from i0 on)
+        i0 = z - n_bin // 2 - 1
+        beams_i = _set_beams(st, table[0, i0:z + n_bin // 2 + 2], sets)
+        beams_j = _set_beams(st, table[1], sets)
         power = np.sum(table.real ** 2 + table.imag ** 2, -1)  # (2, D, K)
         x_i = table[0, z + sub]  # (U, K, V)
         k_one = np.argmax(power[0, z + sub], -1)  # (U,) I alone: its strongest bin
@@ -279,8 +290,8 @@ class PairPhasors:
         b_one, _, _ = _beam_derivatives(st, one, u_one[:, 0])
         p_one = np.abs(b_one) ** 2  # (U,)
         probe_beams = st.beam(table[:, :, nb], st.directions(probes))  # (2, D, P)
-        design = _Design(frozen(beams), frozen(power), frozen(p_one), frozen(probe_beams),
-                         model.unit_gain, reach)
+        design = _Design(frozen(beams_i), frozen(beams_j), i0, frozen(power), frozen(p_one),
+                         frozen(probe_beams), model.unit_gain, reach)
         amps, kbin, ok, _ = design(table, z + sub, z + sub, np.arange(sub.size))
         c0 = int(np.flatnonzero(sub == 0)[0])
         # no closed-form design at the bin centre (spacings beyond the beam's resolution):
