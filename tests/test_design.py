@@ -48,7 +48,9 @@ def test_spacing_above_the_angular_resolution_is_flagged(scene, grid):
     # tolerates more than the uncalibrated one
     m = grid.metrics
     assert np.all(m["worst_error_deg"][0] < 1e-3)
-    assert np.all(m["sigma_calibrated_mm"][0] > 5 * m["sigma_uncalibrated_mm"][0])
+    # (by less with the target's sub-bin position drawn per draw, issue 13: where the
+    # calibration delay moves J's echo across a bin boundary the design misses; 3x measured)
+    assert np.all(m["sigma_calibrated_mm"][0] > 2 * m["sigma_uncalibrated_mm"][0])
 
 
 def test_near_field_bias_shrinks_with_radius(grid):

@@ -225,20 +225,17 @@ class ChannelModel:
     def solve_checked(self, alpha: float, phases) -> tuple[float | None, bool, float]:
         """:meth:`_solve_pair_closed` with whether design and detection agree on the bin and
         the detected bin's power over the next strongest (1 where they do not agree)."""
-        from .sweep import design_ratio
+        from .sweep import design_at_detected_bin, design_ratio
         ph = np.zeros(2) if phases is None else np.asarray(phases, float)
         x = tdm_compensate(self.responses, self.doppler_hz, self.setup.rut,
                            self.setup.scene.radar)  # (K, 2, V)
+        r, _, ok, margin = design_at_detected_bin(self.steering, x, alpha, ph[1] - ph[0])
+        if ok:
+            return float(r), True, float(margin)
         rho = design_ratio(self.steering, x[:, 0], x[:, 1], alpha, ph[1] - ph[0])  # (K,)
         n_k = rho.size
         ks = [k for k in sorted(range(n_k), key=lambda k: abs(k - n_k // 2))
               if np.isfinite(rho[k]) and rho[k] > 0]
-        for k in ks:
-            w = self.weights([rho[k]], phases)
-            y = self.responses[:, 0] * w[0] + self.responses[:, 1] * w[1]
-            pw = np.sum(np.abs(y) ** 2, -1)
-            if int(np.argmax(pw)) == k:
-                return float(rho[k]), True, float(pw[k] / max(np.sort(pw)[-2], 1e-300))
         if not ks:
             return None, False, 1.0
         miss = [abs(float(self.direction(self.weights([rho[k]], phases))) - alpha) for k in ks]

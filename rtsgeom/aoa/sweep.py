@@ -35,7 +35,7 @@ from ..rts import KIND_DIRECT, RtsProgram, channel_echoes, requested_delay
 from ..scene import TargetConfig
 from .model import ChannelModel
 
-__all__ = ["design_ratio", "SweepResult", "phasor_sweep", "fit_minimum", "HALF_BINS",
+__all__ = ["design_ratio", "ratio_from_beams", "design_at_detected_bin", "detected_bin_choice", "SweepResult", "phasor_sweep", "fit_minimum", "HALF_BINS",
            "place_probes", "chain_errors"]
 
 HALF_BINS = 3  # candidate bins either side of the set range's bin (J moves <= ~2 bins)
@@ -68,29 +68,103 @@ def design_ratio(st: Steering, x_i, x_j, alpha_rad, phase=0.0):
         from .model import estimator_ratio
         return estimator_ratio(st, x_i, x_j, float(alpha_rad), phase)
     u = np.sin(np.asarray(alpha_rad, float))
-    bi, bi1, bi2 = _beam_derivatives(st, x_i, u)
+    return ratio_from_beams(_beam_derivatives(st, x_i, u), _beam_derivatives(st, x_j, u), phase)
+
+
+def ratio_from_beams(beam_i, beam_j, phase=0.0):
+    """:func:`design_ratio` from the channels' beam responses and their first two derivatives
+    in u at the set direction, ``(b, b', b'')`` each (...,) (e.g. gathered from a table).
+
+    P, dP/du and d2P/du2 of ``b_I + rho y`` are quadratics in rho with real coefficients
+    (``Re(conj(f) g)`` of the beams), formed once; the roots and the maximum test are then
+    real arithmetic (the Monte-Carlo studies call this for millions of set-points)."""
+    bi, bi1, bi2 = beam_i
     ph = np.exp(1j * np.asarray(phase, float))
-    bj, bj1, bj2 = _beam_derivatives(st, x_j, u)
-    y, y1, y2 = ph * bj, ph * bj1, ph * bj2
-    a0 = np.real(np.conj(bi) * bi1)
-    a1 = np.real(np.conj(bi) * y1 + np.conj(y) * bi1)
-    a2 = np.real(np.conj(y) * y1)
+    y, y1, y2 = (ph * b for b in beam_j)
+
+    def re(f, g):  # Re(conj(f) g)
+        return f.real * g.real + f.imag * g.imag
+
+    a0 = re(bi, bi1)
+    a1 = re(bi, y1) + re(y, bi1)
+    a2 = re(y, y1)
     disc = a1 * a1 - 4 * a0 * a2
     sq = np.sqrt(np.where(disc >= 0, disc, np.nan))
     with np.errstate(divide="ignore", invalid="ignore"):
         lin = -a0 / a1
         roots = np.stack([np.where(a2 != 0, (-a1 + sq) / (2 * a2), lin),
                           np.where(a2 != 0, (-a1 - sq) / (2 * a2), lin)])
-    s = bi[None] + roots * y[None]
-    s1 = bi1[None] + roots * y1[None]
-    s2 = bi2[None] + roots * y2[None]
-    p = np.abs(s) ** 2
-    p2 = 2 * np.real(np.conj(s) * s2) + 2 * np.abs(s1) ** 2
+    # P = |s|^2 and P'' = 2 Re(conj(s) s'') + 2 |s'|^2, s = b_I + rho y, as quadratics in rho
+    p = re(bi, bi) + roots * (2 * re(bi, y) + roots * re(y, y))
+    p2 = 2 * (re(bi, bi2) + roots * (re(bi, y2) + re(y, bi2)) + roots ** 2 * re(y, y2)) \
+        + 2 * (re(bi1, bi1) + roots * (2 * re(bi1, y1)) + roots ** 2 * re(y1, y1))
     ok = np.isfinite(roots) & (roots >= 0) & (p2 < 0)
     score = np.where(ok, p, -np.inf)
     k = np.argmax(score, axis=0)
     rho = np.take_along_axis(roots, k[None], 0)[0]
     return np.where(np.take_along_axis(ok, k[None], 0)[0], rho, np.nan)
+
+
+def design_at_detected_bin(st: Steering, h, alpha_rad, phase=0.0):
+    """The exact design of a pair for the bin the RuT detects (the bin logic of the module
+    docstring, vectorised): ``h`` (..., K, 2, V) the TDM-compensated unit responses of
+    channels I and J at K candidate range bins (the set range's in the middle), ``alpha_rad``
+    and ``phase`` broadcast against (...,).
+
+    For each design bin k the closed-form ratio (:func:`design_ratio`) and the bin the RuT
+    then detects (the strongest candidate of ``I + rho e^{j phase} J``, power summed over all
+    virtual elements); the design bin chosen is the one where design and detection agree,
+    nearest the set range's bin first. Returns ``rho`` (...), ``bin`` (...) (index into K;
+    where no bin agrees: the fixed point of "design at the reported bin" from the middle
+    bin, as :func:`phasor_sweep`), ``consistent`` (...) and ``margin`` (...) (the detected
+    bin's power over the next strongest; 1 where not consistent). NaN ``rho`` where no bin
+    has a design."""
+    h = np.asarray(h)
+    x_i, x_j = h[..., 0, :], h[..., 1, :]  # (..., K, V)
+    a = np.asarray(alpha_rad, float)[..., None]
+    ph = np.asarray(phase, float)[..., None]
+    rho = design_ratio(st, x_i, x_j, a, ph)  # (..., K)
+    p_ii = np.sum(x_i.real ** 2 + x_i.imag ** 2, -1)  # (..., K)
+    p_jj = np.sum(x_j.real ** 2 + x_j.imag ** 2, -1)
+    c_ij = np.sum(np.conj(x_i) * x_j, -1)
+    return detected_bin_choice(rho, ph, p_ii, p_jj, c_ij)
+
+
+def detected_bin_choice(rho, phase, p_ii, p_jj, c_ij, margin: bool = True):
+    """The bin logic of :func:`design_at_detected_bin` from the ratios per design bin ``rho``
+    (..., K), J's phase (broadcast) and the channels' power sums over the virtual elements at
+    each candidate bin: ``p_ii``, ``p_jj`` (..., K) and ``c_ij = sum conj(x_i) x_j``.
+    ``margin=False``: the fourth result is None (saves a sort in Monte-Carlo loops)."""
+    ph = np.broadcast_to(np.asarray(phase, float), rho.shape)
+    finite = np.isfinite(rho) & (rho > 0)
+    r = np.where(finite, rho, 0.0)
+    # power of each design (..., K_design) at every bin (K_bins), in real arithmetic:
+    # |I + r e^{j ph} J|^2 = p_ii + r^2 p_jj + 2 r Re(e^{j ph} c_ij)
+    q = (np.cos(ph)[..., :, None] * c_ij.real[..., None, :]
+         - np.sin(ph)[..., :, None] * c_ij.imag[..., None, :])
+    power = (p_ii[..., None, :] + (r * r)[..., :, None] * p_jj[..., None, :]
+             + 2 * r[..., :, None] * q)
+    # a design that does not exist detects nothing (its row never agrees)
+    det = np.where(finite, np.argmax(power, -1), 0)  # (..., K_design)
+    n_k = rho.shape[-1]
+    ks = np.arange(n_k)
+    agree = finite & (det == ks)
+    # nearest the middle first: rank by |k - mid|, ties to the lower bin
+    rank = np.abs(ks - n_k // 2) * 2 + (ks > n_k // 2)
+    best = np.argmin(np.where(agree, rank, n_k * 4), -1)
+    consistent = np.take_along_axis(agree, best[..., None], -1)[..., 0]
+    k = best
+    if not np.all(consistent):  # none agrees: redesign at the reported bin
+        k0 = np.broadcast_to(det[..., n_k // 2], consistent.shape).copy()
+        for _ in range(4):
+            k0 = np.take_along_axis(det, k0[..., None], -1)[..., 0]
+        k = np.where(consistent, best, k0)
+    out = np.take_along_axis(rho, k[..., None], -1)[..., 0]
+    if not margin:
+        return out, k, consistent, None
+    pw = np.sort(np.take_along_axis(power, k[..., None, None], -2)[..., 0, :], -1)
+    mg = np.where(consistent, pw[..., -1] / np.maximum(pw[..., -2], 1e-300), 1.0)
+    return out, k, consistent, mg
 
 
 @dataclass(frozen=True)

@@ -23,17 +23,18 @@ from .aoa import _pair, _pair_arg
 from .arc import coverage_spec
 
 MAX_SIGMA_MM = 10.0  # the phasor model is first order in the errors; checked to 0.3 mm
-#: Peak memory of one Monte-Carlo chunk is about ``chunk * chunk_bytes_per_draw(points)``
-#: (measured with tracemalloc: 9.4 kB/draw at 21 set-points, 83 kB/draw at 201); ``--chunk`` is
-#: capped so that one chunk stays within this budget. The draws do not depend on the chunk size,
-#: so the cap changes no result.
+#: Peak memory of one Monte-Carlo chunk is at most about ``chunk * chunk_bytes_per_draw(points)``
+#: (measured with tracemalloc, all three cases, the issue-13 model: 17 kB/draw at 5 set-points,
+#: 40 kB at 21, 112 kB at 61; a chunk is evaluated in blocks of ``tolerance.BLOCK_DRAWS``, so
+#: past that the peak stops growing); ``--chunk`` is capped so that one chunk stays within this
+#: budget. The draws do not depend on the chunk size, so the cap changes no result.
 CHUNK_MEMORY_BYTES = 256 * 2 ** 20
 
 
 def chunk_bytes_per_draw(points: int) -> int:
     """Upper bound of the peak bytes per draw of one tolerance chunk with ``points`` set-points
-    (all cases: ~420 B per set-point and draw, plus a fixed part)."""
-    return 450 * int(points) + 2000
+    (all cases: ~1.9 kB per set-point and draw, plus a fixed part)."""
+    return 2000 * int(points) + 10000
 
 
 def capped_chunk(chunk: int, points: int) -> int:
@@ -107,6 +108,9 @@ def _tolerance(args, scene, stage) -> int:
     from .arc import save_pair_npz, scales, tolerance_arc, wants_arc
     sigma, extra = scales(args)
     if wants_arc(args):
+        if args.verify:
+            raise UsageError("--verify: only for one pair with offsets (not --pair all, "
+                             "rotations or RuT-pose errors)")
         return tolerance_arc(args, scene, sigma, extra, stage)
     model = _model(scene, args.pair, args.points)
     chunk = capped_chunk(args.chunk, len(model.set_rad))
@@ -118,6 +122,11 @@ def _tolerance(args, scene, stage) -> int:
         res = monte_carlo(model, sigma, args.draws, seed, args.distribution, args.spec_deg,
                           cases, chunk, progress, "Monte Carlo", mapper)
         out = res.to_dict()
+        if args.verify:
+            from ..analysis.tolerance_verify import verify_draws
+            out["verify"] = verify_draws(model, sigma, min(args.verify, args.draws), seed,
+                                         args.distribution, cases, progress=progress,
+                                         all_points=args.verify_all_points).to_dict()
         if args.invert_yield is not None:
             out["inversion"] = {
                 case: max_sigma_for_yield(model, sigma, args.draws, seed, args.invert_yield,
@@ -142,13 +151,18 @@ def _tolerance(args, scene, stage) -> int:
     scale = "sigma" if args.distribution == "normal" else "bound"
     print(f"pair {tuple(model.pair)}, {args.draws} draws ({args.distribution}, {scale} "
           + ", ".join(f"{a} {s * 1e3:g} mm" for a, s in zip(AXES, sigma))
-          + f"), {len(model.set_rad)} set-points, {elapsed:.2f} s")
+          + f"), {len(model.set_rad)} set-points, {elapsed:.2f} s ({res.cpu_s:.2f} s CPU in "
+             "the Monte Carlo)")
     for case in cases:
         st = out[case]
         p = st["angle_error_deg"]
         print(f"  {case:>30}: |error| p50 {p['p50']:.4f}, p95 {p['p95']:.4f}, p99 "
               f"{p['p99']:.4f}, max {p['max']:.4f} deg; yield {100 * st['yield']:.2f} % within "
               f"{args.spec_deg:g} deg")
+    if "verify" in out:
+        v = out["verify"]
+        print(f"  verify: {v['draws']} draws through the ADC-cube chain, largest |chain - model| "
+              f"{v['max_abs_difference_deg']:.2e} deg (at {v['set_point']})")
     cal = out["calibration"]
     print(f"  calibration |delta tau| p95 {cal['abs_delta_tau_ps']['p95']:.0f} ps, range offset "
           f"p95 {cal['abs_range_offset_mm']['p95']:.1f} mm")
@@ -294,6 +308,13 @@ def register(sub) -> None:
     p.add_argument("--nominal-amplitudes", action="store_true",
                    help=f"add the case '{NOMINAL_AMPLITUDES}': calibrated, but the amplitudes "
                         "not designed for the calibration delay's range offset")
+    p.add_argument("--verify", type=number(0, 10_000, integer=True), default=0, metavar="N",
+                   help="push the first N draws (same seed) through the full ADC-cube chain "
+                        "(synthesis, range-Doppler, CFAR, angle) and report the largest "
+                        "difference from the fast model, in [0, 10000] (default 0)")
+    p.add_argument("--verify-all-points", action="store_true",
+                   help="with --verify: every set-point of each draw through the chain, not "
+                        "only its worst (--points times the frames)")
     p.add_argument("--chunk", type=number(100, 1_000_000, integer=True), default=10_000,
                    help="draws per chunk (memory), in [100, 1000000] (default 10000); capped "
                         f"so that one chunk needs at most {CHUNK_MEMORY_BYTES >> 20} MiB "
