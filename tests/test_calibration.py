@@ -577,3 +577,28 @@ def test_grid_sample_calibrates_to_coherence_and_linearity_within_spec(radius, f
     lin = linearity(setup, paths, (0, 1), "exact", probe, cal, 11, setup.scene.seed)
     assert np.all(np.isfinite(lin.detected_deg))
     assert lin.max_abs_error_deg <= 0.02
+
+
+@pytest.mark.parametrize("samples,adc_rate_hz", [(128, 12.5e6), (256, 25e6)])
+@pytest.mark.parametrize("training", [4, 8, 12])
+def test_probes_clear_each_others_cfar_window(samples, adc_rate_hz, training):
+    """probe_front_ends puts each front end alone at its own range; the probes are spaced by
+    more than the CFAR window (guard + training cells) on any cube, so every front end is
+    detected (on a 128-sample cube 8 bins used to leave front end 1 undetected: a silent NaN,
+    now a RuntimeWarning)."""
+    import warnings
+
+    from rtsgeom.aoa.calibration import probe_ranges
+
+    def small(doc):
+        doc["radar"].pop("snr_db", None)
+        doc["radar"].update(chirps_per_tx=32, samples_per_chirp=samples, adc_rate_hz=adc_rate_hz)
+        doc["radar"]["cfar"] = {"training_cells": [training, 4], "guard_cells": [2, 2]}
+    setup = build_setup(make_scene(small))
+    radar = setup.scene.radar
+    ranges = probe_ranges(setup, setup.fe.count)
+    assert np.min(np.diff(ranges)) / radar.range_resolution_m > 2 + training
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        probe = probe_front_ends(setup, exact_paths(setup))
+    assert np.all(np.isfinite(probe.angle_rad))

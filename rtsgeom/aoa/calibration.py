@@ -16,6 +16,8 @@ The delay offset also moves channel J's echo in range ("Disadvantages"): the rep
 
 from __future__ import annotations
 
+import warnings
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -182,7 +184,11 @@ def probe_ranges(setup: Setup, n: int) -> np.ndarray:
               if fe.return_loss_fe_db is not None and fe.return_loss_be_db is not None
               for k in range(1, 6)]
     clear = 4 * radar.range_resolution_m
-    step = max(8 * radar.range_resolution_m, 3.0)
+    # Apart by more than the CFAR window in range (guard + training cells): a probe inside a
+    # neighbour's training cells raises that one's noise estimate, and on a coarse cube
+    # (128 samples: 8 bins = 4.8 m) one probe went undetected.
+    cfar_cells = radar.cfar.guard_cells[0] + radar.cfar.training_cells[0] + 2
+    step = max(max(8, cfar_cells) * radar.range_resolution_m, 3.0)
     while any(abs(m * step - g) < clear for g in ghosts for m in range(1, n)):
         step += radar.range_resolution_m
     return r0 + step * np.arange(n)
@@ -229,6 +235,12 @@ def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe
         k = nearest_detection(det, rd, ranges[q])
         if k is not None:
             ang[q], pw[q] = det.angle_rad[k], det.power_db[k]
+    missed = [q for q in range(n) if not np.isfinite(ang[q])]
+    if missed:  # not silently: its angle is NaN and its gain correction falls back to 1
+        warnings.warn(f"front end(s) {missed} not detected alone at the probe range(s) "
+                      f"{np.round(ranges[missed], 3).tolist()} m (below the CFAR threshold or "
+                      "beyond the range axis): their measured angle is NaN and their gain "
+                      "correction 1", RuntimeWarning, stacklevel=2)
     meas = 10 ** (pw / 10) / amps ** 2
     corr = np.sqrt(model_p / meas)
     return FrontEndProbe(ang, pw, np.where(np.isfinite(corr), corr, 1.0))
