@@ -57,7 +57,7 @@ from scipy.constants import c
 from .._util import frozen
 from ..aoa.calibration import if_phase_slope_hz, probe_ranges
 from ..aoa.model import ChannelModel
-from ..aoa.sweep import _beam_derivatives, detected_bin_choice, ratio_from_beams
+from ..aoa.sweep import beam_derivatives, detected_bin_choice, ratio_from_beams
 from ..geometry import Setup
 from ..geometry.setup import nominal_setup
 from ..paths import exact_paths
@@ -287,7 +287,7 @@ class PairPhasors:
         k_one = np.argmax(power[0, z + sub], -1)  # (U,) I alone: its strongest bin
         one = x_i[np.arange(sub.size), k_one]  # (U, V)
         u_one, _ = st.peak(one, st.directions(np.full(sub.size, th[0])))
-        b_one, _, _ = _beam_derivatives(st, one, u_one[:, 0])
+        b_one, _, _ = beam_derivatives(st, one, u_one[:, 0])
         p_one = np.abs(b_one) ** 2  # (U,)
         probe_beams = st.beam(table[:, :, nb], st.directions(probes))  # (2, D, P)
         design = _Design(frozen(beams_i), frozen(beams_j), i0, frozen(power), frozen(p_one),

@@ -49,11 +49,12 @@ SOLVERS = SYNTHESIS_MODES  # the registry lists every AoA mode once (rtsgeom/reg
 JUMP_RAD = np.radians(1e-3)
 
 
-def estimator_ratio(st: Steering, x_i, x_j, alpha_rad: float, phase=0.0,
+def estimator_ratio(st: Steering, x_i, x_j, alpha_rad, phase=0.0,
                     log_span: float = 12.0, grid: int = 13, iterations: int = 40
                     ) -> np.ndarray:
     """The ratio rho >= 0 (...,) for which the estimator's detected angle of
-    ``x_i + rho e^{j phase} x_j`` (snapshots (..., V)) is ``alpha_rad``, by bisection on
+    ``x_i + rho e^{j phase} x_j`` (snapshots (..., V)) is ``alpha_rad`` (broadcast against
+    (...,), as ``phase``), by bisection on
     log rho, batched over all snapshots: what ``aoa.sweep.design_ratio`` (Bartlett's peak
     condition in closed form) is for an estimator without one (a smoothed Capon or MUSIC,
     ``Steering.smoothing``). The bracket is the first sign change of (angle - alpha) on
@@ -66,9 +67,10 @@ def estimator_ratio(st: Steering, x_i, x_j, alpha_rad: float, phase=0.0,
     ph = np.broadcast_to(np.exp(1j * np.asarray(phase, float)), shape)
     xi = x_i.reshape(-1, n_v)
     xj = (x_j * ph[..., None]).reshape(-1, n_v)
+    alpha = np.broadcast_to(np.asarray(alpha_rad, float), shape).reshape(-1)  # (n,)
     n = xi.shape[0]
     lr = np.linspace(-log_span, log_span, grid)
-    f = st.search(xi[:, None, :] + np.exp(lr)[None, :, None] * xj[:, None, :]) - alpha_rad
+    f = st.search(xi[:, None, :] + np.exp(lr)[None, :, None] * xj[:, None, :]) - alpha[:, None]
     change = (np.sign(f[:, :-1]) * np.sign(f[:, 1:]) <= 0) & np.isfinite(f[:, :-1] + f[:, 1:])
     has = change.any(axis=1)
     k = np.argmax(change, axis=1)
@@ -76,13 +78,13 @@ def estimator_ratio(st: Steering, x_i, x_j, alpha_rad: float, phase=0.0,
     lo, hi, f_lo = lr[k], lr[k + 1], f[rows, k]
     for _ in range(iterations):
         mid = 0.5 * (lo + hi)
-        f_mid = st.search(xi + np.exp(mid)[:, None] * xj) - alpha_rad
+        f_mid = st.search(xi + np.exp(mid)[:, None] * xj) - alpha
         left = np.sign(f_mid) == np.sign(f_lo)
         lo, f_lo = np.where(left, mid, lo), np.where(left, f_mid, f_lo)
         hi = np.where(left, hi, mid)
     x = 0.5 * (lo + hi)
     got = st.search(xi + np.exp(x)[:, None] * xj)
-    ok = has & (np.abs(got - alpha_rad) < JUMP_RAD)
+    ok = has & (np.abs(got - alpha) < JUMP_RAD)
     return np.where(ok, np.exp(x), np.nan).reshape(shape)
 
 

@@ -35,13 +35,13 @@ from ..rts import KIND_DIRECT, RtsProgram, channel_echoes, requested_delay
 from ..scene import TargetConfig
 from .model import ChannelModel
 
-__all__ = ["design_ratio", "ratio_from_beams", "design_at_detected_bin", "detected_bin_choice", "SweepResult", "phasor_sweep", "fit_minimum", "HALF_BINS",
+__all__ = ["design_ratio", "beam_derivatives", "ratio_from_beams", "design_at_detected_bin", "detected_bin_choice", "SweepResult", "phasor_sweep", "fit_minimum", "HALF_BINS",
            "place_probes", "chain_errors"]
 
 HALF_BINS = 3  # candidate bins either side of the set range's bin (J moves <= ~2 bins)
 
 
-def _beam_derivatives(st: Steering, x, u):
+def beam_derivatives(st: Steering, x, u):
     """Beamformer output b(u) and its first two derivatives in u at directions ``u`` (...,)
     for snapshots ``x`` (..., V) (D = 1): three arrays (...,)."""
     w = st.weighted(x)  # (..., V_s)
@@ -66,9 +66,9 @@ def design_ratio(st: Steering, x_i, x_j, alpha_rad, phase=0.0):
     the estimator's own peak."""
     if st.smoothing:
         from .model import estimator_ratio
-        return estimator_ratio(st, x_i, x_j, float(alpha_rad), phase)
+        return estimator_ratio(st, x_i, x_j, alpha_rad, phase)
     u = np.sin(np.asarray(alpha_rad, float))
-    return ratio_from_beams(_beam_derivatives(st, x_i, u), _beam_derivatives(st, x_j, u), phase)
+    return ratio_from_beams(beam_derivatives(st, x_i, u), beam_derivatives(st, x_j, u), phase)
 
 
 def ratio_from_beams(beam_i, beam_j, phase=0.0):
@@ -277,8 +277,8 @@ def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair,
         phases = mn.coherent_phases(alphas, hn)[..., 1:]  # (K, S): J's coherent phase per bin
         rho = design_ratio(st, hn[:, :1, :], hn[:, 1:, :], alpha, phases)  # (K, S)
         # power normalisation (ChannelModel.scale): the combined peak as strong as I alone
-        b_i, _, _ = _beam_derivatives(st, hn[:, :1, :], np.sin(alpha))
-        b_j, _, _ = _beam_derivatives(st, hn[:, 1:, :], np.sin(alpha))
+        b_i, _, _ = beam_derivatives(st, hn[:, :1, :], np.sin(alpha))
+        b_j, _, _ = beam_derivatives(st, hn[:, 1:, :], np.sin(alpha))
         p_sum = np.abs(b_i + rho * np.exp(1j * phases) * b_j) ** 2  # (K, S)
         k_one = int(np.argmax(np.sum(np.abs(hn[:, 0]) ** 2, -1)))
         u_one, _ = st.peak(hn[k_one, 0], np.sin(alpha))
