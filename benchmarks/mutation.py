@@ -60,23 +60,30 @@ MODULES: dict[str, tuple[str, tuple[str, ...]]] = {
     "geometry": ("rtsgeom/geometry/*", (
         "tests/test_geometry.py", "tests/test_frontends.py", "tests/test_arrays.py",
         "tests/test_patterns.py", "tests/test_properties.py", "tests/test_warnings_geometry.py",
-        "tests/test_fields.py", "tests/test_mutants.py")),
+        "tests/test_fields.py", "tests/test_mutants.py", "tests/test_sphere.py",
+        "tests/test_setups.py", "tests/test_elevation.py", "tests/test_physics_core.py")),
     "paths.exact": ("rtsgeom/paths/exact.py", (
         "tests/test_geometry.py", "tests/test_patterns.py", "tests/test_properties.py",
-        "tests/test_frontends.py", "tests/test_mutants.py")),
+        "tests/test_frontends.py", "tests/test_mutants.py", "tests/test_sphere.py",
+        "tests/test_setups.py", "tests/test_physics_core.py")),
     "rts": ("rtsgeom/rts.py", (
         "tests/test_signal.py", "tests/test_signal_properties.py", "tests/test_ghosts.py",
-        "tests/test_fields.py", "tests/test_mutants.py")),
+        "tests/test_fields.py", "tests/test_mutants.py", "tests/test_calibration.py",
+        "tests/test_link.py", "tests/test_windows.py", "tests/test_physics_core.py")),
     "radar": ("rtsgeom/radar/*", (
         "tests/test_signal.py", "tests/test_signal_properties.py", "tests/test_steering.py",
         "tests/test_windows.py", "tests/test_fields.py", "tests/test_mutants.py",
-        "tests/test_cfar.py")),
+        "tests/test_cfar.py", "tests/test_elevation.py", "tests/test_link.py",
+        "tests/test_fast_numerics.py", "tests/test_identify.py", "tests/test_physics_core.py")),
     "aoa": ("rtsgeom/aoa/*", (
         "tests/test_aoa.py", "tests/test_steering.py", "tests/test_windows.py",
-        "tests/test_fields.py", "tests/test_mutants.py", "tests/test_calibration.py")),
+        "tests/test_fields.py", "tests/test_mutants.py", "tests/test_calibration.py",
+        "tests/test_nchannel.py", "tests/test_sphere.py", "tests/test_elevation.py",
+        "tests/test_setups.py", "tests/test_reachable.py", "tests/test_physics_core.py")),
     "analysis": ("rtsgeom/analysis/*", (
         "tests/test_tolerance.py", "tests/test_nearfield.py", "tests/test_ghosts.py",
-        "tests/test_design.py", "tests/test_mutants.py")),
+        "tests/test_design.py", "tests/test_mutants.py", "tests/test_setups.py",
+        "tests/test_windows.py", "tests/test_physics_core.py")),
 }
 
 # Functions outside the physics core although they sit in its modules: plotting, mesh export
