@@ -207,3 +207,212 @@ def test_plan_reports_each_pairs_calibration_delay_in_picoseconds():
     want_ps = float(cal["delta_tau_s"]) * 1e12
     assert abs(want_ps) > 1.0  # the 0.4 mm offset moves the point by ~2.7 ps
     assert shown[0] == pytest.approx(want_ps, abs=0.051)
+
+
+# -- aoa.cells / aoa.ncal: cells and the pairs an N-channel calibration measures ------------
+
+
+@pytest.mark.parametrize("count", [2, 3, 5])
+def test_enclosing_interval_is_the_adjacent_pair_in_one_dimension(count):
+    """1-D cells: a direction between two neighbouring front ends (in any index order) is
+    enclosed by exactly that pair, also with only two front ends; outside the span none."""
+    from rtsgeom.aoa.cells import CellUnreachable, enclosing_cell
+    rng = np.random.default_rng(count)
+    x = np.sort(rng.uniform(-0.5, 0.5, count))
+    perm = rng.permutation(count)
+    pts = x[perm][:, None]
+    for k in range(count - 1):
+        for f in (0.0, 0.3, 0.99):
+            u = x[k] + f * (x[k + 1] - x[k])
+            got = enclosing_cell([u], pts)
+            assert sorted(perm[list(got)]) == [k, k + 1]  # channel q sits at rank perm[q]
+    for u in (x[0] - 0.01, x[-1] + 0.01):
+        with pytest.raises(CellUnreachable):
+            enclosing_cell([u], pts)
+
+
+@pytest.mark.parametrize("grid", [(2, 1), (4, 1), (2, 2), (3, 2), (3, 3)])
+def test_pair_edges_are_neighbours_in_1d_and_delaunay_edges_in_2d(grid):
+    """The pairs an N-channel calibration sweeps: in 1-D the F - 1 neighbours by direction
+    (whatever the channel numbering); in 2-D the edges of the Delaunay triangulation, 3 F - 3
+    - h of them for F points with h on the hull (Euler), each joining two given channels."""
+    from rtsgeom.aoa.ncal import pair_edges
+    n_a, n_e = grid
+    rng = np.random.default_rng(n_a * 10 + n_e)
+    az = np.arange(n_a) * 0.1 + rng.uniform(-0.01, 0.01, n_a)
+    if n_e == 1:
+        u = az[:, None]
+        perm = rng.permutation(n_a)
+        u_fe = np.empty_like(u)
+        u_fe[perm] = u  # channel perm[k] sits at the k-th direction
+        edges = pair_edges(u_fe, range(n_a))
+        want = sorted(tuple(sorted((int(perm[k]), int(perm[k + 1])))) for k in range(n_a - 1))
+        assert sorted(edges) == want
+        return
+    el = np.arange(n_e) * 0.08
+    u_fe = np.array([(a, e) for a in az for e in el]) + rng.uniform(-0.003, 0.003, (n_a * n_e, 2))
+    f = len(u_fe)
+    from scipy.spatial import ConvexHull
+    h = len(ConvexHull(u_fe).vertices)
+    edges = pair_edges(u_fe, range(f))
+    assert len(edges) == len(set(edges)) == 3 * f - 3 - h
+    assert all(0 <= i < j < f for i, j in edges)
+    # a subset of channels: only edges among them
+    sub = [0, 1, f - 1]
+    assert {q for e in pair_edges(u_fe, sub) for q in e} == set(sub)
+
+
+def _small_noiseless(mutate=None):
+    def m(doc):
+        doc["radar"].pop("snr_db", None)
+        doc["radar"].update(chirps_per_tx=32, samples_per_chirp=128, adc_rate_hz=12.5e6)
+        if mutate:
+            mutate(doc)
+    return make_scene(m)
+
+
+@pytest.mark.parametrize("fe, dr_mm", [(1, -0.097), (0, -0.3)])
+def test_nd_pair_calibration_lands_on_the_coherence_point(fe, dr_mm):
+    """The N-channel pair sweep (``ncal.calibrate_pair_nd``, full ADC-cube chain at each
+    step, a parabola through the points around the minimum) lands within 3 ps of the
+    phasor model's coherence point for a radial offset that puts the point half a coarse
+    step (100 ps) off the sweep grid, on either front end; its period is 1/(f_rts + S t_mid
+    - S tau) as the pair calibration's."""
+    from rtsgeom.aoa.calibration import coherence_delay, probe_angles, probe_front_ends
+    from rtsgeom.aoa.ncal import calibrate_pair_nd
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    setup = build_setup(_small_noiseless(
+        lambda d: d["rts"]["front_ends"][fe].update(radial_offset_mm=dr_mm)))
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, 1)
+    got = calibrate_pair_nd(setup, paths, (0, 1), probe, 1, span_s=(-0.3e-9, 0.3e-9),
+                            step_s=100e-12)
+    point = coherence_delay(setup, paths, (0, 1), probe_angles(*probe.angle_rad[[0, 1]]))
+    period = got["period_s"]
+    dist = (got["delta_tau_s"] - point + period / 2) % period - period / 2
+    assert abs(dist) < 3e-12
+    assert got["residual_error_deg"] < 0.05
+    assert got["range_offset_m"] == pytest.approx(0.5 * 299792458.0 * got["delta_tau_s"])
+
+
+def test_channel_calibration_of_one_channel_is_its_own_reference():
+    from rtsgeom.aoa.calibration import probe_front_ends
+    from rtsgeom.aoa.ncal import calibrate_channels
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    setup = build_setup(_small_noiseless())
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, 1)
+    for q in (0, 1):
+        cal = calibrate_channels(setup, paths, [q], probe)
+        assert cal.reference == q and np.all(cal.offsets_s == 0.0) and cal.tree == []
+        assert cal.gain_correction == pytest.approx(tuple(probe.gain_correction))
+
+
+# -- aoa.linearity2d: the 2-D error map through the ADC-cube chain ---------------------------
+
+
+def test_2d_error_map_exact_mode_puts_every_grid_point_on_its_direction():
+    """sphere4 as built = nominal (no errors, noiseless): ``exact`` amplitudes synthesize
+    every grid point inside the four front ends' cell at its (azimuth, elevation) through
+    the whole chain (1e-4 deg); ``array-factor`` (closed form, no near field) is off by a
+    finite amount. The n x n grid inside a rectangular cell keeps all n^2 points."""
+    from rtsgeom.aoa.linearity2d import linearity_grid
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    from rtsgeom.scene import load_scene
+    sc = load_scene("scenes/sphere4.toml")
+    sc = sc.evolve(radar=sc.radar.evolve(snr_db=None, samples_per_chirp=128, chirps_per_tx=32,
+                                         adc_rate_hz=12.5e6))
+    setup = build_setup(sc)
+    paths = exact_paths(setup)
+    em = linearity_grid(setup, paths, "exact", n=2, calibrate=False, seed=1)
+    assert em.set_deg.shape == (4, 2)
+    assert max(em.max_abs_error_deg()) < 1e-4
+    af = linearity_grid(setup, paths, "array-factor", n=2, calibrate=False, seed=1)
+    assert 0.05 < max(af.max_abs_error_deg()) < 1.0
+
+
+# -- aoa.nchannel: the closed form does not depend on a common phase -------------------------
+
+
+@pytest.mark.parametrize("common", [0.0, 0.7, -2.1, 3.0])
+def test_closed_form_amplitudes_ignore_a_common_phase(common):
+    """Adding one phase to every channel's programmed phase changes nothing physical (the
+    beamformer output rotates as a whole): the ``array-factor`` amplitudes on sphere4's four
+    front ends are the same for phases + c as for phases, over set points in the cell."""
+    from rtsgeom.aoa.nchannel import ChannelSet, closed_form_amplitudes
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    from rtsgeom.scene import TargetConfig, load_scene
+    setup = build_setup(load_scene("scenes/sphere4.toml"))
+    cs = ChannelSet.build(setup, exact_paths(setup), (0, 1, 2, 3), TargetConfig(25.0))
+    st = cs.steering
+    u_fe = setup.fe_direction_cosines()
+    lo, hi = u_fe.min(0), u_fe.max(0)
+    phases = np.array([0.3, -1.2, 2.0, 0.4])
+    for fx, fz in ((0.3, 0.4), (0.7, 0.8), (0.5, 0.2)):
+        u = lo + np.array([fx, fz]) * (hi - lo)
+        a = closed_form_amplitudes(st, u_fe, u, phases)
+        b = closed_form_amplitudes(st, u_fe, u, phases + common)
+        np.testing.assert_allclose(b, a, rtol=1e-9, atol=1e-12)
+        assert np.max(a) == pytest.approx(1.0)
+
+
+# -- aoa.linearity: the closed forms with measured end angles ---------------------------------
+
+
+@pytest.mark.parametrize("mode", ["array-factor", "paper"])
+def test_measured_end_angles_equal_geometric_ones_in_the_ideal_far_field(mode):
+    """In the ideal far field (50 m, no Rx/Tx separation) each front end alone is detected
+    at its geometric angle, so the closed forms with measured end angles program the same
+    ratios as with the geometric ones: the same detected angles through the chain."""
+    from rtsgeom.aoa.calibration import probe_front_ends
+    from rtsgeom.aoa.linearity import linearity
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+
+    def far(doc):
+        doc["rts"]["arc_radius_m"] = 50.0
+        doc["sheet"]["enabled"] = False
+        for fe in doc["rts"]["front_ends"]:
+            fe["rx_tx_separation_m"] = 0.0
+            fe.pop("return_loss_fe_db", None)
+            fe.pop("return_loss_be_db", None)
+        doc["targets"] = [{"range_m": 60.0, "angle_deg": 7.0}]
+    setup = build_setup(_small_noiseless(far))
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, 1)
+    geo = linearity(setup, paths, (0, 1), mode, probe, None, 5, 1, "geometric")
+    meas = linearity(setup, paths, (0, 1), mode, probe, None, 5, 1, "measured")
+    assert np.all(np.isfinite(meas.error_deg))
+    np.testing.assert_allclose(meas.error_deg, geo.error_deg, atol=0.02)
+
+
+# -- radar.capture: probe captures round trip --------------------------------------------
+
+
+@pytest.mark.parametrize("fmt", ["npy", "bin"])
+@pytest.mark.parametrize("active", [0, 1])
+def test_probe_capture_round_trip(tmp_path, fmt, active):
+    """A probe capture written (``.npy`` or DCA1000 ``.bin`` + sidecar) reads back with its
+    active front end, probe range, velocity and amplitude, and the same samples (DCA1000:
+    within int16 quantisation). The default probe is the calibration's first probe range."""
+    from rtsgeom.aoa.calibration import probe_ranges
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.radar.capture import capture_probe, read_capture, simulate_capture, write_capture
+    setup = build_setup(_small_noiseless())
+    r0, amp0 = capture_probe(setup)
+    assert r0 == pytest.approx(float(probe_ranges(setup, 1)[0]))
+    r1, amp1 = capture_probe(setup, 2 * r0)
+    assert r1 == 2 * r0 and amp1 == pytest.approx(amp0 / 4, rel=1e-9)  # amplitude ~ 1/R^2
+    cap = simulate_capture(setup, active, velocity_mps=-1.5, seed=3)
+    out = tmp_path / f"cap.{fmt}"
+    write_capture(cap, setup.rut, out, fmt)
+    back = read_capture(out)
+    assert (back.active, back.range_m, back.velocity_mps, back.amplitude) == (
+        active, cap.range_m, -1.5, cap.amplitude)
+    assert back.data.shape == cap.data.shape
+    tol = 1e-6 if fmt == "npy" else 2.0 / 32767
+    assert np.max(np.abs(back.data - cap.data)) <= tol * np.max(np.abs(cap.data))
