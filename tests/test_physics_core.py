@@ -416,3 +416,119 @@ def test_probe_capture_round_trip(tmp_path, fmt, active):
     assert back.data.shape == cap.data.shape
     tol = 1e-6 if fmt == "npy" else 2.0 / 32767
     assert np.max(np.abs(back.data - cap.data)) <= tol * np.max(np.abs(cap.data))
+
+
+# -- analysis.arc: tolerance bounds, draws and the arc yield search ---------------------------
+
+
+@pytest.mark.parametrize("distribution, level", [("normal", 3.0), ("normal", 2.0),
+                                                 ("uniform", 3.0)])
+def test_bounds_from_tolerances_scale_every_field(distribution, level):
+    """A tolerance t is a normal draw's t / sigma_level standard deviation and a uniform
+    draw's bound t, for every field (front-end offsets and rotations, the RuT's position
+    and yaw); a field left out is 0."""
+    from rtsgeom.analysis.arc import Bounds
+    tol = {"offsets_m": (1e-4, 2e-4, 3e-4), "yaw_rad": 0.01, "pitch_rad": 0.02,
+           "rut_position_m": (4e-4, 5e-4, 6e-4), "rut_yaw_rad": 0.03}
+    k = 1.0 / level if distribution == "normal" else 1.0
+    b = Bounds.from_tolerances(tol, distribution, level)
+    assert b.offsets_m == pytest.approx(tuple(k * v for v in tol["offsets_m"]))
+    assert (b.yaw_rad, b.pitch_rad, b.rut_yaw_rad) == pytest.approx((0.01 * k, 0.02 * k,
+                                                                      0.03 * k))
+    assert b.rut_position_m == pytest.approx(tuple(k * v for v in tol["rut_position_m"]))
+    only = Bounds.from_tolerances({"rut_yaw_rad": 0.03}, distribution, level)
+    assert only.rut_yaw_rad == pytest.approx(0.03 * k) and only.rut_pose and not only.rotations
+    assert only.offsets_m == (0.0, 0.0, 0.0) and only.rut_position_m == (0.0, 0.0, 0.0)
+
+
+@pytest.mark.parametrize("distribution", ["normal", "uniform"])
+def test_arc_draws_do_not_depend_on_the_chunk(distribution):
+    """The unit draws are the same whatever the chunk size (each stream from its own
+    generator), with the documented shapes; uniform ones fill [-1, 1], normal ones have unit
+    variance."""
+    from rtsgeom.analysis.arc import arc_draws
+    draws, count = 400, 3
+    ref = None
+    for chunk in (1, 37, 400, 10_000):
+        parts = list(arc_draws(5, draws, count, distribution, chunk))
+        assert len(parts) == -(-draws // chunk)
+        got = {k: np.concatenate([p[k] for p in parts]) for k in ("offsets", "rotations", "rut")}
+        assert got["offsets"].shape == (draws, count, 3)
+        assert got["rotations"].shape == (draws, count, 2) and got["rut"].shape == (draws, 4)
+        if ref is None:
+            ref = got
+        for k in ref:
+            np.testing.assert_array_equal(got[k], ref[k])
+    x = ref["offsets"].ravel()
+    assert np.unique(x).size == x.size  # independent draws, not one value broadcast
+    if distribution == "uniform":
+        assert x.min() >= -1.0 and x.max() <= 1.0 and x.min() < -0.98 and x.max() > 0.98
+    else:
+        assert np.std(x) == pytest.approx(1.0, abs=0.05)
+
+
+def test_arc_yield_search_stops_at_zero_when_the_nominal_arc_fails():
+    """When even the arc without errors misses the spec, the largest passing scale is 0 and
+    its yield is the nominal one (0); with a reachable spec the scale is positive."""
+    from rtsgeom.analysis.arc import Bounds, arc_models, max_scale_for_yield
+    from rtsgeom.geometry import build_setup
+    setup = build_setup(make_scene())
+    models = arc_models(setup, [(0, 1)], 3)
+    b = Bounds((1e-4, 1e-4, 1e-4))
+    # the nominal calibrated synthesis is exact to ~1e-5 deg: a spec below that fails at 0
+    res = max_scale_for_yield(models, 2, b, 20, 1, 0.9, spec_deg=1e-12, case="uncalibrated")
+    assert res["factor"] == 0.0 and res["yield"] == 0.0 and not res["capped"]
+    ok = max_scale_for_yield(models, 2, b, 20, 1, 0.9, spec_deg=0.1, case="calibrated",
+                             rel_tol=0.1)
+    assert ok["factor"] > 0 and ok["yield"] >= 0.9
+
+
+# -- analysis.coverage: the planned arc ------------------------------------------------------
+
+
+def test_arc_scene_copies_the_first_front_end_without_its_errors():
+    """``arc_scene`` places copies of the first front end (layout, cables) at the given angles
+    on the given radius with none of its mounting or channel errors: the modules sit exactly
+    on the arc at their angles, unrotated, whatever errors the template had."""
+    from rtsgeom.analysis.coverage import arc_scene
+    from rtsgeom.geometry import build_setup
+
+    def errors(doc):
+        fe = doc["rts"]["front_ends"][0]
+        fe.update(radial_offset_mm=0.4, tangential_offset_mm=-0.3, height_offset_mm=0.7,
+                  yaw_offset_deg=1.5, pitch_offset_deg=-2.0, gain_offset_db=3.0,
+                  phase_offset_deg=20.0)
+    scene = make_scene(errors)
+    angles = np.radians([-6.0, 2.0, 10.0])
+    for radius in (1.0, 2.5):
+        variant, _ = arc_scene(scene, radius, angles)
+        clean, _ = arc_scene(make_scene(), radius, angles)
+        assert len(variant.rts.front_ends) == 3
+        for fe in variant.rts.front_ends:
+            assert (fe.radial_offset_m, fe.tangential_offset_m, fe.height_offset_m,
+                    fe.yaw_offset_rad, fe.pitch_offset_rad, fe.gain_offset_db,
+                    fe.phase_offset_rad) == (0.0,) * 7
+            assert fe.cable_length_m == scene.rts.front_ends[0].cable_length_m
+        s, s0 = build_setup(variant), build_setup(clean)
+        np.testing.assert_allclose(s.fe.module, s0.fe.module, atol=1e-12)
+        np.testing.assert_allclose(s.fe_azimuth_rad(), angles, atol=1e-9)
+        d = np.linalg.norm(s.fe.module - s.fe.arc_centre, axis=-1)
+        np.testing.assert_allclose(d, radius, atol=1e-12)
+
+
+def test_planned_arc_reports_the_outer_front_ends_near_field_bias():
+    """``plan_arc``'s outer bias is each outer front end's detected minus module angle (the
+    near-field bias, README ~+0.57 deg at 1 m with 20 mm separation): positive, first order
+    in 1/R (half at twice the radius), and what ``evaluate_arc`` carries over; the arc's
+    calibrated nominal synthesis is exact."""
+    from rtsgeom.analysis.coverage import evaluate_arc, plan_arc
+    scene = make_scene()
+    cov = (math.radians(0.0), math.radians(12.0))
+    p1, p2 = plan_arc(scene, cov, 1.0), plan_arc(scene, cov, 2.0)
+    b1, b2 = np.array(p1["outer_bias_deg"]), np.array(p2["outer_bias_deg"])
+    assert np.all(b1 > 0.3) and np.all(b1 < 0.9)
+    np.testing.assert_allclose(b1 / b2, 2.0, rtol=0.1)
+    ev = evaluate_arc(p2, draws=20, points=3)
+    assert ev["outer_bias_deg"] == p2["outer_bias_deg"] and ev["problem"] is None
+    assert ev["worst_calibrated_deg"] < 1e-3
+    assert 0.0 <= ev["tolerance_yield"] <= 1.0 and ev["sigma_mm"] > 0
