@@ -532,3 +532,122 @@ def test_planned_arc_reports_the_outer_front_ends_near_field_bias():
     assert ev["outer_bias_deg"] == p2["outer_bias_deg"] and ev["problem"] is None
     assert ev["worst_calibrated_deg"] < 1e-3
     assert 0.0 <= ev["tolerance_yield"] <= 1.0 and ev["sigma_mm"] > 0
+
+
+# -- radar.steering: the 2-D search does not depend on the snapshot's phase ------------------
+
+
+@pytest.mark.parametrize("preset", ["awr1843boost", "iwr6843isk", "awr2944"])
+@pytest.mark.parametrize("window", ["none", "hann", "hamming", "blackman"])
+def test_2d_search_is_independent_of_the_targets_phase(preset, window):
+    """A target's echo carries an arbitrary phase (range, RCS): multiplying a plane wave's
+    snapshot by e^{j phi} must not move the 2-D beamformer peak, for every taper and array:
+    the same (azimuth, elevation) for phases all around the circle, at the plane wave's
+    direction."""
+    from rtsgeom.radar.steering import Steering
+    from rtsgeom.scene import load_scene
+    sc = load_scene("scenes/diewald2022.toml")
+    radar = sc.radar.evolve(antenna_preset=preset, use_elevation_tx=True, angle_window=window,
+                            elevation_processing=True)
+    rut = build_setup_of(sc.evolve(radar=radar, targets=())).rut
+    st = Steering.auto(rut, radar)
+    assert st.dims == 2
+    rng = np.random.default_rng(11)
+    ae = np.radians(np.column_stack([rng.uniform(-40, 40, 12), rng.uniform(-20, 20, 12)]))
+    x = np.zeros((ae.shape[0], rut.num_virtual), complex)
+    x[:, st.mask] = np.exp(-1j * (st.wavevector @ st.directions(ae).T)).T
+    for phi in np.linspace(0, 2 * np.pi, 7, endpoint=False):
+        got = st.search(x * np.exp(1j * (phi + rng.uniform(0, 0.2))))
+        assert np.degrees(np.abs(got - ae)).max() < 1e-6
+
+
+def build_setup_of(scene):
+    from rtsgeom.geometry import build_setup
+    return build_setup(scene)
+
+
+# -- aoa.model: the RuT's pose in the channel model ------------------------------------------
+
+
+@pytest.mark.parametrize("h_mm", [-3.0, 0.5, 4.0])
+def test_raising_the_rut_equals_lowering_every_front_end(h_mm):
+    """Only relative geometry matters: the legs with the RuT raised by h (a RuT position
+    error alone, no yaw) equal those with every front end lowered by h (height offset -h),
+    for both channels of the pair; and they differ from the nominal legs."""
+    from rtsgeom.analysis.tolerance import PairPhasors
+    from rtsgeom.geometry import build_setup
+    model = PairPhasors.build(build_setup(make_scene()), (0, 1), 3)
+    h = h_mm * 1e-3
+    zero = np.zeros((2, 3))
+    raised = model.air_legs(zero, {"rut_offset_m": np.array([0.0, 0.0, h])})
+    lowered = model.air_legs(np.array([[0.0, 0.0, -h]] * 2))
+    nominal = model.air_legs(zero)
+    for a, b, n in zip(raised, lowered, nominal):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-18)
+        assert np.max(np.abs(a - n)) > 1e-16
+
+
+# -- radar.frame: the physical link's receiver noise ----------------------------------------
+
+
+def test_linked_frame_noise_is_the_receivers_thermal_noise_through_the_if_chain():
+    """With ``[radar.link]`` and no ``snr_db`` the frame's noise per sample is k T0 F f_adc at
+    the receiver input (no RTS channel programmed here) through the IF chain (mean |H|^2 over
+    the bins) plus the ADC's quantisation, for a grid of noise figures (within 5 %); the
+    seed decides the realisation."""
+    from rtsgeom import link as lk
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    from rtsgeom.radar.frame import simulate
+    from rtsgeom.rts import program_nearest
+
+    def linked(nf_db):
+        def m(doc):
+            doc["radar"].pop("snr_db", None)
+            doc["radar"].update(chirps_per_tx=32, samples_per_chirp=128, adc_rate_hz=12.5e6)
+            doc["radar"]["link"] = {"noise_figure_db": nf_db}
+            doc["targets"] = []
+            for fe in doc["rts"]["front_ends"]:
+                fe.pop("return_loss_fe_db", None)
+                fe.pop("return_loss_be_db", None)
+        return make_scene(m)
+    for nf in (12.0, 18.0, 24.0):
+        scene = linked(nf)
+        radar = scene.radar
+        setup = build_setup(scene)
+        paths = exact_paths(setup)
+        prog = program_nearest(scene, setup)
+        assert len(prog) == 0
+        _, cube = simulate(setup, paths, prog, seed=4)
+        _, again = simulate(setup, paths, prog, seed=4)
+        _, other = simulate(setup, paths, prog, seed=5)
+        assert np.array_equal(cube.data, again.data) and not np.array_equal(cube.data, other.data)
+        rl = lk.radar_link(radar)
+        n = radar.samples_per_chirp
+        h2 = np.mean(np.abs(lk.if_response(rl, np.arange(n) * radar.adc_rate_hz / n)) ** 2)
+        want = lk.thermal_noise_w(radar, rl) * h2 + rl.quantisation_noise_w
+        assert np.mean(np.abs(cube.data.astype(complex)) ** 2) == pytest.approx(want, rel=0.05)
+
+
+# -- aoa.calibration: the paper's procedure reports the exact period ------------------------
+
+
+def test_paper_procedure_reports_the_exact_period_at_its_target():
+    """``calibrate_pair_paper`` (one target at one set angle) reports the period
+    1/(f_rts + S t_mid - S tau) at its target's delay, as the pair calibration does at its
+    probes' (not eq. 27's 1/(f_rts + B/2))."""
+    from scipy.constants import c
+    from rtsgeom.aoa.calibration import calibrate_pair_paper, probe_front_ends, probe_ranges
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    for f_rts in (500e6, 300e6):
+        setup = build_setup(_small_noiseless(lambda d: d["rts"].update(f_rts_hz=f_rts)))
+        paths = exact_paths(setup)
+        probe = probe_front_ends(setup, paths, 1)
+        cal = calibrate_pair_paper(setup, paths, (0, 1), probe, 1, span_s=(0.0, 50e-12),
+                                   step_s=25e-12)
+        r = setup.scene.radar
+        t_mid = r.adc_start_s + 0.5 * (r.samples_per_chirp - 1) / r.adc_rate_hz
+        s = r.bandwidth_hz / r.chirp_duration_s
+        tau = 2 * float(probe_ranges(setup, 1)[0]) / c
+        assert cal.period_s == pytest.approx(1 / (f_rts + s * t_mid - s * tau), rel=1e-4)
