@@ -651,3 +651,79 @@ def test_paper_procedure_reports_the_exact_period_at_its_target():
         s = r.bandwidth_hz / r.chirp_duration_s
         tau = 2 * float(probe_ranges(setup, 1)[0]) / c
         assert cal.period_s == pytest.approx(1 / (f_rts + s * t_mid - s * tau), rel=1e-4)
+
+
+# -- aoa.sweep.design_ratio: the closed-form exact design ------------------------------------
+
+
+@pytest.mark.parametrize("angle_window", ["none", "hann", "hamming", "blackman"])
+@pytest.mark.parametrize("radius", [0.5, 1.0, 3.0])
+def test_closed_form_design_is_scale_free_and_puts_the_peak_on_the_set_angle(angle_window,
+                                                                            radius):
+    """``design_ratio``: the ratio whose composite x_i + rho e^{j phase} x_j peaks at the set
+    angle. Its beamformer peak is there (searched), and the ratio does not depend on the
+    echoes' common scale (volts or sqrt(W), 1e-6 or 1e6: P'' < 0 is a sign, not a level)."""
+    from rtsgeom.aoa.model import ChannelModel
+    from rtsgeom.aoa.sweep import design_ratio
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    from rtsgeom.scene import TargetConfig
+
+    def mutate(doc):
+        doc["radar"]["angle_window"] = angle_window
+        doc["rts"]["arc_radius_m"] = radius
+    setup = build_setup(make_scene(mutate))
+    cm = ChannelModel.build(setup, exact_paths(setup), (0, 1), TargetConfig(20.0))
+    st = cm.steering
+    x_i, x_j = cm.phasors
+    th = np.sort(st.search(cm.phasors))
+    phase = float(cm.coherent_phases(th[0] + np.array([0.25, 0.75]) * (th[1] - th[0]))[1])
+    alphas = th[0] + np.array([0.15, 0.4, 0.6, 0.85]) * (th[1] - th[0])
+    rho = design_ratio(st, x_i, x_j, alphas, phase)
+    assert np.all(np.isfinite(rho)) and np.all(rho >= 0)
+    comp = x_i[None] + (rho * np.exp(1j * phase))[:, None] * x_j[None]
+    np.testing.assert_allclose(st.search(comp), alphas, atol=1e-7)
+    for scale in (1e-6, 1e-3, 1e3, 1e6):
+        np.testing.assert_allclose(design_ratio(st, scale * x_i, scale * x_j, alphas, phase),
+                                   rho, rtol=1e-9)
+
+
+# -- aoa.sweep: the calibration's noise model against the ADC-cube chain -----------------------
+
+
+@pytest.mark.parametrize("snr_db", [-10.0, 0.0])
+def test_calibration_sweep_noise_is_the_adc_chains_within_a_factor_of_a_few(snr_db):
+    """The phasor sweep adds receiver noise of the scene's SNR to each step's spectra (what
+    sizes the frames per step and ``one_frame_scatter_ps``); the full ADC-cube chain adds it
+    to the samples. Near the coherence point both give the probes' angles a noise variance
+    (noisy minus noiseless squared error, 6 seeds x 2 steps x 2 probes); they agree within a
+    factor 5 (measured: the phasor model's is 1.4-1.5 times the chain's at SNR -10 and 0 dB),
+    where a noise level off by the windows' sum w^2 (thousands) would not."""
+    from rtsgeom.aoa.calibration import calibrate_pair, probe_front_ends
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+
+    def scene(snr):
+        def m(doc):
+            doc["radar"].pop("snr_db", None)
+            if snr is not None:
+                doc["radar"]["snr_db"] = snr
+            doc["radar"]["chirps_per_tx"] = 32
+            for fe in doc["rts"]["front_ends"]:
+                fe.pop("return_loss_fe_db", None)
+                fe.pop("return_loss_be_db", None)
+        return build_setup(make_scene(m))
+    clean = scene(None)
+    paths = exact_paths(clean)
+    probe = probe_front_ends(clean, paths, 1)
+    kw = dict(span_s=(0.0, 25e-12), step_s=25e-12, frames=1)  # two steps at coherence
+    e0 = {fc: calibrate_pair(clean, paths, (0, 1), probe, seed=1, full_chain=fc,
+                             **kw).sweep_error_deg for fc in (False, True)}
+    noisy = scene(snr_db)
+    var = {}
+    for fc in (False, True):
+        d = [calibrate_pair(noisy, paths, (0, 1), probe, seed=s, full_chain=fc,
+                            **kw).sweep_error_deg ** 2 - e0[fc] ** 2 for s in range(6)]
+        var[fc] = float(np.mean(d))
+    assert var[True] > 0 and var[False] > 0
+    assert 0.2 < var[False] / var[True] < 5.0
