@@ -38,7 +38,7 @@ are listed in ``EQUIVALENT`` with the reason; they are reported apart and left o
 
 Keep ``MODULES`` in step with the tests: a module whose tests are not mapped shows its
 mutants as "no tests" (the seed-3 sample found 21 such mutants in modules added after the map
-was written). New tests for a sample's survivors go to ``tests/test_physics_core.py``
+was written). New tests for a sample's survivors go to ``tests/test_physics_core.py`` / ``_aoa.py``
 (``KILLED_BY`` names the test per mutant); judge the suite on a sample it was not written
 for (a new ``--seed``).
 """
@@ -87,7 +87,8 @@ MODULES: dict[str, tuple[str, tuple[str, ...]]] = {
         "tests/test_aoa.py", "tests/test_steering.py", "tests/test_windows.py",
         "tests/test_fields.py", "tests/test_mutants.py", "tests/test_calibration.py",
         "tests/test_nchannel.py", "tests/test_sphere.py", "tests/test_elevation.py",
-        "tests/test_setups.py", "tests/test_reachable.py", "tests/test_physics_core.py")),
+        "tests/test_setups.py", "tests/test_reachable.py", "tests/test_physics_core.py",
+        "tests/test_physics_core_aoa.py")),
     "analysis": ("rtsgeom/analysis/*", (
         "tests/test_tolerance.py", "tests/test_nearfield.py", "tests/test_ghosts.py",
         "tests/test_design.py", "tests/test_mutants.py", "tests/test_setups.py",
@@ -167,8 +168,9 @@ EQUIVALENT: dict[str, str] = {
 }
 
 
-# first-pass survivor -> the test that kills it (tests/test_physics_core.py unless a file is
-# named); the fresh sample (seed 3). Printed in the report's "killed by later tests" section.
+# first-pass survivor -> the test that kills it (tests/test_physics_core.py for analysis/,
+# geometry/, radar/; tests/test_physics_core_aoa.py for aoa/); the fresh sample (seed 3).
+# Printed in the report's "killed by later tests" section.
 KILLED_BY: dict[str, str] = {
     "rtsgeom.analysis.arc.x_max_scale_for_yield__mutmut_56":
         "test_arc_yield_search_stops_at_zero_when_the_nominal_arc_fails",
@@ -469,8 +471,8 @@ def write_report(s: dict) -> None:
     if s["killed_later"]:
         lines += ["## First-pass survivors killed by later tests", "",
                   "Each was killed by a test added after the first pass (named below; in "
-                  "`tests/test_physics_core.py` for the seed-3 sample, `tests/test_mutants.py` "
-                  "for the seed-2 one).", ""]
+                  "`tests/test_physics_core.py` or, for `aoa/`, `tests/test_physics_core_aoa.py` "
+                  "for the seed-3 sample, `tests/test_mutants.py` for the seed-2 one).", ""]
         for k, d in s["killed_later"].items():
             by = [f"Killed by `{KILLED_BY[k]}`.", ""] if k in KILLED_BY else []
             lines += [f"### `{k}` (first pass: {d['first_status']})", "", *by, "```diff",
