@@ -272,3 +272,39 @@ def test_n_channel_exact_mode_hits_cell_points_for_every_taper(angle_window):
         u = lo + np.array([fx, fz]) * (hi - lo)
         w = cs.solve(u)
         assert np.abs(cs.direction_cosines(w, u) - u).max() < 1e-9
+
+
+@pytest.mark.parametrize("angle_window", WINDOWS)
+@pytest.mark.parametrize("radius", [0.5, 3.0])
+def test_coherence_point_moves_by_the_closed_form_for_every_taper(angle_window, radius):
+    """The calibration's target, the phasor model's coherence point, shifts by
+    -(f_c + S t_mid - S tau) / (f_rts + S t_mid - S tau) * 2 dr / c0 for a radial offset dr
+    of front end J (the opposite way for I), whatever the angle window: the taper weights the
+    elements, not the channels' relative phase."""
+    from scipy.constants import c
+    from rtsgeom.aoa.calibration import (air_phase_slope_hz, coherence_delay, if_phase_slope_hz,
+                                         probe_angles, probe_front_ends, probe_ranges,
+                                         probe_total_delay)
+
+    def scene(offsets=None):
+        def mutate(doc):
+            _quiet(doc, angle_window=angle_window)
+            doc["rts"]["arc_radius_m"] = radius
+            for k, v in (offsets or {}).items():
+                doc["rts"]["front_ends"][k]["radial_offset_mm"] = v
+        return build_setup(make_scene(mutate))
+    nom = scene()
+    paths = exact_paths(nom)
+    probe = probe_front_ends(nom, paths, 1)
+    alphas = probe_angles(*probe.angle_rad[[0, 1]])
+    d0 = coherence_delay(nom, paths, (0, 1), alphas)
+    tau = probe_total_delay(nom, probe_ranges(nom, 2))
+    ratio = air_phase_slope_hz(nom.scene, tau) / if_phase_slope_hz(nom.scene, tau)
+    period = 1 / if_phase_slope_hz(nom.scene, tau)
+    for fe, dr_mm in ((1, 0.3), (0, -0.7)):
+        s = scene({fe: dr_mm})
+        d = coherence_delay(s, exact_paths(s), (0, 1), alphas, d0)
+        sign = 1.0 if fe == 1 else -1.0
+        predicted = d0 - sign * ratio * 2 * dr_mm * 1e-3 / c
+        wrapped = (d - predicted + period / 2) % period - period / 2
+        assert abs(wrapped) < 1e-12
