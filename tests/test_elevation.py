@@ -27,7 +27,7 @@ def plane_waves(st, rut, ae):
 
 
 @pytest.mark.parametrize("preset", ["awr1843boost", "iwr6843isk", "awr2944", "awr2243-cascade"])
-@pytest.mark.parametrize("window", ["none", "hann"])
+@pytest.mark.parametrize("window", ["none", "hann", "hamming", "blackman"])
 def test_2d_search_finds_plane_waves(preset, window):
     rut, st = steering(preset, True, window)
     assert st.dims == 2 and Steering.has_elevation(rut)

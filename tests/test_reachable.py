@@ -37,7 +37,7 @@ def _bracket(text: str) -> tuple[str, str]:
 
 
 @pytest.mark.parametrize("radius_m,separation_m", [(1.0, 0.02), (2.0, 0.0), (0.7, 0.03)])
-@pytest.mark.parametrize("mode", ["exact", "paper"])
+@pytest.mark.parametrize("mode", ["exact", "array-factor", "paper"])
 def test_info_span_is_the_span_run_enforces(radius_m, separation_m, mode):
     """Across radii, Rx/Tx separations and amplitude modes: a target just outside the span that
     ``info`` reports is refused by ``run`` quoting the same span end; one just inside it is

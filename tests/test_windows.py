@@ -188,3 +188,121 @@ def test_tolerance_refine_matches_the_grid_search_and_calibrates_to_zero(pair_ph
     zero = np.zeros((2, 3))
     assert np.max(np.abs(model.angle_errors(zero, "calibrated"))) < 1e-4
     assert set(CASES) >= {"uncalibrated", "calibrated"}
+
+
+@pytest.mark.parametrize("range_window", WINDOWS)
+@pytest.mark.parametrize("doppler_window", WINDOWS)
+def test_fft_snr_gain_is_the_link_budgets_window_loss(range_window, doppler_window):
+    """White noise and an on-bin tone through ``range_doppler``: the SNR gain of the windowed
+    range and Doppler FFTs is N L (sum w)^2 / (N sum w^2) per axis, the factor the link budget
+    (``link.window_snr_loss``) and the calibration's noise model use, for every pair of
+    windows (noise power per cell sum w_r^2 sum w_d^2 sigma^2, tone (sum w_r)^2 (sum w_d)^2)."""
+    import dataclasses
+    from rtsgeom.link import window_snr_loss
+    scene = make_scene(lambda d: _quiet(d, range_window=range_window,
+                                        doppler_window=doppler_window) or d.update(targets=[]))
+    r = scene.radar
+    rut = build_setup(scene).rut
+    n_l, n_s, v = r.chirps_per_tx, r.samples_per_chirp, rut.num_virtual
+    k, m = 17, 3
+    tone = 0.01 * np.exp(2j * np.pi * (k * np.arange(n_s) / n_s
+                                       + m * np.arange(n_l)[:, None] / n_l))[:, None, :]
+    ech = Echoes(np.zeros((0, v)), *[np.zeros(0)] * 3, np.zeros((0, v), complex),
+                 *[np.zeros(0, int)] * 4)
+    empty = synthesize(ech, r, rut)
+    rng = np.random.default_rng(7)
+    sigma2 = 2.0
+    frames = 8
+    noise_power = []
+    for _ in range(frames):
+        z = np.sqrt(sigma2 / 2) * (rng.standard_normal((n_l, v, n_s))
+                                   + 1j * rng.standard_normal((n_l, v, n_s)))
+        noise_power.append(range_doppler(dataclasses.replace(empty, data=z.astype(np.complex64))
+                                         ).power.mean() / v)
+    sig = range_doppler(dataclasses.replace(
+        empty, data=np.broadcast_to(tone, (n_l, v, n_s)).astype(np.complex64)))
+    p_sig = sig.power[k, m + n_l // 2] / v
+    gain = (p_sig / np.mean(noise_power)) / (0.01 ** 2 / sigma2)
+    closed = n_s * n_l * window_snr_loss(range_window, n_s) * window_snr_loss(doppler_window, n_l)
+    w_r, w_d = window(range_window, n_s), window(doppler_window, n_l)
+    assert np.mean(noise_power) == pytest.approx(sigma2 * np.sum(w_r ** 2) * np.sum(w_d ** 2),
+                                                 rel=0.03)
+    assert gain == pytest.approx(closed, rel=0.03)
+
+
+@pytest.mark.parametrize("angle_window", WINDOWS)
+@pytest.mark.parametrize("radius", [0.5, 1.0, 3.0])
+def test_exact_mode_hits_the_set_angle_in_the_near_field_for_every_taper(angle_window, radius):
+    """``exact`` solves the pair's ratio on the modelled (tapered) beamformer of the real
+    near-field geometry: at a calibration delay offset too, every set-point between the two
+    front ends' detected angles is the modelled peak, for every angle window and radius."""
+    def mutate(doc):
+        _quiet(doc, angle_window=angle_window)
+        doc["rts"]["arc_radius_m"] = radius
+    scene = make_scene(mutate)
+    setup = build_setup(scene)
+    paths = exact_paths(setup)
+    for delay in (0.0, 150e-12):
+        cm = ChannelModel.build(setup, paths, (0, 1), TargetConfig(20.0), (0.0, delay))
+        th = np.sort(cm.steering.search(cm.phasors))
+        phases = cm.coherent_phases(th[0] + np.array([0.25, 0.75]) * (th[1] - th[0]))
+        for a in th[0] + np.array([0.1, 0.35, 0.6, 0.9]) * (th[1] - th[0]):
+            w = cm.solve(a, phases, "exact")
+            assert float(cm.direction(w)) == pytest.approx(a, abs=1e-8)
+
+
+@pytest.mark.parametrize("angle_window", WINDOWS)
+def test_n_channel_exact_mode_hits_cell_points_for_every_taper(angle_window):
+    """The N-channel exact mode (sphere4, four front ends in azimuth and elevation): the
+    modelled 2-D peak at each set point inside the cell, for every angle window."""
+    from rtsgeom.aoa.nchannel import ChannelSet
+    from rtsgeom.scene import load_scene
+    scene = load_scene("scenes/sphere4.toml")
+    scene = scene.evolve(radar=scene.radar.evolve(angle_window=angle_window))
+    setup = build_setup(scene)
+    cs = ChannelSet.build(setup, exact_paths(setup), (0, 1, 2, 3), TargetConfig(25.0))
+    u_fe = setup.fe_direction_cosines()
+    lo, hi = u_fe.min(0), u_fe.max(0)
+    for fx, fz in ((0.2, 0.5), (0.5, 0.15), (0.8, 0.85), (0.5, 0.5)):
+        u = lo + np.array([fx, fz]) * (hi - lo)
+        w = cs.solve(u)
+        assert np.abs(cs.direction_cosines(w, u) - u).max() < 1e-9
+
+
+@pytest.mark.parametrize("angle_window", WINDOWS)
+@pytest.mark.parametrize("radius", [0.5, 3.0])
+def test_coherence_point_moves_by_the_closed_form_for_every_taper(angle_window, radius):
+    """The calibration's target, the phasor model's coherence point, shifts by
+    -(f_c + S t_mid - S tau) / (f_rts + S t_mid - S tau) * 2 dr / c0 for a radial offset dr
+    of front end J (the opposite way for I), whatever the angle window: the taper weights the
+    elements, not the channels' relative phase."""
+    from scipy.constants import c
+    from rtsgeom.aoa.calibration import (air_phase_slope_hz, coherence_delay, if_phase_slope_hz,
+                                         probe_angles, probe_front_ends, probe_ranges,
+                                         probe_total_delay)
+
+    def scene(offsets=None):
+        def mutate(doc):
+            _quiet(doc, angle_window=angle_window)
+            # 256 samples: on the 128-sample cube probe_front_ends returns NaN for front end
+            # 1 without an error (probe at 20.3 m not found; an open finding, aoa/calibration.py)
+            doc["radar"].update(samples_per_chirp=256, adc_rate_hz=25e6)
+            doc["rts"]["arc_radius_m"] = radius
+            for k, v in (offsets or {}).items():
+                doc["rts"]["front_ends"][k]["radial_offset_mm"] = v
+        return build_setup(make_scene(mutate))
+    nom = scene()
+    paths = exact_paths(nom)
+    probe = probe_front_ends(nom, paths, 1)
+    alphas = probe_angles(*probe.angle_rad[[0, 1]])
+    d0 = coherence_delay(nom, paths, (0, 1), alphas)
+    tau = probe_total_delay(nom, probe_ranges(nom, 2))
+    ratio = air_phase_slope_hz(nom.scene, tau) / if_phase_slope_hz(nom.scene, tau)
+    period = 1 / if_phase_slope_hz(nom.scene, tau)
+    for fe, dr_mm in ((1, 0.3), (0, -0.7)):
+        s = scene({fe: dr_mm})
+        d = coherence_delay(s, exact_paths(s), (0, 1), alphas, d0)
+        sign = 1.0 if fe == 1 else -1.0
+        predicted = d0 - sign * ratio * 2 * dr_mm * 1e-3 / c
+        wrapped = (d - predicted + period / 2) % period - period / 2
+        assert abs(wrapped) < 1e-12
