@@ -90,7 +90,7 @@ def bench() -> list[dict]:
                 miss, unreachable = [], 0
                 for al in alphas:
                     try:
-                        w = m.solve(al, ph)
+                        m.solve(al, ph)  # reachable? (AngleUnreachable otherwise)
                     except AngleUnreachable:
                         unreachable += 1
                         continue

@@ -31,3 +31,13 @@ def make_scene(mutate=None, **radar_overrides):
 def default_scene():
     from rtsgeom.scene import load_scene
     return load_scene(DEFAULT_SCENE)
+
+
+@pytest.fixture(scope="session")
+def rt():
+    """The Sionna RT adapter, or a skip naming why it cannot run here (the ray-tracing tests)."""
+    from rtsgeom.paths import raytrace
+    ok, msg = raytrace.preflight()
+    if not ok:
+        pytest.skip(f"Sionna RT unavailable: {msg}")
+    return raytrace

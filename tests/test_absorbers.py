@@ -20,15 +20,6 @@ from rtsgeom.scene import SceneError, parse_scene
 pytestmark = pytest.mark.raytrace
 
 
-@pytest.fixture(scope="module")
-def rt():
-    from rtsgeom.paths import raytrace
-    ok, msg = raytrace.preflight()
-    if not ok:
-        pytest.skip(f"Sionna RT unavailable: {msg}")
-    return raytrace
-
-
 def _plate(folder, dist_m: float, az_deg: float) -> None:
     """A 0.4 m x 0.4 m plate ``dist_m`` from the RuT at azimuth ``az_deg`` (outside the sheet's
     -15..30 deg, which would shadow it), facing it."""

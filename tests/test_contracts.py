@@ -208,7 +208,6 @@ def test_a_broken_capture_is_a_capture_error_and_exit_2(capture_files, tmp_path,
 
 
 def test_odd_samples_cannot_be_dca1000(tmp_path, capsys):
-    from rtsgeom.cli import main
     from rtsgeom.errors import ParameterError
     from rtsgeom.geometry import build_setup
     from rtsgeom.radar.dca1000 import to_dca1000

@@ -278,7 +278,9 @@ def test_os_cfar_noise_is_the_ring_quantile(rank):
     power = rng.exponential(size=(48, 24))
     _, noise = cfar_mask(power, scene.radar.cfar)
     g, t = (1, 1), (3, 2)
-    offs = [(a, b) for a in range(-4, 5) for b in range(-3, 4) if not (abs(a) <= g[0] and abs(b) <= g[1])]
+    r = (g[0] + t[0], g[1] + t[1])  # the window's half-widths: guard + training
+    offs = [(a, b) for a in range(-r[0], r[0] + 1) for b in range(-r[1], r[1] + 1)
+            if not (abs(a) <= g[0] and abs(b) <= g[1])]
     # interior cells (away from the edges, where padding differs between implementations)
     for i, j in [(10, 10), (20, 5), (30, 17), (24, 12)]:
         vals = np.array([power[i + a, j + b] for a, b in offs])

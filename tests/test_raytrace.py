@@ -26,15 +26,6 @@ pytestmark = pytest.mark.raytrace
 
 
 @pytest.fixture(scope="module")
-def rt():
-    from rtsgeom.paths import raytrace
-    ok, msg = raytrace.preflight()
-    if not ok:
-        pytest.skip(f"Sionna RT unavailable: {msg}")
-    return raytrace
-
-
-@pytest.fixture(scope="module")
 def setup():
     return build_setup(load_scene(DEFAULT_SCENE))
 
