@@ -93,6 +93,8 @@ def link_budget(scene, echoes: Echoes, program: RtsProgram, linked: bool,
     link = radar_link(radar)
     raw = echoes
     e = echoes if linked else apply_radar_link(echoes, scene, link)
+    # whether the scene models the link (``info`` passes relative echoes of a linked scene)
+    modelled = linked or radar.link is not None
     f_b = beat_hz(raw, radar)
     # the IF response per echo (|H|^2 averaged over the virtual channels)
     h2 = np.mean(np.abs(if_response(link, f_b)) ** 2, axis=1) if len(raw) else np.zeros(0)
@@ -106,7 +108,7 @@ def link_budget(scene, echoes: Echoes, program: RtsProgram, linked: bool,
     else:
         noise = n_th + n_ch
         src = "thermal k T0 F f_adc + RTS channel noise"
-        if not linked:
+        if not modelled:
             src += (" (prediction: the scene has no [radar.link])" if predict else
                     "; not in the signal (no [radar.link], no snr_db)")
     nq = link.quantisation_noise_w if linked or predict else 0.0  # no ADC in the relative model
@@ -164,7 +166,7 @@ def link_budget(scene, echoes: Echoes, program: RtsProgram, linked: bool,
            "adc_bits": link.adc_bits, "adc_full_scale_dbm": float(dbm(link.adc_full_scale_w)),
            "thermal_noise_dbm_per_sample": float(dbm(n_th)),
            "rts_noise_dbm_per_sample": float(dbm(n_ch)), "sources": link.sources}
-    return LinkBudget(linked, src, float(noise), nq, gain_db, rad, fes, targets, rows_setup)
+    return LinkBudget(modelled, src, float(noise), nq, gain_db, rad, fes, targets, rows_setup)
 
 
 def link_warnings(budget: LinkBudget, threshold_db: float) -> list[str]:

@@ -260,3 +260,20 @@ def test_if_lowpass_is_scipys_butterworth(order):
     z, p, k = butter(order, 2 * np.pi * rl.if_lowpass_hz, analog=True, output="zpk")
     _, ref = freqs_zpk(z, p, k, worN=2 * np.pi * f)
     np.testing.assert_allclose(lk.if_response(rl, f), ref, rtol=1e-10, atol=1e-12)
+
+
+@pytest.mark.parametrize("linked", [False, True])
+def test_info_budget_says_whether_the_scene_models_the_link(linked):
+    """``rtsgeom info``'s budget (``static_budget``, computed from relative echoes) reports
+    ``modelled`` from the scene: with [radar.link] the link is in the signal, its noise
+    thermal; without, a prediction (found by a new-user trial: it said "no [radar.link]" on a
+    linked scene). The target's ADC power is the same prediction either way."""
+    def mut(doc):
+        linked_doc(doc)
+        if not linked:
+            del doc["radar"]["link"]
+            doc["radar"]["snr_db"] = 30.0
+    b = lk.static_budget(build_setup(make_scene(mut)))
+    assert b.to_dict()["modelled"] is linked
+    assert ("prediction" in b.to_dict()["noise_source"]) is (not linked)
+    assert b.to_dict()["targets"][0]["adc_power_dbm"] is not None
