@@ -53,11 +53,9 @@ def _setup_paths(scene: Scene):
 
 
 def _check_pair(setup, pair) -> tuple[int, int]:
+    from .aoa.plan import check_pair
     i, j = (int(p) for p in pair)
-    n = setup.fe.count
-    if not (0 <= i < n and 0 <= j < n) or abs(i - j) != 1:
-        raise ParameterError(f"pair {pair}: must be two adjacent front-end indices in [0, {n - 1}]")
-    return i, j
+    return check_pair(setup, i, j, f"pair {tuple(pair)}")
 
 
 def calibrate(scene: Scene, pair=(0, 1)):

@@ -139,3 +139,15 @@ def test_default_scene_run_unchanged_with_explicit_zero_elevations():
         assert np.array_equal(getattr(a.detections, name), getattr(b.detections, name))
     assert a.calibration == b.calibration
     assert all("elevation_deg" not in m["set"] for m in a.matches)
+
+
+@pytest.mark.parametrize("command", ["calibrate", "linearity", "tolerance"])
+@pytest.mark.parametrize("pair", [("0", "1"), ("0", "2"), ("1", "0")])
+def test_pair_commands_refuse_2d_cells(command, pair, capsys):
+    """A scene of 2-D cells has no pairs on an arc: the pair commands exit 2 naming the
+    argument and the cell commands (they used to exit 0 with an inf residual or a span of
+    zero width; new-user trial)."""
+    from rtsgeom.cli import main
+    assert main([command, "scenes/sphere4.toml", "--pair", *pair, "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert f"--pair {pair[0]} {pair[1]}" in err and "2-D cells" in err and "--grid" in err

@@ -147,6 +147,25 @@ def channel_offsets(n_fe: int, cals: dict[tuple[int, int], Calibration]) -> np.n
     return off
 
 
+def check_pair(setup: Setup, i: int, j: int, name: str) -> tuple[int, int]:
+    """A front-end pair of the arc in canonical order (the lower index first: I keeps its
+    delay, J is swept); ``name`` labels the argument in the error (``--pair 0 1``).
+
+    Pairs synthesize along the arc's azimuth: two adjacent front ends of an arc. A scene of
+    2-D cells (front ends off elevation 0, :func:`uses_cells`) has no such pair: the error
+    points to the commands that handle its cells."""
+    from ..errors import ParameterError
+    if uses_cells(setup.scene):
+        raise ParameterError(
+            f"{name}: this scene's front ends form 2-D cells (azimuth and elevation), not "
+            "pairs on an arc: use `run`, `linearity --grid N`, `nearfield` and `tolerance "
+            "--cell` for the cell")
+    n = setup.fe.count
+    if not (0 <= i < n and 0 <= j < n) or abs(i - j) != 1:
+        raise ParameterError(f"{name}: must be two adjacent front-end indices in [0, {n - 1}]")
+    return (min(i, j), max(i, j))
+
+
 def uses_cells(scene) -> bool:
     """Whether the scene needs cells of N front ends in (azimuth, elevation): a front end off
     the arc, or a target with an elevation. Otherwise the cells are pairs on the arc."""

@@ -43,11 +43,13 @@ def _pair(setup, pair):
     if len(pair) != 2 or "all" in pair:
         raise UsageError(f"--pair {' '.join(map(str, pair))}: must be two adjacent front-end "
                          "indices I J, or all")
+    from ..aoa.plan import check_pair
+    from ..errors import ParameterError
     i, j = pair
-    n = setup.fe.count
-    if not (0 <= i < n and 0 <= j < n) or abs(i - j) != 1:
-        raise UsageError(f"--pair {i} {j}: must be two adjacent front-end indices in [0, {n - 1}]")
-    return (min(i, j), max(i, j))
+    try:
+        return check_pair(setup, i, j, f"--pair {i} {j}")
+    except ParameterError as exc:
+        raise UsageError(str(exc)) from None
 
 
 def _prepare(args):
