@@ -52,6 +52,7 @@ from ..errors import ParameterError
 from ..geometry import Setup
 from ..geometry.setup import nominal_setup
 from ..paths import exact_paths
+from ..radar.steering import Steering
 from ..scene import TargetConfig
 from .tolerance import (AXES, CASES, DEFAULT_CHUNK, Mapper, Progress, largest_passing_scale,
                         percentiles, standard_draws)
@@ -95,6 +96,10 @@ class CellPhasors:
         (default the calibration's first probe range)."""
         nom = nominal_setup(setup)
         radar, rts = nom.scene.radar, nom.scene.rts
+        if Steering.auto(nom.rut, radar).dims != 2:
+            raise ParameterError("tolerance --cell needs a RuT that beamforms in azimuth and "
+                                 "elevation (an array with elevation extent, e.g. "
+                                 "radar.use_elevation_tx = true)")
         n_fe = nom.fe.count
         cell = tuple(range(n_fe)) if cell is None else tuple(sorted(int(q) for q in cell))
         if len(cell) not in (3, 4) or len(set(cell)) != len(cell) or not all(
@@ -106,10 +111,6 @@ class CellPhasors:
         target = TargetConfig(max(round(r0 / bin_m), 1) * bin_m)
         paths = exact_paths(nom)
         cs = ChannelSet.build(nom, paths, cell, target)
-        if cs.dims != 2:
-            raise ParameterError("tolerance --cell needs a RuT that beamforms in azimuth and "
-                                 "elevation (an array with elevation extent, e.g. "
-                                 "radar.use_elevation_tx = true)")
         st = cs.steering
         u_fe = cs.fe_directions()
         all_u = nom.fe_direction_cosines()
