@@ -28,6 +28,10 @@ smallest |delay|, quantised to the delay resolution, refined on the table's exac
 amplitude calibration (each channel's power over the virtual elements against the model's)
 and the delay's known loss at the bin divided out.
 
+With ``bounds`` the front ends' rotations (yaw, pitch) and the RuT's pose errors (position,
+yaw) are drawn too (``analysis.arc``'s streams, the offsets unchanged) and enter through
+:meth:`ChannelModel.perturbed`.
+
 Not modelled (the pair study has them): the target's sub-bin position and the RuT's bin
 choice (the calibration delays move the echoes by up to half an IF period, c0 / 4 f_IF-ish,
 in range), and the planner's alternative delays one IF period away.
@@ -36,6 +40,7 @@ in range), and the planner's alternative delays one IF period away.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import time
 from dataclasses import dataclass
@@ -56,6 +61,7 @@ from ..radar.steering import Steering
 from ..scene import TargetConfig
 from .tolerance import (AXES, CASES, DEFAULT_CHUNK, Mapper, Progress, largest_passing_scale,
                         percentiles, standard_draws)
+from .arc import Bounds, _scale, arc_draws
 from .tolerance_model import response_table
 
 __all__ = ["CellPhasors", "CellToleranceResult", "ANGLES", "monte_carlo_cell",
@@ -168,17 +174,20 @@ class CellPhasors:
         x0 = self.x_nominal
         return np.sqrt(np.sum(x0.real ** 2 + x0.imag ** 2, axis=-1) / p)
 
-    def draw(self, offsets_m, cases=CASES) -> dict:
+    def draw(self, offsets_m, cases=CASES, pose: dict | None = None) -> dict:
         """Per case the detected minus set (azimuth, elevation) (n, M, 2) rad, the angular
         distance (n, M) rad and whether the beamformer's Newton peak converged (n, M), for
-        mounting errors ``offsets_m`` (n, Q, 3); and the calibration steps (n, Q) and the
-        range offset between the channels after calibration (n,) m."""
+        mounting errors ``offsets_m`` (n, Q, 3) and ``pose`` (the rotations ``yaw_rad``,
+        ``pitch_rad`` (n, Q) and RuT pose errors ``rut_offset_m`` (n, 3), ``rut_yaw_rad``
+        (n,) of :meth:`ChannelModel.air_legs`; None: none); and the calibration steps (n, Q)
+        and the range offset between the channels after calibration (n,) m."""
         off = np.asarray(offsets_m, float)
+        pose = {k: v for k, v in (pose or {}).items() if v is not None}
         cm, st = self.cells.model, self.cells.steering
-        x, shift = cm.perturbed(off, return_shift=True)  # (n, Q, V)
+        x, shift = cm.perturbed(off, return_shift=True, **pose)  # (n, Q, V)
         steps = self.calibration_steps(x)
         q = np.arange(len(self.cell))
-        out = {"steps": steps, "range_offset_m": self._range_offset(off, steps)}
+        out = {"steps": steps, "range_offset_m": self._range_offset(off, steps, pose)}
         v_set = _unit_vectors(self.set_u)
         for case in cases:
             if case not in CASES:
@@ -199,10 +208,10 @@ class CellPhasors:
                          "converged": ok}
         return out
 
-    def _range_offset(self, off, steps) -> np.ndarray:
+    def _range_offset(self, off, steps, pose=None) -> np.ndarray:
         """The largest range offset (m) between a channel's echo and the reference's after
         calibration: c0/2 times the element-mean air delay plus the delay offset, (n,)."""
-        t_a, t_b = self.cells.model.air_legs(off)
+        t_a, t_b = self.cells.model.air_legs(off, **(pose or {}))
         tot = (t_a + t_b).mean(-1) + steps * self.delay_resolution_s  # (n, Q)
         return 0.5 * c * np.max(np.abs(tot - tot[:, :1]), axis=-1)
 
@@ -228,12 +237,14 @@ def _unit_vectors(u) -> np.ndarray:
     return np.concatenate([u, w[..., None]], axis=-1)
 
 
-def evaluate_cell_chunk(model: CellPhasors, offsets_m: np.ndarray, cases=CASES) -> dict:
+def evaluate_cell_chunk(model: CellPhasors, offsets_m: np.ndarray, cases=CASES,
+                        pose: dict | None = None) -> dict:
     """Per draw of ``offsets_m`` (k, Q, 3), per case: the signed azimuth and elevation errors of
     the worst set-point in each (the largest |error|), the largest angular distance (deg),
     (k, 3), and the count of peaks Newton left unconverged; the calibration steps (k, Q) and
-    range offsets (k,). Pure: the same offsets give the same bits."""
-    d = model.draw(offsets_m, cases)
+    range offsets (k,). ``pose``: :meth:`CellPhasors.draw`'s. Pure: the same offsets give
+    the same bits."""
+    d = model.draw(offsets_m, cases, pose)
     out = {"steps": d["steps"], "range_offset_m": d["range_offset_m"]}
     for case in cases:
         e = np.degrees(d[case]["error_rad"])  # (k, M, 2)
@@ -269,6 +280,7 @@ class CellToleranceResult:
     fallbacks: dict
     elapsed_s: float = 0.0
     cpu_s: float = 0.0
+    bounds: Bounds | None = None  # with the rotations and RuT pose errors drawn
 
     def yield_(self, case: str) -> float:
         """Fraction of draws whose every set-point is within the spec in both angles."""
@@ -292,6 +304,7 @@ class CellToleranceResult:
             "scale": "sigma" if self.distribution == "normal" else "bound",
             "sigma_mm": {a: float(s * 1e3) for a, s in zip(AXES, self.sigma_m)},
             "spec_deg": self.spec_deg,
+            "bounds": None if self.bounds is None else self.bounds.to_dict(),
             "yield_rule": "every set-point within spec_deg in azimuth and in elevation",
             "cell": self.model.to_dict(),
             "subbin": {"distribution": "bin centre", "positions": 1,
@@ -306,24 +319,28 @@ class CellToleranceResult:
         return out
 
 
-def _evaluate(model: CellPhasors, offsets: np.ndarray, cases) -> dict:
-    return evaluate_cell_chunk(model, offsets, cases)
+def _evaluate(model: CellPhasors, part: dict, cases) -> dict:
+    pose = {k: part[k] for k in ("yaw_rad", "pitch_rad", "rut_offset_m", "rut_yaw_rad")}
+    return evaluate_cell_chunk(model, part["offsets_m"], cases, pose)
 
 
 def monte_carlo_cell(model: CellPhasors, sigma_m, draws: int, seed: int,
                      distribution: str = "normal", spec_deg: float = 0.1, cases=CASES,
                      chunk: int = DEFAULT_CHUNK, progress: Progress | None = None,
-                     label: str = "tolerance", mapper: Mapper | None = None
-                     ) -> CellToleranceResult:
+                     label: str = "tolerance", mapper: Mapper | None = None,
+                     bounds: Bounds | None = None) -> CellToleranceResult:
     """``draws`` setups of the cell with mounting errors scaled by ``sigma_m`` (3,) (the pair
     study's :func:`~rtsgeom.analysis.tolerance.monte_carlo` for a cell: the same unit draws
-    per front end, chunked, optionally mapped; the outcome depends on neither)."""
+    per front end, chunked, optionally mapped; the outcome depends on neither). ``bounds``:
+    also the front ends' rotations and the RuT's pose errors (``analysis.arc``'s draws, their
+    own streams; its offsets are replaced by ``sigma_m``): the offsets stay the same draws."""
     t0, c0 = time.perf_counter(), time.process_time()
     sigma = np.asarray(sigma_m, float).reshape(3)
     if np.any(~np.isfinite(sigma)) or np.any(sigma < 0):
         raise ValueError(f"sigma_m {sigma.tolist()}: must be finite and >= 0")
     n_q = len(model.cell)
-    chunks = (z * sigma for z in standard_draws(seed, draws, distribution, chunk, n_q))
+    b = dataclasses.replace(bounds or Bounds((0.0, 0.0, 0.0)), offsets_m=tuple(sigma))
+    chunks = (_scale(u, b) for u in arc_draws(seed, draws, n_q, distribution, chunk))
     func = functools.partial(_evaluate, model, cases=tuple(cases))
     parts, done = [], 0
     for part in (map(func, chunks) if mapper is None else mapper(func, list(chunks))):
@@ -341,7 +358,7 @@ def monte_carlo_cell(model: CellPhasors, sigma_m, draws: int, seed: int,
         frozen(joined("steps", (0, n_q)) * model.delay_resolution_s),
         joined("range_offset_m", (0,)),
         {case: sum(p[case + "_fallbacks"] for p in parts) for case in cases},
-        time.perf_counter() - t0, time.process_time() - c0)
+        time.perf_counter() - t0, time.process_time() - c0, b)
 
 
 def max_sigma_for_yield_cell(model: CellPhasors, sigma_m, draws: int, seed: int,

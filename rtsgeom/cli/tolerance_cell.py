@@ -45,9 +45,16 @@ def tolerance_cell(args, scene, sigma, extra, stage) -> int:
                                            monte_carlo_cell, verify_cell_draws)
     from ..parallel import dask_client, map_chunks
     from .tolerance import _progress, capped_chunk
-    if list(args.pair) == ["all"] or any(v for v in extra.values() if np.any(v)):
-        raise UsageError("--cell: the cell study draws the three offsets per front end (not "
-                         "--pair all, rotations or RuT-pose errors)")
+    from ..analysis.arc import Bounds
+    if list(args.pair) == ["all"]:
+        raise UsageError("--cell and --pair all: give one of them")
+    k = 1.0 / args.sigma_level if args.distribution == "normal" else 1.0
+    bounds = Bounds(tuple(float(x) for x in sigma), k * extra["yaw_rad"],
+                    k * extra["pitch_rad"], tuple(k * x for x in extra["rut_position_m"]),
+                    k * extra["rut_yaw_rad"])
+    if (bounds.rotations or bounds.rut_pose) and (args.verify or args.invert_yield is not None):
+        raise UsageError("--verify, --invert-yield: only without rotation or RuT-pose errors "
+                         "so far")
     if args.nominal_amplitudes:
         raise UsageError("--nominal-amplitudes: only for the pair study (the cell study has no "
                          "bin logic yet)")
@@ -66,7 +73,8 @@ def tolerance_cell(args, scene, sigma, extra, stage) -> int:
     with _progress(args.quiet) as progress, dask_client(args.dask, args.workers) as client:
         mapper = None if client is None else functools.partial(map_chunks, client=client)
         res = monte_carlo_cell(model, sigma, args.draws, seed, args.distribution,
-                               args.spec_deg, CASES, chunk, progress, "Monte Carlo", mapper)
+                               args.spec_deg, CASES, chunk, progress, "Monte Carlo", mapper,
+                               bounds)
         out = res.to_dict()
         if args.verify:
             v = verify_cell_draws(model, sigma, min(args.verify, args.draws), seed,
