@@ -231,3 +231,13 @@ def test_rotation_draws_keep_the_offset_draws(model):
     for case in CASES:
         assert np.array_equal(a.worst_error_deg[case], b.worst_error_deg[case])
         assert not np.array_equal(a.worst_error_deg[case], c.worst_error_deg[case])
+
+
+def test_gain_calibration_inverts_a_channel_gain(model):
+    """The amplitude calibration: channel q's phasors scaled by g_q (any complex factor) give
+    the correction 1/|g_q| (each channel's power against the model's)."""
+    rng = np.random.default_rng(0)
+    g = rng.uniform(0.3, 3.0, len(model.cell)) * np.exp(1j * rng.uniform(-3, 3, len(model.cell)))
+    x = model.x_nominal * g[:, None]
+    assert np.allclose(model.gain_correction(x), 1 / np.abs(g), rtol=1e-12)
+    assert np.allclose(model.gain_correction(model.x_nominal), 1.0, rtol=1e-12)
