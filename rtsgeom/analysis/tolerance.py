@@ -61,9 +61,10 @@ Mapper = Callable[[Callable, list], Iterable]  # ordered map of a pure function 
 
 
 def standard_draws(seed: int, draws: int, distribution: str = "normal",
-                   chunk: int = DEFAULT_CHUNK) -> Iterator[np.ndarray]:
+                   chunk: int = DEFAULT_CHUNK, front_ends: int = 2) -> Iterator[np.ndarray]:
     """Unit-scale draws (k, 2, 3) chunk by chunk from ``numpy.random.default_rng(seed)``:
-    standard normal, or uniform in [-1, 1]. The stream does not depend on ``chunk``."""
+    standard normal, or uniform in [-1, 1]. The stream does not depend on ``chunk``.
+    ``front_ends``: (k, front_ends, 3) (a cell of front ends, ``tolerance_cell``)."""
     if distribution not in DISTRIBUTIONS:
         raise ValueError(f"distribution {distribution!r}: must be one of "
                          f"{', '.join(DISTRIBUTIONS)}")
@@ -72,9 +73,9 @@ def standard_draws(seed: int, draws: int, distribution: str = "normal",
     for start in range(0, draws, chunk):
         k = min(chunk, draws - start)
         if distribution == "normal":
-            yield rng.standard_normal((k, 2, 3))
+            yield rng.standard_normal((k, front_ends, 3))
         else:
-            yield rng.uniform(-1.0, 1.0, (k, 2, 3))
+            yield rng.uniform(-1.0, 1.0, (k, front_ends, 3))
 
 
 def subbin_draws(seed: int, draws: int, positions: int, chunk: int = DEFAULT_CHUNK

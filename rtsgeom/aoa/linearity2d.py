@@ -18,7 +18,7 @@ from ..scene import TargetConfig
 from .calibration import _simulate_detect, nominal_model, probe_front_ends, probe_ranges
 from .nchannel import ChannelSet
 
-__all__ = ["ErrorMap", "linearity_grid"]
+__all__ = ["ErrorMap", "cell_grid", "linearity_grid"]
 
 
 @dataclass(frozen=True)
@@ -49,6 +49,19 @@ class ErrorMap:
                 "max_abs_error_deg": {"azimuth": mx[0], "elevation": mx[1]}}
 
 
+def cell_grid(steering: Steering, u_fe, n: int) -> np.ndarray:
+    """Set directions (P, 2) (azimuth, elevation) rad over a cell of front ends at direction
+    cosines ``u_fe`` (Q, 2): an n x n grid at fractions (k + 1) / (n + 1) of the corners'
+    extent in each angle (ends excluded), the points outside the cell's hull dropped."""
+    u_fe = np.asarray(u_fe, float)
+    ang_fe = steering.angles(u_fe)
+    lo, hi = ang_fe.min(0), ang_fe.max(0)
+    f = np.arange(1, n + 1) / (n + 1)
+    grid = np.stack(np.meshgrid(lo[0] + f * (hi[0] - lo[0]), lo[1] + f * (hi[1] - lo[1]),
+                                indexing="ij"), -1).reshape(-1, 2)
+    return grid[Delaunay(u_fe).find_simplex(steering.directions(grid)) >= 0]
+
+
 def linearity_grid(setup: Setup, paths: Paths, mode: str = "exact", n: int = 5,
                    calibrate: bool = True, seed: int = 0, progress=None) -> ErrorMap:
     """An n x n grid of set directions over the cell of all front ends (at most 4: one cell)
@@ -73,13 +86,7 @@ def linearity_grid(setup: Setup, paths: Paths, mode: str = "exact", n: int = 5,
         cal = calibrate_channels(setup, paths, cell, probe, seed, progress)
         offsets, tree = cal.offsets_s, cal.tree
     cs = ChannelSet.build(nom, nom_paths, cell, target0, offsets[list(cell)])
-    u_fe = cs.fe_directions()
-    ang_fe = st.angles(u_fe)
-    lo, hi = ang_fe.min(0), ang_fe.max(0)
-    f = np.arange(1, n + 1) / (n + 1)
-    grid = np.stack(np.meshgrid(lo[0] + f * (hi[0] - lo[0]), lo[1] + f * (hi[1] - lo[1]),
-                                indexing="ij"), -1).reshape(-1, 2)
-    grid = grid[Delaunay(u_fe).find_simplex(st.directions(grid)) >= 0]
+    grid = cell_grid(st, cs.fe_directions(), n)
     phases = None if tree is None else tree_phases(cs, tree)
     corr = probe.gain_correction[list(cell)] if calibrate else np.ones(len(cell))
     tau = float(requested_delay(setup.scene, rng))

@@ -33,7 +33,7 @@ from ..scene import TargetConfig
 from .nchannel import ChannelSet
 
 __all__ = ["ChannelCalibration", "calibrate_channels", "calibrate_pair_nd", "pair_edges",
-           "tree_phases"]
+           "spanning_tree", "tree_phases"]
 
 PROBE_RATIOS = (1 / 3, 3.0)  # channel j's amplitude over channel i's for the two probes
 
@@ -193,20 +193,11 @@ def calibrate_channels(setup, paths, channels, probe, seed=None, progress=None,
         meas[e] = calibrate_pair_nd(setup, paths, e, probe, seed, span_s, step_s)
         if progress:
             progress(f"calibrated pair {e}: delta_tau {meas[e]['delta_tau_s'] * 1e12:.1f} ps")
-    n = setup.fe.count
-    w = np.zeros((n, n))
-    for i, j in edges:  # shortest edges first (the most reliable sweeps), +1 keeps 0-length
-        w[i, j] = 1.0 + np.linalg.norm(u_fe[i] - u_fe[j])
-    tree = minimum_spanning_tree(csr_matrix(w)).toarray()
-    sym = csr_matrix((tree + tree.T) > 0)
-    order, pred = breadth_first_order(sym, ref, directed=False)
-    tree_edges = []
-    for q in order[1:]:
-        p = int(pred[q])
+    tree_edges = spanning_tree(u_fe, edges, ref)
+    for p, q in tree_edges:
         i, j = min(p, q), max(p, q)
         d = meas[(i, j)]["delta_tau_s"]  # j relative to i
         offsets[q] = offsets[p] + (d if q == j else -d)
-        tree_edges.append((p, int(q)))
     on_tree = {tuple(sorted(e)) for e in tree_edges}
     closure = []
     for (i, j), m in meas.items():
@@ -220,22 +211,41 @@ def calibrate_channels(setup, paths, channels, probe, seed=None, progress=None,
                               tuple(probe.gain_correction))
 
 
-def tree_phases(cs: ChannelSet, tree) -> np.ndarray:
+def spanning_tree(u_fe, edges, ref: int) -> list[tuple[int, int]]:
+    """The edges [(parent, child)] (front-end indices, breadth-first from ``ref``) along which
+    :func:`calibrate_channels` adds the measured pairs' delays: the minimum spanning tree of
+    the measured ``edges`` weighted by their length in direction cosines (the shortest, most
+    reliable sweeps first; +1 keeps a 0-length edge)."""
+    u_fe = np.asarray(u_fe, float)
+    n = u_fe.shape[0]
+    w = np.zeros((n, n))
+    for i, j in edges:
+        w[i, j] = 1.0 + np.linalg.norm(u_fe[i] - u_fe[j])
+    tree = minimum_spanning_tree(csr_matrix(w)).toarray()
+    sym = csr_matrix((tree + tree.T) > 0)
+    order, pred = breadth_first_order(sym, ref, directed=False)
+    return [(int(pred[q]), int(q)) for q in order[1:]]
+
+
+def tree_phases(cs: ChannelSet, tree, phasors=None) -> np.ndarray:
     """The channel phases (Q,) a calibration along ``tree`` [(i, j)] (front-end indices,
     parent first) establishes on the channel set ``cs``: each pair coherent at the midpoint
     of its front ends' directions, where its probes sat (``coherent_phases`` of the pair),
-    added up from the reference; channels not on the tree keep phase 0."""
+    added up from the reference; channels not on the tree keep phase 0. ``phasors``
+    (..., Q, V): the channels as built (e.g. a tolerance draw's, ``ChannelModel.perturbed``;
+    the probes stay at the nominal directions), default ``cs.model.phasors``: (..., Q)."""
     ch = list(cs.model.channels)
     pos = {q: k for k, q in enumerate(ch)}
     u = cs.fe_directions()
-    ph = np.zeros(len(ch))
+    x = cs.model.phasors if phasors is None else np.asarray(phasors)
+    ph = np.zeros(x.shape[:-1])
     for i, j in tree:
         if i not in pos or j not in pos:
             continue
         a, b = pos[i], pos[j]
         mid = 0.5 * (u[a] + u[b])
-        beams = cs.steering.beam(cs.model.phasors[[a, b]], mid[None])[:, 0]
-        ph[b] = ph[a] + np.angle(beams[0] * np.conj(beams[1]))
+        beams = cs.steering.beam(x[..., [a, b], :], mid[None])[..., 0]
+        ph[..., b] = ph[..., a] + np.angle(beams[..., 0] * np.conj(beams[..., 1]))
     return ph
 
 

@@ -22,6 +22,8 @@ from ._common import (UsageError, load_scene_checked, number, output_folder, out
 from .aoa import _pair, _pair_arg
 from .arc import coverage_spec
 
+#: ``tolerance``'s ``--pair`` default, by identity: left at it, a 2-D RuT gets the cell study
+DEFAULT_PAIR = [0, 1]
 MAX_SIGMA_MM = 10.0  # the phasor model is first order in the errors; checked to 0.3 mm
 #: Peak memory of one Monte-Carlo chunk is at most about ``chunk * chunk_bytes_per_draw(points)``
 #: (measured with tracemalloc, all three cases, the issue-13 model: 17 kB/draw at 5 set-points,
@@ -107,6 +109,9 @@ def cmd_tolerance(args) -> int:
 def _tolerance(args, scene, stage) -> int:
     from .arc import save_pair_npz, scales, tolerance_arc, wants_arc
     sigma, extra = scales(args)
+    from .tolerance_cell import tolerance_cell, wants_cell
+    if wants_cell(args, scene, DEFAULT_PAIR):  # a 2-D cell of front ends (issue 15)
+        return tolerance_cell(args, scene, sigma, extra, stage)
     if wants_arc(args):
         if args.verify:
             raise UsageError("--verify: only for one pair with offsets (not --pair all, "
@@ -323,7 +328,12 @@ def register(sub) -> None:
                    help="run the chunks on an existing Dask scheduler (tcp://host:8786)")
     p.add_argument("--workers", type=number(1, 1024, integer=True), default=None,
                    help="run the chunks on a local Dask cluster of N worker processes")
-    p.set_defaults(func=cmd_tolerance)
+    p.add_argument("--cell", nargs="+", type=_pair_arg, metavar="Q | all", default=None,
+                   help="the study for a 2-D cell: 3 or 4 front-end indices, or all (a RuT "
+                        "beamforming in azimuth and elevation; its default there when --pair "
+                        "is not given); --points N gives about N set directions (a "
+                        "round(sqrt N)^2 azimuth x elevation grid, those inside the cell)")
+    p.set_defaults(func=cmd_tolerance, pair=DEFAULT_PAIR)
 
     p = sub.add_parser("design", help="arc radius x front-end spacing design map")
     _common(p, 2000)

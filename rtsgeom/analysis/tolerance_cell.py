@@ -1,0 +1,472 @@
+"""Mounting-tolerance Monte Carlo of a 2-D cell of front ends (issue 15: the tolerance study
+for a cell of Q = 3 or 4 front ends on a sphere, a RuT beamforming in azimuth and elevation;
+the pair study, :mod:`rtsgeom.analysis.tolerance`, is the arc's).
+
+Each draw moves every front end of the cell radially, tangentially and in height (the pair
+study's unit draws, :func:`~rtsgeom.analysis.tolerance.standard_draws` with ``front_ends=Q``,
+scaled by the per-axis sigmas or bounds). The operator does not know the errors: the channel
+weights of set directions over the cell (an n x n azimuth x elevation grid inside it,
+:func:`~rtsgeom.aoa.linearity2d.cell_grid`) are designed once on the nominal setup
+(:meth:`ChannelSet.solve <rtsgeom.aoa.nchannel.ChannelSet.solve>`, ``exact``: peak matching on
+the modelled 2-D beamformer output), for the channel phases the cell's calibration
+establishes (:func:`~rtsgeom.aoa.ncal.tree_phases`: each measured pair of the spanning tree
+coherent at the midpoint of its front ends' directions).
+
+A draw at phasor level (the bin-centre special case of ``PairPhasors.snapshots``, per
+channel; eq. 15/16 with the exact legs, :meth:`ChannelModel.perturbed`)::
+
+    x_qv(draw) = x_qv(nominal) * (a_qv b_qv / a'_qv b'_qv) exp(j 2 pi f_air d_qv)
+                 * F_qv(k_q) * exp(s_qv(k_q) d_qv)
+
+with ``F_q(k)`` channel q's response to an RTS delay offset of k steps over its response at
+0 (``tolerance_model.response_table`` through the ADC-cube chain's ``rts.channel_echoes``),
+``s`` its log-magnitude slope (the echo slides along the range window by the air delay
+change d as by an RTS delay). ``uncalibrated``: k = 0 and the nominal amplitudes.
+``calibrated``: the cell's calibration at phasor level: the tree phases of the draw's
+channels (the pairs' probes at the nominal directions) as delays by eq. (27) (wrapped to the
+smallest |delay|, quantised to the delay resolution, refined on the table's exact phase), the
+amplitude calibration (each channel's power over the virtual elements against the model's)
+and the delay's known loss at the bin divided out.
+
+With ``bounds`` the front ends' rotations (yaw, pitch) and the RuT's pose errors (position,
+yaw) are drawn too (``analysis.arc``'s streams, the offsets unchanged) and enter through
+:meth:`ChannelModel.perturbed`.
+
+Not modelled (the pair study has them): the target's sub-bin position and the RuT's bin
+choice (the calibration delays move the echoes by up to half an IF period, c0 / 4 f_IF-ish,
+in range), and the planner's alternative delays one IF period away.
+``verify_cell_draws`` pushes draws through the full ADC-cube chain.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.constants import c
+
+from .._util import frozen
+from ..aoa.calibration import probe_ranges
+from ..aoa.linearity2d import cell_grid
+from ..aoa.ncal import pair_edges, spanning_tree, tree_phases
+from ..aoa.nchannel import ChannelSet
+from ..errors import ParameterError
+from ..geometry import Setup
+from ..geometry.setup import nominal_setup
+from ..paths import exact_paths
+from ..radar.steering import Steering
+from ..scene import TargetConfig
+from .tolerance import (AXES, CASES, DEFAULT_CHUNK, Mapper, Progress, largest_passing_scale,
+                        percentiles, standard_draws)
+from .arc import Bounds, _scale, arc_draws
+from .tolerance_model import response_table
+
+__all__ = ["CellPhasors", "CellToleranceResult", "ANGLES", "monte_carlo_cell",
+           "max_sigma_for_yield_cell", "evaluate_cell_chunk", "draw_cell_offsets",
+           "verify_cell_draws"]
+
+ANGLES = ("azimuth", "elevation", "angular_distance")
+STAT_KEYS = ("azimuth_error_deg", "elevation_error_deg", "angular_distance_deg")
+REFINE_STEPS = 8  # the calibration delay refined +-this many steps on the table's phase
+
+
+def _wrap(phi):
+    return np.angle(np.exp(1j * np.asarray(phi)))
+
+
+@dataclass(frozen=True)
+class CellPhasors:
+    """The design (set directions, amplitudes) and the delay tables of one cell of front ends
+    on its nominal :class:`~rtsgeom.aoa.nchannel.ChannelSet` (``cells``, 2-D beamformer)."""
+
+    cells: ChannelSet  # Q channels, nominal setup, target at the bin centre
+    set_rad: np.ndarray  # (M, 2) set (azimuth, elevation)
+    set_u: np.ndarray  # (M, 2) their direction cosines
+    amplitudes: np.ndarray  # (M, Q) designed |w| (the strongest 1)
+    phases: np.ndarray  # (Q,) the nominal calibration's channel phases (the design's)
+    tree: tuple  # ((parent, child), ...) front-end indices, the calibration's spanning tree
+    delay_factor: np.ndarray  # (Q, 2 S + 1, V) F_q(k), k = -S..S
+    delay_log_slope: np.ndarray  # (Q, 2 S + 1, V) Re d ln F / d tau (1/s)
+    cal_slope_hz: float  # f_rts + B/2: eq. (27)
+    delay_resolution_s: float
+
+    @classmethod
+    def build(cls, setup: Setup, cell=None, grid: int = 5,
+              range_m: float | None = None) -> "CellPhasors":
+        """Design on the nominal setup of ``setup`` for the cell ``cell`` (front-end indices;
+        default all, which must be 3 or 4), ``grid`` x ``grid`` set directions (the points
+        inside the cell), the target at the centre of the range bin nearest ``range_m``
+        (default the calibration's first probe range)."""
+        nom = nominal_setup(setup)
+        radar, rts = nom.scene.radar, nom.scene.rts
+        if Steering.auto(nom.rut, radar).dims != 2:
+            raise ParameterError("tolerance --cell needs a RuT that beamforms in azimuth and "
+                                 "elevation (an array with elevation extent, e.g. "
+                                 "radar.use_elevation_tx = true)")
+        n_fe = nom.fe.count
+        cell = tuple(range(n_fe)) if cell is None else tuple(sorted(int(q) for q in cell))
+        if len(cell) not in (3, 4) or len(set(cell)) != len(cell) or not all(
+                0 <= q < n_fe for q in cell):
+            raise ParameterError(f"cell {list(cell)}: must be 3 or 4 distinct front-end indices "
+                                 f"in [0, {n_fe - 1}]")
+        bin_m = radar.range_resolution_m
+        r0 = float(probe_ranges(nom, 1)[0]) if range_m is None else float(range_m)
+        target = TargetConfig(max(round(r0 / bin_m), 1) * bin_m)
+        paths = exact_paths(nom)
+        cs = ChannelSet.build(nom, paths, cell, target)
+        st = cs.steering
+        u_fe = cs.fe_directions()
+        all_u = nom.fe_direction_cosines()
+        tree = tuple(spanning_tree(all_u, pair_edges(all_u, cell), cell[0]))
+        phases = tree_phases(cs, tree)
+        sets = cell_grid(st, u_fe, int(grid))
+        if sets.shape[0] == 0:
+            raise ParameterError(f"cell {list(cell)}: no set direction of a {grid} x {grid} "
+                                 "grid lies inside it")
+        set_u = st.directions(sets)
+        amps = np.stack([np.abs(cs.solve(u, phases, "exact")) for u in set_u])
+        res = rts.delay_resolution_s
+        slope = rts.f_rts_hz + 0.5 * radar.bandwidth_hz
+        max_steps = int(np.ceil(0.5 / (slope * res))) + REFINE_STEPS + 1
+        steps = np.arange(-max_steps, max_steps + 1)
+        tables = np.stack([response_table(nom, paths, q, target, res, steps, 0)[:, 0]
+                           for q in cell])  # (Q, D, V)
+        factor = tables / tables[:, max_steps:max_steps + 1]
+        with np.errstate(divide="ignore"):
+            log_slope = np.gradient(np.log(np.abs(tables)), res, axis=1)
+        return cls(cs, frozen(sets), frozen(set_u), frozen(amps), frozen(phases), tree,
+                   frozen(factor), frozen(log_slope), float(slope), float(res))
+
+    cell = property(lambda self: tuple(self.cells.model.channels))
+    setup = property(lambda self: self.cells.model.setup)  # nominal
+    range_m = property(lambda self: self.cells.model.range_m)
+    x_nominal = property(lambda self: self.cells.model.phasors)  # (Q, V)
+
+    @property
+    def max_steps(self) -> int:
+        return (self.delay_factor.shape[1] - 1) // 2
+
+    # -- one draw ---------------------------------------------------------------------------
+
+    def calibration_steps(self, xq: np.ndarray) -> np.ndarray:
+        """The cell's calibration in delay steps (..., Q) (the reference channel 0) for the
+        channels' phasors (..., Q, V): the tree phases (:func:`tree_phases`) as delays by
+        eq. (27), wrapped to the smallest |delay|, quantised, refined on the table's phase."""
+        psi = tree_phases(self.cells, self.tree, xq)  # (..., Q)
+        mask = self.cells.steering.mask
+        table_phase = np.angle(self.delay_factor[..., mask].mean(-1))  # (Q, D)
+        s = self.max_steps
+        sign = np.sign(np.median(table_phase[:, s + 1]))
+        k0 = np.round(_wrap(psi) / (sign * 2 * np.pi * self.cal_slope_hz
+                                    * self.delay_resolution_s)).astype(int)
+        r = s - REFINE_STEPS - 1
+        cand = np.clip(k0[..., None], -r, r) + np.arange(-REFINE_STEPS, REFINE_STEPS + 1)
+        q = np.arange(psi.shape[-1])[:, None]
+        miss = np.abs(_wrap(psi[..., None] - table_phase[q, cand + s]))
+        return np.take_along_axis(cand, np.argmin(miss, -1)[..., None], -1)[..., 0]
+
+    def gain_correction(self, xq: np.ndarray) -> np.ndarray:
+        """The amplitude calibration: per channel sqrt(modelled / measured power), (..., Q)."""
+        p = np.sum(xq.real ** 2 + xq.imag ** 2, axis=-1)
+        x0 = self.x_nominal
+        return np.sqrt(np.sum(x0.real ** 2 + x0.imag ** 2, axis=-1) / p)
+
+    def draw(self, offsets_m, cases=CASES, pose: dict | None = None) -> dict:
+        """Per case the detected minus set (azimuth, elevation) (n, M, 2) rad, the angular
+        distance (n, M) rad and whether the beamformer's Newton peak converged (n, M), for
+        mounting errors ``offsets_m`` (n, Q, 3) and ``pose`` (the rotations ``yaw_rad``,
+        ``pitch_rad`` (n, Q) and RuT pose errors ``rut_offset_m`` (n, 3), ``rut_yaw_rad``
+        (n,) of :meth:`ChannelModel.air_legs`; None: none); and the calibration steps (n, Q)
+        and the range offset between the channels after calibration (n,) m."""
+        off = np.asarray(offsets_m, float)
+        pose = {k: v for k, v in (pose or {}).items() if v is not None}
+        cm, st = self.cells.model, self.cells.steering
+        x, shift = cm.perturbed(off, return_shift=True, **pose)  # (n, Q, V)
+        steps = self.calibration_steps(x)
+        q = np.arange(len(self.cell))
+        out = {"steps": steps, "range_offset_m": self._range_offset(off, steps, pose)}
+        v_set = _unit_vectors(self.set_u)
+        for case in cases:
+            if case not in CASES:
+                raise ValueError(f"case {case!r}: must be one of {', '.join(CASES)}")
+            k = steps if case == "calibrated" else np.zeros_like(steps)
+            f = self.delay_factor[q, k + self.max_steps]  # (n, Q, V)
+            xk = x * f * np.exp(self.delay_log_slope[q, k + self.max_steps] * shift)
+            amps = np.broadcast_to(self.amplitudes, (off.shape[0],) + self.amplitudes.shape)
+            if case == "calibrated":  # the gains measured, the delay's known loss divided out
+                loss = np.abs(f[..., st.mask].mean(-1))  # (n, Q)
+                amps = amps * (self.gain_correction(x) / loss)[:, None, :]
+            snaps = np.einsum("nmq,nqv->nmv", amps, xk)
+            u, ok = st.peak(snaps, self.set_u)
+            ang = st.angles(u)
+            dist = 2 * np.arcsin(np.clip(np.linalg.norm(_unit_vectors(u) - v_set, axis=-1) / 2,
+                                         0.0, 1.0))
+            out[case] = {"error_rad": ang - self.set_rad, "distance_rad": dist,
+                         "converged": ok}
+        return out
+
+    def _range_offset(self, off, steps, pose=None) -> np.ndarray:
+        """The largest range offset (m) between a channel's echo and the reference's after
+        calibration: c0/2 times the element-mean air delay plus the delay offset, (n,)."""
+        t_a, t_b = self.cells.model.air_legs(off, **(pose or {}))
+        tot = (t_a + t_b).mean(-1) + steps * self.delay_resolution_s  # (n, Q)
+        return 0.5 * c * np.max(np.abs(tot - tot[:, :1]), axis=-1)
+
+    def to_dict(self) -> dict:
+        k = self.calibration_steps(self.x_nominal)
+        fe = self.cells.steering.angles(self.cells.fe_directions())
+        return {
+            "cell": list(self.cell),
+            "range_m": self.range_m,
+            "front_end_directions_deg": [[float(a) for a in np.degrees(d)] for d in fe],
+            "set_points": int(self.set_rad.shape[0]),
+            "set_directions_deg": [[float(a) for a in np.degrees(d)] for d in self.set_rad],
+            "spanning_tree": [list(e) for e in self.tree],
+            "nominal_delta_tau_s": [float(x) * self.delay_resolution_s for x in k],
+            "delay_resolution_s": self.delay_resolution_s,
+        }
+
+
+def _unit_vectors(u) -> np.ndarray:
+    """Unit direction vectors (..., 3) of direction cosines (..., 2) (the front hemisphere)."""
+    u = np.asarray(u, float)
+    w = np.sqrt(np.clip(1.0 - np.sum(u ** 2, axis=-1), 0.0, None))
+    return np.concatenate([u, w[..., None]], axis=-1)
+
+
+def evaluate_cell_chunk(model: CellPhasors, offsets_m: np.ndarray, cases=CASES,
+                        pose: dict | None = None) -> dict:
+    """Per draw of ``offsets_m`` (k, Q, 3), per case: the signed azimuth and elevation errors of
+    the worst set-point in each (the largest |error|), the largest angular distance (deg),
+    (k, 3), and the count of peaks Newton left unconverged; the calibration steps (k, Q) and
+    range offsets (k,). ``pose``: :meth:`CellPhasors.draw`'s. Pure: the same offsets give
+    the same bits."""
+    d = model.draw(offsets_m, cases, pose)
+    out = {"steps": d["steps"], "range_offset_m": d["range_offset_m"]}
+    for case in cases:
+        e = np.degrees(d[case]["error_rad"])  # (k, M, 2)
+        k = np.argmax(np.abs(e), axis=1)  # (k, 2)
+        worst = np.take_along_axis(e, k[:, None, :], axis=1)[:, 0]
+        out[case] = np.column_stack([worst, np.degrees(d[case]["distance_rad"].max(-1))])
+        out[case + "_fallbacks"] = int(np.count_nonzero(~d[case]["converged"]))
+    return out
+
+
+def draw_cell_offsets(seed: int, draws: int, sigma_m, front_ends: int,
+                      distribution: str = "normal") -> np.ndarray:
+    """All mounting errors (draws, front_ends, 3) of a cell study at once (its first draws)."""
+    z = list(standard_draws(seed, draws, distribution, max(draws, 1), front_ends))
+    z = z[0] if z else np.zeros((0, front_ends, 3))
+    return z * np.asarray(sigma_m, float)
+
+
+@dataclass(frozen=True)
+class CellToleranceResult:
+    """A cell's Monte-Carlo run: per draw and case the worst signed azimuth and elevation
+    errors and the worst angular distance (deg), (draws, 3)."""
+
+    model: CellPhasors
+    sigma_m: np.ndarray  # (3,) radial, tangential, height
+    distribution: str
+    draws: int
+    seed: int
+    spec_deg: float
+    worst_error_deg: dict  # case -> (draws, 3): azimuth, elevation, angular distance
+    delay_s: np.ndarray  # (draws, Q) calibration delay offsets (reference: 0)
+    range_offset_m: np.ndarray  # (draws,) largest range offset between the channels
+    fallbacks: dict
+    elapsed_s: float = 0.0
+    cpu_s: float = 0.0
+    bounds: Bounds | None = None  # with the rotations and RuT pose errors drawn
+
+    def yield_(self, case: str) -> float:
+        """Fraction of draws whose every set-point is within the spec in both angles."""
+        e = self.worst_error_deg[case]
+        if not e.size:
+            return float("nan")
+        return float(np.mean(np.all(np.abs(e[:, :2]) <= self.spec_deg, axis=-1)))
+
+    def stats(self, case: str) -> dict:
+        e = np.abs(self.worst_error_deg[case])
+        out = {key: percentiles(e[:, k]) for k, key in enumerate(STAT_KEYS)}
+        out["angle_error_deg"] = percentiles(np.max(e[:, :2], axis=-1))
+        out.update({"yield": self.yield_(case), "fallbacks": self.fallbacks[case]})
+        return out
+
+    def to_dict(self) -> dict:
+        out = {
+            "draws": self.draws,
+            "seed": self.seed,
+            "distribution": self.distribution,
+            "scale": "sigma" if self.distribution == "normal" else "bound",
+            "sigma_mm": {a: float(s * 1e3) for a, s in zip(AXES, self.sigma_m)},
+            "spec_deg": self.spec_deg,
+            "bounds": None if self.bounds is None else self.bounds.to_dict(),
+            "yield_rule": "every set-point within spec_deg in azimuth and in elevation",
+            "cell": self.model.to_dict(),
+            "subbin": {"distribution": "bin centre", "positions": 1,
+                       "step_s": self.model.delay_resolution_s},
+        }
+        for case in self.worst_error_deg:
+            out[case] = self.stats(case)
+        out["calibration"] = {
+            "abs_delta_tau_ps": percentiles(np.abs(self.delay_s[:, 1:]), 1e12),
+            "abs_range_offset_mm": percentiles(self.range_offset_m, 1e3),
+        }
+        return out
+
+
+def _evaluate(model: CellPhasors, part: dict, cases) -> dict:
+    pose = {k: part[k] for k in ("yaw_rad", "pitch_rad", "rut_offset_m", "rut_yaw_rad")}
+    return evaluate_cell_chunk(model, part["offsets_m"], cases, pose)
+
+
+def monte_carlo_cell(model: CellPhasors, sigma_m, draws: int, seed: int,
+                     distribution: str = "normal", spec_deg: float = 0.1, cases=CASES,
+                     chunk: int = DEFAULT_CHUNK, progress: Progress | None = None,
+                     label: str = "tolerance", mapper: Mapper | None = None,
+                     bounds: Bounds | None = None) -> CellToleranceResult:
+    """``draws`` setups of the cell with mounting errors scaled by ``sigma_m`` (3,) (the pair
+    study's :func:`~rtsgeom.analysis.tolerance.monte_carlo` for a cell: the same unit draws
+    per front end, chunked, optionally mapped; the outcome depends on neither). ``bounds``:
+    also the front ends' rotations and the RuT's pose errors (``analysis.arc``'s draws, their
+    own streams; its offsets are replaced by ``sigma_m``): the offsets stay the same draws."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    sigma = np.asarray(sigma_m, float).reshape(3)
+    if np.any(~np.isfinite(sigma)) or np.any(sigma < 0):
+        raise ValueError(f"sigma_m {sigma.tolist()}: must be finite and >= 0")
+    n_q = len(model.cell)
+    b = dataclasses.replace(bounds or Bounds((0.0, 0.0, 0.0)), offsets_m=tuple(sigma))
+    chunks = (_scale(u, b) for u in arc_draws(seed, draws, n_q, distribution, chunk))
+    func = functools.partial(_evaluate, model, cases=tuple(cases))
+    parts, done = [], 0
+    for part in (map(func, chunks) if mapper is None else mapper(func, list(chunks))):
+        parts.append(part)
+        done += len(part["steps"])
+        if progress:
+            progress(label, done, draws)
+
+    def joined(key, shape):
+        return frozen(np.concatenate([p[key] for p in parts]) if parts else np.zeros(shape))
+
+    return CellToleranceResult(
+        model, frozen(sigma), distribution, int(draws), int(seed), float(spec_deg),
+        {case: joined(case, (0, 3)) for case in cases},
+        frozen(joined("steps", (0, n_q)) * model.delay_resolution_s),
+        joined("range_offset_m", (0,)),
+        {case: sum(p[case + "_fallbacks"] for p in parts) for case in cases},
+        time.perf_counter() - t0, time.process_time() - c0, b)
+
+
+def max_sigma_for_yield_cell(model: CellPhasors, sigma_m, draws: int, seed: int,
+                             target_yield: float, spec_deg: float = 0.1,
+                             case: str = "calibrated", axis: str = "all",
+                             distribution: str = "normal", rel_tol: float = 0.01,
+                             cap_m: float = 0.01, chunk: int = DEFAULT_CHUNK,
+                             progress: Progress | None = None,
+                             mapper: Mapper | None = None) -> dict:
+    """The pair study's ``max_sigma_for_yield`` for a cell (the same search,
+    :func:`~rtsgeom.analysis.tolerance.largest_passing_scale`, the same keys)."""
+    base = np.asarray(sigma_m, float).reshape(3)
+    if axis == "all":
+        direction = base / base.max() if base.max() > 0 else np.ones(3)
+        fixed = np.zeros(3)
+    elif axis in AXES:
+        direction = np.eye(3)[AXES.index(axis)]
+        fixed = base * (1 - direction)
+    else:
+        raise ValueError(f"axis {axis!r}: must be 'all' or one of {', '.join(AXES)}")
+    history = []
+
+    def yield_at(t: float) -> float:
+        res = monte_carlo_cell(model, fixed + t * direction, draws, seed, distribution,
+                               spec_deg, (case,), chunk, progress,
+                               f"{case}: sigma {t * 1e3:.4g} mm", mapper)
+        y = res.yield_(case)
+        history.append({"scale_mm": t * 1e3, "yield": y})
+        return y
+
+    def result(t, y, capped=False, note=None):
+        sig = fixed + t * direction
+        return {"case": case, "axis": axis, "target_yield": target_yield, "spec_deg": spec_deg,
+                "sigma_mm": {a: float(s * 1e3) for a, s in zip(AXES, sig)},
+                "yield": y, "capped": capped, "note": note, "evaluations": history}
+
+    y0 = yield_at(0.0)
+    if y0 < target_yield:
+        return result(0.0, y0, note="the setup misses the spec even without the varied errors")
+    start = min(float(np.max(base * direction)) or 1e-4, cap_m)
+    return result(*largest_passing_scale(yield_at, y0, target_yield, start, cap_m, rel_tol))
+
+
+def verify_cell_draws(model: CellPhasors, sigma_m, n: int, seed: int,
+                      distribution: str = "normal", cases=CASES, all_points: bool = False,
+                      progress=None) -> dict:
+    """The first ``n`` draws of ``monte_carlo_cell`` through the full chain
+    (``tolerance_verify`` for a cell): each draw built as a real setup (the offsets on the
+    cell's front ends, exact paths), the programme the fast model assumes (the target's delay
+    plus each channel's calibration delay, the designed amplitudes with the gain correction)
+    synthesized as a noise-free ADC cube and processed (``radar.process``: range-Doppler,
+    CFAR, 2-D beamformer), one frame per draw and case at the set-point with the draw's
+    largest angular distance in the fast model (``all_points``: at every set-point). Returns
+    per case the model's and the chain's (azimuth, elevation) errors (n, P, 2) deg and the
+    largest |chain - model| (inf where the chain detected nothing)."""
+    from ..geometry import build_setup
+    from ..radar import process
+    from ..radar.frame import simulate
+    from ..radar.processing import nearest_detection
+    from ..rts import RtsProgram, requested_delay
+    t0 = time.perf_counter()
+    cell = list(model.cell)
+    n_q, n_m = len(cell), model.set_rad.shape[0]
+    off = draw_cell_offsets(seed, n, sigma_m, n_q, distribution)
+    d = model.draw(off, cases)
+    scene = model.setup.scene
+    tau0 = float(requested_delay(scene, model.range_m))
+    res = model.delay_resolution_s
+    n_p = n_m if all_points else 1
+    out = {case: {"set_index": np.zeros((n, n_p), int),
+                  "model_deg": np.full((n, n_p, 2), np.nan),
+                  "chain_deg": np.full((n, n_p, 2), np.nan)} for case in cases}
+    gains = model.gain_correction(model.cells.model.perturbed(off))
+    mask = model.cells.steering.mask
+    for i in range(n):
+        offsets = np.zeros((len(scene.rts.front_ends), 3))
+        offsets[cell] = off[i]
+        setup = build_setup(scene, offsets_m=offsets)
+        paths = exact_paths(setup)
+        for case in cases:
+            cal = case == "calibrated"
+            k = d["steps"][i] if cal else np.zeros(n_q, int)
+            f = model.delay_factor[np.arange(n_q), k + model.max_steps]
+            g = gains[i] / np.abs(f[:, mask].mean(-1)) if cal else np.ones(n_q)
+            pts = (range(n_m) if all_points
+                   else [int(np.argmax(d[case]["distance_rad"][i]))])
+            for j, m in enumerate(pts):
+                amps = model.cells.model.unit_gain * model.amplitudes[m] * g
+                prog = RtsProgram.build([0] * n_q, cell, list(tau0 + k * res), [0.0] * n_q,
+                                        list(amps))
+                _, cube = simulate(setup, paths, prog)  # noise-free
+                rd, dets = process(cube)
+                hit = nearest_detection(dets, rd, model.range_m)
+                out[case]["set_index"][i, j] = m
+                out[case]["model_deg"][i, j] = np.degrees(d[case]["error_rad"][i, m])
+                if hit is not None:
+                    got = np.array([dets.angle_rad[hit], dets.elevation_rad[hit]])
+                    out[case]["chain_deg"][i, j] = np.degrees(got - model.set_rad[m])
+        if progress:
+            progress("verify (ADC-cube chain)", i + 1, n)
+    summary = {}
+    for case in cases:
+        diff = np.abs(out[case]["chain_deg"] - out[case]["model_deg"])
+        diff = np.where(np.isfinite(diff), diff, np.inf)
+        summary[case] = {"max_abs_difference_deg": float(diff.max()) if diff.size else 0.0,
+                         "missed": int(np.count_nonzero(~np.isfinite(diff[..., 0])))}
+    return {"draws": n, "set_point": ("every set-point" if all_points
+                                      else "the draw's worst (angular distance) in the fast model"),
+            "max_abs_difference_deg": max((v["max_abs_difference_deg"]
+                                           for v in summary.values()), default=0.0),
+            "cases": summary, "detail": out, "elapsed_s": time.perf_counter() - t0}
