@@ -88,3 +88,23 @@ def test_cli_verify_reports_the_difference(tmp_path, capsys):
             code = e.code
         assert code == 2
         assert "--verify" in capsys.readouterr().err
+
+
+@pytest.mark.xfail(strict=True, reason="known bug (session 3): the pair model at the exact "
+                   "bin centre (sub-bin index subbin_zero +- 2) puts 14-deg split-composite "
+                   "errors on ~20 % of draws at 0.5 mm where the ADC chain detects < 0.04 deg; "
+                   "positions 10 steps away agree. The whole-arc study (design --coverage-deg, "
+                   "--pair all) evaluates at the bin centre and is pessimistic until fixed")
+def test_bin_centre_model_agrees_with_the_chain_on_a_planned_arc():
+    import math
+
+    from rtsgeom.analysis import coverage
+    from rtsgeom.analysis.arc import arc_models
+    from rtsgeom.analysis.tolerance_verify import verify_draws
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.scene import load_scene
+    plan = coverage.plan_arc(load_scene("scenes/diewald2022.toml"),
+                             (math.radians(-10), math.radians(10)), 1.0)
+    model = arc_models(build_setup(plan.scene), [(0, 1)], 11)[0]
+    v = verify_draws(model, (0.5e-3,) * 3, 12, 0, cases=("calibrated",), subbin=False)
+    assert np.max(v.difference_deg("calibrated")) < 0.005
