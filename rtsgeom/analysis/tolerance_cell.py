@@ -62,7 +62,7 @@ from ..scene import TargetConfig
 from .tolerance import (AXES, CASES, DEFAULT_CHUNK, Mapper, Progress, largest_passing_scale,
                         percentiles, standard_draws)
 from .arc import Bounds, _scale, arc_draws
-from .tolerance_model import response_table
+from .tolerance_model import _slide, response_table
 
 __all__ = ["CellPhasors", "CellToleranceResult", "ANGLES", "monte_carlo_cell",
            "max_sigma_for_yield_cell", "evaluate_cell_chunk", "draw_cell_offsets",
@@ -194,7 +194,7 @@ class CellPhasors:
                 raise ValueError(f"case {case!r}: must be one of {', '.join(CASES)}")
             k = steps if case == "calibrated" else np.zeros_like(steps)
             f = self.delay_factor[q, k + self.max_steps]  # (n, Q, V)
-            xk = x * f * np.exp(self.delay_log_slope[q, k + self.max_steps] * shift)
+            xk = x * f * _slide(self.delay_log_slope[q, k + self.max_steps], shift)
             amps = np.broadcast_to(self.amplitudes, (off.shape[0],) + self.amplitudes.shape)
             if case == "calibrated":  # the gains measured, the delay's known loss divided out
                 loss = np.abs(f[..., st.mask].mean(-1))  # (n, Q)

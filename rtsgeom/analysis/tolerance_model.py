@@ -197,6 +197,21 @@ class _Design:
         return amps, m_best
 
 
+#: Largest |d ln|x| / d tau * shift| the first-order slide applies (see :func:`_slide`).
+MAX_SLIDE = 0.5
+
+
+def _slide(log_slope, shift_s):
+    """exp(d ln|x|/d tau * shift): the first-order change of a spectrum's magnitude as the
+    draw's air delay slides the echo along the range window. The log slope is unbounded at the
+    window's spectral nulls (a Hann window has them two bins from an echo at a bin centre), where
+    exp() of it blew an empty bin up into the strongest one (a phantom detection two bins off);
+    the exponent is limited to +-MAX_SLIDE (and NaN at an exact null to 0), which leaves every
+    regular bin bit-identical (exponents ~1e-4) and keeps a null bin near null."""
+    x = np.nan_to_num(log_slope * shift_s, nan=0.0, posinf=MAX_SLIDE, neginf=-MAX_SLIDE)
+    return np.exp(np.clip(x, -MAX_SLIDE, MAX_SLIDE))
+
+
 @dataclass(frozen=True)
 class PairPhasors:
     """The design (set-points, amplitudes per sub-bin position) and the response tables of one
@@ -380,7 +395,7 @@ class PairPhasors:
             if redesign:  # from the nominal model: the operator does not know the shift
                 g[..., 1] /= np.abs(f[..., self.channels.steering.mask].mean(axis=-1))
             if shift_s is not None:
-                f = f * np.exp(self.delay_log_slope[k] * shift_s[..., 1, :])
+                f = f * _slide(self.delay_log_slope[k], shift_s[..., 1, :])
             x_j = x_j * f
             a_i, a_j = a_i * g[..., 0, None], a_j * g[..., 1, None]  # (..., M)
         return a_i[..., None] * x_i[..., None, :] + a_j[..., None] * x_j[..., None, :]
@@ -409,7 +424,7 @@ class PairPhasors:
 
         def spectrum(q, j):  # (n, K, V)
             return (self.table[q, j] * fac[:, q, None, :]
-                    * np.exp(self.table_log_slope[q, j] * shift[:, q, None, :]))
+                    * _slide(self.table_log_slope[q, j], shift[:, q, None, :]))
 
         x_i = spectrum(0, z + d_u)
         p_ii = np.sum(x_i.real ** 2 + x_i.imag ** 2, -1)  # (n, K)
