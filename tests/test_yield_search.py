@@ -81,3 +81,18 @@ def test_critical_ratio_decides_the_yield():
                 y = float(np.mean(np.abs(e) <= spec))
                 r = critical_ratio(e, spec, target)
                 assert (y >= target) == (r <= 1), (n, target, spec, y, r)
+
+
+@pytest.mark.parametrize("subbin", [True, False])
+def test_yield_without_errors_per_subbin_position_is_the_monte_carlos(subbin):
+    """The search's sigma-0 evaluation (each sub-bin position drawn evaluated once) gives the
+    Monte Carlo's worst errors bit for bit, for both cases and distributions."""
+    from rtsgeom.analysis.tolerance import PairPhasors, _worst_without_errors, monte_carlo
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.scene import load_scene
+    model = PairPhasors.build(build_setup(load_scene("scenes/diewald2022.toml")), (0, 1), 5)
+    for case in ("uncalibrated", "calibrated"):
+        for dist in ("normal", "uniform"):
+            mc = monte_carlo(model, [0.0] * 3, 700, 5, dist, cases=(case,), subbin=subbin)
+            got = _worst_without_errors(model, 700, 5, case, subbin)
+            assert np.array_equal(mc.worst_error_deg[case], got)
