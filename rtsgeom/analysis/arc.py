@@ -32,8 +32,8 @@ import numpy as np
 
 from .._util import frozen
 from ..errors import ParameterError
-from .tolerance import (CASES, DISTRIBUTIONS, PairPhasors, evaluate_chunk, largest_passing_scale,
-                        percentiles)
+from .tolerance import (CASES, DISTRIBUTIONS, PairPhasors, critical_ratio, evaluate_chunk,
+                        largest_passing_scale, percentiles)
 
 __all__ = ["Bounds", "ArcResult", "arc_draws", "arc_monte_carlo", "arc_models",
            "adjacent_pairs", "max_scale_for_yield"]
@@ -292,7 +292,7 @@ def max_scale_for_yield(models, count: int, bounds: Bounds, draws: int, seed: in
                         distribution: str = "normal", rel_tol: float = 0.02,
                         cap: float = 100.0, chunk: int = DEFAULT_CHUNK) -> dict:
     """The largest factor s on ``bounds`` that keeps ``target_yield`` of the *arcs* within
-    ``spec_deg`` (every pair), by bisection with common random numbers (the same seed), as
+    ``spec_deg`` (every pair), by the secant search with common random numbers (the same seed), as
     :func:`~rtsgeom.analysis.tolerance.max_sigma_for_yield` does for one pair. Returns the
     factor, the scaled bounds, the yield there and whether the search hit ``cap``."""
     history = []
@@ -302,13 +302,13 @@ def max_scale_for_yield(models, count: int, bounds: Bounds, draws: int, seed: in
                               spec_deg, (case,), chunk)
         y = res.yield_(case)
         history.append({"scale": s, "yield": y})
-        return y
+        return y, critical_ratio(res.worst_error_deg[case], spec_deg, target_yield)
 
     def result(s, y, capped=False):
         return {"case": case, "factor": s, "scales": bounds.scaled(s).to_dict(), "yield": y,
                 "capped": capped, "evaluations": history}
 
-    y0 = yield_at(0.0)
+    y0, _ = yield_at(0.0)
     if y0 < target_yield:
         return result(0.0, y0)
     return result(*largest_passing_scale(yield_at, y0, target_yield, 1.0, cap, rel_tol))

@@ -192,10 +192,11 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     """Evaluate every (spacing, radius) design; ``progress(done, total)`` after each.
 
     ``workers`` > 1: the designs in a pool of that many processes (each design is pure: the
-    same result, in the same order, however they are spread). About 85 % of a design's time
-    is its two tolerance searches (``max_sigma_for_yield``: ~22 Monte Carlos of ``draws``
-    draws x ``points`` set-points, ``Steering.peak`` at ~1 M snapshots per CPU second), the
-    rest its ``PairPhasors.build``."""
+    same result, in the same order, however they are spread). A design's time is about half
+    its ``PairPhasors.build`` (the delay tables: the FIR's response along the chirp and
+    ``bin_response`` for ~6000 delays) and half its two tolerance searches
+    (``max_sigma_for_yield``: ~5 Monte Carlos each of ``draws`` draws x ``points``
+    set-points, the one without errors per sub-bin position drawn)."""
     radii = np.asarray(radius_m, float).ravel()
     spacings = np.asarray(spacing_deg, float).ravel()
     fes = scene.rts.front_ends

@@ -306,7 +306,7 @@ def register(sub) -> None:
                    help="error distribution (default normal)")
     p.add_argument("--invert-yield", type=number(1e-6, 1.0), default=None, metavar="Y",
                    help="also find the largest sigma keeping the fraction Y, in (0, 1], of the "
-                        "setups within the spec (bisection, same seed)")
+                        "setups within the spec (secant search on the scale, same seed)")
     p.add_argument("--invert-axis", choices=("all",) + AXES, default="all",
                    help="with --invert-yield: scale all three sigmas together (default) or vary "
                         "one axis, the others held")

@@ -342,6 +342,12 @@ class Steering:
         snaps = snaps.reshape(-1, snaps.shape[-1])
         grid, steer = self._search_grid
         x = self.weighted(snaps)
+        # a snapshot with a NaN has no power anywhere: its peak is the grid's first angle,
+        # which the zooms below keep exactly (argmax over NaN: index 0; the parabola: 0), so
+        # they run on the others only (a failed design's NaN snapshots: 4 s per Monte Carlo)
+        nan = np.isnan(x).any(axis=1)
+        out = np.full(x.shape[0], grid[0])
+        x = x[~nan] if nan.any() else x
         p = self._power(x, steer)
         best = grid[np.argmax(p, axis=1)]
         for half, step in ((0.3, 0.005), (0.006, 1e-4)):
@@ -352,7 +358,8 @@ class Steering:
             rows = np.arange(pw.shape[0])
             frac = parabolic(pw[rows, i - 1], pw[rows, i], pw[rows, i + 1])
             best = cand[rows, i] + np.clip(frac, -1, 1) * np.radians(step)
-        out = best.reshape(shape)
+        out[~nan] = best
+        out = out.reshape(shape)
         return out if np.ndim(snapshots) > 1 else out[0]
 
     def _search_2d(self, snapshots) -> np.ndarray:
@@ -414,27 +421,55 @@ class Steering:
 
     def _peak_blocks(self, flat, u0, u, ok, best_grid, kv, grid, steer, iterations):
         """:meth:`peak`'s Newton steps and global check, block by block (fills ``u``,
-        ``ok`` and ``best_grid`` in place)."""
+        ``ok`` and, where not ok, ``best_grid`` in place).
+
+        The grid's powers are formed in single precision (6x faster than double: this was
+        most of a Monte-Carlo draw's angle estimate); where that cannot decide the global check
+        (the Newton peak within ``_P32_TOL`` of the grid's maximum, relative to the power
+        bound (sum |w x|)^2, far above single precision's rounding) and for the snapshots
+        that fail it, the grid is recomputed in double precision, so the outcome (u, ok and
+        the restarts) is the double-precision check's."""
+        steer32 = steer.astype(np.complex64)
         for b in range(0, u0.shape[0], BLOCK):
             blk = slice(b, b + BLOCK)
             x = self.weighted(flat[blk])
-            y = x @ steer
-            p_grid = y.real ** 2 + y.imag ** 2  # (n, G)
-            p_max = p_grid.max(axis=1)
-            best_grid[blk] = grid[np.argmax(p_grid, axis=1)]
+            mag = np.abs(x)
+            top = mag.max(axis=1)  # scaled to |x| <= 1: no float32 overflow or underflow
+            with np.errstate(divide="ignore", invalid="ignore"):
+                y = (x / top[:, None]).astype(np.complex64) @ steer32
+            p_max = (y.real ** 2 + y.imag ** 2).max(axis=1) * top ** 2  # (n,), NaN: undecided
+            tol = _P32_TOL * np.sum(mag, axis=1) ** 2
             xr, xi = np.ascontiguousarray(x.real.T), np.ascontiguousarray(x.imag.T)
-            u[blk], ok[blk] = _newton(kv, xr, xi, u0[blk], p_max, iterations)
-            bad = np.flatnonzero(~ok[blk])
+            u_b, conv, p_last = _newton(kv, xr, xi, u0[blk], None, iterations)
+            good = conv & (p_last >= p_max + tol)
+            # undecided or failed: the double-precision grid (exact p_max, the restart point)
+            redo = np.flatnonzero(~good)
+            if redo.size:
+                y64 = x[redo] @ steer
+                p_grid = y64.real ** 2 + y64.imag ** 2
+                p_max[redo] = p_grid.max(axis=1)
+                best_grid[b + redo] = grid[np.argmax(p_grid, axis=1)]
+                good[redo] = conv[redo] & (p_last[redo] >= p_max[redo] * (1 - 1e-9))
+            u[blk], ok[blk] = u_b, good
+            bad = np.flatnonzero(~good)
             if bad.size:  # restart from the grid's maximum
-                u2, ok2 = _newton(kv, xr[:, bad], xi[:, bad], best_grid[blk][bad], p_max[bad],
-                                  iterations + 4)
+                u2, ok2, p2 = _newton(kv, xr[:, bad], xi[:, bad], best_grid[b + bad], None,
+                                      iterations + 4)
+                ok2 &= p2 >= p_max[bad] * (1 - 1e-9)
                 u[b + bad[ok2]] = u2[ok2]
                 ok[b + bad[ok2]] = True
 
 
+#: single-precision grid powers decide the global check only this far (relative to
+#: (sum |w x|)^2, which bounds every power) from the Newton peak's power; their error is
+#: below ~1e-6 of it (8 products and sums in float32), so the decision is exact
+_P32_TOL = 1e-5
+
+
 def _newton(kv, xr, xi, u, p_max, steps):
     """Newton steps on log P from ``u`` (n, D) for tapered snapshots (V_s, n) split in real and
-    imaginary parts: (u, accepted); accepted needs the power at the peak >= ``p_max``.
+    imaginary parts: (u, accepted); accepted needs the power at the peak >= ``p_max``. With
+    ``p_max`` None: (u, accepted without the power condition, the power at the peak).
 
     With B = sum_v y_v (y_v = w_v x_v e^{j k p_v . u}), C_a = sum k_va y_v, D_ab = sum k_va
     k_vb y_v: dB/du_a = j C_a, d2B/du_a du_b = -D_ab, so for log P, P = |B|^2,
@@ -450,6 +485,15 @@ def _newton(kv, xr, xi, u, p_max, steps):
         if act.size == 0:
             break
         ar, ai, ua = xr[:, act], xi[:, act], u[act]
+        if n_d == 1:  # the same arithmetic with fewer temporaries (bit-equal, tested)
+            step, p = _newton_step_1d(kv[:, 0], ar, ai, ua[:, 0])
+            fine = np.isfinite(step[:, 0])
+            u[act] = ua + np.clip(np.where(fine[:, None], step, 0.0), -0.05, 0.05)
+            p_last[act] = p
+            done = fine & (np.abs(np.where(fine, step[:, 0], 0.0)) < 1e-6)
+            ok[act[done]] = True
+            act = act[fine & ~done]
+            continue
         ph = np.sum(kv[:, :, None] * ua.T[None], axis=1)  # (V_s, n)
         co, si = np.cos(ph), np.sin(ph)
         y = np.stack([ar * co - ai * si, ar * si + ai * co])  # (2, V_s, n): Re, Im
@@ -481,7 +525,27 @@ def _newton(kv, xr, xi, u, p_max, steps):
         ok[act[done]] = True
         act = act[fine & ~done]
     radius = np.sqrt(np.sum(u ** 2, axis=-1))
+    if p_max is None:
+        return u, ok & (radius < 1), p_last
     return u, ok & (radius < 1) & (p_last >= p_max * (1 - 1e-9))
+
+
+def _newton_step_1d(k, ar, ai, u):
+    """One Newton step of :func:`_newton` for D = 1 (wavenumbers ``k`` (V_s,), snapshots
+    (V_s, n), u (n,)): (step (n, 1), NaN where log P is not concave; P (n,))."""
+    ph = k[:, None] * u
+    co, si = np.cos(ph), np.sin(ph)
+    yr, yi = ar * co - ai * si, ar * si + ai * co
+    k1, k2 = k[:, None], (k * k)[:, None]
+    b0, b1 = yr.sum(axis=0), yi.sum(axis=0)
+    c0, c1 = (yr * k1).sum(axis=0), (yi * k1).sum(axis=0)
+    d0, d1 = (yr * k2).sum(axis=0), (yi * k2).sum(axis=0)
+    p = b0 ** 2 + b1 ** 2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        g = 2 * (b1 * c0 - b0 * c1) / p
+        h = 2 * (c0 * c0 + c1 * c1 - b0 * d0 - b1 * d1) / p - g * g
+        step = np.where(h < 0, -g / h, np.nan)[:, None]
+    return step, p
 
 
 def parabolic(y0, y1, y2) -> np.ndarray:
