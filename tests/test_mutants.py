@@ -21,7 +21,7 @@ from rtsgeom.paths.table import RUT_TO_RUT, Paths
 from rtsgeom.radar import process
 from rtsgeom.radar.frame import simulate
 from rtsgeom.radar.processing import range_angle_map
-from rtsgeom.radar.steering import parabolic
+from rtsgeom.radar.newton import parabolic
 from rtsgeom.rts import KIND_SETUP, program_nearest, requested_delay, setup_echoes
 
 SMALL = dict(chirps_per_tx=32, samples_per_chirp=128, adc_rate_hz=12.5e6)

@@ -11,6 +11,7 @@ import pytest
 
 from rtsgeom.geometry import build_setup
 from rtsgeom.radar import steering as S
+from rtsgeom.radar.newton import newton
 from rtsgeom.radar.steering import Steering
 from rtsgeom.scene import load_scene
 
@@ -36,10 +37,10 @@ def _reference_block(st, snaps, u0, iterations):
     p_max = p_grid.max(axis=1)
     best = grid[np.argmax(p_grid, axis=1)]
     xr, xi = np.ascontiguousarray(x.real.T), np.ascontiguousarray(x.imag.T)
-    u, ok = S._newton(kv, xr, xi, u0, p_max, iterations)
+    u, ok = newton(kv, xr, xi, u0, p_max, iterations)
     bad = np.flatnonzero(~ok)
     if bad.size:
-        u2, ok2 = S._newton(kv, xr[:, bad], xi[:, bad], best[bad], p_max[bad], iterations + 4)
+        u2, ok2 = newton(kv, xr[:, bad], xi[:, bad], best[bad], p_max[bad], iterations + 4)
         u[bad[ok2]] = u2[ok2]
         ok[bad[ok2]] = True
     if not ok.all():

@@ -24,7 +24,8 @@ from .._util import frozen
 from ..geometry import RutArray
 from ..scene import CfarConfig, RadarConfig
 from .fmcw import AdcCube
-from .steering import Steering, parabolic as _parabolic, window
+from .newton import parabolic as _parabolic
+from .steering import Steering, window
 
 __all__ = ["RangeDoppler", "Detections", "range_doppler", "cfar_mask", "detect",
            "nearest_detection",
