@@ -277,3 +277,22 @@ def test_info_budget_says_whether_the_scene_models_the_link(linked):
     assert b.to_dict()["modelled"] is linked
     assert ("prediction" in b.to_dict()["noise_source"]) is (not linked)
     assert b.to_dict()["targets"][0]["adc_power_dbm"] is not None
+
+
+def test_a_front_end_lost_to_clipping_says_so():
+    """A linked scene whose probe frame clips (ADC full scale far below the echoes): the
+    probe's note names the clipping and its remedies, and the planner's error carries it (a
+    new-user trial got 'blocked line of sight' for a sheet reflection that clipped the ADC)."""
+    import warnings
+
+    from rtsgeom.aoa.calibration import probe_front_ends
+    clipping = build_setup(make_scene(lambda d: linked_doc(d, {"adc_full_scale_dbm": -90.0})))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # the lost front end warns as well
+        probe = probe_front_ends(clipping, exact_paths(clipping))
+    assert probe.adc_clipped > 0
+    note = probe.clipping_note()
+    assert "ADC clipped" in note and "reflection_loss_db" in note
+    clean = build_setup(make_scene(linked_doc))
+    unclipped = probe_front_ends(clean, exact_paths(clean))
+    assert unclipped.adc_clipped == 0 and unclipped.clipping_note() == ""

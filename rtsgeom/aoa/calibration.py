@@ -49,6 +49,16 @@ class FrontEndProbe:
     angle_rad: np.ndarray  # (F,) detected azimuth
     power_db: np.ndarray  # (F,) detected range-Doppler power
     gain_correction: np.ndarray  # (F,) multiply the programmed amplitude by this
+    adc_clipped: int = 0  # samples the ADC clipped in the probe frame (with [radar.link])
+
+    def clipping_note(self) -> str:
+        """Why a front end may be missing: the probe frame's ADC clipping, if any."""
+        if not self.adc_clipped:
+            return ""
+        return (f"; the ADC clipped {self.adc_clipped} samples of the probe frame (a setup "
+                "echo above full scale, e.g. the sheet's reflection: add an absorber, "
+                "sheet.reflection_loss_db or [[structure]] reflection_loss_db, or lower the "
+                "gain in [radar.link])")
 
 
 @dataclass(frozen=True)
@@ -194,7 +204,7 @@ def probe_ranges(setup: Setup, n: int) -> np.ndarray:
     return r0 + step * np.arange(n)
 
 
-def _simulate_detect(setup, paths, program, seed, frames: int = 1):
+def _simulate_detect(setup, paths, program, seed, frames: int = 1, clipped: bool = False):
     """One radar output: the coherent average of ``frames`` frames of a static RTS program.
 
     The K frames carry the same noise-free cube and independent receiver noise, so their
@@ -205,7 +215,8 @@ def _simulate_detect(setup, paths, program, seed, frames: int = 1):
     if snr is not None and frames > 1:
         snr = snr + 10 * np.log10(frames)
     _, cube = simulate(setup, paths, program, seed, snr, noise_frames=frames)
-    return process(cube)
+    rd, det = process(cube)
+    return (rd, det, int(cube.clipped)) if clipped else (rd, det)
 
 
 TARGET_BIAS_PS = 2.0  # the averaging keeps the noise's pull on the chosen delay below this
@@ -228,7 +239,7 @@ def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe
         amps[q] = m.unit_gain
     prog = RtsProgram.build(np.arange(n), np.arange(n), requested_delay(scene, ranges),
                             np.zeros(n), amps)
-    rd, det = _simulate_detect(setup, paths, prog, seed)
+    rd, det, n_clip = _simulate_detect(setup, paths, prog, seed, clipped=True)
     ang = np.full(n, np.nan)
     pw = np.full(n, np.nan)
     for q in range(n):
@@ -240,10 +251,11 @@ def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe
         warnings.warn(f"front end(s) {missed} not detected alone at the probe range(s) "
                       f"{np.round(ranges[missed], 3).tolist()} m (below the CFAR threshold or "
                       "beyond the range axis): their measured angle is NaN and their gain "
-                      "correction 1", RuntimeWarning, stacklevel=2)
+                      "correction 1" + FrontEndProbe(ang, pw, amps, n_clip).clipping_note(),
+                      RuntimeWarning, stacklevel=2)
     meas = 10 ** (pw / 10) / amps ** 2
     corr = np.sqrt(model_p / meas)
-    return FrontEndProbe(ang, pw, np.where(np.isfinite(corr), corr, 1.0))
+    return FrontEndProbe(ang, pw, np.where(np.isfinite(corr), corr, 1.0), n_clip)
 
 
 def _probe_program(design, pair, base, delta):

@@ -206,7 +206,8 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
     if lost.size:
         raise SceneError(f"{scene.source}: rts.front_ends[{lost[0]}]: the RuT does not detect "
                          "this front end alone (blocked line of sight, or an echo far weaker "
-                         "than the noise): cannot synthesize angles with it")
+                         "than the noise" + probe.clipping_note() + "): cannot synthesize "
+                         "angles with it")
     res = angular_resolution_rad(setup.rut)
     pairs = {}
     for k, t in enumerate(scene.targets):

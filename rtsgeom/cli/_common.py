@@ -114,7 +114,7 @@ class steps:
         if self._status is not None:
             self._status.stop()
             self._console.print(f"  {self._label}: {time.perf_counter() - self._t0:.1f} s",
-                                style="dim", highlight=False)
+                                style="dim", highlight=False, soft_wrap=True)
             self._status = None
 
     def __exit__(self, *exc):
