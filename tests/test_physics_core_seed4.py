@@ -133,3 +133,157 @@ def test_a_capture_that_is_not_a_complex_3d_cube_is_refused(tmp_path, bad):
     np.save(out, data)
     with pytest.raises(ValueError, match="cap.npy: expected a complex"):
         read_capture(out)
+
+
+# -- rts.channel_echoes: every path combination of the two legs --------------------------------
+
+
+@pytest.mark.parametrize("extra_tx, extra_rx", [(1, 0), (0, 2), (2, 1)])
+def test_channel_echoes_pair_every_path_of_one_leg_with_every_path_of_the_other(extra_tx,
+                                                                              extra_rx):
+    """A leg with Pa paths (Tx -> front end) and one with Pb (front end -> Rx) give Pa x Pb
+    direct echoes per channel and virtual element, with delays tau_a + tau_b (+ the RTS's)
+    and amplitudes conj(g_a g_b G): here the line-of-sight legs plus copies 0.1 ns later each
+    and half as strong, so the echoes' delays are the LoS one plus 0.1 ns x (m + n)."""
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    from rtsgeom.paths.table import FE_TO_RX, TX_TO_FE, Paths
+    from rtsgeom.rts import KIND_DIRECT, RtsProgram, channel_echoes
+    setup = build_setup(_small_noiseless())
+    los = exact_paths(setup)
+    extra = []
+    for direction, count in ((TX_TO_FE, extra_tx), (FE_TO_RX, extra_rx)):
+        leg = los.select(los.direction == direction)
+        for m in range(1, count + 1):
+            extra.append(Paths.build(leg.front_end, leg.direction, leg.rut_tx, leg.rut_rx,
+                                     leg.delay_s + m * 0.1e-9, leg.gain * 0.5 ** m,
+                                     np.ones(len(leg), int)))
+    paths = Paths.concat([los, *extra])
+    prog = RtsProgram.build([0, 1], [0, 1], [1e-7, 1.2e-7], [0.0, 0.0], [1.0, 0.5])
+    ref = channel_echoes(setup, los, prog)
+    ref = ref.select(ref.kind == KIND_DIRECT)
+    got = channel_echoes(setup, paths, prog)
+    got = got.select(got.kind == KIND_DIRECT)
+    pa, pb = 1 + extra_tx, 1 + extra_rx
+    assert len(got) == len(ref) * pa * pb
+    for k in range(len(prog)):
+        r = np.flatnonzero(ref.target == k)[0]
+        rows = np.flatnonzero(got.target == k)
+        assert rows.size == pa * pb
+        lag = got.tau_air_s[rows] - ref.tau_air_s[r]  # (Pa Pb, V): 0.1 ns x (m + n)
+        steps = np.round(lag / 0.1e-9)
+        np.testing.assert_allclose(lag, steps * 0.1e-9, atol=1e-15)
+        expect = sorted(m + n for m in range(pa) for n in range(pb))
+        assert sorted(steps[:, 0].astype(int).tolist()) == expect
+        np.testing.assert_allclose(got.amplitude[rows], ref.amplitude[r] * 0.5 ** steps,
+                                   rtol=1e-12)
+
+
+# -- radar.steering.peak: what did not converge falls back to the grid search -----------------
+
+
+@pytest.mark.parametrize("angles_deg", [(-20.0, 5.0), (3.0,), (0.0, 12.0, -40.0)])
+def test_unconverged_peaks_fall_back_to_the_search_and_the_others_keep_newton(angles_deg):
+    """A batch of plane waves and silent snapshots (no power: Newton cannot converge): each
+    plane wave's u is sin(alpha) and converged; each silent one is not converged and its u is
+    the grid search's (``Steering.search``), in its own place of the batch."""
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.radar.steering import Steering
+    scene = make_scene()
+    st = Steering.build(build_setup(scene).rut, scene.radar)
+    u_true = np.sin(np.radians(angles_deg))
+    waves = np.exp(-1j * np.outer(u_true, st.wavevector[:, 0]))  # (A, V_s) plane waves
+    silent_rows = np.zeros((2, waves.shape[1]), complex)
+    full = np.concatenate([waves, silent_rows])[[0, -1, *range(1, len(u_true)), -2]]
+    assert st.dims == 1
+    u, ok = st.peak(full, 0.0)
+    silent = np.all(full == 0, axis=1)
+    assert np.array_equal(ok, ~silent)
+    np.testing.assert_allclose(u[~silent, 0], u_true, atol=1e-6)
+    np.testing.assert_allclose(u[silent, 0], np.sin(st.search(full[silent])), atol=1e-12)
+
+
+# -- aoa.sweep.fit_minimum: the search half-width ----------------------------------------------
+
+
+@pytest.mark.parametrize("offset_steps", [-3.2, 2.6, 4.0])
+def test_fit_minimum_searches_the_half_width_it_is_given(offset_steps):
+    """The criterion's minimum ``offset_steps`` sweep steps from the coarse minimum: the
+    default search (1.5 steps either side) stops at its edge, a ``search_s`` of 5 steps finds
+    the minimum within the 0.05 ps grid."""
+    from rtsgeom.aoa.sweep import fit_minimum
+    period, step = 1.0e-9, 25e-12
+    d = np.arange(-20, 21) * step
+    true = offset_steps * step
+    th = 2 * np.pi * (d - true) / period
+    e = np.stack([0.8 * (1 - np.cos(th)), -0.5 * (1 - np.cos(th))], axis=1)
+    near = fit_minimum(d, e, period, 0.0)
+    assert near == pytest.approx(math.copysign(1.5 * step, offset_steps), abs=0.051e-12)
+    wide = fit_minimum(d, e, period, 0.0, search_s=5 * step)
+    assert wide == pytest.approx(true, abs=0.051e-12)
+
+
+# -- aoa.calibration.calibrate_pair: probe placement and frames per step -----------------------
+
+
+@pytest.mark.parametrize("dr_mm", [0.0, -0.2])
+def test_pair_calibration_places_its_probes_over_the_fine_window_and_reports_its_frames(dr_mm):
+    """Step 2 of ``calibrate_pair``: the probes' ranges are where ``sweep.place_probes`` puts
+    them for the window +-period/4 around the coarse minimum (the fine sweep's centre), not
+    for one delay of it; a noiseless sweep averages one frame per step, ``frames`` sets it."""
+    from rtsgeom.aoa.calibration import (calibrate_pair, nominal_model, probe_angles,
+                                         probe_front_ends, probe_ranges)
+    from rtsgeom.aoa.sweep import place_probes
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    setup = build_setup(_small_noiseless(
+        lambda d: d["rts"]["front_ends"][1].update(radial_offset_mm=dr_mm)))
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, 0)
+    span = (-0.6e-9, 0.6e-9)
+    cal = calibrate_pair(setup, paths, (0, 1), probe, span_s=span)
+    assert cal.frames_per_step == 1
+    near = cal.refine_delta_tau_s[cal.refine_delta_tau_s.size // 2]
+    half, step = cal.period_s / 4, setup.scene.rts.calibration_step_s
+    alphas = np.asarray(probe_angles(probe.angle_rad[0], probe.angle_rad[1]))
+    expect = place_probes(setup, paths, nominal_model(setup, paths), (0, 1),
+                          probe_ranges(setup, 2), alphas, near + np.arange(-half, half + 1e-15, step),
+                          (0.0, 0.0), tuple(probe.gain_correction[[0, 1]]))
+    np.testing.assert_allclose(cal.probe_ranges_m, expect, rtol=1e-12)
+    assert calibrate_pair(setup, paths, (0, 1), probe, span_s=span, frames=3).frames_per_step == 3
+
+
+# -- aoa.plan / plan_cells: the calibration record and the programmed Doppler ------------------
+
+
+def test_plan_record_says_where_its_calibration_came_from():
+    """Measured front-end angles (no calibration file): the record's source is "measured"."""
+    from rtsgeom.aoa.plan import plan_targets
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    setup = build_setup(_small_noiseless())
+    _, record, _ = plan_targets(setup, exact_paths(setup), "array-factor", calibrate=False)
+    assert record["source"] == "measured"
+
+
+@pytest.mark.parametrize("velocity_mps", [-5.0, 0.0, 3.0])
+def test_cell_plan_programs_the_doppler_of_each_targets_velocity(velocity_mps):
+    """Front ends on a sphere (N channels per target): every channel of target k is programmed
+    with the Doppler 2 f_c v_k / c0 of its set velocity."""
+    import tomllib
+    from rtsgeom.aoa.plan import plan_targets, uses_cells
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    from rtsgeom.scene import parse_scene
+    doc = tomllib.loads((ROOT / "scenes" / "sphere4.toml").read_text())
+    for k, t in enumerate(doc["targets"]):
+        t["velocity_mps"] = velocity_mps * (k + 1) / len(doc["targets"])
+    scene = parse_scene(doc, str(ROOT / "scenes" / "sphere4.toml"))
+    assert uses_cells(scene)
+    setup = build_setup(scene)
+    prog, _, _ = plan_targets(setup, exact_paths(setup), "array-factor", calibrate=False)
+    for k, t in enumerate(scene.targets):
+        rows = np.asarray(prog.target) == k
+        assert rows.sum() >= 3
+        np.testing.assert_allclose(prog.doppler_hz[rows], 2 * scene.radar.f_c_hz * t.velocity_mps
+                                   / c, rtol=1e-12, atol=1e-9)
