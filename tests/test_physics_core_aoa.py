@@ -421,3 +421,23 @@ def test_calibration_sweep_noise_is_the_adc_chains_within_a_factor_of_a_few(snr_
         assert len({np.asarray(x).round(12).tobytes() for x in d}) == len(d)
     assert var[True] > 0 and var[False] > 0
     assert 0.2 < var[False] / var[True] < 5.0
+
+
+@pytest.mark.parametrize("taps", [9, 11, 17])
+def test_fir_effect_reports_its_filter_and_a_small_passband_ripple(taps):
+    """``fir_effect`` names the filter it evaluated ("none" without a fractional delay, where
+    nothing ripples) and a windowed-sinc FIR's gain ripple along the chirp's IF sweep: a
+    passband ripple, positive and below 1 dB from 9 taps on, that a twice as long filter does not increase."""
+    from rtsgeom.aoa.calibration import fir_effect
+    from rtsgeom.geometry import build_setup
+    fir = fir_effect(build_setup(_fir_scene(taps, "windowed-sinc")), 0.37e-9)
+    assert fir["model"] == "windowed-sinc"
+    assert 0.0 < fir["gain_ripple_db"] < 1.0 and 0.0 < fir["phase_ripple_deg"] < 10.0
+    longer = fir_effect(build_setup(_fir_scene(2 * taps + 1, "windowed-sinc")), 0.37e-9)
+    assert longer["gain_ripple_db"] <= fir["gain_ripple_db"] * 1.05
+
+    def off(doc):
+        doc["rts"].update(fractional_delay=False, calibration_step_ps=250.0)
+    none = fir_effect(build_setup(make_scene(off)), 0.37e-9)
+    assert none == {"model": "none", "gain_ripple_db": 0.0, "phase_ripple_deg": 0.0,
+                    "predicted_shift_ps": 0.0}
