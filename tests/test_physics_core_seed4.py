@@ -322,3 +322,30 @@ def test_strong_cable_ghosts_outside_the_cfar_window_are_reported_as_detected(ca
     if cable_m / vf > (ring + 1) * bin_m:
         assert first["order"] == 1 and first["cfar_detected"] is True
         assert not first["within_cfar_window_of_target"]
+
+
+# -- aoa.ncal: the scene seed enters every noise draw modulo 2^32 -----------------------------
+
+
+@pytest.mark.parametrize("seed", [3, 5])
+def test_channel_calibration_depends_on_the_seed_modulo_2_to_the_32(seed):
+    """``scene.seed`` may be up to 2^63 - 1; every noise draw of the calibration (the pair
+    sweeps and the residual check at the cell centre) takes it modulo 2^32, so seeds 2^32
+    apart give the same calibration and residual, and neighbouring seeds different noise."""
+    from rtsgeom.aoa.calibration import probe_front_ends
+    from rtsgeom.aoa.ncal import calibrate_channels
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    setup = build_setup(make_scene(lambda d: d["radar"].update(
+        chirps_per_tx=32, samples_per_chirp=128, adc_rate_hz=12.5e6, snr_db=20.0)))
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, 1)
+
+    def cal(s):
+        return calibrate_channels(setup, paths, (0, 1), probe, seed=s, span_s=(-0.3e-9, 0.3e-9),
+                                  step_s=100e-12)
+    a = cal(seed)
+    for k in (1, 2 ** 8):
+        b = cal(seed + k * 2 ** 32)
+        assert np.array_equal(a.offsets_s, b.offsets_s) and a.residual_deg == b.residual_deg
+    assert cal(seed + 1).residual_deg != a.residual_deg
