@@ -10,11 +10,9 @@ import math
 
 import numpy as np
 import pytest
-from scipy.constants import c
-
 from conftest import ROOT, make_scene
+from scipy.constants import c
 from test_physics_core import _small_noiseless
-
 
 # -- analysis.coverage: the binding constraint of a planned arc ------------------------------
 
@@ -231,8 +229,13 @@ def test_pair_calibration_places_its_probes_over_the_fine_window_and_reports_its
     """Step 2 of ``calibrate_pair``: the probes' ranges are where ``sweep.place_probes`` puts
     them for the window +-period/4 around the coarse minimum (the fine sweep's centre), not
     for one delay of it; a noiseless sweep averages one frame per step, ``frames`` sets it."""
-    from rtsgeom.aoa.calibration import (calibrate_pair, nominal_model, probe_angles,
-                                         probe_front_ends, probe_ranges)
+    from rtsgeom.aoa.calibration import (
+        calibrate_pair,
+        nominal_model,
+        probe_angles,
+        probe_front_ends,
+        probe_ranges,
+    )
     from rtsgeom.aoa.sweep import place_probes
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
@@ -271,6 +274,7 @@ def test_cell_plan_programs_the_doppler_of_each_targets_velocity(velocity_mps):
     """Front ends on a sphere (N channels per target): every channel of target k is programmed
     with the Doppler 2 f_c v_k / c0 of its set velocity."""
     import tomllib
+
     from rtsgeom.aoa.plan import plan_targets, uses_cells
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
