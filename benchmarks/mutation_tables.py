@@ -69,6 +69,11 @@ EQUIVALENT: dict[str, str] = {
         "under it to 1e-6 deg with the target's phase all around the circle).",
     "rtsgeom.radar.steering.x__newton__mutmut_250":
         "axis=+1 instead of -1 on u of shape (n, D): the same axis.",
+    "rtsgeom.aoa.sweep.x_design_ratio__mutmut_128":
+        "code replaced since the sample: P'' = 2 Re(s* s2) + 2 |s1|^2 is now written per "
+        "coefficient in ratio_from_beams (re(bi1, bi1) + ...), the mutated line no longer "
+        "exists (mutmut generates no such mutant). Before that it survived every setup tried "
+        "(|s1| is nearly 0 at the designed root), unproven; listed here as code that is gone.",
     # second fresh sample (seed 4)
     "rtsgeom.analysis.ghosts.x__unit_echoes__mutmut_43":
         "code replaced since the sample (the unit echoes are built by Echoes.build, which has "
@@ -213,6 +218,9 @@ KILLED_BY: dict[str, str] = {
         "test_unconverged_peaks_fall_back_to_the_search_and_the_others_keep_newton",
     "rtsgeom.rts.x_channel_echoes__mutmut_36":
         "test_channel_echoes_pair_every_path_of_one_leg_with_every_path_of_the_other",
+    # a seed-3 survivor, killed with the seed-4 tests
+    "rtsgeom.radar.steering.xǁSteeringǁbuild__mutmut_16":
+        "test_2d_steering_aperture_counts_distinct_positions_in_grid_units (grid unit lambda/16)",
 }
 
 # a sample's mutant -> the same change under its name in today's code (the function moved to
@@ -234,24 +242,12 @@ RENAMED: dict[str, str] = {
         "rtsgeom.radar.capture.x_read_capture__mutmut_113",
     "rtsgeom.radar.steering.xǁSteeringǁpeak__mutmut_69":
         "rtsgeom.radar.steering.xǁSteeringǁpeak__mutmut_87",
+    "rtsgeom.radar.steering.xǁSteeringǁbuild__mutmut_16":
+        "rtsgeom.radar.steering.xǁSteeringǁbuild__mutmut_39",
 }
 
 # survivors not killed and not shown equivalent: why (printed with their diff)
 NOT_KILLED: dict[str, str] = {
-    "rtsgeom.aoa.sweep.x_design_ratio__mutmut_128":
-        "|s1|^3 instead of |s1|^2 in P'' (the test that a stationary point is a maximum). At "
-        "the designed root s1 = dB/du is nearly 0 (the beam is nearly real about its peak "
-        "with the array's own phase reference), so both terms are negligible against "
-        "Re(s* s2) and the sign does not change on any setup tried (windows x radii in "
-        "test_closed_form_design_is_scale_free_and_puts_the_peak_on_the_set_angle, which "
-        "passes under the mutant). Not proven equivalent (an array whose phase reference is "
-        "far from its centre would make s1 large), so counted as a survivor.",
-    "rtsgeom.radar.steering.xǁSteeringǁbuild__mutmut_16":
-        "the 2-D grid's aperture counts distinct positions of pos * spacing instead of pos / "
-        "spacing rounded to 1e-6: on a lambda/2 lattice the products step by spacing^2 "
-        "(3.8e-6 m^2 at 77 GHz), still distinct after rounding, so every preset gets the same "
-        "grid; an off-lattice custom array with sub-0.25 mm differences would get a coarser "
-        "global-check grid. Not equivalent in general; counted as a survivor.",
     "rtsgeom.analysis.design.x_evaluate_design__mutmut_62":
         "the 'synthesis failed' branch needs PairPhasors.build to raise ValueError; no design "
         "tried reaches it (spacings 35-140 deg at 0.3 and 1 m: the composite's searched peak "

@@ -353,3 +353,27 @@ def test_channel_calibration_depends_on_the_seed_modulo_2_to_the_32(seed):
         b = cal(seed + k * 2 ** 32)
         assert np.array_equal(a.offsets_s, b.offsets_s) and a.residual_deg == b.residual_deg
     assert cal(seed + 1).residual_deg != a.residual_deg
+
+
+# -- radar.steering.build: the 2-D aperture of an explicit array -------------------------------
+
+
+@pytest.mark.parametrize("unit", [2, 4, 16])
+@pytest.mark.parametrize("n_rx, n_tx", [(4, 2), (3, 3)])
+def test_2d_steering_aperture_counts_distinct_positions_in_grid_units(unit, n_rx, n_tx):
+    """An explicit array (Tx stacked in z, Rx in a row in x, both on a lambda/2 lattice) with
+    the grid unit d = lambda / ``unit``: the 2-D beamformer's aperture per axis is the number
+    of distinct virtual positions on that axis times d (n_rx d in x, n_tx d in z), whatever d
+    (the global check's grid density follows it)."""
+    from rtsgeom.geometry.arrays import array_from_spec
+    from rtsgeom.radar.steering import Steering
+    from rtsgeom.radar_presets import ArraySpec
+    scene = make_scene()
+    lam = c / scene.radar.f_c_hz
+    tx = tuple((0.0, k * lam / 2) for k in range(n_tx))
+    rx = tuple((k * lam / 2, 0.0) for k in range(n_rx))
+    rut = array_from_spec(ArraySpec(tx, rx, tuple(range(n_tx)), spacing_m=lam / unit), lam)
+    st = Steering.build(rut, scene.radar, elevation=True)
+    np.testing.assert_allclose(st.aperture_m, np.array([n_rx, n_tx]) * lam / unit, rtol=1e-12)
+    n_grid = [int(np.ceil(16 * a / lam)) + 1 for a in st.aperture_m]
+    assert st.grid().shape[0] <= n_grid[0] * n_grid[1]
