@@ -127,10 +127,14 @@ def prepare(workdir: Path, modules: list[str]) -> None:
     ignore = shutil.ignore_patterns("__pycache__", "*.pyc", ".hypothesis", ".pytest_cache")
     for d in ("rtsgeom", "tests", "scenes", "docs"):
         shutil.copytree(ROOT / d, workdir / d, ignore=ignore)
+    # result tables some tests read (e.g. test_calibration's sample of the linearity grid)
+    shutil.copytree(ROOT / "benchmarks", workdir / "benchmarks",
+                    ignore=shutil.ignore_patterns("__pycache__", "*.py", "*.md"))
     base = tomllib.loads((ROOT / "pyproject.toml").read_text()).get("tool", {})
     cfg = dict(base.get("mutmut", {}))
     globs, tests = selection(modules)
     cfg["only_mutate"] = globs
+    cfg["also_copy"] = sorted(set(cfg.get("also_copy", [])) | {"benchmarks/"})
     cfg["pytest_add_cli_args_test_selection"] = tests
     lines = ["[tool.pytest.ini_options]", 'testpaths = ["tests"]',
              "markers = " + _toml_list(base.get("pytest", {}).get("ini_options", {})

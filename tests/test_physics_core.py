@@ -240,13 +240,13 @@ def test_planned_arc_reports_the_outer_front_ends_near_field_bias():
     scene = make_scene()
     cov = (math.radians(0.0), math.radians(12.0))
     p1, p2 = plan_arc(scene, cov, 1.0), plan_arc(scene, cov, 2.0)
-    b1, b2 = np.array(p1["outer_bias_deg"]), np.array(p2["outer_bias_deg"])
+    b1, b2 = np.array(p1.outer_bias_deg), np.array(p2.outer_bias_deg)
     assert np.all(b1 > 0.3) and np.all(b1 < 0.9)
     np.testing.assert_allclose(b1 / b2, 2.0, rtol=0.1)
     ev = evaluate_arc(p2, draws=20, points=3)
-    assert ev["outer_bias_deg"] == p2["outer_bias_deg"] and ev["problem"] is None
-    assert ev["worst_calibrated_deg"] < 1e-3
-    assert 0.0 <= ev["tolerance_yield"] <= 1.0 and ev["sigma_mm"] > 0
+    assert ev.plan.outer_bias_deg == p2.outer_bias_deg and ev.problem is None
+    assert ev.worst_calibrated_deg < 1e-3
+    assert 0.0 <= ev.tolerance_yield <= 1.0 and ev.sigma_mm > 0
 
 
 # -- radar.steering: the 2-D search does not depend on the snapshot's phase ------------------
