@@ -39,8 +39,13 @@ are listed in ``EQUIVALENT`` with the reason; they are reported apart and left o
 Keep ``MODULES`` in step with the tests: a module whose tests are not mapped shows its
 mutants as "no tests" (the seed-3 sample found 21 such mutants in modules added after the map
 was written). New tests for a sample's survivors go to ``tests/test_physics_core.py`` / ``_aoa.py``
-(``KILLED_BY`` names the test per mutant); judge the suite on a sample it was not written
-for (a new ``--seed``).
+(seed 3), ``tests/test_physics_core_seed4.py`` (seed 4); ``KILLED_BY`` names the test per
+mutant, ``RENAMED`` a mutant's name in today's code where its function moved or was
+renumbered (``benchmarks/mutation_tables.py``); judge the suite on a sample it was not
+written for (a new ``--seed``).
+
+    python -m benchmarks.mutation --rerun-survivors --workdir /tmp/mut-fresh4 \
+        --report mutation-report-seed4             # the seed-4 sample's survivors again
 """
 
 from __future__ import annotations
