@@ -44,8 +44,7 @@ mutant, ``RENAMED`` a mutant's name in today's code where its function moved or 
 renumbered (``benchmarks/mutation_tables.py``); judge the suite on a sample it was not
 written for (a new ``--seed``).
 
-    python -m benchmarks.mutation --rerun-survivors --workdir /tmp/mut-fresh4 \
-        --report mutation-report-seed4             # the seed-4 sample's survivors again
+    python -m benchmarks.mutation --rerun-survivors --workdir /tmp/mut-fresh4 --report mutation-report-seed4
 """
 
 from __future__ import annotations
