@@ -191,6 +191,7 @@ def test_nd_pair_calibration_lands_on_the_coherence_point(fe, dr_mm):
     from rtsgeom.aoa.ncal import calibrate_pair_nd
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
+    from rtsgeom.geometry.farfield import two_way_lengths
     setup = build_setup(_small_noiseless(
         lambda d: d["rts"]["front_ends"][fe].update(radial_offset_mm=dr_mm)))
     paths = exact_paths(setup)
@@ -202,7 +203,11 @@ def test_nd_pair_calibration_lands_on_the_coherence_point(fe, dr_mm):
     dist = (got["delta_tau_s"] - point + period / 2) % period - period / 2
     assert abs(dist) < 3e-12
     assert got["residual_error_deg"] < 0.05
-    assert got["range_offset_m"] == pytest.approx(0.5 * 299792458.0 * got["delta_tau_s"])
+    # the range offset the pair's echoes get: half the path of J's delay plus its air-path
+    # excess over I (each front end's two-way line-of-sight length, mean over the elements)
+    air = two_way_lengths(setup.rut, setup.fe.rx, setup.fe.tx).mean(axis=1)
+    assert got["range_offset_m"] == pytest.approx(
+        0.5 * (299792458.0 * got["delta_tau_s"] + air[1] - air[0]), abs=1e-9)
 
 
 def test_channel_calibration_of_one_channel_is_its_own_reference():
