@@ -39,8 +39,12 @@ are listed in ``EQUIVALENT`` with the reason; they are reported apart and left o
 Keep ``MODULES`` in step with the tests: a module whose tests are not mapped shows its
 mutants as "no tests" (the seed-3 sample found 21 such mutants in modules added after the map
 was written). New tests for a sample's survivors go to ``tests/test_physics_core.py`` / ``_aoa.py``
-(``KILLED_BY`` names the test per mutant); judge the suite on a sample it was not written
-for (a new ``--seed``).
+(seed 3), ``tests/test_physics_core_seed4.py`` (seed 4); ``KILLED_BY`` names the test per
+mutant, ``RENAMED`` a mutant's name in today's code where its function moved or was
+renumbered (``benchmarks/mutation_tables.py``); judge the suite on a sample it was not
+written for (a new ``--seed``).
+
+    python -m benchmarks.mutation --rerun-survivors --workdir /tmp/mut-fresh4 --report mutation-report-seed4
 """
 
 from __future__ import annotations
@@ -69,7 +73,8 @@ MODULES: dict[str, tuple[str, tuple[str, ...]]] = {
         "tests/test_geometry.py", "tests/test_frontends.py", "tests/test_arrays.py",
         "tests/test_patterns.py", "tests/test_properties.py", "tests/test_warnings_geometry.py",
         "tests/test_fields.py", "tests/test_mutants.py", "tests/test_sphere.py",
-        "tests/test_setups.py", "tests/test_elevation.py", "tests/test_physics_core.py")),
+        "tests/test_setups.py", "tests/test_elevation.py", "tests/test_physics_core.py",
+        "tests/test_physics_core_seed4.py")),
     "paths.exact": ("rtsgeom/paths/exact.py", (
         "tests/test_geometry.py", "tests/test_patterns.py", "tests/test_properties.py",
         "tests/test_frontends.py", "tests/test_mutants.py", "tests/test_sphere.py",
@@ -77,22 +82,25 @@ MODULES: dict[str, tuple[str, tuple[str, ...]]] = {
     "rts": ("rtsgeom/rts.py", (
         "tests/test_signal.py", "tests/test_signal_properties.py", "tests/test_ghosts.py",
         "tests/test_fields.py", "tests/test_mutants.py", "tests/test_calibration.py",
-        "tests/test_link.py", "tests/test_windows.py", "tests/test_physics_core.py")),
+        "tests/test_link.py", "tests/test_windows.py", "tests/test_physics_core.py",
+        "tests/test_physics_core_seed4.py")),
     "radar": ("rtsgeom/radar/*", (
         "tests/test_signal.py", "tests/test_signal_properties.py", "tests/test_steering.py",
         "tests/test_windows.py", "tests/test_fields.py", "tests/test_mutants.py",
         "tests/test_cfar.py", "tests/test_elevation.py", "tests/test_link.py",
-        "tests/test_fast_numerics.py", "tests/test_identify.py", "tests/test_physics_core.py")),
+        "tests/test_fast_numerics.py", "tests/test_identify.py", "tests/test_physics_core.py",
+        "tests/test_physics_core_seed4.py")),
     "aoa": ("rtsgeom/aoa/*", (
         "tests/test_aoa.py", "tests/test_steering.py", "tests/test_windows.py",
         "tests/test_fields.py", "tests/test_mutants.py", "tests/test_calibration.py",
         "tests/test_nchannel.py", "tests/test_sphere.py", "tests/test_elevation.py",
         "tests/test_setups.py", "tests/test_reachable.py", "tests/test_physics_core.py",
-        "tests/test_physics_core_aoa.py")),
+        "tests/test_physics_core_aoa.py", "tests/test_physics_core_seed4.py")),
     "analysis": ("rtsgeom/analysis/*", (
         "tests/test_tolerance.py", "tests/test_nearfield.py", "tests/test_ghosts.py",
         "tests/test_design.py", "tests/test_mutants.py", "tests/test_setups.py",
-        "tests/test_windows.py", "tests/test_physics_core.py")),
+        "tests/test_windows.py", "tests/test_physics_core.py",
+        "tests/test_physics_core_seed4.py")),
 }
 
 # Functions outside the physics core although they sit in its modules: plotting, mesh export
@@ -100,164 +108,8 @@ MODULES: dict[str, tuple[str, tuple[str, ...]]] = {
 # left out here). fnmatch patterns on the mutant name.
 EXCLUDE = ("*figure*", "rtsgeom.geometry.export.*", "*to_dict*")
 
-# mutant name -> why it is equivalent (no observable change); filled in from the survivors
-EQUIVALENT: dict[str, str] = {
-    "rtsgeom.geometry.arrays.x__grid_unit__mutmut_5":
-        "np.asarray(x) instead of np.asarray(x, float): every caller passes float positions "
-        "(metres), so the array is the same.",
-    "rtsgeom.geometry.arrays.x_posed_positions__mutmut_3":
-        "np.asarray(yaw, None) instead of float: a yaw offset is a float or a float array, the "
-        "array is the same (and cos/sin make floats of any integer).",
-    "rtsgeom.geometry.sheet.x_sheet_mesh__mutmut_29":
-        "np.asarray(angles) without float: the cutout angles are floats (radians) already.",
-    "rtsgeom.geometry.farfield.x_coarray_period_m__mutmut_1":
-        "the default search depth 64 -> 65 differs only for an array whose co-array period is "
-        "d_min/65; the scene selects presets only (periods d_min or d_min/2), custom arrays "
-        "are not wired to the scene.",
-    "rtsgeom.geometry.patterns.x_direction_angles__mutmut_16":
-        "no lower clip for arcsin(v_z / |v|): the ratio of a component to the norm lies in "
-        "[-1, 1] (exactly -1 straight down); only a rounding past -1 could differ.",
-    "rtsgeom.radar.dca1000.x_to_dca1000__mutmut_48":
-        "the I part rounded to float64 instead of int16 before `.astype('<i2')`: the values "
-        "are whole numbers within int16, so the bytes are the same.",
-    "rtsgeom.radar.steering.xǁSteeringǁsearch__mutmut_60":
-        "the zoom grid loses its last point (+half): the coarse peak is within half a coarse "
-        "step (0.125 deg < 0.3 deg; 0.0025 deg < 0.006 deg) of the grid centre, so the "
-        "argmax never falls on that point.",
-    "rtsgeom.radar.steering.xǁSteeringǁsearch__mutmut_4":
-        "the error message gains 'XX' around the same text (the test matches the text).",
-    "rtsgeom.analysis.tolerance.x_evaluate_chunk__mutmut_59":
-        "np.take_along_axis without axis= uses axis=-1 in numpy 2, the axis given.",
-    # fresh sample (seed 3)
-    "rtsgeom.aoa.calibration.x_frames_per_step__mutmut_23":
-        "dead code: aoa.calibration.frames_per_step is called nowhere (the calibration sizes its "
-        "frames per step by a Monte-Carlo of the phasor model since), so no output can change.",
-    "rtsgeom.aoa.calibration.x_frames_per_step__mutmut_80":
-        "dead code: frames_per_step is called nowhere (see mutmut_23).",
-    "rtsgeom.aoa.calibration.x_frames_per_step__mutmut_86":
-        "dead code: frames_per_step is called nowhere (see mutmut_23).",
-    "rtsgeom.analysis.design.x__fit_sheet__mutmut_38":
-        "a redundant guard: the scene rules (scene_rules: rx_tx_separation_m < "
-        "cutout_diameter_m, |antenna offset| < cutout_diameter_m / 2) reject every scene in "
-        "which 'max antenna offset >= d/2' could hold, and two_front_end_scene keeps the "
-        "layout and the cutout; the clause is false before and after (0.5 / d is 10 m).",
-    "rtsgeom.analysis.ghosts.x__peak__mutmut_19":
-        "the +-1-bin window around a predicted echo keeps row -1 unclipped only when the echo "
-        "is in range bin 0; the extra row is the last range bin, which the target range rule "
-        "keeps k_r bins clear of any echo, and the echo itself (bin 0 or 1) is in the window "
-        "either way, so the window's maximum is the same cell.",
-    "rtsgeom.geometry.arrays.x__to3__mutmut_5":
-        "np.asarray(xz) without float: np.stack with np.zeros (float64) promotes integer "
-        "positions to float64 anyway; same array.",
-    "rtsgeom.geometry.arrays.x_array_from_spec__mutmut_14":
-        "meshgrid with indexing='xy' over (slots, [0], rx) swaps the first two axes, one of "
-        "which has length 1: the raveled slot and rx indices are in the same order.",
-    "rtsgeom.geometry.farfield.x_smallest_spacing_m__mutmut_10":
-        "float('INF') is float('inf').",
-    "rtsgeom.geometry.patterns.xǁTablePatternǁfrom_samples__mutmut_42":
-        "np.asarray(phase_deg) without float: np.radians returns float64 for integer input; "
-        "same table.",
-    "rtsgeom.radar.steering.xǁSteeringǁ_search_2d__mutmut_41":
-        "the coarse start of the 2-D search ranks grid points by re^3 + im^2 instead of the "
-        "power: Steering.peak checks every Newton result against the grid's power maximum and "
-        "restarts from that maximum when the start led elsewhere, so only the number of "
-        "Newton steps changes (test_2d_search_is_independent_of_the_targets_phase passes "
-        "under it to 1e-6 deg with the target's phase all around the circle).",
-    "rtsgeom.radar.steering.x__newton__mutmut_250":
-        "axis=+1 instead of -1 on u of shape (n, D): the same axis.",
-}
-
-
-# first-pass survivor -> the test that kills it (tests/test_physics_core.py for analysis/,
-# geometry/, radar/; tests/test_physics_core_aoa.py for aoa/); the fresh sample (seed 3).
-# Printed in the report's "killed by later tests" section.
-KILLED_BY: dict[str, str] = {
-    "rtsgeom.analysis.arc.x_max_scale_for_yield__mutmut_56":
-        "test_arc_yield_search_stops_at_zero_when_the_nominal_arc_fails",
-    "rtsgeom.analysis.arc.xǁBoundsǁfrom_tolerances__mutmut_65":
-        "test_bounds_from_tolerances_scale_every_field",
-    "rtsgeom.analysis.coverage.x_arc_scene__mutmut_14":
-        "test_arc_scene_copies_the_first_front_end_without_its_errors",
-    "rtsgeom.analysis.coverage.x_arc_scene__mutmut_20":
-        "test_arc_scene_copies_the_first_front_end_without_its_errors",
-    "rtsgeom.analysis.coverage.x_evaluate_arc__mutmut_149":
-        "test_planned_arc_reports_the_outer_front_ends_near_field_bias",
-    "rtsgeom.analysis.coverage.x_plan_arc__mutmut_179":
-        "test_planned_arc_reports_the_outer_front_ends_near_field_bias",
-    "rtsgeom.analysis.nearfield.x_synthesis_worst_errors_deg__mutmut_104":
-        "test_nearfield_rows_and_exact_synthesis_on_the_nominal_setup",
-    "rtsgeom.analysis.nearfield.x_synthesis_worst_errors_deg__mutmut_92":
-        "test_nearfield_rows_and_exact_synthesis_on_the_nominal_setup",
-    "rtsgeom.analysis.nearfield.xǁNearFieldǁ_row__mutmut_13":
-        "test_nearfield_rows_and_exact_synthesis_on_the_nominal_setup",
-    "rtsgeom.analysis.tolerance.x_largest_passing_scale__mutmut_20":
-        "test_largest_passing_scale_stops_when_the_bracket_is_within_rel_tol",
-    "rtsgeom.analysis.tolerance.x_monte_carlo__mutmut_69":
-        "test_monte_carlo_without_draws_has_no_errors_and_no_yield",
-    "rtsgeom.aoa.calibration.x_calibrate_pair_paper__mutmut_171":
-        "test_paper_procedure_reports_the_exact_period_at_its_target",
-    "rtsgeom.aoa.calibration.x_fir_effect__mutmut_146":
-        "test_fir_effect_predicts_the_coherence_shift_in_picoseconds",
-    "rtsgeom.aoa.cells.x__interval__mutmut_29":
-        "test_enclosing_interval_is_the_adjacent_pair_in_one_dimension",
-    "rtsgeom.aoa.linearity.x__closed_form_measured__mutmut_37":
-        "test_measured_end_angles_equal_geometric_ones_in_the_ideal_far_field",
-    "rtsgeom.aoa.linearity2d.x_linearity_grid__mutmut_132":
-        "test_2d_error_map_exact_mode_puts_every_grid_point_on_its_direction",
-    "rtsgeom.aoa.linearity2d.x_linearity_grid__mutmut_170":
-        "test_2d_error_map_exact_mode_puts_every_grid_point_on_its_direction",
-    "rtsgeom.aoa.model.xǁChannelModelǁair_legs__mutmut_59":
-        "test_raising_the_rut_equals_lowering_every_front_end",
-    "rtsgeom.aoa.ncal.x_calibrate_channels__mutmut_36":
-        "test_channel_calibration_of_one_channel_is_its_own_reference",
-    "rtsgeom.aoa.ncal.x_calibrate_pair_nd__mutmut_230":
-        "test_nd_pair_calibration_lands_on_the_coherence_point",
-    "rtsgeom.aoa.ncal.x_calibrate_pair_nd__mutmut_264":
-        "test_nd_pair_calibration_lands_on_the_coherence_point",
-    "rtsgeom.aoa.ncal.x_pair_edges__mutmut_23":
-        "test_pair_edges_are_neighbours_in_1d_and_delaunay_edges_in_2d",
-    "rtsgeom.aoa.ncal.x_pair_edges__mutmut_27":
-        "test_pair_edges_are_neighbours_in_1d_and_delaunay_edges_in_2d",
-    "rtsgeom.aoa.nchannel.x_closed_form_amplitudes__mutmut_44":
-        "test_closed_form_amplitudes_ignore_a_common_phase",
-    "rtsgeom.aoa.nchannel.xǁChannelSetǁamplitudes__mutmut_4":
-        "test_2d_error_map_exact_mode_puts_every_grid_point_on_its_direction",
-    "rtsgeom.aoa.plan.x_plan_targets__mutmut_88":
-        "test_plan_reports_each_pairs_calibration_delay_in_picoseconds",
-    "rtsgeom.aoa.sweep.x__noise_sigma__mutmut_78":
-        "test_calibration_sweep_noise_is_the_adc_chains_within_a_factor_of_a_few",
-    "rtsgeom.aoa.sweep.x_chain_errors__mutmut_45":
-        "test_calibration_sweep_noise_is_the_adc_chains_within_a_factor_of_a_few (each seed "
-        "its own noise)",
-    "rtsgeom.aoa.sweep.x_fit_minimum__mutmut_22":
-        "test_fit_minimum_finds_the_minimum_of_the_periodic_criterion_despite_lost_steps",
-    "rtsgeom.radar.capture.x_read_capture__mutmut_96": "test_probe_capture_round_trip",
-    "rtsgeom.radar.frame.x__simulate_linked__mutmut_64":
-        "test_linked_frame_noise_is_the_receivers_thermal_noise_through_the_if_chain",
-}
-
-# survivors not killed and not shown equivalent: why (printed with their diff)
-NOT_KILLED: dict[str, str] = {
-    "rtsgeom.aoa.sweep.x_design_ratio__mutmut_128":
-        "|s1|^3 instead of |s1|^2 in P'' (the test that a stationary point is a maximum). At "
-        "the designed root s1 = dB/du is nearly 0 (the beam is nearly real about its peak "
-        "with the array's own phase reference), so both terms are negligible against "
-        "Re(s* s2) and the sign does not change on any setup tried (windows x radii in "
-        "test_closed_form_design_is_scale_free_and_puts_the_peak_on_the_set_angle, which "
-        "passes under the mutant). Not proven equivalent (an array whose phase reference is "
-        "far from its centre would make s1 large), so counted as a survivor.",
-    "rtsgeom.radar.steering.xǁSteeringǁbuild__mutmut_16":
-        "the 2-D grid's aperture counts distinct positions of pos * spacing instead of pos / "
-        "spacing rounded to 1e-6: on a lambda/2 lattice the products step by spacing^2 "
-        "(3.8e-6 m^2 at 77 GHz), still distinct after rounding, so every preset gets the same "
-        "grid; an off-lattice custom array with sub-0.25 mm differences would get a coarser "
-        "global-check grid. Not equivalent in general; counted as a survivor.",
-    "rtsgeom.analysis.design.x_evaluate_design__mutmut_62":
-        "the 'synthesis failed' branch needs PairPhasors.build to raise ValueError; no design "
-        "tried reaches it (spacings 35-140 deg at 0.3 and 1 m: the composite's searched peak "
-        "always brackets the set angle, the design returns a worst error of 26-132 deg "
-        "instead). Unreachable in practice, not proven; counted as a survivor.",
-}
+# the per-mutant tables (equivalent with reasons, killed by which test, renamed, not killed)
+from benchmarks.mutation_tables import EQUIVALENT, KILLED_BY, NOT_KILLED, RENAMED
 
 
 def _toml_list(xs) -> str:
@@ -279,10 +131,14 @@ def prepare(workdir: Path, modules: list[str]) -> None:
     ignore = shutil.ignore_patterns("__pycache__", "*.pyc", ".hypothesis", ".pytest_cache")
     for d in ("rtsgeom", "tests", "scenes", "docs"):
         shutil.copytree(ROOT / d, workdir / d, ignore=ignore)
+    # result tables some tests read (e.g. test_calibration's sample of the linearity grid)
+    shutil.copytree(ROOT / "benchmarks", workdir / "benchmarks",
+                    ignore=shutil.ignore_patterns("__pycache__", "*.py", "*.md"))
     base = tomllib.loads((ROOT / "pyproject.toml").read_text()).get("tool", {})
     cfg = dict(base.get("mutmut", {}))
     globs, tests = selection(modules)
     cfg["only_mutate"] = globs
+    cfg["also_copy"] = sorted(set(cfg.get("also_copy", [])) | {"benchmarks/"})
     cfg["pytest_add_cli_args_test_selection"] = tests
     lines = ["[tool.pytest.ini_options]", 'testpaths = ["tests"]',
              "markers = " + _toml_list(base.get("pytest", {}).get("ini_options", {})
@@ -431,7 +287,8 @@ def summarise(results: dict, meta: dict) -> dict:
                           + by["suspicious"]},
             "equivalent": {k: {"reason": EQUIVALENT[k], "diff": results[k]["diff"]}
                            for k in by["equivalent"]},
-            "killed_later": {k: {"first_status": r["first_status"], "diff": r.get("first_diff", "")}
+            "killed_later": {k: {"first_status": r["first_status"], "diff": r.get("first_diff", ""),
+                                 **({"renamed_to": r["renamed_to"]} if "renamed_to" in r else {})}
                              for k, r in sorted(results.items())
                              if r.get("first_status", r["status"]) != r["status"]
                              and r["status"] == "killed"},
@@ -472,9 +329,14 @@ def write_report(s: dict) -> None:
         lines += ["## First-pass survivors killed by later tests", "",
                   "Each was killed by a test added after the first pass (named below; in "
                   "`tests/test_physics_core.py` or, for `aoa/`, `tests/test_physics_core_aoa.py` "
-                  "for the seed-3 sample, `tests/test_mutants.py` for the seed-2 one).", ""]
+                  "for the seed-3 sample, `tests/test_physics_core_seed4.py` (and two in "
+                  "`_aoa.py`) for the seed-4 one, `tests/test_mutants.py` for the seed-2 one).",
+                  ""]
         for k, d in s["killed_later"].items():
             by = [f"Killed by `{KILLED_BY[k]}`.", ""] if k in KILLED_BY else []
+            if d.get("renamed_to"):
+                by += [f"Run as `{d['renamed_to']}`: the same change in today's code (the "
+                       "function moved or its mutants were renumbered since the sample).", ""]
             lines += [f"### `{k}` (first pass: {d['first_status']})", "", *by, "```diff",
                       d["diff"].strip(), "```", ""]
     if s["equivalent"]:
@@ -502,9 +364,14 @@ def main(argv: list[str] | None = None) -> int:
                     help="run exactly these mutants (e.g. the survivors of a report)")
     ap.add_argument("--rerun-survivors", action="store_true",
                     help="run the last run's survivors again (after new tests) and merge")
+    ap.add_argument("--report", default="mutation-report",
+                    help="report name in benchmarks/ (NAME.md and NAME.json)")
     ap.add_argument("--note", action="append", default=[],
                     help="a line for the report's header (kept with the run's state)")
     a = ap.parse_args(argv)
+    global REPORT_MD, REPORT_JSON
+    REPORT_MD = ROOT / "benchmarks" / f"{a.report}.md"
+    REPORT_JSON = ROOT / "benchmarks" / f"{a.report}.json"
     from importlib.metadata import version
     meta = {"command": "python -m benchmarks.mutation " + " ".join(argv if argv is not None
                                                                    else sys.argv[1:]),
@@ -519,14 +386,25 @@ def main(argv: list[str] | None = None) -> int:
                        if r["status"] in ("survived", "no tests", "suspicious")
                        and (not a.names or k in a.names))  # --names: only those of them
         prepare(a.workdir, meta["modules"])
-        all_mutants(a.workdir)
+        present = {k for v in all_mutants(a.workdir).values() for k in v}
+        # a mutant of code that moved since the sample runs under its new name (RENAMED);
+        # one of code removed since is no longer generated: it keeps its first status
+        run_as = {k: RENAMED.get(k, k) for k in rerun}
+        gone = [k for k in rerun if run_as[k] not in present]
+        rerun = [k for k in rerun if run_as[k] in present]
+        if gone:
+            print(f"no longer generated (code removed since): {', '.join(gone)}", flush=True)
         print(f"re-running {len(rerun)} survivors", flush=True)
-        wall = run(a.workdir, rerun, a.children, a.timeout_s)
+        wall = run(a.workdir, [run_as[k] for k in rerun], a.children, a.timeout_s)
         meta.setdefault("reruns", []).append({"mutants": len(rerun), "wall_s": round(wall, 1)})
         names = meta["names"]
         state.write_text(json.dumps(meta))
-        new = collect(a.workdir, rerun)
-        for k, r in new.items():
+        got = collect(a.workdir, [run_as[k] for k in rerun])
+        new = {}
+        for k in rerun:
+            r = new[k] = got[run_as[k]]
+            if run_as[k] != k:
+                r["renamed_to"] = run_as[k]
             r["first_status"] = previous[k].get("first_status", previous[k]["status"])
             r["first_diff"] = previous[k].get("first_diff") or previous[k]["diff"]
         previous.update(new)

@@ -191,6 +191,7 @@ def test_nd_pair_calibration_lands_on_the_coherence_point(fe, dr_mm):
     from rtsgeom.aoa.ncal import calibrate_pair_nd
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
+    from rtsgeom.geometry.farfield import two_way_lengths
     setup = build_setup(_small_noiseless(
         lambda d: d["rts"]["front_ends"][fe].update(radial_offset_mm=dr_mm)))
     paths = exact_paths(setup)
@@ -202,11 +203,11 @@ def test_nd_pair_calibration_lands_on_the_coherence_point(fe, dr_mm):
     dist = (got["delta_tau_s"] - point + period / 2) % period - period / 2
     assert abs(dist) < 3e-12
     assert got["residual_error_deg"] < 0.05
-    # the echoes' range offset after calibration: c0/2 times the delay offset plus the
-    # radial offset's air path (J's minus I's, one way), as calibrate_pair reports it
-    air_m = dr_mm * 1e-3 * (1 if fe == 1 else -1)
-    assert got["range_offset_m"] == pytest.approx(0.5 * 299792458.0 * got["delta_tau_s"]
-                                                  + air_m, abs=1e-5)
+    # the range offset the pair's echoes get: half the path of J's delay plus its air-path
+    # excess over I (each front end's two-way line-of-sight length, mean over the elements)
+    air = two_way_lengths(setup.rut, setup.fe.rx, setup.fe.tx).mean(axis=1)
+    assert got["range_offset_m"] == pytest.approx(
+        0.5 * (299792458.0 * got["delta_tau_s"] + air[1] - air[0]), abs=1e-9)
 
 
 def test_channel_calibration_of_one_channel_is_its_own_reference():
@@ -425,3 +426,23 @@ def test_calibration_sweep_noise_is_the_adc_chains_within_a_factor_of_a_few(snr_
         assert len({np.asarray(x).round(12).tobytes() for x in d}) == len(d)
     assert var[True] > 0 and var[False] > 0
     assert 0.2 < var[False] / var[True] < 5.0
+
+
+@pytest.mark.parametrize("taps", [9, 11, 17])
+def test_fir_effect_reports_its_filter_and_a_small_passband_ripple(taps):
+    """``fir_effect`` names the filter it evaluated ("none" without a fractional delay, where
+    nothing ripples) and a windowed-sinc FIR's gain ripple along the chirp's IF sweep: a
+    passband ripple, positive and below 1 dB from 9 taps on, that a twice as long filter does not increase."""
+    from rtsgeom.aoa.calibration import fir_effect
+    from rtsgeom.geometry import build_setup
+    fir = fir_effect(build_setup(_fir_scene(taps, "windowed-sinc")), 0.37e-9)
+    assert fir["model"] == "windowed-sinc"
+    assert 0.0 < fir["gain_ripple_db"] < 1.0 and 0.0 < fir["phase_ripple_deg"] < 10.0
+    longer = fir_effect(build_setup(_fir_scene(2 * taps + 1, "windowed-sinc")), 0.37e-9)
+    assert longer["gain_ripple_db"] <= fir["gain_ripple_db"] * 1.05
+
+    def off(doc):
+        doc["rts"].update(fractional_delay=False, calibration_step_ps=250.0)
+    none = fir_effect(build_setup(make_scene(off)), 0.37e-9)
+    assert none == {"model": "none", "gain_ripple_db": 0.0, "phase_ripple_deg": 0.0,
+                    "predicted_shift_ps": 0.0}
