@@ -109,7 +109,7 @@ def cmd_tolerance(args) -> int:
 def _tolerance(args, scene, stage) -> int:
     from .arc import save_pair_npz, scales, tolerance_arc, wants_arc
     sigma, extra = scales(args)
-    from .tolerance_cell import tolerance_cell, wants_cell
+    from .tolerance_cell import print_study_footer, tolerance_cell, wants_cell
     if wants_cell(args, scene, DEFAULT_PAIR):  # a 2-D cell of front ends (issue 15)
         return tolerance_cell(args, scene, sigma, extra, stage)
     if wants_arc(args):
@@ -164,17 +164,7 @@ def _tolerance(args, scene, stage) -> int:
         print(f"  {case:>30}: |error| p50 {p['p50']:.4f}, p95 {p['p95']:.4f}, p99 "
               f"{p['p99']:.4f}, max {p['max']:.4f} deg; yield {100 * st['yield']:.2f} % within "
               f"{args.spec_deg:g} deg")
-    if "verify" in out:
-        v = out["verify"]
-        print(f"  verify: {v['draws']} draws through the ADC-cube chain, largest |chain - model| "
-              f"{v['max_abs_difference_deg']:.2e} deg (at {v['set_point']})")
-    cal = out["calibration"]
-    print(f"  calibration |delta tau| p95 {cal['abs_delta_tau_ps']['p95']:.0f} ps, range offset "
-          f"p95 {cal['abs_range_offset_mm']['p95']:.1f} mm")
-    for case, inv in out.get("inversion", {}).items():
-        sig = ", ".join(f"{a} {inv['sigma_mm'][a]:.4g}" for a in AXES)
-        print(f"  {100 * args.invert_yield:g} % within {args.spec_deg:g} deg, {case}: {scale} "
-              f"{sig} mm{' (search cap)' if inv['capped'] else ''}")
+    print_study_footer(out, args, scale)
     return 0
 
 

@@ -120,6 +120,13 @@ def tolerance_cell(args, scene, sigma, extra, stage) -> int:
             parts.append(f"{name} p95 {p['p95']:.4f} p99 {p['p99']:.4f} max {p['max']:.4f}")
         print(f"  {case:>12}: |error| " + "; ".join(parts) + f" deg; yield "
               f"{100 * st['yield']:.2f} % within {args.spec_deg:g} deg in both angles")
+    print_study_footer(out, args, scale)
+    return 0
+
+
+def print_study_footer(out: dict, args, scale: str) -> None:
+    """The lines a pair study and a cell study print alike: the chain check (``--verify``),
+    the calibration's delays and range offsets, and the yield search (``--invert-yield``)."""
     if "verify" in out:
         v = out["verify"]
         print(f"  verify: {v['draws']} draws through the ADC-cube chain, largest |chain - model| "
@@ -131,4 +138,3 @@ def tolerance_cell(args, scene, sigma, extra, stage) -> int:
         sig = ", ".join(f"{a} {inv['sigma_mm'][a]:.4g}" for a in AXES)
         print(f"  {100 * args.invert_yield:g} % within {args.spec_deg:g} deg, {case}: {scale} "
               f"{sig} mm{' (search cap)' if inv['capped'] else ''}")
-    return 0
