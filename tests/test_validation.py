@@ -21,6 +21,7 @@ import pytest
 
 from rtsgeom.cli import main
 from rtsgeom.cli._common import number
+from rtsgeom.registry import RADAR_PRESETS
 from rtsgeom.scene import SceneError, TargetConfig, load_scene, loads_scene, parse_scene
 from rtsgeom.validate import scene_warnings
 
@@ -670,9 +671,8 @@ def test_amplitudes_override_cannot_bypass_the_spacing_rule():
         run_scene(s, "exact", "exact")
 
 
-@pytest.mark.parametrize("preset", [p for p in __import__("rtsgeom.registry", fromlist=["x"])
-                                    .RADAR_PRESETS.values() if p.board_gap_units is not None],
-                         ids=lambda p: p.name)
+@pytest.mark.parametrize("preset", [p for p in RADAR_PRESETS.values()
+                                    if p.board_gap_units is not None], ids=lambda p: p.name)
 def test_preset_board_gap_bounds_the_element_spacing(preset):
     """A preset's own Tx-Rx gap is board_gap_units * d: a spacing that pushes it past 0.5 m is
     refused on load, naming the field and its limit (found by the fuzzer: it used to pass

@@ -133,7 +133,7 @@ def evaluate_design(scene: Scene, pair: tuple[int, int], radius_m: float, spacin
     steps = model.calibration_steps(model.x_nominal)
     out["range_offset_mm"] = float(model.range_offset_m(zero, steps)) * 1e3
     out["delta_tau_ps"] = float(steps * model.delay_resolution_s * 1e12)
-    _, detail = model.draw_errors(zero[None], None, ("calibrated",), return_detail=True)
+    err, detail = model.draw_errors(zero[None], None, ("calibrated",), return_detail=True)
     if not np.all(np.isfinite(detail["amplitudes"]["calibrated"])):
         # no ratio puts the composite at some set angle (its closed-form design has no root:
         # the beams are too far apart and the composite splits): an error in degrees would
@@ -141,7 +141,7 @@ def evaluate_design(scene: Scene, pair: tuple[int, int], radius_m: float, spacin
         out["problem"] = ("synthesis failed: no amplitude ratio places the target at every "
                           "set angle (the composite splits)")
         return out
-    out["worst_error_deg"] = float(np.max(np.abs(model.angle_errors(zero, "calibrated"))))
+    out["worst_error_deg"] = float(np.degrees(np.max(np.abs(err["calibrated"]))))
     for case in CASES:
         inv = max_sigma_for_yield(model, [1e-4] * 3, draws, seed, target_yield, spec_deg, case,
                                   rel_tol=rel_tol)

@@ -179,6 +179,14 @@ def percentiles(values: np.ndarray, scale: float = 1.0) -> dict:
     return {"p50": float(p[0]), "p95": float(p[1]), "p99": float(p[2]), "max": float(a.max())}
 
 
+def draws_header(draws: int, seed: int, distribution: str, sigma_m, spec_deg: float) -> dict:
+    """The leading keys of a tolerance study's JSON (pair and cell alike): what was drawn."""
+    return {"draws": draws, "seed": seed, "distribution": distribution,
+            "scale": "sigma" if distribution == "normal" else "bound",
+            "sigma_mm": {a: float(s * 1e3) for a, s in zip(AXES, sigma_m)},
+            "spec_deg": spec_deg}
+
+
 @dataclass(frozen=True)
 class ToleranceResult:
     """A Monte-Carlo run: per draw the worst signed angle error of each case (deg)."""
@@ -211,12 +219,8 @@ class ToleranceResult:
 
     def to_dict(self) -> dict:
         out = {
-            "draws": self.draws,
-            "seed": self.seed,
-            "distribution": self.distribution,
-            "scale": "sigma" if self.distribution == "normal" else "bound",
-            "sigma_mm": {a: float(s * 1e3) for a, s in zip(AXES, self.sigma_m)},
-            "spec_deg": self.spec_deg,
+            **draws_header(self.draws, self.seed, self.distribution, self.sigma_m,
+                           self.spec_deg),
             "pair": self.model.to_dict(),
             "subbin": {
                 "distribution": ("uniform over one range bin" if self.subbin_steps is not None

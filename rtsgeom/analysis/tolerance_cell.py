@@ -49,7 +49,6 @@ import numpy as np
 from scipy.constants import c
 
 from .._util import frozen
-from ..aoa.calibration import probe_ranges
 from ..aoa.linearity2d import cell_grid
 from ..aoa.ncal import pair_edges, spanning_tree, tree_phases
 from ..aoa.nchannel import ChannelSet
@@ -58,11 +57,10 @@ from ..geometry import Setup
 from ..geometry.setup import nominal_setup
 from ..paths import exact_paths
 from ..radar.steering import Steering
-from ..scene import TargetConfig
-from .tolerance import (AXES, CASES, DEFAULT_CHUNK, Mapper, Progress, largest_passing_scale,
+from .tolerance import (AXES, CASES, DEFAULT_CHUNK, draws_header, Mapper, Progress, largest_passing_scale,
                         percentiles, standard_draws)
 from .arc import Bounds, _scale, arc_draws
-from .tolerance_model import _slide, response_table
+from .tolerance_model import reference_target, response_table, slide
 
 __all__ = ["CellPhasors", "CellToleranceResult", "ANGLES", "monte_carlo_cell",
            "max_sigma_for_yield_cell", "evaluate_cell_chunk", "draw_cell_offsets",
@@ -112,9 +110,7 @@ class CellPhasors:
                 0 <= q < n_fe for q in cell):
             raise ParameterError(f"cell {list(cell)}: must be 3 or 4 distinct front-end indices "
                                  f"in [0, {n_fe - 1}]")
-        bin_m = radar.range_resolution_m
-        r0 = float(probe_ranges(nom, 1)[0]) if range_m is None else float(range_m)
-        target = TargetConfig(max(round(r0 / bin_m), 1) * bin_m)
+        target = reference_target(nom, range_m)
         paths = exact_paths(nom)
         cs = ChannelSet.build(nom, paths, cell, target)
         st = cs.steering
@@ -194,7 +190,7 @@ class CellPhasors:
                 raise ValueError(f"case {case!r}: must be one of {', '.join(CASES)}")
             k = steps if case == "calibrated" else np.zeros_like(steps)
             f = self.delay_factor[q, k + self.max_steps]  # (n, Q, V)
-            xk = x * f * _slide(self.delay_log_slope[q, k + self.max_steps], shift)
+            xk = x * f * slide(self.delay_log_slope[q, k + self.max_steps], shift)
             amps = np.broadcast_to(self.amplitudes, (off.shape[0],) + self.amplitudes.shape)
             if case == "calibrated":  # the gains measured, the delay's known loss divided out
                 loss = np.abs(f[..., st.mask].mean(-1))  # (n, Q)
@@ -298,12 +294,8 @@ class CellToleranceResult:
 
     def to_dict(self) -> dict:
         out = {
-            "draws": self.draws,
-            "seed": self.seed,
-            "distribution": self.distribution,
-            "scale": "sigma" if self.distribution == "normal" else "bound",
-            "sigma_mm": {a: float(s * 1e3) for a, s in zip(AXES, self.sigma_m)},
-            "spec_deg": self.spec_deg,
+            **draws_header(self.draws, self.seed, self.distribution, self.sigma_m,
+                           self.spec_deg),
             "bounds": None if self.bounds is None else self.bounds.to_dict(),
             "yield_rule": "every set-point within spec_deg in azimuth and in elevation",
             "cell": self.model.to_dict(),

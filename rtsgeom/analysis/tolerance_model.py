@@ -202,11 +202,19 @@ class _Design:
         return amps, m_best
 
 
-#: Largest |d ln|x| / d tau * shift| the first-order slide applies (see :func:`_slide`).
+def reference_target(nominal: Setup, range_m: float | None = None) -> TargetConfig:
+    """The tolerance studies' reference target: at the centre of the range bin nearest
+    ``range_m`` (default: the calibration's first probe range), velocity 0, boresight."""
+    bin_m = nominal.scene.radar.range_resolution_m
+    r0 = float(probe_ranges(nominal, 1)[0]) if range_m is None else float(range_m)
+    return TargetConfig(max(round(r0 / bin_m), 1) * bin_m)
+
+
+#: Largest |d ln|x| / d tau * shift| the first-order slide applies (see :func:`slide`).
 MAX_SLIDE = 0.5
 
 
-def _slide(log_slope, shift_s):
+def slide(log_slope, shift_s):
     """exp(d ln|x|/d tau * shift): the first-order change of a spectrum's magnitude as the
     draw's air delay slides the echo along the range window. The log slope is unbounded at the
     window's spectral nulls (a Hann window has them two bins from an echo at a bin centre), where
@@ -260,9 +268,7 @@ class PairPhasors:
         nom = nominal_setup(setup)
         radar, rts = nom.scene.radar, nom.scene.rts
         pair = (int(pair[0]), int(pair[1]))
-        bin_m = radar.range_resolution_m
-        r0 = float(probe_ranges(nom, 1)[0]) if range_m is None else float(range_m)
-        target = TargetConfig(max(round(r0 / bin_m), 1) * bin_m)
+        target = reference_target(nom, range_m)
         paths = exact_paths(nom)
         model = ChannelModel.build(nom, paths, pair, target)
         st = model.steering
@@ -273,7 +279,7 @@ class PairPhasors:
         res = rts.delay_resolution_s
         slope = rts.f_rts_hz + 0.5 * radar.bandwidth_hz
         max_steps = int(np.ceil(0.5 / (slope * res))) + 4
-        n_bin = max(1, int(round(2 * bin_m / c / res)))  # delay steps per range bin
+        n_bin = max(1, int(round(2 * radar.range_resolution_m / c / res)))  # delay steps per range bin
         sub = np.arange(n_bin) - n_bin // 2
         # the exact period of J's IF phase at the target (eq. 27 refined), as aoa.plan uses it
         period = 1.0 / float(if_phase_slope_hz(nom.scene, 2 * target.range_m / c))
@@ -400,7 +406,7 @@ class PairPhasors:
             if redesign:  # from the nominal model: the operator does not know the shift
                 g[..., 1] /= np.abs(f[..., self.channels.steering.mask].mean(axis=-1))
             if shift_s is not None:
-                f = f * _slide(self.delay_log_slope[k], shift_s[..., 1, :])
+                f = f * slide(self.delay_log_slope[k], shift_s[..., 1, :])
             x_j = x_j * f
             a_i, a_j = a_i * g[..., 0, None], a_j * g[..., 1, None]  # (..., M)
         return a_i[..., None] * x_i[..., None, :] + a_j[..., None] * x_j[..., None, :]
@@ -429,7 +435,7 @@ class PairPhasors:
 
         def spectrum(q, j):  # (n, K, V)
             return (self.table[q, j] * fac[:, q, None, :]
-                    * _slide(self.table_log_slope[q, j], shift[:, q, None, :]))
+                    * slide(self.table_log_slope[q, j], shift[:, q, None, :]))
 
         x_i = spectrum(0, z + d_u)
         p_ii = np.sum(x_i.real ** 2 + x_i.imag ** 2, -1)  # (n, K)

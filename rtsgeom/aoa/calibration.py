@@ -53,12 +53,16 @@ class FrontEndProbe:
 
     def clipping_note(self) -> str:
         """Why a front end may be missing: the probe frame's ADC clipping, if any."""
-        if not self.adc_clipped:
-            return ""
-        return (f"; the ADC clipped {self.adc_clipped} samples of the probe frame (a setup "
-                "echo above full scale, e.g. the sheet's reflection: add an absorber, "
-                "sheet.reflection_loss_db or [[structure]] reflection_loss_db, or lower the "
-                "gain in [radar.link])")
+        return clipping_note(self.adc_clipped)
+
+
+def clipping_note(clipped: int) -> str:
+    """A clause for a 'not detected' message when the ADC clipped ``clipped`` samples."""
+    if not clipped:
+        return ""
+    return (f"; the ADC clipped {clipped} samples of the probe frame (a setup echo above full "
+            "scale, e.g. the sheet's reflection: add an absorber, sheet.reflection_loss_db or "
+            "[[structure]] reflection_loss_db, or lower the gain in [radar.link])")
 
 
 @dataclass(frozen=True)
@@ -251,7 +255,7 @@ def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe
         warnings.warn(f"front end(s) {missed} not detected alone at the probe range(s) "
                       f"{np.round(ranges[missed], 3).tolist()} m (below the CFAR threshold or "
                       "beyond the range axis): their measured angle is NaN and their gain "
-                      "correction 1" + FrontEndProbe(ang, pw, amps, n_clip).clipping_note(),
+                      "correction 1" + clipping_note(n_clip),
                       RuntimeWarning, stacklevel=2)
     meas = 10 ** (pw / 10) / amps ** 2
     corr = np.sqrt(model_p / meas)
