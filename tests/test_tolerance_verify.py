@@ -90,7 +90,8 @@ def test_cli_verify_reports_the_difference(tmp_path, capsys):
         assert "--verify" in capsys.readouterr().err
 
 
-def test_bin_centre_model_agrees_with_the_chain_on_a_planned_arc():
+@pytest.mark.parametrize("radius_m", [0.5, 1.0, 2.0])
+def test_bin_centre_model_agrees_with_the_chain_on_a_planned_arc(radius_m):
     """At the exact bin centre a Hann range window has spectral nulls two bins off, where the
     log slope of the magnitude is unbounded: the model's first-order slide once blew such an
     empty bin into a phantom detection (14-deg errors on ~20 % of draws at 0.5 mm, the chain
@@ -103,7 +104,7 @@ def test_bin_centre_model_agrees_with_the_chain_on_a_planned_arc():
     from rtsgeom.geometry import build_setup
     from rtsgeom.scene import load_scene
     plan = coverage.plan_arc(load_scene("scenes/diewald2022.toml"),
-                             (math.radians(-10), math.radians(10)), 1.0)
+                             (math.radians(-10), math.radians(10)), radius_m)
     model = arc_models(build_setup(plan.scene), [(0, 1)], 11)[0]
     v = verify_draws(model, (0.5e-3,) * 3, 12, 0, cases=("calibrated",), subbin=False)
     assert np.max(v.difference_deg("calibrated")) < 0.005
