@@ -217,7 +217,7 @@ def sheet_paths(setup, step_m: float | None = None):
     m, k, tau, g = (np.array(x) for x in zip(*rows))
     return Paths.build(front_end=np.full(m.size, -1), direction=np.full(m.size, RUT_TO_RUT),
                        rut_tx=m, rut_rx=k, delay_s=tau, gain=g, bounces=np.ones(m.size, int),
-                       method="po")
+                       method="po", surfaces=np.full(m.size, "sheet"))
 
 
 def static_budget(setup) -> LinkBudget:

@@ -145,6 +145,9 @@ def test_exact_paths_table_and_csv(default_scene, tmp_path):
                                             abs=1e-12)
     header = p.to_csv().splitlines()[0].split(",")
     assert header[:5] == ["front_end", "direction", "rut_element", "length_m", "delay_s"]
+    assert header[-2:] == ["interactions", "surfaces"]
+    rows = [r.split(",") for r in p.to_csv().splitlines()[1:]]
+    assert all(r[-2:] == ["los", ""] for r in rows)  # exact paths: line of sight, no surface
 
 
 def test_export_formats(default_scene, tmp_path):

@@ -64,6 +64,11 @@ def test_rows_are_well_formed(traced, setup):
     assert not np.any(np.all((res.objects[rr] == "rut_board") | (res.objects[rr] == ""), axis=1))
     assert np.all((p.bounces == 0) == (p.interactions == "los"))
     assert np.all([s.count("+") + 1 == b for s, b in zip(p.interactions, p.bounces) if b])
+    # the surface column names each bounce's object, in order (the CSV's `surfaces`)
+    assert np.all((p.bounces == 0) == (p.surfaces == ""))
+    assert [s.split("+") if s else [] for s in p.surfaces] == [
+        [o for o in row if o] for row in res.objects]
+    assert set("+".join(p.surfaces).split("+")) - {""} <= {"sheet", "rut_board"}
     # duplicates dropped: no element pair has two rows on the same triangles
     keys = [(d, f, m, k, tuple(o), tuple(pr)) for d, f, m, k, o, pr in
             zip(p.direction, p.front_end, p.rut_tx, p.rut_rx, res.objects, res.primitives)]

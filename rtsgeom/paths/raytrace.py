@@ -300,7 +300,7 @@ def trace(setup: Setup, config: RaytraceConfig | None = None) -> RaytraceResult:
     n_fe = setup.fe.count
     board_id = next(i for i, name in built.object_names.items() if name == "rut_board")
     cols = {k: [] for k in ("front_end", "direction", "rut_tx", "rut_rx", "delay_s", "gain",
-                            "bounces", "interactions")}
+                            "bounces", "interactions", "surfaces")}
     det_v, det_p, det_o = [], [], []
     raw = dupes = weak = 0
 
@@ -345,6 +345,7 @@ def trace(setup: Setup, config: RaytraceConfig | None = None) -> RaytraceResult:
             det_p.append(np.where(it[j] != 0, pr[j].astype(np.int64), -1))
             det_o.append([built.object_names.get(int(o), "?") if x != 0 else ""
                           for o, x in zip(ob[j], it[j])])
+            cols["surfaces"].append("+".join(o for o in det_o[-1] if o))
 
     for q in range(n_fe):
         for m in range(n_tx):  # RuT Tx m -> FE q Rx

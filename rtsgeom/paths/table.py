@@ -39,33 +39,40 @@ class Paths:
     gain: np.ndarray  # (P,) complex128, no propagation phase
     bounces: np.ndarray  # (P,) int, 0 = line of sight
     interactions: np.ndarray  # (P,) str, e.g. "los", "specular", "specular+specular"
+    surfaces: np.ndarray  # (P,) str, what each bounce hit, e.g. "sheet+structure[0]"; "" for LOS
     method: str = "exact"
 
     def __post_init__(self):
         n = self.delay_s.shape[0]
         for name in ("front_end", "direction", "rut_tx", "rut_rx", "gain", "bounces",
-                     "interactions"):
+                     "interactions", "surfaces"):
             if getattr(self, name).shape != (n,):
                 raise ValueError(f"Paths.{name} must have shape ({n},)")
 
     @classmethod
     def build(cls, front_end, direction, rut_tx, rut_rx, delay_s, gain, bounces=None,
-              interactions=None, method="exact") -> "Paths":
+              interactions=None, method="exact", surfaces=None) -> "Paths":
+        """The table from columns (each (P,)). ``bounces`` default 0 (line of sight);
+        ``interactions`` default ``los`` / ``reflection``; ``surfaces`` (what each bounce hit,
+        ``+``-joined in the order of the bounces) default ``""`` for line of sight and
+        ``unknown`` for a reflection whose producer did not say."""
         delay = np.asarray(delay_s, float).ravel()
         n = delay.size
         b = np.zeros(n, int) if bounces is None else np.asarray(bounces, int).ravel()
         k = (np.where(b == 0, "los", "reflection") if interactions is None
              else np.asarray(interactions, str).ravel())
+        sf = (np.where(b == 0, "", "unknown") if surfaces is None
+              else np.asarray(surfaces, str).ravel())
         return cls(frozen(np.asarray(front_end, int).ravel()),
                    frozen(np.asarray(direction, np.int8).ravel()),
                    frozen(np.asarray(rut_tx, int).ravel()), frozen(np.asarray(rut_rx, int).ravel()),
                    frozen(delay), frozen(np.asarray(gain, complex).ravel()), frozen(b), frozen(k),
-                   method)
+                   frozen(sf), method)
 
     @classmethod
     def concat(cls, tables: list["Paths"]) -> "Paths":
         names = ("front_end", "direction", "rut_tx", "rut_rx", "delay_s", "gain", "bounces",
-                 "interactions")
+                 "interactions", "surfaces")
         cols = {n: np.concatenate([getattr(t, n) for t in tables]) for n in names}
         return cls.build(**cols, method="+".join(sorted({t.method for t in tables})))
 
@@ -80,7 +87,7 @@ class Paths:
         m = np.asarray(mask, bool)
         return Paths.build(self.front_end[m], self.direction[m], self.rut_tx[m], self.rut_rx[m],
                            self.delay_s[m], self.gain[m], self.bounces[m], self.interactions[m],
-                           self.method)
+                           self.method, self.surfaces[m])
 
     def leg(self, front_end: int, direction: int, element: int) -> "Paths":
         """All rows of one leg: (front end, direction, RuT element)."""
@@ -89,12 +96,12 @@ class Paths:
                            & (col == element))
 
     def to_csv(self) -> str:
-        """CSV text: ``front_end, direction, rut_element, length_m, delay_s`` plus gain and
-        interaction columns. ``rut_element`` is ``tx<i>``, ``rx<k>`` or ``tx<i>-rx<k>``."""
+        """CSV text: ``front_end, direction, rut_element, length_m, delay_s`` plus gain,
+        interaction and surface columns (``surfaces``: what each bounce hit). ``rut_element`` is ``tx<i>``, ``rx<k>`` or ``tx<i>-rx<k>``."""
         buf = io.StringIO()
         w = csv.writer(buf, lineterminator="\n")
         w.writerow(["front_end", "direction", "rut_element", "length_m", "delay_s",
-                    "gain_db", "gain_phase_deg", "bounces", "interactions"])
+                    "gain_db", "gain_phase_deg", "bounces", "interactions", "surfaces"])
         for i in range(len(self)):
             d = int(self.direction[i])
             if d == TX_TO_FE:
@@ -107,5 +114,5 @@ class Paths:
             w.writerow([int(self.front_end[i]), DIRECTIONS[d], el, f"{self.length_m[i]:.12f}",
                         f"{self.delay_s[i]:.15e}", f"{20 * np.log10(max(abs(g), 1e-300)):.4f}",
                         f"{np.degrees(np.angle(g)):.4f}", int(self.bounces[i]),
-                        self.interactions[i]])
+                        self.interactions[i], self.surfaces[i]])
         return buf.getvalue()
