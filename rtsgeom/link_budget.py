@@ -111,6 +111,9 @@ def link_budget(scene, echoes: Echoes, program: RtsProgram, linked: bool,
         if not modelled:
             src += (" (prediction: the scene has no [radar.link])" if predict else
                     "; not in the signal (no [radar.link], no snr_db)")
+        if predict and radar.snr_db is not None:  # info: what run will simulate instead
+            src += (f"; the simulation's noise is radar.snr_db = {radar.snr_db:g} dB per sample "
+                    "for the strongest echo, not this")
     nq = link.quantisation_noise_w if linked or predict else 0.0  # no ADC in the relative model
     gain_db = float(10 * np.log10(radar.samples_per_chirp * radar.chirps_per_tx
                                   * window_snr_loss(radar.range_window, radar.samples_per_chirp)

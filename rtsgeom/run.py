@@ -91,8 +91,37 @@ def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angl
         else:
             entry["detection"] = None
             entry["error"] = None
+            entry["undetected"] = undetected_reason(scene, det, rd, t, bins)
         out.append(entry)
     return out
+
+
+def undetected_reason(scene: Scene, det: Detections, rd: RangeDoppler, target,
+                      bins: int = 2) -> dict:
+    """Why a target has no detection: the map's strongest cell within one bin of the target's
+    cell over the map's noise (the median of the channel-summed power, a Gamma(V) variable,
+    referred to its mean), against the CFAR threshold; or that a detection within ``bins``
+    went to another target (two targets in one cell). ``snr_db`` None: a noiseless map."""
+    ri = int(np.argmin(np.abs(rd.range_m - target.range_m)))
+    vi = int(np.argmin(np.abs(rd.velocity_mps - target.velocity_mps)))
+    cell = rd.power[max(ri - 1, 0):ri + 2, max(vi - 1, 0):vi + 2]
+    v = rd.spectrum.shape[-1]
+    from scipy.special import gammaincinv  # median of Gamma(V, 1)
+    noise = float(np.median(rd.power)) * v / float(gammaincinv(v, 0.5))
+    thr = float(scene.radar.cfar.threshold_db)
+    snr = None if noise <= 0 else float(10 * np.log10(max(float(cell.max()), 1e-300) / noise))
+    dr = rd.range_m[1] - rd.range_m[0]
+    dv = rd.velocity_mps[1] - rd.velocity_mps[0]
+    near = ((np.abs(det.range_m - target.range_m) <= bins * dr)
+            & (np.abs(det.velocity_mps - target.velocity_mps) <= bins * dv))
+    if np.any(near):
+        why = "its cell's detection went to another target (two targets in one cell)"
+    elif snr is not None and snr < thr:
+        why = (f"{snr:.1f} dB over the noise at its cell, under the CFAR threshold "
+               f"{thr:g} dB (radar.snr_db, when set, is the SNR of the strongest echo)")
+    else:
+        why = "the CFAR did not report its cell (masked by a stronger neighbour or out of range)"
+    return {"snr_db": snr, "threshold_db": thr, "reason": why}
 
 
 def label_detections(result: "RunResult", bins: float = 2.0) -> list[str]:

@@ -182,11 +182,13 @@ def _corrupt(kind, path):
         side.write_text(json.dumps(meta))
     elif kind == "no-sidecar":
         side.unlink()
+    elif kind == "missing":  # the capture itself gone: say so, not "no sidecar"
+        path.unlink()
 
 
 @pytest.mark.parametrize("name", ["c.bin", "c.npy"])
 @pytest.mark.parametrize("kind", ["truncated", "not-json", "not-object", "missing-key",
-                                  "bad-value", "no-sidecar"])
+                                  "bad-value", "no-sidecar", "missing"])
 def test_a_broken_capture_is_a_capture_error_and_exit_2(capture_files, tmp_path, name, kind,
                                                         capsys):
     import shutil
@@ -200,8 +202,9 @@ def test_a_broken_capture_is_a_capture_error_and_exit_2(capture_files, tmp_path,
     shutil.copy(capture_files / (name + ".json"), tmp_path / (name + ".json"))
     assert read_capture(path).data.ndim == 3  # intact: reads
     _corrupt(kind, path)
-    with pytest.raises(CaptureError, match=re.escape(str(tmp_path))):
+    with pytest.raises(CaptureError, match=re.escape(str(tmp_path))) as exc:
         read_capture(path)
+    assert ("no such capture file" in str(exc.value)) == (kind == "missing")
     assert main(["identify", str(DEFAULT_SCENE), str(path)]) == 2
     err = capsys.readouterr().err
     assert err.startswith("rtsgeom: error: CAPTURE: ") and "Traceback" not in err

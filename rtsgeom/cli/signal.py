@@ -273,7 +273,7 @@ def cmd_run(args) -> int:
         for m in result.matches:
             d, e = m["detection"], m["error"]
             if d is None:
-                print(f"target {m['index']}: NOT DETECTED")
+                print(f"target {m['index']}: NOT DETECTED: {m['undetected']['reason']}")
                 continue
             el = (f" el {d['elevation_deg']:7.3f} deg" if "elevation_deg" in d else "")
             el_e = (f", el {e['elevation_deg']:+.3f} deg" if "elevation_deg" in e else "")

@@ -95,6 +95,8 @@ def read_capture(path) -> Capture:
     from .dca1000 import from_dca1000
     path = Path(path)
     side = Path(str(path) + ".json")
+    if not path.is_file():
+        raise CaptureError(f"{path}: no such capture file")
     if not side.is_file():
         raise CaptureError(f"{path}: no sidecar {side.name} (write captures with rtsgeom adc "
                            "--active I)")
