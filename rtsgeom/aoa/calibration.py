@@ -31,15 +31,16 @@ from ..paths import Paths, exact_paths
 from ..radar import process
 from ..radar.processing import nearest_detection
 from ..radar.frame import simulate
-from ..rts import RtsProgram, requested_delay
+from ..rts import RtsProgram, realised_delay, requested_delay
 from ..scene import TargetConfig
 from .fir import fir_bin_gain, fir_effect, fir_sweep_phase  # noqa: F401 (re-exported)
 from .synthesis import PairModel
 
 __all__ = ["Calibration", "FrontEndProbe", "probe_front_ends", "calibrate_pair", "probe_ranges",
-           "if_phase_slope_hz", "air_phase_slope_hz", "coherence_delay", "probe_total_delay",
+           "if_phase_slope_hz", "air_phase_slope_hz", "coherence_delay", "coherence_point",
+           "CoherencePoint", "continuous_delay_setup", "probe_total_delay",
            "TARGET_BIAS_PS", "calibrate_pair_paper", "fir_effect",
-           "fir_bin_gain", "realisable"]
+           "fir_bin_gain", "realisable", "realisation_shift", "sweep_phase", "fine_window"]
 
 
 @dataclass(frozen=True)
@@ -152,25 +153,72 @@ def probe_total_delay(setup: Setup, ranges) -> float:
                  + np.mean(_mean_air_delay(setup)))
 
 
-def coherence_delay(setup: Setup, paths: Paths, pair: tuple[int, int], alphas,
-                    near_s: float = 0.0, base_offsets=(0.0, 0.0), iterations: int = 4) -> float:
+def continuous_delay_setup(setup: Setup) -> Setup:
+    """The same setup with an RTS that realises any delay (1 fs steps, the field's minimum;
+    ``rts.realised_delay`` rounds to these): the continuous model the calibration's optimum
+    is defined on. A coarse RTS rounds every delay it is given, so its model's phase is a
+    staircase in the delay (flat over each step, jumping 2 pi f_if res at each edge); it
+    agrees with this one at every realisable delay. The fractional-delay FIR keeps its
+    modelled response (``rts.fir_if_gain``, continuous in its setting); an RTS without one
+    (whole 1/f_s samples) gets none (``fractional_delay_filter = "ideal"``)."""
+    import dataclasses
+    rts = setup.scene.rts
+    if rts.fractional_delay and rts.fractional_delay_step_s <= CONTINUOUS_STEP_S:
+        return setup
+    flt = rts.fractional_delay_filter if rts.fractional_delay else "ideal"
+    cont = rts.evolve(fractional_delay=True, fractional_delay_step_s=CONTINUOUS_STEP_S,
+                      fractional_delay_filter=flt)
+    return dataclasses.replace(setup, scene=setup.scene.evolve(rts=cont))
+
+
+CONTINUOUS_STEP_S = 1e-15  # the smallest rts.fractional_delay_step_s: "continuous"
+
+
+@dataclass(frozen=True)
+class CoherencePoint:
+    """The pair's phase-coherence point on the continuous delay model and the delay the RTS
+    can set nearest it (:func:`realisable`)."""
+
+    continuous_s: float  # the coherence point (continuous delay offset of channel J)
+    delta_tau_s: float  # the nearest realisable offset: a whole number of resolution steps
+    quantisation_residual_s: float  # continuous_s - delta_tau_s, |.| <= resolution / 2
+    delay_resolution_s: float  # rts.delay_resolution_s
+
+
+def coherence_point(setup: Setup, paths: Paths, pair: tuple[int, int], alphas,
+                    near_s: float = 0.0, base_offsets=(0.0, 0.0), iterations: int = 4
+                    ) -> CoherencePoint:
     """The delay offset of channel J that makes both channels coherent at the probe angles
     ``alphas`` on the setup *as built* (phasor model of both probe targets, with the range
     offset the delay causes), the one nearest ``near_s``: the point the sweep should find.
 
     Newton on the circular mean of the two probes' coherent phases, slope
-    ``2 pi if_phase_slope_hz``.
-    """
+    ``2 pi if_phase_slope_hz``, on the **continuous** delay model
+    (:func:`continuous_delay_setup`): the base delays of channels I and J realised as the RTS
+    realises them (``rts.realised_delay``), channel J's offset added unrounded. On the RTS's
+    own (quantised) model the phase is a staircase and Newton lands anywhere within a step
+    of the point (3 to 34 ps off for 10 to 100 ps steps); the continuous model equals it at
+    every realisable offset (when the step divides 1/f_s). Then quantised: the nearest
+    realisable offset and the residual."""
     scene = setup.scene
+    rts = scene.rts
     ranges = probe_ranges(setup, 2)
     targets = [TargetConfig(float(r)) for r in ranges]
     f_if = float(if_phase_slope_hz(scene, probe_total_delay(setup, ranges)))
     period = 1.0 / f_if
+    cont = continuous_delay_setup(setup)
+    # each probe's I and J base delays as the RTS realises them, as offsets from the request
+    base = []
+    for t in targets:
+        tau = float(requested_delay(scene, t.range_m))
+        base.append([float(realised_delay(tau + b, rts.f_s_hz, rts.fractional_delay,
+                                          rts.fractional_delay_step_s)) - tau
+                     for b in base_offsets])
 
     def phase(d):
         z = 0j
-        for t in targets:
-            m = PairModel.build(setup, paths, pair, t, (base_offsets[0], base_offsets[1] + d))
+        for t, (o_i, o_j) in zip(targets, base):
+            m = PairModel.build(cont, paths, pair, t, (o_i, o_j + d))
             z += np.exp(1j * m.coherent_phase(alphas))
         return float(np.angle(z))
 
@@ -179,7 +227,16 @@ def coherence_delay(setup: Setup, paths: Paths, pair: tuple[int, int], alphas,
         for _ in range(iterations):
             d += phase(d) / (2 * np.pi * f_if)
         d += np.round((near_s - d) / period) * period
-    return float(d)
+    res = rts.delay_resolution_s
+    q = float(realisable(d, res))
+    return CoherencePoint(float(d), q, float(d - q), float(res))
+
+
+def coherence_delay(setup: Setup, paths: Paths, pair: tuple[int, int], alphas,
+                    near_s: float = 0.0, base_offsets=(0.0, 0.0), iterations: int = 4) -> float:
+    """The continuous coherence point of :func:`coherence_point` (seconds)."""
+    return coherence_point(setup, paths, pair, alphas, near_s, base_offsets,
+                           iterations).continuous_s
 
 
 def probe_angles(theta_i: float, theta_j: float) -> tuple[float, float]:
@@ -339,29 +396,32 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
         fine_t, fine_e, n_frames, noise = grid, errs, k_coarse, 0.0
     else:
         half = period / 4
-        ranges = place_probes(setup, paths, nominal, pair, ranges, alphas,
-                              near + np.arange(-half, half + 1e-15, step), base_offsets, corr)
+        # the window's delays as the RTS realises them (a coarse RTS would round them)
+        window = np.unique(realisable(near + np.arange(-half, half + 1e-15, step), res))
+        ranges = place_probes(setup, paths, nominal, pair, ranges, alphas, window,
+                              base_offsets, corr)
         targets = [TargetConfig(float(r)) for r in ranges]
         # fine steps the RTS can set: FINE_STEP_S rounded to whole resolution steps (an RTS
         # whose delay moves in 25 ps cannot take 5 ps steps; the model would round them)
         fine_step = res * max(1, round(FINE_STEP_S / res))
-        k_half = int(np.floor(half / fine_step + 1e-9))
+        k_half, harmonics, criterion = fine_window(half, fine_step)
         fine_t = near + np.arange(-k_half, k_half + 1) * fine_step
+        search = max(half / 2, fine_step)  # the coarse minimum is within half a step
         fine = phasor_sweep(setup, paths, nominal, pair, targets, alphas, fine_t,
                             base_offsets, corr)
         noise = 0.0
         n_frames = 1 if frames is None else int(frames)
-        extra = fir_sweep_phase(setup, ranges, fine_t, base_offsets)
+        extra, search_phase = sweep_phase(setup, ranges, fine_t, base_offsets, period)
         if noisy and frames is None:  # scatter of the fitted minimum with one frame per step
             draws = fine.errors(1, rng, MC_DRAWS)
-            est = [fit_minimum(fine_t, e, period, near, search_s=half / 2,
-                               extra_phase_rad=extra) for e in draws]
+            est = [fit_minimum(fine_t, e, period, near, harmonics, search, extra, criterion,
+                               search_phase) for e in draws]
             noise = float(np.std(est))
             n_frames = int(min(MAX_FRAMES, max(1, np.ceil((2 * noise / (TARGET_BIAS_PS
                                                                           * 1e-12)) ** 2))))
         e_fine = measure(targets, fine, n_frames)
-        best_fit = fit_minimum(fine_t, e_fine, period, near, search_s=half / 2,
-                               extra_phase_rad=extra)
+        best_fit = fit_minimum(fine_t, e_fine, period, near, harmonics, search, extra,
+                               criterion, search_phase)
         fine_e = rms_deg(e_fine)
     best = float(realisable(best_fit, res))  # what the RTS can set; the fit's optimum is between
     confirm = phasor_sweep(setup, paths, nominal, pair, targets, alphas, [best], base_offsets,
@@ -378,6 +438,47 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
                        float(res))
 
 
+def realisation_shift(setup: Setup, ranges, deltas, base_offsets=(0.0, 0.0)) -> np.ndarray:
+    """How much further (S, P) channel J of each probe (at ``ranges``) moves than the offset
+    ``deltas`` (S,) it is given: ``Q(tau_J + delta) - Q(tau_J) - delta`` with Q the RTS's
+    realised delay (``rts.realised_delay``). Zero where the delay step divides 1/f_s;
+    otherwise (e.g. 100 ps FIR steps at 4 GSPS: settings 0/100/200 ps in each 250 ps sample)
+    up to a step, different per probe, and the probes' sweep curves are staircases on the
+    offset axis (a fit on it landed 20 to 56 ps off)."""
+    rts = setup.scene.rts
+    base = (requested_delay(setup.scene, np.asarray(ranges, float)) + base_offsets[1])[None, :]
+    d = np.asarray(deltas, float)[:, None]
+    q = (realised_delay(base + d, rts.f_s_hz, rts.fractional_delay, rts.fractional_delay_step_s)
+         - realised_delay(base, rts.f_s_hz, rts.fractional_delay, rts.fractional_delay_step_s))
+    return q - d
+
+
+def sweep_phase(setup: Setup, ranges, deltas, base_offsets, period_s: float):
+    """The phase (S, P) each fine-sweep step adds to channel J of each probe beyond ``2 pi
+    delta / period`` and known in advance (``sweep.fit_minimum``'s ``extra_phase_rad``):
+    the FIR's (``fir.fir_sweep_phase``) and the quantiser's offset error
+    (:func:`realisation_shift`), and the function that gives the FIR's on the continuous
+    delays the fit searches (``search_phase``). ``(None, None)`` where both are zero (an
+    ideal delay whose step divides 1/f_s)."""
+    fir = fir_sweep_phase(setup, ranges, deltas, base_offsets)
+    shift = realisation_shift(setup, ranges, deltas, base_offsets)
+    if fir is None and not np.any(np.abs(shift) > 1e-18):
+        return None, None
+    extra = (0.0 if fir is None else fir) + 2 * np.pi * shift / period_s
+    d = np.asarray(deltas, float)
+    step = float(np.min(np.diff(np.sort(d)))) if d.size > 1 else 0.0
+    if not np.any(np.abs(shift) > 1e-18) and step <= FINE_STEP_S * (1 + 1e-9):
+        return extra, None  # dense and exact: the FIR's phase interpolates between steps
+    p = np.asarray(ranges).size
+    if fir is None:
+        return extra, lambda t: np.zeros((np.size(t), p))
+    # the FIR's phase on the continuous delays, once on a 0.5 ps grid over the sweep (it
+    # cycles every 1/f_s: smooth on that scale), then interpolated
+    grid = np.arange(d.min() - step, d.max() + step + 1e-15, 0.5e-12)
+    table = fir_sweep_phase(setup, ranges, grid, base_offsets, continuous=True)
+    return extra, lambda t: np.stack([np.interp(t, grid, table[:, k]) for k in range(p)], 1)
+
+
 def realisable(delay_s, resolution_s: float):
     """``delay_s`` rounded to a whole number of the RTS's delay steps ``resolution_s``
     (``rts.delay_resolution_s``: the fractional-delay FIR's step, or 1/f_s without one).
@@ -387,6 +488,27 @@ def realisable(delay_s, resolution_s: float):
 
 
 FINE_STEP_S = 5e-12  # step of the fitted fine sweep
+MIN_FIT_POINTS = 7  # fine-sweep points a least-squares fit of 2 harmonics (5 coefficients) needs
+
+
+def fine_window(half_s: float, step_s: float) -> tuple[int, int, str]:
+    """Steps either side of the coarse minimum for the fitted fine sweep (+-``half_s``,
+    period / 4, in steps of ``step_s``, at least one), the harmonics to fit and the fit's
+    criterion (``sweep.fit_minimum``). With ``MIN_FIT_POINTS`` or more points: 2 harmonics,
+    least squares, the joint minimum of the fitted errors (``"joint"``). An RTS with steps
+    coarser than ~period / 6 (100 ps at 1 ns: 5 points) leaves too few for that (the fit
+    fell back to the coarse minimum and the chosen delay was one 100 ps step from the
+    realisable one nearest the coherence point): the fitted curves then pass through the
+    points (2 harmonics on 5, 1 on 3) and the optimum is their common vertex
+    (``"vertex"``: each probe's error is even about the coherence point; a fitted curve
+    that interpolates may overshoot zero, which puts the joint minimum beside the vertex).
+    Widening the window instead (to a full period) fitted worse: 50 to 120 ps off."""
+    k = max(1, int(np.floor(half_s / step_s + 1e-9)))
+    if 2 * k + 1 >= MIN_FIT_POINTS:
+        return k, 2, "joint"
+    return k, (2 if 2 * k + 1 >= 5 else 1), "vertex"
+
+
 MC_DRAWS = 32  # noise realisations that size the frames per step
 
 
