@@ -40,7 +40,7 @@ __all__ = ["Calibration", "FrontEndProbe", "probe_front_ends", "calibrate_pair",
            "if_phase_slope_hz", "air_phase_slope_hz", "coherence_delay", "coherence_point",
            "CoherencePoint", "continuous_delay_setup", "probe_total_delay",
            "TARGET_BIAS_PS", "calibrate_pair_paper", "fir_effect",
-           "fir_bin_gain", "realisable", "realisation_shift", "sweep_phase", "fine_window"]
+           "fir_bin_gain", "realisable", "predicted_angle_noise", "coarse_frames", "realisation_shift", "sweep_phase", "fine_window"]
 
 
 @dataclass(frozen=True)
@@ -79,7 +79,7 @@ class Calibration:
     probe_angles_deg: tuple[float, float]
     period_s: float  # exact: 1 / (f_rts + S t_mid - S tau) at the probes (eq. 27 refined)
     frames_per_step: int = 1  # frames averaged (coherently) per sweep step
-    frame_noise_deg: float = 0.0  # predicted 1-sigma probe-angle noise of one frame
+    frame_noise_deg: float = 0.0  # predicted 1-sigma probe-angle noise of one frame (deg)
     method: str = "phasor"  # what evaluated the sweep: phasor model or full-chain
     probe_ranges_m: tuple = ()  # the probes' set ranges (moved within a bin, sweep.place_probes)
     one_frame_scatter_ps: float = 0.0  # 1-sigma of the chosen delay with one frame per step
@@ -87,6 +87,7 @@ class Calibration:
     # (rts.delay_resolution_s); |residual| <= resolution / 2
     quantisation_residual_s: float = 0.0
     delay_resolution_s: float = 0.0  # the RTS's delay step the chosen delay is a multiple of
+    coarse_frames_per_step: int = 1  # frames averaged per coarse-sweep step (coarse_frames)
 
     def to_dict(self) -> dict:
         def pts(t, e):
@@ -106,6 +107,7 @@ class Calibration:
             "one_frame_scatter_ps": self.one_frame_scatter_ps,
             "quantisation_residual_s": self.quantisation_residual_s,
             "delay_resolution_s": self.delay_resolution_s,
+            "coarse_frames_per_step": self.coarse_frames_per_step,
             "probe_angles_deg": list(self.probe_angles_deg),
             "sweep": pts(self.sweep_delta_tau_s, self.sweep_error_deg),
             "refinement": pts(self.refine_delta_tau_s, self.refine_error_deg),
@@ -126,7 +128,8 @@ class Calibration:
                    float(d.get("frame_noise_deg", 0.0)), str(d.get("method", "phasor")),
                    tuple(d.get("probe_ranges_m", ())), float(d.get("one_frame_scatter_ps", 0.0)),
                    float(d.get("quantisation_residual_s", 0.0)),
-                   float(d.get("delay_resolution_s", 0.0)))
+                   float(d.get("delay_resolution_s", 0.0)),
+                   int(d.get("coarse_frames_per_step", 1)))
 
 
 def if_phase_slope_hz(scene, tau_s) -> np.ndarray:
@@ -281,6 +284,35 @@ def _simulate_detect(setup, paths, program, seed, frames: int = 1, clipped: bool
 
 
 TARGET_BIAS_PS = 2.0  # the averaging keeps the noise's pull on the chosen delay below this
+COARSE_NOISE_DEG = 0.1  # the coarse sweep averages until a probe's angle noise is below this
+SIZE_DRAWS = 16  # noise realisations that predict the probe-angle noise
+
+
+def predicted_angle_noise(sweep, seed: int = 0) -> float:
+    """The predicted 1-sigma probe-angle noise (deg) of one frame at a sweep's steps: the
+    median over steps and probes of the angle's standard deviation over ``SIZE_DRAWS``
+    noise realisations of the phasor model (``SweepResult.errors``), whose noise is the
+    link budget's (``[radar.link]``) or ``snr_db``'s. The median: where a step's design is
+    weak a few draws jump bins, which would dominate a mean (measured 0.005 deg on the
+    default scene; 0.011 / 0.085 / 0.28 / 0.5 / 0.9 deg with the link at NF 12 / 30 / 40 /
+    45 / 50 dB; the same from 1 to 4096 frames scaled by sqrt(frames)). Its own random
+    stream, so the sweep's draws are the same as without it."""
+    if not np.any(sweep.noise_sigma > 0):
+        return 0.0
+    rng = np.random.default_rng(np.random.SeedSequence([int(seed) % 2 ** 32, 1714]))
+    e = sweep.errors(1, rng, SIZE_DRAWS)  # (D, S, P)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN steps (no design)
+        sig = np.nanmedian(np.nanstd(e, axis=0))
+    return float(np.degrees(sig)) if np.isfinite(sig) else 0.0
+
+
+def coarse_frames(frame_noise_deg: float) -> int:
+    """Frames per coarse-sweep step that bring the predicted probe-angle noise
+    (:func:`predicted_angle_noise`) below ``COARSE_NOISE_DEG``: 1 on the default scene and
+    with the link up to NF ~30 dB (unchanged there); 8 / 25 / 81 at NF 40 / 45 / 50 dB, where
+    one frame per step picked a minimum 48 ps or a period off on 3 of 3 seeds at 50 dB."""
+    return int(min(MAX_FRAMES, max(1, np.ceil((frame_noise_deg / COARSE_NOISE_DEG) ** 2))))
 MAX_FRAMES = 1 << 20
 
 
@@ -382,7 +414,10 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
 
     targets = [TargetConfig(float(r)) for r in ranges]
     coarse = phasor_sweep(setup, paths, nominal, pair, targets, alphas, grid, base_offsets, corr)
-    k_coarse = 1 if frames is None else frames
+    # frames per coarse step from the predicted noise (the link budget's or snr_db's), before
+    # the sweep: one frame at NF 50 dB (0.9 deg of probe-angle noise) picked a wrong minimum
+    frame_noise = predicted_angle_noise(coarse, seed) if noisy else 0.0
+    k_coarse = (coarse_frames(frame_noise) if frames is None else int(frames))
     errs = rms_deg(measure(targets, coarse, k_coarse))
     # Minima repeat every period; among those about as deep as the deepest, take the one with
     # the smallest |delta tau|: it costs the least range offset ("Disadvantages").
@@ -413,10 +448,13 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
         n_frames = 1 if frames is None else int(frames)
         extra, search_phase = sweep_phase(setup, ranges, fine_t, base_offsets, period)
         if noisy and frames is None:  # scatter of the fitted minimum with one frame per step
-            draws = fine.errors(1, rng, MC_DRAWS)
+            # drawn at the coarse sweep's frames, where the fit is linear in the noise, and
+            # scaled to one frame (drawn at one frame, the scatter compressed above ~30 ps:
+            # 20-30 ps at NF 50 dB, under NF 45 dB's, and too few frames followed)
+            draws = fine.errors(k_coarse, rng, MC_DRAWS)
             est = [fit_minimum(fine_t, e, period, near, harmonics, search, extra, criterion,
                                search_phase) for e in draws]
-            noise = float(np.std(est))
+            noise = float(np.std(est)) * np.sqrt(k_coarse)
             n_frames = int(min(MAX_FRAMES, max(1, np.ceil((2 * noise / (TARGET_BIAS_PS
                                                                           * 1e-12)) ** 2))))
         e_fine = measure(targets, fine, n_frames)
@@ -433,9 +471,9 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
     return Calibration(pair, float(best), best_err, float(range_offset), frozen(grid),
                        frozen(errs), frozen(np.asarray(fine_t)), frozen(np.asarray(fine_e)),
                        (float(np.degrees(alphas[0])), float(np.degrees(alphas[1]))), period,
-                       n_frames, 0.0, "full-chain" if full_chain else "phasor",
+                       n_frames, frame_noise, "full-chain" if full_chain else "phasor",
                        tuple(float(r) for r in ranges), noise * 1e12, float(best_fit - best),
-                       float(res))
+                       float(res), int(k_coarse))
 
 
 def realisation_shift(setup: Setup, ranges, deltas, base_offsets=(0.0, 0.0)) -> np.ndarray:
