@@ -54,8 +54,8 @@ def _tolerance(res):
 @pytest.mark.parametrize("dr_mm", [0.0, 0.3, -0.6])
 def test_coherence_point_is_the_continuous_one_whatever_the_step(radius, dr_mm, probe):
     """The coherence point does not depend on the RTS's delay step (it did: Newton on the
-    staircase landed within a step of it, 4 / 19 / 34 / 16 ps off at 10 / 25 / 50 / 100 ps
-    steps); its realisable delay is the nearest whole step and the residual at most half a
+    staircase landed within a step of it, up to 7 / 18 / 27 / 18 ps off at 10 / 25 / 50 /
+    100 ps steps); its realisable delay is the nearest whole step and the residual at most half a
     step."""
     alphas = probe_angles(*probe.angle_rad[[0, 1]])
     ref = _scene(1e-3, radius, dr_mm)
@@ -118,10 +118,10 @@ def test_fine_window_and_realisation_shift():
     assert np.max(np.abs(sh)) > 10e-12 and np.max(np.abs(sh)) <= 100e-12 + 1e-18
 
 
-def _check_calibration(res_ps, radius, dr_mm, probe, fractional=True):
+def _check_calibration(res_ps, radius, dr_mm, probe, fractional=True, full_chain=False):
     s = _scene(res_ps, radius, dr_mm, fractional=fractional)
     paths = exact_paths(s)
-    cal = calibrate_pair(s, paths, (0, 1), probe, seed=1)
+    cal = calibrate_pair(s, paths, (0, 1), probe, seed=1, full_chain=full_chain)
     res = s.scene.rts.delay_resolution_s
     cp = coherence_point(s, paths, (0, 1), probe_angles(*probe.angle_rad[[0, 1]]),
                          cal.delta_tau_s)
@@ -145,6 +145,14 @@ def test_calibration_finds_the_continuous_point_on_coarse_steps(res_ps, radius, 
     """The paper's 25 ps and a 100 ps step (5 fine points; before, the fit fell back to the
     coarse minimum and set a delay one step from the nearest, 54 to 88 ps from the point)."""
     _check_calibration(res_ps, radius, dr_mm, probe)
+
+
+@pytest.mark.parametrize("res_ps, radius, dr_mm", [(25.0, 1.0, 0.3), (100.0, 3.0, -0.6)])
+def test_full_chain_calibration_finds_the_continuous_point_on_coarse_steps(res_ps, radius,
+                                                                          dr_mm, probe):
+    """Every step through the ADC-cube chain (measured: 0.04 ps and 1.0 ps from the point)."""
+    cal = _check_calibration(res_ps, radius, dr_mm, probe, full_chain=True)
+    assert cal.method == "full-chain"
 
 
 @pytest.mark.slow

@@ -62,7 +62,8 @@ def test_relative_noise_power_counts_the_rts_channels_noise():
 def test_linked_calibration_frames_follow_the_link_noise_and_hold_2_ps():
     """No snr_db, NF 25/30/40 dB (one-frame scatter of the fitted minimum 7-30 ps, so 50-900
     frames per step): the scatter grows as the noise amplitude (x 10^(5/20) for +5 dB, same
-    draws; measured 1.77 at 25 -> 30 dB, the fit is linear there and compresses above ~30 ps),
+    draws; measured 1.77 at 25 -> 30 dB, the fit is linear there; drawn at one frame it
+    compressed above ~30 ps, so it is drawn at the coarse sweep's frames, see below),
     the frames per step as its square, and with them the chosen delay lands within 2 ps of
     the noiseless sweep's (same probe, 3 noise seeds each). Before, a linked scene's sweep was
     noiseless (1 frame, scatter 0) whatever its SNR."""
