@@ -31,15 +31,19 @@ from ..paths import Paths, exact_paths
 from ..radar import process
 from ..radar.processing import nearest_detection
 from ..radar.frame import simulate
-from ..rts import RtsProgram, requested_delay
+from ..rts import RtsProgram, realised_delay, requested_delay
 from ..scene import TargetConfig
+from .calsteps import (COARSE_NOISE_DEG, FINE_STEP_S, MAX_FRAMES, MC_DRAWS,  # noqa: F401
+                       MIN_FIT_POINTS, coarse_frames, continuous_delay_setup, fine_window,
+                       predicted_angle_noise, realisable, realisation_shift, sweep_phase)
 from .fir import fir_bin_gain, fir_effect, fir_sweep_phase  # noqa: F401 (re-exported)
 from .synthesis import PairModel
 
 __all__ = ["Calibration", "FrontEndProbe", "probe_front_ends", "calibrate_pair", "probe_ranges",
-           "if_phase_slope_hz", "air_phase_slope_hz", "coherence_delay", "probe_total_delay",
+           "if_phase_slope_hz", "air_phase_slope_hz", "coherence_delay", "coherence_point",
+           "CoherencePoint", "continuous_delay_setup", "probe_total_delay",
            "TARGET_BIAS_PS", "calibrate_pair_paper", "fir_effect",
-           "fir_bin_gain", "realisable"]
+           "fir_bin_gain", "realisable", "predicted_angle_noise", "coarse_frames", "realisation_shift", "sweep_phase", "fine_window"]
 
 
 @dataclass(frozen=True)
@@ -78,7 +82,7 @@ class Calibration:
     probe_angles_deg: tuple[float, float]
     period_s: float  # exact: 1 / (f_rts + S t_mid - S tau) at the probes (eq. 27 refined)
     frames_per_step: int = 1  # frames averaged (coherently) per sweep step
-    frame_noise_deg: float = 0.0  # predicted 1-sigma probe-angle noise of one frame
+    frame_noise_deg: float = 0.0  # predicted 1-sigma probe-angle noise of one frame (deg)
     method: str = "phasor"  # what evaluated the sweep: phasor model or full-chain
     probe_ranges_m: tuple = ()  # the probes' set ranges (moved within a bin, sweep.place_probes)
     one_frame_scatter_ps: float = 0.0  # 1-sigma of the chosen delay with one frame per step
@@ -86,6 +90,7 @@ class Calibration:
     # (rts.delay_resolution_s); |residual| <= resolution / 2
     quantisation_residual_s: float = 0.0
     delay_resolution_s: float = 0.0  # the RTS's delay step the chosen delay is a multiple of
+    coarse_frames_per_step: int = 1  # frames averaged per coarse-sweep step (coarse_frames)
 
     def to_dict(self) -> dict:
         def pts(t, e):
@@ -105,6 +110,7 @@ class Calibration:
             "one_frame_scatter_ps": self.one_frame_scatter_ps,
             "quantisation_residual_s": self.quantisation_residual_s,
             "delay_resolution_s": self.delay_resolution_s,
+            "coarse_frames_per_step": self.coarse_frames_per_step,
             "probe_angles_deg": list(self.probe_angles_deg),
             "sweep": pts(self.sweep_delta_tau_s, self.sweep_error_deg),
             "refinement": pts(self.refine_delta_tau_s, self.refine_error_deg),
@@ -125,7 +131,8 @@ class Calibration:
                    float(d.get("frame_noise_deg", 0.0)), str(d.get("method", "phasor")),
                    tuple(d.get("probe_ranges_m", ())), float(d.get("one_frame_scatter_ps", 0.0)),
                    float(d.get("quantisation_residual_s", 0.0)),
-                   float(d.get("delay_resolution_s", 0.0)))
+                   float(d.get("delay_resolution_s", 0.0)),
+                   int(d.get("coarse_frames_per_step", 1)))
 
 
 def if_phase_slope_hz(scene, tau_s) -> np.ndarray:
@@ -152,25 +159,52 @@ def probe_total_delay(setup: Setup, ranges) -> float:
                  + np.mean(_mean_air_delay(setup)))
 
 
-def coherence_delay(setup: Setup, paths: Paths, pair: tuple[int, int], alphas,
-                    near_s: float = 0.0, base_offsets=(0.0, 0.0), iterations: int = 4) -> float:
+@dataclass(frozen=True)
+class CoherencePoint:
+    """The pair's phase-coherence point on the continuous delay model and the delay the RTS
+    can set nearest it (:func:`realisable`)."""
+
+    continuous_s: float  # the coherence point (continuous delay offset of channel J)
+    delta_tau_s: float  # the nearest realisable offset: a whole number of resolution steps
+    quantisation_residual_s: float  # continuous_s - delta_tau_s, |.| <= resolution / 2
+    delay_resolution_s: float  # rts.delay_resolution_s
+
+
+def coherence_point(setup: Setup, paths: Paths, pair: tuple[int, int], alphas,
+                    near_s: float = 0.0, base_offsets=(0.0, 0.0), iterations: int = 4
+                    ) -> CoherencePoint:
     """The delay offset of channel J that makes both channels coherent at the probe angles
     ``alphas`` on the setup *as built* (phasor model of both probe targets, with the range
     offset the delay causes), the one nearest ``near_s``: the point the sweep should find.
 
     Newton on the circular mean of the two probes' coherent phases, slope
-    ``2 pi if_phase_slope_hz``.
-    """
+    ``2 pi if_phase_slope_hz``, on the **continuous** delay model
+    (:func:`continuous_delay_setup`): the base delays of channels I and J realised as the RTS
+    realises them (``rts.realised_delay``), channel J's offset added unrounded. On the RTS's
+    own (quantised) model the phase is a staircase and Newton lands anywhere within a step
+    of the point (up to 7 / 18 / 27 / 18 ps off at 10 / 25 / 50 / 100 ps steps, 148 ps with
+    whole 250 ps samples: ``benchmarks.calibration_resolution``); the continuous model
+    equals it at every realisable offset (when the step divides 1/f_s). Then quantised: the
+    nearest realisable offset and the residual."""
     scene = setup.scene
+    rts = scene.rts
     ranges = probe_ranges(setup, 2)
     targets = [TargetConfig(float(r)) for r in ranges]
     f_if = float(if_phase_slope_hz(scene, probe_total_delay(setup, ranges)))
     period = 1.0 / f_if
+    cont = continuous_delay_setup(setup)
+    # each probe's I and J base delays as the RTS realises them, as offsets from the request
+    base = []
+    for t in targets:
+        tau = float(requested_delay(scene, t.range_m))
+        base.append([float(realised_delay(tau + b, rts.f_s_hz, rts.fractional_delay,
+                                          rts.fractional_delay_step_s)) - tau
+                     for b in base_offsets])
 
     def phase(d):
         z = 0j
-        for t in targets:
-            m = PairModel.build(setup, paths, pair, t, (base_offsets[0], base_offsets[1] + d))
+        for t, (o_i, o_j) in zip(targets, base):
+            m = PairModel.build(cont, paths, pair, t, (o_i, o_j + d))
             z += np.exp(1j * m.coherent_phase(alphas))
         return float(np.angle(z))
 
@@ -179,7 +213,16 @@ def coherence_delay(setup: Setup, paths: Paths, pair: tuple[int, int], alphas,
         for _ in range(iterations):
             d += phase(d) / (2 * np.pi * f_if)
         d += np.round((near_s - d) / period) * period
-    return float(d)
+    res = rts.delay_resolution_s
+    q = float(realisable(d, res))
+    return CoherencePoint(float(d), q, float(d - q), float(res))
+
+
+def coherence_delay(setup: Setup, paths: Paths, pair: tuple[int, int], alphas,
+                    near_s: float = 0.0, base_offsets=(0.0, 0.0), iterations: int = 4) -> float:
+    """The continuous coherence point of :func:`coherence_point` (seconds)."""
+    return coherence_point(setup, paths, pair, alphas, near_s, base_offsets,
+                           iterations).continuous_s
 
 
 def probe_angles(theta_i: float, theta_j: float) -> tuple[float, float]:
@@ -224,9 +267,6 @@ def _simulate_detect(setup, paths, program, seed, frames: int = 1, clipped: bool
 
 
 TARGET_BIAS_PS = 2.0  # the averaging keeps the noise's pull on the chosen delay below this
-MAX_FRAMES = 1 << 20
-
-
 def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe:
     """Each front end alone at its own probe range (one simulated frame): measured angle and
     power; the gain correction equalises measured against modelled power."""
@@ -325,7 +365,10 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
 
     targets = [TargetConfig(float(r)) for r in ranges]
     coarse = phasor_sweep(setup, paths, nominal, pair, targets, alphas, grid, base_offsets, corr)
-    k_coarse = 1 if frames is None else frames
+    # frames per coarse step from the predicted noise (the link budget's or snr_db's), before
+    # the sweep: one frame at NF 50 dB (0.9 deg of probe-angle noise) picked a wrong minimum
+    frame_noise = predicted_angle_noise(coarse, seed) if noisy else 0.0
+    k_coarse = (coarse_frames(frame_noise) if frames is None else int(frames))
     errs = rms_deg(measure(targets, coarse, k_coarse))
     # Minima repeat every period; among those about as deep as the deepest, take the one with
     # the smallest |delta tau|: it costs the least range offset ("Disadvantages").
@@ -339,29 +382,35 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
         fine_t, fine_e, n_frames, noise = grid, errs, k_coarse, 0.0
     else:
         half = period / 4
-        ranges = place_probes(setup, paths, nominal, pair, ranges, alphas,
-                              near + np.arange(-half, half + 1e-15, step), base_offsets, corr)
+        # the window's delays as the RTS realises them (a coarse RTS would round them)
+        window = np.unique(realisable(near + np.arange(-half, half + 1e-15, step), res))
+        ranges = place_probes(setup, paths, nominal, pair, ranges, alphas, window,
+                              base_offsets, corr)
         targets = [TargetConfig(float(r)) for r in ranges]
         # fine steps the RTS can set: FINE_STEP_S rounded to whole resolution steps (an RTS
         # whose delay moves in 25 ps cannot take 5 ps steps; the model would round them)
         fine_step = res * max(1, round(FINE_STEP_S / res))
-        k_half = int(np.floor(half / fine_step + 1e-9))
+        k_half, harmonics, criterion = fine_window(half, fine_step)
         fine_t = near + np.arange(-k_half, k_half + 1) * fine_step
+        search = max(half / 2, fine_step)  # the coarse minimum is within half a step
         fine = phasor_sweep(setup, paths, nominal, pair, targets, alphas, fine_t,
                             base_offsets, corr)
         noise = 0.0
         n_frames = 1 if frames is None else int(frames)
-        extra = fir_sweep_phase(setup, ranges, fine_t, base_offsets)
+        extra, search_phase = sweep_phase(setup, ranges, fine_t, base_offsets, period)
         if noisy and frames is None:  # scatter of the fitted minimum with one frame per step
-            draws = fine.errors(1, rng, MC_DRAWS)
-            est = [fit_minimum(fine_t, e, period, near, search_s=half / 2,
-                               extra_phase_rad=extra) for e in draws]
-            noise = float(np.std(est))
+            # drawn at the coarse sweep's frames, where the fit is linear in the noise, and
+            # scaled to one frame (drawn at one frame, the scatter compressed above ~30 ps:
+            # 20-30 ps at NF 50 dB, under NF 45 dB's, and too few frames followed)
+            draws = fine.errors(k_coarse, rng, MC_DRAWS)
+            est = [fit_minimum(fine_t, e, period, near, harmonics, search, extra, criterion,
+                               search_phase) for e in draws]
+            noise = float(np.std(est)) * np.sqrt(k_coarse)
             n_frames = int(min(MAX_FRAMES, max(1, np.ceil((2 * noise / (TARGET_BIAS_PS
                                                                           * 1e-12)) ** 2))))
         e_fine = measure(targets, fine, n_frames)
-        best_fit = fit_minimum(fine_t, e_fine, period, near, search_s=half / 2,
-                               extra_phase_rad=extra)
+        best_fit = fit_minimum(fine_t, e_fine, period, near, harmonics, search, extra,
+                               criterion, search_phase)
         fine_e = rms_deg(e_fine)
     best = float(realisable(best_fit, res))  # what the RTS can set; the fit's optimum is between
     confirm = phasor_sweep(setup, paths, nominal, pair, targets, alphas, [best], base_offsets,
@@ -373,21 +422,9 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
     return Calibration(pair, float(best), best_err, float(range_offset), frozen(grid),
                        frozen(errs), frozen(np.asarray(fine_t)), frozen(np.asarray(fine_e)),
                        (float(np.degrees(alphas[0])), float(np.degrees(alphas[1]))), period,
-                       n_frames, 0.0, "full-chain" if full_chain else "phasor",
+                       n_frames, frame_noise, "full-chain" if full_chain else "phasor",
                        tuple(float(r) for r in ranges), noise * 1e12, float(best_fit - best),
-                       float(res))
-
-
-def realisable(delay_s, resolution_s: float):
-    """``delay_s`` rounded to a whole number of the RTS's delay steps ``resolution_s``
-    (``rts.delay_resolution_s``: the fractional-delay FIR's step, or 1/f_s without one).
-    An offset that is a multiple of the step moves every channel's realised delay
-    (``rts.realised_delay``) by exactly that offset when 1/f_s is a multiple of the step."""
-    return np.round(np.asarray(delay_s, float) / resolution_s) * resolution_s
-
-
-FINE_STEP_S = 5e-12  # step of the fitted fine sweep
-MC_DRAWS = 32  # noise realisations that size the frames per step
+                       float(res), int(k_coarse))
 
 
 def nominal_model(setup: Setup, paths: Paths) -> tuple[Setup, Paths]:

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..rts import fir_if_gain, requested_delay
+from ..rts import fir_if_gain, realised_delay, requested_delay
 
 __all__ = ["fir_bin_gain", "fir_effect", "fir_sweep_phase"]
 
@@ -61,21 +61,31 @@ def fir_effect(setup, delta_tau_s: float, base_offsets=(0.0, 0.0), ranges=None) 
             "predicted_shift_ps": shift * 1e12}
 
 
-def fir_sweep_phase(setup, ranges, deltas, base_offsets) -> np.ndarray | None:
+def fir_sweep_phase(setup, ranges, deltas, base_offsets, continuous: bool = False
+                    ) -> np.ndarray | None:
     """The phase (S, P) the fractional-delay FIR adds to channel J relative to channel I of
     each probe (at ``ranges``) at every sweep step ``deltas`` (S,): the beat-signal phase of
     the filter's own response at the probe's bin (:func:`fir_bin_gain`) at J's setting
-    (base + delta) minus I's. It cycles with the setting every 1/f_s, which the RTS's
-    designer knows; the fit of the sweep takes it out (``sweep.fit_minimum``). None for an
-    ideal delay."""
+    (base + delta) minus I's, both at the settings the RTS realises (``rts.realised_delay``;
+    with ``continuous``: J at its realised base plus the unrounded delta, the continuous
+    model of ``calibration.continuous_delay_setup``). It cycles with the setting every
+    1/f_s, which the RTS's designer knows; the fit of the sweep takes it out
+    (``sweep.fit_minimum``). None for an ideal delay."""
     from .calibration import _mean_air_delay
     scene = setup.scene
-    if not scene.rts.fractional_delay or scene.rts.fractional_delay_filter == "ideal":
+    rts = scene.rts
+    if not rts.fractional_delay or rts.fractional_delay_filter == "ideal":
         return None
+
+    def realise(t):
+        return realised_delay(t, rts.f_s_hz, rts.fractional_delay, rts.fractional_delay_step_s)
     base = requested_delay(scene, np.asarray(ranges, float))  # (P,)
     air = float(np.mean(_mean_air_delay(setup)))
     d = np.asarray(deltas, float)
-    g_i = fir_bin_gain(scene, base + base_offsets[0], base + air)  # (P,)
-    j_delay = base[None, :] + base_offsets[1] + d[:, None]  # (S, P)
+    g_i = fir_bin_gain(scene, realise(base + base_offsets[0]), base + air)  # (P,)
+    if continuous:
+        j_delay = realise(base + base_offsets[1])[None, :] + d[:, None]  # (S, P)
+    else:
+        j_delay = realise(base[None, :] + base_offsets[1] + d[:, None])
     g_j = fir_bin_gain(scene, j_delay.ravel(), np.broadcast_to(base + air, j_delay.shape).ravel())
     return np.angle(g_j.reshape(j_delay.shape) / g_i[None, :])

@@ -155,8 +155,12 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     # noise): a parabola through the points within +-period/8 of the minimum finds its vertex
     # from all of them, on the sweep and then on a finer grid around it.
     pts_d, pts_e = list(grid), list(errs)
+    res = rts.delay_resolution_s
     for _ in range(2):
-        fine = best + np.linspace(-period / 8, period / 8, 11)
+        # the delays as the RTS realises them: a coarse RTS rounds what it is given, and a
+        # point recorded at the requested delay would sit up to half a step off its value
+        fine = np.unique(np.round((best + np.linspace(-period / 8, period / 8, 11)) / res)
+                         * res)
         pts_d += list(fine)
         pts_e += [error(d) for d in fine]
         d_a, e_a = np.array(pts_d), np.array(pts_e)
@@ -164,7 +168,6 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
         a2, a1, _ = np.polyfit(d_a[near] - best, e_a[near], 2)
         if a2 > 0 and abs(a1 / (2 * a2)) < period / 8:
             best = best - a1 / (2 * a2)
-    res = rts.delay_resolution_s
     best = float(np.round(best / res) * res)  # what the RTS can set
     best_err = error(best)
     return {"pair": [int(pair[0]), int(pair[1])], "delta_tau_s": best,

@@ -315,7 +315,8 @@ def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair,
 
 
 def fit_minimum(deltas, error_rad, period_s: float, near_s: float, harmonics: int = 2,
-                search_s: float | None = None, extra_phase_rad=None) -> float:
+                search_s: float | None = None, extra_phase_rad=None,
+                criterion: str = "joint", search_phase=None) -> float:
     """The delay where the probes' fitted signed angle errors are jointly smallest, from a
     least-squares fit of the criterion's known periodic shape over one period of steps
     centred at ``near_s`` (the sweep's coarse minimum).
@@ -328,39 +329,58 @@ def fit_minimum(deltas, error_rad, period_s: float, near_s: float, harmonics: in
     frames per step). The minimum of sum_p e_p^2 on the fitted curves within one sweep step
     of ``near_s`` (0.05 ps grid; ``search_s``: that half-width instead).
 
+    ``criterion="vertex"`` (a coarse RTS whose few realisable steps the curves interpolate,
+    ``calibration.fine_window``): the common vertex instead, the minimum of sum_p e_p'^2;
+    it needs 1 + 2 harmonics points (least squares: 2 more).
+
     ``extra_phase_rad`` (S, P): a phase each step adds to channel J of each probe beyond the
     delay's own ``2 pi delta / period`` and known in advance -- the fractional-delay FIR's
     phase at the step's setting (``aoa.fir.fir_bin_gain``), which cycles with the
     setting every 1/f_s (+-3.7 deg with 5 taps) and would otherwise bend the periodic shape
     (a 33 ps bias with 5 taps). The shape is then fitted on each probe's phase axis
     ``2 pi (delta - near) / period + extra`` and searched with the extra phase interpolated
-    between the steps."""
+    between the steps, or, with ``search_phase`` (a function of the delays (F,) -> (F, P)),
+    evaluated there: a coarse RTS's steps are too far apart to interpolate the FIR's phase,
+    and its data axis also carries the quantiser's own offset error (where the delay step
+    does not divide 1/f_s, ``calibration.realisation_shift``), which the continuous delays
+    searched do not have."""
     d = np.asarray(deltas, float)
     e = np.asarray(error_rad, float)
     sel = (np.abs(d - near_s) <= period_s / 2) & np.all(np.isfinite(e), axis=1)
     th = 2 * np.pi * (d[sel] - near_s) / period_s
     h = np.arange(1, harmonics + 1)
+    vertex = criterion == "vertex"
 
     def basis(theta):
+        if vertex:  # the derivative's basis: the vertex is where it is zero
+            return np.concatenate([np.zeros((theta.size, 1)), -h * np.sin(np.outer(theta, h)),
+                                   h * np.cos(np.outer(theta, h))], axis=1)
         return np.concatenate([np.ones((theta.size, 1)), np.cos(np.outer(theta, h)),
                                np.sin(np.outer(theta, h))], axis=1)
-    if th.size < 2 * harmonics + 3:
+
+    def values(theta):
+        return np.concatenate([np.ones((theta.size, 1)), np.cos(np.outer(theta, h)),
+                               np.sin(np.outer(theta, h))], axis=1)
+    if th.size < 2 * harmonics + (1 if vertex else 3):
         return float(near_s)
     step = np.median(np.diff(np.sort(d))) if d.size > 1 else period_s / 40
     half = 1.5 * step if search_s is None else search_s
     fine = near_s + np.arange(-half, half + 1e-15, 0.05e-12)
     tf = 2 * np.pi * (fine - near_s) / period_s
     if extra_phase_rad is None:
-        coef, *_ = np.linalg.lstsq(basis(th), e[sel], rcond=None)  # (1 + 2H, P)
+        coef, *_ = np.linalg.lstsq(values(th), e[sel], rcond=None)  # (1 + 2H, P)
         crit = np.sum((basis(tf) @ coef) ** 2, axis=1)
         return float(fine[np.argmin(crit)])
     extra = np.asarray(extra_phase_rad, float).reshape(d.size, -1)
     order = np.argsort(d[sel])
     crit = np.zeros(fine.size)
+    search_x = None if search_phase is None else np.asarray(search_phase(fine), float).reshape(
+        fine.size, -1)
     for p in range(e.shape[1]):  # each probe on its own phase axis
         x = extra[sel, p]
-        coef, *_ = np.linalg.lstsq(basis(th + x), e[sel, p], rcond=None)
-        x_f = np.interp(fine, d[sel][order], x[order])  # smooth in the setting: 5 ps steps
+        coef, *_ = np.linalg.lstsq(values(th + x), e[sel, p], rcond=None)
+        x_f = (search_x[:, p] if search_phase is not None
+               else np.interp(fine, d[sel][order], x[order]))  # smooth in the setting: 5 ps
         crit += (basis(tf + x_f) @ coef) ** 2
     return float(fine[np.argmin(crit)])
 
