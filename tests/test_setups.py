@@ -222,17 +222,26 @@ def test_front_end_pattern_enters_the_exact_paths(hpbw_deg):
 
 
 def test_arc_of_two_front_ends_equals_the_pair_study():
-    # the arc study keeps its targets at the bin centre (sub-bin draws: pair study only)
+    """An arc of two front ends is the pair study bit for bit: with the target's sub-bin
+    position drawn per draw (the default of both) and with it at the bin centre."""
     scene = load_scene(DEFAULT)
     setup = build_setup(scene)
     model = PairPhasors.build(setup, (0, 1), 5)
     sigma = np.array([0.1, 0.15, 0.05]) * 1e-3
     for dist in ("normal", "uniform"):
-        pair = monte_carlo(model, sigma, 300, 11, dist, 0.05, chunk=120, subbin=False)
-        arc = arc_monte_carlo([model], 2, Bounds(tuple(sigma)), 300, 11, dist, 0.05, chunk=70)
-        for case in ("uncalibrated", "calibrated"):
-            assert np.array_equal(arc.worst_error_deg[case][:, 0], pair.worst_error_deg[case])
-            assert arc.yield_(case) == pair.yield_(case)
+        for subbin in (True, False):
+            pair = monte_carlo(model, sigma, 300, 11, dist, 0.05, chunk=120, subbin=subbin)
+            arc = arc_monte_carlo([model], 2, Bounds(tuple(sigma)), 300, 11, dist, 0.05,
+                                  chunk=70, subbin=subbin)
+            for case in ("uncalibrated", "calibrated"):
+                assert np.array_equal(arc.worst_error_deg[case][:, 0],
+                                      pair.worst_error_deg[case])
+                assert arc.yield_(case) == pair.yield_(case)
+            assert np.array_equal(arc.delay_s[:, 0], pair.delay_s)
+            if subbin:
+                assert np.array_equal(arc.subbin_steps, pair.subbin_steps)
+            else:
+                assert arc.subbin_steps is None and pair.subbin_steps is None
 
 
 def test_arc_yield_shares_front_ends(tmp_path):
@@ -261,6 +270,11 @@ def test_arc_yield_shares_front_ends(tmp_path):
     res0 = arc_monte_carlo(models[:1], 5, Bounds((0.15e-3, 0.15e-3, 0.1e-3)), 200, 3,
                            keep_errors=True, chunk=200)
     assert np.array_equal(res0.errors["offsets_m"], res.errors["offsets_m"])
+    # nor the sub-bin positions: one target, one position per draw whatever is drawn beside
+    assert np.array_equal(res0.subbin_steps, res.subbin_steps)
+    with np.load(tmp_path / "d.npz") as z:
+        assert np.array_equal(z["subbin_steps"], res.subbin_steps)
+    assert out["subbin"]["positions"] == models[0].subbin_steps.size
 
 
 def test_tolerance_pair_all_cli(tmp_path, capsys):

@@ -70,12 +70,23 @@ def test_zero_sigma_gives_the_nominal_design(model):
 
 
 def test_zero_sigma_monte_carlo_repeats_the_nominal_errors(model):
-    res = monte_carlo_cell(model, [0.0, 0.0, 0.0], 5, seed=1)
+    """Without errors at the bin centre every draw is the nominal setup; with the sub-bin
+    drawn, every draw is the nominal setup with its target at the drawn position."""
+    res = monte_carlo_cell(model, [0.0, 0.0, 0.0], 5, seed=1, subbin=False)
     nominal = errors_deg(model, np.zeros((1, len(model.cell), 3)))
     for case in CASES:
         w = res.worst_error_deg[case]
         assert np.all(w == w[0])  # every draw is the nominal setup
         assert np.isclose(np.max(np.abs(w[0, :2])), np.max(np.abs(nominal[case])))
+    res = monte_carlo_cell(model, [0.0, 0.0, 0.0], 6, seed=1)
+    idx = np.searchsorted(model.subbin_steps, res.subbin_steps)
+    assert np.array_equal(model.subbin_steps[idx], res.subbin_steps)
+    for i, u in enumerate(idx):
+        d = model.draw(np.zeros((1, len(model.cell), 3)), CASES, subbin=[u])
+        for case in CASES:
+            e = np.degrees(d[case]["error_rad"][0])
+            assert np.isclose(np.max(np.abs(res.worst_error_deg[case][i, :2])),
+                              np.max(np.abs(e)), rtol=0, atol=1e-12)
 
 
 def test_calibration_absorbs_one_front_end_moved_radially(model):

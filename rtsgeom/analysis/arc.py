@@ -9,11 +9,20 @@ A draw *passes* only if every pair's worst set-point stays within the spec, so t
 is the fraction of built arcs that meet the spec everywhere -- not a product of pair yields
 (which would treat shared front ends as independent).
 
+The target: one target at one range for the whole arc, at a sub-bin position drawn per draw
+(uniform over one range bin in steps of the RTS delay resolution, the pair study's
+:func:`~rtsgeom.analysis.tolerance.subbin_draws`) and shared by every pair: each pair's
+:class:`~rtsgeom.analysis.tolerance.PairPhasors` reads its tables at that position and follows
+the bin the RuT detects there (``subbin=False``: every draw at the bin centre, as before).
+
 Random streams: the position errors come from ``numpy.random.default_rng(seed)`` in chunks of
 shape (k, F, 3), the same stream :func:`~rtsgeom.analysis.tolerance.standard_draws` gives a
-pair (F = 2), so an arc of two front ends reproduces the pair study bit for bit; the rotations
-and the RuT pose come from their own streams (``default_rng([seed, 1])``, ``[seed, 2]``), so
-adding them leaves the position draws unchanged. No stream depends on the chunk size.
+pair (F = 2), and the sub-bin positions from the pair study's ``default_rng([seed, 1])``
+(:func:`~rtsgeom.analysis.tolerance.subbin_draws`), so an arc of two front ends reproduces the
+pair study bit for bit, with or without the sub-bin draws; the rotations and the RuT pose come
+from their own streams (``default_rng([seed, 3])``, ``[seed, 2]``; the rotations moved from
+``[seed, 1]`` when the arc took over the pair study's sub-bin stream), so adding them leaves the
+position and sub-bin draws unchanged. No stream depends on the chunk size.
 
 Tolerance bounds are given as the value of the tolerance and the sigma level it stands for:
 normal errors have sigma = bound / sigma_level ("+-0.2 mm at 3 sigma"); uniform errors are
@@ -33,10 +42,10 @@ import numpy as np
 from .._util import frozen
 from ..errors import ParameterError
 from .tolerance import (CASES, DISTRIBUTIONS, PairPhasors, critical_ratio, evaluate_chunk,
-                        largest_passing_scale, percentiles)
+                        largest_passing_scale, percentiles, subbin_draws)
 
 __all__ = ["Bounds", "ArcResult", "arc_draws", "arc_monte_carlo", "arc_models",
-           "adjacent_pairs", "max_scale_for_yield"]
+           "adjacent_pairs", "max_scale_for_yield", "shared_subbin_steps"]
 
 DEFAULT_CHUNK = 10_000
 Progress = Callable[[str, int, int], None]
@@ -103,23 +112,33 @@ def _unit(rng, distribution: str, shape) -> np.ndarray:
     return rng.uniform(-1.0, 1.0, shape)
 
 
+#: the rotations' stream, ``default_rng([seed, ROTATION_STREAM])`` (1 is the sub-bin positions')
+ROTATION_STREAM = 3
+
+
 def arc_draws(seed: int, draws: int, count: int, distribution: str = "normal",
-              chunk: int = DEFAULT_CHUNK) -> Iterator[dict]:
+              chunk: int = DEFAULT_CHUNK, positions: int | None = None) -> Iterator[dict]:
     """Unit-scale draws chunk by chunk: ``offsets`` (k, F, 3), ``rotations`` (k, F, 2) (yaw,
     pitch) and ``rut`` (k, 4) (x, y, z, yaw), each from its own generator (see the module
-    docstring); none depends on ``chunk``."""
+    docstring); with ``positions`` (the count of sub-bin positions, ``PairPhasors.subbin_steps``)
+    also ``subbin`` (k,), the target's sub-bin position index per draw (the pair study's
+    :func:`~rtsgeom.analysis.tolerance.subbin_draws`). None depends on ``chunk``."""
     if distribution not in DISTRIBUTIONS:
         raise ParameterError(f"distribution {distribution!r}: must be one of "
                          f"{', '.join(DISTRIBUTIONS)}")
     g_off = np.random.default_rng(seed)
-    g_rot = np.random.default_rng([seed, 1])
+    g_rot = np.random.default_rng([seed, ROTATION_STREAM])
     g_rut = np.random.default_rng([seed, 2])
     chunk = max(1, int(chunk))
+    subs = None if positions is None else subbin_draws(seed, draws, int(positions), chunk)
     for start in range(0, draws, chunk):
         k = min(chunk, draws - start)
-        yield {"offsets": _unit(g_off, distribution, (k, count, 3)),
+        out = {"offsets": _unit(g_off, distribution, (k, count, 3)),
                "rotations": _unit(g_rot, distribution, (k, count, 2)),
                "rut": _unit(g_rut, distribution, (k, 4))}
+        if subs is not None:
+            out["subbin"] = next(subs)
+        yield out
 
 
 def _scale(unit: dict, b: Bounds) -> dict:
@@ -151,11 +170,24 @@ def _pair_pose(err: dict, pair: tuple[int, int]) -> tuple[np.ndarray, dict]:
 
 def _evaluate(models: tuple, unit: dict, bounds: Bounds, cases) -> dict:
     err = _scale(unit, bounds)
-    out = {"errors": err, "pairs": []}
+    sub = unit.get("subbin")  # one target: the same sub-bin position in every pair
+    out = {"errors": err, "pairs": [], "subbin": sub}
     for m in models:
         off, pose = _pair_pose(err, m.pair)
-        out["pairs"].append(evaluate_chunk(m, off, cases, pose=pose))
+        out["pairs"].append(evaluate_chunk(m, off, cases, pose=pose, subbin=sub))
     return out
+
+
+def shared_subbin_steps(models) -> np.ndarray:
+    """The target's sub-bin positions (delay steps) common to every pair's model: one target,
+    one range, so every pair must offer the same positions (the same range bin, delay
+    resolution and reference target); a clear error where they differ."""
+    steps = [np.asarray(m.subbin_steps) for m in models]
+    if any(s.shape != steps[0].shape or not np.array_equal(s, steps[0]) for s in steps[1:]):
+        raise ParameterError("arc: the pairs' models disagree on the target's sub-bin "
+                             "positions (built for different ranges or radars); build them "
+                             "with arc_models on one setup")
+    return steps[0]
 
 
 @dataclass(frozen=True)
@@ -175,6 +207,10 @@ class ArcResult:
     fallbacks: dict  # case -> (P,)
     errors: dict = field(default_factory=dict)  # per-draw offsets and rotations (SI), or {}
     elapsed_s: float = 0.0
+    subbin_steps: np.ndarray | None = None  # (draws,) the target's sub-bin offset (delay
+    # steps), shared by every pair; None: at the bin centre
+    subbin_positions: int = 1  # positions the sub-bin draw chooses among
+    delay_resolution_s: float = 0.0
 
     def passes(self, case: str) -> np.ndarray:
         """(draws,) bool: every pair within the spec."""
@@ -198,7 +234,12 @@ class ArcResult:
         out = {"pairs": [], "front_ends": self.count, "draws": self.draws, "seed": self.seed,
                "distribution": self.distribution,
                "scale": "sigma" if self.distribution == "normal" else "bound",
-               "scales": self.bounds.to_dict(), "spec_deg": self.spec_deg}
+               "scales": self.bounds.to_dict(), "spec_deg": self.spec_deg,
+               "subbin": {"distribution": ("uniform over one range bin, one position per "
+                                           "draw shared by every pair"
+                                           if self.subbin_steps is not None else "bin centre"),
+                          "positions": int(self.subbin_positions),
+                          "step_s": self.delay_resolution_s}}
         for p, pair in enumerate(self.pairs):
             entry = {"pair": list(pair)}
             for case in self.worst_error_deg:
@@ -222,8 +263,11 @@ class ArcResult:
         """Per-draw errors (SI) and worst angle errors per pair for sensitivity analysis:
         ``offsets_m`` (draws, F, 3), ``yaw_rad``/``pitch_rad`` (draws, F), ``rut_offset_m``
         (draws, 3), ``rut_yaw_rad`` (draws,), ``<case>_deg`` (draws, P), ``pairs`` (P, 2),
-        ``delay_s``, ``range_offset_m`` (draws, P)."""
+        ``delay_s``, ``range_offset_m`` (draws, P), ``subbin_steps`` (draws,) (the target's
+        sub-bin offset in delay steps; zeros at the bin centre)."""
         arrays = {k: v for k, v in self.errors.items()}
+        arrays["subbin_steps"] = (np.zeros(self.draws, int) if self.subbin_steps is None
+                                  else np.asarray(self.subbin_steps))
         arrays.update({f"{case}_deg": v for case, v in self.worst_error_deg.items()})
         arrays.update(pairs=np.array(self.pairs), delay_s=self.delay_s,
                       range_offset_m=self.range_offset_m, spec_deg=np.float64(self.spec_deg))
@@ -244,16 +288,20 @@ def arc_monte_carlo(models, count: int, bounds: Bounds, draws: int, seed: int,
                     distribution: str = "normal", spec_deg: float = 0.1, cases=CASES,
                     chunk: int = DEFAULT_CHUNK, keep_errors: bool = False,
                     progress: Progress | None = None, label: str = "arc",
-                    mapper=None) -> ArcResult:
+                    mapper=None, subbin: bool = True) -> ArcResult:
     """``draws`` arcs of ``count`` front ends with errors of scale ``bounds``, every pair of
-    ``models`` evaluated on the same draw (shared front ends, shared RuT pose). ``mapper``:
-    an ordered map over chunks (e.g. a Dask client's, ``parallel.map_chunks``)."""
+    ``models`` evaluated on the same draw (shared front ends, shared RuT pose, and with
+    ``subbin`` one target at a sub-bin position drawn per draw, shared by every pair; False:
+    at the bin centre). ``mapper``: an ordered map over chunks (e.g. a Dask client's,
+    ``parallel.map_chunks``)."""
     import functools
     t0 = time.perf_counter()
     bounds.check()
     models = tuple(models)
+    positions = shared_subbin_steps(models) if models else np.zeros(1, int)
     func = functools.partial(_evaluate, models, bounds=bounds, cases=tuple(cases))
-    chunks = arc_draws(seed, draws, count, distribution, chunk)
+    chunks = arc_draws(seed, draws, count, distribution, chunk,
+                       positions.size if subbin else None)
     parts, done = [], 0
     for part in (map(func, chunks) if mapper is None else mapper(func, list(chunks))):
         parts.append(part)
@@ -282,24 +330,33 @@ def arc_monte_carlo(models, count: int, bounds: Bounds, draws: int, seed: int,
                 errors[key] = np.zeros((draws,) + shape)
             else:
                 errors[key] = np.concatenate(vals)
+    sub = None
+    if subbin:
+        idx = (np.concatenate([pt["subbin"] for pt in parts]) if parts
+               else np.zeros(0, int))
+        sub = frozen(positions[idx.astype(int)])
     return ArcResult(tuple(m.pair for m in models), int(count), bounds, distribution,
                      int(draws), int(seed), float(spec_deg), worst, delay,
-                     joined("range_offset_m"), fallbacks, errors, time.perf_counter() - t0)
+                     joined("range_offset_m"), fallbacks, errors, time.perf_counter() - t0,
+                     sub, int(positions.size),
+                     float(models[0].delay_resolution_s) if models else 0.0)
 
 
 def max_scale_for_yield(models, count: int, bounds: Bounds, draws: int, seed: int,
                         target_yield: float, spec_deg: float = 0.1, case: str = "calibrated",
                         distribution: str = "normal", rel_tol: float = 0.02,
-                        cap: float = 100.0, chunk: int = DEFAULT_CHUNK) -> dict:
+                        cap: float = 100.0, chunk: int = DEFAULT_CHUNK,
+                        subbin: bool = True) -> dict:
     """The largest factor s on ``bounds`` that keeps ``target_yield`` of the *arcs* within
     ``spec_deg`` (every pair), by the secant search with common random numbers (the same seed), as
     :func:`~rtsgeom.analysis.tolerance.max_sigma_for_yield` does for one pair. Returns the
-    factor, the scaled bounds, the yield there and whether the search hit ``cap``."""
+    factor, the scaled bounds, the yield there and whether the search hit ``cap``.
+    ``subbin``: :func:`arc_monte_carlo`'s (the same sub-bin positions at every scale)."""
     history = []
 
     def yield_at(s):
         res = arc_monte_carlo(models, count, bounds.scaled(s), draws, seed, distribution,
-                              spec_deg, (case,), chunk)
+                              spec_deg, (case,), chunk, subbin=subbin)
         y = res.yield_(case)
         history.append({"scale": s, "yield": y})
         return y, critical_ratio(res.worst_error_deg[case], spec_deg, target_yield)

@@ -12,29 +12,38 @@ the modelled 2-D beamformer output), for the channel phases the cell's calibrati
 establishes (:func:`~rtsgeom.aoa.ncal.tree_phases`: each measured pair of the spanning tree
 coherent at the midpoint of its front ends' directions).
 
-A draw at phasor level (the bin-centre special case of ``PairPhasors.snapshots``, per
-channel; eq. 15/16 with the exact legs, :meth:`ChannelModel.perturbed`)::
+The target sits at a sub-bin position drawn per draw (uniform over one range bin in steps of
+the RTS delay resolution, :func:`~rtsgeom.analysis.subbin.subbin_positions`, the pair study's
+stream :func:`~rtsgeom.analysis.tolerance.subbin_draws`; ``subbin=False``: the bin centre), and
+the RuT picks the range bin: a draw at phasor level is, as in
+``PairPhasors.draw_errors`` (eq. 15/16 with the exact legs, :meth:`ChannelModel.perturbed`)::
 
-    x_qv(draw) = x_qv(nominal) * (a_qv b_qv / a'_qv b'_qv) exp(j 2 pi f_air d_qv)
-                 * F_qv(k_q) * exp(s_qv(k_q) d_qv)
+    x_qkv(draw) = table[q, u + k_q, k, v] * (x_qv(draw) / x_qv(nominal))
+                  * exp(s_qkv(u + k_q) d_qv)
 
-with ``F_q(k)`` channel q's response to an RTS delay offset of k steps over its response at
-0 (``tolerance_model.response_table`` through the ADC-cube chain's ``rts.channel_echoes``),
-``s`` its log-magnitude slope (the echo slides along the range window by the air delay
-change d as by an RTS delay). ``uncalibrated``: k = 0 and the nominal amplitudes.
-``calibrated``: the cell's calibration at phasor level: the tree phases of the draw's
-channels (the pairs' probes at the nominal directions) as delays by eq. (27) (wrapped to the
-smallest |delay|, quantised to the delay resolution, refined on the table's exact phase), the
-amplitude calibration (each channel's power over the virtual elements against the model's)
-and the delay's known loss at the bin divided out.
+with ``table[q, D, k, v]`` channel q's spectrum at candidate bin k (the set range's and
+``HALF_BINS`` either side) with its RTS delay offset by D steps
+(``tolerance_model.response_table``, through the ADC-cube chain's ``rts.channel_echoes``),
+``u`` the sub-bin position and ``k_q`` the channel's calibration delay (steps), and ``s`` the
+table's log-magnitude slope over the delay (the echo slides along the range window by the air
+delay change d as by an RTS delay; bounded, ``tolerance_model.slide``). The detected bin is the
+strongest candidate of the weighted sum (power over the virtual elements), the snapshot that
+bin's. ``uncalibrated``: k = 0 and the nominal amplitudes. ``calibrated``: the cell's
+calibration at phasor level: the tree phases of the draw's channels (the pairs' probes at the
+nominal directions, probes at a bin centre) as delays by eq. (27) (wrapped to the smallest
+|delay|, quantised to the delay resolution, refined on the table's exact phase), the amplitude
+calibration (each channel's power over the virtual elements against the model's) and each
+channel's known loss from its delay divided out, at the bin the operator's nominal model
+detects for that set direction, sub-bin position and delays (the amplitudes are designed once,
+at the bin centre: every channel slides alike with the target's position, so the design holds
+across the bin up to what the calibration delays move).
 
 With ``bounds`` the front ends' rotations (yaw, pitch) and the RuT's pose errors (position,
 yaw) are drawn too (``analysis.arc``'s streams, the offsets unchanged) and enter through
 :meth:`ChannelModel.perturbed`.
 
-Not modelled (the pair study has them): the target's sub-bin position and the RuT's bin
-choice (the calibration delays move the echoes by up to half an IF period, c0 / 4 f_IF-ish,
-in range), and the planner's alternative delays one IF period away.
+Not modelled (the pair study has them): a redesign of the amplitudes per sub-bin position and
+delay (the pair study's ``_Design``), and the planner's alternative delays one IF period away.
 ``verify_cell_draws`` pushes draws through the full ADC-cube chain.
 """
 
@@ -60,6 +69,7 @@ from ..radar.steering import Steering
 from .tolerance import (AXES, CASES, DEFAULT_CHUNK, draws_header, Mapper, Progress, largest_passing_scale,
                         percentiles, standard_draws)
 from .arc import Bounds, _scale, arc_draws
+from .subbin import subbin_positions
 from .tolerance_model import reference_target, response_table, slide
 
 __all__ = ["CellPhasors", "CellToleranceResult", "ANGLES", "monte_carlo_cell",
@@ -69,6 +79,12 @@ __all__ = ["CellPhasors", "CellToleranceResult", "ANGLES", "monte_carlo_cell",
 ANGLES = ("azimuth", "elevation", "angular_distance")
 STAT_KEYS = ("azimuth_error_deg", "elevation_error_deg", "angular_distance_deg")
 REFINE_STEPS = 8  # the calibration delay refined +-this many steps on the table's phase
+#: candidate range bins either side of the set range's: an echo lies at most half a bin (its
+#: sub-bin position) plus half an IF period of calibration delay (~0.3 bins on sphere4) from
+#: the set range's bin centre, so the combined peak is within one bin; one more is compared
+HALF_BINS = 2
+#: draws per block of :meth:`CellPhasors.draw` (its (n, M, K, V) temporaries bounded)
+BLOCK_DRAWS = 500
 
 
 def _wrap(phi):
@@ -90,6 +106,11 @@ class CellPhasors:
     delay_log_slope: np.ndarray  # (Q, 2 S + 1, V) Re d ln F / d tau (1/s)
     cal_slope_hz: float  # f_rts + B/2: eq. (27)
     delay_resolution_s: float
+    table: np.ndarray  # (Q, D, K, V) channel q's spectrum at candidate bin k, RTS delay
+    # offset (j - table_zero) steps (the middle bin: the set range's)
+    table_log_slope: np.ndarray  # (Q, D, K, V) d ln|table| / d tau (1/s)
+    table_zero: int
+    subbin_steps: np.ndarray  # (U,) the target's sub-bin positions (delay steps, 0 centre)
 
     @classmethod
     def build(cls, setup: Setup, cell=None, grid: int = 5,
@@ -127,14 +148,19 @@ class CellPhasors:
         res = rts.delay_resolution_s
         slope = rts.f_rts_hz + 0.5 * radar.bandwidth_hz
         max_steps = int(np.ceil(0.5 / (slope * res))) + REFINE_STEPS + 1
-        steps = np.arange(-max_steps, max_steps + 1)
-        tables = np.stack([response_table(nom, paths, q, target, res, steps, 0)[:, 0]
-                           for q in cell])  # (Q, D, V)
-        factor = tables / tables[:, max_steps:max_steps + 1]
+        sub = subbin_positions(radar.range_resolution_m, res)
+        # rows: every sub-bin position plus every calibration delay, one more for the slope
+        z = int(np.max(np.abs(sub))) + max_steps + 1
+        steps = np.arange(-z, z + 1)
+        table = np.stack([response_table(nom, paths, q, target, res, steps, HALF_BINS)
+                          for q in cell])  # (Q, D, K, V)
         with np.errstate(divide="ignore"):
-            log_slope = np.gradient(np.log(np.abs(tables)), res, axis=1)
+            log_slope = np.gradient(np.log(np.abs(table)), res, axis=1)
+        ks = slice(z - max_steps, z + max_steps + 1)
+        factor = table[:, ks, HALF_BINS] / table[:, z:z + 1, HALF_BINS]  # (Q, 2 S + 1, V)
         return cls(cs, frozen(sets), frozen(set_u), frozen(amps), frozen(phases), tree,
-                   frozen(factor), frozen(log_slope), float(slope), float(res))
+                   frozen(factor), frozen(log_slope[:, ks, HALF_BINS]), float(slope),
+                   float(res), frozen(table), frozen(log_slope), z, frozen(sub))
 
     cell = property(lambda self: tuple(self.cells.model.channels))
     setup = property(lambda self: self.cells.model.setup)  # nominal
@@ -144,6 +170,11 @@ class CellPhasors:
     @property
     def max_steps(self) -> int:
         return (self.delay_factor.shape[1] - 1) // 2
+
+    @property
+    def subbin_zero(self) -> int:
+        """Index of the bin centre in :attr:`subbin_steps`."""
+        return int(np.flatnonzero(self.subbin_steps == 0)[0])
 
     # -- one draw ---------------------------------------------------------------------------
 
@@ -170,38 +201,77 @@ class CellPhasors:
         x0 = self.x_nominal
         return np.sqrt(np.sum(x0.real ** 2 + x0.imag ** 2, axis=-1) / p)
 
-    def draw(self, offsets_m, cases=CASES, pose: dict | None = None) -> dict:
+    def draw(self, offsets_m, cases=CASES, pose: dict | None = None, subbin=None) -> dict:
         """Per case the detected minus set (azimuth, elevation) (n, M, 2) rad, the angular
-        distance (n, M) rad and whether the beamformer's Newton peak converged (n, M), for
-        mounting errors ``offsets_m`` (n, Q, 3) and ``pose`` (the rotations ``yaw_rad``,
-        ``pitch_rad`` (n, Q) and RuT pose errors ``rut_offset_m`` (n, 3), ``rut_yaw_rad``
-        (n,) of :meth:`ChannelModel.air_legs`; None: none); and the calibration steps (n, Q)
-        and the range offset between the channels after calibration (n,) m."""
+        distance (n, M) rad, whether the beamformer's Newton peak converged (n, M), the
+        detected range bin as an offset from the set range's (n, M) and the programme
+        amplitudes (n, M, Q) (relative: times ``cells.model.unit_gain``), for mounting errors
+        ``offsets_m`` (n, Q, 3), ``pose`` (the rotations ``yaw_rad``, ``pitch_rad`` (n, Q) and
+        RuT pose errors ``rut_offset_m`` (n, 3), ``rut_yaw_rad`` (n,) of
+        :meth:`ChannelModel.air_legs`; None: none) and the target's sub-bin positions
+        ``subbin`` (n,) (indices into :attr:`subbin_steps`; None: the bin centre); and the
+        calibration steps (n, Q) and the range offset between the channels after calibration
+        (n,) m. Blocks of :data:`BLOCK_DRAWS` draws (row by row: the same bits)."""
         off = np.asarray(offsets_m, float)
+        n = off.shape[0]
+        u = np.full(n, self.subbin_zero) if subbin is None else np.asarray(subbin, int)
         pose = {k: v for k, v in (pose or {}).items() if v is not None}
-        cm, st = self.cells.model, self.cells.steering
-        x, shift = cm.perturbed(off, return_shift=True, **pose)  # (n, Q, V)
-        steps = self.calibration_steps(x)
-        q = np.arange(len(self.cell))
-        out = {"steps": steps, "range_offset_m": self._range_offset(off, steps, pose)}
-        v_set = _unit_vectors(self.set_u)
         for case in cases:
             if case not in CASES:
                 raise ValueError(f"case {case!r}: must be one of {', '.join(CASES)}")
-            k = steps if case == "calibrated" else np.zeros_like(steps)
-            f = self.delay_factor[q, k + self.max_steps]  # (n, Q, V)
-            xk = x * f * slide(self.delay_log_slope[q, k + self.max_steps], shift)
-            amps = np.broadcast_to(self.amplitudes, (off.shape[0],) + self.amplitudes.shape)
-            if case == "calibrated":  # the gains measured, the delay's known loss divided out
-                loss = np.abs(f[..., st.mask].mean(-1))  # (n, Q)
-                amps = amps * (self.gain_correction(x) / loss)[:, None, :]
-            snaps = np.einsum("nmq,nqv->nmv", amps, xk)
-            u, ok = st.peak(snaps, self.set_u)
-            ang = st.angles(u)
-            dist = 2 * np.arcsin(np.clip(np.linalg.norm(_unit_vectors(u) - v_set, axis=-1) / 2,
+        parts = []
+        for b in range(0, max(n, 1), BLOCK_DRAWS):
+            sl = slice(b, b + BLOCK_DRAWS)
+            parts.append(self._draw(off[sl], cases, {k: np.asarray(v)[sl]
+                                                     for k, v in pose.items()}, u[sl]))
+        if len(parts) == 1:
+            return parts[0]
+
+        def join(items):
+            first = items[0]
+            if isinstance(first, dict):
+                return {k: join([i[k] for i in items]) for k in first}
+            return np.concatenate(items)
+
+        return join(parts)
+
+    def _draw(self, off, cases, pose, u) -> dict:
+        cm, st = self.cells.model, self.cells.steering
+        x, shift = cm.perturbed(off, return_shift=True, **pose)  # (n, Q, V)
+        nom = self.x_nominal
+        fac = x / np.where(nom != 0, nom, 1.0)  # the draw's factor per channel and element
+        steps = self.calibration_steps(x)
+        n, n_q = off.shape[0], len(self.cell)
+        q = np.arange(n_q)
+        d_u = self.subbin_steps[u]  # (n,)
+        out = {"steps": steps, "range_offset_m": self._range_offset(off, steps, pose)}
+        v_set = _unit_vectors(self.set_u)
+        mask = st.mask
+        for case in cases:
+            cal = case == "calibrated"
+            rows = self.table_zero + d_u[:, None] + (steps if cal else 0)  # (n, Q)
+            t_nom = self.table[q, rows]  # (n, Q, K, V) the operator's nominal model
+            xk = t_nom * fac[:, :, None] * slide(self.table_log_slope[q, rows],
+                                                 shift[:, :, None])
+            amps = np.broadcast_to(self.amplitudes, (n,) + self.amplitudes.shape)
+            if cal:  # the gains measured, each delay's known loss divided out at the bin
+                # the operator's nominal model detects (target at its sub-bin position)
+                t_pos = self.table[q, self.table_zero + d_u[:, None]]  # delays at 0
+                k_plan = _detected_bin(np.einsum("nmq,nqkv->nmkv", amps, t_nom))  # (n, M)
+                pick = k_plan[:, :, None, None]
+                f_d = np.take_along_axis(t_nom[..., mask].mean(-1)[:, None], pick, -1)[..., 0]
+                f_0 = np.take_along_axis(t_pos[..., mask].mean(-1)[:, None], pick, -1)[..., 0]
+                loss = np.abs(f_d) / np.maximum(np.abs(f_0), 1e-300)  # (n, M, Q)
+                amps = amps * self.gain_correction(x)[:, None, :] / loss
+            y = np.einsum("nmq,nqkv->nmkv", amps, xk)  # (n, M, K, V)
+            det = _detected_bin(y)  # (n, M): the RuT's bin
+            snaps = np.take_along_axis(y, det[:, :, None, None], 2)[:, :, 0]  # (n, M, V)
+            uu, ok = st.peak(snaps, self.set_u)
+            ang = st.angles(uu)
+            dist = 2 * np.arcsin(np.clip(np.linalg.norm(_unit_vectors(uu) - v_set, axis=-1) / 2,
                                          0.0, 1.0))
             out[case] = {"error_rad": ang - self.set_rad, "distance_rad": dist,
-                         "converged": ok}
+                         "converged": ok, "bin": det - HALF_BINS, "amplitudes": amps}
         return out
 
     def _range_offset(self, off, steps, pose=None) -> np.ndarray:
@@ -226,6 +296,12 @@ class CellPhasors:
         }
 
 
+def _detected_bin(y) -> np.ndarray:
+    """The RuT's range bin of spectra ``y`` (..., K, V): the strongest candidate, the power
+    summed over the virtual elements (as ``PairPhasors.draw_errors`` picks it), (...,)."""
+    return np.argmax(np.sum(y.real ** 2 + y.imag ** 2, -1), -1)
+
+
 def _unit_vectors(u) -> np.ndarray:
     """Unit direction vectors (..., 3) of direction cosines (..., 2) (the front hemisphere)."""
     u = np.asarray(u, float)
@@ -234,13 +310,13 @@ def _unit_vectors(u) -> np.ndarray:
 
 
 def evaluate_cell_chunk(model: CellPhasors, offsets_m: np.ndarray, cases=CASES,
-                        pose: dict | None = None) -> dict:
+                        pose: dict | None = None, subbin=None) -> dict:
     """Per draw of ``offsets_m`` (k, Q, 3), per case: the signed azimuth and elevation errors of
     the worst set-point in each (the largest |error|), the largest angular distance (deg),
-    (k, 3), and the count of peaks Newton left unconverged; the calibration steps (k, Q) and
-    range offsets (k,). ``pose``: :meth:`CellPhasors.draw`'s. Pure: the same offsets give
-    the same bits."""
-    d = model.draw(offsets_m, cases, pose)
+    (k, 3), the count of peaks Newton left unconverged and of set-points detected off the set
+    range's bin; the calibration steps (k, Q) and range offsets (k,). ``pose``, ``subbin``:
+    :meth:`CellPhasors.draw`'s. Pure: the same offsets give the same bits."""
+    d = model.draw(offsets_m, cases, pose, subbin)
     out = {"steps": d["steps"], "range_offset_m": d["range_offset_m"]}
     for case in cases:
         e = np.degrees(d[case]["error_rad"])  # (k, M, 2)
@@ -248,6 +324,7 @@ def evaluate_cell_chunk(model: CellPhasors, offsets_m: np.ndarray, cases=CASES,
         worst = np.take_along_axis(e, k[:, None, :], axis=1)[:, 0]
         out[case] = np.column_stack([worst, np.degrees(d[case]["distance_rad"].max(-1))])
         out[case + "_fallbacks"] = int(np.count_nonzero(~d[case]["converged"]))
+        out[case + "_off_bin"] = int(np.count_nonzero(d[case]["bin"]))
     return out
 
 
@@ -277,6 +354,9 @@ class CellToleranceResult:
     elapsed_s: float = 0.0
     cpu_s: float = 0.0
     bounds: Bounds | None = None  # with the rotations and RuT pose errors drawn
+    subbin_steps: np.ndarray | None = None  # (draws,) the target's sub-bin offset (delay
+    # steps); None: at the bin centre
+    off_bin: dict | None = None  # case -> set-points detected off the set range's bin
 
     def yield_(self, case: str) -> float:
         """Fraction of draws whose every set-point is within the spec in both angles."""
@@ -290,6 +370,8 @@ class CellToleranceResult:
         out = {key: percentiles(e[:, k]) for k, key in enumerate(STAT_KEYS)}
         out["angle_error_deg"] = percentiles(np.max(e[:, :2], axis=-1))
         out.update({"yield": self.yield_(case), "fallbacks": self.fallbacks[case]})
+        if self.off_bin is not None:
+            out["detected_off_bin"] = self.off_bin[case]
         return out
 
     def to_dict(self) -> dict:
@@ -299,7 +381,10 @@ class CellToleranceResult:
             "bounds": None if self.bounds is None else self.bounds.to_dict(),
             "yield_rule": "every set-point within spec_deg in azimuth and in elevation",
             "cell": self.model.to_dict(),
-            "subbin": {"distribution": "bin centre", "positions": 1,
+            "subbin": {"distribution": ("uniform over one range bin"
+                                        if self.subbin_steps is not None else "bin centre"),
+                       "positions": (int(self.model.subbin_steps.size)
+                                     if self.subbin_steps is not None else 1),
                        "step_s": self.model.delay_resolution_s},
         }
         for case in self.worst_error_deg:
@@ -313,26 +398,35 @@ class CellToleranceResult:
 
 def _evaluate(model: CellPhasors, part: dict, cases) -> dict:
     pose = {k: part[k] for k in ("yaw_rad", "pitch_rad", "rut_offset_m", "rut_yaw_rad")}
-    return evaluate_cell_chunk(model, part["offsets_m"], cases, pose)
+    out = evaluate_cell_chunk(model, part["offsets_m"], cases, pose, part.get("subbin"))
+    out["subbin"] = part.get("subbin")
+    return out
 
 
 def monte_carlo_cell(model: CellPhasors, sigma_m, draws: int, seed: int,
                      distribution: str = "normal", spec_deg: float = 0.1, cases=CASES,
                      chunk: int = DEFAULT_CHUNK, progress: Progress | None = None,
                      label: str = "tolerance", mapper: Mapper | None = None,
-                     bounds: Bounds | None = None) -> CellToleranceResult:
+                     bounds: Bounds | None = None, subbin: bool = True) -> CellToleranceResult:
     """``draws`` setups of the cell with mounting errors scaled by ``sigma_m`` (3,) (the pair
     study's :func:`~rtsgeom.analysis.tolerance.monte_carlo` for a cell: the same unit draws
     per front end, chunked, optionally mapped; the outcome depends on neither). ``bounds``:
     also the front ends' rotations and the RuT's pose errors (``analysis.arc``'s draws, their
-    own streams; its offsets are replaced by ``sigma_m``): the offsets stay the same draws."""
+    own streams; its offsets are replaced by ``sigma_m``): the offsets stay the same draws.
+    ``subbin``: the target at a sub-bin position drawn per draw (the pair study's stream,
+    :func:`~rtsgeom.analysis.tolerance.subbin_draws`); False: at the bin centre."""
     t0, c0 = time.perf_counter(), time.process_time()
     sigma = np.asarray(sigma_m, float).reshape(3)
     if np.any(~np.isfinite(sigma)) or np.any(sigma < 0):
         raise ValueError(f"sigma_m {sigma.tolist()}: must be finite and >= 0")
     n_q = len(model.cell)
     b = dataclasses.replace(bounds or Bounds((0.0, 0.0, 0.0)), offsets_m=tuple(sigma))
-    chunks = (_scale(u, b) for u in arc_draws(seed, draws, n_q, distribution, chunk))
+    positions = model.subbin_steps.size if subbin else None
+
+    def scaled(unit):
+        return {**_scale(unit, b), "subbin": unit.get("subbin")}
+
+    chunks = (scaled(u) for u in arc_draws(seed, draws, n_q, distribution, chunk, positions))
     func = functools.partial(_evaluate, model, cases=tuple(cases))
     parts, done = [], 0
     for part in (map(func, chunks) if mapper is None else mapper(func, list(chunks))):
@@ -350,7 +444,9 @@ def monte_carlo_cell(model: CellPhasors, sigma_m, draws: int, seed: int,
         frozen(joined("steps", (0, n_q)) * model.delay_resolution_s),
         joined("range_offset_m", (0,)),
         {case: sum(p[case + "_fallbacks"] for p in parts) for case in cases},
-        time.perf_counter() - t0, time.process_time() - c0, b)
+        time.perf_counter() - t0, time.process_time() - c0, b,
+        frozen(model.subbin_steps[joined("subbin", (0,)).astype(int)]) if subbin else None,
+        {case: sum(p[case + "_off_bin"] for p in parts) for case in cases})
 
 
 def max_sigma_for_yield_cell(model: CellPhasors, sigma_m, draws: int, seed: int,
@@ -359,9 +455,10 @@ def max_sigma_for_yield_cell(model: CellPhasors, sigma_m, draws: int, seed: int,
                              distribution: str = "normal", rel_tol: float = 0.01,
                              cap_m: float = 0.01, chunk: int = DEFAULT_CHUNK,
                              progress: Progress | None = None,
-                             mapper: Mapper | None = None) -> dict:
+                             mapper: Mapper | None = None, subbin: bool = True) -> dict:
     """The pair study's ``max_sigma_for_yield`` for a cell (the same search,
-    :func:`~rtsgeom.analysis.tolerance.largest_passing_scale`, the same keys)."""
+    :func:`~rtsgeom.analysis.tolerance.largest_passing_scale`, the same keys; ``subbin``:
+    :func:`monte_carlo_cell`'s, the same positions at every scale)."""
     base = np.asarray(sigma_m, float).reshape(3)
     if axis == "all":
         direction = base / base.max() if base.max() > 0 else np.ones(3)
@@ -376,7 +473,7 @@ def max_sigma_for_yield_cell(model: CellPhasors, sigma_m, draws: int, seed: int,
     def yield_at(t: float) -> float:
         res = monte_carlo_cell(model, fixed + t * direction, draws, seed, distribution,
                                spec_deg, (case,), chunk, progress,
-                               f"{case}: sigma {t * 1e3:.4g} mm", mapper)
+                               f"{case}: sigma {t * 1e3:.4g} mm", mapper, subbin=subbin)
         y = res.yield_(case)
         history.append({"scale_mm": t * 1e3, "yield": y})
         return y
@@ -394,71 +491,5 @@ def max_sigma_for_yield_cell(model: CellPhasors, sigma_m, draws: int, seed: int,
     return result(*largest_passing_scale(yield_at, y0, target_yield, start, cap_m, rel_tol))
 
 
-def verify_cell_draws(model: CellPhasors, sigma_m, n: int, seed: int,
-                      distribution: str = "normal", cases=CASES, all_points: bool = False,
-                      progress=None) -> dict:
-    """The first ``n`` draws of ``monte_carlo_cell`` through the full chain
-    (``tolerance_verify`` for a cell): each draw built as a real setup (the offsets on the
-    cell's front ends, exact paths), the programme the fast model assumes (the target's delay
-    plus each channel's calibration delay, the designed amplitudes with the gain correction)
-    synthesized as a noise-free ADC cube and processed (``radar.process``: range-Doppler,
-    CFAR, 2-D beamformer), one frame per draw and case at the set-point with the draw's
-    largest angular distance in the fast model (``all_points``: at every set-point). Returns
-    per case the model's and the chain's (azimuth, elevation) errors (n, P, 2) deg and the
-    largest |chain - model| (inf where the chain detected nothing)."""
-    from ..geometry import build_setup
-    from ..radar import process
-    from ..radar.frame import simulate
-    from ..radar.processing import nearest_detection
-    from ..rts import RtsProgram, requested_delay
-    t0 = time.perf_counter()
-    cell = list(model.cell)
-    n_q, n_m = len(cell), model.set_rad.shape[0]
-    off = draw_cell_offsets(seed, n, sigma_m, n_q, distribution)
-    d = model.draw(off, cases)
-    scene = model.setup.scene
-    tau0 = float(requested_delay(scene, model.range_m))
-    res = model.delay_resolution_s
-    n_p = n_m if all_points else 1
-    out = {case: {"set_index": np.zeros((n, n_p), int),
-                  "model_deg": np.full((n, n_p, 2), np.nan),
-                  "chain_deg": np.full((n, n_p, 2), np.nan)} for case in cases}
-    gains = model.gain_correction(model.cells.model.perturbed(off))
-    mask = model.cells.steering.mask
-    for i in range(n):
-        offsets = np.zeros((len(scene.rts.front_ends), 3))
-        offsets[cell] = off[i]
-        setup = build_setup(scene, offsets_m=offsets)
-        paths = exact_paths(setup)
-        for case in cases:
-            cal = case == "calibrated"
-            k = d["steps"][i] if cal else np.zeros(n_q, int)
-            f = model.delay_factor[np.arange(n_q), k + model.max_steps]
-            g = gains[i] / np.abs(f[:, mask].mean(-1)) if cal else np.ones(n_q)
-            pts = (range(n_m) if all_points
-                   else [int(np.argmax(d[case]["distance_rad"][i]))])
-            for j, m in enumerate(pts):
-                amps = model.cells.model.unit_gain * model.amplitudes[m] * g
-                prog = RtsProgram.build([0] * n_q, cell, list(tau0 + k * res), [0.0] * n_q,
-                                        list(amps))
-                _, cube = simulate(setup, paths, prog)  # noise-free
-                rd, dets = process(cube)
-                hit = nearest_detection(dets, rd, model.range_m)
-                out[case]["set_index"][i, j] = m
-                out[case]["model_deg"][i, j] = np.degrees(d[case]["error_rad"][i, m])
-                if hit is not None:
-                    got = np.array([dets.angle_rad[hit], dets.elevation_rad[hit]])
-                    out[case]["chain_deg"][i, j] = np.degrees(got - model.set_rad[m])
-        if progress:
-            progress("verify (ADC-cube chain)", i + 1, n)
-    summary = {}
-    for case in cases:
-        diff = np.abs(out[case]["chain_deg"] - out[case]["model_deg"])
-        diff = np.where(np.isfinite(diff), diff, np.inf)
-        summary[case] = {"max_abs_difference_deg": float(diff.max()) if diff.size else 0.0,
-                         "missed": int(np.count_nonzero(~np.isfinite(diff[..., 0])))}
-    return {"draws": n, "set_point": ("every set-point" if all_points
-                                      else "the draw's worst (angular distance) in the fast model"),
-            "max_abs_difference_deg": max((v["max_abs_difference_deg"]
-                                           for v in summary.values()), default=0.0),
-            "cases": summary, "detail": out, "elapsed_s": time.perf_counter() - t0}
+# the full-chain check lives in its own module (size); re-exported here, where it was
+from .tolerance_cell_verify import verify_cell_draws

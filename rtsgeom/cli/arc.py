@@ -196,6 +196,8 @@ def tolerance_arc(args, scene, sigma, extra, folder) -> int:
           f"pitch {sc['pitch_deg']:.4g} deg per front end; RuT position "
           f"{sc['rut_position_mm'][0]:.4g} mm, yaw {sc['rut_yaw_deg']:.4g} deg), "
           f"{elapsed:.2f} s")
+    print(f"  target: one per draw, at a sub-bin position drawn uniform over one range bin "
+          f"({out['subbin']['positions']} positions), the same for every pair")
     for entry in out["pairs"]:
         print(f"  pair {tuple(entry['pair'])}: " + "; ".join(
             f"{case} p95 {entry[case]['angle_error_deg']['p95']:.4f} deg, yield "

@@ -56,8 +56,8 @@ def tolerance_cell(args, scene, sigma, extra, stage) -> int:
         raise UsageError("--verify, --invert-yield: only without rotation or RuT-pose errors "
                          "so far")
     if args.nominal_amplitudes:
-        raise UsageError("--nominal-amplitudes: only for the pair study (the cell study has no "
-                         "bin logic yet)")
+        raise UsageError("--nominal-amplitudes: only for the pair study (the cell study "
+                         "designs its amplitudes once, at the bin centre)")
     setup = build_setup(scene)
     n = max(2, int(round(np.sqrt(args.points))))
     try:
@@ -100,7 +100,9 @@ def tolerance_cell(args, scene, sigma, extra, stage) -> int:
         arrays = {"offsets_m": draw_cell_offsets(seed, res.draws, res.sigma_m, len(model.cell),
                                                  res.distribution),
                   "cell": np.array(model.cell), "delay_s": res.delay_s,
-                  "range_offset_m": res.range_offset_m}
+                  "range_offset_m": res.range_offset_m,
+                  "subbin_steps": (np.zeros(res.draws, int) if res.subbin_steps is None
+                                   else np.asarray(res.subbin_steps))}
         arrays.update({f"{case}_deg": v for case, v in res.worst_error_deg.items()})
         np.savez_compressed(stage / "tolerance_draws.npz", **arrays)
     if args.json:
@@ -111,6 +113,10 @@ def tolerance_cell(args, scene, sigma, extra, stage) -> int:
           + ", ".join(f"{a} {s * 1e3:g} mm" for a, s in zip(AXES, sigma))
           + f"), {model.set_rad.shape[0]} set directions (azimuth x elevation), "
             f"{elapsed:.2f} s ({res.cpu_s:.2f} s CPU in the Monte Carlo)")
+    print(f"  target at a sub-bin position drawn per draw, uniform over one range bin "
+          f"({out['subbin']['positions']} positions); the RuT's bin: set-points detected off "
+          "the set range's bin " + ", ".join(f"{case} {out[case]['detected_off_bin']}"
+                                               for case in CASES))
     for case in CASES:
         st = out[case]
         parts = []
