@@ -12,7 +12,10 @@ numpy formulation avoids those temporaries; a scalar loop per snapshot does.
 Rules: ``cache=True`` (compiled once per machine into ``__pycache__``; see README
 "Performance" for the cost), ``nogil=True`` (threads may share them), no ``fastmath`` (IEEE
 arithmetic: the results agree with the numpy definitions to rounding, tested in
-``tests/test_kernels.py``), ``error_model="numpy"`` (0/0 is NaN, as in numpy). numba is
+``tests/test_kernels.py``), ``error_model="numpy"`` (0/0 is NaN, as in numpy); the small
+per-snapshot helpers ``inline="always"`` (numba-level inlining lets it drop the reference
+counting of the arrays passed down: the planned design 760 -> 320 ns per set-point, the
+Newton steps about 2x). numba is
 imported only with this module, which the callers import inside the functions that need it
 (``rtsgeom --help`` and ``info`` do not load it).
 """
@@ -24,8 +27,8 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["peak_1d", "newton_1d", "lattice", "ratio_one", "ratios", "bin_choice_rows", "design_rows",
-           "plan_rows"]
+__all__ = ["peak_1d", "newton_1d", "lattice", "ratio_one", "ratios", "choice_row",
+           "bin_choice_rows", "design_rows", "plan_rows", "detect_rows"]
 
 _JIT = dict(cache=True, nogil=True, error_model="numpy")
 
