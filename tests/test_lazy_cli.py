@@ -16,9 +16,10 @@ from rtsgeom.cli import COMMANDS, build_parser
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "scenes" / "diewald2022.toml"
 
-#: Loaded only by the commands that use them (3D view, ray tracing, clusters, figures, tables).
+#: Loaded only by the commands that use them (3D view, ray tracing, clusters, figures, tables,
+#: compiled kernels).
 OPTIONAL = ("sionna", "mitsuba", "drjit", "pyvista", "vtk", "dask", "distributed", "matplotlib",
-            "pandas", "xarray", "trimesh", "rich")
+            "pandas", "xarray", "trimesh", "rich", "numba", "llvmlite")
 
 _PROBE = """
 import json, runpy, sys

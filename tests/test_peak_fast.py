@@ -1,8 +1,10 @@
-"""Steering.peak's fast paths against the plain double-precision algorithm: the global check
-on single-precision grid powers (undecided ones redone in double), the 1-D Newton step, and
+"""Steering.peak's fast paths against the plain double-precision algorithm (numpy's D-general
+Newton, the grid in double precision): the compiled 1-D peak (``rtsgeom.kernels.peak_1d``:
+Newton with phasors from the array's lattice, the global check in double precision), and
 search's skip of NaN snapshots. Across arrays (the default RuT, a sparse and a wide ULA),
-snapshot kinds (one source, two sources of nearly equal power, noise), scales that would
-under- or overflow float32, and NaN rows."""
+snapshot kinds (one source, two sources of nearly equal power, noise), scales 1e-30 and
+1e30, and NaN rows. The compiled sums and cosines round differently from numpy's: u agrees
+to 1e-12, the decisions (converged, restarted, fallen back) exactly."""
 
 import dataclasses
 
@@ -85,8 +87,13 @@ def test_fast_global_check_decides_as_double_precision(scale):
         snaps = snaps * scale
         u, ok = st.peak(snaps, start[:, None])
         u_ref, ok_ref = _reference_peak(st, snaps, start[:, None])
-        assert np.array_equal(ok, ok_ref)
-        assert np.array_equal(u, u_ref)
+        # where the grid's maximum is a tie (a lambda/2 array: u = -1 and 1 are the same
+        # direction of its pattern), rounding picks the restart point, here as before
+        p = np.sort(st.power(snaps, st.grid()), axis=1)
+        tie = p[:, -2] >= p[:, -1] * (1 - 1e-12)
+        assert tie.mean() < 0.01
+        assert np.array_equal(ok[~tie], ok_ref[~tie])
+        np.testing.assert_allclose(u[~tie], u_ref[~tie], rtol=0, atol=1e-12)
 
 
 def test_nan_snapshots_give_what_the_zoom_search_gave():

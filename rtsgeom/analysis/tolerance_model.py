@@ -57,7 +57,7 @@ from scipy.constants import c
 from .._util import frozen
 from ..aoa.calibration import if_phase_slope_hz, probe_ranges
 from ..aoa.model import ChannelModel
-from ..aoa.sweep import beam_derivatives, detected_bin_choice, ratio_from_beams
+from ..aoa.sweep import beam_derivatives
 from ..geometry import Setup
 from ..geometry.setup import nominal_setup
 from ..paths import exact_paths
@@ -142,64 +142,53 @@ class _Design:
         mag = np.abs(z)
         return np.angle(np.sum(z / np.where(mag > 0, mag, 1.0), axis=-1))
 
+    def _bins(self, reach: int) -> tuple[int, int]:
+        """The first and the number of the bins compared with ``reach`` design bins either
+        side of the set range's (the detection compared one bin further)."""
+        return self.beams_j.shape[-1] // 2 - reach - 1, 2 * reach + 3
+
+    def _args(self, table):
+        return (self.beams_i, self.beams_j, self.i0, table, self.power, self.p_one,
+                float(self.unit_gain))
+
     def __call__(self, table, row_i, row_j, sub, reach: int | None = None, sp=None):
         """Programme amplitudes (n, M, 2), the design bin (n, M, index into the table's K),
         whether design and detection agree (n, M) and the detected bin's power over the next
         strongest (n, M) for channel I at table row ``row_i`` (n,), J at ``row_j`` (n,), sub-bin
         position index ``sub`` (n,); designs in the ``reach`` bins either side of the set
         range's (default :attr:`reach`), the detection compared one bin further. ``sp`` (n,):
-        one set-point per row instead of all (M = 1)."""
-        n_k = self.beams_j.shape[-1]
-        r = self.reach if reach is None else reach
-        lo = n_k // 2 - r - 1
-        kk = slice(lo, n_k // 2 + r + 2)  # the bins compared
-        if sp is None:  # whole rows: contiguous copies
-            b_i = np.moveaxis(self.beams_i[row_i - self.i0][..., kk], 1, 0)  # (3, n, M, K')
-            b_j = np.moveaxis(self.beams_j[row_j][..., kk], 1, 0)
-        else:
-            b_i = np.moveaxis(self.beams_i[row_i - self.i0, :, sp][..., None, kk], 1, 0)
-            b_j = np.moveaxis(self.beams_j[row_j, :, sp][..., None, kk], 1, 0)
-        phase = self.phase(row_i, row_j)[:, None, None]  # (n, 1, 1)
-        rho = np.full(b_i.shape[1:], np.nan)  # (n, M, K'): no design in the outermost bins
-        rho[..., 1:-1] = ratio_from_beams(tuple(b_i[..., 1:-1]), tuple(b_j[..., 1:-1]), phase)
-        c_ij = np.sum(np.conj(table[0, row_i, kk]) * table[1, row_j, kk], -1)[:, None]
-        rho, k, ok, margin = detected_bin_choice(rho, phase, self.power[0, row_i, kk][:, None],
-                                                 self.power[1, row_j, kk][:, None], c_ij)
-        pick = k[..., None]
-        bi = np.take_along_axis(b_i[0], pick, -1)[..., 0]
-        bj = np.take_along_axis(b_j[0], pick, -1)[..., 0]
-        p_sum = np.abs(bi + rho * np.exp(1j * phase[..., 0]) * bj) ** 2  # (n, M)
-        scale = self.unit_gain * np.sqrt(self.p_one[sub][:, None] / np.maximum(p_sum, 1e-300))
-        return np.stack([scale, scale * rho], -1), k + lo, ok, margin
+        one set-point per row instead of all (M = 1). Compiled per draw and set-point
+        (``rtsgeom.kernels.design_rows``: ``ratio_from_beams`` and ``detected_bin_choice``
+        for one set-point, without the batch's temporaries)."""
+        from ..kernels import design_rows
+        row_i, row_j, sub = (np.ascontiguousarray(a, np.int64) for a in (row_i, row_j, sub))
+        lo, n_k = self._bins(self.reach if reach is None else reach)
+        n = row_i.size
+        m = self.beams_j.shape[2] if sp is None else 1
+        sp = np.zeros(0, np.int64) if sp is None else np.ascontiguousarray(sp, np.int64)
+        amps, k = np.empty((n, m, 2)), np.empty((n, m), np.int64)
+        ok, margin = np.empty((n, m), bool), np.empty((n, m))
+        design_rows(*self._args(table), row_i, row_j, sub,
+                    np.exp(1j * self.phase(row_i, row_j)), sp, lo, n_k, amps, k, ok, margin)
+        return amps, k, ok, margin
 
     def planned(self, table, row_i, row_j, sub, period_steps: int, reach_far: int):
         """``aoa.plan.pair_design``'s choice of J's delay, per set-point: the calibrated one
         (row ``row_j``) or one period of the IF phase either side (m = 0, -1, 1: the same
         phase, J's echo about a bin further), the first whose design the RuT detects at the
         bin it was designed for with a power margin above ``plan.MIN_BIN_MARGIN``, else the
-        best (consistent, margin, smallest |m|). Returns amplitudes (n, M, 2) and m (n, M)."""
+        best (consistent, margin, smallest |m|). Returns amplitudes (n, M, 2) and m (n, M).
+        Compiled per draw and set-point (``rtsgeom.kernels.plan_rows``)."""
         from ..aoa.plan import MIN_BIN_MARGIN
-        amps, _, ok, mg = self(table, row_i, row_j, sub)
-        m_best = np.zeros(ok.shape, int)
-        s_ok, s_mg = ok.copy(), np.where(ok, mg, 0.0)
-        done = ok & (mg > MIN_BIN_MARGIN)
-        d_idx, p_idx = np.nonzero(~done)  # (draw, set-point) pairs still open
-        for m in (-1, 1):
-            if d_idx.size == 0:
-                break
-            a2, _, ok2, mg2 = self(table, row_i[d_idx], row_j[d_idx] + m * period_steps,
-                                   sub[d_idx], reach_far, p_idx)
-            a2, ok2, mg2 = a2[:, 0], ok2[:, 0], np.where(ok2[:, 0], mg2[:, 0], 0.0)
-            # score (ok, margin if ok, -|m|) against the best so far; m = 0 ranks first on a tie
-            better = (ok2 > s_ok[d_idx, p_idx]) | ((ok2 == s_ok[d_idx, p_idx])
-                                                   & (mg2 > s_mg[d_idx, p_idx]))
-            bd, bp = d_idx[better], p_idx[better]
-            amps[bd, bp] = a2[better]
-            m_best[bd, bp] = m
-            s_ok[bd, bp], s_mg[bd, bp] = ok2[better], mg2[better]
-            keep = ~(ok2 & (mg2 > MIN_BIN_MARGIN))
-            d_idx, p_idx = d_idx[keep], p_idx[keep]
-        return amps, m_best
+        from ..kernels import plan_rows
+        row_i, row_j, sub = (np.ascontiguousarray(a, np.int64) for a in (row_i, row_j, sub))
+        p = int(period_steps)
+        e = np.exp(1j * np.stack([self.phase(row_i, row_j + s * p) for s in (0, -1, 1)]))
+        n, m = row_i.size, self.beams_j.shape[2]
+        amps, shift = np.empty((n, m, 2)), np.empty((n, m), np.int64)
+        plan_rows(*self._args(table), row_i, row_j, sub, e, p, *self._bins(self.reach),
+                  *self._bins(int(reach_far)), float(MIN_BIN_MARGIN), amps, shift)
+        return amps, shift
 
 
 def reference_target(nominal: Setup, range_m: float | None = None) -> TargetConfig:
@@ -421,6 +410,7 @@ class PairPhasors:
         {"steps": (n,), "converged": {case: (n, M)}, "bin": {case: (n, M)},
         "amplitudes": {case: (n, M, 2)}} (the detected bin as an offset from the set range's,
         the programme amplitudes)."""
+        from ..kernels import detect_rows
         offsets_m = np.asarray(offsets_m, float)
         n = offsets_m.shape[0]
         u = np.full(n, self.subbin_zero) if subbin is None else np.asarray(subbin, int)
@@ -431,14 +421,12 @@ class PairPhasors:
         g = self.gain_correction(xq)
         d_u = self.subbin_steps[u]  # (n,)
         z = self.table_zero
-        ar = np.arange(n)
 
         def spectrum(q, j):  # (n, K, V)
             return (self.table[q, j] * fac[:, q, None, :]
                     * slide(self.table_log_slope[q, j], shift[:, q, None, :]))
 
         x_i = spectrum(0, z + d_u)
-        p_ii = np.sum(x_i.real ** 2 + x_i.imag ** 2, -1)  # (n, K)
         amps0 = self.design_amplitudes[u]  # (n, M, 2)
         out, detail = {}, {"steps": steps, "converged": {}, "bin": {}, "amplitudes": {},
                            "j_steps": {}}
@@ -456,15 +444,12 @@ class PairPhasors:
                 a_i, a_j = a_i * g[:, 0, None], a_j * g[:, 1, None]
             shifts = (0, -1, 1) if np.any(m) else (0,)  # J's alternative delays (plan)
             x_j = np.stack([spectrum(1, j + s_ * self.period_steps) for s_ in shifts])
-            p_jj = np.sum(x_j.real ** 2 + x_j.imag ** 2, -1)  # (S, n, K)
-            c_ij = np.sum(np.conj(x_i)[None] * x_j, -1).real
             sel = np.where(m == -1, 1, np.where(m == 1, 2, 0))  # (n, M) index into shifts
-            p_jj, c_ij = p_jj[sel, ar[:, None]], c_ij[sel, ar[:, None]]  # (n, M, K)
-            power = (a_i[..., None] ** 2 * p_ii[:, None] + a_j[..., None] ** 2 * p_jj
-                     + 2 * a_i[..., None] * a_j[..., None] * c_ij)  # (n, M, K)
-            det = np.argmax(power, -1)  # (n, M): the RuT's bin
-            snaps = (a_i[..., None] * x_i[ar[:, None], det]
-                     + a_j[..., None] * x_j[sel, ar[:, None], det])  # (n, M, V)
+            # the RuT's bin (the strongest) and the snapshot there, (n, M) and (n, M, V)
+            snaps = np.empty(sel.shape + x_i.shape[-1:], complex)
+            det = np.empty(sel.shape, np.int64)
+            detect_rows(x_i, x_j, sel, np.ascontiguousarray(a_i), np.ascontiguousarray(a_j),
+                        snaps, det)
             ang, ok = refine_angles(snaps, self.channels.steering, None, self.set_rad,
                                     return_converged=True)
             out[case] = ang - self.set_rad

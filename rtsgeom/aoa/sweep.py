@@ -73,36 +73,19 @@ def design_ratio(st: Steering, x_i, x_j, alpha_rad, phase=0.0):
 
 def ratio_from_beams(beam_i, beam_j, phase=0.0):
     """:func:`design_ratio` from the channels' beam responses and their first two derivatives
-    in u at the set direction, ``(b, b', b'')`` each (...,) (e.g. gathered from a table).
+    in u at the set direction, ``(b, b', b'')`` each (...,) (e.g. gathered from a table),
+    broadcast with ``phase``: rho (...).
 
     P, dP/du and d2P/du2 of ``b_I + rho y`` are quadratics in rho with real coefficients
     (``Re(conj(f) g)`` of the beams), formed once; the roots and the maximum test are then
-    real arithmetic (the Monte-Carlo studies call this for millions of set-points)."""
-    bi, bi1, bi2 = beam_i
-    ph = np.exp(1j * np.asarray(phase, float))
-    y, y1, y2 = (ph * b for b in beam_j)
-
-    def re(f, g):  # Re(conj(f) g)
-        return f.real * g.real + f.imag * g.imag
-
-    a0 = re(bi, bi1)
-    a1 = re(bi, y1) + re(y, bi1)
-    a2 = re(y, y1)
-    disc = a1 * a1 - 4 * a0 * a2
-    sq = np.sqrt(np.where(disc >= 0, disc, np.nan))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        lin = -a0 / a1
-        roots = np.stack([np.where(a2 != 0, (-a1 + sq) / (2 * a2), lin),
-                          np.where(a2 != 0, (-a1 - sq) / (2 * a2), lin)])
-    # P = |s|^2 and P'' = 2 Re(conj(s) s'') + 2 |s'|^2, s = b_I + rho y, as quadratics in rho
-    p = re(bi, bi) + roots * (2 * re(bi, y) + roots * re(y, y))
-    p2 = 2 * (re(bi, bi2) + roots * (re(bi, y2) + re(y, bi2)) + roots ** 2 * re(y, y2)) \
-        + 2 * (re(bi1, bi1) + roots * (2 * re(bi1, y1)) + roots ** 2 * re(y1, y1))
-    ok = np.isfinite(roots) & (roots >= 0) & (p2 < 0)
-    score = np.where(ok, p, -np.inf)
-    k = np.argmax(score, axis=0)
-    rho = np.take_along_axis(roots, k[None], 0)[0]
-    return np.where(np.take_along_axis(ok, k[None], 0)[0], rho, np.nan)
+    real arithmetic, compiled per set-point (``rtsgeom.kernels.ratio_one``: the Monte-Carlo
+    studies call it for millions of set-points)."""
+    from ..kernels import ratios
+    arrs = np.broadcast_arrays(*(np.asarray(b, complex) for b in (*beam_i, *beam_j)),
+                               np.exp(1j * np.asarray(phase, float)))
+    out = np.empty(arrs[0].shape)
+    ratios(*(np.ascontiguousarray(a).reshape(-1) for a in arrs), out.reshape(-1))
+    return out
 
 
 def design_at_detected_bin(st: Steering, h, alpha_rad, phase=0.0):
@@ -133,38 +116,31 @@ def design_at_detected_bin(st: Steering, h, alpha_rad, phase=0.0):
 def detected_bin_choice(rho, phase, p_ii, p_jj, c_ij, margin: bool = True):
     """The bin logic of :func:`design_at_detected_bin` from the ratios per design bin ``rho``
     (..., K), J's phase (broadcast) and the channels' power sums over the virtual elements at
-    each candidate bin: ``p_ii``, ``p_jj`` (..., K) and ``c_ij = sum conj(x_i) x_j``.
-    ``margin=False``: the fourth result is None (saves a sort in Monte-Carlo loops)."""
-    ph = np.broadcast_to(np.asarray(phase, float), rho.shape)
-    finite = np.isfinite(rho) & (rho > 0)
-    r = np.where(finite, rho, 0.0)
-    # power of each design (..., K_design) at every bin (K_bins), in real arithmetic:
-    # |I + r e^{j ph} J|^2 = p_ii + r^2 p_jj + 2 r Re(e^{j ph} c_ij)
-    q = (np.cos(ph)[..., :, None] * c_ij.real[..., None, :]
-         - np.sin(ph)[..., :, None] * c_ij.imag[..., None, :])
-    power = (p_ii[..., None, :] + (r * r)[..., :, None] * p_jj[..., None, :]
-             + 2 * r[..., :, None] * q)
-    # a design that does not exist detects nothing (its row never agrees)
-    det = np.where(finite, np.argmax(power, -1), 0)  # (..., K_design)
+    each candidate bin: ``p_ii``, ``p_jj`` (..., K) and ``c_ij = sum conj(x_i) x_j``:
+    (rho, k, consistent, margin), each (...). ``margin=False``: the fourth result is None.
+
+    Per row (``rtsgeom.kernels.choice_row``, compiled): the power of each design at every bin,
+    |I + r e^{j ph} J|^2 = p_ii + r^2 p_jj + 2 r Re(e^{j ph} c_ij) (r = 0 where rho is not a
+    positive number), each design's detected bin the strongest; of the designs detected at
+    their own bin the one nearest the middle (ties to the lower bin), else the fixed point of
+    "design at the reported bin" from the middle bin; the margin is the detected bin's power
+    over the next strongest (1 where not consistent)."""
+    from ..kernels import bin_choice_rows
+    rho = np.asarray(rho, float)
+    c_ij = np.asarray(c_ij)
     n_k = rho.shape[-1]
-    ks = np.arange(n_k)
-    agree = finite & (det == ks)
-    # nearest the middle first: rank by |k - mid|, ties to the lower bin
-    rank = np.abs(ks - n_k // 2) * 2 + (ks > n_k // 2)
-    best = np.argmin(np.where(agree, rank, n_k * 4), -1)
-    consistent = np.take_along_axis(agree, best[..., None], -1)[..., 0]
-    k = best
-    if not np.all(consistent):  # none agrees: redesign at the reported bin
-        k0 = np.broadcast_to(det[..., n_k // 2], consistent.shape).copy()
-        for _ in range(4):
-            k0 = np.take_along_axis(det, k0[..., None], -1)[..., 0]
-        k = np.where(consistent, best, k0)
-    out = np.take_along_axis(rho, k[..., None], -1)[..., 0]
-    if not margin:
-        return out, k, consistent, None
-    pw = np.sort(np.take_along_axis(power, k[..., None, None], -2)[..., 0, :], -1)
-    mg = np.where(consistent, pw[..., -1] / np.maximum(pw[..., -2], 1e-300), 1.0)
-    return out, k, consistent, mg
+    lead = np.broadcast_shapes(rho.shape[:-1], np.shape(p_ii)[:-1], np.shape(p_jj)[:-1],
+                               c_ij.shape[:-1])
+    rows = [np.ascontiguousarray(np.broadcast_to(a, lead + (n_k,)), float).reshape(-1, n_k)
+            for a in (rho, *(f(np.broadcast_to(np.asarray(phase, float), rho.shape))
+                                   for f in (np.cos, np.sin)), p_ii, p_jj, c_ij.real,
+                      np.imag(c_ij))]
+    n = rows[0].shape[0]
+    out, k = np.empty(n), np.empty(n, np.int64)
+    ok, mg = np.empty(n, bool), np.empty(n)
+    bin_choice_rows(*rows, out, k, ok, mg)
+    out, k, ok, mg = (a.reshape(lead) for a in (out, k, ok, mg))
+    return out, k, ok, (mg if margin else None)
 
 
 @dataclass(frozen=True)

@@ -1,13 +1,15 @@
 """Numerical kernels of the beamformer's peak search (:meth:`rtsgeom.radar.steering.Steering.peak`):
-Newton steps on the log power of tapered snapshots in D = 1 or 2 direction cosines, and the
-parabolic interpolation of a sampled peak. Plain numpy on (V_s, n) arrays, no state.
+Newton steps on the log power of tapered snapshots in D direction cosines (what ``peak`` runs
+for D = 2; D = 1 runs compiled, snapshot by snapshot: ``rtsgeom.kernels.newton_1d``, the
+same steps), and the parabolic interpolation of a sampled peak. Plain numpy on (V_s, n)
+arrays, no state.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["newton", "newton_step_1d", "parabolic"]
+__all__ = ["newton", "parabolic"]
 
 
 def newton(kv, xr, xi, u, p_max, steps):
@@ -29,15 +31,6 @@ def newton(kv, xr, xi, u, p_max, steps):
         if act.size == 0:
             break
         ar, ai, ua = xr[:, act], xi[:, act], u[act]
-        if n_d == 1:  # the same arithmetic with fewer temporaries (bit-equal, tested)
-            step, p = newton_step_1d(kv[:, 0], ar, ai, ua[:, 0])
-            fine = np.isfinite(step[:, 0])
-            u[act] = ua + np.clip(np.where(fine[:, None], step, 0.0), -0.05, 0.05)
-            p_last[act] = p
-            done = fine & (np.abs(np.where(fine, step[:, 0], 0.0)) < 1e-6)
-            ok[act[done]] = True
-            act = act[fine & ~done]
-            continue
         ph = np.sum(kv[:, :, None] * ua.T[None], axis=1)  # (V_s, n)
         co, si = np.cos(ph), np.sin(ph)
         y = np.stack([ar * co - ai * si, ar * si + ai * co])  # (2, V_s, n): Re, Im
@@ -72,24 +65,6 @@ def newton(kv, xr, xi, u, p_max, steps):
     if p_max is None:
         return u, ok & (radius < 1), p_last
     return u, ok & (radius < 1) & (p_last >= p_max * (1 - 1e-9))
-
-
-def newton_step_1d(k, ar, ai, u):
-    """One Newton step of :func:`newton` for D = 1 (wavenumbers ``k`` (V_s,), snapshots
-    (V_s, n), u (n,)): (step (n, 1), NaN where log P is not concave; P (n,))."""
-    ph = k[:, None] * u
-    co, si = np.cos(ph), np.sin(ph)
-    yr, yi = ar * co - ai * si, ar * si + ai * co
-    k1, k2 = k[:, None], (k * k)[:, None]
-    b0, b1 = yr.sum(axis=0), yi.sum(axis=0)
-    c0, c1 = (yr * k1).sum(axis=0), (yi * k1).sum(axis=0)
-    d0, d1 = (yr * k2).sum(axis=0), (yi * k2).sum(axis=0)
-    p = b0 ** 2 + b1 ** 2
-    with np.errstate(divide="ignore", invalid="ignore"):
-        g = 2 * (b1 * c0 - b0 * c1) / p
-        h = 2 * (c0 * c0 + c1 * c1 - b0 * d0 - b1 * d1) / p - g * g
-        step = np.where(h < 0, -g / h, np.nan)[:, None]
-    return step, p
 
 
 def parabolic(y0, y1, y2) -> np.ndarray:

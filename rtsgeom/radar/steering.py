@@ -404,15 +404,23 @@ class Steering:
             return u.reshape(shape + (1,)), np.ones(shape, bool)
         flat = snaps.reshape(-1, snaps.shape[-1])
         n_d = self.dims
-        kv = self.wavevector  # (V_s, D)
-        grid = self.grid()
-        steer = self.steer(grid).T  # (V_s, G)
         u0 = np.broadcast_to(np.asarray(u0, float), shape + (n_d,)).reshape(-1, n_d)
-        u = np.empty_like(u0)
         ok = np.zeros(u0.shape[0], bool)
-        best_grid = np.empty_like(u0)
-        with single_threaded_blas():  # (BLOCK x V_s) @ (V_s x G) is too small to share out
-            self._peak_blocks(flat, u0, u, ok, best_grid, kv, grid, steer, iterations)
+        if n_d == 1:  # compiled, snapshot by snapshot (rtsgeom.kernels)
+            from ..kernels import peak_1d
+            k, lat, gc, gs, g1 = self._grid_1d
+            u1 = np.empty(u0.shape[0])
+            peak_1d(k, lat, np.ascontiguousarray(self.weighted(flat), complex),
+                    np.ascontiguousarray(u0[:, 0]), gc, gs, g1, int(iterations), u1, ok)
+            u = u1[:, None]
+        else:
+            kv = self.wavevector  # (V_s, D)
+            grid = self.grid()
+            steer = self.steer(grid).T  # (V_s, G)
+            u = np.empty_like(u0)
+            best_grid = np.empty_like(u0)
+            with single_threaded_blas():  # (BLOCK x V_s) @ (V_s x G) is too small to share out
+                self._peak_blocks(flat, u0, u, ok, best_grid, kv, grid, steer, iterations)
         if not ok.all():
             if n_d == 1:
                 u[~ok, 0] = np.sin(self.search(flat[~ok]))
@@ -420,8 +428,21 @@ class Steering:
                 u[~ok] = best_grid[~ok]
         return u.reshape(shape + (n_d,)), ok.reshape(shape)
 
+    @cached_property
+    def _grid_1d(self) -> tuple:
+        """What the compiled peak (D = 1) reads: the wavenumbers k p_v (V_s,), their lattice
+        on the pitch grid (``kernels.lattice``), and the global check's grid: the steering
+        vectors' real and imaginary parts (V_s, G) and the grid's u (G,)."""
+        from ..kernels import lattice
+        k = np.ascontiguousarray(self.wavevector[:, 0])
+        lat = lattice(k, 2 * np.pi / self.wavelength_m * self.pitch_m)
+        grid = self.grid()
+        steer = self.steer(grid).T
+        return (k, lat, np.ascontiguousarray(steer.real), np.ascontiguousarray(steer.imag),
+                np.ascontiguousarray(grid[:, 0]))
+
     def _peak_blocks(self, flat, u0, u, ok, best_grid, kv, grid, steer, iterations):
-        """:meth:`peak`'s Newton steps and global check, block by block (fills ``u``,
+        """:meth:`peak`'s Newton steps and global check for D = 2, block by block (fills ``u``,
         ``ok`` and, where not ok, ``best_grid`` in place).
 
         The grid's powers are formed in single precision (6x faster than double: this was

@@ -1,0 +1,123 @@
+"""The compiled kernels (``rtsgeom.kernels``) against their definitions, on a grid of arrays
+(uniform rows of V = 4, 8, 12, 16 elements at lambda/2, and an uneven one off the lattice)
+and taper windows: the beamformer peak is a stationary maximum of P with no grid point of more
+power and finds a plane wave's direction; the closed-form design puts the composite's peak on
+the set angle; the bin choice equals a plain loop over the docstring's rule."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rtsgeom.aoa.sweep import design_ratio, detected_bin_choice
+from rtsgeom.radar.steering import Steering, window
+
+WAVELENGTH = 3.9e-3
+
+
+def steering(v: int, win: str, uneven: bool = False) -> Steering:
+    d = WAVELENGTH / 2
+    x = (np.arange(v) - (v - 1) / 2) * d
+    if uneven:  # off the lattice: every element's phasor by its own cosine and sine
+        x = x + np.random.default_rng(v).uniform(-0.2, 0.2, v) * d
+    return Steering(np.ones(v, bool), x[:, None], window(win, v), WAVELENGTH,
+                    np.array([v * d]), pitch_m=d)
+
+
+GRID = [(v, w, un) for v in (4, 8, 12, 16) for w in ("none", "hann", "blackman")
+        for un in (False, True)]
+
+
+def plane(st, u):
+    return np.exp(-1j * st.wavevector[:, 0] * np.asarray(u)[..., None])
+
+
+@pytest.mark.parametrize("v,win,uneven", GRID)
+def test_peak_is_a_global_stationary_maximum(v, win, uneven):
+    st = steering(v, win, uneven)
+    rng = np.random.default_rng(v)
+    n = 400
+    u1 = rng.uniform(-0.7, 0.7, n)
+    u2 = u1 + rng.uniform(0.1, 0.3, n) * rng.choice([-1, 1], n)
+    x = plane(st, u1) + rng.uniform(0.2, 1, n)[:, None] * plane(st, u2) * np.exp(
+        1j * rng.uniform(0, 2 * np.pi, n))[:, None]
+    x = np.concatenate([x, x[:50] + 0.3 * (rng.standard_normal((50, v))
+                                           + 1j * rng.standard_normal((50, v)))])
+    u, ok = st.peak(x, np.concatenate([u1, u1[:50]])[:, None])
+    assert ok.mean() > 0.9
+    u, x = u[ok, 0], x[ok]
+    p = np.einsum("nn->n", st.power(x, u[:, None]))
+    grid = st.power(x, st.grid())
+    assert np.all(p >= grid.max(axis=1) * (1 - 1e-9))  # the global check's property
+    h = 1e-6  # stationary: P'(u) = 0 to the central difference's rounding, P'' < 0
+    pp, pm = (np.einsum("nn->n", st.power(x, (u + s)[:, None])) for s in (h, -h))
+    assert np.all(np.abs(pp - pm) / (2 * h) <= 1e-5 * p)
+    assert np.all(pp + pm - 2 * p < 0)
+
+
+@pytest.mark.parametrize("v,win,uneven", GRID)
+def test_peak_finds_a_plane_wave(v, win, uneven):
+    st = steering(v, win, uneven)
+    u_true = np.linspace(-0.9, 0.9, 37)
+    u, ok = st.peak(plane(st, u_true), (u_true + 0.02)[:, None])
+    assert ok.all()
+    np.testing.assert_allclose(u[:, 0], u_true, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("v,win,uneven", GRID)
+def test_design_puts_the_composite_peak_on_the_set_angle(v, win, uneven):
+    st = steering(v, win, uneven)
+    beam = 2 / v  # null-to-null half width in u
+    a_i, a_j = -0.3 * beam, 0.35 * beam
+    x_i, x_j = plane(st, np.sin(a_i)), plane(st, np.sin(a_j))
+    sets = np.linspace(a_i, a_j, 9)[1:-1]
+    for phase in (0.0, 0.4, -0.7):
+        rho = design_ratio(st, x_i, x_j, sets, phase)
+        fine = np.isfinite(rho)
+        assert fine.sum() >= 5 and np.all(rho[fine] >= 0)
+        comp = x_i + rho[fine, None] * np.exp(1j * phase) * x_j
+        u, ok = st.peak(comp, np.sin(sets[fine])[:, None])
+        assert ok.all()
+        np.testing.assert_allclose(u[:, 0], np.sin(sets[fine]), rtol=0, atol=1e-9)
+
+
+def _choice_loop(rho, ph, p_ii, p_jj, c_ij):
+    """The bin rule, written as plain loops over one row (the definition)."""
+    n_k = rho.size
+    fin = [bool(np.isfinite(r) and r > 0) for r in rho]
+    power = np.zeros((n_k, n_k))
+    det = []
+    for kd in range(n_k):
+        r = rho[kd] if fin[kd] else 0.0
+        for kb in range(n_k):
+            power[kd, kb] = p_ii[kb] + r * r * p_jj[kb] + 2 * r * np.real(
+                np.exp(1j * ph[kd]) * c_ij[kb])
+        det.append(int(np.argmax(power[kd])) if fin[kd] else 0)
+    order = sorted(range(n_k), key=lambda k: (abs(k - n_k // 2), k))
+    agree = [k for k in order if fin[k] and det[k] == k]
+    if agree:
+        k = agree[0]
+        pw = np.sort(power[k])
+        return rho[k], k, True, pw[-1] / max(pw[-2], 1e-300)
+    k = det[n_k // 2]
+    for _ in range(4):
+        k = det[k]
+    return rho[k], k, False, 1.0
+
+
+@pytest.mark.parametrize("n_k", [3, 5, 7])
+def test_bin_choice_equals_the_rule(n_k):
+    rng = np.random.default_rng(n_k)
+    n = 3000
+    rho = rng.uniform(-0.2, 2, (n, n_k))
+    rho[rng.random((n, n_k)) < 0.15] = np.nan
+    ph = rng.uniform(-np.pi, np.pi, (n, 1))
+    p_ii, p_jj = rng.uniform(0, 1, (2, n, n_k)) ** 3
+    c_ij = np.sqrt(p_ii * p_jj) * rng.uniform(0, 1, (n, n_k)) * np.exp(
+        1j * rng.uniform(-np.pi, np.pi, (n, n_k)))
+    got = detected_bin_choice(rho, ph, p_ii, p_jj, c_ij)
+    assert 0.05 < got[2].mean() < 0.999  # both branches taken
+    for i in range(n):
+        ref = _choice_loop(rho[i], np.full(n_k, ph[i, 0]), p_ii[i], p_jj[i], c_ij[i])
+        assert got[1][i] == ref[1] and got[2][i] == ref[2]
+        np.testing.assert_allclose([got[0][i], got[3][i]], [ref[0], ref[3]], rtol=1e-12)
