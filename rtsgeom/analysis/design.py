@@ -42,7 +42,8 @@ from ..geometry.farfield import angular_resolution_rad
 from ..scene import Scene, SheetConfig, arc_centre_m, problems
 from .tolerance import CASES, PairPhasors, max_sigma_for_yield
 
-__all__ = ["METRICS", "DesignGrid", "two_front_end_scene", "evaluate_design", "design_grid"]
+__all__ = ["METRICS", "DesignGrid", "two_front_end_scene", "evaluate_design", "design_grid",
+           "check_azimuth_arc"]
 
 # name -> (heat-map colour label, title)
 METRICS = {
@@ -53,6 +54,23 @@ METRICS = {
     "sigma_uncalibrated_mm": ("mounting sigma (mm)", "Tolerance for the spec, uncalibrated"),
 }
 SHEET_MARGIN_RAD = math.radians(2.0)  # sheet beyond the outer cutouts when it is widened
+
+
+def check_azimuth_arc(scene: Scene, name: str = "design") -> None:
+    """Raise :class:`~rtsgeom.errors.ParameterError` (its message naming what to use instead)
+    where the scene's front ends form 2-D cells (a front end or a target off elevation 0,
+    :func:`rtsgeom.aoa.plan.uses_cells`): the design varies a pair's azimuth spacing on an arc
+    and synthesizes in azimuth only, so on a sphere it would silently design one plane of the
+    cell and report that as the cell's design."""
+    from ..aoa.plan import uses_cells
+    from ..errors import ParameterError
+    if uses_cells(scene):
+        raise ParameterError(
+            f"{name}: this scene's front ends form 2-D cells (azimuth and elevation); the arc "
+            "design varies the azimuth spacing of front ends on an arc and synthesizes in "
+            "azimuth only, it has no design for a cell: use `tolerance SCENE --cell all` (the "
+            "cell's mounting tolerance), `linearity SCENE --grid N` and `nearfield SCENE` for "
+            "the cell")
 
 
 def two_front_end_scene(scene: Scene, pair: tuple[int, int], radius_m: float,
@@ -205,6 +223,7 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     ``bin_response`` for ~6000 delays) and half its two tolerance searches
     (``max_sigma_for_yield``: ~5 Monte Carlos each of ``draws`` draws x ``points``
     set-points, the one without errors per sub-bin position drawn)."""
+    check_azimuth_arc(scene)
     radii = np.asarray(radius_m, float).ravel()
     spacings = np.asarray(spacing_deg, float).ravel()
     fes = scene.rts.front_ends
