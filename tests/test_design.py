@@ -114,3 +114,37 @@ def test_design_grid_in_processes_is_the_same_grid(scene, grid):
                       workers=2)
     assert json.dumps(par.to_dict()) == json.dumps(grid.to_dict())
     assert seen == [(k, 6) for k in range(1, 7)]
+
+
+SPHERE_SCENE = DEFAULT_SCENE.parent / "sphere4.toml"
+
+
+@pytest.mark.parametrize("extra", [[], ["--coverage-deg", "0:10"], ["--json", "--pair", "0", "1"]])
+def test_cli_refuses_a_scene_of_2d_cells(extra, capsys):
+    """A sphere of front ends (azimuth and elevation): the arc design has no design for a
+    cell; it refuses (exit 2) naming the cell's commands instead of designing one plane."""
+    rc = main(["design", str(SPHERE_SCENE), "--radius-m", "1:1:1", "--spacing-deg", "8:8:1",
+               "--draws", "10", "--quiet", *extra])
+    cap = capsys.readouterr()
+    assert rc == 2 and cap.out == ""
+    assert "2-D cells" in cap.err and "tolerance SCENE --cell all" in cap.err
+    assert "Traceback" not in cap.err
+
+
+@pytest.mark.parametrize("where", ["front end", "target"])
+@pytest.mark.parametrize("elevation_deg", [-3.0, 0.5, 5.0])
+def test_design_grid_refuses_elevation(scene, where, elevation_deg):
+    """Any front end or target off elevation 0 makes the scene a cell (``uses_cells``), at any
+    elevation; the API raises ParameterError before any design is built."""
+    import dataclasses
+    from rtsgeom.errors import ParameterError
+    from rtsgeom.scene import TargetConfig
+    el = math.radians(elevation_deg)
+    if where == "front end":
+        fes = list(scene.rts.front_ends)
+        fes[1] = dataclasses.replace(fes[1], elevation_rad=el)
+        cell = dataclasses.replace(scene, rts=dataclasses.replace(scene.rts, front_ends=tuple(fes)))
+    else:
+        cell = dataclasses.replace(scene, targets=(TargetConfig(5.0, elevation_rad=el),))
+    with pytest.raises(ParameterError, match="tolerance SCENE --cell all"):
+        design_grid(cell, (0, 1), [1.0], [8.0], draws=10, points=5)

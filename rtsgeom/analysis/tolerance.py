@@ -313,7 +313,7 @@ def max_sigma_for_yield(model: PairPhasors, sigma_m, draws: int, seed: int, targ
                         distribution: str = "normal", rel_tol: float = 0.01,
                         cap_m: float = 0.01, chunk: int = DEFAULT_CHUNK,
                         progress: Progress | None = None, mapper: Mapper | None = None,
-                        subbin: bool = True) -> dict:
+                        subbin: bool = True, slope: float = 1.0) -> dict:
     """The largest mounting tolerance that keeps ``target_yield`` of the setups within
     ``spec_deg`` for ``case``, by a safeguarded secant search on the scale
     (:func:`largest_passing_scale`) with the same seed (the same unit draws scaled: common
@@ -324,7 +324,9 @@ def max_sigma_for_yield(model: PairPhasors, sigma_m, draws: int, seed: int, targ
     all are zero); an axis name varies that axis alone, the other two held at ``sigma_m``.
     Returns the sigmas found (m), the yield there, the bracket and the evaluations; the search
     stops at ``cap_m`` (a tolerance that large is reported as ``capped``). The result is the
-    largest passing scale evaluated, within ``rel_tol`` of the smallest failing one."""
+    largest passing scale evaluated, within ``rel_tol`` of the smallest failing one. ``slope``:
+    the power of the scale the deciding draw's error is taken to follow until two evaluations
+    measure it (:func:`largest_passing_scale`)."""
     base = np.asarray(sigma_m, float).reshape(3)
     if axis == "all":
         direction = base / base.max() if base.max() > 0 else np.ones(3)
@@ -359,7 +361,8 @@ def max_sigma_for_yield(model: PairPhasors, sigma_m, draws: int, seed: int, targ
     if y0 < target_yield:
         return result(0.0, y0, note="the setup misses the spec even without the varied errors")
     start = min(float(np.max(base * direction)) or 1e-4, cap_m)
-    return result(*largest_passing_scale(yield_at, y0, target_yield, start, cap_m, rel_tol))
+    return result(*largest_passing_scale(yield_at, y0, target_yield, start, cap_m, rel_tol,
+                                         slope=slope))
 
 
 def _worst_without_errors(model: PairPhasors, draws: int, seed: int, case: str,
@@ -377,7 +380,8 @@ def _worst_without_errors(model: PairPhasors, draws: int, seed: int, case: str,
 
 
 def largest_passing_scale(evaluate, y0: float, target_yield: float, start: float, cap: float,
-                          rel_tol: float, max_evaluations: int = 60) -> tuple[float, float, bool]:
+                          rel_tol: float, max_evaluations: int = 60, slope: float = 1.0
+                          ) -> tuple[float, float, bool]:
     """The largest scale t in [0, cap] with yield >= ``target_yield`` (``y0`` the yield at 0,
     which passes), to ``rel_tol``: returns the largest passing t evaluated (its yield) once a
     failing one lies within ``rel_tol`` above it, or ``cap`` if that passes (``capped``).
@@ -409,14 +413,14 @@ def largest_passing_scale(evaluate, y0: float, target_yield: float, start: float
             if hi - lo <= rel_tol * hi:
                 break
             widths.append(hi - lo)
-        t = _next_scale(lo, hi, logs, cap, rel_tol, widths)
+        t = _next_scale(lo, hi, logs, cap, rel_tol, widths, slope)
     return lo, y_lo, False
 
 
 def _next_scale(lo: float, hi: float, logs: dict, cap: float, rel_tol: float,
-                widths: list) -> float:
+                widths: list, slope: float = 1.0) -> float:
     """:func:`largest_passing_scale`'s next evaluation, strictly inside (lo, hi)."""
-    est = _secant(lo, hi, logs)
+    est = _secant(lo, hi, logs, slope)
     d = rel_tol / 3
     if hi == math.inf:  # nothing failed yet: aim just above the estimate (at most x10)
         t = 2 * lo if est is None else max(est * (1 + d), lo * (1 + d))
@@ -441,9 +445,9 @@ def _next_scale(lo: float, hi: float, logs: dict, cap: float, rel_tol: float,
     return min(max(t, lo + margin), hi - margin)
 
 
-def _secant(lo: float, hi: float, logs: dict) -> float | None:
+def _secant(lo: float, hi: float, logs: dict, slope: float = 1.0) -> float | None:
     """Where log r(t) = 0, linear in log t through the bracket's ends (their r known), else
-    through the two points nearest to it; one point: r taken proportional to t."""
+    through the two points nearest to it; one point: r taken proportional to t^slope."""
     pts = [(t, v) for t, v in logs.items()]
     if not pts:
         return None
@@ -454,7 +458,7 @@ def _secant(lo: float, hi: float, logs: dict) -> float | None:
         near = sorted(pts, key=lambda p: abs(p[1]))
         if len(near) == 1 or near[0][0] == near[1][0]:
             t1, v1 = near[0]
-            return t1 * math.exp(min(-v1, 700.0))  # r proportional to t
+            return t1 * math.exp(min(-v1 / slope, 700.0))  # r proportional to t^slope
         (t1, v1), (t2, v2) = near[:2]
     slope = (v2 - v1) / (math.log(t2) - math.log(t1))
     if not slope > 0 or not math.isfinite(slope):

@@ -49,12 +49,13 @@ delay (J at the target's own delay), which is also the ``uncalibrated`` design.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.constants import c
 
-from .._util import frozen
+from .._util import frozen, single_threaded_blas
 from ..aoa.calibration import if_phase_slope_hz, probe_ranges
 from ..aoa.model import ChannelModel
 from ..aoa.sweep import beam_derivatives
@@ -82,6 +83,11 @@ def response_table(setup: Setup, paths, channel: int, target: TargetConfig, reso
     ``radar.phasors.bin_response``, in blocks of bounded memory."""
     scene, radar, rut = setup.scene, setup.scene.radar, setup.rut
     steps = np.asarray(steps, int)
+    # the cable ghosts land bins away and are dropped: not formed at all (the direct echoes
+    # do not depend on the return losses; a fifth of the table's time was their copies)
+    fes = tuple(dataclasses.replace(f, return_loss_fe_db=None) for f in scene.rts.front_ends)
+    setup = dataclasses.replace(setup, scene=dataclasses.replace(
+        scene, rts=dataclasses.replace(scene.rts, front_ends=fes)))
     tau = float(requested_delay(scene, target.range_m))
     r0 = int(np.round(target.range_m / radar.range_resolution_m))
     rbins = np.arange(r0 - half_bins, r0 + half_bins + 1) % radar.samples_per_chirp
@@ -93,7 +99,7 @@ def response_table(setup: Setup, paths, channel: int, target: TargetConfig, reso
         prog = RtsProgram.build(np.arange(k.size), np.full(k.size, channel),
                                 tau + k * resolution_s, np.zeros(k.size), np.ones(k.size))
         ech = channel_echoes(setup, paths, prog)
-        ech = ech.select(ech.kind == KIND_DIRECT)  # ghosts land bins away
+        ech = ech.select(ech.kind == KIND_DIRECT)  # (none: see above)
         resp = bin_response(ech, radar, rut, rbins, dbin)  # (K, E, V)
         acc = np.zeros((k.size,) + resp.shape[::2], complex)  # each target's echoes summed
         np.add.at(acc, ech.target, np.swapaxes(resp, 0, 1))  # (a one-hot einsum was 15 %)
@@ -107,12 +113,13 @@ def _set_beams(st, rows: np.ndarray, sets: np.ndarray) -> np.ndarray:
     w = st.weighted(rows)  # (R, K, V_s)
     kv = st.wavevector[:, 0]
     e = np.exp(1j * kv * np.sin(sets)[:, None])  # (M, V_s)
-    # the three sums over the elements as one product with (V_s, 3 M) (broadcasting the
-    # (R, K, M, V_s) products was 10 % of a design); numpy's own loops, not BLAS (each row
-    # is short: see Steering._power)
+    # the three sums over the elements as one product (R K, V_s) x (V_s, 3 M) (broadcasting
+    # the (R, K, M, V_s) products was 10 % of a design; numpy's einsum loops 4x this product,
+    # run with single-threaded BLAS by PairPhasors.build)
     ops = np.concatenate([e, 1j * kv * e, -(kv * kv) * e]).T  # (V_s, 3 M)
-    beams = np.einsum("rkv,vc->rck", w, ops).reshape(w.shape[0], 3, sets.size, w.shape[1])
-    return np.ascontiguousarray(beams)
+    r, k = w.shape[:2]
+    beams = (w.reshape(r * k, -1) @ ops).reshape(r, k, 3, sets.size)
+    return np.ascontiguousarray(np.moveaxis(beams, 1, -1))
 
 
 @dataclass(frozen=True)
@@ -253,7 +260,16 @@ class PairPhasors:
         The reference target sits at the centre of the range bin nearest ``range_m`` (default:
         the calibration's first probe range), velocity 0; a draw moves it within the bin
         (:attr:`subbin_steps`). The set-points divide the span between the two front ends'
-        detected angles into ``points + 1`` parts (ends excluded, as ``aoa.linearity``)."""
+        detected angles into ``points + 1`` parts (ends excluded, as ``aoa.linearity``).
+
+        BLAS single-threaded: the tables' products are many and small (two threads took 2.4x
+        the CPU time of one for the same build)."""
+        with single_threaded_blas():
+            return cls._build(setup, pair, points, range_m)
+
+    @classmethod
+    def _build(cls, setup: Setup, pair: tuple[int, int], points: int,
+               range_m: float | None) -> "PairPhasors":
         nom = nominal_setup(setup)
         radar, rts = nom.scene.radar, nom.scene.rts
         pair = (int(pair[0]), int(pair[1]))

@@ -175,6 +175,12 @@ def cmd_design(args) -> int:
 
 
 def _design(args, scene, stage) -> int:
+    from ..analysis.design import check_azimuth_arc
+    from ..errors import ParameterError
+    try:  # an arc of pairs in azimuth only (the grid and --coverage-deg alike)
+        check_azimuth_arc(scene, f"design {args.scene}")
+    except ParameterError as exc:
+        raise UsageError(str(exc)) from None
     if args.coverage_deg is not None:
         from .arc import design_coverage
         return design_coverage(args, scene, stage)

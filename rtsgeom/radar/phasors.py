@@ -59,19 +59,41 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
     w_r = window(radar.range_window, n_s)
     n = np.arange(n_s)
     kern_r = w_r * np.exp(-2j * np.pi * np.outer(r, n) / n_s)  # (K, N)
-    beat = s * tau + f_d[:, None]  # (E, V)
-    fast = _tones(beat, radar.adc_start_s, 1.0 / radar.adc_rate_hz, n_s)  # (E, V, N) at t_n
-    if echoes.fast_gain is not None:  # fractional-delay FIR ripple along the chirp
-        fast = fast * echoes.fast_gain[:, None, :]
-    # the window-and-DFT sums as one matrix product (BLAS: 10x numpy's einsum loops here,
-    # which were a third of the tolerance model's tables); rounding-level differences only
-    rr = np.moveaxis(fast @ kern_r.T, -1, 0)
+    t0, dt = radar.adc_start_s, 1.0 / radar.adc_rate_hz
+    air, group = np.unique(echoes.tau_air_s, axis=0, return_inverse=True)
+    group = np.ravel(group)
+    if 4 * air.shape[0] <= len(echoes):
+        # many echoes share their air delays (a delay table: one geometry, many RTS delays):
+        # exp(j 2 pi S tau t) = exp(j 2 pi S tau_if t) exp(j 2 pi S tau_air t), the element
+        # factor folded into the DFT kernel once per geometry, so each echo needs N tones and
+        # one (N,) x (N, V K) product instead of V N tones (the same sums; ~1e-14 rounding)
+        fast = _tones(s * echoes.tau_if_s + f_d, t0, dt, n_s)  # (E, N)
+        if echoes.fast_gain is not None:  # fractional-delay FIR ripple along the chirp
+            fast = fast * echoes.fast_gain
+        elem = _tones(s * air, t0, dt, n_s)  # (G, V, N)
+        kern = (elem[:, :, None, :] * kern_r).reshape(air.shape[0], -1, n_s)  # (G, V K, N)
+        rr = np.empty((len(echoes), tau.shape[1] * r.size), complex)
+        for g in range(air.shape[0]):  # a few geometries (loop over groups, not echoes)
+            sel = np.flatnonzero(group == g)
+            rr[sel] = fast[sel] @ kern[g].T
+        rr = np.moveaxis(rr.reshape(len(echoes), tau.shape[1], r.size), -1, 0)
+    else:
+        beat = s * tau + f_d[:, None]  # (E, V)
+        fast = _tones(beat, t0, dt, n_s)  # (E, V, N) at t_n
+        if echoes.fast_gain is not None:  # fractional-delay FIR ripple along the chirp
+            fast = fast * echoes.fast_gain[:, None, :]
+        # the window-and-DFT sums as one matrix product (BLAS: 10x numpy's einsum loops
+        # here, which were a third of the tolerance model's tables); rounding-level
+        # differences only
+        rr = np.moveaxis(fast @ kern_r.T, -1, 0)
     # slow time (Doppler bin d of the fftshifted spectrum is DFT index d - L/2)
     t_c = chirp_start_s(radar, rut)  # (L, V)
     w_d = window(radar.doppler_window, n_l)
     l = np.arange(n_l)
     kdop = (d - n_l // 2) % n_l
     kern_d = w_d * np.exp(-2j * np.pi * np.outer(kdop, l) / n_l)  # (K, L)
-    slow = np.exp(2j * np.pi * f_d[:, None, None] * t_c.T[None, :, :])  # (E, V, L)
-    dd = np.moveaxis(slow @ kern_d.T, -1, 0)
+    # per distinct Doppler shift (a delay table has one): the same arithmetic, fewer rows
+    f_u, f_inv = np.unique(f_d, return_inverse=True)
+    slow = np.exp(2j * np.pi * f_u[:, None, None] * t_c.T[None, :, :])  # (U, V, L)
+    dd = np.moveaxis((slow @ kern_d.T)[np.ravel(f_inv)], -1, 0)
     return amp[None] * rr * dd

@@ -1,0 +1,73 @@
+"""Delay tables through ``bin_response`` and the FIR's response (issue 17, the `design`
+target): the shortcuts for echoes that share their geometry agree with the direct sums."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rtsgeom.geometry import build_setup
+from rtsgeom.paths import exact_paths
+from rtsgeom.radar.phasors import bin_response
+from rtsgeom.rts import (KIND_DIRECT, RtsProgram, channel_echoes, fir_error_response,
+                         fractional_delay_fir)
+
+from conftest import make_scene
+
+
+def _horner(mu, taps, f_s, f):
+    """The FIR's error response by Horner on every (setting, frequency): the reference."""
+    h = fractional_delay_fir(mu, taps)
+    w = 2 * np.pi * f / f_s
+    z = np.exp(-1j * w)
+    resp = np.zeros(w.shape, complex)
+    for k in range(taps - 1, -1, -1):
+        resp = resp * z + h[:, k:k + 1]
+    return resp * np.exp(1j * w * ((taps - 1) / 2 + mu)[:, None])
+
+
+@pytest.mark.parametrize("taps", [3, 8, 33, 129])
+@pytest.mark.parametrize("f_s", [1e9, 4e9])
+def test_fir_response_on_shifted_grids_is_the_direct_sum(taps, f_s):
+    rng = np.random.default_rng(taps)
+    mu = np.round(rng.random(300), 9)
+    mu[::5] = mu[0]  # repeated settings (a delay table's)
+    grid = 0.5e9 + np.linspace(0.0, 0.35 * f_s, 257)
+    shift = rng.uniform(-2e6, 2e6, mu.size)
+    ref = _horner(mu, taps, f_s, grid[None] + shift[:, None])
+    assert np.abs(fir_error_response(mu, taps, f_s, grid, shift) - ref).max() < 1e-13 * taps
+    # (M, N) rows that are shifted copies of one grid: the same response
+    rows = fir_error_response(mu, taps, f_s, grid[None] + shift[:, None])
+    assert np.abs(rows - ref).max() < 1e-13 * taps
+    with pytest.raises(ValueError, match="f_hz"):
+        fir_error_response(mu[:2], taps, f_s, np.stack([grid, grid[::-1]]))
+
+
+@pytest.mark.parametrize("radius_m", [0.5, 1.0, 2.5])
+@pytest.mark.parametrize("filt", ["windowed-sinc", "ideal"])
+@pytest.mark.parametrize("doppler_hz", [0.0, 1.7e3])
+def test_delay_table_through_bin_response_is_echo_by_echo(radius_m, filt, doppler_hz):
+    """Many echoes of one channel at different RTS delays (a delay table: shared air delays)
+    take the grouped path; one echo at a time takes the direct one: the same spectra."""
+    def mutate(doc):
+        doc["rts"]["arc_radius_m"] = radius_m
+        doc["rts"]["fractional_delay_filter"] = filt
+    scene = make_scene(mutate)
+    setup = build_setup(scene)
+    paths = exact_paths(setup)
+    k = np.arange(-40, 41, 3)
+    prog = RtsProgram.build(np.arange(k.size), np.full(k.size, 1), 3e-8 + k * 1e-12,
+                            np.full(k.size, doppler_hz), np.ones(k.size))
+    ech = channel_echoes(setup, paths, prog)
+    ech = ech.select(ech.kind == KIND_DIRECT)
+    assert len(ech) == k.size
+    radar, rut = scene.radar, setup.rut
+    r0 = int(round(radar.slope_hz_per_s * ech.tau_s.mean() * radar.samples_per_chirp
+                   / radar.adc_rate_hz))
+    bins = r0 + np.arange(-2, 3)  # the echoes' bin and two either side
+    dop = np.full(bins.size, radar.chirps_per_tx // 2 + 1)
+    table = bin_response(ech, radar, rut, bins, dop)
+    one = np.concatenate([bin_response(ech.select(np.arange(len(ech)) == e), radar, rut, bins,
+                                       dop) for e in range(len(ech))], axis=1)
+    assert table.shape == one.shape == (bins.size, len(ech), rut.num_virtual)
+    assert np.abs(table - one).max() < 1e-12 * np.abs(one).max()
