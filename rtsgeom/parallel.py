@@ -101,7 +101,10 @@ def map_chunks(func: Callable, chunks: Sequence, client=None,
                 progress(k + 1, total)
         return out
     from dask.distributed import as_completed
-    futures = client.map(func, list(chunks), pure=False)
+    # the function carries the model (tens of MiB of tables): sent to every worker once, not
+    # packed into the task graph (which Dask warns about and ships through the scheduler)
+    remote = client.scatter(func, broadcast=True, hash=False)
+    futures = client.map(_apply, list(chunks), fn=remote, pure=False)
     index = {f.key: k for k, f in enumerate(futures)}
     results: list = [None] * total
     for done, f in enumerate(as_completed(futures), start=1):
@@ -109,3 +112,8 @@ def map_chunks(func: Callable, chunks: Sequence, client=None,
         if progress:
             progress(done, total)
     return results
+
+
+def _apply(chunk, fn):
+    """``fn(chunk)`` on a worker (``fn`` arrives resolved from its scattered future)."""
+    return fn(chunk)

@@ -3,7 +3,6 @@ of the same draws puts the answer, with the power law the pilot measured."""
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 from rtsgeom.analysis.design import pilot_estimate, tolerance_search

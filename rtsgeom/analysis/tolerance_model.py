@@ -66,6 +66,7 @@ from ..radar.phasors import bin_response
 from ..radar.processing import refine_angles, tdm_compensate
 from ..rts import KIND_DIRECT, RtsProgram, channel_echoes, requested_delay
 from ..scene import TargetConfig
+from .subbin import subbin_positions
 
 __all__ = ["PairPhasors", "HALF_BINS", "PROBE_FRACTIONS", "response_table"]
 
@@ -284,8 +285,8 @@ class PairPhasors:
         res = rts.delay_resolution_s
         slope = rts.f_rts_hz + 0.5 * radar.bandwidth_hz
         max_steps = int(np.ceil(0.5 / (slope * res))) + 4
-        n_bin = max(1, int(round(2 * radar.range_resolution_m / c / res)))  # delay steps per range bin
-        sub = np.arange(n_bin) - n_bin // 2
+        sub = subbin_positions(radar.range_resolution_m, res)  # the target's places in its bin
+        n_bin = sub.size  # delay steps per range bin
         # the exact period of J's IF phase at the target (eq. 27 refined), as aoa.plan uses it
         period = 1.0 / float(if_phase_slope_hz(nom.scene, 2 * target.range_m / c))
         p_steps = int(round(period / res))
