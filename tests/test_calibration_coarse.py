@@ -159,8 +159,13 @@ def test_full_chain_calibration_finds_the_continuous_point_on_coarse_steps(res_p
 @pytest.mark.parametrize("radius", [1.0, 3.0])
 @pytest.mark.parametrize("dr_mm", [0.0, 0.3, -0.6])
 def test_calibration_finds_the_continuous_point_on_the_resolution_grid(radius, dr_mm, probe):
-    """The grid: 1 to 100 ps fractional-delay steps and whole 4 GSPS samples (250 ps, 3 fine
-    points: one harmonic through them) x 3 radial offsets x 2 arc radii."""
-    for res_ps in RES_PS:
+    """The grid, 1 to 100 ps fractional-delay steps and whole 4 GSPS samples (250 ps, 3 fine
+    points: one harmonic through them) x 3 radial offsets x 2 arc radii, sampled so that the
+    suite stays short: each (offset, radius) case takes two of the steps, in turn, so the six
+    cases visit every step twice; whole samples on the largest offset. The full 42-setup grid:
+    python -m benchmarks.calibration_resolution."""
+    case = [0.0, 0.3, -0.6].index(dr_mm) * 2 + [1.0, 3.0].index(radius)
+    for res_ps in (RES_PS[case % len(RES_PS)], RES_PS[(case + 3) % len(RES_PS)]):
         _check_calibration(res_ps, radius, dr_mm, probe)
-    _check_calibration(250.0, radius, dr_mm, probe, fractional=False)
+    if dr_mm == -0.6:
+        _check_calibration(250.0, radius, dr_mm, probe, fractional=False)

@@ -143,14 +143,15 @@ def test_linked_calibration_at_the_maximum_noise_figure(seed, quiet_reference):
 
 @pytest.mark.slow
 def test_linked_calibration_noise_grid(quiet_reference):
-    """NF 12 / 30 / 45 / 50 dB x 3 seeds: every chosen delay within 2 ps of the noiseless one,
-    and the one-frame scatter of the fitted delay (same draws) x 10^(5/20) from 45 to 50 dB
-    (it compressed there before: 20-30 ps at 50 dB, under 45 dB's). The full grid (5 noise
-    figures x 5 seeds): python -m benchmarks.calibration_noise."""
+    """NF 45 / 50 dB x 2 seeds (the low noise figures: the tests above): every chosen delay
+    within 2 ps of the noiseless one, and the one-frame scatter of the fitted delay (same
+    draws) x 10^(5/20) from 45 to 50 dB (it compressed there before: 20-30 ps at 50 dB, under
+    45 dB's). The full grid (5 noise figures x 5 seeds): python -m
+    benchmarks.calibration_noise."""
     probe, ref = quiet_reference
     scatter = {}
-    for nf in (12.0, 30.0, 45.0, 50.0):
-        for seed in range(3):
+    for nf in (45.0, 50.0):
+        for seed in range(2):
             cal = _noisy_calibration(nf, seed, probe)
             assert abs(cal.delta_tau_s - ref.delta_tau_s) <= 2e-12 + 1e-15, (nf, seed)
             scatter.setdefault(nf, []).append(cal.one_frame_scatter_ps)
