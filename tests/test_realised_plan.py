@@ -5,7 +5,7 @@ step does not divide 1/f_s (100 ps at 4 GSPS: 0/100/200 ps in each 250 ps sample
 difference a pair realises depends on where the target's delay falls in the sample. Before
 the fix J was requested at the calibrated offset (plus a period where the bin is ambiguous)
 and the design took the realised setting for coherent: at 100 ps steps the red-team's 7 deg
-target at 33.5 m realised 80 ps off (-0.17 deg). Grids: delay resolution x f_s x target
+target at 33.5 m realised 95 ps off the plan (-0.173 deg). Grids: delay resolution x f_s x target
 range (x a hardware phase and a radial mounting error the calibration must absorb).
 """
 

@@ -171,8 +171,8 @@ def plan_pair(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str,
     establishes at the planned difference (``coherent_phase`` of the continuous model,
     ``calsteps.continuous_delay_setup``): the residual's phase is designed for, not assumed
     away. Before this the design took the realised setting for coherent, and at 100 ps
-    steps and 4 GSPS J at 33.5 m realised 80 ps from the planned difference (28 deg of IF
-    phase; -0.17 deg of angle).
+    steps and 4 GSPS J at 33.5 m realised -1100 ps from I, 95 ps off the planned -1005 ps
+    (34 deg of IF phase; -0.173 deg of angle).
 
     ``paper`` / ``array-factor``: :func:`pair_amplitudes` at the calibrated offsets."""
     from .calibration import if_phase_slope_hz, nominal_model
