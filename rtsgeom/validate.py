@@ -150,8 +150,9 @@ def scene_warnings(scene: Scene) -> list[str]:
                  f"does not divide the back end's sample period 1/rts.f_s_hz = {ts * 1e12:.6g} "
                  f"ps ({n:.4g} steps): the settings within each sample are uneven and the "
                  "delay difference a front-end pair realises varies with the target's range "
-                 f"by up to a step ({step * 1e12:.4g} ps); `run` plans on realised delays and "
-                 "designs the amplitudes for what is left (summary.json calibration.targets); "
+                 f"by up to a step ({step * 1e12:.4g} ps); `run` plans pairs on an arc on "
+                 "realised delays and designs the amplitudes for what is left (summary.json "
+                 "calibration.targets; cells on a sphere are not planned so yet); "
                  f"a step that divides 1/f_s, e.g. {finer * 1e12:.6g} ps, leaves none")
 
     if radar.snr_db is None and radar.link is None:
