@@ -340,12 +340,11 @@ def test_one_detection_matches_at_most_one_target(nearest_result):
                         angle_rad=0.1, rcs_dbsm=10.0)
     t2 = SimpleNamespace(**vars(t))
     t2.range_m += 0.3 * (rd.range_m[1] - rd.range_m[0])  # the same range-Doppler cell
-    radar = nearest_result.scene.radar  # undetected_reason reads the CFAR threshold
-    scene = SimpleNamespace(targets=[t, t2], radar=radar)
+    scene = SimpleNamespace(targets=[t, t2])
     m = match_targets(scene, det, rd)
     assert m[0]["detection"] is not None and m[1]["detection"] is None
     # the order of the targets does not decide which one gets it: the closer one does
-    m = match_targets(SimpleNamespace(targets=[t2, t], radar=radar), det, rd)
+    m = match_targets(SimpleNamespace(targets=[t2, t]), det, rd)
     assert m[0]["detection"] is None and m[1]["detection"] is not None
 
 
