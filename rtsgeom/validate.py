@@ -138,6 +138,23 @@ def scene_warnings(scene: Scene) -> list[str]:
              f"not a whole multiple of the RTS delay resolution "
              f"{rts.delay_resolution_s * 1e12:g} ps: the steps will be uneven")
 
+    # A fractional-delay step that does not divide the sample period 1/f_s leaves uneven
+    # settings in each sample (100 ps at 4 GSPS: 0/100/200 ps, then 250 ps): a pair's realised
+    # delay difference then depends on where the target's delay falls in the sample.
+    if rts.fractional_delay:
+        ts, step = 1.0 / rts.f_s_hz, rts.fractional_delay_step_s
+        n = ts / step
+        if abs(n - round(n)) > 1e-6 * n:
+            finer = ts / math.ceil(n)
+            warn("rts.fractional_delay_step_s", step,
+                 f"does not divide the back end's sample period 1/rts.f_s_hz = {ts * 1e12:.6g} "
+                 f"ps ({n:.4g} steps): the settings within each sample are uneven and the "
+                 "delay difference a front-end pair realises varies with the target's range "
+                 f"by up to a step ({step * 1e12:.4g} ps); `run` plans pairs on an arc on "
+                 "realised delays and designs the amplitudes for what is left (summary.json "
+                 "calibration.targets; cells on a sphere are not planned so yet); "
+                 f"a step that divides 1/f_s, e.g. {finer * 1e12:.6g} ps, leaves none")
+
     if radar.snr_db is None and radar.link is None:
         out.append(f"{src}: radar.snr_db is not set: the simulation is noiseless")
     if radar.snr_db is not None and radar.link is not None:

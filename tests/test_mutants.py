@@ -326,7 +326,8 @@ def test_linearity_sweeps_the_inner_span_and_reports_relative_amplitudes(cal_set
     rng = float(probe_ranges(setup, 1)[0])
     amps = np.array([pair_design(setup, paths, (0, 1), TargetConfig(rng, 0.0, 10.0, float(a)),
                                  "exact", probe_angles(*probe.angle_rad[[0, 1]]),
-                                 (0.0, cal.delta_tau_s), probe.gain_correction[[0, 1]])[:2]
+                                 (0.0, cal.delta_tau_s), probe.gain_correction[[0, 1]],
+                                 cal.quantisation_residual_s)[:2]
                      for a in np.radians(lin.set_deg)]).T
     np.testing.assert_allclose(amp_db, 20 * np.log10(amps / amps.max()), atol=1e-9)
     # the channels trade amplitude across the span: A_J grows, A_I falls

@@ -107,7 +107,9 @@ def linearity(setup: Setup, paths: Paths, pair: tuple[int, int], mode: str,
             a_i, a_j, _ = _closed_form_measured(setup, paths, pair, t, mode, probe, off, corr)
         else:
             a_i, a_j, _, off_j = pair_design(setup, paths, pair, t, mode,
-                                             probe_angles(*probe.angle_rad[[i, j]]), off, corr)
+                                             probe_angles(*probe.angle_rad[[i, j]]), off, corr,
+                                             calibration.quantisation_residual_s
+                                             if calibration else 0.0)
         amp[:, k] = a_i, a_j
         off_j = off[1] if end_angles == "measured" and mode != "exact" else off_j
         prog = RtsProgram.build([0, 0], [i, j], [tau + off[0], tau + off_j], [0.0, 0.0],
