@@ -63,7 +63,7 @@ def nominal_sphere4():
     return setup, exact_paths(setup)
 
 
-@pytest.mark.parametrize("offset_ps", [0.0, 120.0, 250.0, -250.0])
+@pytest.mark.parametrize("offset_ps", [0.0, 120.0, 250.0, -250.0, 750.0])
 @pytest.mark.parametrize("u_set", [(0.121869, 0.0), "centre", (0.17, 0.05)])
 def test_calibrated_cell_reaches_its_directions_whatever_its_channel_offsets(
         nominal_sphere4, offset_ps, u_set):
@@ -72,9 +72,9 @@ def test_calibrated_cell_reaches_its_directions_whatever_its_channel_offsets(
     pairwise whatever the offset, so every direction inside the cell is reached. The
     closed-form start once took the tree phases as deviations from coherence, and from
     90 deg on the Gauss-Newton did not recover (sphere4 + 0.5 mm: 'outside what this cell
-    can synthesize' at the cell's centre). Up to a quarter period: at half a period (500
-    ps, 7.5 cm: half a range bin between the rows) the elevation of (7, 0) deg is not
-    reached even from coherent phases (open, see benchmarks.cell_calibration at 1 mm)."""
+    can synthesize' at the cell's centre). Not at half a period (500 ps, 7.5 cm: half a
+    range bin between the rows): there the elevation of (7, 0) deg and the centre are not
+    reached (the detected elevation jumps across 0 as the rows' ratio grows; open)."""
     from rtsgeom.aoa.ncal import ChannelSet, tree_phases
     from rtsgeom.scene import TargetConfig
     setup, paths = nominal_sphere4
@@ -198,3 +198,22 @@ def test_elevation_pair_calibrates_to_its_coherence_point_with_a_front_end_off(f
     else:
         shift = np.radians(value) / (2 * np.pi * f_if)
     assert abs(_wrap(point - p0 - shift, per)) < 6e-12
+
+
+@pytest.mark.parametrize("d01_ps, d13_ps", [(-484.0, -500.0), (480.0, 470.0), (-250.0, -260.0)])
+def test_channel_offsets_are_taken_to_the_period_nearest_zero(nominal_sphere4, monkeypatch,
+                                                               d01_ps, d13_ps):
+    """Pair delays add up along the tree to beyond half a period (180 deg on front end 1:
+    channel 3 at -984 ps, its echo a whole range bin from the others); each channel's
+    offset is wrapped to (-period/2, period/2], and the loop closures do not change."""
+    from rtsgeom.aoa.calibration import probe_front_ends
+    from rtsgeom.aoa.ncal import calibrate_channels
+    setup, paths = nominal_sphere4
+    delays = {(0, 1): d01_ps, (0, 2): 2.0, (0, 3): d01_ps + d13_ps, (1, 3): d13_ps,
+              (2, 3): d01_ps + d13_ps - 2.0}
+    _fake_pairs(monkeypatch, delays)
+    cal = calibrate_channels(setup, paths, [0, 1, 2, 3], probe_front_ends(setup, paths, 1))
+    assert np.all(np.abs(cal.offsets_s) <= PERIOD / 2 + 1e-15)
+    want = np.array([0.0, d01_ps, 2.0, d01_ps + d13_ps]) * 1e-12
+    assert np.allclose(_wrap(cal.offsets_s - want), 0.0, atol=1e-15)
+    assert np.allclose(cal.loop_closure_s, 0.0, atol=1e-15)

@@ -3,15 +3,18 @@
 
 A phase is always measured between two channels: each measured pair (i, j) is swept like the
 paper's pair calibration (channel j's RTS delay offset over at least one period, two probe
-targets synthesized by the pair at amplitude ratios 1:3 and 3:1, the probes' detected
-directions compared with the model's coherent prediction, RMS over both probes and both
-angles; the vertex of a parabola through the points near the minimum, on the sweep and on a
-finer grid, rounded to the delay resolution), but in the RuT's own D-dimensional
-beamformer, so pairs stacked in elevation calibrate as pairs side by side. The pairs are the
+targets synthesized by the pair at amplitude ratios 1:3 and 3:1, designed at every step on the
+nominal model, the probes' detected directions compared with the design's), but in the RuT's
+own D-dimensional beamformer, so pairs stacked in elevation calibrate as pairs side by side:
+the coarse minimum of the RMS error, then the 1-D pair calibration's fine sweep and periodic
+least-squares fit (``sweep.fit_minimum``) on the signed errors that cross zero
+(:func:`crossing_columns`), rounded to the delay resolution. The pairs are the
 edges between the cell's front ends (Delaunay edges; the pair on an arc); the per-channel
 delays add up along a minimum spanning tree (shortest edges) from the reference channel, and
 each measured edge off the tree closes a loop whose closure error (wrapped to one period) is
-reported as a check. The amplitude calibration is each front end alone
+a check: beyond ``LOOP_CLOSURE_TOL_S`` it is a warning naming the pair, as is a pair whose
+sweep detected nothing (:class:`CalibrationFailed` when it leaves a channel without a path to
+the reference). The amplitude calibration is each front end alone
 (``calibration.probe_front_ends``' gain correction); the residual is the detected error of
 one target at the cell's centre, synthesized by all its channels, in both angles.
 """
@@ -196,8 +199,12 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     least-squares fit, full-chain confirmation), as a dict; the pair on an arc is the N = 2,
     D = 1 case of the channel calibration, not a second sweep. With a 2-D beamformer (D = 2:
     pairs side by side or stacked in elevation) the sweep of the module doc, through the
-    full ADC-cube chain, comparing the probes' detected direction cosines in both axes (the
-    phasor sweep's closed-form design and Newton reading are 1-D so far)."""
+    full ADC-cube chain (one frame a step: 61 coarse + 51 fine on sphere4), comparing the
+    probes' detected direction cosines in both axes; the coarse and fine steps and the fit
+    are the 1-D pair's (``calsteps.fine_window``, ``calsteps.sweep_phase``,
+    ``sweep.fit_minimum``); the phasor sweep's closed-form design, bin logic, probe
+    placement and frames per step are 1-D so far. Raises :class:`CalibrationFailed` when no
+    probe is detected at any step."""
     from .calibration import calibrate_pair, if_phase_slope_hz, nominal_model, probe_total_delay
     from .calsteps import fine_window, realisable, sweep_phase
     from .sweep import fit_minimum
@@ -320,6 +327,13 @@ def calibrate_channels(setup, paths, channels, probe, seed=None, progress=None,
         i, j = min(p, q), max(p, q)
         d = meas[(i, j)]["delta_tau_s"]  # j relative to i
         offsets[q] = offsets[p] + (d if q == j else -d)
+    # Each channel's offset to the period nearest zero: the pair delays add up along the
+    # tree to beyond half a period (sphere4 with 180 deg on front end 1: channel 3 at -984
+    # ps, its echo a whole range bin (15 cm) from the others, and the cell no longer
+    # synthesized (5, 3) deg); one period is the same phase at the probes' range (at another
+    # range, 0.6 % of a turn per period at 40 m: what any calibration offset costs there).
+    per = float(np.median([m["period_s"] for m in meas.values()]))
+    offsets = offsets - per * np.round(offsets / per)
     on_tree = {tuple(sorted(e)) for e in tree_edges}
     closure = []
     for (i, j), m in meas.items():

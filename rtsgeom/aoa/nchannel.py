@@ -173,8 +173,8 @@ class ChannelSet:
         # phases on this model, whose channels carry their own: delays, calibration offsets;
         # handed to the closed form as they are, a calibrated channel 87 deg off its
         # geometric phase (a 0.5 mm radial offset) gave a start the Gauss-Newton did not
-        # recover from, sphere4), then coherent, then equal amplitudes; each start tried in
-        # turn until one reaches u_set.
+        # recover from, sphere4), then coherent; each start tried in turn until one reaches
+        # u_set.
         starts = []
         for ph in ((None if phases is None else self._coherence_offsets(u_set, phases)), None):
             try:
@@ -182,7 +182,11 @@ class ChannelSet:
                                                      ph))
             except AngleUnreachable:
                 pass
-        starts.append(np.ones(self.count))
+        # a channel the closed form leaves at 0 stays there (its log-amplitude's column of
+        # the Jacobian vanishes): the same starts with every channel at 0.1 or more next
+        # (sphere4 with a 180 deg phase on a front end, (5, 3) deg: the triangle's start
+        # stopped 0.008 off in elevation), then equal amplitudes
+        starts += [np.maximum(a, 0.1) for a in starts] + [np.ones(self.count)]
         for n, a0 in enumerate(starts):
             try:
                 return self.weights(self._peak_match(u_set, a0, phases, tol, max_iter), phases)

@@ -87,7 +87,9 @@ def plan_cells(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, pr
                 raise SceneError(f"{scene.source}: targets[{k}]: the channel calibration "
                                  f"failed ({'; '.join(cal.warnings)}), and with its offsets "
                                  f"{exc}") from None
-            raise SceneError(f"{scene.source}: targets[{k}]: {exc}") from None
+            cal_note = ("" if tree is None else " (with the channel calibration's delay "
+                        f"offsets {np.round(offsets[list(cell)] * 1e12, 1).tolist()} ps)")
+            raise SceneError(f"{scene.source}: targets[{k}]: {exc}{cal_note}") from None
         amps = cs.amplitudes(w, u) * probe.gain_correction[list(cell)]
         tau = float(requested_delay(scene, t.range_m))
         f_d = 2 * scene.radar.f_c_hz * t.velocity_mps / c
