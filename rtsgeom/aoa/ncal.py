@@ -288,8 +288,15 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
             "residual_error_deg": best_err, "points": int(grid_pts.size),
             "range_offset_m": 0.5 * c * best, "period_s": period,
             "sweep_points": int(grid.size), "fit_s": float(best_fit),
-            "coarse_minimum_s": near, "fine_rms_deg": [float(x) for x in rms_deg(e_fine)],
-            "fit_columns": [int(q) for q in cols]}
+            "coarse_minimum_s": near,
+            "fit_columns": [int(q) for q in cols],
+            # the arc pair's record (``Calibration.to_dict``): RMS probe error per step
+            "sweep": _points(grid, errs), "refinement": _points(fine_t, rms_deg(e_fine))}
+
+
+def _points(t, e) -> list[dict]:
+    return [{"delta_tau_s": float(a), "angle_error_deg": float(b) if np.isfinite(b) else None}
+            for a, b in zip(t, e)]
 
 
 def calibrate_channels(setup, paths, channels, probe, seed=None, progress=None,
