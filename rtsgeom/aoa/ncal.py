@@ -3,21 +3,25 @@
 
 A phase is always measured between two channels: each measured pair (i, j) is swept like the
 paper's pair calibration (channel j's RTS delay offset over at least one period, two probe
-targets synthesized by the pair at amplitude ratios 1:3 and 3:1, the probes' detected
-directions compared with the model's coherent prediction, RMS over both probes and both
-angles; the vertex of a parabola through the points near the minimum, on the sweep and on a
-finer grid, rounded to the delay resolution), but in the RuT's own D-dimensional
-beamformer, so pairs stacked in elevation calibrate as pairs side by side. The pairs are the
+targets synthesized by the pair at amplitude ratios 1:3 and 3:1, designed at every step on the
+nominal model, the probes' detected directions compared with the design's), but in the RuT's
+own D-dimensional beamformer, so pairs stacked in elevation calibrate as pairs side by side:
+the coarse minimum of the RMS error, then the 1-D pair calibration's fine sweep and periodic
+least-squares fit (``sweep.fit_minimum``) on the signed errors that cross zero
+(:func:`crossing_columns`), rounded to the delay resolution. The pairs are the
 edges between the cell's front ends (Delaunay edges; the pair on an arc); the per-channel
 delays add up along a minimum spanning tree (shortest edges) from the reference channel, and
 each measured edge off the tree closes a loop whose closure error (wrapped to one period) is
-reported as a check. The amplitude calibration is each front end alone
+a check: beyond ``LOOP_CLOSURE_TOL_S`` it is a warning naming the pair, as is a pair whose
+sweep detected nothing (:class:`CalibrationFailed` when it leaves a channel without a path to
+the reference). The amplitude calibration is each front end alone
 (``calibration.probe_front_ends``' gain correction); the residual is the detected error of
 one target at the cell's centre, synthesized by all its channels, in both angles.
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -32,10 +36,21 @@ from ..rts import RtsProgram, requested_delay
 from ..scene import TargetConfig
 from .nchannel import ChannelSet
 
-__all__ = ["ChannelCalibration", "calibrate_channels", "calibrate_pair_nd", "pair_edges",
+__all__ = ["CalibrationFailed", "ChannelCalibration", "coherence_point_nd", "crossing_columns", "calibrate_channels", "calibrate_pair_nd", "pair_edges",
            "spanning_tree", "tree_phases"]
 
-PROBE_RATIOS = (1 / 3, 3.0)  # channel j's amplitude over channel i's for the two probes
+PROBE_RATIOS = (1 / 3, 3.0)
+# A loop of pair calibrations closes to within this (wrapped to one period), or the
+# calibration is reported as failed, naming the loop's pair: sphere4's loops close to 2 to 18
+# ps (the elevation pairs' fits scatter ~10 ps); 29 and 37 ps before the 2-D fit was the 1-D
+# one (run's elevation errors up to 0.10 deg against <= 0.03 deg).
+LOOP_CLOSURE_TOL_S = 25e-12
+FINE_STEP_ND_S = 10e-12  # the 2-D fine sweep's step (each step a full-chain frame: 51 of them)
+
+
+class CalibrationFailed(ValueError):
+    """A pair's calibration found no coherence point (no probe detected over the sweep), or
+    the calibrated channels do not synthesize the cell's centre."""  # channel j's amplitude over channel i's for the two probes
 
 
 @dataclass(frozen=True)
@@ -47,6 +62,12 @@ class ChannelCalibration:
     loop_closure_s: list = field(default_factory=list)  # per off-tree edge
     residual_deg: tuple = (np.nan, np.nan)  # (azimuth, elevation) error at the cell centre
     gain_correction: tuple = ()
+    warnings: tuple = ()  # failed pairs, loop closures beyond LOOP_CLOSURE_TOL_S, no residual
+
+    @property
+    def failed(self) -> bool:
+        """Whether the calibration is not to be trusted (any of :attr:`warnings`)."""
+        return bool(self.warnings)
 
     def to_dict(self) -> dict:
         return {"reference": self.reference,
@@ -56,6 +77,8 @@ class ChannelCalibration:
                 "residual_deg": {"azimuth": float(self.residual_deg[0]),
                                  "elevation": float(self.residual_deg[1])},
                 "gain_correction": [float(x) for x in self.gain_correction],
+                "loop_closure_tolerance_s": LOOP_CLOSURE_TOL_S,
+                "warnings": list(self.warnings),
                 "pairs": self.pairs}
 
 
@@ -87,6 +110,86 @@ def _detect(setup, paths, program, seed):
     return process(cube)
 
 
+def _pair_probes(setup, paths, pair, probe, delta_s: float = 0.0):
+    """The 2-D pair sweep's two probes at a step ``delta_s`` of channel j: their ranges (P,),
+    programme amplitudes (P, 2) (the nominal model's design, with channel j at that delay,
+    for channels coherent at the front ends' midpoint, amplitude ratios ``PROBE_RATIOS``,
+    times the gain correction), the direction cosines (P, D) the design puts them at, and
+    the RuT's steering. Designed at every step, as the 1-D sweep (``sweep.phasor_sweep``):
+    channel j's echo moves by c0 delta / 2 in range (a quarter bin over +-period/4) and its
+    gain in the bin with it; a design fixed at delta = 0 made each probe's error curve
+    lopsided about the coherence point (its vertex 50 to 70 ps off in elevation, sphere4)."""
+    from .calibration import nominal_model, probe_ranges
+    nom, nom_paths = nominal_model(setup, paths)
+    ranges = probe_ranges(setup, 2)
+    corr = probe.gain_correction[list(pair)]
+    designs, predicted = [], []
+    for r, rho in zip(ranges, PROBE_RATIOS):
+        cs = ChannelSet.build(nom, nom_paths, pair, TargetConfig(float(r)), (0.0, delta_s))
+        u_mid = cs.fe_directions().mean(axis=0)
+        ph = cs.coherent_phases(u_mid[None])
+        w = cs.weights([1.0, rho], ph)
+        u_pred = cs.direction_cosines(w, u_mid)
+        designs.append(cs.amplitudes(w, u_pred) * corr)
+        predicted.append(u_pred)
+    return ranges, designs, predicted, cs.steering
+
+
+def crossing_columns(e_fine, edge: int = 3) -> np.ndarray:
+    """The columns (probe x axis) of a fine sweep's signed errors ``e_fine`` (S, P * D) the
+    2-D pair fit uses: those that cross zero over the window (opposite signs at its two
+    ends, mean of ``edge`` steps each), else all of them.
+
+    Along the pair's own axis a probe's error is even in the phase mismatch (quadratic about
+    the coherence point, as on an arc), and its vertex reaches zero only where the chain's
+    angle estimate is unbiased: in elevation (one wavelength of aperture) the vertex sits
+    0.01 to 0.04 deg off zero, the curve crosses zero ~40 ps either side of it and the
+    joint minimum lands on a crossing (sphere4, pair (0, 1): 67 ps against the coherence
+    point's 29). Across the axis the error is odd (the elevated virtual rows are offset in
+    azimuth) and crosses zero at the coherence point: fitted alone, 4 to 6 ps from it on
+    sphere4 with 0 / 0.5 mm radial / 90 deg phase on a front end. A pair on an arc (D = 1)
+    has no such column: all of them, the 1-D fit."""
+    e = np.asarray(e_fine, float)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a column never detected: NaN
+        lo = np.nanmean(e[:edge], axis=0)
+        hi = np.nanmean(e[-edge:], axis=0)
+    odd = np.isfinite(lo) & np.isfinite(hi) & (lo * hi < 0)
+    return np.flatnonzero(odd) if np.any(odd) else np.arange(e.shape[1])
+
+
+def coherence_point_nd(setup, paths, pair, probe, near_s: float = 0.0,
+                       iterations: int = 4) -> float:
+    """The continuous coherence point (s) of a pair in the RuT's D-dimensional beamformer:
+    the delay offset of channel j, nearest ``near_s``, at which both channels' beam outputs
+    at the 2-D sweep's probe directions (:func:`_pair_probes`) are in phase on the setup
+    *as built* (circular mean over the probes), on the continuous delay model
+    (``calsteps.continuous_delay_setup``). The D-dimensional counterpart of
+    ``calibration.coherence_point`` (the point the sweep should find; a check, since a lab
+    does not know the setup as built). Newton with slope ``2 pi if_phase_slope_hz``."""
+    from .calibration import if_phase_slope_hz, probe_total_delay
+    from .calsteps import continuous_delay_setup
+    ranges, _, predicted, _ = _pair_probes(setup, paths, pair, probe)
+    f_if = float(if_phase_slope_hz(setup.scene, probe_total_delay(setup, ranges)))
+    period = 1.0 / f_if
+    cont = continuous_delay_setup(setup)
+
+    def phase(d):
+        z = 0j
+        for r, u in zip(ranges, predicted):
+            cs = ChannelSet.build(cont, paths, pair, TargetConfig(float(r)), (0.0, d))
+            b = cs.steering.beam(cs.model.phasors, np.atleast_2d(u))[:, 0]
+            z += b[0] * np.conj(b[1]) / max(abs(b[0] * np.conj(b[1])), 1e-300)
+        return float(np.angle(z))
+
+    d = float(near_s)
+    for _ in range(2):
+        for _ in range(iterations):
+            d += phase(d) / (2 * np.pi * f_if)
+        d += np.round((near_s - d) / period) * period
+    return d
+
+
 def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=None) -> dict:
     """Delay offset of channel j relative to channel i of ``pair`` (a row of
     :attr:`ChannelCalibration.pairs`).
@@ -96,10 +199,15 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     least-squares fit, full-chain confirmation), as a dict; the pair on an arc is the N = 2,
     D = 1 case of the channel calibration, not a second sweep. With a 2-D beamformer (D = 2:
     pairs side by side or stacked in elevation) the sweep of the module doc, through the
-    full ADC-cube chain, comparing the probes' detected direction cosines in both axes (the
-    phasor sweep's closed-form design and Newton reading are 1-D so far)."""
-    from .calibration import (calibrate_pair, if_phase_slope_hz, nominal_model, probe_ranges,
-                              probe_total_delay)
+    full ADC-cube chain (one frame a step: 61 coarse + 51 fine on sphere4), comparing the
+    probes' detected direction cosines in both axes; the coarse and fine steps and the fit
+    are the 1-D pair's (``calsteps.fine_window``, ``calsteps.sweep_phase``,
+    ``sweep.fit_minimum``); the phasor sweep's closed-form design, bin logic, probe
+    placement and frames per step are 1-D so far. Raises :class:`CalibrationFailed` when no
+    probe is detected at any step."""
+    from .calibration import calibrate_pair, if_phase_slope_hz, nominal_model, probe_total_delay
+    from .calsteps import fine_window, realisable, sweep_phase
+    from .sweep import fit_minimum
     scene = setup.scene
     rts = scene.rts
     nom, nom_paths = nominal_model(setup, paths)
@@ -109,21 +217,12 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
         row = cal.to_dict()
         row["residual_error_deg"] = float(cal.residual_error_deg)
         return row
-    ranges = probe_ranges(setup, 2)
-    corr = probe.gain_correction[list(pair)]
-    designs, predicted = [], []
-    for r, rho in zip(ranges, PROBE_RATIOS):
-        cs = ChannelSet.build(nom, nom_paths, pair, TargetConfig(float(r)))
-        u_mid = cs.fe_directions().mean(axis=0)
-        ph = cs.coherent_phases(u_mid[None])
-        w = cs.weights([1.0, rho], ph)
-        u_pred = cs.direction_cosines(w, u_mid)
-        designs.append(cs.amplitudes(w, u_pred) * corr)
-        predicted.append(u_pred)
-    st = cs.steering
+    ranges, _, _, st = _pair_probes(setup, paths, pair, probe)
     base = [float(requested_delay(scene, r)) for r in ranges]
 
-    def error(delta: float) -> float:
+    def signed(delta: float) -> np.ndarray:
+        """The probes' detected direction-cosine errors (P * D,) (NaN: not detected)."""
+        _, designs, predicted, _ = _pair_probes(setup, paths, pair, probe, delta)
         tg, fe, dl, amp = [], [], [], []
         for k, (a, b) in enumerate(zip(base, designs)):
             tg += [k, k]
@@ -134,45 +233,70 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
         step_seed = np.random.SeedSequence([int(seed) % 2 ** 32, int(round(delta * 1e15))
                                             + 2 ** 40, pair[0], pair[1]])
         rd, det = _detect(setup, paths, prog, step_seed)
-        errs = []
-        for r, u_pred in zip(ranges, predicted):
+        out = np.full((len(ranges), st.dims), np.nan)
+        for p, (r, u_pred) in enumerate(zip(ranges, predicted)):
             k = nearest_detection(det, rd, r)
-            if k is None:
-                return np.inf
-            errs.append(np.degrees(_angles_to_u(st, det, k) - u_pred))
-        return float(np.sqrt(np.mean(np.square(errs))))
+            if k is not None:
+                out[p] = _angles_to_u(st, det, k) - u_pred
+        return out.ravel()
+
+    def rms_deg(e) -> np.ndarray:
+        out = np.degrees(np.sqrt(np.mean(np.square(e), axis=-1)))
+        return np.where(np.isfinite(out), out, np.inf)
 
     span = span_s or rts.calibration_span_s
     step = step_s or rts.calibration_step_s
     grid = np.arange(span[0], span[1] + step / 2, step)
-    errs = np.array([error(d) for d in grid])
+    res = rts.delay_resolution_s
+    grid = np.unique(realisable(grid, res))  # the delays as the RTS realises them
+    errs = rms_deg(np.array([signed(d) for d in grid]))
+    if not np.any(np.isfinite(errs)):
+        raise CalibrationFailed(f"pair {tuple(int(q) for q in pair)}: no probe detected at any "
+                                "step of the sweep")
     is_min = (np.r_[True, errs[1:] <= errs[:-1]] & np.r_[errs[:-1] <= errs[1:], True])
     good = np.flatnonzero(is_min & (errs <= 2 * np.min(errs) + 0.01))
-    k = int(good[np.argmin(np.abs(grid[good]))])  # the least range offset among the deepest
-    best, best_err = float(grid[k]), float(errs[k])
+    near = float(grid[int(good[np.argmin(np.abs(grid[good]))])])  # least range offset
     period = 1.0 / float(if_phase_slope_hz(scene, probe_total_delay(setup, ranges)))
-    # Near coherence each probe's error is quadratic in the phase error (flat-bottomed under
-    # noise): a parabola through the points within +-period/8 of the minimum finds its vertex
-    # from all of them, on the sweep and then on a finer grid around it.
-    pts_d, pts_e = list(grid), list(errs)
-    res = rts.delay_resolution_s
-    for _ in range(2):
-        # the delays as the RTS realises them: a coarse RTS rounds what it is given, and a
-        # point recorded at the requested delay would sit up to half a step off its value
-        fine = np.unique(np.round((best + np.linspace(-period / 8, period / 8, 11)) / res)
-                         * res)
-        pts_d += list(fine)
-        pts_e += [error(d) for d in fine]
-        d_a, e_a = np.array(pts_d), np.array(pts_e)
-        near = np.isfinite(e_a) & (np.abs(d_a - best) <= period / 8 + 1e-15)
-        a2, a1, _ = np.polyfit(d_a[near] - best, e_a[near], 2)
-        if a2 > 0 and abs(a1 / (2 * a2)) < period / 8:
-            best = best - a1 / (2 * a2)
-    best = float(np.round(best / res) * res)  # what the RTS can set
-    best_err = error(best)
+    # The fine sweep and its fit are the pair calibration's (``calibration.calibrate_pair``):
+    # +-period/4 around the coarse minimum, the signed errors of each probe in each axis
+    # fitted with their periodic shape (``sweep.fit_minimum``), the FIR's known phase taken
+    # out (``calsteps.sweep_phase``). A parabola through the RMS (what this was before) is
+    # biased towards the coarse grid point where the RMS is V-shaped and noisy, and a shallow
+    # axis (elevation: one wavelength of aperture) carried 16 to 32 ps into the pair
+    # (sphere4: 30 ps on the diagonal pair, loop closure -29 ps; 32 ps with a 90 deg phase
+    # offset on a front end).
+    half = period / 4
+    fine_step = res * max(1, round(FINE_STEP_ND_S / res))
+    k_half, harmonics, criterion = fine_window(half, fine_step)
+    fine_t = near + np.arange(-k_half, k_half + 1) * fine_step
+    e_fine = np.array([signed(d) for d in fine_t])  # (S, P * D)
+    extra, search_phase = sweep_phase(setup, ranges, fine_t, (0.0, 0.0), period)
+    cols = crossing_columns(e_fine)
+    if extra is not None:  # per probe -> per probe and axis
+        extra = np.repeat(np.asarray(extra, float).reshape(fine_t.size, -1), st.dims,
+                          axis=1)[:, cols]
+    if search_phase is not None:
+        sp = search_phase
+        search_phase = lambda t: np.repeat(np.asarray(sp(t), float), st.dims,  # noqa: E731
+                                           axis=1)[:, cols]
+    best_fit = fit_minimum(fine_t, e_fine[:, cols], period, near, harmonics,
+                           max(half / 2, fine_step), extra, criterion, search_phase)
+    best = float(realisable(best_fit, res))  # what the RTS can set
+    best_err = float(rms_deg(signed(best)))
+    grid_pts = np.concatenate([grid, fine_t, [best]])
     return {"pair": [int(pair[0]), int(pair[1])], "delta_tau_s": best,
-            "residual_error_deg": best_err, "points": int(len(pts_d)) + 1, "range_offset_m": 0.5 * c * best,
-            "period_s": period, "sweep_points": int(grid.size)}
+            "residual_error_deg": best_err, "points": int(grid_pts.size),
+            "range_offset_m": 0.5 * c * best, "period_s": period,
+            "sweep_points": int(grid.size), "fit_s": float(best_fit),
+            "coarse_minimum_s": near,
+            "fit_columns": [int(q) for q in cols],
+            # the arc pair's record (``Calibration.to_dict``): RMS probe error per step
+            "sweep": _points(grid, errs), "refinement": _points(fine_t, rms_deg(e_fine))}
+
+
+def _points(t, e) -> list[dict]:
+    return [{"delta_tau_s": float(a), "angle_error_deg": float(b) if np.isfinite(b) else None}
+            for a, b in zip(t, e)]
 
 
 def calibrate_channels(setup, paths, channels, probe, seed=None, progress=None,
@@ -191,16 +315,32 @@ def calibrate_channels(setup, paths, channels, probe, seed=None, progress=None,
     if len(ch) < 2:
         return ChannelCalibration(offsets, ref, gain_correction=tuple(probe.gain_correction))
     edges = pair_edges(u_fe, ch)
-    meas = {}
+    meas, notes = {}, []
     for e in edges:
-        meas[e] = calibrate_pair_nd(setup, paths, e, probe, seed, span_s, step_s)
+        try:
+            meas[e] = calibrate_pair_nd(setup, paths, e, probe, seed, span_s, step_s)
+        except CalibrationFailed as exc:
+            notes.append(f"channel calibration: {exc}")
+            continue
         if progress:
             progress(f"calibrated pair {e}: delta_tau {meas[e]['delta_tau_s'] * 1e12:.1f} ps")
-    tree_edges = spanning_tree(u_fe, edges, ref)
+    edges = [e for e in edges if e in meas]
+    tree_edges = spanning_tree(u_fe, edges, ref) if edges else []
+    cut = sorted(set(ch) - {ref} - {q for _, q in tree_edges})
+    if cut:  # no chain of calibrated pairs from the reference: no offset for these
+        raise CalibrationFailed("; ".join(notes + [f"channels {cut} are not connected to the "
+                                                   f"reference {ref} by calibrated pairs"]))
     for p, q in tree_edges:
         i, j = min(p, q), max(p, q)
         d = meas[(i, j)]["delta_tau_s"]  # j relative to i
         offsets[q] = offsets[p] + (d if q == j else -d)
+    # Each channel's offset to the period nearest zero: the pair delays add up along the
+    # tree to beyond half a period (sphere4 with 180 deg on front end 1: channel 3 at -984
+    # ps, its echo a whole range bin (15 cm) from the others, and the cell no longer
+    # synthesized (5, 3) deg); one period is the same phase at the probes' range (at another
+    # range, 0.6 % of a turn per period at 40 m: what any calibration offset costs there).
+    per = float(np.median([m["period_s"] for m in meas.values()]))
+    offsets = offsets - per * np.round(offsets / per)
     on_tree = {tuple(sorted(e)) for e in tree_edges}
     closure = []
     for (i, j), m in meas.items():
@@ -209,9 +349,17 @@ def calibrate_channels(setup, paths, channels, probe, seed=None, progress=None,
         per = m["period_s"]
         c = offsets[i] + m["delta_tau_s"] - offsets[j]
         closure.append(float(c - per * np.round(c / per)))
+        if abs(closure[-1]) > LOOP_CLOSURE_TOL_S:
+            notes.append(f"channel calibration: the loop through pair ({i}, {j}) closes to "
+                         f"{closure[-1] * 1e12:.1f} ps (tolerance "
+                         f"{LOOP_CLOSURE_TOL_S * 1e12:g} ps): that pair or one on the tree "
+                         f"{tree_edges} is off its coherence point")
     residual = _residual(setup, paths, nom, nom_paths, ch, offsets, probe, st, seed, tree_edges)
+    if not np.all(np.isfinite(residual)):
+        notes.append(f"channel calibration: the calibrated channels {ch} do not synthesize "
+                     "(or the RuT does not detect) a target at the cell's centre: no residual")
     return ChannelCalibration(offsets, ref, list(meas.values()), tree_edges, closure, residual,
-                              tuple(probe.gain_correction))
+                              tuple(probe.gain_correction), tuple(notes))
 
 
 def spanning_tree(u_fe, edges, ref: int) -> list[tuple[int, int]]:

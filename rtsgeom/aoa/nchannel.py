@@ -168,14 +168,44 @@ class ChannelSet:
         if mode == "array-factor":
             a0 = closed_form_amplitudes(self.steering, self.fe_directions(), u_set, phases)
             return self.weights(a0, phases)
-        try:  # the start of the peak matching: the closed form, else equal amplitudes
-            a0 = closed_form_amplitudes(self.steering, self.fe_directions(), u_set, phases)
-        except AngleUnreachable:
+        # The start of the peak matching: the closed form with the phases the weighted
+        # channels have at u_set relative to coherence there (the given phases are programme
+        # phases on this model, whose channels carry their own: delays, calibration offsets;
+        # handed to the closed form as they are, a calibrated channel 87 deg off its
+        # geometric phase (a 0.5 mm radial offset) gave a start the Gauss-Newton did not
+        # recover from, sphere4), then coherent; each start tried in turn until one reaches
+        # u_set.
+        starts = []
+        for ph in ((None if phases is None else self._coherence_offsets(u_set, phases)), None):
             try:
-                a0 = closed_form_amplitudes(self.steering, self.fe_directions(), u_set)
+                starts.append(closed_form_amplitudes(self.steering, self.fe_directions(), u_set,
+                                                     ph))
             except AngleUnreachable:
-                a0 = np.ones(self.count)
-        return self.weights(self._peak_match(u_set, a0, phases, tol, max_iter), phases)
+                pass
+        # a channel the closed form leaves at 0 stays there (its log-amplitude's column of
+        # the Jacobian vanishes): the same starts with every channel at 0.1 or more next
+        # (sphere4 with a 180 deg phase on a front end, (5, 3) deg: the triangle's start
+        # stopped 0.008 off in elevation), then equal amplitudes
+        starts += [np.maximum(a, 0.1) for a in starts] + [np.ones(self.count)]
+        for n, a0 in enumerate(starts):
+            try:
+                return self.weights(self._peak_match(u_set, a0, phases, tol, max_iter), phases)
+            except AngleUnreachable:
+                if n == len(starts) - 1:
+                    raise
+
+    def _coherence_offsets(self, u_set, phases) -> np.ndarray:
+        """Phases (Q,) for :func:`closed_form_amplitudes` that put each channel as far from
+        coherence with channel 0 at ``u_set`` as the weighted model's channels are: its
+        array factor's coherent phase ``-arg AF_q(u_set)`` plus the model's deviation
+        ``phi_q + arg b_q(u_set) - phi_0 - arg b_0(u_set)`` (b: the channels' beams)."""
+        st = self.steering
+        u_set = np.atleast_1d(np.asarray(u_set, float))
+        b = st.beam(self.model.phasors, u_set[None])[:, 0]  # (Q,)
+        dev = np.asarray(phases, float) + np.angle(b)
+        dev = np.angle(np.exp(1j * (dev - dev[0])))
+        af = np.sum(st.taper * st.steer(u_set[None, :] - self.fe_directions()), -1)
+        return -np.angle(af) + dev
 
     def _peak_match(self, u_set, a0, phases, tol, max_iter) -> np.ndarray:
         ref = int(np.argmax(a0))  # the strongest channel keeps amplitude 1

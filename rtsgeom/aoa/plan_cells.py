@@ -35,7 +35,7 @@ def plan_cells(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, pr
 
     Returns the program, the calibration record (for summary.json) and warnings."""
     from .calibration import nominal_model, probe_front_ends
-    from .ncal import calibrate_channels, tree_phases
+    from .ncal import CalibrationFailed, calibrate_channels, tree_phases
     scene = setup.scene
     nom, nom_paths = nominal_model(setup, paths)
     probe = probe_front_ends(setup, paths, scene.seed)
@@ -64,9 +64,13 @@ def plan_cells(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, pr
     used = sorted({q for cell in cells.values() for q in cell})
     tree = None
     if calibrate:
-        cal = calibrate_channels(setup, paths, used, probe, progress=progress)
+        try:
+            cal = calibrate_channels(setup, paths, used, probe, progress=progress)
+        except CalibrationFailed as exc:
+            raise SceneError(f"{scene.source}: the channel calibration failed: {exc}") from None
         offsets, tree = cal.offsets_s, cal.tree
         cal_record = cal.to_dict()
+        warnings += list(cal.warnings)
     rows = []
     for k, t in enumerate(scene.targets):
         cell = cells[k]
@@ -79,7 +83,13 @@ def plan_cells(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, pr
         try:
             w = cs.solve(u, phases, mode=mode)
         except AngleUnreachable as exc:
-            raise SceneError(f"{scene.source}: targets[{k}]: {exc}") from None
+            if tree is not None and cal.failed:  # inside the cell: the calibration is why
+                raise SceneError(f"{scene.source}: targets[{k}]: the channel calibration "
+                                 f"failed ({'; '.join(cal.warnings)}), and with its offsets "
+                                 f"{exc}") from None
+            cal_note = ("" if tree is None else " (with the channel calibration's delay "
+                        f"offsets {np.round(offsets[list(cell)] * 1e12, 1).tolist()} ps)")
+            raise SceneError(f"{scene.source}: targets[{k}]: {exc}{cal_note}") from None
         amps = cs.amplitudes(w, u) * probe.gain_correction[list(cell)]
         tau = float(requested_delay(scene, t.range_m))
         f_d = 2 * scene.radar.f_c_hz * t.velocity_mps / c
