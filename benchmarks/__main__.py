@@ -169,7 +169,7 @@ def _time_inproc(f, repeat: int = 1) -> tuple[dict, object]:
 #: issue 17's targets (quiet 2-core machine), seconds
 TARGETS = {"run_simulation": 1.0, "frame": 0.030, "calibrate": 1.0, "adc_dca1000": 2.0,
            "design_default_grid": 5.0, "design_default_grid_2_workers": 5.0, "nearfield": 2.0,
-           "tolerance": 20.0, "help": 0.5}
+           "tolerance": 20.0, "tolerance_2_workers": 20.0, "help": 0.5}
 
 
 def bench_commands(scene_path: Path, quick: bool, repeat: int, workers: int) -> dict:
@@ -222,6 +222,9 @@ def bench_commands(scene_path: Path, quick: bool, repeat: int, workers: int) -> 
            "--sigma-tangential-mm", "0.1", "--sigma-height-mm", "0.1", "--seed", "1",
            "--json", "--quiet"]
     out["tolerance"] = {"draws": draws, **_time_cli(tol + ["--draws", str(draws)])}
+    # "on one machine": both cores, the chunks on a local Dask cluster of 2 processes
+    out["tolerance_2_workers"] = {"draws": draws, **_time_cli(
+        tol + ["--draws", str(draws), "--workers", "2"])}
     dask_draws = 100_000 if quick else 400_000
     out["tolerance_dask"] = bench_dask_scaling(scene_path, dask_draws, workers)
     for name, v in out.items():
