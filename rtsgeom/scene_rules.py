@@ -197,7 +197,8 @@ def _array_rules(scene, fail) -> None:
 
 
 def _rts_rules(scene, fail) -> None:
-    """Front ends ordered by strictly increasing angle_deg; fractional_delay_step_s <= 1/f_s_hz;
+    """Front ends ordered by strictly increasing angle_deg; f_s_hz >= the chirp's bandwidth;
+    fractional_delay_step_s <= 1/f_s_hz;
     calibration_span_ns [start, stop] with stop > start."""
     rts = scene.rts
     angles = [fe.angle_rad for fe in rts.front_ends]
@@ -212,6 +213,12 @@ def _rts_rules(scene, fail) -> None:
             fail("rts.front_ends", [[round(math.degrees(a), 6), round(math.degrees(e), 6)]
                                     for a, e in keys],
                  "ordered by strictly increasing (angle_deg, elevation_deg)")
+    if rts.f_s_hz < scene.radar.bandwidth_hz:  # no sampling scheme keeps a band wider than f_s
+        fail("rts.f_s_hz", rts.f_s_hz,
+             f">= the chirp's bandwidth radar.bandwidth_hz = {scene.radar.bandwidth_hz:g} Hz "
+             f"(the back end samples the IF band [f_rts - B/2, f_rts + B/2]; without aliasing: "
+             f">= 2 (rts.f_rts_hz + B/2) = {2 * (rts.f_rts_hz + 0.5 * scene.radar.bandwidth_hz):g}"
+             " Hz)")
     if rts.fractional_delay_step_s > 1.0 / rts.f_s_hz:
         fail("rts.fractional_delay_step_s", rts.fractional_delay_step_s,
              f"in [1e-15, {1.0 / rts.f_s_hz:g}] s")

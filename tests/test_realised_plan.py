@@ -20,7 +20,6 @@ from rtsgeom.aoa.plan import PairPlan, nearest_setting, plan_targets, residual_w
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.rts import realised_delay, requested_delay
-from rtsgeom.scene import TargetConfig
 from rtsgeom.validate import scene_warnings
 
 RES_PS = (1.0, 25.0, 50.0, 100.0)
