@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.constants import c
 
-__all__ = ["subbin_positions"]
+__all__ = ["subbin_positions", "centre_index"]
 
 
 def subbin_positions(range_resolution_m: float, delay_resolution_s: float) -> np.ndarray:
@@ -24,3 +24,8 @@ def subbin_positions(range_resolution_m: float, delay_resolution_s: float) -> np
     places them this way (a test holds both to it)."""
     n_bin = max(1, round(2 * float(range_resolution_m) / c / float(delay_resolution_s)))
     return np.arange(n_bin) - n_bin // 2
+
+
+def centre_index(steps) -> int:
+    """Index of the bin centre (offset 0) in sub-bin positions ``steps``."""
+    return int(np.flatnonzero(np.asarray(steps) == 0)[0])

@@ -38,7 +38,7 @@ import numpy as np
 from .._util import frozen
 from .tolerance_model import PROBE_FRACTIONS, PairPhasors  # noqa: F401 (public here too)
 
-__all__ = ["AXES", "DISTRIBUTIONS", "CASES", "ALL_CASES", "NOMINAL_AMPLITUDES", "PairPhasors",
+__all__ = ["AXES", "search_direction", "DISTRIBUTIONS", "CASES", "ALL_CASES", "NOMINAL_AMPLITUDES", "PairPhasors",
            "ToleranceResult", "draw_offsets", "standard_draws", "subbin_draws", "evaluate_chunk",
            "monte_carlo", "max_sigma_for_yield", "critical_ratio", "largest_passing_scale",
            "percentiles"]
@@ -308,6 +308,19 @@ def critical_ratio(worst_deg, spec_deg: float, target_yield: float) -> float:
     return float(np.partition(a, k - 1)[k - 1] / spec_deg)
 
 
+def search_direction(sigma_m, axis: str) -> tuple[np.ndarray, np.ndarray]:
+    """The yield searches' line in sigma space, sigma = fixed + t * direction (m): ``axis``
+    "all" scales the three sigmas together (their ratios as given; all ones where all are
+    zero), an axis name varies that axis alone with the other two held at ``sigma_m``."""
+    base = np.asarray(sigma_m, float).reshape(3)
+    if axis == "all":
+        return (base / base.max() if base.max() > 0 else np.ones(3)), np.zeros(3)
+    if axis in AXES:
+        direction = np.eye(3)[AXES.index(axis)]
+        return direction, base * (1 - direction)
+    raise ValueError(f"axis {axis!r}: must be 'all' or one of {', '.join(AXES)}")
+
+
 def max_sigma_for_yield(model: PairPhasors, sigma_m, draws: int, seed: int, target_yield: float,
                         spec_deg: float = 0.1, case: str = "calibrated", axis: str = "all",
                         distribution: str = "normal", rel_tol: float = 0.01,
@@ -328,14 +341,7 @@ def max_sigma_for_yield(model: PairPhasors, sigma_m, draws: int, seed: int, targ
     the power of the scale the deciding draw's error is taken to follow until two evaluations
     measure it (:func:`largest_passing_scale`)."""
     base = np.asarray(sigma_m, float).reshape(3)
-    if axis == "all":
-        direction = base / base.max() if base.max() > 0 else np.ones(3)
-        fixed = np.zeros(3)
-    elif axis in AXES:
-        direction = np.eye(3)[AXES.index(axis)]
-        fixed = base * (1 - direction)
-    else:
-        raise ValueError(f"axis {axis!r}: must be 'all' or one of {', '.join(AXES)}")
+    direction, fixed = search_direction(base, axis)
     history = []
 
     def yield_at(t: float) -> tuple[float, float]:

@@ -67,9 +67,9 @@ from ..geometry.setup import nominal_setup
 from ..paths import exact_paths
 from ..radar.steering import Steering
 from .tolerance import (AXES, CASES, DEFAULT_CHUNK, draws_header, Mapper, Progress, largest_passing_scale,
-                        percentiles, standard_draws)
+                        percentiles, search_direction, standard_draws)
 from .arc import Bounds, _scale, arc_draws
-from .subbin import subbin_positions
+from .subbin import centre_index, subbin_positions
 from .tolerance_model import reference_target, response_table, slide
 
 __all__ = ["CellPhasors", "CellToleranceResult", "ANGLES", "monte_carlo_cell",
@@ -174,7 +174,7 @@ class CellPhasors:
     @property
     def subbin_zero(self) -> int:
         """Index of the bin centre in :attr:`subbin_steps`."""
-        return int(np.flatnonzero(self.subbin_steps == 0)[0])
+        return centre_index(self.subbin_steps)
 
     # -- one draw ---------------------------------------------------------------------------
 
@@ -460,14 +460,7 @@ def max_sigma_for_yield_cell(model: CellPhasors, sigma_m, draws: int, seed: int,
     :func:`~rtsgeom.analysis.tolerance.largest_passing_scale`, the same keys; ``subbin``:
     :func:`monte_carlo_cell`'s, the same positions at every scale)."""
     base = np.asarray(sigma_m, float).reshape(3)
-    if axis == "all":
-        direction = base / base.max() if base.max() > 0 else np.ones(3)
-        fixed = np.zeros(3)
-    elif axis in AXES:
-        direction = np.eye(3)[AXES.index(axis)]
-        fixed = base * (1 - direction)
-    else:
-        raise ValueError(f"axis {axis!r}: must be 'all' or one of {', '.join(AXES)}")
+    direction, fixed = search_direction(base, axis)
     history = []
 
     def yield_at(t: float) -> float:

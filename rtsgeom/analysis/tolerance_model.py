@@ -66,7 +66,7 @@ from ..radar.phasors import bin_response
 from ..radar.processing import refine_angles, tdm_compensate
 from ..rts import KIND_DIRECT, RtsProgram, channel_echoes, requested_delay
 from ..scene import TargetConfig
-from .subbin import subbin_positions
+from .subbin import centre_index, subbin_positions
 
 __all__ = ["PairPhasors", "HALF_BINS", "PROBE_FRACTIONS", "response_table"]
 
@@ -325,7 +325,7 @@ class PairPhasors:
         design = _Design(frozen(beams_i), frozen(beams_j), i0, frozen(power), frozen(p_one),
                          frozen(probe_beams), model.unit_gain, reach)
         amps, kbin, ok, _ = design(table, z + sub, z + sub, np.arange(sub.size))
-        c0 = int(np.flatnonzero(sub == 0)[0])
+        c0 = centre_index(sub)
         # no closed-form design at the bin centre (spacings beyond the beam's resolution):
         # ChannelModel.solve's root finder on the searched peak, AngleUnreachable where even
         # that fails; elsewhere in the bin NaN, which fails the spec
@@ -352,7 +352,7 @@ class PairPhasors:
     @property
     def subbin_zero(self) -> int:
         """Index of the bin centre in :attr:`subbin_steps`."""
-        return int(np.flatnonzero(self.subbin_steps == 0)[0])
+        return centre_index(self.subbin_steps)
 
     # -- one draw's channels -------------------------------------------------------------
 
