@@ -82,6 +82,9 @@ def scene_info(setup: Setup, reachable: bool = False) -> dict:
     curv = np.degrees(curvature_phase_error_rad(setup))
     spacing = np.degrees(np.diff(fe.angle_rad))
     res = np.degrees(angular_resolution_rad(rut))
+    # elevation of each module centre seen from the RuT: u_el = sin(el) (radar frame)
+    fe_el = np.zeros(fe.count) if fe.elevation_rad is None else fe.elevation_rad  # None: an arc
+    el_rut = np.degrees(np.arcsin(np.clip(setup.fe_direction_cosines()[:, 1], -1.0, 1.0)))
     out = {
         "rtsgeom_version": __version__,
         "scene": s.name,
@@ -123,6 +126,8 @@ def scene_info(setup: Setup, reachable: bool = False) -> dict:
                 "rx_tx_separation_m": float(fe.separation_m[i]),
                 "mounting_offsets_mm": [float(x) for x in fe.offsets_m[i] * 1e3],
                 "curvature_phase_error_deg": float(curv[i]),
+                "elevation_deg": float(np.degrees(fe_el[i])),
+                "elevation_from_rut_deg": float(el_rut[i]),
             }
             for i in range(fe.count)
         ],
@@ -130,7 +135,8 @@ def scene_info(setup: Setup, reachable: bool = False) -> dict:
         "spacing_within_resolution": [bool(x <= res) for x in spacing],
         "targets": [
             {"range_m": t.range_m, "velocity_mps": t.velocity_mps, "rcs_dbsm": t.rcs_dbsm,
-             "angle_deg": float(np.degrees(t.angle_rad))}
+             "angle_deg": float(np.degrees(t.angle_rad)),
+             "elevation_deg": float(np.degrees(t.elevation_rad))}
             for t in s.targets
         ],
     }
@@ -182,10 +188,15 @@ def format_info(info: dict) -> str:
         "front ends:",
         "   #  arc deg  azimuth from RuT  apparent (Rx/Tx split)  distance m  array phase error deg p-p",
     ]
+    el = _has_elevation(info)
+    if el:
+        lines[-1] += "  elevation deg (sphere, from RuT)"
     for fe in info["front_ends"]:
         lines.append(f"  {fe['index']:2d} {fe['arc_angle_deg']:8.3f} {fe['azimuth_from_rut_deg']:17.4f}"
                      f" {fe['apparent_azimuth_deg']:23.4f} {fe['distance_m']:11.5f}"
-                     f" {fe['curvature_phase_error_deg']:18.2f}")
+                     f" {fe['curvature_phase_error_deg']:18.2f}"
+                     + (f"  {fe['elevation_deg']:8.3f} {fe['elevation_from_rut_deg']:9.4f}"
+                        if el else ""))
     for i, (sp, ok) in enumerate(zip(info["front_end_spacing_deg"],
                                      info["spacing_within_resolution"])):
         lines.append(f"  spacing {i}-{i + 1}: {sp:.3f} deg "
@@ -203,7 +214,9 @@ def format_info(info: dict) -> str:
         lines.append("targets:")
         for i, t in enumerate(info["targets"]):
             line = (f"  {i}: {t['range_m']:.3f} m, {t['velocity_mps']:+.3f} m/s, "
-                    f"{t['angle_deg']:.3f} deg, {t['rcs_dbsm']:.1f} dBsm")
+                    f"{t['angle_deg']:.3f} deg"
+                    + (f" el {t['elevation_deg']:.3f} deg" if el else "")
+                    + f", {t['rcs_dbsm']:.1f} dBsm")
             if reach:
                 rt = reach["targets"][i]
                 if not rt["reachable"]:
@@ -215,6 +228,11 @@ def format_info(info: dict) -> str:
         from .link import format_budget
         lines += format_budget(info["link_budget"])
     return "\n".join(lines)
+
+
+def _has_elevation(info: dict) -> bool:
+    """Whether a front end or a target of ``info`` is off elevation 0 (a 2-D cell scene)."""
+    return any(x.get("elevation_deg", 0.0) for x in info["front_ends"] + info["targets"])
 
 
 def unreachable_warnings(info: dict, skip_outside_geometric: bool = False) -> list[str]:

@@ -129,7 +129,8 @@ def _calibration_figures(result: RunResult) -> list[bytes]:
             residual_error_deg=cal.get("residual_error_deg"),
             refine_delta_tau_s=[p["delta_tau_s"] for p in rf],
             refine_error_deg=[np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
-                              for p in rf])
+                              for p in rf],
+            title=f"Phase coherency calibration, front ends {cal['pair'][0]}-{cal['pair'][1]}")
         out.append(figure_png(fig))
     return out
 
@@ -143,6 +144,27 @@ def _setup_png(result: RunResult, paths_method: str) -> bytes:
     with tempfile.TemporaryDirectory(prefix="rtsgeom-3d-") as tmp:  # private to this run
         return render_setup_png(result.setup, Path(tmp) / "setup.png",
                                 paths=paths).read_bytes()
+
+
+def _targets_table(matches: list[dict]) -> dict:
+    """The report's set-point vs detection table; with elevation columns when a target has
+    an elevation (a 2-D cell scene: ``set`` carries ``elevation_deg``)."""
+    el = any("elevation_deg" in m["set"] for m in matches)
+    keys = [("range_m", "range (m)", 4), ("velocity_mps", "velocity (m/s)", 4),
+            ("angle_deg", "angle (deg)", 3)] + ([("elevation_deg", "elevation (deg)", 3)]
+                                                 if el else [])
+    rows = []
+    for m in matches:
+        s, d, e = m["set"], m["detection"], m["error"]
+        found = (("not detected",) + ("-",) * (2 * len(keys) - 1) if d is None else
+                 tuple(d.get(k, "-") for k, _, _ in keys) + tuple(e.get(k, "-")
+                                                                  for k, _, _ in keys))
+        rows.append([m["index"], *(s.get(k, 0.0) for k, _, _ in keys), *found])
+    digits = [d for _, _, d in keys]
+    return {"columns": ["target", *(f"set {name}" for _, name, _ in keys),
+                        *(name for _, name, _ in keys),
+                        *(name.replace(" (", " error (") for _, name, _ in keys)],
+            "rows": rows, "digits": [None] + digits * 3}
 
 
 def run_report_html(result: RunResult, maps: dict[str, bytes], paths_method: str,
@@ -161,20 +183,8 @@ def run_report_html(result: RunResult, maps: dict[str, bytes], paths_method: str
         warnings = warnings + [f"3D view not rendered: {exc}"]
     sections.append({"heading": "Setup", "images": images,
                      "text": f"Paths: {paths_method} ({len(result.paths)} rows)."})
-    rows = []
-    for m in result.matches:
-        s, d, e = m["set"], m["detection"], m["error"]
-        rows.append([m["index"], s["range_m"], s["velocity_mps"], s["angle_deg"],
-                     *(("not detected",) + ("-",) * 5 if d is None else
-                       (d["range_m"], d["velocity_mps"], d["angle_deg"], e["range_m"],
-                        e["velocity_mps"], e["angle_deg"]))])
     sections.append({"heading": "Targets: set-points and detections",
-                     "table": {"columns": ["target", "set range (m)", "set velocity (m/s)",
-                                           "set angle (deg)", "range (m)", "velocity (m/s)",
-                                           "angle (deg)", "range error (m)",
-                                           "velocity error (m/s)", "angle error (deg)"],
-                               "rows": rows,
-                               "digits": [None, 4, 4, 3, 4, 4, 3, 4, 4, 3]},
+                     "table": _targets_table(result.matches),
                      "images": list(maps.values())})
     cal = result.calibration
     if cal:
