@@ -29,6 +29,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import os
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from typing import Callable
@@ -265,15 +266,26 @@ class DesignGrid:
         }
 
 
+def available_cores() -> int:
+    """The cores this process may run on (its CPU affinity where the OS reports one, as a
+    container's CPU set limits it; else ``os.cpu_count()``)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
 def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
                 spec_deg: float = 0.1, target_yield: float = 0.95, draws: int = 2000,
                 seed: int = 0, points: int = 21,
                 progress: Callable[[int, int], None] | None = None,
-                workers: int = 1) -> DesignGrid:
+                workers: int | None = 1) -> DesignGrid:
     """Evaluate every (spacing, radius) design; ``progress(done, total)`` after each.
 
     ``workers`` > 1: the designs in a pool of that many processes (each design is pure: the
-    same result, in the same order, however they are spread). A design's time is about half
+    same result, in the same order, however they are spread); None: as many as this process
+    may run on (:func:`available_cores`; ``rtsgeom design``'s default; one process on one
+    core). A design's time is about half
     its ``PairPhasors.build`` (the delay tables: the FIR's response along the chirp and
     ``bin_response`` for ~6000 delays) and half its two tolerance searches
     (``max_sigma_for_yield``: ~5 Monte Carlos each of ``draws`` draws x ``points``
@@ -285,6 +297,7 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     centre = 0.5 * (fes[pair[0]].angle_rad + fes[pair[1]].angle_rad)
     cells = [(float(r), math.radians(s)) for s in spacings for r in radii]
     total = len(cells)
+    workers = available_cores() if workers is None else int(workers)
     one = functools.partial(_evaluate_cell, scene, pair, spec_deg, target_yield, draws, seed,
                             points)
     designs = []

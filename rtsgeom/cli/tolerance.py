@@ -194,7 +194,7 @@ def _design(args, scene, stage) -> int:
                            args.yield_, args.draws, seed, args.points,
                            None if progress is None else
                            (lambda done, total: progress("designs", done, total)),
-                           workers=args.workers or 1)
+                           workers=args.workers)
     out = grid.to_dict()
     if stage is not None:
         from ..viz.figures import design_heatmap_figure, design_lines_figure, save_figure
@@ -346,7 +346,8 @@ def register(sub) -> None:
                    help="fraction of setups within the spec for the tolerance, in (0, 1] "
                         "(default 0.95)")
     p.add_argument("--workers", type=number(1, 1024, integer=True), default=None,
-                   help="evaluate the grid's designs in N processes (same result; default 1)")
+                   help="evaluate the grid's designs in N processes (same result; default: "
+                        "the cores this process may run on)")
     # "--coverage-deg -10:10": argparse takes a word starting with "-" for an option unless it
     # looks like a negative number; teach this parser that A:B ranges are numbers too.
     import re
