@@ -110,7 +110,7 @@ def _detect(setup, paths, program, seed):
     return process(cube)
 
 
-def _pair_probes(setup, paths, pair, probe, delta_s: float = 0.0):
+def _pair_probes(setup, paths, pair, probe, delta_s: float = 0.0, p_ref: dict | None = None):
     """The 2-D pair sweep's two probes at a step ``delta_s`` of channel j: their ranges (P,),
     programme amplitudes (P, 2) (the nominal model's design, with channel j at that delay,
     for channels coherent at the front ends' midpoint, amplitude ratios ``PROBE_RATIOS``,
@@ -118,19 +118,24 @@ def _pair_probes(setup, paths, pair, probe, delta_s: float = 0.0):
     the RuT's steering. Designed at every step, as the 1-D sweep (``sweep.phasor_sweep``):
     channel j's echo moves by c0 delta / 2 in range (a quarter bin over +-period/4) and its
     gain in the bin with it; a design fixed at delta = 0 made each probe's error curve
-    lopsided about the coherence point (its vertex 50 to 70 ps off in elevation, sphere4)."""
+    lopsided about the coherence point (its vertex 50 to 70 ps off in elevation, sphere4).
+    ``p_ref``: a dict the sweep keeps across its steps, probe -> channel i's single-channel
+    peak power (``ChannelSet.reference_power``; channel i does not move with delta, so one
+    2-D grid search a probe instead of one a step)."""
     from .calibration import nominal_model, probe_ranges
     nom, nom_paths = nominal_model(setup, paths)
     ranges = probe_ranges(setup, 2)
     corr = probe.gain_correction[list(pair)]
     designs, predicted = [], []
-    for r, rho in zip(ranges, PROBE_RATIOS):
+    for p, (r, rho) in enumerate(zip(ranges, PROBE_RATIOS)):
         cs = ChannelSet.build(nom, nom_paths, pair, TargetConfig(float(r)), (0.0, delta_s))
         u_mid = cs.fe_directions().mean(axis=0)
         ph = cs.coherent_phases(u_mid[None])
         w = cs.weights([1.0, rho], ph)
         u_pred = cs.direction_cosines(w, u_mid)
-        designs.append(cs.amplitudes(w, u_pred) * corr)
+        if p_ref is not None and p not in p_ref:
+            p_ref[p] = cs.reference_power()
+        designs.append(cs.amplitudes(w, u_pred, None if p_ref is None else p_ref[p]) * corr)
         predicted.append(u_pred)
     return ranges, designs, predicted, cs.steering
 
@@ -217,12 +222,13 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
         row = cal.to_dict()
         row["residual_error_deg"] = float(cal.residual_error_deg)
         return row
-    ranges, _, _, st = _pair_probes(setup, paths, pair, probe)
+    p_ref: dict = {}  # channel i's reference power per probe (fixed over the sweep)
+    ranges, _, _, st = _pair_probes(setup, paths, pair, probe, 0.0, p_ref)
     base = [float(requested_delay(scene, r)) for r in ranges]
 
     def signed(delta: float) -> np.ndarray:
         """The probes' detected direction-cosine errors (P * D,) (NaN: not detected)."""
-        _, designs, predicted, _ = _pair_probes(setup, paths, pair, probe, delta)
+        _, designs, predicted, _ = _pair_probes(setup, paths, pair, probe, delta, p_ref)
         tg, fe, dl, amp = [], [], [], []
         for k, (a, b) in enumerate(zip(base, designs)):
             tg += [k, k]

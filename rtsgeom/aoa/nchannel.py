@@ -241,13 +241,21 @@ class ChannelSet:
                 f"{np.round(u_set + r, 6).tolist()}): outside what this cell can synthesize")
         return amps(x)
 
-    def amplitudes(self, w, u_set) -> np.ndarray:
+    def reference_power(self) -> float:
+        """Beamformer power of channel 0 alone at its own (global) peak: the level
+        :meth:`amplitudes` keeps. Depends on channel 0 only, so a sweep that moves only
+        other channels' delays may compute it once and pass it in (``ncal``'s 2-D sweep:
+        one 2-D grid search a probe instead of one a step)."""
+        single = self.model.snapshot(np.eye(self.count)[0])
+        u_one = self.direction_cosines(np.eye(self.count)[0])
+        return float(self.steering.power(single, np.atleast_2d(u_one))[0])
+
+    def amplitudes(self, w, u_set, p_ref: float | None = None) -> np.ndarray:
         """Programme amplitudes (Q,): ``|w|`` scaled so the combined beamformer peak (at
-        ``u_set``) is as strong as channel 0 alone at its own peak (the target keeps its RCS)."""
+        ``u_set``) is as strong as channel 0 alone at its own peak (the target keeps its RCS);
+        ``p_ref``: that single-channel power (:meth:`reference_power`) when known."""
         st = self.steering
         u_set = np.atleast_2d(np.asarray(u_set, float))
         p_sum = st.power(self.model.snapshot(w), u_set)[0]
-        single = self.model.snapshot(np.eye(self.count)[0])
-        u_one = self.direction_cosines(np.eye(self.count)[0])
-        p_one = st.power(single, np.atleast_2d(u_one))[0]
+        p_one = self.reference_power() if p_ref is None else p_ref
         return self.model.unit_gain * np.sqrt(p_one / max(p_sum, 1e-300)) * np.abs(w)
