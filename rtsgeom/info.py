@@ -43,10 +43,12 @@ def reachable_spans(setup: Setup, mode: str | None = None, paths=None) -> dict:
         ``reachable``).
     """
     from .aoa.calibration import probe_front_ends
-    from .aoa.plan import bracketing_pair
+    from .aoa.plan import bracketing_pair, uses_cells
     from .paths import exact_paths
     scene = setup.scene
     mode = mode or scene.rts.aoa_mode
+    if uses_cells(scene):
+        return _reachable_cells(setup, mode)
     probe = probe_front_ends(setup, exact_paths(setup) if paths is None else paths, scene.seed)
     meas = probe.angle_rad
     geo = setup.fe_azimuth_rad()
@@ -71,6 +73,20 @@ def reachable_spans(setup: Setup, mode: str | None = None, paths=None) -> dict:
                         "reachable": bool(ok or mode == "nearest")})
     return {"mode": mode, "measured_angle_deg": [float(x) for x in np.degrees(meas)],
             "pairs": pairs, "targets": targets}
+
+
+def _reachable_cells(setup: Setup, mode: str) -> dict:
+    """:func:`reachable_spans` of a scene of 2-D cells: each target's enclosing cell of front
+    ends (``aoa.plan_cells.target_cells``, what ``run`` plans with); ``pairs`` is empty (the
+    cells are not pairs along an arc) and ``cells`` True."""
+    from .aoa.plan_cells import target_cells
+    _, _, found = target_cells(setup)
+    targets = [{"index": k, "angle_deg": float(np.degrees(t.angle_rad)),
+                "elevation_deg": float(np.degrees(t.elevation_rad)),
+                "pair": None, "cell": None if cell is None else [int(q) for q in cell],
+                "reachable": cell is not None, "why": why}
+               for k, (t, (cell, why)) in enumerate(zip(setup.scene.targets, found))]
+    return {"mode": mode, "cells": True, "pairs": [], "targets": targets}
 
 
 def scene_info(setup: Setup, reachable: bool = False) -> dict:
@@ -197,12 +213,16 @@ def format_info(info: dict) -> str:
                      f" {fe['curvature_phase_error_deg']:18.2f}"
                      + (f"  {fe['elevation_deg']:8.3f} {fe['elevation_from_rut_deg']:9.4f}"
                         if el else ""))
-    for i, (sp, ok) in enumerate(zip(info["front_end_spacing_deg"],
+    # consecutive indices' arc angles: a spacing along an arc, not between a 2-D cell's corners
+    for i, (sp, ok) in enumerate(zip(info["front_end_spacing_deg"] if not el else (),
                                      info["spacing_within_resolution"])):
         lines.append(f"  spacing {i}-{i + 1}: {sp:.3f} deg "
                      f"({'within' if ok else 'EXCEEDS'} the angular resolution)")
     reach = info.get("reachable")
-    if reach:
+    if reach and reach.get("cells"):
+        lines.append("reachable directions: each target in the cell of front ends that encloses "
+                     "its direction cosines (as `run` plans it; 2-D cells, not arc pairs)")
+    elif reach:
         how = (" (intersected with the geometric angles: closed-form amplitudes)"
                if reach["mode"] in CLOSED_FORM_MODES else "")
         lines.append(f"reachable angles ({reach['mode']} amplitudes; each front end alone as "
@@ -221,6 +241,8 @@ def format_info(info: dict) -> str:
                 rt = reach["targets"][i]
                 if not rt["reachable"]:
                     line += "  OUTSIDE the reachable angles: `run` refuses it"
+                elif rt.get("cell") is not None:
+                    line += f"  (cell {'-'.join(str(q) for q in rt['cell'])})"
                 elif rt["pair"] is not None and reach["mode"] != "nearest":
                     line += f"  (pair {rt['pair'][0]}-{rt['pair'][1]})"
             lines.append(line)
@@ -243,6 +265,8 @@ def unreachable_warnings(info: dict, skip_outside_geometric: bool = False) -> li
     reach = info.get("reachable")
     if not reach:
         return []
+    if reach.get("cells"):
+        return [f"{t['why']}; `run` refuses it" for t in reach["targets"] if not t["reachable"]]
     geo = [fe["azimuth_from_rut_deg"] for fe in info["front_ends"]]
     spans = ", ".join(f"pair {p['pair'][0]}-{p['pair'][1]} [{p['lo_deg']:.4f}, "
                       f"{p['hi_deg']:.4f}] deg" for p in reach["pairs"])

@@ -61,3 +61,30 @@ def test_targets_table_columns(el):
         assert row[tab["columns"].index("elevation error (deg)")] == -0.01
         assert row[tab["columns"].index("set elevation (deg)")] == el
     assert tab["rows"][1][1 + n] == "not detected"
+
+
+@pytest.mark.parametrize("radius", [0.6, 1.5])
+def test_reachable_cells_in_info(radius):
+    """`info` on a cell scene names each target's enclosing cell (the planner's choice, not arc
+    pairs) and warns, naming the target, for a direction outside every cell."""
+    from rtsgeom.aoa.plan_cells import target_cells
+    from rtsgeom.info import reachable_spans, unreachable_warnings
+    from rtsgeom.scene import TargetConfig
+    scene = corners(load_scene(SCENE), (-3.0, 5.0), (-3.0, 3.0), radius=radius, height=1.5)
+    inside = TargetConfig(20.0, angle_rad=np.radians(1.0), elevation_rad=np.radians(0.5))
+    outside = TargetConfig(25.0, angle_rad=np.radians(9.0), elevation_rad=np.radians(0.5))
+    scene = scene.evolve(radar=scene.radar.evolve(use_elevation_tx=True))  # elevation extent
+    setup = build_setup(scene.evolve(targets=(inside, outside)))
+    reach = reachable_spans(setup)
+    assert reach["cells"] and reach["pairs"] == []
+    _, _, found = target_cells(setup)
+    assert [t["cell"] for t in reach["targets"]] == [
+        None if c is None else list(c) for c, _ in found]
+    assert reach["targets"][0]["cell"] == [0, 1, 2, 3] and reach["targets"][0]["reachable"]
+    assert not reach["targets"][1]["reachable"]
+    info = scene_info(setup)
+    info["reachable"] = reach
+    warns = unreachable_warnings(info)
+    assert len(warns) == 1 and "targets[1]" in warns[0]
+    text = format_info(info)
+    assert "(cell 0-1-2-3)" in text and "spacing 0-1" not in text

@@ -26,7 +26,35 @@ from .model import AngleUnreachable
 from .nchannel import ChannelSet, target_direction
 from .plan import uses_cells  # noqa: F401  (re-exported: the planner decides with it)
 
-__all__ = ["plan_cells", "uses_cells"]
+__all__ = ["plan_cells", "target_cells", "uses_cells"]
+
+
+def target_cells(setup: Setup) -> tuple[Steering, np.ndarray, list]:
+    """Each target's enclosing cell of front ends (``aoa.cells.enclosing_cell`` on the front
+    ends' geometric direction cosines seen from the RuT, 1-D where the RuT beamforms in
+    azimuth only): the RuT's steering, the front ends' direction cosines (F, D) and per
+    target ``(cell, None)`` or ``(None, why)`` (the field and the reason it is unreachable).
+    Shared by the planner and ``rtsgeom info``."""
+    scene = setup.scene
+    st = Steering.auto(setup.rut, scene.radar)  # the beamformer the RuT runs
+    u_fe = setup.fe_direction_cosines()
+    u_fe = np.sin(setup.fe_azimuth_rad())[:, None] if st.dims == 1 else u_fe
+    out: list = []
+    for k, t in enumerate(scene.targets):
+        if st.dims == 1 and getattr(t, "elevation_rad", 0.0):
+            out.append((None, f"targets[{k}].elevation_deg = {np.degrees(t.elevation_rad):g}: "
+                              f"must be 0: the RuT's array ({scene.radar.antenna_preset}, "
+                              "use_elevation_tx = "
+                              f"{str(scene.radar.use_elevation_tx).lower()}) has no elevation "
+                              "extent, it cannot see a target's elevation"))
+            continue
+        try:
+            out.append((enclosing_cell(target_direction(st, t), u_fe), None))
+        except CellUnreachable as exc:
+            out.append((None, f"targets[{k}] (angle_deg = {np.degrees(t.angle_rad):g}, "
+                              f"elevation_deg = {np.degrees(getattr(t, 'elevation_rad', 0.0)):g})"
+                              f": unreachable: {exc}"))
+    return st, u_fe, out
 
 
 def plan_cells(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, progress=None
@@ -40,25 +68,12 @@ def plan_cells(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, pr
     nom, nom_paths = nominal_model(setup, paths)
     probe = probe_front_ends(setup, paths, scene.seed)
     warnings: list[str] = []
-    st = Steering.auto(nom.rut, scene.radar)  # the beamformer the RuT runs
-    u_fe = nom.fe_direction_cosines()
-    u_fe = np.sin(nom.fe_azimuth_rad())[:, None] if st.dims == 1 else u_fe
+    st, u_fe, found = target_cells(nom)
     cells = {}
-    for k, t in enumerate(scene.targets):
-        if st.dims == 1 and getattr(t, "elevation_rad", 0.0):
-            raise SceneError(f"{scene.source}: targets[{k}].elevation_deg = "
-                             f"{np.degrees(t.elevation_rad):g}: must be 0: the RuT's array "
-                             f"({scene.radar.antenna_preset}, use_elevation_tx = "
-                             f"{str(scene.radar.use_elevation_tx).lower()}) has no elevation "
-                             "extent, it cannot see a target's elevation")
-        u = target_direction(st, t)
-        try:
-            cells[k] = enclosing_cell(u, u_fe)
-        except CellUnreachable as exc:
-            raise SceneError(f"{scene.source}: targets[{k}] (angle_deg = "
-                             f"{np.degrees(t.angle_rad):g}, elevation_deg = "
-                             f"{np.degrees(getattr(t, 'elevation_rad', 0.0)):g}): unreachable: "
-                             f"{exc}") from None
+    for k, (cell, why) in enumerate(found):
+        if cell is None:
+            raise SceneError(f"{scene.source}: {why}")
+        cells[k] = cell
     offsets = np.zeros(setup.fe.count)
     cal_record: dict = {}
     used = sorted({q for cell in cells.values() for q in cell})
