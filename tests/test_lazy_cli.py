@@ -68,6 +68,29 @@ def test_commands_import_only_what_they_use(tmp_path, args):
     assert heavy == [], f"rtsgeom {' '.join(args)} imports {heavy}"
 
 
+@pytest.mark.parametrize("args", [["ghosts", str(SCENE)], ["calibrate", "--help"]])
+def test_commands_without_kernels_skip_numba(tmp_path, args):
+    """The compiled kernels (numba, ~0.16 s to import) load inside the functions that call
+    them: commands that never call one do not pay for numba."""
+    code, mods = _imported(args, tmp_path)
+    assert code == 0
+    assert _loaded(mods, ("numba", "llvmlite")) == [], f"rtsgeom {' '.join(args)} imports numba"
+
+
+def test_calibrate_imports_only_what_it_uses(tmp_path):
+    """``calibrate --pair 0 1`` (issue 17: a new process under a second): the kernels it
+    calls and matplotlib for its figure, none of the other optional libraries and none of
+    scipy's optimize/signal/interpolate/stats."""
+    code, mods = _imported(["calibrate", str(SCENE), "--pair", "0", "1", "--quiet",
+                            "--out", str(tmp_path / "cal")], tmp_path)
+    assert code == 0
+    assert (tmp_path / "cal" / "calibration.json").is_file()
+    unused = [n for n in OPTIONAL if n not in ("numba", "llvmlite", "matplotlib")]
+    heavy = _loaded(mods, (*unused, "scipy.signal", "scipy.optimize", "scipy.interpolate",
+                           "scipy.stats"))
+    assert heavy == [], f"rtsgeom calibrate imports {heavy}"
+
+
 def test_unknown_command_is_a_one_line_error(tmp_path):
     code, _mods = _imported(["no-such-command"], tmp_path)
     assert code == 2

@@ -238,7 +238,9 @@ def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair,
     deltas = np.atleast_1d(np.asarray(deltas, float))
     n_s, n_p = deltas.size, len(targets)
     nom_models = _models(*nominal, pair, targets, base_offsets, deltas)
-    real_models = _models(setup, paths, pair, targets, base_offsets, deltas)
+    # no mounting errors (nominal_model returns the same objects): the same models, built once
+    real_models = (nom_models if nominal[0] is setup and nominal[1] is paths
+                   else _models(setup, paths, pair, targets, base_offsets, deltas))
     st = nom_models[0].steering
     radar = setup.scene.radar
     kbin = np.empty((n_s, n_p), int)
@@ -249,7 +251,7 @@ def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair,
     steps = np.arange(n_s)
     for p, (mn, mr, alpha) in enumerate(zip(nom_models, real_models, alphas)):
         hn = tdm_compensate(mn.responses, mn.doppler_hz, setup.rut, radar)  # (K, 1+S, V)
-        ha = tdm_compensate(mr.responses, mr.doppler_hz, setup.rut, radar)
+        ha = hn if mr is mn else tdm_compensate(mr.responses, mr.doppler_hz, setup.rut, radar)
         phases = mn.coherent_phases(alphas, hn)[..., 1:]  # (K, S): J's coherent phase per bin
         rho = design_ratio(st, hn[:, :1, :], hn[:, 1:, :], alpha, phases)  # (K, S)
         # power normalisation (ChannelModel.scale): the combined peak as strong as I alone
