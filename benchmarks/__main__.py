@@ -222,7 +222,7 @@ def bench_commands(scene_path: Path, quick: bool, repeat: int, workers: int) -> 
            "--sigma-tangential-mm", "0.1", "--sigma-height-mm", "0.1", "--seed", "1",
            "--json", "--quiet"]
     out["tolerance"] = {"draws": draws, **_time_cli(tol + ["--draws", str(draws)])}
-    # "on one machine": both cores, the chunks on a local Dask cluster of 2 processes
+    # "on one machine": both cores, the chunks in 2 forked worker processes (parallel.fork_map)
     out["tolerance_2_workers"] = {"draws": draws, **_time_cli(
         tol + ["--draws", str(draws), "--workers", "2"])}
     dask_draws = 100_000 if quick else 400_000
@@ -278,7 +278,8 @@ def bench_design_parts(scene, quick: bool) -> dict:
 def bench_dask_scaling(scene_path: Path, draws: int, workers: int) -> dict:
     """Tolerance draws on a warm LocalCluster of 1 and of ``workers`` single-threaded worker
     processes (cluster start and the first chunk excluded: the scaling of the study itself).
-    The CLI's ``--workers N`` adds the cluster start (about 10 s here) to this."""
+    (The CLI's ``--workers N`` forks a process pool instead, with no cluster to start; ``--dask
+    ADDRESS`` runs on a cluster like this one, sent per chunk the draw streams' states.)"""
     from rtsgeom.analysis.tolerance import PairPhasors, monte_carlo
     from rtsgeom.geometry import build_setup
     from rtsgeom.parallel import dask_client, map_chunks

@@ -262,6 +262,39 @@ def test_same_seed_gives_identical_results(model):
     assert a.to_dict() == b.to_dict()
 
 
+@pytest.mark.parametrize("distribution", ["normal", "uniform"])
+@pytest.mark.parametrize("chunk", [1, 7, 64, 1000])
+def test_draw_chunks_regenerate_the_streams_bit_for_bit(distribution, chunk):
+    """The chunks a cluster is sent (stream states, not draws) rebuild exactly the draws of
+    standard_draws / subbin_draws, whatever the chunk size."""
+    from rtsgeom.analysis.tolerance import draw_chunks, standard_draws, subbin_draws
+    sigma = np.array([1.0, 2.0, 3.0]) * 1e-4
+    parts = list(draw_chunks(5, 300, sigma, distribution, chunk, positions=9, centre=4))
+    assert [p.k for p in parts] == [min(chunk, 300 - s) for s in range(0, 300, chunk)]
+    offsets = np.concatenate([p.offsets() for p in parts])
+    subbin = np.concatenate([p.subbin() for p in parts])
+    assert np.array_equal(offsets, np.concatenate(list(standard_draws(5, 300, distribution))) * sigma)
+    assert np.array_equal(subbin, np.concatenate(list(subbin_draws(5, 300, 9))))
+    centre = draw_chunks(5, 300, sigma, distribution, chunk, 9, 4, subbin=False)
+    assert np.array_equal(np.concatenate([p.subbin() for p in centre]), np.full(300, 4))
+
+
+def test_fork_pool_gives_bit_identical_results(model):
+    """--workers N (a forked process pool) equals the single-process run bit for bit."""
+    import functools
+
+    from rtsgeom.parallel import _can_fork, fork_map
+    if not _can_fork():
+        pytest.skip("no fork on this platform")
+    local = monte_carlo(model, [1e-4] * 3, 300, seed=9, chunk=64)
+    pooled = monte_carlo(model, [1e-4] * 3, 300, seed=9, chunk=64,
+                         mapper=functools.partial(fork_map, workers=2))
+    for case in CASES:
+        assert np.array_equal(local.worst_error_deg[case], pooled.worst_error_deg[case])
+    assert np.array_equal(local.delay_s, pooled.delay_s)
+    assert local.to_dict() == pooled.to_dict()
+
+
 def test_larger_sigma_gives_larger_p95(model):
     p95 = {case: [] for case in CASES}
     for sigma in (0.03e-3, 0.1e-3, 0.3e-3):
