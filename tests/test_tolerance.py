@@ -386,3 +386,26 @@ def test_dask_local_cluster_gives_bit_identical_results():
     for case in local.worst_error_deg:
         assert np.array_equal(local.worst_error_deg[case], remote.worst_error_deg[case])
     assert np.array_equal(local.delay_s, remote.delay_s)
+
+
+def test_chunk_mapper_fork_pool_every_draw_mode():
+    """``--workers N``'s forked pool (chunk_mapper without a scheduler) equals one process bit
+    for bit, with uneven chunks, for normal and uniform draws and both sub-bin modes."""
+    from rtsgeom.analysis.tolerance import PairPhasors, monte_carlo
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.parallel import chunk_mapper
+    model = PairPhasors.build(build_setup(make_scene()), (0, 1), points=5)
+    sigma = np.array([0.3, 0.2, 0.5]) * 1e-3
+    for distribution, subbin in (("normal", True), ("uniform", False)):
+        local = monte_carlo(model, sigma, 1300, 7, distribution, chunk=300, subbin=subbin)
+        with chunk_mapper(None, 2) as mapper:
+            assert mapper is not None
+            pooled = monte_carlo(model, sigma, 1300, 7, distribution, chunk=300,
+                                 mapper=mapper, subbin=subbin)
+        for case in local.worst_error_deg:
+            assert np.array_equal(local.worst_error_deg[case], pooled.worst_error_deg[case])
+        assert np.array_equal(local.delay_s, pooled.delay_s)
+        assert np.array_equal(local.range_offset_m, pooled.range_offset_m)
+        assert local.fallbacks == pooled.fallbacks and local.off_bin == pooled.off_bin
+    with chunk_mapper(None, 1) as mapper:
+        assert mapper is None  # one worker: this process
