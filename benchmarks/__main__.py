@@ -6,8 +6,9 @@ matters less. Not part of the test suite.
   the default scene), one full-chain frame (synthesis + range-Doppler + CFAR + angle),
   ``calibrate --pair 0 1``, ``adc --format dca1000``, ``design`` (default grid; also with
   ``--workers 2``, and its CPU split into model builds and tolerance searches),
-  ``nearfield``, ``tolerance`` (1e6 draws x 21 set-points; 1e5 with ``--quick``; also on a
-  2-worker Dask LocalCluster), ``info`` and ``--help``. Each: wall time, CPU time (this
+  ``nearfield``, ``tolerance`` (1e6 draws x 21 set-points; 1e5 with ``--quick``; also with
+  ``--workers 2``, forked processes, and on a warm Dask LocalCluster of 1 and 2 workers),
+  ``info`` and ``--help``. Each: wall time, CPU time (this
   process's ``time.process_time`` in process, the child's user + system time for a
   subprocess) and wall / reference, the reference being the per-echo ADC synthesis
   (``synthesize_exact``) of the default scene timed in the same run: a machine-speed unit.
