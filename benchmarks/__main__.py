@@ -6,8 +6,9 @@ matters less. Not part of the test suite.
   the default scene), one full-chain frame (synthesis + range-Doppler + CFAR + angle),
   ``calibrate --pair 0 1``, ``adc --format dca1000``, ``design`` (default grid; also with
   ``--workers 2``, and its CPU split into model builds and tolerance searches),
-  ``nearfield``, ``tolerance`` (1e6 draws x 21 set-points; 1e5 with ``--quick``; also on a
-  2-worker Dask LocalCluster), ``info`` and ``--help``. Each: wall time, CPU time (this
+  ``nearfield``, ``tolerance`` (1e6 draws x 21 set-points; 1e5 with ``--quick``; also with
+  ``--workers 2``, forked processes, and on a warm Dask LocalCluster of 1 and 2 workers),
+  ``info`` and ``--help``. Each: wall time, CPU time (this
   process's ``time.process_time`` in process, the child's user + system time for a
   subprocess) and wall / reference, the reference being the per-echo ADC synthesis
   (``synthesize_exact``) of the default scene timed in the same run: a machine-speed unit.
@@ -222,7 +223,7 @@ def bench_commands(scene_path: Path, quick: bool, repeat: int, workers: int) -> 
            "--sigma-tangential-mm", "0.1", "--sigma-height-mm", "0.1", "--seed", "1",
            "--json", "--quiet"]
     out["tolerance"] = {"draws": draws, **_time_cli(tol + ["--draws", str(draws)])}
-    # "on one machine": both cores, the chunks on a local Dask cluster of 2 processes
+    # "on one machine": both cores, the chunks in 2 forked worker processes (parallel.fork_map)
     out["tolerance_2_workers"] = {"draws": draws, **_time_cli(
         tol + ["--draws", str(draws), "--workers", "2"])}
     dask_draws = 100_000 if quick else 400_000
@@ -278,7 +279,8 @@ def bench_design_parts(scene, quick: bool) -> dict:
 def bench_dask_scaling(scene_path: Path, draws: int, workers: int) -> dict:
     """Tolerance draws on a warm LocalCluster of 1 and of ``workers`` single-threaded worker
     processes (cluster start and the first chunk excluded: the scaling of the study itself).
-    The CLI's ``--workers N`` adds the cluster start (about 10 s here) to this."""
+    (The CLI's ``--workers N`` forks a process pool instead, with no cluster to start; ``--dask
+    ADDRESS`` runs on a cluster like this one, sent per chunk the draw streams' states.)"""
     from rtsgeom.analysis.tolerance import PairPhasors, monte_carlo
     from rtsgeom.geometry import build_setup
     from rtsgeom.parallel import dask_client, map_chunks

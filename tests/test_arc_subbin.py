@@ -42,8 +42,7 @@ def test_two_front_end_arc_reproduces_the_pair_study_with_subbin(radius_m):
     assert problem is None
     model = PairPhasors.build(build_setup(scene), (0, 1), 3)
     sigma = np.array([0.3, 0.2, 0.2]) * 1e-3
-    # the same chunk: at 0.5 m the pair study itself differs by 2e-15 deg between chunk
-    # sizes on a few multi-degree uncalibrated draws (refine_angles' batching, not the arc)
+    # the same chunk here; the pair study's bits do not depend on it either (test_tolerance)
     pair = monte_carlo(model, sigma, 120, 4, "normal", 0.05, chunk=40)
     arc = arc_monte_carlo([model], 2, Bounds(tuple(sigma)), 120, 4, "normal", 0.05, chunk=40)
     for case in ("uncalibrated", "calibrated"):

@@ -262,6 +262,61 @@ def test_same_seed_gives_identical_results(model):
     assert a.to_dict() == b.to_dict()
 
 
+@pytest.mark.parametrize("distribution", ["normal", "uniform"])
+@pytest.mark.parametrize("chunk", [1, 7, 64, 1000])
+def test_draw_chunks_regenerate_the_streams_bit_for_bit(distribution, chunk):
+    """The chunks a cluster is sent (stream states, not draws) rebuild exactly the draws of
+    standard_draws / subbin_draws, whatever the chunk size."""
+    from rtsgeom.analysis.tolerance import draw_chunks, standard_draws, subbin_draws
+    sigma = np.array([1.0, 2.0, 3.0]) * 1e-4
+    parts = list(draw_chunks(5, 300, sigma, distribution, chunk, positions=9, centre=4))
+    assert [p.k for p in parts] == [min(chunk, 300 - s) for s in range(0, 300, chunk)]
+    offsets = np.concatenate([p.offsets() for p in parts])
+    subbin = np.concatenate([p.subbin() for p in parts])
+    assert np.array_equal(offsets, np.concatenate(list(standard_draws(5, 300, distribution))) * sigma)
+    assert np.array_equal(subbin, np.concatenate(list(subbin_draws(5, 300, 9))))
+    centre = draw_chunks(5, 300, sigma, distribution, chunk, 9, 4, subbin=False)
+    assert np.array_equal(np.concatenate([p.subbin() for p in centre]), np.full(300, 4))
+
+
+@pytest.mark.parametrize("radius_m", [0.5, 2.0])
+def test_pair_study_bits_do_not_depend_on_the_chunk_on_other_radii(radius_m):
+    """The same bits whatever the chunk (1 draw, odd sizes, all at once), also at 0.5 m where the
+    multi-degree uncalibrated errors once differed by 2e-15 deg between chunk sizes (the
+    numpy Newton/grid check on the chunk's batch, before the per-row compiled kernels)."""
+    import math
+
+    from rtsgeom.analysis.design import two_front_end_scene
+    from rtsgeom.scene import load_scene
+    scene, _, problem = two_front_end_scene(load_scene(DEFAULT_SCENE), (0, 1), radius_m,
+                                            math.radians(8.0))
+    assert problem is None
+    two = PairPhasors.build(build_setup(scene), (0, 1), 3)
+    sigma = np.array([0.3, 0.2, 0.2]) * 1e-3
+    whole = monte_carlo(two, sigma, 120, 4, "normal", 0.05, chunk=120)
+    for chunk in (1, 7, 40):
+        part = monte_carlo(two, sigma, 120, 4, "normal", 0.05, chunk=chunk)
+        for case in CASES:
+            assert np.array_equal(part.worst_error_deg[case], whole.worst_error_deg[case])
+        assert np.array_equal(part.delay_s, whole.delay_s)
+
+
+def test_fork_pool_gives_bit_identical_results(model):
+    """--workers N (a forked process pool) equals the single-process run bit for bit."""
+    import functools
+
+    from rtsgeom.parallel import _can_fork, fork_map
+    if not _can_fork():
+        pytest.skip("no fork on this platform")
+    local = monte_carlo(model, [1e-4] * 3, 300, seed=9, chunk=64)
+    pooled = monte_carlo(model, [1e-4] * 3, 300, seed=9, chunk=64,
+                         mapper=functools.partial(fork_map, workers=2))
+    for case in CASES:
+        assert np.array_equal(local.worst_error_deg[case], pooled.worst_error_deg[case])
+    assert np.array_equal(local.delay_s, pooled.delay_s)
+    assert local.to_dict() == pooled.to_dict()
+
+
 def test_larger_sigma_gives_larger_p95(model):
     p95 = {case: [] for case in CASES}
     for sigma in (0.03e-3, 0.1e-3, 0.3e-3):
@@ -353,3 +408,26 @@ def test_dask_local_cluster_gives_bit_identical_results():
     for case in local.worst_error_deg:
         assert np.array_equal(local.worst_error_deg[case], remote.worst_error_deg[case])
     assert np.array_equal(local.delay_s, remote.delay_s)
+
+
+def test_chunk_mapper_fork_pool_every_draw_mode():
+    """``--workers N``'s forked pool (chunk_mapper without a scheduler) equals one process bit
+    for bit, with uneven chunks, for normal and uniform draws and both sub-bin modes."""
+    from rtsgeom.analysis.tolerance import PairPhasors, monte_carlo
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.parallel import chunk_mapper
+    model = PairPhasors.build(build_setup(make_scene()), (0, 1), points=5)
+    sigma = np.array([0.3, 0.2, 0.5]) * 1e-3
+    for distribution, subbin in (("normal", True), ("uniform", False)):
+        local = monte_carlo(model, sigma, 1300, 7, distribution, chunk=300, subbin=subbin)
+        with chunk_mapper(None, 2) as mapper:
+            assert mapper is not None
+            pooled = monte_carlo(model, sigma, 1300, 7, distribution, chunk=300,
+                                 mapper=mapper, subbin=subbin)
+        for case in local.worst_error_deg:
+            assert np.array_equal(local.worst_error_deg[case], pooled.worst_error_deg[case])
+        assert np.array_equal(local.delay_s, pooled.delay_s)
+        assert np.array_equal(local.range_offset_m, pooled.range_offset_m)
+        assert local.fallbacks == pooled.fallbacks and local.off_bin == pooled.off_bin
+    with chunk_mapper(None, 1) as mapper:
+        assert mapper is None  # one worker: this process

@@ -5,7 +5,6 @@ these functions; ``folder`` is where ``--out`` files go (None: no ``--out``)."""
 from __future__ import annotations
 
 import argparse
-import functools
 import time
 from pathlib import Path
 
@@ -17,7 +16,7 @@ from ..aoa.model import AngleUnreachable
 from ..aoa.linearity import linearity
 from ..geometry import build_setup
 from ..io import write_json
-from ..parallel import dask_client, map_chunks
+from ..parallel import chunk_mapper
 from ..paths import exact_paths
 from ._common import UsageError, load_scene_checked, print_json, steps
 from .aoa import _pairs
@@ -166,8 +165,7 @@ def tolerance_arc(args, scene, sigma, extra, folder) -> int:
     except AngleUnreachable as exc:
         raise UsageError(f"--pair: a pair cannot synthesize its span ({exc})") from None
     from .tolerance import _progress
-    with _progress(args.quiet) as progress, dask_client(args.dask, args.workers) as client:
-        mapper = None if client is None else functools.partial(map_chunks, client=client)
+    with _progress(args.quiet) as progress, chunk_mapper(args.dask, args.workers) as mapper:
         res = arc_monte_carlo(models, setup.fe.count, bounds, args.draws, seed,
                               args.distribution, args.spec_deg, cases, args.chunk,
                               keep_errors=folder is not None, progress=progress,

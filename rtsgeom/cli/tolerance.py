@@ -4,7 +4,6 @@ arc design map (radius x front-end spacing)."""
 from __future__ import annotations
 
 import argparse
-import functools
 import sys
 import time
 from contextlib import contextmanager
@@ -16,7 +15,7 @@ from ..analysis.tolerance import (AXES, CASES, DISTRIBUTIONS, NOMINAL_AMPLITUDES
 from ..aoa.model import AngleUnreachable
 from ..geometry import build_setup
 from ..io import write_json
-from ..parallel import ClusterError, check_address, dask_client, map_chunks
+from ..parallel import ClusterError, check_address, chunk_mapper
 from ._common import (UsageError, load_scene_checked, number, output_folder, output_path,
                       print_json, scene_arg)
 from .aoa import _pair, _pair_arg
@@ -122,8 +121,7 @@ def _tolerance(args, scene, stage) -> int:
     seed = scene.seed if args.seed is None else args.seed
     cases = CASES + ((NOMINAL_AMPLITUDES,) if args.nominal_amplitudes else ())
     t0 = time.perf_counter()
-    with _progress(args.quiet) as progress, dask_client(args.dask, args.workers) as client:
-        mapper = None if client is None else functools.partial(map_chunks, client=client)
+    with _progress(args.quiet) as progress, chunk_mapper(args.dask, args.workers) as mapper:
         res = monte_carlo(model, sigma, args.draws, seed, args.distribution, args.spec_deg,
                           cases, chunk, progress, "Monte Carlo", mapper)
         out = res.to_dict()
@@ -323,7 +321,8 @@ def register(sub) -> None:
     p.add_argument("--dask", metavar="ADDRESS", default=None, type=_dask_address,
                    help="run the chunks on an existing Dask scheduler (tcp://host:8786)")
     p.add_argument("--workers", type=number(1, 1024, integer=True), default=None,
-                   help="run the chunks on a local Dask cluster of N worker processes")
+                   help="run the chunks in N local worker processes (forked; a local Dask "
+                        "cluster where the platform cannot fork); results identical")
     p.add_argument("--cell", nargs="+", type=_pair_arg, metavar="Q | all", default=None,
                    help="the study for a 2-D cell: 3 or 4 front-end indices, or all (a RuT "
                         "beamforming in azimuth and elevation; its default there when --pair "

@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import functools
 import time
 
 import numpy as np
@@ -43,7 +42,7 @@ def _cell(setup, words) -> tuple[int, ...] | None:
 def tolerance_cell(args, scene, sigma, extra, stage) -> int:
     from ..analysis.tolerance_cell import (CellPhasors, max_sigma_for_yield_cell,
                                            monte_carlo_cell, verify_cell_draws)
-    from ..parallel import dask_client, map_chunks
+    from ..parallel import chunk_mapper
     from .tolerance import _progress, capped_chunk
     from ..analysis.arc import Bounds
     if list(args.pair) == ["all"]:
@@ -70,8 +69,7 @@ def tolerance_cell(args, scene, sigma, extra, stage) -> int:
     chunk = capped_chunk(args.chunk, model.set_rad.shape[0] * len(model.cell))
     seed = scene.seed if args.seed is None else args.seed
     t0 = time.perf_counter()
-    with _progress(args.quiet) as progress, dask_client(args.dask, args.workers) as client:
-        mapper = None if client is None else functools.partial(map_chunks, client=client)
+    with _progress(args.quiet) as progress, chunk_mapper(args.dask, args.workers) as mapper:
         res = monte_carlo_cell(model, sigma, args.draws, seed, args.distribution,
                                args.spec_deg, CASES, chunk, progress, "Monte Carlo", mapper,
                                bounds)
