@@ -24,7 +24,6 @@ the systematic part from the per-frame noise bias). ``--workers N``: a process p
 from __future__ import annotations
 
 import argparse
-import csv
 import dataclasses
 import json
 import time
@@ -33,6 +32,8 @@ from pathlib import Path
 
 import numpy as np
 from scipy.constants import c
+
+from benchmarks._io import csv_writer, write_json_csv
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_SCENE = ROOT / "scenes" / "diewald2022.toml"
@@ -139,8 +140,7 @@ def main(argv=None) -> int:
     for row in mapper(one_case, cases):
         rows.append(row)
         if writer is None:
-            writer = csv.DictWriter(partial, fieldnames=list(row))
-            writer.writeheader()
+            writer = csv_writer(partial, row)
         writer.writerow(row)
         partial.flush()
         print(f"R_c {row['radius_m']:.2f} m  fe {row['front_end']}  dr {row['radial_offset_mm']:+.2f}"
@@ -174,11 +174,7 @@ def main(argv=None) -> int:
         "nominal_coherence_ps": {str(r): noms[r] * 1e12 for r in a.radii},
         "worst": worst, "seconds": time.perf_counter() - t0,
     }
-    Path(str(stem) + ".json").write_text(json.dumps({"summary": summary, "rows": rows}, indent=1))
-    with open(str(stem) + ".csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    write_json_csv(stem, {"summary": summary, "rows": rows}, rows)
     print(json.dumps({k: v for k, v in summary.items() if k != "worst"}, indent=1))
     print("worst cases (|calibrated - closed-form coherence point|):")
     for r in worst:

@@ -20,13 +20,13 @@ prints one line per case.
 from __future__ import annotations
 
 import argparse
-import csv
-import json
 import os
 import time
 from pathlib import Path
 
 import numpy as np
+
+from benchmarks._io import write_json_csv
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_SCENE = ROOT / "scenes" / "diewald2022.toml"
@@ -37,6 +37,7 @@ def linked(nf_db: float | None):
     """The default scene without ``snr_db``; with ``[radar.link] noise_figure_db = nf_db``
     (None: no link, noiseless), parsed as a scene file would be."""
     import tomllib
+
     from rtsgeom.scene import parse_scene
     doc = tomllib.loads(DEFAULT_SCENE.read_text())
     doc["radar"].pop("snr_db", None)
@@ -83,11 +84,7 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default=str(ROOT / "benchmarks" / "calibration_noise"))
     a = ap.parse_args(argv)
     out = run(a.nf, range(a.seeds))
-    Path(a.out + ".json").write_text(json.dumps(out, indent=1))
-    with open(a.out + ".csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(out["rows"][0]))
-        w.writeheader()
-        w.writerows(out["rows"])
+    write_json_csv(a.out, out, out["rows"])
     pulls = np.array([abs(r["pull_ps"]) for r in out["rows"]])
     print(f"max |pull| {pulls.max():.2f} ps over {pulls.size} cases; wrote {a.out}.json/.csv")
     return 0

@@ -18,13 +18,13 @@ Writes ``benchmarks/calibration_resolution.json`` and ``.csv``; prints one line 
 from __future__ import annotations
 
 import argparse
-import csv
-import json
 import os
 import time
 from pathlib import Path
 
 import numpy as np
+
+from benchmarks._io import write_json_csv
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_SCENE = ROOT / "scenes" / "diewald2022.toml"
@@ -105,11 +105,7 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default=str(ROOT / "benchmarks" / "calibration_resolution"))
     a = ap.parse_args(argv)
     out = run()
-    Path(a.out + ".json").write_text(json.dumps(out, indent=1))
-    with open(a.out + ".csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(out["rows"][0]))
-        w.writeheader()
-        w.writerows(out["rows"])
+    write_json_csv(a.out, out, out["rows"])
     for res in sorted({r["resolution_ps"] for r in out["rows"]}):
         sel = [r for r in out["rows"] if r["resolution_ps"] == res]
         print(f"{res:5.0f} ps: staircase max {max(abs(r['staircase_ps']) for r in sel):6.2f} "

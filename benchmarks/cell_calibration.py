@@ -20,12 +20,13 @@ from __future__ import annotations
 
 import argparse
 import copy
-import json
 import time
 import tomllib
 from pathlib import Path
 
 import numpy as np
+
+from benchmarks._io import write_json
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "scenes" / "sphere4.toml"
@@ -97,7 +98,7 @@ def main(argv=None) -> int:
               + f"; closures {np.round(o['loop_closure_ps'], 1).tolist()} ps; worst angle "
               f"error {worst:.4f} deg ({'within' if worst <= SPEC_DEG else 'BEYOND'} spec); "
               f"{len(o['warnings'])} warnings; {o['cpu_s']:.0f} s CPU", flush=True)
-    Path(a.out + ".json").write_text(json.dumps(res, indent=1, default=float))
+    write_json(a.out + ".json", res, default=float)
     return 0
 
 

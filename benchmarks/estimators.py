@@ -18,12 +18,12 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import json
 import tomllib
 from pathlib import Path
 
 import numpy as np
 
+from benchmarks._io import write_json
 from rtsgeom.analysis.estimators import pair_sweep
 from rtsgeom.aoa.model import AngleUnreachable, ChannelModel
 from rtsgeom.geometry import build_setup
@@ -106,7 +106,7 @@ def bench() -> list[dict]:
 
 def main() -> None:
     out = {"far_field": far_field(), "bench": bench()}
-    (ROOT / "benchmarks" / "estimators.json").write_text(json.dumps(out, indent=1) + "\n")
+    write_json(ROOT / "benchmarks" / "estimators.json", out, newline=True)
     print("far field: largest spacing (x resolution) at which the synthesis holds")
     seen = {}
     for r in out["far_field"]:

@@ -12,11 +12,12 @@ difference and the run warnings about it. Writes ``benchmarks/realised_plan.json
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 
 import numpy as np
+
+from benchmarks._io import write_json
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_SCENE = ROOT / "scenes" / "diewald2022.toml"
@@ -79,7 +80,7 @@ def main() -> None:
             print(f"f_s {f_s / 1e9:g} GSPS, {res:g} ps: max |error| "
                   f"{row['max_abs_error_deg']:.4f} deg over {len(err)} targets, max |residual| "
                   f"{row['max_abs_residual_ps'] or 0:.1f} ps, {warns} warnings", flush=True)
-    (ROOT / "benchmarks" / "realised_plan.json").write_text(json.dumps(rows, indent=1))
+    write_json(ROOT / "benchmarks" / "realised_plan.json", rows)
 
 
 if __name__ == "__main__":

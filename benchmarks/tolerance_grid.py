@@ -15,12 +15,13 @@ Writes ``benchmarks/tolerance_grid.json`` and ``.csv``; prints a table.
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import time
 from pathlib import Path
 
 import numpy as np
+
+from benchmarks._io import write_json_csv
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_SCENE = ROOT / "scenes" / "diewald2022.toml"
@@ -93,12 +94,7 @@ def main(argv=None) -> int:
     a = p.parse_args(argv)
     rows = run(a.draws, a.verify, a.inversion_draws)
     out = ROOT / "benchmarks" / "tolerance_grid"
-    out.with_suffix(".json").write_text(json.dumps(rows, indent=1) + "\n")
-    keys = sorted({k for r in rows for k in r})
-    with open(out.with_suffix(".csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, keys)
-        w.writeheader()
-        w.writerows(rows)
+    write_json_csv(out, rows, rows, newline=True, fieldnames=sorted({k for r in rows for k in r}))
     print(f"{'R_c m':>6} {'sub-bin':>10} {'cal p99':>8} {'cal max':>8} {'cal yield':>9} "
           f"{'sig95 all':>9} {'sig95 rad':>9}")
     for r in rows:

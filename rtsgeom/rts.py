@@ -53,7 +53,10 @@ class RtsProgram:
     ``delay_s`` is the requested RTS delay tau_rts (before the buffer/FIR quantisation),
     ``doppler_hz`` the Doppler shift f_D,rts = 2 f_c v / c0 of eq. (2) *as the RuT's beat
     signal sees it* (positive for a receding target; the hardware mixer lowers the re-emitted
-    frequency by it, i.e. multiplies by exp(-j 2 pi f_D t)), ``amplitude`` the complex channel
+    frequency by it, i.e. multiplies by exp(-j 2 pi f_D t)), with f_c the chirp's start
+    frequency ``radar.f_c_hz``: the same frequency the processing converts back with, so the
+    reported velocity is the programmed one (a real target's phase follows the carrier at the
+    ADC window's middle instead; README "Velocity and the carrier frequency"), ``amplitude`` the complex channel
     gain the RTS applies (attenuation and AoA weight). Hardware offsets of the scene are *not* in here: they
     belong to the channel, not to what the RTS is told.
     """

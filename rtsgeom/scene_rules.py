@@ -337,7 +337,9 @@ def _placement_rules(scene, fail) -> None:
 
 def _calibration_rules(scene, fail) -> None:
     """The RTS delay must take the calibration's steps; the sweep must cover one period of the
-    phase it calibrates (paper: 1 / (f_rts + B/2) = 1 ns)."""
+    phase it calibrates (paper: 1 / (f_rts + B/2) = 1 ns). Where the sweep is left at its
+    default [-0.5, 1.0] ns, a too-long period is blamed on rts.f_rts_hz (with its lower bound
+    1/span - B/2), else on rts.calibration_span_ns."""
     rts, radar = scene.rts, scene.radar
     step = rts.calibration_step_s
     if rts.delay_resolution_s > step * (1.0 + 1e-9):
@@ -353,7 +355,15 @@ def _calibration_rules(scene, fail) -> None:
         return
     period = 1.0 / (rts.f_rts_hz + 0.5 * radar.bandwidth_hz)
     span_ns = [round(x * 1e9, 9) for x in rts.calibration_span_s]
-    if span < period * (1.0 - 1e-9):
+    if span < period * (1.0 - 1e-9) and _default_span(rts.calibration_span_s):
+        # the sweep is the default one: the IF that sets the period is what departs from it
+        fail("rts.f_rts_hz", rts.f_rts_hz,
+             f">= 1/span - radar.bandwidth_hz/2 = {1.0 / span - 0.5 * radar.bandwidth_hz:g} Hz "
+             f"(at most {1e11:g} Hz), so that one period 1/(rts.f_rts_hz + radar.bandwidth_hz/2)"
+             f" = {period * 1e9:.4g} ns fits the calibration sweep rts.calibration_span_ns = "
+             f"{span_ns} (default, {span * 1e9:.4g} ns); or widen rts.calibration_span_ns to "
+             f">= {period * 1e9:.4g} ns")
+    elif span < period * (1.0 - 1e-9):
         fail("rts.calibration_span_ns", span_ns,
              f"at least one period 1/(rts.f_rts_hz + radar.bandwidth_hz/2) = "
              f"{period * 1e9:.4g} ns wide (it spans {span * 1e9:.4g} ns)")
@@ -361,6 +371,15 @@ def _calibration_rules(scene, fail) -> None:
         fail("rts.calibration_step_ps", step * 1e12,
              f">= {span / MAX_CALIBRATION_STEPS * 1e12:.4g} ps: rts.calibration_span_ns "
              f"{span_ns} would take {span / step:.4g} steps (at most {MAX_CALIBRATION_STEPS})")
+
+
+def _default_span(span_s) -> bool:
+    """Whether the calibration sweep is the scene format's default (not set by the user)."""
+    from .scene import RtsConfig  # here: scene.py imports this module
+    import dataclasses
+    default = next(f.default for f in dataclasses.fields(RtsConfig)
+                   if f.name == "calibration_span_s")
+    return all(abs(a - b) <= 1e-21 for a, b in zip(span_s, default))
 
 
 def resolvable_limits(radar: "RadarConfig") -> tuple[float, float, str, str]:

@@ -41,3 +41,63 @@ def rt():
     if not ok:
         pytest.skip(f"Sionna RT unavailable: {msg}")
     return raytrace
+
+
+# ---------------------------------------------------------------- shared scene mutations
+# (used as ``make_scene(lambda d: quiet(d, ...))`` or inside a test's own ``mutate``)
+
+SMALL = dict(chirps_per_tx=32, samples_per_chirp=128, adc_rate_hz=12.5e6)  # a small, fast cube
+
+
+def no_ghosts(doc) -> None:
+    """No cable ghosts: drop every front end's return losses."""
+    for fe in doc["rts"]["front_ends"]:
+        fe.pop("return_loss_fe_db", None)
+        fe.pop("return_loss_be_db", None)
+
+
+def quiet(doc, small=False, **radar) -> None:
+    """No receiver noise and no ghosts (a clean channel for closed-form checks); the small cube
+    (:data:`SMALL`) when ``small``; then the ``radar`` fields given."""
+    doc["radar"].pop("snr_db", None)
+    if small:
+        doc["radar"].update(SMALL)
+    doc["radar"].update(radar)
+    no_ghosts(doc)
+
+
+def far_field(doc) -> None:
+    """The ideal far field: a 50 m arc, no sheet, no Rx/Tx separation, no ghosts."""
+    doc["rts"]["arc_radius_m"] = 50.0
+    doc["sheet"]["enabled"] = False
+    for fe in doc["rts"]["front_ends"]:
+        fe["rx_tx_separation_m"] = 0.0
+    no_ghosts(doc)
+
+
+class CoherenceShift:
+    """The phasor model's coherence point of a nominal pair (0, 1) setup and its closed-form
+    move for a radial offset dr of one front end: -(f_c + S t_mid - S tau) /
+    (f_rts + S t_mid - S tau) * 2 dr / c0 for J (front end 1), the opposite way for I."""
+
+    def __init__(self, nom, probe):
+        from rtsgeom.aoa.calibration import (air_phase_slope_hz, coherence_delay,
+                                             if_phase_slope_hz, probe_angles, probe_ranges,
+                                             probe_total_delay)
+        from rtsgeom.paths import exact_paths
+        self.alphas = probe_angles(*probe.angle_rad[[0, 1]])
+        self.d0 = coherence_delay(nom, exact_paths(nom), (0, 1), self.alphas)
+        tau = probe_total_delay(nom, probe_ranges(nom, 2))
+        self.ratio = air_phase_slope_hz(nom.scene, tau) / if_phase_slope_hz(nom.scene, tau)
+        self.period = 1 / if_phase_slope_hz(nom.scene, tau)
+
+    def predicted(self, fe: int, dr_mm: float) -> float:
+        """The closed-form coherence point with front end ``fe`` moved radially by ``dr_mm``."""
+        from scipy.constants import c
+        sign = 1.0 if fe == 1 else -1.0
+        return self.d0 - sign * self.ratio * 2 * dr_mm * 1e-3 / c
+
+    def wrapped(self, delay_s: float, fe: int, dr_mm: float) -> float:
+        """``delay_s`` minus the predicted point, wrapped into one period around 0."""
+        p = self.period
+        return (delay_s - self.predicted(fe, dr_mm) + p / 2) % p - p / 2

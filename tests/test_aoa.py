@@ -12,17 +12,13 @@ from rtsgeom.aoa.synthesis import array_factor, g_paper, ratio_array_factor, rat
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 
+from conftest import far_field as ideal_far_field
 from conftest import make_scene
 
 
 def far_field(doc):
     doc["radar"].pop("snr_db", None)
-    doc["rts"]["arc_radius_m"] = 50.0
-    doc["sheet"]["enabled"] = False
-    for fe in doc["rts"]["front_ends"]:
-        fe["rx_tx_separation_m"] = 0.0
-        fe.pop("return_loss_fe_db", None)
-        fe.pop("return_loss_be_db", None)
+    ideal_far_field(doc)
     doc["targets"] = []
 
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.constants import c
 
-from rtsgeom.aoa.calibration import (air_phase_slope_hz, calibrate_pair, coherence_delay,
+from rtsgeom.aoa.calibration import (calibrate_pair, coherence_delay,
                                      if_phase_slope_hz, probe_angles, probe_front_ends,
                                      probe_ranges, probe_total_delay)
 from rtsgeom.cli import main
@@ -18,7 +18,7 @@ from rtsgeom.paths import exact_paths
 from rtsgeom.rts import RtsProgram, channel_echoes
 from rtsgeom.validate import height_phase_deg, scene_warnings
 
-from conftest import DEFAULT_SCENE, make_scene
+from conftest import DEFAULT_SCENE, CoherenceShift, make_scene
 
 
 def _noiseless(radius_m=1.0, f_rts_hz=None, offsets=None):
@@ -104,20 +104,11 @@ def test_coherence_point_moves_by_the_closed_form(radius):
     (f_rts + S t_mid - S tau) * 2 dr / c0 for a radial offset dr of front end J (and the
     opposite way for I)."""
     nom = build_setup(_noiseless(radius))
-    paths = exact_paths(nom)
-    probe = probe_front_ends(nom, paths, 1)
-    alphas = probe_angles(*probe.angle_rad[[0, 1]])
-    d0 = coherence_delay(nom, paths, (0, 1), alphas)
-    tau = probe_total_delay(nom, probe_ranges(nom, 2))
-    ratio = air_phase_slope_hz(nom.scene, tau) / if_phase_slope_hz(nom.scene, tau)
-    period = 1 / if_phase_slope_hz(nom.scene, tau)
+    shift = CoherenceShift(nom, probe_front_ends(nom, exact_paths(nom), 1))
     for fe, dr_mm in ((1, 0.3), (0, -0.7), (1, -0.45)):
         s = build_setup(_noiseless(radius, offsets={fe: dr_mm}))
-        d = coherence_delay(s, exact_paths(s), (0, 1), alphas, d0)
-        sign = 1.0 if fe == 1 else -1.0
-        predicted = d0 - sign * ratio * 2 * dr_mm * 1e-3 / c
-        wrapped = (d - predicted + period / 2) % period - period / 2
-        assert abs(wrapped) < 1e-12  # 1st order in dr: 0.6 ps at 0.7 mm on 0.5 m
+        d = coherence_delay(s, exact_paths(s), (0, 1), shift.alphas, shift.d0)
+        assert abs(shift.wrapped(d, fe, dr_mm)) < 1e-12  # 1st order in dr: 0.6 ps at 0.7 mm on 0.5 m
 
 
 # ---------------------------------------------------------------- period (items 2, 22)
@@ -280,14 +271,8 @@ def _offset_scene(radius_m, fe, dr_mm, tangential_mm=0.0, snr=True):
 def _closed_form_point(radius_m, fe, dr_mm, probe, snr=True):
     """The coherence point of the nominal setup (phasor model) moved by the closed form
     -(f_c + S t_mid - S tau) / (f_rts + S t_mid - S tau) * 2 dr / c0 (J; opposite for I)."""
-    nom = build_setup(_offset_scene(radius_m, fe, 0.0, snr=snr))
-    paths = exact_paths(nom)
-    alphas = probe_angles(*probe.angle_rad[[0, 1]])
-    d0 = coherence_delay(nom, paths, (0, 1), alphas)
-    tau = probe_total_delay(nom, probe_ranges(nom, 2))
-    ratio = air_phase_slope_hz(nom.scene, tau) / if_phase_slope_hz(nom.scene, tau)
-    sign = 1.0 if fe == 1 else -1.0
-    return d0 - sign * ratio * 2 * dr_mm * 1e-3 / c, 1 / if_phase_slope_hz(nom.scene, tau)
+    shift = CoherenceShift(build_setup(_offset_scene(radius_m, fe, 0.0, snr=snr)), probe)
+    return shift.predicted(fe, dr_mm), shift.period
 
 
 # the grid's worst cases before the fix (benchmarks/calibration_grid_quick_partial.txt: 75 ps

@@ -14,7 +14,7 @@ import pytest
 import trimesh
 from scipy.constants import c
 
-from conftest import make_scene
+from conftest import SMALL, make_scene, quiet
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.paths.table import RUT_TO_RUT, Paths
@@ -24,17 +24,9 @@ from rtsgeom.radar.processing import range_angle_map
 from rtsgeom.radar.newton import parabolic
 from rtsgeom.rts import KIND_SETUP, program_nearest, requested_delay, setup_echoes
 
-SMALL = dict(chirps_per_tx=32, samples_per_chirp=128, adc_rate_hz=12.5e6)
-
-
 def small_quiet(targets=None, **radar):
     def mutate(doc):
-        doc["radar"].pop("snr_db", None)
-        doc["radar"].update(SMALL)
-        doc["radar"].update(radar)
-        for fe in doc["rts"]["front_ends"]:
-            fe.pop("return_loss_fe_db", None)
-            fe.pop("return_loss_be_db", None)
+        quiet(doc, small=True, **radar)
         doc["targets"] = targets if targets is not None else [
             {"range_m": 30.0, "angle_deg": 7.0}, {"range_m": 45.0, "velocity_mps": 2.0,
                                                   "angle_deg": 10.0}]

@@ -287,13 +287,10 @@ def test_measured_end_angles_equal_geometric_ones_in_the_ideal_far_field(mode):
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
 
+    from conftest import far_field
+
     def far(doc):
-        doc["rts"]["arc_radius_m"] = 50.0
-        doc["sheet"]["enabled"] = False
-        for fe in doc["rts"]["front_ends"]:
-            fe["rx_tx_separation_m"] = 0.0
-            fe.pop("return_loss_fe_db", None)
-            fe.pop("return_loss_be_db", None)
+        far_field(doc)
         doc["targets"] = [{"range_m": 60.0, "angle_deg": 7.0}]
     setup = build_setup(_small_noiseless(far))
     paths = exact_paths(setup)

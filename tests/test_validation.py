@@ -159,6 +159,8 @@ MALFORMED = [
      _set("rts.fractional_delay_step_s", 50e-12), "rts.calibration_step_ps", "25"),
     ("calibration span shorter than a period", _set("rts.calibration_span_ns", [0.0, 0.5]),
      "rts.calibration_span_ns", "[0.0, 0.5]"),
+    ("zero IF with the default calibration sweep", _set("rts.f_rts_hz", 0.0),
+     "rts.f_rts_hz", "1.66667e+08"),
     ("back end sampling slower than the chirp's bandwidth", _set("rts.f_s_hz", 1e6),
      "rts.f_s_hz", "1e+06"),
     ("calibration span reversed", _set("rts.calibration_span_ns", [1.0, 0.0]),

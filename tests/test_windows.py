@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from conftest import make_scene
+from conftest import CoherenceShift, far_field, make_scene, quiet
 from rtsgeom.aoa.model import ChannelModel
 from rtsgeom.analysis.tolerance import CASES, PairPhasors
 from rtsgeom.geometry import build_setup
@@ -28,7 +28,6 @@ from rtsgeom.run import match_targets
 from rtsgeom.scene import TargetConfig
 
 WINDOWS = tuple(WINDOW_REGISTRY)
-SMALL = dict(chirps_per_tx=32, samples_per_chirp=128, adc_rate_hz=12.5e6)
 
 
 def test_the_grid_covers_every_registered_window():
@@ -36,20 +35,12 @@ def test_the_grid_covers_every_registered_window():
 
 
 def _quiet(doc, **radar):
-    doc["radar"].pop("snr_db", None)
-    doc["radar"].update(SMALL)
-    doc["radar"].update(radar)
-    for fe in doc["rts"]["front_ends"]:
-        fe.pop("return_loss_fe_db", None)
-        fe.pop("return_loss_be_db", None)
+    quiet(doc, small=True, **radar)
 
 
 def _far(doc, **radar):
     _quiet(doc, **radar)
-    doc["rts"]["arc_radius_m"] = 50.0
-    doc["sheet"]["enabled"] = False
-    for fe in doc["rts"]["front_ends"]:
-        fe["rx_tx_separation_m"] = 0.0
+    far_field(doc)
     doc["targets"] = []
 
 
@@ -276,10 +267,7 @@ def test_coherence_point_moves_by_the_closed_form_for_every_taper(angle_window, 
     -(f_c + S t_mid - S tau) / (f_rts + S t_mid - S tau) * 2 dr / c0 for a radial offset dr
     of front end J (the opposite way for I), whatever the angle window: the taper weights the
     elements, not the channels' relative phase."""
-    from scipy.constants import c
-    from rtsgeom.aoa.calibration import (air_phase_slope_hz, coherence_delay, if_phase_slope_hz,
-                                         probe_angles, probe_front_ends, probe_ranges,
-                                         probe_total_delay)
+    from rtsgeom.aoa.calibration import coherence_delay, probe_front_ends
 
     def scene(offsets=None):
         def mutate(doc):
@@ -292,17 +280,8 @@ def test_coherence_point_moves_by_the_closed_form_for_every_taper(angle_window, 
                 doc["rts"]["front_ends"][k]["radial_offset_mm"] = v
         return build_setup(make_scene(mutate))
     nom = scene()
-    paths = exact_paths(nom)
-    probe = probe_front_ends(nom, paths, 1)
-    alphas = probe_angles(*probe.angle_rad[[0, 1]])
-    d0 = coherence_delay(nom, paths, (0, 1), alphas)
-    tau = probe_total_delay(nom, probe_ranges(nom, 2))
-    ratio = air_phase_slope_hz(nom.scene, tau) / if_phase_slope_hz(nom.scene, tau)
-    period = 1 / if_phase_slope_hz(nom.scene, tau)
+    shift = CoherenceShift(nom, probe_front_ends(nom, exact_paths(nom), 1))
     for fe, dr_mm in ((1, 0.3), (0, -0.7)):
         s = scene({fe: dr_mm})
-        d = coherence_delay(s, exact_paths(s), (0, 1), alphas, d0)
-        sign = 1.0 if fe == 1 else -1.0
-        predicted = d0 - sign * ratio * 2 * dr_mm * 1e-3 / c
-        wrapped = (d - predicted + period / 2) % period - period / 2
-        assert abs(wrapped) < 1e-12
+        d = coherence_delay(s, exact_paths(s), (0, 1), shift.alphas, shift.d0)
+        assert abs(shift.wrapped(d, fe, dr_mm)) < 1e-12

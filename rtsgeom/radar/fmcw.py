@@ -12,6 +12,12 @@ with ``tau = tau_c + tau_if``, ``t_n = t_adc + n / f_adc`` (time since ramp star
 (``Echoes.fast_gain``, 1 for an ideal delay) (TDM: the Tx take turns chirp by chirp, so a moving target carries
 the Tx-switching phase 2 pi f_D s T_rep) and ``S = B / T``.
 
+``f_D`` is the RTS's frequency shift (2 f_c v / c0 with f_c the start frequency,
+:class:`rtsgeom.rts.RtsProgram`), so the slow-time frequency at the target's range bin is f_D
+exactly. A delay that moves at 2 v / c0 instead (a real target, :func:`synthesize_exact` with
+``delay_rate``) gives 2 v f_mid / c0 with f_mid = f_c + S (t_mid - tau), t_mid the middle of
+the ADC window (README "Velocity and the carrier frequency"; tests/test_velocity_frequency.py).
+
 Every echo is separable into a slow-time factor and a fast-time factor, so for each virtual
 channel the cube is a complex matrix product ``X_v = A_v @ F_v`` with ``A_v`` (loops x echoes)
 and ``F_v`` (echoes x samples): one batched GEMM instead of one ``exp`` over the full cube per

@@ -1,0 +1,46 @@
+"""The benchmarks' result files: one JSON writer and one CSV writer for all of them.
+
+Standard library ``json`` and ``csv`` rather than pandas: the rows are lists of flat dicts
+that are already in memory, ``csv.DictWriter`` writes them as they are (pandas would format
+floats and missing keys its own way and change the committed files' bytes), and a
+benchmark should not need pandas to be imported just to write a few hundred lines.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+__all__ = ["write_json", "write_csv", "csv_writer", "write_json_csv"]
+
+
+def write_json(path, obj, *, indent: int = 1, newline: bool = False, default=None) -> Path:
+    """``obj`` as JSON at ``path`` (``indent`` spaces; a final ``\\n`` when ``newline``;
+    ``default`` as in :func:`json.dumps`, for values JSON cannot hold)."""
+    path = Path(path)
+    path.write_text(json.dumps(obj, indent=indent, default=default) + ("\n" if newline else ""))
+    return path
+
+
+def csv_writer(fh, fieldnames) -> csv.DictWriter:
+    """A :class:`csv.DictWriter` on the open file ``fh`` with its header written."""
+    w = csv.DictWriter(fh, fieldnames=list(fieldnames))
+    w.writeheader()
+    return w
+
+
+def write_csv(path, rows: list[dict], fieldnames=None) -> Path:
+    """``rows`` as CSV at ``path``; columns ``fieldnames``, else the first row's keys in order."""
+    path = Path(path)
+    with open(path, "w", newline="") as fh:
+        csv_writer(fh, list(rows[0]) if fieldnames is None else fieldnames).writerows(rows)
+    return path
+
+
+def write_json_csv(stem, obj, rows: list[dict], *, newline: bool = False,
+                   fieldnames=None) -> tuple[Path, Path]:
+    """``obj`` to ``stem.json`` and ``rows`` to ``stem.csv`` (the usual pair of a benchmark;
+    ``stem`` gets the suffixes appended, it is not treated as having one)."""
+    return (write_json(str(stem) + ".json", obj, newline=newline),
+            write_csv(str(stem) + ".csv", rows, fieldnames))
