@@ -275,6 +275,18 @@ def _closed_form_point(radius_m, fe, dr_mm, probe, snr=True):
     return shift.predicted(fe, dr_mm), shift.period
 
 
+
+def _calibrated_off_coherence(radius_m, fe, dr_mm):
+    """Calibrate pair (0, 1) of the offset setup: (setup, paths, probe, calibration, distance
+    of the calibrated delay from the closed-form coherence point, wrapped into one period)."""
+    setup = build_setup(_offset_scene(radius_m, fe, dr_mm))
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, setup.scene.seed)
+    cal = calibrate_pair(setup, paths, (0, 1), probe, seed=setup.scene.seed)
+    point, period = _closed_form_point(radius_m, fe, dr_mm, probe)
+    return setup, paths, probe, cal, (cal.delta_tau_s - point + period / 2) % period - period / 2
+
+
 # the grid's worst cases before the fix (benchmarks/calibration_grid_quick_partial.txt: 75 ps
 # off at +-0.75 mm on 0.5 and 1 m) and a 3 m arc; the full grid: python -m
 # benchmarks.calibration_grid
@@ -282,12 +294,7 @@ def _closed_form_point(radius_m, fe, dr_mm, probe, snr=True):
 @pytest.mark.parametrize("radius, fe, dr_mm", [(0.5, 0, 0.75), (0.5, 1, -0.75), (1.0, 0, 0.75),
                                                (1.0, 1, -0.75), (3.0, 0, -0.6), (3.0, 1, 1.0)])
 def test_calibration_lands_on_the_coherence_point(radius, fe, dr_mm):
-    setup = build_setup(_offset_scene(radius, fe, dr_mm))
-    paths = exact_paths(setup)
-    probe = probe_front_ends(setup, paths, setup.scene.seed)
-    cal = calibrate_pair(setup, paths, (0, 1), probe, seed=setup.scene.seed)
-    point, period = _closed_form_point(radius, fe, dr_mm, probe)
-    dist = (cal.delta_tau_s - point + period / 2) % period - period / 2
+    setup, paths, probe, cal, dist = _calibrated_off_coherence(radius, fe, dr_mm)
     assert abs(dist) < 10e-12
     assert cal.residual_error_deg < 0.02  # the full-chain confirmation at the chosen delay
     assert cal.frames_per_step >= 1 and cal.method == "phasor"
@@ -552,12 +559,7 @@ def test_grid_sample_calibrates_to_coherence_and_linearity_within_spec(radius, f
     linearity (11 set-points, receiver noise on) at or below 0.02 deg at every set-point
     (about 1.3 s of CPU per setup)."""
     from rtsgeom.aoa.linearity import linearity
-    setup = build_setup(_offset_scene(radius, fe, dr_mm))
-    paths = exact_paths(setup)
-    probe = probe_front_ends(setup, paths, setup.scene.seed)
-    cal = calibrate_pair(setup, paths, (0, 1), probe, seed=setup.scene.seed)
-    point, period = _closed_form_point(radius, fe, dr_mm, probe)
-    dist = (cal.delta_tau_s - point + period / 2) % period - period / 2
+    setup, paths, probe, cal, dist = _calibrated_off_coherence(radius, fe, dr_mm)
     assert abs(dist) < 10e-12
     lin = linearity(setup, paths, (0, 1), "exact", probe, cal, 11, setup.scene.seed)
     assert np.all(np.isfinite(lin.detected_deg))
