@@ -36,3 +36,11 @@ def test_nearfield_reports_progress(tmp_path, capsys):
     assert cap.err == "" and json.loads(cap.out)
     assert main(args + ["--quiet"]) == 0
     assert capsys.readouterr().err == ""
+
+
+def test_failed_step_reports_no_duration(tmp_path, capsys):
+    """A step that raises prints the error only, not "step: 0.0 s" as if it had finished."""
+    missing = tmp_path / "missing.toml"
+    assert main(["calibrate", str(missing), "--pair", "0", "1"]) == 2
+    err = capsys.readouterr().err
+    assert "cannot read scene file" in err and not _STEP.findall(err), err

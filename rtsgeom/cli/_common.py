@@ -109,14 +109,17 @@ class steps:
         self._status = self._console.status(label + " ...")
         self._status.start()
 
-    def _finish(self) -> None:
+    def _finish(self, failed: bool = False) -> None:
         import time
         if self._status is not None:
             self._status.stop()
+            if failed:  # the error message follows; no duration for a step that did not finish
+                self._status = None
+                return
             self._console.print(f"  {self._label}: {time.perf_counter() - self._t0:.1f} s",
                                 style="dim", highlight=False, soft_wrap=True)
             self._status = None
 
-    def __exit__(self, *exc):
-        self._finish()
+    def __exit__(self, exc_type, exc, tb):
+        self._finish(failed=exc_type is not None)
         return False
