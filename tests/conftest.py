@@ -101,3 +101,18 @@ class CoherenceShift:
         """``delay_s`` minus the predicted point, wrapped into one period around 0."""
         p = self.period
         return (delay_s - self.predicted(fe, dr_mm) + p / 2) % p - p / 2
+
+
+def two_front_end_pair(radius_m: float, spacing_deg: float = 8.0):
+    """The default scene as the arc design's clean two-front-end variant (pair (0, 1) at
+    ``radius_m`` and ``spacing_deg``, no mounting or channel errors) and its pair-study model
+    (3 candidate bins): ``(scene, PairPhasors)``."""
+    import math
+
+    from rtsgeom.analysis.design import two_front_end_scene
+    from rtsgeom.analysis.tolerance import PairPhasors
+    from rtsgeom.geometry import build_setup
+    scene, _, problem = two_front_end_scene(make_scene(), (0, 1), radius_m,
+                                            math.radians(spacing_deg))
+    assert problem is None, problem
+    return scene, PairPhasors.build(build_setup(scene), (0, 1), 3)

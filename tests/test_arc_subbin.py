@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,7 +17,7 @@ from rtsgeom.errors import ParameterError
 from rtsgeom.geometry import build_setup
 from rtsgeom.scene import load_scene
 
-DEFAULT = Path(__file__).resolve().parents[1] / "scenes" / "diewald2022.toml"
+from conftest import DEFAULT_SCENE as DEFAULT, two_front_end_pair
 
 
 def _arc_scene(radius_m: float, angles_deg):
@@ -37,10 +36,7 @@ def _arc_scene(radius_m: float, angles_deg):
 @pytest.mark.parametrize("radius_m", [0.5, 2.0])
 def test_two_front_end_arc_reproduces_the_pair_study_with_subbin(radius_m):
     """Bit for bit on other radii too (the pair study's streams: positions and sub-bin)."""
-    scene, _, problem = two_front_end_scene(load_scene(DEFAULT), (0, 1), radius_m,
-                                            math.radians(8.0))
-    assert problem is None
-    model = PairPhasors.build(build_setup(scene), (0, 1), 3)
+    _, model = two_front_end_pair(radius_m)
     sigma = np.array([0.3, 0.2, 0.2]) * 1e-3
     # the same chunk here; the pair study's bits do not depend on it either (test_tolerance)
     pair = monte_carlo(model, sigma, 120, 4, "normal", 0.05, chunk=40)

@@ -20,7 +20,7 @@ from rtsgeom.rts import RtsProgram, requested_delay
 from rtsgeom.radar.frame import simulate
 from rtsgeom.scene import TargetConfig
 
-from conftest import DEFAULT_SCENE, make_scene
+from conftest import DEFAULT_SCENE, make_scene, two_front_end_pair
 
 ZERO = np.zeros((2, 3))
 
@@ -284,14 +284,7 @@ def test_pair_study_bits_do_not_depend_on_the_chunk_on_other_radii(radius_m):
     """The same bits whatever the chunk (1 draw, odd sizes, all at once), also at 0.5 m where the
     multi-degree uncalibrated errors once differed by 2e-15 deg between chunk sizes (the
     numpy Newton/grid check on the chunk's batch, before the per-row compiled kernels)."""
-    import math
-
-    from rtsgeom.analysis.design import two_front_end_scene
-    from rtsgeom.scene import load_scene
-    scene, _, problem = two_front_end_scene(load_scene(DEFAULT_SCENE), (0, 1), radius_m,
-                                            math.radians(8.0))
-    assert problem is None
-    two = PairPhasors.build(build_setup(scene), (0, 1), 3)
+    _, two = two_front_end_pair(radius_m)
     sigma = np.array([0.3, 0.2, 0.2]) * 1e-3
     whole = monte_carlo(two, sigma, 120, 4, "normal", 0.05, chunk=120)
     for chunk in (1, 7, 40):
