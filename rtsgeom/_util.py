@@ -7,6 +7,12 @@ import numpy as np
 
 _BLAS_CONTROLLER = None
 
+#: Batches of at least this many items (snapshots, set-points) run the compiled kernels
+#: (``rtsgeom.kernels``); smaller ones their numpy definitions, bit for bit the same results
+#: (tested), without numba's ~0.5 s import and first-call set-up per process. At this size
+#: the numpy forms take ~50 ms (the 1-D peak's, the dearer one), a tenth of that set-up.
+KERNEL_MIN_BATCH = 20_000
+
 
 def single_threaded_blas():
     """Context manager limiting BLAS to one thread (``threadpoolctl``; the controller is built
