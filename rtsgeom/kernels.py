@@ -20,8 +20,9 @@ imported only with this module, which the callers import inside the functions th
 (``rtsgeom --help`` and ``info`` do not load it).
 
 Small batches skip them: ``Steering.peak`` (D = 1) and ``aoa.sweep.ratio_from_beams`` run
-their numpy definitions (``radar.newton.peak_1d``, ``aoa.sweep.ratio_from_beams``) below
-``rtsgeom._util.KERNEL_MIN_BATCH`` items, the same arithmetic bit for bit (tested), because
+their numpy definitions (``radar.newton.peak_1d``, ``aoa.sweep._ratios``) until a process's
+work in them would pass half of numba's set-up (``rtsgeom._util.use_kernels``), the same
+arithmetic bit for bit (tested), because
 importing numba and setting up its target on the first call costs about 0.5 s per process,
 more than the rest of ``rtsgeom calibrate`` (issue 17).
 """

@@ -87,7 +87,7 @@ def test_design_puts_the_composite_peak_on_the_set_angle(v, win, uneven):
 @pytest.mark.parametrize("v,win,uneven", GRID[::2])
 def test_ratio_kernel_gives_the_definitions_bits(v, win, uneven, monkeypatch):
     """``kernels.ratios`` (large batches) against ``sweep._ratios`` (numpy, the definition,
-    below ``KERNEL_MIN_BATCH``), bit for bit: designs across the pair's span and beyond it
+    small batches), bit for bit: designs across the pair's span and beyond it
     (no root: NaN), J's phases, and degenerate beams (zero, a2 = 0, NaN, inf), through
     ratio_from_beams with either path forced."""
     st = steering(v, win, uneven)
@@ -109,8 +109,8 @@ def test_ratio_kernel_gives_the_definitions_bits(v, win, uneven, monkeypatch):
     b_j[2][160:170] = np.inf
     phase = rng.uniform(-np.pi, np.pi, n)
     out = []
-    for limit in (0, 10 ** 9):
-        monkeypatch.setattr(sweep, "KERNEL_MIN_BATCH", limit)
+    for compiled in (True, False):
+        monkeypatch.setattr(sweep, "use_kernels", lambda n, s: compiled)
         out.append(sweep.ratio_from_beams(b_i, b_j, phase))
     np.testing.assert_array_equal(out[0], out[1])
     np.testing.assert_array_equal(np.signbit(out[0]), np.signbit(out[1]))

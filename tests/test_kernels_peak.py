@@ -10,6 +10,8 @@ gives the same bits whichever of the two a batch's size selects."""
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 import pytest
 
@@ -106,14 +108,31 @@ def test_the_grid_bound_bounds_the_direct_powers():
 
 @pytest.mark.parametrize("v,win,uneven", GRID[::3])
 def test_steering_peak_is_the_same_whatever_the_batch_size(v, win, uneven, monkeypatch):
-    """Below ``KERNEL_MIN_BATCH`` snapshots Steering.peak runs numpy, above it the kernel:
-    the same u and the same decisions, so a calibration (a few thousand snapshots) and a
-    Monte-Carlo study (millions) agree bit for bit on equal snapshots."""
+    """Steering.peak runs numpy or the kernel (``_util.use_kernels``: numpy while numba's
+    set-up would cost more): the same u and the same decisions, so a calibration (a few
+    thousand snapshots, numpy) and a Monte-Carlo study (millions, compiled) agree bit for
+    bit on equal snapshots."""
     st = steering(v, win, uneven)
     x, u0 = snapshots(st, v, v + 7 * uneven)
     out = []
-    for limit in (0, 10 ** 9):  # everything compiled, everything numpy
-        monkeypatch.setattr(steering_mod, "KERNEL_MIN_BATCH", limit)
+    for compiled in (True, False):
+        monkeypatch.setattr(steering_mod, "use_kernels", lambda n, s: compiled)
         out.append(st.peak(x, u0[:, None]))
     np.testing.assert_array_equal(out[0][0], out[1][0])
     np.testing.assert_array_equal(out[0][1], out[1][1])
+
+
+def test_use_kernels_rents_numpy_until_numba_would_be_cheaper(monkeypatch):
+    """``_util.use_kernels``: numpy while a process's estimated numpy work stays below half
+    of numba's set-up, the kernels from the batch that would pass it on, and always once
+    the kernels are loaded."""
+    from rtsgeom import _util
+    monkeypatch.setattr(_util, "_numpy_s", 0.0)
+    assert _util.use_kernels(1, 1.0)  # loaded here (this module imports them)
+    monkeypatch.delitem(sys.modules, "rtsgeom.kernels")
+    half = _util.KERNEL_SETUP_S / 2
+    assert not _util.use_kernels(1000, 0.4 * half / 1000)
+    assert not _util.use_kernels(1000, 0.4 * half / 1000)
+    assert _util.use_kernels(1000, 0.4 * half / 1000)  # would pass half the set-up
+    assert _util.use_kernels(10 ** 9, 1e-6)
+    assert not _util.use_kernels(10, 1e-6)  # small batches still fit the budget

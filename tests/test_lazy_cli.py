@@ -73,9 +73,9 @@ def test_commands_import_only_what_they_use(tmp_path, args):
                                    "--quiet"]])
 def test_commands_without_kernels_skip_numba(tmp_path, args):
     """The compiled kernels (numba, ~0.2 s to import and ~0.3 s to set up on the first call)
-    load inside the functions that call them, and only for batches of ``KERNEL_MIN_BATCH``
-    or more (smaller ones run the numpy definitions, the same bits): commands that never
-    call one, and ``calibrate`` (a few thousand snapshots), do not pay for numba."""
+    load inside the functions that call them, and only once a process's work would pay for
+    them (``_util.use_kernels``; before that the numpy definitions, the same bits): commands
+    that never call one, and ``calibrate`` (a few thousand snapshots), do not pay for numba."""
     code, mods = _imported(args, tmp_path)
     assert code == 0
     assert _loaded(mods, ("numba", "llvmlite")) == [], f"rtsgeom {' '.join(args)} imports numba"

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.constants import c
 
-from .._util import KERNEL_MIN_BATCH
+from .._util import use_kernels
 from ..geometry import Setup
 from ..paths import Paths
 from ..radar.processing import tdm_compensate
@@ -81,11 +81,12 @@ def ratio_from_beams(beam_i, beam_j, phase=0.0):
     (``Re(conj(f) g)`` of the beams), formed once; the roots and the maximum test are then
     real arithmetic (:func:`_ratios`, the definition), compiled per set-point for large
     batches (``rtsgeom.kernels.ratio_one``, the same bits: the Monte-Carlo studies call it for
-    millions of set-points; below ``KERNEL_MIN_BATCH`` numpy, without numba's import)."""
+    millions of set-points; small batches numpy, without numba's import:
+    ``rtsgeom._util.use_kernels``)."""
     arrs = np.broadcast_arrays(*(np.asarray(b, complex) for b in (*beam_i, *beam_j)),
                                np.exp(1j * np.asarray(phase, float)))
     flat = [np.ascontiguousarray(a).reshape(-1) for a in arrs]
-    if flat[0].size < KERNEL_MIN_BATCH:
+    if not use_kernels(flat[0].size, 2e-7):  # numpy ~0.2 us per set-point (measured)
         return _ratios(*flat).reshape(arrs[0].shape)
     from ..kernels import ratios
     out = np.empty(arrs[0].shape)

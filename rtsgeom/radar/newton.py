@@ -87,8 +87,9 @@ def parabolic(y0, y1, y2) -> np.ndarray:
 # numpy's reductions, whose order depends on the array's layout), complex products written
 # out as (ac - bd, ad + bc) (the kernel's, CPython's), cosines and sines from numpy (equal to
 # the C library's that the kernel calls, checked bit for bit by tests/test_kernels_peak.py).
-# Steering.peak runs this below ``rtsgeom._util.KERNEL_MIN_BATCH`` snapshots (no numba import
-# for a few thousand: the calibration), the kernel above; both give the same bits.
+# Steering.peak runs this while numba's set-up would cost more (``rtsgeom._util.use_kernels``:
+# no numba import for a few thousand snapshots, the calibration), the kernel after; both give
+# the same bits.
 
 
 def lattice(k: np.ndarray, kappa: float):

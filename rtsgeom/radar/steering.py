@@ -23,7 +23,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .._util import KERNEL_MIN_BATCH, frozen, single_threaded_blas
+from .._util import frozen, single_threaded_blas, use_kernels
 from ..geometry import RutArray
 from ..scene import RadarConfig, SceneError
 from . import estimators as est
@@ -410,7 +410,9 @@ class Steering:
             k, lat, gc, gs, g1 = self._grid_1d
             x = np.ascontiguousarray(self.weighted(flat), complex)
             start = np.ascontiguousarray(u0[:, 0])
-            if x.shape[0] < KERNEL_MIN_BATCH:  # numpy, the same bits (no numba import)
+            # numpy, the same bits, while numba's set-up would cost more (~10 ns per
+            # element and grid point, measured)
+            if not use_kernels(x.shape[0], 1e-8 * gc.size):
                 u1, ok = peak_1d(k, lat, x, start, gc, gs, g1, int(iterations))
             else:
                 from ..kernels import peak_1d as compiled
