@@ -2,10 +2,34 @@
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
 
 _BLAS_CONTROLLER = None
+
+#: numba's cost per process before the first compiled kernel (``rtsgeom.kernels``) returns:
+#: its import (~0.2 s) and its target's set-up on the first call of a cached kernel (~0.3 s),
+#: quiet 2-core machine
+KERNEL_SETUP_S = 0.5
+_numpy_s = 0.0  # what this process has spent so far in the kernels' numpy definitions (est.)
+
+
+def use_kernels(n: int, numpy_s_per_item: float) -> bool:
+    """Whether a batch of ``n`` items (snapshots, set-points) runs the compiled kernels or
+    their numpy definitions, which give the same bits (tested): the kernels once they are
+    loaded, and once this process's numpy work (this batch included, estimated at
+    ``numpy_s_per_item``) would pass half of numba's set-up ``KERNEL_SETUP_S``; numpy
+    before that (ski rental: a command with a few thousand snapshots, ``calibrate``, never
+    pays for numba; one with millions pays at most 0.25 s of numpy before it does)."""
+    global _numpy_s
+    if "rtsgeom.kernels" in sys.modules:
+        return True
+    if _numpy_s + n * numpy_s_per_item > KERNEL_SETUP_S / 2:
+        return True
+    _numpy_s += n * numpy_s_per_item
+    return False
 
 
 def single_threaded_blas():

@@ -18,6 +18,13 @@ counting of the arrays passed down: the planned design 760 -> 320 ns per set-poi
 Newton steps about 2x). numba is
 imported only with this module, which the callers import inside the functions that need it
 (``rtsgeom --help`` and ``info`` do not load it).
+
+Small batches skip them: ``Steering.peak`` (D = 1) and ``aoa.sweep.ratio_from_beams`` run
+their numpy definitions (``radar.newton.peak_1d``, ``aoa.sweep._ratios``) until a process's
+work in them would pass half of numba's set-up (``rtsgeom._util.use_kernels``), the same
+arithmetic bit for bit (tested), because
+importing numba and setting up its target on the first call costs about 0.5 s per process,
+more than the rest of ``rtsgeom calibrate`` (issue 17).
 """
 
 from __future__ import annotations
@@ -27,16 +34,14 @@ import math
 import numpy as np
 from numba import njit
 
+from .radar.newton import P_SLACK, STEP_CLIP, STEP_TOL, lattice  # noqa: F401 (re-exported)
+
 __all__ = ["peak_1d", "newton_1d", "lattice", "ratio_one", "ratios", "choice_row",
            "bin_choice_rows", "design_rows", "plan_rows", "detect_rows"]
 
 _JIT = dict(cache=True, nogil=True, error_model="numpy")
-
-#: Newton: each step clipped to this in u, converged when a step is below ``STEP_TOL``
-STEP_CLIP = 0.05
-STEP_TOL = 1e-6
-#: the global check's relative slack (rounding of the powers)
-P_SLACK = 1e-9
+# (numba's cache is keyed on this file: after changing the constants in radar/newton.py,
+# touch this file or clear __pycache__/kernels.*.nb*)
 
 
 # -- the beamformer's peak (Steering.peak, D = 1) ------------------------------------------------
@@ -98,20 +103,6 @@ def newton_1d(k, lat, x, u, steps, pw, e):
         if abs(step) < STEP_TOL:
             return u, abs(u) < 1, p
     return u, False, p
-
-
-def lattice(k: np.ndarray, kappa: float):
-    """The wavenumbers ``k`` (V_s,) as k_0 + m_v kappa + r_v (m_v >= 0 integers, r_v the
-    remainder, set to 0 at rounding level): (k_0, kappa, m, r) for :func:`_phasors`.
-    ``kappa`` the grid's wavenumber step (2 pi pitch / lambda; 0: no grid, every r_v kept)."""
-    k = np.asarray(k, float)
-    k0 = float(k.min())
-    m = np.zeros(k.size, np.int64)
-    if kappa > 0:
-        m = np.round((k - k0) / kappa).astype(np.int64)
-    r = k - (k0 + m * kappa)
-    r[np.abs(r) <= 1e-13 * np.abs(k).max()] = 0.0
-    return k0, float(kappa), m, r
 
 
 @njit(**_JIT)

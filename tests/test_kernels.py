@@ -2,14 +2,17 @@
 (uniform rows of V = 4, 8, 12, 16 elements at lambda/2, and an uneven one off the lattice)
 and taper windows: the beamformer peak is a stationary maximum of P with no grid point of more
 power and finds a plane wave's direction; the closed-form design puts the composite's peak on
-the set angle; the bin choice equals a plain loop over the docstring's rule."""
+the set angle; its compiled form gives the numpy definition's bits; the bin choice equals a
+plain loop over the docstring's rule."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from rtsgeom.aoa.sweep import design_ratio, detected_bin_choice
+from rtsgeom import kernels
+from rtsgeom.aoa import sweep
+from rtsgeom.aoa.sweep import beam_derivatives, design_ratio, detected_bin_choice
 from rtsgeom.radar.steering import Steering, window
 
 WAVELENGTH = 3.9e-3
@@ -79,6 +82,44 @@ def test_design_puts_the_composite_peak_on_the_set_angle(v, win, uneven):
         u, ok = st.peak(comp, np.sin(sets[fine])[:, None])
         assert ok.all()
         np.testing.assert_allclose(u[:, 0], np.sin(sets[fine]), rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("v,win,uneven", GRID[::2])
+def test_ratio_kernel_gives_the_definitions_bits(v, win, uneven, monkeypatch):
+    """``kernels.ratios`` (large batches) against ``sweep._ratios`` (numpy, the definition,
+    small batches), bit for bit: designs across the pair's span and beyond it
+    (no root: NaN), J's phases, and degenerate beams (zero, a2 = 0, NaN, inf), through
+    ratio_from_beams with either path forced."""
+    st = steering(v, win, uneven)
+    rng = np.random.default_rng(v + 100 * uneven)
+    beam = 2 / v
+    n = 3000
+    a_i, a_j = rng.uniform(-0.6, -0.1, n) * beam, rng.uniform(0.1, 0.6, n) * beam
+    sets = rng.uniform(-0.9, 0.9, n) * beam
+    x_i = plane(st, np.sin(a_i)) * np.exp(1j * rng.uniform(-np.pi, np.pi, (n, 1)))
+    x_j = plane(st, np.sin(a_j)) * rng.uniform(0.3, 3, (n, 1))
+    x_j[:200] += 0.3 * (rng.standard_normal((200, v)) + 1j * rng.standard_normal((200, v)))
+    u = np.sin(sets)
+    b_i = list(beam_derivatives(st, x_i, u))
+    b_j = list(beam_derivatives(st, x_j, u))
+    b_j[0][:50] = 0          # no J beam
+    b_j[1][50:100] = 0       # a2 = 0: the linear root
+    b_i[1][100:150] = 0      # a0 = 0
+    b_i[0][150:160] = np.nan
+    b_j[2][160:170] = np.inf
+    phase = rng.uniform(-np.pi, np.pi, n)
+    out = []
+    for compiled in (True, False):
+        monkeypatch.setattr(sweep, "use_kernels", lambda n, s: compiled)
+        out.append(sweep.ratio_from_beams(b_i, b_j, phase))
+    np.testing.assert_array_equal(out[0], out[1])
+    np.testing.assert_array_equal(np.signbit(out[0]), np.signbit(out[1]))
+    fine = np.isfinite(out[0])
+    assert 0.3 < fine.mean() < 0.97  # designs inside the span, none beyond it
+    direct = np.empty(n)  # and the kernel called directly
+    kernels.ratios(*(np.ascontiguousarray(a, complex) for a in (*b_i, *b_j)),
+                   np.exp(1j * phase), direct)
+    np.testing.assert_array_equal(direct, out[1])
 
 
 def _choice_loop(rho, ph, p_ii, p_jj, c_ij):

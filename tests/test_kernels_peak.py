@@ -1,17 +1,22 @@
-"""``kernels.peak_1d``'s global check against its definition, bit for bit: the Newton peak is
-accepted iff it converged and its power is at least ``1 - P_SLACK`` of the largest power on
-the grid (each point's sum in element order), otherwise Newton restarts from the grid's
-maximum under the same test. The kernel may decide the acceptance from a cheaper bound
-first; these tests check that it accepts and rejects exactly the same snapshots, on a grid of
-arrays (V = 4 .. 16, on and off the lattice) and tapers, with clean, two-target, ambiguous
-(two equal targets far apart, started at the wrong one) and noise-only snapshots."""
+"""``kernels.peak_1d`` against its definition (``radar.newton.peak_1d``, numpy), bit for bit:
+the Newton peak (phasors from the array's lattice) is accepted iff it converged and its power
+is at least ``1 - P_SLACK`` of the largest power on the grid (each point's sum in element
+order), otherwise Newton restarts from the grid's maximum under the same test. The kernel may
+decide the acceptance from a cheaper bound first; these tests check that it returns exactly
+the same u and accepts and rejects exactly the same snapshots, on a grid of arrays (V = 4 ..
+16, on and off the lattice) and tapers, with clean, two-target, ambiguous (two equal targets
+far apart, started at the wrong one) and noise-only snapshots; and that ``Steering.peak``
+gives the same bits whichever of the two a batch's size selects."""
 
 from __future__ import annotations
+
+import sys
 
 import numpy as np
 import pytest
 
 from rtsgeom import kernels
+from rtsgeom.radar import newton, steering as steering_mod
 from tests.test_kernels import plane, steering
 
 GRID = [(v, w, un) for v in (4, 5, 8, 11, 16) for w in ("none", "hann", "blackman")
@@ -19,32 +24,17 @@ GRID = [(v, w, un) for v in (4, 5, 8, 11, 16) for w in ("none", "hann", "blackma
 
 
 def reference(st, x, u0, iterations=4):
-    """The check's definition, snapshot by snapshot, with the grid's powers summed over
-    the elements in order (the kernel's direct arithmetic)."""
+    """The check's definition (``radar.newton.peak_1d``, numpy, each grid point's power
+    summed over the elements in order), and which snapshots it accepts at once (``direct``)
+    and which converged to a peak that a grid point beats (``beaten``: a local maximum)."""
     k, lat, gc, gs, grid = st._grid_1d
-    pw = np.empty(lat[2].max() + 1, complex)
-    e = np.empty(k.size, complex)
-    br = np.zeros((x.shape[0], gc.shape[1]))
-    bi = np.zeros_like(br)
-    for v in range(k.size):
-        xr, xi = x[:, v, None].real, x[:, v, None].imag
-        br += xr * gc[v] - xi * gs[v]
-        bi += xr * gs[v] + xi * gc[v]
-    power = br * br + bi * bi
-    n_x = x.shape[0]
-    u_out, ok_out, direct, beaten = (np.empty(n_x), np.zeros(n_x, bool), np.zeros(n_x, bool),
-                                     np.zeros(n_x, bool))
-    for n in range(x.shape[0]):
-        u, conv, p = kernels.newton_1d(k, lat, x[n], u0[n], iterations, pw, e)
-        best = int(np.argmax(power[n]))
-        floor = power[n, best] * (1 - kernels.P_SLACK)
-        if conv and p >= floor:
-            u_out[n], ok_out[n], direct[n] = u, True, True
-            continue
-        beaten[n] = conv  # a converged peak with a grid point above it: a local maximum
-        u2, conv2, p2 = kernels.newton_1d(k, lat, x[n], grid[best], iterations + 4, pw, e)
-        u_out[n], ok_out[n] = (u2, True) if conv2 and p2 >= floor else (u, False)
-    return u_out, ok_out, direct, beaten
+    u_out, ok_out = newton.peak_1d(k, lat, x, u0, gc, gs, grid, iterations)
+    _, conv, p = newton.newton_1d(k, lat, np.ascontiguousarray(x.real.T),
+                                  np.ascontiguousarray(x.imag.T), u0, iterations)
+    b = x[:, :, None] * (gc + 1j * gs)[None]
+    power = np.abs(b.sum(1)) ** 2
+    direct = conv & (p >= power.max(1) * (1 - newton.P_SLACK))
+    return u_out, ok_out, direct, conv & ~direct
 
 
 def snapshots(st, v, seed):
@@ -114,3 +104,35 @@ def test_the_grid_bound_bounds_the_direct_powers():
                 assert bound <= (br * br + bi * bi).max() * (1 + 1e-12) + 1e-300 * scale ** 2
         xn = np.full(v, np.nan + 0j)
         assert np.isnan(kernels._grid_bound(xn, gc, gs, *scratch))
+
+
+@pytest.mark.parametrize("v,win,uneven", GRID[::3])
+def test_steering_peak_is_the_same_whatever_the_batch_size(v, win, uneven, monkeypatch):
+    """Steering.peak runs numpy or the kernel (``_util.use_kernels``: numpy while numba's
+    set-up would cost more): the same u and the same decisions, so a calibration (a few
+    thousand snapshots, numpy) and a Monte-Carlo study (millions, compiled) agree bit for
+    bit on equal snapshots."""
+    st = steering(v, win, uneven)
+    x, u0 = snapshots(st, v, v + 7 * uneven)
+    out = []
+    for compiled in (True, False):
+        monkeypatch.setattr(steering_mod, "use_kernels", lambda n, s: compiled)
+        out.append(st.peak(x, u0[:, None]))
+    np.testing.assert_array_equal(out[0][0], out[1][0])
+    np.testing.assert_array_equal(out[0][1], out[1][1])
+
+
+def test_use_kernels_rents_numpy_until_numba_would_be_cheaper(monkeypatch):
+    """``_util.use_kernels``: numpy while a process's estimated numpy work stays below half
+    of numba's set-up, the kernels from the batch that would pass it on, and always once
+    the kernels are loaded."""
+    from rtsgeom import _util
+    monkeypatch.setattr(_util, "_numpy_s", 0.0)
+    assert _util.use_kernels(1, 1.0)  # loaded here (this module imports them)
+    monkeypatch.delitem(sys.modules, "rtsgeom.kernels")
+    half = _util.KERNEL_SETUP_S / 2
+    assert not _util.use_kernels(1000, 0.4 * half / 1000)
+    assert not _util.use_kernels(1000, 0.4 * half / 1000)
+    assert _util.use_kernels(1000, 0.4 * half / 1000)  # would pass half the set-up
+    assert _util.use_kernels(10 ** 9, 1e-6)
+    assert not _util.use_kernels(10, 1e-6)  # small batches still fit the budget

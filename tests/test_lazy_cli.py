@@ -68,19 +68,23 @@ def test_commands_import_only_what_they_use(tmp_path, args):
     assert heavy == [], f"rtsgeom {' '.join(args)} imports {heavy}"
 
 
-@pytest.mark.parametrize("args", [["ghosts", str(SCENE)], ["calibrate", "--help"]])
+@pytest.mark.parametrize("args", [["ghosts", str(SCENE)], ["calibrate", "--help"],
+                                  ["calibrate", str(SCENE), "--pair", "0", "1", "--json",
+                                   "--quiet"]])
 def test_commands_without_kernels_skip_numba(tmp_path, args):
-    """The compiled kernels (numba, ~0.16 s to import) load inside the functions that call
-    them: commands that never call one do not pay for numba."""
+    """The compiled kernels (numba, ~0.2 s to import and ~0.3 s to set up on the first call)
+    load inside the functions that call them, and only once a process's work would pay for
+    them (``_util.use_kernels``; before that the numpy definitions, the same bits): commands
+    that never call one, and ``calibrate`` (a few thousand snapshots), do not pay for numba."""
     code, mods = _imported(args, tmp_path)
     assert code == 0
     assert _loaded(mods, ("numba", "llvmlite")) == [], f"rtsgeom {' '.join(args)} imports numba"
 
 
 def test_calibrate_imports_only_what_it_uses(tmp_path):
-    """``calibrate --pair 0 1`` (issue 17: a new process under a second): the kernels it
-    calls and matplotlib for its figure, none of the other optional libraries and none of
-    scipy's optimize/signal/interpolate/stats."""
+    """``calibrate --pair 0 1`` (issue 17: a new process under a second): matplotlib for its
+    figure, none of the other optional libraries (numba: see above) and none of scipy's
+    optimize/signal/interpolate/stats."""
     code, mods = _imported(["calibrate", str(SCENE), "--pair", "0", "1", "--quiet",
                             "--out", str(tmp_path / "cal")], tmp_path)
     assert code == 0

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.constants import c
 
+from .._util import use_kernels
 from ..geometry import Setup
 from ..paths import Paths
 from ..radar.processing import tdm_compensate
@@ -78,14 +79,58 @@ def ratio_from_beams(beam_i, beam_j, phase=0.0):
 
     P, dP/du and d2P/du2 of ``b_I + rho y`` are quadratics in rho with real coefficients
     (``Re(conj(f) g)`` of the beams), formed once; the roots and the maximum test are then
-    real arithmetic, compiled per set-point (``rtsgeom.kernels.ratio_one``: the Monte-Carlo
-    studies call it for millions of set-points)."""
-    from ..kernels import ratios
+    real arithmetic (:func:`_ratios`, the definition), compiled per set-point for large
+    batches (``rtsgeom.kernels.ratio_one``, the same bits: the Monte-Carlo studies call it for
+    millions of set-points; small batches numpy, without numba's import:
+    ``rtsgeom._util.use_kernels``)."""
     arrs = np.broadcast_arrays(*(np.asarray(b, complex) for b in (*beam_i, *beam_j)),
                                np.exp(1j * np.asarray(phase, float)))
+    flat = [np.ascontiguousarray(a).reshape(-1) for a in arrs]
+    if not use_kernels(flat[0].size, 2e-7):  # numpy ~0.2 us per set-point (measured)
+        return _ratios(*flat).reshape(arrs[0].shape)
+    from ..kernels import ratios
     out = np.empty(arrs[0].shape)
-    ratios(*(np.ascontiguousarray(a).reshape(-1) for a in arrs), out.reshape(-1))
+    ratios(*flat, out.reshape(-1))
     return out
+
+
+def _ratios(bi, bi1, bi2, bj, bj1, bj2, e):
+    """The ratio rho >= 0 per set-point (flat arrays (N,)) that puts the peak of
+    P(u) = |b_I + rho y|^2 (y = e b_J, e = e^{j phase} J's phase factor) at the set
+    direction, from the beams and their first two derivatives in u there.
+
+    dP/du = 0 is a0 + a1 rho + a2 rho^2 = 0 with a0 = Re(b_I* b_I'), a1 = Re(b_I* y' + y* b_I'),
+    a2 = Re(y* y'); of its roots the non-negative ones with P'' < 0 (P'' = 2 Re(s* s'') +
+    2 |s'|^2, s = b_I + rho y, a quadratic in rho), the one with the larger P (the first on a
+    tie); NaN where none is. Real arithmetic in the compiled kernel's order
+    (``kernels.ratio_one``, its compiled form: the complex products written out as
+    (ac - bd, ad + bc)), so both give the same bits (tested)."""
+    def mul(f, g):
+        return (f[0] * g[0] - f[1] * g[1], f[0] * g[1] + f[1] * g[0])
+
+    def re(f, g):  # Re(conj(f) g)
+        return f[0] * g[0] + f[1] * g[1]
+
+    bi, bi1, bi2, bj, bj1, bj2, e = ((a.real, a.imag) for a in (bi, bi1, bi2, bj, bj1, bj2, e))
+    y, y1, y2 = mul(e, bj), mul(e, bj1), mul(e, bj2)
+    a0 = re(bi, bi1)
+    a1 = re(bi, y1) + re(y, bi1)
+    a2 = re(y, y1)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        disc = a1 * a1 - 4 * a0 * a2
+        sq = np.sqrt(np.where(disc >= 0, disc, np.nan))
+        lin = -a0 / a1  # a2 = 0: the one root of the linear equation
+        out = []
+        for sign in (1, -1):
+            r = np.where(a2 != 0, (-a1 + sign * sq) / (2 * a2), lin)
+            p = re(bi, bi) + r * (2 * re(bi, y) + r * re(y, y))
+            p2 = (2 * (re(bi, bi2) + r * (re(bi, y2) + re(y, bi2)) + r * r * re(y, y2))
+                  + 2 * (re(bi1, bi1) + r * (2 * re(bi1, y1)) + r * r * re(y1, y1)))
+            keep = np.isfinite(r) & (r >= 0) & (p2 < 0)
+            out.append((np.where(keep, r, np.nan), np.where(keep, p, -np.inf)))
+    (r0, s0), (r1, s1) = out
+    # numpy's argmax over (s0, s1): the first maximum, or the first NaN
+    return np.where((s0 == s0) & ((s1 != s1) | (s1 > s0)), r1, r0)
 
 
 def design_at_detected_bin(st: Steering, h, alpha_rad, phase=0.0):

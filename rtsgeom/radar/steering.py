@@ -23,11 +23,11 @@ from functools import cached_property
 
 import numpy as np
 
-from .._util import frozen, single_threaded_blas
+from .._util import frozen, single_threaded_blas, use_kernels
 from ..geometry import RutArray
 from ..scene import RadarConfig, SceneError
 from . import estimators as est
-from .newton import newton, parabolic
+from .newton import lattice, newton, parabolic, peak_1d
 
 __all__ = ["Steering", "window"]
 
@@ -406,12 +406,18 @@ class Steering:
         n_d = self.dims
         u0 = np.broadcast_to(np.asarray(u0, float), shape + (n_d,)).reshape(-1, n_d)
         ok = np.zeros(u0.shape[0], bool)
-        if n_d == 1:  # compiled, snapshot by snapshot (rtsgeom.kernels)
-            from ..kernels import peak_1d
+        if n_d == 1:  # compiled, snapshot by snapshot (rtsgeom.kernels), or its definition
             k, lat, gc, gs, g1 = self._grid_1d
-            u1 = np.empty(u0.shape[0])
-            peak_1d(k, lat, np.ascontiguousarray(self.weighted(flat), complex),
-                    np.ascontiguousarray(u0[:, 0]), gc, gs, g1, int(iterations), u1, ok)
+            x = np.ascontiguousarray(self.weighted(flat), complex)
+            start = np.ascontiguousarray(u0[:, 0])
+            # numpy, the same bits, while numba's set-up would cost more (~10 ns per
+            # element and grid point, measured)
+            if not use_kernels(x.shape[0], 1e-8 * gc.size):
+                u1, ok = peak_1d(k, lat, x, start, gc, gs, g1, int(iterations))
+            else:
+                from ..kernels import peak_1d as compiled
+                u1 = np.empty(u0.shape[0])
+                compiled(k, lat, x, start, gc, gs, g1, int(iterations), u1, ok)
             u = u1[:, None]
         else:
             kv = self.wavevector  # (V_s, D)
@@ -431,9 +437,8 @@ class Steering:
     @cached_property
     def _grid_1d(self) -> tuple:
         """What the compiled peak (D = 1) reads: the wavenumbers k p_v (V_s,), their lattice
-        on the pitch grid (``kernels.lattice``), and the global check's grid: the steering
+        on the pitch grid (``newton.lattice``), and the global check's grid: the steering
         vectors' real and imaginary parts (V_s, G) and the grid's u (G,)."""
-        from ..kernels import lattice
         k = np.ascontiguousarray(self.wavevector[:, 0])
         lat = lattice(k, 2 * np.pi / self.wavelength_m * self.pitch_m)
         grid = self.grid()
