@@ -151,3 +151,22 @@ def test_nearfield_cli(tmp_path):
         main(["nearfield", str(DEFAULT_SCENE), "--radius-m", "2:1:3"])
     assert exc.value.code == 2
     assert main(["nearfield", str(DEFAULT_SCENE), "--radius-m", "1:500:3"]) == 2
+
+
+def test_default_sweep_stops_at_the_radar_limit_and_ignores_targets_and_sheet():
+    """A short-range radar's default sweep ends at its own limit (0.8 R_max - 2 m, where the
+    probe target still fits) instead of failing; the scene's targets (inside the arc at large
+    radii) and cutouts (overlapping at small radii) do not stop the free-space analysis."""
+    from rtsgeom.analysis.nearfield import max_radius_m
+    from rtsgeom.scene import load_scene
+    scene = load_scene(DEFAULT_SCENE.parent / "custom-array.toml")
+    r = default_radii(scene)
+    full = scene.rts.arc_radius_m * np.logspace(-0.5, 1.5, 13)
+    assert full[-1] > max_radius_m(scene)  # the unclipped sweep would leave the radar's range
+    assert r[-1] == max_radius_m(scene) and np.all(np.diff(r) > 0)
+    assert np.array_equal(r[:-1], full[full < max_radius_m(scene)])
+    nf = nearfield(scene, r[[0, -1]], points=3)
+    assert np.all(np.isfinite(nf.bias_deg))
+    assert abs(nf.bias_deg[-1]).max() < abs(nf.bias_deg[0]).max()  # ~1/R
+    with pytest.raises(Exception, match=r"must lie in \[0.05, 28.98\] m .*got 40 m"):
+        nearfield(scene, np.array([1.0, 40.0]), points=3)

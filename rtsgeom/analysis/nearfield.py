@@ -75,7 +75,7 @@ from ..rts import requested_delay
 from ..scene import Scene, TargetConfig
 from .nearfield2d import _cells, cell_synthesis_errors_deg, single_front_end_directions_rad
 
-__all__ = ["DEFAULT_DECADES", "DEFAULT_POINTS", "default_radii", "with_arc_radius",
+__all__ = ["DEFAULT_DECADES", "DEFAULT_POINTS", "MIN_RADIUS_M", "max_radius_m", "default_radii", "with_arc_radius",
            "group_azimuth_rad", "beat_frequency_azimuth_rad", "phase_error_deg",
            "single_front_end_angles_rad", "single_front_end_directions_rad",
            "synthesis_worst_errors_deg", "cell_synthesis_errors_deg", "NearField",
@@ -85,10 +85,25 @@ DEFAULT_DECADES = (-0.5, 1.5)  # default sweep: R_c * 10^-0.5 ... R_c * 10^1.5 (
 DEFAULT_POINTS = 13  # 6 per decade, so R_c itself is one of them
 
 
+MIN_RADIUS_M = 0.05  # the smallest arc radius analysed
+
+
+def max_radius_m(scene: Scene) -> float:
+    """The largest arc radius analysed: the probe target (``calibration.probe_ranges``, at
+    least R_c + 2 m) must stay within 80 % of the radar's maximum range."""
+    return 0.8 * scene.radar.max_range_m - 2.0
+
+
 def default_radii(scene: Scene, points: int = DEFAULT_POINTS) -> np.ndarray:
     """Log-spaced arc radii around the scene's, the scene's radius included (odd ``points``
-    centred on it in log scale for the default decades)."""
-    return scene.rts.arc_radius_m * np.logspace(*DEFAULT_DECADES, points)
+    centred on it in log scale for the default decades), clipped to
+    [:data:`MIN_RADIUS_M`, :func:`max_radius_m`] (the clipped end itself kept as the last or
+    first radius: a short-range radar's sweep stops at its own limit instead of failing)."""
+    r = scene.rts.arc_radius_m * np.logspace(*DEFAULT_DECADES, points)
+    lo, hi = MIN_RADIUS_M, max_radius_m(scene)
+    inside = r[(r >= lo) & (r <= hi)]
+    return np.unique(np.concatenate([[lo] if r[0] < lo else [], inside,
+                                     [hi] if r[-1] > hi else []]))
 
 
 def with_arc_radius(scene: Scene, radius_m: float) -> Scene:
@@ -366,11 +381,12 @@ class NearField:
 
 def _check_radii(scene: Scene, radii: np.ndarray) -> None:
     r = np.asarray(radii, float)
-    limit = 0.8 * scene.radar.max_range_m - 2.0
-    if r.ndim != 1 or r.size == 0 or not np.all(np.isfinite(r)) or np.any(r < 0.05) \
-            or np.any(r > limit):
-        raise ParameterError(f"arc radii must lie in [0.05, {limit:.4g}] m (the target must stay "
-                         f"within the radar's range), got {r}")
+    limit = max_radius_m(scene)
+    bad = r[~(np.isfinite(r) & (r >= MIN_RADIUS_M) & (r <= limit))] if r.ndim == 1 else r
+    if r.ndim != 1 or r.size == 0 or bad.size:
+        got = ", ".join(f"{x:.4g}" for x in np.ravel(bad)[:4]) if np.size(bad) else "none"
+        raise ParameterError(f"arc radii must lie in [{MIN_RADIUS_M:g}, {limit:.4g}] m (the probe "
+                             f"target must stay within the radar's range), got {got} m")
 
 
 def nearfield(scene: Scene, radii=None, points: int = 11) -> NearField:
@@ -385,8 +401,12 @@ def nearfield(scene: Scene, radii=None, points: int = 11) -> NearField:
     synth = []
     rut = None
     two_d = False
+    # The analysis places its own probe target (``probe_ranges``) and uses exact free-space
+    # paths: the scene's targets and sheet play no part. Dropped, so that a radius where the
+    # targets would lie inside the arc, or the cutouts would overlap, is still analysed.
+    probe_scene = scene.evolve(targets=(), sheet=scene.sheet.evolve(enabled=False))
     for r in radii:
-        setup = build_setup(with_arc_radius(scene, r))
+        setup = build_setup(with_arc_radius(probe_scene, r))
         paths = exact_paths(setup)
         rut, fe, radar = setup.rut, setup.fe, scene.radar
         rng = float(probe_ranges(setup, 1)[0])
