@@ -254,10 +254,15 @@ def format_budget(b: dict) -> list[str]:
              f"quantisation {_f1(b['quantisation_noise_dbm'])} dBm, FFT gain "
              f"{_f1(b['fft_gain_db'])} dB"]
     for fe in b["front_ends"]:
-        att = ", ".join(_f1(a) for a in fe["attenuation_db"]) or "-"
+        att = (f"attenuation {', '.join(_f1(a) for a in fe['attenuation_db'])} dB"
+               if fe["attenuation_db"] else
+               # info's budget puts each target on its nearest front end only (static_budget);
+               # run's summary.json has the synthesis' attenuations on every front end it uses
+               "no target on it in this budget (each target on its nearest front end: "
+               "run's summary.json has the synthesis' attenuations)")
         lines.append(f"  front end {fe['index']}: RuT chirp at the back end's ADC "
                      f"{_f1(fe['rut_chirp_at_adc_dbm'])} dBm ({_f1(fe['adc_level_dbfs'])} dBFS), "
-                     f"attenuation {att} dB of at most {_f1(fe['max_attenuation_db'])} dB; "
+                     f"{att}; the back end attenuates at most {_f1(fe['max_attenuation_db'])} dB; "
                      f"antennas toward each other: RuT {_f1(fe.get('rut_tx_gain_dbi'))}/"
                      f"{_f1(fe.get('rut_rx_gain_dbi'))} dBi, front end "
                      f"{_f1(fe.get('fe_rx_gain_dbi'))}/{_f1(fe.get('fe_tx_gain_dbi'))} dBi")

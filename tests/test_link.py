@@ -296,3 +296,20 @@ def test_a_front_end_lost_to_clipping_says_so():
     clean = build_setup(make_scene(linked_doc))
     unclipped = probe_front_ends(clean, exact_paths(clean))
     assert unclipped.adc_clipped == 0 and unclipped.clipping_note() == ""
+
+
+def test_info_budget_names_front_ends_without_a_target():
+    """``info`` puts each target on its nearest front end; a front end carrying none says so
+    instead of ``attenuation - dB`` (a new-user trial read that as a missing attenuation on a
+    front end the synthesis does use)."""
+    from conftest import DEFAULT_SCENE
+    from rtsgeom.scene import load_scene
+    setup = build_setup(load_scene(DEFAULT_SCENE.parent / "custom-array.toml"))
+    b = lk.static_budget(setup).to_dict()
+    carrying = set(int(q) for q in program_nearest(setup.scene, setup).front_end)
+    assert carrying and carrying != set(range(len(b["front_ends"])))
+    for fe, line in zip(b["front_ends"], [ln for ln in lk.format_budget(b)
+                                          if ln.startswith("  front end ")]):
+        assert bool(fe["attenuation_db"]) is (fe["index"] in carrying)
+        assert ("no target on it" in line) is (fe["index"] not in carrying), line
+        assert " - dB" not in line
