@@ -376,6 +376,7 @@ def test_calibration_file_round_trip(tmp_path, capsys):
     a = json.loads((tmp_path / "a" / "summary.json").read_text())
     b = json.loads((tmp_path / "b" / "summary.json").read_text())
     assert b["calibration"]["source"] == "file"
+    assert not any("another setup" in w for w in b["warnings"]), b["warnings"]
     assert a["calibration"]["channel_delay_offsets_s"] == b["calibration"]["channel_delay_offsets_s"]
     assert a["targets"] == b["targets"]
     assert main(["adc", str(DEFAULT_SCENE), "--out", str(tmp_path / "c.npy"), "--quiet",
@@ -589,3 +590,35 @@ def test_probes_clear_each_others_cfar_window(samples, adc_rate_hz, training):
         warnings.simplefilter("error", RuntimeWarning)
         probe = probe_front_ends(setup, exact_paths(setup))
     assert np.all(np.isfinite(probe.angle_rad))
+
+
+def test_calibration_file_names_the_setup_it_was_made_on():
+    """A calibration is a measurement of one setup: its fingerprint (``setup_sha256``) moves
+    with the arc, a front end's mounting or channel and the RuT's chirp, not with the
+    scenario (targets, seed, SNR); a file made before a front end was moved is applied with
+    a warning (a new-user trial applied one silently: -3.7 deg errors, exit 0)."""
+    from rtsgeom.aoa.plan import calibration_mismatch, plan_targets, setup_fingerprint
+
+    def fe1(**kw):
+        return lambda d: d["rts"]["front_ends"][1].update(kw)
+    base = setup_fingerprint(make_scene())
+    same = [make_scene(lambda d: d.update(seed=7)), make_scene(snr_db=5.0),
+            make_scene(lambda d: d["targets"].pop())]
+    assert all(setup_fingerprint(s) == base for s in same)
+    moved = [make_scene(fe1(radial_offset_mm=0.2)), make_scene(fe1(phase_offset_deg=30.0)),
+             make_scene(lambda d: d["rts"].update(arc_radius_m=1.2)),
+             make_scene(f_c_hz=77.5e9)]
+    assert len({setup_fingerprint(s) for s in moved} | {base}) == len(moved) + 1
+    doc = {"setup_sha256": base}
+    assert calibration_mismatch(doc, same[0]) is None
+    assert calibration_mismatch({}, moved[0]) is None  # a file from before the fingerprint
+    nominal = build_setup(make_scene())
+    paths = exact_paths(nominal)
+    probe = probe_front_ends(nominal, paths)
+    cal = calibrate_pair(nominal, paths, (0, 1), probe)
+    doc = {"pairs": [cal.to_dict()], "front_end_angles_deg": np.degrees(probe.angle_rad),
+           "setup_sha256": base}
+    for scene, warned in ((make_scene(), False), (moved[0], True)):
+        setup = build_setup(scene)
+        _, _, warnings = plan_targets(setup, exact_paths(setup), "exact", calibration=doc)
+        assert any("made on another setup" in w for w in warnings) is warned, warnings

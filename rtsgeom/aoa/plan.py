@@ -24,9 +24,38 @@ from .synthesis import PairModel
 
 __all__ = ["bracketing_pair", "pair_amplitudes", "PairPlan", "plan_pair", "pair_design",
            "nearest_setting", "plan_targets", "uses_cells", "channel_offsets",
-           "load_calibration", "CALIBRATION_FORMAT"]
+           "load_calibration", "CALIBRATION_FORMAT", "setup_fingerprint",
+           "calibration_mismatch"]
 
 CALIBRATION_FORMAT = "rtsgeom-calibration"
+
+
+def setup_fingerprint(scene) -> str:
+    """SHA-256 of what a calibration is a measurement of: the RTS (arc, front ends with their
+    mounting and channel fields, delay hardware), the RuT (array, pose, chirp), the sheet
+    and the ray-tracing set-up. Not the targets, the seed, the name, and not the RuT's
+    noise, link levels or CFAR (the same calibration serves other scenarios and SNRs).
+    ``calibrate`` writes it as ``setup_sha256``; ``run``/``adc --calibration`` warn when the
+    scene's differs (a calibration made before a front end was moved)."""
+    import dataclasses
+    import hashlib
+    radar = dataclasses.asdict(scene.radar)
+    for key in ("snr_db", "link", "cfar"):
+        radar.pop(key, None)
+    key = repr((radar, dataclasses.asdict(scene.rts), dataclasses.asdict(scene.sheet),
+                dataclasses.asdict(scene.raytrace), scene.extra_meshes))
+    return hashlib.sha256(key.encode()).hexdigest()
+
+
+def calibration_mismatch(doc: dict, scene) -> str | None:
+    """The warning for a calibration file made on another setup (:func:`setup_fingerprint`),
+    None where it matches or the file predates the fingerprint."""
+    made = doc.get("setup_sha256")
+    if made is None or made == setup_fingerprint(scene):
+        return None
+    return ("--calibration: the file was made on another setup (the arc, a front end's "
+            "mounting or channel, the RuT or the RTS differ from this scene's): applied as it "
+            "is; run `rtsgeom calibrate` on this scene if the setup changed")
 
 
 def load_calibration(doc: dict, setup: Setup) -> tuple[FrontEndProbe, dict]:
@@ -325,6 +354,8 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
     else:
         probe = probe_front_ends(setup, paths, seed)
     warnings = []
+    if calibration is not None and (mismatch := calibration_mismatch(calibration, scene)):
+        warnings.append(mismatch)
     lost = np.flatnonzero(~np.isfinite(probe.angle_rad))
     if lost.size:
         raise SceneError(f"{scene.source}: rts.front_ends[{lost[0]}]: the RuT does not detect "

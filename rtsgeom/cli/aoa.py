@@ -96,11 +96,13 @@ def _calibrate(args, stage) -> int:
         else:
             cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed,
                                  full_chain=args.full_chain)
+    from ..aoa.plan import setup_fingerprint
     out = cal.to_dict()
     out["procedure"] = args.procedure
     out["front_end_angles_deg"] = [float(x) for x in np.degrees(probe.angle_rad)]
     out["gain_correction"] = [float(x) for x in probe.gain_correction]
     out["format"] = "rtsgeom-calibration"  # `run/adc --calibration DIR/calibration.json`
+    out["setup_sha256"] = setup_fingerprint(scene)  # run/adc warn when used on another setup
     out["fractional_delay_filter"] = fir_effect(setup, cal.delta_tau_s,
                                                 ranges=cal.probe_ranges_m)
 

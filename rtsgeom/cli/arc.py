@@ -43,6 +43,7 @@ def prepare_all(args):
 
 def calibrate_all(args, folder) -> int:
     """Every adjacent pair calibrated in one run; one JSON entry per pair plus the arc's."""
+    from ..aoa.plan import setup_fingerprint
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
         scene, setup, pairs, paths, probe = prepare_all(args)
@@ -55,7 +56,8 @@ def calibrate_all(args, folder) -> int:
            "front_end_angles_deg": [float(x) for x in np.degrees(probe.angle_rad)],
            "arc": {"pairs": [list(p) for p in pairs], "worst_residual_error_deg": max(res),
                    "worst_pair": list(pairs[int(np.argmax(res))]),
-                   "max_abs_range_offset_mm": max(abs(c.range_offset_m) for c in cals) * 1e3}}
+                   "max_abs_range_offset_mm": max(abs(c.range_offset_m) for c in cals) * 1e3},
+           "format": "rtsgeom-calibration", "setup_sha256": setup_fingerprint(scene)}
     if folder is not None:
         from ..viz.figures import calibration_sweep_figure, save_figure
         for pair, cal in zip(pairs, cals):
