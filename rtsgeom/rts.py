@@ -423,7 +423,9 @@ def channel_echoes(setup: Setup, paths: Paths, program: RtsProgram) -> Echoes:
     )
     ghosts = cable_ghosts(scene, direct)
     keep = np.any(direct.amplitude != 0, axis=1)
-    return Echoes.concat([direct.select(keep), ghosts]) if len(ghosts) else direct.select(keep)
+    if not keep.all():  # (selecting all would only copy every field)
+        direct = direct.select(keep)
+    return Echoes.concat([direct, ghosts]) if len(ghosts) else direct
 
 
 def cable_ghosts(scene: Scene, direct: Echoes, min_level_db: float = -80.0) -> Echoes:

@@ -266,6 +266,16 @@ class DesignGrid:
         }
 
 
+def _import_for_workers() -> None:
+    """Import here what every design imports on its first use (the root finder of
+    ``ChannelModel.solve``, the compiled kernels with numba), so that the pool's forked
+    workers inherit the modules instead of each importing them again (~0.35 s CPU per
+    worker, measured)."""
+    import scipy.optimize  # noqa: F401
+
+    from .. import kernels  # noqa: F401
+
+
 def available_cores() -> int:
     """The cores this process may run on (its CPU affinity where the OS reports one, as a
     container's CPU set limits it; else ``os.cpu_count()``)."""
@@ -301,8 +311,10 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     one = functools.partial(_evaluate_cell, scene, pair, spec_deg, target_yield, draws, seed,
                             points)
     designs = []
-    pool = (None if int(workers) <= 1 or total <= 1
-            else ProcessPoolExecutor(min(int(workers), total)))
+    pool = None
+    if int(workers) > 1 and total > 1:
+        _import_for_workers()
+        pool = ProcessPoolExecutor(min(int(workers), total))
     try:
         for d in (map(one, cells) if pool is None else pool.map(one, cells)):
             designs.append(d)

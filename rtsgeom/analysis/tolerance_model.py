@@ -100,7 +100,8 @@ def response_table(setup: Setup, paths, channel: int, target: TargetConfig, reso
         prog = RtsProgram.build(np.arange(k.size), np.full(k.size, channel),
                                 tau + k * resolution_s, np.zeros(k.size), np.ones(k.size))
         ech = channel_echoes(setup, paths, prog)
-        ech = ech.select(ech.kind == KIND_DIRECT)  # (none: see above)
+        if np.any(ech.kind != KIND_DIRECT):  # (none: see above)
+            ech = ech.select(ech.kind == KIND_DIRECT)
         resp = bin_response(ech, radar, rut, rbins, dbin)  # (K, E, V)
         acc = np.zeros((k.size,) + resp.shape[::2], complex)  # each target's echoes summed
         np.add.at(acc, ech.target, np.swapaxes(resp, 0, 1))  # (a one-hot einsum was 15 %)
