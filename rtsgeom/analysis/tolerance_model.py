@@ -256,7 +256,7 @@ class PairPhasors:
 
     @classmethod
     def build(cls, setup: Setup, pair: tuple[int, int], points: int = 21,
-              range_m: float | None = None) -> "PairPhasors":
+              range_m: float | None = None, solve_bin_centre: bool = True) -> "PairPhasors":
         """Design on the nominal setup of ``setup`` (its mounting and channel errors dropped).
 
         The reference target sits at the centre of the range bin nearest ``range_m`` (default:
@@ -264,10 +264,35 @@ class PairPhasors:
         (:attr:`subbin_steps`). The set-points divide the span between the two front ends'
         detected angles into ``points + 1`` parts (ends excluded, as ``aoa.linearity``).
 
+        ``solve_bin_centre`` False: the set-points without a closed-form design at the bin
+        centre are left NaN (:meth:`solved` designs them; ``analysis.design`` first checks
+        whether the calibrated plan exists at all).
+
         BLAS single-threaded: the tables' products are many and small (two threads took 2.4x
         the CPU time of one for the same build)."""
         with single_threaded_blas():
-            return cls._build(setup, pair, points, range_m)
+            model = cls._build(setup, pair, points, range_m)
+        return model.solved() if solve_bin_centre else model
+
+    def solved(self) -> "PairPhasors":
+        """The model with the bin-centre set-points that have no closed-form design (spacings
+        beyond the beam's resolution) designed by ``ChannelModel.solve``'s root finder on the
+        searched peak (:class:`~rtsgeom.aoa.model.AngleUnreachable` where even that fails);
+        elsewhere in the bin they stay NaN, which fails the spec. (A root finder per set-point:
+        most of the build of such a design.)"""
+        c0 = self.subbin_zero
+        missing = np.flatnonzero(~np.isfinite(self.design_amplitudes[c0]).all(-1))
+        if missing.size == 0:
+            return self
+        amps = np.array(self.design_amplitudes)
+        model = self.channels
+        with single_threaded_blas():
+            for m in missing:
+                phases = model.coherent_phases(self.probe_rad)
+                amps[c0, m] = model.amplitudes(model.solve(float(self.set_rad[m]), phases),
+                                               float(self.set_rad[m]))
+        return dataclasses.replace(self, amplitudes=frozen(amps[c0]),
+                                   design_amplitudes=frozen(amps))
 
     @classmethod
     def _build(cls, setup: Setup, pair: tuple[int, int], points: int,
@@ -327,12 +352,8 @@ class PairPhasors:
                          frozen(probe_beams), model.unit_gain, reach)
         amps, kbin, ok, _ = design(table, z + sub, z + sub, np.arange(sub.size))
         c0 = centre_index(sub)
-        # no closed-form design at the bin centre (spacings beyond the beam's resolution):
-        # ChannelModel.solve's root finder on the searched peak, AngleUnreachable where even
-        # that fails; elsewhere in the bin NaN, which fails the spec
-        for m in np.flatnonzero(~np.isfinite(amps[c0]).all(-1)):
-            phases = model.coherent_phases(probes)
-            amps[c0, m] = model.amplitudes(model.solve(float(sets[m]), phases), float(sets[m]))
+        # (no closed-form design at the bin centre, spacings beyond the beam's resolution: NaN
+        # here, designed by solved())
         ks = slice(z - max_steps, z + max_steps + 1)
         centre = nb
         factor = table[1, ks, centre] / table[1, z, centre]
