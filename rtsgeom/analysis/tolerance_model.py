@@ -109,6 +109,12 @@ def response_table(setup: Setup, paths, channel: int, target: TargetConfig, reso
     return tdm_compensate(out, 0.0, rut, radar)
 
 
+def _readonly(a: np.ndarray) -> np.ndarray:
+    """``a`` made read-only in place (an array this module made and shares with no one)."""
+    a.flags.writeable = False
+    return a
+
+
 def _set_beams(st, rows: np.ndarray, sets: np.ndarray) -> np.ndarray:
     """Beam responses and their first two derivatives in u at the set angles of table rows
     (R, K, V): (R, 3, M, K), contiguous per row (a draw's lookup copies one block)."""
@@ -348,9 +354,14 @@ class PairPhasors:
         b_one, _, _ = beam_derivatives(st, one, u_one[:, 0])
         p_one = np.abs(b_one) ** 2  # (U,)
         probe_beams = st.beam(table[:, :, nb], st.directions(probes))  # (2, D, P)
-        design = _Design(frozen(beams_i), frozen(beams_j), i0, frozen(power), frozen(p_one),
+        # the tables were made here and nothing else holds them: read-only in place (frozen()
+        # would copy ~50 MiB per design; the table after its design below, whose kernel was
+        # compiled for a writeable one)
+        log_slope, beams_i, beams_j = (_readonly(a) for a in (log_slope, beams_i, beams_j))
+        design = _Design(beams_i, beams_j, i0, frozen(power), frozen(p_one),
                          frozen(probe_beams), model.unit_gain, reach)
         amps, kbin, ok, _ = design(table, z + sub, z + sub, np.arange(sub.size))
+        table = _readonly(table)
         c0 = centre_index(sub)
         # (no closed-form design at the bin centre, spacings beyond the beam's resolution: NaN
         # here, designed by solved())
@@ -359,7 +370,7 @@ class PairPhasors:
         factor = table[1, ks, centre] / table[1, z, centre]
         return cls(model, frozen(th), frozen(sets), frozen(probes), frozen(amps[c0]),
                    frozen(factor), frozen(log_slope[1, ks, centre]), slope, res,
-                   frozen(table), frozen(log_slope), z, frozen(sub), frozen(amps),
+                   table, log_slope, z, frozen(sub), frozen(amps),
                    frozen(kbin), frozen(ok), design, p_steps, reach_far)
 
     setup = property(lambda self: self.channels.setup)  # nominal
