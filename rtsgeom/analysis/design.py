@@ -298,11 +298,13 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     ``workers`` > 1: the designs in a pool of that many processes (each design is pure: the
     same result, in the same order, however they are spread); None: as many as this process
     may run on (:func:`available_cores`; ``rtsgeom design``'s default; one process on one
-    core). A design's time is about half
-    its ``PairPhasors.build`` (the delay tables: the FIR's response along the chirp and
-    ``bin_response`` for ~6000 delays) and half its two tolerance searches
-    (``max_sigma_for_yield``: ~5 Monte Carlos each of ``draws`` draws x ``points``
-    set-points, the one without errors per sub-bin position drawn)."""
+    core). A design's time is about a quarter its ``PairPhasors.build`` (the delay tables:
+    the FIR's response along the chirp and ``bin_response`` for ~5000 delays; the FIR's
+    per-setting rows are shared by all designs of a process) and three quarters its two
+    tolerance searches (:func:`tolerance_search`: a 250-draw pilot, then ~3 Monte Carlos of
+    ``draws`` draws x ``points`` set-points, and the one without errors per sub-bin position
+    drawn); a design whose composite splits costs one build. The forked workers each load
+    the compiled kernels once (~0.3 s CPU each)."""
     check_azimuth_arc(scene)
     radii = np.asarray(radius_m, float).ravel()
     spacings = np.asarray(spacing_deg, float).ravel()
