@@ -76,10 +76,13 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
             fast = fast * echoes.fast_gain
         elem = _tones(s * air, t0, dt, n_s)  # (G, V, N)
         kern = (elem[:, :, None, :] * kern_r).reshape(air.shape[0], -1, n_s)  # (G, V K, N)
-        rr = np.empty((len(echoes), tau.shape[1] * r.size), complex)
-        for g in range(air.shape[0]):  # a few geometries (loop over groups, not echoes)
-            sel = np.flatnonzero(group == g)
-            rr[sel] = fast[sel] @ kern[g].T
+        if air.shape[0] == 1:  # one geometry: the same product without the row copies
+            rr = fast @ kern[0].T
+        else:
+            rr = np.empty((len(echoes), tau.shape[1] * r.size), complex)
+            for g in range(air.shape[0]):  # a few geometries (loop over groups, not echoes)
+                sel = np.flatnonzero(group == g)
+                rr[sel] = fast[sel] @ kern[g].T
         rr = np.moveaxis(rr.reshape(len(echoes), tau.shape[1], r.size), -1, 0)
     else:
         beat = s * tau + f_d[:, None]  # (E, V)
