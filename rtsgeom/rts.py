@@ -254,7 +254,8 @@ def fir_error_response(mu, taps: int, f_s_hz: float, f_hz, shift_hz=0.0) -> np.n
 #: per (taps, f_s, frequency grid): the settings met so far (sorted), their taps and the
 #: window's ``exp(j w mu)`` rows, and ``exp(-j w k)`` (see :func:`_fir_rows`)
 _FIR_ROWS: dict = {}
-_FIR_ROWS_MAX = 4096  # settings kept per key (~35 MiB at N = 512); beyond: start afresh
+_FIR_ROWS_MAX = 2048  # settings kept per key (~17 MiB at N = 512); beyond: start afresh
+_FIR_KEYS_MAX = 2  # frequency grids kept (a process meets one per scene)
 
 
 def _fir_rows(uniq: np.ndarray, taps: int, f_s_hz: float, grid: np.ndarray):
@@ -283,7 +284,7 @@ def _fir_rows(uniq: np.ndarray, taps: int, f_s_hz: float, grid: np.ndarray):
         mus = np.concatenate([mus, new])[order]
         h = np.concatenate([h, fractional_delay_fir(new, taps)])[order]
         phase = np.concatenate([phase, np.exp(1j * np.outer(new, w))])[order]
-        if key not in _FIR_ROWS and len(_FIR_ROWS) >= 8:  # a few grids per process
+        if key not in _FIR_ROWS and len(_FIR_ROWS) >= _FIR_KEYS_MAX:
             _FIR_ROWS.clear()
         _FIR_ROWS[key] = (mus, h, phase, kern)
         pos = np.searchsorted(mus, uniq)
