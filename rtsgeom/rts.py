@@ -240,16 +240,55 @@ def fir_error_response(mu, taps: int, f_s_hz: float, f_hz, shift_hz=0.0) -> np.n
     shift = np.broadcast_to(np.asarray(shift_hz, float) + off, mu.shape)
     uniq, inv = np.unique(mu, return_inverse=True)
     inv = np.ravel(inv)
-    h = fractional_delay_fir(uniq, taps)[inv]  # (M, taps)
+    h, phase, kern = _fir_rows(uniq, int(taps), float(f_s_hz), grid)
     k = np.arange(taps) - (taps - 1) / 2  # centred: small phases
-    w = 2 * np.pi * grid / f_s_hz  # (N,)
     v = 2 * np.pi * shift / f_s_hz  # (M,)
     # exp(-j (w_n + v_m)(k - D_m)), D_m = (taps - 1)/2 + mu_m, as exp(-j v_m (k - mu_m))
     # exp(-j w_n k) exp(j w_n mu_m)
-    coef = h * np.exp(-1j * v[:, None] * (k[None, :] - mu[:, None]))  # (M, taps)
-    resp = coef @ np.exp(-1j * np.outer(k, w))  # (M, N)
-    resp *= np.exp(1j * np.outer(uniq, w))[inv]
+    coef = h[inv] * np.exp(-1j * v[:, None] * (k[None, :] - mu[:, None]))  # (M, taps)
+    resp = coef @ kern  # (M, N)
+    resp *= phase[inv]
     return resp
+
+
+#: per (taps, f_s, frequency grid): the settings met so far (sorted), their taps and the
+#: window's ``exp(j w mu)`` rows, and ``exp(-j w k)`` (see :func:`_fir_rows`)
+_FIR_ROWS: dict = {}
+_FIR_ROWS_MAX = 2048  # settings kept per key (~17 MiB at N = 512); beyond: start afresh
+_FIR_KEYS_MAX = 2  # frequency grids kept (a process meets one per scene)
+
+
+def _fir_rows(uniq: np.ndarray, taps: int, f_s_hz: float, grid: np.ndarray):
+    """:func:`fir_error_response`'s per-setting factors for the sorted distinct settings
+    ``uniq``: the FIR's taps (U, taps), ``exp(j w mu)`` (U, N) and the common ``exp(-j w k)``
+    (taps, N), w = 2 pi grid / f_s. A delay table meets the same few hundred settings (one
+    per delay step in a sample period) in every block of echoes and in every design of a
+    grid; their taps and phase rows (U N complex exponentials per call: over half of the
+    response's time) are computed once per process and looked up. Each row is computed by
+    the same elementwise arithmetic as before, so the bits do not depend on the memo."""
+    key = (taps, f_s_hz, grid.tobytes())
+    w = 2 * np.pi * grid / f_s_hz  # (N,)
+    entry = _FIR_ROWS.get(key)
+    if entry is None:
+        k = np.arange(taps) - (taps - 1) / 2
+        entry = (np.zeros(0), np.zeros((0, taps)), np.zeros((0, grid.size), complex),
+                 np.exp(-1j * np.outer(k, w)))
+    mus, h, phase, kern = entry
+    pos = np.minimum(np.searchsorted(mus, uniq), max(mus.size - 1, 0))
+    hit = (mus[pos] == uniq) if mus.size else np.zeros(uniq.size, bool)
+    if not hit.all():
+        new = uniq[~hit]
+        if mus.size + new.size > _FIR_ROWS_MAX:
+            mus, h, phase = np.zeros(0), np.zeros((0, taps)), np.zeros((0, grid.size), complex)
+        order = np.argsort(np.concatenate([mus, new]), kind="stable")
+        mus = np.concatenate([mus, new])[order]
+        h = np.concatenate([h, fractional_delay_fir(new, taps)])[order]
+        phase = np.concatenate([phase, np.exp(1j * np.outer(new, w))])[order]
+        if key not in _FIR_ROWS and len(_FIR_ROWS) >= _FIR_KEYS_MAX:
+            _FIR_ROWS.clear()
+        _FIR_ROWS[key] = (mus, h, phase, kern)
+        pos = np.searchsorted(mus, uniq)
+    return h[pos], phase[pos], kern
 
 
 def fir_if_gain(scene: Scene, delay_s, tau_total_s) -> np.ndarray | None:
@@ -385,7 +424,9 @@ def channel_echoes(setup: Setup, paths: Paths, program: RtsProgram) -> Echoes:
     )
     ghosts = cable_ghosts(scene, direct)
     keep = np.any(direct.amplitude != 0, axis=1)
-    return Echoes.concat([direct.select(keep), ghosts]) if len(ghosts) else direct.select(keep)
+    if not keep.all():  # (selecting all would only copy every field)
+        direct = direct.select(keep)
+    return Echoes.concat([direct, ghosts]) if len(ghosts) else direct
 
 
 def cable_ghosts(scene: Scene, direct: Echoes, min_level_db: float = -80.0) -> Echoes:

@@ -71,3 +71,33 @@ def test_delay_table_through_bin_response_is_echo_by_echo(radius_m, filt, dopple
                                        dop) for e in range(len(ech))], axis=1)
     assert table.shape == one.shape == (bins.size, len(ech), rut.num_virtual)
     assert np.abs(table - one).max() < 1e-12 * np.abs(one).max()
+
+
+@pytest.mark.parametrize("taps", [5, 33])
+@pytest.mark.parametrize("step_ps", [1.0, 3.7])
+def test_fir_response_does_not_depend_on_its_memo(taps, step_ps, monkeypatch):
+    """The per-setting rows are memoised per process (``rts._FIR_ROWS``): a delay table's
+    blocks give the same bits with the memo cleared before each block (every row computed
+    for that block alone), warm, or overflowing (a memo that keeps restarting)."""
+    import rtsgeom.rts as rts
+    f_s = 4e9
+    grid = 77e6 + 29.98e12 * (1e-6 + np.arange(300) / 20e6)
+    d = rts.realised_delay(7.3e-8 + np.arange(-700, 700) * step_ps * 1e-12, f_s, True, 1e-12)
+    ts = 1.0 / f_s
+    mu = np.round((d - np.floor(d / ts) * ts) / ts, 9)
+    shift = -29.98e12 * (d + 3e-9)
+
+    def table(clear: bool):
+        out = []
+        for b in range(0, mu.size, 97):
+            if clear:
+                rts._FIR_ROWS.clear()
+            out.append(fir_error_response(mu[b:b + 97], taps, f_s, grid, shift[b:b + 97]))
+        return np.concatenate(out).view(np.uint64)
+
+    monkeypatch.setattr(rts, "_FIR_ROWS", {})
+    cold = table(True)
+    assert np.array_equal(table(False), cold)
+    monkeypatch.setattr(rts, "_FIR_ROWS_MAX", 40)
+    assert np.array_equal(table(False), cold)
+    assert len(rts._FIR_ROWS) == 1

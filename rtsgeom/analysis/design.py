@@ -142,19 +142,24 @@ def evaluate_design(scene: Scene, pair: tuple[int, int], radius_m: float, spacin
     setup = build_setup(variant)
     gap = abs(float(np.diff(setup.fe_azimuth_rad())[0]))
     out["exceeds_resolution"] = bool(gap > angular_resolution_rad(setup.rut))
+    zero = np.zeros((2, 3))
     try:
-        model = PairPhasors.build(setup, (0, 1), points)
+        # the calibrated plan first (it does not depend on the bin-centre designs that
+        # solved() adds with a root finder per set-point, most of a split design's build)
+        model = PairPhasors.build(setup, (0, 1), points, solve_bin_centre=False)
+        err, detail = model.draw_errors(zero[None], None, ("calibrated",), return_detail=True)
+        split = not np.all(np.isfinite(detail["amplitudes"]["calibrated"]))
+        if not split:
+            model = model.solved()
     except AngleUnreachable as exc:  # no ratio reaches a set angle: the composite has split
         out["problem"] = f"synthesis failed: {exc}"
         return out
-    zero = np.zeros((2, 3))
     bias = np.degrees(model.fe_angle_rad - setup.fe_azimuth_rad())
     out["near_field_bias_deg"] = float(np.mean(bias))
     steps = model.calibration_steps(model.x_nominal)
     out["range_offset_mm"] = float(model.range_offset_m(zero, steps)) * 1e3
     out["delta_tau_ps"] = float(steps * model.delay_resolution_s * 1e12)
-    err, detail = model.draw_errors(zero[None], None, ("calibrated",), return_detail=True)
-    if not np.all(np.isfinite(detail["amplitudes"]["calibrated"])):
+    if split:
         # no ratio puts the composite at some set angle (its closed-form design has no root:
         # the beams are too far apart and the composite splits): an error in degrees would
         # only be the distance to wherever the estimator lands on an undefined snapshot
@@ -266,6 +271,14 @@ class DesignGrid:
         }
 
 
+def _import_for_workers() -> None:
+    """Import here what every design imports on its first use (the compiled kernels: numba),
+    so that the pool's forked workers inherit the modules instead of each importing them
+    again (~0.15 s CPU per worker; loading each kernel's compiled code from numba's cache,
+    ~0.3 s more, still happens per worker, on its first call)."""
+    from .. import kernels  # noqa: F401
+
+
 def available_cores() -> int:
     """The cores this process may run on (its CPU affinity where the OS reports one, as a
     container's CPU set limits it; else ``os.cpu_count()``)."""
@@ -285,11 +298,13 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     ``workers`` > 1: the designs in a pool of that many processes (each design is pure: the
     same result, in the same order, however they are spread); None: as many as this process
     may run on (:func:`available_cores`; ``rtsgeom design``'s default; one process on one
-    core). A design's time is about half
-    its ``PairPhasors.build`` (the delay tables: the FIR's response along the chirp and
-    ``bin_response`` for ~6000 delays) and half its two tolerance searches
-    (``max_sigma_for_yield``: ~5 Monte Carlos each of ``draws`` draws x ``points``
-    set-points, the one without errors per sub-bin position drawn)."""
+    core). A design's time is about a quarter its ``PairPhasors.build`` (the delay tables:
+    the FIR's response along the chirp and ``bin_response`` for ~5000 delays; the FIR's
+    per-setting rows are shared by all designs of a process) and three quarters its two
+    tolerance searches (:func:`tolerance_search`: a 250-draw pilot, then ~3 Monte Carlos of
+    ``draws`` draws x ``points`` set-points, and the one without errors per sub-bin position
+    drawn); a design whose composite splits costs one build. The forked workers each load
+    the compiled kernels once (~0.3 s CPU each)."""
     check_azimuth_arc(scene)
     radii = np.asarray(radius_m, float).ravel()
     spacings = np.asarray(spacing_deg, float).ravel()
@@ -301,8 +316,10 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     one = functools.partial(_evaluate_cell, scene, pair, spec_deg, target_yield, draws, seed,
                             points)
     designs = []
-    pool = (None if int(workers) <= 1 or total <= 1
-            else ProcessPoolExecutor(min(int(workers), total)))
+    pool = None
+    if int(workers) > 1 and total > 1:
+        _import_for_workers()
+        pool = ProcessPoolExecutor(min(int(workers), total))
     try:
         for d in (map(one, cells) if pool is None else pool.map(one, cells)):
             designs.append(d)

@@ -100,12 +100,19 @@ def response_table(setup: Setup, paths, channel: int, target: TargetConfig, reso
         prog = RtsProgram.build(np.arange(k.size), np.full(k.size, channel),
                                 tau + k * resolution_s, np.zeros(k.size), np.ones(k.size))
         ech = channel_echoes(setup, paths, prog)
-        ech = ech.select(ech.kind == KIND_DIRECT)  # (none: see above)
+        if np.any(ech.kind != KIND_DIRECT):  # (none: see above)
+            ech = ech.select(ech.kind == KIND_DIRECT)
         resp = bin_response(ech, radar, rut, rbins, dbin)  # (K, E, V)
         acc = np.zeros((k.size,) + resp.shape[::2], complex)  # each target's echoes summed
         np.add.at(acc, ech.target, np.swapaxes(resp, 0, 1))  # (a one-hot einsum was 15 %)
         out[b:b + block] = acc
     return tdm_compensate(out, 0.0, rut, radar)
+
+
+def _readonly(a: np.ndarray) -> np.ndarray:
+    """``a`` made read-only in place (an array this module made and shares with no one)."""
+    a.flags.writeable = False
+    return a
 
 
 def _set_beams(st, rows: np.ndarray, sets: np.ndarray) -> np.ndarray:
@@ -255,7 +262,7 @@ class PairPhasors:
 
     @classmethod
     def build(cls, setup: Setup, pair: tuple[int, int], points: int = 21,
-              range_m: float | None = None) -> "PairPhasors":
+              range_m: float | None = None, solve_bin_centre: bool = True) -> "PairPhasors":
         """Design on the nominal setup of ``setup`` (its mounting and channel errors dropped).
 
         The reference target sits at the centre of the range bin nearest ``range_m`` (default:
@@ -263,10 +270,35 @@ class PairPhasors:
         (:attr:`subbin_steps`). The set-points divide the span between the two front ends'
         detected angles into ``points + 1`` parts (ends excluded, as ``aoa.linearity``).
 
+        ``solve_bin_centre`` False: the set-points without a closed-form design at the bin
+        centre are left NaN (:meth:`solved` designs them; ``analysis.design`` first checks
+        whether the calibrated plan exists at all).
+
         BLAS single-threaded: the tables' products are many and small (two threads took 2.4x
         the CPU time of one for the same build)."""
         with single_threaded_blas():
-            return cls._build(setup, pair, points, range_m)
+            model = cls._build(setup, pair, points, range_m)
+        return model.solved() if solve_bin_centre else model
+
+    def solved(self) -> "PairPhasors":
+        """The model with the bin-centre set-points that have no closed-form design (spacings
+        beyond the beam's resolution) designed by ``ChannelModel.solve``'s root finder on the
+        searched peak (:class:`~rtsgeom.aoa.model.AngleUnreachable` where even that fails);
+        elsewhere in the bin they stay NaN, which fails the spec. (A root finder per set-point:
+        most of the build of such a design.)"""
+        c0 = self.subbin_zero
+        missing = np.flatnonzero(~np.isfinite(self.design_amplitudes[c0]).all(-1))
+        if missing.size == 0:
+            return self
+        amps = np.array(self.design_amplitudes)
+        model = self.channels
+        with single_threaded_blas():
+            for m in missing:
+                phases = model.coherent_phases(self.probe_rad)
+                amps[c0, m] = model.amplitudes(model.solve(float(self.set_rad[m]), phases),
+                                               float(self.set_rad[m]))
+        return dataclasses.replace(self, amplitudes=frozen(amps[c0]),
+                                   design_amplitudes=frozen(amps))
 
     @classmethod
     def _build(cls, setup: Setup, pair: tuple[int, int], points: int,
@@ -322,22 +354,23 @@ class PairPhasors:
         b_one, _, _ = beam_derivatives(st, one, u_one[:, 0])
         p_one = np.abs(b_one) ** 2  # (U,)
         probe_beams = st.beam(table[:, :, nb], st.directions(probes))  # (2, D, P)
-        design = _Design(frozen(beams_i), frozen(beams_j), i0, frozen(power), frozen(p_one),
+        # the tables were made here and nothing else holds them: read-only in place (frozen()
+        # would copy ~50 MiB per design; the table after its design below, whose kernel was
+        # compiled for a writeable one)
+        log_slope, beams_i, beams_j = (_readonly(a) for a in (log_slope, beams_i, beams_j))
+        design = _Design(beams_i, beams_j, i0, frozen(power), frozen(p_one),
                          frozen(probe_beams), model.unit_gain, reach)
         amps, kbin, ok, _ = design(table, z + sub, z + sub, np.arange(sub.size))
+        table = _readonly(table)
         c0 = centre_index(sub)
-        # no closed-form design at the bin centre (spacings beyond the beam's resolution):
-        # ChannelModel.solve's root finder on the searched peak, AngleUnreachable where even
-        # that fails; elsewhere in the bin NaN, which fails the spec
-        for m in np.flatnonzero(~np.isfinite(amps[c0]).all(-1)):
-            phases = model.coherent_phases(probes)
-            amps[c0, m] = model.amplitudes(model.solve(float(sets[m]), phases), float(sets[m]))
+        # (no closed-form design at the bin centre, spacings beyond the beam's resolution: NaN
+        # here, designed by solved())
         ks = slice(z - max_steps, z + max_steps + 1)
         centre = nb
         factor = table[1, ks, centre] / table[1, z, centre]
         return cls(model, frozen(th), frozen(sets), frozen(probes), frozen(amps[c0]),
                    frozen(factor), frozen(log_slope[1, ks, centre]), slope, res,
-                   frozen(table), frozen(log_slope), z, frozen(sub), frozen(amps),
+                   table, log_slope, z, frozen(sub), frozen(amps),
                    frozen(kbin), frozen(ok), design, p_steps, reach_far)
 
     setup = property(lambda self: self.channels.setup)  # nominal

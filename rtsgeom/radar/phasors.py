@@ -60,8 +60,12 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
     n = np.arange(n_s)
     kern_r = w_r * np.exp(-2j * np.pi * np.outer(r, n) / n_s)  # (K, N)
     t0, dt = radar.adc_start_s, 1.0 / radar.adc_rate_hz
-    air, group = np.unique(echoes.tau_air_s, axis=0, return_inverse=True)
-    group = np.ravel(group)
+    tau_air = echoes.tau_air_s
+    if len(echoes) and np.all(tau_air == tau_air[:1]):  # one geometry (a delay table's block)
+        air, group = tau_air[:1], np.zeros(len(echoes), int)  # np.unique's answer, unsorted
+    else:
+        air, group = np.unique(tau_air, axis=0, return_inverse=True)
+        group = np.ravel(group)
     if 4 * air.shape[0] <= len(echoes):
         # many echoes share their air delays (a delay table: one geometry, many RTS delays):
         # exp(j 2 pi S tau t) = exp(j 2 pi S tau_if t) exp(j 2 pi S tau_air t), the element
@@ -72,10 +76,13 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
             fast = fast * echoes.fast_gain
         elem = _tones(s * air, t0, dt, n_s)  # (G, V, N)
         kern = (elem[:, :, None, :] * kern_r).reshape(air.shape[0], -1, n_s)  # (G, V K, N)
-        rr = np.empty((len(echoes), tau.shape[1] * r.size), complex)
-        for g in range(air.shape[0]):  # a few geometries (loop over groups, not echoes)
-            sel = np.flatnonzero(group == g)
-            rr[sel] = fast[sel] @ kern[g].T
+        if air.shape[0] == 1:  # one geometry: the same product without the row copies
+            rr = fast @ kern[0].T
+        else:
+            rr = np.empty((len(echoes), tau.shape[1] * r.size), complex)
+            for g in range(air.shape[0]):  # a few geometries (loop over groups, not echoes)
+                sel = np.flatnonzero(group == g)
+                rr[sel] = fast[sel] @ kern[g].T
         rr = np.moveaxis(rr.reshape(len(echoes), tau.shape[1], r.size), -1, 0)
     else:
         beat = s * tau + f_d[:, None]  # (E, V)
