@@ -39,7 +39,7 @@ from .._util import frozen
 from .tolerance_model import PROBE_FRACTIONS, PairPhasors  # noqa: F401 (public here too)
 
 __all__ = ["AXES", "search_direction", "DISTRIBUTIONS", "CASES", "ALL_CASES", "NOMINAL_AMPLITUDES", "PairPhasors",
-           "ToleranceResult", "draw_offsets", "standard_draws", "DrawChunk", "draw_chunks", "subbin_draws", "evaluate_chunk",
+           "ToleranceResult", "draw_offsets", "standard_draws", "unit_block", "DrawChunk", "draw_chunks", "subbin_draws", "evaluate_chunk",
            "monte_carlo", "max_sigma_for_yield", "critical_ratio", "largest_passing_scale",
            "percentiles"]
 
@@ -91,11 +91,18 @@ def _check_distribution(distribution: str) -> None:
                          f"{', '.join(DISTRIBUTIONS)}")
 
 
+def unit_block(rng: np.random.Generator, shape, distribution: str) -> np.ndarray:
+    """The next unit-scale draws of ``shape`` from ``rng``: standard normal, or uniform in
+    [-1, 1] (every study's draws: the pair's, the cell's and the arc's offsets, rotations
+    and RuT pose)."""
+    if distribution == "normal":
+        return rng.standard_normal(shape)
+    return rng.uniform(-1.0, 1.0, shape)
+
+
 def _unit_block(rng: np.random.Generator, k: int, distribution: str, front_ends: int = 2):
     """The next ``k`` unit-scale draws of :func:`standard_draws`' stream ``rng``."""
-    if distribution == "normal":
-        return rng.standard_normal((k, front_ends, 3))
-    return rng.uniform(-1.0, 1.0, (k, front_ends, 3))
+    return unit_block(rng, (k, front_ends, 3), distribution)
 
 
 def _subbin_block(rng: np.random.Generator, k: int, positions: int) -> np.ndarray:
