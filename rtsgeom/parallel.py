@@ -1,11 +1,13 @@
 """Chunked studies that run in this process or on a Dask cluster with identical results.
 
 A study is split into chunks of work; :func:`chunk_mapper` gives the ordered map that applies
-one pure function to each chunk: here in order, in N forked local processes
-(:func:`fork_map`), or on ``dask.distributed`` (an existing scheduler's address,
+one pure function to each chunk: here in order, in N forked local processes kept for the
+command (:class:`ForkPool`), or on ``dask.distributed`` (an existing scheduler's address,
 :func:`map_chunks`). Results come back in chunk order, so as long as the function is
-deterministic in its arguments (all random draws made up front from the study's seed, never
-inside a chunk) the outcome is bit-identical however it was scheduled.
+deterministic in its arguments (a chunk's random draws fixed by the study's seed: it carries
+its streams' states) the outcome is bit-identical however it was scheduled. Either way the
+function's shared state (a ``functools.partial``'s positional arguments: the model) reaches
+a worker once, not with every chunk.
 
 Running a study on an existing cluster::
 
@@ -23,7 +25,7 @@ import weakref
 from contextlib import contextmanager
 from typing import Callable, Sequence
 
-__all__ = ["chunk_mapper", "fork_map", "map_chunks", "dask_client", "ClusterError",
+__all__ = ["chunk_mapper", "ForkPool", "fork_map", "map_chunks", "dask_client", "ClusterError",
            "check_address"]
 
 _ADDRESS = re.compile(r"(?:(tcp|tls|ws|wss|ucx|inproc)://)?(\[[0-9a-fA-F:]+\]|[A-Za-z0-9_.-]+)"
