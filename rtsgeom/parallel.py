@@ -1,11 +1,13 @@
 """Chunked studies that run in this process or on a Dask cluster with identical results.
 
 A study is split into chunks of work; :func:`chunk_mapper` gives the ordered map that applies
-one pure function to each chunk: here in order, in N forked local processes
-(:func:`fork_map`), or on ``dask.distributed`` (an existing scheduler's address,
+one pure function to each chunk: here in order, in N forked local processes kept for the
+command (:class:`ForkPool`), or on ``dask.distributed`` (an existing scheduler's address,
 :func:`map_chunks`). Results come back in chunk order, so as long as the function is
-deterministic in its arguments (all random draws made up front from the study's seed, never
-inside a chunk) the outcome is bit-identical however it was scheduled.
+deterministic in its arguments (a chunk's random draws fixed by the study's seed: it carries
+its streams' states) the outcome is bit-identical however it was scheduled. Either way the
+function's shared state (a ``functools.partial``'s positional arguments: the model) reaches
+a worker once, not with every chunk.
 
 Running a study on an existing cluster::
 
@@ -19,10 +21,11 @@ from __future__ import annotations
 import functools
 import multiprocessing
 import re
+import weakref
 from contextlib import contextmanager
 from typing import Callable, Sequence
 
-__all__ = ["chunk_mapper", "fork_map", "map_chunks", "dask_client", "ClusterError",
+__all__ = ["chunk_mapper", "ForkPool", "fork_map", "map_chunks", "dask_client", "ClusterError",
            "check_address"]
 
 _ADDRESS = re.compile(r"(?:(tcp|tls|ws|wss|ucx|inproc)://)?(\[[0-9a-fA-F:]+\]|[A-Za-z0-9_.-]+)"
@@ -43,6 +46,20 @@ def check_address(address: str) -> str:
     return address.strip()
 
 
+#: Dask settings of the local cluster :func:`dask_client` starts: its housekeeping takes
+#: cores from the study. Idle, a 2-worker cluster used 0.09 of a core with the defaults (the
+#: event-loop tick every 20 ms in each process, the memory monitor every 100 ms, the system
+#: monitor every 500 ms), 0.015 with these; and the workers' statistical profiler took the
+#: GIL from the task every 10 ms to walk its stack. (Workers of an existing scheduler keep
+#: their own settings.)
+LOCAL_CLUSTER_CONFIG = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.tick.interval": "1s",
+    "distributed.admin.system-monitor.interval": "5s",
+    "distributed.worker.memory.monitor-interval": "1s",
+}
+
+
 @contextmanager
 def dask_client(scheduler: str | None = None, workers: int | None = None):
     """A ``dask.distributed`` client for the block: connected to ``scheduler`` (an address such
@@ -59,7 +76,8 @@ def dask_client(scheduler: str | None = None, workers: int | None = None):
     cluster = None
     if scheduler is None:
         import dask
-        with dask.config.set({"distributed.nanny.pre-spawn-environ": _worker_environ()}):
+        with dask.config.set({"distributed.nanny.pre-spawn-environ": _worker_environ(),
+                              **LOCAL_CLUSTER_CONFIG}):
             cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1,
                                    processes=True, dashboard_address=None)
     if cluster is None:
@@ -84,10 +102,12 @@ def dask_client(scheduler: str | None = None, workers: int | None = None):
 def chunk_mapper(scheduler: str | None = None, workers: int | None = None):
     """The ordered map (``mapper(func, chunks) -> list``) for a study's chunks: on the Dask
     scheduler at ``scheduler`` (:func:`map_chunks`), else in ``workers`` (> 1) local processes
-    (:func:`fork_map`; a Dask ``LocalCluster`` where the platform cannot fork), else None
+    (:class:`ForkPool`, one for the block; a Dask ``LocalCluster`` where the platform cannot
+    fork), else None
     (this process, in order). The results are the same bits whichever runs them."""
     if scheduler is None and workers is not None and int(workers) > 1 and _can_fork():
-        yield functools.partial(fork_map, workers=int(workers))
+        with ForkPool(int(workers)) as pool:  # forked at the first map, kept to the end
+            yield pool.map
         return
     if scheduler is None and (workers is None or int(workers) <= 1):
         yield None
@@ -100,46 +120,102 @@ def _can_fork() -> bool:
     return "fork" in multiprocessing.get_all_start_methods()
 
 
-#: (func, chunks) of the running :func:`fork_map`: the forked workers inherit it
-_FORK_JOB: tuple | None = None
+def _split(func: Callable) -> tuple[Callable, tuple, dict]:
+    """``(fn, shared, keywords)`` with ``func(chunk) == fn(*shared, chunk, **keywords)``: a
+    ``functools.partial``'s positional arguments are the study's shared state (the model:
+    tens of MiB), shipped to a worker once per pool or cluster; ``fn`` and the keywords
+    (small) travel with every chunk. Any other callable is itself the shared state."""
+    if isinstance(func, functools.partial):
+        return func.func, tuple(func.args), dict(func.keywords)
+    return _call, (func,), {}
+
+
+def _call(func: Callable, chunk):
+    return func(chunk)
+
+
+#: token -> the shared arguments a live :class:`ForkPool` was forked with (its workers
+#: inherit them; nothing of them is pickled)
+_FORK_SHARED: dict[int, tuple] = {}
+
+
+class ForkPool:
+    """``workers`` processes forked from this one, kept open for every study a command maps
+    (``chunk_mapper``), so that a yield search's twenty Monte Carlos fork once, not twenty
+    times (each fork copied the page tables of this process and took ~23 000 page faults).
+
+    The workers inherit the studies' shared state (:func:`_split`: the model, tens of MiB of
+    tables) by ``fork``; per chunk only the function's name, its keywords and the chunk (a
+    :class:`~rtsgeom.analysis.tolerance.DrawChunk`: the draw streams' states, a few hundred
+    bytes) are pickled, and the results back. A map with other shared state (by identity)
+    forks a new pool. Chunks are handed out one at a time (dynamic balancing) and the
+    results come back in chunk order, so the outcome is the in-order map's bit for bit. Each
+    worker runs BLAS single-threaded (the cores are the workers')."""
+
+    def __init__(self, workers: int):
+        self.workers = max(1, int(workers))
+        self._pool = None
+        self._shared: tuple = ()
+
+    def __enter__(self) -> "ForkPool":
+        return self
+
+    def __exit__(self, kind, value, tb) -> None:
+        self.close(terminate=kind is not None)
+
+    def map(self, func: Callable, chunks: Sequence,
+            progress: Callable[[int, int], None] | None = None) -> list:
+        """``[func(c) for c in chunks]`` in the workers (in this process for one chunk)."""
+        chunks = list(chunks)
+        total = len(chunks)
+        if self.workers <= 1 or total <= 1:
+            return map_chunks(func, chunks, None, progress)
+        fn, shared, kw = _split(func)
+        if self._pool is None or len(shared) != len(self._shared) or any(
+                a is not b for a, b in zip(shared, self._shared)):
+            self.close()
+            self._start(shared)
+        token = id(self)
+        out = []
+        try:
+            tasks = ((token, fn, kw, c) for c in chunks)
+            for k, r in enumerate(self._pool.imap(_fork_apply, tasks), start=1):
+                out.append(r)
+                if progress:
+                    progress(k, total)
+        except BaseException:
+            self.close(terminate=True)
+            raise
+        return out
+
+    def _start(self, shared: tuple) -> None:
+        _FORK_SHARED[id(self)] = shared
+        self._shared = shared
+        ctx = multiprocessing.get_context("fork")
+        self._pool = ctx.Pool(self.workers, initializer=_fork_worker_init)
+
+    def close(self, terminate: bool = False) -> None:
+        """End the workers (waiting for them, or at once with ``terminate``)."""
+        pool, self._pool, self._shared = self._pool, None, ()
+        _FORK_SHARED.pop(id(self), None)
+        if pool is None:
+            return
+        if terminate:
+            pool.terminate()
+        else:
+            pool.close()
+        pool.join()
 
 
 def fork_map(func: Callable, chunks: Sequence, workers: int = 2,
              progress: Callable[[int, int], None] | None = None) -> list:
-    """``[func(c) for c in chunks]`` in ``workers`` processes forked for this call.
-
-    The workers inherit ``func`` (with the model it carries: tens of MiB of tables) and the
-    chunks (the draws) from this process by ``fork``; nothing is pickled but the chunk index
-    and the results. A Dask ``LocalCluster`` spent ~4.7 s per 1e6-draw study on starting its
-    processes and shipping the model and the draws (19 MiB per 4e5 draws) to them; forking
-    costs milliseconds. Chunks are handed out one at a time (dynamic balancing) and the
-    results come back in chunk order, so the outcome is the in-order map's bit for bit. Each
-    worker runs BLAS single-threaded (the cores are the workers')."""
-    global _FORK_JOB
+    """``[func(c) for c in chunks]`` in a :class:`ForkPool` of ``workers`` processes forked
+    for this call (``chunk_mapper`` keeps one open across a command's calls). A Dask
+    ``LocalCluster`` spent ~4.7 s per 1e6-draw study on starting its processes and shipping
+    the model to them; forking costs milliseconds."""
     chunks = list(chunks)
-    total = len(chunks)
-    workers = max(1, min(int(workers), total))
-    if workers <= 1:
-        return map_chunks(func, chunks, None, progress)
-    _FORK_JOB = (func, chunks)
-    try:
-        ctx = multiprocessing.get_context("fork")
-        pool = ctx.Pool(workers, initializer=_fork_worker_init)
-        try:
-            out = []
-            for k, r in enumerate(pool.imap(_fork_apply, range(total)), start=1):
-                out.append(r)
-                if progress:
-                    progress(k, total)
-            pool.close()
-        except BaseException:
-            pool.terminate()
-            raise
-        finally:
-            pool.join()
-        return out
-    finally:
-        _FORK_JOB = None
+    with ForkPool(min(int(workers), max(len(chunks), 1))) as pool:
+        return pool.map(func, chunks, progress)
 
 
 def _fork_worker_init() -> None:
@@ -153,9 +229,9 @@ def _fork_worker_init() -> None:
     threadpool_limits(limits=1, user_api="blas")
 
 
-def _fork_apply(k: int):
-    func, chunks = _FORK_JOB
-    return func(chunks[k])
+def _fork_apply(task):
+    token, fn, kw, chunk = task
+    return fn(*_FORK_SHARED[token], chunk, **kw)
 
 
 def _worker_environ() -> dict:
@@ -173,7 +249,12 @@ def _worker_environ() -> dict:
 def map_chunks(func: Callable, chunks: Sequence, client=None,
                progress: Callable[[int, int], None] | None = None) -> list:
     """``[func(c) for c in chunks]`` here, or on the Dask ``client``; results in chunk order and
-    ``progress(done, total)`` after each chunk."""
+    ``progress(done, total)`` after each chunk.
+
+    On a cluster the shared state of ``func`` (:func:`_split`: the model, tens of MiB) is
+    scattered to every worker once per client and object (:func:`_scattered`), not once per
+    call (a yield search maps twenty studies with one model) and not inside the task graph;
+    each task carries the function's name, its keywords and its chunk."""
     total = len(chunks)
     if client is None:
         out = []
@@ -183,19 +264,37 @@ def map_chunks(func: Callable, chunks: Sequence, client=None,
                 progress(k + 1, total)
         return out
     from dask.distributed import as_completed
-    # the function carries the model (tens of MiB of tables): sent to every worker once, not
-    # packed into the task graph (which Dask warns about and ships through the scheduler)
-    remote = client.scatter(func, broadcast=True, hash=False)
-    futures = client.map(_apply, list(chunks), fn=remote, pure=False)
+    fn, shared, kw = _split(func)
+    remote = [_scattered(client, a) for a in shared]
+    futures = client.map(_apply, list(chunks), fn=fn, shared=remote, kw=kw, pure=False)
     index = {f.key: k for k, f in enumerate(futures)}
     results: list = [None] * total
-    for done, f in enumerate(as_completed(futures), start=1):
-        results[index[f.key]] = f.result()
+    # results fetched by the client in the background as they complete
+    for done, (f, r) in enumerate(as_completed(futures, with_results=True), start=1):
+        results[index[f.key]] = r
         if progress:
             progress(done, total)
     return results
 
 
-def _apply(chunk, fn):
-    """``fn(chunk)`` on a worker (``fn`` arrives resolved from its scattered future)."""
-    return fn(chunk)
+#: client -> {id(obj): (obj, future)}: what :func:`_scattered` has sent to the client's workers
+_SCATTERED: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def _scattered(client, obj):
+    """A future of ``obj`` on every worker of ``client`` (``scatter(broadcast=True)``), sent
+    once per client and object (by identity; the cache holds the object, so the identity
+    stays its)."""
+    cache = _SCATTERED.setdefault(client, {})
+    hit = cache.get(id(obj))
+    if hit is None or hit[0] is not obj:
+        # wrapped in a list: scatter sends a list's (or tuple's) items as separate data
+        hit = (obj, client.scatter([obj], broadcast=True, hash=False)[0])
+        cache[id(obj)] = hit
+    return hit[1]
+
+
+def _apply(chunk, fn: Callable, shared, kw: dict):
+    """``fn(*shared, chunk, **kw)`` on a worker (``shared`` arrives resolved from its
+    scattered futures)."""
+    return fn(*shared, chunk, **kw)

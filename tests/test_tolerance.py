@@ -310,6 +310,27 @@ def test_fork_pool_gives_bit_identical_results(model):
     assert local.to_dict() == pooled.to_dict()
 
 
+def test_fork_pool_is_kept_across_studies_of_one_model(model):
+    """chunk_mapper's ForkPool forks once for a command's studies of one model (a yield
+    search: many Monte Carlos), forks anew for another model, and every study equals the
+    single-process run bit for bit."""
+    from rtsgeom.parallel import ForkPool, _can_fork
+    if not _can_fork():
+        pytest.skip("no fork on this platform")
+    other = PairPhasors.build(build_setup(make_scene()), (0, 1), points=3)
+    with ForkPool(2) as pool:
+        pids = []
+        for m, sigma in ((model, 1e-4), (model, 3e-4), (other, 2e-4)):
+            local = monte_carlo(m, [sigma] * 3, 200, seed=5, chunk=50)
+            pooled = monte_carlo(m, [sigma] * 3, 200, seed=5, chunk=50, mapper=pool.map)
+            assert local.to_dict() == pooled.to_dict()
+            for case in CASES:
+                assert np.array_equal(local.worst_error_deg[case], pooled.worst_error_deg[case])
+            pids.append(sorted(p.pid for p in pool._pool._pool))
+        assert pids[0] == pids[1] != pids[2]
+    assert pool._pool is None
+
+
 def test_larger_sigma_gives_larger_p95(model):
     p95 = {case: [] for case in CASES}
     for sigma in (0.03e-3, 0.1e-3, 0.3e-3):

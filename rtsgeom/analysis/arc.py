@@ -42,7 +42,8 @@ import numpy as np
 from .._util import frozen
 from ..errors import ParameterError
 from .tolerance import (CASES, DISTRIBUTIONS, PairPhasors, critical_ratio, evaluate_chunk,
-                        largest_passing_scale, percentiles, subbin_draws)
+                        largest_passing_scale, percentiles, standard_draws, subbin_draws,
+                        unit_block)
 
 __all__ = ["Bounds", "ArcResult", "arc_draws", "arc_monte_carlo", "arc_models",
            "adjacent_pairs", "max_scale_for_yield", "shared_subbin_steps"]
@@ -106,12 +107,6 @@ class Bounds:
                 "rut_yaw_deg": math.degrees(self.rut_yaw_rad)}
 
 
-def _unit(rng, distribution: str, shape) -> np.ndarray:
-    if distribution == "normal":
-        return rng.standard_normal(shape)
-    return rng.uniform(-1.0, 1.0, shape)
-
-
 #: the rotations' stream, ``default_rng([seed, ROTATION_STREAM])`` (1 is the sub-bin positions')
 ROTATION_STREAM = 3
 
@@ -126,16 +121,16 @@ def arc_draws(seed: int, draws: int, count: int, distribution: str = "normal",
     if distribution not in DISTRIBUTIONS:
         raise ParameterError(f"distribution {distribution!r}: must be one of "
                          f"{', '.join(DISTRIBUTIONS)}")
-    g_off = np.random.default_rng(seed)
     g_rot = np.random.default_rng([seed, ROTATION_STREAM])
     g_rut = np.random.default_rng([seed, 2])
     chunk = max(1, int(chunk))
+    offsets = standard_draws(seed, draws, distribution, chunk, count)  # the pair study's
     subs = None if positions is None else subbin_draws(seed, draws, int(positions), chunk)
     for start in range(0, draws, chunk):
         k = min(chunk, draws - start)
-        out = {"offsets": _unit(g_off, distribution, (k, count, 3)),
-               "rotations": _unit(g_rot, distribution, (k, count, 2)),
-               "rut": _unit(g_rut, distribution, (k, 4))}
+        out = {"offsets": next(offsets),
+               "rotations": unit_block(g_rot, (k, count, 2), distribution),
+               "rut": unit_block(g_rut, (k, 4), distribution)}
         if subs is not None:
             out["subbin"] = next(subs)
         yield out

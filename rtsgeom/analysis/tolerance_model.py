@@ -224,9 +224,12 @@ def slide(log_slope, shift_s):
     window's spectral nulls (a Hann window has them two bins from an echo at a bin centre), where
     exp() of it blew an empty bin up into the strongest one (a phantom detection two bins off);
     the exponent is limited to +-MAX_SLIDE (and NaN at an exact null to 0), which leaves every
-    regular bin bit-identical (exponents ~1e-4) and keeps a null bin near null."""
-    x = np.nan_to_num(log_slope * shift_s, nan=0.0, posinf=MAX_SLIDE, neginf=-MAX_SLIDE)
-    return np.exp(np.clip(x, -MAX_SLIDE, MAX_SLIDE))
+    regular bin bit-identical (exponents ~1e-4) and keeps a null bin near null. (In place on
+    one temporary: ``nan_to_num`` then ``clip`` made five passes, 4 % of a draw.)"""
+    x = np.asarray(log_slope * shift_s, float)
+    np.clip(x, -MAX_SLIDE, MAX_SLIDE, out=x)  # +-inf to the bounds; NaN stays NaN ...
+    x[np.isnan(x)] = 0.0  # ... and becomes 0
+    return np.exp(x, out=x)
 
 
 @dataclass(frozen=True)
@@ -472,9 +475,11 @@ class PairPhasors:
         d_u = self.subbin_steps[u]  # (n,)
         z = self.table_zero
 
-        def spectrum(q, j):  # (n, K, V)
-            return (self.table[q, j] * fac[:, q, None, :]
-                    * slide(self.table_log_slope[q, j], shift[:, q, None, :]))
+        def spectrum(q, j):  # (n, K, V); in place on the gathered rows (the same products)
+            x = self.table[q, j]
+            x *= fac[:, q, None, :]
+            x *= slide(self.table_log_slope[q, j], shift[:, q, None, :])
+            return x
 
         x_i = spectrum(0, z + d_u)
         amps0 = self.design_amplitudes[u]  # (n, M, 2)
