@@ -445,3 +445,22 @@ def test_chunk_mapper_fork_pool_every_draw_mode():
         assert local.fallbacks == pooled.fallbacks and local.off_bin == pooled.off_bin
     with chunk_mapper(None, 1) as mapper:
         assert mapper is None  # one worker: this process
+
+
+def test_cli_says_the_scenes_own_errors_are_not_the_starting_point(tmp_path, capsys):
+    """The study draws about the nominal setup (the same statistics with or without the
+    scene's own mounting errors); the CLI says so instead of silently ignoring them."""
+    text = DEFAULT_SCENE.read_text()
+    moved = tmp_path / "moved.toml"
+    moved.write_text(text.replace("[[rts.front_ends]]\n",
+                                  "[[rts.front_ends]]\nradial_offset_mm = 0.3\n", 1))
+    args = ["--draws", "200", "--points", "3", "--json", "--quiet"]
+    outs = []
+    for path in (DEFAULT_SCENE, moved):
+        assert main(["tolerance", str(path), *args]) == 0
+        cap = capsys.readouterr()
+        outs.append(json.loads(cap.out))
+        assert ("each draw replaces them" in cap.err) is (path == moved), cap.err
+        assert ("rts.front_ends[0].radial_offset_mm" in cap.err) is (path == moved)
+    for case in CASES:
+        assert outs[0][case] == outs[1][case]

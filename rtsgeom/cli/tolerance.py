@@ -99,8 +99,32 @@ def _model(scene, pair_arg, points: int) -> PairPhasors:
                          f"({exc})") from None
 
 
+_ERROR_FIELDS = (("radial_offset_m", "radial_offset_mm"), ("tangential_offset_m",
+                 "tangential_offset_mm"), ("height_offset_m", "height_offset_mm"),
+                 ("yaw_offset_rad", "yaw_offset_deg"), ("pitch_offset_rad", "pitch_offset_deg"),
+                 ("gain_offset_db", "gain_offset_db"), ("phase_offset_rad", "phase_offset_deg"))
+
+
+def warn_scene_errors(scene, command: str) -> None:
+    """``tolerance`` and ``design`` draw mounting errors about the nominal setup
+    (``geometry.setup.nominal_setup``): say so on stderr when the scene carries its own
+    mounting, channel or RuT pose errors, which the study does not start from (a new-user
+    trial wrote measured offsets into a scene and got the zero-offset scene's numbers)."""
+    fields = [f"rts.front_ends[{q}].{name}" for q, fe in enumerate(scene.rts.front_ends)
+              for attr, name in _ERROR_FIELDS if getattr(fe, attr) != 0.0]
+    radar = scene.radar
+    if radar.yaw_offset_rad != 0.0 or any(radar.position_offset_m):
+        fields.append("radar pose offsets")
+    if fields:
+        more = f" and {len(fields) - 3} more" if len(fields) > 3 else ""
+        print(f"rtsgeom: warning: {command} draws mounting errors about the nominal setup; "
+              f"the scene's own errors ({', '.join(fields[:3])}{more}) are not its starting "
+              "point: each draw replaces them", file=sys.stderr)
+
+
 def cmd_tolerance(args) -> int:
     scene = load_scene_checked(args.scene)
+    warn_scene_errors(scene, "tolerance")
     with output_folder(args.out, [args.scene]) as stage:
         return _tolerance(args, scene, stage)
 
@@ -168,6 +192,7 @@ def _tolerance(args, scene, stage) -> int:
 
 def cmd_design(args) -> int:
     scene = load_scene_checked(args.scene)
+    warn_scene_errors(scene, "design")
     with output_folder(args.out, [args.scene]) as stage:
         return _design(args, scene, stage)
 
