@@ -245,8 +245,8 @@ def _design(args, scene, stage) -> int:
     print(f"{'R_c m':>6} {'sp deg':>7} {'worst deg':>10} {'bias deg':>9} {'offset mm':>10} "
           f"{'sigma cal mm':>13} {'sigma unc mm':>13}  note")
     for d in out["designs"]:
-        def f(key, fmt):
-            return format(d[key], fmt) if d[key] is not None else "-"
+        def f(key, fmt):  # "-" in the column's width where there is no value
+            return format(d[key], fmt) if d[key] is not None else "-".rjust(int(fmt.split(".")[0]))
         note = d["problem"] or ", ".join(
             ([] if d["sheet"] == "kept" else [f"sheet {d['sheet']}"])
             + (["> resolution"] if d["exceeds_resolution"] else []))
