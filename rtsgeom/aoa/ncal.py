@@ -8,8 +8,10 @@ nominal model, the probes' detected directions compared with the design's), but 
 own D-dimensional beamformer, so pairs stacked in elevation calibrate as pairs side by side:
 the coarse minimum of the RMS error, then the 1-D pair calibration's fine sweep and periodic
 least-squares fit (``sweep.fit_minimum``) on the signed errors that cross zero
-(:func:`crossing_columns`), rounded to the delay resolution. The pairs are the
-edges between the cell's front ends (Delaunay edges; the pair on an arc); the per-channel
+(:func:`crossing_columns`), rounded to the delay resolution; each step the coherent
+average of as many frames as keep the fitted minimum's 2-sigma scatter below
+``calsteps.TARGET_BIAS_PS`` (measured on the sweep itself, :func:`_fit_scatter`). The
+pairs are the edges between the cell's front ends (Delaunay edges; the pair on an arc); the per-channel
 delays add up along a minimum spanning tree (shortest edges) from the reference channel, and
 each measured edge off the tree closes a loop whose closure error (wrapped to one period) is
 a check: beyond ``LOOP_CLOSURE_TOL_S`` it is a warning naming the pair, as is a pair whose
@@ -41,9 +43,11 @@ __all__ = ["CalibrationFailed", "ChannelCalibration", "coherence_point_nd", "cro
 
 PROBE_RATIOS = (1 / 3, 3.0)
 # A loop of pair calibrations closes to within this (wrapped to one period), or the
-# calibration is reported as failed, naming the loop's pair: sphere4's loops close to 2 to 18
-# ps (the elevation pairs' fits scatter ~10 ps); 29 and 37 ps before the 2-D fit was the 1-D
-# one (run's elevation errors up to 0.10 deg against <= 0.03 deg).
+# calibration is reported as failed, naming the loop's pair: sphere4's loops close to 0 to 5
+# ps with the frames per step sized (3 seeds; also with 180 deg on a front end and the front
+# ends at +-3 deg), 2 to 25 ps with one frame a step (the elevation pairs' fits scatter ~10
+# ps; 37 / 41 ps at +-3 deg); 29 and 37 ps before the 2-D fit was the 1-D one (run's
+# elevation errors up to 0.10 deg against <= 0.03 deg).
 LOOP_CLOSURE_TOL_S = 25e-12
 FINE_STEP_ND_S = 10e-12  # the 2-D fine sweep's step (each step a full-chain frame: 51 of them)
 
