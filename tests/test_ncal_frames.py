@@ -1,5 +1,5 @@
 """Frames per step of the 2-D pair calibration (``ncal.calibrate_pair_nd``): the fitted
-minimum's scatter estimated from the measured sweep itself (``ncal._fit_scatter``) against
+minimum's scatter estimated from the measured sweep itself (``calsteps.fit_scatter``) against
 the scatter of real refits, over a grid of noise levels and curve shapes, the one sizing
 rule (``calsteps.frames_for``) shared with the arc pair, and (slow) the frames growing as
 the SNR falls while the pair stays at its coherence point."""
@@ -28,7 +28,7 @@ def test_fit_scatter_from_one_sweep_is_the_refits_scatter(sigma_rad, amp_rad, tr
     estimate is within 35 % of the std of the minima of 200 independent noisy sweeps
     (32 draws: ~13 % statistical), and the frames it asks for grow as sigma^2."""
     from rtsgeom.aoa.calsteps import TARGET_BIAS_PS, fine_frames
-    from rtsgeom.aoa.ncal import _fit_scatter
+    from rtsgeom.aoa.calsteps import fit_scatter
     from rtsgeom.aoa.sweep import fit_minimum
     near = true_ps * 1e-12 + 30e-12
     d = near + np.arange(-25, 26) * 10e-12
@@ -42,7 +42,7 @@ def test_fit_scatter_from_one_sweep_is_the_refits_scatter(sigma_rad, amp_rad, tr
     one = clean + sigma_rad * rng.standard_normal(clean.shape)
     _, fitted = fit(one)
     assert fitted.shape == one.shape and np.all(np.isfinite(fitted))
-    scatter, noise = _fit_scatter(fit, fitted, one, 2, 3, (0, 1))
+    scatter, noise = fit_scatter(fit, fitted, one, 2, 3, (0, 1))
     assert abs(scatter / truth - 1) < 0.35, (scatter, truth)
     assert abs(noise / sigma_rad - 1) < 0.25
     want = (2 * truth / (TARGET_BIAS_PS * 1e-12)) ** 2
@@ -50,7 +50,7 @@ def test_fit_scatter_from_one_sweep_is_the_refits_scatter(sigma_rad, amp_rad, tr
 
 
 def test_fit_scatter_is_zero_without_noise_and_without_enough_steps():
-    from rtsgeom.aoa.ncal import _fit_scatter
+    from rtsgeom.aoa.calsteps import fit_scatter
     from rtsgeom.aoa.sweep import fit_minimum
     d = np.arange(-25, 26) * 10e-12
     clean = _curves(d, 0.0, np.radians(0.05))
@@ -58,12 +58,12 @@ def test_fit_scatter_is_zero_without_noise_and_without_enough_steps():
     def fit(e):
         return fit_minimum(d, e, PERIOD, 0.0, 2, 125e-12, return_fit=True)
     _, fitted = fit(clean)
-    assert _fit_scatter(fit, fitted, clean, 2, 0, (0, 1))[0] < 1e-15
+    assert fit_scatter(fit, fitted, clean, 2, 0, (0, 1))[0] < 1e-15
     few = np.full_like(clean, np.nan)
     few[:4] = clean[:4]
     _, f_few = fit(few)
     assert np.all(np.isnan(f_few))
-    assert _fit_scatter(fit, f_few, few, 2, 0, (0, 1)) == (0.0, 0.0)
+    assert fit_scatter(fit, f_few, few, 2, 0, (0, 1)) == (0.0, 0.0)
 
 
 @pytest.mark.parametrize("scatter, target, k", [(0.0, 1.0, 1), (1.0, 1.0, 1), (1.01, 1.0, 2),

@@ -10,11 +10,11 @@ the coarse minimum of the RMS error, then the 1-D pair calibration's fine sweep 
 least-squares fit (``sweep.fit_minimum``) on the signed errors that cross zero
 (:func:`crossing_columns`), rounded to the delay resolution; each step the coherent
 average of as many frames as keep the fitted minimum's 2-sigma scatter below
-``calsteps.TARGET_BIAS_PS`` (measured on the sweep itself, :func:`_fit_scatter`). The
-pairs are the edges between the cell's front ends (Delaunay edges; the pair on an arc); the per-channel
-delays add up along a minimum spanning tree (shortest edges) from the reference channel, and
-each measured edge off the tree closes a loop whose closure error (wrapped to one period) is
-a check: beyond ``LOOP_CLOSURE_TOL_S`` it is a warning naming the pair, as is a pair whose
+``calsteps.TARGET_BIAS_PS`` (measured on the sweep itself, ``calsteps.fit_scatter``). The
+pairs are the edges between the cell's front ends (Delaunay edges; the pair on an arc); the
+per-channel delays add up along a minimum spanning tree (shortest edges) from the reference
+channel, and each measured edge off the tree closes a loop whose closure error (wrapped to
+one period) is a check: beyond ``LOOP_CLOSURE_TOL_S`` it is a warning naming the pair, as is a pair whose
 sweep detected nothing (:class:`CalibrationFailed` when it leaves a channel without a path to
 the reference). The amplitude calibration is each front end alone
 (``calibration.probe_front_ends``' gain correction); the residual is the detected error of
@@ -212,13 +212,13 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     detected direction cosines in both axes; the coarse and fine steps, the fit and the
     frames per step are the 1-D pair's (``calsteps.fine_window``, ``calsteps.sweep_phase``,
     ``sweep.fit_minimum``, ``calsteps.fine_frames`` / ``coarse_frames``), the scatter
-    they are sized from measured on the sweep itself (:func:`_fit_scatter`: one frame a
-    step, then, only where that scatters beyond ``TARGET_BIAS_PS`` / 2, the fine sweep
+    they are sized from measured on the sweep itself (``calsteps.fit_scatter``: one frame
+    a step, then, only where that scatters beyond ``TARGET_BIAS_PS`` / 2, the fine sweep
     again with the frames it needs); the phasor sweep's closed-form design, bin logic and
     probe placement are 1-D so far. Raises :class:`CalibrationFailed` when no probe is
     detected at any step."""
     from .calibration import calibrate_pair, if_phase_slope_hz, nominal_model, probe_total_delay
-    from .calsteps import (coarse_frames, fine_frames, fine_window, realisable,
+    from .calsteps import (coarse_frames, fine_frames, fine_window, fit_scatter, realisable,
                            sweep_phase)
     from .sweep import fit_minimum
     scene = setup.scene
@@ -315,7 +315,7 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     best_fit, fitted = fit(e_fine[:, cols])
     k_fine, scatter, noise = 1, 0.0, 0.0
     if noisy:  # frames per step from the sweep's own scatter (the 1-D pair's rule)
-        scatter, noise = _fit_scatter(fit, fitted, e_fine[:, cols], harmonics, seed, pair)
+        scatter, noise = fit_scatter(fit, fitted, e_fine[:, cols], harmonics, seed, pair)
         k_coarse = coarse_frames(np.degrees(noise))
         k_fine = fine_frames(scatter)
         again = k_fine > 1
@@ -341,36 +341,6 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
             "frame_noise_deg": float(np.degrees(noise)),
             # the arc pair's record (``Calibration.to_dict``): RMS probe error per step
             "sweep": _points(grid, errs), "refinement": _points(fine_t, rms_deg(e_fine))}
-
-
-SCATTER_DRAW_FRAMES = 16  # _fit_scatter draws at this many frames' noise, then scales
-
-
-def _fit_scatter(fit, fitted, e, harmonics: int, seed, pair) -> tuple[float, float]:
-    """The fitted minimum's 1-sigma scatter (s) with one frame a step, and one frame's noise
-    (rad of direction cosine, median over the columns), from a measured fine sweep: its
-    errors ``e`` (S, C) at one frame a step, the curves ``fitted`` to them (S, C) and the
-    ``fit`` (errors -> (minimum, curves); ``sweep.fit_minimum``). Each column's noise is its
-    residual about the curve (least-squares degrees of freedom); ``MC_DRAWS`` sweeps are
-    drawn as the curves plus Gaussian noise of that std / sqrt(``SCATTER_DRAW_FRAMES``)
-    (where the fit is linear in the noise, as ``calibration.calibrate_pair`` draws at its
-    coarse frames) and refitted, their minima's std scaled back to one frame. The 2-D
-    counterpart of the arc pair's Monte-Carlo of the phasor model, which a 2-D pair has not:
-    on its own data (deterministic seed). 0 where the fit had too few steps."""
-    from .calsteps import MC_DRAWS
-    r = np.asarray(e, float) - fitted
-    ok = np.all(np.isfinite(r), axis=1)
-    dof = int(ok.sum()) - (1 + 2 * harmonics)
-    if dof < 1:
-        return 0.0, 0.0
-    sigma = np.sqrt(np.sum(r[ok] ** 2, axis=0) / dof)  # (C,)
-    rng = np.random.default_rng(np.random.SeedSequence([int(seed) % 2 ** 32, 1715,
-                                                        int(pair[0]), int(pair[1])]))
-    base = np.where(np.isfinite(fitted), fitted, e)
-    draws = base[None] + (sigma / np.sqrt(SCATTER_DRAW_FRAMES)
-                          * rng.standard_normal((MC_DRAWS,) + base.shape))
-    est = np.array([fit(d)[0] for d in draws])
-    return float(np.std(est) * np.sqrt(SCATTER_DRAW_FRAMES)), float(np.median(sigma))
 
 
 def _points(t, e) -> list[dict]:
