@@ -102,3 +102,29 @@ def test_elevation_pair_frames_grow_as_snr_falls_and_it_stays_at_its_point(snr_d
     assert 4.0 * 10 ** (snr_drop_db / 20) < scatter < 16.0 * 10 ** (snr_drop_db / 20)
     assert abs(got["frames_per_step"] - np.ceil((2 * scatter / 2.0) ** 2)) <= 1  # the rule
     assert 15 * 10 ** (snr_drop_db / 10) < got["frames_per_step"] < 250 * 10 ** (snr_drop_db / 10)
+
+
+@pytest.mark.slow
+def test_elevation_pair_30_db_below_averages_its_coarse_sweep_too():
+    """30 dB below sphere4's SNR one frame's probe noise (~0.19 deg) is beyond
+    COARSE_NOISE_DEG: the coarse sweep is measured again with the frames that bring it
+    below (coarse_frames, the arc pair's rule), the fine sweep with thousands, and the pair
+    still lands within 5 ps of its coherence point."""
+    from rtsgeom.aoa.calibration import probe_front_ends
+    from rtsgeom.aoa.calsteps import COARSE_NOISE_DEG
+    from rtsgeom.aoa.ncal import calibrate_pair_nd, coherence_point_nd
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    from rtsgeom.scene import load_scene
+    scene = load_scene("scenes/sphere4.toml")
+    scene = scene.evolve(radar=scene.radar.evolve(snr_db=scene.radar.snr_db - 30.0))
+    setup = build_setup(scene)
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, scene.seed)
+    got = calibrate_pair_nd(setup, paths, (0, 1), probe, scene.seed)
+    assert got["frame_noise_deg"] > COARSE_NOISE_DEG
+    assert got["coarse_frames_per_step"] == int(np.ceil((got["frame_noise_deg"]
+                                                         / COARSE_NOISE_DEG) ** 2)) > 1
+    assert got["frames_per_step"] > 1000
+    point = coherence_point_nd(setup, paths, (0, 1), probe, got["delta_tau_s"])
+    assert abs(got["delta_tau_s"] - point) < 5e-12
