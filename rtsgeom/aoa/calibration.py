@@ -34,8 +34,9 @@ from ..radar.frame import simulate
 from ..rts import RtsProgram, realised_delay, requested_delay
 from ..scene import TargetConfig
 from .calsteps import (COARSE_NOISE_DEG, FINE_STEP_S, MAX_FRAMES, MC_DRAWS,  # noqa: F401
-                       MIN_FIT_POINTS, coarse_frames, continuous_delay_setup, fine_window,
-                       predicted_angle_noise, realisable, realisation_shift, sweep_phase)
+                       MIN_FIT_POINTS, TARGET_BIAS_PS, coarse_frames, continuous_delay_setup,
+                       fine_frames, fine_window, predicted_angle_noise, realisable,
+                       realisation_shift, sweep_phase)
 from .fir import fir_bin_gain, fir_effect, fir_sweep_phase  # noqa: F401 (re-exported)
 from .synthesis import PairModel
 
@@ -266,7 +267,6 @@ def _simulate_detect(setup, paths, program, seed, frames: int = 1, clipped: bool
     return (rd, det, int(cube.clipped)) if clipped else (rd, det)
 
 
-TARGET_BIAS_PS = 2.0  # the averaging keeps the noise's pull on the chosen delay below this
 def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe:
     """Each front end alone at its own probe range (one simulated frame): measured angle and
     power; the gain correction equalises measured against modelled power. BLAS on one
@@ -426,8 +426,7 @@ def _calibrate_pair(setup, paths, pair, probe, base_offsets, seed, span_s, step_
             est = [fit_minimum(fine_t, e, period, near, harmonics, search, extra, criterion,
                                search_phase) for e in draws]
             noise = float(np.std(est)) * np.sqrt(k_coarse)
-            n_frames = int(min(MAX_FRAMES, max(1, np.ceil((2 * noise / (TARGET_BIAS_PS
-                                                                          * 1e-12)) ** 2))))
+            n_frames = fine_frames(noise)
         e_fine = measure(targets, fine, n_frames)
         best_fit = fit_minimum(fine_t, e_fine, period, near, harmonics, search, extra,
                                criterion, search_phase)

@@ -8,10 +8,14 @@ setups other than the bundled one: coarse delay steps and high noise figures).
   (:func:`realisable`); a fine sweep too sparse for the least-squares fit is fitted through
   its points (:func:`fine_window`); what each step adds beyond its nominal offset, the FIR's
   phase and the quantiser's offset error, is known in advance (:func:`sweep_phase`).
-* The frames: each coarse-sweep step averages as many frames as bring the predicted
-  probe-angle noise below ``COARSE_NOISE_DEG`` (:func:`predicted_angle_noise`,
-  :func:`coarse_frames`), before the sweep, from the noise the link budget (or ``snr_db``)
-  predicts.
+* The frames: one rule (:func:`frames_for`): K coherently averaged frames divide a
+  one-frame scatter by sqrt(K), so a step averages ceil((scatter / target)^2) of them. Each
+  coarse-sweep step averages as many as bring the predicted probe-angle noise below
+  ``COARSE_NOISE_DEG`` (:func:`predicted_angle_noise`, :func:`coarse_frames`), before the
+  sweep, from the noise the link budget (or ``snr_db``) predicts; each fine-sweep step as
+  many as bring the fitted minimum's 2-sigma scatter below ``TARGET_BIAS_PS`` (the pair on
+  an arc: a Monte-Carlo of the phasor model, ``calibration.calibrate_pair``; a 2-D pair: of
+  its own measured sweep, :func:`fit_scatter`).
 
 ``aoa.calibration`` uses these and re-exports them.
 """
@@ -29,7 +33,9 @@ from .fir import fir_sweep_phase
 __all__ = ["continuous_delay_setup", "CONTINUOUS_STEP_S", "COARSE_NOISE_DEG",
            "predicted_angle_noise", "coarse_frames", "MAX_FRAMES", "realisation_shift",
            "sweep_phase", "realisable", "FINE_STEP_S", "MIN_FIT_POINTS", "fine_window",
-           "MC_DRAWS", "SIZE_DRAWS"]
+           "MC_DRAWS", "SIZE_DRAWS", "TARGET_BIAS_PS", "frames_for", "fine_frames",
+           "fit_scatter",
+           "SCATTER_DRAW_FRAMES"]
 
 
 def continuous_delay_setup(setup: Setup) -> Setup:
@@ -76,13 +82,31 @@ def predicted_angle_noise(sweep, seed: int = 0) -> float:
     return float(np.degrees(sig)) if np.isfinite(sig) else 0.0
 
 
+def frames_for(one_frame_scatter: float, target: float) -> int:
+    """Frames per step to average so that a quantity whose scatter with one frame a step is
+    ``one_frame_scatter`` scatters less than ``target`` (same unit): the coherent average of
+    K frames has 1/K of one frame's noise power (``calibration._simulate_detect``) and a
+    quantity linear in the noise 1/sqrt(K) of its scatter, so ceil((scatter / target)^2),
+    at least 1 and at most ``MAX_FRAMES``."""
+    return int(min(MAX_FRAMES, max(1, np.ceil((one_frame_scatter / target) ** 2))))
+
+
 def coarse_frames(frame_noise_deg: float) -> int:
     """Frames per coarse-sweep step that bring the predicted probe-angle noise
     (:func:`predicted_angle_noise`) below ``COARSE_NOISE_DEG``: 1 on the default scene and
     with the link up to NF ~30 dB (unchanged there); 8 / 25 / 81 at NF 40 / 45 / 50 dB, where
     one frame per step picked a minimum 48 ps or a period off on 3 of 3 seeds at 50 dB."""
-    return int(min(MAX_FRAMES, max(1, np.ceil((frame_noise_deg / COARSE_NOISE_DEG) ** 2))))
+    return frames_for(frame_noise_deg, COARSE_NOISE_DEG)
+
+
+def fine_frames(one_frame_scatter_s: float) -> int:
+    """Frames per fine-sweep step that keep the fitted minimum's 2-sigma scatter below
+    ``TARGET_BIAS_PS``, from its 1-sigma scatter with one frame a step (s)."""
+    return frames_for(2 * one_frame_scatter_s, TARGET_BIAS_PS * 1e-12)
+
+
 MAX_FRAMES = 1 << 20
+TARGET_BIAS_PS = 2.0  # the averaging keeps the noise's pull on the chosen delay below this
 
 
 def realisation_shift(setup: Setup, ranges, deltas, base_offsets=(0.0, 0.0)) -> np.ndarray:
@@ -158,3 +182,32 @@ def fine_window(half_s: float, step_s: float) -> tuple[int, int, str]:
 
 MC_DRAWS = 32  # noise realisations that size the frames per step
 
+
+SCATTER_DRAW_FRAMES = 16  # fit_scatter draws at this many frames' noise, then scales
+
+
+def fit_scatter(fit, fitted, e, harmonics: int, seed, pair) -> tuple[float, float]:
+    """The fitted minimum's 1-sigma scatter (s) with one frame a step, and one frame's noise
+    (rad of direction cosine, median over the columns), from a measured fine sweep: its
+    errors ``e`` (S, C) at one frame a step, the curves ``fitted`` to them (S, C) and the
+    ``fit`` (errors -> (minimum, curves); ``sweep.fit_minimum``). Each column's noise is its
+    residual about the curve (least-squares degrees of freedom); ``MC_DRAWS`` sweeps are
+    drawn as the curves plus Gaussian noise of that std / sqrt(``SCATTER_DRAW_FRAMES``)
+    (where the fit is linear in the noise, as ``calibration.calibrate_pair`` draws at its
+    coarse frames) and refitted, their minima's std scaled back to one frame. The 2-D
+    counterpart of the arc pair's Monte-Carlo of the phasor model, which a 2-D pair has not:
+    on its own data (deterministic seed; ``ncal.calibrate_pair_nd``). 0 where the fit had
+    too few steps. The seed: ``seed`` and the ``pair`` (i, j) measured."""
+    r = np.asarray(e, float) - fitted
+    ok = np.all(np.isfinite(r), axis=1)
+    dof = int(ok.sum()) - (1 + 2 * harmonics)
+    if dof < 1:
+        return 0.0, 0.0
+    sigma = np.sqrt(np.sum(r[ok] ** 2, axis=0) / dof)  # (C,)
+    rng = np.random.default_rng(np.random.SeedSequence([int(seed) % 2 ** 32, 1715,
+                                                        int(pair[0]), int(pair[1])]))
+    base = np.where(np.isfinite(fitted), fitted, e)
+    draws = base[None] + (sigma / np.sqrt(SCATTER_DRAW_FRAMES)
+                          * rng.standard_normal((MC_DRAWS,) + base.shape))
+    est = np.array([fit(d)[0] for d in draws])
+    return float(np.std(est) * np.sqrt(SCATTER_DRAW_FRAMES)), float(np.median(sigma))

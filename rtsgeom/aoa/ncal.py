@@ -8,11 +8,13 @@ nominal model, the probes' detected directions compared with the design's), but 
 own D-dimensional beamformer, so pairs stacked in elevation calibrate as pairs side by side:
 the coarse minimum of the RMS error, then the 1-D pair calibration's fine sweep and periodic
 least-squares fit (``sweep.fit_minimum``) on the signed errors that cross zero
-(:func:`crossing_columns`), rounded to the delay resolution. The pairs are the
-edges between the cell's front ends (Delaunay edges; the pair on an arc); the per-channel
-delays add up along a minimum spanning tree (shortest edges) from the reference channel, and
-each measured edge off the tree closes a loop whose closure error (wrapped to one period) is
-a check: beyond ``LOOP_CLOSURE_TOL_S`` it is a warning naming the pair, as is a pair whose
+(:func:`crossing_columns`), rounded to the delay resolution; each step the coherent
+average of as many frames as keep the fitted minimum's 2-sigma scatter below
+``calsteps.TARGET_BIAS_PS`` (measured on the sweep itself, ``calsteps.fit_scatter``). The
+pairs are the edges between the cell's front ends (Delaunay edges; the pair on an arc); the
+per-channel delays add up along a minimum spanning tree (shortest edges) from the reference
+channel, and each measured edge off the tree closes a loop whose closure error (wrapped to
+one period) is a check: beyond ``LOOP_CLOSURE_TOL_S`` it is a warning naming the pair, as is a pair whose
 sweep detected nothing (:class:`CalibrationFailed` when it leaves a channel without a path to
 the reference). The amplitude calibration is each front end alone
 (``calibration.probe_front_ends``' gain correction); the residual is the detected error of
@@ -41,9 +43,11 @@ __all__ = ["CalibrationFailed", "ChannelCalibration", "coherence_point_nd", "cro
 
 PROBE_RATIOS = (1 / 3, 3.0)
 # A loop of pair calibrations closes to within this (wrapped to one period), or the
-# calibration is reported as failed, naming the loop's pair: sphere4's loops close to 2 to 18
-# ps (the elevation pairs' fits scatter ~10 ps); 29 and 37 ps before the 2-D fit was the 1-D
-# one (run's elevation errors up to 0.10 deg against <= 0.03 deg).
+# calibration is reported as failed, naming the loop's pair: sphere4's loops close to 0 to 5
+# ps with the frames per step sized (3 seeds; also with 180 deg on a front end and the front
+# ends at +-3 deg), 2 to 25 ps with one frame a step (the elevation pairs' fits scatter ~10
+# ps; 37 / 41 ps at +-3 deg); 29 and 37 ps before the 2-D fit was the 1-D one (run's
+# elevation errors up to 0.10 deg against <= 0.03 deg).
 LOOP_CLOSURE_TOL_S = 25e-12
 FINE_STEP_ND_S = 10e-12  # the 2-D fine sweep's step (each step a full-chain frame: 51 of them)
 
@@ -103,11 +107,11 @@ def _angles_to_u(st, det, k):
     return st.directions(np.array([det.angle_rad[k], det.elevation_rad[k]]))
 
 
-def _detect(setup, paths, program, seed):
-    from ..radar import process
-    from ..radar.frame import simulate
-    _, cube = simulate(setup, paths, program, seed, setup.scene.radar.snr_db)
-    return process(cube)
+def _detect(setup, paths, program, seed, frames: int = 1):
+    """The radar's output for ``program``: the coherent average of ``frames`` frames
+    (``calibration._simulate_detect``: one frame with 1/frames of the noise power)."""
+    from .calibration import _simulate_detect
+    return _simulate_detect(setup, paths, program, seed, frames)
 
 
 def _pair_probes(setup, paths, pair, probe, delta_s: float = 0.0, p_ref: dict | None = None):
@@ -204,14 +208,18 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     least-squares fit, full-chain confirmation), as a dict; the pair on an arc is the N = 2,
     D = 1 case of the channel calibration, not a second sweep. With a 2-D beamformer (D = 2:
     pairs side by side or stacked in elevation) the sweep of the module doc, through the
-    full ADC-cube chain (one frame a step: 61 coarse + 51 fine on sphere4), comparing the
-    probes' detected direction cosines in both axes; the coarse and fine steps and the fit
-    are the 1-D pair's (``calsteps.fine_window``, ``calsteps.sweep_phase``,
-    ``sweep.fit_minimum``); the phasor sweep's closed-form design, bin logic, probe
-    placement and frames per step are 1-D so far. Raises :class:`CalibrationFailed` when no
-    probe is detected at any step."""
+    full ADC-cube chain (61 coarse + 51 fine frames on sphere4), comparing the probes'
+    detected direction cosines in both axes; the coarse and fine steps, the fit and the
+    frames per step are the 1-D pair's (``calsteps.fine_window``, ``calsteps.sweep_phase``,
+    ``sweep.fit_minimum``, ``calsteps.fine_frames`` / ``coarse_frames``), the scatter
+    they are sized from measured on the sweep itself (``calsteps.fit_scatter``: one frame
+    a step, then, only where that scatters beyond ``TARGET_BIAS_PS`` / 2, the fine sweep
+    again with the frames it needs); the phasor sweep's closed-form design, bin logic and
+    probe placement are 1-D so far. Raises :class:`CalibrationFailed` when no probe is
+    detected at any step."""
     from .calibration import calibrate_pair, if_phase_slope_hz, nominal_model, probe_total_delay
-    from .calsteps import fine_window, realisable, sweep_phase
+    from .calsteps import (coarse_frames, fine_frames, fine_window, fit_scatter, realisable,
+                           sweep_phase)
     from .sweep import fit_minimum
     scene = setup.scene
     rts = scene.rts
@@ -225,9 +233,11 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     p_ref: dict = {}  # channel i's reference power per probe (fixed over the sweep)
     ranges, _, _, st = _pair_probes(setup, paths, pair, probe, 0.0, p_ref)
     base = [float(requested_delay(scene, r)) for r in ranges]
+    noisy = scene.radar.snr_db is not None or scene.radar.link is not None  # link: kTBF noise
 
-    def signed(delta: float) -> np.ndarray:
-        """The probes' detected direction-cosine errors (P * D,) (NaN: not detected)."""
+    def signed(delta: float, frames: int = 1) -> np.ndarray:
+        """The probes' detected direction-cosine errors (P * D,) (NaN: not detected), the
+        coherent average of ``frames`` frames."""
         _, designs, predicted, _ = _pair_probes(setup, paths, pair, probe, delta, p_ref)
         tg, fe, dl, amp = [], [], [], []
         for k, (a, b) in enumerate(zip(base, designs)):
@@ -237,8 +247,9 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
             amp += list(b)
         prog = RtsProgram.build(tg, fe, dl, np.zeros(len(tg)), amp)
         step_seed = np.random.SeedSequence([int(seed) % 2 ** 32, int(round(delta * 1e15))
-                                            + 2 ** 40, pair[0], pair[1]])
-        rd, det = _detect(setup, paths, prog, step_seed)
+                                            + 2 ** 40, pair[0], pair[1]]
+                                           + ([int(frames)] if frames > 1 else []))
+        rd, det = _detect(setup, paths, prog, step_seed, frames)
         out = np.full((len(ranges), st.dims), np.nan)
         for p, (r, u_pred) in enumerate(zip(ranges, predicted)):
             k = nearest_detection(det, rd, r)
@@ -255,13 +266,16 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     grid = np.arange(span[0], span[1] + step / 2, step)
     res = rts.delay_resolution_s
     grid = np.unique(realisable(grid, res))  # the delays as the RTS realises them
-    errs = rms_deg(np.array([signed(d) for d in grid]))
-    if not np.any(np.isfinite(errs)):
-        raise CalibrationFailed(f"pair {tuple(int(q) for q in pair)}: no probe detected at any "
-                                "step of the sweep")
-    is_min = (np.r_[True, errs[1:] <= errs[:-1]] & np.r_[errs[:-1] <= errs[1:], True])
-    good = np.flatnonzero(is_min & (errs <= 2 * np.min(errs) + 0.01))
-    near = float(grid[int(good[np.argmin(np.abs(grid[good]))])])  # least range offset
+
+    def coarse(frames: int):
+        errs = rms_deg(np.array([signed(d, frames) for d in grid]))
+        if not np.any(np.isfinite(errs)):
+            raise CalibrationFailed(f"pair {tuple(int(q) for q in pair)}: no probe detected "
+                                    "at any step of the sweep")
+        is_min = (np.r_[True, errs[1:] <= errs[:-1]] & np.r_[errs[:-1] <= errs[1:], True])
+        good = np.flatnonzero(is_min & (errs <= 2 * np.min(errs) + 0.01))
+        return errs, float(grid[int(good[np.argmin(np.abs(grid[good]))])])  # least offset
+
     period = 1.0 / float(if_phase_slope_hz(scene, probe_total_delay(setup, ranges)))
     # The fine sweep and its fit are the pair calibration's (``calibration.calibrate_pair``):
     # +-period/4 around the coarse minimum, the signed errors of each probe in each axis
@@ -274,21 +288,45 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     half = period / 4
     fine_step = res * max(1, round(FINE_STEP_ND_S / res))
     k_half, harmonics, criterion = fine_window(half, fine_step)
-    fine_t = near + np.arange(-k_half, k_half + 1) * fine_step
-    e_fine = np.array([signed(d) for d in fine_t])  # (S, P * D)
-    extra, search_phase = sweep_phase(setup, ranges, fine_t, (0.0, 0.0), period)
-    cols = crossing_columns(e_fine)
-    if extra is not None:  # per probe -> per probe and axis
-        extra = np.repeat(np.asarray(extra, float).reshape(fine_t.size, -1), st.dims,
-                          axis=1)[:, cols]
-    if search_phase is not None:
-        sp = search_phase
-        search_phase = lambda t: np.repeat(np.asarray(sp(t), float), st.dims,  # noqa: E731
-                                           axis=1)[:, cols]
-    best_fit = fit_minimum(fine_t, e_fine[:, cols], period, near, harmonics,
-                           max(half / 2, fine_step), extra, criterion, search_phase)
+
+    def fine(near: float, frames: int):
+        """The fine sweep around ``near`` and its fit: (delays, errors (S, P * D), the fit
+        (a function of the errors' fitted columns -> (minimum, fitted curves)), columns)."""
+        fine_t = near + np.arange(-k_half, k_half + 1) * fine_step
+        e_fine = np.array([signed(d, frames) for d in fine_t])  # (S, P * D)
+        extra, search_phase = sweep_phase(setup, ranges, fine_t, (0.0, 0.0), period)
+        cols = crossing_columns(e_fine)
+        if extra is not None:  # per probe -> per probe and axis
+            extra = np.repeat(np.asarray(extra, float).reshape(fine_t.size, -1), st.dims,
+                              axis=1)[:, cols]
+        if search_phase is not None:
+            sp = search_phase
+            search_phase = lambda t: np.repeat(np.asarray(sp(t), float),  # noqa: E731
+                                               st.dims, axis=1)[:, cols]
+
+        def fit(e):
+            return fit_minimum(fine_t, e, period, near, harmonics, max(half / 2, fine_step),
+                               extra, criterion, search_phase, return_fit=True)
+        return fine_t, e_fine, fit, cols
+
+    k_coarse = 1
+    errs, near = coarse(k_coarse)
+    fine_t, e_fine, fit, cols = fine(near, 1)
+    best_fit, fitted = fit(e_fine[:, cols])
+    k_fine, scatter, noise = 1, 0.0, 0.0
+    if noisy:  # frames per step from the sweep's own scatter (the 1-D pair's rule)
+        scatter, noise = fit_scatter(fit, fitted, e_fine[:, cols], harmonics, seed, pair)
+        k_coarse = coarse_frames(np.degrees(noise))
+        k_fine = fine_frames(scatter)
+        again = k_fine > 1
+        if k_coarse > 1:  # the coarse sweep was too noisy to trust its minimum: again
+            errs, near_k = coarse(k_coarse)
+            again, near = again or near_k != near, near_k
+        if again:
+            fine_t, e_fine, fit, cols = fine(near, k_fine)
+            best_fit, fitted = fit(e_fine[:, cols])
     best = float(realisable(best_fit, res))  # what the RTS can set
-    best_err = float(rms_deg(signed(best)))
+    best_err = float(rms_deg(signed(best, k_fine)))
     grid_pts = np.concatenate([grid, fine_t, [best]])
     return {"pair": [int(pair[0]), int(pair[1])], "delta_tau_s": best,
             "residual_error_deg": best_err, "points": int(grid_pts.size),
@@ -296,6 +334,11 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
             "sweep_points": int(grid.size), "fit_s": float(best_fit),
             "coarse_minimum_s": near,
             "fit_columns": [int(q) for q in cols],
+            # as the arc pair's record (``Calibration.to_dict``): frames averaged per step,
+            # the fitted minimum's 1-sigma with one frame a step, one frame's probe noise
+            "frames_per_step": int(k_fine), "coarse_frames_per_step": int(k_coarse),
+            "one_frame_scatter_ps": scatter * 1e12,
+            "frame_noise_deg": float(np.degrees(noise)),
             # the arc pair's record (``Calibration.to_dict``): RMS probe error per step
             "sweep": _points(grid, errs), "refinement": _points(fine_t, rms_deg(e_fine))}
 

@@ -339,7 +339,7 @@ def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair,
 
 def fit_minimum(deltas, error_rad, period_s: float, near_s: float, harmonics: int = 2,
                 search_s: float | None = None, extra_phase_rad=None,
-                criterion: str = "joint", search_phase=None) -> float:
+                criterion: str = "joint", search_phase=None, return_fit: bool = False):
     """The delay where the probes' fitted signed angle errors are jointly smallest, from a
     least-squares fit of the criterion's known periodic shape over one period of steps
     centred at ``near_s`` (the sweep's coarse minimum).
@@ -366,7 +366,12 @@ def fit_minimum(deltas, error_rad, period_s: float, near_s: float, harmonics: in
     evaluated there: a coarse RTS's steps are too far apart to interpolate the FIR's phase,
     and its data axis also carries the quantiser's own offset error (where the delay step
     does not divide 1/f_s, ``calibration.realisation_shift``), which the continuous delays
-    searched do not have."""
+    searched do not have.
+
+    ``return_fit``: also the fitted curves at the data's steps (S, P) (NaN at the steps left
+    out: off the period or not detected), whose residual is the steps' noise
+    (``ncal.calibrate_pair_nd`` sizes its frames per step from it); all NaN where too few
+    steps for the fit (the minimum is then ``near_s``)."""
     d = np.asarray(deltas, float)
     e = np.asarray(error_rad, float)
     sel = (np.abs(d - near_s) <= period_s / 2) & np.all(np.isfinite(e), axis=1)
@@ -384,16 +389,21 @@ def fit_minimum(deltas, error_rad, period_s: float, near_s: float, harmonics: in
     def values(theta):
         return np.concatenate([np.ones((theta.size, 1)), np.cos(np.outer(theta, h)),
                                np.sin(np.outer(theta, h))], axis=1)
+    fitted = np.full(e.shape, np.nan)
+
+    def result(best):
+        return (float(best), fitted) if return_fit else float(best)
     if th.size < 2 * harmonics + (1 if vertex else 3):
-        return float(near_s)
+        return result(near_s)
     step = np.median(np.diff(np.sort(d))) if d.size > 1 else period_s / 40
     half = 1.5 * step if search_s is None else search_s
     fine = near_s + np.arange(-half, half + 1e-15, 0.05e-12)
     tf = 2 * np.pi * (fine - near_s) / period_s
     if extra_phase_rad is None:
         coef, *_ = np.linalg.lstsq(values(th), e[sel], rcond=None)  # (1 + 2H, P)
+        fitted[sel] = values(th) @ coef
         crit = np.sum((basis(tf) @ coef) ** 2, axis=1)
-        return float(fine[np.argmin(crit)])
+        return result(fine[np.argmin(crit)])
     extra = np.asarray(extra_phase_rad, float).reshape(d.size, -1)
     order = np.argsort(d[sel])
     crit = np.zeros(fine.size)
@@ -402,10 +412,11 @@ def fit_minimum(deltas, error_rad, period_s: float, near_s: float, harmonics: in
     for p in range(e.shape[1]):  # each probe on its own phase axis
         x = extra[sel, p]
         coef, *_ = np.linalg.lstsq(values(th + x), e[sel, p], rcond=None)
+        fitted[sel, p] = values(th + x) @ coef
         x_f = (search_x[:, p] if search_phase is not None
                else np.interp(fine, d[sel][order], x[order]))  # smooth in the setting: 5 ps
         crit += (basis(tf + x_f) @ coef) ** 2
-    return float(fine[np.argmin(crit)])
+    return result(fine[np.argmin(crit)])
 
 
 def place_probes(setup, paths, nominal, pair, ranges, alphas, window_s, base_offsets,

@@ -1,0 +1,130 @@
+"""Frames per step of the 2-D pair calibration (``ncal.calibrate_pair_nd``): the fitted
+minimum's scatter estimated from the measured sweep itself (``calsteps.fit_scatter``) against
+the scatter of real refits, over a grid of noise levels and curve shapes, the one sizing
+rule (``calsteps.frames_for``) shared with the arc pair, and (slow) the frames growing as
+the SNR falls while the pair stays at its coherence point."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+PERIOD = 1.0e-9
+
+
+def _curves(d, true_s, amp_rad):
+    """Two crossing columns as the elevation pair gives them (odd about the coherence
+    point, with a second harmonic)."""
+    th = 2 * np.pi * (d - true_s) / PERIOD
+    return np.stack([amp_rad * np.sin(th), 0.7 * amp_rad * np.sin(th) + 0.2 * amp_rad
+                     * np.sin(2 * th)], axis=1)
+
+
+@pytest.mark.parametrize("sigma_rad", [2e-5, 1e-4, 4e-4])
+@pytest.mark.parametrize("amp_rad, true_ps", [(np.radians(0.03), 29.0),
+                                              (np.radians(0.1), -140.0)])
+def test_fit_scatter_from_one_sweep_is_the_refits_scatter(sigma_rad, amp_rad, true_ps):
+    """From ONE noisy sweep (its residual about the fit, refitted on drawn sweeps) the
+    estimate is within 35 % of the std of the minima of 200 independent noisy sweeps
+    (32 draws: ~13 % statistical), and the frames it asks for grow as sigma^2."""
+    from rtsgeom.aoa.calsteps import TARGET_BIAS_PS, fine_frames
+    from rtsgeom.aoa.calsteps import fit_scatter
+    from rtsgeom.aoa.sweep import fit_minimum
+    near = true_ps * 1e-12 + 30e-12
+    d = near + np.arange(-25, 26) * 10e-12
+    clean = _curves(d, true_ps * 1e-12, amp_rad)
+    rng = np.random.default_rng(7)
+
+    def fit(e):
+        return fit_minimum(d, e, PERIOD, near, 2, 125e-12, return_fit=True)
+    truth = np.std([fit(clean + sigma_rad * rng.standard_normal(clean.shape))[0]
+                    for _ in range(200)])
+    one = clean + sigma_rad * rng.standard_normal(clean.shape)
+    _, fitted = fit(one)
+    assert fitted.shape == one.shape and np.all(np.isfinite(fitted))
+    scatter, noise = fit_scatter(fit, fitted, one, 2, 3, (0, 1))
+    assert abs(scatter / truth - 1) < 0.35, (scatter, truth)
+    assert abs(noise / sigma_rad - 1) < 0.25
+    want = (2 * truth / (TARGET_BIAS_PS * 1e-12)) ** 2
+    assert 0.4 * want <= fine_frames(scatter) <= 2.0 * want + 1
+
+
+def test_fit_scatter_is_zero_without_noise_and_without_enough_steps():
+    from rtsgeom.aoa.calsteps import fit_scatter
+    from rtsgeom.aoa.sweep import fit_minimum
+    d = np.arange(-25, 26) * 10e-12
+    clean = _curves(d, 0.0, np.radians(0.05))
+
+    def fit(e):
+        return fit_minimum(d, e, PERIOD, 0.0, 2, 125e-12, return_fit=True)
+    _, fitted = fit(clean)
+    assert fit_scatter(fit, fitted, clean, 2, 0, (0, 1))[0] < 1e-15
+    few = np.full_like(clean, np.nan)
+    few[:4] = clean[:4]
+    _, f_few = fit(few)
+    assert np.all(np.isnan(f_few))
+    assert fit_scatter(fit, f_few, few, 2, 0, (0, 1)) == (0.0, 0.0)
+
+
+@pytest.mark.parametrize("scatter, target, k", [(0.0, 1.0, 1), (1.0, 1.0, 1), (1.01, 1.0, 2),
+                                                (2.5, 1.0, 7), (1e9, 1.0, 1 << 20)])
+def test_frames_for_is_the_square_of_the_scatter_over_the_target(scatter, target, k):
+    """The one sizing rule of both sweeps and both pairs (coarse: probe-angle noise over
+    COARSE_NOISE_DEG; fine: 2 sigma of the minimum over TARGET_BIAS_PS)."""
+    from rtsgeom.aoa.calsteps import (COARSE_NOISE_DEG, TARGET_BIAS_PS, coarse_frames,
+                                      fine_frames, frames_for)
+    assert frames_for(scatter, target) == k
+    assert coarse_frames(scatter * COARSE_NOISE_DEG) == k
+    assert fine_frames(scatter * TARGET_BIAS_PS * 1e-12 / 2) == k
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("snr_drop_db", [0.0, 10.0])
+def test_elevation_pair_frames_grow_as_snr_falls_and_it_stays_at_its_point(snr_drop_db):
+    """sphere4's elevation pair (0, 1) at its SNR and 10 dB below: one frame a step scatters
+    the fitted minimum by ~8 ps (~25 ps 10 dB below: the pairs landed -11 to +17 ps off
+    at the scene's SNR); the frames chosen bring it within 5 ps of the continuous coherence
+    point, and grow ~10x (1/SNR) with the 10 dB."""
+    from rtsgeom.aoa.calibration import probe_front_ends
+    from rtsgeom.aoa.ncal import calibrate_pair_nd, coherence_point_nd
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    from rtsgeom.scene import load_scene
+    scene = load_scene("scenes/sphere4.toml")
+    scene = scene.evolve(radar=scene.radar.evolve(snr_db=scene.radar.snr_db - snr_drop_db))
+    setup = build_setup(scene)
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, scene.seed)
+    got = calibrate_pair_nd(setup, paths, (0, 1), probe, scene.seed)
+    point = coherence_point_nd(setup, paths, (0, 1), probe, got["delta_tau_s"])
+    assert abs(got["delta_tau_s"] - point) < 5e-12
+    scatter = got["one_frame_scatter_ps"]
+    assert 4.0 * 10 ** (snr_drop_db / 20) < scatter < 16.0 * 10 ** (snr_drop_db / 20)
+    assert abs(got["frames_per_step"] - np.ceil((2 * scatter / 2.0) ** 2)) <= 1  # the rule
+    assert 15 * 10 ** (snr_drop_db / 10) < got["frames_per_step"] < 250 * 10 ** (snr_drop_db / 10)
+
+
+@pytest.mark.slow
+def test_elevation_pair_30_db_below_averages_its_coarse_sweep_too():
+    """30 dB below sphere4's SNR one frame's probe noise (~0.19 deg) is beyond
+    COARSE_NOISE_DEG: the coarse sweep is measured again with the frames that bring it
+    below (coarse_frames, the arc pair's rule), the fine sweep with thousands, and the pair
+    still lands within 5 ps of its coherence point."""
+    from rtsgeom.aoa.calibration import probe_front_ends
+    from rtsgeom.aoa.calsteps import COARSE_NOISE_DEG
+    from rtsgeom.aoa.ncal import calibrate_pair_nd, coherence_point_nd
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    from rtsgeom.scene import load_scene
+    scene = load_scene("scenes/sphere4.toml")
+    scene = scene.evolve(radar=scene.radar.evolve(snr_db=scene.radar.snr_db - 30.0))
+    setup = build_setup(scene)
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, scene.seed)
+    got = calibrate_pair_nd(setup, paths, (0, 1), probe, scene.seed)
+    assert got["frame_noise_deg"] > COARSE_NOISE_DEG
+    assert got["coarse_frames_per_step"] == int(np.ceil((got["frame_noise_deg"]
+                                                         / COARSE_NOISE_DEG) ** 2)) > 1
+    assert got["frames_per_step"] > 1000
+    point = coherence_point_nd(setup, paths, (0, 1), probe, got["delta_tau_s"])
+    assert abs(got["delta_tau_s"] - point) < 5e-12
