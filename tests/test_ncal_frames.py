@@ -105,6 +105,9 @@ def test_elevation_pair_frames_grow_as_snr_falls_and_it_stays_at_its_point(snr_d
 
 
 @pytest.mark.slow
+# 30 dB below, front end 3 alone falls under the CFAR threshold at the probe range (it warns;
+# the pair calibrated here is (0, 1))
+@pytest.mark.filterwarnings("ignore:front end\\(s\\) \\[3\\] not detected alone")
 def test_elevation_pair_30_db_below_averages_its_coarse_sweep_too():
     """30 dB below sphere4's SNR one frame's probe noise (~0.19 deg) is beyond
     COARSE_NOISE_DEG: the coarse sweep is measured again with the frames that bring it
