@@ -49,7 +49,9 @@ def test_fit_scatter_from_one_sweep_is_the_refits_scatter(sigma_rad, amp_rad, tr
     assert 0.4 * want <= fine_frames(scatter) <= 2.0 * want + 1
 
 
-def test_fit_scatter_is_zero_without_noise_and_without_enough_steps():
+def test_fit_scatter_is_zero_without_noise_and_unknown_without_enough_steps():
+    """No noise: no scatter. Too few steps for a residual (the curves pass through them): not
+    "no noise" but unknown (NaN), which ``calibrate_pair_nd`` answers with a second sweep."""
     from rtsgeom.aoa.calsteps import fit_scatter
     from rtsgeom.aoa.sweep import fit_minimum
     d = np.arange(-25, 26) * 10e-12
@@ -63,7 +65,30 @@ def test_fit_scatter_is_zero_without_noise_and_without_enough_steps():
     few[:4] = clean[:4]
     _, f_few = fit(few)
     assert np.all(np.isnan(f_few))
-    assert fit_scatter(fit, f_few, few, 2, 0, (0, 1)) == (0.0, 0.0)
+    assert all(np.isnan(fit_scatter(fit, f_few, few, 2, 0, (0, 1))))
+
+
+@pytest.mark.parametrize("sigma_rad", [5e-5, 3e-4])
+def test_coarse_rts_steps_measure_the_noise_from_a_repeated_sweep(sigma_rad):
+    """100 ps RTS steps leave 5 fine steps, through which 2 harmonics pass exactly: the fit's
+    residual is zero whatever the noise (the frames were sized to 1, the scatter reported 0).
+    With a second, independent sweep the noise is that of their difference: within 40 % of
+    sigma on 5 steps x 2 columns, and the scatter grows with it."""
+    from rtsgeom.aoa.calsteps import fit_scatter
+    from rtsgeom.aoa.sweep import fit_minimum
+    d = np.arange(-2, 3) * 100e-12
+    clean = _curves(d, 20e-12, np.radians(0.05))
+    rng = np.random.default_rng(11)
+    one = clean + sigma_rad * rng.standard_normal(clean.shape)
+    two = clean + sigma_rad * rng.standard_normal(clean.shape)
+
+    def fit(e):
+        return fit_minimum(d, e, PERIOD, 0.0, 2, 250e-12, criterion="vertex", return_fit=True)
+    _, fitted = fit(one)
+    assert np.allclose(fitted, one, atol=1e-12 + 1e-9 * sigma_rad)  # interpolates: no residual
+    assert all(np.isnan(fit_scatter(fit, fitted, one, 2, 0, (0, 1))))
+    scatter, noise = fit_scatter(fit, fitted, one, 2, 0, (0, 1), repeat=two)
+    assert abs(noise / sigma_rad - 1) < 0.4 and scatter > 0
 
 
 @pytest.mark.parametrize("scatter, target, k", [(0.0, 1.0, 1), (1.0, 1.0, 1), (1.01, 1.0, 2),

@@ -186,7 +186,8 @@ MC_DRAWS = 32  # noise realisations that size the frames per step
 SCATTER_DRAW_FRAMES = 16  # fit_scatter draws at this many frames' noise, then scales
 
 
-def fit_scatter(fit, fitted, e, harmonics: int, seed, pair) -> tuple[float, float]:
+def fit_scatter(fit, fitted, e, harmonics: int, seed, pair,
+                repeat=None) -> tuple[float, float]:
     """The fitted minimum's 1-sigma scatter (s) with one frame a step, and one frame's noise
     (rad of direction cosine, median over the columns), from a measured fine sweep: its
     errors ``e`` (S, C) at one frame a step, the curves ``fitted`` to them (S, C) and the
@@ -196,13 +197,25 @@ def fit_scatter(fit, fitted, e, harmonics: int, seed, pair) -> tuple[float, floa
     (where the fit is linear in the noise, as ``calibration.calibrate_pair`` draws at its
     coarse frames) and refitted, their minima's std scaled back to one frame. The 2-D
     counterpart of the arc pair's Monte-Carlo of the phasor model, which a 2-D pair has not:
-    on its own data (deterministic seed; ``ncal.calibrate_pair_nd``). 0 where the fit had
-    too few steps. The seed: ``seed`` and the ``pair`` (i, j) measured."""
-    r = np.asarray(e, float) - fitted
-    ok = np.all(np.isfinite(r), axis=1)
-    dof = int(ok.sum()) - (1 + 2 * harmonics)
+    on its own data (deterministic seed; ``ncal.calibrate_pair_nd``). The seed: ``seed`` and
+    the ``pair`` (i, j) measured.
+
+    Where the fit has no residual degrees of freedom (an RTS with coarse delay steps leaves
+    3 or 5 fine steps, through which the curves pass exactly: a zero residual is no evidence
+    of no noise) the result is (NaN, NaN): measure the sweep again, independently, and give
+    it as ``repeat`` (S, C): each column's noise is then that of the two sweeps' difference,
+    var(e - repeat) = 2 sigma^2, with no fit involved."""
+    e = np.asarray(e, float)
+    if repeat is not None:
+        r = (e - np.asarray(repeat, float)) / np.sqrt(2.0)
+        ok = np.all(np.isfinite(r), axis=1)
+        dof = int(ok.sum())
+    else:
+        r = e - fitted
+        ok = np.all(np.isfinite(r), axis=1)
+        dof = int(ok.sum()) - (1 + 2 * harmonics)
     if dof < 1:
-        return 0.0, 0.0
+        return float("nan"), float("nan")
     sigma = np.sqrt(np.sum(r[ok] ** 2, axis=0) / dof)  # (C,)
     rng = np.random.default_rng(np.random.SeedSequence([int(seed) % 2 ** 32, 1715,
                                                         int(pair[0]), int(pair[1])]))

@@ -235,9 +235,10 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     base = [float(requested_delay(scene, r)) for r in ranges]
     noisy = scene.radar.snr_db is not None or scene.radar.link is not None  # link: kTBF noise
 
-    def signed(delta: float, frames: int = 1) -> np.ndarray:
+    def signed(delta: float, frames: int = 1, repeat: int = 0) -> np.ndarray:
         """The probes' detected direction-cosine errors (P * D,) (NaN: not detected), the
-        coherent average of ``frames`` frames."""
+        coherent average of ``frames`` frames (``repeat`` > 0: an independent measurement
+        of the same step, other noise)."""
         _, designs, predicted, _ = _pair_probes(setup, paths, pair, probe, delta, p_ref)
         tg, fe, dl, amp = [], [], [], []
         for k, (a, b) in enumerate(zip(base, designs)):
@@ -248,7 +249,8 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
         prog = RtsProgram.build(tg, fe, dl, np.zeros(len(tg)), amp)
         step_seed = np.random.SeedSequence([int(seed) % 2 ** 32, int(round(delta * 1e15))
                                             + 2 ** 40, pair[0], pair[1]]
-                                           + ([int(frames)] if frames > 1 else []))
+                                           + ([int(frames)] if frames > 1 else [])
+                                           + ([7919, int(repeat)] if repeat else []))
         rd, det = _detect(setup, paths, prog, step_seed, frames)
         out = np.full((len(ranges), st.dims), np.nan)
         for p, (r, u_pred) in enumerate(zip(ranges, predicted)):
@@ -316,6 +318,15 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     k_fine, scatter, noise = 1, 0.0, 0.0
     if noisy:  # frames per step from the sweep's own scatter (the 1-D pair's rule)
         scatter, noise = fit_scatter(fit, fitted, e_fine[:, cols], harmonics, seed, pair)
+        if not np.isfinite(scatter):  # too few fine steps for a residual (coarse RTS steps):
+            # the noise from a second, independent one-frame sweep (no fit involved)
+            again_e = np.array([signed(d, 1, repeat=1) for d in fine_t])
+            scatter, noise = fit_scatter(fit, fitted, e_fine[:, cols], harmonics, seed, pair,
+                                         repeat=again_e[:, cols])
+        if not np.isfinite(scatter):
+            raise CalibrationFailed(f"pair {tuple(int(q) for q in pair)}: the probes were not "
+                                    "detected at enough steps of the fine sweep to measure "
+                                    "its noise")
         k_coarse = coarse_frames(np.degrees(noise))
         k_fine = fine_frames(scatter)
         again = k_fine > 1
