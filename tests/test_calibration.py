@@ -622,3 +622,27 @@ def test_calibration_file_names_the_setup_it_was_made_on():
         setup = build_setup(scene)
         _, _, warnings = plan_targets(setup, exact_paths(setup), "exact", calibration=doc)
         assert any("made on another setup" in w for w in warnings) is warned, warnings
+
+
+def test_calibration_fingerprint_follows_file_contents_not_paths(tmp_path):
+    """The same scene and antenna table in two folders: one fingerprint (a moved project
+    keeps its calibrations); an edited table: another. The sheet, the ray tracing, the
+    calibration procedure's steps and the RTS's noise are not the setup measured."""
+    from rtsgeom.aoa.plan import setup_fingerprint
+    from rtsgeom.scene import load_scene
+    text = DEFAULT_SCENE.read_text().replace(
+        "[radar.cfar]", '[radar.pattern]\nkind = "table"\ntable = "pat.csv"\n\n[radar.cfar]')
+
+    def scene_in(folder, gain_db):
+        folder.mkdir()
+        rows = ["azimuth_deg,elevation_deg,gain_db,phase_deg"]
+        rows += [f"{a},{e},{gain_db},0" for a in range(-90, 91, 10) for e in range(-90, 91, 10)]
+        (folder / "pat.csv").write_text("\n".join(rows))
+        (folder / "s.toml").write_text(text)
+        return load_scene(folder / "s.toml")
+    a, b, c = (scene_in(tmp_path / n, g) for n, g in (("a", 0.0), ("b", 0.0), ("c", -3.0)))
+    assert setup_fingerprint(a) == setup_fingerprint(b) != setup_fingerprint(c)
+    base = setup_fingerprint(make_scene())
+    for mut in (lambda d: d["sheet"].update(enabled=False),
+                lambda d: d["rts"].update(calibration_step_ps=10.0)):
+        assert setup_fingerprint(make_scene(mut)) == base

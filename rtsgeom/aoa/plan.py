@@ -31,20 +31,37 @@ CALIBRATION_FORMAT = "rtsgeom-calibration"
 
 
 def setup_fingerprint(scene) -> str:
-    """SHA-256 of what a calibration is a measurement of: the RTS (arc, front ends with their
-    mounting and channel fields, delay hardware), the RuT (array, pose, chirp), the sheet
-    and the ray-tracing set-up. Not the targets, the seed, the name, and not the RuT's
-    noise, link levels or CFAR (the same calibration serves other scenarios and SNRs).
+    """SHA-256 of what a calibration is a measurement of: the RTS's arc, front ends (their
+    mounting and channel fields) and delay hardware, and the RuT (array, pose, chirp,
+    processing). Not the scenario (targets, seed, name), not what only changes noise or
+    levels (the RuT's ``snr_db``, ``link`` and CFAR, ``rts.link``), not the calibration
+    procedure's own settings (``rts.calibration_span_ns``/``calibration_step_ps``) or the
+    AoA mode, and not the sheet or ray tracing (``calibrate`` measures on exact paths).
+    Files the scene names (antenna pattern tables) count by their content, not their path,
+    so a moved or copied project keeps its fingerprint and an edited table changes it.
     ``calibrate`` writes it as ``setup_sha256``; ``run``/``adc --calibration`` warn when the
     scene's differs (a calibration made before a front end was moved)."""
     import dataclasses
     import hashlib
+    from pathlib import Path
+
+    def canonical(v):
+        if isinstance(v, dict):
+            return {k: canonical(x) for k, x in v.items()}
+        if isinstance(v, (list, tuple)):
+            return [canonical(x) for x in v]
+        if isinstance(v, str) and Path(v).is_absolute() and Path(v).is_file():
+            return "sha256:" + hashlib.sha256(Path(v).read_bytes()).hexdigest()
+        if isinstance(v, (int, float)) and not isinstance(v, bool):
+            return float(v)  # 1, 1.0 and np.float64(1.0) alike
+        return v
     radar = dataclasses.asdict(scene.radar)
     for key in ("snr_db", "link", "cfar"):
         radar.pop(key, None)
-    key = repr((radar, dataclasses.asdict(scene.rts), dataclasses.asdict(scene.sheet),
-                dataclasses.asdict(scene.raytrace), scene.extra_meshes))
-    return hashlib.sha256(key.encode()).hexdigest()
+    rts = dataclasses.asdict(scene.rts)
+    for key in ("link", "aoa_mode", "calibration_span_s", "calibration_step_s"):
+        rts.pop(key, None)
+    return hashlib.sha256(repr(canonical((radar, rts))).encode()).hexdigest()
 
 
 def calibration_mismatch(doc: dict, scene) -> str | None:
@@ -54,8 +71,8 @@ def calibration_mismatch(doc: dict, scene) -> str | None:
     if made is None or made == setup_fingerprint(scene):
         return None
     return ("--calibration: the file was made on another setup (the arc, a front end's "
-            "mounting or channel, the RuT or the RTS differ from this scene's): applied as it "
-            "is; run `rtsgeom calibrate` on this scene if the setup changed")
+            "mounting or channel, the RuT or the RTS's delays differ from this scene's): "
+            "applied as it is; run `rtsgeom calibrate` on this scene if the setup changed")
 
 
 def load_calibration(doc: dict, setup: Setup) -> tuple[FrontEndProbe, dict]:
