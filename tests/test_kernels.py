@@ -162,3 +162,16 @@ def test_bin_choice_equals_the_rule(n_k):
         ref = _choice_loop(rho[i], np.full(n_k, ph[i, 0]), p_ii[i], p_jj[i], c_ij[i])
         assert got[1][i] == ref[1] and got[2][i] == ref[2]
         np.testing.assert_allclose([got[0][i], got[3][i]], [ref[0], ref[3]], rtol=1e-12)
+
+
+def test_numpy_definitions_are_as_silent_as_the_kernels():
+    """inf, NaN and 1e300 beams: the numpy definition of the design ratio warns no more than
+    the compiled kernel (a RuntimeWarning must not depend on which path a process took)."""
+    import warnings
+
+    from rtsgeom.aoa.sweep import _ratios
+    z = np.array([1e300 + 1e300j, np.inf + 0j, np.nan + 0j, 1 + 1j])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out = _ratios(z, z, z, z, z, z, np.ones(4, complex))
+    assert out.shape == (4,) and np.all(np.isnan(out[:3]))

@@ -94,6 +94,7 @@ def ratio_from_beams(beam_i, beam_j, phase=0.0):
     return out
 
 
+@np.errstate(all="ignore")  # as silent as the compiled kernel (radar/newton.py)
 def _ratios(bi, bi1, bi2, bj, bj1, bj2, e):
     """The ratio rho >= 0 per set-point (flat arrays (N,)) that puts the peak of
     P(u) = |b_I + rho y|^2 (y = e b_J, e = e^{j phase} J's phase factor) at the set

@@ -129,6 +129,10 @@ def lattice_phasors(lat, u):
     return er, ei
 
 
+# The numpy definitions of the compiled kernels are as silent as the kernels
+# (``error_model="numpy"``: inf/NaN propagate without warnings): a warning must not depend on
+# which of the two paths a process happened to take (``_util.use_kernels``).
+@np.errstate(all="ignore")
 def newton_1d(k, lat, xr, xi, u, steps):
     """Newton steps on log P(u), P = |B|^2, B(u) = sum_v y_v, y_v = x_v e^{j k_v u}, for
     tapered snapshots ``xr + j xi`` (V_s, n) (wavenumbers times positions ``k`` (V_s,), their
@@ -175,6 +179,7 @@ def newton_1d(k, lat, xr, xi, u, steps):
     return u, conv, p_last
 
 
+@np.errstate(all="ignore")
 def peak_1d(k, lat, x, u0, gc, gs, grid, iterations):
     """:meth:`Steering.peak` for D = 1 on tapered snapshots ``x`` (n, V_s): Newton
     (:func:`newton_1d`, ``iterations`` steps) from ``u0`` (n,), accepted when it converged
