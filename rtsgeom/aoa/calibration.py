@@ -36,7 +36,7 @@ from ..scene import TargetConfig
 from .calsteps import (COARSE_NOISE_DEG, FINE_STEP_S, MAX_FRAMES, MC_DRAWS,  # noqa: F401
                        MIN_FIT_POINTS, TARGET_BIAS_PS, coarse_frames, continuous_delay_setup,
                        fine_frames, fine_window, predicted_angle_noise, realisable,
-                       realisation_shift, sweep_phase)
+                       realisation_shift, sweep_phase, rms_error_deg, coarse_minimum)
 from .fir import fir_bin_gain, fir_effect, fir_sweep_phase  # noqa: F401 (re-exported)
 from .synthesis import PairModel
 
@@ -379,9 +379,7 @@ def _calibrate_pair(setup, paths, pair, probe, base_offsets, seed, span_s, step_
                                 seed)[0]
         return res.errors(k_frames, rng if noisy else None)
 
-    def rms_deg(e):
-        out = np.degrees(np.sqrt(np.mean(e ** 2, axis=-1)))
-        return np.where(np.isfinite(out), out, np.inf)
+    rms_deg = rms_error_deg
 
     targets = [TargetConfig(float(r)) for r in ranges]
     coarse = phasor_sweep(setup, paths, nominal, pair, targets, alphas, grid, base_offsets, corr)
@@ -390,13 +388,8 @@ def _calibrate_pair(setup, paths, pair, probe, base_offsets, seed, span_s, step_
     frame_noise = predicted_angle_noise(coarse, seed) if noisy else 0.0
     k_coarse = (coarse_frames(frame_noise) if frames is None else int(frames))
     errs = rms_deg(measure(targets, coarse, k_coarse))
-    # Minima repeat every period; among those about as deep as the deepest, take the one with
-    # the smallest |delta tau|: it costs the least range offset ("Disadvantages").
-    inner = np.arange(len(errs))
-    is_min = (np.r_[True, errs[1:] <= errs[:-1]] & np.r_[errs[:-1] <= errs[1:], True])
-    good = inner[is_min & (errs <= 2 * np.min(errs) + 0.01)]
     res = rts.delay_resolution_s  # every delay the sweep sets and reports is a multiple
-    near = float(realisable(grid[int(good[np.argmin(np.abs(grid[good]))])], res))
+    near = float(realisable(coarse_minimum(grid, errs), res))
     best_fit = near
     if grid.size < 3:  # no sweep to speak of (e.g. only the period asked for)
         fine_t, fine_e, n_frames, noise = grid, errs, k_coarse, 0.0

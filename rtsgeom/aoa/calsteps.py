@@ -34,7 +34,7 @@ __all__ = ["continuous_delay_setup", "CONTINUOUS_STEP_S", "COARSE_NOISE_DEG",
            "predicted_angle_noise", "coarse_frames", "MAX_FRAMES", "realisation_shift",
            "sweep_phase", "realisable", "FINE_STEP_S", "MIN_FIT_POINTS", "fine_window",
            "MC_DRAWS", "SIZE_DRAWS", "TARGET_BIAS_PS", "frames_for", "fine_frames",
-           "fit_scatter",
+           "fit_scatter", "rms_error_deg", "coarse_minimum",
            "SCATTER_DRAW_FRAMES"]
 
 
@@ -224,3 +224,21 @@ def fit_scatter(fit, fitted, e, harmonics: int, seed, pair,
                           * rng.standard_normal((MC_DRAWS,) + base.shape))
     est = np.array([fit(d)[0] for d in draws])
     return float(np.std(est) * np.sqrt(SCATTER_DRAW_FRAMES)), float(np.median(sigma))
+
+
+def rms_error_deg(e) -> np.ndarray:
+    """The RMS over the last axis of probe angle errors ``e`` (rad), in degrees; inf where it
+    is undefined (a probe not detected), so that a sweep's minimum never lands there."""
+    out = np.degrees(np.sqrt(np.mean(np.square(e), axis=-1)))
+    return np.where(np.isfinite(out), out, np.inf)
+
+
+def coarse_minimum(grid, errs) -> float:
+    """The coarse sweep's minimum (s) from its RMS errors ``errs`` (deg) at delays ``grid``:
+    minima repeat every period; among the local minima about as deep as the deepest (within
+    2 x the deepest + 0.01 deg) the one with the smallest |delta tau|, which costs the least
+    range offset (paper, "Disadvantages"). The arc pair's and the 2-D pair's one rule."""
+    errs = np.asarray(errs, float)
+    is_min = (np.r_[True, errs[1:] <= errs[:-1]] & np.r_[errs[:-1] <= errs[1:], True])
+    good = np.flatnonzero(is_min & (errs <= 2 * np.min(errs) + 0.01))
+    return float(np.asarray(grid)[int(good[np.argmin(np.abs(np.asarray(grid)[good]))])])

@@ -218,8 +218,8 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     probe placement are 1-D so far. Raises :class:`CalibrationFailed` when no probe is
     detected at any step."""
     from .calibration import calibrate_pair, if_phase_slope_hz, nominal_model, probe_total_delay
-    from .calsteps import (coarse_frames, fine_frames, fine_window, fit_scatter, realisable,
-                           sweep_phase)
+    from .calsteps import (coarse_frames, coarse_minimum, fine_frames, fine_window, fit_scatter,
+                           realisable, rms_error_deg, sweep_phase)
     from .sweep import fit_minimum
     scene = setup.scene
     rts = scene.rts
@@ -259,9 +259,7 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
                 out[p] = _angles_to_u(st, det, k) - u_pred
         return out.ravel()
 
-    def rms_deg(e) -> np.ndarray:
-        out = np.degrees(np.sqrt(np.mean(np.square(e), axis=-1)))
-        return np.where(np.isfinite(out), out, np.inf)
+    rms_deg = rms_error_deg
 
     span = span_s or rts.calibration_span_s
     step = step_s or rts.calibration_step_s
@@ -274,9 +272,7 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
         if not np.any(np.isfinite(errs)):
             raise CalibrationFailed(f"pair {tuple(int(q) for q in pair)}: no probe detected "
                                     "at any step of the sweep")
-        is_min = (np.r_[True, errs[1:] <= errs[:-1]] & np.r_[errs[:-1] <= errs[1:], True])
-        good = np.flatnonzero(is_min & (errs <= 2 * np.min(errs) + 0.01))
-        return errs, float(grid[int(good[np.argmin(np.abs(grid[good]))])])  # least offset
+        return errs, coarse_minimum(grid, errs)
 
     period = 1.0 / float(if_phase_slope_hz(scene, probe_total_delay(setup, ranges)))
     # The fine sweep and its fit are the pair calibration's (``calibration.calibrate_pair``):
