@@ -99,22 +99,14 @@ def _model(scene, pair_arg, points: int) -> PairPhasors:
                          f"({exc})") from None
 
 
-_ERROR_FIELDS = (("radial_offset_m", "radial_offset_mm"), ("tangential_offset_m",
-                 "tangential_offset_mm"), ("height_offset_m", "height_offset_mm"),
-                 ("yaw_offset_rad", "yaw_offset_deg"), ("pitch_offset_rad", "pitch_offset_deg"),
-                 ("gain_offset_db", "gain_offset_db"), ("phase_offset_rad", "phase_offset_deg"))
-
-
 def warn_scene_errors(scene, command: str) -> None:
     """``tolerance`` and ``design`` draw mounting errors about the nominal setup
     (``geometry.setup.nominal_setup``): say so on stderr when the scene carries its own
-    mounting, channel or RuT pose errors, which the study does not start from (a new-user
-    trial wrote measured offsets into a scene and got the zero-offset scene's numbers)."""
-    fields = [f"rts.front_ends[{q}].{name}" for q, fe in enumerate(scene.rts.front_ends)
-              for attr, name in _ERROR_FIELDS if getattr(fe, attr) != 0.0]
-    radar = scene.radar
-    if radar.yaw_offset_rad != 0.0 or any(radar.position_offset_m):
-        fields.append("radar pose offsets")
+    mounting, channel or RuT pose errors (``geometry.setup.setup_errors``), which the study
+    does not start from (a new-user trial wrote measured offsets into a scene and got the
+    zero-offset scene's numbers)."""
+    from ..geometry.setup import setup_errors
+    fields = setup_errors(scene)
     if fields:
         more = f" and {len(fields) - 3} more" if len(fields) > 3 else ""
         print(f"rtsgeom: warning: {command} draws mounting errors about the nominal setup; "

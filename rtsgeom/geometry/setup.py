@@ -16,7 +16,8 @@ from .sheet import sheet_mesh
 if TYPE_CHECKING:  # trimesh loads where the mesh is built (geometry.sheet)
     import trimesh
 
-__all__ = ["Setup", "build_setup", "nominal_setup"]
+__all__ = ["Setup", "build_setup", "nominal_setup", "setup_errors", "FRONT_END_ERRORS",
+           "RUT_POSE_ERRORS"]
 
 
 @dataclass(frozen=True)
@@ -59,6 +60,25 @@ def build_setup(scene: Scene, offsets_m: np.ndarray | None = None, *, yaw_rad=No
     return Setup(scene, rut, fe)
 
 
+#: the front-end fields that are errors of the setup as built (zero on the nominal setup)
+FRONT_END_ERRORS = ("radial_offset_m", "tangential_offset_m", "height_offset_m",
+                    "yaw_offset_rad", "pitch_offset_rad", "gain_offset_db", "phase_offset_rad")
+#: the RuT's pose errors
+RUT_POSE_ERRORS = ("position_offset_m", "yaw_offset_rad")
+
+
+def setup_errors(scene: Scene) -> list[str]:
+    """The scene's fields that :func:`nominal_setup` zeroes and that are not zero, as file
+    keys (``rts.front_ends[1].radial_offset_mm``, ``radar.yaw_offset_deg``)."""
+    from ..schema import specs
+    from ..scene import FrontEndConfig, RadarConfig
+    fe_key, radar_key = dict(specs(FrontEndConfig)), dict(specs(RadarConfig))
+    out = [f"rts.front_ends[{q}].{fe_key[name].key}" for q, fe in enumerate(scene.rts.front_ends)
+           for name in FRONT_END_ERRORS if getattr(fe, name) != 0.0]
+    return out + [f"radar.{radar_key[name].key}" for name in RUT_POSE_ERRORS
+                  if np.any(np.asarray(getattr(scene.radar, name)) != 0.0)]
+
+
 def nominal_setup(setup: Setup) -> Setup:
     """The setup as designed: no mounting errors and no channel gain/phase errors.
 
@@ -66,9 +86,7 @@ def nominal_setup(setup: Setup) -> Setup:
     sees the setup as built (``setup``), so calibration has to absorb the difference.
     """
     scene = setup.scene
-    fes = tuple(f.evolve(radial_offset_m=0.0, tangential_offset_m=0.0, height_offset_m=0.0,
-                         yaw_offset_rad=0.0, pitch_offset_rad=0.0,
-                         gain_offset_db=0.0, phase_offset_rad=0.0) for f in scene.rts.front_ends)
+    fes = tuple(f.evolve(**dict.fromkeys(FRONT_END_ERRORS, 0.0)) for f in scene.rts.front_ends)
     radar = scene.radar
     if radar.yaw_offset_rad != 0.0 or any(radar.position_offset_m):
         radar = radar.evolve(position_offset_m=(0.0, 0.0, 0.0), yaw_offset_rad=0.0)
