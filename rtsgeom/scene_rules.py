@@ -359,7 +359,7 @@ def _calibration_rules(scene, fail) -> None:
         # the sweep is the default one: the IF that sets the period is what departs from it
         fail("rts.f_rts_hz", rts.f_rts_hz,
              f">= 1/span - radar.bandwidth_hz/2 = {1.0 / span - 0.5 * radar.bandwidth_hz:g} Hz "
-             f"(at most {1e11:g} Hz), so that one period 1/(rts.f_rts_hz + radar.bandwidth_hz/2)"
+             f"(at most {_rts_spec('f_rts_hz').hi:g} Hz), so that one period 1/(rts.f_rts_hz + radar.bandwidth_hz/2)"
              f" = {period * 1e9:.4g} ns fits the calibration sweep rts.calibration_span_ns = "
              f"{span_ns} (default, {span * 1e9:.4g} ns); or widen rts.calibration_span_ns to "
              f">= {period * 1e9:.4g} ns")
@@ -373,12 +373,17 @@ def _calibration_rules(scene, fail) -> None:
              f"{span_ns} would take {span / step:.4g} steps (at most {MAX_CALIBRATION_STEPS})")
 
 
+def _rts_spec(name: str):
+    """The declaration of field ``name`` of ``[rts]`` (its file key, range, default)."""
+    from .scene import RtsConfig  # here: scene.py imports this module
+    from .schema import specs
+    return dict(specs(RtsConfig))[name]
+
+
 def _default_span(span_s) -> bool:
     """Whether the calibration sweep is the scene format's default (not set by the user)."""
-    from .scene import RtsConfig  # here: scene.py imports this module
-    import dataclasses
-    default = next(f.default for f in dataclasses.fields(RtsConfig)
-                   if f.name == "calibration_span_s")
+    default = [x * _rts_spec("calibration_span_s").scale
+               for x in _rts_spec("calibration_span_s").default]
     return all(abs(a - b) <= 1e-21 for a, b in zip(span_s, default))
 
 
