@@ -509,5 +509,8 @@ def nearfield_figure(nf: NearField, title: str = ""):
         ax3.set_xlabel("arc radius R_c (m)")
         for a in (ax, ax2, ax3):
             if a.get_legend_handles_labels()[0]:
-                a.legend(loc="lower left", fontsize=6, ncols=2 if a is ax3 else 1)
+                # the single-FE bias may be negative (Rx at the smaller azimuth): let
+                # matplotlib place that legend clear of its curves
+                a.legend(loc="best" if a is ax else "lower left", fontsize=6,
+                         ncols=2 if a is ax3 else 1)
     return fig
