@@ -12,7 +12,8 @@ numpy formulation avoids those temporaries; a scalar loop per snapshot does.
 Rules: ``cache=True`` (compiled once per machine into ``__pycache__``; see README
 "Performance" for the cost), ``nogil=True`` (threads may share them), no ``fastmath`` (IEEE
 arithmetic: the results agree with the numpy definitions to rounding, tested in
-``tests/test_kernels.py``), ``error_model="numpy"`` (0/0 is NaN, as in numpy); the small
+``tests/test_kernels.py``; ``peak_1d`` and ``ratio_one`` bit for bit with theirs in
+``radar/newton.py`` and ``aoa/sweep.py``, ``tests/test_kernels_peak.py``), ``error_model="numpy"`` (0/0 is NaN, as in numpy); the small
 per-snapshot helpers ``inline="always"`` (numba-level inlining lets it drop the reference
 counting of the arrays passed down: the planned design 760 -> 320 ns per set-point, the
 Newton steps about 2x). numba is
@@ -34,9 +35,9 @@ import math
 import numpy as np
 from numba import njit
 
-from .radar.newton import P_SLACK, STEP_CLIP, STEP_TOL, lattice  # noqa: F401 (re-exported)
+from .radar.newton import P_SLACK, STEP_CLIP, STEP_TOL
 
-__all__ = ["peak_1d", "newton_1d", "lattice", "ratio_one", "ratios", "choice_row",
+__all__ = ["peak_1d", "newton_1d", "ratio_one", "ratios", "choice_row",
            "bin_choice_rows", "design_rows", "plan_rows", "detect_rows"]
 
 _JIT = dict(cache=True, nogil=True, error_model="numpy")
@@ -49,7 +50,7 @@ _JIT = dict(cache=True, nogil=True, error_model="numpy")
 
 @njit(inline="always", **_JIT)
 def _phasors(lat, u, pw, e):
-    """e^{j k_v u} (V_s,) into ``e`` for the wavenumbers of lattice ``lat`` (:func:`lattice`):
+    """e^{j k_v u} (V_s,) into ``e`` for the wavenumbers of lattice ``lat`` (``radar.newton.lattice``):
     ``e^{j k_0 u} z^{m_v} e^{j r_v u}``, z = e^{j kappa u}, the powers by products (``pw``:
     scratch of max m + 1), the last factor only where r_v != 0 (two cosines and sines per
     snapshot and step on a uniform grid instead of two per element)."""

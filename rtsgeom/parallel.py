@@ -4,8 +4,9 @@ A study is split into chunks of work; :func:`chunk_mapper` gives the ordered map
 one pure function to each chunk: here in order, in N forked local processes kept for the
 command (:class:`ForkPool`), or on ``dask.distributed`` (an existing scheduler's address,
 :func:`map_chunks`). Results come back in chunk order, so as long as the function is
-deterministic in its arguments (a chunk's random draws fixed by the study's seed: it carries
-its streams' states) the outcome is bit-identical however it was scheduled. Either way the
+deterministic in its arguments (a chunk's random draws fixed by the study's seed: the pair
+study's chunk carries its streams' states, the arc and cell studies' chunks their draws) the
+outcome is bit-identical however it was scheduled. Either way the
 function's shared state (a ``functools.partial``'s positional arguments: the model) reaches
 a worker once, not with every chunk.
 
@@ -103,8 +104,7 @@ def chunk_mapper(scheduler: str | None = None, workers: int | None = None):
     """The ordered map (``mapper(func, chunks) -> list``) for a study's chunks: on the Dask
     scheduler at ``scheduler`` (:func:`map_chunks`), else in ``workers`` (> 1) local processes
     (:class:`ForkPool`, one for the block; a Dask ``LocalCluster`` where the platform cannot
-    fork), else None
-    (this process, in order). The results are the same bits whichever runs them."""
+    fork), else None (this process, in order). The results are the same bits whichever runs them."""
     if scheduler is None and workers is not None and int(workers) > 1 and _can_fork():
         with ForkPool(int(workers)) as pool:  # forked at the first map, kept to the end
             yield pool.map
@@ -231,7 +231,7 @@ def _fork_worker_init() -> None:
 
 def _fork_apply(task):
     token, fn, kw, chunk = task
-    return fn(*_FORK_SHARED[token], chunk, **kw)
+    return _apply(chunk, fn, _FORK_SHARED[token], kw)
 
 
 def _worker_environ() -> dict:

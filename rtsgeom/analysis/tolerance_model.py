@@ -296,8 +296,8 @@ class PairPhasors:
         amps = np.array(self.design_amplitudes)
         model = self.channels
         with single_threaded_blas():
+            phases = model.coherent_phases(self.probe_rad)
             for m in missing:
-                phases = model.coherent_phases(self.probe_rad)
                 amps[c0, m] = model.amplitudes(model.solve(float(self.set_rad[m]), phases),
                                                float(self.set_rad[m]))
         return dataclasses.replace(self, amplitudes=frozen(amps[c0]),

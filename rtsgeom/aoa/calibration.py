@@ -36,7 +36,7 @@ from ..scene import TargetConfig
 from .calsteps import (COARSE_NOISE_DEG, FINE_STEP_S, MAX_FRAMES, MC_DRAWS,  # noqa: F401
                        MIN_FIT_POINTS, TARGET_BIAS_PS, coarse_frames, continuous_delay_setup,
                        fine_frames, fine_window, predicted_angle_noise, realisable,
-                       realisation_shift, sweep_phase, rms_error_deg, coarse_minimum)
+                       realisation_shift, sweep_phase, rms_error_deg, coarse_minimum, adds_noise)
 from .fir import fir_bin_gain, fir_effect, fir_sweep_phase  # noqa: F401 (re-exported)
 from .synthesis import PairModel
 
@@ -371,7 +371,7 @@ def _calibrate_pair(setup, paths, pair, probe, base_offsets, seed, span_s, step_
     step = step_s or rts.calibration_step_s
     grid = np.arange(span[0], span[1] + step / 2, step)
     rng = np.random.default_rng(np.random.SeedSequence([int(seed) % 2 ** 32, 1713]))
-    noisy = scene.radar.snr_db is not None or scene.radar.link is not None  # link: kTBF noise
+    noisy = adds_noise(scene)
 
     def measure(targets, res, k_frames):
         if full_chain:
@@ -379,15 +379,13 @@ def _calibrate_pair(setup, paths, pair, probe, base_offsets, seed, span_s, step_
                                 seed)[0]
         return res.errors(k_frames, rng if noisy else None)
 
-    rms_deg = rms_error_deg
-
     targets = [TargetConfig(float(r)) for r in ranges]
     coarse = phasor_sweep(setup, paths, nominal, pair, targets, alphas, grid, base_offsets, corr)
     # frames per coarse step from the predicted noise (the link budget's or snr_db's), before
     # the sweep: one frame at NF 50 dB (0.9 deg of probe-angle noise) picked a wrong minimum
     frame_noise = predicted_angle_noise(coarse, seed) if noisy else 0.0
     k_coarse = (coarse_frames(frame_noise) if frames is None else int(frames))
-    errs = rms_deg(measure(targets, coarse, k_coarse))
+    errs = rms_error_deg(measure(targets, coarse, k_coarse))
     res = rts.delay_resolution_s  # every delay the sweep sets and reports is a multiple
     near = float(realisable(coarse_minimum(grid, errs), res))
     best_fit = near
@@ -423,12 +421,12 @@ def _calibrate_pair(setup, paths, pair, probe, base_offsets, seed, span_s, step_
         e_fine = measure(targets, fine, n_frames)
         best_fit = fit_minimum(fine_t, e_fine, period, near, harmonics, search, extra,
                                criterion, search_phase)
-        fine_e = rms_deg(e_fine)
+        fine_e = rms_error_deg(e_fine)
     best = float(realisable(best_fit, res))  # what the RTS can set; the fit's optimum is between
     confirm = phasor_sweep(setup, paths, nominal, pair, targets, alphas, [best], base_offsets,
                            corr)
     e_conf = chain_errors(setup, paths, pair, targets, confirm, base_offsets, n_frames, seed)[0]
-    best_err = float(rms_deg(e_conf)[0])
+    best_err = float(rms_error_deg(e_conf)[0])
     air = _mean_air_delay(setup)
     range_offset = 0.5 * c * ((air[j] + base_offsets[1] + best) - (air[i] + base_offsets[0]))
     return Calibration(pair, float(best), best_err, float(range_offset), frozen(grid),

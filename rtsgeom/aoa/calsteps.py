@@ -34,7 +34,7 @@ __all__ = ["continuous_delay_setup", "CONTINUOUS_STEP_S", "COARSE_NOISE_DEG",
            "predicted_angle_noise", "coarse_frames", "MAX_FRAMES", "realisation_shift",
            "sweep_phase", "realisable", "FINE_STEP_S", "MIN_FIT_POINTS", "fine_window",
            "MC_DRAWS", "SIZE_DRAWS", "TARGET_BIAS_PS", "frames_for", "fine_frames",
-           "fit_scatter", "rms_error_deg", "coarse_minimum",
+           "fit_scatter", "rms_error_deg", "coarse_minimum", "adds_noise",
            "SCATTER_DRAW_FRAMES"]
 
 
@@ -242,3 +242,9 @@ def coarse_minimum(grid, errs) -> float:
     is_min = (np.r_[True, errs[1:] <= errs[:-1]] & np.r_[errs[:-1] <= errs[1:], True])
     good = np.flatnonzero(is_min & (errs <= 2 * np.min(errs) + 0.01))
     return float(np.asarray(grid)[int(good[np.argmin(np.abs(np.asarray(grid)[good]))])])
+
+
+def adds_noise(scene) -> bool:
+    """Whether the scene's radar adds receiver noise (``snr_db``, or ``[radar.link]``: kTBF
+    noise), so that a sweep's frames per step must be sized."""
+    return scene.radar.snr_db is not None or scene.radar.link is not None

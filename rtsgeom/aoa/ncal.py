@@ -49,7 +49,7 @@ PROBE_RATIOS = (1 / 3, 3.0)
 # ps; 37 / 41 ps at +-3 deg); 29 and 37 ps before the 2-D fit was the 1-D one (run's
 # elevation errors up to 0.10 deg against <= 0.03 deg).
 LOOP_CLOSURE_TOL_S = 25e-12
-FINE_STEP_ND_S = 10e-12  # the 2-D fine sweep's step (each step a full-chain frame: 51 of them)
+FINE_STEP_ND_S = 10e-12  # the 2-D fine sweep's step (each step one full-chain simulation)
 
 
 class CalibrationFailed(ValueError):
@@ -105,13 +105,6 @@ def _angles_to_u(st, det, k):
     if st.dims == 1:
         return np.array([np.sin(det.angle_rad[k])])
     return st.directions(np.array([det.angle_rad[k], det.elevation_rad[k]]))
-
-
-def _detect(setup, paths, program, seed, frames: int = 1):
-    """The radar's output for ``program``: the coherent average of ``frames`` frames
-    (``calibration._simulate_detect``: one frame with 1/frames of the noise power)."""
-    from .calibration import _simulate_detect
-    return _simulate_detect(setup, paths, program, seed, frames)
 
 
 def _pair_probes(setup, paths, pair, probe, delta_s: float = 0.0, p_ref: dict | None = None):
@@ -208,7 +201,8 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     least-squares fit, full-chain confirmation), as a dict; the pair on an arc is the N = 2,
     D = 1 case of the channel calibration, not a second sweep. With a 2-D beamformer (D = 2:
     pairs side by side or stacked in elevation) the sweep of the module doc, through the
-    full ADC-cube chain (61 coarse + 51 fine frames on sphere4), comparing the probes'
+    full ADC-cube chain (one simulation per step and sweep: 61 coarse + 51 fine steps on
+    sphere4, a sweep again where its frames per step or its noise estimate need it), comparing the probes'
     detected direction cosines in both axes; the coarse and fine steps, the fit and the
     frames per step are the 1-D pair's (``calsteps.fine_window``, ``calsteps.sweep_phase``,
     ``sweep.fit_minimum``, ``calsteps.fine_frames`` / ``coarse_frames``), the scatter
@@ -217,9 +211,10 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     again with the frames it needs); the phasor sweep's closed-form design, bin logic and
     probe placement are 1-D so far. Raises :class:`CalibrationFailed` when no probe is
     detected at any step."""
-    from .calibration import calibrate_pair, if_phase_slope_hz, nominal_model, probe_total_delay
+    from .calibration import (_simulate_detect, calibrate_pair, if_phase_slope_hz, nominal_model,
+                              probe_total_delay)
     from .calsteps import (coarse_frames, coarse_minimum, fine_frames, fine_window, fit_scatter,
-                           realisable, rms_error_deg, sweep_phase)
+                           realisable, rms_error_deg, sweep_phase, adds_noise)
     from .sweep import fit_minimum
     scene = setup.scene
     rts = scene.rts
@@ -233,7 +228,7 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     p_ref: dict = {}  # channel i's reference power per probe (fixed over the sweep)
     ranges, _, _, st = _pair_probes(setup, paths, pair, probe, 0.0, p_ref)
     base = [float(requested_delay(scene, r)) for r in ranges]
-    noisy = scene.radar.snr_db is not None or scene.radar.link is not None  # link: kTBF noise
+    noisy = adds_noise(scene)
 
     def signed(delta: float, frames: int = 1, repeat: int = 0) -> np.ndarray:
         """The probes' detected direction-cosine errors (P * D,) (NaN: not detected), the
@@ -251,15 +246,13 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
                                             + 2 ** 40, pair[0], pair[1]]
                                            + ([int(frames)] if frames > 1 else [])
                                            + ([7919, int(repeat)] if repeat else []))
-        rd, det = _detect(setup, paths, prog, step_seed, frames)
+        rd, det = _simulate_detect(setup, paths, prog, step_seed, frames)
         out = np.full((len(ranges), st.dims), np.nan)
         for p, (r, u_pred) in enumerate(zip(ranges, predicted)):
             k = nearest_detection(det, rd, r)
             if k is not None:
                 out[p] = _angles_to_u(st, det, k) - u_pred
         return out.ravel()
-
-    rms_deg = rms_error_deg
 
     span = span_s or rts.calibration_span_s
     step = step_s or rts.calibration_step_s
@@ -268,7 +261,7 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     grid = np.unique(realisable(grid, res))  # the delays as the RTS realises them
 
     def coarse(frames: int):
-        errs = rms_deg(np.array([signed(d, frames) for d in grid]))
+        errs = rms_error_deg(np.array([signed(d, frames) for d in grid]))
         if not np.any(np.isfinite(errs)):
             raise CalibrationFailed(f"pair {tuple(int(q) for q in pair)}: no probe detected "
                                     "at any step of the sweep")
@@ -323,6 +316,8 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
             raise CalibrationFailed(f"pair {tuple(int(q) for q in pair)}: the probes were not "
                                     "detected at enough steps of the fine sweep to measure "
                                     "its noise")
+        # the direction-cosine noise taken as the probe-angle noise (du = cos(theta) d theta:
+        # exact at broadside, an underestimate by cos(theta) off it)
         k_coarse = coarse_frames(np.degrees(noise))
         k_fine = fine_frames(scatter)
         again = k_fine > 1
@@ -333,7 +328,7 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
             fine_t, e_fine, fit, cols = fine(near, k_fine)
             best_fit, fitted = fit(e_fine[:, cols])
     best = float(realisable(best_fit, res))  # what the RTS can set
-    best_err = float(rms_deg(signed(best, k_fine)))
+    best_err = float(rms_error_deg(signed(best, k_fine)))
     grid_pts = np.concatenate([grid, fine_t, [best]])
     return {"pair": [int(pair[0]), int(pair[1])], "delta_tau_s": best,
             "residual_error_deg": best_err, "points": int(grid_pts.size),
@@ -347,7 +342,7 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
             "one_frame_scatter_ps": scatter * 1e12,
             "frame_noise_deg": float(np.degrees(noise)),
             # the arc pair's record (``Calibration.to_dict``): RMS probe error per step
-            "sweep": _points(grid, errs), "refinement": _points(fine_t, rms_deg(e_fine))}
+            "sweep": _points(grid, errs), "refinement": _points(fine_t, rms_error_deg(e_fine))}
 
 
 def _points(t, e) -> list[dict]:
@@ -459,7 +454,7 @@ def tree_phases(cs: ChannelSet, tree, phasors=None) -> np.ndarray:
 def _residual(setup, paths, nom, nom_paths, ch, offsets, probe, st, seed, tree):
     """(azimuth, elevation) error (deg) of one target at the channels' centre, synthesized by
     all of them with the calibrated offsets (exact mode)."""
-    from .calibration import probe_ranges
+    from .calibration import _simulate_detect, probe_ranges
     from .model import AngleUnreachable
     r = float(probe_ranges(setup, 1)[0])
     cs = ChannelSet.build(nom, nom_paths, tuple(ch), TargetConfig(r), offsets[ch])
@@ -472,7 +467,8 @@ def _residual(setup, paths, nom, nom_paths, ch, offsets, probe, st, seed, tree):
     tau = float(requested_delay(setup.scene, r))
     prog = RtsProgram.build([0] * len(ch), ch, list(tau + offsets[ch]), [0.0] * len(ch),
                             list(amps))
-    rd, det = _detect(setup, paths, prog, np.random.SeedSequence([int(seed) % 2 ** 32, 7]))
+    rd, det = _simulate_detect(setup, paths, prog,
+                               np.random.SeedSequence([int(seed) % 2 ** 32, 7]))
     k = nearest_detection(det, rd, r)
     if k is None:
         return (np.nan, np.nan)

@@ -117,18 +117,17 @@ def _ratios(bi, bi1, bi2, bj, bj1, bj2, e):
     a0 = re(bi, bi1)
     a1 = re(bi, y1) + re(y, bi1)
     a2 = re(y, y1)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        disc = a1 * a1 - 4 * a0 * a2
-        sq = np.sqrt(np.where(disc >= 0, disc, np.nan))
-        lin = -a0 / a1  # a2 = 0: the one root of the linear equation
-        out = []
-        for sign in (1, -1):
-            r = np.where(a2 != 0, (-a1 + sign * sq) / (2 * a2), lin)
-            p = re(bi, bi) + r * (2 * re(bi, y) + r * re(y, y))
-            p2 = (2 * (re(bi, bi2) + r * (re(bi, y2) + re(y, bi2)) + r * r * re(y, y2))
-                  + 2 * (re(bi1, bi1) + r * (2 * re(bi1, y1)) + r * r * re(y1, y1)))
-            keep = np.isfinite(r) & (r >= 0) & (p2 < 0)
-            out.append((np.where(keep, r, np.nan), np.where(keep, p, -np.inf)))
+    disc = a1 * a1 - 4 * a0 * a2
+    sq = np.sqrt(np.where(disc >= 0, disc, np.nan))
+    lin = -a0 / a1  # a2 = 0: the one root of the linear equation
+    out = []
+    for sign in (1, -1):
+        r = np.where(a2 != 0, (-a1 + sign * sq) / (2 * a2), lin)
+        p = re(bi, bi) + r * (2 * re(bi, y) + r * re(y, y))
+        p2 = (2 * (re(bi, bi2) + r * (re(bi, y2) + re(y, bi2)) + r * r * re(y, y2))
+              + 2 * (re(bi1, bi1) + r * (2 * re(bi1, y1)) + r * r * re(y1, y1)))
+        keep = np.isfinite(r) & (r >= 0) & (p2 < 0)
+        out.append((np.where(keep, r, np.nan), np.where(keep, p, -np.inf)))
     (r0, s0), (r1, s1) = out
     # numpy's argmax over (s0, s1): the first maximum, or the first NaN
     return np.where((s0 == s0) & ((s1 != s1) | (s1 > s0)), r1, r0)

@@ -88,7 +88,7 @@ def nominal_setup(setup: Setup) -> Setup:
     scene = setup.scene
     fes = tuple(f.evolve(**dict.fromkeys(FRONT_END_ERRORS, 0.0)) for f in scene.rts.front_ends)
     radar = scene.radar
-    if radar.yaw_offset_rad != 0.0 or any(radar.position_offset_m):
+    if any(np.any(np.asarray(getattr(radar, name)) != 0.0) for name in RUT_POSE_ERRORS):
         radar = radar.evolve(position_offset_m=(0.0, 0.0, 0.0), yaw_offset_rad=0.0)
     if fes == scene.rts.front_ends and radar is scene.radar:
         return setup

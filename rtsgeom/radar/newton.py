@@ -12,7 +12,7 @@ import numpy as np
 __all__ = ["newton", "parabolic", "lattice", "newton_1d", "peak_1d", "STEP_CLIP", "STEP_TOL",
            "P_SLACK"]
 
-#: Newton (D = 1): each step clipped to this in u, converged when a step is below ``STEP_TOL``
+#: Newton: each step clipped to this in u, converged when a step is below ``STEP_TOL``
 STEP_CLIP = 0.05
 STEP_TOL = 1e-6
 #: the global check's relative slack (rounding of the powers)
@@ -63,15 +63,15 @@ def newton(kv, xr, xi, u, p_max, steps):
                 step = np.where(concave[:, None], -np.linalg.solve(safe, gm[..., None])[..., 0],
                                 np.nan)
         fine = np.all(np.isfinite(step), axis=-1)
-        u[act] = ua + np.clip(np.where(fine[:, None], step, 0.0), -0.05, 0.05)
+        u[act] = ua + np.clip(np.where(fine[:, None], step, 0.0), -STEP_CLIP, STEP_CLIP)
         p_last[act] = p  # within ~1e-10 (relative) of the power at the final u
-        done = fine & (np.max(np.abs(np.where(fine[:, None], step, 0.0)), axis=-1) < 1e-6)
+        done = fine & (np.max(np.abs(np.where(fine[:, None], step, 0.0)), axis=-1) < STEP_TOL)
         ok[act[done]] = True
         act = act[fine & ~done]
     radius = np.sqrt(np.sum(u ** 2, axis=-1))
     if p_max is None:
         return u, ok & (radius < 1), p_last
-    return u, ok & (radius < 1) & (p_last >= p_max * (1 - 1e-9))
+    return u, ok & (radius < 1) & (p_last >= p_max * (1 - P_SLACK))
 
 
 def parabolic(y0, y1, y2) -> np.ndarray:
@@ -166,10 +166,9 @@ def newton_1d(k, lat, xr, xi, u, steps):
             d0 += yr * kk[v]
             d1 += yi * kk[v]
         p = b0 * b0 + b1 * b1
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            g = 2 * (b1 * c0 - b0 * c1) / p
-            h = 2 * (c0 * c0 + c1 * c1 - b0 * d0 - b1 * d1) / p - g * g
-            step = -g / h
+        g = 2 * (b1 * c0 - b0 * c1) / p  # (warnings off: the function's errstate)
+        h = 2 * (c0 * c0 + c1 * c1 - b0 * d0 - b1 * d1) / p - g * g
+        step = -g / h
         p_last[act] = p
         go = (h < 0) & np.isfinite(step)
         u[act[go]] = ua[go] + np.minimum(np.maximum(step[go], -STEP_CLIP), STEP_CLIP)

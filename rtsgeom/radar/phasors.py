@@ -62,7 +62,7 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
     t0, dt = radar.adc_start_s, 1.0 / radar.adc_rate_hz
     tau_air = echoes.tau_air_s
     if len(echoes) and np.all(tau_air == tau_air[:1]):  # one geometry (a delay table's block)
-        air, group = tau_air[:1], np.zeros(len(echoes), int)  # np.unique's answer, unsorted
+        air, group = tau_air[:1], None  # (no groups to tell apart)
     else:
         air, group = np.unique(tau_air, axis=0, return_inverse=True)
         group = np.ravel(group)
