@@ -26,7 +26,7 @@ import weakref
 from contextlib import contextmanager
 from typing import Callable, Sequence
 
-__all__ = ["chunk_mapper", "ForkPool", "fork_map", "map_chunks", "dask_client", "ClusterError",
+__all__ = ["chunk_mapper", "available_cores", "ForkPool", "fork_map", "map_chunks", "dask_client", "ClusterError",
            "check_address"]
 
 _ADDRESS = re.compile(r"(?:(tcp|tls|ws|wss|ucx|inproc)://)?(\[[0-9a-fA-F:]+\]|[A-Za-z0-9_.-]+)"
@@ -114,6 +114,16 @@ def chunk_mapper(scheduler: str | None = None, workers: int | None = None):
         return
     with dask_client(scheduler, workers) as client:
         yield functools.partial(map_chunks, client=client)
+
+
+def available_cores() -> int:
+    """The cores this process may run on (its CPU affinity where the OS reports one, as a
+    container's CPU set limits it; else ``os.cpu_count()``)."""
+    import os
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not on Linux
+        return max(1, os.cpu_count() or 1)
 
 
 def _can_fork() -> bool:

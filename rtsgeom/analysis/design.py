@@ -29,8 +29,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-import os
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from typing import Callable
 
@@ -40,6 +38,7 @@ from .._util import frozen
 from ..aoa.model import AngleUnreachable
 from ..geometry import build_setup
 from ..geometry.farfield import angular_resolution_rad
+from ..parallel import available_cores, chunk_mapper, map_chunks
 from ..scene import Scene, SheetConfig, arc_centre_m, problems
 from .tolerance import (CASES, PairPhasors, critical_ratio, largest_passing_scale,
                         max_sigma_for_yield, monte_carlo)
@@ -279,15 +278,6 @@ def _import_for_workers() -> None:
     from .. import kernels  # noqa: F401
 
 
-def available_cores() -> int:
-    """The cores this process may run on (its CPU affinity where the OS reports one, as a
-    container's CPU set limits it; else ``os.cpu_count()``)."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # not on Linux
-        return max(1, os.cpu_count() or 1)
-
-
 def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
                 spec_deg: float = 0.1, target_yield: float = 0.95, draws: int = 2000,
                 seed: int = 0, points: int = 21,
@@ -297,7 +287,7 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
 
     ``workers`` > 1: the designs in a pool of that many processes (each design is pure: the
     same result, in the same order, however they are spread); None: as many as this process
-    may run on (:func:`available_cores`; ``rtsgeom design``'s default; one process on one
+    may run on (``parallel.available_cores``; ``rtsgeom design``'s default; one process on one
     core). A design's time is about a quarter its ``PairPhasors.build`` (the delay tables:
     the FIR's response along the chirp and ``bin_response`` for ~5000 delays; the FIR's
     per-setting rows are shared by all designs of a process) and three quarters its two
@@ -315,19 +305,14 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     workers = available_cores() if workers is None else int(workers)
     one = functools.partial(_evaluate_cell, scene, pair, spec_deg, target_yield, draws, seed,
                             points)
-    designs = []
-    pool = None
-    if int(workers) > 1 and total > 1:
-        _import_for_workers()
-        pool = ProcessPoolExecutor(min(int(workers), total))
-    try:
-        for d in (map(one, cells) if pool is None else pool.map(one, cells)):
-            designs.append(d)
-            if progress:
-                progress(len(designs), total)
-    finally:
-        if pool is not None:
-            pool.shutdown(cancel_futures=True)
+    # the studies' own pool (parallel.chunk_mapper: forked workers inheriting the scene, one
+    # BLAS thread each; results in order, so the same bits however they are spread)
+    with chunk_mapper(None, min(workers, total)) as mapper:
+        if mapper is None:
+            designs = map_chunks(one, cells, progress=progress)
+        else:
+            _import_for_workers()
+            designs = mapper(one, cells, progress=progress)
     shape = (spacings.size, radii.size)
     metrics = {name: frozen(np.array([d[name] for d in designs], float).reshape(shape))
                for name in METRICS}
