@@ -41,7 +41,7 @@ import numpy as np
 
 from .._util import frozen
 from ..errors import ParameterError
-from .tolerance import (CASES, DISTRIBUTIONS, PairPhasors, critical_ratio, evaluate_chunk,
+from .tolerance import (CASES, PairPhasors, check_distribution, critical_ratio, evaluate_chunk,
                         largest_passing_scale, percentiles, standard_draws, subbin_draws,
                         unit_block)
 
@@ -118,9 +118,7 @@ def arc_draws(seed: int, draws: int, count: int, distribution: str = "normal",
     docstring); with ``positions`` (the count of sub-bin positions, ``PairPhasors.subbin_steps``)
     also ``subbin`` (k,), the target's sub-bin position index per draw (the pair study's
     :func:`~rtsgeom.analysis.tolerance.subbin_draws`). None depends on ``chunk``."""
-    if distribution not in DISTRIBUTIONS:
-        raise ParameterError(f"distribution {distribution!r}: must be one of "
-                         f"{', '.join(DISTRIBUTIONS)}")
+    check_distribution(distribution)
     g_rot = np.random.default_rng([seed, ROTATION_STREAM])
     g_rut = np.random.default_rng([seed, 2])
     chunk = max(1, int(chunk))

@@ -36,6 +36,7 @@ from typing import Callable, Iterable, Iterator
 import numpy as np
 
 from .._util import frozen
+from ..errors import ParameterError
 from .tolerance_model import PROBE_FRACTIONS, PairPhasors  # noqa: F401 (public here too)
 
 __all__ = ["AXES", "search_direction", "DISTRIBUTIONS", "CASES", "ALL_CASES", "NOMINAL_AMPLITUDES", "PairPhasors",
@@ -66,7 +67,7 @@ def standard_draws(seed: int, draws: int, distribution: str = "normal",
     """Unit-scale draws (k, 2, 3) chunk by chunk from ``numpy.random.default_rng(seed)``:
     standard normal, or uniform in [-1, 1]. The stream does not depend on ``chunk``.
     ``front_ends``: (k, front_ends, 3) (a cell of front ends, ``tolerance_cell``)."""
-    _check_distribution(distribution)
+    check_distribution(distribution)
     rng = np.random.default_rng(seed)
     chunk = max(1, int(chunk))
     for start in range(0, draws, chunk):
@@ -85,9 +86,10 @@ def subbin_draws(seed: int, draws: int, positions: int, chunk: int = DEFAULT_CHU
         yield _subbin_block(rng, min(chunk, draws - start), positions)
 
 
-def _check_distribution(distribution: str) -> None:
+def check_distribution(distribution: str) -> None:
+    """A clear error naming the allowed draw distributions (every study's draws)."""
     if distribution not in DISTRIBUTIONS:
-        raise ValueError(f"distribution {distribution!r}: must be one of "
+        raise ParameterError(f"distribution {distribution!r}: must be one of "
                          f"{', '.join(DISTRIBUTIONS)}")
 
 
@@ -148,7 +150,7 @@ def draw_chunks(seed: int, draws: int, sigma_m, distribution: str, chunk: int,
                 positions: int, centre: int, subbin: bool = True) -> Iterator[DrawChunk]:
     """A study's draws chunk by chunk as :class:`DrawChunk` (the streams advanced here by
     drawing each chunk once: normal draws take a varying number of raw numbers each)."""
-    _check_distribution(distribution)
+    check_distribution(distribution)
     sigma = np.asarray(sigma_m, float)
     rng = np.random.default_rng(seed)
     rng_u = np.random.default_rng([int(seed), 1]) if subbin else None
