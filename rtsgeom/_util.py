@@ -44,6 +44,17 @@ def single_threaded_blas():
     return _BLAS_CONTROLLER.limit(limits=1, user_api="blas")
 
 
+def one_blas_thread(func):
+    """Decorator: ``func`` runs under :func:`single_threaded_blas`."""
+    import functools
+
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        with single_threaded_blas():
+            return func(*args, **kwargs)
+    return wrapper
+
+
 def frozen(values, dtype=None) -> np.ndarray:
     """Return a read-only copy of ``values`` so frozen dataclasses stay immutable all the way down."""
     a = np.array(values, dtype=dtype, copy=True)

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.constants import c
 
-from .._util import frozen, single_threaded_blas
+from .._util import frozen, one_blas_thread
 from ..geometry import Setup
 from ..geometry.farfield import two_way_lengths
 from ..geometry.setup import nominal_setup
@@ -267,15 +267,11 @@ def _simulate_detect(setup, paths, program, seed, frames: int = 1, clipped: bool
     return (rd, det, int(cube.clipped)) if clipped else (rd, det)
 
 
+@one_blas_thread
 def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe:
     """Each front end alone at its own probe range (one simulated frame): measured angle and
     power; the gain correction equalises measured against modelled power. BLAS on one
     thread, as :func:`calibrate_pair`."""
-    with single_threaded_blas():
-        return _probe_front_ends(setup, paths, seed)
-
-
-def _probe_front_ends(setup: Setup, paths: Paths, seed: int) -> FrontEndProbe:
     scene = setup.scene
     n = setup.fe.count
     ranges = probe_ranges(setup, n)
@@ -319,6 +315,7 @@ def _probe_program(design, pair, base, delta):
     return RtsProgram.build(tg, fe, dl, np.zeros(len(tg)), amp)
 
 
+@one_blas_thread
 def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
                    probe: FrontEndProbe | None = None, base_offsets=(0.0, 0.0),
                    seed: int = 0, span_s=None, step_s=None, full_chain: bool = False,
@@ -349,14 +346,6 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
     one thread also makes the bits independent of the machine's core count (with threads,
     the sweep's errors moved in their 15th digit; the chosen delay and residual did not).
     """
-    with single_threaded_blas():
-        return _calibrate_pair(setup, paths, pair, probe, base_offsets, seed, span_s, step_s,
-                               full_chain, frames)
-
-
-def _calibrate_pair(setup, paths, pair, probe, base_offsets, seed, span_s, step_s,
-                    full_chain, frames) -> Calibration:
-    """:func:`calibrate_pair` (its BLAS limited to one thread)."""
     from .sweep import chain_errors, fit_minimum, phasor_sweep, place_probes
     scene = setup.scene
     rts = scene.rts
