@@ -27,7 +27,7 @@ from contextlib import contextmanager
 from typing import Callable, Sequence
 
 __all__ = ["chunk_mapper", "available_cores", "ForkPool", "fork_map", "map_chunks", "dask_client", "ClusterError",
-           "check_address"]
+           "check_address", "retain_freed_memory"]
 
 _ADDRESS = re.compile(r"(?:(tcp|tls|ws|wss|ucx|inproc)://)?(\[[0-9a-fA-F:]+\]|[A-Za-z0-9_.-]+)"
                       r"(?::(\d{1,5}))?")
@@ -231,12 +231,42 @@ def fork_map(func: Callable, chunks: Sequence, workers: int = 2,
 def _fork_worker_init() -> None:
     """One BLAS thread per forked worker (threadpoolctl, as ``_util.single_threaded_blas``);
     the default SIGTERM (the parent's handler, e.g. the CLI's, must not run in a worker that
-    the pool terminates) and SIGINT ignored (Ctrl-C interrupts the parent, which ends them)."""
+    the pool terminates) and SIGINT ignored (Ctrl-C interrupts the parent, which ends them);
+    freed memory kept for reuse (:func:`retain_freed_memory`)."""
     import signal
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     from threadpoolctl import threadpool_limits
     threadpool_limits(limits=1, user_api="blas")
+    retain_freed_memory()
+
+
+#: glibc's ``mallopt`` parameters (malloc.h) and the values :func:`retain_freed_memory` sets
+_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
+MMAP_THRESHOLD_BYTES = 32 * 2 ** 20  # glibc's largest dynamic threshold on 64-bit
+TRIM_THRESHOLD_BYTES = 256 * 2 ** 20
+
+
+def retain_freed_memory() -> bool:
+    """Let this process's C allocator (glibc) keep the memory it frees, for the next
+    allocation, instead of handing it back to the kernel and faulting it in afresh: blocks up
+    to :data:`MMAP_THRESHOLD_BYTES` come from the heap, and up to
+    :data:`TRIM_THRESHOLD_BYTES` of free heap stay mapped. A design's delay tables and their
+    temporaries (~100 MiB, allocated and freed per design) cost ~7 000 page faults a design
+    with glibc's adaptive defaults, ~0.3 s of system time per 20 designs in one process and
+    0.6-0.9 s in two workers, and the same again in user time on the cold pages; with this,
+    ~500 faults in all (measured; ``rtsgeom design``'s default grid ~0.3 s faster on two
+    cores). The peak memory is unchanged; a pool worker holds its peak until it ends.
+    ``mallopt`` is called through ctypes (no Python binding exists). Returns False where the
+    C library has no ``mallopt`` (not glibc) or refuses the values."""
+    import ctypes
+    try:
+        mallopt = ctypes.CDLL(None).mallopt
+    except (OSError, AttributeError):
+        return False
+    mallopt.argtypes, mallopt.restype = (ctypes.c_int, ctypes.c_int), ctypes.c_int
+    return bool(mallopt(_M_MMAP_THRESHOLD, MMAP_THRESHOLD_BYTES)) and bool(
+        mallopt(_M_TRIM_THRESHOLD, TRIM_THRESHOLD_BYTES))
 
 
 def _fork_apply(task):
