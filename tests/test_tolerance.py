@@ -331,6 +331,46 @@ def test_fork_pool_is_kept_across_studies_of_one_model(model):
     assert pool._pool is None
 
 
+def _alloc_faults(chunk: int) -> int:
+    """Minor page faults of a pattern of freed and re-allocated 12-28 MiB arrays (a design's
+    tables and temporaries in miniature), after a first pass that faults them in."""
+    import resource
+
+    def one_pass():
+        a, b, c = np.ones(3_000_000), np.ones(1_500_000), np.ones(3_500_000)
+        del a
+        d = np.ones(2_000_000)
+        del b, c, d
+
+    one_pass()
+    r0 = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+    for _ in range(9):
+        one_pass()
+    return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - r0
+
+
+def test_fork_pool_workers_reuse_the_memory_they_free():
+    """A ForkPool worker keeps freed memory for its next allocations
+    (``parallel.retain_freed_memory``, glibc): after a first pass, the pattern faults no
+    pages in, where a plain forked process faults them in again on every pass."""
+    import multiprocessing
+
+    from rtsgeom.parallel import ForkPool, _can_fork
+    if not _can_fork() or not _glibc():
+        pytest.skip("fork and glibc's mallopt needed")
+    with multiprocessing.get_context("fork").Pool(1) as plain:
+        base = plain.apply(_alloc_faults, (0,))
+    with ForkPool(2) as pool:
+        kept = pool.map(_alloc_faults, [0, 1])
+    assert base > 9_000, (base, kept)  # ~16 000: ~60 MiB faulted in on every pass
+    assert max(kept) < 500, (base, kept)
+
+
+def _glibc() -> bool:
+    import platform
+    return platform.libc_ver()[0] == "glibc"
+
+
 def test_larger_sigma_gives_larger_p95(model):
     p95 = {case: [] for case in CASES}
     for sigma in (0.03e-3, 0.1e-3, 0.3e-3):
