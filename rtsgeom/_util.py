@@ -60,3 +60,19 @@ def frozen(values, dtype=None) -> np.ndarray:
     a = np.array(values, dtype=dtype, copy=True)
     a.flags.writeable = False
     return a
+
+
+def tones(freq_hz: np.ndarray, t0_s: float, dt_s: float, n: int) -> np.ndarray:
+    """``exp(2 pi j f (t0 + i dt))`` for i = 0..n-1: (..., n) for frequencies (...).
+
+    Factored as ``exp(2 pi j f (t0 + a B dt)) exp(2 pi j f b dt)``, i = a B + b with
+    B ~ sqrt(n): 2 sqrt(n) complex exponentials and n products per frequency instead of n
+    exponentials (numpy's complex ``exp`` dominated the model construction: 0.2 s for the
+    delay table of ~1000 echoes). Agrees with the direct form to ~1e-15 (tested); each
+    phase is a product of two exact-to-rounding factors, no recursion that accumulates."""
+    f = np.asarray(freq_hz, float)[..., None]
+    block = max(1, int(np.ceil(np.sqrt(n))))
+    outer = np.exp(2j * np.pi * f * (t0_s + np.arange(-(-n // block)) * block * dt_s))
+    inner = np.exp(2j * np.pi * f * (np.arange(block) * dt_s))
+    out = outer[..., :, None] * inner[..., None, :]
+    return out.reshape(out.shape[:-2] + (-1,))[..., :n]

@@ -22,14 +22,14 @@ from enum import IntEnum
 import numpy as np
 from scipy.constants import c
 
-from ._util import frozen
+from ._util import frozen, tones
 from .geometry import Setup
 from .paths.table import FE_TO_RX, RUT_TO_RUT, TX_TO_FE, Paths
 from .scene import Scene
 
 __all__ = ["RtsProgram", "EchoKind", "Echoes", "realised_delay", "target_amplitude",
            "channel_echoes", "setup_echoes", "cable_ghosts", "program_nearest", "build_echoes",
-           "fractional_delay_fir", "fir_error_response", "fir_if_gain"]
+           "fractional_delay_fir", "fir_error_response", "fir_if_gain", "FirTaps", "fir_taps", "fir_modelled"]
 
 
 class EchoKind(IntEnum):
@@ -300,19 +300,79 @@ def fir_if_gain(scene: Scene, delay_s, tau_total_s) -> np.ndarray | None:
     conjugate of the RTS's complex gain (eq. 8: tx * conj(rx)). None for an ideal delay
     (``fractional_delay_filter = "ideal"`` or no fractional delay)."""
     rts, radar = scene.rts, scene.radar
-    if not rts.fractional_delay or rts.fractional_delay_filter == "ideal":
+    if not fir_modelled(scene):
+        return None
+    t_n = radar.adc_start_s + np.arange(radar.samples_per_chirp) / radar.adc_rate_hz
+    # every echo at its setting; the IF f_rts + S t_n shifted by -S tau per echo
+    out = fir_error_response(_fir_setting(delay_s, rts.f_s_hz), rts.fractional_delay_taps,
+                             rts.f_s_hz, rts.f_rts_hz + radar.slope_hz_per_s * t_n,
+                             -radar.slope_hz_per_s * np.asarray(tau_total_s, float))
+    return np.conj(out)
+
+
+def fir_modelled(scene: Scene) -> bool:
+    """Whether the scene's RTS realises its delays with a modelled fractional-delay FIR (whose
+    response :func:`fir_if_gain` and :func:`fir_taps` give); else an ideal delay."""
+    return bool(scene.rts.fractional_delay and scene.rts.fractional_delay_filter != "ideal")
+
+
+def _fir_setting(delay_s, f_s_hz: float) -> np.ndarray:
+    """The FIR's fractional delay mu in samples, [0, 1), for realised delays ``delay_s``:
+    rounded to 1e-9 samples (a setting within 1e-9 of a whole sample is 0)."""
+    ts = 1.0 / f_s_hz
+    d = np.asarray(delay_s, float)
+    mu = (d - np.floor(d / ts) * ts) / ts
+    return np.round(np.where(mu >= 1.0 - 1e-9, 0.0, mu), 9)
+
+
+@dataclass(frozen=True)
+class FirTaps:
+    """The fractional-delay FIR's action on echoes as whole-sample-delayed copies: with
+    ``t_s = 1 / f_s`` and the taps centred (k_c = k - (T - 1) / 2), echo e's fast-time
+    signal ``exp(j 2 pi S tau_if t) fir_if_gain(t)`` equals::
+
+        exp(j 2 pi S residual_s[e] t) sum_k weights[e, k] exp(j 2 pi S t_s (samples[e] + k_c) t)
+
+    (the FIR's output is the sum of its taps' copies of the input, each delayed by whole
+    samples: ``weights = h_k(mu) exp(j 2 pi (f_rts - S tau) (k_c - mu) t_s)``, ``samples`` the
+    buffer's whole samples n with tau_if = (n + mu) t_s + residual, the residual below
+    1e-9 samples, from mu's rounding). A delay table's thousands of settings then share a
+    few dozen tones (:func:`rtsgeom.radar.phasors.bin_response`, ``taps``)."""
+
+    samples: np.ndarray  # (E,) int
+    weights: np.ndarray  # (E, T) complex
+    residual_s: np.ndarray  # (E,)
+    sample_period_s: float
+
+    def select(self, rows) -> "FirTaps":
+        return FirTaps(self.samples[rows], self.weights[rows], self.residual_s[rows],
+                       self.sample_period_s)
+
+
+def fir_taps(scene: Scene, delay_s, tau_total_s) -> FirTaps | None:
+    """:func:`fir_if_gain` of the same echoes (realised RTS delays ``delay_s`` (E,), total
+    delays ``tau_total_s`` (E,)) in its whole-sample form, :class:`FirTaps` (None for an ideal
+    delay). The same model: ``exp(j 2 pi S delay t) fir_if_gain(t)`` of each echo is its
+    ``FirTaps`` sum to rounding, with the residual's phase, below 1e-8 rad, to first order
+    (tested)."""
+    rts, radar = scene.rts, scene.radar
+    if not fir_modelled(scene):
         return None
     ts = 1.0 / rts.f_s_hz
     d = np.asarray(delay_s, float)
-    mu = (d - np.floor(d / ts) * ts) / ts
-    mu = np.where(mu >= 1.0 - 1e-9, 0.0, mu)
+    mu = _fir_setting(d, rts.f_s_hz)
+    uniq, inv = np.unique(mu, return_inverse=True)
+    taps = rts.fractional_delay_taps
     t_n = radar.adc_start_s + np.arange(radar.samples_per_chirp) / radar.adc_rate_hz
-    # every echo at its setting rounded to 1e-9 samples; the IF f_rts + S t_n shifted by
-    # -S tau per echo
-    out = fir_error_response(np.round(mu, 9), rts.fractional_delay_taps, rts.f_s_hz,
-                             rts.f_rts_hz + radar.slope_hz_per_s * t_n,
-                             -radar.slope_hz_per_s * np.asarray(tau_total_s, float))
-    return np.conj(out)
+    # the taps of the settings met so far (fir_error_response's memo, the same grid)
+    h = _fir_rows(uniq, taps, float(rts.f_s_hz), rts.f_rts_hz + radar.slope_hz_per_s * t_n)[0]
+    n = np.round(d / ts - mu)
+    f = rts.f_rts_hz - radar.slope_hz_per_s * np.asarray(tau_total_s, float)  # (E,)
+    # exp(j 2 pi f (k_c - mu) t_s) as exp(j 2 pi f k_c t_s) exp(-j 2 pi f mu t_s), the
+    # first factor by tones (2 sqrt(T) exponentials a row instead of T)
+    w = (h[np.ravel(inv)] * tones(f, -0.5 * (taps - 1) * ts, ts, taps)
+         * np.exp(-2j * np.pi * f * mu * ts)[:, None])
+    return FirTaps(frozen(n.astype(np.int64)), frozen(w), frozen(d - (n + mu) * ts), ts)
 
 
 def target_amplitude(range_m, rcs_m2, wavelength_m: float) -> np.ndarray:

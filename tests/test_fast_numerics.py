@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from rtsgeom.radar.phasors import _tones
+from rtsgeom._util import tones
 from rtsgeom.radar.processing import range_doppler
 from rtsgeom.radar.steering import window
 from rtsgeom.registry import WINDOWS
@@ -28,7 +28,7 @@ def test_tones_match_the_direct_exponential():
             f = rng.uniform(-3e7, 3e7, (6, 5))
             direct = np.exp(2j * np.pi * f[..., None] * (t0 + np.arange(n) * dt))
             phase_scale = 2 * np.pi * np.max(np.abs(f)) * (t0 + n * dt)  # rad
-            got = _tones(f, t0, dt, n)
+            got = tones(f, t0, dt, n)
             assert got.shape == (6, 5, n)
             # both forms round the phase argument; they agree to that rounding
             assert np.max(np.abs(got - direct)) <= 8 * np.finfo(float).eps * max(phase_scale, 1)

@@ -101,3 +101,67 @@ def test_fir_response_does_not_depend_on_its_memo(taps, step_ps, monkeypatch):
     monkeypatch.setattr(rts, "_FIR_ROWS_MAX", 40)
     assert np.array_equal(table(False), cold)
     assert len(rts._FIR_ROWS) == 1
+
+
+@pytest.mark.parametrize("taps", [5, 8, 33])
+@pytest.mark.parametrize("f_s, step_ps", [(4e9, 1.0), (1e9, 3.7), (3.76543e9, 1.234567),
+                                        (2.5e9, 25.0)])
+@pytest.mark.parametrize("radius_m, doppler_hz", [(0.5, 0.0), (2.5, 1.7e3)])
+def test_fir_taps_through_bin_response_are_the_fir_gain(taps, f_s, step_ps, radius_m,
+                                                         doppler_hz):
+    """The FIR as whole-sample copies (``rts.fir_taps``, what the delay tables use) gives the
+    spectra of the FIR's gain along the chirp (``rts.fir_if_gain``, what the ADC chain
+    synthesizes) to rounding: odd and even tap counts, settings on whole samples and next
+    to them, delays over many buffer samples, two front ends' geometries in one call (the
+    grouped path), a Doppler shift."""
+    from rtsgeom.rts import fir_taps
+
+    def mutate(doc, filt="windowed-sinc"):
+        doc["rts"].update(arc_radius_m=radius_m, fractional_delay_filter=filt,
+                          fractional_delay_taps=taps, f_s_hz=f_s,
+                          fractional_delay_step_s=step_ps * 1e-12)
+    scene = make_scene(mutate)
+    ideal = make_scene(lambda d: mutate(d, "ideal"))
+    setup, setup_ideal = build_setup(scene), build_setup(ideal)
+    paths = exact_paths(setup)
+    ts_ps = 1e12 / f_s
+    k = np.concatenate([np.arange(-300, 301, 7) * step_ps,  # settings over many samples
+                        np.arange(-3, 4) * ts_ps,  # whole samples ...
+                        np.arange(-3, 4) * ts_ps + step_ps,  # ... and one step beside them
+                        np.arange(-3, 4) * ts_ps - step_ps])
+    n = k.size
+    prog = RtsProgram.build(np.arange(2 * n), np.repeat([0, 1], n),
+                            np.tile(3e-8 + k * 1e-12, 2), np.full(2 * n, doppler_hz),
+                            np.ones(2 * n))
+    fir = channel_echoes(setup, paths, prog)
+    plain = channel_echoes(setup_ideal, paths, prog)
+    fir, plain = (e.select(e.kind == KIND_DIRECT) for e in (fir, plain))
+    assert fir.fast_gain is not None and plain.fast_gain is None
+    assert np.array_equal(fir.tau_if_s, plain.tau_if_s)
+    t = fir_taps(scene, plain.tau_if_s, plain.tau_if_s + plain.tau_air_s.mean(axis=1))
+    # (the setting rounded to 1e-9 samples: a residual where step x f_s has more decimals)
+    assert np.abs(t.residual_s).max() < 1e-9 / f_s
+    radar, rut = scene.radar, setup.rut
+    r0 = int(round(radar.slope_hz_per_s * fir.tau_s.mean() * radar.samples_per_chirp
+                   / radar.adc_rate_hz))
+    bins = r0 + np.arange(-2, 3)
+    dop = np.full(bins.size, radar.chirps_per_tx // 2 + 1)
+    ref = bin_response(fir, radar, rut, bins, dop)
+    got = bin_response(plain, radar, rut, bins, dop, t)
+    assert np.abs(got - ref).max() < 1e-12 * np.abs(ref).max()
+    assert fir_taps(ideal, plain.tau_if_s, plain.tau_if_s) is None
+    with pytest.raises(ValueError, match="taps"):
+        bin_response(fir, radar, rut, bins, dop, t)
+
+
+def test_fir_taps_need_one_doppler():
+    from rtsgeom.rts import fir_taps
+    scene = make_scene()
+    setup = build_setup(scene)
+    prog = RtsProgram.build(np.arange(2), np.zeros(2, int), np.full(2, 3e-8), np.array([0.0, 1e3]),
+                            np.ones(2))
+    ideal = build_setup(make_scene(lambda d: d["rts"].update(fractional_delay_filter="ideal")))
+    ech = channel_echoes(ideal, exact_paths(setup), prog)
+    t = fir_taps(scene, ech.tau_if_s, ech.tau_if_s)
+    with pytest.raises(ValueError, match="one Doppler"):
+        bin_response(ech, scene.radar, setup.rut, [3], [4], t)

@@ -288,12 +288,11 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     ``workers`` > 1: the designs in a pool of that many processes (each design is pure: the
     same result, in the same order, however they are spread); None: as many as this process
     may run on (``parallel.available_cores``; ``rtsgeom design``'s default; one process on one
-    core). A design's time is about a quarter its ``PairPhasors.build`` (the delay tables:
-    the FIR's response along the chirp and ``bin_response`` for ~5000 delays; the FIR's
-    per-setting rows are shared by all designs of a process) and three quarters its two
-    tolerance searches (:func:`tolerance_search`: a 250-draw pilot, then ~3 Monte Carlos of
-    ``draws`` draws x ``points`` set-points, and the one without errors per sub-bin position
-    drawn); a design whose composite splits costs one build. The forked workers each load
+    core). A design's time is about a sixth its ``PairPhasors.build`` (the delay tables:
+    ``bin_response`` of ~5000 delays through the FIR's whole-sample taps, ``rts.fir_taps``;
+    the beam responses at the set angles) and five sixths its two tolerance searches
+    (:func:`tolerance_search`: a 250-draw pilot, then ~3 Monte Carlos of ``draws`` draws x
+    ``points`` set-points, and the one without errors per sub-bin position drawn); a design whose composite splits costs one build. The forked workers each load
     the compiled kernels once (~0.3 s CPU each)."""
     check_azimuth_arc(scene)
     radii = np.asarray(radius_m, float).ravel()

@@ -64,7 +64,8 @@ from ..geometry.setup import nominal_setup
 from ..paths import exact_paths
 from ..radar.phasors import bin_response
 from ..radar.processing import refine_angles, tdm_compensate
-from ..rts import KIND_DIRECT, RtsProgram, channel_echoes, requested_delay
+from ..rts import (KIND_DIRECT, RtsProgram, channel_echoes, fir_modelled, fir_taps,
+                   requested_delay)
 from ..scene import TargetConfig
 from .subbin import centre_index, subbin_positions
 
@@ -72,7 +73,7 @@ __all__ = ["PairPhasors", "HALF_BINS", "PROBE_FRACTIONS", "response_table"]
 
 HALF_BINS = 2  # candidate bins either side of the set range's (default scene; see build)
 PROBE_FRACTIONS = (0.25, 0.75)  # calibrate_pair's probe angles across the span
-_TABLE_BYTES = 64 * 2 ** 20  # peak of one block of bin_response's fast-time tones
+_TABLE_BYTES = 64 * 2 ** 20  # peak of one block of response_table's temporaries
 
 
 def response_table(setup: Setup, paths, channel: int, target: TargetConfig, resolution_s: float,
@@ -85,15 +86,23 @@ def response_table(setup: Setup, paths, channel: int, target: TargetConfig, reso
     scene, radar, rut = setup.scene, setup.scene.radar, setup.rut
     steps = np.asarray(steps, int)
     # the cable ghosts land bins away and are dropped: not formed at all (the direct echoes
-    # do not depend on the return losses; a fifth of the table's time was their copies)
+    # do not depend on the return losses; a fifth of the table's time was their copies); the
+    # fractional-delay FIR not formed along the chirp (an ideal delay for channel_echoes) but
+    # as its taps' whole-sample copies (rts.fir_taps): bin_response then sums a few dozen
+    # tones per geometry instead of every echo's N samples (a design's tables 74 -> 15 ms)
     fes = tuple(dataclasses.replace(f, return_loss_fe_db=None) for f in scene.rts.front_ends)
     setup = dataclasses.replace(setup, scene=dataclasses.replace(
-        scene, rts=dataclasses.replace(scene.rts, front_ends=fes)))
+        scene, rts=dataclasses.replace(scene.rts, front_ends=fes,
+                                       fractional_delay_filter="ideal")))
     tau = float(requested_delay(scene, target.range_m))
     r0 = int(np.round(target.range_m / radar.range_resolution_m))
     rbins = np.arange(r0 - half_bins, r0 + half_bins + 1) % radar.samples_per_chirp
     dbin = np.full(rbins.size, radar.chirps_per_tx // 2)  # velocity 0
-    block = max(1, _TABLE_BYTES // (16 * rut.num_virtual * radar.samples_per_chirp * 4))
+    # per row: the fast-time tones and their FIR gain (E, N) each, or with the taps (E, T)
+    # weights and the (E, V K) sums
+    row = (16 * rut.num_virtual * radar.samples_per_chirp * 4 if not fir_modelled(scene) else
+           16 * (scene.rts.fractional_delay_taps * 2 + 4 * rut.num_virtual * rbins.size))
+    block = max(1, _TABLE_BYTES // row)
     out = np.empty((steps.size, rbins.size, rut.num_virtual), complex)
     for b in range(0, steps.size, block):
         k = steps[b:b + block]
@@ -102,7 +111,9 @@ def response_table(setup: Setup, paths, channel: int, target: TargetConfig, reso
         ech = channel_echoes(setup, paths, prog)
         if np.any(ech.kind != KIND_DIRECT):  # (none: see above)
             ech = ech.select(ech.kind == KIND_DIRECT)
-        resp = bin_response(ech, radar, rut, rbins, dbin)  # (K, E, V)
+        # (what channel_echoes forms as fast_gain: rts.fir_if_gain of the same delays)
+        taps = fir_taps(scene, ech.tau_if_s, ech.tau_if_s + ech.tau_air_s.mean(axis=1))
+        resp = bin_response(ech, radar, rut, rbins, dbin, taps)  # (K, E, V)
         acc = np.zeros((k.size,) + resp.shape[::2], complex)  # each target's echoes summed
         np.add.at(acc, ech.target, np.swapaxes(resp, 0, 1))  # (a one-hot einsum was 15 %)
         out[b:b + block] = acc

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..rts import fir_if_gain, realised_delay, requested_delay
+from ..rts import fir_if_gain, fir_modelled, realised_delay, requested_delay
 
 __all__ = ["fir_bin_gain", "fir_effect", "fir_sweep_phase"]
 
@@ -74,7 +74,7 @@ def fir_sweep_phase(setup, ranges, deltas, base_offsets, continuous: bool = Fals
     from .calibration import _mean_air_delay
     scene = setup.scene
     rts = scene.rts
-    if not rts.fractional_delay or rts.fractional_delay_filter == "ideal":
+    if not fir_modelled(scene):
         return None
 
     def realise(t):

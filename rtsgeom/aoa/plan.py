@@ -13,7 +13,7 @@ import numpy as np
 from ..geometry import Setup
 from ..geometry.farfield import angular_resolution_rad
 from ..paths import Paths
-from ..rts import RtsProgram, realised_delay, requested_delay
+from ..rts import RtsProgram, fir_modelled, realised_delay, requested_delay
 from ..scene import SceneError, TargetConfig
 from scipy.constants import c
 from .calibration import (Calibration, FrontEndProbe, calibrate_pair, probe_angles,
@@ -239,7 +239,7 @@ def plan_pair(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str,
     # I's delay as realised, as an offset from the request: the continuous model's base
     base_i = float(realised_delay(tau + o_i, rts.f_s_hz, rts.fractional_delay,
                                   rts.fractional_delay_step_s)) - tau
-    fir = rts.fractional_delay and rts.fractional_delay_filter != "ideal"
+    fir = fir_modelled(scene)
 
     def ideal(want):  # the continuous model with J exactly at the planned difference
         return PairModel(ChannelModel.build(cont, nom_paths, pair, target,

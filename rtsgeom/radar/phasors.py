@@ -16,8 +16,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._util import tones
 from ..geometry import RutArray
-from ..rts import Echoes
+from ..rts import Echoes, FirTaps
 from ..scene import RadarConfig
 from .fmcw import beat_phase0, chirp_start_s
 from .steering import window
@@ -25,27 +26,52 @@ from .steering import window
 __all__ = ["bin_response"]
 
 
-def _tones(freq_hz: np.ndarray, t0_s: float, dt_s: float, n: int) -> np.ndarray:
-    """``exp(2 pi j f (t0 + i dt))`` for i = 0..n-1: (..., n) for frequencies (...).
+def _tap_sums(taps: FirTaps, kern: np.ndarray, slope: float, f_d: float, t0: float,
+              dt: float) -> np.ndarray:
+    """Each echo's fast-time sums ``sum_n x_e(n) kern[c, n]`` (E, C) for the signal of
+    :class:`~rtsgeom.rts.FirTaps` (Doppler ``f_d``): the tones at the taps' whole-sample
+    delays m t_s, Q[m] = sum_n exp(j 2 pi (S t_s m + f_D) t_n) kern[:, n] and the same with a
+    factor t_n (Q1, the residual's first order), formed once for every m the echoes reach;
+    then per echo sum_k w_ek (Q[n_e + k] + j 2 pi S residual_e Q1[n_e + k]), one product per
+    buffer position n_e (echoes grouped by it)."""
+    n_e, w, res = taps.samples, taps.weights, taps.residual_s
+    n_t, n_s = w.shape[1], kern.shape[1]
+    out = np.empty((n_e.size, kern.shape[0]), complex)
+    if n_e.size == 0:
+        return out
+    lo = int(n_e.min())
+    m = lo - (n_t - 1) / 2 + np.arange(int(n_e.max()) - lo + n_t)  # whole-sample delays
+    tone = tones(slope * taps.sample_period_s * m + f_d, t0, dt, n_s)  # (M, N)
+    q = tone @ kern.T  # (M, C)
+    t_n = t0 + np.arange(n_s) * dt
+    # the residual's phase 2 pi S r t_n (mu's rounding to 1e-9 samples: zero to rounding
+    # where the delay step is a round fraction of the sample period) to first order, where
+    # it reaches the last bit
+    x = 2j * np.pi * slope * res
+    q1 = ((tone * t_n) @ kern.T if np.abs(x).max() * np.abs(t_n).max() > 2.0 ** -53
+          else None)
+    order = np.argsort(n_e, kind="stable")
+    starts = np.flatnonzero(np.r_[True, np.diff(n_e[order]) != 0])
+    for a, b in zip(starts, np.r_[starts[1:], n_e.size]):
+        rows = order[a:b]
+        j = int(n_e[rows[0]]) - lo
+        wr = w[rows]
+        out[rows] = wr @ q[j:j + n_t]
+        if q1 is not None:
+            out[rows] += (wr * x[rows, None]) @ q1[j:j + n_t]
+    return out
 
-    Factored as ``exp(2 pi j f (t0 + a B dt)) exp(2 pi j f b dt)``, i = a B + b with
-    B ~ sqrt(n): 2 sqrt(n) complex exponentials and n products per frequency instead of n
-    exponentials (numpy's complex ``exp`` dominated the model construction: 0.2 s for the
-    delay table of ~1000 echoes). Agrees with the direct form to ~1e-15 (tested); each
-    phase is a product of two exact-to-rounding factors, no recursion that accumulates."""
-    f = np.asarray(freq_hz, float)[..., None]
-    block = max(1, int(np.ceil(np.sqrt(n))))
-    outer = np.exp(2j * np.pi * f * (t0_s + np.arange(-(-n // block)) * block * dt_s))
-    inner = np.exp(2j * np.pi * f * (np.arange(block) * dt_s))
-    out = outer[..., :, None] * inner[..., None, :]
-    return out.reshape(out.shape[:-2] + (-1,))[..., :n]
 
-
-def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, doppler_bin
-                 ) -> np.ndarray:
+def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, doppler_bin,
+                 taps: FirTaps | None = None) -> np.ndarray:
     """Spectrum contributions of each echo at the given bins.
 
     ``range_bin``, ``doppler_bin``: (K,) indices into ``RangeDoppler`` (Doppler fftshifted).
+    ``taps``: the echoes' fractional-delay FIR as whole-sample copies (:func:`rtsgeom.rts.fir_taps`,
+    in place of ``echoes.fast_gain``, which must then be None; echoes of one Doppler shift):
+    the fast-time sums of the tones at the few whole-sample delays the taps reach, formed once
+    and combined per echo, T x V K products per echo instead of N x (V K + T) (a delay table of
+    thousands of settings; the same sums to rounding).
     Returns (K, E, V) complex128; sum over axis 1 for the total.
     """
     r = np.atleast_1d(np.asarray(range_bin))
@@ -66,27 +92,33 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
     else:
         air, group = np.unique(tau_air, axis=0, return_inverse=True)
         group = np.ravel(group)
-    if 4 * air.shape[0] <= len(echoes):
+    if taps is not None and (echoes.fast_gain is not None or np.any(f_d != f_d[:1])):
+        raise ValueError("bin_response: taps replace echoes.fast_gain (which must be None) "
+                         "and need echoes of one Doppler shift")
+    if taps is not None or 4 * air.shape[0] <= len(echoes):
         # many echoes share their air delays (a delay table: one geometry, many RTS delays):
         # exp(j 2 pi S tau t) = exp(j 2 pi S tau_if t) exp(j 2 pi S tau_air t), the element
         # factor folded into the DFT kernel once per geometry, so each echo needs N tones and
         # one (N,) x (N, V K) product instead of V N tones (the same sums; ~1e-14 rounding)
-        fast = _tones(s * echoes.tau_if_s + f_d, t0, dt, n_s)  # (E, N)
-        if echoes.fast_gain is not None:  # fractional-delay FIR ripple along the chirp
-            fast = fast * echoes.fast_gain
-        elem = _tones(s * air, t0, dt, n_s)  # (G, V, N)
+        if taps is None:
+            fast = tones(s * echoes.tau_if_s + f_d, t0, dt, n_s)  # (E, N)
+            if echoes.fast_gain is not None:  # fractional-delay FIR ripple along the chirp
+                fast = fast * echoes.fast_gain
+        elem = tones(s * air, t0, dt, n_s)  # (G, V, N)
         kern = (elem[:, :, None, :] * kern_r).reshape(air.shape[0], -1, n_s)  # (G, V K, N)
-        if air.shape[0] == 1:  # one geometry: the same product without the row copies
+        if air.shape[0] == 1 and taps is None:  # one geometry: without the row copies
             rr = fast @ kern[0].T
         else:
             rr = np.empty((len(echoes), tau.shape[1] * r.size), complex)
             for g in range(air.shape[0]):  # a few geometries (loop over groups, not echoes)
-                sel = np.flatnonzero(group == g)
-                rr[sel] = fast[sel] @ kern[g].T
+                sel = slice(None) if group is None else np.flatnonzero(group == g)
+                rr[sel] = (fast[sel] @ kern[g].T if taps is None else
+                           _tap_sums(taps.select(sel), kern[g], s, f_d[0] if len(f_d) else 0.0,
+                                     t0, dt))
         rr = np.moveaxis(rr.reshape(len(echoes), tau.shape[1], r.size), -1, 0)
     else:
         beat = s * tau + f_d[:, None]  # (E, V)
-        fast = _tones(beat, t0, dt, n_s)  # (E, V, N) at t_n
+        fast = tones(beat, t0, dt, n_s)  # (E, V, N) at t_n
         if echoes.fast_gain is not None:  # fractional-delay FIR ripple along the chirp
             fast = fast * echoes.fast_gain[:, None, :]
         # the window-and-DFT sums as one matrix product (BLAS: 10x numpy's einsum loops
