@@ -256,7 +256,10 @@ def retain_freed_memory() -> bool:
     with glibc's adaptive defaults, ~0.3 s of system time per 20 designs in one process and
     0.6-0.9 s in two workers, and the same again in user time on the cold pages; with this,
     ~500 faults in all (measured; ``rtsgeom design``'s default grid ~0.3 s faster on two
-    cores). The peak memory is unchanged; a pool worker holds its peak until it ends.
+    cores). The cost: glibc's own adaptation is off, and a pool worker keeps what it has
+    freed (up to its peak, fragmentation included, and at most 256 MiB of free heap above
+    its live data) until the pool ends, so the pool's resident memory is about workers
+    times a worker's peak (a design worker's ~270 MiB).
     ``mallopt`` is called through ctypes (no Python binding exists). Returns False where the
     C library has no ``mallopt`` (not glibc) or refuses the values."""
     import ctypes

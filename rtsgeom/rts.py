@@ -334,10 +334,12 @@ class FirTaps:
         exp(j 2 pi S residual_s[e] t) sum_k weights[e, k] exp(j 2 pi S t_s (samples[e] + k_c) t)
 
     (the FIR's output is the sum of its taps' copies of the input, each delayed by whole
-    samples: ``weights = h_k(mu) exp(j 2 pi (f_rts - S tau) (k_c - mu) t_s)``, ``samples`` the
-    buffer's whole samples n with tau_if = (n + mu) t_s + residual, the residual below
-    1e-9 samples, from mu's rounding). A delay table's thousands of settings then share a
-    few dozen tones (:func:`rtsgeom.radar.phasors.bin_response`, ``taps``)."""
+    samples: ``weights = h_k(mu) exp(j 2 pi (f_rts - S tau) (k_c - mu) t_s)``, the taps h_k
+    real; ``samples`` the buffer's whole samples n with tau_if = (n + mu) t_s + residual, the
+    residual from mu's rounding to 1e-9 samples, its phase 2 pi S residual t below 1e-8 rad
+    (B <= f_s)). A delay table's thousands of settings then share a few dozen tones
+    (:func:`rtsgeom.radar.phasors.bin_response`, ``taps``). Direct echoes only: a cable
+    ghost carries its direct echo's FIR, not one set to its own delay."""
 
     samples: np.ndarray  # (E,) int
     weights: np.ndarray  # (E, T) complex
@@ -360,9 +362,12 @@ def fir_taps(scene: Scene, delay_s, tau_total_s) -> FirTaps | None:
         return None
     ts = 1.0 / rts.f_s_hz
     d = np.asarray(delay_s, float)
+    taps = rts.fractional_delay_taps
+    if d.size == 0:
+        return FirTaps(frozen(np.zeros(0, np.int64)), frozen(np.zeros((0, taps), complex)),
+                       frozen(np.zeros(0)), ts)
     mu = _fir_setting(d, rts.f_s_hz)
     uniq, inv = np.unique(mu, return_inverse=True)
-    taps = rts.fractional_delay_taps
     t_n = radar.adc_start_s + np.arange(radar.samples_per_chirp) / radar.adc_rate_hz
     # the taps of the settings met so far (fir_error_response's memo, the same grid)
     h = _fir_rows(uniq, taps, float(rts.f_s_hz), rts.f_rts_hz + radar.slope_hz_per_s * t_n)[0]

@@ -165,3 +165,30 @@ def test_fir_taps_need_one_doppler():
     t = fir_taps(scene, ech.tau_if_s, ech.tau_if_s)
     with pytest.raises(ValueError, match="one Doppler"):
         bin_response(ech, scene.radar, setup.rut, [3], [4], t)
+
+
+def test_fir_taps_refuse_what_they_do_not_model():
+    """Taps for other echoes than these (a row count that differs) or for cable ghosts (a
+    ghost carries its direct echo's FIR, not one set to its own delay) are an error; no
+    echoes give an empty table."""
+    from rtsgeom.rts import Echoes, fir_taps
+    scene = make_scene(lambda d: d["rts"].update(fractional_delay_filter="ideal"))
+    fir_scene = make_scene()
+    setup = build_setup(scene)
+    prog = RtsProgram.build(np.arange(3), np.zeros(3, int), 3e-8 + np.arange(3) * 1e-12,
+                            np.zeros(3), np.ones(3))
+    ech = channel_echoes(setup, exact_paths(setup), prog)
+    assert np.any(ech.kind != KIND_DIRECT)  # the default scene's cables ring
+    radar, rut = scene.radar, setup.rut
+    with pytest.raises(ValueError, match="direct echoes"):
+        bin_response(ech, radar, rut, [3], [4], fir_taps(fir_scene, ech.tau_if_s, ech.tau_if_s))
+    direct = ech.select(ech.kind == KIND_DIRECT)
+    t = fir_taps(fir_scene, direct.tau_if_s, direct.tau_if_s)
+    with pytest.raises(ValueError, match="one row per echo"):
+        bin_response(direct, radar, rut, [3], [4], t.select(slice(0, 1)))
+    none = direct.select(np.zeros(len(direct), bool))
+    empty = fir_taps(fir_scene, none.tau_if_s, none.tau_if_s)
+    assert empty.weights.shape == (0, fir_scene.rts.fractional_delay_taps)
+    out = bin_response(none, radar, rut, [3, 4], [4, 4], empty)
+    assert out.shape == (2, 0, rut.num_virtual)
+    assert isinstance(none, Echoes)

@@ -20,7 +20,7 @@ from rtsgeom.rts import RtsProgram, requested_delay
 from rtsgeom.radar.frame import simulate
 from rtsgeom.scene import TargetConfig
 
-from conftest import DEFAULT_SCENE, make_scene, two_front_end_pair
+from conftest import DEFAULT_SCENE, ROOT, make_scene, two_front_end_pair
 
 ZERO = np.zeros((2, 3))
 
@@ -331,39 +331,64 @@ def test_fork_pool_is_kept_across_studies_of_one_model(model):
     assert pool._pool is None
 
 
-def _alloc_faults(chunk: int) -> int:
-    """Minor page faults of a pattern of freed and re-allocated 12-28 MiB arrays (a design's
-    tables and temporaries in miniature), after a first pass that faults them in."""
-    import resource
+_HEAP_POLICY = """
+import ctypes, numpy as np
+from rtsgeom.parallel import retain_freed_memory
+class MallInfo2(ctypes.Structure):
+    _fields_ = [(n, ctypes.c_size_t) for n in ("arena", "ordblks", "smblks", "hblks", "hblkhd",
+                                                "usmblks", "fsmblks", "uordblks", "fordblks",
+                                                "keepcost")]
+libc = ctypes.CDLL(None)
+libc.mallinfo2.restype = MallInfo2
+libc.mallopt(-3, 128 * 1024)  # M_MMAP_THRESHOLD fixed: every block above 128 KiB mapped
+out = []
+for retain in (False, True):
+    if retain:
+        assert retain_freed_memory()
+    h0 = libc.mallinfo2().hblkhd
+    a = np.ones(3_500_000)  # 28 MiB
+    out.append(libc.mallinfo2().hblkhd - h0)
+    arena = libc.mallinfo2().arena
+    del a
+    out.append(arena - libc.mallinfo2().arena)
+print(*out)
+"""
 
-    def one_pass():
-        a, b, c = np.ones(3_000_000), np.ones(1_500_000), np.ones(3_500_000)
-        del a
-        d = np.ones(2_000_000)
-        del b, c, d
 
-    one_pass()
-    r0 = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
-    for _ in range(9):
-        one_pass()
-    return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - r0
+def test_retained_memory_is_reused_not_mapped_afresh():
+    """``parallel.retain_freed_memory`` (glibc): a 28 MiB block that glibc maps afresh and
+    unmaps on every allocation (a design's tables and temporaries: ~7 000 page faults a
+    design) comes from the heap instead and stays there when freed (a fresh process: a
+    forked one inherits this process's heap, whose free blocks would serve it anyway)."""
+    import subprocess
+    import sys
+    if not _glibc():
+        pytest.skip("glibc's mallopt/mallinfo2 needed")
+    run = subprocess.run([sys.executable, "-c", _HEAP_POLICY], capture_output=True, text=True,
+                         check=True, cwd=ROOT)
+    mapped, _, mapped_after, trimmed = map(int, run.stdout.split())
+    assert mapped >= 28e6  # before: a fresh mapping
+    assert mapped_after == 0 and trimmed == 0  # after: from the heap, and kept there
 
 
-def test_fork_pool_workers_reuse_the_memory_they_free():
-    """A ForkPool worker keeps freed memory for its next allocations
-    (``parallel.retain_freed_memory``, glibc): after a first pass, the pattern faults no
-    pages in, where a plain forked process faults them in again on every pass."""
-    import multiprocessing
+def _worker_retains() -> bool:
+    import rtsgeom.parallel as parallel
+    return getattr(parallel, "_test_retained", False)
 
-    from rtsgeom.parallel import ForkPool, _can_fork
-    if not _can_fork() or not _glibc():
-        pytest.skip("fork and glibc's mallopt needed")
-    with multiprocessing.get_context("fork").Pool(1) as plain:
-        base = plain.apply(_alloc_faults, (0,))
-    with ForkPool(2) as pool:
-        kept = pool.map(_alloc_faults, [0, 1])
-    assert base > 9_000, (base, kept)  # ~16 000: ~60 MiB faulted in on every pass
-    assert max(kept) < 500, (base, kept)
+
+def test_fork_pool_workers_retain_freed_memory(monkeypatch):
+    """Every ForkPool worker runs ``retain_freed_memory`` when it starts."""
+    import rtsgeom.parallel as parallel
+    if not parallel._can_fork():
+        pytest.skip("no fork on this platform")
+
+    def spy():
+        parallel._test_retained = True
+        return True
+    monkeypatch.setattr(parallel, "retain_freed_memory", spy)
+    with parallel.ForkPool(2) as pool:
+        assert pool.map(lambda _: _worker_retains(), [0, 1, 2]) == [True] * 3
+    assert not getattr(parallel, "_test_retained", False)  # (the parent's module untouched)
 
 
 def _glibc() -> bool:

@@ -98,11 +98,17 @@ def response_table(setup: Setup, paths, channel: int, target: TargetConfig, reso
     r0 = int(np.round(target.range_m / radar.range_resolution_m))
     rbins = np.arange(r0 - half_bins, r0 + half_bins + 1) % radar.samples_per_chirp
     dbin = np.full(rbins.size, radar.chirps_per_tx // 2)  # velocity 0
-    # per row: the fast-time tones and their FIR gain (E, N) each, or with the taps (E, T)
-    # weights and the (E, V K) sums
-    row = (16 * rut.num_virtual * radar.samples_per_chirp * 4 if not fir_modelled(scene) else
-           16 * (scene.rts.fractional_delay_taps * 2 + 4 * rut.num_virtual * rbins.size))
-    block = max(1, _TABLE_BYTES // row)
+    # memory per delay step: per echo (one per path combination of the two legs) the
+    # fast-time tones and their FIR gain, (N,) each per element; or with the taps (T,)
+    # weights and the (V K) sums, plus the tones at the whole-sample delays the block spans
+    # (res / t_s of them per step, (N,) each, three arrays)
+    per_step = len(channel_echoes(setup, paths, RtsProgram.build(
+        [0], [channel], [tau], [0.0], [1.0])))
+    n_s, taps = radar.samples_per_chirp, scene.rts.fractional_delay_taps
+    row = (per_step * 16 * rut.num_virtual * n_s * 4 if not fir_modelled(scene) else
+           per_step * 16 * (2 * taps + 4 * rut.num_virtual * rbins.size)
+           + 48 * n_s * resolution_s * scene.rts.f_s_hz)
+    block = max(1, int(_TABLE_BYTES // row))
     out = np.empty((steps.size, rbins.size, rut.num_virtual), complex)
     for b in range(0, steps.size, block):
         k = steps[b:b + block]

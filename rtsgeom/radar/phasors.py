@@ -18,7 +18,7 @@ import numpy as np
 
 from .._util import tones
 from ..geometry import RutArray
-from ..rts import Echoes, FirTaps
+from ..rts import Echoes, EchoKind, FirTaps
 from ..scene import RadarConfig
 from .fmcw import beat_phase0, chirp_start_s
 from .steering import window
@@ -44,12 +44,12 @@ def _tap_sums(taps: FirTaps, kern: np.ndarray, slope: float, f_d: float, t0: flo
     tone = tones(slope * taps.sample_period_s * m + f_d, t0, dt, n_s)  # (M, N)
     q = tone @ kern.T  # (M, C)
     t_n = t0 + np.arange(n_s) * dt
-    # the residual's phase 2 pi S r t_n (mu's rounding to 1e-9 samples: zero to rounding
-    # where the delay step is a round fraction of the sample period) to first order, where
-    # it reaches the last bit
+    # the residual's phase 2 pi S r t_n (mu's rounding to 1e-9 samples) to first order,
+    # where the residual exceeds the delays' own rounding (where the delay step is a round
+    # fraction of the sample period it is that rounding: the term is skipped)
     x = 2j * np.pi * slope * res
-    q1 = ((tone * t_n) @ kern.T if np.abs(x).max() * np.abs(t_n).max() > 2.0 ** -53
-          else None)
+    ulp = 4 * np.finfo(float).eps * (np.abs(n_e).max() + n_t) * taps.sample_period_s
+    q1 = (tone * t_n) @ kern.T if np.abs(res).max() > ulp else None
     order = np.argsort(n_e, kind="stable")
     starts = np.flatnonzero(np.r_[True, np.diff(n_e[order]) != 0])
     for a, b in zip(starts, np.r_[starts[1:], n_e.size]):
@@ -67,16 +67,20 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
     """Spectrum contributions of each echo at the given bins.
 
     ``range_bin``, ``doppler_bin``: (K,) indices into ``RangeDoppler`` (Doppler fftshifted).
-    ``taps``: the echoes' fractional-delay FIR as whole-sample copies (:func:`rtsgeom.rts.fir_taps`,
-    in place of ``echoes.fast_gain``, which must then be None; echoes of one Doppler shift):
-    the fast-time sums of the tones at the few whole-sample delays the taps reach, formed once
-    and combined per echo, T x V K products per echo instead of N x (V K + T) (a delay table of
-    thousands of settings; the same sums to rounding).
+    ``taps``: the echoes' fractional-delay FIR as whole-sample copies (:func:`rtsgeom.rts.fir_taps`
+    of these echoes, in place of ``echoes.fast_gain``, which must then be None; direct echoes
+    of one Doppler shift): the fast-time sums of the tones at the few whole-sample delays the
+    taps reach, formed once per geometry (M x N x V K products, M ~ the delays' span in
+    samples plus T) and combined per echo, T x V K products (2 T x V K where the setting's
+    rounding leaves a residual) instead of N x (V K + T) (a delay table of thousands of
+    settings; the same sums to rounding).
     Returns (K, E, V) complex128; sum over axis 1 for the total.
     """
     r = np.atleast_1d(np.asarray(range_bin))
     d = np.atleast_1d(np.asarray(doppler_bin))
     n_l, n_s = radar.chirps_per_tx, radar.samples_per_chirp
+    if len(echoes) == 0:  # (every path blocked)
+        return np.zeros((r.size, 0, echoes.tau_air_s.shape[1]), complex)
     s = radar.slope_hz_per_s
     tau = echoes.tau_s  # (E, V)
     f_d = echoes.doppler_hz
@@ -92,9 +96,12 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
     else:
         air, group = np.unique(tau_air, axis=0, return_inverse=True)
         group = np.ravel(group)
-    if taps is not None and (echoes.fast_gain is not None or np.any(f_d != f_d[:1])):
-        raise ValueError("bin_response: taps replace echoes.fast_gain (which must be None) "
-                         "and need echoes of one Doppler shift")
+    if taps is not None and (echoes.fast_gain is not None or np.any(f_d != f_d[:1])
+                             or taps.samples.shape != (len(echoes),)
+                             or np.any(echoes.kind != EchoKind.DIRECT)):
+        raise ValueError("bin_response: taps (one row per echo) replace echoes.fast_gain "
+                         "(which must be None) and need direct echoes of one Doppler shift "
+                         "(a cable ghost's FIR is its direct echo's, not its own delay's)")
     if taps is not None or 4 * air.shape[0] <= len(echoes):
         # many echoes share their air delays (a delay table: one geometry, many RTS delays):
         # exp(j 2 pi S tau t) = exp(j 2 pi S tau_if t) exp(j 2 pi S tau_air t), the element
