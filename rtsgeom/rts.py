@@ -29,7 +29,8 @@ from .scene import Scene
 
 __all__ = ["RtsProgram", "EchoKind", "Echoes", "realised_delay", "target_amplitude",
            "channel_echoes", "setup_echoes", "cable_ghosts", "program_nearest", "build_echoes",
-           "fractional_delay_fir", "fir_error_response", "fir_if_gain", "FirTaps", "fir_taps", "fir_modelled"]
+           "fractional_delay_fir", "fir_error_response", "fir_if_gain", "FirTaps", "fir_taps",
+           "fir_modelled"]
 
 
 class EchoKind(IntEnum):

@@ -292,8 +292,10 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     ``bin_response`` of ~5000 delays through the FIR's whole-sample taps, ``rts.fir_taps``;
     the beam responses at the set angles) and five sixths its two tolerance searches
     (:func:`tolerance_search`: a 250-draw pilot, then ~3 Monte Carlos of ``draws`` draws x
-    ``points`` set-points, and the one without errors per sub-bin position drawn); a design whose composite splits costs one build. The forked workers each load
-    the compiled kernels once (~0.3 s CPU each)."""
+    ``points`` set-points, and the one without errors per sub-bin position drawn); a design
+    whose composite splits costs one build. The forked workers each load the compiled
+    kernels once (~0.3 s CPU each) and keep the memory they free
+    (``parallel.retain_freed_memory``)."""
     check_azimuth_arc(scene)
     radii = np.asarray(radius_m, float).ravel()
     spacings = np.asarray(spacing_deg, float).ravel()

@@ -120,8 +120,7 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
             for g in range(air.shape[0]):  # a few geometries (loop over groups, not echoes)
                 sel = slice(None) if group is None else np.flatnonzero(group == g)
                 rr[sel] = (fast[sel] @ kern[g].T if taps is None else
-                           _tap_sums(taps.select(sel), kern[g], s, f_d[0] if len(f_d) else 0.0,
-                                     t0, dt))
+                           _tap_sums(taps.select(sel), kern[g], s, f_d[0], t0, dt))
         rr = np.moveaxis(rr.reshape(len(echoes), tau.shape[1], r.size), -1, 0)
     else:
         beat = s * tau + f_d[:, None]  # (E, V)
