@@ -116,3 +116,29 @@ def two_front_end_pair(radius_m: float, spacing_deg: float = 8.0):
                                             math.radians(spacing_deg))
     assert problem is None, problem
     return scene, PairPhasors.build(build_setup(scene), (0, 1), 3)
+
+
+#: one mounting, channel or RuT pose error per file key (``geometry.setup.FRONT_END_ERRORS``,
+#: ``RUT_POSE_ERRORS``): (section, key, value); "fe" is the second front end
+SETUP_ERRORS = [("fe", "radial_offset_mm", 0.3), ("fe", "tangential_offset_mm", -0.2),
+                ("fe", "height_offset_mm", 0.25), ("fe", "yaw_offset_deg", 1.5),
+                ("fe", "pitch_offset_deg", -1.0), ("fe", "gain_offset_db", 0.7),
+                ("fe", "phase_offset_deg", 40.0), ("radar", "position_offset_mm", [0.4, -0.3, 0.2]),
+                ("radar", "yaw_offset_deg", 0.5)]
+ERROR_KEYS = {"fe": ("radial_offset_mm", "tangential_offset_mm", "height_offset_mm",
+                     "yaw_offset_deg", "pitch_offset_deg", "gain_offset_db", "phase_offset_deg"),
+              "radar": ("position_offset_mm", "yaw_offset_deg")}
+
+
+def scenes_with_and_without_error(path: Path, section: str, key: str, value):
+    """The scene at ``path`` without any of its own setup errors, and the same with one error
+    (``SETUP_ERRORS``)."""
+    doc = tomllib.loads(path.read_text())
+    for fe in doc["rts"]["front_ends"]:
+        for k in ERROR_KEYS["fe"]:
+            fe.pop(k, None)
+    for k in ERROR_KEYS["radar"]:
+        doc["radar"].pop(k, None)
+    moved = copy.deepcopy(doc)
+    (moved["rts"]["front_ends"][1] if section == "fe" else moved["radar"])[key] = value
+    return (parse_scene(doc, str(path), path.parent), parse_scene(moved, str(path), path.parent))

@@ -14,7 +14,7 @@ from rtsgeom.cli import main
 from rtsgeom.geometry import build_setup
 from rtsgeom.geometry.farfield import angular_resolution_rad
 
-from conftest import DEFAULT_SCENE, make_scene
+from conftest import DEFAULT_SCENE, ROOT, SETUP_ERRORS, make_scene, scenes_with_and_without_error
 
 
 @pytest.fixture(scope="module")
@@ -172,3 +172,28 @@ def test_design_grid_refuses_elevation(scene, where, elevation_deg):
         cell = dataclasses.replace(scene, targets=(TargetConfig(5.0, elevation_rad=el),))
     with pytest.raises(ParameterError, match="tolerance SCENE --cell all"):
         design_grid(cell, (0, 1), [1.0], [8.0], draws=10, points=5)
+
+
+@pytest.mark.parametrize("scene_file", ["diewald2022.toml", "custom-array.toml"])
+@pytest.mark.parametrize("section, key, value", SETUP_ERRORS)
+def test_the_scenes_own_errors_do_not_enter_the_design(scene_file, section, key, value):
+    """A design is made on the nominal setup (its variant drops every mounting, channel and
+    RuT pose error, ``nominal_scene``): every metric is the same with or without one, on two
+    scenes. (The RuT's yaw had entered the near-field bias's geometric reference: +0.5 deg
+    of 'bias' from 0.5 deg of yaw.)"""
+    from rtsgeom.analysis.design import evaluate_design
+    clean, moved = scenes_with_and_without_error(ROOT / "scenes" / scene_file, section, key,
+                                                 value)
+    a, b = (evaluate_design(s, (0, 1), 1.0, math.radians(8), draws=40, points=3)
+            for s in (clean, moved))
+    assert a == b
+
+
+@pytest.mark.parametrize("section, key, value", SETUP_ERRORS)
+def test_the_scenes_own_errors_do_not_enter_a_coverage_design(section, key, value):
+    """``design --coverage-deg``'s arcs are built on the nominal setup too: the same arc scene
+    (and so the same bias, spacing and tolerance) with or without any one setup error."""
+    from rtsgeom.analysis.coverage import arc_scene
+    clean, moved = scenes_with_and_without_error(DEFAULT_SCENE, section, key, value)
+    angles = np.radians([-8.0, 0.0, 8.0])
+    assert arc_scene(moved, 1.2, angles) == arc_scene(clean, 1.2, angles)

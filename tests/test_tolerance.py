@@ -20,7 +20,8 @@ from rtsgeom.rts import RtsProgram, requested_delay
 from rtsgeom.radar.frame import simulate
 from rtsgeom.scene import TargetConfig
 
-from conftest import DEFAULT_SCENE, ROOT, make_scene, two_front_end_pair
+from conftest import (DEFAULT_SCENE, ROOT, SETUP_ERRORS, make_scene, scenes_with_and_without_error,
+                      two_front_end_pair)
 
 ZERO = np.zeros((2, 3))
 
@@ -529,3 +530,23 @@ def test_cli_says_the_scenes_own_errors_are_not_the_starting_point(tmp_path, cap
         assert ("rts.front_ends[0].radial_offset_mm" in cap.err) is (path == moved)
     for case in CASES:
         assert outs[0][case] == outs[1][case]
+
+
+@pytest.mark.parametrize("scene_file", ["diewald2022.toml", "custom-array.toml"])
+@pytest.mark.parametrize("section, key, value", SETUP_ERRORS)
+def test_the_scenes_own_errors_do_not_enter_the_study(scene_file, section, key, value):
+    """Every mounting, channel and RuT pose error a scene can carry is dropped from the
+    tolerance model (``nominal_setup``), which the draws then perturb: the model's tables,
+    designs and a Monte Carlo are the same bits with or without it, on two scenes; and
+    ``setup_errors`` names it (what the CLI's warning prints)."""
+    from rtsgeom.geometry.setup import setup_errors
+    clean, moved = scenes_with_and_without_error(ROOT / "scenes" / scene_file, section, key,
+                                                 value)
+    assert setup_errors(clean) == []
+    assert setup_errors(moved) == [(f"rts.front_ends[1].{key}" if section == "fe"
+                                    else f"radar.{key}")]
+    a, b = (PairPhasors.build(build_setup(s), (0, 1), points=3) for s in (clean, moved))
+    for name in ("table", "design_amplitudes", "fe_angle_rad", "set_rad"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    ra, rb = (monte_carlo(m, [2e-4] * 3, 60, seed=3) for m in (a, b))
+    assert ra.to_dict() == rb.to_dict()

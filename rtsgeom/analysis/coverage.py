@@ -36,6 +36,7 @@ import numpy as np
 
 from ..aoa.model import AngleUnreachable
 from ..geometry import build_setup
+from ..geometry.setup import nominal_scene
 from ..geometry.farfield import angular_resolution_rad
 from ..paths import exact_paths
 from ..scene import Scene
@@ -110,14 +111,13 @@ class ArcDesign:
 
 
 def arc_scene(scene: Scene, radius_m: float, angles_rad) -> tuple[Scene, str]:
-    """``scene`` with N front ends (copies of its first: layout, cables; no mounting or channel
-    errors) at ``angles_rad`` on an arc of ``radius_m``, no targets; the sheet kept, widened or
-    removed so its cutouts fit (``design._fit_sheet``). Returns the scene and the sheet's fate."""
+    """``scene`` with N front ends (copies of its first: layout, cables) at ``angles_rad`` on
+    an arc of ``radius_m``, no targets, no mounting, channel or RuT pose errors
+    (``geometry.setup.nominal_scene``); the sheet kept, widened or removed so its cutouts fit
+    (``design._fit_sheet``). Returns the scene and the sheet's fate."""
+    scene = nominal_scene(scene)
     tmpl = scene.rts.front_ends[0]
-    clean = dict(radial_offset_m=0.0, tangential_offset_m=0.0, height_offset_m=0.0,
-                 yaw_offset_rad=0.0, pitch_offset_rad=0.0, gain_offset_db=0.0,
-                 phase_offset_rad=0.0)
-    fes = tuple(dataclasses.replace(tmpl, angle_rad=float(a), **clean) for a in angles_rad)
+    fes = tuple(dataclasses.replace(tmpl, angle_rad=float(a)) for a in angles_rad)
     rts = dataclasses.replace(scene.rts, arc_radius_m=float(radius_m), front_ends=fes)
     variant = dataclasses.replace(scene, rts=rts, targets=())
     sheet, state = _fit_sheet(variant)

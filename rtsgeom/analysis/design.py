@@ -37,6 +37,7 @@ import numpy as np
 from .._util import frozen
 from ..aoa.model import AngleUnreachable
 from ..geometry import build_setup
+from ..geometry.setup import nominal_scene
 from ..geometry.farfield import angular_resolution_rad
 from ..parallel import available_cores, chunk_mapper, map_chunks
 from ..scene import Scene, SheetConfig, arc_centre_m, problems
@@ -77,18 +78,18 @@ def check_azimuth_arc(scene: Scene, name: str = "design") -> None:
 def two_front_end_scene(scene: Scene, pair: tuple[int, int], radius_m: float,
                         spacing_rad: float) -> tuple[Scene, str, str | None]:
     """The scene with only the pair's front ends, ``spacing_rad`` apart on an arc of
-    ``radius_m`` symmetric about their centre angle; no targets, no mounting or channel errors.
+    ``radius_m`` symmetric about their centre angle; no targets, no mounting, channel or RuT
+    pose errors (``geometry.setup.nominal_scene``: the design's geometric reference, the
+    front ends' angles seen from the RuT, is the nominal one its model is built on).
 
     Returns the scene, what happened to the sheet (``kept``, ``widened``, ``disabled``) and why
     the design cannot be built (None when it can)."""
+    scene = nominal_scene(scene)
     fes = scene.rts.front_ends
     lo, hi = sorted((fes[pair[0]], fes[pair[1]]), key=lambda f: f.angle_rad)
     centre = 0.5 * (lo.angle_rad + hi.angle_rad)
-    clean = dict(radial_offset_m=0.0, tangential_offset_m=0.0, height_offset_m=0.0,
-                 yaw_offset_rad=0.0, pitch_offset_rad=0.0,
-                 gain_offset_db=0.0, phase_offset_rad=0.0)
-    new = (dataclasses.replace(lo, angle_rad=centre - 0.5 * spacing_rad, **clean),
-           dataclasses.replace(hi, angle_rad=centre + 0.5 * spacing_rad, **clean))
+    new = (dataclasses.replace(lo, angle_rad=centre - 0.5 * spacing_rad),
+           dataclasses.replace(hi, angle_rad=centre + 0.5 * spacing_rad))
     rts = dataclasses.replace(scene.rts, arc_radius_m=float(radius_m), front_ends=new)
     variant = dataclasses.replace(scene, rts=rts, targets=())
     sheet, state = _fit_sheet(variant)

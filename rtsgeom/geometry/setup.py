@@ -16,8 +16,8 @@ from .sheet import sheet_mesh
 if TYPE_CHECKING:  # trimesh loads where the mesh is built (geometry.sheet)
     import trimesh
 
-__all__ = ["Setup", "build_setup", "nominal_setup", "setup_errors", "FRONT_END_ERRORS",
-           "RUT_POSE_ERRORS"]
+__all__ = ["Setup", "build_setup", "nominal_setup", "nominal_scene", "setup_errors",
+           "FRONT_END_ERRORS", "RUT_POSE_ERRORS"]
 
 
 @dataclass(frozen=True)
@@ -68,7 +68,7 @@ RUT_POSE_ERRORS = ("position_offset_m", "yaw_offset_rad")
 
 
 def setup_errors(scene: Scene) -> list[str]:
-    """The scene's fields that :func:`nominal_setup` zeroes and that are not zero, as file
+    """The scene's fields that :func:`nominal_scene` zeroes and that are not zero, as file
     keys (``rts.front_ends[1].radial_offset_mm``, ``radar.yaw_offset_deg``)."""
     from ..schema import specs
     from ..scene import FrontEndConfig, RadarConfig
@@ -79,18 +79,22 @@ def setup_errors(scene: Scene) -> list[str]:
                   if np.any(np.asarray(getattr(scene.radar, name)) != 0.0)]
 
 
-def nominal_setup(setup: Setup) -> Setup:
-    """The setup as designed: no mounting errors and no channel gain/phase errors.
-
-    The RuT's pose errors are dropped too. This is what an RTS operator knows; the AoA design works on it, while the simulated RuT
-    sees the setup as built (``setup``), so calibration has to absorb the difference.
-    """
-    scene = setup.scene
+def nominal_scene(scene: Scene) -> Scene:
+    """The scene as designed: every field of :data:`FRONT_END_ERRORS` and
+    :data:`RUT_POSE_ERRORS` zero (``scene`` itself where they already are)."""
     fes = tuple(f.evolve(**dict.fromkeys(FRONT_END_ERRORS, 0.0)) for f in scene.rts.front_ends)
     radar = scene.radar
     if any(np.any(np.asarray(getattr(radar, name)) != 0.0) for name in RUT_POSE_ERRORS):
         radar = radar.evolve(position_offset_m=(0.0, 0.0, 0.0), yaw_offset_rad=0.0)
     if fes == scene.rts.front_ends and radar is scene.radar:
-        return setup
-    nominal = scene.evolve(rts=scene.rts.evolve(front_ends=fes), radar=radar)  # validated again
-    return build_setup(nominal)
+        return scene
+    return scene.evolve(rts=scene.rts.evolve(front_ends=fes), radar=radar)  # validated again
+
+
+def nominal_setup(setup: Setup) -> Setup:
+    """The setup as designed (:func:`nominal_scene`): no mounting errors, no channel
+    gain/phase errors, no RuT pose errors. This is what an RTS operator knows; the AoA design
+    works on it, while the simulated RuT sees the setup as built (``setup``), so calibration
+    has to absorb the difference."""
+    nominal = nominal_scene(setup.scene)
+    return setup if nominal is setup.scene else build_setup(nominal)
