@@ -358,8 +358,7 @@ def calibrate_channels(setup, paths, channels, probe, seed=None, progress=None,
     seed = scene.seed if seed is None else seed
     nom, nom_paths = nominal_model(setup, paths)
     st = Steering.auto(nom.rut, scene.radar)
-    u_fe = nom.fe_direction_cosines()
-    u_fe = np.sin(nom.fe_azimuth_rad())[:, None] if st.dims == 1 else u_fe
+    u_fe = nom.fe_direction_cosines(st.dims)
     ch = sorted(int(q) for q in channels)
     ref = ch[0]
     offsets = np.zeros(setup.fe.count)

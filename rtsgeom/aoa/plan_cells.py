@@ -37,8 +37,7 @@ def target_cells(setup: Setup) -> tuple[Steering, np.ndarray, list]:
     Shared by the planner and ``rtsgeom info``."""
     scene = setup.scene
     st = Steering.auto(setup.rut, scene.radar)  # the beamformer the RuT runs
-    u_fe = setup.fe_direction_cosines()
-    u_fe = np.sin(setup.fe_azimuth_rad())[:, None] if st.dims == 1 else u_fe
+    u_fe = setup.fe_direction_cosines(st.dims)
     out: list = []
     for k, t in enumerate(scene.targets):
         if st.dims == 1 and getattr(t, "elevation_rad", 0.0):

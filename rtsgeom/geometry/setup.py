@@ -40,9 +40,12 @@ class Setup:
         """Azimuth of each front end's module centre as seen from the RuT phase centre."""
         return self.rut.azimuth_of(self.fe.module)
 
-    def fe_direction_cosines(self) -> np.ndarray:
+    def fe_direction_cosines(self, dims: int = 2) -> np.ndarray:
         """Direction cosines u = (sin az cos el, sin el) (F, 2) of each front end's module
-        centre seen from the RuT phase centre, in the radar frame (``radar.steering``)."""
+        centre seen from the RuT phase centre, in the radar frame (``radar.steering``);
+        ``dims`` 1: (F, 1) sin az, what a RuT that beamforms in azimuth only steers to."""
+        if dims == 1:
+            return np.sin(self.fe_azimuth_rad())[:, None]
         p = self.rut.to_local(self.fe.module)
         return p[:, [0, 2]] / np.linalg.norm(p, axis=-1, keepdims=True)
 
