@@ -15,10 +15,9 @@ import numpy as np
 import pytest
 
 from conftest import ROOT
-from rtsgeom.analysis.tolerance import CASES, standard_draws
-from rtsgeom.analysis.tolerance_cell import (CellPhasors, draw_cell_offsets,
-                                             max_sigma_for_yield_cell, monte_carlo_cell,
-                                             verify_cell_draws)
+from rtsgeom.analysis.tolerance import CASES, draw_offsets, standard_draws
+from rtsgeom.analysis.tolerance_cell import (CellPhasors, max_sigma_for_yield_cell,
+                                             monte_carlo_cell, verify_cell_draws)
 from rtsgeom.geometry import build_setup
 from rtsgeom.scene import parse_scene
 
@@ -119,7 +118,7 @@ def test_common_radial_shift_moves_nothing(model):
 
 def test_uncalibrated_errors_scale_linearly_with_small_sigma(model):
     """The same unit draws at 5 and 10 um: the error change from nominal doubles (6 %)."""
-    z = draw_cell_offsets(3, 20, [1.0, 1.0, 1.0], len(model.cell))
+    z = draw_offsets(3, 20, [1.0, 1.0, 1.0], front_ends=len(model.cell))
     e0 = errors_deg(model, np.zeros((1,) + z.shape[1:]))["uncalibrated"]
     a = errors_deg(model, 5e-6 * z)["uncalibrated"] - e0
     b = errors_deg(model, 1e-5 * z)["uncalibrated"] - e0
@@ -137,7 +136,7 @@ def test_draws_do_not_depend_on_chunk_and_pair_stream_kept(model):
     from rtsgeom.analysis.arc import arc_draws
     for dist in ("normal", "uniform"):
         unit = next(arc_draws(5, 30, len(model.cell), dist, 30))["offsets"]
-        assert np.array_equal(unit, draw_cell_offsets(5, 30, [1.0] * 3, len(model.cell), dist))
+        assert np.array_equal(unit, draw_offsets(5, 30, [1.0] * 3, dist, len(model.cell)))
     # the pair study's stream is the front_ends=2 case, bit for bit
     old = np.random.default_rng(5).standard_normal((30, 2, 3))
     assert np.array_equal(next(standard_draws(5, 30, "normal", 30)), old)

@@ -166,11 +166,13 @@ def draw_chunks(seed: int, draws: int, sigma_m, distribution: str, chunk: int,
         yield DrawChunk(k, state, state_u, sigma, distribution, int(positions), int(centre))
 
 
-def draw_offsets(seed: int, draws: int, sigma_m, distribution: str = "normal") -> np.ndarray:
-    """All mounting errors (draws, 2, 3) of a study at once (the per-axis scale ``sigma_m``
-    (3,) is the standard deviation, or the bound of the uniform distribution)."""
-    z = list(standard_draws(seed, draws, distribution, max(draws, 1)))
-    z = z[0] if z else np.zeros((0, 2, 3))
+def draw_offsets(seed: int, draws: int, sigma_m, distribution: str = "normal",
+                 front_ends: int = 2) -> np.ndarray:
+    """All mounting errors (draws, front_ends, 3) of a study at once (the per-axis scale
+    ``sigma_m`` (3,) is the standard deviation, or the bound of the uniform distribution):
+    a pair's, or a cell's of ``front_ends`` (``tolerance_cell``)."""
+    z = list(standard_draws(seed, draws, distribution, max(draws, 1), front_ends))
+    z = z[0] if z else np.zeros((0, front_ends, 3))
     return z * np.asarray(sigma_m, float)
 
 

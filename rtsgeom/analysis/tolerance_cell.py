@@ -67,13 +67,13 @@ from ..geometry.setup import nominal_setup
 from ..paths import exact_paths
 from ..radar.steering import Steering
 from .tolerance import (AXES, CASES, DEFAULT_CHUNK, draws_header, Mapper, Progress, largest_passing_scale,
-                        percentiles, search_direction, standard_draws)
+                        percentiles, search_direction)
 from .arc import Bounds, _scale, arc_draws
 from .subbin import centre_index, subbin_positions
 from .tolerance_model import reference_target, response_table, slide
 
 __all__ = ["CellPhasors", "CellToleranceResult", "ANGLES", "monte_carlo_cell",
-           "max_sigma_for_yield_cell", "evaluate_cell_chunk", "draw_cell_offsets",
+           "max_sigma_for_yield_cell", "evaluate_cell_chunk",
            "verify_cell_draws"]
 
 ANGLES = ("azimuth", "elevation", "angular_distance")
@@ -326,14 +326,6 @@ def evaluate_cell_chunk(model: CellPhasors, offsets_m: np.ndarray, cases=CASES,
         out[case + "_fallbacks"] = int(np.count_nonzero(~d[case]["converged"]))
         out[case + "_off_bin"] = int(np.count_nonzero(d[case]["bin"]))
     return out
-
-
-def draw_cell_offsets(seed: int, draws: int, sigma_m, front_ends: int,
-                      distribution: str = "normal") -> np.ndarray:
-    """All mounting errors (draws, front_ends, 3) of a cell study at once (its first draws)."""
-    z = list(standard_draws(seed, draws, distribution, max(draws, 1), front_ends))
-    z = z[0] if z else np.zeros((0, front_ends, 3))
-    return z * np.asarray(sigma_m, float)
 
 
 @dataclass(frozen=True)

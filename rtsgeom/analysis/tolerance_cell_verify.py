@@ -13,7 +13,8 @@ from scipy.constants import c
 from ..paths import exact_paths
 from .arc import arc_draws
 from .tolerance import CASES
-from .tolerance_cell import CellPhasors, draw_cell_offsets
+from .tolerance import draw_offsets
+from .tolerance_cell import CellPhasors
 
 __all__ = ["verify_cell_draws"]
 
@@ -41,7 +42,7 @@ def verify_cell_draws(model: CellPhasors, sigma_m, n: int, seed: int,
     t0 = time.perf_counter()
     cell = list(model.cell)
     n_q, n_m = len(cell), model.set_rad.shape[0]
-    off = draw_cell_offsets(seed, n, sigma_m, n_q, distribution)
+    off = draw_offsets(seed, n, sigma_m, distribution, n_q)
     if positions is not None:
         sub = np.asarray(positions, int).reshape(n)
     elif subbin:

@@ -94,9 +94,9 @@ def tolerance_cell(args, scene, sigma, extra, stage) -> int:
                                    f"{tuple(model.cell)}")
         save_figure(fig, stage / "tolerance.png")
         write_json(stage / "tolerance.json", out)
-        from ..analysis.tolerance_cell import draw_cell_offsets
-        arrays = {"offsets_m": draw_cell_offsets(seed, res.draws, res.sigma_m, len(model.cell),
-                                                 res.distribution),
+        from ..analysis.tolerance import draw_offsets
+        arrays = {"offsets_m": draw_offsets(seed, res.draws, res.sigma_m, res.distribution,
+                                            len(model.cell)),
                   "cell": np.array(model.cell), "delay_s": res.delay_s,
                   "range_offset_m": res.range_offset_m,
                   "subbin_steps": (np.zeros(res.draws, int) if res.subbin_steps is None
