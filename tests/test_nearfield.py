@@ -13,7 +13,7 @@ from rtsgeom.cli import main
 from rtsgeom.geometry import build_setup
 from rtsgeom.geometry.farfield import curvature_phase_error_rad, fraunhofer_distance_m
 
-from conftest import DEFAULT_SCENE, make_scene
+from conftest import DEFAULT_SCENE, SETUP_ERRORS, make_scene, scenes_with_and_without_error
 
 RADII = np.array([0.5, 1.0, 3.0, 10.0, 30.0])
 SCENE_K = 1  # index of R_c = 1 m in RADII
@@ -170,3 +170,37 @@ def test_default_sweep_stops_at_the_radar_limit_and_ignores_targets_and_sheet():
     assert abs(nf.bias_deg[-1]).max() < abs(nf.bias_deg[0]).max()  # ~1/R
     with pytest.raises(Exception, match=r"must lie in \[0.05, 28.98\] m .*got 40 m"):
         nearfield(scene, np.array([1.0, 40.0]), points=3)
+
+
+def test_radius_sweep_keeps_its_ends_exactly(capsys):
+    """``--radius-m A:B:N`` is log-spaced with A and B exactly (logspace gave 0.04999..., which
+    the radius check then refused at its own minimum 0.05 m)."""
+    assert main(["nearfield", str(DEFAULT_SCENE), "--radius-m", "0.05:0.2:3", "--points", "3",
+                 "--json", "--quiet"]) == 0
+    radii = [r["radius_m"] for r in json.loads(capsys.readouterr().out)["radii"]]
+    assert radii[0] == 0.05 and radii[-1] == 0.2 and radii[1] == pytest.approx(0.1)
+
+
+@pytest.mark.parametrize("section, key, value", SETUP_ERRORS)
+def test_the_scenes_own_errors_do_not_enter_the_near_field(section, key, value):
+    """The near field of the arc is analysed on the nominal setup: the same report with or
+    without any one of the scene's own errors (a RuT yaw had turned the detected angles but
+    not the synthesis's set-points: 0.5 deg of yaw read as 0.5 deg of "exact" synthesis
+    error), and the CLI names the errors it leaves out."""
+    clean, moved = scenes_with_and_without_error(DEFAULT_SCENE, section, key, value)
+    a, b = (nearfield(s, [0.7, 2.0], points=3).to_dict() for s in (clean, moved))
+    assert a == b
+
+
+def test_nearfield_cli_names_the_errors_it_leaves_out(tmp_path, capsys):
+    text = DEFAULT_SCENE.read_text()
+    moved = tmp_path / "moved.toml"
+    moved.write_text(text.replace("[radar]\n", "[radar]\nyaw_offset_deg = 0.5\n", 1))
+    args = ["--radius-m", "0.7:2:2", "--points", "3", "--json", "--quiet"]
+    outs = []
+    for path in (DEFAULT_SCENE, moved):
+        assert main(["nearfield", str(path), *args]) == 0
+        cap = capsys.readouterr()
+        outs.append(json.loads(cap.out)["radii"])
+        assert ("radar.yaw_offset_deg" in cap.err) is (path == moved), cap.err
+    assert outs[0] == outs[1]

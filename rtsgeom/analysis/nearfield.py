@@ -67,6 +67,7 @@ from ..aoa.model import ChannelModel
 from ..aoa.synthesis import AngleUnreachable, PairModel
 from ..errors import ParameterError
 from ..geometry import RutArray, Setup, build_setup
+from ..geometry.setup import nominal_scene
 from ..geometry.farfield import (aperture_m, apparent_azimuth_rad, fraunhofer_distance_m,
                                  two_way_lengths)
 from ..paths import Paths, exact_paths
@@ -403,8 +404,11 @@ def nearfield(scene: Scene, radii=None, points: int = 11) -> NearField:
     two_d = False
     # The analysis places its own probe target (``probe_ranges``) and uses exact free-space
     # paths: the scene's targets and sheet play no part. Dropped, so that a radius where the
-    # targets would lie inside the arc, or the cutouts would overlap, is still analysed.
-    probe_scene = scene.evolve(targets=(), sheet=scene.sheet.evolve(enabled=False))
+    # targets would lie inside the arc, or the cutouts would overlap, is still analysed. It
+    # is the arc's near field, on the nominal setup (``nominal_scene``): a scene's own
+    # mounting, channel or RuT pose errors had entered the detected angles but not the
+    # synthesis's set-points (0.5 deg of RuT yaw read as 0.5 deg of "exact" synthesis error).
+    probe_scene = nominal_scene(scene).evolve(targets=(), sheet=scene.sheet.evolve(enabled=False))
     for r in radii:
         setup = build_setup(with_arc_radius(probe_scene, r))
         paths = exact_paths(setup)

@@ -123,3 +123,22 @@ class steps:
     def __exit__(self, exc_type, exc, tb):
         self._finish(failed=exc_type is not None)
         return False
+
+
+#: what ``tolerance`` and ``design`` do with the scene's own errors (warn_scene_errors)
+DRAWS_REPLACE = ("draws mounting errors about the nominal setup; the scene's own errors ({}) "
+                 "are not its starting point: each draw replaces them")
+
+
+def warn_scene_errors(scene, command: str, what: str = DRAWS_REPLACE) -> None:
+    """Say on stderr that ``command`` works on the nominal setup
+    (``geometry.setup.nominal_scene``) when the scene carries its own mounting, channel or RuT
+    pose errors (``geometry.setup.setup_errors``), which it does not start from (a new-user
+    trial wrote measured offsets into a scene and got the zero-offset scene's numbers).
+    ``what``: the sentence after the command, ``{}`` the fields."""
+    from ..geometry.setup import setup_errors
+    fields = setup_errors(scene)
+    if fields:
+        more = f" and {len(fields) - 3} more" if len(fields) > 3 else ""
+        print(f"rtsgeom: warning: {command} " + what.format(", ".join(fields[:3]) + more),
+              file=sys.stderr)

@@ -10,7 +10,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..io import write_json
 from ._common import (UsageError, load_scene_checked, number, output_folder, output_path,
-                      print_json, scene_arg, steps)
+                      print_json, scene_arg, steps, warn_scene_errors)
 
 
 def radius_sweep(text: str) -> tuple[float, float, int]:
@@ -76,9 +76,13 @@ def _nearfield_text(d: dict) -> str:
 def cmd_nearfield(args) -> int:
     from ..analysis.nearfield import default_radii, nearfield, nearfield_figure
     scene = load_scene_checked(args.scene)
-    radii = (default_radii(scene) if args.radius_m is None
-             else np.logspace(math.log10(args.radius_m[0]), math.log10(args.radius_m[1]),
-                              args.radius_m[2]))
+    warn_scene_errors(scene, "nearfield", "analyses the arc's near field on the nominal setup: "
+                      "the scene's own errors ({}) play no part")
+    if args.radius_m is None:
+        radii = default_radii(scene)
+    else:  # log-spaced with the ends exactly as given (logspace put 0.05 at 0.04999...)
+        radii = np.geomspace(*args.radius_m)
+        radii[[0, -1]] = args.radius_m[:2]
     with output_folder(args.out, [args.scene]) as stage:
         try:
             with steps(args.quiet or args.json) as step:

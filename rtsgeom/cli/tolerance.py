@@ -17,7 +17,7 @@ from ..geometry import build_setup
 from ..io import write_json
 from ..parallel import ClusterError, check_address, chunk_mapper
 from ._common import (UsageError, load_scene_checked, number, output_folder, output_path,
-                      print_json, scene_arg)
+                      print_json, scene_arg, warn_scene_errors)
 from .aoa import _pair, _pair_arg
 from .arc import coverage_spec
 
@@ -97,21 +97,6 @@ def _model(scene, pair_arg, points: int) -> PairPhasors:
     except AngleUnreachable as exc:  # the composite cannot reach a set angle
         raise UsageError(f"--pair {pair[0]} {pair[1]}: the pair cannot synthesize its span "
                          f"({exc})") from None
-
-
-def warn_scene_errors(scene, command: str) -> None:
-    """``tolerance`` and ``design`` draw mounting errors about the nominal setup
-    (``geometry.setup.nominal_setup``): say so on stderr when the scene carries its own
-    mounting, channel or RuT pose errors (``geometry.setup.setup_errors``), which the study
-    does not start from (a new-user trial wrote measured offsets into a scene and got the
-    zero-offset scene's numbers)."""
-    from ..geometry.setup import setup_errors
-    fields = setup_errors(scene)
-    if fields:
-        more = f" and {len(fields) - 3} more" if len(fields) > 3 else ""
-        print(f"rtsgeom: warning: {command} draws mounting errors about the nominal setup; "
-              f"the scene's own errors ({', '.join(fields[:3])}{more}) are not its starting "
-              "point: each draw replaces them", file=sys.stderr)
 
 
 def cmd_tolerance(args) -> int:
