@@ -157,7 +157,11 @@ def scene_info(setup: Setup, reachable: bool = False) -> dict:
         ],
     }
     if reachable:
-        out["reachable"] = reachable_spans(setup)
+        from .scene import SceneError
+        try:
+            out["reachable"] = reachable_spans(setup)
+        except SceneError as exc:  # a setup the synthesis does not model (its message says)
+            out["reachable_unavailable"] = str(exc)
     return out
 
 
@@ -219,6 +223,8 @@ def format_info(info: dict) -> str:
         lines.append(f"  spacing {i}-{i + 1}: {sp:.3f} deg "
                      f"({'within' if ok else 'EXCEEDS'} the angular resolution)")
     reach = info.get("reachable")
+    if info.get("reachable_unavailable"):
+        lines.append(f"reachable angles: not computed: {info['reachable_unavailable']}")
     if reach and reach.get("cells"):
         lines.append("reachable directions: each target in the cell of front ends that encloses "
                      "its direction cosines (as `run` plans it; 2-D cells, not arc pairs)")

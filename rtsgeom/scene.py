@@ -319,7 +319,9 @@ class RtsConfig(Evolvable):
     fractional_delay_taps: int = spec("fractional_delay_taps", "int", "FIR taps", 33,
                                       lo=3, hi=1025)
     compensate_air_path: bool = spec("compensate_air_path", "bool", "the RTS subtracts the "
-                                     "nominal 2 R_c / c0", True)
+                                     "nominal 2 R_c / c0 (false: the echoes lie R_c further; "
+                                     "the AoA synthesis and the studies on it refuse it, "
+                                     "run --amplitudes nearest runs)", True)
     aoa_mode: str = spec("aoa_mode", "str", "how target angles are set (see the AoA modes)",
                          "exact", choices=tuple(registry.AOA_MODES))
     calibration_span_s: tuple[float, float] = spec(

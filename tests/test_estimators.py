@@ -348,3 +348,18 @@ def test_run_cli_offers_the_registry_estimators(tmp_path, capsys):
     rc = main(["run", scene, "--out", str(tmp_path / "b"), "--estimator", "bartlett",
                "--subarray", "4", "--quiet"])
     assert rc == 2 and "radar.angle_subarray = 4" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("estimator", ["capon", "music"])
+def test_the_tolerance_model_refuses_a_smoothed_estimator(estimator, capsys):
+    """The tolerance model (tolerance, design, coverage design) designs for the beamformer's
+    peak and estimates the draws' angles there; a smoothed Capon or MUSIC peaks elsewhere
+    (they had reported NaN statistics, "composite splits" and 0 mm tolerances): a named
+    error, while without smoothing (rank one: they peak where Bartlett does) it runs."""
+    from rtsgeom.analysis.tolerance import PairPhasors
+    smoothed = make_scene(angle_estimator=estimator, angle_subarray=5)
+    with pytest.raises(SceneError, match=rf"radar.angle_estimator = {estimator} with "
+                                         r"radar.angle_subarray = 5"):
+        PairPhasors.build(build_setup(smoothed), (0, 1), points=3)
+    plain = make_scene(angle_estimator=estimator, angle_subarray=0)
+    assert np.isfinite(PairPhasors.build(build_setup(plain), (0, 1), points=3).amplitudes).all()

@@ -295,7 +295,23 @@ class PairPhasors:
         whether the calibrated plan exists at all).
 
         BLAS single-threaded: the tables' products are many and small (two threads took 2.4x
-        the CPU time of one for the same build)."""
+        the CPU time of one for the same build).
+
+        :class:`~rtsgeom.scene.SceneError` for an estimator that does not peak where the
+        beamformer does (Capon or MUSIC with spatial smoothing): the design is the closed
+        form for the beamformer's peak (``aoa.sweep.ratio_from_beams``) and the draws'
+        angles are its peak; those estimators' are not modelled (the ADC chain, ``calibrate``
+        and ``linearity``, runs them)."""
+        radar = setup.scene.radar
+        if radar.angle_estimator != "bartlett" and radar.angle_subarray > 0:
+            from ..scene import SceneError
+            raise SceneError(
+                f"radar.angle_estimator = {radar.angle_estimator} with radar.angle_subarray = "
+                f"{radar.angle_subarray}: the tolerance model (tolerance, design) designs the "
+                "amplitudes in closed form for the beamformer's peak and estimates the draws' "
+                "angles there; a smoothed Capon or MUSIC peaks elsewhere (0.37 deg on the "
+                "default scene), which it does not model: set angle_subarray = 0 (both then "
+                "peak where the beamformer does) or use the ADC chain (calibrate, linearity)")
         with single_threaded_blas():
             model = cls._build(setup, pair, points, range_m)
         return model.solved() if solve_bin_centre else model

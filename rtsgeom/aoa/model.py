@@ -92,6 +92,23 @@ class AngleUnreachable(ValueError):
     """The set angle lies outside what the front-end pair can synthesize."""
 
 
+def require_air_path_compensation(scene) -> None:
+    """:class:`~rtsgeom.scene.SceneError` (one line, exit 2) for an RTS that does not subtract
+    the air path (``rts.compensate_air_path = false``): its echoes appear about R_c beyond the
+    set range (``rts.requested_delay``), and the synthesis models, the calibration and the
+    studies built on them look for each echo at its set range's bin. Not modelled yet; a plain
+    program of the RTS (``run --amplitudes nearest``) is."""
+    from ..scene import SceneError
+    if not scene.rts.compensate_air_path:
+        raise SceneError(
+            "rts.compensate_air_path = false: the AoA synthesis, its calibration and the "
+            "studies built on them (calibrate, run and adc with synthesized amplitudes, "
+            "tolerance, design, nearfield, linearity) assume the RTS subtracts the air path, "
+            "so that each echo lies at its set range's bin; without it the echoes lie about "
+            f"R_c = {scene.rts.arc_radius_m:g} m further, which they do not model yet: set it "
+            "to true, or run the plain program (run --amplitudes nearest)")
+
+
 @dataclass(frozen=True)
 class ChannelModel:
     """The modelled RuT output of channels ``channels`` (Q,) for one target.
@@ -115,6 +132,7 @@ class ChannelModel:
         ``half_bins``: candidate range bins on either side of the set range's bin (the
         calibration sweep moves channel J by up to ~2 bins: it asks for more)."""
         scene, radar = setup.scene, setup.scene.radar
+        require_air_path_compensation(scene)
         ch = tuple(int(q) for q in channels)
         n_q = len(ch)
         dtau = np.zeros(n_q) if delta_tau_s is None else np.asarray(delta_tau_s, float)
