@@ -21,6 +21,7 @@ from rtsgeom.paths import exact_paths
 from rtsgeom.paths.table import TX_TO_FE
 from rtsgeom.radar_presets import PRESETS
 from rtsgeom.scene import SceneError, load_scene, loads_scene
+from conftest import make_scene
 
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT = ROOT / "scenes" / "diewald2022.toml"
@@ -363,25 +364,40 @@ def test_nearfield_bias_sign_follows_the_front_end_layout():
 # ------------------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("radius_m", [0.2, 1.0])
-def test_coverage_plan_respects_resolution_bias_and_cutouts(radius_m):
-    """The planned arc: spacing within the resolution (eq. 24), the outer front ends' detected
-    angles reach the coverage (bias compensated), and the sheet removed exactly when the
+COVERAGE_SETUPS = {"centred": None,
+                   "arc centre +0.1 m x": lambda d: d["rts"].update(arc_center_m=[0.1, 0.0, 0.0]),
+                   "arc centre -0.2 m y": lambda d: d["rts"].update(arc_center_m=[0.0, -0.2, 0.0]),
+                   "RuT turned 10 deg": lambda d: d["radar"].update(yaw_deg=10.0)}
+
+
+@pytest.mark.parametrize("radius_m, setup_name", [(0.2, "centred"), (0.2, "RuT turned 10 deg")]
+                         + [(1.0, name) for name in COVERAGE_SETUPS])
+def test_coverage_plan_respects_resolution_bias_and_cutouts(radius_m, setup_name):
+    """The planned arc: the outer front ends' detected angles reach the coverage (in the RuT's
+    frame: near-field bias compensated; off-centre arcs and a turned RuT had been placed in
+    the arc's frame, e.g. -4.3..15.5 deg detected for -10..10), neighbours at most the
+    resolution (eq. 24) apart as the RuT sees them, and the sheet removed exactly when the
     cutouts cannot fit the spacing."""
-    from rtsgeom.analysis.coverage import plan_arc, _bias_rad
-    scene = load_scene(DEFAULT)
+    from rtsgeom.analysis.coverage import _detected_rad, plan_arc
+    mutate = COVERAGE_SETUPS[setup_name]
+    scene = load_scene(DEFAULT) if mutate is None else make_scene(
+        lambda d: (d.update(targets=[]), mutate(d)))
     cov = (math.radians(-10.0), math.radians(10.0))
     for extra in (0, 1):
         plan = plan_arc(scene, cov, radius_m, extra)
-        assert plan.spacing_deg <= plan.resolution_deg * (1 + 1e-9)
-        detected = np.degrees(np.radians(plan.angles_deg) + _bias_rad(plan.scene))
-        assert detected[0] <= -10.0 + 0.02 and detected[-1] >= 10.0 - 0.02
+        detected, geometric = (np.degrees(x) for x in _detected_rad(plan.scene))
+        assert detected[0] == pytest.approx(-10.0, abs=0.002)
+        assert detected[-1] == pytest.approx(10.0, abs=0.002)
+        gaps = np.abs(np.diff(geometric))
+        assert gaps.max() <= plan.resolution_deg * (1 + 1e-9)
+        if mutate is None:  # centred: the arc's spacing is the RuT's, the fewest (+ extra)
+            assert plan.spacing_deg <= plan.resolution_deg * (1 + 1e-9)
+            assert plan.front_ends == math.ceil(
+                (plan.angles_deg[-1] - plan.angles_deg[0]) / plan.resolution_deg
+                - 1e-9) + 1 + extra
         fits = plan.spacing_deg >= plan.min_cutout_spacing_deg
         assert (plan.sheet == "disabled") == (not fits)
         assert ("cutout fit" in plan.binding) == (not fits)
-        assert plan.front_ends == math.ceil(
-            (plan.angles_deg[-1] - plan.angles_deg[0]) / plan.resolution_deg
-            - 1e-9) + 1 + extra
 
 
 def test_design_coverage_cli_prints_the_sheet_change(tmp_path, capsys):

@@ -4,8 +4,10 @@ For each arc radius the design chooses the number of front ends N and their (uni
 
 1. **Near-field bias.** A front end alone is detected ``bias`` off its module angle (Rx/Tx
    split, the RuT's Tx/Rx parallax, ~1/R_c; ``analysis.nearfield``). The synthesizable span
-   runs between the *detected* angles of the outer front ends, so they are placed at
-   ``A - bias_0`` and ``B - bias_last`` (two passes: the bias is measured on the placed arc).
+   runs between the *detected* angles of the outer front ends, so they are placed where the
+   RuT detects them at A and B (``A - bias_0``, ``B - bias_last`` on an arc centred on the
+   RuT: two passes, the bias measured on the placed arc; off-centre or with the RuT turned,
+   more passes take the frames' difference out too).
 2. **Resolution** (paper eq. 24). Neighbouring front ends at most 1.22 lambda / d_A apart seen
    from the RuT: ``N_min = ceil(span / resolution) + 1``; the candidates are ``N_min`` and
    ``N_min + 1`` (closer spacing, more hardware).
@@ -132,13 +134,20 @@ def _min_cutout_spacing_rad(scene: Scene, radius_m: float) -> float:
     return 2 * math.asin(min(1.0, 0.5 * sh.cutout_diameter_m / r)) if r > 0 else math.inf
 
 
-def _bias_rad(variant: Scene) -> np.ndarray:
-    """Detected minus module angle of each front end alone (near-field bias), radians."""
+def _detected_rad(variant: Scene) -> tuple[np.ndarray, np.ndarray]:
+    """Each front end alone as the RuT detects it and its module's geometric azimuth, both
+    seen from the RuT (radians): their difference is the near-field bias."""
     from ..aoa.calibration import probe_ranges
     from .nearfield import single_front_end_angles_rad
     setup = build_setup(variant)
     rng = float(probe_ranges(setup, 1)[0])
-    return single_front_end_angles_rad(setup, exact_paths(setup), rng) - setup.fe_azimuth_rad()
+    return single_front_end_angles_rad(setup, exact_paths(setup), rng), setup.fe_azimuth_rad()
+
+
+#: placement of the outer front ends: passes (at least two) until their detected angles miss
+#: the coverage's ends by less than this
+PLACE_TOL_RAD = math.radians(1e-3)
+PLACE_PASSES_MAX = 8
 
 
 def plan_arc(scene: Scene, coverage_rad: tuple[float, float], radius_m: float,
@@ -149,16 +158,44 @@ def plan_arc(scene: Scene, coverage_rad: tuple[float, float], radius_m: float,
     rut = build_setup(scene).rut
     res = angular_resolution_rad(rut)
     n_bare = max(2, math.ceil((b - a) / res * (1 - 1e-12)) + 1)
-    lo, hi = a, b
+    # the outer front ends' arc angles: start at the coverage's ends, measure where the RuT
+    # detects them and move each by what it misses (its near-field bias; where the arc is not
+    # centred on the RuT, or the RuT is turned, also the difference of the two frames), until
+    # they miss by less than PLACE_TOL_RAD (two passes on an arc centred on the RuT)
+    # (N from the widest gap the RuT sees between neighbours: on an arc centred on the RuT the
+    # arc's spacing; off-centre the arc's span scaled by the last pass's ratio of the RuT's
+    # widest gap to the arc's spacing)
+    ends = np.array([a, b])
     bias = np.zeros(2)
-    for _ in range(2):  # place, measure the bias of the outer front ends, place again
-        n = max(2, math.ceil((hi - lo) / res * (1 - 1e-12)) + 1) + extra
-        angles = np.linspace(lo, hi, n)
-        variant, _ = arc_scene(scene, radius_m, angles)
-        bias_all = _bias_rad(variant)
-        bias = bias_all[[0, -1]]
-        lo, hi = a - bias[0], b - bias[1]
-    n = max(2, math.ceil((hi - lo) / res * (1 - 1e-12)) + 1) + extra
+    widest = 1.0  # the RuT's widest neighbour gap over the arc's spacing (last pass)
+    slope, last = np.ones(2), None  # d(detected) / d(arc angle) of each end (secant)
+
+    def count(lo, hi):
+        return max(2, math.ceil(widest * (hi - lo) / res * (1 - 1e-12)) + 1) + extra
+
+    for k in range(PLACE_PASSES_MAX):
+        lo, hi = ends
+        n = count(lo, hi)
+        variant, _ = arc_scene(scene, radius_m, np.linspace(lo, hi, n))
+        det, geo = _detected_rad(variant)
+        bias = (det - geo)[[0, -1]]
+        if n > 1 and hi > lo:  # (at most 4: an arc that nearly reaches the RuT is refused
+            # by the scene rules when the design is evaluated)
+            ratio = float(np.max(np.abs(np.diff(geo)))) / ((hi - lo) / (n - 1))
+            widest = min(max(1.0, ratio), 4.0) if math.isfinite(ratio) else widest
+        if last is not None:
+            step = ends - last[0]
+            moved = det[[0, -1]] - last[1]
+            ok = np.abs(step) > 1e-12
+            slope = np.where(ok, moved / np.where(ok, step, 1.0), slope)
+            slope = np.clip(slope, 0.2, 5.0)
+        miss = np.array([a, b]) - det[[0, -1]]
+        last = (ends.copy(), det[[0, -1]])
+        ends = ends + miss / slope
+        if k >= 1 and np.max(np.abs(miss)) < PLACE_TOL_RAD:
+            break
+    lo, hi = (float(x) for x in ends)
+    n = count(lo, hi)
     angles = np.linspace(lo, hi, n)
     variant, sheet = arc_scene(scene, radius_m, angles)
     spacing = (hi - lo) / (n - 1)
