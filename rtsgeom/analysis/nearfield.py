@@ -329,9 +329,17 @@ class NearField:
         k = np.flatnonzero(np.isclose(self.radius_m, self.scene.rts.arc_radius_m, rtol=1e-9))
         return int(k[0]) if k.size else None
 
+    def _smoothed(self) -> bool:
+        radar = self.scene.radar
+        return radar.angle_estimator != "bartlett" and radar.angle_subarray > 0
+
     def bias_times_radius_deg_m(self) -> np.ndarray:
         """(F,) the 1/R coefficient of the bias: (separation + parallax) x R at the largest
-        radius (the closed forms; the detected bias x R agrees to ~1 % over the sweep)."""
+        radius (the closed forms of the beamformer's peak; the detected bias x R agrees to
+        ~1 % over the sweep); for a smoothed Capon or MUSIC, which peaks elsewhere (twice
+        the beamformer's bias on the default scene), the detected bias x R there."""
+        if self._smoothed():
+            return self.bias_deg[-1] * self.radius_m[-1]
         return (self.separation_deg[-1] + self.parallax_deg[-1]) * self.radius_m[-1]
 
     def to_dict(self) -> dict:
@@ -348,6 +356,9 @@ class NearField:
                                "phase-front curvature, not the first-order (1/R) bias from the "
                                "Rx/Tx separation and the RuT's Tx/Rx group parallax",
             "bias_1_over_r_coefficient_deg_m": fl(coef),
+            "bias_1_over_r_coefficient_from": (
+                "the detected bias at the largest radius (a smoothed estimator)"
+                if self._smoothed() else "the closed forms (separation + parallax)"),
             "radius_for_bias_below_deg": {
                 str(lim): fl(np.abs(coef) / lim) for lim in (0.1, 0.01)},
             "at_scene_radius": None if k is None else self._row(k),
