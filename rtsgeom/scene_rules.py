@@ -245,7 +245,8 @@ def _sheet_rules(scene, fail) -> None:
     r_sheet = rts.arc_radius_m + sheet.radius_offset_m
     if r_sheet <= 0.05:
         fail("sheet.radius_offset_m", sheet.radius_offset_m,
-             f"> {0.05 - rts.arc_radius_m:g} m (the sheet radius must stay positive)")
+             f"> {0.05 - rts.arc_radius_m:g} m (the sheet's inner radius, rts.arc_radius_m = "
+             f"{rts.arc_radius_m:g} m plus this, must exceed 0.05 m)")
         return
     for i, fe in enumerate(rts.front_ends):
         if fe.rx_offset_m is None or fe.tx_offset_m is None:

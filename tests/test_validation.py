@@ -696,3 +696,13 @@ def test_preset_board_gap_bounds_the_element_spacing(preset):
         else:
             with pytest.raises(SceneError, match=r"radar\.element_spacing_m.*at most"):
                 make_scene(edit)
+
+
+def test_a_sheet_at_the_smallest_arc_says_what_its_radius_must_exceed():
+    """arc_radius_m at its minimum (0.05 m) with the sheet on the arc: the message names the
+    sheet's inner radius limit, not a "positive radius" the offset 0 already has."""
+    from conftest import make_scene
+    with pytest.raises(SceneError, match=r"sheet.radius_offset_m = 0: must be > 0 m \(the "
+                                         r"sheet's inner radius, rts.arc_radius_m = 0.05 m plus "
+                                         r"this, must exceed 0.05 m\)"):
+        make_scene(lambda d: d["rts"].update(arc_radius_m=0.05))
