@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from rtsgeom.analysis.design import METRICS, design_grid, two_front_end_scene
+from rtsgeom.analysis.design import METRICS, design_grid, evaluate_design, two_front_end_scene
 from rtsgeom.analysis.tolerance import PairPhasors
 from rtsgeom.cli import main
 from rtsgeom.geometry import build_setup
@@ -197,3 +197,33 @@ def test_the_scenes_own_errors_do_not_enter_a_coverage_design(section, key, valu
     clean, moved = scenes_with_and_without_error(DEFAULT_SCENE, section, key, value)
     angles = np.radians([-8.0, 0.0, 8.0])
     assert arc_scene(moved, 1.2, angles) == arc_scene(clean, 1.2, angles)
+
+
+def test_a_valid_scene_whose_nominal_would_break_a_target_rule_is_still_designed():
+    """Zeroing a scene's negative radial offsets lengthens the air path, which lowers the
+    farthest target range the rules allow: a valid scene with a target just inside its limit
+    has an invalid nominal scene. The studies drop the targets; they must not refuse it
+    (design, coverage and nearfield had, after their variants were made nominal)."""
+    import re
+    from rtsgeom.analysis.coverage import arc_scene
+    from rtsgeom.analysis.nearfield import nearfield
+    from rtsgeom.geometry.setup import nominal_scene
+    from rtsgeom.scene import SceneError
+
+    def moved(range_m):
+        def mutate(d):
+            d["rts"].update(arc_center_m=[0.0, 0.1, 0.0])
+            for fe in d["rts"]["front_ends"]:
+                fe["radial_offset_mm"] = -5.0
+            d["targets"] = [dict(d["targets"][0], range_m=range_m)]
+        return make_scene(mutate)
+    with pytest.raises(SceneError) as far:
+        moved(1000.0)
+    limit = float(re.search(r"must be < ([0-9.]+) m", str(far.value)).group(1))
+    scene = moved(limit - 0.004)  # valid as built ...
+    with pytest.raises(SceneError, match="targets"):
+        nominal_scene(scene)  # ... not as designed
+    d = evaluate_design(scene, (0, 1), 1.0, math.radians(8), draws=40, points=3)
+    assert d["problem"] is None and math.isfinite(d["sigma_calibrated_mm"])
+    arc_scene(scene, 1.0, np.radians([-8.0, 0.0, 8.0]))
+    assert nearfield(scene, [1.0], points=3).radius_m.size == 1

@@ -525,3 +525,17 @@ def test_rut_yaw_error_shifts_every_synthesized_angle():
     drawn = np.degrees(res.errors["rut_yaw_rad"])
     for case in ("uncalibrated", "calibrated"):
         assert np.allclose(res.worst_error_deg[case][:, 0], -drawn, atol=2e-3)
+
+
+def test_coverage_plan_that_cannot_reach_the_coverage_has_no_design():
+    """An arc far off the RuT for its radius (R_c 0.2 m, centre 8 cm behind the RuT), where a
+    front end's detected angle jumps with its place: the placement does not converge, and
+    the design says so (NaN and the problem) instead of an arc short of the coverage
+    ("2 front ends at 4.44, 13.67 deg" detected at -10 .. 3.7 had passed as a design)."""
+    from rtsgeom.analysis.coverage import evaluate_arc, plan_arc
+    scene = make_scene(lambda d: (d.update(targets=[]),
+                                  d["rts"].update(arc_center_m=[0.0, -0.08, 0.0])))
+    plan = plan_arc(scene, (math.radians(-10.0), math.radians(10.0)), 0.2)
+    assert plan.problem is not None and "coverage's ends" in plan.problem
+    design = evaluate_arc(plan, draws=10, points=3)
+    assert design.problem == plan.problem

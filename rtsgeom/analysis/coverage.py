@@ -6,8 +6,9 @@ For each arc radius the design chooses the number of front ends N and their (uni
    split, the RuT's Tx/Rx parallax, ~1/R_c; ``analysis.nearfield``). The synthesizable span
    runs between the *detected* angles of the outer front ends, so they are placed where the
    RuT detects them at A and B (``A - bias_0``, ``B - bias_last`` on an arc centred on the
-   RuT: two passes, the bias measured on the placed arc; off-centre or with the RuT turned,
-   more passes take the frames' difference out too).
+   RuT: two or three passes, the bias measured on the placed arc; off-centre or with the
+   RuT turned, more passes take the frames' difference out too; where they do not converge,
+   the plan has no design and says why).
 2. **Resolution** (paper eq. 24). Neighbouring front ends at most 1.22 lambda / d_A apart seen
    from the RuT: ``N_min = ceil(span / resolution) + 1``; the candidates are ``N_min`` and
    ``N_min + 1`` (closer spacing, more hardware).
@@ -67,6 +68,7 @@ class ArcPlan:
     sheet_change: str  # what happened to the sheet, in words
     binding: tuple[str, ...]  # the binding constraints
     extra: int  # front ends beyond the fewest the resolution allows
+    problem: str | None = None  # why the placement has no design (it missed the coverage)
 
     def to_dict(self) -> dict:
         """The plan's JSON keys (the scene left out)."""
@@ -117,7 +119,7 @@ def arc_scene(scene: Scene, radius_m: float, angles_rad) -> tuple[Scene, str]:
     an arc of ``radius_m``, no targets, no mounting, channel or RuT pose errors
     (``geometry.setup.nominal_scene``); the sheet kept, widened or removed so its cutouts fit
     (``design._fit_sheet``). Returns the scene and the sheet's fate."""
-    scene = nominal_scene(scene)
+    scene = nominal_scene(scene, validate=False)  # (the variant: its own rules below)
     tmpl = scene.rts.front_ends[0]
     fes = tuple(dataclasses.replace(tmpl, angle_rad=float(a)) for a in angles_rad)
     rts = dataclasses.replace(scene.rts, arc_radius_m=float(radius_m), front_ends=fes)
@@ -145,9 +147,12 @@ def _detected_rad(variant: Scene) -> tuple[np.ndarray, np.ndarray]:
 
 
 #: placement of the outer front ends: passes (at least two) until their detected angles miss
-#: the coverage's ends by less than this
+#: the coverage's ends by less than this; a pass moves an end by at most PLACE_STEP_RAD; more
+#: than PLACE_FRONT_ENDS_MAX front ends, or ends that cross, stop it (the plan's problem)
 PLACE_TOL_RAD = math.radians(1e-3)
 PLACE_PASSES_MAX = 8
+PLACE_STEP_RAD = math.radians(10.0)
+PLACE_FRONT_ENDS_MAX = 64
 
 
 def plan_arc(scene: Scene, coverage_rad: tuple[float, float], radius_m: float,
@@ -161,7 +166,7 @@ def plan_arc(scene: Scene, coverage_rad: tuple[float, float], radius_m: float,
     # the outer front ends' arc angles: start at the coverage's ends, measure where the RuT
     # detects them and move each by what it misses (its near-field bias; where the arc is not
     # centred on the RuT, or the RuT is turned, also the difference of the two frames), until
-    # they miss by less than PLACE_TOL_RAD (two passes on an arc centred on the RuT)
+    # they miss by less than PLACE_TOL_RAD (two or three passes on an arc centred on the RuT)
     # (N from the widest gap the RuT sees between neighbours: on an arc centred on the RuT the
     # arc's spacing; off-centre the arc's span scaled by the last pass's ratio of the RuT's
     # widest gap to the arc's spacing)
@@ -171,8 +176,10 @@ def plan_arc(scene: Scene, coverage_rad: tuple[float, float], radius_m: float,
     slope, last = np.ones(2), None  # d(detected) / d(arc angle) of each end (secant)
 
     def count(lo, hi):
-        return max(2, math.ceil(widest * (hi - lo) / res * (1 - 1e-12)) + 1) + extra
+        n = max(2, math.ceil(widest * (hi - lo) / res * (1 - 1e-12)) + 1) + extra
+        return min(n, PLACE_FRONT_ENDS_MAX)
 
+    problem, miss, det = None, np.full(2, np.inf), np.array([a, b])
     for k in range(PLACE_PASSES_MAX):
         lo, hi = ends
         n = count(lo, hi)
@@ -190,10 +197,21 @@ def plan_arc(scene: Scene, coverage_rad: tuple[float, float], radius_m: float,
             slope = np.where(ok, moved / np.where(ok, step, 1.0), slope)
             slope = np.clip(slope, 0.2, 5.0)
         miss = np.array([a, b]) - det[[0, -1]]
-        last = (ends.copy(), det[[0, -1]])
-        ends = ends + miss / slope
         if k >= 1 and np.max(np.abs(miss)) < PLACE_TOL_RAD:
             break
+        last = (ends.copy(), det[[0, -1]])
+        new = ends + np.clip(miss / slope, -PLACE_STEP_RAD, PLACE_STEP_RAD)
+        if not new[0] < new[1] or count(*new) >= PLACE_FRONT_ENDS_MAX:
+            break  # (diverging: reported below)
+        ends = new
+    if not np.max(np.abs(miss)) < PLACE_TOL_RAD:
+        # the detected angle of an outer front end does not follow its place smoothly here
+        # (an arc far off the RuT for this radius): no design, rather than one short of
+        # the coverage
+        problem = (f"placement: the RuT detects the outer front ends at "
+                   f"{math.degrees(det[0]):.3f} and {math.degrees(det[-1]):.3f} deg, not at the "
+                   f"coverage's ends {math.degrees(a):g} and {math.degrees(b):g} deg (the arc is "
+                   "too far off the RuT for this radius)")
     lo, hi = (float(x) for x in ends)
     n = count(lo, hi)
     angles = np.linspace(lo, hi, n)
@@ -219,14 +237,14 @@ def plan_arc(scene: Scene, coverage_rad: tuple[float, float], radius_m: float,
     return ArcPlan(variant, float(radius_m), int(n), tuple(float(x) for x in np.degrees(angles)),
                    math.degrees(spacing), math.degrees(res), math.degrees(cut),
                    tuple(float(x) for x in np.degrees(bias)), sheet, sheet_text,
-                   tuple(binding), extra)
+                   tuple(binding), extra, problem)
 
 
 def evaluate_arc(plan: ArcPlan, spec_deg: float = 0.1, target_yield: float = 0.95,
                  draws: int = 200, seed: int = 0, points: int = 11) -> ArcDesign:
     """Worst calibrated / uncalibrated angle error over the coverage and the mounting tolerance
     for the yield of one planned arc (NaN and ``problem`` where it cannot be built)."""
-    problem = _problem(plan.scene)
+    problem = plan.problem or _problem(plan.scene)
     if problem is not None:
         return ArcDesign(plan, problem=problem)
     setup = build_setup(plan.scene)
