@@ -125,9 +125,20 @@ SETUP_ERRORS = [("fe", "radial_offset_mm", 0.3), ("fe", "tangential_offset_mm", 
                 ("fe", "pitch_offset_deg", -1.0), ("fe", "gain_offset_db", 0.7),
                 ("fe", "phase_offset_deg", 40.0), ("radar", "position_offset_mm", [0.4, -0.3, 0.2]),
                 ("radar", "yaw_offset_deg", 0.5)]
-ERROR_KEYS = {"fe": ("radial_offset_mm", "tangential_offset_mm", "height_offset_mm",
-                     "yaw_offset_deg", "pitch_offset_deg", "gain_offset_db", "phase_offset_deg"),
-              "radar": ("position_offset_mm", "yaw_offset_deg")}
+
+
+def _error_keys() -> dict:
+    """The file keys of ``geometry.setup.FRONT_END_ERRORS`` and ``RUT_POSE_ERRORS`` (the
+    schema's names for them, as ``setup_errors`` reports them)."""
+    from rtsgeom.geometry.setup import FRONT_END_ERRORS, RUT_POSE_ERRORS
+    from rtsgeom.scene import FrontEndConfig, RadarConfig
+    from rtsgeom.schema import specs
+    fe, radar = dict(specs(FrontEndConfig)), dict(specs(RadarConfig))
+    return {"fe": tuple(fe[n].key for n in FRONT_END_ERRORS),
+            "radar": tuple(radar[n].key for n in RUT_POSE_ERRORS)}
+
+
+ERROR_KEYS = _error_keys()
 
 
 def scenes_with_and_without_error(path: Path, section: str, key: str, value):

@@ -71,7 +71,7 @@ from ..geometry.setup import nominal_scene
 from ..geometry.farfield import (aperture_m, apparent_azimuth_rad, fraunhofer_distance_m,
                                  two_way_lengths)
 from ..paths import Paths, exact_paths
-from ..radar.steering import Steering
+from ..radar.steering import Steering, smoothed_estimator
 from ..rts import requested_delay
 from ..scene import Scene, TargetConfig
 from .nearfield2d import _cells, cell_synthesis_errors_deg, single_front_end_directions_rad
@@ -331,7 +331,7 @@ class NearField:
 
     def _smoothed(self) -> bool:
         radar = self.scene.radar
-        return radar.angle_estimator != "bartlett" and radar.angle_subarray > 0
+        return smoothed_estimator(radar.angle_estimator, radar.angle_subarray)
 
     def bias_times_radius_deg_m(self) -> np.ndarray:
         """(F,) the 1/R coefficient of the bias: (separation + parallax) x R at the largest

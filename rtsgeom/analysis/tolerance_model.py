@@ -64,6 +64,7 @@ from ..geometry.setup import nominal_setup
 from ..paths import exact_paths
 from ..radar.phasors import bin_response
 from ..radar.processing import refine_angles, tdm_compensate
+from ..radar.steering import smoothed_estimator
 from ..rts import (KIND_DIRECT, RtsProgram, channel_echoes, fir_modelled, fir_taps,
                    requested_delay)
 from ..scene import TargetConfig
@@ -303,7 +304,7 @@ class PairPhasors:
         angles are its peak; those estimators' are not modelled (the ADC chain, ``calibrate``
         and ``linearity``, runs them)."""
         radar = setup.scene.radar
-        if radar.angle_estimator != "bartlett" and radar.angle_subarray > 0:
+        if smoothed_estimator(radar.angle_estimator, radar.angle_subarray):
             from ..scene import SceneError
             raise SceneError(
                 f"radar.angle_estimator = {radar.angle_estimator} with radar.angle_subarray = "

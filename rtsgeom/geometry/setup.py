@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import TYPE_CHECKING
 
@@ -96,8 +96,7 @@ def nominal_scene(scene: Scene, validate: bool = True) -> Scene:
         return scene
     rts = scene.rts.evolve(front_ends=fes)
     if not validate:
-        import dataclasses
-        return dataclasses.replace(scene, rts=rts, radar=radar)
+        return replace(scene, rts=rts, radar=radar)
     return scene.evolve(rts=rts, radar=radar)  # validated again
 
 

@@ -29,7 +29,7 @@ from ..scene import RadarConfig, SceneError
 from . import estimators as est
 from .newton import lattice, newton, parabolic, peak_1d
 
-__all__ = ["Steering", "window"]
+__all__ = ["Steering", "window", "smoothed_estimator"]
 
 BLOCK = 4096  # snapshots per block of the Newton refinement (cache-sized)
 
@@ -80,6 +80,13 @@ def _taper(name: str, positions: np.ndarray) -> np.ndarray:
     return w
 
 
+def smoothed_estimator(estimator: str, subarray: int) -> bool:
+    """Whether the direction estimator ``estimator`` (``radar.angle_estimator``) with spatial
+    smoothing over ``subarray`` elements (``radar.angle_subarray``, 0 = none) peaks anywhere
+    but at the beamformer's peak: Capon or MUSIC with smoothing (:attr:`Steering.smoothing`)."""
+    return estimator != "bartlett" and subarray > 0
+
+
 @dataclass(frozen=True)
 class Steering:
     """Virtual positions, taper and element selection of the RuT's beamformer (eq. 14).
@@ -125,7 +132,7 @@ class Steering:
         """Whether the estimator differs from Bartlett's peak: Capon or MUSIC with spatial
         smoothing. Without smoothing the covariance of one snapshot is rank 1 and both peak
         exactly where Bartlett does (``radar.estimators``): the Bartlett search is used."""
-        return self.estimator != "bartlett" and self.subarray > 0
+        return smoothed_estimator(self.estimator, self.subarray)
 
     def _check_smoothing(self) -> None:
         field = f"radar.angle_subarray = {self.subarray}"
