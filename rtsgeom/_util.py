@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import sys
 
 import numpy as np
@@ -46,8 +47,6 @@ def single_threaded_blas():
 
 def one_blas_thread(func):
     """Decorator: ``func`` runs under :func:`single_threaded_blas`."""
-    import functools
-
     @functools.wraps(func)
     def wrapper(*args, **kwargs):
         with single_threaded_blas():

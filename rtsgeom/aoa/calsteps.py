@@ -238,10 +238,10 @@ def coarse_minimum(grid, errs) -> float:
     minima repeat every period; among the local minima about as deep as the deepest (within
     2 x the deepest + 0.01 deg) the one with the smallest |delta tau|, which costs the least
     range offset (paper, "Disadvantages"). The arc pair's and the 2-D pair's one rule."""
-    errs = np.asarray(errs, float)
+    errs, grid = np.asarray(errs, float), np.asarray(grid, float)
     is_min = (np.r_[True, errs[1:] <= errs[:-1]] & np.r_[errs[:-1] <= errs[1:], True])
     good = np.flatnonzero(is_min & (errs <= 2 * np.min(errs) + 0.01))
-    return float(np.asarray(grid)[int(good[np.argmin(np.abs(np.asarray(grid)[good]))])])
+    return float(grid[int(good[np.argmin(np.abs(grid[good]))])])
 
 
 def adds_noise(scene) -> bool:

@@ -37,7 +37,7 @@ from ..radar.steering import Steering
 from ..registry import SYNTHESIS_MODES
 from ..rts import (KIND_DIRECT, RtsProgram, channel_echoes, nominal_link_gain, requested_delay,
                    target_amplitude)
-from ..scene import TargetConfig
+from ..scene import SceneError, TargetConfig
 
 __all__ = ["ChannelModel", "AngleUnreachable", "SOLVERS", "estimator_ratio"]
 
@@ -98,7 +98,6 @@ def require_air_path_compensation(scene) -> None:
     set range (``rts.requested_delay``), and the synthesis models, the calibration and the
     studies built on them look for each echo at its set range's bin. Not modelled yet; a plain
     program of the RTS (``run --amplitudes nearest``) is."""
-    from ..scene import SceneError
     if not scene.rts.compensate_air_path:
         raise SceneError(
             "rts.compensate_air_path = false: the AoA synthesis, its calibration and the "

@@ -326,7 +326,7 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
             again, near = again or near_k != near, near_k
         if again:
             fine_t, e_fine, fit, cols = fine(near, k_fine)
-            best_fit, fitted = fit(e_fine[:, cols])
+            best_fit, _ = fit(e_fine[:, cols])
     best = float(realisable(best_fit, res))  # what the RTS can set
     best_err = float(rms_error_deg(signed(best, k_fine)))
     grid_pts = np.concatenate([grid, fine_t, [best]])

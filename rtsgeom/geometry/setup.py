@@ -78,8 +78,12 @@ def setup_errors(scene: Scene) -> list[str]:
     fe_key, radar_key = dict(specs(FrontEndConfig)), dict(specs(RadarConfig))
     out = [f"rts.front_ends[{q}].{fe_key[name].key}" for q, fe in enumerate(scene.rts.front_ends)
            for name in FRONT_END_ERRORS if getattr(fe, name) != 0.0]
-    return out + [f"radar.{radar_key[name].key}" for name in RUT_POSE_ERRORS
-                  if np.any(np.asarray(getattr(scene.radar, name)) != 0.0)]
+    return out + [f"radar.{radar_key[name].key}" for name in _rut_pose_errors(scene.radar)]
+
+
+def _rut_pose_errors(radar) -> list[str]:
+    """The fields of :data:`RUT_POSE_ERRORS` that are not zero."""
+    return [name for name in RUT_POSE_ERRORS if np.any(np.asarray(getattr(radar, name)) != 0.0)]
 
 
 def nominal_scene(scene: Scene, validate: bool = True) -> Scene:
@@ -90,7 +94,7 @@ def nominal_scene(scene: Scene, validate: bool = True) -> Scene:
     study drops anyway, beyond the range the rules allow)."""
     fes = tuple(f.evolve(**dict.fromkeys(FRONT_END_ERRORS, 0.0)) for f in scene.rts.front_ends)
     radar = scene.radar
-    if any(np.any(np.asarray(getattr(radar, name)) != 0.0) for name in RUT_POSE_ERRORS):
+    if _rut_pose_errors(radar):  # (zeroing every field of RUT_POSE_ERRORS)
         radar = radar.evolve(position_offset_m=(0.0, 0.0, 0.0), yaw_offset_rad=0.0)
     if fes == scene.rts.front_ends and radar is scene.radar:
         return scene

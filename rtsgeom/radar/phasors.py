@@ -37,9 +37,7 @@ def _tap_sums(taps: FirTaps, kern: np.ndarray, slope: float, f_d: float, t0: flo
     n_e, w, res = taps.samples, taps.weights, taps.residual_s
     n_t, n_s = w.shape[1], kern.shape[1]
     out = np.empty((n_e.size, kern.shape[0]), complex)
-    if n_e.size == 0:
-        return out
-    lo = int(n_e.min())
+    lo = int(n_e.min())  # (a group of bin_response's: one echo or more)
     m = lo - (n_t - 1) / 2 + np.arange(int(n_e.max()) - lo + n_t)  # whole-sample delays
     tone = tones(slope * taps.sample_period_s * m + f_d, t0, dt, n_s)  # (M, N)
     q = tone @ kern.T  # (M, C)
@@ -91,7 +89,7 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
     kern_r = w_r * np.exp(-2j * np.pi * np.outer(r, n) / n_s)  # (K, N)
     t0, dt = radar.adc_start_s, 1.0 / radar.adc_rate_hz
     tau_air = echoes.tau_air_s
-    if len(echoes) and np.all(tau_air == tau_air[:1]):  # one geometry (a delay table's block)
+    if np.all(tau_air == tau_air[:1]):  # one geometry (a delay table's block)
         air, group = tau_air[:1], None  # (no groups to tell apart)
     else:
         air, group = np.unique(tau_air, axis=0, return_inverse=True)
