@@ -43,7 +43,6 @@ import tomllib
 from pathlib import Path
 
 import numpy as np
-from scipy.constants import c
 
 from benchmarks._io import write_json
 
@@ -77,11 +76,6 @@ def scene_doc(phase_deg: float = 0.0, radius_m: float = 1.0, el_deg: float = 5.0
 def parse(doc):
     from rtsgeom.scene import parse_scene
     return parse_scene(doc, str(SCENE))
-
-
-def bin_m(scene) -> float:
-    r = scene.radar
-    return c * r.adc_rate_hz / (2 * r.slope_hz_per_s * r.samples_per_chirp)
 
 
 class Bench:
@@ -192,7 +186,7 @@ class Bench:
 
 def edge_range(range_m: float, sub_bin: float) -> float:
     """A range near ``range_m`` at ``sub_bin`` bins from its bin's centre (sphere4's bin)."""
-    w = bin_m(parse(scene_doc()))
+    w = parse(scene_doc()).radar.range_resolution_m
     return float((np.round(range_m / w) + sub_bin) * w)
 
 
@@ -238,7 +232,7 @@ def case(name: str, doc: dict, seed_frames: int = 8) -> dict:
     prog_q, setup_q, paths_q = b.program(ideal_cont, scene=sc_q)
     out["no_quant"] = b.chain(setup_q, paths_q, prog_q, None, scene.seed)
     # each target at the centre of its range bin
-    w = bin_m(scene)
+    w = scene.radar.range_resolution_m
     centred = [(np.round(t.range_m / w) * w, np.degrees(t.angle_rad), np.degrees(t.elevation_rad))
                for t in scene.targets]
     sc_c = parse(set_targets(doc, centred))

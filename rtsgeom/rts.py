@@ -175,7 +175,11 @@ class Echoes:
         return cls(**out)
 
     def select(self, mask) -> "Echoes":
+        """The echoes where ``mask`` (E,) is True (this table itself where it is True
+        everywhere: its fields are read-only, a copy of every field would buy nothing)."""
         m = np.asarray(mask, bool)
+        if m.shape == (len(self),) and m.all():
+            return self
         return Echoes(**{n: (None if getattr(self, n) is None else frozen(getattr(self, n)[m]))
                          for n in self.__dataclass_fields__})
 
@@ -489,9 +493,7 @@ def channel_echoes(setup: Setup, paths: Paths, program: RtsProgram) -> Echoes:
         fast_gain=None if fir is None else frozen(fir),
     )
     ghosts = cable_ghosts(scene, direct)
-    keep = np.any(direct.amplitude != 0, axis=1)
-    if not keep.all():  # (selecting all would only copy every field)
-        direct = direct.select(keep)
+    direct = direct.select(np.any(direct.amplitude != 0, axis=1))
     return Echoes.concat([direct, ghosts]) if len(ghosts) else direct
 
 

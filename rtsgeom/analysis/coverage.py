@@ -171,7 +171,6 @@ def plan_arc(scene: Scene, coverage_rad: tuple[float, float], radius_m: float,
     # arc's spacing; off-centre the arc's span scaled by the last pass's ratio of the RuT's
     # widest gap to the arc's spacing)
     ends = np.array([a, b])
-    bias = np.zeros(2)
     widest = 1.0  # the RuT's widest neighbour gap over the arc's spacing (last pass)
     slope, last = np.ones(2), None  # d(detected) / d(arc angle) of each end (secant)
 
@@ -179,14 +178,13 @@ def plan_arc(scene: Scene, coverage_rad: tuple[float, float], radius_m: float,
         n = max(2, math.ceil(widest * (hi - lo) / res * (1 - 1e-12)) + 1) + extra
         return min(n, PLACE_FRONT_ENDS_MAX)
 
-    problem, miss, det = None, np.full(2, np.inf), np.array([a, b])
-    for k in range(PLACE_PASSES_MAX):
+    for k in range(PLACE_PASSES_MAX):  # (at least one pass: det, bias, miss are set)
         lo, hi = ends
         n = count(lo, hi)
         variant, _ = arc_scene(scene, radius_m, np.linspace(lo, hi, n))
         det, geo = _detected_rad(variant)
         bias = (det - geo)[[0, -1]]
-        if n > 1 and hi > lo:  # (at most 4: an arc that nearly reaches the RuT is refused
+        if hi > lo:  # (at most 4: an arc that nearly reaches the RuT is refused
             # by the scene rules when the design is evaluated)
             ratio = float(np.max(np.abs(np.diff(geo)))) / ((hi - lo) / (n - 1))
             widest = min(max(1.0, ratio), 4.0) if math.isfinite(ratio) else widest
@@ -204,6 +202,7 @@ def plan_arc(scene: Scene, coverage_rad: tuple[float, float], radius_m: float,
         if not new[0] < new[1] or count(*new) >= PLACE_FRONT_ENDS_MAX:
             break  # (diverging: reported below)
         ends = new
+    problem = None
     if not np.max(np.abs(miss)) < PLACE_TOL_RAD:
         # the detected angle of an outer front end does not follow its place smoothly here
         # (an arc far off the RuT for this radius): no design, rather than one short of

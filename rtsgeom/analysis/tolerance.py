@@ -71,7 +71,7 @@ def standard_draws(seed: int, draws: int, distribution: str = "normal",
     rng = np.random.default_rng(seed)
     chunk = max(1, int(chunk))
     for start in range(0, draws, chunk):
-        yield _unit_block(rng, min(chunk, draws - start), distribution, front_ends)
+        yield unit_block(rng, (min(chunk, draws - start), front_ends, 3), distribution)
 
 
 def subbin_draws(seed: int, draws: int, positions: int, chunk: int = DEFAULT_CHUNK
@@ -100,11 +100,6 @@ def unit_block(rng: np.random.Generator, shape, distribution: str) -> np.ndarray
     if distribution == "normal":
         return rng.standard_normal(shape)
     return rng.uniform(-1.0, 1.0, shape)
-
-
-def _unit_block(rng: np.random.Generator, k: int, distribution: str, front_ends: int = 2):
-    """The next ``k`` unit-scale draws of :func:`standard_draws`' stream ``rng``."""
-    return unit_block(rng, (k, front_ends, 3), distribution)
 
 
 def _subbin_block(rng: np.random.Generator, k: int, positions: int) -> np.ndarray:
@@ -137,7 +132,8 @@ class DrawChunk:
 
     def offsets(self) -> np.ndarray:
         """The chunk's mounting errors (k, 2, 3) (m)."""
-        return _unit_block(_generator_at(self.state), self.k, self.distribution) * self.sigma_m
+        return (unit_block(_generator_at(self.state), (self.k, 2, 3), self.distribution)
+                * self.sigma_m)
 
     def subbin(self) -> np.ndarray:
         """The chunk's sub-bin indices (k,)."""
@@ -158,7 +154,7 @@ def draw_chunks(seed: int, draws: int, sigma_m, distribution: str, chunk: int,
     for start in range(0, draws, chunk):
         k = min(chunk, draws - start)
         state = rng.bit_generator.state
-        _unit_block(rng, k, distribution)
+        unit_block(rng, (k, 2, 3), distribution)
         state_u = None
         if rng_u is not None:
             state_u = rng_u.bit_generator.state

@@ -105,9 +105,9 @@ def response_table(setup: Setup, paths, channel: int, target: TargetConfig, reso
     # (res / t_s of them per step, (N,) each, three arrays)
     per_step = len(channel_echoes(setup, paths, RtsProgram.build(
         [0], [channel], [tau], [0.0], [1.0])))
-    n_s, taps = radar.samples_per_chirp, scene.rts.fractional_delay_taps
+    n_s, n_taps = radar.samples_per_chirp, scene.rts.fractional_delay_taps
     row = (per_step * 16 * rut.num_virtual * n_s * 4 if not fir_modelled(scene) else
-           per_step * 16 * (2 * taps + 4 * rut.num_virtual * rbins.size)
+           per_step * 16 * (2 * n_taps + 4 * rut.num_virtual * rbins.size)
            + 48 * n_s * resolution_s * scene.rts.f_s_hz)
     block = max(1, int(_TABLE_BYTES // row))
     out = np.empty((steps.size, rbins.size, rut.num_virtual), complex)
@@ -116,11 +116,10 @@ def response_table(setup: Setup, paths, channel: int, target: TargetConfig, reso
         prog = RtsProgram.build(np.arange(k.size), np.full(k.size, channel),
                                 tau + k * resolution_s, np.zeros(k.size), np.ones(k.size))
         ech = channel_echoes(setup, paths, prog)
-        if np.any(ech.kind != KIND_DIRECT):  # (none: see above)
-            ech = ech.select(ech.kind == KIND_DIRECT)
+        ech = ech.select(ech.kind == KIND_DIRECT)  # (none other: see above)
         # (what channel_echoes forms as fast_gain: rts.fir_if_gain of the same delays)
-        taps = fir_taps(scene, ech.tau_if_s, ech.tau_if_s + ech.tau_air_s.mean(axis=1))
-        resp = bin_response(ech, radar, rut, rbins, dbin, taps)  # (K, E, V)
+        fir = fir_taps(scene, ech.tau_if_s, ech.tau_if_s + ech.tau_air_s.mean(axis=1))
+        resp = bin_response(ech, radar, rut, rbins, dbin, fir)  # (K, E, V)
         acc = np.zeros((k.size,) + resp.shape[::2], complex)  # each target's echoes summed
         np.add.at(acc, ech.target, np.swapaxes(resp, 0, 1))  # (a one-hot einsum was 15 %)
         out[b:b + block] = acc
