@@ -64,8 +64,8 @@ def _peak_mib(f) -> float:
 
 def bench_synthesis(scene_path: Path, paths_method: str, repeat: int) -> dict:
     from rtsgeom.radar.fmcw import synthesize, synthesize_exact
-    from rtsgeom.run import run_scene
-    from rtsgeom.scene import load_scene
+    from rtsgeom.pipeline.run import run_scene
+    from rtsgeom.scene.scene import load_scene
     result = run_scene(load_scene(scene_path), paths_method)
     ech, radar, rut = result.echoes, result.scene.radar, result.setup.rut
     t_fast, fast = _best(lambda: synthesize(ech, radar, rut), repeat)
@@ -93,9 +93,9 @@ def bench_synthesis(scene_path: Path, paths_method: str, repeat: int) -> dict:
 
 def bench_tolerance(scene_path: Path, draws: int) -> dict:
     """Monte-Carlo tolerance draws (phasor level, 21 set-points, uncalibrated + calibrated)."""
-    from rtsgeom.analysis.tolerance import PairPhasors, monte_carlo
+    from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
     from rtsgeom.geometry import build_setup
-    from rtsgeom.scene import load_scene
+    from rtsgeom.scene.scene import load_scene
     model = PairPhasors.build(build_setup(load_scene(scene_path)), (0, 1), points=21)
     sigma = [1e-4, 1e-4, 1e-4]
     monte_carlo(model, sigma, 1000, 0)  # warm-up
@@ -178,8 +178,8 @@ def bench_commands(scene_path: Path, quick: bool, repeat: int, workers: int) -> 
     import tempfile
     from rtsgeom.radar.fmcw import synthesize, synthesize_exact
     from rtsgeom.radar.processing import cfar_mask, detect, range_doppler
-    from rtsgeom.run import run_scene
-    from rtsgeom.scene import load_scene
+    from rtsgeom.pipeline.run import run_scene
+    from rtsgeom.scene.scene import load_scene
     scene_arg = str(scene_path)
     scene = load_scene(scene_path)
     out: dict = {}
@@ -244,7 +244,7 @@ def bench_design_parts(scene, quick: bool) -> dict:
     set-points each, counted)."""
     import math
     from rtsgeom.analysis.design import two_front_end_scene
-    from rtsgeom.analysis.tolerance import CASES, PairPhasors, max_sigma_for_yield
+    from rtsgeom.analysis.tolerance.driver import CASES, PairPhasors, max_sigma_for_yield
     from rtsgeom.geometry import build_setup
     radii = np.linspace(0.5, 2.0, 2 if quick else 4)
     spacings = np.linspace(4.0, 20.0, 2 if quick else 5)
@@ -282,10 +282,10 @@ def bench_dask_scaling(scene_path: Path, draws: int, workers: int) -> dict:
     model to the workers, once per client: the scaling of the study itself).
     (The CLI's ``--workers N`` forks a process pool instead, with no cluster to start; ``--dask
     ADDRESS`` runs on a cluster like this one, sent per chunk the draw streams' states.)"""
-    from rtsgeom.analysis.tolerance import PairPhasors, monte_carlo
+    from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
     from rtsgeom.geometry import build_setup
-    from rtsgeom.parallel import dask_client, map_chunks
-    from rtsgeom.scene import load_scene
+    from rtsgeom._lib.parallel import dask_client, map_chunks
+    from rtsgeom.scene.scene import load_scene
     model = PairPhasors.build(build_setup(load_scene(scene_path)), (0, 1), points=21)
     sigma = [1e-4, 1e-4, 1e-4]
     out = {"draws": draws, "workers": workers}
@@ -404,7 +404,7 @@ def main(argv=None) -> int:
     m = results["machine"]
     print(f"load average before/after: {m['load_average_before'][0]:.1f} / "
           f"{m['load_average_after'][0]:.1f} on {m['cpus']} CPUs")
-    from rtsgeom.io import write_json
+    from rtsgeom._lib.io import write_json
     write_json(args.out, results)
     print(f"wrote {args.out}")
     return 0

@@ -52,10 +52,10 @@ def variant(scene, radius_m: float, fe: int | None, dr_m: float, noiseless: bool
 
 def nominal_point(scene_path: str, radius_m: float, noiseless: bool) -> dict:
     """Coherence point of the nominal setup at this radius (phasor model)."""
-    from rtsgeom.aoa.calibration import coherence_delay, probe_angles, probe_front_ends
+    from rtsgeom.calibration.pair import coherence_delay, probe_angles, probe_front_ends
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene import load_scene
+    from rtsgeom.scene.scene import load_scene
     scene = variant(load_scene(scene_path), radius_m, None, 0.0, noiseless)
     setup = build_setup(scene)
     paths = exact_paths(setup)
@@ -68,12 +68,12 @@ def nominal_point(scene_path: str, radius_m: float, noiseless: bool) -> dict:
 
 def one_case(args: tuple) -> dict:
     scene_path, radius_m, fe, dr_m, noiseless, nominal_s, lin_points = args
-    from rtsgeom.aoa.calibration import (air_phase_slope_hz, calibrate_pair, coherence_delay,
-                                         if_phase_slope_hz, probe_angles, probe_front_ends,
-                                         probe_ranges)
+    from rtsgeom.calibration.pair import (air_phase_slope_hz, calibrate_pair, coherence_delay,
+                                          if_phase_slope_hz, probe_angles, probe_front_ends,
+                                          probe_ranges)
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene import load_scene
+    from rtsgeom.scene.scene import load_scene
     t0 = time.perf_counter()
     scene = variant(load_scene(scene_path), radius_m, fe, dr_m, noiseless)
     setup = build_setup(scene)
@@ -92,7 +92,7 @@ def one_case(args: tuple) -> dict:
         return float((x + period / 2) % period - period / 2)
     lin = {}
     if lin_points:
-        from rtsgeom.aoa.linearity import linearity
+        from rtsgeom.analysis.linearity import linearity
         res = linearity(setup, paths, PAIR, "exact", probe, cal, lin_points, scene.seed)
         lin = {"linearity_max_abs_deg": res.max_abs_error_deg}
     return {**lin, "radius_m": radius_m, "front_end": fe, "radial_offset_mm": round(dr_m * 1e3, 6),

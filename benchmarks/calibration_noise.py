@@ -38,7 +38,7 @@ def linked(nf_db: float | None):
     (None: no link, noiseless), parsed as a scene file would be."""
     import tomllib
 
-    from rtsgeom.scene import parse_scene
+    from rtsgeom.scene.scene import parse_scene
     doc = tomllib.loads(DEFAULT_SCENE.read_text())
     doc["radar"].pop("snr_db", None)
     if nf_db is not None:
@@ -47,7 +47,7 @@ def linked(nf_db: float | None):
 
 
 def run(nf_db=(12.0, 30.0, 40.0, 45.0, 50.0), seeds=range(5)) -> dict:
-    from rtsgeom.aoa.calibration import calibrate_pair, probe_front_ends
+    from rtsgeom.calibration.pair import calibrate_pair, probe_front_ends
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     quiet = build_setup(linked(None))

@@ -33,7 +33,7 @@ PAIR = (0, 1)
 
 def scene(res_ps: float, radius_m: float, dr_mm: float):
     import tomllib
-    from rtsgeom.scene import parse_scene
+    from rtsgeom.scene.scene import parse_scene
     doc = tomllib.loads(DEFAULT_SCENE.read_text())
     doc["radar"].pop("snr_db", None)
     rts = doc["rts"]
@@ -47,9 +47,9 @@ def scene(res_ps: float, radius_m: float, dr_mm: float):
 
 def staircase_point(setup, paths, alphas, near_s: float) -> float:
     """The old ``coherence_delay``: Newton on the quantised model's phase (a staircase)."""
-    from rtsgeom.aoa.calibration import if_phase_slope_hz, probe_ranges, probe_total_delay
-    from rtsgeom.aoa.synthesis import PairModel
-    from rtsgeom.scene import TargetConfig
+    from rtsgeom.calibration.pair import if_phase_slope_hz, probe_ranges, probe_total_delay
+    from rtsgeom.synthesis.closed_form import PairModel
+    from rtsgeom.scene.scene import TargetConfig
     ranges = probe_ranges(setup, 2)
     f_if = float(if_phase_slope_hz(setup.scene, probe_total_delay(setup, ranges)))
 
@@ -66,8 +66,8 @@ def staircase_point(setup, paths, alphas, near_s: float) -> float:
 
 
 def run(res_ps=(1, 5, 10, 25, 50, 100, 250), radii=(1.0, 3.0), offsets_mm=(0.0, 0.3, -0.6)):
-    from rtsgeom.aoa.calibration import (calibrate_pair, coherence_point, probe_angles,
-                                         probe_front_ends)
+    from rtsgeom.calibration.pair import (calibrate_pair, coherence_point, probe_angles,
+                                          probe_front_ends)
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     s1 = build_setup(scene(1.0, 1.0, 0.0))

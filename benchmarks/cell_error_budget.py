@@ -74,7 +74,7 @@ def scene_doc(phase_deg: float = 0.0, radius_m: float = 1.0, el_deg: float = 5.0
 
 
 def parse(doc):
-    from rtsgeom.scene import parse_scene
+    from rtsgeom.scene.scene import parse_scene
     return parse_scene(doc, str(SCENE))
 
 
@@ -82,7 +82,7 @@ class Bench:
     """One scene: setup, paths, probe, the measured and the ideal calibration."""
 
     def __init__(self, scene):
-        from rtsgeom.aoa.calibration import probe_front_ends
+        from rtsgeom.calibration.pair import probe_front_ends
         from rtsgeom.geometry import build_setup
         from rtsgeom.paths import compute_paths
         self.scene = scene
@@ -93,14 +93,14 @@ class Bench:
         self.ideal = None
 
     def used(self):
-        from rtsgeom.aoa.calibration import nominal_model
-        from rtsgeom.aoa.plan_cells import target_cells
+        from rtsgeom.calibration.pair import nominal_model
+        from rtsgeom.pipeline.plan_cells import target_cells
         nom, _ = nominal_model(self.setup, self.paths)
         _, _, found = target_cells(nom)
         return sorted({q for cell, _ in found for q in cell})
 
     def calibrate(self):
-        from rtsgeom.aoa.ncal import calibrate_channels
+        from rtsgeom.calibration.channels import calibrate_channels
         self.cal = calibrate_channels(self.setup, self.paths, self.used(), self.probe)
         return self.cal
 
@@ -108,8 +108,8 @@ class Bench:
         """``cal`` with its tree pairs at their continuous coherence points."""
         import dataclasses
 
-        from rtsgeom.aoa.calsteps import realisable
-        from rtsgeom.aoa.ncal import coherence_point_nd
+        from rtsgeom.calibration.steps import realisable
+        from rtsgeom.calibration.channels import coherence_point_nd
         meas = {tuple(p["pair"]): p for p in cal.pairs}
         off = np.zeros(self.setup.fe.count)
         per = float(np.median([p["period_s"] for p in cal.pairs]))
@@ -127,7 +127,8 @@ class Bench:
 
     def program(self, cal, mode="exact", scene=None):
         """plan_cells with ``cal`` as the channel calibration (its measurement skipped)."""
-        from rtsgeom.aoa import ncal, plan_cells
+        from rtsgeom.calibration import channels as ncal
+        from rtsgeom.pipeline import plan_cells
         from rtsgeom.geometry import build_setup
         from rtsgeom.paths import compute_paths
         setup, paths = self.setup, self.paths
@@ -147,7 +148,7 @@ class Bench:
         """(az, el) errors (deg) (T, 2) of one frame through the ADC-cube chain."""
         from rtsgeom.radar import process
         from rtsgeom.radar.frame import simulate
-        from rtsgeom.run import match_targets
+        from rtsgeom.pipeline.run import match_targets
         _, cube = simulate(setup, paths, prog, seed, snr_db)
         rd, det = process(cube)
         out = []
@@ -163,9 +164,9 @@ class Bench:
         next."""
         import dataclasses
 
-        from rtsgeom.aoa.model import ChannelModel
+        from rtsgeom.synthesis.model import ChannelModel
         from rtsgeom.radar.steering import Steering
-        from rtsgeom.rts import requested_delay
+        from rtsgeom.rts.channels import requested_delay
         scene = setup.scene
         st = Steering.auto(setup.rut, scene.radar)
         errs, margins = [], []
@@ -289,7 +290,7 @@ def cases(quick: bool):
 def ideal_tree_calibration(b: Bench, tree=((0, 1), (0, 2), (1, 3))):
     """A calibration whose tree pairs sit at their continuous coherence points nearest zero
     (rounded to 1 ps), without measuring: the reference the noise study designs on."""
-    from rtsgeom.aoa.ncal import ChannelCalibration, coherence_point_nd
+    from rtsgeom.calibration.channels import ChannelCalibration, coherence_point_nd
     off = np.zeros(b.setup.fe.count)
     for p, q in tree:
         off[q] = off[p] + coherence_point_nd(b.setup, b.paths, (p, q), b.probe, 0.0)
@@ -315,7 +316,7 @@ def noise_study(doc: dict, frames: int = 40) -> dict:
     errs, snrs = [], []
     from rtsgeom.radar import process
     from rtsgeom.radar.frame import simulate
-    from rtsgeom.run import match_targets
+    from rtsgeom.pipeline.run import match_targets
     for s in range(frames):
         _, cube = simulate(setup, paths, prog, 100 + s, setup.scene.radar.snr_db)
         rd, det = process(cube)
@@ -349,11 +350,11 @@ def noise_study(doc: dict, frames: int = 40) -> dict:
 
 def frames_study(doc: dict, runs) -> list[dict]:
     """The proposed fix measured: the channel calibration with ``k`` coherently averaged
-    frames per sweep step (its SNR raised by 10 log10 k, as ``calibration._simulate_detect``
+    frames per sweep step (its SNR raised by 10 log10 k, as ``calibration.simulate_detect``
     averages) for each ``(k, seed)`` of ``runs``; each tree pair's distance from its
     continuous coherence point and the targets' noiseless and one-frame (the scene's
     ``snr_db``) errors with that calibration."""
-    from rtsgeom.aoa.ncal import calibrate_channels, coherence_point_nd
+    from rtsgeom.calibration.channels import calibrate_channels, coherence_point_nd
     b0 = Bench(parse(doc))
     cps, out = {}, []
     for k, seed in runs:

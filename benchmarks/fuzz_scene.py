@@ -1,7 +1,7 @@
 """Fuzz the scene loader: mutated documents and mutated bytes of the default scene.
 
-Every input must end in a valid :class:`~rtsgeom.scene.Scene` (all numbers finite, and
-``scene_warnings`` runs on it) or in a :class:`~rtsgeom.scene.SceneError` whose message starts
+Every input must end in a valid :class:`~rtsgeom.scene.scene.Scene` (all numbers finite, and
+``scene_warnings`` runs on it) or in a :class:`~rtsgeom.scene.scene.SceneError` whose message starts
 with the source name; anything else (another exception, a NaN, an input slower than
 ``--max-seconds``) is reported and the exit code is 1.
 
@@ -31,8 +31,8 @@ import tomllib
 import traceback
 from pathlib import Path
 
-from rtsgeom.scene import SceneError, loads_scene, parse_scene
-from rtsgeom.validate import scene_warnings
+from rtsgeom.scene.scene import SceneError, loads_scene, parse_scene
+from rtsgeom.geometry.warnings import scene_warnings
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_SCENE = ROOT / "scenes" / "diewald2022.toml"

@@ -30,15 +30,15 @@ EQUIVALENT: dict[str, str] = {
         "argmax never falls on that point.",
     "rtsgeom.radar.steering.xǁSteeringǁsearch__mutmut_4":
         "the error message gains 'XX' around the same text (the test matches the text).",
-    "rtsgeom.analysis.tolerance.x_evaluate_chunk__mutmut_59":
+    "rtsgeom.analysis.tolerance.driver.x_evaluate_chunk__mutmut_59":
         "np.take_along_axis without axis= uses axis=-1 in numpy 2, the axis given.",
     # fresh sample (seed 3)
-    "rtsgeom.aoa.calibration.x_frames_per_step__mutmut_23":
+    "rtsgeom.calibration.pair.x_frames_per_step__mutmut_23":
         "dead code: aoa.calibration.frames_per_step is called nowhere (the calibration sizes its "
         "frames per step by a Monte-Carlo of the phasor model since), so no output can change.",
-    "rtsgeom.aoa.calibration.x_frames_per_step__mutmut_80":
+    "rtsgeom.calibration.pair.x_frames_per_step__mutmut_80":
         "dead code: frames_per_step is called nowhere (see mutmut_23).",
-    "rtsgeom.aoa.calibration.x_frames_per_step__mutmut_86":
+    "rtsgeom.calibration.pair.x_frames_per_step__mutmut_86":
         "dead code: frames_per_step is called nowhere (see mutmut_23).",
     "rtsgeom.analysis.design.x__fit_sheet__mutmut_38":
         "a redundant guard: the scene rules (scene_rules: rx_tx_separation_m < "
@@ -69,7 +69,7 @@ EQUIVALENT: dict[str, str] = {
         "under it to 1e-6 deg with the target's phase all around the circle).",
     "rtsgeom.radar.steering.x__newton__mutmut_250":
         "axis=+1 instead of -1 on u of shape (n, D): the same axis.",
-    "rtsgeom.aoa.sweep.x_design_ratio__mutmut_128":
+    "rtsgeom.calibration.sweep.x_design_ratio__mutmut_128":
         "code replaced since the sample: P'' = 2 Re(s* s2) + 2 |s1|^2 is now written per "
         "coefficient in ratio_from_beams (re(bi1, bi1) + ...), the mutated line no longer "
         "exists (mutmut generates no such mutant). Before that it survived every setup tried "
@@ -79,24 +79,24 @@ EQUIVALENT: dict[str, str] = {
         "code replaced since the sample (the unit echoes are built by Echoes.build, which has "
         "no order argument); and equivalent before: order as float zeros instead of int "
         "zeros is only argsorted and read through int() by ghost_orders.",
-    "rtsgeom.aoa.calibration.x_frames_per_step__mutmut_26":
+    "rtsgeom.calibration.pair.x_frames_per_step__mutmut_26":
         "dead code, removed since the sample: frames_per_step was called nowhere (see "
         "mutmut_23 of the seed-3 sample).",
-    "rtsgeom.aoa.calibration.x_frames_per_step__mutmut_29":
+    "rtsgeom.calibration.pair.x_frames_per_step__mutmut_29":
         "dead code, removed since the sample (frames_per_step, see mutmut_26).",
-    "rtsgeom.aoa.calibration.x_frames_per_step__mutmut_70":
+    "rtsgeom.calibration.pair.x_frames_per_step__mutmut_70":
         "dead code, removed since the sample (frames_per_step, see mutmut_26).",
-    "rtsgeom.aoa.calibration.x_frames_per_step__mutmut_85":
+    "rtsgeom.calibration.pair.x_frames_per_step__mutmut_85":
         "dead code, removed since the sample (frames_per_step, see mutmut_26).",
-    "rtsgeom.aoa.nchannel.xǁChannelSetǁcoherent_phases__mutmut_27":
+    "rtsgeom.synthesis.nchannel.xǁChannelSetǁcoherent_phases__mutmut_27":
         "z / where(|z| > 0, |z|, 2) instead of 1: the fallback divides only where z = 0, and "
         "0 / 2 = 0 / 1 = 0; same sum.",
-    "rtsgeom.aoa.sweep.x__noise_sigma__mutmut_2":
+    "rtsgeom.calibration.sweep.x__noise_sigma__mutmut_2":
         "the unit program's delay None (NaN) instead of the probe's: _noise_sigma reads only "
         "the direct echoes' amplitudes, conj(g_a g_b G_q) (paths, programmed gain, hardware "
         "error), none of which depends on the programmed delay (the FIR's ripple is a "
         "separate fast_gain, unused here); same sigma.",
-    "rtsgeom.aoa.sweep.x_phasor_sweep__mutmut_248":
+    "rtsgeom.calibration.sweep.x_phasor_sweep__mutmut_248":
         "np.stack of two 1-D arrays (S,) along axis +1 instead of -1: for the 2-D result "
         "(S, 2) both are axis 1; same array.",
     "rtsgeom.geometry.sheet.x_segments_blocked__mutmut_12":
@@ -113,9 +113,9 @@ EQUIVALENT: dict[str, str] = {
 # geometry/, radar/; tests/test_physics_core_aoa.py for aoa/); the fresh sample (seed 3).
 # Printed in the report's "killed by later tests" section.
 KILLED_BY: dict[str, str] = {
-    "rtsgeom.analysis.arc.x_max_scale_for_yield__mutmut_56":
+    "rtsgeom.analysis.tolerance.arc.x_max_scale_for_yield__mutmut_56":
         "test_arc_yield_search_stops_at_zero_when_the_nominal_arc_fails",
-    "rtsgeom.analysis.arc.xǁBoundsǁfrom_tolerances__mutmut_65":
+    "rtsgeom.analysis.tolerance.arc.xǁBoundsǁfrom_tolerances__mutmut_65":
         "test_bounds_from_tolerances_scale_every_field",
     "rtsgeom.analysis.coverage.x_arc_scene__mutmut_14":
         "test_arc_scene_copies_the_first_front_end_without_its_errors",
@@ -131,48 +131,48 @@ KILLED_BY: dict[str, str] = {
         "test_nearfield_rows_and_exact_synthesis_on_the_nominal_setup",
     "rtsgeom.analysis.nearfield.xǁNearFieldǁ_row__mutmut_13":
         "test_nearfield_rows_and_exact_synthesis_on_the_nominal_setup",
-    "rtsgeom.analysis.tolerance.x_largest_passing_scale__mutmut_20":
+    "rtsgeom.analysis.tolerance.driver.x_largest_passing_scale__mutmut_20":
         "test_largest_passing_scale_stops_when_the_bracket_is_within_rel_tol",
-    "rtsgeom.analysis.tolerance.x_monte_carlo__mutmut_69":
+    "rtsgeom.analysis.tolerance.driver.x_monte_carlo__mutmut_69":
         "test_monte_carlo_without_draws_has_no_errors_and_no_yield",
-    "rtsgeom.aoa.calibration.x_calibrate_pair_paper__mutmut_171":
+    "rtsgeom.calibration.pair.x_calibrate_pair_paper__mutmut_171":
         "test_paper_procedure_reports_the_exact_period_at_its_target",
-    "rtsgeom.aoa.calibration.x_fir_effect__mutmut_146":
+    "rtsgeom.calibration.pair.x_fir_effect__mutmut_146":
         "test_fir_effect_predicts_the_coherence_shift_in_picoseconds",
-    "rtsgeom.aoa.cells.x__interval__mutmut_29":
+    "rtsgeom.synthesis.cells.x__interval__mutmut_29":
         "test_enclosing_interval_is_the_adjacent_pair_in_one_dimension",
-    "rtsgeom.aoa.linearity.x__closed_form_measured__mutmut_37":
+    "rtsgeom.analysis.linearity.x__closed_form_measured__mutmut_37":
         "test_measured_end_angles_equal_geometric_ones_in_the_ideal_far_field",
-    "rtsgeom.aoa.linearity2d.x_linearity_grid__mutmut_132":
+    "rtsgeom.analysis.linearity2d.x_linearity_grid__mutmut_132":
         "test_2d_error_map_exact_mode_puts_every_grid_point_on_its_direction",
-    "rtsgeom.aoa.linearity2d.x_linearity_grid__mutmut_170":
+    "rtsgeom.analysis.linearity2d.x_linearity_grid__mutmut_170":
         "test_2d_error_map_exact_mode_puts_every_grid_point_on_its_direction",
-    "rtsgeom.aoa.model.xǁChannelModelǁair_legs__mutmut_59":
+    "rtsgeom.synthesis.model.xǁChannelModelǁair_legs__mutmut_59":
         "test_raising_the_rut_equals_lowering_every_front_end",
-    "rtsgeom.aoa.ncal.x_calibrate_channels__mutmut_36":
+    "rtsgeom.calibration.channels.x_calibrate_channels__mutmut_36":
         "test_channel_calibration_of_one_channel_is_its_own_reference",
-    "rtsgeom.aoa.ncal.x_calibrate_pair_nd__mutmut_230":
+    "rtsgeom.calibration.channels.x_calibrate_pair_nd__mutmut_230":
         "test_nd_pair_calibration_lands_on_the_coherence_point",
-    "rtsgeom.aoa.ncal.x_calibrate_pair_nd__mutmut_264":
+    "rtsgeom.calibration.channels.x_calibrate_pair_nd__mutmut_264":
         "test_nd_pair_calibration_lands_on_the_coherence_point",
-    "rtsgeom.aoa.ncal.x_pair_edges__mutmut_23":
+    "rtsgeom.calibration.channels.x_pair_edges__mutmut_23":
         "test_pair_edges_are_neighbours_in_1d_and_delaunay_edges_in_2d",
-    "rtsgeom.aoa.ncal.x_pair_edges__mutmut_27":
+    "rtsgeom.calibration.channels.x_pair_edges__mutmut_27":
         "test_pair_edges_are_neighbours_in_1d_and_delaunay_edges_in_2d",
-    "rtsgeom.aoa.nchannel.x_closed_form_amplitudes__mutmut_44":
+    "rtsgeom.synthesis.nchannel.x_closed_form_amplitudes__mutmut_44":
         "test_closed_form_amplitudes_ignore_a_common_phase",
-    "rtsgeom.aoa.nchannel.xǁChannelSetǁamplitudes__mutmut_4":
+    "rtsgeom.synthesis.nchannel.xǁChannelSetǁamplitudes__mutmut_4":
         "test_2d_error_map_exact_mode_puts_every_grid_point_on_its_direction",
-    "rtsgeom.aoa.plan.x_plan_targets__mutmut_88":
+    "rtsgeom.pipeline.plan.x_plan_targets__mutmut_88":
         "test_plan_reports_each_pairs_calibration_delay_in_picoseconds",
-    "rtsgeom.aoa.sweep.x__noise_sigma__mutmut_78":
+    "rtsgeom.calibration.sweep.x__noise_sigma__mutmut_78":
         "test_calibration_sweep_noise_is_the_adc_chains_within_a_factor_of_a_few",
-    "rtsgeom.aoa.sweep.x_chain_errors__mutmut_45":
+    "rtsgeom.calibration.sweep.x_chain_errors__mutmut_45":
         "test_calibration_sweep_noise_is_the_adc_chains_within_a_factor_of_a_few (each seed "
         "its own noise)",
-    "rtsgeom.aoa.sweep.x_fit_minimum__mutmut_22":
+    "rtsgeom.calibration.sweep.x_fit_minimum__mutmut_22":
         "test_fit_minimum_finds_the_minimum_of_the_periodic_criterion_despite_lost_steps",
-    "rtsgeom.radar.capture.x_read_capture__mutmut_96": "test_probe_capture_round_trip",
+    "rtsgeom.identify.capture.x_read_capture__mutmut_96": "test_probe_capture_round_trip",
     "rtsgeom.radar.frame.x__simulate_linked__mutmut_64":
         "test_linked_frame_noise_is_the_receivers_thermal_noise_through_the_if_chain",
     # second fresh sample (seed 4): tests/test_physics_core_seed4.py (fir_effect: _aoa.py)
@@ -182,33 +182,33 @@ KILLED_BY: dict[str, str] = {
         "test_coverage_designs_plan_every_radius_for_the_coverage_in_degrees",
     "rtsgeom.analysis.ghosts.x_measure_ghosts__mutmut_189":
         "test_strong_cable_ghosts_outside_the_cfar_window_are_reported_as_detected",
-    "rtsgeom.aoa.calibration.x_calibrate_pair__mutmut_207":
+    "rtsgeom.calibration.pair.x_calibrate_pair__mutmut_207":
         "test_pair_calibration_places_its_probes_over_the_fine_window_and_reports_its_frames",
-    "rtsgeom.aoa.calibration.x_calibrate_pair__mutmut_245":
+    "rtsgeom.calibration.pair.x_calibrate_pair__mutmut_245":
         "test_pair_calibration_places_its_probes_over_the_fine_window_and_reports_its_frames",
-    "rtsgeom.aoa.calibration.x_fir_effect__mutmut_134":
+    "rtsgeom.calibration.pair.x_fir_effect__mutmut_134":
         "test_fir_effect_reports_its_filter_and_a_small_passband_ripple",
-    "rtsgeom.aoa.calibration.x_fir_effect__mutmut_5":
+    "rtsgeom.calibration.pair.x_fir_effect__mutmut_5":
         "test_fir_effect_reports_its_filter_and_a_small_passband_ripple",
-    "rtsgeom.aoa.ncal.x_calibrate_channels__mutmut_71":
+    "rtsgeom.calibration.channels.x_calibrate_channels__mutmut_71":
         "test_channel_calibration_depends_on_the_seed_modulo_2_to_the_32 (two channels: the "
         "tree's edges)",
-    "rtsgeom.aoa.ncal.x_calibrate_channels__mutmut_95":
+    "rtsgeom.calibration.channels.x_calibrate_channels__mutmut_95":
         "test_channel_calibration_depends_on_the_seed_modulo_2_to_the_32 (two channels: the "
         "tree's edges)",
-    "rtsgeom.aoa.ncal.x__residual__mutmut_78":
+    "rtsgeom.calibration.channels.x__residual__mutmut_78":
         "test_channel_calibration_depends_on_the_seed_modulo_2_to_the_32",
-    "rtsgeom.aoa.plan.x_plan_targets__mutmut_161":
+    "rtsgeom.pipeline.plan.x_plan_targets__mutmut_161":
         "test_plan_record_says_where_its_calibration_came_from",
-    "rtsgeom.aoa.plan_cells.x_plan_cells__mutmut_153":
+    "rtsgeom.pipeline.plan_cells.x_plan_cells__mutmut_153":
         "test_cell_plan_programs_the_doppler_of_each_targets_velocity",
-    "rtsgeom.aoa.sweep.x_fit_minimum__mutmut_80":
+    "rtsgeom.calibration.sweep.x_fit_minimum__mutmut_80":
         "test_fit_minimum_searches_the_half_width_it_is_given",
     "rtsgeom.geometry.setup.x_build_setup__mutmut_7":
         "test_rut_yaw_error_rotates_the_array_about_its_position",
     "rtsgeom.geometry.patterns.xǁPatternǁgain_db_towards__mutmut_5":
         "test_pattern_gain_db_is_twenty_log_of_the_field_and_finite_behind",
-    "rtsgeom.radar.capture.x_read_capture__mutmut_78":
+    "rtsgeom.identify.capture.x_read_capture__mutmut_78":
         "test_a_capture_that_is_not_a_complex_3d_cube_is_refused",
     "rtsgeom.radar.processing.x_detect__mutmut_76":
         "test_a_silent_cube_has_no_detections_and_empty_angles",
@@ -216,7 +216,7 @@ KILLED_BY: dict[str, str] = {
         "test_a_silent_cube_has_no_detections_and_empty_angles",
     "rtsgeom.radar.steering.xǁSteeringǁpeak__mutmut_69":
         "test_unconverged_peaks_fall_back_to_the_search_and_the_others_keep_newton",
-    "rtsgeom.rts.x_channel_echoes__mutmut_36":
+    "rtsgeom.rts.channels.x_channel_echoes__mutmut_36":
         "test_channel_echoes_pair_every_path_of_one_leg_with_every_path_of_the_other",
     # a seed-3 survivor, killed with the seed-4 tests
     "rtsgeom.radar.steering.xǁSteeringǁbuild__mutmut_16":
@@ -227,19 +227,19 @@ KILLED_BY: dict[str, str] = {
 # another module, or edits above it renumbered its mutants); --rerun-survivors runs that one.
 # Found by comparing mutmut's diffs (the changed lines must be identical).
 RENAMED: dict[str, str] = {
-    "rtsgeom.aoa.calibration.x_fir_effect__mutmut_5": "rtsgeom.aoa.fir.x_fir_effect__mutmut_5",
-    "rtsgeom.aoa.calibration.x_fir_effect__mutmut_134":
-        "rtsgeom.aoa.fir.x_fir_effect__mutmut_108",
+    "rtsgeom.calibration.pair.x_fir_effect__mutmut_5": "rtsgeom.calibration.fir.x_fir_effect__mutmut_5",
+    "rtsgeom.calibration.pair.x_fir_effect__mutmut_134":
+        "rtsgeom.calibration.fir.x_fir_effect__mutmut_108",
     "rtsgeom.analysis.ghosts.x_measure_ghosts__mutmut_189":
         "rtsgeom.analysis.ghosts.x_measure_ghosts__mutmut_151",
-    "rtsgeom.aoa.calibration.x_calibrate_pair__mutmut_207":
-        "rtsgeom.aoa.calibration.x_calibrate_pair__mutmut_215",
-    "rtsgeom.aoa.calibration.x_calibrate_pair__mutmut_245":
-        "rtsgeom.aoa.calibration.x_calibrate_pair__mutmut_267",
-    "rtsgeom.aoa.plan.x_plan_targets__mutmut_161": "rtsgeom.aoa.plan.x_plan_targets__mutmut_178",
-    "rtsgeom.aoa.sweep.x_fit_minimum__mutmut_80": "rtsgeom.aoa.sweep.x_fit_minimum__mutmut_74",
-    "rtsgeom.radar.capture.x_read_capture__mutmut_78":
-        "rtsgeom.radar.capture.x_read_capture__mutmut_113",
+    "rtsgeom.calibration.pair.x_calibrate_pair__mutmut_207":
+        "rtsgeom.calibration.pair.x_calibrate_pair__mutmut_215",
+    "rtsgeom.calibration.pair.x_calibrate_pair__mutmut_245":
+        "rtsgeom.calibration.pair.x_calibrate_pair__mutmut_267",
+    "rtsgeom.pipeline.plan.x_plan_targets__mutmut_161": "rtsgeom.pipeline.plan.x_plan_targets__mutmut_178",
+    "rtsgeom.calibration.sweep.x_fit_minimum__mutmut_80": "rtsgeom.calibration.sweep.x_fit_minimum__mutmut_74",
+    "rtsgeom.identify.capture.x_read_capture__mutmut_78":
+        "rtsgeom.identify.capture.x_read_capture__mutmut_113",
     "rtsgeom.radar.steering.xǁSteeringǁpeak__mutmut_69":
         "rtsgeom.radar.steering.xǁSteeringǁpeak__mutmut_87",
     "rtsgeom.radar.steering.xǁSteeringǁbuild__mutmut_16":

@@ -29,7 +29,7 @@ RANGES_M = tuple(float(r) for r in np.round(np.linspace(8.3, 70.1, 14), 2))
 
 def scene(res_ps: float, f_s: float, angle_deg: float):
     import tomllib
-    from rtsgeom.scene import parse_scene
+    from rtsgeom.scene.scene import parse_scene
     doc = tomllib.loads(DEFAULT_SCENE.read_text())
     rts = doc["rts"]
     rts["fractional_delay_step_s"] = res_ps * 1e-12
@@ -44,8 +44,8 @@ def scene(res_ps: float, f_s: float, angle_deg: float):
 
 def angle_errors_deg(setup, paths, program) -> np.ndarray:
     """Each target's detected minus set angle on the phasor model of the setup as built."""
-    from rtsgeom.aoa.model import ChannelModel
-    from rtsgeom.rts import requested_delay
+    from rtsgeom.synthesis.model import ChannelModel
+    from rtsgeom.rts.channels import requested_delay
     out = []
     for k, t in enumerate(setup.scene.targets):
         rows = np.flatnonzero(program.target == k)
@@ -57,7 +57,7 @@ def angle_errors_deg(setup, paths, program) -> np.ndarray:
 
 
 def main() -> None:
-    from rtsgeom.aoa.plan import plan_targets
+    from rtsgeom.pipeline.plan import plan_targets
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     rows = []

@@ -32,14 +32,14 @@ SPEC_DEG = 0.1
 
 
 def _scene(radius_m: float):
-    from rtsgeom.scene import load_scene
+    from rtsgeom.scene.scene import load_scene
     scene = load_scene(DEFAULT_SCENE)
     return scene.evolve(rts=scene.rts.evolve(arc_radius_m=radius_m))
 
 
 def run(draws: int, verify: int, inversion_draws: int) -> list[dict]:
-    from rtsgeom.analysis.tolerance import PairPhasors, max_sigma_for_yield, monte_carlo
-    from rtsgeom.analysis.tolerance_verify import verify_draws
+    from rtsgeom.analysis.tolerance.driver import PairPhasors, max_sigma_for_yield, monte_carlo
+    from rtsgeom.analysis.tolerance.verify import verify_draws
     from rtsgeom.geometry import build_setup
     rows = []
     for radius in RADII_M:

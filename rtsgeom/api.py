@@ -1,6 +1,6 @@
 """Scene-level conveniences for notebooks and scripts: each wraps one CLI job.
 
-The functions here take a :class:`~rtsgeom.scene.Scene` (and a front-end pair) and return the
+The functions here take a :class:`~rtsgeom.scene.scene.Scene` (and a front-end pair) and return the
 library's own result objects; they add no physics. Import them from the package::
 
     import rtsgeom
@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import ParameterError
-from .scene import Scene
+from .scene.scene import Scene
 
 __all__ = ["replace", "calibrate", "linearity", "tolerance", "design", "nearfield", "ghosts",
            "show"]
@@ -53,7 +53,7 @@ def _setup_paths(scene: Scene):
 
 
 def _check_pair(setup, pair) -> tuple[int, int]:
-    from .aoa.plan import check_pair
+    from .pipeline.plan import check_pair
     i, j = (int(p) for p in pair)
     return check_pair(setup, i, j, f"pair {tuple(pair)}")
 
@@ -75,14 +75,14 @@ def calibrate(scene: Scene, pair=(0, 1)):
         the sweep (``sweep_delta_tau_s``, ``sweep_error_deg``); ``to_dict()`` gives the JSON of
         ``rtsgeom calibrate``.
     """
-    from .aoa.calibration import calibrate_pair
+    from .calibration.pair import calibrate_pair
     setup, paths, pair, probe = _pair_setup(scene, pair)
     return calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
 
 
 def _pair_setup(scene: Scene, pair):
     """Setup, exact paths, the checked pair and each front end alone as the RuT detects it."""
-    from .aoa.calibration import probe_front_ends
+    from .calibration.pair import probe_front_ends
     setup, paths = _setup_paths(scene)
     pair = _check_pair(setup, pair)
     return setup, paths, pair, probe_front_ends(setup, paths, scene.seed)
@@ -101,7 +101,7 @@ def linearity(scene: Scene, pair=(0, 1), amplitudes: str = "exact", calibration=
         How the amplitude ratio of the two channels is designed (eqs. 21-23, or the exact model).
     calibration : bool or Calibration
         ``True``: run the phase calibration first (:func:`calibrate`); a
-        :class:`~rtsgeom.aoa.calibration.Calibration` of this pair: use it (one calibration
+        :class:`~rtsgeom.calibration.pair.Calibration` of this pair: use it (one calibration
         for several modes); ``False``: uncalibrated, delay offset 0.
     points : int
         Set-points across the span (its ends excluded).
@@ -112,8 +112,8 @@ def linearity(scene: Scene, pair=(0, 1), amplitudes: str = "exact", calibration=
         ``set_deg``, ``detected_deg``, ``error_deg``, ``amplitude_db`` (2, points) and
         ``max_abs_error_deg``.
     """
-    from .aoa.calibration import calibrate_pair
-    from .aoa.linearity import linearity as _linearity
+    from .calibration.pair import calibrate_pair
+    from .analysis.linearity import linearity as _linearity
     setup, paths, pair, probe = _pair_setup(scene, pair)
     if calibration is True:
         cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
@@ -155,7 +155,7 @@ def tolerance(scene: Scene, pair=(0, 1), sigma_mm=(0.1, 0.1, 0.1), draws: int = 
         ``worst_error_deg[case]`` per draw for ``'uncalibrated'`` and ``'calibrated'``,
         ``yield_(case)``, ``stats(case)`` and ``to_dict()``.
     """
-    from .analysis.tolerance import PairPhasors, monte_carlo
+    from .analysis.tolerance.driver import PairPhasors, monte_carlo
     from .geometry import build_setup
     setup = build_setup(scene)
     pair = _check_pair(setup, pair)

@@ -11,13 +11,13 @@ Defined here, with no imports, so that any module can raise them:
 
 Defined beside what they guard (import them from there):
 
-* ``rtsgeom.scene.SceneError`` (``schema.py``): a scene file or field is invalid;
-  ``rtsgeom.link.LinkError`` is one.
-* ``rtsgeom.io.OutputError``: an output path cannot or must not be written.
-* ``rtsgeom.aoa.model.AngleUnreachable``, ``rtsgeom.aoa.cells.CellUnreachable``: a set direction
+* ``rtsgeom.scene.scene.SceneError`` (``schema.py``): a scene file or field is invalid;
+  ``rtsgeom.radar.link.LinkError`` is one.
+* ``rtsgeom._lib.io.OutputError``: an output path cannot or must not be written.
+* ``rtsgeom.synthesis.model.AngleUnreachable``, ``rtsgeom.synthesis.cells.CellUnreachable``: a set direction
   lies outside what the front ends can synthesize.
 * ``rtsgeom.paths.raytrace.RaytraceUnavailable``, ``rtsgeom.viz.render_backend.VizError``,
-  ``rtsgeom.parallel.ClusterError`` (``RuntimeError``): ray tracing, rendering or a cluster is
+  ``rtsgeom._lib.parallel.ClusterError`` (``RuntimeError``): ray tracing, rendering or a cluster is
   not available here.
 """
 

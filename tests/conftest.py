@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from rtsgeom.scene import parse_scene
+from rtsgeom.scene.scene import parse_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_SCENE = ROOT / "scenes" / "diewald2022.toml"
@@ -29,7 +29,7 @@ def make_scene(mutate=None, **radar_overrides):
 
 @pytest.fixture(scope="session")
 def default_scene():
-    from rtsgeom.scene import load_scene
+    from rtsgeom.scene.scene import load_scene
     return load_scene(DEFAULT_SCENE)
 
 
@@ -81,9 +81,9 @@ class CoherenceShift:
     (f_rts + S t_mid - S tau) * 2 dr / c0 for J (front end 1), the opposite way for I."""
 
     def __init__(self, nom, probe):
-        from rtsgeom.aoa.calibration import (air_phase_slope_hz, coherence_delay,
-                                             if_phase_slope_hz, probe_angles, probe_ranges,
-                                             probe_total_delay)
+        from rtsgeom.calibration.pair import (air_phase_slope_hz, coherence_delay,
+                                              if_phase_slope_hz, probe_angles, probe_ranges,
+                                              probe_total_delay)
         from rtsgeom.paths import exact_paths
         self.alphas = probe_angles(*probe.angle_rad[[0, 1]])
         self.d0 = coherence_delay(nom, exact_paths(nom), (0, 1), self.alphas)
@@ -110,7 +110,7 @@ def two_front_end_pair(radius_m: float, spacing_deg: float = 8.0):
     import math
 
     from rtsgeom.analysis.design import two_front_end_scene
-    from rtsgeom.analysis.tolerance import PairPhasors
+    from rtsgeom.analysis.tolerance.driver import PairPhasors
     from rtsgeom.geometry import build_setup
     scene, _, problem = two_front_end_scene(make_scene(), (0, 1), radius_m,
                                             math.radians(spacing_deg))
@@ -131,8 +131,8 @@ def _error_keys() -> dict:
     """The file keys of ``geometry.setup.FRONT_END_ERRORS`` and ``RUT_POSE_ERRORS`` (the
     schema's names for them, as ``setup_errors`` reports them)."""
     from rtsgeom.geometry.setup import FRONT_END_ERRORS, RUT_POSE_ERRORS
-    from rtsgeom.scene import FrontEndConfig, RadarConfig
-    from rtsgeom.schema import specs
+    from rtsgeom.scene.scene import FrontEndConfig, RadarConfig
+    from rtsgeom.scene.schema import specs
     fe, radar = dict(specs(FrontEndConfig)), dict(specs(RadarConfig))
     return {"fe": tuple(fe[n].key for n in FRONT_END_ERRORS),
             "radar": tuple(radar[n].key for n in RUT_POSE_ERRORS)}

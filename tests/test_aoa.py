@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from scipy.constants import c
 
-from rtsgeom.aoa.calibration import calibrate_pair, probe_front_ends
-from rtsgeom.aoa.linearity import linearity
-from rtsgeom.aoa.synthesis import array_factor, g_paper, ratio_array_factor, ratio_paper
+from rtsgeom.calibration.pair import calibrate_pair, probe_front_ends
+from rtsgeom.analysis.linearity import linearity
+from rtsgeom.synthesis.closed_form import array_factor, g_paper, ratio_array_factor, ratio_paper
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 
@@ -159,9 +159,9 @@ def test_paper_g_is_accurate_near_zero():
 
 
 def test_closed_form_modes_refuse_angles_outside_the_geometric_span():
-    from rtsgeom.aoa.plan import pair_amplitudes
-    from rtsgeom.aoa.synthesis import AngleUnreachable
-    from rtsgeom.scene import TargetConfig
+    from rtsgeom.pipeline.plan import pair_amplitudes
+    from rtsgeom.synthesis.closed_form import AngleUnreachable
+    from rtsgeom.scene.scene import TargetConfig
     setup = build_setup(make_scene())
     paths = exact_paths(setup)
     probes = np.radians([6.0, 10.0])

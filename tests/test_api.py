@@ -23,7 +23,7 @@ def test_all_names_resolve():
 def test_import_is_lazy():
     """``import rtsgeom`` loads neither Sionna, pyvista, matplotlib nor the pipeline."""
     code = ("import sys, rtsgeom; heavy = [m for m in ('sionna', 'pyvista', 'matplotlib', "
-            "'mitsuba', 'drjit', 'pandas', 'xarray', 'rtsgeom.run') if m in sys.modules]; "
+            "'mitsuba', 'drjit', 'pandas', 'xarray', 'rtsgeom.pipeline.run') if m in sys.modules]; "
             "print(heavy)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout.strip()

@@ -9,13 +9,13 @@ import math
 import numpy as np
 import pytest
 
-from rtsgeom.analysis.arc import (Bounds, adjacent_pairs, arc_draws, arc_models,
-                                  arc_monte_carlo, shared_subbin_steps)
+from rtsgeom.analysis.tolerance.arc import (Bounds, adjacent_pairs, arc_draws, arc_models,
+                                            arc_monte_carlo, shared_subbin_steps)
 from rtsgeom.analysis.design import two_front_end_scene
-from rtsgeom.analysis.tolerance import PairPhasors, evaluate_chunk, monte_carlo, subbin_draws
+from rtsgeom.analysis.tolerance.driver import PairPhasors, evaluate_chunk, monte_carlo, subbin_draws
 from rtsgeom.errors import ParameterError
 from rtsgeom.geometry import build_setup
-from rtsgeom.scene import load_scene
+from rtsgeom.scene.scene import load_scene
 
 from conftest import DEFAULT_SCENE as DEFAULT, two_front_end_pair
 

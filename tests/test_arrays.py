@@ -10,14 +10,14 @@ import numpy as np
 import pytest
 from scipy.constants import c
 
-from rtsgeom.geometry.arrays import (ArraySpec, array_from_spec, array_spec,
-                                     awr1843boost_layout, posed_positions, rut_array)
+from rtsgeom.geometry.arrays import (ArraySpec, array_from_spec, array_spec, awr1843boost_layout,
+                                     posed_positions, rut_array)
 from rtsgeom.geometry.farfield import (angular_resolution_rad, aperture_m, array_factor,
                                        coarray_period_m, fraunhofer_distance_m,
                                        grating_lobe_directions_rad, smallest_spacing_m,
                                        unambiguous_half_width_rad)
 from rtsgeom.radar.processing import estimate_angles
-from rtsgeom.radar_presets import PRESETS, preset
+from rtsgeom.scene.presets import PRESETS, preset
 
 from conftest import make_scene
 

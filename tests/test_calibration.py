@@ -9,14 +9,14 @@ import numpy as np
 import pytest
 from scipy.constants import c
 
-from rtsgeom.aoa.calibration import (calibrate_pair, coherence_delay,
-                                     if_phase_slope_hz, probe_angles, probe_front_ends,
-                                     probe_ranges, probe_total_delay)
+from rtsgeom.calibration.pair import (calibrate_pair, coherence_delay, if_phase_slope_hz,
+                                      probe_angles, probe_front_ends, probe_ranges,
+                                      probe_total_delay)
 from rtsgeom.cli import main
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
-from rtsgeom.rts import RtsProgram, channel_echoes
-from rtsgeom.validate import height_phase_deg, scene_warnings
+from rtsgeom.rts.channels import RtsProgram, channel_echoes
+from rtsgeom.geometry.warnings import height_phase_deg, scene_warnings
 
 from conftest import DEFAULT_SCENE, CoherenceShift, make_scene
 
@@ -163,7 +163,7 @@ def _fir_scene(taps, model, snr=False):
 
 @pytest.mark.parametrize("taps", [3, 9, 33, 129])
 def test_fir_is_the_delay_it_is_set_to_at_low_frequency_and_exact_at_integer_settings(taps):
-    from rtsgeom.rts import fir_error_response, fractional_delay_fir
+    from rtsgeom.rts.channels import fir_error_response, fractional_delay_fir
     mu = np.array([0.0, 0.13, 0.5, 0.87])
     h = fractional_delay_fir(mu, taps)
     assert np.allclose(h.sum(1), 1.0)
@@ -176,7 +176,7 @@ def test_fir_is_the_delay_it_is_set_to_at_low_frequency_and_exact_at_integer_set
 
 
 def test_fir_ripple_falls_with_the_number_of_taps():
-    from rtsgeom.rts import fir_error_response
+    from rtsgeom.rts.channels import fir_error_response
     f = np.linspace(0.5e9, 1.5e9, 101)[None]
     worst = [np.abs(np.angle(fir_error_response([0.5], t, 4e9, f))).max() for t in (5, 17, 65)]
     assert worst[0] > worst[1] > worst[2]
@@ -184,7 +184,7 @@ def test_fir_ripple_falls_with_the_number_of_taps():
 
 def test_ideal_filter_reproduces_the_pure_delay_and_integer_settings_match_it():
     from rtsgeom.radar.fmcw import synthesize
-    from rtsgeom.rts import build_echoes
+    from rtsgeom.rts.channels import build_echoes
     ideal, fir = build_setup(_fir_scene(33, "ideal")), build_setup(_fir_scene(33, "windowed-sinc"))
     paths = exact_paths(ideal)
     ts = 1 / ideal.scene.rts.f_s_hz
@@ -206,9 +206,9 @@ def test_fir_moves_the_coherence_point_by_its_phase_ripple(taps):
     """The channels' coherent phase with the FIR minus without it, at programmed delays
     across a period, equals -2 pi f_if times the shift `fir_effect` predicts from the
     filter's own response (window-weighted phase at each probe's bin)."""
-    from rtsgeom.aoa.calibration import fir_effect
-    from rtsgeom.aoa.synthesis import PairModel
-    from rtsgeom.scene import TargetConfig
+    from rtsgeom.calibration.pair import fir_effect
+    from rtsgeom.synthesis.closed_form import PairModel
+    from rtsgeom.scene.scene import TargetConfig
     ideal, fir = build_setup(_fir_scene(taps, "ideal")), build_setup(_fir_scene(taps, "windowed-sinc"))
     paths = exact_paths(ideal)
     ranges = probe_ranges(ideal, 2)
@@ -238,7 +238,7 @@ def test_paper_procedure_minima_are_one_period_apart_and_its_optimum_is_off_cohe
     late because a period of delay moves J's echo by 1.3 range bins and the fixed amplitudes
     do not know it (measured: 1.10 ns apart); its optimum is not the coherence point (the
     fixed design's own error is traded against phase)."""
-    from rtsgeom.aoa.calibration import calibrate_pair_paper
+    from rtsgeom.calibration.pair import calibrate_pair_paper
     setup = build_setup(make_scene())
     paths = exact_paths(setup)
     probe = probe_front_ends(setup, paths, 1)
@@ -304,8 +304,8 @@ def test_closed_form_design_matches_the_root_finder():
     """The exact ratio in closed form (dP/du = 0 at the set angle, a quadratic in rho) is
     the root finder's on the searched beamformer peak, on a grid of radii, delays and
     angles."""
-    from rtsgeom.aoa.model import ChannelModel
-    from rtsgeom.scene import TargetConfig
+    from rtsgeom.synthesis.model import ChannelModel
+    from rtsgeom.scene.scene import TargetConfig
     for radius in (0.5, 1.0, 3.0):
         setup = build_setup(_noiseless(radius))
         paths = exact_paths(setup)
@@ -324,7 +324,7 @@ def test_closed_form_design_matches_the_root_finder():
 @pytest.mark.slow
 @pytest.mark.parametrize("radius, fe, dr_mm", [(0.5, 0, 0.75), (1.0, 1, -0.75)])
 def test_exact_linearity_after_calibration_on_straddling_setups(radius, fe, dr_mm):
-    from rtsgeom.aoa.linearity import linearity
+    from rtsgeom.analysis.linearity import linearity
     setup = build_setup(_offset_scene(radius, fe, dr_mm))
     paths = exact_paths(setup)
     probe = probe_front_ends(setup, paths, setup.scene.seed)
@@ -417,8 +417,8 @@ def test_calibrated_delay_is_realisable_and_the_residual_is_reported(res_ps, fra
     multiples of the resolution, the RTS realises the chosen offset exactly on both probes'
     delays, the reported residual is the fit's optimum minus the chosen delay (at most half
     a step), and the chosen delay is the realisable one nearest the coherence point."""
-    from rtsgeom.aoa.calibration import realisable
-    from rtsgeom.rts import realised_delay, requested_delay
+    from rtsgeom.calibration.pair import realisable
+    from rtsgeom.rts.channels import realised_delay, requested_delay
 
     def mutate(doc):
         doc["radar"].pop("snr_db", None)
@@ -478,7 +478,7 @@ def test_fir_moves_the_calibrated_delay_by_its_predicted_shift(taps, radius_m):
     window-weighted phase of each channel's beat gain at the probe's bin). Before the sweep's
     fit took the filter's setting-dependent phase out (it cycles every 1/f_s, +-3.7 deg at the
     bin with 5 taps), the 5-tap calibration landed 33 ps off."""
-    from rtsgeom.aoa.calibration import fir_effect
+    from rtsgeom.calibration.pair import fir_effect
     ideal, fir = _fir_pair(taps, radius_m)
     paths = exact_paths(ideal)
     probe = probe_front_ends(ideal, paths, 1)
@@ -500,12 +500,12 @@ def test_fir_changes_linearity_by_no_more_than_its_phase_ripple_explains(taps):
     on the ideal model (the error is second order in the phase near coherence). With 33 taps
     both are below 1e-5 deg. Before the fit and ``pair_design`` accounted for the setting-
     dependent phase, the 5-tap change was 0.041 deg, ten times this bound."""
-    from rtsgeom.aoa.calibration import _mean_air_delay, fir_bin_gain
-    from rtsgeom.aoa.linearity import linearity
-    from rtsgeom.aoa.plan import pair_design
-    from rtsgeom.aoa.synthesis import PairModel
-    from rtsgeom.rts import requested_delay
-    from rtsgeom.scene import TargetConfig
+    from rtsgeom.calibration.pair import _mean_air_delay, fir_bin_gain
+    from rtsgeom.analysis.linearity import linearity
+    from rtsgeom.pipeline.plan import pair_design
+    from rtsgeom.synthesis.closed_form import PairModel
+    from rtsgeom.rts.channels import requested_delay
+    from rtsgeom.scene.scene import TargetConfig
     ideal, fir = _fir_pair(taps)
     paths = exact_paths(ideal)
     probe = probe_front_ends(ideal, paths, 1)
@@ -559,7 +559,7 @@ def test_grid_sample_calibrates_to_coherence_and_linearity_within_spec(radius, f
     """The calibrated delay within 10 ps of the closed-form coherence point and exact-mode
     linearity (11 set-points, receiver noise on) at or below 0.02 deg at every set-point
     (about 1.3 s of CPU per setup)."""
-    from rtsgeom.aoa.linearity import linearity
+    from rtsgeom.analysis.linearity import linearity
     setup, paths, probe, cal, dist = _calibrated_off_coherence(radius, fe, dr_mm)
     assert abs(dist) < 10e-12
     lin = linearity(setup, paths, (0, 1), "exact", probe, cal, 11, setup.scene.seed)
@@ -576,7 +576,7 @@ def test_probes_clear_each_others_cfar_window(samples, adc_rate_hz, training):
     now a RuntimeWarning)."""
     import warnings
 
-    from rtsgeom.aoa.calibration import probe_ranges
+    from rtsgeom.calibration.pair import probe_ranges
 
     def small(doc):
         doc["radar"].pop("snr_db", None)
@@ -597,7 +597,7 @@ def test_calibration_file_names_the_setup_it_was_made_on():
     with the arc, a front end's mounting or channel and the RuT's chirp, not with the
     scenario (targets, seed, SNR); a file made before a front end was moved is applied with
     a warning (a new-user trial applied one silently: -3.7 deg errors, exit 0)."""
-    from rtsgeom.aoa.plan import calibration_mismatch, plan_targets, setup_fingerprint
+    from rtsgeom.pipeline.plan import calibration_mismatch, plan_targets, setup_fingerprint
 
     def fe1(**kw):
         return lambda d: d["rts"]["front_ends"][1].update(kw)
@@ -628,8 +628,8 @@ def test_calibration_fingerprint_follows_file_contents_not_paths(tmp_path):
     """The same scene and antenna table in two folders: one fingerprint (a moved project
     keeps its calibrations); an edited table: another. The sheet, the ray tracing, the
     calibration procedure's steps and the RTS's noise are not the setup measured."""
-    from rtsgeom.aoa.plan import setup_fingerprint
-    from rtsgeom.scene import load_scene
+    from rtsgeom.pipeline.plan import setup_fingerprint
+    from rtsgeom.scene.scene import load_scene
     text = DEFAULT_SCENE.read_text().replace(
         "[radar.cfar]", '[radar.pattern]\nkind = "table"\ntable = "pat.csv"\n\n[radar.cfar]')
 

@@ -15,14 +15,14 @@ import numpy as np
 import pytest
 
 from conftest import make_scene
-from rtsgeom.aoa.calibration import (calibrate_pair, coherence_point, continuous_delay_setup,
-                                     fine_window, probe_angles, probe_front_ends, probe_ranges,
-                                     realisable, realisation_shift)
-from rtsgeom.aoa.synthesis import PairModel
+from rtsgeom.calibration.pair import (calibrate_pair, coherence_point, continuous_delay_setup,
+                                      fine_window, probe_angles, probe_front_ends, probe_ranges,
+                                      realisable, realisation_shift)
+from rtsgeom.synthesis.closed_form import PairModel
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
-from rtsgeom.rts import realised_delay, requested_delay
-from rtsgeom.scene import TargetConfig
+from rtsgeom.rts.channels import realised_delay, requested_delay
+from rtsgeom.scene.scene import TargetConfig
 
 RES_PS = (1.0, 5.0, 10.0, 25.0, 50.0, 100.0)
 

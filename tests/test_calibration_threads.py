@@ -8,10 +8,10 @@ from __future__ import annotations
 import pytest
 from threadpoolctl import threadpool_limits
 
-from rtsgeom.aoa.calibration import calibrate_pair, probe_front_ends
+from rtsgeom.calibration.pair import calibrate_pair, probe_front_ends
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
-from rtsgeom.scene import load_scene
+from rtsgeom.scene.scene import load_scene
 
 OFFSETS = dict(radial_offset_m=0.8e-3, tangential_offset_m=-0.5e-3, height_offset_m=0.3e-3,
                gain_offset_db=0.6)

@@ -29,8 +29,8 @@ def test_fit_on_the_crossing_columns_finds_the_coherence_point_despite_biased_ve
     crosses zero twice), across it odd (sin). The
     joint fit of all columns lands on a zero crossing of a biased even curve; of the
     crossing columns alone, on the point (to the 0.05 ps search grid)."""
-    from rtsgeom.aoa.ncal import crossing_columns
-    from rtsgeom.aoa.sweep import fit_minimum
+    from rtsgeom.calibration.channels import crossing_columns
+    from rtsgeom.calibration.sweep import fit_minimum
     near = true_ps * 1e-12 + 40e-12  # the coarse minimum, a step and a half off
     d = near + np.arange(-25, 26) * 10e-12
     th = 2 * np.pi * (d - true_ps * 1e-12) / PERIOD
@@ -47,7 +47,7 @@ def test_fit_on_the_crossing_columns_finds_the_coherence_point_despite_biased_ve
 
 def test_crossing_columns_are_all_columns_when_none_crosses():
     """A pair on an arc: every probe's error even (1-D fit unchanged)."""
-    from rtsgeom.aoa.ncal import crossing_columns
+    from rtsgeom.calibration.channels import crossing_columns
     th = np.linspace(-np.pi / 2, np.pi / 2, 31)
     e = np.stack([1 - np.cos(th), 0.5 * (1 - np.cos(th)), np.full(th.size, np.nan)], 1)
     assert crossing_columns(e).tolist() == [0, 1, 2]
@@ -75,8 +75,8 @@ def test_calibrated_cell_reaches_its_directions_whatever_its_channel_offsets(
     can synthesize' at the cell's centre). Not at half a period (500 ps, 7.5 cm: half a
     range bin between the rows): there the elevation of (7, 0) deg and the centre are not
     reached (the detected elevation jumps across 0 as the rows' ratio grows; open)."""
-    from rtsgeom.aoa.ncal import ChannelSet, tree_phases
-    from rtsgeom.scene import TargetConfig
+    from rtsgeom.calibration.channels import ChannelSet, tree_phases
+    from rtsgeom.scene.scene import TargetConfig
     setup, paths = nominal_sphere4
     offs = np.array([0.0, offset_ps, 2.0, offset_ps + 35.0]) * 1e-12
     cs = ChannelSet.build(setup, paths, (0, 1, 2, 3), TargetConfig(20.0), offs)
@@ -89,7 +89,7 @@ def test_calibrated_cell_reaches_its_directions_whatever_its_channel_offsets(
 # -- failures and loop closures are said, naming the pair --------------------------------------
 
 def _fake_pairs(monkeypatch, delays_ps, fail=()):
-    import rtsgeom.aoa.ncal as ncal
+    import rtsgeom.calibration.channels as ncal
 
     def fake(setup, paths, pair, probe, seed=0, span_s=None, step_s=None):
         if tuple(pair) in fail:
@@ -105,8 +105,8 @@ CONSISTENT = {(0, 1): 29.0, (0, 2): 2.0, (0, 3): 31.0, (1, 3): 2.0, (2, 3): 29.0
 @pytest.mark.parametrize("closure_ps", [0.0, 20.0, 40.0, -120.0])
 def test_loop_closure_beyond_tolerance_is_a_warning_naming_the_pair(
         nominal_sphere4, monkeypatch, closure_ps):
-    from rtsgeom.aoa.calibration import probe_front_ends
-    from rtsgeom.aoa.ncal import LOOP_CLOSURE_TOL_S, calibrate_channels
+    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.calibration.channels import LOOP_CLOSURE_TOL_S, calibrate_channels
     setup, paths = nominal_sphere4
     delays = dict(CONSISTENT)
     delays[(0, 3)] += closure_ps  # off the tree (0,1), (0,2), (1,3)
@@ -123,10 +123,10 @@ def test_loop_closure_beyond_tolerance_is_a_warning_naming_the_pair(
 
 def test_a_pair_that_fails_is_named_and_a_cell_it_disconnects_stops_the_run(
         nominal_sphere4, monkeypatch):
-    from rtsgeom.aoa.calibration import probe_front_ends
-    from rtsgeom.aoa.ncal import CalibrationFailed, calibrate_channels
-    from rtsgeom.aoa.plan_cells import plan_cells
-    from rtsgeom.scene import SceneError
+    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.calibration.channels import CalibrationFailed, calibrate_channels
+    from rtsgeom.pipeline.plan_cells import plan_cells
+    from rtsgeom.scene.scene import SceneError
     setup, paths = nominal_sphere4
     probe = probe_front_ends(setup, paths, 1)
     _fake_pairs(monkeypatch, CONSISTENT, fail={(0, 3)})  # a Delaunay edge off the tree
@@ -143,11 +143,11 @@ def test_run_says_the_calibration_failed_when_it_is_why_a_target_is_unreachable(
         nominal_sphere4, monkeypatch):
     """A target inside its cell that the calibrated channels cannot reach, after a
     calibration with warnings: the message says the calibration failed and why."""
-    import rtsgeom.aoa.ncal as ncal
-    from rtsgeom.aoa.model import AngleUnreachable
-    from rtsgeom.aoa.nchannel import ChannelSet
-    from rtsgeom.aoa.plan_cells import plan_cells
-    from rtsgeom.scene import SceneError
+    import rtsgeom.calibration.channels as ncal
+    from rtsgeom.synthesis.model import AngleUnreachable
+    from rtsgeom.synthesis.nchannel import ChannelSet
+    from rtsgeom.pipeline.plan_cells import plan_cells
+    from rtsgeom.scene.scene import SceneError
     setup, paths = nominal_sphere4
     bad = ncal.ChannelCalibration(np.zeros(4), 0, [], [(0, 1), (0, 2), (1, 3)], [40e-12],
                                   warnings=("channel calibration: the loop through pair "
@@ -176,9 +176,9 @@ def test_elevation_pair_calibrates_to_its_coherence_point_with_a_front_end_off(f
     -air/IF phase slope x 2 dr / c0 (~-258 ps per 0.5 mm), the phase by phi / (2 pi f_IF)."""
     from scipy.constants import c
 
-    from rtsgeom.aoa.calibration import (air_phase_slope_hz, if_phase_slope_hz,
-                                         probe_front_ends, probe_ranges, probe_total_delay)
-    from rtsgeom.aoa.ncal import calibrate_pair_nd, coherence_point_nd
+    from rtsgeom.calibration.pair import (air_phase_slope_hz, if_phase_slope_hz, probe_front_ends,
+                                          probe_ranges, probe_total_delay)
+    from rtsgeom.calibration.channels import calibrate_pair_nd, coherence_point_nd
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     scene = sphere4(field, value)
@@ -207,8 +207,8 @@ def test_channel_offsets_are_taken_to_the_period_nearest_zero(nominal_sphere4, m
     """Pair delays add up along the tree to beyond half a period (180 deg on front end 1:
     channel 3 at -984 ps, its echo a whole range bin from the others); each channel's
     offset is wrapped to (-period/2, period/2], and the loop closures do not change."""
-    from rtsgeom.aoa.calibration import probe_front_ends
-    from rtsgeom.aoa.ncal import calibrate_channels
+    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.calibration.channels import calibrate_channels
     setup, paths = nominal_sphere4
     delays = {(0, 1): d01_ps, (0, 2): 2.0, (0, 3): d01_ps + d13_ps, (1, 3): d13_ps,
               (2, 3): d01_ps + d13_ps - 2.0}

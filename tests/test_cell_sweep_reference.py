@@ -14,11 +14,11 @@ from benchmarks.cell_calibration import sphere4
 @pytest.mark.parametrize("field,value", [(None, None), ("radial_offset_mm", 0.5),
                                          ("phase_offset_deg", 90.0)])
 def test_reference_power_does_not_move_with_the_other_channels_delay(field, value):
-    from rtsgeom.aoa.calibration import nominal_model, probe_ranges
-    from rtsgeom.aoa.nchannel import ChannelSet
+    from rtsgeom.calibration.pair import nominal_model, probe_ranges
+    from rtsgeom.synthesis.nchannel import ChannelSet
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene import TargetConfig
+    from rtsgeom.scene.scene import TargetConfig
     scene = sphere4() if field is None else sphere4(field, value)
     setup = build_setup(scene)
     nom, nom_paths = nominal_model(setup, exact_paths(setup))

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import rtsgeom
-from rtsgeom.rts import KIND_DIRECT, KIND_GHOST, KIND_SETUP, EchoKind, Echoes
+from rtsgeom.rts.channels import KIND_DIRECT, KIND_GHOST, KIND_SETUP, EchoKind, Echoes
 
 ROOT = Path(__file__).resolve().parents[1]
 PER_ECHO = ("tau_if_s", "f_if_hz", "doppler_hz", "target", "front_end", "kind", "order")

@@ -6,7 +6,8 @@ from __future__ import annotations
 import pytest
 
 from rtsgeom.analysis.design import pilot_estimate, tolerance_search
-from rtsgeom.analysis.tolerance import PairPhasors, largest_passing_scale, max_sigma_for_yield
+from rtsgeom.analysis.tolerance.driver import (PairPhasors, largest_passing_scale,
+                                               max_sigma_for_yield)
 from rtsgeom.geometry import build_setup
 
 from test_yield_search import _study

@@ -19,15 +19,15 @@ import pytest
 
 from conftest import ROOT, make_scene
 from rtsgeom.analysis.estimators import pair_snapshots, pair_sweep
-from rtsgeom.aoa.model import AngleUnreachable, ChannelModel
+from rtsgeom.synthesis.model import AngleUnreachable, ChannelModel
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.radar import estimators as est
 from rtsgeom.radar import process
 from rtsgeom.radar.frame import simulate
 from rtsgeom.radar.steering import Steering
-from rtsgeom.rts import RtsProgram, requested_delay
-from rtsgeom.scene import SceneError, TargetConfig
+from rtsgeom.rts.channels import RtsProgram, requested_delay
+from rtsgeom.scene.scene import SceneError, TargetConfig
 
 PRESETS = ("awr1843boost", "awr2944")  # 8 and 12 elements in the azimuth row, lambda/2
 
@@ -338,7 +338,7 @@ def test_run_cli_offers_the_registry_estimators(tmp_path, capsys):
     """``run --estimator`` takes its choices from ``registry.ANGLE_ESTIMATORS``; the override
     is validated like the scene file (exit 2 naming the field)."""
     from rtsgeom.cli import main
-    from rtsgeom.registry import ANGLE_ESTIMATORS
+    from rtsgeom.scene.registry import ANGLE_ESTIMATORS
     scene = str(ROOT / "scenes" / "diewald2022.toml")
     with pytest.raises(SystemExit) as exc:
         main(["run", scene, "--out", str(tmp_path / "a"), "--estimator", "esprit"])
@@ -356,7 +356,7 @@ def test_the_tolerance_model_refuses_a_smoothed_estimator(estimator, capsys):
     peak and estimates the draws' angles there; a smoothed Capon or MUSIC peaks elsewhere
     (they had reported NaN statistics, "composite splits" and 0 mm tolerances): a named
     error, while without smoothing (rank one: they peak where Bartlett does) it runs."""
-    from rtsgeom.analysis.tolerance import PairPhasors
+    from rtsgeom.analysis.tolerance.driver import PairPhasors
     smoothed = make_scene(angle_estimator=estimator, angle_subarray=5)
     with pytest.raises(SceneError, match=rf"radar.angle_estimator = {estimator} with "
                                          r"radar.angle_subarray = 5"):

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from rtsgeom._util import tones
+from rtsgeom._lib.util import tones
 from rtsgeom.radar.processing import range_doppler
 from rtsgeom.radar.steering import window
-from rtsgeom.registry import WINDOWS
+from rtsgeom.scene.registry import WINDOWS
 
 
 @pytest.mark.parametrize("name", [w for w in WINDOWS if w != "none"])

@@ -25,9 +25,10 @@ from rtsgeom.paths import exact_paths
 from rtsgeom.radar import process, synthesize
 from rtsgeom.radar.frame import simulate
 from rtsgeom.radar.processing import cfar_mask, detect, range_doppler
-from rtsgeom.rts import Echoes, RtsProgram, channel_echoes, program_nearest, requested_delay
-from rtsgeom.scene import Scene
-from rtsgeom.schema import specs
+from rtsgeom.rts.channels import (Echoes, RtsProgram, channel_echoes, program_nearest,
+                                  requested_delay)
+from rtsgeom.scene.scene import Scene
+from rtsgeom.scene.schema import specs
 
 
 def quiet(doc):
@@ -294,7 +295,7 @@ def test_os_cfar_noise_is_the_ring_quantile(rank):
 def test_snr_sets_the_noise_power_and_the_seed_the_realisation(snr_db):
     """radar.snr_db and seed: run_scene adds noise of power max|a|^2 / 10^(snr/10) per sample,
     drawn from the scene's seed (same seed: same bits; another seed: other noise)."""
-    from rtsgeom.run import run_scene
+    from rtsgeom.pipeline.run import run_scene
     tg = [{"range_m": 30.0, "angle_deg": 3.4}]
     radar = dict(snr_db=snr_db, chirps_per_tx=32)
     runs = {seed: run_scene(scene_with(radar=radar, targets=tg, top=dict(seed=seed), noisy=True),
@@ -406,8 +407,8 @@ def test_range_sets_delay_and_radar_equation_amplitude():
 def test_the_scenes_aoa_mode_is_the_one_run(mode, monkeypatch):
     """rts.aoa_mode: run_scene plans with the scene's mode when none is given; nearest puts each
     target on one channel at its nearest front end."""
-    from rtsgeom import run as run_mod
-    from rtsgeom.aoa import plan
+    from rtsgeom.pipeline import run as run_mod
+    from rtsgeom.pipeline import plan
     seen = []
 
     def fake_plan(setup, paths, m, **kw):
@@ -427,7 +428,7 @@ def test_the_scenes_aoa_mode_is_the_one_run(mode, monkeypatch):
 def test_calibration_sweep_follows_span_and_step(span_ns, step_ps):
     """rts.calibration_span_ns, calibration_step_ps: the sweep runs over
     [start, stop] in steps of the step (a small cube and a coarse FIR keep it fast)."""
-    from rtsgeom.aoa.calibration import calibrate_pair
+    from rtsgeom.calibration.pair import calibrate_pair
     s = scene_with(radar=dict(chirps_per_tx=16, samples_per_chirp=128, adc_rate_hz=3.125e6),
                    rts=dict(calibration_span_ns=list(span_ns), calibration_step_ps=step_ps,
                             fractional_delay_step_s=step_ps * 1e-12),

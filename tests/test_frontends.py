@@ -8,11 +8,11 @@ import pytest
 
 from rtsgeom.analysis.nearfield import (group_azimuth_rad, single_front_end_angles_rad,
                                         with_arc_radius)
-from rtsgeom.aoa.calibration import probe_ranges
+from rtsgeom.calibration.pair import probe_ranges
 from rtsgeom.geometry import Setup, build_setup
-from rtsgeom.geometry.arc import antenna_positions, front_ends, module_axes, radial_tangent
+from rtsgeom.geometry.frontends import antenna_positions, front_ends, module_axes, radial_tangent
 from rtsgeom.geometry.arrays import rut_array
-from rtsgeom.radar_presets import preset
+from rtsgeom.scene.presets import preset
 from rtsgeom.paths import exact_paths
 
 from conftest import make_scene

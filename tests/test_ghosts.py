@@ -11,8 +11,8 @@ from scipy.constants import c
 
 from rtsgeom.analysis.ghosts import _peak, _zoom_power, ghost_analysis, ghost_orders
 from rtsgeom.cli import main
-from rtsgeom.rts import KIND_GHOST
-from rtsgeom.run import run_scene
+from rtsgeom.rts.channels import KIND_GHOST
+from rtsgeom.pipeline.run import run_scene
 
 from conftest import DEFAULT_SCENE, make_scene
 

@@ -1,4 +1,4 @@
-"""The compiled kernels (``rtsgeom.kernels``) against their definitions, on a grid of arrays
+"""The compiled kernels (``rtsgeom.synthesis.kernels``) against their definitions, on a grid of arrays
 (uniform rows of V = 4, 8, 12, 16 elements at lambda/2, and an uneven one off the lattice)
 and taper windows: the beamformer peak is a stationary maximum of P with no grid point of more
 power and finds a plane wave's direction; the closed-form design puts the composite's peak on
@@ -10,9 +10,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rtsgeom import kernels
-from rtsgeom.aoa import sweep
-from rtsgeom.aoa.sweep import beam_derivatives, design_ratio, detected_bin_choice
+from rtsgeom.synthesis import kernels
+from rtsgeom.calibration import sweep
+from rtsgeom.calibration.sweep import beam_derivatives, design_ratio, detected_bin_choice
 from rtsgeom.radar.steering import Steering, window
 
 WAVELENGTH = 3.9e-3
@@ -169,7 +169,7 @@ def test_numpy_definitions_are_as_silent_as_the_kernels():
     the compiled kernel (a RuntimeWarning must not depend on which path a process took)."""
     import warnings
 
-    from rtsgeom.aoa.sweep import _ratios
+    from rtsgeom.calibration.sweep import _ratios
     z = np.array([1e300 + 1e300j, np.inf + 0j, np.nan + 0j, 1 + 1j])
     with warnings.catch_warnings():
         warnings.simplefilter("error")

@@ -15,7 +15,7 @@ import sys
 import numpy as np
 import pytest
 
-from rtsgeom import kernels
+from rtsgeom.synthesis import kernels
 from rtsgeom.radar import newton, steering as steering_mod
 from tests.test_kernels import plane, steering
 
@@ -126,10 +126,10 @@ def test_use_kernels_rents_numpy_until_numba_would_be_cheaper(monkeypatch):
     """``_util.use_kernels``: numpy while a process's estimated numpy work stays below half
     of numba's set-up, the kernels from the batch that would pass it on, and always once
     the kernels are loaded."""
-    from rtsgeom import _util
+    from rtsgeom._lib import util as _util
     monkeypatch.setattr(_util, "_numpy_s", 0.0)
     assert _util.use_kernels(1, 1.0)  # loaded here (this module imports them)
-    monkeypatch.delitem(sys.modules, "rtsgeom.kernels")
+    monkeypatch.delitem(sys.modules, "rtsgeom.synthesis.kernels")
     half = _util.KERNEL_SETUP_S / 2
     assert not _util.use_kernels(1000, 0.4 * half / 1000)
     assert not _util.use_kernels(1000, 0.4 * half / 1000)

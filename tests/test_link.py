@@ -1,4 +1,4 @@
-"""The physical link budget (rtsgeom.link): radar equation through the RTS, IF chain, ADC."""
+"""The physical link budget (rtsgeom.radar.link): radar equation through the RTS, IF chain, ADC."""
 
 from __future__ import annotations
 
@@ -7,13 +7,13 @@ import pytest
 from scipy.constants import c, k as K_B
 
 from conftest import make_scene
-from rtsgeom import link as lk
+from rtsgeom.radar import link as lk
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.paths.table import RUT_TO_RUT, Paths
 from rtsgeom.radar.fmcw import fast_time_s, synthesize
 from rtsgeom.radar.steering import window
-from rtsgeom.rts import build_echoes, program_nearest, setup_echoes
+from rtsgeom.rts.channels import build_echoes, program_nearest, setup_echoes
 
 
 def linked_doc(doc, link=None, n_s=128, n_c=32, targets=None):
@@ -221,7 +221,7 @@ def test_adc_clips_and_quantises(bits):
 
 def test_default_scene_unchanged_and_budget_states_the_override(default_scene):
     """No [radar.link]: the signal keeps its relative model; the budget says snr_db rules."""
-    from rtsgeom.run import run_scene, summary
+    from rtsgeom.pipeline.run import run_scene, summary
     assert default_scene.radar.link is None
     r = run_scene(default_scene.evolve(targets=default_scene.targets[:1]), aoa_mode="nearest")
     s = summary(r, "exact")
@@ -239,7 +239,7 @@ def test_default_scene_unchanged_and_budget_states_the_override(default_scene):
 def test_linked_run_warns_on_clipping_and_reports_the_budget():
     """run_scene with [radar.link]: the budget is 'modelled', thermal noise is named, the
     sheet (estimated) clips at the highest Rx gain and run warns; same seed, same bytes."""
-    from rtsgeom.run import run_scene, summary
+    from rtsgeom.pipeline.run import run_scene, summary
     scene = make_scene(lambda d: linked_doc(d, link={"adc_full_scale_dbm": -43.0}))
     r = run_scene(scene, aoa_mode="nearest")
     lb = summary(r, "exact")["link_budget"]
@@ -285,7 +285,7 @@ def test_a_front_end_lost_to_clipping_says_so():
     new-user trial got 'blocked line of sight' for a sheet reflection that clipped the ADC)."""
     import warnings
 
-    from rtsgeom.aoa.calibration import probe_front_ends
+    from rtsgeom.calibration.pair import probe_front_ends
     clipping = build_setup(make_scene(lambda d: linked_doc(d, {"adc_full_scale_dbm": -90.0})))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # the lost front end warns as well
@@ -303,7 +303,7 @@ def test_info_budget_names_front_ends_without_a_target():
     instead of ``attenuation - dB`` (a new-user trial read that as a missing attenuation on a
     front end the synthesis does use)."""
     from conftest import DEFAULT_SCENE
-    from rtsgeom.scene import load_scene
+    from rtsgeom.scene.scene import load_scene
     setup = build_setup(load_scene(DEFAULT_SCENE.parent / "custom-array.toml"))
     b = lk.static_budget(setup).to_dict()
     carrying = set(int(q) for q in program_nearest(setup.scene, setup).front_end)

@@ -1,7 +1,7 @@
 """Calibration under the link budget's thermal noise (issue 20 with issue 13's 2 ps target).
 
 With ``[radar.link]`` and no ``snr_db`` the noise is k T F f_adc (+ the RTS channels' and the
-ADC's): the calibration's phasor sweep takes that noise (``rtsgeom.link.relative_noise_power``),
+ADC's): the calibration's phasor sweep takes that noise (``rtsgeom.radar.link.relative_noise_power``),
 so the frames it averages per step follow from the actual SNR, and the chosen delay stays
 within 2 ps of the noiseless one on a low-SNR setup.
 """
@@ -14,11 +14,11 @@ from scipy.constants import c
 
 from conftest import make_scene
 from test_link import _setup_paths
-from rtsgeom import link as lk
-from rtsgeom.aoa.calibration import TARGET_BIAS_PS, calibrate_pair, probe_front_ends
+from rtsgeom.radar import link as lk
+from rtsgeom.calibration.pair import TARGET_BIAS_PS, calibrate_pair, probe_front_ends
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
-from rtsgeom.rts import program_nearest, setup_echoes
+from rtsgeom.rts.channels import program_nearest, setup_echoes
 
 
 def _linked(nf_db=None, **link):
@@ -102,10 +102,10 @@ def test_predicted_angle_noise_follows_the_noise_figure(quiet_reference):
     amplitude (x 10^(5/20) per 5 dB, in the linear regime) and the coarse frames as its
     square; NF 12 dB keeps one frame per coarse step (the path before), NF 50 dB averages
     ~100 (one frame there: 1 deg of noise per step, a wrong minimum on 3 of 3 seeds)."""
-    from rtsgeom.aoa.calibration import (COARSE_NOISE_DEG, coarse_frames, nominal_model,
-                                         predicted_angle_noise, probe_angles, probe_ranges)
-    from rtsgeom.aoa.sweep import phasor_sweep
-    from rtsgeom.scene import TargetConfig
+    from rtsgeom.calibration.pair import (COARSE_NOISE_DEG, coarse_frames, nominal_model,
+                                          predicted_angle_noise, probe_angles, probe_ranges)
+    from rtsgeom.calibration.sweep import phasor_sweep
+    from rtsgeom.scene.scene import TargetConfig
     probe, _ = quiet_reference
     noise = {}
     for nf in (12.0, 40.0, 45.0, 50.0):

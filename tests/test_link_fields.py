@@ -18,12 +18,12 @@ from scipy.constants import c, k as K_B
 
 from conftest import make_scene
 from test_link import _setup_paths, _tone, linked_doc
-from rtsgeom import link as lk
+from rtsgeom.radar import link as lk
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.radar.fmcw import synthesize
 from rtsgeom.radar.frame import simulate
-from rtsgeom.rts import build_echoes, program_nearest, setup_echoes
+from rtsgeom.rts.channels import build_echoes, program_nearest, setup_echoes
 
 TARGET = [{"range_m": 20.0, "rcs_dbsm": 10.0, "angle_deg": 0.0}]
 

@@ -15,11 +15,11 @@ import pytest
 from scipy.constants import c
 
 from conftest import make_scene
-from rtsgeom import link as lk
+from rtsgeom.radar import link as lk
 from rtsgeom.geometry import build_setup
 from rtsgeom.geometry.patterns import cos_power_exponent
 from rtsgeom.paths import exact_paths
-from rtsgeom.rts import build_echoes, program_nearest
+from rtsgeom.rts.channels import build_echoes, program_nearest
 
 
 def _scene(fe_deg, target_deg=None, radar_pattern=None, fe_pattern=None, link=None,

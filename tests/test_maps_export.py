@@ -21,8 +21,8 @@ def run_out(tmp_path_factory):
     """One ``rtsgeom run`` of the default scene (nearest amplitudes: the fast simulation,
     injected like tests/test_reliability.py's ``fast_run``) and its in-memory result."""
     import rtsgeom.cli.signal as sig
-    from rtsgeom.run import run_scene
-    from rtsgeom.scene import load_scene
+    from rtsgeom.pipeline.run import run_scene
+    from rtsgeom.scene.scene import load_scene
     result = run_scene(load_scene(DEFAULT_SCENE), "exact", "nearest")
     out = tmp_path_factory.mktemp("maps") / "out"
     with pytest.MonkeyPatch.context() as mp:
@@ -98,7 +98,7 @@ def test_netcdf(run_out):
 def test_other_outputs_unchanged(run_out):
     """detections.csv / summary.json keep their contract; the PNGs are still written."""
     from rtsgeom.cli.signal import detections_csv
-    from rtsgeom.run import summary
+    from rtsgeom.pipeline.run import summary
     out, result = run_out
     assert (out / "detections.csv").read_text() == detections_csv(result)
     assert json.loads((out / "summary.json").read_text()) == json.loads(

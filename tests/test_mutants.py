@@ -22,7 +22,7 @@ from rtsgeom.radar import process
 from rtsgeom.radar.frame import simulate
 from rtsgeom.radar.processing import range_angle_map
 from rtsgeom.radar.newton import parabolic
-from rtsgeom.rts import KIND_SETUP, program_nearest, requested_delay, setup_echoes
+from rtsgeom.rts.channels import KIND_SETUP, program_nearest, requested_delay, setup_echoes
 
 def small_quiet(targets=None, **radar):
     def mutate(doc):
@@ -71,7 +71,7 @@ def test_range_angle_map_peaks_at_each_detection_angle():
 def test_smallest_spacing_of_a_single_position_is_infinite():
     from rtsgeom.geometry.arrays import array_from_spec
     from rtsgeom.geometry.farfield import smallest_spacing_m
-    from rtsgeom.radar_presets import ArraySpec
+    from rtsgeom.scene.presets import ArraySpec
     lam = 3.9e-3
     one = array_from_spec(ArraySpec(((0.0, 0.0),), ((0.0, 0.0),), (0,)), lam)
     assert smallest_spacing_m(one) == float("inf")
@@ -110,7 +110,7 @@ def test_segments_through_a_triangle_edge_are_blocked():
 def test_front_end_layout_fields_read_per_front_end():
     """Front ends whose configs carry explicit (t, h) offsets and rotations (the library
     layer; some may leave them unset, i.e. default): placed by those, not the shorthand."""
-    from rtsgeom.geometry.arc import front_ends
+    from rtsgeom.geometry.frontends import front_ends
     base = make_scene().rts.front_ends
     fes = [SimpleNamespace(**{k: getattr(f, k) for k in (
         "angle_rad", "rx_tx_separation_m", "radial_offset_m", "tangential_offset_m",
@@ -175,9 +175,9 @@ def test_probe_finds_each_front_end_at_the_model_angle_with_unit_gain_correction
     """Each front end alone, measured in the noise-free chain: at the exact model's angle of
     that front end (the beamformer peak of its own phasors), and with a gain correction of 1
     where the setup is the nominal one (the model then is the measurement)."""
-    from rtsgeom.aoa.calibration import probe_front_ends, probe_ranges
-    from rtsgeom.aoa.model import ChannelModel
-    from rtsgeom.scene import TargetConfig
+    from rtsgeom.calibration.pair import probe_front_ends, probe_ranges
+    from rtsgeom.synthesis.model import ChannelModel
+    from rtsgeom.scene.scene import TargetConfig
     setup, paths = small_setup
     probe = probe_front_ends(setup, paths)
     ranges = probe_ranges(setup, setup.fe.count)
@@ -195,7 +195,7 @@ def test_plan_programs_two_channels_per_target_at_the_set_range_and_doppler(smal
     """``plan_targets`` without calibration: per target the bracketing pair, each at the
     requested delay and Doppler 2 f_c v / c0, positive amplitudes; with exact amplitudes on the
     nominal setup the chain detects each target at its set angle."""
-    from rtsgeom.aoa.plan import plan_targets
+    from rtsgeom.pipeline.plan import plan_targets
     setup, paths = small_setup
     scene = setup.scene
     prog, record, warnings = plan_targets(setup, paths, mode, calibrate=False)
@@ -216,7 +216,7 @@ def test_plan_programs_two_channels_per_target_at_the_set_range_and_doppler(smal
     if mode == "exact":
         _, cube = simulate(setup, paths, prog)
         rd, det = process(cube)
-        from rtsgeom.run import match_targets
+        from rtsgeom.pipeline.run import match_targets
         for e in match_targets(scene, det, rd):
             assert abs(e["error"]["angle_deg"]) < 0.05
 
@@ -227,7 +227,7 @@ def test_plan_programs_two_channels_per_target_at_the_set_range_and_doppler(smal
 def test_tolerance_table_spans_half_a_calibration_period():
     """The delay table of the tolerance model covers +-(half a period 1/(f_rts + B/2)) in
     delay-resolution steps, plus 4 for the refinement."""
-    from rtsgeom.analysis.tolerance import PairPhasors
+    from rtsgeom.analysis.tolerance.driver import PairPhasors
     scene = small_quiet([])
     model = PairPhasors.build(build_setup(scene), (0, 1), points=3)
     slope = scene.rts.f_rts_hz + 0.5 * scene.radar.bandwidth_hz
@@ -236,7 +236,7 @@ def test_tolerance_table_spans_half_a_calibration_period():
 
 @pytest.mark.parametrize("sigma", [[-1e-4, 0, 0], [0, float("nan"), 0], [0, 0, float("inf")]])
 def test_monte_carlo_refuses_negative_or_non_finite_sigmas(sigma):
-    from rtsgeom.analysis.tolerance import PairPhasors, monte_carlo
+    from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
     model = PairPhasors.build(build_setup(small_quiet([])), (0, 1), points=3)
     with pytest.raises(ValueError, match="sigma_m"):
         monte_carlo(model, sigma, 4, seed=0)
@@ -266,7 +266,7 @@ def cal_setup():
 
 @pytest.fixture(scope="module")
 def calibrated(cal_setup):
-    from rtsgeom.aoa.calibration import calibrate_pair, probe_front_ends
+    from rtsgeom.calibration.pair import calibrate_pair, probe_front_ends
     setup, paths = cal_setup
     probe = probe_front_ends(setup, paths)
     return probe, calibrate_pair(setup, paths, (0, 1), probe)
@@ -277,7 +277,7 @@ def test_calibrate_pair_sweep_refinement_and_probes(cal_setup, calibrated):
     around the best point (9 points per level), the probe angles are the pair's 1/4 and 3/4
     points, and the calibrated pair is coherent: residual below 0.05 deg with the gain error
     corrected by the probe."""
-    from rtsgeom.aoa.calibration import probe_angles
+    from rtsgeom.calibration.pair import probe_angles
     setup, paths = cal_setup
     probe, cal = calibrated
     assert probe.gain_correction[0] == pytest.approx(10 ** (-3 / 20), rel=0.02)
@@ -298,7 +298,7 @@ def test_calibrate_pair_sweep_refinement_and_probes(cal_setup, calibrated):
 def test_linearity_sweeps_the_inner_span_and_reports_relative_amplitudes(cal_setup, calibrated):
     """Set angles at k/(points + 1) of the span, each detected near it (exact amplitudes on a
     calibrated pair), amplitudes in dB relative to the largest (max 0 dB)."""
-    from rtsgeom.aoa.linearity import linearity
+    from rtsgeom.analysis.linearity import linearity
     setup, paths = cal_setup
     probe, cal = calibrated
     lin = linearity(setup, paths, (0, 1), "exact", probe, cal, points=3)
@@ -311,10 +311,10 @@ def test_linearity_sweeps_the_inner_span_and_reports_relative_amplitudes(cal_set
     amp_db = np.asarray(lin.amplitude_db)
     assert amp_db.max() == 0.0 and np.all(amp_db <= 0.0)
     # 20 log10 of the programmed amplitudes relative to the largest
-    from rtsgeom.aoa.calibration import probe_angles
-    from rtsgeom.aoa.plan import pair_design
-    from rtsgeom.aoa.calibration import probe_ranges
-    from rtsgeom.scene import TargetConfig
+    from rtsgeom.calibration.pair import probe_angles
+    from rtsgeom.pipeline.plan import pair_design
+    from rtsgeom.calibration.pair import probe_ranges
+    from rtsgeom.scene.scene import TargetConfig
     rng = float(probe_ranges(setup, 1)[0])
     amps = np.array([pair_design(setup, paths, (0, 1), TargetConfig(rng, 0.0, 10.0, float(a)),
                                  "exact", probe_angles(*probe.angle_rad[[0, 1]]),
@@ -329,7 +329,7 @@ def test_linearity_sweeps_the_inner_span_and_reports_relative_amplitudes(cal_set
 @pytest.mark.parametrize("length", [1.0, 2.1, 2.9, 4.2])
 def test_probe_ranges_keep_clear_of_every_cable_ghost(length):
     """Probes m * step apart never sit within 4 range bins of a ghost k L / VF of another."""
-    from rtsgeom.aoa.calibration import probe_ranges
+    from rtsgeom.calibration.pair import probe_ranges
     s = make_scene(lambda d: [fe.update(cable_length_m=length) for fe in d["rts"]["front_ends"]])
     setup = build_setup(s)
     r = probe_ranges(setup, 3)
@@ -342,8 +342,8 @@ def test_probe_ranges_keep_clear_of_every_cable_ghost(length):
 
 @pytest.mark.parametrize("angles", [(3.4, 12.2), (-5.0, 5.0), (-12.0, -2.0)])
 def test_closed_forms_put_a_span_end_on_one_channel_alone(angles):
-    from rtsgeom.aoa.model import ChannelModel
-    from rtsgeom.scene import TargetConfig
+    from rtsgeom.synthesis.model import ChannelModel
+    from rtsgeom.scene.scene import TargetConfig
 
     def mutate(doc):
         doc["radar"].update(SMALL)
@@ -363,9 +363,9 @@ def test_closed_forms_put_a_span_end_on_one_channel_alone(angles):
 def test_pair_amplitudes_design_for_the_channel_delay_offsets():
     """``exact`` designs J's amplitude for its calibration delay (the range offset it causes):
     an offset of a whole period changes the ratio, by the model built with that delay."""
-    from rtsgeom.aoa.plan import pair_amplitudes
-    from rtsgeom.aoa.synthesis import PairModel
-    from rtsgeom.scene import TargetConfig
+    from rtsgeom.pipeline.plan import pair_amplitudes
+    from rtsgeom.synthesis.closed_form import PairModel
+    from rtsgeom.scene.scene import TargetConfig
     setup = build_setup(small_quiet([], samples_per_chirp=512))
     paths = exact_paths(setup)
     th = setup.fe_azimuth_rad()
@@ -383,7 +383,7 @@ def test_pair_amplitudes_design_for_the_channel_delay_offsets():
 def test_ghosts_of_a_later_front_end_when_an_earlier_one_is_idle():
     """Cable ghosts are added per front end with echoes; a front end without any programmed
     channel does not end the loop, and the ghost order is an integer."""
-    from rtsgeom.rts import RtsProgram, channel_echoes
+    from rtsgeom.rts.channels import RtsProgram, channel_echoes
     s = make_scene(lambda d: d["radar"].pop("snr_db", None))
     setup = build_setup(s)
     prog = RtsProgram.build([0], [1], [1e-7], [0.0], [1.0])  # only front end 1
@@ -394,7 +394,7 @@ def test_ghosts_of_a_later_front_end_when_an_earlier_one_is_idle():
 
 
 def test_monte_carlo_maps_its_chunks_through_the_mapper_and_times_itself():
-    from rtsgeom.analysis.tolerance import PairPhasors, monte_carlo
+    from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
     model = PairPhasors.build(build_setup(small_quiet([])), (0, 1), points=3)
     calls = []
 
@@ -412,7 +412,7 @@ def test_monte_carlo_maps_its_chunks_through_the_mapper_and_times_itself():
 
 
 def test_yield_inversion_says_when_the_nominal_setup_misses_the_spec():
-    from rtsgeom.analysis.tolerance import PairPhasors, max_sigma_for_yield
+    from rtsgeom.analysis.tolerance.driver import PairPhasors, max_sigma_for_yield
     model = PairPhasors.build(build_setup(small_quiet([])), (0, 1), points=3)
     res = max_sigma_for_yield(model, [1e-4] * 3, 20, 0, 0.95, spec_deg=1e-9,
                               case="uncalibrated")
@@ -421,7 +421,7 @@ def test_yield_inversion_says_when_the_nominal_setup_misses_the_spec():
 
 def test_range_offset_is_half_c_times_the_mean_delay_mismatch():
     """range_offset_m = c0/2 (element-mean air delay of J + its steps - that of I)."""
-    from rtsgeom.analysis.tolerance import PairPhasors
+    from rtsgeom.analysis.tolerance.driver import PairPhasors
     model = PairPhasors.build(build_setup(small_quiet([])), (0, 1), points=3)
     off = np.zeros((2, 3))
     off[1, 0] = 2e-3  # 2 mm radial on J: both legs longer by 2 mm

@@ -27,9 +27,9 @@ def test_fit_scatter_from_one_sweep_is_the_refits_scatter(sigma_rad, amp_rad, tr
     """From ONE noisy sweep (its residual about the fit, refitted on drawn sweeps) the
     estimate is within 35 % of the std of the minima of 200 independent noisy sweeps
     (32 draws: ~13 % statistical), and the frames it asks for grow as sigma^2."""
-    from rtsgeom.aoa.calsteps import TARGET_BIAS_PS, fine_frames
-    from rtsgeom.aoa.calsteps import fit_scatter
-    from rtsgeom.aoa.sweep import fit_minimum
+    from rtsgeom.calibration.steps import TARGET_BIAS_PS, fine_frames
+    from rtsgeom.calibration.steps import fit_scatter
+    from rtsgeom.calibration.sweep import fit_minimum
     near = true_ps * 1e-12 + 30e-12
     d = near + np.arange(-25, 26) * 10e-12
     clean = _curves(d, true_ps * 1e-12, amp_rad)
@@ -52,8 +52,8 @@ def test_fit_scatter_from_one_sweep_is_the_refits_scatter(sigma_rad, amp_rad, tr
 def test_fit_scatter_is_zero_without_noise_and_unknown_without_enough_steps():
     """No noise: no scatter. Too few steps for a residual (the curves pass through them): not
     "no noise" but unknown (NaN), which ``calibrate_pair_nd`` answers with a second sweep."""
-    from rtsgeom.aoa.calsteps import fit_scatter
-    from rtsgeom.aoa.sweep import fit_minimum
+    from rtsgeom.calibration.steps import fit_scatter
+    from rtsgeom.calibration.sweep import fit_minimum
     d = np.arange(-25, 26) * 10e-12
     clean = _curves(d, 0.0, np.radians(0.05))
 
@@ -74,8 +74,8 @@ def test_coarse_rts_steps_measure_the_noise_from_a_repeated_sweep(sigma_rad):
     residual is zero whatever the noise (the frames were sized to 1, the scatter reported 0).
     With a second, independent sweep the noise is that of their difference: within 40 % of
     sigma on 5 steps x 2 columns, and the scatter grows with it."""
-    from rtsgeom.aoa.calsteps import fit_scatter
-    from rtsgeom.aoa.sweep import fit_minimum
+    from rtsgeom.calibration.steps import fit_scatter
+    from rtsgeom.calibration.sweep import fit_minimum
     d = np.arange(-2, 3) * 100e-12
     clean = _curves(d, 20e-12, np.radians(0.05))
     rng = np.random.default_rng(11)
@@ -96,8 +96,8 @@ def test_coarse_rts_steps_measure_the_noise_from_a_repeated_sweep(sigma_rad):
 def test_frames_for_is_the_square_of_the_scatter_over_the_target(scatter, target, k):
     """The one sizing rule of both sweeps and both pairs (coarse: probe-angle noise over
     COARSE_NOISE_DEG; fine: 2 sigma of the minimum over TARGET_BIAS_PS)."""
-    from rtsgeom.aoa.calsteps import (COARSE_NOISE_DEG, TARGET_BIAS_PS, coarse_frames,
-                                      fine_frames, frames_for)
+    from rtsgeom.calibration.steps import (COARSE_NOISE_DEG, TARGET_BIAS_PS, coarse_frames,
+                                           fine_frames, frames_for)
     assert frames_for(scatter, target) == k
     assert coarse_frames(scatter * COARSE_NOISE_DEG) == k
     assert fine_frames(scatter * TARGET_BIAS_PS * 1e-12 / 2) == k
@@ -110,11 +110,11 @@ def test_elevation_pair_frames_grow_as_snr_falls_and_it_stays_at_its_point(snr_d
     the fitted minimum by ~8 ps (~25 ps 10 dB below: the pairs landed -11 to +17 ps off
     at the scene's SNR); the frames chosen bring it within 5 ps of the continuous coherence
     point, and grow ~10x (1/SNR) with the 10 dB."""
-    from rtsgeom.aoa.calibration import probe_front_ends
-    from rtsgeom.aoa.ncal import calibrate_pair_nd, coherence_point_nd
+    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.calibration.channels import calibrate_pair_nd, coherence_point_nd
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene import load_scene
+    from rtsgeom.scene.scene import load_scene
     scene = load_scene("scenes/sphere4.toml")
     scene = scene.evolve(radar=scene.radar.evolve(snr_db=scene.radar.snr_db - snr_drop_db))
     setup = build_setup(scene)
@@ -138,12 +138,12 @@ def test_elevation_pair_30_db_below_averages_its_coarse_sweep_too():
     COARSE_NOISE_DEG: the coarse sweep is measured again with the frames that bring it
     below (coarse_frames, the arc pair's rule), the fine sweep with thousands, and the pair
     still lands within 5 ps of its coherence point."""
-    from rtsgeom.aoa.calibration import probe_front_ends
-    from rtsgeom.aoa.calsteps import COARSE_NOISE_DEG
-    from rtsgeom.aoa.ncal import calibrate_pair_nd, coherence_point_nd
+    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.calibration.steps import COARSE_NOISE_DEG
+    from rtsgeom.calibration.channels import calibrate_pair_nd, coherence_point_nd
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene import load_scene
+    from rtsgeom.scene.scene import load_scene
     scene = load_scene("scenes/sphere4.toml")
     scene = scene.evolve(radar=scene.radar.evolve(snr_db=scene.radar.snr_db - 30.0))
     setup = build_setup(scene)

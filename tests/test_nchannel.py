@@ -6,12 +6,12 @@ import dataclasses
 import numpy as np
 import pytest
 
-from rtsgeom.aoa.cells import CellUnreachable, enclosing_cell
-from rtsgeom.aoa.model import AngleUnreachable, ChannelModel
-from rtsgeom.aoa.nchannel import ChannelSet, closed_form_amplitudes
+from rtsgeom.synthesis.cells import CellUnreachable, enclosing_cell
+from rtsgeom.synthesis.model import AngleUnreachable, ChannelModel
+from rtsgeom.synthesis.nchannel import ChannelSet, closed_form_amplitudes
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
-from rtsgeom.scene import TargetConfig, load_scene
+from rtsgeom.scene.scene import TargetConfig, load_scene
 
 SPHERE = "scenes/sphere4.toml"
 
@@ -85,7 +85,7 @@ def test_closed_form_equals_exact_in_ideal_far_field(sphere, cell, spread):
 
 def test_closed_form_pair_is_paper_array_factor():
     """D = 1, Q = 2: the null-space closed form is eq. 23 with the true array factor."""
-    from rtsgeom.aoa.synthesis import ratio_array_factor
+    from rtsgeom.synthesis.closed_form import ratio_array_factor
     from rtsgeom.radar.steering import Steering
     scene = load_scene("scenes/diewald2022.toml")
     setup = build_setup(scene)
@@ -135,7 +135,7 @@ def test_exact_model_hits_cell_points(sphere):
 def test_sphere4_run_within_0_05_deg():
     """Done-when: targets at several (az, el) inside the cell, detected within 0.05 deg in both
     angles after calibration (exact mode), for the bundled targets and a second set."""
-    from rtsgeom.run import run_scene
+    from rtsgeom.pipeline.run import run_scene
     scene = load_scene(SPHERE)
     moved = tuple(t.evolve(angle_rad=np.radians(a), elevation_rad=np.radians(e))
                   for t, a, e in zip(scene.targets, (4.0, 11.5, 8.0, 6.0),

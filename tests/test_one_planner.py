@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 
 from conftest import make_scene
-from rtsgeom.aoa.calibration import calibrate_pair, probe_front_ends
-from rtsgeom.aoa.ncal import calibrate_channels, calibrate_pair_nd
-from rtsgeom.aoa.plan import plan_targets, uses_cells
+from rtsgeom.calibration.pair import calibrate_pair, probe_front_ends
+from rtsgeom.calibration.channels import calibrate_channels, calibrate_pair_nd
+from rtsgeom.pipeline.plan import plan_targets, uses_cells
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
-from rtsgeom.scene import SceneError, load_scene
+from rtsgeom.scene.scene import SceneError, load_scene
 
 from conftest import ROOT
 

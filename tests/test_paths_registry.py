@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rtsgeom import registry
+from rtsgeom.scene import registry
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import compute_paths, exact_paths
 

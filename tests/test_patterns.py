@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from rtsgeom.geometry import Setup, build_setup
-from rtsgeom.geometry.arc import front_ends
+from rtsgeom.geometry.frontends import front_ends
 from rtsgeom.geometry.patterns import (ISOTROPIC, AntennaPatterns, CosinePattern, TablePattern,
                                        cos_power_exponent, direction_angles, pattern_from_config)
 from rtsgeom.paths import exact_paths

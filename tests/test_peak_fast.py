@@ -1,5 +1,5 @@
 """Steering.peak's fast paths against the plain double-precision algorithm (numpy's D-general
-Newton, the grid in double precision): the compiled 1-D peak (``rtsgeom.kernels.peak_1d``:
+Newton, the grid in double precision): the compiled 1-D peak (``rtsgeom.synthesis.kernels.peak_1d``:
 Newton with phasors from the array's lattice, the global check in double precision), and
 search's skip of NaN snapshots. Across arrays (the default RuT, a sparse and a wide ULA),
 snapshot kinds (one source, two sources of nearly equal power, noise), scales 1e-30 and
@@ -15,7 +15,7 @@ from rtsgeom.geometry import build_setup
 from rtsgeom.radar import steering as S
 from rtsgeom.radar.newton import newton
 from rtsgeom.radar.steering import Steering
-from rtsgeom.scene import load_scene
+from rtsgeom.scene.scene import load_scene
 
 
 def _reference_peak(st, snaps, u0, iterations=4):

@@ -35,7 +35,7 @@ def test_largest_passing_scale_stops_when_the_bracket_is_within_rel_tol(t_star, 
     """A yield that passes for t <= t*: the search returns lo <= t* within rel_tol of it and
     stops as soon as the bracket is that narrow, so its cost is the doublings plus
     ceil(log2(log(hi/lo) / log(1 + rel_tol))) + 1 geometric bisections, not all of them."""
-    from rtsgeom.analysis.tolerance import largest_passing_scale
+    from rtsgeom.analysis.tolerance.driver import largest_passing_scale
     calls = []
 
     def yield_at(t):
@@ -55,7 +55,7 @@ def test_largest_passing_scale_stops_when_the_bracket_is_within_rel_tol(t_star, 
 
 
 def test_largest_passing_scale_caps():
-    from rtsgeom.analysis.tolerance import largest_passing_scale
+    from rtsgeom.analysis.tolerance.driver import largest_passing_scale
     for cap in (0.5, 3.0, 10.0):
         t, y, capped = largest_passing_scale(lambda t: 1.0, 1.0, 0.9, 0.1, cap, 0.01)
         assert capped and t == cap and y == 1.0
@@ -64,7 +64,7 @@ def test_largest_passing_scale_caps():
 def test_monte_carlo_without_draws_has_no_errors_and_no_yield():
     """Zero draws: every case's error array is empty and its yield undefined (NaN), never a
     phantom draw with zero error (a 100 % yield)."""
-    from rtsgeom.analysis.tolerance import PairPhasors, monte_carlo
+    from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
     from rtsgeom.geometry import build_setup
     model = PairPhasors.build(build_setup(make_scene()), (0, 1), 3)
     res = monte_carlo(model, [1e-4, 1e-4, 1e-4], 0, 1)
@@ -114,9 +114,10 @@ def test_probe_capture_round_trip(tmp_path, fmt, active):
     """A probe capture written (``.npy`` or DCA1000 ``.bin`` + sidecar) reads back with its
     active front end, probe range, velocity and amplitude, and the same samples (DCA1000:
     within int16 quantisation). The default probe is the calibration's first probe range."""
-    from rtsgeom.aoa.calibration import probe_ranges
+    from rtsgeom.calibration.pair import probe_ranges
     from rtsgeom.geometry import build_setup
-    from rtsgeom.radar.capture import capture_probe, read_capture, simulate_capture, write_capture
+    from rtsgeom.identify.capture import (capture_probe, read_capture, simulate_capture,
+                                          write_capture)
     setup = build_setup(_small_noiseless())
     r0, amp0 = capture_probe(setup)
     assert r0 == pytest.approx(float(probe_ranges(setup, 1)[0]))
@@ -142,7 +143,7 @@ def test_bounds_from_tolerances_scale_every_field(distribution, level):
     """A tolerance t is a normal draw's t / sigma_level standard deviation and a uniform
     draw's bound t, for every field (front-end offsets and rotations, the RuT's position
     and yaw); a field left out is 0."""
-    from rtsgeom.analysis.arc import Bounds
+    from rtsgeom.analysis.tolerance.arc import Bounds
     tol = {"offsets_m": (1e-4, 2e-4, 3e-4), "yaw_rad": 0.01, "pitch_rad": 0.02,
            "rut_position_m": (4e-4, 5e-4, 6e-4), "rut_yaw_rad": 0.03}
     k = 1.0 / level if distribution == "normal" else 1.0
@@ -161,7 +162,7 @@ def test_arc_draws_do_not_depend_on_the_chunk(distribution):
     """The unit draws are the same whatever the chunk size (each stream from its own
     generator), with the documented shapes; uniform ones fill [-1, 1], normal ones have unit
     variance."""
-    from rtsgeom.analysis.arc import arc_draws
+    from rtsgeom.analysis.tolerance.arc import arc_draws
     draws, count = 400, 3
     ref = None
     for chunk in (1, 37, 400, 10_000):
@@ -185,7 +186,7 @@ def test_arc_draws_do_not_depend_on_the_chunk(distribution):
 def test_arc_yield_search_stops_at_zero_when_the_nominal_arc_fails():
     """When even the arc without errors misses the spec, the largest passing scale is 0 and
     its yield is the nominal one (0); with a reachable spec the scale is positive."""
-    from rtsgeom.analysis.arc import Bounds, arc_models, max_scale_for_yield
+    from rtsgeom.analysis.tolerance.arc import Bounds, arc_models, max_scale_for_yield
     from rtsgeom.geometry import build_setup
     setup = build_setup(make_scene())
     models = arc_models(setup, [(0, 1)], 3)
@@ -260,7 +261,7 @@ def test_2d_search_is_independent_of_the_targets_phase(preset, window):
     the same (azimuth, elevation) for phases all around the circle, at the plane wave's
     direction."""
     from rtsgeom.radar.steering import Steering
-    from rtsgeom.scene import load_scene
+    from rtsgeom.scene.scene import load_scene
     sc = load_scene("scenes/diewald2022.toml")
     radar = sc.radar.evolve(antenna_preset=preset, use_elevation_tx=True, angle_window=window,
                             elevation_processing=True)
@@ -289,11 +290,11 @@ def test_linked_frame_noise_is_the_receivers_thermal_noise_through_the_if_chain(
     the receiver input (no RTS channel programmed here) through the IF chain (mean |H|^2 over
     the bins) plus the ADC's quantisation, for a grid of noise figures (within 5 %); the
     seed decides the realisation."""
-    from rtsgeom import link as lk
+    from rtsgeom.radar import link as lk
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     from rtsgeom.radar.frame import simulate
-    from rtsgeom.rts import program_nearest
+    from rtsgeom.rts.channels import program_nearest
 
     def linked(nf_db):
         def m(doc):

@@ -22,7 +22,7 @@ from test_physics_core import _small_noiseless
 def test_array_factor_of_filled_positions_is_the_dirichlet_kernel(n):
     """``array_factor`` with the positions of a filled lambda/2 array equals its closed form
     sin(n pi u/2) / (n sin(pi u/2)) (docstring), for any u, also past the grating lobes."""
-    from rtsgeom.aoa.synthesis import array_factor
+    from rtsgeom.synthesis.closed_form import array_factor
     u = np.linspace(-1.9, 1.9, 381)
     closed = array_factor(u, n)
     for offset in (0.0, 3.25):  # the centroid is removed: a shifted array has the same AF
@@ -44,7 +44,7 @@ def test_fit_minimum_finds_the_minimum_of_the_periodic_criterion_despite_lost_st
     periodic, minimum at delta_0) over one period of steps: the fit returns delta_0 within
     its 0.05 ps grid, also when some steps lost a probe (NaN: no detection) -- only those
     steps are dropped."""
-    from rtsgeom.aoa.sweep import fit_minimum
+    from rtsgeom.calibration.sweep import fit_minimum
     period, step = 1.0e-9, 25e-12
     near = 0.0
     d = near + np.arange(-20, 21) * step
@@ -75,12 +75,12 @@ def test_fir_effect_predicts_the_coherence_shift_in_picoseconds(taps):
     phasor model with the filter against without it at fractional delay settings across a
     period: the least-squares gain measured / predicted is 1 within 30 % (first order in
     the filter's phase ripple), and a short filter shifts the point measurably."""
-    from rtsgeom.aoa.calibration import (fir_effect, if_phase_slope_hz, probe_ranges,
-                                         probe_total_delay)
-    from rtsgeom.aoa.synthesis import PairModel
+    from rtsgeom.calibration.pair import (fir_effect, if_phase_slope_hz, probe_ranges,
+                                          probe_total_delay)
+    from rtsgeom.synthesis.closed_form import PairModel
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene import TargetConfig
+    from rtsgeom.scene.scene import TargetConfig
     ideal = build_setup(_fir_scene(taps, "ideal"))
     fir = build_setup(_fir_scene(taps, "windowed-sinc"))
     paths = exact_paths(ideal)
@@ -107,7 +107,7 @@ def test_fir_effect_predicts_the_coherence_shift_in_picoseconds(taps):
 def test_plan_reports_each_pairs_calibration_delay_in_picoseconds():
     """``run``'s progress line for a calibrated pair gives delta_tau in ps: the value
     the calibration record holds (s) times 1e12, within the printed precision."""
-    from rtsgeom.aoa.plan import plan_targets
+    from rtsgeom.pipeline.plan import plan_targets
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
 
@@ -134,7 +134,7 @@ def test_plan_reports_each_pairs_calibration_delay_in_picoseconds():
 def test_enclosing_interval_is_the_adjacent_pair_in_one_dimension(count):
     """1-D cells: a direction between two neighbouring front ends (in any index order) is
     enclosed by exactly that pair, also with only two front ends; outside the span none."""
-    from rtsgeom.aoa.cells import CellUnreachable, enclosing_cell
+    from rtsgeom.synthesis.cells import CellUnreachable, enclosing_cell
     rng = np.random.default_rng(count)
     x = np.sort(rng.uniform(-0.5, 0.5, count))
     perm = rng.permutation(count)
@@ -154,7 +154,7 @@ def test_pair_edges_are_neighbours_in_1d_and_delaunay_edges_in_2d(grid):
     """The pairs an N-channel calibration sweeps: in 1-D the F - 1 neighbours by direction
     (whatever the channel numbering); in 2-D the edges of the Delaunay triangulation, 3 F - 3
     - h of them for F points with h on the hull (Euler), each joining two given channels."""
-    from rtsgeom.aoa.ncal import pair_edges
+    from rtsgeom.calibration.channels import pair_edges
     n_a, n_e = grid
     rng = np.random.default_rng(n_a * 10 + n_e)
     az = np.arange(n_a) * 0.1 + rng.uniform(-0.01, 0.01, n_a)
@@ -187,8 +187,8 @@ def test_nd_pair_calibration_lands_on_the_coherence_point(fe, dr_mm):
     phasor model's coherence point for a radial offset that puts the point half a coarse
     step (100 ps) off the sweep grid, on either front end; its period is 1/(f_rts + S t_mid
     - S tau) as the pair calibration's."""
-    from rtsgeom.aoa.calibration import coherence_delay, probe_angles, probe_front_ends
-    from rtsgeom.aoa.ncal import calibrate_pair_nd
+    from rtsgeom.calibration.pair import coherence_delay, probe_angles, probe_front_ends
+    from rtsgeom.calibration.channels import calibrate_pair_nd
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     from rtsgeom.geometry.farfield import two_way_lengths
@@ -211,8 +211,8 @@ def test_nd_pair_calibration_lands_on_the_coherence_point(fe, dr_mm):
 
 
 def test_channel_calibration_of_one_channel_is_its_own_reference():
-    from rtsgeom.aoa.calibration import probe_front_ends
-    from rtsgeom.aoa.ncal import calibrate_channels
+    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.calibration.channels import calibrate_channels
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     setup = build_setup(_small_noiseless())
@@ -232,10 +232,10 @@ def test_2d_error_map_exact_mode_puts_every_grid_point_on_its_direction():
     every grid point inside the four front ends' cell at its (azimuth, elevation) through
     the whole chain (1e-4 deg); ``array-factor`` (closed form, no near field) is off by a
     finite amount. The n x n grid inside a rectangular cell keeps all n^2 points."""
-    from rtsgeom.aoa.linearity2d import linearity_grid
+    from rtsgeom.analysis.linearity2d import linearity_grid
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene import load_scene
+    from rtsgeom.scene.scene import load_scene
     sc = load_scene("scenes/sphere4.toml")
     sc = sc.evolve(radar=sc.radar.evolve(snr_db=None, samples_per_chirp=128, chirps_per_tx=32,
                                          adc_rate_hz=12.5e6))
@@ -256,10 +256,10 @@ def test_closed_form_amplitudes_ignore_a_common_phase(common):
     """Adding one phase to every channel's programmed phase changes nothing physical (the
     beamformer output rotates as a whole): the ``array-factor`` amplitudes on sphere4's four
     front ends are the same for phases + c as for phases, over set points in the cell."""
-    from rtsgeom.aoa.nchannel import ChannelSet, closed_form_amplitudes
+    from rtsgeom.synthesis.nchannel import ChannelSet, closed_form_amplitudes
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene import TargetConfig, load_scene
+    from rtsgeom.scene.scene import TargetConfig, load_scene
     setup = build_setup(load_scene("scenes/sphere4.toml"))
     cs = ChannelSet.build(setup, exact_paths(setup), (0, 1, 2, 3), TargetConfig(25.0))
     st = cs.steering
@@ -282,8 +282,8 @@ def test_measured_end_angles_equal_geometric_ones_in_the_ideal_far_field(mode):
     """In the ideal far field (50 m, no Rx/Tx separation) each front end alone is detected
     at its geometric angle, so the closed forms with measured end angles program the same
     ratios as with the geometric ones: the same detected angles through the chain."""
-    from rtsgeom.aoa.calibration import probe_front_ends
-    from rtsgeom.aoa.linearity import linearity
+    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.analysis.linearity import linearity
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
 
@@ -309,7 +309,7 @@ def test_raising_the_rut_equals_lowering_every_front_end(h_mm):
     """Only relative geometry matters: the legs with the RuT raised by h (a RuT position
     error alone, no yaw) equal those with every front end lowered by h (height offset -h),
     for both channels of the pair; and they differ from the nominal legs."""
-    from rtsgeom.analysis.tolerance import PairPhasors
+    from rtsgeom.analysis.tolerance.driver import PairPhasors
     from rtsgeom.geometry import build_setup
     model = PairPhasors.build(build_setup(make_scene()), (0, 1), 3)
     h = h_mm * 1e-3
@@ -330,7 +330,7 @@ def test_paper_procedure_reports_the_exact_period_at_its_target():
     1/(f_rts + S t_mid - S tau) at its target's delay, as the pair calibration does at its
     probes' (not eq. 27's 1/(f_rts + B/2))."""
     from scipy.constants import c
-    from rtsgeom.aoa.calibration import calibrate_pair_paper, probe_front_ends, probe_ranges
+    from rtsgeom.calibration.pair import calibrate_pair_paper, probe_front_ends, probe_ranges
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     for f_rts in (500e6, 300e6):
@@ -356,11 +356,11 @@ def test_closed_form_design_is_scale_free_and_puts_the_peak_on_the_set_angle(ang
     """``design_ratio``: the ratio whose composite x_i + rho e^{j phase} x_j peaks at the set
     angle. Its beamformer peak is there (searched), and the ratio does not depend on the
     echoes' common scale (volts or sqrt(W), 1e-6 or 1e6: P'' < 0 is a sign, not a level)."""
-    from rtsgeom.aoa.model import ChannelModel
-    from rtsgeom.aoa.sweep import design_ratio
+    from rtsgeom.synthesis.model import ChannelModel
+    from rtsgeom.calibration.sweep import design_ratio
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene import TargetConfig
+    from rtsgeom.scene.scene import TargetConfig
 
     def mutate(doc):
         doc["radar"]["angle_window"] = angle_window
@@ -393,7 +393,7 @@ def test_calibration_sweep_noise_is_the_adc_chains_within_a_factor_of_a_few(snr_
     noise realisation in both); they agree within a
     factor 5 (measured: the phasor model's is 1.4-1.5 times the chain's at SNR -10 and 0 dB),
     where a noise level off by the windows' sum w^2 (thousands) would not."""
-    from rtsgeom.aoa.calibration import calibrate_pair, probe_front_ends
+    from rtsgeom.calibration.pair import calibrate_pair, probe_front_ends
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
 
@@ -430,7 +430,7 @@ def test_fir_effect_reports_its_filter_and_a_small_passband_ripple(taps):
     """``fir_effect`` names the filter it evaluated ("none" without a fractional delay, where
     nothing ripples) and a windowed-sinc FIR's gain ripple along the chirp's IF sweep: a
     passband ripple, positive and below 1 dB from 9 taps on, that a twice as long filter does not increase."""
-    from rtsgeom.aoa.calibration import fir_effect
+    from rtsgeom.calibration.pair import fir_effect
     from rtsgeom.geometry import build_setup
     fir = fir_effect(build_setup(_fir_scene(taps, "windowed-sinc")), 0.37e-9)
     assert fir["model"] == "windowed-sinc"

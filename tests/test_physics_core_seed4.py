@@ -105,7 +105,7 @@ def test_a_silent_cube_has_no_detections_and_empty_angles(preset):
     from rtsgeom.paths import exact_paths
     from rtsgeom.radar.frame import simulate
     from rtsgeom.radar.processing import process
-    from rtsgeom.rts import RtsProgram
+    from rtsgeom.rts.channels import RtsProgram
     setup = build_setup(_small_noiseless(lambda d: d["radar"].update(antenna_preset=preset)))
     _, cube = simulate(setup, exact_paths(setup), RtsProgram.build([], [], [], [], []))
     rd, det = process(cube)
@@ -122,7 +122,7 @@ def test_a_capture_that_is_not_a_complex_3d_cube_is_refused(tmp_path, bad):
     """``read_capture`` refuses a ``.npy`` whose data is real (a 3-D cube of floats) or complex
     but not 3-D, naming the file."""
     from rtsgeom.geometry import build_setup
-    from rtsgeom.radar.capture import read_capture, simulate_capture, write_capture
+    from rtsgeom.identify.capture import read_capture, simulate_capture, write_capture
     setup = build_setup(_small_noiseless())
     cap = simulate_capture(setup, 0, seed=1)
     out = tmp_path / "cap.npy"
@@ -146,7 +146,7 @@ def test_channel_echoes_pair_every_path_of_one_leg_with_every_path_of_the_other(
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     from rtsgeom.paths.table import FE_TO_RX, TX_TO_FE, Paths
-    from rtsgeom.rts import KIND_DIRECT, RtsProgram, channel_echoes
+    from rtsgeom.rts.channels import KIND_DIRECT, RtsProgram, channel_echoes
     setup = build_setup(_small_noiseless())
     los = exact_paths(setup)
     extra = []
@@ -209,7 +209,7 @@ def test_fit_minimum_searches_the_half_width_it_is_given(offset_steps):
     """The criterion's minimum ``offset_steps`` sweep steps from the coarse minimum: the
     default search (1.5 steps either side) stops at its edge, a ``search_s`` of 5 steps finds
     the minimum within the 0.05 ps grid."""
-    from rtsgeom.aoa.sweep import fit_minimum
+    from rtsgeom.calibration.sweep import fit_minimum
     period, step = 1.0e-9, 25e-12
     d = np.arange(-20, 21) * step
     true = offset_steps * step
@@ -229,14 +229,9 @@ def test_pair_calibration_places_its_probes_over_the_fine_window_and_reports_its
     """Step 2 of ``calibrate_pair``: the probes' ranges are where ``sweep.place_probes`` puts
     them for the window +-period/4 around the coarse minimum (the fine sweep's centre), not
     for one delay of it; a noiseless sweep averages one frame per step, ``frames`` sets it."""
-    from rtsgeom.aoa.calibration import (
-        calibrate_pair,
-        nominal_model,
-        probe_angles,
-        probe_front_ends,
-        probe_ranges,
-    )
-    from rtsgeom.aoa.sweep import place_probes
+    from rtsgeom.calibration.pair import (calibrate_pair, nominal_model, probe_angles,
+                                          probe_front_ends, probe_ranges)
+    from rtsgeom.calibration.sweep import place_probes
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     setup = build_setup(_small_noiseless(
@@ -261,7 +256,7 @@ def test_pair_calibration_places_its_probes_over_the_fine_window_and_reports_its
 
 def test_plan_record_says_where_its_calibration_came_from():
     """Measured front-end angles (no calibration file): the record's source is "measured"."""
-    from rtsgeom.aoa.plan import plan_targets
+    from rtsgeom.pipeline.plan import plan_targets
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     setup = build_setup(_small_noiseless())
@@ -275,10 +270,10 @@ def test_cell_plan_programs_the_doppler_of_each_targets_velocity(velocity_mps):
     with the Doppler 2 f_c v_k / c0 of its set velocity."""
     import tomllib
 
-    from rtsgeom.aoa.plan import plan_targets, uses_cells
+    from rtsgeom.pipeline.plan import plan_targets, uses_cells
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene import parse_scene
+    from rtsgeom.scene.scene import parse_scene
     doc = tomllib.loads((ROOT / "scenes" / "sphere4.toml").read_text())
     for k, t in enumerate(doc["targets"]):
         t["velocity_mps"] = velocity_mps * (k + 1) / len(doc["targets"])
@@ -336,8 +331,8 @@ def test_channel_calibration_depends_on_the_seed_modulo_2_to_the_32(seed):
     """``scene.seed`` may be up to 2^63 - 1; every noise draw of the calibration (the pair
     sweeps and the residual check at the cell centre) takes it modulo 2^32, so seeds 2^32
     apart give the same calibration and residual, and neighbouring seeds different noise."""
-    from rtsgeom.aoa.calibration import probe_front_ends
-    from rtsgeom.aoa.ncal import calibrate_channels
+    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.calibration.channels import calibrate_channels
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     setup = build_setup(make_scene(lambda d: d["radar"].update(
@@ -367,7 +362,7 @@ def test_2d_steering_aperture_counts_distinct_positions_in_grid_units(unit, n_rx
     (the global check's grid density follows it)."""
     from rtsgeom.geometry.arrays import array_from_spec
     from rtsgeom.radar.steering import Steering
-    from rtsgeom.radar_presets import ArraySpec
+    from rtsgeom.scene.presets import ArraySpec
     scene = make_scene()
     lam = c / scene.radar.f_c_hz
     tx = tuple((0.0, k * lam / 2) for k in range(n_tx))

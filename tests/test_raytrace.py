@@ -20,7 +20,7 @@ from conftest import DEFAULT_SCENE, ROOT, default_doc, make_scene
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.paths.table import FE_TO_RX, RUT_TO_RUT, TX_TO_FE
-from rtsgeom.scene import SceneError, load_scene, parse_scene
+from rtsgeom.scene.scene import SceneError, load_scene, parse_scene
 
 pytestmark = pytest.mark.raytrace
 
@@ -189,7 +189,7 @@ def test_extra_structure_reflects(rt, tmp_path):
 
 def test_full_chain_detects_the_static_sheet_echo(rt, traced, setup):
     """run_scene with ray-traced paths: a detection at the sheet's range, velocity 0."""
-    from rtsgeom.run import run_scene
+    from rtsgeom.pipeline.run import run_scene
     t0 = time.perf_counter()
     result = run_scene(load_scene(DEFAULT_SCENE), paths_method="raytrace", aoa_mode="nearest")
     print(f"\n[raytrace] run_scene(paths_method='raytrace'): {time.perf_counter() - t0:.2f} s")
@@ -219,7 +219,7 @@ def test_missing_llvm_is_a_clear_error():
         pytest.skip(f"pre-flight passes without LLVM here: {msg}")
     assert "libllvm19" in msg and "DRJIT_LIBLLVM_PATH" in msg
     code = ("from rtsgeom.paths import raytrace as r\n"
-            "from rtsgeom.geometry import build_setup\nfrom rtsgeom.scene import load_scene\n"
+            "from rtsgeom.geometry import build_setup\nfrom rtsgeom.scene.scene import load_scene\n"
             f"s = build_setup(load_scene({str(DEFAULT_SCENE)!r}))\n"
             "try:\n    r.raytrace_paths(s)\nexcept r.RaytraceUnavailable as e:\n"
             "    print('unavailable:', e)\n")

@@ -12,11 +12,11 @@ import pytest
 from conftest import make_scene
 from rtsgeom.cli import main
 from rtsgeom.geometry import build_setup
-from rtsgeom.info import reachable_spans, scene_info, unreachable_warnings
-from rtsgeom.aoa.plan import plan_targets
+from rtsgeom.pipeline.info import reachable_spans, scene_info, unreachable_warnings
+from rtsgeom.pipeline.plan import plan_targets
 from rtsgeom.paths import exact_paths
-from rtsgeom.run import run_scene
-from rtsgeom.scene import SceneError
+from rtsgeom.pipeline.run import run_scene
+from rtsgeom.scene.scene import SceneError
 
 
 def _variant(radius_m, mode, angle_deg, separation_m=0.02):

@@ -15,12 +15,12 @@ import numpy as np
 import pytest
 
 from conftest import make_scene
-from rtsgeom.aoa.model import ChannelModel
-from rtsgeom.aoa.plan import PairPlan, nearest_setting, plan_targets, residual_warning
+from rtsgeom.synthesis.model import ChannelModel
+from rtsgeom.pipeline.plan import PairPlan, nearest_setting, plan_targets, residual_warning
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
-from rtsgeom.rts import realised_delay, requested_delay
-from rtsgeom.validate import scene_warnings
+from rtsgeom.rts.channels import realised_delay, requested_delay
+from rtsgeom.geometry.warnings import scene_warnings
 
 RES_PS = (1.0, 25.0, 50.0, 100.0)
 F_S = (4e9, 3e9)  # 1/f_s = 250 ps (divided by 1/25/50 ps, not by 100) and 333.3 ps (by 1 ps)
@@ -157,7 +157,7 @@ def test_full_chain_run_on_coarse_steps(res_ps, f_s, range_m):
     per-sample SNR of 30 dB: at the scene's 10 dB a target 0 at 21.7 m is so much stronger
     than the others that their noise alone moves them by 0.03 deg, with any step (checked
     at 1 ps, and the same before the fix)."""
-    from rtsgeom.run import run_scene
+    from rtsgeom.pipeline.run import run_scene
 
     def mutate(doc):
         doc["rts"]["fractional_delay_step_s"] = res_ps * 1e-12

@@ -29,8 +29,8 @@ ENV = {**os.environ, "PYTHONPATH": str(ROOT)}
 
 @pytest.fixture(scope="module")
 def nearest_result():
-    from rtsgeom.run import run_scene
-    from rtsgeom.scene import load_scene
+    from rtsgeom.pipeline.run import run_scene
+    from rtsgeom.scene.scene import load_scene
     return run_scene(load_scene(DEFAULT_SCENE), "exact", "nearest")
 
 
@@ -48,7 +48,7 @@ def fast_run(monkeypatch, nearest_result):
 
 
 def staged_dir(*args, **kwargs):
-    from rtsgeom.io import staged_dir as impl  # imported here: each test fails on its own
+    from rtsgeom._lib.io import staged_dir as impl  # imported here: each test fails on its own
     return impl(*args, **kwargs)
 
 
@@ -166,7 +166,7 @@ def test_sigkill_mid_run_leaves_the_old_folder_and_the_next_run_cleans_up(tmp_pa
     _old_folder(out)
     code = textwrap.dedent(f"""
         import os, signal
-        from rtsgeom.io import staged_dir
+        from rtsgeom._lib.io import staged_dir
         with staged_dir({str(out)!r}) as stage:
             (stage / "detections.csv").write_text("new")
             os.kill(os.getpid(), signal.SIGKILL)
@@ -228,7 +228,7 @@ def test_special_files_are_never_replaced(tmp_path, kind, capsys):
     assert after.st_ino == before.st_ino
     err = capsys.readouterr().err
     assert str(target) in err and ".part" not in err
-    from rtsgeom.io import OutputError, atomic_path
+    from rtsgeom._lib.io import OutputError, atomic_path
     with pytest.raises(OutputError):
         with atomic_path(target):
             pass
@@ -313,10 +313,10 @@ def test_malformed_dask_address_is_one_line(address, capsys):
 def test_tolerance_chunk_is_bounded_by_memory():
     import tracemalloc
 
-    from rtsgeom.analysis.tolerance import PairPhasors, monte_carlo
+    from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
     from rtsgeom.cli.tolerance import CHUNK_MEMORY_BYTES, capped_chunk, chunk_bytes_per_draw
     from rtsgeom.geometry import build_setup
-    from rtsgeom.scene import load_scene
+    from rtsgeom.scene.scene import load_scene
     for points in (3, 21, 201):
         assert capped_chunk(1_000_000, points) * chunk_bytes_per_draw(points) <= CHUNK_MEMORY_BYTES
     # the per-draw bound holds on a measured chunk (201 points: benchmarks/redteam.py; the
@@ -333,7 +333,7 @@ def test_tolerance_chunk_is_bounded_by_memory():
 # --- 4. no silent wrong answer --------------------------------------------------------------
 
 def test_one_detection_matches_at_most_one_target(nearest_result):
-    from rtsgeom.run import match_targets
+    from rtsgeom.pipeline.run import match_targets
     det, rd = nearest_result.detections, nearest_result.rd
     j = 0
     t = SimpleNamespace(range_m=float(det.range_m[j]), velocity_mps=float(det.velocity_mps[j]),
@@ -382,8 +382,8 @@ def test_detections_csv_labels_each_detection(nearest_result):
 
     from rtsgeom.cli.signal import detections_csv
     from rtsgeom.radar.processing import Detections
-    from rtsgeom.rts import KIND_GHOST, KIND_SETUP
-    from rtsgeom.run import label_detections
+    from rtsgeom.rts.channels import KIND_GHOST, KIND_SETUP
+    from rtsgeom.pipeline.run import label_detections
     r = nearest_result
     rows = list(csv.DictReader(io.StringIO(detections_csv(r))))
     assert list(rows[0])[-1] == "label" and list(rows[0])[:5] == [

@@ -11,16 +11,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rtsgeom.analysis.arc import Bounds, adjacent_pairs, arc_models, arc_monte_carlo
-from rtsgeom.analysis.tolerance import PairPhasors, monte_carlo
+from rtsgeom.analysis.tolerance.arc import Bounds, adjacent_pairs, arc_models, arc_monte_carlo
+from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
 from rtsgeom.cli import main
 from rtsgeom.geometry import build_setup
 from rtsgeom.geometry.patterns import CosinePattern
-from rtsgeom.info import scene_info
+from rtsgeom.pipeline.info import scene_info
 from rtsgeom.paths import exact_paths
 from rtsgeom.paths.table import TX_TO_FE
-from rtsgeom.radar_presets import PRESETS
-from rtsgeom.scene import SceneError, load_scene, loads_scene
+from rtsgeom.scene.presets import PRESETS
+from rtsgeom.scene.scene import SceneError, load_scene, loads_scene
 from conftest import make_scene
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -155,8 +155,8 @@ def test_channel_model_legs_match_exact_paths_for_signed_layouts_and_rotations(y
     """ChannelModel.air_legs (the tolerance model) on a zero draw = the exact paths of the
     setup, for mirrored and normal layouts, yawed or not; and a draw's legs = the exact paths
     of build_setup with that draw (layouts and rotations kept)."""
-    from rtsgeom.aoa.model import ChannelModel
-    from rtsgeom.scene import TargetConfig
+    from rtsgeom.synthesis.model import ChannelModel
+    from rtsgeom.scene.scene import TargetConfig
     text = _text(CUSTOM).replace("yaw_offset_deg = 2.0", f"yaw_offset_deg = {yaw_deg}")
     text = text.replace("rx_offset_mm = [-15.0, 0.0]", f"rx_offset_mm = [{rx_t_mm}, 3.0]")
     scene = loads_scene(text, "x.toml")
@@ -310,7 +310,7 @@ def _small(text: str) -> str:
 
 @pytest.mark.parametrize("name", list(PRESETS))
 def test_every_preset_runs_end_to_end(name, tmp_path, capsys):
-    from rtsgeom.run import run_scene
+    from rtsgeom.pipeline.run import run_scene
     p = tmp_path / f"{name}.toml"
     p.write_text(_small(_text()).replace('"awr1843boost"', f'"{name}"'))
     assert main(["info", str(p)]) == 0
@@ -333,7 +333,7 @@ def test_every_preset_runs_end_to_end(name, tmp_path, capsys):
 @pytest.mark.slow
 def test_custom_array_scene_runs_and_finds_its_targets(tmp_path):
     """Done-when: custom non-uniform 3 x 4 array, mirrored front ends, 2 deg yaw error."""
-    from rtsgeom.run import run_scene
+    from rtsgeom.pipeline.run import run_scene
     scene = load_scene(CUSTOM)
     for t in run_scene(scene).matches:
         assert t["detection"] is not None
@@ -442,7 +442,7 @@ def test_array_factor_closed_form_is_the_rut_beamformer(name, window):
     positions count with their multiplicity). Symmetric arrays: |AF| = |beam| / sum w to
     1e-12; the cascade's row is asymmetric, so the real part about the weighted centroid is
     an approximation there -- still closer than the distinct-position kernel it replaced."""
-    from rtsgeom.aoa.synthesis import array_factor, array_factor_args
+    from rtsgeom.synthesis.closed_form import array_factor, array_factor_args
     from rtsgeom.radar.steering import Steering
     scene = load_scene(DEFAULT)
     scene = scene.evolve(radar=scene.radar.evolve(antenna_preset=name, angle_window=window),

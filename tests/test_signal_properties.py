@@ -8,12 +8,12 @@ import numpy as np
 from hypothesis import given, settings, strategies as st
 from scipy.constants import c
 
-from rtsgeom.aoa.synthesis import PairModel
+from rtsgeom.synthesis.closed_form import PairModel
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.radar import synthesize
-from rtsgeom.rts import build_echoes, program_nearest
-from rtsgeom.scene import TargetConfig
+from rtsgeom.rts.channels import build_echoes, program_nearest
+from rtsgeom.scene.scene import TargetConfig
 
 from conftest import make_scene
 

@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from rtsgeom.arcmath import antenna_positions, module_axes, sphere_frame
+from rtsgeom._lib.arcmath import antenna_positions, module_axes, sphere_frame
 from rtsgeom.geometry import build_setup
 from rtsgeom.geometry.sheet import segments_blocked
-from rtsgeom.scene import SceneError, load_scene
+from rtsgeom.scene.scene import SceneError, load_scene
 
 SCENE = "scenes/diewald2022.toml"
 
@@ -106,7 +106,7 @@ def test_rules_for_the_sphere():
 def test_all_elevations_zero_keeps_the_1d_pipeline():
     """The default scene: no N-channel planner, the azimuth-only beamformer, the arc, and a
     scene with every elevation written out as 0 builds the same bits."""
-    from rtsgeom.aoa.plan_cells import uses_cells
+    from rtsgeom.pipeline.plan_cells import uses_cells
     from rtsgeom.radar.steering import Steering
     scene = load_scene(SCENE)
     assert not uses_cells(scene)
@@ -128,7 +128,7 @@ def test_all_elevations_zero_keeps_the_1d_pipeline():
 def test_default_scene_run_unchanged_with_explicit_zero_elevations():
     """The whole run (pair calibration, synthesis, detection) with every elevation written out
     as 0 gives the same detections and calibration as the scene without the keys."""
-    from rtsgeom.run import run_scene
+    from rtsgeom.pipeline.run import run_scene
     scene = load_scene(SCENE)
     zero = scene.evolve(rts=scene.rts.evolve(front_ends=tuple(
         f.evolve(elevation_rad=0.0) for f in scene.rts.front_ends)),

@@ -7,13 +7,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rtsgeom.analysis.tolerance import PairPhasors
-from rtsgeom.aoa.synthesis import PairModel
+from rtsgeom.analysis.tolerance.driver import PairPhasors
+from rtsgeom.synthesis.closed_form import PairModel
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.radar.processing import angle_spectrum, estimate_angles, refine_angles
 from rtsgeom.radar.steering import Steering
-from rtsgeom.scene import TargetConfig
+from rtsgeom.scene.scene import TargetConfig
 
 from conftest import make_scene
 

@@ -8,17 +8,17 @@ import json
 import numpy as np
 import pytest
 
-from rtsgeom.aoa.synthesis import PairModel
-from rtsgeom.analysis.tolerance import (CASES, NOMINAL_AMPLITUDES, PairPhasors,
-                                        draw_offsets, max_sigma_for_yield, monte_carlo)
+from rtsgeom.synthesis.closed_form import PairModel
+from rtsgeom.analysis.tolerance.driver import (CASES, NOMINAL_AMPLITUDES, PairPhasors, draw_offsets,
+                                               max_sigma_for_yield, monte_carlo)
 from rtsgeom.cli import main
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.radar import process
 from rtsgeom.radar.processing import estimate_angles, refine_angles, tdm_compensate
-from rtsgeom.rts import RtsProgram, requested_delay
+from rtsgeom.rts.channels import RtsProgram, requested_delay
 from rtsgeom.radar.frame import simulate
-from rtsgeom.scene import TargetConfig
+from rtsgeom.scene.scene import TargetConfig
 
 from conftest import (DEFAULT_SCENE, ROOT, SETUP_ERRORS, make_scene, scenes_with_and_without_error,
                       two_front_end_pair)
@@ -268,7 +268,7 @@ def test_same_seed_gives_identical_results(model):
 def test_draw_chunks_regenerate_the_streams_bit_for_bit(distribution, chunk):
     """The chunks a cluster is sent (stream states, not draws) rebuild exactly the draws of
     standard_draws / subbin_draws, whatever the chunk size."""
-    from rtsgeom.analysis.tolerance import draw_chunks, standard_draws, subbin_draws
+    from rtsgeom.analysis.tolerance.driver import draw_chunks, standard_draws, subbin_draws
     sigma = np.array([1.0, 2.0, 3.0]) * 1e-4
     parts = list(draw_chunks(5, 300, sigma, distribution, chunk, positions=9, centre=4))
     assert [p.k for p in parts] == [min(chunk, 300 - s) for s in range(0, 300, chunk)]
@@ -299,7 +299,7 @@ def test_fork_pool_gives_bit_identical_results(model):
     """--workers N (a forked process pool) equals the single-process run bit for bit."""
     import functools
 
-    from rtsgeom.parallel import _can_fork, fork_map
+    from rtsgeom._lib.parallel import _can_fork, fork_map
     if not _can_fork():
         pytest.skip("no fork on this platform")
     local = monte_carlo(model, [1e-4] * 3, 300, seed=9, chunk=64)
@@ -315,7 +315,7 @@ def test_fork_pool_is_kept_across_studies_of_one_model(model):
     """chunk_mapper's ForkPool forks once for a command's studies of one model (a yield
     search: many Monte Carlos), forks anew for another model, and every study equals the
     single-process run bit for bit."""
-    from rtsgeom.parallel import ForkPool, _can_fork
+    from rtsgeom._lib.parallel import ForkPool, _can_fork
     if not _can_fork():
         pytest.skip("no fork on this platform")
     other = PairPhasors.build(build_setup(make_scene()), (0, 1), points=3)
@@ -334,7 +334,7 @@ def test_fork_pool_is_kept_across_studies_of_one_model(model):
 
 _HEAP_POLICY = """
 import ctypes, numpy as np
-from rtsgeom.parallel import retain_freed_memory
+from rtsgeom._lib.parallel import retain_freed_memory
 class MallInfo2(ctypes.Structure):
     _fields_ = [(n, ctypes.c_size_t) for n in ("arena", "ordblks", "smblks", "hblks", "hblkhd",
                                                 "usmblks", "fsmblks", "uordblks", "fordblks",
@@ -373,13 +373,13 @@ def test_retained_memory_is_reused_not_mapped_afresh():
 
 
 def _worker_retains() -> bool:
-    import rtsgeom.parallel as parallel
+    import rtsgeom._lib.parallel as parallel
     return getattr(parallel, "_test_retained", False)
 
 
 def test_fork_pool_workers_retain_freed_memory(monkeypatch):
     """Every ForkPool worker runs ``retain_freed_memory`` when it starts."""
-    import rtsgeom.parallel as parallel
+    import rtsgeom._lib.parallel as parallel
     if not parallel._can_fork():
         pytest.skip("no fork on this platform")
 
@@ -475,9 +475,9 @@ def test_dask_local_cluster_gives_bit_identical_results():
     pytest.importorskip("dask.distributed")
     import functools
 
-    from rtsgeom.analysis.tolerance import PairPhasors, monte_carlo
+    from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
     from rtsgeom.geometry import build_setup
-    from rtsgeom.parallel import dask_client, map_chunks
+    from rtsgeom._lib.parallel import dask_client, map_chunks
     setup = build_setup(make_scene())
     model = PairPhasors.build(setup, (0, 1), points=7)
     sigma = np.array([0.2, 0.2, 0.2]) * 1e-3
@@ -493,9 +493,9 @@ def test_dask_local_cluster_gives_bit_identical_results():
 def test_chunk_mapper_fork_pool_every_draw_mode():
     """``--workers N``'s forked pool (chunk_mapper without a scheduler) equals one process bit
     for bit, with uneven chunks, for normal and uniform draws and both sub-bin modes."""
-    from rtsgeom.analysis.tolerance import PairPhasors, monte_carlo
+    from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
     from rtsgeom.geometry import build_setup
-    from rtsgeom.parallel import chunk_mapper
+    from rtsgeom._lib.parallel import chunk_mapper
     model = PairPhasors.build(build_setup(make_scene()), (0, 1), points=5)
     sigma = np.array([0.3, 0.2, 0.5]) * 1e-3
     for distribution, subbin in (("normal", True), ("uniform", False)):

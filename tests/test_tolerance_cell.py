@@ -15,11 +15,11 @@ import numpy as np
 import pytest
 
 from conftest import ROOT
-from rtsgeom.analysis.tolerance import CASES, draw_offsets, standard_draws
-from rtsgeom.analysis.tolerance_cell import (CellPhasors, max_sigma_for_yield_cell,
+from rtsgeom.analysis.tolerance.driver import CASES, draw_offsets, standard_draws
+from rtsgeom.analysis.tolerance.cell import (CellPhasors, max_sigma_for_yield_cell,
                                              monte_carlo_cell, verify_cell_draws)
 from rtsgeom.geometry import build_setup
-from rtsgeom.scene import parse_scene
+from rtsgeom.scene.scene import parse_scene
 
 SPHERE = ROOT / "scenes" / "sphere4.toml"
 
@@ -133,7 +133,7 @@ def test_draws_do_not_depend_on_chunk_and_pair_stream_kept(model):
         assert np.array_equal(a.worst_error_deg[case], b.worst_error_deg[case])
     assert np.array_equal(a.delay_s, b.delay_s)
     # the offsets are the arc study's per-front-end draws (what --out's npz rebuilds)
-    from rtsgeom.analysis.arc import arc_draws
+    from rtsgeom.analysis.tolerance.arc import arc_draws
     for dist in ("normal", "uniform"):
         unit = next(arc_draws(5, 30, len(model.cell), dist, 30))["offsets"]
         assert np.array_equal(unit, draw_offsets(5, 30, [1.0] * 3, dist, len(model.cell)))
@@ -233,7 +233,7 @@ def test_rut_yaw_turns_every_azimuth_alike(model):
 def test_rotation_draws_keep_the_offset_draws(model):
     """Adding rotation and RuT-pose errors draws them from their own streams: with their
     bounds at zero the study is bit for bit the offsets-only one."""
-    from rtsgeom.analysis.arc import Bounds
+    from rtsgeom.analysis.tolerance.arc import Bounds
     a = monte_carlo_cell(model, [1e-4] * 3, 20, seed=9)
     b = monte_carlo_cell(model, [1e-4] * 3, 20, seed=9, bounds=Bounds((0.0, 0.0, 0.0)))
     c = monte_carlo_cell(model, [1e-4] * 3, 20, seed=9,

@@ -21,9 +21,9 @@ import pytest
 
 from rtsgeom.cli import main
 from rtsgeom.cli._common import number
-from rtsgeom.registry import RADAR_PRESETS
-from rtsgeom.scene import SceneError, TargetConfig, load_scene, loads_scene, parse_scene
-from rtsgeom.validate import scene_warnings
+from rtsgeom.scene.registry import RADAR_PRESETS
+from rtsgeom.scene.scene import SceneError, TargetConfig, load_scene, loads_scene, parse_scene
+from rtsgeom.geometry.warnings import scene_warnings
 
 from conftest import DEFAULT_SCENE, ROOT, default_doc
 
@@ -543,14 +543,14 @@ def test_map_axes_must_hold_the_cfar_window(window, guard, training):
     """The smallest accepted samples_per_chirp / chirps_per_tx hold the CFAR window 2 (guard +
     training) + 1 cells and room for a target away from the edges, and a target at 0 m/s in the middle of the map is found there; one
     cell less is refused naming that field (not, later, 'blocked line of sight')."""
-    from rtsgeom.run import run_scene
+    from rtsgeom.pipeline.run import run_scene
 
     def base(d):
         d["radar"].update(range_window=window, doppler_window=window)
         d["radar"]["cfar"].update(guard_cells=list(guard), training_cells=list(training))
         d["targets"] = []
     for ax, key in ((0, "samples_per_chirp"), (1, "chirps_per_tx")):
-        from rtsgeom.registry import WINDOWS
+        from rtsgeom.scene.registry import WINDOWS
         ml = WINDOWS[window].mainlobe_half_bins
         edge = ml + guard[ax] + training[ax] + 1 if ax == 0 else 2 * (ml + 1) + 1
         need = max(16 if ax == 0 else 2, 2 * (guard[ax] + training[ax]) + 1, edge)
@@ -582,7 +582,7 @@ def test_training_cells_bounded_by_the_map():
 
 def test_adc_size_limit_bounds_memory():
     """2^25 complex64 samples pass (about 2 GiB peak), one chirp loop more does not."""
-    from rtsgeom.scene_rules import MAX_ADC_SAMPLES
+    from rtsgeom.scene.rules import MAX_ADC_SAMPLES
     big = dict(samples_per_chirp=8192, adc_rate_hz=250e6)
     n_l = MAX_ADC_SAMPLES // (8192 * 8)
     s = parse_scene(_mutated(lambda d: d["radar"].update(big, chirps_per_tx=n_l)), "a.toml")
@@ -598,8 +598,8 @@ def test_edge_targets_are_refused_or_resolved(window, training):
     """Just inside the accepted range / velocity limits a target is detected where it was set;
     just beyond them the loader refuses, naming the field and the limit (before the fix such
     targets wrapped to ~0 m or to the negative maximum velocity, silently)."""
-    from rtsgeom.run import run_scene
-    from rtsgeom.scene_rules import resolvable_limits
+    from rtsgeom.pipeline.run import run_scene
+    from rtsgeom.scene.rules import resolvable_limits
 
     def base(d):
         d["radar"].update(range_window=window, doppler_window=window, snr_db=30.0)
@@ -668,7 +668,7 @@ def test_mesh_paths_stay_in_the_scene_folder(tmp_path):
 def test_amplitudes_override_cannot_bypass_the_spacing_rule():
     """`run --amplitudes exact` on a `nearest` scene with front ends wider apart than the
     resolution is refused like the same mode written in the scene (eq. 24), before computing."""
-    from rtsgeom.run import run_scene
+    from rtsgeom.pipeline.run import run_scene
     s = parse_scene(_mutated(_all(_set("rts.front_ends.1.angle_deg", 25.0),
                                   _set("rts.aoa_mode", "nearest"))), "n.toml")
     with pytest.raises(SceneError, match="eq. 24"):

@@ -19,7 +19,7 @@ from matplotlib.image import imread
 
 from rtsgeom.cli import main
 from rtsgeom.geometry import build_setup
-from rtsgeom.info import scene_info
+from rtsgeom.pipeline.info import scene_info
 from rtsgeom.paths import Paths, exact_paths
 from rtsgeom.paths.table import FE_TO_RX, TX_TO_FE
 from rtsgeom.viz import figures as F
@@ -350,7 +350,7 @@ def test_user_text_in_titles_never_crashes_a_figure(tmp_path, name):
     # the whole run with such a scene name writes its figures
     scene = make_scene(lambda doc: doc.__setitem__("name", name))
     from rtsgeom.cli.signal import write_maps
-    from rtsgeom.run import run_scene
+    from rtsgeom.pipeline.run import run_scene
     paths = write_maps(run_scene(scene, aoa_mode="nearest"), tmp_path)
     assert all(p.stat().st_size > 1000 for p in paths)
 

@@ -23,7 +23,7 @@ import pytest
 from conftest import make_scene
 from rtsgeom.geometry import build_setup
 from rtsgeom.geometry.farfield import fraunhofer_distance_m
-from rtsgeom.validate import scene_warnings
+from rtsgeom.geometry.warnings import scene_warnings
 
 # (arc radius R, centre offset rho, centre direction phi in deg): every arc reaches the
 # distances 0.6 .. 1.4 r_ff (R - rho < 0.07 m, R + rho > 0.18 m for r_ff = 0.124 m)

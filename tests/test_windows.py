@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from conftest import CoherenceShift, far_field, make_scene, quiet
-from rtsgeom.aoa.model import ChannelModel
-from rtsgeom.analysis.tolerance import CASES, PairPhasors
+from rtsgeom.synthesis.model import ChannelModel
+from rtsgeom.analysis.tolerance.driver import CASES, PairPhasors
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.radar import process, synthesize
@@ -22,10 +22,10 @@ from rtsgeom.radar.frame import simulate
 from rtsgeom.radar.phasors import bin_response
 from rtsgeom.radar.processing import estimate_angles, range_doppler, refine_angles
 from rtsgeom.radar.steering import window
-from rtsgeom.registry import WINDOWS as WINDOW_REGISTRY
-from rtsgeom.rts import Echoes, build_echoes, program_nearest
-from rtsgeom.run import match_targets
-from rtsgeom.scene import TargetConfig
+from rtsgeom.scene.registry import WINDOWS as WINDOW_REGISTRY
+from rtsgeom.rts.channels import Echoes, build_echoes, program_nearest
+from rtsgeom.pipeline.run import match_targets
+from rtsgeom.scene.scene import TargetConfig
 
 WINDOWS = tuple(WINDOW_REGISTRY)
 
@@ -189,7 +189,7 @@ def test_fft_snr_gain_is_the_link_budgets_window_loss(range_window, doppler_wind
     (``link.window_snr_loss``) and the calibration's noise model use, for every pair of
     windows (noise power per cell sum w_r^2 sum w_d^2 sigma^2, tone (sum w_r)^2 (sum w_d)^2)."""
     import dataclasses
-    from rtsgeom.link import window_snr_loss
+    from rtsgeom.radar.link import window_snr_loss
     scene = make_scene(lambda d: _quiet(d, range_window=range_window,
                                         doppler_window=doppler_window) or d.update(targets=[]))
     r = scene.radar
@@ -246,8 +246,8 @@ def test_exact_mode_hits_the_set_angle_in_the_near_field_for_every_taper(angle_w
 def test_n_channel_exact_mode_hits_cell_points_for_every_taper(angle_window):
     """The N-channel exact mode (sphere4, four front ends in azimuth and elevation): the
     modelled 2-D peak at each set point inside the cell, for every angle window."""
-    from rtsgeom.aoa.nchannel import ChannelSet
-    from rtsgeom.scene import load_scene
+    from rtsgeom.synthesis.nchannel import ChannelSet
+    from rtsgeom.scene.scene import load_scene
     scene = load_scene("scenes/sphere4.toml")
     scene = scene.evolve(radar=scene.radar.evolve(angle_window=angle_window))
     setup = build_setup(scene)
@@ -267,7 +267,7 @@ def test_coherence_point_moves_by_the_closed_form_for_every_taper(angle_window, 
     -(f_c + S t_mid - S tau) / (f_rts + S t_mid - S tau) * 2 dr / c0 for a radial offset dr
     of front end J (the opposite way for I), whatever the angle window: the taper weights the
     elements, not the channels' relative phase."""
-    from rtsgeom.aoa.calibration import coherence_delay, probe_front_ends
+    from rtsgeom.calibration.pair import coherence_delay, probe_front_ends
 
     def scene(offsets=None):
         def mutate(doc):

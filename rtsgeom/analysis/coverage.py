@@ -37,13 +37,13 @@ from typing import Callable
 
 import numpy as np
 
-from ..aoa.model import AngleUnreachable
+from ..synthesis.model import AngleUnreachable
 from ..geometry import build_setup
 from ..geometry.setup import nominal_scene
 from ..geometry.farfield import angular_resolution_rad
 from ..paths import exact_paths
-from ..scene import Scene
-from .arc import Bounds, adjacent_pairs, arc_models, arc_monte_carlo, max_scale_for_yield
+from ..scene.scene import Scene
+from .tolerance.arc import Bounds, adjacent_pairs, arc_models, arc_monte_carlo, max_scale_for_yield
 from .design import _fit_sheet, _problem
 
 __all__ = ["ArcPlan", "ArcDesign", "CoverageDesign", "arc_scene", "plan_arc", "evaluate_arc",
@@ -139,7 +139,7 @@ def _min_cutout_spacing_rad(scene: Scene, radius_m: float) -> float:
 def _detected_rad(variant: Scene) -> tuple[np.ndarray, np.ndarray]:
     """Each front end alone as the RuT detects it and its module's geometric azimuth, both
     seen from the RuT (radians): their difference is the near-field bias."""
-    from ..aoa.calibration import probe_ranges
+    from ..calibration.pair import probe_ranges
     from .nearfield import single_front_end_angles_rad
     setup = build_setup(variant)
     rng = float(probe_ranges(setup, 1)[0])

@@ -5,7 +5,7 @@ For each (arc radius R_c, front-end spacing) a two-front-end variant of a scene 
 pair's two front ends (their antenna separation, cables and so on kept, mounting and channel
 errors dropped) placed symmetrically about the pair's centre angle, targets dropped, the sheet
 kept, widened, or disabled where its cutouts would not fit. Per design, at phasor level
-(:class:`~rtsgeom.analysis.tolerance.PairPhasors`: exact geometry, exact amplitudes, no noise):
+(:class:`~rtsgeom.analysis.tolerance.driver.PairPhasors`: exact geometry, exact amplitudes, no noise):
 
 ``worst_error_deg``
     worst |synthesized - set| angle over the span after the delay calibration, nominal setup;
@@ -18,7 +18,7 @@ kept, widened, or disabled where its cutouts would not fit. Per design, at phaso
 ``sigma_calibrated_mm``, ``sigma_uncalibrated_mm``
     the mounting tolerance (one sigma, the same on the radial, tangential and height axes) that
     keeps ``target_yield`` of the setups within ``spec_deg``: a small Monte Carlo
-    (:func:`~rtsgeom.analysis.tolerance.max_sigma_for_yield`);
+    (:func:`~rtsgeom.analysis.tolerance.driver.max_sigma_for_yield`);
 
 and ``exceeds_resolution``: the spacing seen from the RuT is larger than its angular
 resolution 1.22 lambda / d_A (paper eq. 24), where the composite splits into two peaks.
@@ -34,15 +34,15 @@ from typing import Callable
 
 import numpy as np
 
-from .._util import frozen
-from ..aoa.model import AngleUnreachable
+from .._lib.util import frozen
+from ..synthesis.model import AngleUnreachable
 from ..geometry import build_setup
 from ..geometry.setup import nominal_scene
 from ..geometry.farfield import angular_resolution_rad
-from ..parallel import available_cores, chunk_mapper, map_chunks
-from ..scene import Scene, SheetConfig, arc_centre_m, problems
-from .tolerance import (CASES, PairPhasors, critical_ratio, largest_passing_scale,
-                        max_sigma_for_yield, monte_carlo)
+from .._lib.parallel import available_cores, chunk_mapper, map_chunks
+from ..scene.scene import Scene, SheetConfig, arc_centre_m, problems
+from .tolerance.driver import (CASES, PairPhasors, critical_ratio, largest_passing_scale,
+                               max_sigma_for_yield, monte_carlo)
 
 __all__ = ["METRICS", "DesignGrid", "two_front_end_scene", "evaluate_design", "design_grid",
            "check_azimuth_arc"]
@@ -61,10 +61,10 @@ SHEET_MARGIN_RAD = math.radians(2.0)  # sheet beyond the outer cutouts when it i
 def check_azimuth_arc(scene: Scene, name: str = "design") -> None:
     """Raise :class:`~rtsgeom.errors.ParameterError` (its message naming what to use instead)
     where the scene's front ends form 2-D cells (a front end or a target off elevation 0,
-    :func:`rtsgeom.aoa.plan.uses_cells`): the design varies a pair's azimuth spacing on an arc
+    :func:`rtsgeom.pipeline.plan.uses_cells`): the design varies a pair's azimuth spacing on an arc
     and synthesizes in azimuth only, so on a sphere it would silently design one plane of the
     cell and report that as the cell's design."""
-    from ..aoa.plan import uses_cells
+    from ..pipeline.plan import uses_cells
     from ..errors import ParameterError
     if uses_cells(scene):
         raise ParameterError(
@@ -183,7 +183,7 @@ PILOT_EVALUATIONS = 3
 
 def tolerance_search(model: PairPhasors, case: str, draws: int, seed: int,
                      target_yield: float, spec_deg: float, rel_tol: float) -> dict:
-    """:func:`~rtsgeom.analysis.tolerance.max_sigma_for_yield` of ``draws`` draws (all three
+    """:func:`~rtsgeom.analysis.tolerance.driver.max_sigma_for_yield` of ``draws`` draws (all three
     axes scaled together), started where a pilot search on the first :data:`PILOT_DRAWS` of
     the same draws (the same seed and stream) puts the tolerance, with the power law of the
     deciding draw's error in the scale that the pilot measured (:func:`pilot_estimate`): the
@@ -276,7 +276,7 @@ def _import_for_workers() -> None:
     so that the pool's forked workers inherit the modules instead of each importing them
     again (~0.15 s CPU per worker; loading each kernel's compiled code from numba's cache,
     ~0.3 s more, still happens per worker, on its first call)."""
-    from .. import kernels  # noqa: F401
+    from ..synthesis import kernels  # noqa: F401
 
 
 def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,

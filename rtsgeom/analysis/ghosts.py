@@ -2,7 +2,7 @@
 (paper section "Measurement": "spurious peaks ... with an additional range offset ... caused by
 the mismatch of the characteristic impedance between the front ends and the coaxial cables").
 
-The prediction is the signal chain's own model, :func:`rtsgeom.rts.cable_ghosts`, applied to a
+The prediction is the signal chain's own model, :func:`rtsgeom.rts.channels.cable_ghosts`, applied to a
 unit echo per front end: the n-th ghost has ``n`` extra round trips in the cable, an extra delay
 ``n 2 L / (VF c0)`` (a range offset ``n L / VF``) and the amplitude ``(n + 1) rho^n`` relative to
 the target, ``rho = Gamma_fe Gamma_be a^2`` (``Gamma = 10^(-RL/20)``, ``a`` the one-way cable
@@ -26,8 +26,8 @@ from scipy.constants import c
 
 from ..geometry import build_setup
 from ..radar.processing import window
-from ..rts import EchoKind, Echoes, cable_ghosts, program_nearest
-from ..scene import Scene
+from ..rts.channels import EchoKind, Echoes, cable_ghosts, program_nearest
+from ..scene.scene import Scene
 
 __all__ = ["DEFAULT_FLOOR_DB", "ghost_orders", "predict_ghosts", "measure_ghosts",
            "GhostReport", "ghost_analysis", "ghosts_figure"]
@@ -213,7 +213,7 @@ def ghost_analysis(scene: Scene, floor_db: float = DEFAULT_FLOOR_DB, simulate: b
     tg = predict_ghosts(scene, floor_db)
     if not simulate:
         return GhostReport(scene, floor_db, fes, tg)
-    from ..run import run_scene
+    from ..pipeline.run import run_scene
     result = run_scene(scene, aoa_mode="nearest")
     return GhostReport(scene, floor_db, fes, tg, measure_ghosts(result, tg), result)
 

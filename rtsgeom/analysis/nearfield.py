@@ -6,7 +6,7 @@ For a sweep of arc radii (front-end angles kept) and per front end:
 
 (a) **Single front-end bias.** The angle the RuT detects one front end alone at, minus its
     geometric angle (module centre seen from the RuT phase centre), at phasor level with the
-    exact geometry (``radar.phasors.bin_response`` through :class:`~rtsgeom.aoa.synthesis.PairModel`,
+    exact geometry (``radar.phasors.bin_response`` through :class:`~rtsgeom.synthesis.closed_form.PairModel`,
     TDM compensation, ``estimate_angles``). It is split into closed-form parts:
 
     * ``separation``: the front end's own Rx/Tx split, far-field closed form
@@ -62,9 +62,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.constants import c
 
-from ..aoa.calibration import nominal_model, probe_angles, probe_ranges
-from ..aoa.model import ChannelModel
-from ..aoa.synthesis import AngleUnreachable, PairModel
+from ..calibration.pair import nominal_model, probe_angles, probe_ranges
+from ..synthesis.model import ChannelModel
+from ..synthesis.closed_form import AngleUnreachable, PairModel
 from ..errors import ParameterError
 from ..geometry import RutArray, Setup, build_setup
 from ..geometry.setup import nominal_scene
@@ -72,8 +72,8 @@ from ..geometry.farfield import (aperture_m, apparent_azimuth_rad, fraunhofer_di
                                  two_way_lengths)
 from ..paths import Paths, exact_paths
 from ..radar.steering import Steering, smoothed_estimator
-from ..rts import requested_delay
-from ..scene import Scene, TargetConfig
+from ..rts.channels import requested_delay
+from ..scene.scene import Scene, TargetConfig
 from .nearfield2d import _cells, cell_synthesis_errors_deg, single_front_end_directions_rad
 
 __all__ = ["DEFAULT_DECADES", "DEFAULT_POINTS", "MIN_RADIUS_M", "max_radius_m", "default_radii", "with_arc_radius",
@@ -218,7 +218,7 @@ def phase_error_deg(setup: Setup, steering: Steering | None = None) -> dict[str,
 def single_front_end_angles_rad(setup: Setup, paths: Paths, range_m: float) -> np.ndarray:
     """Detected angle (rad) of each front end alone (unit amplitude, zero Doppler) at
     ``range_m``: phasor level through the exact paths, TDM compensation and the RuT's
-    beamformer (the :class:`~rtsgeom.aoa.model.ChannelModel` of all front ends, each alone)."""
+    beamformer (the :class:`~rtsgeom.synthesis.model.ChannelModel` of all front ends, each alone)."""
     n = setup.fe.count
     model = ChannelModel.build(setup, paths, range(n), TargetConfig(float(range_m)))
     return model.direction(np.eye(n))

@@ -8,12 +8,12 @@ import dataclasses
 
 import numpy as np
 
-from ..aoa.calibration import nominal_model
-from ..aoa.model import AngleUnreachable, ChannelModel
+from ..calibration.pair import nominal_model
+from ..synthesis.model import AngleUnreachable, ChannelModel
 from ..geometry import Setup
 from ..paths import Paths
 from ..radar.steering import Steering
-from ..scene import TargetConfig
+from ..scene.scene import TargetConfig
 
 __all__ = ["single_front_end_directions_rad", "cell_synthesis_errors_deg"]
 
@@ -47,7 +47,7 @@ def cell_synthesis_errors_deg(setup: Setup, paths: Paths, cell, range_m: float,
     dropped (as ``linearity --grid``). Design on the nominal setup, detection on the setup as
     built."""
     from scipy.spatial import Delaunay
-    from ..aoa.nchannel import ChannelSet
+    from ..synthesis.nchannel import ChannelSet
     target = TargetConfig(float(range_m))
     nom, nom_paths = nominal_model(setup, paths)
     design = ChannelSet.build(nom, nom_paths, cell, target)

@@ -127,9 +127,9 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _dispatch(args) -> int:
-    from ..io import OutputError
-    from ..parallel import ClusterError
-    from ..scene import SceneError
+    from .._lib.io import OutputError
+    from .._lib.parallel import ClusterError
+    from ..scene.scene import SceneError
     from ._common import UsageError
     try:
         return int(args.func(args) or 0)

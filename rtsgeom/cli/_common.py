@@ -44,19 +44,19 @@ def output_path(text: str) -> Path:
 @contextmanager
 def output_folder(out, inputs=()):
     """``--out DIR`` of a command: the staging folder to write into (see
-    :func:`rtsgeom.io.staged_dir`), or None without ``--out``. Enter it BEFORE computing: the
+    :func:`rtsgeom._lib.io.staged_dir`), or None without ``--out``. Enter it BEFORE computing: the
     path is checked and the folder locked at once."""
     if out is None:
         yield None
         return
-    from ..io import staged_dir
+    from .._lib.io import staged_dir
     with staged_dir(out, [i for i in inputs if i is not None]) as stage:
         yield stage
 
 
 def output_file(out, inputs=()) -> Path:
     """Check an output file path before computing (exit 2 naming it); returns it."""
-    from ..io import check_output_file
+    from .._lib.io import check_output_file
     check_output_file(out, [i for i in inputs if i is not None])
     return Path(out)
 
@@ -70,11 +70,11 @@ def print_json(obj) -> None:
 
 
 def load_scene_checked(path):
-    """Load and validate a scene (errors raise :class:`~rtsgeom.scene.SceneError`, exit code 2)
-    and print its physical warnings (``rtsgeom.validate.scene_warnings``) to stderr as
+    """Load and validate a scene (errors raise :class:`~rtsgeom.scene.scene.SceneError`, exit code 2)
+    and print its physical warnings (``rtsgeom.geometry.warnings.scene_warnings``) to stderr as
     ``rtsgeom: warning: ...``. Every subcommand that reads a scene should load it with this."""
-    from ..scene import load_scene
-    from ..validate import scene_warnings
+    from ..scene.scene import load_scene
+    from ..geometry.warnings import scene_warnings
     scene = load_scene(path)
     for line in scene_warnings(scene):
         print(f"rtsgeom: warning: {line}", file=sys.stderr)

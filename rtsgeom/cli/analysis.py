@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from ..errors import ParameterError
-from ..io import write_json
+from .._lib.io import write_json
 from ._common import (UsageError, load_scene_checked, number, output_folder, output_path,
                       print_json, scene_arg, steps, warn_scene_errors)
 

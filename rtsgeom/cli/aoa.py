@@ -5,16 +5,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..aoa.calibration import (calibrate_pair, calibrate_pair_paper, fir_effect,
-                               probe_front_ends)
-from ..aoa.linearity import linearity
-from ..aoa.model import AngleUnreachable
+from ..calibration.pair import calibrate_pair, calibrate_pair_paper, fir_effect, probe_front_ends
+from ..analysis.linearity import linearity
+from ..synthesis.model import AngleUnreachable
 from ..errors import ParameterError
 from ..geometry import build_setup
-from ..io import write_json
+from .._lib.io import write_json
 from ..paths import exact_paths
 
-from ..registry import SYNTHESIS_MODES
+from ..scene.registry import SYNTHESIS_MODES
 from ._common import (UsageError, load_scene_checked, number, output_folder, output_path,
                       print_json, scene_arg, steps)
 
@@ -43,7 +42,7 @@ def _pair(setup, pair):
     if len(pair) != 2 or "all" in pair:
         raise UsageError(f"--pair {' '.join(map(str, pair))}: must be two adjacent front-end "
                          "indices I J, or all")
-    from ..aoa.plan import check_pair
+    from ..pipeline.plan import check_pair
     from ..errors import ParameterError
     i, j = pair
     try:
@@ -96,7 +95,7 @@ def _calibrate(args, stage) -> int:
         else:
             cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed,
                                  full_chain=args.full_chain)
-    from ..aoa.plan import setup_fingerprint
+    from ..pipeline.plan import setup_fingerprint
     out = cal.to_dict()
     out["procedure"] = args.procedure
     out["front_end_angles_deg"] = [float(x) for x in np.degrees(probe.angle_rad)]
@@ -172,7 +171,7 @@ def _linearity(args, stage) -> int:
 
 
 def _linearity_grid(args, stage) -> int:
-    from ..aoa.linearity2d import error_map_figure, linearity_grid
+    from ..analysis.linearity2d import error_map_figure, linearity_grid
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
         scene = load_scene_checked(args.scene)

@@ -10,13 +10,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.tolerance import AXES, CASES, NOMINAL_AMPLITUDES
-from ..aoa.calibration import calibrate_pair, probe_front_ends
-from ..aoa.model import AngleUnreachable
-from ..aoa.linearity import linearity
+from ..analysis.tolerance.driver import AXES, CASES, NOMINAL_AMPLITUDES
+from ..calibration.pair import calibrate_pair, probe_front_ends
+from ..synthesis.model import AngleUnreachable
+from ..analysis.linearity import linearity
 from ..geometry import build_setup
-from ..io import write_json
-from ..parallel import chunk_mapper
+from .._lib.io import write_json
+from .._lib.parallel import chunk_mapper
 from ..paths import exact_paths
 from ._common import UsageError, load_scene_checked, print_json, steps
 from .aoa import _pairs
@@ -43,7 +43,7 @@ def prepare_all(args):
 
 def calibrate_all(args, folder) -> int:
     """Every adjacent pair calibrated in one run; one JSON entry per pair plus the arc's."""
-    from ..aoa.plan import setup_fingerprint
+    from ..pipeline.plan import setup_fingerprint
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
         scene, setup, pairs, paths, probe = prepare_all(args)
@@ -134,7 +134,7 @@ def scales(args) -> tuple[np.ndarray, dict]:
 
 def save_pair_npz(path: Path, res, seed: int) -> None:
     """Per-draw offsets (draws, 2, 3) m and worst errors (deg) of a pair study (NPZ)."""
-    from ..analysis.tolerance import draw_offsets
+    from ..analysis.tolerance.driver import draw_offsets
     off = draw_offsets(seed, res.draws, res.sigma_m, res.distribution)
     arrays = {"offsets_m": off, "pairs": np.array([res.model.pair]),
               "delay_s": res.delay_s[:, None], "range_offset_m": res.range_offset_m[:, None]}
@@ -149,7 +149,7 @@ def save_pair_npz(path: Path, res, seed: int) -> None:
 def tolerance_arc(args, scene, sigma, extra, folder) -> int:
     """``--pair all`` (or rotation / RuT-pose errors): every pair on shared per-front-end
     draws (``analysis.arc``); one JSON entry per pair plus the arc's yield."""
-    from ..analysis.arc import Bounds, arc_models, arc_monte_carlo
+    from ..analysis.tolerance.arc import Bounds, arc_models, arc_monte_carlo
     setup = build_setup(scene)
     pairs = _pairs(setup, args.pair)
     seed = scene.seed if args.seed is None else args.seed

@@ -4,18 +4,18 @@ from __future__ import annotations
 
 
 from ..geometry import build_setup
-from ..info import format_info, scene_info
-from ..io import write_text
-from ..registry import PATH_METHODS
+from ..pipeline.info import format_info, scene_info
+from .._lib.io import write_text
+from ..scene.registry import PATH_METHODS
 from ._common import load_scene_checked, output_file, output_path, print_json, scene_arg
 
 
 def cmd_info(args) -> int:
     import sys
-    from ..info import unreachable_warnings
+    from ..pipeline.info import unreachable_warnings
     setup = build_setup(load_scene_checked(args.scene))
     info = scene_info(setup, reachable=True)
-    from ..link import static_budget
+    from ..radar.link import static_budget
     info["link_budget"] = static_budget(setup).to_dict()
     for w in unreachable_warnings(info, skip_outside_geometric=True):  # those: validate's
         print(f"rtsgeom: warning: {args.scene}: {w}", file=sys.stderr)

@@ -11,16 +11,16 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
-from ..io import atomic_path, write_bytes, write_json, write_text
-from ..registry import ANGLE_ESTIMATORS, AOA_MODES, PATH_METHODS
-from ..run import RunResult, label_detections, run_scene, summary
+from .._lib.io import atomic_path, write_bytes, write_json, write_text
+from ..scene.registry import ANGLE_ESTIMATORS, AOA_MODES, PATH_METHODS
+from ..pipeline.run import RunResult, label_detections, run_scene, summary
 from ._common import (UsageError, load_scene_checked, number, output_file, output_folder,
                       output_path, scene_arg, steps)
 
 
 def detections_csv(result: RunResult) -> str:
     """One row per detection, sorted by range then velocity; the last column ``label`` says
-    what the simulation put there (:func:`rtsgeom.run.label_detections`); ``elevation_deg``
+    what the simulation put there (:func:`rtsgeom.pipeline.run.label_detections`); ``elevation_deg``
     (0 for an azimuth-only array) sits after ``snr_db``, so the earlier columns keep their
     places."""
     det = result.detections
@@ -172,7 +172,7 @@ def run_report_html(result: RunResult, maps: dict[str, bytes], paths_method: str
     """``report.html`` of a run: scene summary, 3D view, figures, detections vs set-points,
     calibration, warnings; self-contained. Every image is bytes this run produced (``maps``
     from :func:`render_maps`), never a file read back from the output folder."""
-    from ..info import scene_info
+    from ..pipeline.info import scene_info
     from ..viz.report import render_report
     sections = []
     images = []
@@ -258,7 +258,7 @@ def _with_estimator(scene, args):
 
 
 def cmd_run(args) -> int:
-    from ..validate import scene_warnings
+    from ..geometry.warnings import scene_warnings
     scene = _with_estimator(load_scene_checked(args.scene), args)
     out = args.out
     with output_folder(out, [args.scene]) as stage, steps(args.quiet) as step:

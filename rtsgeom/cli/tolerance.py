@@ -10,12 +10,12 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from ..analysis.tolerance import (AXES, CASES, DISTRIBUTIONS, NOMINAL_AMPLITUDES, PairPhasors,
-                                  max_sigma_for_yield, monte_carlo)
-from ..aoa.model import AngleUnreachable
+from ..analysis.tolerance.driver import (AXES, CASES, DISTRIBUTIONS, NOMINAL_AMPLITUDES,
+                                         PairPhasors, max_sigma_for_yield, monte_carlo)
+from ..synthesis.model import AngleUnreachable
 from ..geometry import build_setup
-from ..io import write_json
-from ..parallel import ClusterError, check_address, chunk_mapper
+from .._lib.io import write_json
+from .._lib.parallel import ClusterError, check_address, chunk_mapper
 from ._common import (UsageError, load_scene_checked, number, output_folder, output_path,
                       print_json, scene_arg, warn_scene_errors)
 from .aoa import _pair, _pair_arg
@@ -127,7 +127,7 @@ def _tolerance(args, scene, stage) -> int:
                           cases, chunk, progress, "Monte Carlo", mapper)
         out = res.to_dict()
         if args.verify:
-            from ..analysis.tolerance_verify import verify_draws
+            from ..analysis.tolerance.verify import verify_draws
             out["verify"] = verify_draws(model, sigma, min(args.verify, args.draws), seed,
                                          args.distribution, cases, progress=progress,
                                          all_points=args.verify_all_points).to_dict()

@@ -7,11 +7,11 @@ import time
 
 import numpy as np
 
-from ..analysis.tolerance import AXES, CASES
-from ..aoa.model import AngleUnreachable
+from ..analysis.tolerance.driver import AXES, CASES
+from ..synthesis.model import AngleUnreachable
 from ..errors import ParameterError
 from ..geometry import build_setup
-from ..io import write_json
+from .._lib.io import write_json
 from ._common import UsageError, print_json
 
 __all__ = ["wants_cell", "tolerance_cell"]
@@ -40,11 +40,11 @@ def _cell(setup, words) -> tuple[int, ...] | None:
 
 
 def tolerance_cell(args, scene, sigma, extra, stage) -> int:
-    from ..analysis.tolerance_cell import (CellPhasors, max_sigma_for_yield_cell,
-                                           monte_carlo_cell, verify_cell_draws)
-    from ..parallel import chunk_mapper
+    from ..analysis.tolerance.cell import (CellPhasors, max_sigma_for_yield_cell, monte_carlo_cell,
+                                           verify_cell_draws)
+    from .._lib.parallel import chunk_mapper
     from .tolerance import _progress, capped_chunk
-    from ..analysis.arc import Bounds
+    from ..analysis.tolerance.arc import Bounds
     if list(args.pair) == ["all"]:
         raise UsageError("--cell and --pair all: give one of them")
     k = 1.0 / args.sigma_level if args.distribution == "normal" else 1.0
@@ -94,7 +94,7 @@ def tolerance_cell(args, scene, sigma, extra, stage) -> int:
                                    f"{tuple(model.cell)}")
         save_figure(fig, stage / "tolerance.png")
         write_json(stage / "tolerance.json", out)
-        from ..analysis.tolerance import draw_offsets
+        from ..analysis.tolerance.driver import draw_offsets
         arrays = {"offsets_m": draw_offsets(seed, res.draws, res.sigma_m, res.distribution,
                                             len(model.cell)),
                   "cell": np.array(model.cell), "delay_s": res.delay_s,

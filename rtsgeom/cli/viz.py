@@ -6,7 +6,7 @@ import argparse
 import os
 
 from ..geometry import build_setup
-from ..registry import PATH_METHODS
+from ..scene.registry import PATH_METHODS
 from ._common import UsageError, load_scene_checked, output_file, output_path, scene_arg
 
 

@@ -4,7 +4,7 @@ Local radar frame: ``x`` lateral, ``y`` boresight, ``z`` up; the origin is the p
 virtual array (the mean of the Tx-Rx midpoints of the azimuth virtual elements), so a radar placed
 at ``position_m`` has its phase centre there.
 
-Every array, preset or custom, is an :class:`~rtsgeom.radar_presets.ArraySpec` (board positions in
+Every array, preset or custom, is an :class:`~rtsgeom.scene.presets.ArraySpec` (board positions in
 metres and the TDM order) built by the one function :func:`array_from_spec`; :func:`rut_array` is
 the preset/scene path (spec lookup + :func:`array_from_spec`). Sparse and non-uniform virtual arrays
 work: the beamformer steers on ``virtual_local``, and :attr:`RutArray.virtual_unique` maps
@@ -19,9 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.constants import c
 
-from .._util import frozen
-from ..radar_presets import PRESETS, ArrayPreset, ArraySpec, preset
-from ..scene import RadarConfig
+from .._lib.util import frozen
+from ..scene.presets import PRESETS, ArrayPreset, ArraySpec, preset
+from ..scene.scene import RadarConfig
 
 __all__ = ["ArraySpec", "ArrayPreset", "PRESETS", "RutArray", "array_from_spec", "array_spec",
            "awr1843boost_layout", "posed_positions", "rut_array", "yaw_matrix"]
@@ -46,7 +46,7 @@ def awr1843boost_layout(d: float, board_gap_m: float | None = None
     documented) right of TX3. The gap does not change the virtual array, but it is *not* only a
     shift: the Tx group sees a front end's Rx antenna and the Rx group its Tx antenna from
     different places, a near-field parallax of +0.27 deg at R_c = 1 m (``analysis.nearfield``).
-    See :data:`~rtsgeom.radar_presets.PRESETS` ``["awr1843boost"]`` for the source.
+    See :data:`~rtsgeom.scene.presets.PRESETS` ``["awr1843boost"]`` for the source.
     """
     tx, rx = PRESETS["awr1843boost"].positions_m(d, board_gap_m)
     return _to3(tx), _to3(rx)

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from ..io import OutputError, atomic_path
+from .._lib.io import OutputError, atomic_path
 from .setup import Setup
 
 __all__ = ["COLOURS", "rut_board_mesh", "setup_scene", "export_setup"]

@@ -8,8 +8,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..scene import Scene, arc_centre_m
-from .arc import FrontEnds, front_ends
+from ..scene.scene import Scene, arc_centre_m
+from .frontends import FrontEnds, front_ends
 from .arrays import RutArray, rut_array
 from .sheet import sheet_mesh
 
@@ -73,8 +73,8 @@ RUT_POSE_ERRORS = ("position_offset_m", "yaw_offset_rad")
 def setup_errors(scene: Scene) -> list[str]:
     """The scene's fields that :func:`nominal_scene` zeroes and that are not zero, as file
     keys (``rts.front_ends[1].radial_offset_mm``, ``radar.yaw_offset_deg``)."""
-    from ..schema import specs
-    from ..scene import FrontEndConfig, RadarConfig
+    from ..scene.schema import specs
+    from ..scene.scene import FrontEndConfig, RadarConfig
     fe_key, radar_key = dict(specs(FrontEndConfig)), dict(specs(RadarConfig))
     out = [f"rts.front_ends[{q}].{fe_key[name].key}" for q, fe in enumerate(scene.rts.front_ends)
            for name in FRONT_END_ERRORS if getattr(fe, name) != 0.0]

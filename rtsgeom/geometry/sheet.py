@@ -14,9 +14,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..scene import SheetConfig
-from .arc import radial_tangent
-from ..arcmath import sphere_frame
+from ..scene.scene import SheetConfig
+from .frontends import radial_tangent
+from .._lib.arcmath import sphere_frame
 
 if TYPE_CHECKING:  # trimesh itself loads where a mesh is built (1 s of imports)
     import trimesh

@@ -36,12 +36,12 @@ arc radius). Everything is importable from ``rtsgeom.identify``.
 
 from __future__ import annotations
 
-from ..radar.capture import Capture, capture_probe, read_capture, simulate_capture, write_capture
+from .capture import Capture, capture_probe, read_capture, simulate_capture, write_capture
 from .built import (PredictedCalibration, calibrate_from_identified, detected_angles,
                     identified_scene, identified_scene_toml, predicted_calibration, setup_of)
 from .crb import crb_figure, crb_grid
-from .fit import (MIN_EIGENVALUE, SEPARATE_BY, STD_LIMIT, FrontEndFit, Identification,
-                  cramer_rao, fisher, fit_front_end, free_parameters, identify)
+from .fit import (MIN_EIGENVALUE, SEPARATE_BY, STD_LIMIT, FrontEndFit, Identification, cramer_rao,
+                  fisher, fit_front_end, free_parameters, identify)
 from .model import PARAMS, ProbeModel, measure
 
 __all__ = ["PARAMS", "Capture", "ProbeModel", "FrontEndFit", "Identification", "capture_probe",

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry.setup import build_setup
-from ..radar.capture import Capture, capture_probe
-from ..scene import Scene
+from .capture import Capture, capture_probe
+from ..scene.scene import Scene
 from .fit import cramer_rao
 from .model import ProbeModel
 

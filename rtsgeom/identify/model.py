@@ -9,15 +9,15 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.constants import c
 
-from ..arcmath import antenna_positions, layout_offsets
+from .._lib.arcmath import antenna_positions, layout_offsets
 from ..errors import CaptureError
 from ..geometry import Setup
 from ..paths.exact import leg_delays
-from ..radar.capture import Capture
+from .capture import Capture
 from ..radar.frame import noise_power
 from ..radar.phasors import bin_response
 from ..radar.processing import range_doppler, window
-from ..rts import EchoKind, Echoes, fir_if_gain, realised_delay, requested_delay
+from ..rts.channels import EchoKind, Echoes, fir_if_gain, realised_delay, requested_delay
 
 __all__ = ["PARAMS", "ProbeModel", "measure"]
 

@@ -16,7 +16,7 @@ def compute_paths(setup, method: str = "exact", *, for_drawing: bool = False):
     here, so Sionna loads only when ray tracing is asked for. Adding a method is one registry
     entry.
     """
-    from ..registry import PATH_METHODS
+    from ..scene.registry import PATH_METHODS
     try:
         m = PATH_METHODS[method]
     except KeyError:

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.constants import c
 
-from .._util import frozen
+from .._lib.util import frozen
 
 __all__ = ["DIRECTIONS", "Paths"]
 

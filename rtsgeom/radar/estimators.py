@@ -36,7 +36,7 @@ synthesized target become two sources, and a super-resolution estimator may reso
 front ends instead of the one synthesized direction. The taper is not applied with smoothing
 (a tapered subarray does not see a plane wave as a shifted copy; Capon and MUSIC need no
 side-lobe taper). Only 1-D uniform rows: a row with gaps (a sparse or minimum-redundancy
-array) or a 2-D array raises :class:`~rtsgeom.scene.SceneError` naming
+array) or a 2-D array raises :class:`~rtsgeom.scene.scene.SceneError` naming
 ``radar.angle_subarray`` (no silent fallback).
 
 Snapshot averaging over a target's neighbouring range or Doppler bins does not decorrelate the

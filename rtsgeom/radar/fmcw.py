@@ -13,7 +13,7 @@ with ``tau = tau_c + tau_if``, ``t_n = t_adc + n / f_adc`` (time since ramp star
 the Tx-switching phase 2 pi f_D s T_rep) and ``S = B / T``.
 
 ``f_D`` is the RTS's frequency shift (2 f_c v / c0 with f_c the start frequency,
-:class:`rtsgeom.rts.RtsProgram`), so the slow-time frequency at the target's range bin is f_D
+:class:`rtsgeom.rts.channels.RtsProgram`), so the slow-time frequency at the target's range bin is f_D
 exactly. A delay that moves at 2 v / c0 instead (a real target, :func:`synthesize_exact` with
 ``delay_rate``) gives 2 v f_mid / c0 with f_mid = f_c + S (t_mid - tau), t_mid the middle of
 the ADC window (README "Velocity and the carrier frequency"; tests/test_velocity_frequency.py).
@@ -36,10 +36,10 @@ from functools import cached_property
 
 import numpy as np
 
-from .._util import single_threaded_blas
+from .._lib.util import single_threaded_blas
 from ..geometry import RutArray
-from ..rts import Echoes
-from ..scene import RadarConfig
+from ..rts.channels import Echoes
+from ..scene.scene import RadarConfig
 from .steering import Steering
 
 __all__ = ["AdcCube", "fast_time_s", "chirp_start_s", "beat_phase0", "synthesize",
@@ -53,7 +53,7 @@ class AdcCube:
     data: np.ndarray
     radar: RadarConfig
     rut: RutArray
-    clipped: int = 0  # samples the ADC clipped (with [radar.link]; rtsgeom.link.adc_convert)
+    clipped: int = 0  # samples the ADC clipped (with [radar.link]; rtsgeom.radar.link.adc_convert)
 
     @property
     def shape(self) -> tuple[int, int, int]:
@@ -102,7 +102,7 @@ def beat_phase0(echoes: Echoes, radar: RadarConfig) -> np.ndarray:
 
 
 def _single_threaded_blas():
-    """BLAS limited to one thread (:func:`rtsgeom._util.single_threaded_blas`)."""
+    """BLAS limited to one thread (:func:`rtsgeom._lib.util.single_threaded_blas`)."""
     return single_threaded_blas()
 
 

@@ -6,7 +6,7 @@ import numpy as np
 
 from ..geometry import Setup
 from ..paths import Paths
-from ..rts import EchoKind, Echoes, RtsProgram, build_echoes
+from ..rts.channels import EchoKind, Echoes, RtsProgram, build_echoes
 from .fmcw import AdcCube, add_noise, synthesize
 
 __all__ = ["noise_power", "simulate"]
@@ -29,7 +29,7 @@ def simulate(setup: Setup, paths: Paths, program: RtsProgram, seed: int | None =
              snr_db: float | None = None, noise_frames: int = 1) -> tuple[Echoes, AdcCube]:
     """Echoes and ADC cube of a programmed RTS (noise from ``seed`` when ``snr_db`` is set).
 
-    With ``[radar.link]`` the chain is physical (:mod:`rtsgeom.link`): echoes in sqrt(W) at the
+    With ``[radar.link]`` the chain is physical (:mod:`rtsgeom.radar.link`): echoes in sqrt(W) at the
     receiver input through the IF chain, thermal + RTS channel noise shaped by it (``snr_db``,
     when given, overrides that noise), then the ADC's clipping and quantisation.
     ``noise_frames`` K: the coherent average of K frames of a static program, simulated as
@@ -48,7 +48,7 @@ def simulate(setup: Setup, paths: Paths, program: RtsProgram, seed: int | None =
 
 def _simulate_linked(setup: Setup, echoes: Echoes, program: RtsProgram, seed, snr_db,
                      noise_frames: int = 1):
-    from .. import link as lk
+    from . import link as lk
     scene = setup.scene
     rl = lk.radar_link(scene.radar)
     lk.check_channels(scene, program, rl, setup)

@@ -1,7 +1,7 @@
 """Numerical kernels of the beamformer's peak search (:meth:`rtsgeom.radar.steering.Steering.peak`):
 Newton steps on the log power of tapered snapshots in D direction cosines (what ``peak`` runs
 for D = 2), the D = 1 peak with its global check (:func:`peak_1d`: the definition that
-``rtsgeom.kernels.peak_1d`` compiles, bit for bit, for large batches), and the parabolic
+``rtsgeom.synthesis.kernels.peak_1d`` compiles, bit for bit, for large batches), and the parabolic
 interpolation of a sampled peak. Plain numpy on (V_s, n) arrays, no state.
 """
 
@@ -80,14 +80,14 @@ def parabolic(y0, y1, y2) -> np.ndarray:
     return np.where(den < 0, 0.5 * (y0 - y2) / np.where(den == 0, -1, den), 0.0)
 
 
-# -- D = 1: the definition of the compiled peak (rtsgeom.kernels.peak_1d) --------------------
+# -- D = 1: the definition of the compiled peak (rtsgeom.synthesis.kernels.peak_1d) --------------------
 #
 # Vectorised over the snapshots with, per snapshot, exactly the compiled kernel's arithmetic:
 # sums accumulated element by element from 0.0 (explicit loops over the V_s elements, not
 # numpy's reductions, whose order depends on the array's layout), complex products written
 # out as (ac - bd, ad + bc) (the kernel's, CPython's), cosines and sines from numpy (equal to
 # the C library's that the kernel calls, checked bit for bit by tests/test_kernels_peak.py).
-# Steering.peak runs this while numba's set-up would cost more (``rtsgeom._util.use_kernels``:
+# Steering.peak runs this while numba's set-up would cost more (``rtsgeom._lib.util.use_kernels``:
 # no numba import for a few thousand snapshots, the calibration), the kernel after; both give
 # the same bits.
 

@@ -16,10 +16,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._util import tones
+from .._lib.util import tones
 from ..geometry import RutArray
-from ..rts import Echoes, EchoKind, FirTaps
-from ..scene import RadarConfig
+from ..rts.channels import Echoes, EchoKind, FirTaps
+from ..scene.scene import RadarConfig
 from .fmcw import beat_phase0, chirp_start_s
 from .steering import window
 
@@ -29,7 +29,7 @@ __all__ = ["bin_response"]
 def _tap_sums(taps: FirTaps, kern: np.ndarray, slope: float, f_d: float, t0: float,
               dt: float) -> np.ndarray:
     """Each echo's fast-time sums ``sum_n x_e(n) kern[c, n]`` (E, C) for the signal of
-    :class:`~rtsgeom.rts.FirTaps` (Doppler ``f_d``): the tones at the taps' whole-sample
+    :class:`~rtsgeom.rts.channels.FirTaps` (Doppler ``f_d``): the tones at the taps' whole-sample
     delays m t_s, Q[m] = sum_n exp(j 2 pi (S t_s m + f_D) t_n) kern[:, n] and the same with a
     factor t_n (Q1, the residual's first order), formed once for every m the echoes reach;
     then per echo sum_k w_ek (Q[n_e + k] + j 2 pi S residual_e Q1[n_e + k]), one product per
@@ -65,7 +65,7 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
     """Spectrum contributions of each echo at the given bins.
 
     ``range_bin``, ``doppler_bin``: (K,) indices into ``RangeDoppler`` (Doppler fftshifted).
-    ``taps``: the echoes' fractional-delay FIR as whole-sample copies (:func:`rtsgeom.rts.fir_taps`
+    ``taps``: the echoes' fractional-delay FIR as whole-sample copies (:func:`rtsgeom.rts.channels.fir_taps`
     of these echoes, in place of ``echoes.fast_gain``, which must then be None; direct echoes
     of one Doppler shift): the fast-time sums of the tones at the few whole-sample delays the
     taps reach, formed once per geometry (M x N x V K products, M ~ the delays' span in

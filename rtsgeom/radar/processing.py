@@ -20,9 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.constants import c
 
-from .._util import frozen
+from .._lib.util import frozen
 from ..geometry import RutArray
-from ..scene import CfarConfig, RadarConfig
+from ..scene.scene import CfarConfig, RadarConfig
 from .fmcw import AdcCube
 from .newton import parabolic as _parabolic
 from .steering import Steering, window

@@ -23,9 +23,9 @@ from functools import cached_property
 
 import numpy as np
 
-from .._util import frozen, single_threaded_blas, use_kernels
+from .._lib.util import frozen, single_threaded_blas, use_kernels
 from ..geometry import RutArray
-from ..scene import RadarConfig, SceneError
+from ..scene.scene import RadarConfig, SceneError
 from . import estimators as est
 from .newton import lattice, newton, parabolic, peak_1d
 
@@ -413,7 +413,7 @@ class Steering:
         n_d = self.dims
         u0 = np.broadcast_to(np.asarray(u0, float), shape + (n_d,)).reshape(-1, n_d)
         ok = np.zeros(u0.shape[0], bool)
-        if n_d == 1:  # compiled, snapshot by snapshot (rtsgeom.kernels), or its definition
+        if n_d == 1:  # compiled, snapshot by snapshot (rtsgeom.synthesis.kernels), or its definition
             k, lat, gc, gs, g1 = self._grid_1d
             x = np.ascontiguousarray(self.weighted(flat), complex)
             start = np.ascontiguousarray(u0[:, 0])
@@ -422,7 +422,7 @@ class Steering:
             if not use_kernels(x.shape[0], 1e-8 * gc.size):
                 u1, ok = peak_1d(k, lat, x, start, gc, gs, g1, int(iterations))
             else:
-                from ..kernels import peak_1d as compiled
+                from ..synthesis.kernels import peak_1d as compiled
                 u1 = np.empty(u0.shape[0])
                 compiled(k, lat, x, start, gc, gs, g1, int(iterations), u1, ok)
             u = u1[:, None]

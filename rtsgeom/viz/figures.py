@@ -21,7 +21,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
-from ..io import atomic_path
+from .._lib.io import atomic_path
 
 __all__ = ["STYLE", "new_figure", "save_figure", "range_doppler_figure", "range_angle_figure",
            "calibration_sweep_figure", "linearity_figure", "tolerance_cdf_figure",

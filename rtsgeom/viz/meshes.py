@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pyvista as pv
 
-from ..arcmath import radial_tangent, sphere_frame
+from .._lib.arcmath import radial_tangent, sphere_frame
 from ..geometry import Setup
 from ..geometry.export import COLOURS
 

@@ -1,6 +1,6 @@
 """Self-contained HTML reports: one file, images embedded as data URIs, no scripts, no links out.
 
-A report is a title, the scene summary (the dict of :func:`rtsgeom.info.scene_info`, shown as
+A report is a title, the scene summary (the dict of :func:`rtsgeom.pipeline.info.scene_info`, shown as
 tables) and a list of sections. A section is a dict with
 
 * ``heading`` (str, required),
@@ -24,7 +24,7 @@ from typing import Any, Iterable, Mapping
 from matplotlib.ticker import EngFormatter
 
 from .. import __version__
-from ..io import write_text
+from .._lib.io import write_text
 
 __all__ = ["write_report", "render_report"]
 
@@ -278,7 +278,7 @@ def write_report(path: str | Path, title: str, scene_info: Mapping[str, Any],
                  sections: list[Mapping[str, Any]]) -> Path:
     """Write a self-contained HTML report (images inline, no scripts, no external resources).
 
-    ``scene_info`` is the dict of :func:`rtsgeom.info.scene_info`; it becomes the first section.
+    ``scene_info`` is the dict of :func:`rtsgeom.pipeline.info.scene_info`; it becomes the first section.
     """
     path = Path(path)
     write_text(path, render_report(title, scene_info, sections))

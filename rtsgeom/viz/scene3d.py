@@ -25,7 +25,7 @@ import numpy as np
 import pyvista as pv
 
 from ..geometry import Setup
-from ..io import atomic_path, write_text
+from .._lib.io import atomic_path, write_text
 from .meshes import (ARC, BACKGROUND, LOS, MODULE, PANEL_BACKGROUND, REFLECTION, RIM, SHEET,
                      SHEET_LEGEND, TARGET, TARGET_RADIUS_FACTOR, angle_span, arc_points, board,
                      cutout_rims, merge, merge_lines, modules, path_polylines, polyline, rgb,

@@ -1,0 +1,465 @@
+"""The calibration sweep evaluated where it is decided: the phasor model at the detected bin
+(issue 13 item 1, issue 17).
+
+Each step of the phase calibration (paper section "Calibration") programs both probe targets
+on channels I (delay ``base``) and J (``base + delta``) with amplitudes designed for coherent
+channels, and reads the probes' angles off the RuT's detections. The RuT detects a probe at the
+range bin with the most power, and channel J's echo moves by ``c0 delta / 2`` (0.3 to 2 bins
+over the sweep): near a bin boundary two bins carry nearly equal power. The amplitudes must be
+designed **for the bin the RuT detects**; otherwise the design is right at one bin and the
+angle is read at the other, the error at the coherence point is not zero and the sweep's
+minimum moves (up to 75 ps). A lab does the same: it reads the probe's range bin off the
+detection list and designs for it (a fixed point: design at bin k, detect, redesign if the
+RuT reported another bin).
+
+Everything here is batched over all sweep steps at once (one :class:`ChannelModel` per probe
+whose channels are I once and J once per step), with the phasor model
+(``radar.phasors.bin_response``, which agrees with the ADC-cube chain to complex64
+precision), the exact amplitude design in closed form (:func:`design_ratio`) and the angle by
+Newton on the beamformer peak (:meth:`Steering.peak`). Receiver noise is added to the bins'
+spectra with the variance the windowed range and Doppler DFTs give it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.constants import c
+
+from .._lib.util import use_kernels
+from ..geometry import Setup
+from ..paths import Paths
+from ..radar.processing import tdm_compensate
+from ..radar.steering import Steering, window
+from ..rts.channels import KIND_DIRECT, RtsProgram, channel_echoes, requested_delay
+from ..scene.scene import TargetConfig
+from ..synthesis.model import ChannelModel
+
+__all__ = ["design_ratio", "beam_derivatives", "ratio_from_beams", "design_at_detected_bin", "detected_bin_choice", "SweepResult", "phasor_sweep", "fit_minimum", "HALF_BINS",
+           "place_probes", "chain_errors"]
+
+HALF_BINS = 3  # candidate bins either side of the set range's bin (J moves <= ~2 bins)
+
+
+def beam_derivatives(st: Steering, x, u):
+    """Beamformer output b(u) and its first two derivatives in u at directions ``u`` (...,)
+    for snapshots ``x`` (..., V) (D = 1): three arrays (...,)."""
+    w = st.weighted(x)  # (..., V_s)
+    k = st.wavevector[:, 0]  # (V_s,)
+    e = np.exp(1j * k * np.asarray(u)[..., None])
+    y = w * e
+    return y.sum(-1), (1j * k * y).sum(-1), (-(k * k) * y).sum(-1)
+
+
+def design_ratio(st: Steering, x_i, x_j, alpha_rad, phase=0.0):
+    """The exact amplitude design in closed form: the ratio rho >= 0 (...,) for which the
+    beamformer peak of ``x_i + rho e^{j phase} x_j`` (snapshots (..., V)) lies at
+    ``alpha_rad``.
+
+    With b_q(u) the channels' beam responses at u = sin(alpha), the peak condition
+    dP/du = 0, P = |b_I + rho y|^2 (y = e^{j phase} b_J), is the quadratic
+    ``Re(b_I* b_I') + rho Re(b_I* y' + y* b_I') + rho^2 Re(y* y') = 0``; of its non-negative
+    roots the one where P is a maximum (P'' < 0) with the larger P. NaN where none is (the
+    angle is outside the pair's span). Agrees with the root finder on the searched peak
+    (``ChannelModel.solve``) to its tolerance (tested). A smoothed Capon or MUSIC
+    (``Steering.smoothing``) has no such closed form: ``model.estimator_ratio`` solves it on
+    the estimator's own peak."""
+    if st.smoothing:
+        from ..synthesis.model import estimator_ratio
+        return estimator_ratio(st, x_i, x_j, alpha_rad, phase)
+    u = np.sin(np.asarray(alpha_rad, float))
+    return ratio_from_beams(beam_derivatives(st, x_i, u), beam_derivatives(st, x_j, u), phase)
+
+
+def ratio_from_beams(beam_i, beam_j, phase=0.0):
+    """:func:`design_ratio` from the channels' beam responses and their first two derivatives
+    in u at the set direction, ``(b, b', b'')`` each (...,) (e.g. gathered from a table),
+    broadcast with ``phase``: rho (...).
+
+    P, dP/du and d2P/du2 of ``b_I + rho y`` are quadratics in rho with real coefficients
+    (``Re(conj(f) g)`` of the beams), formed once; the roots and the maximum test are then
+    real arithmetic (:func:`_ratios`, the definition), compiled per set-point for large
+    batches (``rtsgeom.synthesis.kernels.ratio_one``, the same bits: the Monte-Carlo studies call it for
+    millions of set-points; small batches numpy, without numba's import:
+    ``rtsgeom._lib.util.use_kernels``)."""
+    arrs = np.broadcast_arrays(*(np.asarray(b, complex) for b in (*beam_i, *beam_j)),
+                               np.exp(1j * np.asarray(phase, float)))
+    flat = [np.ascontiguousarray(a).reshape(-1) for a in arrs]
+    if not use_kernels(flat[0].size, 2e-7):  # numpy ~0.2 us per set-point (measured)
+        return _ratios(*flat).reshape(arrs[0].shape)
+    from ..synthesis.kernels import ratios
+    out = np.empty(arrs[0].shape)
+    ratios(*flat, out.reshape(-1))
+    return out
+
+
+@np.errstate(all="ignore")  # as silent as the compiled kernel (radar/newton.py)
+def _ratios(bi, bi1, bi2, bj, bj1, bj2, e):
+    """The ratio rho >= 0 per set-point (flat arrays (N,)) that puts the peak of
+    P(u) = |b_I + rho y|^2 (y = e b_J, e = e^{j phase} J's phase factor) at the set
+    direction, from the beams and their first two derivatives in u there.
+
+    dP/du = 0 is a0 + a1 rho + a2 rho^2 = 0 with a0 = Re(b_I* b_I'), a1 = Re(b_I* y' + y* b_I'),
+    a2 = Re(y* y'); of its roots the non-negative ones with P'' < 0 (P'' = 2 Re(s* s'') +
+    2 |s'|^2, s = b_I + rho y, a quadratic in rho), the one with the larger P (the first on a
+    tie); NaN where none is. Real arithmetic in the compiled kernel's order
+    (``kernels.ratio_one``, its compiled form: the complex products written out as
+    (ac - bd, ad + bc)), so both give the same bits (tested)."""
+    def mul(f, g):
+        return (f[0] * g[0] - f[1] * g[1], f[0] * g[1] + f[1] * g[0])
+
+    def re(f, g):  # Re(conj(f) g)
+        return f[0] * g[0] + f[1] * g[1]
+
+    bi, bi1, bi2, bj, bj1, bj2, e = ((a.real, a.imag) for a in (bi, bi1, bi2, bj, bj1, bj2, e))
+    y, y1, y2 = mul(e, bj), mul(e, bj1), mul(e, bj2)
+    a0 = re(bi, bi1)
+    a1 = re(bi, y1) + re(y, bi1)
+    a2 = re(y, y1)
+    disc = a1 * a1 - 4 * a0 * a2
+    sq = np.sqrt(np.where(disc >= 0, disc, np.nan))
+    lin = -a0 / a1  # a2 = 0: the one root of the linear equation
+    out = []
+    for sign in (1, -1):
+        r = np.where(a2 != 0, (-a1 + sign * sq) / (2 * a2), lin)
+        p = re(bi, bi) + r * (2 * re(bi, y) + r * re(y, y))
+        p2 = (2 * (re(bi, bi2) + r * (re(bi, y2) + re(y, bi2)) + r * r * re(y, y2))
+              + 2 * (re(bi1, bi1) + r * (2 * re(bi1, y1)) + r * r * re(y1, y1)))
+        keep = np.isfinite(r) & (r >= 0) & (p2 < 0)
+        out.append((np.where(keep, r, np.nan), np.where(keep, p, -np.inf)))
+    (r0, s0), (r1, s1) = out
+    # numpy's argmax over (s0, s1): the first maximum, or the first NaN
+    return np.where((s0 == s0) & ((s1 != s1) | (s1 > s0)), r1, r0)
+
+
+def design_at_detected_bin(st: Steering, h, alpha_rad, phase=0.0):
+    """The exact design of a pair for the bin the RuT detects (the bin logic of the module
+    docstring, vectorised): ``h`` (..., K, 2, V) the TDM-compensated unit responses of
+    channels I and J at K candidate range bins (the set range's in the middle), ``alpha_rad``
+    and ``phase`` broadcast against (...,).
+
+    For each design bin k the closed-form ratio (:func:`design_ratio`) and the bin the RuT
+    then detects (the strongest candidate of ``I + rho e^{j phase} J``, power summed over all
+    virtual elements); the design bin chosen is the one where design and detection agree,
+    nearest the set range's bin first. Returns ``rho`` (...), ``bin`` (...) (index into K;
+    where no bin agrees: the fixed point of "design at the reported bin" from the middle
+    bin, as :func:`phasor_sweep`), ``consistent`` (...) and ``margin`` (...) (the detected
+    bin's power over the next strongest; 1 where not consistent). NaN ``rho`` where no bin
+    has a design."""
+    h = np.asarray(h)
+    x_i, x_j = h[..., 0, :], h[..., 1, :]  # (..., K, V)
+    a = np.asarray(alpha_rad, float)[..., None]
+    ph = np.asarray(phase, float)[..., None]
+    rho = design_ratio(st, x_i, x_j, a, ph)  # (..., K)
+    p_ii = np.sum(x_i.real ** 2 + x_i.imag ** 2, -1)  # (..., K)
+    p_jj = np.sum(x_j.real ** 2 + x_j.imag ** 2, -1)
+    c_ij = np.sum(np.conj(x_i) * x_j, -1)
+    return detected_bin_choice(rho, ph, p_ii, p_jj, c_ij)
+
+
+def detected_bin_choice(rho, phase, p_ii, p_jj, c_ij, margin: bool = True):
+    """The bin logic of :func:`design_at_detected_bin` from the ratios per design bin ``rho``
+    (..., K), J's phase (broadcast) and the channels' power sums over the virtual elements at
+    each candidate bin: ``p_ii``, ``p_jj`` (..., K) and ``c_ij = sum conj(x_i) x_j``:
+    (rho, k, consistent, margin), each (...). ``margin=False``: the fourth result is None.
+
+    Per row (``rtsgeom.synthesis.kernels.choice_row``, compiled): the power of each design at every bin,
+    |I + r e^{j ph} J|^2 = p_ii + r^2 p_jj + 2 r Re(e^{j ph} c_ij) (r = 0 where rho is not a
+    positive number), each design's detected bin the strongest; of the designs detected at
+    their own bin the one nearest the middle (ties to the lower bin), else the fixed point of
+    "design at the reported bin" from the middle bin; the margin is the detected bin's power
+    over the next strongest (1 where not consistent)."""
+    from ..synthesis.kernels import bin_choice_rows
+    rho = np.asarray(rho, float)
+    c_ij = np.asarray(c_ij)
+    n_k = rho.shape[-1]
+    lead = np.broadcast_shapes(rho.shape[:-1], np.shape(p_ii)[:-1], np.shape(p_jj)[:-1],
+                               c_ij.shape[:-1])
+    rows = [np.ascontiguousarray(np.broadcast_to(a, lead + (n_k,)), float).reshape(-1, n_k)
+            for a in (rho, *(f(np.broadcast_to(np.asarray(phase, float), rho.shape))
+                                   for f in (np.cos, np.sin)), p_ii, p_jj, c_ij.real,
+                      np.imag(c_ij))]
+    n = rows[0].shape[0]
+    out, k = np.empty(n), np.empty(n, np.int64)
+    ok, mg = np.empty(n, bool), np.empty(n)
+    bin_choice_rows(*rows, out, k, ok, mg)
+    out, k, ok, mg = (a.reshape(lead) for a in (out, k, ok, mg))
+    return out, k, ok, (mg if margin else None)
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """Per step s and probe p (noiseless model): the spectra at the candidate bins for the
+    design the RuT's bin selects, the design's bin (index into the model's bins,
+    ``HALF_BINS`` is the set range's), the designed amplitudes (A_I, A_J), whether design and
+    detection agree on the bin, and the detected bin's power over the next strongest."""
+
+    delta_tau_s: np.ndarray  # (S,)
+    spectra: np.ndarray  # (S, P, K, V) TDM-compensated
+    bin_index: np.ndarray  # (S, P)
+    amplitudes: np.ndarray  # (S, P, 2)
+    range_bin0: np.ndarray  # (P,) absolute range bin of the set range
+    consistent: np.ndarray  # (S, P)
+    margin: np.ndarray  # (S, P)
+    noise_sigma: np.ndarray  # (S,) per-element noise std of one frame (0: noiseless scene)
+    alphas: np.ndarray  # (P,) probe angles (rad)
+    steering: Steering
+
+    def errors(self, frames: int = 1, rng=None, draws: int | None = None) -> np.ndarray:
+        """Signed probe-angle errors (rad) as the RuT detects them: (S, P), or (draws, S, P)
+        with ``draws`` independent noise realisations of ``frames`` coherently averaged
+        frames each (noiseless when ``rng`` is None). The detected bin is the strongest
+        candidate of the noisy spectra; its angle the beamformer peak (Newton)."""
+        x = self.spectra if draws is None else np.broadcast_to(
+            self.spectra, (draws,) + self.spectra.shape)
+        if rng is not None and np.any(self.noise_sigma > 0):
+            sig = (self.noise_sigma / np.sqrt(frames))[:, None, None, None] / np.sqrt(2)
+            x = x + sig * (rng.standard_normal(x.shape) + 1j * rng.standard_normal(x.shape))
+        power = np.sum(x.real ** 2 + x.imag ** 2, -1)
+        k = np.argmax(power, -1)
+        sel = np.take_along_axis(x, k[..., None, None], -2)[..., 0, :]
+        a = self.alphas
+        u, _ = self.steering.peak(sel, np.broadcast_to(np.sin(a)[:, None], sel.shape[:-1] + (1,)))
+        err = np.arcsin(np.clip(u[..., 0], -1, 1)) - a
+        return np.where(np.isfinite(self.amplitudes).all(-1), err, np.nan)
+
+
+def _models(setup, paths, pair, targets, base_offsets, deltas):
+    """One model per probe: channel I, then J at every step's delay."""
+    i, j = pair
+    ch = [i] + [j] * len(deltas)
+    dt = np.concatenate([[base_offsets[0]], base_offsets[1] + np.asarray(deltas, float)])
+    return [ChannelModel.build(setup, paths, ch, t, dt, HALF_BINS) for t in targets]
+
+
+def _range_bin(scene, range_m: float) -> int:
+    r = scene.radar
+    return int(np.round(range_m * 2 * r.slope_hz_per_s / c * r.samples_per_chirp
+                        / r.adc_rate_hz))
+
+
+def _noise_sigma(setup, paths, pair, targets, amps, snr_db) -> np.ndarray:
+    """Per-element noise standard deviation (complex) of the range-Doppler spectrum per step
+    (S,): the frame's noise power per sample is referred to its strongest direct echo
+    (``radar.frame.noise_power``), here the largest programmed amplitude ``amps`` (S, P, 2)
+    times its channel's strongest unit echo; the windowed DFTs add sum w_r^2 sum w_d^2."""
+    scene, radar = setup.scene, setup.scene.radar
+    tau = float(requested_delay(scene, targets[0].range_m))
+    prog = RtsProgram.build([0, 1], list(pair), [tau, tau], [0.0, 0.0], [1.0, 1.0])
+    ech = channel_echoes(setup, paths, prog)
+    ech = ech.select(ech.kind == KIND_DIRECT)
+    unit = np.array([np.max(np.abs(ech.amplitude[ech.target == q])) for q in (0, 1)])
+    a_max = np.nanmax(np.abs(amps) * unit, axis=(1, 2))  # (S,)
+    n0 = a_max ** 2 / 10 ** (snr_db / 10)
+    g = (np.sum(window(radar.range_window, radar.samples_per_chirp) ** 2)
+         * np.sum(window(radar.doppler_window, radar.chirps_per_tx) ** 2))
+    return np.sqrt(n0 * g)
+
+
+def _linked_noise_sigma(setup, targets, amps) -> np.ndarray:
+    """As :func:`_noise_sigma` with ``[radar.link]`` and no ``snr_db``: the per-sample noise
+    from the link budget, referred to the model's relative amplitudes
+    (:func:`rtsgeom.radar.link.relative_noise_power`; the RTS channels' noise from every programmed
+    row ``amps`` (S, P, 2), the quantisation at the weakest probe's IF response)."""
+    from ..radar.link import relative_noise_power
+    scene, radar = setup.scene, setup.scene.radar
+    beat = radar.slope_hz_per_s * 2.0 * np.array([t.range_m for t in targets]) / c  # (P,)
+    n0 = np.max(relative_noise_power(scene, np.nansum(np.abs(amps) ** 2, axis=(1, 2))[:, None],
+                                     beat[None, :]), axis=1)  # (S,)
+    g = (np.sum(window(radar.range_window, radar.samples_per_chirp) ** 2)
+         * np.sum(window(radar.doppler_window, radar.chirps_per_tx) ** 2))
+    return np.sqrt(n0 * g)
+
+
+def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair, targets,
+                 alphas, deltas, base_offsets=(0.0, 0.0), gain_correction=(1.0, 1.0),
+                 bins=None) -> SweepResult:
+    """The calibration sweep's spectra at every delay ``deltas`` (S,) of channel J, on the
+    setup as built (``setup``, ``paths``), with amplitudes designed on the ``nominal`` setup
+    for the bin the RuT detects (fixed point, see the module); ``bins`` (S, P) forces the
+    design bins (the full chain passes the bins its detection reported). Noise and angles:
+    :meth:`SweepResult.errors`."""
+    deltas = np.atleast_1d(np.asarray(deltas, float))
+    n_s, n_p = deltas.size, len(targets)
+    nom_models = _models(*nominal, pair, targets, base_offsets, deltas)
+    # no mounting errors (nominal_model returns the same objects): the same models, built once
+    real_models = (nom_models if nominal[0] is setup and nominal[1] is paths
+                   else _models(setup, paths, pair, targets, base_offsets, deltas))
+    st = nom_models[0].steering
+    radar = setup.scene.radar
+    kbin = np.empty((n_s, n_p), int)
+    amps = np.empty((n_s, n_p, 2))
+    consistent = np.empty((n_s, n_p), bool)
+    margin = np.empty((n_s, n_p))
+    snaps = []
+    steps = np.arange(n_s)
+    for p, (mn, mr, alpha) in enumerate(zip(nom_models, real_models, alphas)):
+        hn = tdm_compensate(mn.responses, mn.doppler_hz, setup.rut, radar)  # (K, 1+S, V)
+        ha = hn if mr is mn else tdm_compensate(mr.responses, mr.doppler_hz, setup.rut, radar)
+        phases = mn.coherent_phases(alphas, hn)[..., 1:]  # (K, S): J's coherent phase per bin
+        rho = design_ratio(st, hn[:, :1, :], hn[:, 1:, :], alpha, phases)  # (K, S)
+        # power normalisation (ChannelModel.scale): the combined peak as strong as I alone
+        b_i, _, _ = beam_derivatives(st, hn[:, :1, :], np.sin(alpha))
+        b_j, _, _ = beam_derivatives(st, hn[:, 1:, :], np.sin(alpha))
+        p_sum = np.abs(b_i + rho * np.exp(1j * phases) * b_j) ** 2  # (K, S)
+        k_one = int(np.argmax(np.sum(np.abs(hn[:, 0]) ** 2, -1)))
+        u_one, _ = st.peak(hn[k_one, 0], np.sin(alpha))
+        p_one = float(st.power(hn[k_one, 0], u_one[None])[0])
+        scale = mn.unit_gain * np.sqrt(p_one / np.maximum(p_sum, 1e-300))
+        a_i, a_j = scale * gain_correction[0], scale * rho * gain_correction[1]  # (K, S)
+        # spectra at every candidate bin for every design bin: (K_design, S, K_bins, V)
+        x = (a_i[:, :, None, None] * ha[None, :, 0, :][:, None]
+             + a_j[:, :, None, None] * np.moveaxis(ha[:, 1:, :], 0, 1)[None])
+        power = np.sum(np.abs(x) ** 2, -1)  # (K_design, S, K_bins)
+        det = np.argmax(np.where(np.isfinite(power), power, -1), -1)  # (K_design, S)
+        if bins is None:
+            k = det[HALF_BINS, steps]  # design at the set range's bin, see what is detected
+            for _ in range(4):  # redesign at the reported bin until they agree
+                k = det[k, steps]
+        else:
+            k = np.asarray(bins)[:, p]
+        kbin[:, p] = k
+        consistent[:, p] = det[k, steps] == k
+        pw = np.sort(np.where(np.isfinite(power[k, steps]), power[k, steps], 0.0), -1)
+        margin[:, p] = pw[:, -1] / np.maximum(pw[:, -2], 1e-300)
+        amps[:, p] = np.stack([a_i[k, steps], a_j[k, steps]], -1)
+        snaps.append(x[k, steps])  # (S, K_bins, V)
+    x = np.stack(snaps, 1)  # (S, P, K_bins, V)
+    if radar.snr_db is not None:
+        sigma = _noise_sigma(setup, paths, pair, targets, amps, radar.snr_db)
+    elif radar.link is not None:  # the link budget's thermal noise (kTBF, RTS, ADC)
+        sigma = _linked_noise_sigma(setup, targets, amps)
+    else:
+        sigma = np.zeros(n_s)
+    r0 = np.array([_range_bin(setup.scene, t.range_m) for t in targets])
+    return SweepResult(deltas, x, kbin, amps, r0, consistent, margin, sigma,
+                       np.asarray(alphas, float), st)
+
+
+def fit_minimum(deltas, error_rad, period_s: float, near_s: float, harmonics: int = 2,
+                search_s: float | None = None, extra_phase_rad=None,
+                criterion: str = "joint", search_phase=None, return_fit: bool = False):
+    """The delay where the probes' fitted signed angle errors are jointly smallest, from a
+    least-squares fit of the criterion's known periodic shape over one period of steps
+    centred at ``near_s`` (the sweep's coarse minimum).
+
+    Each probe's signed error is an even, smooth, periodic function of the phase mismatch
+    (the two beams' cross term goes with cos(phi)): ``e_p = sum_h a_h cos(h theta) + b_h
+    sin(h theta)``, theta = 2 pi (delta - near) / period. Fitting it uses every step of the
+    period, so receiver noise enters the chosen delay linearly through the fit, not through
+    one step's quadratically flat neighbourhood (what makes the step-minimum need ~2e4
+    frames per step). The minimum of sum_p e_p^2 on the fitted curves within one sweep step
+    of ``near_s`` (0.05 ps grid; ``search_s``: that half-width instead).
+
+    ``criterion="vertex"`` (a coarse RTS whose few realisable steps the curves interpolate,
+    ``calibration.fine_window``): the common vertex instead, the minimum of sum_p e_p'^2;
+    it needs 1 + 2 harmonics points (least squares: 2 more).
+
+    ``extra_phase_rad`` (S, P): a phase each step adds to channel J of each probe beyond the
+    delay's own ``2 pi delta / period`` and known in advance -- the fractional-delay FIR's
+    phase at the step's setting (``aoa.fir.fir_bin_gain``), which cycles with the
+    setting every 1/f_s (+-3.7 deg with 5 taps) and would otherwise bend the periodic shape
+    (a 33 ps bias with 5 taps). The shape is then fitted on each probe's phase axis
+    ``2 pi (delta - near) / period + extra`` and searched with the extra phase interpolated
+    between the steps, or, with ``search_phase`` (a function of the delays (F,) -> (F, P)),
+    evaluated there: a coarse RTS's steps are too far apart to interpolate the FIR's phase,
+    and its data axis also carries the quantiser's own offset error (where the delay step
+    does not divide 1/f_s, ``calibration.realisation_shift``), which the continuous delays
+    searched do not have.
+
+    ``return_fit``: also the fitted curves at the data's steps (S, P) (NaN at the steps left
+    out: off the period or not detected), whose residual is the steps' noise
+    (``ncal.calibrate_pair_nd`` sizes its frames per step from it); all NaN where too few
+    steps for the fit (the minimum is then ``near_s``)."""
+    d = np.asarray(deltas, float)
+    e = np.asarray(error_rad, float)
+    sel = (np.abs(d - near_s) <= period_s / 2) & np.all(np.isfinite(e), axis=1)
+    th = 2 * np.pi * (d[sel] - near_s) / period_s
+    h = np.arange(1, harmonics + 1)
+    vertex = criterion == "vertex"
+
+    def basis(theta):
+        if vertex:  # the derivative's basis: the vertex is where it is zero
+            return np.concatenate([np.zeros((theta.size, 1)), -h * np.sin(np.outer(theta, h)),
+                                   h * np.cos(np.outer(theta, h))], axis=1)
+        return np.concatenate([np.ones((theta.size, 1)), np.cos(np.outer(theta, h)),
+                               np.sin(np.outer(theta, h))], axis=1)
+
+    def values(theta):
+        return np.concatenate([np.ones((theta.size, 1)), np.cos(np.outer(theta, h)),
+                               np.sin(np.outer(theta, h))], axis=1)
+    fitted = np.full(e.shape, np.nan)
+
+    def result(best):
+        return (float(best), fitted) if return_fit else float(best)
+    if th.size < 2 * harmonics + (1 if vertex else 3):
+        return result(near_s)
+    step = np.median(np.diff(np.sort(d))) if d.size > 1 else period_s / 40
+    half = 1.5 * step if search_s is None else search_s
+    fine = near_s + np.arange(-half, half + 1e-15, 0.05e-12)
+    tf = 2 * np.pi * (fine - near_s) / period_s
+    if extra_phase_rad is None:
+        coef, *_ = np.linalg.lstsq(values(th), e[sel], rcond=None)  # (1 + 2H, P)
+        fitted[sel] = values(th) @ coef
+        crit = np.sum((basis(tf) @ coef) ** 2, axis=1)
+        return result(fine[np.argmin(crit)])
+    extra = np.asarray(extra_phase_rad, float).reshape(d.size, -1)
+    order = np.argsort(d[sel])
+    crit = np.zeros(fine.size)
+    search_x = None if search_phase is None else np.asarray(search_phase(fine), float).reshape(
+        fine.size, -1)
+    for p in range(e.shape[1]):  # each probe on its own phase axis
+        x = extra[sel, p]
+        coef, *_ = np.linalg.lstsq(values(th + x), e[sel, p], rcond=None)
+        fitted[sel, p] = values(th + x) @ coef
+        x_f = (search_x[:, p] if search_phase is not None
+               else np.interp(fine, d[sel][order], x[order]))  # smooth in the setting: 5 ps
+        crit += (basis(tf + x_f) @ coef) ** 2
+    return result(fine[np.argmin(crit)])
+
+
+def place_probes(setup, paths, nominal, pair, ranges, alphas, window_s, base_offsets,
+                 gain_correction, offsets_bins=np.linspace(-0.5, 0.4, 10)) -> np.ndarray:
+    """Probe ranges (P,) moved within a range bin so that over the delays ``window_s`` the
+    design and the detection agree on each probe's bin with the largest power margin (what
+    a lab chooses when it sets its probe targets' ranges): the sweep curve stays on one bin,
+    continuous, around the coherence point."""
+    radar = setup.scene.radar
+    bin_m = c * radar.adc_rate_hz / (2 * radar.slope_hz_per_s * radar.samples_per_chirp)
+    ranges = np.asarray(ranges, float)
+    score = np.empty((len(offsets_bins), ranges.size))
+    for n, o in enumerate(offsets_bins):
+        t = [TargetConfig(float(r + o * bin_m)) for r in ranges]
+        res = phasor_sweep(setup, paths, nominal, pair, t, alphas, window_s, base_offsets,
+                           gain_correction)
+        score[n] = np.min(np.where(res.consistent, res.margin, 0.0), axis=0)
+    best = np.asarray(offsets_bins)[np.argmax(score, axis=0)]
+    return ranges + best * bin_m
+
+
+def chain_errors(setup, paths, pair, targets, res: SweepResult, base_offsets, frames, seed
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """The same steps through the full ADC-cube chain (synthesis, range-Doppler, CFAR,
+    angle): signed probe-angle errors (S, P) (NaN: not detected) and the detected candidate
+    bins (S, P) (-1: not detected), with the amplitudes of ``res`` (the phasor model's
+    design for the bin it predicts the RuT detects)."""
+    from ..radar.processing import nearest_detection
+    from .pair import _probe_program, simulate_detect
+    scene = setup.scene
+    base = [(float(requested_delay(scene, t.range_m)) + base_offsets[0],
+             float(requested_delay(scene, t.range_m)) + base_offsets[1]) for t in targets]
+    n_s, n_p = res.bin_index.shape
+    err = np.full((n_s, n_p), np.nan)
+    got = np.full((n_s, n_p), -1)
+    for s_, d in enumerate(res.delta_tau_s):
+        prog = _probe_program(res.amplitudes[s_], pair, base, float(d))
+        step_seed = np.random.SeedSequence([int(seed) % 2 ** 32,
+                                            int(round(d * 1e15)) + 2 ** 40])
+        rd, det = simulate_detect(setup, paths, prog, step_seed, frames)
+        for p, t in enumerate(targets):
+            k = nearest_detection(det, rd, t.range_m)
+            if k is not None:
+                err[s_, p] = det.angle_rad[k] - res.alphas[p]
+                got[s_, p] = int(det.range_bin[k]) - res.range_bin0[p] + HALF_BINS
+    return err, got

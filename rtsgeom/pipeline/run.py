@@ -1,0 +1,268 @@
+"""The main job: a scene through the whole pipeline, and its matched results.
+
+Scene -> Setup -> Paths -> RTS program (AoA synthesis + calibration) -> Echoes -> ADC cube
+(+ noise) -> range-Doppler -> detections -> per-target match against the set-points.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import __version__
+from ..geometry import Setup, build_setup
+from ..paths import Paths, compute_paths
+from ..radar import AdcCube, Detections, RangeDoppler, process
+from ..radar.frame import noise_power, simulate
+from ..rts.channels import Echoes, RtsProgram, program_nearest
+from ..scene.scene import Scene
+
+__all__ = ["RunResult", "simulate", "run_scene", "match_targets", "label_detections",
+           "noise_power"]
+
+
+@dataclass(frozen=True)
+class RunResult:
+    scene: Scene
+    setup: Setup
+    paths: Paths
+    program: RtsProgram
+    echoes: Echoes
+    cube: AdcCube
+    rd: RangeDoppler
+    detections: Detections
+    matches: list[dict]
+    calibration: dict = field(default_factory=dict)
+    warnings: tuple[str, ...] = ()
+    aoa_mode: str = "exact"  # the amplitude mode actually used
+    link_budget: object = None  # rtsgeom.radar.link.LinkBudget
+
+
+def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angle_rad=None,
+                  bins: int = 2) -> list[dict]:
+    """For each target, the strongest detection within ``bins`` range and Doppler bins, each
+    detection matched to at most one target.
+
+    Two targets in one range-Doppler cell produce one detection: it goes to the target closest
+    to it (in bins; ties to the lower index) and the other target is reported not detected
+    (``detection`` None). Pairs are assigned greedily by (detection power, closeness), which
+    for well-separated targets is the strongest detection near each one.
+    """
+    dr = rd.range_m[1] - rd.range_m[0]
+    dv = rd.velocity_mps[1] - rd.velocity_mps[0]
+    pairs = []
+    for i, t in enumerate(scene.targets):
+        er = (det.range_m - t.range_m) / dr
+        ev = (det.velocity_mps - t.velocity_mps) / dv
+        for j in np.flatnonzero((np.abs(er) <= bins) & (np.abs(ev) <= bins)):
+            pairs.append((-float(det.power_db[j]), float(er[j] ** 2 + ev[j] ** 2), i, int(j)))
+    chosen: dict[int, int] = {}
+    used: set[int] = set()
+    for _, _, i, j in sorted(pairs):
+        if i not in chosen and j not in used:
+            chosen[i] = j
+            used.add(j)
+    out = []
+    for i, t in enumerate(scene.targets):
+        j = chosen.get(i)
+        entry = {"index": i, "set": {"range_m": t.range_m, "velocity_mps": t.velocity_mps,
+                                     "angle_deg": float(np.degrees(t.angle_rad)),
+                                     "rcs_dbsm": t.rcs_dbsm}}
+        if det.elevation_rad is not None:
+            entry["set"]["elevation_deg"] = float(np.degrees(t.elevation_rad))
+        if j is not None:
+            d = {"range_m": float(det.range_m[j]), "velocity_mps": float(det.velocity_mps[j]),
+                 "angle_deg": float(det.angle_deg[j]), "power_db": float(det.power_db[j]),
+                 "snr_db": float(det.snr_db[j])}
+            entry["detection"] = d
+            entry["detection_index"] = j
+            entry["error"] = {
+                "range_m": d["range_m"] - t.range_m,
+                "velocity_mps": d["velocity_mps"] - t.velocity_mps,
+                "angle_deg": d["angle_deg"] - entry["set"]["angle_deg"],
+                "range_bins": (d["range_m"] - t.range_m) / dr,
+                "doppler_bins": (d["velocity_mps"] - t.velocity_mps) / dv,
+            }
+            if det.elevation_rad is not None:  # a RuT with elevation: both angles
+                d["elevation_deg"] = float(det.elevation_deg[j])
+                entry["error"]["elevation_deg"] = d["elevation_deg"] - entry["set"][
+                    "elevation_deg"]
+        else:
+            entry["detection"] = None
+            entry["error"] = None
+            entry["undetected"] = undetected_reason(scene, det, rd, t, bins)
+        out.append(entry)
+    return out
+
+
+def undetected_reason(scene: Scene, det: Detections, rd: RangeDoppler, target,
+                      bins: int = 2) -> dict:
+    """Why a target has no detection: the map's strongest cell within one bin of the target's
+    cell over the map's noise (the median of the channel-summed power, a Gamma(V) variable,
+    referred to its mean), against the CFAR threshold; or that a detection within ``bins``
+    went to another target (two targets in one cell). ``snr_db`` None: a noiseless map."""
+    ri = int(np.argmin(np.abs(rd.range_m - target.range_m)))
+    vi = int(np.argmin(np.abs(rd.velocity_mps - target.velocity_mps)))
+    cell = rd.power[max(ri - 1, 0):ri + 2, max(vi - 1, 0):vi + 2]
+    v = rd.spectrum.shape[-1]
+    from scipy.special import gammaincinv  # median of Gamma(V, 1)
+    noise = float(np.median(rd.power)) * v / float(gammaincinv(v, 0.5))
+    thr = float(scene.radar.cfar.threshold_db)
+    snr = None if noise <= 0 else float(10 * np.log10(max(float(cell.max()), 1e-300) / noise))
+    dr = rd.range_m[1] - rd.range_m[0]
+    dv = rd.velocity_mps[1] - rd.velocity_mps[0]
+    near = ((np.abs(det.range_m - target.range_m) <= bins * dr)
+            & (np.abs(det.velocity_mps - target.velocity_mps) <= bins * dv))
+    if np.any(near):
+        why = "its cell's detection went to another target (two targets in one cell)"
+    elif snr is not None and snr < thr:
+        why = (f"{snr:.1f} dB over the noise at its cell, under the CFAR threshold "
+               f"{thr:g} dB (radar.snr_db, when set, is the SNR of the strongest echo)")
+    else:
+        why = "the CFAR did not report its cell (masked by a stronger neighbour or out of range)"
+    return {"snr_db": snr, "threshold_db": thr, "reason": why}
+
+
+def label_detections(result: "RunResult", bins: float = 2.0) -> list[str]:
+    """What each detection is, from what the simulation knows about its echoes: ``target N``
+    (the detection matched to target N), ``cable ghost of target N`` (order k of its cable
+    reflections), ``setup reflection`` (the sheet, the board), or ``unmatched``.
+
+    Each echo's apparent position follows from the beat model (eq. 8): beat frequency
+    ``S tau + f_D`` (range, wrapped at the unambiguous range) and Doppler ``f_D`` (velocity,
+    wrapped at the unambiguous velocity). A detection takes the kind of the strongest echo
+    within ``bins`` range and Doppler bins of it (cyclic distances).
+    """
+    from scipy.constants import c
+
+    from ..rts.channels import EchoKind
+    det, rd, echoes, radar = result.detections, result.rd, result.echoes, result.scene.radar
+    labels = ["unmatched"] * len(det)
+    if len(det) and len(echoes):
+        dr = rd.range_m[1] - rd.range_m[0]
+        dv = rd.velocity_mps[1] - rd.velocity_mps[0]
+        span_r, span_v = dr * rd.range_m.size, dv * rd.velocity_mps.size
+        beat = radar.slope_hz_per_s * echoes.tau_s.mean(axis=1) + echoes.doppler_hz
+        e_r = beat * c / (2 * radar.slope_hz_per_s)
+        e_v = echoes.doppler_hz * c / (2 * radar.f_c_hz)
+        power = np.mean(np.abs(echoes.amplitude) ** 2, axis=1)
+
+        def cyc(a, span):
+            return np.abs((a + span / 2) % span - span / 2)
+        near = ((cyc(det.range_m[:, None] - e_r[None, :], span_r) <= bins * dr)
+                & (cyc(det.velocity_mps[:, None] - e_v[None, :], span_v) <= bins * dv))
+        for j in range(len(det)):
+            cand = np.flatnonzero(near[j])
+            if cand.size == 0:
+                continue
+            e = cand[np.argmax(power[cand])]
+            if echoes.kind[e] == EchoKind.SETUP:
+                labels[j] = "setup reflection"
+            elif echoes.kind[e] == EchoKind.GHOST:
+                labels[j] = f"cable ghost of target {int(echoes.target[e])}"
+            else:
+                labels[j] = f"target {int(echoes.target[e])}"
+    for m in result.matches:  # the matching decides which detection is the target itself
+        j = m.get("detection_index")
+        if j is not None:
+            labels[j] = f"target {m['index']}"
+    for j, lab in enumerate(labels):  # a target's second detection is not the target
+        if lab.startswith("target ") and not any(m.get("detection_index") == j
+                                                 for m in result.matches):
+            labels[j] = "unmatched"
+    return labels
+
+
+def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = None,
+              progress=None, calibration: dict | None = None) -> RunResult:
+    """Run the whole pipeline on ``scene``.
+
+    ``aoa_mode`` overrides the scene's ``rts.aoa_mode``: ``nearest`` puts each target on its
+    nearest front end; the synthesis modes calibrate the front-end pairs first, or take
+    them from ``calibration`` (a calibration file's content, ``aoa.plan.load_calibration``).
+    The override is validated like the scene's own mode (``Scene.evolve``: e.g. paper eq. 24's
+    spacing rule for the synthesis modes), so it cannot bypass a rule the scene file must meet.
+    """
+    if aoa_mode is not None and aoa_mode != scene.rts.aoa_mode:
+        scene = scene.evolve(rts=scene.rts.evolve(aoa_mode=aoa_mode))
+    setup = build_setup(scene)
+    paths = compute_paths(setup, paths_method)
+    mode = aoa_mode or scene.rts.aoa_mode
+    cal_file, calibration = calibration, {}
+    warnings: list[str] = []
+    if mode == "nearest" or not scene.targets:
+        program = program_nearest(scene, setup)
+    else:
+        from .plan import plan_targets  # pairs on an arc, or cells on a sphere
+        program, calibration, warnings = plan_targets(setup, paths, mode, progress=progress,
+                                                       calibration=cal_file)
+    echoes, cube = simulate(setup, paths, program, scene.seed, scene.radar.snr_db)
+    rd, det = process(cube)
+    budget = _budget(scene, setup, echoes, program)
+    if scene.radar.link is not None:
+        from ..radar.link import link_warnings
+        warnings = list(warnings) + link_warnings(budget, scene.radar.cfar.threshold_db)
+        if cube.clipped:
+            warnings.append(f"link: the ADC clipped {cube.clipped} of {cube.data.size} samples "
+                            "of this frame")
+    return RunResult(scene, setup, paths, program, echoes, cube, rd, det,
+                     match_targets(scene, det, rd), calibration, tuple(warnings), mode, budget)
+
+
+def _budget(scene: Scene, setup: Setup, echoes: Echoes, program: RtsProgram):
+    """The run's link budget (rtsgeom.radar.link); the snr_db override's noise where it is set; with
+    ``[radar.link]``, the sheet's echo estimated by physical optics where the paths carry no
+    setup reflection."""
+    from ..radar.link import link_budget, sheet_paths
+    from ..rts.channels import EchoKind, setup_echoes
+    est = None
+    # the physical-optics sheet estimate costs ~1 s: only for a physical budget ([radar.link])
+    if scene.radar.link is not None and not np.any(echoes.kind == EchoKind.SETUP):
+        sp = sheet_paths(setup)
+        est = setup_echoes(setup, sp) if sp is not None else None
+    override = None
+    if scene.radar.snr_db is not None:
+        override = noise_power(echoes, scene.radar.snr_db)
+        if scene.radar.link is None:  # relative echoes: scale the override like the link would
+            from ..radar.link import radar_link
+            rl = radar_link(scene.radar)
+            override *= rl.tx_power_w * rl.tx_gain * rl.rx_gain
+    return link_budget(scene, echoes, program, scene.radar.link is not None, override, est)
+
+
+def summary(result: RunResult, paths_method: str) -> dict:
+    """The content of ``summary.json`` (no timestamps: same seed -> same bytes)."""
+    from .info import scene_info
+    s, r, rut = result.scene, result.scene.radar, result.setup.rut
+    info = scene_info(result.setup)
+    return {
+        "rtsgeom_version": __version__,
+        "scene": s.name,
+        "scene_sha256": s.sha256,
+        "seed": s.seed,
+        "paths": paths_method,
+        "aoa_mode": result.aoa_mode,
+        "radar": {
+            "f_c_hz": r.f_c_hz, "bandwidth_hz": r.bandwidth_hz,
+            "slope_hz_per_s": r.slope_hz_per_s, "adc_rate_hz": r.adc_rate_hz,
+            "adc_start_s": r.adc_start_s, "samples_per_chirp": r.samples_per_chirp,
+            "chirps_per_tx": r.chirps_per_tx, "chirp_repetition_s": r.chirp_repetition_s,
+            "tx_order": list(rut.tx_order), "num_rx": rut.num_rx,
+            "cube_layout": "[chirp_loop, virtual_channel (tx_slot * num_rx + rx), sample]",
+            "range_resolution_m": r.range_resolution_m,
+            "velocity_resolution_mps": r.velocity_resolution_mps,
+            "snr_db": r.snr_db,
+        },
+        "far_field": info["far_field"],
+        "front_ends": info["front_ends"],
+        "calibration": result.calibration,
+        "targets": [{k: v for k, v in m.items() if k != "detection_index"}
+                    for m in result.matches],
+        "link_budget": (result.link_budget.to_dict() if result.link_budget is not None
+                        else None),
+        "adc_clipped_samples": result.cube.clipped,
+        "num_detections": len(result.detections),
+        "num_echoes": len(result.echoes),
+        "warnings": list(result.warnings),
+    }

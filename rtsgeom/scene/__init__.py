@@ -1,0 +1,14 @@
+"""The scene: a setup declared in a TOML file, read into typed, frozen, SI objects.
+
+Every field is declared once (:mod:`.schema`), the rules between fields live in :mod:`.rules`,
+the named choices in :mod:`.registry`, the radar presets in :mod:`.presets`, and
+``docs/scene-format.md`` is generated from the declarations (``python -m rtsgeom.scene.docs``).
+"""
+
+from .scene import (ArrayConfig, CfarConfig, FrontEndConfig, PatternConfig, RadarConfig,
+                    RaytraceConfig, RtsConfig, Scene, SceneError, SheetConfig, StructureConfig,
+                    TargetConfig, load_scene, loads_scene, parse_scene)
+
+__all__ = ["Scene", "SceneError", "RadarConfig", "CfarConfig", "FrontEndConfig", "RtsConfig",
+           "SheetConfig", "TargetConfig", "RaytraceConfig", "PatternConfig", "ArrayConfig",
+           "StructureConfig", "load_scene", "loads_scene", "parse_scene"]
