@@ -65,7 +65,7 @@ def _peak_mib(f) -> float:
 def bench_synthesis(scene_path: Path, paths_method: str, repeat: int) -> dict:
     from rtsgeom.radar.fmcw import synthesize, synthesize_exact
     from rtsgeom.pipeline.run import run_scene
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     result = run_scene(load_scene(scene_path), paths_method)
     ech, radar, rut = result.echoes, result.scene.radar, result.setup.rut
     t_fast, fast = _best(lambda: synthesize(ech, radar, rut), repeat)
@@ -95,7 +95,7 @@ def bench_tolerance(scene_path: Path, draws: int) -> dict:
     """Monte-Carlo tolerance draws (phasor level, 21 set-points, uncalibrated + calibrated)."""
     from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
     from rtsgeom.geometry import build_setup
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     model = PairPhasors.build(build_setup(load_scene(scene_path)), (0, 1), points=21)
     sigma = [1e-4, 1e-4, 1e-4]
     monte_carlo(model, sigma, 1000, 0)  # warm-up
@@ -179,7 +179,7 @@ def bench_commands(scene_path: Path, quick: bool, repeat: int, workers: int) -> 
     from rtsgeom.radar.fmcw import synthesize, synthesize_exact
     from rtsgeom.radar.processing import cfar_mask, detect, range_doppler
     from rtsgeom.pipeline.run import run_scene
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     scene_arg = str(scene_path)
     scene = load_scene(scene_path)
     out: dict = {}
@@ -285,7 +285,7 @@ def bench_dask_scaling(scene_path: Path, draws: int, workers: int) -> dict:
     from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
     from rtsgeom.geometry import build_setup
     from rtsgeom._lib.parallel import dask_client, map_chunks
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     model = PairPhasors.build(build_setup(load_scene(scene_path)), (0, 1), points=21)
     sigma = [1e-4, 1e-4, 1e-4]
     out = {"draws": draws, "workers": workers}

@@ -55,7 +55,7 @@ def nominal_point(scene_path: str, radius_m: float, noiseless: bool) -> dict:
     from rtsgeom.calibration.pair import coherence_delay, probe_angles, probe_front_ends
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     scene = variant(load_scene(scene_path), radius_m, None, 0.0, noiseless)
     setup = build_setup(scene)
     paths = exact_paths(setup)
@@ -73,7 +73,7 @@ def one_case(args: tuple) -> dict:
                                           probe_ranges)
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     t0 = time.perf_counter()
     scene = variant(load_scene(scene_path), radius_m, fe, dr_m, noiseless)
     setup = build_setup(scene)

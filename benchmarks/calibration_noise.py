@@ -38,7 +38,7 @@ def linked(nf_db: float | None):
     (None: no link, noiseless), parsed as a scene file would be."""
     import tomllib
 
-    from rtsgeom.scene.scene import parse_scene
+    from rtsgeom.scene import parse_scene
     doc = tomllib.loads(DEFAULT_SCENE.read_text())
     doc["radar"].pop("snr_db", None)
     if nf_db is not None:

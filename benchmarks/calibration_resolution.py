@@ -33,7 +33,7 @@ PAIR = (0, 1)
 
 def scene(res_ps: float, radius_m: float, dr_mm: float):
     import tomllib
-    from rtsgeom.scene.scene import parse_scene
+    from rtsgeom.scene import parse_scene
     doc = tomllib.loads(DEFAULT_SCENE.read_text())
     doc["radar"].pop("snr_db", None)
     rts = doc["rts"]
@@ -49,7 +49,7 @@ def staircase_point(setup, paths, alphas, near_s: float) -> float:
     """The old ``coherence_delay``: Newton on the quantised model's phase (a staircase)."""
     from rtsgeom.calibration.pair import if_phase_slope_hz, probe_ranges, probe_total_delay
     from rtsgeom.synthesis.closed_form import PairModel
-    from rtsgeom.scene.scene import TargetConfig
+    from rtsgeom.scene import TargetConfig
     ranges = probe_ranges(setup, 2)
     f_if = float(if_phase_slope_hz(setup.scene, probe_total_delay(setup, ranges)))
 

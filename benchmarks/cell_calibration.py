@@ -37,7 +37,7 @@ SPEC_DEG = 0.03
 
 def sphere4(field: str | None = None, value: float = 0.0, fe: int = 1):
     """sphere4 with ``field = value`` on front end ``fe``."""
-    from rtsgeom.scene.scene import parse_scene
+    from rtsgeom.scene import parse_scene
     doc = tomllib.loads(SCENE.read_text())
     doc = copy.deepcopy(doc)
     if field is not None:
@@ -48,7 +48,7 @@ def sphere4(field: str | None = None, value: float = 0.0, fe: int = 1):
 def case(field: str, value: float) -> dict:
     from rtsgeom.calibration.pair import probe_front_ends
     from rtsgeom.calibration.channels import coherence_point_nd
-    from rtsgeom.scene.scene import SceneError
+    from rtsgeom.errors import SceneError
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     from rtsgeom.pipeline.run import run_scene

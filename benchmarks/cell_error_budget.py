@@ -74,7 +74,7 @@ def scene_doc(phase_deg: float = 0.0, radius_m: float = 1.0, el_deg: float = 5.0
 
 
 def parse(doc):
-    from rtsgeom.scene.scene import parse_scene
+    from rtsgeom.scene import parse_scene
     return parse_scene(doc, str(SCENE))
 
 

@@ -25,11 +25,12 @@ import numpy as np
 
 from benchmarks._io import write_json
 from rtsgeom.analysis.estimators import pair_sweep
-from rtsgeom.synthesis.model import AngleUnreachable, ChannelModel
+from rtsgeom.errors import AngleUnreachable
+from rtsgeom.synthesis.model import ChannelModel
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.radar.steering import Steering
-from rtsgeom.scene.scene import TargetConfig, parse_scene
+from rtsgeom.scene import TargetConfig, parse_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 SPACINGS = np.round(np.arange(0.1, 1.21, 0.1), 2)

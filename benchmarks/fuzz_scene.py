@@ -31,7 +31,8 @@ import tomllib
 import traceback
 from pathlib import Path
 
-from rtsgeom.scene.scene import SceneError, loads_scene, parse_scene
+from rtsgeom.errors import SceneError
+from rtsgeom.scene import loads_scene, parse_scene
 from rtsgeom.geometry.warnings import scene_warnings
 
 ROOT = Path(__file__).resolve().parents[1]

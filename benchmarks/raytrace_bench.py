@@ -39,7 +39,7 @@ def worker(scene_path: str, samples: int | None, depth: int | None, repeat: int)
     t0 = time.perf_counter()
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import raytrace
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     t_rtsgeom = time.perf_counter() - t0
     setup = build_setup(load_scene(scene_path))
     _ = setup.sheet  # build the mesh outside the timed calls

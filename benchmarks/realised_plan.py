@@ -29,7 +29,7 @@ RANGES_M = tuple(float(r) for r in np.round(np.linspace(8.3, 70.1, 14), 2))
 
 def scene(res_ps: float, f_s: float, angle_deg: float):
     import tomllib
-    from rtsgeom.scene.scene import parse_scene
+    from rtsgeom.scene import parse_scene
     doc = tomllib.loads(DEFAULT_SCENE.read_text())
     rts = doc["rts"]
     rts["fractional_delay_step_s"] = res_ps * 1e-12

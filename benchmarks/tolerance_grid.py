@@ -32,7 +32,7 @@ SPEC_DEG = 0.1
 
 
 def _scene(radius_m: float):
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     scene = load_scene(DEFAULT_SCENE)
     return scene.evolve(rts=scene.rts.evolve(arc_radius_m=radius_m))
 

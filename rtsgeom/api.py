@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import ParameterError
-from .scene.scene import Scene
+from .scene import Scene
 
 __all__ = ["replace", "calibrate", "linearity", "tolerance", "design", "nearfield", "ghosts",
            "show"]

@@ -1,34 +1,84 @@
-"""The exceptions a user's input can cause, each a ``ValueError`` (or, for a missing system
-capability, a ``RuntimeError``) whose message names the field or argument and its allowed range.
-The CLI turns each into ``rtsgeom: error: ...`` and exit code 2; library callers catch the
-specific class, never a bare ``ValueError`` (which then stays what it is: a bug).
+"""Every exception rtsgeom raises on purpose, in one place (as scikit-learn's ``exceptions``).
 
-Defined here, with no imports, so that any module can raise them:
-
-* :class:`ParameterError`: an argument that is not a scene field (a radius sweep, a pair, a
-  distribution, an output format's constraint) is outside its allowed range.
-* :class:`CaptureError`: a probe capture (read or to simulate) does not fit the scene.
-
-Defined beside what they guard (import them from there):
-
-* ``rtsgeom.scene.scene.SceneError`` (``schema.py``): a scene file or field is invalid;
-  ``rtsgeom.radar.link.LinkError`` is one.
-* ``rtsgeom._lib.io.OutputError``: an output path cannot or must not be written.
-* ``rtsgeom.synthesis.model.AngleUnreachable``, ``rtsgeom.synthesis.cells.CellUnreachable``: a set direction
-  lies outside what the front ends can synthesize.
-* ``rtsgeom.paths.raytrace.RaytraceUnavailable``, ``rtsgeom.viz.render_backend.VizError``,
-  ``rtsgeom._lib.parallel.ClusterError`` (``RuntimeError``): ray tracing, rendering or a cluster is
-  not available here.
+A user's input that is out of range is a ``ValueError`` subclass whose message names the field
+or argument and its allowed range; a missing capability of the machine is a ``RuntimeError``
+subclass that says what to install. The CLI turns each into ``rtsgeom: error: ...`` and exit
+code 2; library callers catch the specific class, never a bare ``ValueError`` (which then stays
+what it is: a bug). This module imports nothing, so that any module can raise them.
 """
 
 from __future__ import annotations
 
-__all__ = ["ParameterError", "CaptureError"]
+__all__ = ["SceneError", "LinkError", "ParameterError", "UsageError", "CaptureError",
+           "OutputError", "AngleUnreachable", "CellUnreachable", "CalibrationFailed",
+           "ClusterError", "RaytraceUnavailable", "VizError", "Terminated"]
+
+
+# -- input out of range (ValueError) ---------------------------------------------------------
+
+
+class SceneError(ValueError):
+    """A scene file (or a value derived from one) is invalid. The message names the field.
+
+    ``problems`` holds every violated rule when the error came from the cross-field rules."""
+
+    def __init__(self, message: str, problems: list[str] | None = None):
+        super().__init__(message)
+        self.problems = problems or [message]
+
+
+class LinkError(SceneError):
+    """A target the RTS cannot produce with its gains and dynamic range (names the field)."""
 
 
 class ParameterError(ValueError):
     """An argument (not a scene field) is outside its allowed range; the message names it."""
 
 
+class UsageError(ValueError):
+    """A command-line argument is invalid (exit code 2)."""
+
+
 class CaptureError(ValueError):
     """A probe capture does not fit the scene, or its file or sidecar cannot be read."""
+
+
+class OutputError(ValueError):
+    """An output path that cannot or must not be written (exit code 2 in the CLI)."""
+
+
+class AngleUnreachable(ValueError):
+    """The set direction lies outside what the channels can synthesize."""
+
+
+class CellUnreachable(ValueError):
+    """No cell of front ends encloses the direction."""
+
+
+class CalibrationFailed(ValueError):
+    """A pair's calibration found no coherence point (no probe detected over the sweep), or
+    the calibrated channels do not synthesize the cell's centre."""
+
+
+# -- a capability this machine lacks (RuntimeError) ------------------------------------------
+
+
+class ClusterError(RuntimeError):
+    """A Dask scheduler address that is malformed or cannot be reached (one line, exit 2)."""
+
+
+class RaytraceUnavailable(RuntimeError):
+    """Sionna RT cannot run here (package missing, no usable LLVM/CUDA backend). The message
+    says what to install."""
+
+
+class VizError(RuntimeError):
+    """Rendering is not possible here (no OpenGL context, no display, a missing package)."""
+
+
+# -- control flow ------------------------------------------------------------------------------
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised like Ctrl-C so that every cleanup (staging folders, temporary files)
+    runs the same way."""

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from rtsgeom.scene.scene import parse_scene
+from rtsgeom.scene import parse_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_SCENE = ROOT / "scenes" / "diewald2022.toml"
@@ -29,7 +29,7 @@ def make_scene(mutate=None, **radar_overrides):
 
 @pytest.fixture(scope="session")
 def default_scene():
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     return load_scene(DEFAULT_SCENE)
 
 
@@ -131,7 +131,7 @@ def _error_keys() -> dict:
     """The file keys of ``geometry.setup.FRONT_END_ERRORS`` and ``RUT_POSE_ERRORS`` (the
     schema's names for them, as ``setup_errors`` reports them)."""
     from rtsgeom.geometry.setup import FRONT_END_ERRORS, RUT_POSE_ERRORS
-    from rtsgeom.scene.scene import FrontEndConfig, RadarConfig
+    from rtsgeom.scene import FrontEndConfig, RadarConfig
     from rtsgeom.scene.schema import specs
     fe, radar = dict(specs(FrontEndConfig)), dict(specs(RadarConfig))
     return {"fe": tuple(fe[n].key for n in FRONT_END_ERRORS),

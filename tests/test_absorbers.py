@@ -15,7 +15,8 @@ from scipy.constants import c
 from conftest import default_doc
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths.table import RUT_TO_RUT
-from rtsgeom.scene.scene import SceneError, parse_scene
+from rtsgeom.errors import SceneError
+from rtsgeom.scene import parse_scene
 
 pytestmark = pytest.mark.raytrace
 

@@ -15,7 +15,7 @@ from rtsgeom.analysis.design import two_front_end_scene
 from rtsgeom.analysis.tolerance.driver import PairPhasors, evaluate_chunk, monte_carlo, subbin_draws
 from rtsgeom.errors import ParameterError
 from rtsgeom.geometry import build_setup
-from rtsgeom.scene.scene import load_scene
+from rtsgeom.scene import load_scene
 
 from conftest import DEFAULT_SCENE as DEFAULT, two_front_end_pair
 

@@ -208,7 +208,7 @@ def test_fir_moves_the_coherence_point_by_its_phase_ripple(taps):
     filter's own response (window-weighted phase at each probe's bin)."""
     from rtsgeom.calibration.pair import fir_effect
     from rtsgeom.synthesis.closed_form import PairModel
-    from rtsgeom.scene.scene import TargetConfig
+    from rtsgeom.scene import TargetConfig
     ideal, fir = build_setup(_fir_scene(taps, "ideal")), build_setup(_fir_scene(taps, "windowed-sinc"))
     paths = exact_paths(ideal)
     ranges = probe_ranges(ideal, 2)
@@ -305,7 +305,7 @@ def test_closed_form_design_matches_the_root_finder():
     the root finder's on the searched beamformer peak, on a grid of radii, delays and
     angles."""
     from rtsgeom.synthesis.model import ChannelModel
-    from rtsgeom.scene.scene import TargetConfig
+    from rtsgeom.scene import TargetConfig
     for radius in (0.5, 1.0, 3.0):
         setup = build_setup(_noiseless(radius))
         paths = exact_paths(setup)
@@ -505,7 +505,7 @@ def test_fir_changes_linearity_by_no_more_than_its_phase_ripple_explains(taps):
     from rtsgeom.pipeline.plan import pair_design
     from rtsgeom.synthesis.closed_form import PairModel
     from rtsgeom.rts.channels import requested_delay
-    from rtsgeom.scene.scene import TargetConfig
+    from rtsgeom.scene import TargetConfig
     ideal, fir = _fir_pair(taps)
     paths = exact_paths(ideal)
     probe = probe_front_ends(ideal, paths, 1)
@@ -629,7 +629,7 @@ def test_calibration_fingerprint_follows_file_contents_not_paths(tmp_path):
     keeps its calibrations); an edited table: another. The sheet, the ray tracing, the
     calibration procedure's steps and the RTS's noise are not the setup measured."""
     from rtsgeom.pipeline.plan import setup_fingerprint
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     text = DEFAULT_SCENE.read_text().replace(
         "[radar.cfar]", '[radar.pattern]\nkind = "table"\ntable = "pat.csv"\n\n[radar.cfar]')
 

@@ -22,7 +22,7 @@ from rtsgeom.synthesis.closed_form import PairModel
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.rts.channels import realised_delay, requested_delay
-from rtsgeom.scene.scene import TargetConfig
+from rtsgeom.scene import TargetConfig
 
 RES_PS = (1.0, 5.0, 10.0, 25.0, 50.0, 100.0)
 

@@ -11,7 +11,7 @@ from threadpoolctl import threadpool_limits
 from rtsgeom.calibration.pair import calibrate_pair, probe_front_ends
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
-from rtsgeom.scene.scene import load_scene
+from rtsgeom.scene import load_scene
 
 OFFSETS = dict(radial_offset_m=0.8e-3, tangential_offset_m=-0.5e-3, height_offset_m=0.3e-3,
                gain_offset_db=0.6)

@@ -76,7 +76,7 @@ def test_calibrated_cell_reaches_its_directions_whatever_its_channel_offsets(
     range bin between the rows): there the elevation of (7, 0) deg and the centre are not
     reached (the detected elevation jumps across 0 as the rows' ratio grows; open)."""
     from rtsgeom.calibration.channels import ChannelSet, tree_phases
-    from rtsgeom.scene.scene import TargetConfig
+    from rtsgeom.scene import TargetConfig
     setup, paths = nominal_sphere4
     offs = np.array([0.0, offset_ps, 2.0, offset_ps + 35.0]) * 1e-12
     cs = ChannelSet.build(setup, paths, (0, 1, 2, 3), TargetConfig(20.0), offs)
@@ -124,9 +124,10 @@ def test_loop_closure_beyond_tolerance_is_a_warning_naming_the_pair(
 def test_a_pair_that_fails_is_named_and_a_cell_it_disconnects_stops_the_run(
         nominal_sphere4, monkeypatch):
     from rtsgeom.calibration.pair import probe_front_ends
-    from rtsgeom.calibration.channels import CalibrationFailed, calibrate_channels
+    from rtsgeom.errors import CalibrationFailed
+    from rtsgeom.calibration.channels import calibrate_channels
     from rtsgeom.pipeline.plan_cells import plan_cells
-    from rtsgeom.scene.scene import SceneError
+    from rtsgeom.errors import SceneError
     setup, paths = nominal_sphere4
     probe = probe_front_ends(setup, paths, 1)
     _fake_pairs(monkeypatch, CONSISTENT, fail={(0, 3)})  # a Delaunay edge off the tree
@@ -144,10 +145,10 @@ def test_run_says_the_calibration_failed_when_it_is_why_a_target_is_unreachable(
     """A target inside its cell that the calibrated channels cannot reach, after a
     calibration with warnings: the message says the calibration failed and why."""
     import rtsgeom.calibration.channels as ncal
-    from rtsgeom.synthesis.model import AngleUnreachable
+    from rtsgeom.errors import AngleUnreachable
     from rtsgeom.synthesis.nchannel import ChannelSet
     from rtsgeom.pipeline.plan_cells import plan_cells
-    from rtsgeom.scene.scene import SceneError
+    from rtsgeom.errors import SceneError
     setup, paths = nominal_sphere4
     bad = ncal.ChannelCalibration(np.zeros(4), 0, [], [(0, 1), (0, 2), (1, 3)], [40e-12],
                                   warnings=("channel calibration: the loop through pair "

@@ -6,7 +6,7 @@ import pytest
 from rtsgeom.cli.signal import _targets_table
 from rtsgeom.geometry import build_setup
 from rtsgeom.pipeline.info import format_info, scene_info
-from rtsgeom.scene.scene import load_scene
+from rtsgeom.scene import load_scene
 
 from test_sphere import corners
 
@@ -69,7 +69,7 @@ def test_reachable_cells_in_info(radius):
     pairs) and warns, naming the target, for a direction outside every cell."""
     from rtsgeom.pipeline.plan_cells import target_cells
     from rtsgeom.pipeline.info import reachable_spans, unreachable_warnings
-    from rtsgeom.scene.scene import TargetConfig
+    from rtsgeom.scene import TargetConfig
     scene = corners(load_scene(SCENE), (-3.0, 5.0), (-3.0, 3.0), radius=radius, height=1.5)
     inside = TargetConfig(20.0, angle_rad=np.radians(1.0), elevation_rad=np.radians(0.5))
     outside = TargetConfig(25.0, angle_rad=np.radians(9.0), elevation_rad=np.radians(0.5))

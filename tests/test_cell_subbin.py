@@ -17,7 +17,7 @@ from rtsgeom.analysis.tolerance.subbin import subbin_positions
 from rtsgeom.analysis.tolerance.driver import CASES, PairPhasors, subbin_draws
 from rtsgeom.analysis.tolerance.cell import CellPhasors, monte_carlo_cell, verify_cell_draws
 from rtsgeom.geometry import build_setup
-from rtsgeom.scene.scene import load_scene
+from rtsgeom.scene import load_scene
 from test_tolerance_cell import CELLS, cell_scene
 
 

@@ -18,7 +18,7 @@ def test_reference_power_does_not_move_with_the_other_channels_delay(field, valu
     from rtsgeom.synthesis.nchannel import ChannelSet
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene.scene import TargetConfig
+    from rtsgeom.scene import TargetConfig
     scene = sphere4() if field is None else sphere4(field, value)
     setup = build_setup(scene)
     nom, nom_paths = nominal_model(setup, exact_paths(setup))

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from rtsgeom.radar.processing import OS_MAX_CELLS, cfar_mask
-from rtsgeom.scene.scene import CfarConfig
+from rtsgeom.scene import CfarConfig
 
 WINDOWS = [((0, 0), (1, 1)), ((2, 2), (8, 4)), ((1, 3), (2, 5)), ((4, 0), (3, 2))]
 SHAPES = [(64, 32), (128, 24), (40, 40)]

@@ -162,7 +162,7 @@ def test_design_grid_refuses_elevation(scene, where, elevation_deg):
     elevation; the API raises ParameterError before any design is built."""
     import dataclasses
     from rtsgeom.errors import ParameterError
-    from rtsgeom.scene.scene import TargetConfig
+    from rtsgeom.scene import TargetConfig
     el = math.radians(elevation_deg)
     if where == "front end":
         fes = list(scene.rts.front_ends)
@@ -208,7 +208,7 @@ def test_a_valid_scene_whose_nominal_would_break_a_target_rule_is_still_designed
     from rtsgeom.analysis.coverage import arc_scene
     from rtsgeom.analysis.nearfield import nearfield
     from rtsgeom.geometry.setup import nominal_scene
-    from rtsgeom.scene.scene import SceneError
+    from rtsgeom.errors import SceneError
 
     def moved(range_m):
         def mutate(d):

@@ -6,7 +6,7 @@ import pytest
 from rtsgeom.geometry import build_setup
 from rtsgeom.radar.processing import Detections
 from rtsgeom.radar.steering import Steering
-from rtsgeom.scene.scene import load_scene
+from rtsgeom.scene import load_scene
 
 SCENE = "scenes/diewald2022.toml"
 
@@ -59,7 +59,7 @@ def test_elevation_processing_is_opt_in_and_required_off_the_plane():
     """2-D beamforming only with radar.elevation_processing (a flat arc's pair designs solve on
     the azimuth row, which a 2-D RuT would see ~0.2 deg off); a front end off the horizontal
     plane without it is a scene error naming the field."""
-    from rtsgeom.scene.scene import SceneError
+    from rtsgeom.errors import SceneError
     sc = load_scene(SCENE)
     radar = sc.radar.evolve(use_elevation_tx=True)
     rut = build_setup(sc.evolve(radar=radar, targets=())).rut

@@ -19,7 +19,8 @@ import pytest
 
 from conftest import ROOT, make_scene
 from rtsgeom.analysis.estimators import pair_snapshots, pair_sweep
-from rtsgeom.synthesis.model import AngleUnreachable, ChannelModel
+from rtsgeom.errors import AngleUnreachable
+from rtsgeom.synthesis.model import ChannelModel
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.radar import estimators as est
@@ -27,7 +28,8 @@ from rtsgeom.radar import process
 from rtsgeom.radar.frame import simulate
 from rtsgeom.radar.steering import Steering
 from rtsgeom.rts.channels import RtsProgram, requested_delay
-from rtsgeom.scene.scene import SceneError, TargetConfig
+from rtsgeom.errors import SceneError
+from rtsgeom.scene import TargetConfig
 
 PRESETS = ("awr1843boost", "awr2944")  # 8 and 12 elements in the azimuth row, lambda/2
 

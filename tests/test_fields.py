@@ -27,7 +27,7 @@ from rtsgeom.radar.frame import simulate
 from rtsgeom.radar.processing import cfar_mask, detect, range_doppler
 from rtsgeom.rts.channels import (Echoes, RtsProgram, channel_echoes, program_nearest,
                                   requested_delay)
-from rtsgeom.scene.scene import Scene
+from rtsgeom.scene import Scene
 from rtsgeom.scene.schema import specs
 
 

@@ -27,7 +27,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from rtsgeom.cli import build_parser, main
-from rtsgeom.scene.scene import loads_scene, parse_scene
+from rtsgeom.scene import loads_scene, parse_scene
 
 from conftest import DEFAULT_SCENE, ROOT, default_doc
 

@@ -13,7 +13,7 @@ from rtsgeom import identify as ident_mod
 from rtsgeom.calibration.pair import coherence_delay, probe_angles, probe_front_ends
 from rtsgeom.cli import main
 from rtsgeom.paths import exact_paths
-from rtsgeom.scene.scene import load_scene
+from rtsgeom.scene import load_scene
 
 BASE = load_scene(DEFAULT_SCENE)
 

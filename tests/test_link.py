@@ -7,7 +7,7 @@ import pytest
 from scipy.constants import c, k as K_B
 
 from conftest import make_scene
-from rtsgeom.radar import link as lk
+from rtsgeom.radar import budget, link as lk
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.paths.table import RUT_TO_RUT, Paths
@@ -70,12 +70,12 @@ def test_post_fft_snr_is_the_radar_equation_through_the_rts(range_m, rcs_dbsm):
     h2 = abs(lk.if_response(rl, f_b)) ** 2
     n0 = K_B * 290.0 * rl.noise_figure * radar.adc_rate_hz + lk.channel_noise_w(scene, program, rl)
     gain = (radar.samples_per_chirp * radar.chirps_per_tx
-            * lk.window_snr_loss(radar.range_window, radar.samples_per_chirp)
-            * lk.window_snr_loss(radar.doppler_window, radar.chirps_per_tx))
+            * budget.window_snr_loss(radar.range_window, radar.samples_per_chirp)
+            * budget.window_snr_loss(radar.doppler_window, radar.chirps_per_tx))
     closed = 10 * np.log10(p_r * h2 / (n0 * h2 + rl.quantisation_noise_w) * gain)
     assert measured == pytest.approx(closed, abs=0.5)
     # and the budget reports the same
-    b = lk.link_budget(scene, echoes, program, linked=True)
+    b = budget.link_budget(scene, echoes, program, linked=True)
     assert b.targets[0]["snr_after_fft_db"] == pytest.approx(closed, abs=0.5)
     assert b.targets[0]["adc_power_dbm"] == pytest.approx(float(lk.dbm(p_r * h2)), abs=0.3)
 
@@ -122,7 +122,7 @@ def test_setup_reflection_follows_path_gain_and_if_response(dist_m, hpf_hz, loss
         radar.doppler_window, radar.chirps_per_tx).sum()
     assert np.allclose(np.abs(x) ** 2 / w_sum ** 2, expect, rtol=1e-3)
     empty = program_nearest(scene.evolve(targets=()), setup)
-    b = lk.link_budget(scene, raw, empty, linked=False)
+    b = budget.link_budget(scene, raw, empty, linked=False)
     assert b.setup_echoes[0]["adc_power_dbm"] == pytest.approx(float(lk.dbm(expect)), abs=1e-6)
     assert b.setup_echoes[0]["if_response_db"] == pytest.approx(20 * np.log10(abs(h)), abs=1e-9)
 
@@ -134,8 +134,8 @@ def _sheet_budget(link, loss_db):
     scene = make_scene(mut)
     setup = build_setup(scene)
     program = program_nearest(scene, setup)
-    raw = setup_echoes(setup, lk.sheet_paths(setup))
-    return lk.link_budget(scene, raw, program, linked=False).setup_echoes, scene, setup, raw
+    raw = setup_echoes(setup, budget.sheet_paths(setup))
+    return budget.link_budget(scene, raw, program, linked=False).setup_echoes, scene, setup, raw
 
 
 @pytest.mark.parametrize("radius_m,offset_m", [(1.0, 0.0), (2.0, 0.05)])
@@ -151,11 +151,11 @@ def test_sheet_absorber_scales_the_po_echo(radius_m, offset_m):
             d["sheet"]["reflection_loss_db"] = loss
         return make_scene(mut)
     lam = c / scene_with(0.0).radar.f_center_hz
-    ref = lk.sheet_paths(build_setup(scene_with(0.0)), step_m=lam)
+    ref = budget.sheet_paths(build_setup(scene_with(0.0)), step_m=lam)
     for loss in (7.0, 20.0, 43.0):
         scene = scene_with(loss)
         setup = build_setup(scene)
-        p = lk.sheet_paths(setup, step_m=lam)
+        p = budget.sheet_paths(setup, step_m=lam)
         np.testing.assert_allclose(p.delay_s, ref.delay_s, rtol=0, atol=0)
         np.testing.assert_allclose(p.gain, ref.gain * 10 ** (-loss / 20), rtol=1e-12)
         e0 = lk.apply_radar_link(setup_echoes(setup, ref), scene)
@@ -175,7 +175,7 @@ def test_uncovered_sheet_at_1m_on_an_awr1843():
     hi_gain = {"adc_full_scale_dbm": -25.0 - 18.0}
     rows, _, _, _ = _sheet_budget(hi_gain, 0.0)
     assert min(r["clip_margin_db"] for r in rows) < 0
-    warns = lk.link_warnings(lk.LinkBudget(True, "", 0, 0, 0, {"adc_full_scale_dbm": -43.0},
+    warns = budget.link_warnings(budget.LinkBudget(True, "", 0, 0, 0, {"adc_full_scale_dbm": -43.0},
                                            [], [], rows), 15.0)
     assert any("clips" in w for w in warns)
     rows, _, _, _ = _sheet_budget(hi_gain, 20.0)
@@ -273,7 +273,7 @@ def test_info_budget_says_whether_the_scene_models_the_link(linked):
         if not linked:
             del doc["radar"]["link"]
             doc["radar"]["snr_db"] = 30.0
-    b = lk.static_budget(build_setup(make_scene(mut)))
+    b = budget.static_budget(build_setup(make_scene(mut)))
     assert b.to_dict()["modelled"] is linked
     assert ("prediction" in b.to_dict()["noise_source"]) is (not linked)
     assert b.to_dict()["targets"][0]["adc_power_dbm"] is not None
@@ -303,12 +303,12 @@ def test_info_budget_names_front_ends_without_a_target():
     instead of ``attenuation - dB`` (a new-user trial read that as a missing attenuation on a
     front end the synthesis does use)."""
     from conftest import DEFAULT_SCENE
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     setup = build_setup(load_scene(DEFAULT_SCENE.parent / "custom-array.toml"))
-    b = lk.static_budget(setup).to_dict()
+    b = budget.static_budget(setup).to_dict()
     carrying = set(int(q) for q in program_nearest(setup.scene, setup).front_end)
     assert carrying and carrying != set(range(len(b["front_ends"])))
-    for fe, line in zip(b["front_ends"], [ln for ln in lk.format_budget(b)
+    for fe, line in zip(b["front_ends"], [ln for ln in budget.format_budget(b)
                                           if ln.startswith("  front end ")]):
         assert bool(fe["attenuation_db"]) is (fe["index"] in carrying)
         assert ("no target on it" in line) is (fe["index"] not in carrying), line

@@ -14,7 +14,7 @@ from scipy.constants import c
 
 from conftest import make_scene
 from test_link import _setup_paths
-from rtsgeom.radar import link as lk
+from rtsgeom.radar import budget, link as lk
 from rtsgeom.calibration.pair import TARGET_BIAS_PS, calibrate_pair, probe_front_ends
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
@@ -39,7 +39,7 @@ def test_relative_noise_power_is_the_budgets_noise(nf_db, fs_dbm, dist_m):
     setup = build_setup(scene)
     tau, a = 2 * dist_m / c, 3e-4
     raw = setup_echoes(setup, _setup_paths(setup, tau, a))
-    b = lk.link_budget(scene, raw, program_nearest(scene.evolve(targets=()), setup), linked=False,
+    b = budget.link_budget(scene, raw, program_nearest(scene.evolve(targets=()), setup), linked=False,
                        predict=True)
     n_rel = lk.relative_noise_power(scene, 0.0, scene.radar.slope_hz_per_s * tau)
     assert b.setup_echoes[0]["snr_after_fft_db"] == pytest.approx(
@@ -105,7 +105,7 @@ def test_predicted_angle_noise_follows_the_noise_figure(quiet_reference):
     from rtsgeom.calibration.pair import (COARSE_NOISE_DEG, coarse_frames, nominal_model,
                                           predicted_angle_noise, probe_angles, probe_ranges)
     from rtsgeom.calibration.sweep import phasor_sweep
-    from rtsgeom.scene.scene import TargetConfig
+    from rtsgeom.scene import TargetConfig
     probe, _ = quiet_reference
     noise = {}
     for nf in (12.0, 40.0, 45.0, 50.0):

@@ -18,7 +18,7 @@ from scipy.constants import c, k as K_B
 
 from conftest import make_scene
 from test_link import _setup_paths, _tone, linked_doc
-from rtsgeom.radar import link as lk
+from rtsgeom.radar import budget, link as lk
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.radar.fmcw import synthesize
@@ -43,7 +43,7 @@ def _target_budget(scene):
     program = program_nearest(scene, setup)
     rl = lk.radar_link(scene.radar)
     echoes = lk.apply_radar_link(build_echoes(setup, exact_paths(setup), program), scene, rl)
-    b = lk.link_budget(scene, echoes, program, linked=True)
+    b = budget.link_budget(scene, echoes, program, linked=True)
     return b, synthesize(echoes, scene.radar, setup.rut).data, echoes, setup
 
 
@@ -99,13 +99,13 @@ def test_noise_figure_and_temperature_set_the_noise_floor(nf_db, t_k):
     expect = K_B * t_k * 10 ** (nf_db / 10) * radar.adc_rate_hz * np.mean(
         np.abs(lk.if_response(rl, f)) ** 2)
     assert np.mean(np.abs(x) ** 2) == pytest.approx(expect, rel=0.02)
-    b = lk.link_budget(scene, setup_echoes(build_setup(scene), _setup_paths(
+    b = budget.link_budget(scene, setup_echoes(build_setup(scene), _setup_paths(
         build_setup(scene), 2 * 5.0 / c, 1e-4)), program_nearest(scene, build_setup(scene)),
         linked=True)
     assert b.radar["thermal_noise_dbm_per_sample"] == pytest.approx(
         float(lk.dbm(K_B * t_k * 10 ** (nf_db / 10) * radar.adc_rate_hz)), abs=1e-9)
     # the SNR of a thermal-limited echo falls dB for dB with the noise figure
-    b3 = lk.link_budget(_scene(dict(link, noise_figure_db=nf_db + 3.0), targets=[]),
+    b3 = budget.link_budget(_scene(dict(link, noise_figure_db=nf_db + 3.0), targets=[]),
                         *_setup_args(scene), linked=True)
     d = b3.setup_echoes[0]["snr_after_fft_db"] - b.setup_echoes[0]["snr_after_fft_db"]
     assert d == pytest.approx(-3.0, abs=1e-3)  # the 24-bit quantisation floor: 5e-5 dB
@@ -160,7 +160,7 @@ def test_if_lowpass_attenuates_an_echo_by_its_response(ratio, order):
         raw = setup_echoes(setup, _setup_paths(setup, tau, 1e-4))
         e = lk.apply_radar_link(raw, scene)
         x = synthesize(e, scene.radar, setup.rut).data
-        b = lk.link_budget(scene, raw, program_nearest(scene, setup), linked=False)
+        b = budget.link_budget(scene, raw, program_nearest(scene, setup), linked=False)
         out[name] = (np.mean(np.abs(_tone(x, f_b, scene.radar)) ** 2),
                      b.setup_echoes[0]["adc_power_dbm"])
     expect = 1.0 / (1.0 + ratio ** (2 * order))
@@ -203,7 +203,7 @@ def test_adc_full_scale_sets_the_clip_margin(fs_dbm, margin_db):
     p_adc = 10 ** ((fs_dbm - margin_db - 30) / 10)
     g = np.sqrt(p_adc / (rl.tx_power_w * rl.tx_gain * rl.rx_gain * h2))
     raw = setup_echoes(setup, _setup_paths(setup, tau, g))
-    b = lk.link_budget(scene, raw, program_nearest(scene, setup), linked=False)
+    b = budget.link_budget(scene, raw, program_nearest(scene, setup), linked=False)
     assert b.setup_echoes[0]["clip_margin_db"] == pytest.approx(margin_db, abs=1e-6)
     _, n = lk.adc_convert(synthesize(lk.apply_radar_link(raw, scene, rl), scene.radar,
                                      setup.rut).data, rl)

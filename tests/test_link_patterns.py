@@ -15,7 +15,7 @@ import pytest
 from scipy.constants import c
 
 from conftest import make_scene
-from rtsgeom.radar import link as lk
+from rtsgeom.radar import budget, link as lk
 from rtsgeom.geometry import build_setup
 from rtsgeom.geometry.patterns import cos_power_exponent
 from rtsgeom.paths import exact_paths
@@ -51,7 +51,7 @@ def _budget(scene):
     setup = build_setup(scene)
     program = program_nearest(scene, setup)
     echoes = lk.apply_radar_link(build_echoes(setup, exact_paths(setup), program), scene)
-    return lk.link_budget(scene, echoes, program, linked=True, setup=setup), setup
+    return budget.link_budget(scene, echoes, program, linked=True, setup=setup), setup
 
 
 @pytest.mark.parametrize("hpbw_deg", [30.0, 60.0, 120.0])

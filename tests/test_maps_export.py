@@ -22,7 +22,7 @@ def run_out(tmp_path_factory):
     injected like tests/test_reliability.py's ``fast_run``) and its in-memory result."""
     import rtsgeom.cli.signal as sig
     from rtsgeom.pipeline.run import run_scene
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     result = run_scene(load_scene(DEFAULT_SCENE), "exact", "nearest")
     out = tmp_path_factory.mktemp("maps") / "out"
     with pytest.MonkeyPatch.context() as mp:

@@ -177,7 +177,7 @@ def test_probe_finds_each_front_end_at_the_model_angle_with_unit_gain_correction
     where the setup is the nominal one (the model then is the measurement)."""
     from rtsgeom.calibration.pair import probe_front_ends, probe_ranges
     from rtsgeom.synthesis.model import ChannelModel
-    from rtsgeom.scene.scene import TargetConfig
+    from rtsgeom.scene import TargetConfig
     setup, paths = small_setup
     probe = probe_front_ends(setup, paths)
     ranges = probe_ranges(setup, setup.fe.count)
@@ -314,7 +314,7 @@ def test_linearity_sweeps_the_inner_span_and_reports_relative_amplitudes(cal_set
     from rtsgeom.calibration.pair import probe_angles
     from rtsgeom.pipeline.plan import pair_design
     from rtsgeom.calibration.pair import probe_ranges
-    from rtsgeom.scene.scene import TargetConfig
+    from rtsgeom.scene import TargetConfig
     rng = float(probe_ranges(setup, 1)[0])
     amps = np.array([pair_design(setup, paths, (0, 1), TargetConfig(rng, 0.0, 10.0, float(a)),
                                  "exact", probe_angles(*probe.angle_rad[[0, 1]]),
@@ -343,7 +343,7 @@ def test_probe_ranges_keep_clear_of_every_cable_ghost(length):
 @pytest.mark.parametrize("angles", [(3.4, 12.2), (-5.0, 5.0), (-12.0, -2.0)])
 def test_closed_forms_put_a_span_end_on_one_channel_alone(angles):
     from rtsgeom.synthesis.model import ChannelModel
-    from rtsgeom.scene.scene import TargetConfig
+    from rtsgeom.scene import TargetConfig
 
     def mutate(doc):
         doc["radar"].update(SMALL)
@@ -365,7 +365,7 @@ def test_pair_amplitudes_design_for_the_channel_delay_offsets():
     an offset of a whole period changes the ratio, by the model built with that delay."""
     from rtsgeom.pipeline.plan import pair_amplitudes
     from rtsgeom.synthesis.closed_form import PairModel
-    from rtsgeom.scene.scene import TargetConfig
+    from rtsgeom.scene import TargetConfig
     setup = build_setup(small_quiet([], samples_per_chirp=512))
     paths = exact_paths(setup)
     th = setup.fe_azimuth_rad()

@@ -114,7 +114,7 @@ def test_elevation_pair_frames_grow_as_snr_falls_and_it_stays_at_its_point(snr_d
     from rtsgeom.calibration.channels import calibrate_pair_nd, coherence_point_nd
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     scene = load_scene("scenes/sphere4.toml")
     scene = scene.evolve(radar=scene.radar.evolve(snr_db=scene.radar.snr_db - snr_drop_db))
     setup = build_setup(scene)
@@ -143,7 +143,7 @@ def test_elevation_pair_30_db_below_averages_its_coarse_sweep_too():
     from rtsgeom.calibration.channels import calibrate_pair_nd, coherence_point_nd
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     scene = load_scene("scenes/sphere4.toml")
     scene = scene.evolve(radar=scene.radar.evolve(snr_db=scene.radar.snr_db - 30.0))
     setup = build_setup(scene)

@@ -6,12 +6,14 @@ import dataclasses
 import numpy as np
 import pytest
 
-from rtsgeom.synthesis.cells import CellUnreachable, enclosing_cell
-from rtsgeom.synthesis.model import AngleUnreachable, ChannelModel
+from rtsgeom.errors import CellUnreachable
+from rtsgeom.synthesis.cells import enclosing_cell
+from rtsgeom.errors import AngleUnreachable
+from rtsgeom.synthesis.model import ChannelModel
 from rtsgeom.synthesis.nchannel import ChannelSet, closed_form_amplitudes
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
-from rtsgeom.scene.scene import TargetConfig, load_scene
+from rtsgeom.scene import TargetConfig, load_scene
 
 SPHERE = "scenes/sphere4.toml"
 

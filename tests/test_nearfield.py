@@ -158,7 +158,7 @@ def test_default_sweep_stops_at_the_radar_limit_and_ignores_targets_and_sheet():
     probe target still fits) instead of failing; the scene's targets (inside the arc at large
     radii) and cutouts (overlapping at small radii) do not stop the free-space analysis."""
     from rtsgeom.analysis.nearfield import max_radius_m
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     scene = load_scene(DEFAULT_SCENE.parent / "custom-array.toml")
     r = default_radii(scene)
     full = scene.rts.arc_radius_m * np.logspace(-0.5, 1.5, 13)

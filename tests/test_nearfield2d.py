@@ -12,7 +12,7 @@ from conftest import ROOT
 from rtsgeom.analysis.nearfield import _residual_deg, nearfield
 from rtsgeom.geometry import build_setup
 from rtsgeom.radar.steering import Steering
-from rtsgeom.scene.scene import load_scene
+from rtsgeom.scene import load_scene
 
 SPHERE = ROOT / "scenes" / "sphere4.toml"
 

@@ -13,7 +13,8 @@ from rtsgeom.calibration.channels import calibrate_channels, calibrate_pair_nd
 from rtsgeom.pipeline.plan import plan_targets, uses_cells
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
-from rtsgeom.scene.scene import SceneError, load_scene
+from rtsgeom.errors import SceneError
+from rtsgeom.scene import load_scene
 
 from conftest import ROOT
 

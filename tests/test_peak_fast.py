@@ -15,7 +15,7 @@ from rtsgeom.geometry import build_setup
 from rtsgeom.radar import steering as S
 from rtsgeom.radar.newton import newton
 from rtsgeom.radar.steering import Steering
-from rtsgeom.scene.scene import load_scene
+from rtsgeom.scene import load_scene
 
 
 def _reference_peak(st, snaps, u0, iterations=4):

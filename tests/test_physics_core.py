@@ -261,7 +261,7 @@ def test_2d_search_is_independent_of_the_targets_phase(preset, window):
     the same (azimuth, elevation) for phases all around the circle, at the plane wave's
     direction."""
     from rtsgeom.radar.steering import Steering
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     sc = load_scene("scenes/diewald2022.toml")
     radar = sc.radar.evolve(antenna_preset=preset, use_elevation_tx=True, angle_window=window,
                             elevation_processing=True)

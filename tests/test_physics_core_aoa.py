@@ -80,7 +80,7 @@ def test_fir_effect_predicts_the_coherence_shift_in_picoseconds(taps):
     from rtsgeom.synthesis.closed_form import PairModel
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene.scene import TargetConfig
+    from rtsgeom.scene import TargetConfig
     ideal = build_setup(_fir_scene(taps, "ideal"))
     fir = build_setup(_fir_scene(taps, "windowed-sinc"))
     paths = exact_paths(ideal)
@@ -134,7 +134,8 @@ def test_plan_reports_each_pairs_calibration_delay_in_picoseconds():
 def test_enclosing_interval_is_the_adjacent_pair_in_one_dimension(count):
     """1-D cells: a direction between two neighbouring front ends (in any index order) is
     enclosed by exactly that pair, also with only two front ends; outside the span none."""
-    from rtsgeom.synthesis.cells import CellUnreachable, enclosing_cell
+    from rtsgeom.errors import CellUnreachable
+    from rtsgeom.synthesis.cells import enclosing_cell
     rng = np.random.default_rng(count)
     x = np.sort(rng.uniform(-0.5, 0.5, count))
     perm = rng.permutation(count)
@@ -235,7 +236,7 @@ def test_2d_error_map_exact_mode_puts_every_grid_point_on_its_direction():
     from rtsgeom.analysis.linearity2d import linearity_grid
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     sc = load_scene("scenes/sphere4.toml")
     sc = sc.evolve(radar=sc.radar.evolve(snr_db=None, samples_per_chirp=128, chirps_per_tx=32,
                                          adc_rate_hz=12.5e6))
@@ -259,7 +260,7 @@ def test_closed_form_amplitudes_ignore_a_common_phase(common):
     from rtsgeom.synthesis.nchannel import ChannelSet, closed_form_amplitudes
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene.scene import TargetConfig, load_scene
+    from rtsgeom.scene import TargetConfig, load_scene
     setup = build_setup(load_scene("scenes/sphere4.toml"))
     cs = ChannelSet.build(setup, exact_paths(setup), (0, 1, 2, 3), TargetConfig(25.0))
     st = cs.steering
@@ -360,7 +361,7 @@ def test_closed_form_design_is_scale_free_and_puts_the_peak_on_the_set_angle(ang
     from rtsgeom.calibration.sweep import design_ratio
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene.scene import TargetConfig
+    from rtsgeom.scene import TargetConfig
 
     def mutate(doc):
         doc["radar"]["angle_window"] = angle_window

@@ -273,7 +273,7 @@ def test_cell_plan_programs_the_doppler_of_each_targets_velocity(velocity_mps):
     from rtsgeom.pipeline.plan import plan_targets, uses_cells
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.scene.scene import parse_scene
+    from rtsgeom.scene import parse_scene
     doc = tomllib.loads((ROOT / "scenes" / "sphere4.toml").read_text())
     for k, t in enumerate(doc["targets"]):
         t["velocity_mps"] = velocity_mps * (k + 1) / len(doc["targets"])

@@ -25,7 +25,8 @@ from hypothesis import strategies as st
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.paths.exact import distances
-from rtsgeom.scene.scene import SceneError, parse_scene
+from rtsgeom.errors import SceneError
+from rtsgeom.scene import parse_scene
 
 from conftest import default_doc
 
@@ -178,7 +179,7 @@ def test_random_setups_are_valid_and_warnings_run(p):
     """The strategy above really produces valid scenes (few rejections), so the properties
     are not vacuous; the loader's scalar geometry (used by its consistency checks) agrees with
     the geometry package."""
-    from rtsgeom.scene.scene import arc_centre_m, azimuth_from_radar_rad, front_end_module_m
+    from rtsgeom.scene.rules import arc_centre_m, azimuth_from_radar_rad, front_end_module_m
     from rtsgeom.geometry.warnings import scene_warnings
     scene = scene_of(p)
     assert all(w.startswith("property.toml: ") for w in scene_warnings(scene))

@@ -20,7 +20,8 @@ from conftest import DEFAULT_SCENE, ROOT, default_doc, make_scene
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.paths.table import FE_TO_RX, RUT_TO_RUT, TX_TO_FE
-from rtsgeom.scene.scene import SceneError, load_scene, parse_scene
+from rtsgeom.errors import SceneError
+from rtsgeom.scene import load_scene, parse_scene
 
 pytestmark = pytest.mark.raytrace
 

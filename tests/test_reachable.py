@@ -16,7 +16,7 @@ from rtsgeom.pipeline.info import reachable_spans, scene_info, unreachable_warni
 from rtsgeom.pipeline.plan import plan_targets
 from rtsgeom.paths import exact_paths
 from rtsgeom.pipeline.run import run_scene
-from rtsgeom.scene.scene import SceneError
+from rtsgeom.errors import SceneError
 
 
 def _variant(radius_m, mode, angle_deg, separation_m=0.02):

@@ -30,7 +30,7 @@ ENV = {**os.environ, "PYTHONPATH": str(ROOT)}
 @pytest.fixture(scope="module")
 def nearest_result():
     from rtsgeom.pipeline.run import run_scene
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     return run_scene(load_scene(DEFAULT_SCENE), "exact", "nearest")
 
 
@@ -228,7 +228,8 @@ def test_special_files_are_never_replaced(tmp_path, kind, capsys):
     assert after.st_ino == before.st_ino
     err = capsys.readouterr().err
     assert str(target) in err and ".part" not in err
-    from rtsgeom._lib.io import OutputError, atomic_path
+    from rtsgeom.errors import OutputError
+    from rtsgeom._lib.io import atomic_path
     with pytest.raises(OutputError):
         with atomic_path(target):
             pass
@@ -316,7 +317,7 @@ def test_tolerance_chunk_is_bounded_by_memory():
     from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
     from rtsgeom.cli.tolerance import CHUNK_MEMORY_BYTES, capped_chunk, chunk_bytes_per_draw
     from rtsgeom.geometry import build_setup
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     for points in (3, 21, 201):
         assert capped_chunk(1_000_000, points) * chunk_bytes_per_draw(points) <= CHUNK_MEMORY_BYTES
     # the per-draw bound holds on a measured chunk (201 points: benchmarks/redteam.py; the

@@ -6,7 +6,8 @@ import copy
 
 import pytest
 
-from rtsgeom.scene.scene import SceneError, load_scene, parse_scene
+from rtsgeom.errors import SceneError
+from rtsgeom.scene import load_scene, parse_scene
 
 from conftest import DEFAULT_SCENE, default_doc
 
@@ -79,7 +80,7 @@ def test_cli_info_and_bad_scene(tmp_path, capsys):
 
 def test_scene_format_doc_is_generated_from_the_declarations():
     """docs/scene-format.md is what ``python -m rtsgeom.scene.docs`` writes; every key is in it."""
-    from rtsgeom.scene import scene as sc
+    import rtsgeom.scene as sc
     from rtsgeom.scene.docs import DOC_PATH, render
     from rtsgeom.scene.schema import specs
     text = render()
@@ -116,7 +117,7 @@ def test_cli_choices_are_the_registries():
 
 def test_defaults_written_once_match_the_dataclasses(default_scene):
     """A scene that sets only the required keys gets each declared default (converted to SI)."""
-    from rtsgeom.scene.scene import CfarConfig, FrontEndConfig, RaytraceConfig, SheetConfig
+    from rtsgeom.scene import CfarConfig, FrontEndConfig, RaytraceConfig, SheetConfig
     doc = {"radar": {k: default_doc()["radar"][k] for k in (
         "f_c_hz", "bandwidth_hz", "chirp_duration_s", "samples_per_chirp", "adc_rate_hz",
         "chirps_per_tx")},
@@ -147,7 +148,7 @@ def test_evolve_validates_again(default_scene):
 
 
 def test_problems_lists_every_violated_rule(default_scene):
-    from rtsgeom.scene.scene import problems
+    from rtsgeom.scene.rules import problems
     assert problems(default_scene) == []
     s = dataclasses_replace(default_scene, targets=(
         default_scene.targets[0].__class__(range_m=0.5), default_scene.targets[1].__class__(
@@ -173,7 +174,7 @@ def test_scene_module_positions_are_the_geometry_formula(radius, offsets_mm):
     """One formula: the scene's rules see the modules where geometry builds them."""
     import numpy as np
     from rtsgeom.geometry import build_setup
-    from rtsgeom.scene.scene import arc_centre_m, front_end_module_m
+    from rtsgeom.scene.rules import arc_centre_m, front_end_module_m
     doc = copy.deepcopy(default_doc())
     doc["rts"]["arc_radius_m"] = radius
     doc["sheet"]["enabled"] = False
@@ -190,7 +191,7 @@ def test_scene_module_positions_are_the_geometry_formula(radius, offsets_mm):
 def test_design_filters_candidates_with_the_scene_rules(default_scene):
     import math
     from rtsgeom.analysis.design import two_front_end_scene
-    from rtsgeom.scene.scene import problems
+    from rtsgeom.scene.rules import problems
     for radius, spacing in ((1.0, 8.0), (0.3, 8.0), (0.06, 60.0), (2.0, 179.0)):
         variant, _, problem = two_front_end_scene(default_scene, (0, 1), radius,
                                                   math.radians(spacing))

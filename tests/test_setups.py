@@ -20,7 +20,8 @@ from rtsgeom.pipeline.info import scene_info
 from rtsgeom.paths import exact_paths
 from rtsgeom.paths.table import TX_TO_FE
 from rtsgeom.scene.presets import PRESETS
-from rtsgeom.scene.scene import SceneError, load_scene, loads_scene
+from rtsgeom.errors import SceneError
+from rtsgeom.scene import load_scene, loads_scene
 from conftest import make_scene
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -156,7 +157,7 @@ def test_channel_model_legs_match_exact_paths_for_signed_layouts_and_rotations(y
     setup, for mirrored and normal layouts, yawed or not; and a draw's legs = the exact paths
     of build_setup with that draw (layouts and rotations kept)."""
     from rtsgeom.synthesis.model import ChannelModel
-    from rtsgeom.scene.scene import TargetConfig
+    from rtsgeom.scene import TargetConfig
     text = _text(CUSTOM).replace("yaw_offset_deg = 2.0", f"yaw_offset_deg = {yaw_deg}")
     text = text.replace("rx_offset_mm = [-15.0, 0.0]", f"rx_offset_mm = [{rx_t_mm}, 3.0]")
     scene = loads_scene(text, "x.toml")

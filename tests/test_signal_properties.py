@@ -13,7 +13,7 @@ from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.radar import synthesize
 from rtsgeom.rts.channels import build_echoes, program_nearest
-from rtsgeom.scene.scene import TargetConfig
+from rtsgeom.scene import TargetConfig
 
 from conftest import make_scene
 

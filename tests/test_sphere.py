@@ -6,7 +6,8 @@ import pytest
 from rtsgeom._lib.arcmath import antenna_positions, module_axes, sphere_frame
 from rtsgeom.geometry import build_setup
 from rtsgeom.geometry.sheet import segments_blocked
-from rtsgeom.scene.scene import SceneError, load_scene
+from rtsgeom.errors import SceneError
+from rtsgeom.scene import load_scene
 
 SCENE = "scenes/diewald2022.toml"
 

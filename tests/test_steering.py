@@ -13,7 +13,7 @@ from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.radar.processing import angle_spectrum, estimate_angles, refine_angles
 from rtsgeom.radar.steering import Steering
-from rtsgeom.scene.scene import TargetConfig
+from rtsgeom.scene import TargetConfig
 
 from conftest import make_scene
 

@@ -18,7 +18,7 @@ from rtsgeom.radar import process
 from rtsgeom.radar.processing import estimate_angles, refine_angles, tdm_compensate
 from rtsgeom.rts.channels import RtsProgram, requested_delay
 from rtsgeom.radar.frame import simulate
-from rtsgeom.scene.scene import TargetConfig
+from rtsgeom.scene import TargetConfig
 
 from conftest import (DEFAULT_SCENE, ROOT, SETUP_ERRORS, make_scene, scenes_with_and_without_error,
                       two_front_end_pair)

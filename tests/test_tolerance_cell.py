@@ -19,7 +19,7 @@ from rtsgeom.analysis.tolerance.driver import CASES, draw_offsets, standard_draw
 from rtsgeom.analysis.tolerance.cell import (CellPhasors, max_sigma_for_yield_cell,
                                              monte_carlo_cell, verify_cell_draws)
 from rtsgeom.geometry import build_setup
-from rtsgeom.scene.scene import parse_scene
+from rtsgeom.scene import parse_scene
 
 SPHERE = ROOT / "scenes" / "sphere4.toml"
 

@@ -58,7 +58,7 @@ def test_subbin_positions_cover_one_bin_uniformly():
 def test_verify_200_on_the_default_study():
     """The issue's criterion as stated: ``--verify 200`` on the default study (default pair,
     sigmas 0.1 mm, the scene's seed) within 0.005 deg per draw."""
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     scene = load_scene("scenes/diewald2022.toml")
     model = PairPhasors.build(build_setup(scene), (0, 1))
     res = verify_draws(model, [1e-4] * 3, 200, scene.seed)
@@ -102,7 +102,7 @@ def test_bin_centre_model_agrees_with_the_chain_on_a_planned_arc(radius_m):
     from rtsgeom.analysis.tolerance.arc import arc_models
     from rtsgeom.analysis.tolerance.verify import verify_draws
     from rtsgeom.geometry import build_setup
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     plan = coverage.plan_arc(load_scene("scenes/diewald2022.toml"),
                              (math.radians(-10), math.radians(10)), radius_m)
     model = arc_models(build_setup(plan.scene), [(0, 1)], 11)[0]

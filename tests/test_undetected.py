@@ -7,7 +7,7 @@ import pytest
 from conftest import make_scene
 from rtsgeom.radar.processing import Detections, RangeDoppler
 from rtsgeom.pipeline.run import undetected_reason
-from rtsgeom.scene.scene import TargetConfig
+from rtsgeom.scene import TargetConfig
 
 
 def _map(snr_db, v, rng, r0=40, d0=16):

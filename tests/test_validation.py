@@ -22,7 +22,8 @@ import pytest
 from rtsgeom.cli import main
 from rtsgeom.cli._common import number
 from rtsgeom.scene.registry import RADAR_PRESETS
-from rtsgeom.scene.scene import SceneError, TargetConfig, load_scene, loads_scene, parse_scene
+from rtsgeom.errors import SceneError
+from rtsgeom.scene import TargetConfig, load_scene, loads_scene, parse_scene
 from rtsgeom.geometry.warnings import scene_warnings
 
 from conftest import DEFAULT_SCENE, ROOT, default_doc

@@ -25,7 +25,7 @@ from rtsgeom.radar.steering import window
 from rtsgeom.scene.registry import WINDOWS as WINDOW_REGISTRY
 from rtsgeom.rts.channels import Echoes, build_echoes, program_nearest
 from rtsgeom.pipeline.run import match_targets
-from rtsgeom.scene.scene import TargetConfig
+from rtsgeom.scene import TargetConfig
 
 WINDOWS = tuple(WINDOW_REGISTRY)
 
@@ -189,7 +189,7 @@ def test_fft_snr_gain_is_the_link_budgets_window_loss(range_window, doppler_wind
     (``link.window_snr_loss``) and the calibration's noise model use, for every pair of
     windows (noise power per cell sum w_r^2 sum w_d^2 sigma^2, tone (sum w_r)^2 (sum w_d)^2)."""
     import dataclasses
-    from rtsgeom.radar.link import window_snr_loss
+    from rtsgeom.radar.budget import window_snr_loss
     scene = make_scene(lambda d: _quiet(d, range_window=range_window,
                                         doppler_window=doppler_window) or d.update(targets=[]))
     r = scene.radar
@@ -247,7 +247,7 @@ def test_n_channel_exact_mode_hits_cell_points_for_every_taper(angle_window):
     """The N-channel exact mode (sphere4, four front ends in azimuth and elevation): the
     modelled 2-D peak at each set point inside the cell, for every angle window."""
     from rtsgeom.synthesis.nchannel import ChannelSet
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     scene = load_scene("scenes/sphere4.toml")
     scene = scene.evolve(radar=scene.radar.evolve(angle_window=angle_window))
     setup = build_setup(scene)

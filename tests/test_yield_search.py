@@ -89,7 +89,7 @@ def test_yield_without_errors_per_subbin_position_is_the_monte_carlos(subbin):
     Monte Carlo's worst errors bit for bit, for both cases and distributions."""
     from rtsgeom.analysis.tolerance.driver import PairPhasors, _worst_without_errors, monte_carlo
     from rtsgeom.geometry import build_setup
-    from rtsgeom.scene.scene import load_scene
+    from rtsgeom.scene import load_scene
     model = PairPhasors.build(build_setup(load_scene("scenes/diewald2022.toml")), (0, 1), 5)
     for case in ("uncalibrated", "calibrated"):
         for dist in ("normal", "uniform"):

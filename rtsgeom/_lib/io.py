@@ -34,6 +34,7 @@ import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterable, Iterator
+from ..errors import OutputError
 
 __all__ = ["OutputError", "atomic_path", "write_text", "write_bytes", "write_json",
            "check_output_file", "check_output_dir", "staged_dir", "OUTPUT_NAMES"]
@@ -47,10 +48,6 @@ OUTPUT_NAMES = re.compile(
     r"design(_\w+)?\.(png|json)|nearfield\.(png|json)|ghosts\.(png|json)|"
     r"\.rtsgeom-output)")
 MARKER = ".rtsgeom-output"
-
-
-class OutputError(ValueError):
-    """An output path that cannot or must not be written (exit code 2 in the CLI)."""
 
 
 def _kind(mode: int) -> str:

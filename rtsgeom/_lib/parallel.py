@@ -25,16 +25,13 @@ import re
 import weakref
 from contextlib import contextmanager
 from typing import Callable, Sequence
+from ..errors import ClusterError
 
 __all__ = ["chunk_mapper", "available_cores", "ForkPool", "fork_map", "map_chunks", "dask_client", "ClusterError",
            "check_address", "retain_freed_memory"]
 
 _ADDRESS = re.compile(r"(?:(tcp|tls|ws|wss|ucx|inproc)://)?(\[[0-9a-fA-F:]+\]|[A-Za-z0-9_.-]+)"
                       r"(?::(\d{1,5}))?")
-
-
-class ClusterError(RuntimeError):
-    """A Dask scheduler address that is malformed or cannot be reached (one line, exit 2)."""
 
 
 def check_address(address: str) -> str:

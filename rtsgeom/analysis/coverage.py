@@ -37,12 +37,12 @@ from typing import Callable
 
 import numpy as np
 
-from ..synthesis.model import AngleUnreachable
+from ..errors import AngleUnreachable
 from ..geometry import build_setup
 from ..geometry.setup import nominal_scene
 from ..geometry.farfield import angular_resolution_rad
 from ..paths import exact_paths
-from ..scene.scene import Scene
+from ..scene import Scene
 from .tolerance.arc import Bounds, adjacent_pairs, arc_models, arc_monte_carlo, max_scale_for_yield
 from .design import _fit_sheet, _problem
 

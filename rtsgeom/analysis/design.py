@@ -35,12 +35,13 @@ from typing import Callable
 import numpy as np
 
 from .._lib.util import frozen
-from ..synthesis.model import AngleUnreachable
+from ..errors import AngleUnreachable
 from ..geometry import build_setup
 from ..geometry.setup import nominal_scene
 from ..geometry.farfield import angular_resolution_rad
 from .._lib.parallel import available_cores, chunk_mapper, map_chunks
-from ..scene.scene import Scene, SheetConfig, arc_centre_m, problems
+from ..scene import Scene, SheetConfig
+from ..scene.rules import arc_centre_m, problems
 from .tolerance.driver import (CASES, PairPhasors, critical_ratio, largest_passing_scale,
                                max_sigma_for_yield, monte_carlo)
 

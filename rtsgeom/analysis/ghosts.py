@@ -27,7 +27,7 @@ from scipy.constants import c
 from ..geometry import build_setup
 from ..radar.processing import window
 from ..rts.channels import EchoKind, Echoes, cable_ghosts, program_nearest
-from ..scene.scene import Scene
+from ..scene import Scene
 
 __all__ = ["DEFAULT_FLOOR_DB", "ghost_orders", "predict_ghosts", "measure_ghosts",
            "GhostReport", "ghost_analysis", "ghosts_figure"]

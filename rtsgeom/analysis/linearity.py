@@ -11,7 +11,7 @@ from ..errors import ParameterError
 from ..geometry import Setup
 from ..paths import Paths
 from ..rts.channels import RtsProgram, requested_delay
-from ..scene.scene import TargetConfig
+from ..scene import TargetConfig
 from ..radar.processing import nearest_detection
 from ..calibration.pair import (Calibration, FrontEndProbe, simulate_detect, probe_angles,
                                 probe_ranges)

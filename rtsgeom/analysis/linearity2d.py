@@ -14,7 +14,7 @@ from ..paths import Paths
 from ..radar.processing import nearest_detection
 from ..radar.steering import Steering
 from ..rts.channels import RtsProgram, requested_delay
-from ..scene.scene import TargetConfig
+from ..scene import TargetConfig
 from ..calibration.pair import simulate_detect, nominal_model, probe_front_ends, probe_ranges
 from ..synthesis.nchannel import ChannelSet
 

@@ -64,7 +64,8 @@ from scipy.constants import c
 
 from ..calibration.pair import nominal_model, probe_angles, probe_ranges
 from ..synthesis.model import ChannelModel
-from ..synthesis.closed_form import AngleUnreachable, PairModel
+from ..errors import AngleUnreachable
+from ..synthesis.closed_form import PairModel
 from ..errors import ParameterError
 from ..geometry import RutArray, Setup, build_setup
 from ..geometry.setup import nominal_scene
@@ -73,7 +74,7 @@ from ..geometry.farfield import (aperture_m, apparent_azimuth_rad, fraunhofer_di
 from ..paths import Paths, exact_paths
 from ..radar.steering import Steering, smoothed_estimator
 from ..rts.channels import requested_delay
-from ..scene.scene import Scene, TargetConfig
+from ..scene import Scene, TargetConfig
 from .nearfield2d import _cells, cell_synthesis_errors_deg, single_front_end_directions_rad
 
 __all__ = ["DEFAULT_DECADES", "DEFAULT_POINTS", "MIN_RADIUS_M", "max_radius_m", "default_radii", "with_arc_radius",

@@ -9,11 +9,12 @@ import dataclasses
 import numpy as np
 
 from ..calibration.pair import nominal_model
-from ..synthesis.model import AngleUnreachable, ChannelModel
+from ..errors import AngleUnreachable
+from ..synthesis.model import ChannelModel
 from ..geometry import Setup
 from ..paths import Paths
 from ..radar.steering import Steering
-from ..scene.scene import TargetConfig
+from ..scene import TargetConfig
 
 __all__ = ["single_front_end_directions_rad", "cell_synthesis_errors_deg"]
 

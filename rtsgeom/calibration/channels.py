@@ -35,8 +35,9 @@ from scipy.spatial import Delaunay
 from ..radar.processing import nearest_detection
 from ..radar.steering import Steering
 from ..rts.channels import RtsProgram, requested_delay
-from ..scene.scene import TargetConfig
+from ..scene import TargetConfig
 from ..synthesis.nchannel import ChannelSet
+from ..errors import CalibrationFailed
 
 __all__ = ["CalibrationFailed", "ChannelCalibration", "coherence_point_nd", "crossing_columns", "calibrate_channels", "calibrate_pair_nd", "pair_edges",
            "spanning_tree", "tree_phases"]
@@ -50,11 +51,6 @@ PROBE_RATIOS = (1 / 3, 3.0)
 # elevation errors up to 0.10 deg against <= 0.03 deg).
 LOOP_CLOSURE_TOL_S = 25e-12
 FINE_STEP_ND_S = 10e-12  # the 2-D fine sweep's step (each step one full-chain simulation)
-
-
-class CalibrationFailed(ValueError):
-    """A pair's calibration found no coherence point (no probe detected over the sweep), or
-    the calibrated channels do not synthesize the cell's centre."""  # channel j's amplitude over channel i's for the two probes
 
 
 @dataclass(frozen=True)
@@ -454,7 +450,7 @@ def _residual(setup, paths, nom, nom_paths, ch, offsets, probe, st, seed, tree):
     """(azimuth, elevation) error (deg) of one target at the channels' centre, synthesized by
     all of them with the calibrated offsets (exact mode)."""
     from .pair import simulate_detect, probe_ranges
-    from ..synthesis.model import AngleUnreachable
+    from ..errors import AngleUnreachable
     r = float(probe_ranges(setup, 1)[0])
     cs = ChannelSet.build(nom, nom_paths, tuple(ch), TargetConfig(r), offsets[ch])
     u = cs.fe_directions().mean(axis=0)

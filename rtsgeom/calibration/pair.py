@@ -32,7 +32,7 @@ from ..radar import process
 from ..radar.processing import nearest_detection
 from ..radar.frame import simulate
 from ..rts.channels import RtsProgram, realised_delay, requested_delay
-from ..scene.scene import TargetConfig
+from ..scene import TargetConfig
 from .steps import (COARSE_NOISE_DEG, FINE_STEP_S, MAX_FRAMES, MC_DRAWS, MIN_FIT_POINTS,
                     TARGET_BIAS_PS, coarse_frames, continuous_delay_setup, fine_frames, fine_window,
                     predicted_angle_noise, realisable, realisation_shift, sweep_phase,

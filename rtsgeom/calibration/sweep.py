@@ -33,7 +33,7 @@ from ..paths import Paths
 from ..radar.processing import tdm_compensate
 from ..radar.steering import Steering, window
 from ..rts.channels import KIND_DIRECT, RtsProgram, channel_echoes, requested_delay
-from ..scene.scene import TargetConfig
+from ..scene import TargetConfig
 from ..synthesis.model import ChannelModel
 
 __all__ = ["design_ratio", "beam_derivatives", "ratio_from_beams", "design_at_detected_bin", "detected_bin_choice", "SweepResult", "phasor_sweep", "fit_minimum", "HALF_BINS",

@@ -11,6 +11,7 @@ import signal as _sig
 import sys
 
 from .. import __version__
+from ..errors import Terminated
 
 __all__ = ["main", "build_parser"]
 
@@ -49,11 +50,6 @@ class _Parser(argparse.ArgumentParser):
         sub = self.prog.split(" ", 1)[1] if " " in self.prog else ""
         where = f"{sub}: " if sub else ""
         self.exit(2, f"rtsgeom: error: {where}{message} (see '{self.prog} --help')\n")
-
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM, raised like Ctrl-C so that every cleanup (staging folders, temporary files)
-    runs the same way."""
 
 
 def _on_sigterm(signum, frame):
@@ -107,7 +103,7 @@ def _command_of(argv: list[str]) -> str | None:
 
 def _raytrace_unavailable() -> type[Exception]:
     """The ray tracer's 'no suitable LLVM/Sionna' error, without importing Sionna."""
-    from ..paths.raytrace import RaytraceUnavailable
+    from ..errors import RaytraceUnavailable
     return RaytraceUnavailable
 
 
@@ -127,10 +123,10 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _dispatch(args) -> int:
-    from .._lib.io import OutputError
-    from .._lib.parallel import ClusterError
-    from ..scene.scene import SceneError
-    from ._common import UsageError
+    from ..errors import OutputError
+    from ..errors import ClusterError
+    from ..errors import SceneError
+    from ..errors import UsageError
     try:
         return int(args.func(args) or 0)
     except (SceneError, UsageError, OutputError, ClusterError, _raytrace_unavailable()) as exc:

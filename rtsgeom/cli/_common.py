@@ -8,13 +8,10 @@ import math
 import sys
 from contextlib import contextmanager
 from pathlib import Path
+from ..errors import UsageError
 
 __all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checked", "steps",
            "output_path", "output_folder", "output_file"]
-
-
-class UsageError(ValueError):
-    """A command-line argument is invalid (exit code 2)."""
 
 
 def number(lo=None, hi=None, integer=False):
@@ -73,7 +70,7 @@ def load_scene_checked(path):
     """Load and validate a scene (errors raise :class:`~rtsgeom.scene.scene.SceneError`, exit code 2)
     and print its physical warnings (``rtsgeom.geometry.warnings.scene_warnings``) to stderr as
     ``rtsgeom: warning: ...``. Every subcommand that reads a scene should load it with this."""
-    from ..scene.scene import load_scene
+    from ..scene import load_scene
     from ..geometry.warnings import scene_warnings
     scene = load_scene(path)
     for line in scene_warnings(scene):

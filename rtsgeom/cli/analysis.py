@@ -9,8 +9,9 @@ import numpy as np
 
 from ..errors import ParameterError
 from .._lib.io import write_json
-from ._common import (UsageError, load_scene_checked, number, output_folder, output_path,
-                      print_json, scene_arg, steps, warn_scene_errors)
+from ..errors import UsageError
+from ._common import (load_scene_checked, number, output_folder, output_path, print_json, scene_arg,
+                      steps, warn_scene_errors)
 
 
 def radius_sweep(text: str) -> tuple[float, float, int]:

@@ -7,15 +7,16 @@ import numpy as np
 
 from ..calibration.pair import calibrate_pair, calibrate_pair_paper, fir_effect, probe_front_ends
 from ..analysis.linearity import linearity
-from ..synthesis.model import AngleUnreachable
+from ..errors import AngleUnreachable
 from ..errors import ParameterError
 from ..geometry import build_setup
 from .._lib.io import write_json
 from ..paths import exact_paths
 
 from ..scene.registry import SYNTHESIS_MODES
-from ._common import (UsageError, load_scene_checked, number, output_folder, output_path,
-                      print_json, scene_arg, steps)
+from ..errors import UsageError
+from ._common import (load_scene_checked, number, output_folder, output_path, print_json, scene_arg,
+                      steps)
 
 
 def _pair_arg(text: str):

@@ -12,13 +12,14 @@ import numpy as np
 
 from ..analysis.tolerance.driver import AXES, CASES, NOMINAL_AMPLITUDES
 from ..calibration.pair import calibrate_pair, probe_front_ends
-from ..synthesis.model import AngleUnreachable
+from ..errors import AngleUnreachable
 from ..analysis.linearity import linearity
 from ..geometry import build_setup
 from .._lib.io import write_json
 from .._lib.parallel import chunk_mapper
 from ..paths import exact_paths
-from ._common import UsageError, load_scene_checked, print_json, steps
+from ..errors import UsageError
+from ._common import load_scene_checked, print_json, steps
 from .aoa import _pairs
 
 __all__ = ["prepare_all", "calibrate_all", "linearity_all", "scales", "wants_arc",

@@ -15,7 +15,7 @@ def cmd_info(args) -> int:
     from ..pipeline.info import unreachable_warnings
     setup = build_setup(load_scene_checked(args.scene))
     info = scene_info(setup, reachable=True)
-    from ..radar.link import static_budget
+    from ..radar.budget import static_budget
     info["link_budget"] = static_budget(setup).to_dict()
     for w in unreachable_warnings(info, skip_outside_geometric=True):  # those: validate's
         print(f"rtsgeom: warning: {args.scene}: {w}", file=sys.stderr)

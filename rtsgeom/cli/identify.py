@@ -6,8 +6,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import CaptureError, ParameterError
-from ._common import (UsageError, load_scene_checked, output_folder, output_path, print_json,
-                      scene_arg, steps)
+from ..errors import UsageError
+from ._common import load_scene_checked, output_folder, output_path, print_json, scene_arg, steps
 
 
 def adc_probe_capture(scene, args) -> int:

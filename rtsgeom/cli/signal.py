@@ -14,8 +14,9 @@ from ..errors import ParameterError
 from .._lib.io import atomic_path, write_bytes, write_json, write_text
 from ..scene.registry import ANGLE_ESTIMATORS, AOA_MODES, PATH_METHODS
 from ..pipeline.run import RunResult, label_detections, run_scene, summary
-from ._common import (UsageError, load_scene_checked, number, output_file, output_folder,
-                      output_path, scene_arg, steps)
+from ..errors import UsageError
+from ._common import (load_scene_checked, number, output_file, output_folder, output_path,
+                      scene_arg, steps)
 
 
 def detections_csv(result: RunResult) -> str:

@@ -12,12 +12,14 @@ import numpy as np
 
 from ..analysis.tolerance.driver import (AXES, CASES, DISTRIBUTIONS, NOMINAL_AMPLITUDES,
                                          PairPhasors, max_sigma_for_yield, monte_carlo)
-from ..synthesis.model import AngleUnreachable
+from ..errors import AngleUnreachable
 from ..geometry import build_setup
 from .._lib.io import write_json
-from .._lib.parallel import ClusterError, check_address, chunk_mapper
-from ._common import (UsageError, load_scene_checked, number, output_folder, output_path,
-                      print_json, scene_arg, warn_scene_errors)
+from ..errors import ClusterError
+from .._lib.parallel import check_address, chunk_mapper
+from ..errors import UsageError
+from ._common import (load_scene_checked, number, output_folder, output_path, print_json, scene_arg,
+                      warn_scene_errors)
 from .aoa import _pair, _pair_arg
 from .arc import coverage_spec
 

@@ -8,11 +8,12 @@ import time
 import numpy as np
 
 from ..analysis.tolerance.driver import AXES, CASES
-from ..synthesis.model import AngleUnreachable
+from ..errors import AngleUnreachable
 from ..errors import ParameterError
 from ..geometry import build_setup
 from .._lib.io import write_json
-from ._common import UsageError, print_json
+from ..errors import UsageError
+from ._common import print_json
 
 __all__ = ["wants_cell", "tolerance_cell"]
 

@@ -7,7 +7,8 @@ import os
 
 from ..geometry import build_setup
 from ..scene.registry import PATH_METHODS
-from ._common import UsageError, load_scene_checked, output_file, output_path, scene_arg
+from ..errors import UsageError
+from ._common import load_scene_checked, output_file, output_path, scene_arg
 
 
 def _window_size(text: str) -> tuple[int, int]:

@@ -21,7 +21,7 @@ from scipy.constants import c
 
 from .._lib.util import frozen
 from ..scene.presets import PRESETS, ArrayPreset, ArraySpec, preset
-from ..scene.scene import RadarConfig
+from ..scene import RadarConfig
 
 __all__ = ["ArraySpec", "ArrayPreset", "PRESETS", "RutArray", "array_from_spec", "array_spec",
            "awr1843boost_layout", "posed_positions", "rut_array", "yaw_matrix"]

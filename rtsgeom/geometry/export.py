@@ -7,7 +7,8 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from .._lib.io import OutputError, atomic_path
+from ..errors import OutputError
+from .._lib.io import atomic_path
 from .setup import Setup
 
 __all__ = ["COLOURS", "rut_board_mesh", "setup_scene", "export_setup"]

@@ -19,7 +19,7 @@ import numpy as np
 
 from .._lib.util import frozen
 from .._lib.arcmath import antenna_positions, layout_offsets, module_axes, radial_tangent
-from ..scene.scene import Scene
+from ..scene import Scene
 
 __all__ = ["FrontEnds", "antenna_positions", "front_ends", "layout_offsets", "module_axes",
            "radial_tangent"]

@@ -8,7 +8,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..scene.scene import Scene, arc_centre_m
+from ..scene import Scene
+from ..scene.rules import arc_centre_m
 from .frontends import FrontEnds, front_ends
 from .arrays import RutArray, rut_array
 from .sheet import sheet_mesh
@@ -74,7 +75,7 @@ def setup_errors(scene: Scene) -> list[str]:
     """The scene's fields that :func:`nominal_scene` zeroes and that are not zero, as file
     keys (``rts.front_ends[1].radial_offset_mm``, ``radar.yaw_offset_deg``)."""
     from ..scene.schema import specs
-    from ..scene.scene import FrontEndConfig, RadarConfig
+    from ..scene import FrontEndConfig, RadarConfig
     fe_key, radar_key = dict(specs(FrontEndConfig)), dict(specs(RadarConfig))
     out = [f"rts.front_ends[{q}].{fe_key[name].key}" for q, fe in enumerate(scene.rts.front_ends)
            for name in FRONT_END_ERRORS if getattr(fe, name) != 0.0]

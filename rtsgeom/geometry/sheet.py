@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..scene.scene import SheetConfig
+from ..scene import SheetConfig
 from .frontends import radial_tangent
 from .._lib.arcmath import sphere_frame
 

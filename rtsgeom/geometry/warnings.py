@@ -16,7 +16,7 @@ import numpy as np
 
 from . import build_setup
 from .farfield import angular_resolution_rad, fraunhofer_distance_m
-from ..scene.scene import Scene
+from ..scene import Scene
 from ..scene.schema import fmt as _fmt
 
 __all__ = ["scene_warnings", "height_phase_deg"]

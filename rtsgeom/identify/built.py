@@ -14,7 +14,7 @@ from ..geometry import Setup
 from ..geometry.setup import build_setup
 from ..paths import exact_paths
 from .capture import capture_probe
-from ..scene.scene import FrontEndConfig, Scene
+from ..scene import FrontEndConfig, Scene
 from .fit import Identification
 
 __all__ = ["identified_scene", "identified_scene_toml", "setup_of", "detected_angles",
@@ -100,7 +100,7 @@ def detected_angles(setup: Setup, paths=None) -> np.ndarray:
     """Each front end alone as the RuT's beamformer sees it (noise-free phasor model at the
     calibration's probe range): what ``calibrate``'s amplitude step measures."""
     from ..synthesis.model import ChannelModel
-    from ..scene.scene import TargetConfig
+    from ..scene import TargetConfig
     paths = exact_paths(setup) if paths is None else paths
     r, _ = capture_probe(setup)
     return np.array([float(ChannelModel.build(setup, paths, [q], TargetConfig(r))

@@ -7,7 +7,7 @@ import numpy as np
 
 from ..geometry.setup import build_setup
 from .capture import Capture, capture_probe
-from ..scene.scene import Scene
+from ..scene import Scene
 from .fit import cramer_rao
 from .model import ProbeModel
 

@@ -11,7 +11,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..geometry.setup import build_setup
-from ..scene.scene import Scene
+from ..scene import Scene
 from .model import PARAMS, ProbeModel, measure
 
 __all__ = ["STD_LIMIT", "MIN_EIGENVALUE", "SEPARATE_BY", "fisher", "free_parameters",

@@ -405,7 +405,7 @@ def main(argv=None) -> int:  # pragma: no cover - thin wrapper
     import argparse
     import json
     from ..geometry import build_setup
-    from ..scene.scene import load_scene
+    from ..scene import load_scene
     ap = argparse.ArgumentParser(prog="python -m rtsgeom.paths.crosscheck",
                                  description="ray tracer vs exact geometry")
     ap.add_argument("scene")

@@ -49,9 +49,11 @@ import numpy as np
 from scipy.constants import c
 
 from ..geometry import Setup
-from ..scene.scene import RaytraceConfig, SceneError
-from .raytrace_backend import (INSTALL_HINT, RaytraceUnavailable, _default_cache_dir, SIONNA_LOCK,
-                               backend_info, ensure_available, preflight)
+from ..scene import RaytraceConfig
+from ..errors import SceneError
+from .raytrace_backend import (INSTALL_HINT, _default_cache_dir, SIONNA_LOCK, backend_info,
+                               ensure_available, preflight)
+from ..errors import RaytraceUnavailable
 from .table import FE_TO_RX, RUT_TO_RUT, TX_TO_FE, Paths
 
 __all__ = ["RaytraceUnavailable", "RaytraceResult", "preflight", "ensure_available",

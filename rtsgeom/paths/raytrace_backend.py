@@ -15,6 +15,8 @@ import sys
 import threading
 from pathlib import Path
 
+from ..errors import RaytraceUnavailable
+
 __all__ = ["RaytraceUnavailable", "preflight", "ensure_available", "backend_info", "INSTALL_HINT"]
 
 INSTALL_HINT = ("install a recent LLVM for Dr.Jit's CPU backend (Debian/Ubuntu: `apt-get install -y "
@@ -31,11 +33,6 @@ y = dr.maximum(dr.sqrt(x * x + 1), 0.0) + dr.minimum(x, 0.0)
 dr.eval(y)
 print("OK", ".".join(map(str, dr.detail.llvm_version())))
 """
-
-
-class RaytraceUnavailable(RuntimeError):
-    """Sionna RT cannot run here (package missing, no usable LLVM/CUDA backend). The message
-    says what to install."""
 
 
 # ------------------------------------------------------------------------------------------

@@ -157,7 +157,7 @@ def scene_info(setup: Setup, reachable: bool = False) -> dict:
         ],
     }
     if reachable:
-        from ..scene.scene import SceneError
+        from ..errors import SceneError
         try:
             out["reachable"] = reachable_spans(setup)
         except SceneError as exc:  # a setup the synthesis does not model (its message says)
@@ -253,7 +253,7 @@ def format_info(info: dict) -> str:
                     line += f"  (pair {rt['pair'][0]}-{rt['pair'][1]})"
             lines.append(line)
     if info.get("link_budget"):
-        from ..radar.link import format_budget
+        from ..radar.budget import format_budget
         lines += format_budget(info["link_budget"])
     return "\n".join(lines)
 

@@ -14,11 +14,13 @@ from ..geometry import Setup
 from ..geometry.farfield import angular_resolution_rad
 from ..paths import Paths
 from ..rts.channels import RtsProgram, fir_modelled, realised_delay, requested_delay
-from ..scene.scene import SceneError, TargetConfig
+from ..errors import SceneError
+from ..scene import TargetConfig
 from scipy.constants import c
 from ..calibration.pair import (Calibration, FrontEndProbe, calibrate_pair, probe_angles,
                                 probe_front_ends)
-from ..synthesis.model import AngleUnreachable, ChannelModel
+from ..errors import AngleUnreachable
+from ..synthesis.model import ChannelModel
 from ..calibration.sweep import HALF_BINS
 from ..synthesis.closed_form import PairModel
 

@@ -20,9 +20,10 @@ from ..geometry import Setup
 from ..paths import Paths
 from ..radar.steering import Steering
 from ..rts.channels import RtsProgram, requested_delay
-from ..scene.scene import SceneError
-from ..synthesis.cells import CellUnreachable, enclosing_cell
-from ..synthesis.model import AngleUnreachable
+from ..errors import SceneError
+from ..errors import CellUnreachable
+from ..synthesis.cells import enclosing_cell
+from ..errors import AngleUnreachable
 from ..synthesis.nchannel import ChannelSet, target_direction
 from .plan import uses_cells  # noqa: F401  (re-exported: the planner decides with it)
 
@@ -62,7 +63,8 @@ def plan_cells(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, pr
 
     Returns the program, the calibration record (for summary.json) and warnings."""
     from ..calibration.pair import nominal_model, probe_front_ends
-    from ..calibration.channels import CalibrationFailed, calibrate_channels, tree_phases
+    from ..errors import CalibrationFailed
+    from ..calibration.channels import calibrate_channels, tree_phases
     scene = setup.scene
     nom, nom_paths = nominal_model(setup, paths)
     probe = probe_front_ends(setup, paths, scene.seed)

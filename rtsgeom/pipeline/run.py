@@ -16,7 +16,7 @@ from ..paths import Paths, compute_paths
 from ..radar import AdcCube, Detections, RangeDoppler, process
 from ..radar.frame import noise_power, simulate
 from ..rts.channels import Echoes, RtsProgram, program_nearest
-from ..scene.scene import Scene
+from ..scene import Scene
 
 __all__ = ["RunResult", "simulate", "run_scene", "match_targets", "label_detections",
            "noise_power"]
@@ -201,7 +201,7 @@ def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = 
     rd, det = process(cube)
     budget = _budget(scene, setup, echoes, program)
     if scene.radar.link is not None:
-        from ..radar.link import link_warnings
+        from ..radar.budget import link_warnings
         warnings = list(warnings) + link_warnings(budget, scene.radar.cfar.threshold_db)
         if cube.clipped:
             warnings.append(f"link: the ADC clipped {cube.clipped} of {cube.data.size} samples "
@@ -214,7 +214,7 @@ def _budget(scene: Scene, setup: Setup, echoes: Echoes, program: RtsProgram):
     """The run's link budget (rtsgeom.radar.link); the snr_db override's noise where it is set; with
     ``[radar.link]``, the sheet's echo estimated by physical optics where the paths carry no
     setup reflection."""
-    from ..radar.link import link_budget, sheet_paths
+    from ..radar.budget import link_budget, sheet_paths
     from ..rts.channels import EchoKind, setup_echoes
     est = None
     # the physical-optics sheet estimate costs ~1 s: only for a physical budget ([radar.link])

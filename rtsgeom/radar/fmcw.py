@@ -39,7 +39,7 @@ import numpy as np
 from .._lib.util import single_threaded_blas
 from ..geometry import RutArray
 from ..rts.channels import Echoes
-from ..scene.scene import RadarConfig
+from ..scene import RadarConfig
 from .steering import Steering
 
 __all__ = ["AdcCube", "fast_time_s", "chirp_start_s", "beat_phase0", "synthesize",

@@ -36,17 +36,13 @@ from scipy.constants import c, k as K_BOLTZMANN
 
 from ..scene.link import FE_ANTENNA_GAIN_DBI, RADAR_LINK_PRESETS
 from ..rts.channels import Echoes, RtsProgram
-from ..scene.schema import SceneError
+from ..errors import SceneError
+from ..errors import LinkError
 
-__all__ = ["RADAR_LINK_PRESETS", "RadarLink", "LinkError", "LinkBudget", "radar_link",
-           "if_response", "apply_radar_link", "thermal_noise_w", "shaped_noise", "adc_convert",
-           "channel_table", "check_channels", "channel_noise_w", "window_snr_loss",
-           "link_budget", "dbm", "link_warnings", "relative_noise_power", "sheet_paths",
-           "static_budget", "format_budget", "pattern_gains", "fe_gain_db", "beat_hz"]
-
-class LinkError(SceneError):
-    """A target the RTS cannot produce with its gains and dynamic range (names the field)."""
-
+__all__ = ["RADAR_LINK_PRESETS", "RadarLink", "LinkError", "radar_link", "if_response",
+           "apply_radar_link", "thermal_noise_w", "shaped_noise", "adc_convert", "channel_table",
+           "check_channels", "channel_noise_w", "dbm", "relative_noise_power", "pattern_gains",
+           "fe_gain_db", "beat_hz"]
 
 def dbm(p_w) -> np.ndarray:
     """Power in dBm of a power in watts (-inf for 0)."""
@@ -346,8 +342,3 @@ def channel_noise_w(scene, program: RtsProgram, link: RadarLink | None = None,
           * pg["fe_tx"][q] * pg["rut_rx"][q])
     return float(n_in * np.sum(g2) * leg * link.rx_gain)
 
-
-# The budget (per target, setup echo and front end) lives in rtsgeom.radar.budget; its names
-# are re-exported here (imported last: it builds on the functions above).
-from .budget import (LinkBudget, format_budget, link_budget, link_warnings, sheet_paths,
-                     static_budget, window_snr_loss)

@@ -19,7 +19,7 @@ import numpy as np
 from .._lib.util import tones
 from ..geometry import RutArray
 from ..rts.channels import Echoes, EchoKind, FirTaps
-from ..scene.scene import RadarConfig
+from ..scene import RadarConfig
 from .fmcw import beat_phase0, chirp_start_s
 from .steering import window
 

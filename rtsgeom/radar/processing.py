@@ -22,7 +22,7 @@ from scipy.constants import c
 
 from .._lib.util import frozen
 from ..geometry import RutArray
-from ..scene.scene import CfarConfig, RadarConfig
+from ..scene import CfarConfig, RadarConfig
 from .fmcw import AdcCube
 from .newton import parabolic as _parabolic
 from .steering import Steering, window

@@ -25,8 +25,10 @@ import numpy as np
 
 from .._lib.util import frozen, single_threaded_blas, use_kernels
 from ..geometry import RutArray
-from ..scene.scene import RadarConfig, SceneError
-from . import estimators as est
+from ..scene import RadarConfig
+from ..errors import SceneError
+from .estimators import (cell_snapshots, kernel, lag_sums, quadratic, rank_one_covariance,
+                         smoothed_covariance, uniform_cells)
 from .newton import lattice, newton, parabolic, peak_1d
 
 __all__ = ["Steering", "window", "smoothed_estimator"]
@@ -152,7 +154,7 @@ class Steering:
     @cached_property
     def _cells(self) -> tuple[np.ndarray, int]:
         """Grid cell per azimuth element and the number of cells (smoothing)."""
-        return est.uniform_cells(self.positions_m[:, 0], self.pitch_m)
+        return uniform_cells(self.positions_m[:, 0], self.pitch_m)
 
     @staticmethod
     def has_elevation(rut: RutArray) -> bool:
@@ -228,9 +230,9 @@ class Steering:
         x x^H (..., V_s, V_s) of the tapered snapshot."""
         if self.smoothing:
             cell, n = self._cells
-            x = est.cell_snapshots(np.asarray(snapshots)[..., self.mask], cell, n)
-            return est.smoothed_covariance(x, self.subarray)
-        return est.rank_one_covariance(self.weighted(snapshots))
+            x = cell_snapshots(np.asarray(snapshots)[..., self.mask], cell, n)
+            return smoothed_covariance(x, self.subarray)
+        return rank_one_covariance(self.weighted(snapshots))
 
     def manifold(self, u) -> np.ndarray:
         """Array manifold a(u) = e^{-j k p . u} (..., L) for directions ``u`` (..., D): over
@@ -246,8 +248,8 @@ class Steering:
         covariance of :meth:`covariance` whether or not it is smoothed."""
         if self.estimator == "bartlett":
             return self.power(snapshots, u)
-        k = est.kernel(self.covariance(snapshots), self.estimator)
-        q = est.quadratic(k, self.manifold(u))
+        k = kernel(self.covariance(snapshots), self.estimator)
+        q = quadratic(k, self.manifold(u))
         return 1.0 / np.maximum(q, np.finfo(float).tiny)
 
     def _search_smoothed(self, snapshots) -> np.ndarray:
@@ -274,7 +276,7 @@ class Steering:
         with the most power a^H R a, the strongest source, is reported (what a radar reports
         for one detection); Capon's peaks are ordered by power already."""
         cov = self.covariance(snaps)
-        r = est.lag_sums(est.kernel(cov, self.estimator))  # (n, 2L - 1)
+        r = lag_sums(kernel(cov, self.estimator))  # (n, 2L - 1)
         lags = np.arange(-self.subarray + 1, self.subarray)
         kd = 2 * np.pi / self.wavelength_m * self.pitch_m
 
@@ -292,7 +294,7 @@ class Steering:
             low = np.zeros(q.shape, bool)
             low[:, 1:-1] = (q[:, 1:-1] <= q[:, :-2]) & (q[:, 1:-1] <= q[:, 2:])
             low &= q <= q.min(axis=1, keepdims=True) + 0.05 * self.subarray
-            power = quad(grid, est.lag_sums(cov))
+            power = quad(grid, lag_sums(cov))
             pick = np.where(low.any(axis=1), np.argmax(np.where(low, power, -np.inf), axis=1),
                             pick)
         best = grid[pick]

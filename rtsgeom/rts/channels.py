@@ -25,7 +25,7 @@ from scipy.constants import c
 from .._lib.util import frozen, tones
 from ..geometry import Setup
 from ..paths.table import FE_TO_RX, RUT_TO_RUT, TX_TO_FE, Paths
-from ..scene.scene import Scene
+from ..scene import Scene
 
 __all__ = ["RtsProgram", "EchoKind", "Echoes", "realised_delay", "target_amplitude",
            "channel_echoes", "setup_echoes", "cable_ghosts", "program_nearest", "build_echoes",

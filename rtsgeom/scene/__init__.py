@@ -5,9 +5,11 @@ the named choices in :mod:`.registry`, the radar presets in :mod:`.presets`, and
 ``docs/scene-format.md`` is generated from the declarations (``python -m rtsgeom.scene.docs``).
 """
 
-from .scene import (ArrayConfig, CfarConfig, FrontEndConfig, PatternConfig, RadarConfig,
-                    RaytraceConfig, RtsConfig, Scene, SceneError, SheetConfig, StructureConfig,
-                    TargetConfig, load_scene, loads_scene, parse_scene)
+from .hardware import ArrayConfig, PatternConfig
+from .scene import Scene, load_scene, loads_scene, parse_scene
+from ..errors import SceneError
+from .sections import (CfarConfig, FrontEndConfig, RadarConfig, RaytraceConfig, RtsConfig,
+                       SheetConfig, StructureConfig, TargetConfig)
 
 __all__ = ["Scene", "SceneError", "RadarConfig", "CfarConfig", "FrontEndConfig", "RtsConfig",
            "SheetConfig", "TargetConfig", "RaytraceConfig", "PatternConfig", "ArrayConfig",

@@ -15,7 +15,7 @@ import stat
 import tomllib
 from pathlib import Path
 
-from .schema import SceneError
+from ..errors import SceneError
 from .schema import fmt as _fmt
 
 __all__ = ["MAX_SCENE_BYTES", "MAX_KEY_PARTS", "MAX_KEY_CHARS", "decode_toml", "read_scene_bytes",

@@ -10,8 +10,9 @@ import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import registry
-from .schema import Evolvable, SceneError, spec
+from .registry import PATTERN_KINDS
+from .schema import Evolvable, spec
+from ..errors import SceneError
 from .schema import fmt as _fmt
 
 __all__ = ["PatternConfig", "ArrayConfig", "check_layout_keys", "resolve_pattern_tables"]
@@ -25,7 +26,7 @@ class PatternConfig(Evolvable):
     It multiplies the exact paths' amplitudes, and so the amplitude calibration and synthesis."""
 
     kind: str = spec("kind", "str", "pattern model", "isotropic",
-                     choices=tuple(registry.PATTERN_KINDS))
+                     choices=tuple(PATTERN_KINDS))
     hpbw_deg: float | None = spec("hpbw_deg", "float", "half-power beamwidth (kind cos)", None,
                                   unit="deg", lo=0.0, hi=180.0, lo_open=True, hi_open=True)
     hpbw_el_deg: float | None = spec("hpbw_el_deg", "float", "elevation half-power beamwidth "

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .schema import SceneError
+from ..errors import SceneError
 
 __all__ = ["ArrayPreset", "ArraySpec", "PRESETS", "preset"]
 

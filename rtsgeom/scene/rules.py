@@ -16,17 +16,17 @@ positions come from the one shared formula in :mod:`rtsgeom._lib.arcmath`.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from .._lib.arcmath import antenna_positions
 from .presets import ArraySpec
 from .registry import RADAR_PRESETS, WINDOWS, AOA_MODES
-from .schema import SceneError, fmt
+from ..errors import SceneError
+from .schema import fmt, specs
+from .sections import FrontEndConfig, RadarConfig, RtsConfig
 
-if TYPE_CHECKING:
-    from .scene import FrontEndConfig, RadarConfig, Scene
 
 __all__ = ["problems", "arc_centre_m", "azimuth_from_radar_rad", "front_end_module_m",
            "MAX_ADC_SAMPLES", "MAX_CALIBRATION_STEPS"]
@@ -54,13 +54,13 @@ def azimuth_from_radar_rad(radar: "RadarConfig", point) -> float:
                           2.0 * math.pi)
 
 
-def arc_centre_m(scene: "Scene") -> tuple[float, float, float]:
+def arc_centre_m(scene) -> tuple[float, float, float]:
     """The arc centre: ``rts.arc_center_m``, by default the RuT's phase centre."""
     c0 = scene.rts.arc_center_m
     return c0 if c0 is not None else scene.radar.position_m
 
 
-def problems(scene: "Scene") -> list[str]:
+def problems(scene) -> list[str]:
     """Every cross-field rule ``scene`` violates, one message each (empty: none)."""
     out: list[str] = []
     src = scene.source or "<scene>"
@@ -376,8 +376,6 @@ def _calibration_rules(scene, fail) -> None:
 
 def _rts_spec(name: str):
     """The declaration of field ``name`` of ``[rts]`` (its file key, range, default)."""
-    from .scene import RtsConfig  # here: scene.py imports this module
-    from .schema import specs
     return dict(specs(RtsConfig))[name]
 
 

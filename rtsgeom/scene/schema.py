@@ -24,19 +24,10 @@ import math
 import reprlib
 from dataclasses import dataclass
 from typing import Any, Callable
+from ..errors import SceneError
 
 __all__ = ["SceneError", "REQUIRED", "Derived", "Spec", "spec", "specs", "read", "check_fields",
            "Evolvable", "fmt", "range_text"]
-
-
-class SceneError(ValueError):
-    """A scene file (or a value derived from one) is invalid. The message names the field.
-
-    ``problems`` holds every violated rule when the error came from the cross-field rules."""
-
-    def __init__(self, message: str, problems: list[str] | None = None):
-        super().__init__(message)
-        self.problems = problems or [message]
 
 
 REQUIRED = object()

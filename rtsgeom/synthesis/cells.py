@@ -10,12 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.spatial import ConvexHull, Delaunay
+from ..errors import CellUnreachable
 
 __all__ = ["enclosing_cell", "CellUnreachable"]
-
-
-class CellUnreachable(ValueError):
-    """No cell of front ends encloses the direction."""
 
 
 def _interval(u: float, x: np.ndarray) -> tuple[int, ...]:

@@ -26,8 +26,9 @@ import numpy as np
 
 from ..geometry import Setup
 from ..paths import Paths
-from ..scene.scene import TargetConfig
-from .model import SOLVERS, AngleUnreachable, ChannelModel
+from ..scene import TargetConfig
+from .model import SOLVERS, ChannelModel
+from ..errors import AngleUnreachable
 
 __all__ = ["MODES", "g_paper", "array_factor", "ratio_paper", "ratio_array_factor", "array_factor_args", "PairModel",
            "AngleUnreachable"]

@@ -37,7 +37,9 @@ from ..radar.steering import Steering
 from ..scene.registry import SYNTHESIS_MODES
 from ..rts.channels import (KIND_DIRECT, RtsProgram, channel_echoes, nominal_link_gain,
                             requested_delay, target_amplitude)
-from ..scene.scene import SceneError, TargetConfig
+from ..errors import SceneError
+from ..scene import TargetConfig
+from ..errors import AngleUnreachable
 
 __all__ = ["ChannelModel", "AngleUnreachable", "SOLVERS", "estimator_ratio"]
 
@@ -86,10 +88,6 @@ def estimator_ratio(st: Steering, x_i, x_j, alpha_rad, phase=0.0,
     got = st.search(xi + np.exp(x)[:, None] * xj)
     ok = has & (np.abs(got - alpha) < JUMP_RAD)
     return np.where(ok, np.exp(x), np.nan).reshape(shape)
-
-
-class AngleUnreachable(ValueError):
-    """The set angle lies outside what the front-end pair can synthesize."""
 
 
 def require_air_path_compensation(scene) -> None:

@@ -40,8 +40,9 @@ from ..errors import ParameterError
 from ..geometry import Setup
 from ..paths import Paths
 from ..radar.steering import Steering
-from ..scene.scene import TargetConfig
-from .model import SOLVERS, AngleUnreachable, ChannelModel
+from ..scene import TargetConfig
+from .model import SOLVERS, ChannelModel
+from ..errors import AngleUnreachable
 
 __all__ = ["ChannelSet", "closed_form_amplitudes", "target_direction"]
 

@@ -7,12 +7,9 @@ import atexit
 import os
 import shutil
 import subprocess
+from ..errors import VizError
 
 __all__ = ["VizError", "ensure_render_backend"]
-
-
-class VizError(RuntimeError):
-    """Rendering is not possible here (no OpenGL context, no display, a missing package)."""
 
 
 _BACKEND: str | None = None

@@ -31,7 +31,8 @@ from .meshes import (ARC, BACKGROUND, LOS, MODULE, PANEL_BACKGROUND, REFLECTION,
                      cutout_rims, merge, merge_lines, modules, path_polylines, polyline, rgb,
                      rut_scale_factor, scaled, spheres, split_paths, target_positions,
                      undrawable_reflections)
-from .render_backend import VizError, ensure_render_backend
+from ..errors import VizError
+from .render_backend import ensure_render_backend
 
 __all__ = ["VizError", "ensure_render_backend", "build_plotter", "render_setup_png",
            "export_setup_html", "show_setup", "TARGET_RADIUS_FACTOR", "rut_scale_factor",

@@ -67,7 +67,7 @@ from ...radar.processing import refine_angles, tdm_compensate
 from ...radar.steering import smoothed_estimator
 from ...rts.channels import (KIND_DIRECT, RtsProgram, channel_echoes, fir_modelled, fir_taps,
                              requested_delay)
-from ...scene.scene import TargetConfig
+from ...scene import TargetConfig
 from .subbin import centre_index, subbin_positions
 
 __all__ = ["PairPhasors", "HALF_BINS", "PROBE_FRACTIONS", "response_table"]
@@ -304,7 +304,7 @@ class PairPhasors:
         and ``linearity``, runs them)."""
         radar = setup.scene.radar
         if smoothed_estimator(radar.angle_estimator, radar.angle_subarray):
-            from ...scene.scene import SceneError
+            from ...errors import SceneError
             raise SceneError(
                 f"radar.angle_estimator = {radar.angle_estimator} with radar.angle_subarray = "
                 f"{radar.angle_subarray}: the tolerance model (tolerance, design) designs the "
