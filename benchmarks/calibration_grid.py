@@ -52,7 +52,8 @@ def variant(scene, radius_m: float, fe: int | None, dr_m: float, noiseless: bool
 
 def nominal_point(scene_path: str, radius_m: float, noiseless: bool) -> dict:
     """Coherence point of the nominal setup at this radius (phasor model)."""
-    from rtsgeom.calibration.pair import coherence_delay, probe_angles, probe_front_ends
+    from rtsgeom.calibration.pair import coherence_delay
+    from rtsgeom.calibration.probes import probe_angles, probe_front_ends
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     from rtsgeom.scene import load_scene
@@ -68,9 +69,9 @@ def nominal_point(scene_path: str, radius_m: float, noiseless: bool) -> dict:
 
 def one_case(args: tuple) -> dict:
     scene_path, radius_m, fe, dr_m, noiseless, nominal_s, lin_points = args
-    from rtsgeom.calibration.pair import (air_phase_slope_hz, calibrate_pair, coherence_delay,
-                                          if_phase_slope_hz, probe_angles, probe_front_ends,
-                                          probe_ranges)
+    from rtsgeom.calibration.probes import (air_phase_slope_hz, if_phase_slope_hz, probe_angles,
+                                            probe_front_ends, probe_ranges)
+    from rtsgeom.calibration.pair import calibrate_pair, coherence_delay
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     from rtsgeom.scene import load_scene

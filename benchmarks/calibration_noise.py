@@ -47,7 +47,8 @@ def linked(nf_db: float | None):
 
 
 def run(nf_db=(12.0, 30.0, 40.0, 45.0, 50.0), seeds=range(5)) -> dict:
-    from rtsgeom.calibration.pair import calibrate_pair, probe_front_ends
+    from rtsgeom.calibration.pair import calibrate_pair
+    from rtsgeom.calibration.probes import probe_front_ends
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     quiet = build_setup(linked(None))

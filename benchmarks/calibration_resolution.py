@@ -47,15 +47,15 @@ def scene(res_ps: float, radius_m: float, dr_mm: float):
 
 def staircase_point(setup, paths, alphas, near_s: float) -> float:
     """The old ``coherence_delay``: Newton on the quantised model's phase (a staircase)."""
-    from rtsgeom.calibration.pair import if_phase_slope_hz, probe_ranges, probe_total_delay
-    from rtsgeom.synthesis.closed_form import PairModel
+    from rtsgeom.calibration.probes import if_phase_slope_hz, probe_ranges, probe_total_delay
+    from rtsgeom.synthesis.model import ChannelModel
     from rtsgeom.scene import TargetConfig
     ranges = probe_ranges(setup, 2)
     f_if = float(if_phase_slope_hz(setup.scene, probe_total_delay(setup, ranges)))
 
     def phase(d):
-        z = sum(np.exp(1j * PairModel.build(setup, paths, PAIR, TargetConfig(float(r)),
-                                            (0.0, d)).coherent_phase(alphas)) for r in ranges)
+        z = sum(np.exp(1j * ChannelModel.build(setup, paths, PAIR, TargetConfig(float(r)),
+                                               (0.0, d)).pair_phase(alphas)) for r in ranges)
         return float(np.angle(z))
     d = float(near_s)
     for _ in range(2):
@@ -66,8 +66,8 @@ def staircase_point(setup, paths, alphas, near_s: float) -> float:
 
 
 def run(res_ps=(1, 5, 10, 25, 50, 100, 250), radii=(1.0, 3.0), offsets_mm=(0.0, 0.3, -0.6)):
-    from rtsgeom.calibration.pair import (calibrate_pair, coherence_point, probe_angles,
-                                          probe_front_ends)
+    from rtsgeom.calibration.pair import calibrate_pair, coherence_point
+    from rtsgeom.calibration.probes import probe_angles, probe_front_ends
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     s1 = build_setup(scene(1.0, 1.0, 0.0))

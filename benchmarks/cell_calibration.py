@@ -46,7 +46,7 @@ def sphere4(field: str | None = None, value: float = 0.0, fe: int = 1):
 
 
 def case(field: str, value: float) -> dict:
-    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.calibration.probes import probe_front_ends
     from rtsgeom.calibration.channels import coherence_point_nd
     from rtsgeom.errors import SceneError
     from rtsgeom.geometry import build_setup

@@ -82,7 +82,7 @@ class Bench:
     """One scene: setup, paths, probe, the measured and the ideal calibration."""
 
     def __init__(self, scene):
-        from rtsgeom.calibration.pair import probe_front_ends
+        from rtsgeom.calibration.probes import probe_front_ends
         from rtsgeom.geometry import build_setup
         from rtsgeom.paths import compute_paths
         self.scene = scene
@@ -93,7 +93,7 @@ class Bench:
         self.ideal = None
 
     def used(self):
-        from rtsgeom.calibration.pair import nominal_model
+        from rtsgeom.paths import nominal_model
         from rtsgeom.pipeline.plan_cells import target_cells
         nom, _ = nominal_model(self.setup, self.paths)
         _, _, found = target_cells(nom)

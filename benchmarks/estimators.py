@@ -81,21 +81,22 @@ def bench() -> list[dict]:
             scene = _scene(mutate)
             setup = build_setup(scene)
             bart = ChannelModel.build(setup, exact_paths(setup), (0, 1), TargetConfig(33.5))
-            ph = bart.coherent_phases(np.radians([7.8]))
+            ph = (0.0, float(bart.pair_phase(np.radians([7.8]))))
             rho = np.exp(np.linspace(-5, 5, 401))
             for kind, sub in (("bartlett", 0), ("capon", 5), ("capon", 7), ("music", 5),
                               ("music", 7)):
                 m = dataclasses.replace(bart, steering=dataclasses.replace(
                     bart.steering, estimator=kind, subarray=sub))
-                a = np.degrees(m.direction(m.weights(rho[:, None], ph)))
+                a = np.degrees(m.direction(m.pair_weights(rho, ph)))
                 miss, unreachable = [], 0
                 for al in alphas:
                     try:
-                        m.solve(al, ph)  # reachable? (AngleUnreachable otherwise)
+                        m.pair_ratio(al, ph)  # reachable? (AngleUnreachable otherwise)
                     except AngleUnreachable:
                         unreachable += 1
                         continue
-                    miss.append(abs(np.degrees(m.direction(bart.solve(al, ph)) - al)))
+                    miss.append(abs(np.degrees(
+                        m.direction(bart.pair_weights(bart.pair_ratio(al, ph), ph)) - al)))
                 rows.append({"arc_radius_m": radius, "rx_tx_separation_m": sep,
                              "estimator": kind, "subarray": sub,
                              "span_deg": [float(a.min()), float(a.max())],

@@ -82,7 +82,7 @@ def calibrate(scene: Scene, pair=(0, 1)):
 
 def _pair_setup(scene: Scene, pair):
     """Setup, exact paths, the checked pair and each front end alone as the RuT detects it."""
-    from .calibration.pair import probe_front_ends
+    from .calibration.probes import probe_front_ends
     setup, paths = _setup_paths(scene)
     pair = _check_pair(setup, pair)
     return setup, paths, pair, probe_front_ends(setup, paths, scene.seed)

@@ -81,9 +81,9 @@ class CoherenceShift:
     (f_rts + S t_mid - S tau) * 2 dr / c0 for J (front end 1), the opposite way for I."""
 
     def __init__(self, nom, probe):
-        from rtsgeom.calibration.pair import (air_phase_slope_hz, coherence_delay,
-                                              if_phase_slope_hz, probe_angles, probe_ranges,
-                                              probe_total_delay)
+        from rtsgeom.calibration.probes import (air_phase_slope_hz, if_phase_slope_hz, probe_angles,
+                                                probe_ranges, probe_total_delay)
+        from rtsgeom.calibration.pair import coherence_delay
         from rtsgeom.paths import exact_paths
         self.alphas = probe_angles(*probe.angle_rad[[0, 1]])
         self.d0 = coherence_delay(nom, exact_paths(nom), (0, 1), self.alphas)

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 from scipy.constants import c
 
-from rtsgeom.calibration.pair import calibrate_pair, probe_front_ends
+from rtsgeom.calibration.pair import calibrate_pair
+from rtsgeom.calibration.probes import probe_front_ends
 from rtsgeom.analysis.linearity import linearity
 from rtsgeom.synthesis.closed_form import array_factor, g_paper, ratio_array_factor, ratio_paper
 from rtsgeom.geometry import build_setup

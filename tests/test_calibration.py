@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from scipy.constants import c
 
-from rtsgeom.calibration.pair import (calibrate_pair, coherence_delay, if_phase_slope_hz,
-                                      probe_angles, probe_front_ends, probe_ranges,
-                                      probe_total_delay)
+from rtsgeom.calibration.pair import calibrate_pair, coherence_delay
+from rtsgeom.calibration.probes import (if_phase_slope_hz, probe_angles, probe_front_ends,
+                                        probe_ranges, probe_total_delay)
 from rtsgeom.cli import main
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
@@ -206,8 +206,8 @@ def test_fir_moves_the_coherence_point_by_its_phase_ripple(taps):
     """The channels' coherent phase with the FIR minus without it, at programmed delays
     across a period, equals -2 pi f_if times the shift `fir_effect` predicts from the
     filter's own response (window-weighted phase at each probe's bin)."""
-    from rtsgeom.calibration.pair import fir_effect
-    from rtsgeom.synthesis.closed_form import PairModel
+    from rtsgeom.calibration.fir import fir_effect
+    from rtsgeom.synthesis.model import ChannelModel
     from rtsgeom.scene import TargetConfig
     ideal, fir = build_setup(_fir_scene(taps, "ideal")), build_setup(_fir_scene(taps, "windowed-sinc"))
     paths = exact_paths(ideal)
@@ -215,9 +215,9 @@ def test_fir_moves_the_coherence_point_by_its_phase_ripple(taps):
     for d in (0.0, 0.1e-9, 0.37e-9, 0.81e-9):
         z = 0j
         for r in ranges:
-            m0 = PairModel.build(ideal, paths, (0, 1), TargetConfig(float(r)), (0.0, d))
-            m1 = PairModel.build(fir, paths, (0, 1), TargetConfig(float(r)), (0.0, d))
-            z += np.exp(1j * (m1.coherent_phase([0.1]) - m0.coherent_phase([0.1])))
+            m0 = ChannelModel.build(ideal, paths, (0, 1), TargetConfig(float(r)), (0.0, d))
+            m1 = ChannelModel.build(fir, paths, (0, 1), TargetConfig(float(r)), (0.0, d))
+            z += np.exp(1j * (m1.pair_phase([0.1]) - m0.pair_phase([0.1])))
         measured = np.degrees(np.angle(z))
         f_if = if_phase_slope_hz(fir.scene, probe_total_delay(fir, ranges))
         eff = fir_effect(fir, d)
@@ -314,11 +314,11 @@ def test_closed_form_design_matches_the_root_finder():
             for a in th[0] + np.array([0.1, 0.35, 0.6, 0.9]) * (th[1] - th[0]):
                 m = ChannelModel.build(setup, paths, (0, 1), TargetConfig(20.0, 0.0, 10.0, a),
                                        (0.0, delay))
-                ph = m.coherent_phases(probe_angles(*th))
+                ph = (0.0, float(m.pair_phase(probe_angles(*th))))
                 fast = m._solve_pair_closed(a, ph)
                 ref = m._solve_pair(a, ph, 12.0)
                 assert fast == pytest.approx(ref, rel=1e-6)
-                assert float(m.direction(m.weights([fast], ph))) == pytest.approx(a, abs=1e-8)
+                assert float(m.direction(m.pair_weights(fast, ph))) == pytest.approx(a, abs=1e-8)
 
 
 @pytest.mark.slow
@@ -417,7 +417,7 @@ def test_calibrated_delay_is_realisable_and_the_residual_is_reported(res_ps, fra
     multiples of the resolution, the RTS realises the chosen offset exactly on both probes'
     delays, the reported residual is the fit's optimum minus the chosen delay (at most half
     a step), and the chosen delay is the realisable one nearest the coherence point."""
-    from rtsgeom.calibration.pair import realisable
+    from rtsgeom.calibration.steps import realisable
     from rtsgeom.rts.channels import realised_delay, requested_delay
 
     def mutate(doc):
@@ -478,7 +478,7 @@ def test_fir_moves_the_calibrated_delay_by_its_predicted_shift(taps, radius_m):
     window-weighted phase of each channel's beat gain at the probe's bin). Before the sweep's
     fit took the filter's setting-dependent phase out (it cycles every 1/f_s, +-3.7 deg at the
     bin with 5 taps), the 5-tap calibration landed 33 ps off."""
-    from rtsgeom.calibration.pair import fir_effect
+    from rtsgeom.calibration.fir import fir_effect
     ideal, fir = _fir_pair(taps, radius_m)
     paths = exact_paths(ideal)
     probe = probe_front_ends(ideal, paths, 1)
@@ -500,10 +500,11 @@ def test_fir_changes_linearity_by_no_more_than_its_phase_ripple_explains(taps):
     on the ideal model (the error is second order in the phase near coherence). With 33 taps
     both are below 1e-5 deg. Before the fit and ``pair_design`` accounted for the setting-
     dependent phase, the 5-tap change was 0.041 deg, ten times this bound."""
-    from rtsgeom.calibration.pair import _mean_air_delay, fir_bin_gain
+    from rtsgeom.calibration.probes import mean_air_delay
+    from rtsgeom.calibration.fir import fir_bin_gain
     from rtsgeom.analysis.linearity import linearity
     from rtsgeom.pipeline.plan import pair_design
-    from rtsgeom.synthesis.closed_form import PairModel
+    from rtsgeom.synthesis.model import ChannelModel
     from rtsgeom.rts.channels import requested_delay
     from rtsgeom.scene import TargetConfig
     ideal, fir = _fir_pair(taps)
@@ -517,7 +518,7 @@ def test_fir_changes_linearity_by_no_more_than_its_phase_ripple_explains(taps):
     # the filter's phase at the bin over all its settings (one sample period of delay)
     scene = fir.scene
     rng = float(probe_ranges(fir, 1)[0])
-    tau = float(requested_delay(scene, rng)) + float(np.mean(_mean_air_delay(fir)))
+    tau = float(requested_delay(scene, rng)) + float(np.mean(mean_air_delay(fir)))
     d = float(requested_delay(scene, rng)) + np.linspace(0, 1 / scene.rts.f_s_hz, 64)
     psi = np.unwrap(np.angle(fir_bin_gain(scene, d, np.full(d.size, tau))))
     swing = float(np.ptp(psi))
@@ -527,9 +528,10 @@ def test_fir_changes_linearity_by_no_more_than_its_phase_ripple_explains(taps):
         t = TargetConfig(rng, 0.0, 10.0, float(a))
         _, _, rho, off_j = pair_design(ideal, paths, (0, 1), t, "exact", alphas,
                                        (0.0, c_i.delta_tau_s), probe.gain_correction[[0, 1]])
-        m = PairModel.build(ideal, paths, (0, 1), t, (0.0, off_j))
-        ph = m.coherent_phase(alphas)
-        worst = max(abs(float(m.angle(rho, ph + s)) - float(m.angle(rho, ph)))
+        m = ChannelModel.build(ideal, paths, (0, 1), t, (0.0, off_j))
+        ph = float(m.pair_phase(alphas))
+        worst = max(abs(float(m.direction(m.pair_weights(rho, (0.0, ph + s))))
+                        - float(m.direction(m.pair_weights(rho, (0.0, ph)))))
                     for s in np.linspace(-swing, swing, 9))
         assert abs(change[k]) <= np.degrees(worst) + 2e-5
     assert np.max(np.abs(change)) > 0  # the filter is in the chain
@@ -576,7 +578,7 @@ def test_probes_clear_each_others_cfar_window(samples, adc_rate_hz, training):
     now a RuntimeWarning)."""
     import warnings
 
-    from rtsgeom.calibration.pair import probe_ranges
+    from rtsgeom.calibration.probes import probe_ranges
 
     def small(doc):
         doc["radar"].pop("snr_db", None)

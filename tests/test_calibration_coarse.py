@@ -15,10 +15,11 @@ import numpy as np
 import pytest
 
 from conftest import make_scene
-from rtsgeom.calibration.pair import (calibrate_pair, coherence_point, continuous_delay_setup,
-                                      fine_window, probe_angles, probe_front_ends, probe_ranges,
-                                      realisable, realisation_shift)
-from rtsgeom.synthesis.closed_form import PairModel
+from rtsgeom.calibration.pair import calibrate_pair, coherence_point
+from rtsgeom.calibration.steps import (continuous_delay_setup, fine_window, realisable,
+                                       realisation_shift)
+from rtsgeom.calibration.probes import probe_angles, probe_front_ends, probe_ranges
+from rtsgeom.synthesis.model import ChannelModel
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.rts.channels import realised_delay, requested_delay
@@ -90,12 +91,12 @@ def test_continuous_model_equals_the_quantised_one_at_realisable_offsets(res_ps,
     res = res_ps * 1e-12
     for k in (-3, 0, 2):
         d = k * res
-        q = PairModel.build(s, paths, (0, 1), t, (0.0, d)).coherent_phase(alphas)
-        c_ = PairModel.build(cont, paths, (0, 1), t, (o, o + d)).coherent_phase(alphas)
+        q = ChannelModel.build(s, paths, (0, 1), t, (0.0, d)).pair_phase(alphas)
+        c_ = ChannelModel.build(cont, paths, (0, 1), t, (o, o + d)).pair_phase(alphas)
         assert np.angle(np.exp(1j * (q - c_))) == pytest.approx(0.0, abs=1e-6)
         # a third of a step further: the quantised model has not moved, the continuous one has
-        q2 = PairModel.build(s, paths, (0, 1), t, (0.0, d + res / 3)).coherent_phase(alphas)
-        c2 = PairModel.build(cont, paths, (0, 1), t, (o, o + d + res / 3)).coherent_phase(alphas)
+        q2 = ChannelModel.build(s, paths, (0, 1), t, (0.0, d + res / 3)).pair_phase(alphas)
+        c2 = ChannelModel.build(cont, paths, (0, 1), t, (o, o + d + res / 3)).pair_phase(alphas)
         assert np.angle(np.exp(1j * (q2 - q))) == pytest.approx(0.0, abs=1e-6)
         assert abs(np.angle(np.exp(1j * (c2 - c_)))) > 0.5 * 2 * np.pi * 1e9 * res / 3
 

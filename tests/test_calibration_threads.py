@@ -8,7 +8,8 @@ from __future__ import annotations
 import pytest
 from threadpoolctl import threadpool_limits
 
-from rtsgeom.calibration.pair import calibrate_pair, probe_front_ends
+from rtsgeom.calibration.pair import calibrate_pair
+from rtsgeom.calibration.probes import probe_front_ends
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.scene import load_scene

@@ -75,11 +75,14 @@ def test_calibrated_cell_reaches_its_directions_whatever_its_channel_offsets(
     can synthesize' at the cell's centre). Not at half a period (500 ps, 7.5 cm: half a
     range bin between the rows): there the elevation of (7, 0) deg and the centre are not
     reached (the detected elevation jumps across 0 as the rows' ratio grows; open)."""
-    from rtsgeom.calibration.channels import ChannelSet, tree_phases
+    from rtsgeom.calibration.channels import tree_phases
+    from rtsgeom.radar.steering import Steering
+    from rtsgeom.synthesis.model import ChannelModel
     from rtsgeom.scene import TargetConfig
     setup, paths = nominal_sphere4
     offs = np.array([0.0, offset_ps, 2.0, offset_ps + 35.0]) * 1e-12
-    cs = ChannelSet.build(setup, paths, (0, 1, 2, 3), TargetConfig(20.0), offs)
+    cs = ChannelModel.build(setup, paths, (0, 1, 2, 3), TargetConfig(20.0), offs,
+                            steering=Steering.auto(setup.rut, setup.scene.radar))
     u = cs.fe_directions().mean(axis=0) if u_set == "centre" else np.array(u_set)
     w = cs.solve(u, tree_phases(cs, [(0, 1), (0, 2), (1, 3)]))
     assert np.allclose(cs.direction_cosines(w, u), u, atol=1e-8)
@@ -105,7 +108,7 @@ CONSISTENT = {(0, 1): 29.0, (0, 2): 2.0, (0, 3): 31.0, (1, 3): 2.0, (2, 3): 29.0
 @pytest.mark.parametrize("closure_ps", [0.0, 20.0, 40.0, -120.0])
 def test_loop_closure_beyond_tolerance_is_a_warning_naming_the_pair(
         nominal_sphere4, monkeypatch, closure_ps):
-    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.calibration.probes import probe_front_ends
     from rtsgeom.calibration.channels import LOOP_CLOSURE_TOL_S, calibrate_channels
     setup, paths = nominal_sphere4
     delays = dict(CONSISTENT)
@@ -123,7 +126,7 @@ def test_loop_closure_beyond_tolerance_is_a_warning_naming_the_pair(
 
 def test_a_pair_that_fails_is_named_and_a_cell_it_disconnects_stops_the_run(
         nominal_sphere4, monkeypatch):
-    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.calibration.probes import probe_front_ends
     from rtsgeom.errors import CalibrationFailed
     from rtsgeom.calibration.channels import calibrate_channels
     from rtsgeom.pipeline.plan_cells import plan_cells
@@ -146,7 +149,7 @@ def test_run_says_the_calibration_failed_when_it_is_why_a_target_is_unreachable(
     calibration with warnings: the message says the calibration failed and why."""
     import rtsgeom.calibration.channels as ncal
     from rtsgeom.errors import AngleUnreachable
-    from rtsgeom.synthesis.nchannel import ChannelSet
+    from rtsgeom.synthesis.model import ChannelModel
     from rtsgeom.pipeline.plan_cells import plan_cells
     from rtsgeom.errors import SceneError
     setup, paths = nominal_sphere4
@@ -157,7 +160,7 @@ def test_run_says_the_calibration_failed_when_it_is_why_a_target_is_unreachable(
 
     def unreachable(self, *a, **k):
         raise AngleUnreachable("outside what this cell can synthesize")
-    monkeypatch.setattr(ChannelSet, "solve", unreachable)
+    monkeypatch.setattr(ChannelModel, "solve", unreachable)
     with pytest.raises(SceneError, match=r"calibration failed .*\(0, 3\)"):
         plan_cells(setup, paths, "exact")
 
@@ -177,8 +180,8 @@ def test_elevation_pair_calibrates_to_its_coherence_point_with_a_front_end_off(f
     -air/IF phase slope x 2 dr / c0 (~-258 ps per 0.5 mm), the phase by phi / (2 pi f_IF)."""
     from scipy.constants import c
 
-    from rtsgeom.calibration.pair import (air_phase_slope_hz, if_phase_slope_hz, probe_front_ends,
-                                          probe_ranges, probe_total_delay)
+    from rtsgeom.calibration.probes import (air_phase_slope_hz, if_phase_slope_hz, probe_front_ends,
+                                            probe_ranges, probe_total_delay)
     from rtsgeom.calibration.channels import calibrate_pair_nd, coherence_point_nd
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
@@ -208,7 +211,7 @@ def test_channel_offsets_are_taken_to_the_period_nearest_zero(nominal_sphere4, m
     """Pair delays add up along the tree to beyond half a period (180 deg on front end 1:
     channel 3 at -984 ps, its echo a whole range bin from the others); each channel's
     offset is wrapped to (-period/2, period/2], and the loop closures do not change."""
-    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.calibration.probes import probe_front_ends
     from rtsgeom.calibration.channels import calibrate_channels
     setup, paths = nominal_sphere4
     delays = {(0, 1): d01_ps, (0, 2): 2.0, (0, 3): d01_ps + d13_ps, (1, 3): d13_ps,

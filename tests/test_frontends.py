@@ -8,7 +8,7 @@ import pytest
 
 from rtsgeom.analysis.nearfield import (group_azimuth_rad, single_front_end_angles_rad,
                                         with_arc_radius)
-from rtsgeom.calibration.pair import probe_ranges
+from rtsgeom.calibration.probes import probe_ranges
 from rtsgeom.geometry import Setup, build_setup
 from rtsgeom.geometry.frontends import antenna_positions, front_ends, module_axes, radial_tangent
 from rtsgeom.geometry.arrays import rut_array

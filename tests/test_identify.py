@@ -10,7 +10,8 @@ import pytest
 
 from conftest import DEFAULT_SCENE
 from rtsgeom import identify as ident_mod
-from rtsgeom.calibration.pair import coherence_delay, probe_angles, probe_front_ends
+from rtsgeom.calibration.pair import coherence_delay
+from rtsgeom.calibration.probes import probe_angles, probe_front_ends
 from rtsgeom.cli import main
 from rtsgeom.paths import exact_paths
 from rtsgeom.scene import load_scene

@@ -12,7 +12,8 @@ import pytest
 
 from rtsgeom.synthesis import kernels
 from rtsgeom.calibration import sweep
-from rtsgeom.calibration.sweep import beam_derivatives, design_ratio, detected_bin_choice
+from rtsgeom.synthesis import pair as pair_design
+from rtsgeom.synthesis.pair import beam_derivatives, design_ratio, detected_bin_choice
 from rtsgeom.radar.steering import Steering, window
 
 WAVELENGTH = 3.9e-3
@@ -86,7 +87,7 @@ def test_design_puts_the_composite_peak_on_the_set_angle(v, win, uneven):
 
 @pytest.mark.parametrize("v,win,uneven", GRID[::2])
 def test_ratio_kernel_gives_the_definitions_bits(v, win, uneven, monkeypatch):
-    """``kernels.ratios`` (large batches) against ``sweep._ratios`` (numpy, the definition,
+    """``kernels.ratios`` (large batches) against ``pair_design._ratios`` (numpy, the definition,
     small batches), bit for bit: designs across the pair's span and beyond it
     (no root: NaN), J's phases, and degenerate beams (zero, a2 = 0, NaN, inf), through
     ratio_from_beams with either path forced."""
@@ -111,7 +112,7 @@ def test_ratio_kernel_gives_the_definitions_bits(v, win, uneven, monkeypatch):
     out = []
     for compiled in (True, False):
         monkeypatch.setattr(sweep, "use_kernels", lambda n, s: compiled)
-        out.append(sweep.ratio_from_beams(b_i, b_j, phase))
+        out.append(pair_design.ratio_from_beams(b_i, b_j, phase))
     np.testing.assert_array_equal(out[0], out[1])
     np.testing.assert_array_equal(np.signbit(out[0]), np.signbit(out[1]))
     fine = np.isfinite(out[0])
@@ -169,7 +170,7 @@ def test_numpy_definitions_are_as_silent_as_the_kernels():
     the compiled kernel (a RuntimeWarning must not depend on which path a process took)."""
     import warnings
 
-    from rtsgeom.calibration.sweep import _ratios
+    from rtsgeom.synthesis.pair import _ratios
     z = np.array([1e300 + 1e300j, np.inf + 0j, np.nan + 0j, 1 + 1j])
     with warnings.catch_warnings():
         warnings.simplefilter("error")

@@ -1,4 +1,4 @@
-"""``kernels.peak_1d`` against its definition (``radar.newton.peak_1d``, numpy), bit for bit:
+"""``radar.peak_kernels.peak_1d`` against its definition (``radar.newton.peak_1d``, numpy), bit for bit:
 the Newton peak (phasors from the array's lattice) is accepted iff it converged and its power
 is at least ``1 - P_SLACK`` of the largest power on the grid (each point's sum in element
 order), otherwise Newton restarts from the grid's maximum under the same test. The kernel may
@@ -15,7 +15,7 @@ import sys
 import numpy as np
 import pytest
 
-from rtsgeom.synthesis import kernels
+from rtsgeom.radar import peak_kernels as kernels
 from rtsgeom.radar import newton, steering as steering_mod
 from tests.test_kernels import plane, steering
 
@@ -129,7 +129,8 @@ def test_use_kernels_rents_numpy_until_numba_would_be_cheaper(monkeypatch):
     from rtsgeom._lib import util as _util
     monkeypatch.setattr(_util, "_numpy_s", 0.0)
     assert _util.use_kernels(1, 1.0)  # loaded here (this module imports them)
-    monkeypatch.delitem(sys.modules, "rtsgeom.synthesis.kernels")
+    for m in _util.KERNEL_MODULES:
+        monkeypatch.delitem(sys.modules, m, raising=False)
     half = _util.KERNEL_SETUP_S / 2
     assert not _util.use_kernels(1000, 0.4 * half / 1000)
     assert not _util.use_kernels(1000, 0.4 * half / 1000)

@@ -285,7 +285,7 @@ def test_a_front_end_lost_to_clipping_says_so():
     new-user trial got 'blocked line of sight' for a sheet reflection that clipped the ADC)."""
     import warnings
 
-    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.calibration.probes import probe_front_ends
     clipping = build_setup(make_scene(lambda d: linked_doc(d, {"adc_full_scale_dbm": -90.0})))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # the lost front end warns as well

@@ -15,7 +15,9 @@ from scipy.constants import c
 from conftest import make_scene
 from test_link import _setup_paths
 from rtsgeom.radar import budget, link as lk
-from rtsgeom.calibration.pair import TARGET_BIAS_PS, calibrate_pair, probe_front_ends
+from rtsgeom.calibration.steps import TARGET_BIAS_PS
+from rtsgeom.calibration.pair import calibrate_pair
+from rtsgeom.calibration.probes import probe_front_ends
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.rts.channels import program_nearest, setup_echoes
@@ -102,8 +104,9 @@ def test_predicted_angle_noise_follows_the_noise_figure(quiet_reference):
     amplitude (x 10^(5/20) per 5 dB, in the linear regime) and the coarse frames as its
     square; NF 12 dB keeps one frame per coarse step (the path before), NF 50 dB averages
     ~100 (one frame there: 1 deg of noise per step, a wrong minimum on 3 of 3 seeds)."""
-    from rtsgeom.calibration.pair import (COARSE_NOISE_DEG, coarse_frames, nominal_model,
-                                          predicted_angle_noise, probe_angles, probe_ranges)
+    from rtsgeom.calibration.steps import COARSE_NOISE_DEG, coarse_frames, predicted_angle_noise
+    from rtsgeom.paths import nominal_model
+    from rtsgeom.calibration.probes import probe_angles, probe_ranges
     from rtsgeom.calibration.sweep import phasor_sweep
     from rtsgeom.scene import TargetConfig
     probe, _ = quiet_reference

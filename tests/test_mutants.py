@@ -175,7 +175,7 @@ def test_probe_finds_each_front_end_at_the_model_angle_with_unit_gain_correction
     """Each front end alone, measured in the noise-free chain: at the exact model's angle of
     that front end (the beamformer peak of its own phasors), and with a gain correction of 1
     where the setup is the nominal one (the model then is the measurement)."""
-    from rtsgeom.calibration.pair import probe_front_ends, probe_ranges
+    from rtsgeom.calibration.probes import probe_front_ends, probe_ranges
     from rtsgeom.synthesis.model import ChannelModel
     from rtsgeom.scene import TargetConfig
     setup, paths = small_setup
@@ -266,7 +266,8 @@ def cal_setup():
 
 @pytest.fixture(scope="module")
 def calibrated(cal_setup):
-    from rtsgeom.calibration.pair import calibrate_pair, probe_front_ends
+    from rtsgeom.calibration.pair import calibrate_pair
+    from rtsgeom.calibration.probes import probe_front_ends
     setup, paths = cal_setup
     probe = probe_front_ends(setup, paths)
     return probe, calibrate_pair(setup, paths, (0, 1), probe)
@@ -277,7 +278,7 @@ def test_calibrate_pair_sweep_refinement_and_probes(cal_setup, calibrated):
     around the best point (9 points per level), the probe angles are the pair's 1/4 and 3/4
     points, and the calibrated pair is coherent: residual below 0.05 deg with the gain error
     corrected by the probe."""
-    from rtsgeom.calibration.pair import probe_angles
+    from rtsgeom.calibration.probes import probe_angles
     setup, paths = cal_setup
     probe, cal = calibrated
     assert probe.gain_correction[0] == pytest.approx(10 ** (-3 / 20), rel=0.02)
@@ -311,9 +312,9 @@ def test_linearity_sweeps_the_inner_span_and_reports_relative_amplitudes(cal_set
     amp_db = np.asarray(lin.amplitude_db)
     assert amp_db.max() == 0.0 and np.all(amp_db <= 0.0)
     # 20 log10 of the programmed amplitudes relative to the largest
-    from rtsgeom.calibration.pair import probe_angles
+    from rtsgeom.calibration.probes import probe_angles
     from rtsgeom.pipeline.plan import pair_design
-    from rtsgeom.calibration.pair import probe_ranges
+    from rtsgeom.calibration.probes import probe_ranges
     from rtsgeom.scene import TargetConfig
     rng = float(probe_ranges(setup, 1)[0])
     amps = np.array([pair_design(setup, paths, (0, 1), TargetConfig(rng, 0.0, 10.0, float(a)),
@@ -329,7 +330,7 @@ def test_linearity_sweeps_the_inner_span_and_reports_relative_amplitudes(cal_set
 @pytest.mark.parametrize("length", [1.0, 2.1, 2.9, 4.2])
 def test_probe_ranges_keep_clear_of_every_cable_ghost(length):
     """Probes m * step apart never sit within 4 range bins of a ghost k L / VF of another."""
-    from rtsgeom.calibration.pair import probe_ranges
+    from rtsgeom.calibration.probes import probe_ranges
     s = make_scene(lambda d: [fe.update(cable_length_m=length) for fe in d["rts"]["front_ends"]])
     setup = build_setup(s)
     r = probe_ranges(setup, 3)
@@ -355,16 +356,16 @@ def test_closed_forms_put_a_span_end_on_one_channel_alone(angles):
     cm = ChannelModel.build(setup, exact_paths(setup), (0, 1), TargetConfig(20.0))
     th = setup.fe_azimuth_rad()
     for mode in ("array-factor", "paper"):
-        assert cm.solve_ratio(float(th[0]), mode=mode) == 0.0
-        assert cm.solve_ratio(float(th[1]), mode=mode) == 1e12
-        assert 0.0 < cm.solve_ratio(float(th.mean()), mode=mode) < 1e12
+        assert cm.pair_ratio(float(th[0]), mode=mode) == 0.0
+        assert cm.pair_ratio(float(th[1]), mode=mode) == 1e12
+        assert 0.0 < cm.pair_ratio(float(th.mean()), mode=mode) < 1e12
 
 
 def test_pair_amplitudes_design_for_the_channel_delay_offsets():
     """``exact`` designs J's amplitude for its calibration delay (the range offset it causes):
     an offset of a whole period changes the ratio, by the model built with that delay."""
     from rtsgeom.pipeline.plan import pair_amplitudes
-    from rtsgeom.synthesis.closed_form import PairModel
+    from rtsgeom.synthesis.model import ChannelModel
     from rtsgeom.scene import TargetConfig
     setup = build_setup(small_quiet([], samples_per_chirp=512))
     paths = exact_paths(setup)
@@ -374,8 +375,8 @@ def test_pair_amplitudes_design_for_the_channel_delay_offsets():
     off = (0.0, 0.5e-9)
     a0 = pair_amplitudes(setup, paths, (0, 1), t, "exact", probes)
     a1 = pair_amplitudes(setup, paths, (0, 1), t, "exact", probes, off)
-    pm = PairModel.build(setup, paths, (0, 1), t, off)
-    rho = pm.solve(t.angle_rad, pm.coherent_phase(probes))
+    pm = ChannelModel.build(setup, paths, (0, 1), t, off)
+    rho = pm.pair_ratio(t.angle_rad, (0.0, float(pm.pair_phase(probes))))
     assert a1[2] == pytest.approx(rho, rel=1e-6)
     assert abs(a1[2] / a0[2] - 1) > 1e-3
 

@@ -110,7 +110,7 @@ def test_elevation_pair_frames_grow_as_snr_falls_and_it_stays_at_its_point(snr_d
     the fitted minimum by ~8 ps (~25 ps 10 dB below: the pairs landed -11 to +17 ps off
     at the scene's SNR); the frames chosen bring it within 5 ps of the continuous coherence
     point, and grow ~10x (1/SNR) with the 10 dB."""
-    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.calibration.probes import probe_front_ends
     from rtsgeom.calibration.channels import calibrate_pair_nd, coherence_point_nd
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
@@ -138,7 +138,7 @@ def test_elevation_pair_30_db_below_averages_its_coarse_sweep_too():
     COARSE_NOISE_DEG: the coarse sweep is measured again with the frames that bring it
     below (coarse_frames, the arc pair's rule), the fine sweep with thousands, and the pair
     still lands within 5 ps of its coherence point."""
-    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.calibration.probes import probe_front_ends
     from rtsgeom.calibration.steps import COARSE_NOISE_DEG
     from rtsgeom.calibration.channels import calibrate_pair_nd, coherence_point_nd
     from rtsgeom.geometry import build_setup

@@ -9,8 +9,9 @@ import pytest
 from rtsgeom.errors import CellUnreachable
 from rtsgeom.synthesis.cells import enclosing_cell
 from rtsgeom.errors import AngleUnreachable
+from rtsgeom.radar.steering import Steering
 from rtsgeom.synthesis.model import ChannelModel
-from rtsgeom.synthesis.nchannel import ChannelSet, closed_form_amplitudes
+from rtsgeom.synthesis.closed_form import closed_form_amplitudes
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.scene import TargetConfig, load_scene
@@ -53,21 +54,27 @@ def test_cells_grid(du):
 
 # -- the ideal far field: closed form against exact --------------------------------------------
 
-def ideal(cs: ChannelSet, u_fe):
-    """The channel set with ideal far-field responses: plane waves from ``u_fe`` (Q, D), all
-    in the centre candidate bin, no Doppler."""
+def cells(setup, paths, channels, target) -> ChannelModel:
+    """The channel model of ``channels`` seen by the beamformer the RuT runs (2-D here)."""
+    return ChannelModel.build(setup, paths, channels, target,
+                              steering=Steering.auto(setup.rut, setup.scene.radar))
+
+
+def ideal(cs: ChannelModel, u_fe):
+    """The channel model with ideal far-field responses: plane waves from ``u_fe`` (Q, D),
+    all in the centre candidate bin, no Doppler (the closed form told those directions)."""
     st = cs.steering
-    v = cs.model.responses.shape[-1]
+    v = cs.responses.shape[-1]
     x = np.zeros((3, len(u_fe), v), complex)
     x[1][:, st.mask] = np.exp(-1j * (st.wavevector @ np.asarray(u_fe).T)).T
-    return ChannelSet(dataclasses.replace(cs.model, responses=x, doppler_hz=0.0), np.asarray(u_fe))
+    return dataclasses.replace(cs, responses=x, doppler_hz=0.0, fe_u=np.asarray(u_fe))
 
 
 @pytest.mark.parametrize("cell", [(0, 1, 2, 3), (0, 1, 2), (0, 2, 3), (1, 2, 3)])
 @pytest.mark.parametrize("spread", [(0.08, 0.08), (0.15, 0.12), (0.05, 0.2)])
 def test_closed_form_equals_exact_in_ideal_far_field(sphere, cell, spread):
     scene, setup, paths = sphere
-    cs = ChannelSet.build(setup, paths, cell, scene.targets[0])
+    cs = cells(setup, paths, cell, scene.targets[0])
     corners = np.array([[0.0, 0.0], [0.0, 1.0], [1.0, 0.0], [1.0, 1.0]]) * spread + [0.05, -0.04]
     u_fe = corners[list(cell)]
     cs = ideal(cs, u_fe)
@@ -101,16 +108,18 @@ def test_closed_form_pair_is_paper_array_factor():
 
 
 def test_pair_is_the_n2_case():
-    """The 1-D pair through ChannelSet is ChannelModel's solve, bit for bit."""
+    """The 1-D pair's solve at direction cosines u is its closed form at arcsin u, bit for
+    bit, and puts the detected angle there."""
     scene = load_scene("scenes/diewald2022.toml")
     setup = build_setup(scene)
     paths = exact_paths(setup)
     t = scene.targets[0]
-    cs = ChannelSet.build(setup, paths, (0, 1), t)
     m = ChannelModel.build(setup, paths, (0, 1), t)
+    u = np.sin(t.angle_rad)
     for mode in ("exact", "array-factor", "paper"):
-        assert np.array_equal(cs.solve([np.sin(t.angle_rad)], mode=mode),
-                              m.solve(t.angle_rad, None, mode))
+        w = m.solve([u], mode=mode)
+        assert np.array_equal(w, m.pair_weights(m.pair_ratio(float(np.arcsin(u)), None, mode)))
+    assert float(m.direction(m.solve([u]))) == pytest.approx(t.angle_rad, abs=1e-8)
 
 
 # -- the bundled scene ------------------------------------------------------------------------
@@ -121,7 +130,7 @@ def test_exact_model_hits_cell_points(sphere):
     scene, setup, paths = sphere
     u_fe = setup.fe_direction_cosines()
     t = TargetConfig(25.0)
-    cs = ChannelSet.build(setup, paths, (0, 1, 2, 3), t)
+    cs = cells(setup, paths, (0, 1, 2, 3), t)
     lo, hi = u_fe.min(0), u_fe.max(0)
     for fx in (0.2, 0.5, 0.8):
         for fz in (0.15, 0.5, 0.85):

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from conftest import make_scene
-from rtsgeom.calibration.pair import calibrate_pair, probe_front_ends
+from rtsgeom.calibration.pair import calibrate_pair
+from rtsgeom.calibration.probes import probe_front_ends
 from rtsgeom.calibration.channels import calibrate_channels, calibrate_pair_nd
 from rtsgeom.pipeline.plan import plan_targets, uses_cells
 from rtsgeom.geometry import build_setup

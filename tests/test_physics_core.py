@@ -114,7 +114,7 @@ def test_probe_capture_round_trip(tmp_path, fmt, active):
     """A probe capture written (``.npy`` or DCA1000 ``.bin`` + sidecar) reads back with its
     active front end, probe range, velocity and amplitude, and the same samples (DCA1000:
     within int16 quantisation). The default probe is the calibration's first probe range."""
-    from rtsgeom.calibration.pair import probe_ranges
+    from rtsgeom.calibration.probes import probe_ranges
     from rtsgeom.geometry import build_setup
     from rtsgeom.identify.capture import (capture_probe, read_capture, simulate_capture,
                                           write_capture)

@@ -75,9 +75,9 @@ def test_fir_effect_predicts_the_coherence_shift_in_picoseconds(taps):
     phasor model with the filter against without it at fractional delay settings across a
     period: the least-squares gain measured / predicted is 1 within 30 % (first order in
     the filter's phase ripple), and a short filter shifts the point measurably."""
-    from rtsgeom.calibration.pair import (fir_effect, if_phase_slope_hz, probe_ranges,
-                                          probe_total_delay)
-    from rtsgeom.synthesis.closed_form import PairModel
+    from rtsgeom.calibration.fir import fir_effect
+    from rtsgeom.calibration.probes import if_phase_slope_hz, probe_ranges, probe_total_delay
+    from rtsgeom.synthesis.model import ChannelModel
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     from rtsgeom.scene import TargetConfig
@@ -90,9 +90,9 @@ def test_fir_effect_predicts_the_coherence_shift_in_picoseconds(taps):
     for d in (0.1e-9, 0.37e-9, 0.63e-9, 0.81e-9):
         z = 0j
         for r in ranges:
-            m0 = PairModel.build(ideal, paths, (0, 1), TargetConfig(float(r)), (0.0, d))
-            m1 = PairModel.build(fir, paths, (0, 1), TargetConfig(float(r)), (0.0, d))
-            z += np.exp(1j * (m1.coherent_phase([0.1]) - m0.coherent_phase([0.1])))
+            m0 = ChannelModel.build(ideal, paths, (0, 1), TargetConfig(float(r)), (0.0, d))
+            m1 = ChannelModel.build(fir, paths, (0, 1), TargetConfig(float(r)), (0.0, d))
+            z += np.exp(1j * (m1.pair_phase([0.1]) - m0.pair_phase([0.1])))
         measured.append(np.degrees(np.angle(z)))
         predicted.append(fir_effect(fir, d)["predicted_shift_ps"] * 1e-12 * 360 * f_if)
     m, p = np.array(measured), np.array(predicted)
@@ -188,7 +188,8 @@ def test_nd_pair_calibration_lands_on_the_coherence_point(fe, dr_mm):
     phasor model's coherence point for a radial offset that puts the point half a coarse
     step (100 ps) off the sweep grid, on either front end; its period is 1/(f_rts + S t_mid
     - S tau) as the pair calibration's."""
-    from rtsgeom.calibration.pair import coherence_delay, probe_angles, probe_front_ends
+    from rtsgeom.calibration.pair import coherence_delay
+    from rtsgeom.calibration.probes import probe_angles, probe_front_ends
     from rtsgeom.calibration.channels import calibrate_pair_nd
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
@@ -212,7 +213,7 @@ def test_nd_pair_calibration_lands_on_the_coherence_point(fe, dr_mm):
 
 
 def test_channel_calibration_of_one_channel_is_its_own_reference():
-    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.calibration.probes import probe_front_ends
     from rtsgeom.calibration.channels import calibrate_channels
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
@@ -249,7 +250,7 @@ def test_2d_error_map_exact_mode_puts_every_grid_point_on_its_direction():
     assert 0.05 < max(af.max_abs_error_deg()) < 1.0
 
 
-# -- aoa.nchannel: the closed form does not depend on a common phase -------------------------
+# -- the N-channel closed form does not depend on a common phase -------------------------
 
 
 @pytest.mark.parametrize("common", [0.0, 0.7, -2.1, 3.0])
@@ -257,12 +258,15 @@ def test_closed_form_amplitudes_ignore_a_common_phase(common):
     """Adding one phase to every channel's programmed phase changes nothing physical (the
     beamformer output rotates as a whole): the ``array-factor`` amplitudes on sphere4's four
     front ends are the same for phases + c as for phases, over set points in the cell."""
-    from rtsgeom.synthesis.nchannel import ChannelSet, closed_form_amplitudes
+    from rtsgeom.radar.steering import Steering
+    from rtsgeom.synthesis.model import ChannelModel
+    from rtsgeom.synthesis.closed_form import closed_form_amplitudes
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     from rtsgeom.scene import TargetConfig, load_scene
     setup = build_setup(load_scene("scenes/sphere4.toml"))
-    cs = ChannelSet.build(setup, exact_paths(setup), (0, 1, 2, 3), TargetConfig(25.0))
+    cs = ChannelModel.build(setup, exact_paths(setup), (0, 1, 2, 3), TargetConfig(25.0),
+                            steering=Steering.auto(setup.rut, setup.scene.radar))
     st = cs.steering
     u_fe = setup.fe_direction_cosines()
     lo, hi = u_fe.min(0), u_fe.max(0)
@@ -283,7 +287,7 @@ def test_measured_end_angles_equal_geometric_ones_in_the_ideal_far_field(mode):
     """In the ideal far field (50 m, no Rx/Tx separation) each front end alone is detected
     at its geometric angle, so the closed forms with measured end angles program the same
     ratios as with the geometric ones: the same detected angles through the chain."""
-    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.calibration.probes import probe_front_ends
     from rtsgeom.analysis.linearity import linearity
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
@@ -331,7 +335,8 @@ def test_paper_procedure_reports_the_exact_period_at_its_target():
     1/(f_rts + S t_mid - S tau) at its target's delay, as the pair calibration does at its
     probes' (not eq. 27's 1/(f_rts + B/2))."""
     from scipy.constants import c
-    from rtsgeom.calibration.pair import calibrate_pair_paper, probe_front_ends, probe_ranges
+    from rtsgeom.calibration.pair import calibrate_pair_paper
+    from rtsgeom.calibration.probes import probe_front_ends, probe_ranges
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     for f_rts in (500e6, 300e6):
@@ -347,7 +352,7 @@ def test_paper_procedure_reports_the_exact_period_at_its_target():
         assert cal.period_s == pytest.approx(1 / (f_rts + s * t_mid - s * tau), rel=1e-4)
 
 
-# -- aoa.sweep.design_ratio: the closed-form exact design ------------------------------------
+# -- aoa.pair_design.design_ratio: the closed-form exact design ------------------------------------
 
 
 @pytest.mark.parametrize("angle_window", ["none", "hann", "hamming", "blackman"])
@@ -358,7 +363,7 @@ def test_closed_form_design_is_scale_free_and_puts_the_peak_on_the_set_angle(ang
     angle. Its beamformer peak is there (searched), and the ratio does not depend on the
     echoes' common scale (volts or sqrt(W), 1e-6 or 1e6: P'' < 0 is a sign, not a level)."""
     from rtsgeom.synthesis.model import ChannelModel
-    from rtsgeom.calibration.sweep import design_ratio
+    from rtsgeom.synthesis.pair import design_ratio
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     from rtsgeom.scene import TargetConfig
@@ -371,7 +376,7 @@ def test_closed_form_design_is_scale_free_and_puts_the_peak_on_the_set_angle(ang
     st = cm.steering
     x_i, x_j = cm.phasors
     th = np.sort(st.search(cm.phasors))
-    phase = float(cm.coherent_phases(th[0] + np.array([0.25, 0.75]) * (th[1] - th[0]))[1])
+    phase = float(cm.pair_phase(th[0] + np.array([0.25, 0.75]) * (th[1] - th[0])))
     alphas = th[0] + np.array([0.15, 0.4, 0.6, 0.85]) * (th[1] - th[0])
     rho = design_ratio(st, x_i, x_j, alphas, phase)
     assert np.all(np.isfinite(rho)) and np.all(rho >= 0)
@@ -394,7 +399,8 @@ def test_calibration_sweep_noise_is_the_adc_chains_within_a_factor_of_a_few(snr_
     noise realisation in both); they agree within a
     factor 5 (measured: the phasor model's is 1.4-1.5 times the chain's at SNR -10 and 0 dB),
     where a noise level off by the windows' sum w^2 (thousands) would not."""
-    from rtsgeom.calibration.pair import calibrate_pair, probe_front_ends
+    from rtsgeom.calibration.pair import calibrate_pair
+    from rtsgeom.calibration.probes import probe_front_ends
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
 
@@ -431,7 +437,7 @@ def test_fir_effect_reports_its_filter_and_a_small_passband_ripple(taps):
     """``fir_effect`` names the filter it evaluated ("none" without a fractional delay, where
     nothing ripples) and a windowed-sinc FIR's gain ripple along the chirp's IF sweep: a
     passband ripple, positive and below 1 dB from 9 taps on, that a twice as long filter does not increase."""
-    from rtsgeom.calibration.pair import fir_effect
+    from rtsgeom.calibration.fir import fir_effect
     from rtsgeom.geometry import build_setup
     fir = fir_effect(build_setup(_fir_scene(taps, "windowed-sinc")), 0.37e-9)
     assert fir["model"] == "windowed-sinc"

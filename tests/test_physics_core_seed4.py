@@ -229,8 +229,9 @@ def test_pair_calibration_places_its_probes_over_the_fine_window_and_reports_its
     """Step 2 of ``calibrate_pair``: the probes' ranges are where ``sweep.place_probes`` puts
     them for the window +-period/4 around the coarse minimum (the fine sweep's centre), not
     for one delay of it; a noiseless sweep averages one frame per step, ``frames`` sets it."""
-    from rtsgeom.calibration.pair import (calibrate_pair, nominal_model, probe_angles,
-                                          probe_front_ends, probe_ranges)
+    from rtsgeom.calibration.pair import calibrate_pair
+    from rtsgeom.paths import nominal_model
+    from rtsgeom.calibration.probes import probe_angles, probe_front_ends, probe_ranges
     from rtsgeom.calibration.sweep import place_probes
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
@@ -331,7 +332,7 @@ def test_channel_calibration_depends_on_the_seed_modulo_2_to_the_32(seed):
     """``scene.seed`` may be up to 2^63 - 1; every noise draw of the calibration (the pair
     sweeps and the residual check at the cell centre) takes it modulo 2^32, so seeds 2^32
     apart give the same calibration and residual, and neighbouring seeds different noise."""
-    from rtsgeom.calibration.pair import probe_front_ends
+    from rtsgeom.calibration.probes import probe_front_ends
     from rtsgeom.calibration.channels import calibrate_channels
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths

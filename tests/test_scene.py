@@ -111,7 +111,7 @@ def test_cli_choices_are_the_registries():
               ("linearity", "amplitudes"): SYNTHESIS_MODES}
     for k, v in expect.items():
         assert found[k] == v, (k, found[k])
-    from rtsgeom.synthesis.closed_form import MODES
+    from rtsgeom.scene.registry import MODES
     assert MODES == SYNTHESIS_MODES
 
 

@@ -8,7 +8,7 @@ import numpy as np
 from hypothesis import given, settings, strategies as st
 from scipy.constants import c
 
-from rtsgeom.synthesis.closed_form import PairModel
+from rtsgeom.synthesis.model import ChannelModel
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.radar import synthesize
@@ -28,7 +28,7 @@ def _chain():
 @lru_cache(maxsize=None)
 def _pair_model(delta_ps: int = 0):
     setup, paths, _ = _chain()
-    return PairModel.build(setup, paths, (0, 1), TargetConfig(20.0), (0.0, delta_ps * 1e-12))
+    return ChannelModel.build(setup, paths, (0, 1), TargetConfig(20.0), (0.0, delta_ps * 1e-12))
 
 
 @settings(max_examples=20, deadline=None)
@@ -49,7 +49,7 @@ def test_adc_cube_is_linear_in_echo_amplitude(k, phase):
 def test_synthesized_angle_is_monotone_in_the_amplitude_ratio(log_rhos_centi):
     m = _pair_model()
     rho = np.exp(np.sort(np.asarray(log_rhos_centi)) / 100.0)  # ratios 0.0025 .. 400
-    angles = m.angle(rho, m.coherent_phase(np.radians([6.0, 10.0])))
+    angles = m.direction(m.pair_weights(rho, (0.0, float(m.pair_phase(np.radians([6.0, 10.0]))))))
     assert np.all(np.diff(angles) > 0)  # more of front end J (at 12.2 deg) -> larger angle
 
 
@@ -63,8 +63,8 @@ def test_calibration_phase_repeats_every_period(delta_ps, k):
     t_mid = r.adc_start_s + 0.5 * (r.samples_per_chirp - 1) / r.adc_rate_hz
     period = 1 / (setup.scene.rts.f_rts_hz + r.slope_hz_per_s * (t_mid - 2 * 20.0 / c))
     probes = np.radians([6.0, 10.0])
-    a = _pair_model(delta_ps).coherent_phase(probes)
-    shifted = PairModel.build(setup, _chain()[1], (0, 1), TargetConfig(20.0),
+    a = _pair_model(delta_ps).pair_phase(probes)
+    shifted = ChannelModel.build(setup, _chain()[1], (0, 1), TargetConfig(20.0),
                               (0.0, delta_ps * 1e-12 + k * period))
-    b = shifted.coherent_phase(probes)
+    b = shifted.pair_phase(probes)
     assert abs(np.degrees(np.angle(np.exp(1j * (b - a))))) < 0.5

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from rtsgeom.analysis.tolerance.driver import PairPhasors
-from rtsgeom.synthesis.closed_form import PairModel
+from rtsgeom.synthesis.model import ChannelModel
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.radar.processing import angle_spectrum, estimate_angles, refine_angles
@@ -104,18 +104,18 @@ def windowed(request):
     scene = make_scene(angle_window=request.param)
     setup = build_setup(scene)
     tol = PairPhasors.build(setup, (0, 1), points=3)
-    pm = PairModel.build(tol.setup, exact_paths(tol.setup), (0, 1), TargetConfig(tol.range_m))
+    pm = ChannelModel.build(tol.setup, exact_paths(tol.setup), (0, 1), TargetConfig(tol.range_m))
     return tol, pm
 
 
 def test_tolerance_and_channel_model_share_the_coherent_phase(windowed):
-    """The phase the tolerance study calibrates to and the one the channel model (PairModel,
+    """The phase the tolerance study calibrates to and the one the channel model (ChannelModel,
     used by the calibration and the exact mode) designs for are the same for every angle
     window (before issue 21 only the tolerance model applied the taper: 0.030 deg apart with
     hamming on the default scene)."""
     tol, pm = windowed
     a = float(tol.coherence_phase(tol.x_nominal))
-    b = pm.coherent_phase(tol.probe_rad)
+    b = float(pm.pair_phase(tol.probe_rad))
     assert abs(np.degrees(np.angle(np.exp(1j * (a - b))))) < 1e-9
 
 
@@ -127,7 +127,7 @@ def test_coherent_phase_maximises_the_radars_own_beam(windowed):
     rut, radar = pm.setup.rut, pm.setup.scene.radar
     x = tol.x_nominal
     for probe in tol.probe_rad:
-        phi = pm.coherent_phase(np.array([probe]))
+        phi = float(pm.pair_phase(np.array([probe])))
         p = [angle_spectrum(x[0] + np.exp(1j * (phi + d)) * x[1], rut, radar,
                             np.array([probe]))[0] for d in (-1e-4, 0.0, 1e-4)]
         assert p[1] > p[0] and p[1] > p[2]

@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from rtsgeom.synthesis.closed_form import PairModel
+from rtsgeom.synthesis.model import ChannelModel
 from rtsgeom.analysis.tolerance.driver import (CASES, NOMINAL_AMPLITUDES, PairPhasors, draw_offsets,
                                                max_sigma_for_yield, monte_carlo)
 from rtsgeom.cli import main
@@ -66,7 +66,7 @@ def test_refine_angles_agrees_with_the_grid_search(model):
 
 def test_phasor_model_matches_bin_response_on_drawn_setups(scene, model):
     """Per element and channel, the first-order phasor against the exact spectrum
-    (``bin_response`` through PairModel) of the drawn setup, with and without the
+    (``bin_response`` through ChannelModel) of the drawn setup, with and without the
     calibration delay on channel J. The neglected terms are the range window's curvature
     (quadratic in the echo's sub-bin shift S dtau N / f_adc ~ 4e-3 bins here: ~1e-5) and
     -S dtau^2/2."""
@@ -79,7 +79,8 @@ def test_phasor_model_matches_bin_response_on_drawn_setups(scene, model):
         k = int(model.calibration_steps(x))
         assert k != 0
         for delta in (0.0, k * res):
-            pm = PairModel.build(setup, paths, (0, 1), TargetConfig(model.range_m), (0.0, delta))
+            pm = ChannelModel.build(setup, paths, (0, 1), TargetConfig(model.range_m),
+                                    (0.0, delta))
             exact = tdm_compensate(pm.responses[1], 0.0, setup.rut, scene.radar)
             want = x.copy()
             if delta:
@@ -92,19 +93,19 @@ def test_phasor_model_matches_bin_response_on_drawn_setups(scene, model):
 def test_design_puts_the_set_points_on_their_angles(model):
     """The one channel model's design (``solve`` and ``amplitudes`` for the calibrated phase):
     each set-point's combined target is detected at its set angle and is as strong at its peak
-    as one channel alone (the target keeps its RCS); the PairModel view of the same engine
-    (used by the calibration and the exact mode) gives the same ratios."""
+    as one channel alone (the target keeps its RCS); the pair's closed form of the same
+    engine (used by the calibration and the exact mode) gives the same ratios."""
     ch = model.channels
-    w = model.amplitudes * np.exp(1j * ch.coherent_phases(model.probe_rad))  # (M, 2)
+    w = model.amplitudes * np.exp(1j * ch.coherent_phases(ch.steering.directions(model.probe_rad)))
     assert np.max(np.abs(np.degrees(ch.direction(w) - model.set_rad))) < 1e-5
     st = ch.steering
     p_set = np.diagonal(st.power(ch.snapshot(w), st.directions(model.set_rad)))
     single = ch.snapshot(np.array([ch.unit_gain, 0.0]))
     p_one = st.power(single, st.directions(np.array([st.search(single)])))[0]
     assert np.allclose(p_set, p_one, rtol=1e-9)
-    pm = PairModel(ch)
+    phases = (0.0, float(ch.pair_phase(model.probe_rad)))
     for m in (0, 7, 20):
-        rho = pm.design(float(model.set_rad[m]), model.probe_rad)[2]
+        rho = ch.pair_ratio(float(model.set_rad[m]), phases)
         assert model.amplitudes[m, 1] / model.amplitudes[m, 0] == pytest.approx(rho, rel=1e-9)
 
 
@@ -115,14 +116,14 @@ def test_redesign_for_the_delay_matches_pair_model(model):
     pm_paths = exact_paths(model.setup)
     rut, radar = model.setup.rut, model.setup.scene.radar
     for k in (150, -400):
-        pm = PairModel.build(model.setup, pm_paths, (0, 1), TargetConfig(model.range_m),
-                             (0.0, k * model.delay_resolution_s))
+        pm = ChannelModel.build(model.setup, pm_paths, (0, 1), TargetConfig(model.range_m),
+                                (0.0, k * model.delay_resolution_s))
         delayed = tdm_compensate(pm.responses[1], 0.0, rut, radar)
         phase = float(model.coherence_phase(delayed))
         gain = 1 / abs(model.delay_factor[k + model.max_steps][rut.azimuth_mask].mean())
         assert gain > 1.0  # the echo left the bin centre
         for m in (0, 10, 20):
-            rho = pm.solve(float(model.set_rad[m]), phase)
+            rho = pm.pair_ratio(float(model.set_rad[m]), (0.0, phase))
             mine = model.amplitudes[m, 1] * gain / model.amplitudes[m, 0]
             assert mine == pytest.approx(rho, rel=1e-4)
 

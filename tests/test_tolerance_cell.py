@@ -55,7 +55,7 @@ def test_zero_sigma_gives_the_nominal_design(model):
     """No mounting error: the design hits its set directions on the nominal model with the
     calibration's phases (1e-6 deg, both angles); uncalibrated is that model read with the
     channels' own phases (the direction of sum a_q x_q, independently through
-    ``ChannelSet.direction``); calibrated misses only by the delay quantisation (< 3e-3 deg)."""
+    ``ChannelModel.direction``); calibrated misses only by the delay quantisation (< 3e-3 deg)."""
     cs = model.cells
     n_q = len(model.cell)
     got = errors_deg(model, np.zeros((1, n_q, 3)))

@@ -123,12 +123,13 @@ def far_model(request):
     setup = build_setup(scene)
     cm = ChannelModel.build(setup, exact_paths(setup), (0, 1), TargetConfig(20.0))
     th = setup.fe_azimuth_rad()
-    phases = cm.coherent_phases(th[0] + np.array([0.25, 0.75]) * (th[1] - th[0]))
+    phases = (0.0, float(cm.pair_phase(th[0] + np.array([0.25, 0.75]) * (th[1] - th[0]))))
     return request.param, cm, np.linspace(th[0], th[1], 7)[1:-1], phases
 
 
 def _worst_deg(cm, alphas, phases, mode):
-    return max(abs(np.degrees(cm.direction(cm.solve(a, phases, mode)) - a)) for a in alphas)
+    return max(abs(np.degrees(cm.direction(cm.pair_weights(cm.pair_ratio(a, phases, mode), phases))
+                              - a)) for a in alphas)
 
 
 def test_exact_mode_puts_every_set_point_on_its_angle(far_model):
@@ -153,7 +154,8 @@ def test_paper_mode_is_exact_only_at_the_midpoint(far_model):
     err = _worst_deg(cm, alphas, phases, "paper")
     assert 0.1 < err < 0.35
     mid = float(np.mean(cm.setup.fe_azimuth_rad()))
-    mid_err = abs(np.degrees(cm.direction(cm.solve(mid, phases, "paper")) - mid))
+    mid_err = abs(np.degrees(cm.direction(cm.pair_weights(cm.pair_ratio(mid, phases, "paper"),
+                                                          phases)) - mid))
     if window_name == "none":
         assert mid_err < 0.05
 
@@ -236,9 +238,9 @@ def test_exact_mode_hits_the_set_angle_in_the_near_field_for_every_taper(angle_w
     for delay in (0.0, 150e-12):
         cm = ChannelModel.build(setup, paths, (0, 1), TargetConfig(20.0), (0.0, delay))
         th = np.sort(cm.steering.search(cm.phasors))
-        phases = cm.coherent_phases(th[0] + np.array([0.25, 0.75]) * (th[1] - th[0]))
+        phases = (0.0, float(cm.pair_phase(th[0] + np.array([0.25, 0.75]) * (th[1] - th[0]))))
         for a in th[0] + np.array([0.1, 0.35, 0.6, 0.9]) * (th[1] - th[0]):
-            w = cm.solve(a, phases, "exact")
+            w = cm.pair_weights(cm.pair_ratio(a, phases, "exact"), phases)
             assert float(cm.direction(w)) == pytest.approx(a, abs=1e-8)
 
 
@@ -246,12 +248,14 @@ def test_exact_mode_hits_the_set_angle_in_the_near_field_for_every_taper(angle_w
 def test_n_channel_exact_mode_hits_cell_points_for_every_taper(angle_window):
     """The N-channel exact mode (sphere4, four front ends in azimuth and elevation): the
     modelled 2-D peak at each set point inside the cell, for every angle window."""
-    from rtsgeom.synthesis.nchannel import ChannelSet
+    from rtsgeom.radar.steering import Steering
+    from rtsgeom.synthesis.model import ChannelModel
     from rtsgeom.scene import load_scene
     scene = load_scene("scenes/sphere4.toml")
     scene = scene.evolve(radar=scene.radar.evolve(angle_window=angle_window))
     setup = build_setup(scene)
-    cs = ChannelSet.build(setup, exact_paths(setup), (0, 1, 2, 3), TargetConfig(25.0))
+    cs = ChannelModel.build(setup, exact_paths(setup), (0, 1, 2, 3), TargetConfig(25.0),
+                            steering=Steering.auto(setup.rut, scene.radar))
     u_fe = setup.fe_direction_cosines()
     lo, hi = u_fe.min(0), u_fe.max(0)
     for fx, fz in ((0.2, 0.5), (0.5, 0.15), (0.8, 0.85), (0.5, 0.5)):
@@ -267,7 +271,8 @@ def test_coherence_point_moves_by_the_closed_form_for_every_taper(angle_window, 
     -(f_c + S t_mid - S tau) / (f_rts + S t_mid - S tau) * 2 dr / c0 for a radial offset dr
     of front end J (the opposite way for I), whatever the angle window: the taper weights the
     elements, not the channels' relative phase."""
-    from rtsgeom.calibration.pair import coherence_delay, probe_front_ends
+    from rtsgeom.calibration.pair import coherence_delay
+    from rtsgeom.calibration.probes import probe_front_ends
 
     def scene(offsets=None):
         def mutate(doc):

@@ -14,6 +14,9 @@ _BLAS_CONTROLLER = None
 #: its import (~0.2 s) and its target's set-up on the first call of a cached kernel (~0.3 s),
 #: quiet 2-core machine
 KERNEL_SETUP_S = 0.5
+#: the compiled kernels (numba): once one is loaded, numba's set-up is paid
+KERNEL_MODULES = ("rtsgeom.radar.peak_kernels", "rtsgeom.synthesis.kernels",
+                  "rtsgeom.analysis.tolerance.kernels")
 _numpy_s = 0.0  # what this process has spent so far in the kernels' numpy definitions (est.)
 
 
@@ -25,7 +28,7 @@ def use_kernels(n: int, numpy_s_per_item: float) -> bool:
     before that (ski rental: a command with a few thousand snapshots, ``calibrate``, never
     pays for numba; one with millions pays at most 0.25 s of numpy before it does)."""
     global _numpy_s
-    if "rtsgeom.synthesis.kernels" in sys.modules:
+    if any(m in sys.modules for m in KERNEL_MODULES):
         return True
     if _numpy_s + n * numpy_s_per_item > KERNEL_SETUP_S / 2:
         return True

@@ -139,7 +139,7 @@ def _min_cutout_spacing_rad(scene: Scene, radius_m: float) -> float:
 def _detected_rad(variant: Scene) -> tuple[np.ndarray, np.ndarray]:
     """Each front end alone as the RuT detects it and its module's geometric azimuth, both
     seen from the RuT (radians): their difference is the near-field bias."""
-    from ..calibration.pair import probe_ranges
+    from ..calibration.probes import probe_ranges
     from .nearfield import single_front_end_angles_rad
     setup = build_setup(variant)
     rng = float(probe_ranges(setup, 1)[0])

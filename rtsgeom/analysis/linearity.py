@@ -13,8 +13,8 @@ from ..paths import Paths
 from ..rts.channels import RtsProgram, requested_delay
 from ..scene import TargetConfig
 from ..radar.processing import nearest_detection
-from ..calibration.pair import (Calibration, FrontEndProbe, simulate_detect, probe_angles,
-                                probe_ranges)
+from ..calibration.pair import Calibration
+from ..calibration.probes import FrontEndProbe, simulate_detect, probe_angles, probe_ranges
 from ..pipeline.plan import pair_design
 
 __all__ = ["Linearity", "linearity"]
@@ -53,22 +53,22 @@ def _closed_form_measured(setup, paths, pair, target, mode, probe, offsets, corr
     """``paper`` / ``array-factor`` amplitudes with the front ends' *measured* angles (each
     alone as the RuT detects it, as the paper's angles were "determined by measurement")
     in the closed form, instead of their geometric azimuths."""
-    from ..calibration.pair import nominal_model
-    from ..synthesis.closed_form import (PairModel, array_factor_args, ratio_array_factor,
-                                         ratio_paper)
+    from ..paths import nominal_model
+    from ..synthesis.model import ChannelModel
+    from ..synthesis.closed_form import array_factor_args, ratio_array_factor, ratio_paper
     i, j = pair
     th = probe.angle_rad[[i, j]]
     alpha = target.angle_rad
     nom, nom_paths = nominal_model(setup, paths)
-    model = PairModel.build(nom, nom_paths, pair, target, offsets)
+    model = ChannelModel.build(nom, nom_paths, pair, target, offsets)
     if mode == "paper":
         rho = float(ratio_paper(th[0], th[1], alpha))
     else:  # the RuT's own beamformer (taper, repeated elements), as the geometric reading
         rho = float(ratio_array_factor(th[0], th[1], alpha,
-                                       **array_factor_args(model.model.steering)))
+                                       **array_factor_args(model.steering)))
     rho = float(np.clip(rho, 0.0, 1e12))
-    phase = model.coherent_phase(probe_angles(*th))
-    a_i, a_j = model.amplitudes(rho, alpha, phase)
+    phase = float(model.pair_phase(probe_angles(*th)))
+    a_i, a_j = model.amplitudes(model.pair_weights(rho, (0.0, phase)), np.sin([alpha]))
     return a_i * corr[0], a_j * corr[1], rho
 
 

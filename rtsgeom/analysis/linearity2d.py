@@ -15,8 +15,9 @@ from ..radar.processing import nearest_detection
 from ..radar.steering import Steering
 from ..rts.channels import RtsProgram, requested_delay
 from ..scene import TargetConfig
-from ..calibration.pair import simulate_detect, nominal_model, probe_front_ends, probe_ranges
-from ..synthesis.nchannel import ChannelSet
+from ..calibration.probes import simulate_detect, probe_front_ends, probe_ranges
+from ..paths import nominal_model
+from ..synthesis.model import ChannelModel
 
 __all__ = ["ErrorMap", "cell_grid", "linearity_grid"]
 
@@ -85,7 +86,7 @@ def linearity_grid(setup: Setup, paths: Paths, mode: str = "exact", n: int = 5,
     if calibrate:
         cal = calibrate_channels(setup, paths, cell, probe, seed, progress)
         offsets, tree = cal.offsets_s, cal.tree
-    cs = ChannelSet.build(nom, nom_paths, cell, target0, offsets[list(cell)])
+    cs = ChannelModel.build(nom, nom_paths, cell, target0, offsets[list(cell)], steering=st)
     grid = cell_grid(st, cs.fe_directions(), n)
     phases = None if tree is None else tree_phases(cs, tree)
     corr = probe.gain_correction[list(cell)] if calibrate else np.ones(len(cell))

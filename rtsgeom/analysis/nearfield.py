@@ -6,7 +6,7 @@ For a sweep of arc radii (front-end angles kept) and per front end:
 
 (a) **Single front-end bias.** The angle the RuT detects one front end alone at, minus its
     geometric angle (module centre seen from the RuT phase centre), at phasor level with the
-    exact geometry (``radar.phasors.bin_response`` through :class:`~rtsgeom.synthesis.closed_form.PairModel`,
+    exact geometry (``radar.phasors.bin_response`` through :class:`~rtsgeom.synthesis.model.ChannelModel`,
     TDM compensation, ``estimate_angles``). It is split into closed-form parts:
 
     * ``separation``: the front end's own Rx/Tx split, far-field closed form
@@ -45,7 +45,7 @@ its bias is reported in both angles (the azimuth part split into the same closed
 (x, z); (c) the synthesized angle is checked over a grid of set directions inside each cell
 of front ends (the one cell of 3 or 4 front ends, else the Delaunay triangles of their
 direction cosines) with the ``array-factor`` closed form in 2-D and ``exact`` peak matching
-(``aoa.nchannel.ChannelSet``), errors in both angles. The 1-D analysis is the D = 1 case: the
+(``synthesis.model.ChannelModel``), errors in both angles. The 1-D analysis is the D = 1 case: the
 cells are the adjacent pairs and the fit a line.
 
 The Fraunhofer distance ``2 d_A^2 / lambda`` of the virtual aperture is reported alongside: at
@@ -62,10 +62,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.constants import c
 
-from ..calibration.pair import nominal_model, probe_angles, probe_ranges
+from ..paths import nominal_model
+from ..calibration.probes import probe_angles, probe_ranges
 from ..synthesis.model import ChannelModel
 from ..errors import AngleUnreachable
-from ..synthesis.closed_form import PairModel
 from ..errors import ParameterError
 from ..geometry import RutArray, Setup, build_setup
 from ..geometry.setup import nominal_scene
@@ -245,8 +245,8 @@ def synthesis_worst_errors_deg(setup: Setup, paths: Paths, pair: tuple[int, int]
     i, j = pair
     target = TargetConfig(float(range_m))
     nom, nom_paths = nominal_model(setup, paths)
-    design = PairModel.build(nom, nom_paths, pair, target)
-    actual = design if nom is setup else PairModel.build(setup, paths, pair, target)
+    design = ChannelModel.build(nom, nom_paths, pair, target)
+    actual = design if nom is setup else ChannelModel.build(setup, paths, pair, target)
     geo = nom.fe_azimuth_rad()[[i, j]]
     meas = np.sort(single_rad[[i, j]])
     lo, hi = max(meas[0], np.min(geo)), min(meas[1], np.max(geo))
@@ -259,15 +259,16 @@ def synthesis_worst_errors_deg(setup: Setup, paths: Paths, pair: tuple[int, int]
     sets = lo + np.arange(1, points + 1) / (points + 1) * (hi - lo)
     err = {"array-factor": [], "exact": []}
     probes = probe_angles(*single_rad[[i, j]])
-    design_phase, phase = design.coherent_phase(probes), actual.coherent_phase(probes)
+    design_phase, phase = float(design.pair_phase(probes)), float(actual.pair_phase(probes))
     for a in sets:
-        rho_af = design.solve(a, design_phase, mode="array-factor")
+        rho_af = design.pair_ratio(a, (0.0, design_phase), "array-factor")
         try:
-            rho_ex = design.solve(a, design_phase)
+            rho_ex = design.pair_ratio(a, (0.0, design_phase))
         except AngleUnreachable:
             rho_ex = np.nan
         for mode, rho in (("array-factor", rho_af), ("exact", rho_ex)):
-            det = float(actual.angle(rho, phase)) if np.isfinite(rho) else np.nan
+            det = (float(actual.direction(actual.pair_weights(rho, (0.0, phase))))
+                   if np.isfinite(rho) else np.nan)
             err[mode].append(np.degrees(det - a))
     worst = {m: float(np.nanmax(np.abs(e))) if np.any(np.isfinite(e)) else None
              for m, e in err.items()}

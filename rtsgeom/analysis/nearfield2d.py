@@ -8,7 +8,7 @@ import dataclasses
 
 import numpy as np
 
-from ..calibration.pair import nominal_model
+from ..paths import nominal_model
 from ..errors import AngleUnreachable
 from ..synthesis.model import ChannelModel
 from ..geometry import Setup
@@ -48,11 +48,12 @@ def cell_synthesis_errors_deg(setup: Setup, paths: Paths, cell, range_m: float,
     dropped (as ``linearity --grid``). Design on the nominal setup, detection on the setup as
     built."""
     from scipy.spatial import Delaunay
-    from ..synthesis.nchannel import ChannelSet
     target = TargetConfig(float(range_m))
     nom, nom_paths = nominal_model(setup, paths)
-    design = ChannelSet.build(nom, nom_paths, cell, target)
-    actual = design if nom is setup else ChannelSet.build(setup, paths, cell, target)
+    st = Steering.auto(nom.rut, setup.scene.radar)
+    design = ChannelModel.build(nom, nom_paths, cell, target, steering=st)
+    actual = (design if nom is setup
+              else ChannelModel.build(setup, paths, cell, target, steering=st))
     st = design.steering
     u_fe = design.fe_directions()
     ang = st.angles(u_fe)

@@ -36,7 +36,7 @@ from ..radar.processing import nearest_detection
 from ..radar.steering import Steering
 from ..rts.channels import RtsProgram, requested_delay
 from ..scene import TargetConfig
-from ..synthesis.nchannel import ChannelSet
+from ..synthesis.model import ChannelModel
 from ..errors import CalibrationFailed
 
 __all__ = ["CalibrationFailed", "ChannelCalibration", "coherence_point_nd", "crossing_columns", "calibrate_channels", "calibrate_pair_nd", "pair_edges",
@@ -113,15 +113,18 @@ def _pair_probes(setup, paths, pair, probe, delta_s: float = 0.0, p_ref: dict | 
     gain in the bin with it; a design fixed at delta = 0 made each probe's error curve
     lopsided about the coherence point (its vertex 50 to 70 ps off in elevation, sphere4).
     ``p_ref``: a dict the sweep keeps across its steps, probe -> channel i's single-channel
-    peak power (``ChannelSet.reference_power``; channel i does not move with delta, so one
+    peak power (``ChannelModel.reference_power``; channel i does not move with delta, so one
     2-D grid search a probe instead of one a step)."""
-    from .pair import nominal_model, probe_ranges
+    from ..paths import nominal_model
+    from .probes import probe_ranges
     nom, nom_paths = nominal_model(setup, paths)
     ranges = probe_ranges(setup, 2)
     corr = probe.gain_correction[list(pair)]
     designs, predicted = [], []
+    st = Steering.auto(nom.rut, setup.scene.radar)
     for p, (r, rho) in enumerate(zip(ranges, PROBE_RATIOS)):
-        cs = ChannelSet.build(nom, nom_paths, pair, TargetConfig(float(r)), (0.0, delta_s))
+        cs = ChannelModel.build(nom, nom_paths, pair, TargetConfig(float(r)), (0.0, delta_s),
+                                steering=st)
         u_mid = cs.fe_directions().mean(axis=0)
         ph = cs.coherent_phases(u_mid[None])
         w = cs.weights([1.0, rho], ph)
@@ -165,18 +168,21 @@ def coherence_point_nd(setup, paths, pair, probe, near_s: float = 0.0,
     (``calsteps.continuous_delay_setup``). The D-dimensional counterpart of
     ``calibration.coherence_point`` (the point the sweep should find; a check, since a lab
     does not know the setup as built). Newton with slope ``2 pi if_phase_slope_hz``."""
-    from .pair import if_phase_slope_hz, probe_total_delay
+    from .probes import if_phase_slope_hz, probe_total_delay
     from .steps import continuous_delay_setup
     ranges, _, predicted, _ = _pair_probes(setup, paths, pair, probe)
     f_if = float(if_phase_slope_hz(setup.scene, probe_total_delay(setup, ranges)))
     period = 1.0 / f_if
     cont = continuous_delay_setup(setup)
 
+    st = Steering.auto(cont.rut, setup.scene.radar)
+
     def phase(d):
         z = 0j
         for r, u in zip(ranges, predicted):
-            cs = ChannelSet.build(cont, paths, pair, TargetConfig(float(r)), (0.0, d))
-            b = cs.steering.beam(cs.model.phasors, np.atleast_2d(u))[:, 0]
+            cs = ChannelModel.build(cont, paths, pair, TargetConfig(float(r)), (0.0, d),
+                                    steering=st)
+            b = cs.steering.beam(cs.phasors, np.atleast_2d(u))[:, 0]
             z += b[0] * np.conj(b[1]) / max(abs(b[0] * np.conj(b[1])), 1e-300)
         return float(np.angle(z))
 
@@ -207,8 +213,9 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     again with the frames it needs); the phasor sweep's closed-form design, bin logic and
     probe placement are 1-D so far. Raises :class:`CalibrationFailed` when no probe is
     detected at any step."""
-    from .pair import (simulate_detect, calibrate_pair, if_phase_slope_hz, nominal_model,
-                       probe_total_delay)
+    from .probes import simulate_detect, if_phase_slope_hz, probe_total_delay
+    from .pair import calibrate_pair
+    from ..paths import nominal_model
     from .steps import (coarse_frames, coarse_minimum, fine_frames, fine_window, fit_scatter,
                         realisable, rms_error_deg, sweep_phase, adds_noise)
     from .sweep import fit_minimum
@@ -349,7 +356,7 @@ def _points(t, e) -> list[dict]:
 def calibrate_channels(setup, paths, channels, probe, seed=None, progress=None,
                        span_s=None, step_s=None) -> ChannelCalibration:
     """Delay offsets of ``channels`` relative to the lowest of them (module doc)."""
-    from .pair import nominal_model
+    from ..paths import nominal_model
     scene = setup.scene
     seed = scene.seed if seed is None else seed
     nom, nom_paths = nominal_model(setup, paths)
@@ -424,17 +431,17 @@ def spanning_tree(u_fe, edges, ref: int) -> list[tuple[int, int]]:
     return [(int(pred[q]), int(q)) for q in order[1:]]
 
 
-def tree_phases(cs: ChannelSet, tree, phasors=None) -> np.ndarray:
+def tree_phases(cs: ChannelModel, tree, phasors=None) -> np.ndarray:
     """The channel phases (Q,) a calibration along ``tree`` [(i, j)] (front-end indices,
     parent first) establishes on the channel set ``cs``: each pair coherent at the midpoint
     of its front ends' directions, where its probes sat (``coherent_phases`` of the pair),
     added up from the reference; channels not on the tree keep phase 0. ``phasors``
     (..., Q, V): the channels as built (e.g. a tolerance draw's, ``ChannelModel.perturbed``;
-    the probes stay at the nominal directions), default ``cs.model.phasors``: (..., Q)."""
-    ch = list(cs.model.channels)
+    the probes stay at the nominal directions), default ``cs.phasors``: (..., Q)."""
+    ch = list(cs.channels)
     pos = {q: k for k, q in enumerate(ch)}
     u = cs.fe_directions()
-    x = cs.model.phasors if phasors is None else np.asarray(phasors)
+    x = cs.phasors if phasors is None else np.asarray(phasors)
     ph = np.zeros(x.shape[:-1])
     for i, j in tree:
         if i not in pos or j not in pos:
@@ -449,10 +456,10 @@ def tree_phases(cs: ChannelSet, tree, phasors=None) -> np.ndarray:
 def _residual(setup, paths, nom, nom_paths, ch, offsets, probe, st, seed, tree):
     """(azimuth, elevation) error (deg) of one target at the channels' centre, synthesized by
     all of them with the calibrated offsets (exact mode)."""
-    from .pair import simulate_detect, probe_ranges
+    from .probes import simulate_detect, probe_ranges
     from ..errors import AngleUnreachable
     r = float(probe_ranges(setup, 1)[0])
-    cs = ChannelSet.build(nom, nom_paths, tuple(ch), TargetConfig(r), offsets[ch])
+    cs = ChannelModel.build(nom, nom_paths, tuple(ch), TargetConfig(r), offsets[ch], steering=st)
     u = cs.fe_directions().mean(axis=0)
     try:
         w = cs.solve(u, tree_phases(cs, tree))

@@ -41,13 +41,13 @@ def fir_effect(setup, delta_tau_s: float, base_offsets=(0.0, 0.0), ranges=None) 
     predicts, the mean over the probes of ``(phi_I - phi_J) / (2 pi f_if)``, phi the
     range-window-weighted phase of each channel's beat-signal gain (what the range DFT sees
     at the target's bin, :func:`fir_bin_gain`), f_if = 1 / period."""
-    from .pair import _mean_air_delay, if_phase_slope_hz, probe_ranges, probe_total_delay
+    from .probes import mean_air_delay, if_phase_slope_hz, probe_ranges, probe_total_delay
     scene = setup.scene
     model = scene.rts.fractional_delay_filter if scene.rts.fractional_delay else "none"
     rng = probe_ranges(setup, 2) if ranges is None or len(ranges) == 0 else np.asarray(ranges)
     base = requested_delay(scene, rng)  # (2,) one per probe
     delays = np.concatenate([base + base_offsets[0], base + base_offsets[1] + delta_tau_s])
-    tau = np.concatenate([requested_delay(scene, rng)] * 2) + np.mean(_mean_air_delay(setup))
+    tau = np.concatenate([requested_delay(scene, rng)] * 2) + np.mean(mean_air_delay(setup))
     g = fir_if_gain(scene, delays, tau)  # (4, N): I of both probes, then J of both
     if g is None:
         return {"model": model, "gain_ripple_db": 0.0, "phase_ripple_deg": 0.0,
@@ -71,7 +71,7 @@ def fir_sweep_phase(setup, ranges, deltas, base_offsets, continuous: bool = Fals
     model of ``calibration.continuous_delay_setup``). It cycles with the setting every
     1/f_s, which the RTS's designer knows; the fit of the sweep takes it out
     (``sweep.fit_minimum``). None for an ideal delay."""
-    from .pair import _mean_air_delay
+    from .probes import mean_air_delay
     scene = setup.scene
     rts = scene.rts
     if not fir_modelled(scene):
@@ -80,7 +80,7 @@ def fir_sweep_phase(setup, ranges, deltas, base_offsets, continuous: bool = Fals
     def realise(t):
         return realised_delay(t, rts.f_s_hz, rts.fractional_delay, rts.fractional_delay_step_s)
     base = requested_delay(scene, np.asarray(ranges, float))  # (P,)
-    air = float(np.mean(_mean_air_delay(setup)))
+    air = float(np.mean(mean_air_delay(setup)))
     d = np.asarray(deltas, float)
     g_i = fir_bin_gain(scene, realise(base + base_offsets[0]), base + air)  # (P,)
     if continuous:

@@ -16,8 +16,6 @@ The delay offset also moves channel J's echo in range ("Disadvantages"): the rep
 
 from __future__ import annotations
 
-import warnings
-
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,49 +23,21 @@ from scipy.constants import c
 
 from .._lib.util import frozen, one_blas_thread
 from ..geometry import Setup
-from ..geometry.farfield import two_way_lengths
-from ..geometry.setup import nominal_setup
-from ..paths import Paths, exact_paths
-from ..radar import process
+from ..paths import Paths, nominal_model
 from ..radar.processing import nearest_detection
-from ..radar.frame import simulate
 from ..rts.channels import RtsProgram, realised_delay, requested_delay
 from ..scene import TargetConfig
-from .steps import (COARSE_NOISE_DEG, FINE_STEP_S, MAX_FRAMES, MC_DRAWS, MIN_FIT_POINTS,
-                    TARGET_BIAS_PS, coarse_frames, continuous_delay_setup, fine_frames, fine_window,
-                    predicted_angle_noise, realisable, realisation_shift, sweep_phase,
-                    rms_error_deg, coarse_minimum, adds_noise)
-from .fir import fir_bin_gain, fir_effect, fir_sweep_phase  # noqa: F401 (re-exported)
-from ..synthesis.closed_form import PairModel
+from ..synthesis.closed_form import ratio_paper
+from ..synthesis.model import ChannelModel
+from .probes import (FrontEndProbe, if_phase_slope_hz, mean_air_delay, probe_angles,
+                     probe_front_ends, probe_ranges, probe_total_delay, simulate_detect)
+from .steps import (adds_noise, coarse_frames, coarse_minimum, continuous_delay_setup, fine_frames,
+                    fine_window, predicted_angle_noise, realisable, rms_error_deg, sweep_phase,
+                    FINE_STEP_S, MC_DRAWS)
+from .sweep import chain_errors, fit_minimum, phasor_sweep, place_probes
 
-__all__ = ["Calibration", "FrontEndProbe", "probe_front_ends", "calibrate_pair", "probe_ranges",
-           "if_phase_slope_hz", "air_phase_slope_hz", "coherence_delay", "coherence_point",
-           "CoherencePoint", "continuous_delay_setup", "probe_total_delay",
-           "TARGET_BIAS_PS", "calibrate_pair_paper", "fir_effect",
-           "fir_bin_gain", "realisable", "predicted_angle_noise", "coarse_frames", "realisation_shift", "sweep_phase", "fine_window"]
-
-
-@dataclass(frozen=True)
-class FrontEndProbe:
-    """Each front end alone, as the RuT detects it."""
-
-    angle_rad: np.ndarray  # (F,) detected azimuth
-    power_db: np.ndarray  # (F,) detected range-Doppler power
-    gain_correction: np.ndarray  # (F,) multiply the programmed amplitude by this
-    adc_clipped: int = 0  # samples the ADC clipped in the probe frame (with [radar.link])
-
-    def clipping_note(self) -> str:
-        """Why a front end may be missing: the probe frame's ADC clipping, if any."""
-        return clipping_note(self.adc_clipped)
-
-
-def clipping_note(clipped: int) -> str:
-    """A clause for a 'not detected' message when the ADC clipped ``clipped`` samples."""
-    if not clipped:
-        return ""
-    return (f"; the ADC clipped {clipped} samples of the probe frame (a setup echo above full "
-            "scale, e.g. the sheet's reflection: add an absorber, sheet.reflection_loss_db or "
-            "[[structure]] reflection_loss_db, or lower the gain in [radar.link])")
+__all__ = ["Calibration", "CoherencePoint", "coherence_point", "coherence_delay",
+           "calibrate_pair", "calibrate_pair_paper"]
 
 
 @dataclass(frozen=True)
@@ -136,30 +106,6 @@ class Calibration:
                    int(d.get("coarse_frames_per_step", 1)))
 
 
-def if_phase_slope_hz(scene, tau_s) -> np.ndarray:
-    """d(phase)/d(tau_rts) / 2 pi of an echo of total delay ``tau_s`` at the ADC window's
-    centre: ``f_rts + S t_mid - S tau`` (eq. 8 at t = t_mid; eq. 27 is its approximation
-    f_rts + B/2). Its inverse is the exact period of the calibration sweep."""
-    radar = scene.radar
-    return (scene.rts.f_rts_hz + (radar.f_center_hz - radar.f_c_hz)
-            - radar.slope_hz_per_s * np.asarray(tau_s, float))
-
-
-def air_phase_slope_hz(scene, tau_s) -> np.ndarray:
-    """d(phase)/d(tau_c) / 2 pi of the same echo: ``f_c + S t_mid - S tau`` (the over-the-air
-    delay acts at RF). A radial offset dr moves the coherence point by
-    ``-air_phase_slope_hz / if_phase_slope_hz * 2 dr / c0``."""
-    radar = scene.radar
-    return radar.f_center_hz - radar.slope_hz_per_s * np.asarray(tau_s, float)
-
-
-def probe_total_delay(setup: Setup, ranges) -> float:
-    """Mean total delay tau = tau_c + tau_rts of probe targets at ``ranges`` (what sets the
-    beat frequency S tau)."""
-    return float(np.mean(requested_delay(setup.scene, np.asarray(ranges, float)))
-                 + np.mean(_mean_air_delay(setup)))
-
-
 @dataclass(frozen=True)
 class CoherencePoint:
     """The pair's phase-coherence point on the continuous delay model and the delay the RTS
@@ -205,8 +151,8 @@ def coherence_point(setup: Setup, paths: Paths, pair: tuple[int, int], alphas,
     def phase(d):
         z = 0j
         for t, (o_i, o_j) in zip(targets, base):
-            m = PairModel.build(cont, paths, pair, t, (o_i, o_j + d))
-            z += np.exp(1j * m.coherent_phase(alphas))
+            m = ChannelModel.build(cont, paths, pair, t, (o_i, o_j + d))
+            z += np.exp(1j * float(m.pair_phase(alphas)))
         return float(np.angle(z))
 
     d = float(near_s)
@@ -224,95 +170,6 @@ def coherence_delay(setup: Setup, paths: Paths, pair: tuple[int, int], alphas,
     """The continuous coherence point of :func:`coherence_point` (seconds)."""
     return coherence_point(setup, paths, pair, alphas, near_s, base_offsets,
                            iterations).continuous_s
-
-
-def probe_angles(theta_i: float, theta_j: float) -> tuple[float, float]:
-    """Calibration probes at a quarter and three quarters of the span between two front ends."""
-    return theta_i + 0.25 * (theta_j - theta_i), theta_i + 0.75 * (theta_j - theta_i)
-
-
-def probe_ranges(setup: Setup, n: int) -> np.ndarray:
-    """Ranges for n simultaneous probe targets: distinct, away from the setup, and clear of
-    each other's cable ghosts (at multiples of L / VF behind each probe), which would otherwise
-    leak into a neighbour's bin and bias its angle."""
-    scene = setup.scene
-    radar = scene.radar
-    r0 = max(0.2 * radar.max_range_m, scene.rts.arc_radius_m + 2.0)
-    ghosts = [k * fe.cable_length_m / fe.cable_velocity_factor for fe in scene.rts.front_ends
-              if fe.return_loss_fe_db is not None and fe.return_loss_be_db is not None
-              for k in range(1, 6)]
-    clear = 4 * radar.range_resolution_m
-    # Apart by more than the CFAR window in range (guard + training cells): a probe inside a
-    # neighbour's training cells raises that one's noise estimate, and on a coarse cube
-    # (128 samples: 8 bins = 4.8 m) one probe went undetected.
-    cfar_cells = radar.cfar.guard_cells[0] + radar.cfar.training_cells[0] + 2
-    step = max(max(8, cfar_cells) * radar.range_resolution_m, 3.0)
-    while any(abs(m * step - g) < clear for g in ghosts for m in range(1, n)):
-        step += radar.range_resolution_m
-    return r0 + step * np.arange(n)
-
-
-def simulate_detect(setup, paths, program, seed, frames: int = 1, clipped: bool = False):
-    """One radar output: the coherent average of ``frames`` frames of a static RTS program.
-
-    The K frames carry the same noise-free cube and independent receiver noise, so their
-    average is that cube plus noise of power N0 / K: simulated as one frame at an SNR
-    10 log10(K) dB higher, which has exactly the distribution of the average and costs one
-    frame. With ``[radar.link]`` (no ``snr_db``) the same: the link's noise power / K."""
-    snr = setup.scene.radar.snr_db
-    if snr is not None and frames > 1:
-        snr = snr + 10 * np.log10(frames)
-    _, cube = simulate(setup, paths, program, seed, snr, noise_frames=frames)
-    rd, det = process(cube)
-    return (rd, det, int(cube.clipped)) if clipped else (rd, det)
-
-
-@one_blas_thread
-def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe:
-    """Each front end alone at its own probe range (one simulated frame): measured angle and
-    power; the gain correction equalises measured against modelled power. BLAS on one
-    thread, as :func:`calibrate_pair`."""
-    scene = setup.scene
-    n = setup.fe.count
-    ranges = probe_ranges(setup, n)
-    design, design_paths = nominal_model(setup, paths)
-    model_p = np.empty(n)
-    amps = np.empty(n)
-    for q in range(n):
-        j = (q + 1) % n if n > 1 else q
-        m = PairModel.build(design, design_paths, (q, j), TargetConfig(float(ranges[q])))
-        model_p[q] = np.max(np.sum(np.abs(m.responses[:, 0]) ** 2, axis=-1))
-        amps[q] = m.unit_gain
-    prog = RtsProgram.build(np.arange(n), np.arange(n), requested_delay(scene, ranges),
-                            np.zeros(n), amps)
-    rd, det, n_clip = simulate_detect(setup, paths, prog, seed, clipped=True)
-    ang = np.full(n, np.nan)
-    pw = np.full(n, np.nan)
-    for q in range(n):
-        k = nearest_detection(det, rd, ranges[q])
-        if k is not None:
-            ang[q], pw[q] = det.angle_rad[k], det.power_db[k]
-    missed = [q for q in range(n) if not np.isfinite(ang[q])]
-    if missed:  # not silently: its angle is NaN and its gain correction falls back to 1
-        warnings.warn(f"front end(s) {missed} not detected alone at the probe range(s) "
-                      f"{np.round(ranges[missed], 3).tolist()} m (below the CFAR threshold or "
-                      "beyond the range axis): their measured angle is NaN and their gain "
-                      "correction 1" + clipping_note(n_clip),
-                      RuntimeWarning, stacklevel=2)
-    meas = 10 ** (pw / 10) / amps ** 2
-    corr = np.sqrt(model_p / meas)
-    return FrontEndProbe(ang, pw, np.where(np.isfinite(corr), corr, 1.0), n_clip)
-
-
-def _probe_program(design, pair, base, delta):
-    """Both probes on both channels; channel J delayed by ``delta`` more."""
-    tg, fe, dl, amp = [], [], [], []
-    for k, (a_i, a_j) in enumerate(design):
-        tg += [k, k]
-        fe += list(pair)
-        dl += [base[k][0], base[k][1] + delta]
-        amp += [a_i, a_j]
-    return RtsProgram.build(tg, fe, dl, np.zeros(len(tg)), amp)
 
 
 @one_blas_thread
@@ -346,7 +203,6 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
     one thread also makes the bits independent of the machine's core count (with threads,
     the sweep's errors moved in their 15th digit; the chosen delay and residual did not).
     """
-    from .sweep import chain_errors, fit_minimum, phasor_sweep, place_probes
     scene = setup.scene
     rts = scene.rts
     i, j = pair
@@ -416,7 +272,7 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
                            corr)
     e_conf = chain_errors(setup, paths, pair, targets, confirm, base_offsets, n_frames, seed)[0]
     best_err = float(rms_error_deg(e_conf)[0])
-    air = _mean_air_delay(setup)
+    air = mean_air_delay(setup)
     range_offset = 0.5 * c * ((air[j] + base_offsets[1] + best) - (air[i] + base_offsets[0]))
     return Calibration(pair, float(best), best_err, float(range_offset), frozen(grid),
                        frozen(errs), frozen(np.asarray(fine_t)), frozen(np.asarray(fine_e)),
@@ -424,22 +280,6 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
                        n_frames, frame_noise, "full-chain" if full_chain else "phasor",
                        tuple(float(r) for r in ranges), noise * 1e12, float(best_fit - best),
                        float(res), int(k_coarse))
-
-
-def nominal_model(setup: Setup, paths: Paths) -> tuple[Setup, Paths]:
-    """The nominal setup and its paths (the ones given when the setup has no errors)."""
-    nom = nominal_setup(setup)
-    if nom is setup:
-        return setup, paths
-    if paths.method == "exact":
-        return nom, exact_paths(nom)
-    from ..paths.raytrace import raytrace_paths
-    return nom, raytrace_paths(nom)
-
-
-def _mean_air_delay(setup: Setup) -> np.ndarray:
-    """Mean over virtual elements of each front end's two-way line-of-sight delay."""
-    return two_way_lengths(setup.rut, setup.fe.rx, setup.fe.tx).mean(axis=1) / c
 
 
 def calibrate_pair_paper(setup: Setup, paths: Paths, pair: tuple[int, int],
@@ -457,7 +297,6 @@ def calibrate_pair_paper(setup: Setup, paths: Paths, pair: tuple[int, int],
     the exact model at every step and uses two probes; with fixed amplitudes the optimum
     is where the *fixed* design happens to hit the set angle, which need not be the
     coherence point (docs/paper-comparison.md)."""
-    from ..synthesis.closed_form import ratio_paper
     scene = setup.scene
     rts = scene.rts
     i, j = pair
@@ -467,7 +306,7 @@ def calibrate_pair_paper(setup: Setup, paths: Paths, pair: tuple[int, int],
     alpha = float(np.mean(th)) if set_angle_rad is None else float(set_angle_rad)
     rng = float(probe_ranges(setup, 1)[0])
     target = TargetConfig(rng, 0.0, 10.0, alpha)
-    unit = PairModel.build(nom, nom_paths, pair, target).unit_gain
+    unit = ChannelModel.build(nom, nom_paths, pair, target).unit_gain
     rho = float(ratio_paper(th[0], th[1], alpha))
     amp = (unit * probe.gain_correction[i], unit * rho * probe.gain_correction[j])
     tau = float(requested_delay(scene, rng))
@@ -486,7 +325,7 @@ def calibrate_pair_paper(setup: Setup, paths: Paths, pair: tuple[int, int],
     res = rts.delay_resolution_s
     best = float(realisable(grid[k], res))  # the grid's steps are multiples unless the
     # scene's calibration_step_ps is not (validate warns)
-    air = _mean_air_delay(setup)
+    air = mean_air_delay(setup)
     range_offset = 0.5 * c * ((air[j] + best) - air[i])
     period = 1.0 / float(if_phase_slope_hz(scene, probe_total_delay(setup, [rng])))
     deg = float(np.degrees(alpha))

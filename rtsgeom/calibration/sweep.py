@@ -35,157 +35,12 @@ from ..radar.steering import Steering, window
 from ..rts.channels import KIND_DIRECT, RtsProgram, channel_echoes, requested_delay
 from ..scene import TargetConfig
 from ..synthesis.model import ChannelModel
+from ..synthesis.pair import beam_derivatives, design_ratio
 
-__all__ = ["design_ratio", "beam_derivatives", "ratio_from_beams", "design_at_detected_bin", "detected_bin_choice", "SweepResult", "phasor_sweep", "fit_minimum", "HALF_BINS",
-           "place_probes", "chain_errors"]
+__all__ = ["SweepResult", "phasor_sweep", "fit_minimum", "HALF_BINS", "place_probes",
+           "chain_errors"]
 
 HALF_BINS = 3  # candidate bins either side of the set range's bin (J moves <= ~2 bins)
-
-
-def beam_derivatives(st: Steering, x, u):
-    """Beamformer output b(u) and its first two derivatives in u at directions ``u`` (...,)
-    for snapshots ``x`` (..., V) (D = 1): three arrays (...,)."""
-    w = st.weighted(x)  # (..., V_s)
-    k = st.wavevector[:, 0]  # (V_s,)
-    e = np.exp(1j * k * np.asarray(u)[..., None])
-    y = w * e
-    return y.sum(-1), (1j * k * y).sum(-1), (-(k * k) * y).sum(-1)
-
-
-def design_ratio(st: Steering, x_i, x_j, alpha_rad, phase=0.0):
-    """The exact amplitude design in closed form: the ratio rho >= 0 (...,) for which the
-    beamformer peak of ``x_i + rho e^{j phase} x_j`` (snapshots (..., V)) lies at
-    ``alpha_rad``.
-
-    With b_q(u) the channels' beam responses at u = sin(alpha), the peak condition
-    dP/du = 0, P = |b_I + rho y|^2 (y = e^{j phase} b_J), is the quadratic
-    ``Re(b_I* b_I') + rho Re(b_I* y' + y* b_I') + rho^2 Re(y* y') = 0``; of its non-negative
-    roots the one where P is a maximum (P'' < 0) with the larger P. NaN where none is (the
-    angle is outside the pair's span). Agrees with the root finder on the searched peak
-    (``ChannelModel.solve``) to its tolerance (tested). A smoothed Capon or MUSIC
-    (``Steering.smoothing``) has no such closed form: ``model.estimator_ratio`` solves it on
-    the estimator's own peak."""
-    if st.smoothing:
-        from ..synthesis.model import estimator_ratio
-        return estimator_ratio(st, x_i, x_j, alpha_rad, phase)
-    u = np.sin(np.asarray(alpha_rad, float))
-    return ratio_from_beams(beam_derivatives(st, x_i, u), beam_derivatives(st, x_j, u), phase)
-
-
-def ratio_from_beams(beam_i, beam_j, phase=0.0):
-    """:func:`design_ratio` from the channels' beam responses and their first two derivatives
-    in u at the set direction, ``(b, b', b'')`` each (...,) (e.g. gathered from a table),
-    broadcast with ``phase``: rho (...).
-
-    P, dP/du and d2P/du2 of ``b_I + rho y`` are quadratics in rho with real coefficients
-    (``Re(conj(f) g)`` of the beams), formed once; the roots and the maximum test are then
-    real arithmetic (:func:`_ratios`, the definition), compiled per set-point for large
-    batches (``rtsgeom.synthesis.kernels.ratio_one``, the same bits: the Monte-Carlo studies call it for
-    millions of set-points; small batches numpy, without numba's import:
-    ``rtsgeom._lib.util.use_kernels``)."""
-    arrs = np.broadcast_arrays(*(np.asarray(b, complex) for b in (*beam_i, *beam_j)),
-                               np.exp(1j * np.asarray(phase, float)))
-    flat = [np.ascontiguousarray(a).reshape(-1) for a in arrs]
-    if not use_kernels(flat[0].size, 2e-7):  # numpy ~0.2 us per set-point (measured)
-        return _ratios(*flat).reshape(arrs[0].shape)
-    from ..synthesis.kernels import ratios
-    out = np.empty(arrs[0].shape)
-    ratios(*flat, out.reshape(-1))
-    return out
-
-
-@np.errstate(all="ignore")  # as silent as the compiled kernel (radar/newton.py)
-def _ratios(bi, bi1, bi2, bj, bj1, bj2, e):
-    """The ratio rho >= 0 per set-point (flat arrays (N,)) that puts the peak of
-    P(u) = |b_I + rho y|^2 (y = e b_J, e = e^{j phase} J's phase factor) at the set
-    direction, from the beams and their first two derivatives in u there.
-
-    dP/du = 0 is a0 + a1 rho + a2 rho^2 = 0 with a0 = Re(b_I* b_I'), a1 = Re(b_I* y' + y* b_I'),
-    a2 = Re(y* y'); of its roots the non-negative ones with P'' < 0 (P'' = 2 Re(s* s'') +
-    2 |s'|^2, s = b_I + rho y, a quadratic in rho), the one with the larger P (the first on a
-    tie); NaN where none is. Real arithmetic in the compiled kernel's order
-    (``kernels.ratio_one``, its compiled form: the complex products written out as
-    (ac - bd, ad + bc)), so both give the same bits (tested)."""
-    def mul(f, g):
-        return (f[0] * g[0] - f[1] * g[1], f[0] * g[1] + f[1] * g[0])
-
-    def re(f, g):  # Re(conj(f) g)
-        return f[0] * g[0] + f[1] * g[1]
-
-    bi, bi1, bi2, bj, bj1, bj2, e = ((a.real, a.imag) for a in (bi, bi1, bi2, bj, bj1, bj2, e))
-    y, y1, y2 = mul(e, bj), mul(e, bj1), mul(e, bj2)
-    a0 = re(bi, bi1)
-    a1 = re(bi, y1) + re(y, bi1)
-    a2 = re(y, y1)
-    disc = a1 * a1 - 4 * a0 * a2
-    sq = np.sqrt(np.where(disc >= 0, disc, np.nan))
-    lin = -a0 / a1  # a2 = 0: the one root of the linear equation
-    out = []
-    for sign in (1, -1):
-        r = np.where(a2 != 0, (-a1 + sign * sq) / (2 * a2), lin)
-        p = re(bi, bi) + r * (2 * re(bi, y) + r * re(y, y))
-        p2 = (2 * (re(bi, bi2) + r * (re(bi, y2) + re(y, bi2)) + r * r * re(y, y2))
-              + 2 * (re(bi1, bi1) + r * (2 * re(bi1, y1)) + r * r * re(y1, y1)))
-        keep = np.isfinite(r) & (r >= 0) & (p2 < 0)
-        out.append((np.where(keep, r, np.nan), np.where(keep, p, -np.inf)))
-    (r0, s0), (r1, s1) = out
-    # numpy's argmax over (s0, s1): the first maximum, or the first NaN
-    return np.where((s0 == s0) & ((s1 != s1) | (s1 > s0)), r1, r0)
-
-
-def design_at_detected_bin(st: Steering, h, alpha_rad, phase=0.0):
-    """The exact design of a pair for the bin the RuT detects (the bin logic of the module
-    docstring, vectorised): ``h`` (..., K, 2, V) the TDM-compensated unit responses of
-    channels I and J at K candidate range bins (the set range's in the middle), ``alpha_rad``
-    and ``phase`` broadcast against (...,).
-
-    For each design bin k the closed-form ratio (:func:`design_ratio`) and the bin the RuT
-    then detects (the strongest candidate of ``I + rho e^{j phase} J``, power summed over all
-    virtual elements); the design bin chosen is the one where design and detection agree,
-    nearest the set range's bin first. Returns ``rho`` (...), ``bin`` (...) (index into K;
-    where no bin agrees: the fixed point of "design at the reported bin" from the middle
-    bin, as :func:`phasor_sweep`), ``consistent`` (...) and ``margin`` (...) (the detected
-    bin's power over the next strongest; 1 where not consistent). NaN ``rho`` where no bin
-    has a design."""
-    h = np.asarray(h)
-    x_i, x_j = h[..., 0, :], h[..., 1, :]  # (..., K, V)
-    a = np.asarray(alpha_rad, float)[..., None]
-    ph = np.asarray(phase, float)[..., None]
-    rho = design_ratio(st, x_i, x_j, a, ph)  # (..., K)
-    p_ii = np.sum(x_i.real ** 2 + x_i.imag ** 2, -1)  # (..., K)
-    p_jj = np.sum(x_j.real ** 2 + x_j.imag ** 2, -1)
-    c_ij = np.sum(np.conj(x_i) * x_j, -1)
-    return detected_bin_choice(rho, ph, p_ii, p_jj, c_ij)
-
-
-def detected_bin_choice(rho, phase, p_ii, p_jj, c_ij, margin: bool = True):
-    """The bin logic of :func:`design_at_detected_bin` from the ratios per design bin ``rho``
-    (..., K), J's phase (broadcast) and the channels' power sums over the virtual elements at
-    each candidate bin: ``p_ii``, ``p_jj`` (..., K) and ``c_ij = sum conj(x_i) x_j``:
-    (rho, k, consistent, margin), each (...). ``margin=False``: the fourth result is None.
-
-    Per row (``rtsgeom.synthesis.kernels.choice_row``, compiled): the power of each design at every bin,
-    |I + r e^{j ph} J|^2 = p_ii + r^2 p_jj + 2 r Re(e^{j ph} c_ij) (r = 0 where rho is not a
-    positive number), each design's detected bin the strongest; of the designs detected at
-    their own bin the one nearest the middle (ties to the lower bin), else the fixed point of
-    "design at the reported bin" from the middle bin; the margin is the detected bin's power
-    over the next strongest (1 where not consistent)."""
-    from ..synthesis.kernels import bin_choice_rows
-    rho = np.asarray(rho, float)
-    c_ij = np.asarray(c_ij)
-    n_k = rho.shape[-1]
-    lead = np.broadcast_shapes(rho.shape[:-1], np.shape(p_ii)[:-1], np.shape(p_jj)[:-1],
-                               c_ij.shape[:-1])
-    rows = [np.ascontiguousarray(np.broadcast_to(a, lead + (n_k,)), float).reshape(-1, n_k)
-            for a in (rho, *(f(np.broadcast_to(np.asarray(phase, float), rho.shape))
-                                   for f in (np.cos, np.sin)), p_ii, p_jj, c_ij.real,
-                      np.imag(c_ij))]
-    n = rows[0].shape[0]
-    out, k = np.empty(n), np.empty(n, np.int64)
-    ok, mg = np.empty(n, bool), np.empty(n)
-    bin_choice_rows(*rows, out, k, ok, mg)
-    out, k, ok, mg = (a.reshape(lead) for a in (out, k, ok, mg))
-    return out, k, ok, (mg if margin else None)
 
 
 @dataclass(frozen=True)
@@ -297,9 +152,10 @@ def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair,
     for p, (mn, mr, alpha) in enumerate(zip(nom_models, real_models, alphas)):
         hn = tdm_compensate(mn.responses, mn.doppler_hz, setup.rut, radar)  # (K, 1+S, V)
         ha = hn if mr is mn else tdm_compensate(mr.responses, mr.doppler_hz, setup.rut, radar)
-        phases = mn.coherent_phases(alphas, hn)[..., 1:]  # (K, S): J's coherent phase per bin
+        probes_u = st.directions(np.atleast_1d(np.asarray(alphas, float)))
+        phases = mn.coherent_phases(probes_u, hn)[..., 1:]  # (K, S): J's coherent phase per bin
         rho = design_ratio(st, hn[:, :1, :], hn[:, 1:, :], alpha, phases)  # (K, S)
-        # power normalisation (ChannelModel.scale): the combined peak as strong as I alone
+        # power normalisation (ChannelModel.amplitudes): the combined peak as strong as I alone
         b_i, _, _ = beam_derivatives(st, hn[:, :1, :], np.sin(alpha))
         b_j, _, _ = beam_derivatives(st, hn[:, 1:, :], np.sin(alpha))
         p_sum = np.abs(b_i + rho * np.exp(1j * phases) * b_j) ** 2  # (K, S)
@@ -445,7 +301,7 @@ def chain_errors(setup, paths, pair, targets, res: SweepResult, base_offsets, fr
     bins (S, P) (-1: not detected), with the amplitudes of ``res`` (the phasor model's
     design for the bin it predicts the RuT detects)."""
     from ..radar.processing import nearest_detection
-    from .pair import _probe_program, simulate_detect
+    from .probes import probe_program, simulate_detect
     scene = setup.scene
     base = [(float(requested_delay(scene, t.range_m)) + base_offsets[0],
              float(requested_delay(scene, t.range_m)) + base_offsets[1]) for t in targets]
@@ -453,7 +309,7 @@ def chain_errors(setup, paths, pair, targets, res: SweepResult, base_offsets, fr
     err = np.full((n_s, n_p), np.nan)
     got = np.full((n_s, n_p), -1)
     for s_, d in enumerate(res.delta_tau_s):
-        prog = _probe_program(res.amplitudes[s_], pair, base, float(d))
+        prog = probe_program(res.amplitudes[s_], pair, base, float(d))
         step_seed = np.random.SeedSequence([int(seed) % 2 ** 32,
                                             int(round(d * 1e15)) + 2 ** 40])
         rd, det = simulate_detect(setup, paths, prog, step_seed, frames)

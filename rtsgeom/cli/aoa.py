@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..calibration.pair import calibrate_pair, calibrate_pair_paper, fir_effect, probe_front_ends
+from ..calibration.pair import calibrate_pair, calibrate_pair_paper
+from ..calibration.fir import fir_effect
+from ..calibration.probes import probe_front_ends
 from ..analysis.linearity import linearity
 from ..errors import AngleUnreachable
 from ..errors import ParameterError

@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis.tolerance.driver import AXES, CASES, NOMINAL_AMPLITUDES
-from ..calibration.pair import calibrate_pair, probe_front_ends
+from ..calibration.pair import calibrate_pair
+from ..calibration.probes import probe_front_ends
 from ..errors import AngleUnreachable
 from ..analysis.linearity import linearity
 from ..geometry import build_setup

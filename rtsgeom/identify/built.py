@@ -112,7 +112,8 @@ def predicted_calibration(setup: Setup, pair: tuple[int, int], alphas=None
     """The pair's calibration delay predicted from a setup *as identified* (no sweep): the
     coherence point (``aoa.calibration.coherence_delay``) of the identified geometry and channel
     gains at the probes the sweep would use (``alphas``, default from :func:`detected_angles`)."""
-    from ..calibration.pair import coherence_delay, probe_angles
+    from ..calibration.pair import coherence_delay
+    from ..calibration.probes import probe_angles
     paths = exact_paths(setup)
     i, j = pair
     if alphas is None:

@@ -41,7 +41,7 @@ class Capture:
 def capture_probe(setup: Setup, range_m: float | None = None) -> tuple[float, float]:
     """Default probe (range, programmed amplitude): the calibration's first probe range and the
     amplitude that gives a 10 m^2 target (what :class:`aoa.model.ChannelModel` programs)."""
-    from ..calibration.pair import probe_ranges
+    from ..calibration.probes import probe_ranges
     scene = setup.scene
     r = float(probe_ranges(setup, 1)[0]) if range_m is None else float(range_m)
     lam = setup.rut.wavelength_m

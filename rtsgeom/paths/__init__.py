@@ -3,9 +3,10 @@
 from importlib import import_module
 
 from .table import DIRECTIONS, Paths
+from ..geometry.setup import nominal_setup
 from .exact import exact_paths
 
-__all__ = ["DIRECTIONS", "Paths", "exact_paths", "compute_paths"]
+__all__ = ["DIRECTIONS", "Paths", "exact_paths", "compute_paths", "nominal_model"]
 
 
 def compute_paths(setup, method: str = "exact", *, for_drawing: bool = False):
@@ -24,3 +25,14 @@ def compute_paths(setup, method: str = "exact", *, for_drawing: bool = False):
                          f"{', '.join(PATH_METHODS)}") from None
     module, func = (m.draw if for_drawing else m.compute).split(":")
     return getattr(import_module(module), func)(setup)
+
+
+def nominal_model(setup, paths: Paths) -> tuple:
+    """The nominal setup and its paths (the ones given when the setup has no errors)."""
+    nom = nominal_setup(setup)
+    if nom is setup:
+        return setup, paths
+    if paths.method == "exact":
+        return nom, exact_paths(nom)
+    from .raytrace import raytrace_paths  # here: Sionna RT loads only for ray tracing
+    return nom, raytrace_paths(nom)

@@ -42,7 +42,7 @@ def reachable_spans(setup: Setup, mode: str | None = None, paths=None) -> dict:
         ``hi_deg``) and ``targets`` (each ``index``, ``angle_deg``, ``pair`` or None,
         ``reachable``).
     """
-    from ..calibration.pair import probe_front_ends
+    from ..calibration.probes import probe_front_ends
     from .plan import bracketing_pair, uses_cells
     from ..paths import exact_paths
     scene = setup.scene

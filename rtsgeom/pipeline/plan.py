@@ -17,12 +17,11 @@ from ..rts.channels import RtsProgram, fir_modelled, realised_delay, requested_d
 from ..errors import SceneError
 from ..scene import TargetConfig
 from scipy.constants import c
-from ..calibration.pair import (Calibration, FrontEndProbe, calibrate_pair, probe_angles,
-                                probe_front_ends)
+from ..calibration.pair import Calibration, calibrate_pair
+from ..calibration.probes import FrontEndProbe, probe_angles, probe_front_ends
 from ..errors import AngleUnreachable
 from ..synthesis.model import ChannelModel
 from ..calibration.sweep import HALF_BINS
-from ..synthesis.closed_form import PairModel
 
 __all__ = ["bracketing_pair", "pair_amplitudes", "PairPlan", "plan_pair", "pair_design",
            "nearest_setting", "plan_targets", "uses_cells", "channel_offsets",
@@ -127,13 +126,13 @@ def pair_amplitudes(setup: Setup, paths: Paths, pair, target: TargetConfig, mode
     calibration establishes); ``paper`` and ``array-factor`` use their closed forms with the front ends'
     geometric azimuths seen from the RuT.
     """
-    from ..calibration.pair import nominal_model
+    from ..paths import nominal_model
     nom, nom_paths = nominal_model(setup, paths)
-    model = PairModel.build(nom, nom_paths, pair, target, offsets)
+    model = ChannelModel.build(nom, nom_paths, pair, target, offsets)
     alpha = target.angle_rad
-    phase = model.coherent_phase(probes_rad)  # the phase the calibration establishes
-    rho = model.solve(alpha, phase, mode=mode)  # exact: root finder; else closed forms
-    a_i, a_j = model.amplitudes(rho, alpha, phase)
+    phase = float(model.pair_phase(probes_rad))  # the phase the calibration establishes
+    rho = model.pair_ratio(alpha, (0.0, phase), mode)  # exact: closed form; else closed forms
+    a_i, a_j = model.amplitudes(model.pair_weights(rho, (0.0, phase)), np.sin([alpha]))
     return a_i * gain_correction[0], a_j * gain_correction[1], rho
 
 
@@ -223,7 +222,8 @@ def plan_pair(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str,
     (34 deg of IF phase; -0.173 deg of angle).
 
     ``paper`` / ``array-factor``: :func:`pair_amplitudes` at the calibrated offsets."""
-    from ..calibration.pair import if_phase_slope_hz, nominal_model
+    from ..calibration.probes import if_phase_slope_hz
+    from ..paths import nominal_model
     from ..calibration.steps import continuous_delay_setup
     scene = setup.scene
     f_if = float(if_phase_slope_hz(scene, 2 * target.range_m / c))
@@ -244,15 +244,15 @@ def plan_pair(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str,
     fir = fir_modelled(scene)
 
     def ideal(want):  # the continuous model with J exactly at the planned difference
-        return PairModel(ChannelModel.build(cont, nom_paths, pair, target,
-                                            (base_i, base_i + want), HALF_BINS))
+        return ChannelModel.build(cont, nom_paths, pair, target, (base_i, base_i + want),
+                                  HALF_BINS)
 
     best = None
     for m in (0, -1, 1):
         shift = m * period
         want = float(offsets[1] - offsets[0]) + residual_s + shift
         model = ideal(want)
-        phase = model.coherent_phase(probes_rad)
+        phase = float(model.pair_phase(probes_rad))
         if m == 0:
             phase0 = phase
         for _ in range(2 if m and fir else 0):
@@ -261,11 +261,10 @@ def plan_pair(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str,
             shift += miss / (2 * np.pi) * period
             want += miss / (2 * np.pi) * period
             model = ideal(want)
-            phase = model.coherent_phase(probes_rad)
+            phase = float(model.pair_phase(probes_rad))
         req, eps = nearest_setting(scene, tau + o_i, want, tau + float(offsets[1]) + shift)
-        real = PairModel(ChannelModel.build(nom, nom_paths, pair, target,
-                                            (o_i, req - tau), HALF_BINS))
-        rho, ok, margin = real.model.solve_checked(target.angle_rad, (0.0, phase))
+        real = ChannelModel.build(nom, nom_paths, pair, target, (o_i, req - tau), HALF_BINS)
+        rho, ok, margin = real.solve_checked(target.angle_rad, (0.0, phase))
         if rho is None:
             continue
         score = (ok, margin if ok else 0.0, -abs(m))
@@ -279,7 +278,8 @@ def plan_pair(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str,
         return PairPlan(a_i, a_j, rho, float(offsets[1]), float(offsets[1] - offsets[0]),
                         float(offsets[1] - offsets[0]), 0.0, 0, f_if)
     _, model, rho, phase, off_j, want, eps, m = best
-    a_i, a_j = model.amplitudes(rho, target.angle_rad, phase)
+    a_i, a_j = model.amplitudes(model.pair_weights(rho, (0.0, phase)),
+                                np.sin([target.angle_rad]))
     return PairPlan(float(a_i * gain_correction[0]), float(a_j * gain_correction[1]),
                     float(rho), float(off_j), float(want + eps), float(want), float(eps), int(m),
                     f_if)

@@ -4,7 +4,7 @@ channels, solve one weight per channel (issue 15): the cell branch of the one pl
 
 Taken when any front end or target has a non-zero elevation (``plan.uses_cells``). The cells come from the front
 ends' geometric direction cosines seen from the RuT (``aoa.cells``); the weights from
-:class:`~rtsgeom.synthesis.nchannel.ChannelSet` on the nominal setup with the channels' calibrated
+:class:`~rtsgeom.synthesis.model.ChannelModel` on the nominal setup with the channels' calibrated
 delay offsets and their natural phases (what the RuT sees of a nominal setup) when
 uncalibrated, or the phases the calibration establishes (each measured pair
 coherent where its probes sat, ``ncal.tree_phases``), amplitudes times each channel's measured
@@ -24,7 +24,7 @@ from ..errors import SceneError
 from ..errors import CellUnreachable
 from ..synthesis.cells import enclosing_cell
 from ..errors import AngleUnreachable
-from ..synthesis.nchannel import ChannelSet, target_direction
+from ..synthesis.model import ChannelModel, target_direction
 from .plan import uses_cells  # noqa: F401  (re-exported: the planner decides with it)
 
 __all__ = ["plan_cells", "target_cells", "uses_cells"]
@@ -62,7 +62,8 @@ def plan_cells(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, pr
     """The RTS program for the scene's targets at their set (azimuth, elevation).
 
     Returns the program, the calibration record (for summary.json) and warnings."""
-    from ..calibration.pair import nominal_model, probe_front_ends
+    from ..paths import nominal_model
+    from ..calibration.probes import probe_front_ends
     from ..errors import CalibrationFailed
     from ..calibration.channels import calibrate_channels, tree_phases
     scene = setup.scene
@@ -93,9 +94,9 @@ def plan_cells(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, pr
         u = target_direction(st, t)
         phases = None  # uncalibrated: the phases the channels' delays give
         if tree is not None:  # calibrated: coherent pairwise where the probes sat
-            cs_all = ChannelSet.build(nom, nom_paths, used, t, offsets[used])
+            cs_all = ChannelModel.build(nom, nom_paths, used, t, offsets[used], steering=st)
             phases = tree_phases(cs_all, tree)[[used.index(q) for q in cell]]
-        cs = ChannelSet.build(nom, nom_paths, cell, t, offsets[list(cell)])
+        cs = ChannelModel.build(nom, nom_paths, cell, t, offsets[list(cell)], steering=st)
         try:
             w = cs.solve(u, phases, mode=mode)
         except AngleUnreachable as exc:

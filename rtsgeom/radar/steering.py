@@ -424,7 +424,7 @@ class Steering:
             if not use_kernels(x.shape[0], 1e-8 * gc.size):
                 u1, ok = peak_1d(k, lat, x, start, gc, gs, g1, int(iterations))
             else:
-                from ..synthesis.kernels import peak_1d as compiled
+                from .peak_kernels import peak_1d as compiled
                 u1 = np.empty(u0.shape[0])
                 compiled(k, lat, x, start, gc, gs, g1, int(iterations), u1, ok)
             u = u1[:, None]

@@ -1,5 +1,6 @@
-"""Two-channel synthesis of an arbitrary angle of arrival (paper section "Arbitrary Angle of
-Arrival", eqs. 17-23).
+"""The closed forms of the arbitrary-angle synthesis (paper section "Arbitrary Angle of Arrival",
+eqs. 17-23) for a pair, and the far-field closed form for any set of channels in D dimensions
+(:func:`closed_form_amplitudes`).
 
 Two adjacent channels I, J generate the same range and Doppler; their amplitude ratio
 ``rho = A_J / A_I`` steers the beamformer peak between the two front ends. Three modes:
@@ -15,25 +16,30 @@ Two adjacent channels I, J generate the same range and Doppler; their amplitude 
 ``exact``
     ``rho`` solved numerically so that the RuT's own beamformer output -- from the per-element
     geometry through the windowed range/Doppler DFTs (``radar.phasors``) -- peaks at the set
-    angle: near field, Rx/Tx separation, real element positions, windowing, calibration delay.
+    angle: near field, Rx/Tx separation, real element positions, windowing, calibration delay
+    (:class:`~rtsgeom.synthesis.model.ChannelModel`).
+
+With more channels, or in azimuth and elevation, the ``array-factor`` closed form is
+:func:`closed_form_amplitudes`: channel q's beam is the array factor
+AF_q(u) = sum_v t_v e^{j k p_v . (u - u_q)} / sum_v t_v (u_q: the front end's direction
+cosines seen from the RuT); the peak condition ``d|B|^2/du = 0`` at u* with B real there is
+linear in the amplitudes a: ``G a = 0``, ``G_dq = Re(e^{j phi_q} dAF_q/du_d (u*))``,
+phi_q = -arg AF_q(u*) (coherent at u*). Of the solutions the one with the largest peak power
+per unit norm, ``a = P_null(G) f``, f_q = |AF_q(u*)| (for a triangle the null space is one
+line; for the pair it is eq. 22/23 with the true array factor, :func:`ratio_array_factor`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import itertools
 
 import numpy as np
 
-from ..geometry import Setup
-from ..paths import Paths
-from ..scene import TargetConfig
-from .model import SOLVERS, ChannelModel
 from ..errors import AngleUnreachable
+from ..radar.steering import Steering
 
-__all__ = ["MODES", "g_paper", "array_factor", "ratio_paper", "ratio_array_factor", "array_factor_args", "PairModel",
-           "AngleUnreachable"]
-
-MODES = SOLVERS
+__all__ = ["g_paper", "ratio_paper", "array_factor", "ratio_array_factor", "array_factor_args",
+           "closed_form_amplitudes"]
 
 
 def g_paper(theta, alpha):
@@ -99,66 +105,39 @@ def array_factor_args(steering) -> dict:
     return {"positions_wl": x, "weights": w}
 
 
-@dataclass(frozen=True)
-class PairModel:
-    """The front-end pair's view of :class:`~rtsgeom.synthesis.model.ChannelModel` (Q = 2): weights
-    ``w = (1, rho e^{j phase})`` written as the ratio ``rho = A_J / A_I`` and J's phase.
-
-    Build it on the *nominal* setup (``geometry.nominal_setup``): the design knows the setup
-    as drawn, not its mounting errors. ``responses[k, q, v]`` (K, 2, V): the spectrum at
-    candidate range bin k of channel q in (I, J) (``ChannelModel.responses``).
-    """
-
-    model: ChannelModel
-
-    @classmethod
-    def build(cls, setup: Setup, paths: Paths, pair: tuple[int, int], target: TargetConfig,
-              delta_tau_s: tuple[float, float] = (0.0, 0.0)) -> "PairModel":
-        """``delta_tau_s``: the calibration delay offsets of channels I and J."""
-        return cls(ChannelModel.build(setup, paths, pair, target, delta_tau_s))
-
-    setup = property(lambda self: self.model.setup)
-    pair = property(lambda self: self.model.channels)
-    responses = property(lambda self: self.model.responses)
-    doppler_hz = property(lambda self: self.model.doppler_hz)
-    unit_gain = property(lambda self: self.model.unit_gain)
-
-    def _w(self, rho, phase=0.0) -> np.ndarray:
-        return self.model.weights(np.asarray(rho, float)[..., None], (0.0, phase))
-
-    def snapshot(self, rho, phase=0.0) -> np.ndarray:
-        """Spectrum of the combined target at its strongest candidate bin, (..., V)."""
-        return self.model.snapshot(self._w(rho, phase))
-
-    def angle(self, rho, phase=0.0) -> np.ndarray:
-        """Detected angle (rad) of the combined target for amplitude ratio(s) rho."""
-        return self.model.direction(self._w(rho, phase))
-
-    def coherent_phase(self, alpha) -> float:
-        """Phase to give channel J so both channels' beamformer outputs add in phase at the
-        angle(s) ``alpha`` (the circular mean over several): what the phase calibration
-        establishes when its probes sit at those angles."""
-        return float(self.model.coherent_phases(alpha)[1])
-
-    def solve(self, alpha: float, phase: float = 0.0, log_span: float = 12.0,
-              mode: str = "exact") -> float:
-        """The ratio rho = A_J / A_I that puts the detected angle at ``alpha`` (rad)."""
-        return self.model.solve_ratio(alpha, (0.0, phase), mode, log_span)
-
-    def design(self, alpha: float, probes_rad) -> tuple[float, float, float]:
-        """Programmed amplitudes (A_I, A_J) and ratio for a target at ``alpha`` (rad), for the
-        one channel phase the calibration establishes with its probes at ``probes_rad``.
-
-        Not the phase coherent at ``alpha`` itself: for a spacing beyond the beam's first null
-        (lambda / d_A) that phase flips by pi near the span's ends and the design fails there.
-        """
-        phase = self.coherent_phase(probes_rad)
-        rho = self.solve(alpha, phase)
-        a_i, a_j = self.amplitudes(rho, alpha, phase)
-        return a_i, a_j, rho
-
-    def amplitudes(self, rho: float, alpha: float, phase: float = 0.0) -> tuple[float, float]:
-        """Program amplitudes (A_I, A_J) with ratio rho, scaled so the combined beamformer peak
-        is as strong as one channel alone at its own peak (the target keeps its RCS)."""
-        scale = self.model.scale(self._w(rho, phase), alpha)
-        return scale, scale * rho
+def closed_form_amplitudes(steering: Steering, u_fe, u_set, phases=None) -> np.ndarray:
+    """The ``array-factor`` amplitudes a (Q,) (the largest 1) of channels at direction cosines
+    ``u_fe`` (Q, D) synthesizing ``u_set`` (D,) (module docstring); ``phases`` (Q,): the
+    channels' programmed phases, default coherent at ``u_set`` (given ones are taken as making
+    the channels coherent there: B(u*) is rotated real by channel 0's phase)."""
+    u_fe = np.asarray(u_fe, float)
+    du = np.asarray(u_set, float)[None, :] - u_fe  # (Q, D)
+    t = steering.taper
+    e = t * steering.steer(du)  # (Q, V_s)
+    af = e.sum(-1) / t.sum()
+    d_af = 1j * (e @ steering.wavevector) / t.sum()  # (Q, D)
+    phi = -np.angle(af) if phases is None else np.asarray(phases, float)
+    rot = np.exp(1j * (phi - np.angle(np.exp(1j * phi[0]) * af[0])))  # B(u*) real, channel 0
+    g = np.real(rot[:, None] * d_af).T  # (D, Q)
+    f = np.real(rot * af)
+    a = f - g.T @ np.linalg.lstsq(g @ g.T, g @ f, rcond=None)[0]  # P_null(G) f
+    if np.any(a < -1e-12 * np.abs(a).max()) and a.size > g.shape[0] + 1:
+        # more channels than conditions and P_null f not all positive (near a corner of a
+        # quadrilateral): of the sub-cells of D + 1 channels (its triangles) whose one
+        # solution is non-negative, the one with the largest peak power per unit norm
+        best, score = None, -np.inf
+        for sub in itertools.combinations(range(a.size), g.shape[0] + 1):
+            null = np.linalg.svd(g[:, sub])[2][-1]
+            null = null * np.sign(null @ f[list(sub)] or 1.0)
+            if np.all(null >= -1e-12) and null @ f[list(sub)] / np.linalg.norm(null) > score:
+                best, score = (sub, null), null @ f[list(sub)] / np.linalg.norm(null)
+        if best is not None:
+            a = np.zeros(a.size)
+            a[list(best[0])] = best[1]
+    if np.max(a) <= 0:
+        raise AngleUnreachable("the array-factor closed form gives no channel a weight here")
+    a = a / np.max(a)
+    if np.any(a < -1e-9):
+        raise AngleUnreachable(f"the array-factor closed form needs a negative amplitude "
+                               f"{a.min():.3g} here: the direction is outside the cell")
+    return np.clip(a, 0.0, None)

@@ -1,22 +1,37 @@
-"""The modelled RuT output of a set of RTS channels synthesizing one target (paper section
-"Arbitrary Angle of Arrival", eqs. 14-23; ``shared/design/channel-sets.md``).
+"""The modelled RuT output of a set of RTS channels synthesizing one target, and the channel
+weights that put it at a set direction (paper section "Arbitrary Angle of Arrival", eqs. 14-23).
 
 :class:`ChannelModel` holds, for channels q = 0..Q-1 each programmed with unit amplitude, the
 target's delay and Doppler, the spectrum at the target's candidate range bins (the set range's
 bin and its neighbours, at the target's Doppler bin) per virtual element, ``responses[k, q, v]``
 (``radar.phasors.bin_response`` through the exact or ray-traced paths: near field, Rx/Tx
 separation, real element positions, windows), and the RuT's beamformer
-(:class:`~rtsgeom.radar.steering.Steering`). Programme weights ``w`` (Q,) (amplitude times
-e^{j phase}) combine them linearly::
+(:class:`~rtsgeom.radar.steering.Steering`: the azimuth row, D = 1, or azimuth x elevation,
+D = 2). Programme weights ``w`` (Q,) (amplitude times e^{j phase}) combine them linearly::
 
     snapshot(w) = sum_q w_q H[k*, q, :]       (TDM-compensated, strongest candidate bin k*)
     direction(w) = the beamformer's peak of snapshot(w)
 
-The front-end pair is Q = 2 with ``w = (1, rho e^{j phase})``: :meth:`ChannelModel.solve` finds
-``rho`` by a bracketing root finder (``exact``) or the closed forms ``paper`` and
-``array-factor`` (``aoa.synthesis``). :meth:`ChannelModel.perturbed` applies mounting errors
-of the front ends at phasor level (the changed two-way air delay's phase and free-space
-amplitude), which is what the tolerance study draws.
+:meth:`ChannelModel.solve` finds the weights for a set direction, for fixed channel phases
+(what the channels' delays give, or what a calibration establishes), per mode:
+
+``exact``
+    peak matching on the modelled RuT output: the beamformer's peak at the set direction is
+    D conditions on the Q - 1 free log-amplitudes (the strongest channel's fixed at 1).
+    The front-end pair (Q = 2, D = 1, ``w = (1, rho e^{j phase})``) has it in closed form
+    (:mod:`.pair`: the design for the bin the RuT detects; a bracketing root finder on the
+    searched peak where no bin has one); any other set of channels takes Gauss-Newton with
+    minimum-norm steps from the ``array-factor`` start, so that extra freedom (Q > D + 1: a
+    quadrilateral in 2-D) stays at the closed form's choice.
+``array-factor``
+    the closed form for an ideal far field in D dimensions (:mod:`.closed_form`; for the pair
+    paper eqs. 22/23 with the true array factor of the RuT's array).
+``paper``
+    the pair only: paper eq. (23) as printed (with its sign fixed).
+
+:meth:`ChannelModel.perturbed` applies mounting errors of the front ends at phasor level (the
+changed two-way air delay's phase and free-space amplitude), which is what the tolerance
+study draws.
 """
 
 from __future__ import annotations
@@ -26,68 +41,27 @@ from functools import cached_property
 
 import numpy as np
 from scipy.constants import c
+from scipy.optimize import brentq
 
+from ..errors import AngleUnreachable, ParameterError, SceneError
 from ..geometry import Setup
+from ..geometry.arrays import posed_positions
 from ..geometry.frontends import antenna_positions
 from ..paths import Paths
 from ..paths.exact import leg_delays
 from ..radar.phasors import bin_response
 from ..radar.processing import tdm_compensate
 from ..radar.steering import Steering
-from ..scene.registry import SYNTHESIS_MODES
 from ..rts.channels import (KIND_DIRECT, RtsProgram, channel_echoes, nominal_link_gain,
                             requested_delay, target_amplitude)
-from ..errors import SceneError
 from ..scene import TargetConfig
-from ..errors import AngleUnreachable
+from ..scene.registry import SYNTHESIS_MODES
+from .closed_form import array_factor_args, closed_form_amplitudes, ratio_array_factor, ratio_paper
+from .pair import JUMP_RAD, design_at_detected_bin, design_ratio
 
-__all__ = ["ChannelModel", "AngleUnreachable", "SOLVERS", "estimator_ratio"]
+__all__ = ["ChannelModel", "SOLVERS", "target_direction", "require_air_path_compensation"]
 
-SOLVERS = SYNTHESIS_MODES  # the registry lists every AoA mode once (rtsgeom/registry.py)
-
-
-#: How far the root finder's angle may miss the set angle before it counts as a jump (a
-#: smoothed Capon or MUSIC resolving the front ends); continuous peaks meet it to ~1e-8 rad.
-JUMP_RAD = np.radians(1e-3)
-
-
-def estimator_ratio(st: Steering, x_i, x_j, alpha_rad, phase=0.0,
-                    log_span: float = 12.0, grid: int = 13, iterations: int = 40
-                    ) -> np.ndarray:
-    """The ratio rho >= 0 (...,) for which the estimator's detected angle of
-    ``x_i + rho e^{j phase} x_j`` (snapshots (..., V)) is ``alpha_rad`` (broadcast against
-    (...,), as ``phase``), by bisection on
-    log rho, batched over all snapshots: what ``aoa.sweep.design_ratio`` (Bartlett's peak
-    condition in closed form) is for an estimator without one (a smoothed Capon or MUSIC,
-    ``Steering.smoothing``). The bracket is the first sign change of (angle - alpha) on
-    ``grid`` log-spaced ratios over e^{+-log_span}; NaN where there is none, or where the
-    bisection closes in on a jump of the detected angle (the estimator resolves the
-    channels, :data:`JUMP_RAD`). Bisection, not a faster root finder: the detected angle of
-    such an estimator can jump, and bisection stays inside its bracket."""
-    x_i, x_j = np.broadcast_arrays(np.asarray(x_i), np.asarray(x_j))
-    shape, n_v = x_i.shape[:-1], x_i.shape[-1]
-    ph = np.broadcast_to(np.exp(1j * np.asarray(phase, float)), shape)
-    xi = x_i.reshape(-1, n_v)
-    xj = (x_j * ph[..., None]).reshape(-1, n_v)
-    alpha = np.broadcast_to(np.asarray(alpha_rad, float), shape).reshape(-1)  # (n,)
-    n = xi.shape[0]
-    lr = np.linspace(-log_span, log_span, grid)
-    f = st.search(xi[:, None, :] + np.exp(lr)[None, :, None] * xj[:, None, :]) - alpha[:, None]
-    change = (np.sign(f[:, :-1]) * np.sign(f[:, 1:]) <= 0) & np.isfinite(f[:, :-1] + f[:, 1:])
-    has = change.any(axis=1)
-    k = np.argmax(change, axis=1)
-    rows = np.arange(n)
-    lo, hi, f_lo = lr[k], lr[k + 1], f[rows, k]
-    for _ in range(iterations):
-        mid = 0.5 * (lo + hi)
-        f_mid = st.search(xi + np.exp(mid)[:, None] * xj) - alpha
-        left = np.sign(f_mid) == np.sign(f_lo)
-        lo, f_lo = np.where(left, mid, lo), np.where(left, f_mid, f_lo)
-        hi = np.where(left, hi, mid)
-    x = 0.5 * (lo + hi)
-    got = st.search(xi + np.exp(x)[:, None] * xj)
-    ok = has & (np.abs(got - alpha) < JUMP_RAD)
-    return np.where(ok, np.exp(x), np.nan).reshape(shape)
+SOLVERS = SYNTHESIS_MODES  # the registry lists every AoA mode once (scene/registry.py)
 
 
 def require_air_path_compensation(scene) -> None:
@@ -106,12 +80,23 @@ def require_air_path_compensation(scene) -> None:
             "to true, or run the plain program (run --amplitudes nearest)")
 
 
+def target_direction(steering: Steering, target: TargetConfig) -> np.ndarray:
+    """A target's set direction cosines (D,) for ``steering``."""
+    el = getattr(target, "elevation_rad", 0.0)
+    if steering.dims == 1:
+        return np.array([np.sin(target.angle_rad)])
+    return steering.directions(np.array([target.angle_rad, el]))
+
+
 @dataclass(frozen=True)
 class ChannelModel:
     """The modelled RuT output of channels ``channels`` (Q,) for one target.
 
     Build it on the *nominal* setup (``geometry.nominal_setup``) for a design: the design
-    knows the setup as drawn, not its mounting errors.
+    knows the setup as drawn, not its mounting errors. Directions go in as direction cosines
+    ``u`` (D,): ``sin(azimuth)`` for a RuT that beamforms in azimuth (D = 1), ``(sin az cos
+    el, sin el)`` for one that beamforms in both (D = 2); :meth:`direction` returns the
+    detected angles, :meth:`angles` converts.
     """
 
     setup: Setup
@@ -121,13 +106,18 @@ class ChannelModel:
     unit_gain: float  # program amplitude of one channel that gives the target's amplitude
     range_m: float
     steering: Steering
+    fe_u: np.ndarray | None = None  # (Q, D) front-end directions for the closed form (None:
+    #                                  the geometric ones seen from the RuT)
 
     @classmethod
     def build(cls, setup: Setup, paths: Paths, channels, target: TargetConfig,
-              delta_tau_s=None, half_bins: int = 1) -> "ChannelModel":
+              delta_tau_s=None, half_bins: int = 1, steering: Steering | None = None
+              ) -> "ChannelModel":
         """``delta_tau_s`` (Q,): the channels' calibration delay offsets (default zeros);
         ``half_bins``: candidate range bins on either side of the set range's bin (the
-        calibration sweep moves channel J by up to ~2 bins: it asks for more)."""
+        calibration sweep moves channel J by up to ~2 bins: it asks for more); ``steering``:
+        the RuT's beamformer (default the azimuth row; ``Steering.auto`` is the one the RuT
+        runs, 2-D where it beamforms in elevation too)."""
         scene, radar = setup.scene, setup.scene.radar
         require_air_path_compensation(scene)
         ch = tuple(int(q) for q in channels)
@@ -151,19 +141,36 @@ class ChannelModel:
         resp = bin_response(ech, radar, setup.rut, rbins, np.full(rbins.size, dbin))  # (K, E, V)
         per_q = np.stack([resp[:, ech.target == q].sum(1) for q in range(n_q)], 1)
         amp = target_amplitude(target.range_m, target.rcs_m2, lam) / nominal_link_gain(scene, lam)
-        return cls(setup, ch, per_q, f_d, float(amp), float(target.range_m),
-                   Steering.build(setup.rut, radar))
+        st = Steering.build(setup.rut, radar) if steering is None else steering
+        return cls(setup, ch, per_q, f_d, float(amp), float(target.range_m), st)
 
     @property
     def count(self) -> int:
         return len(self.channels)
 
+    @property
+    def dims(self) -> int:
+        return self.steering.dims
+
     @cached_property
     def phasors(self) -> np.ndarray:
         """Each channel's TDM-compensated spectrum at the set range's bin, (Q, V)."""
         return tdm_compensate(self.responses[self.responses.shape[0] // 2], self.doppler_hz,
-                              self.setup.rut,
-                              self.setup.scene.radar)
+                              self.setup.rut, self.setup.scene.radar)
+
+    def fe_directions(self) -> np.ndarray:
+        """The channels' front ends' direction cosines (Q, D) seen from the RuT (geometric, or
+        :attr:`fe_u` where given)."""
+        if self.fe_u is not None:
+            return np.asarray(self.fe_u, float)
+        u = self.setup.fe_direction_cosines()[list(self.channels)]
+        return u[:, :1] if self.dims == 1 else u
+
+    def angles(self, u):
+        """The direction (azimuth, or (azimuth, elevation); rad) of direction cosines ``u``
+        (..., D): the inverse of the steering's ``directions``."""
+        u = np.asarray(u, float)
+        return np.arcsin(np.clip(u[..., 0], -1.0, 1.0)) if self.dims == 1 else Steering.angles(u)
 
     # -- the synthesized target -------------------------------------------------------------
 
@@ -179,52 +186,108 @@ class ChannelModel:
         return tdm_compensate(x, self.doppler_hz, self.setup.rut, self.setup.scene.radar)
 
     def direction(self, w) -> np.ndarray:
-        """Detected azimuth (rad) of the combined target for weights ``w`` (..., Q)."""
+        """Detected direction of the combined target for weights ``w`` (..., Q): azimuth
+        (...,) (D = 1) or (azimuth, elevation) (..., 2), rad."""
         return self.steering.search(self.snapshot(w))
 
-    def coherent_phases(self, probes_rad, phasors=None) -> np.ndarray:
+    def direction_cosines(self, w, u0=None) -> np.ndarray:
+        """Direction cosines (..., D) of the beamformer's (global) peak for weights w (..., Q):
+        Newton from ``u0`` (default: the grid's maximum) with the global check."""
+        snap = self.snapshot(w)
+        if u0 is None:
+            if self.dims == 1:
+                return np.sin(self.steering.search(snap))[..., None]
+            return self.steering.directions(self.steering.search(snap))
+        return self.steering.peak(snap, u0)[0]
+
+    def coherent_phases(self, u, phasors=None) -> np.ndarray:
         """The phase to give each channel so that all channels' beamformer outputs add in phase
-        with channel 0's at the probe angle(s) ``probes_rad`` (the circular mean over them):
+        with channel 0's at direction cosines ``u`` (P, D) (the circular mean over them):
         what the phase calibration establishes when its probes sit there. (..., Q), channel 0
         at 0; ``phasors`` (..., Q, V) default :attr:`phasors` (e.g. a draw's,
         :meth:`perturbed`)."""
         x = self.phasors if phasors is None else np.asarray(phasors)
-        u = self.steering.directions(np.atleast_1d(np.asarray(probes_rad, float)))
-        b = self.steering.beam(x, u)  # (..., Q, P)
+        b = self.steering.beam(x, np.atleast_2d(u))  # (..., Q, P)
         z = b[..., :1, :] * np.conj(b)
         mag = np.abs(z)
         return np.angle(np.sum(z / np.where(mag > 0, mag, 1.0), axis=-1))
 
-    def weights(self, ratios, phases=None) -> np.ndarray:
-        """Weights (..., Q) from amplitude ratios (..., Q - 1) to channel 0 and channel phases
-        (Q,) (default zeros): ``(1, r_1 e^{j phi_1}, ...)``."""
-        r = np.asarray(ratios, float)
+    def pair_phase(self, angles_rad, phasors=None) -> np.ndarray:
+        """The pair's (Q = 2, D = 1) phase of channel 1 that :meth:`coherent_phases` gives at
+        the azimuths ``angles_rad`` (P,) (the calibration's probes), (...,)."""
+        u = self.steering.directions(np.atleast_1d(np.asarray(angles_rad, float)))
+        return self.coherent_phases(u, phasors)[..., 1]
+
+    def weights(self, amplitudes, phases=None) -> np.ndarray:
+        """Programme weights w = a e^{j phi} (..., Q) of amplitudes (..., Q) and channel phases
+        (Q,) (default zeros)."""
         ph = np.zeros(self.count) if phases is None else np.asarray(phases, float)
-        rest = r * np.exp(1j * ph[1:])
-        return np.concatenate([np.ones(rest.shape[:-1] + (1,), complex), rest], axis=-1)
+        return np.asarray(amplitudes, float) * np.exp(1j * ph)
 
-    def solve(self, direction: float, phases=None, mode: str = "exact",
-              log_span: float = 12.0) -> np.ndarray:
-        """Weights (Q,) that put the detected angle at ``direction`` (rad), for the channel
-        phases ``phases`` (Q,) (e.g. :meth:`coherent_phases`).
+    def pair_weights(self, rho, phases=None) -> np.ndarray:
+        """The pair's weights (..., 2) ``(1, rho e^{j phi_1})`` for ratios ``rho`` (...,) and
+        channel phases ``phases`` (2,) (default zeros; :meth:`pair_phase` gives phi_1)."""
+        rho = np.asarray(rho, float)
+        return self.weights(np.stack([np.ones_like(rho), rho], axis=-1), phases)
 
-        Q = 2 only (peak matching with more channels has free parameters left, see
-        ``channel-sets.md``). ``exact``: the ratio rho = |w_1 / w_0| on the modelled RuT
-        output read by the RuT's own direction estimator (``steering.estimator``): Bartlett's
-        peak condition in closed form (``sweep.design_ratio``), for a smoothed Capon or MUSIC
-        a bisection on its peak (:func:`estimator_ratio`), else a bracketing root finder
-        (AngleUnreachable outside the span the pair reaches, or across a jump of a smoothed
-        estimator's angle); ``paper``, ``array-factor``: their closed forms (``aoa.synthesis``) with
-        the front ends' geometric azimuths, span ends included exactly."""
-        return self.weights([self.solve_ratio(direction, phases, mode, log_span)], phases)
-
-    def solve_ratio(self, direction: float, phases=None, mode: str = "exact",
-                    log_span: float = 12.0) -> float:
-        """The pair's ratio rho = A_1 / A_0 of :meth:`solve` (Q = 2)."""
-        if self.count != 2:
-            raise NotImplementedError(f"solve: {self.count} channels; only pairs (Q = 2) so far")
+    def solve(self, u, phases=None, mode: str = "exact", log_span: float = 12.0,
+              tol: float = 1e-10, max_iter: int = 30) -> np.ndarray:
+        """Weights (Q,) whose beamformer peak is at direction cosines ``u`` (D,), for the
+        channel phases ``phases`` (Q,) (e.g. :meth:`coherent_phases`): the pair
+        ``(1, rho e^{j phi_1})`` (:meth:`pair_ratio` at the azimuth arcsin u), more channels
+        with the strongest at amplitude 1 (module docstring). :class:`AngleUnreachable`
+        outside what the channels reach."""
         if mode not in SOLVERS:
-            raise ValueError(f"mode {mode!r}: must be one of {', '.join(SOLVERS)}")
+            raise ParameterError(f"mode {mode!r}: must be one of {', '.join(SOLVERS)}")
+        u_set = np.atleast_1d(np.asarray(u, float))
+        if self.count == 2 and self.dims == 1:  # the pair: its closed form
+            return self.pair_weights(self.pair_ratio(float(np.arcsin(u_set[0])), phases, mode,
+                                                     log_span), phases)
+        if mode == "paper":
+            raise ParameterError("mode 'paper': eq. 23 is defined for a pair of front ends in "
+                                 "azimuth only; use exact or array-factor")
+        if mode == "array-factor":
+            a0 = closed_form_amplitudes(self.steering, self.fe_directions(), u_set, phases)
+            return self.weights(a0, phases)
+        # The start of the peak matching: the closed form with the phases the weighted
+        # channels have at u_set relative to coherence there (the given phases are programme
+        # phases on this model, whose channels carry their own: delays, calibration offsets;
+        # handed to the closed form as they are, a calibrated channel 87 deg off its
+        # geometric phase (a 0.5 mm radial offset) gave a start the Gauss-Newton did not
+        # recover from, sphere4), then coherent; each start tried in turn until one reaches
+        # u_set.
+        starts = []
+        for ph in ((None if phases is None else self._coherence_offsets(u_set, phases)), None):
+            try:
+                starts.append(closed_form_amplitudes(self.steering, self.fe_directions(), u_set,
+                                                     ph))
+            except AngleUnreachable:
+                pass
+        # a channel the closed form leaves at 0 stays there (its log-amplitude's column of
+        # the Jacobian vanishes): the same starts with every channel at 0.1 or more next
+        # (sphere4 with a 180 deg phase on a front end, (5, 3) deg: the triangle's start
+        # stopped 0.008 off in elevation), then equal amplitudes
+        starts += [np.maximum(a, 0.1) for a in starts] + [np.ones(self.count)]
+        for n, a0 in enumerate(starts):
+            try:
+                return self.weights(self._peak_match(u_set, a0, phases, tol, max_iter), phases)
+            except AngleUnreachable:
+                if n == len(starts) - 1:
+                    raise
+
+    def pair_ratio(self, direction: float, phases=None, mode: str = "exact",
+                   log_span: float = 12.0) -> float:
+        """The pair's ratio rho = A_1 / A_0 of :meth:`solve` (Q = 2, D = 1, direction the
+        azimuth in rad). ``exact``: Bartlett's peak condition in closed form for the bin the
+        RuT detects (:func:`~.pair.design_at_detected_bin`; for a smoothed Capon or MUSIC a
+        bisection on its peak, :func:`~.pair.estimator_ratio`), else a bracketing root
+        finder (:class:`AngleUnreachable` outside the span the pair reaches, or across a jump
+        of a smoothed estimator's angle); ``paper``, ``array-factor``: their closed forms
+        with the front ends' geometric azimuths, span ends included exactly."""
+        if self.count != 2:
+            raise ParameterError(f"pair_ratio: {self.count} channels; a ratio needs a pair")
+        if mode not in SOLVERS:
+            raise ParameterError(f"mode {mode!r}: must be one of {', '.join(SOLVERS)}")
         if mode == "exact":
             rho = self._solve_pair_closed(direction, phases)
             return rho if rho is not None else self._solve_pair(direction, phases, log_span)
@@ -242,7 +305,6 @@ class ChannelModel:
     def solve_checked(self, alpha: float, phases) -> tuple[float | None, bool, float]:
         """:meth:`_solve_pair_closed` with whether design and detection agree on the bin and
         the detected bin's power over the next strongest (1 where they do not agree)."""
-        from ..calibration.sweep import design_at_detected_bin, design_ratio
         ph = np.zeros(2) if phases is None else np.asarray(phases, float)
         x = tdm_compensate(self.responses, self.doppler_hz, self.setup.rut,
                            self.setup.scene.radar)  # (K, 2, V)
@@ -255,19 +317,19 @@ class ChannelModel:
               if np.isfinite(rho[k]) and rho[k] > 0]
         if not ks:
             return None, False, 1.0
-        miss = [abs(float(self.direction(self.weights([rho[k]], phases))) - alpha) for k in ks]
+        miss = [abs(float(self.direction(self.pair_weights(rho[k], phases))) - alpha)
+                for k in ks]
         return float(rho[ks[int(np.argmin(miss))]]), False, 1.0
 
     def _solve_pair(self, alpha: float, phases, log_span: float) -> float:
         """Reference: brentq on the searched beamformer peak of the strongest bin."""
         def angle(log_rho):
-            return float(self.direction(self.weights([np.exp(log_rho)], phases)))
+            return float(self.direction(self.pair_weights(np.exp(log_rho), phases)))
         lo, hi = angle(-log_span), angle(log_span)
         if not (min(lo, hi) <= alpha <= max(lo, hi)):
             raise AngleUnreachable(
                 f"angle {np.degrees(alpha):.4f} deg is outside the span this front-end pair "
                 f"can synthesize [{np.degrees(min(lo, hi)):.4f}, {np.degrees(max(lo, hi)):.4f}] deg")
-        from scipy.optimize import brentq  # here: scipy.optimize costs ~0.3 s of imports
         x = brentq(lambda x: angle(x) - alpha, -log_span, log_span, xtol=1e-10)
         got = angle(x)
         # brentq closed in on a jump of the detected angle. Only for a smoothed estimator:
@@ -285,7 +347,6 @@ class ChannelModel:
         return float(np.exp(x))
 
     def _closed_form(self, alpha: float, mode: str) -> float:
-        from .closed_form import array_factor_args, ratio_array_factor, ratio_paper
         th = self.setup.fe_azimuth_rad()[list(self.channels)]  # the nominal angles
         lo, hi = np.sort(th)
         if not lo <= alpha <= hi:
@@ -305,19 +366,70 @@ class ChannelModel:
                                            **array_factor_args(self.steering)))
         return float(np.clip(rho, 0.0, 1e12))
 
-    def scale(self, w, direction: float) -> float:
-        """The factor on the weights ``w`` (Q,) that makes the combined beamformer peak (at
-        ``direction``) as strong as channel 0 alone at its own peak (the target keeps its
-        RCS): programme amplitudes ``scale * |w|`` (:meth:`amplitudes`)."""
+    def _coherence_offsets(self, u_set, phases) -> np.ndarray:
+        """Phases (Q,) for :func:`closed_form_amplitudes` that put each channel as far from
+        coherence with channel 0 at ``u_set`` as the weighted model's channels are: its
+        array factor's coherent phase ``-arg AF_q(u_set)`` plus the model's deviation
+        ``phi_q + arg b_q(u_set) - phi_0 - arg b_0(u_set)`` (b: the channels' beams)."""
         st = self.steering
-        p_sum = st.power(self.snapshot(w), st.directions(np.array([direction])))[0]
-        single = self.snapshot(np.eye(self.count)[0])
-        p_one = st.power(single, st.directions(np.array([st.search(single)])))[0]
-        return float(self.unit_gain * np.sqrt(p_one / max(p_sum, 1e-300)))
+        u_set = np.atleast_1d(np.asarray(u_set, float))
+        b = st.beam(self.phasors, u_set[None])[:, 0]  # (Q,)
+        dev = np.asarray(phases, float) + np.angle(b)
+        dev = np.angle(np.exp(1j * (dev - dev[0])))
+        af = np.sum(st.taper * st.steer(u_set[None, :] - self.fe_directions()), -1)
+        return -np.angle(af) + dev
 
-    def amplitudes(self, w, direction: float) -> np.ndarray:
-        """Programme amplitudes (Q,) for weights ``w``: ``scale(w, direction) * |w|``."""
-        return self.scale(w, direction) * np.abs(np.asarray(w))
+    def _peak_match(self, u_set, a0, phases, tol, max_iter) -> np.ndarray:
+        ref = int(np.argmax(a0))  # the strongest channel keeps amplitude 1
+        free = np.flatnonzero(np.arange(a0.size) != ref)
+        x = np.log(np.maximum(a0[free], 1e-6))  # log-amplitudes of the others
+
+        def amps(xx):
+            a = np.ones(a0.size)
+            a[free] = np.exp(np.clip(xx, -40.0, 40.0))  # beyond: a diverging (unreachable) fit
+            return a
+
+        def resid(xx):
+            return self.direction_cosines(self.weights(amps(xx), phases), u_set) - u_set
+
+        r = resid(x)
+        h = 1e-5
+        for _ in range(max_iter):
+            if np.max(np.abs(r)) < tol:
+                break
+            jac = np.stack([(resid(x + h * e) - r) / h for e in np.eye(x.size)], axis=-1)
+            step = -np.linalg.pinv(jac) @ r  # minimum-norm Gauss-Newton step
+            for damp in (1.0, 0.5, 0.25, 0.125, 0.0625):
+                r_new = resid(x + damp * step)
+                if np.linalg.norm(r_new) < np.linalg.norm(r):
+                    x, r = x + damp * step, r_new
+                    break
+            else:
+                break
+        if np.max(np.abs(r)) > 1e3 * tol:
+            raise AngleUnreachable(
+                f"direction cosines {np.round(u_set, 6).tolist()}: the channels "
+                f"{list(self.channels)} cannot put the beamformer's peak there (closest "
+                f"{np.round(u_set + r, 6).tolist()}): outside what this cell can synthesize")
+        return amps(x)
+
+    def reference_power(self) -> float:
+        """Beamformer power of channel 0 alone at its own (global) peak: the level
+        :meth:`amplitudes` keeps. Depends on channel 0 only, so a sweep that moves only
+        other channels' delays may compute it once and pass it in."""
+        e0 = np.eye(self.count)[0]
+        u_one = self.direction_cosines(e0)
+        return float(self.steering.power(self.snapshot(e0), np.atleast_2d(u_one))[0])
+
+    def amplitudes(self, w, u, p_ref: float | None = None) -> np.ndarray:
+        """Programme amplitudes (Q,): ``|w|`` scaled so the combined beamformer peak (at
+        direction cosines ``u`` (D,)) is as strong as channel 0 alone at its own peak (the
+        target keeps its RCS); ``p_ref``: that single-channel power (:meth:`reference_power`)
+        when known."""
+        st = self.steering
+        p_sum = st.power(self.snapshot(w), np.atleast_2d(u))[0]
+        p_one = self.reference_power() if p_ref is None else p_ref
+        return self.unit_gain * np.sqrt(p_one / max(p_sum, 1e-300)) * np.abs(w)
 
     # -- mounting errors --------------------------------------------------------------------
 
@@ -347,7 +459,6 @@ class ChannelModel:
         if rut_offset_m is None and rut_yaw_rad is None:
             rut_tx, rut_rx = rut.tx_world, rut.rx_world
         else:
-            from ..geometry.arrays import posed_positions
             rut_tx, rut_rx = posed_positions(rut, rut_offset_m, rut_yaw_rad)
         t_a, t_b = leg_delays(rut_tx, rut_rx, rx, tx)
         return t_a[..., rut.virtual_tx], t_b[..., rut.virtual_rx]

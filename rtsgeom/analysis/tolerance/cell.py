@@ -7,7 +7,7 @@ study's unit draws, :func:`~rtsgeom.analysis.tolerance.driver.standard_draws` wi
 scaled by the per-axis sigmas or bounds). The operator does not know the errors: the channel
 weights of set directions over the cell (an n x n azimuth x elevation grid inside it,
 :func:`~rtsgeom.analysis.linearity2d.cell_grid`) are designed once on the nominal setup
-(:meth:`ChannelSet.solve <rtsgeom.synthesis.nchannel.ChannelSet.solve>`, ``exact``: peak matching on
+(:meth:`ChannelModel.solve <rtsgeom.synthesis.model.ChannelModel.solve>`, ``exact``: peak matching on
 the modelled 2-D beamformer output), for the channel phases the cell's calibration
 establishes (:func:`~rtsgeom.calibration.channels.tree_phases`: each measured pair of the spanning tree
 coherent at the midpoint of its front ends' directions).
@@ -60,7 +60,7 @@ from scipy.constants import c
 from ..._lib.util import frozen
 from ..linearity2d import cell_grid
 from ...calibration.channels import pair_edges, spanning_tree, tree_phases
-from ...synthesis.nchannel import ChannelSet
+from ...synthesis.model import ChannelModel
 from ...errors import ParameterError
 from ...geometry import Setup
 from ...geometry.setup import nominal_setup
@@ -94,9 +94,9 @@ def _wrap(phi):
 @dataclass(frozen=True)
 class CellPhasors:
     """The design (set directions, amplitudes) and the delay tables of one cell of front ends
-    on its nominal :class:`~rtsgeom.synthesis.nchannel.ChannelSet` (``cells``, 2-D beamformer)."""
+    on its nominal :class:`~rtsgeom.synthesis.model.ChannelModel` (``cells``, 2-D beamformer)."""
 
-    cells: ChannelSet  # Q channels, nominal setup, target at the bin centre
+    cells: ChannelModel  # Q channels, nominal setup, target at the bin centre
     set_rad: np.ndarray  # (M, 2) set (azimuth, elevation)
     set_u: np.ndarray  # (M, 2) their direction cosines
     amplitudes: np.ndarray  # (M, Q) designed |w| (the strongest 1)
@@ -133,7 +133,8 @@ class CellPhasors:
                                  f"in [0, {n_fe - 1}]")
         target = reference_target(nom, range_m)
         paths = exact_paths(nom)
-        cs = ChannelSet.build(nom, paths, cell, target)
+        cs = ChannelModel.build(nom, paths, cell, target,
+                                steering=Steering.auto(nom.rut, radar))
         st = cs.steering
         u_fe = cs.fe_directions()
         all_u = nom.fe_direction_cosines()
@@ -162,10 +163,10 @@ class CellPhasors:
                    frozen(factor), frozen(log_slope[:, ks, HALF_BINS]), float(slope),
                    float(res), frozen(table), frozen(log_slope), z, frozen(sub))
 
-    cell = property(lambda self: tuple(self.cells.model.channels))
-    setup = property(lambda self: self.cells.model.setup)  # nominal
-    range_m = property(lambda self: self.cells.model.range_m)
-    x_nominal = property(lambda self: self.cells.model.phasors)  # (Q, V)
+    cell = property(lambda self: tuple(self.cells.channels))
+    setup = property(lambda self: self.cells.setup)  # nominal
+    range_m = property(lambda self: self.cells.range_m)
+    x_nominal = property(lambda self: self.cells.phasors)  # (Q, V)
 
     @property
     def max_steps(self) -> int:
@@ -205,7 +206,7 @@ class CellPhasors:
         """Per case the detected minus set (azimuth, elevation) (n, M, 2) rad, the angular
         distance (n, M) rad, whether the beamformer's Newton peak converged (n, M), the
         detected range bin as an offset from the set range's (n, M) and the programme
-        amplitudes (n, M, Q) (relative: times ``cells.model.unit_gain``), for mounting errors
+        amplitudes (n, M, Q) (relative: times ``cells.unit_gain``), for mounting errors
         ``offsets_m`` (n, Q, 3), ``pose`` (the rotations ``yaw_rad``, ``pitch_rad`` (n, Q) and
         RuT pose errors ``rut_offset_m`` (n, 3), ``rut_yaw_rad`` (n,) of
         :meth:`ChannelModel.air_legs`; None: none) and the target's sub-bin positions
@@ -236,7 +237,7 @@ class CellPhasors:
         return join(parts)
 
     def _draw(self, off, cases, pose, u) -> dict:
-        cm, st = self.cells.model, self.cells.steering
+        cm, st = self.cells, self.cells.steering
         x, shift = cm.perturbed(off, return_shift=True, **pose)  # (n, Q, V)
         nom = self.x_nominal
         fac = x / np.where(nom != 0, nom, 1.0)  # the draw's factor per channel and element
@@ -277,7 +278,7 @@ class CellPhasors:
     def _range_offset(self, off, steps, pose=None) -> np.ndarray:
         """The largest range offset (m) between a channel's echo and the reference's after
         calibration: c0/2 times the element-mean air delay plus the delay offset, (n,)."""
-        t_a, t_b = self.cells.model.air_legs(off, **(pose or {}))
+        t_a, t_b = self.cells.air_legs(off, **(pose or {}))
         tot = (t_a + t_b).mean(-1) + steps * self.delay_resolution_s  # (n, Q)
         return 0.5 * c * np.max(np.abs(tot - tot[:, :1]), axis=-1)
 

@@ -56,9 +56,9 @@ import numpy as np
 from scipy.constants import c
 
 from ..._lib.util import frozen, single_threaded_blas
-from ...calibration.pair import if_phase_slope_hz, probe_ranges
+from ...calibration.probes import if_phase_slope_hz, probe_ranges
 from ...synthesis.model import ChannelModel
-from ...calibration.sweep import beam_derivatives
+from ...synthesis.pair import beam_derivatives
 from ...geometry import Setup
 from ...geometry.setup import nominal_setup
 from ...paths import exact_paths
@@ -192,7 +192,7 @@ class _Design:
         one set-point per row instead of all (M = 1). Compiled per draw and set-point
         (``rtsgeom.synthesis.kernels.design_rows``: ``ratio_from_beams`` and ``detected_bin_choice``
         for one set-point, without the batch's temporaries)."""
-        from ...synthesis.kernels import design_rows
+        from .kernels import design_rows
         row_i, row_j, sub = (np.ascontiguousarray(a, np.int64) for a in (row_i, row_j, sub))
         lo, n_k = self._bins(self.reach if reach is None else reach)
         n = row_i.size
@@ -212,7 +212,7 @@ class _Design:
         best (consistent, margin, smallest |m|). Returns amplitudes (n, M, 2) and m (n, M).
         Compiled per draw and set-point (``rtsgeom.synthesis.kernels.plan_rows``)."""
         from ...pipeline.plan import MIN_BIN_MARGIN
-        from ...synthesis.kernels import plan_rows
+        from .kernels import plan_rows
         row_i, row_j, sub = (np.ascontiguousarray(a, np.int64) for a in (row_i, row_j, sub))
         p = int(period_steps)
         e = np.exp(1j * np.stack([self.phase(row_i, row_j + s * p) for s in (0, -1, 1)]))
@@ -329,10 +329,11 @@ class PairPhasors:
         amps = np.array(self.design_amplitudes)
         model = self.channels
         with single_threaded_blas():
-            phases = model.coherent_phases(self.probe_rad)
+            phases = (0.0, float(model.pair_phase(self.probe_rad)))
             for m in missing:
-                amps[c0, m] = model.amplitudes(model.solve(float(self.set_rad[m]), phases),
-                                               float(self.set_rad[m]))
+                a = float(self.set_rad[m])
+                amps[c0, m] = model.amplitudes(
+                    model.pair_weights(model.pair_ratio(a, phases), phases), np.sin([a]))
         return dataclasses.replace(self, amplitudes=frozen(amps[c0]),
                                    design_amplitudes=frozen(amps))
 
@@ -442,7 +443,7 @@ class PairPhasors:
         at the probe angles (the circular mean over the probes), (...,) for phasors
         (..., 2, V) (:meth:`ChannelModel.coherent_phases`). The amplitudes are designed for
         this one phase, the one the calibration establishes (``tests/test_design.py``)."""
-        return self.channels.coherent_phases(self.probe_rad, xq)[..., 1]
+        return self.channels.pair_phase(self.probe_rad, xq)
 
     def calibration_steps(self, xq: np.ndarray) -> np.ndarray:
         """The calibration of channel J, in delay-resolution steps (int, (...,)): the coherence
@@ -496,7 +497,7 @@ class PairPhasors:
         {"steps": (n,), "converged": {case: (n, M)}, "bin": {case: (n, M)},
         "amplitudes": {case: (n, M, 2)}} (the detected bin as an offset from the set range's,
         the programme amplitudes)."""
-        from ...synthesis.kernels import detect_rows
+        from .kernels import detect_rows
         offsets_m = np.asarray(offsets_m, float)
         n = offsets_m.shape[0]
         u = np.full(n, self.subbin_zero) if subbin is None else np.asarray(subbin, int)

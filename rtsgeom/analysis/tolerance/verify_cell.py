@@ -70,7 +70,7 @@ def verify_cell_draws(model: CellPhasors, sigma_m, n: int, seed: int,
             pts = (range(n_m) if all_points
                    else [int(np.argmax(d[case]["distance_rad"][i]))])
             for j, m in enumerate(pts):
-                amps = model.cells.model.unit_gain * d[case]["amplitudes"][i, m]
+                amps = model.cells.unit_gain * d[case]["amplitudes"][i, m]
                 prog = RtsProgram.build([0] * n_q, cell, list(delays), [0.0] * n_q,
                                         list(amps))
                 _, cube = simulate(setup, paths, prog)  # noise-free
