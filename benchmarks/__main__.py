@@ -93,10 +93,11 @@ def bench_synthesis(scene_path: Path, paths_method: str, repeat: int) -> dict:
 
 def bench_tolerance(scene_path: Path, draws: int) -> dict:
     """Monte-Carlo tolerance draws (phasor level, 21 set-points, uncalibrated + calibrated)."""
-    from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
+    from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
+    from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
     from rtsgeom.geometry import build_setup
     from rtsgeom.scene import load_scene
-    model = PairPhasors.build(build_setup(load_scene(scene_path)), (0, 1), points=21)
+    model = ChannelPhasors.build(build_setup(load_scene(scene_path)), (0, 1), points=21)
     sigma = [1e-4, 1e-4, 1e-4]
     monte_carlo(model, sigma, 1000, 0)  # warm-up
     t0 = time.perf_counter()
@@ -239,12 +240,13 @@ def bench_commands(scene_path: Path, quick: bool, repeat: int, workers: int) -> 
 
 def bench_design_parts(scene, quick: bool) -> dict:
     """What ``design`` spends its CPU on, design by design as ``evaluate_design`` does it: the
-    pair model (``PairPhasors.build``) and the two tolerance searches
+    pair model (``ChannelPhasors.build``) and the two tolerance searches
     (``max_sigma_for_yield``, uncalibrated and calibrated: Monte Carlos of 2000 draws x 21
     set-points each, counted)."""
     import math
     from rtsgeom.analysis.design import two_front_end_scene
-    from rtsgeom.analysis.tolerance.driver import CASES, PairPhasors, max_sigma_for_yield
+    from rtsgeom.analysis.tolerance.phasors import CASES, ChannelPhasors
+    from rtsgeom.analysis.tolerance.search import max_sigma_for_yield
     from rtsgeom.geometry import build_setup
     radii = np.linspace(0.5, 2.0, 2 if quick else 4)
     spacings = np.linspace(4.0, 20.0, 2 if quick else 5)
@@ -259,7 +261,7 @@ def bench_design_parts(scene, quick: bool) -> dict:
             setup = build_setup(variant)
             c0 = time.process_time()
             try:
-                model = PairPhasors.build(setup, (0, 1), 21)
+                model = ChannelPhasors.build(setup, (0, 1), 21)
             except ValueError:
                 continue
             cpu["build_s"] += time.process_time() - c0
@@ -282,11 +284,12 @@ def bench_dask_scaling(scene_path: Path, draws: int, workers: int) -> dict:
     model to the workers, once per client: the scaling of the study itself).
     (The CLI's ``--workers N`` forks a process pool instead, with no cluster to start; ``--dask
     ADDRESS`` runs on a cluster like this one, sent per chunk the draw streams' states.)"""
-    from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
+    from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
+    from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
     from rtsgeom.geometry import build_setup
     from rtsgeom._lib.parallel import dask_client, map_chunks
     from rtsgeom.scene import load_scene
-    model = PairPhasors.build(build_setup(load_scene(scene_path)), (0, 1), points=21)
+    model = ChannelPhasors.build(build_setup(load_scene(scene_path)), (0, 1), points=21)
     sigma = [1e-4, 1e-4, 1e-4]
     out = {"draws": draws, "workers": workers}
     p95 = {}

@@ -5,7 +5,7 @@ radii, other elevation spacings of the front ends, targets on a grid inside the 
 target's detected (azimuth, elevation) error is taken apart by switching one cause off at a
 time:
 
-* ``run``: the run as ``rtsgeom run`` does it (measured channel calibration, ``plan_cells``,
+* ``run``: the run as ``rtsgeom run`` does it (measured channel calibration, the planner's cell branch,
   one noisy frame through the ADC-cube chain);
 * ``noiseless``: the same programme, a frame without noise (``snr_db`` None): run - this is
   the receiver noise's share;
@@ -94,7 +94,7 @@ class Bench:
 
     def used(self):
         from rtsgeom.paths import nominal_model
-        from rtsgeom.pipeline.plan_cells import target_cells
+        from rtsgeom.pipeline.plan import target_cells
         nom, _ = nominal_model(self.setup, self.paths)
         _, _, found = target_cells(nom)
         return sorted({q for cell, _ in found for q in cell})
@@ -126,21 +126,20 @@ class Bench:
         return dataclasses.replace(cal, offsets_s=np.asarray(off, float)), cps
 
     def program(self, cal, mode="exact", scene=None):
-        """plan_cells with ``cal`` as the channel calibration (its measurement skipped)."""
-        from rtsgeom.calibration import channels as ncal
-        from rtsgeom.pipeline import plan_cells
+        """The planner with ``cal`` as the channel calibration (its measurement skipped)."""
+        from rtsgeom.pipeline import plan
         from rtsgeom.geometry import build_setup
         from rtsgeom.paths import compute_paths
         setup, paths = self.setup, self.paths
         if scene is not None:
             setup = build_setup(scene)
             paths = compute_paths(setup, "exact")
-        orig = ncal.calibrate_channels
-        ncal.calibrate_channels = lambda *a, **k: cal
+        orig = plan.calibrate_channels
+        plan.calibrate_channels = lambda *a, **k: cal
         try:
-            prog, _, _ = plan_cells.plan_cells(setup, paths, mode, True)
+            prog, _, _ = plan.plan_targets(setup, paths, mode, True)
         finally:
-            ncal.calibrate_channels = orig
+            plan.calibrate_channels = orig
         return prog, setup, paths
 
     @staticmethod

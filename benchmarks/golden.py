@@ -21,6 +21,7 @@ import hashlib
 import io
 import json
 import math
+import re
 import shutil
 import subprocess
 import sys
@@ -161,8 +162,11 @@ def _numbers(a, b, where, out):
         out["struct"].append(f"{where}: {str(a)[:60]!r} != {str(b)[:60]!r}")
 
 
-def _parse(path: Path):
+def _parse(path: Path, root: Path | None = None):
     text = path.read_text()
+    if root is not None:  # where the record was written, and timings, are not outputs
+        text = text.replace(str(root.resolve()), "<record>")
+        text = re.sub(r"\b\d+\.\d+ s\b", "<seconds> s", text)
     if path.suffix == ".json":
         return json.loads(text)
     if path.suffix == ".csv":
@@ -199,13 +203,16 @@ def compare(old: Path, new: Path, rtol: float = 1e-9, show: int = 3) -> int:
             if (case / f).read_bytes() == (other / f).read_bytes():
                 continue
             identical = False
-            a, b = _parse(case / f), _parse(other / f)
+            a, b = _parse(case / f, Path(old)), _parse(other / f, Path(new))
+            if a == b:
+                continue
             if f.name == "result.json":  # timings and progress are not outputs
                 for rec in (a, b):
                     rec.pop("argv", None)
             _numbers(a, b, str(f), out)
-        if identical:
-            print(f"{case.name:24s} identical")
+        if identical or (not out["diffs"] and not out["struct"]):
+            print(f"{case.name:24s} identical" + ("" if identical else
+                                                    " (but where it was written, timings)"))
             continue
         worst = sorted(out["diffs"], reverse=True)
         timing = [d for d in worst if "elapsed" in d[2] or "cpu_s" in d[2] or "wall" in d[2]]

@@ -249,7 +249,7 @@ RENAMED: dict[str, str] = {
 # survivors not killed and not shown equivalent: why (printed with their diff)
 NOT_KILLED: dict[str, str] = {
     "rtsgeom.analysis.design.x_evaluate_design__mutmut_62":
-        "the 'synthesis failed' branch needs PairPhasors.build to raise ValueError; no design "
+        "the 'synthesis failed' branch needs ChannelPhasors.build to raise ValueError; no design "
         "tried reaches it (spacings 35-140 deg at 0.3 and 1 m: the composite's searched peak "
         "always brackets the set angle, the design returns a worst error of 26-132 deg "
         "instead). Unreachable in practice, not proven; counted as a survivor.",

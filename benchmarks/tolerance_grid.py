@@ -38,13 +38,15 @@ def _scene(radius_m: float):
 
 
 def run(draws: int, verify: int, inversion_draws: int) -> list[dict]:
-    from rtsgeom.analysis.tolerance.driver import PairPhasors, max_sigma_for_yield, monte_carlo
+    from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
+    from rtsgeom.analysis.tolerance.search import max_sigma_for_yield
+    from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
     from rtsgeom.analysis.tolerance.verify import verify_draws
     from rtsgeom.geometry import build_setup
     rows = []
     for radius in RADII_M:
         t0 = time.process_time()
-        model = PairPhasors.build(build_setup(_scene(radius)), (0, 1))
+        model = ChannelPhasors.build(build_setup(_scene(radius)), (0, 1))
         build_s = time.process_time() - t0
         for subbin in (False, True):
             t0 = time.process_time()

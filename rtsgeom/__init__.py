@@ -62,9 +62,10 @@ _LAZY = {
     "Linearity": (".analysis.linearity", "Linearity"),
     # analyses
     "tolerance": (".api", "tolerance"),
-    "monte_carlo": (".analysis.tolerance.driver", "monte_carlo"),
-    "PairPhasors": (".analysis.tolerance.driver", "PairPhasors"),
-    "ToleranceResult": (".analysis.tolerance.driver", "ToleranceResult"),
+    "monte_carlo": (".analysis.tolerance", "monte_carlo"),
+    "ChannelPhasors": (".analysis.tolerance", "ChannelPhasors"),
+    "PairPhasors": (".analysis.tolerance", "ChannelPhasors"),  # its former name (a pair's)
+    "ToleranceResult": (".analysis.tolerance", "ToleranceResult"),
     "design": (".api", "design"),
     "design_grid": (".analysis.design", "design_grid"),
     "DesignGrid": (".analysis.design", "DesignGrid"),

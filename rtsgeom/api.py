@@ -155,11 +155,11 @@ def tolerance(scene: Scene, pair=(0, 1), sigma_mm=(0.1, 0.1, 0.1), draws: int = 
         ``worst_error_deg[case]`` per draw for ``'uncalibrated'`` and ``'calibrated'``,
         ``yield_(case)``, ``stats(case)`` and ``to_dict()``.
     """
-    from .analysis.tolerance.driver import PairPhasors, monte_carlo
+    from .analysis.tolerance import ChannelPhasors, monte_carlo
     from .geometry import build_setup
     setup = build_setup(scene)
     pair = _check_pair(setup, pair)
-    model = PairPhasors.build(setup, pair, points)
+    model = ChannelPhasors.build(setup, pair, points)
     sigma = np.asarray(sigma_mm, float).reshape(3) * 1e-3
     return monte_carlo(model, sigma, draws, scene.seed if seed is None else seed, distribution,
                        spec_deg)

@@ -106,16 +106,16 @@ class CoherenceShift:
 def two_front_end_pair(radius_m: float, spacing_deg: float = 8.0):
     """The default scene as the arc design's clean two-front-end variant (pair (0, 1) at
     ``radius_m`` and ``spacing_deg``, no mounting or channel errors) and its pair-study model
-    (3 candidate bins): ``(scene, PairPhasors)``."""
+    (3 candidate bins): ``(scene, ChannelPhasors)``."""
     import math
 
     from rtsgeom.analysis.design import two_front_end_scene
-    from rtsgeom.analysis.tolerance.driver import PairPhasors
+    from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
     from rtsgeom.geometry import build_setup
     scene, _, problem = two_front_end_scene(make_scene(), (0, 1), radius_m,
                                             math.radians(spacing_deg))
     assert problem is None, problem
-    return scene, PairPhasors.build(build_setup(scene), (0, 1), 3)
+    return scene, ChannelPhasors.build(build_setup(scene), (0, 1), 3)
 
 
 #: one mounting, channel or RuT pose error per file key (``geometry.setup.FRONT_END_ERRORS``,

@@ -160,7 +160,7 @@ def test_paper_g_is_accurate_near_zero():
 
 
 def test_closed_form_modes_refuse_angles_outside_the_geometric_span():
-    from rtsgeom.pipeline.plan import pair_amplitudes
+    from rtsgeom.pipeline.pair import pair_amplitudes
     from rtsgeom.errors import AngleUnreachable
     from rtsgeom.scene import TargetConfig
     setup = build_setup(make_scene())

@@ -9,10 +9,12 @@ import math
 import numpy as np
 import pytest
 
-from rtsgeom.analysis.tolerance.arc import (Bounds, adjacent_pairs, arc_draws, arc_models,
-                                            arc_monte_carlo, shared_subbin_steps)
+from rtsgeom.analysis.tolerance.draws import Bounds
+from rtsgeom.analysis.tolerance.montecarlo import ToleranceModel
 from rtsgeom.analysis.design import two_front_end_scene
-from rtsgeom.analysis.tolerance.driver import PairPhasors, evaluate_chunk, monte_carlo, subbin_draws
+from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
+from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
+from rtsgeom.analysis.tolerance.draws import draw_chunks, subbin_draws
 from rtsgeom.errors import ParameterError
 from rtsgeom.geometry import build_setup
 from rtsgeom.scene import load_scene
@@ -40,7 +42,8 @@ def test_two_front_end_arc_reproduces_the_pair_study_with_subbin(radius_m):
     sigma = np.array([0.3, 0.2, 0.2]) * 1e-3
     # the same chunk here; the pair study's bits do not depend on it either (test_tolerance)
     pair = monte_carlo(model, sigma, 120, 4, "normal", 0.05, chunk=40)
-    arc = arc_monte_carlo([model], 2, Bounds(tuple(sigma)), 120, 4, "normal", 0.05, chunk=40)
+    arc = monte_carlo(ToleranceModel.arc([model], 2), Bounds(tuple(sigma)), 120, 4, "normal",
+                      0.05, chunk=40)
     for case in ("uncalibrated", "calibrated"):
         assert np.array_equal(arc.worst_error_deg[case][:, 0], pair.worst_error_deg[case])
     assert np.array_equal(arc.subbin_steps, pair.subbin_steps)
@@ -59,26 +62,26 @@ def test_arc_pairs_share_one_target_position(radius_m, angles):
     chunk; the bin-centre run (``subbin=False``) is every pair at the bin centre."""
     setup = build_setup(_arc_scene(radius_m, angles))
     n_fe = len(angles)
-    models = arc_models(setup, adjacent_pairs(n_fe), 3)
-    steps = shared_subbin_steps(models)
+    models = [ChannelPhasors.build(setup, (i, i + 1), 3) for i in range(n_fe - 1)]
+    steps = ToleranceModel.arc(models, n_fe).subbin_steps
     b = Bounds((0.2e-3, 0.15e-3, 0.1e-3))
     draws, seed = 90, 7
-    res = arc_monte_carlo(models, n_fe, b, draws, seed, "uniform", 0.05, keep_errors=True,
-                          chunk=40)
+    res = monte_carlo(ToleranceModel.arc(models, n_fe), b, draws, seed, "uniform", 0.05,
+                      keep_errors=True, chunk=40)
     idx = next(subbin_draws(seed, draws, steps.size, draws))
     assert np.array_equal(res.subbin_steps, steps[idx])
-    again = next(arc_draws(seed, draws, n_fe, "uniform", draws, steps.size))["subbin"]
+    again = next(draw_chunks(seed, draws, n_fe, "uniform", draws, steps.size)).subbin()
     assert np.array_equal(again, idx)
     off = res.errors["offsets_m"]
-    centre = arc_monte_carlo(models, n_fe, b, draws, seed, "uniform", 0.05, chunk=draws,
-                             subbin=False)
+    centre = monte_carlo(ToleranceModel.arc(models, n_fe), b, draws, seed, "uniform", 0.05,
+                         chunk=draws, subbin=False)
     assert centre.subbin_steps is None
-    for p, (m, pair) in enumerate(zip(models, adjacent_pairs(n_fe))):
-        one = evaluate_chunk(m, off[:, pair[0]:pair[1] + 1], subbin=idx)
-        mid = evaluate_chunk(m, off[:, pair[0]:pair[1] + 1])
+    for p, (m, pair) in enumerate(zip(models, [(i, i + 1) for i in range(n_fe - 1)])):
+        one = m.evaluate(off[:, pair[0]:pair[1] + 1], subbin=idx)
+        mid = m.evaluate(off[:, pair[0]:pair[1] + 1])
         for case in ("uncalibrated", "calibrated"):
-            assert np.array_equal(res.worst_error_deg[case][:, p], one[case])
-            assert np.array_equal(centre.worst_error_deg[case][:, p], mid[case])
+            assert np.array_equal(res.worst_error_deg[case][:, p], one[case][:, 0])
+            assert np.array_equal(centre.worst_error_deg[case][:, p], mid[case][:, 0])
     # the position matters: somewhere in the bin the worst error is not the bin centre's
     assert not np.array_equal(res.worst_error_deg["calibrated"],
                               centre.worst_error_deg["calibrated"])
@@ -86,7 +89,7 @@ def test_arc_pairs_share_one_target_position(radius_m, angles):
 
 def test_arc_refuses_pairs_built_for_different_target_positions():
     setup = build_setup(load_scene(DEFAULT))
-    m = PairPhasors.build(setup, (0, 1), 3)
+    m = ChannelPhasors.build(setup, (0, 1), 3)
     other = dataclasses.replace(m, subbin_steps=m.subbin_steps[1:-1])
     with pytest.raises(ParameterError, match="sub-bin positions"):
-        arc_monte_carlo([m, other], 2, Bounds((1e-4, 0.0, 0.0)), 4, 1)
+        ToleranceModel.arc([m, other], 2)

@@ -503,7 +503,7 @@ def test_fir_changes_linearity_by_no_more_than_its_phase_ripple_explains(taps):
     from rtsgeom.calibration.probes import mean_air_delay
     from rtsgeom.calibration.fir import fir_bin_gain
     from rtsgeom.analysis.linearity import linearity
-    from rtsgeom.pipeline.plan import pair_design
+    from rtsgeom.pipeline.pair import pair_design
     from rtsgeom.synthesis.model import ChannelModel
     from rtsgeom.rts.channels import requested_delay
     from rtsgeom.scene import TargetConfig
@@ -599,7 +599,8 @@ def test_calibration_file_names_the_setup_it_was_made_on():
     with the arc, a front end's mounting or channel and the RuT's chirp, not with the
     scenario (targets, seed, SNR); a file made before a front end was moved is applied with
     a warning (a new-user trial applied one silently: -3.7 deg errors, exit 0)."""
-    from rtsgeom.pipeline.plan import calibration_mismatch, plan_targets, setup_fingerprint
+    from rtsgeom.calibration.file import calibration_mismatch, setup_fingerprint
+    from rtsgeom.pipeline.plan import plan_targets
 
     def fe1(**kw):
         return lambda d: d["rts"]["front_ends"][1].update(kw)
@@ -630,7 +631,7 @@ def test_calibration_fingerprint_follows_file_contents_not_paths(tmp_path):
     """The same scene and antenna table in two folders: one fingerprint (a moved project
     keeps its calibrations); an edited table: another. The sheet, the ray tracing, the
     calibration procedure's steps and the RTS's noise are not the setup measured."""
-    from rtsgeom.pipeline.plan import setup_fingerprint
+    from rtsgeom.calibration.file import setup_fingerprint
     from rtsgeom.scene import load_scene
     text = DEFAULT_SCENE.read_text().replace(
         "[radar.cfar]", '[radar.pattern]\nkind = "table"\ntable = "pat.csv"\n\n[radar.cfar]')

@@ -129,7 +129,7 @@ def test_a_pair_that_fails_is_named_and_a_cell_it_disconnects_stops_the_run(
     from rtsgeom.calibration.probes import probe_front_ends
     from rtsgeom.errors import CalibrationFailed
     from rtsgeom.calibration.channels import calibrate_channels
-    from rtsgeom.pipeline.plan_cells import plan_cells
+    from rtsgeom.pipeline.plan import plan_targets
     from rtsgeom.errors import SceneError
     setup, paths = nominal_sphere4
     probe = probe_front_ends(setup, paths, 1)
@@ -140,7 +140,7 @@ def test_a_pair_that_fails_is_named_and_a_cell_it_disconnects_stops_the_run(
     with pytest.raises(CalibrationFailed, match=r"\(0, 1\)"):
         calibrate_channels(setup, paths, [0, 1, 2, 3], probe)
     with pytest.raises(SceneError, match="channel calibration failed"):
-        plan_cells(setup, paths, "exact")
+        plan_targets(setup, paths, "exact")
 
 
 def test_run_says_the_calibration_failed_when_it_is_why_a_target_is_unreachable(
@@ -148,21 +148,21 @@ def test_run_says_the_calibration_failed_when_it_is_why_a_target_is_unreachable(
     """A target inside its cell that the calibrated channels cannot reach, after a
     calibration with warnings: the message says the calibration failed and why."""
     import rtsgeom.calibration.channels as ncal
+    import rtsgeom.pipeline.plan as plan
     from rtsgeom.errors import AngleUnreachable
     from rtsgeom.synthesis.model import ChannelModel
-    from rtsgeom.pipeline.plan_cells import plan_cells
     from rtsgeom.errors import SceneError
     setup, paths = nominal_sphere4
     bad = ncal.ChannelCalibration(np.zeros(4), 0, [], [(0, 1), (0, 2), (1, 3)], [40e-12],
                                   warnings=("channel calibration: the loop through pair "
                                             "(0, 3) closes to 40.0 ps",))
-    monkeypatch.setattr(ncal, "calibrate_channels", lambda *a, **k: bad)
+    monkeypatch.setattr(plan, "calibrate_channels", lambda *a, **k: bad)
 
     def unreachable(self, *a, **k):
         raise AngleUnreachable("outside what this cell can synthesize")
     monkeypatch.setattr(ChannelModel, "solve", unreachable)
     with pytest.raises(SceneError, match=r"calibration failed .*\(0, 3\)"):
-        plan_cells(setup, paths, "exact")
+        plan.plan_targets(setup, paths, "exact")
 
 
 # -- the elevation pair against its coherence point (full chain at every step) -----------------

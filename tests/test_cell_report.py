@@ -67,7 +67,7 @@ def test_targets_table_columns(el):
 def test_reachable_cells_in_info(radius):
     """`info` on a cell scene names each target's enclosing cell (the planner's choice, not arc
     pairs) and warns, naming the target, for a direction outside every cell."""
-    from rtsgeom.pipeline.plan_cells import target_cells
+    from rtsgeom.pipeline.plan import target_cells
     from rtsgeom.pipeline.info import reachable_spans, unreachable_warnings
     from rtsgeom.scene import TargetConfig
     scene = corners(load_scene(SCENE), (-3.0, 5.0), (-3.0, 3.0), radius=radius, height=1.5)

@@ -13,9 +13,11 @@ import pytest
 from scipy.constants import c
 
 from conftest import ROOT
-from rtsgeom.analysis.tolerance.subbin import subbin_positions
-from rtsgeom.analysis.tolerance.driver import CASES, PairPhasors, subbin_draws
-from rtsgeom.analysis.tolerance.cell import CellPhasors, monte_carlo_cell, verify_cell_draws
+from rtsgeom.analysis.tolerance.draws import subbin_positions
+from rtsgeom.analysis.tolerance.phasors import CASES, ChannelPhasors
+from rtsgeom.analysis.tolerance.draws import subbin_draws
+from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
+from rtsgeom.analysis.tolerance.verify import verify_draws
 from rtsgeom.geometry import build_setup
 from rtsgeom.scene import load_scene
 from test_tolerance_cell import CELLS, cell_scene
@@ -23,7 +25,7 @@ from test_tolerance_cell import CELLS, cell_scene
 
 @pytest.fixture(scope="module", params=[1, 2], ids=lambda k: f"cell{k}")
 def model(request):
-    return CellPhasors.build(build_setup(cell_scene(*CELLS[request.param])), grid=2)
+    return ChannelPhasors.build(build_setup(cell_scene(*CELLS[request.param])), points=4)
 
 
 @pytest.mark.parametrize("resolution_s", [1e-12, 7e-12])
@@ -38,7 +40,7 @@ def test_positions_are_the_pair_studys(resolution_s, bandwidth_hz):
         radar=dataclasses.replace(scene.radar, bandwidth_hz=bandwidth_hz))
     assert scene.rts.delay_resolution_s == resolution_s
     assert (scene.radar.range_resolution_m == base) == (bandwidth_hz == 1e9)
-    pair = PairPhasors.build(build_setup(scene), (0, 1), 3)
+    pair = ChannelPhasors.build(build_setup(scene), (0, 1), 3)
     want = subbin_positions(scene.radar.range_resolution_m, resolution_s)
     assert np.array_equal(pair.subbin_steps, want)
     # one range bin: 2 dR / c0 in steps (to half a step), centred on 0
@@ -52,7 +54,7 @@ def test_cell_positions_and_stream(model):
     rs = model.setup.scene.radar.range_resolution_m
     assert np.array_equal(model.subbin_steps,
                           subbin_positions(rs, model.delay_resolution_s))
-    res = monte_carlo_cell(model, [1e-4] * 3, 400, seed=3, chunk=150)
+    res = monte_carlo(model, [1e-4] * 3, 400, seed=3, chunk=150)
     idx = next(subbin_draws(3, 400, model.subbin_steps.size, 400))
     assert np.array_equal(res.subbin_steps, model.subbin_steps[idx])
     assert res.to_dict()["subbin"]["positions"] == model.subbin_steps.size
@@ -65,9 +67,9 @@ def test_bin_centre_is_the_special_case(model):
     """subbin=None is the centre position, bit for bit, and reads the table row the
     bin-centre model read (x_nominal to rounding)."""
     rng = np.random.default_rng(1)
-    off = rng.standard_normal((6, len(model.cell), 3)) * 1e-4
-    a = model.draw(off, CASES)
-    b = model.draw(off, CASES, subbin=np.full(6, model.subbin_zero))
+    off = rng.standard_normal((6, len(model.front_ends), 3)) * 1e-4
+    a = model.draw(off, None, CASES)
+    b = model.draw(off, np.full(6, model.subbin_zero), CASES)
     for case in CASES:
         assert np.array_equal(a[case]["error_rad"], b[case]["error_rad"])
         assert np.all(a[case]["bin"] == 0)
@@ -83,7 +85,7 @@ def test_detected_bin_follows_the_echo(model):
     deg across the bin)."""
     n_u = model.subbin_steps.size
     u = np.arange(0, n_u, 37)
-    d = model.draw(np.zeros((u.size, len(model.cell), 3)), ("uncalibrated",), subbin=u)
+    d = model.draw(np.zeros((u.size, len(model.front_ends), 3)), u, ("uncalibrated",))
     frac = model.subbin_steps[u] / n_u
     inner = np.abs(frac) <= 0.45
     assert np.all(d["uncalibrated"]["bin"][inner] == 0)
@@ -97,7 +99,7 @@ def test_calibrated_nominal_error_grows_towards_the_bin_edge(model):
     grows towards either edge (the bin-centre model could not see this)."""
     n_u = model.subbin_steps.size
     u = np.array([model.subbin_zero, int(0.1 * n_u), int(0.9 * n_u)])
-    d = model.draw(np.zeros((3, len(model.cell), 3)), ("calibrated",), subbin=u)
+    d = model.draw(np.zeros((3, len(model.front_ends), 3)), u, ("calibrated",))
     e = np.degrees(np.abs(d["calibrated"]["error_rad"])).max(axis=(1, 2))
     assert e[0] < e[1] and e[0] < e[2]
 
@@ -107,22 +109,22 @@ def test_model_matches_the_chain_across_the_bin(model):
     through the full ADC-cube chain at every set-point: the fast model within 1e-4 deg."""
     n_u = model.subbin_steps.size
     pos = [0, n_u // 4, model.subbin_zero, 3 * n_u // 4, n_u - 1]
-    v = verify_cell_draws(model, [1e-4] * 3, len(pos), seed=2, all_points=True,
+    v = verify_draws(model, [1e-4] * 3, len(pos), seed=2, all_points=True,
                           positions=pos)
-    assert v["max_abs_difference_deg"] < 1e-4
-    assert all(c["missed"] == 0 for c in v["cases"].values())
-    assert v["subbin_steps"] == model.subbin_steps[pos].tolist()
+    assert v.max_difference_deg < 1e-4
+    assert all(c["missed"] == 0 for c in v.to_dict()["cases"].values())
+    assert v.subbin_steps.tolist() == model.subbin_steps[pos].tolist()
 
 
 @pytest.mark.slow
 def test_bin_edge_draws_match_the_chain():
     """The draws the sub-bin positions make worst (the calibrated case detected off the set
     range's bin on sphere4 at 0.3 mm): the chain agrees there too (1e-4 deg)."""
-    m = CellPhasors.build(build_setup(load_scene(ROOT / "scenes" / "sphere4.toml")), grid=3)
-    res = monte_carlo_cell(m, [3e-4] * 3, 60, seed=4, cases=("calibrated",))
+    m = ChannelPhasors.build(build_setup(load_scene(ROOT / "scenes" / "sphere4.toml")), points=9)
+    res = monte_carlo(m, [3e-4] * 3, 60, seed=4, cases=("calibrated",))
     worst = np.argsort(-res.worst_error_deg["calibrated"][:, 2])[:4]
     n = int(worst.max()) + 1
-    v = verify_cell_draws(m, [3e-4] * 3, n, seed=4, cases=("calibrated",))
-    diff = np.abs(v["detail"]["calibrated"]["chain_deg"] - v["detail"]["calibrated"]["model_deg"])
+    v = verify_draws(m, [3e-4] * 3, n, seed=4, cases=("calibrated",))
+    diff = np.abs(v.chain_deg["calibrated"] - v.model_deg["calibrated"])
     assert np.max(diff[worst]) < 1e-4
-    assert math.isfinite(v["max_abs_difference_deg"])
+    assert math.isfinite(v.max_difference_deg)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from rtsgeom.analysis.design import METRICS, design_grid, evaluate_design, two_front_end_scene
-from rtsgeom.analysis.tolerance.driver import PairPhasors
+from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
 from rtsgeom.cli import main
 from rtsgeom.geometry import build_setup
 from rtsgeom.geometry.farfield import angular_resolution_rad
@@ -69,32 +69,32 @@ def test_synthesis_beyond_the_first_null_with_one_phase(scene):
     phase the calibration sets, every set-point is still reached."""
     variant, sheet, problem = two_front_end_scene(scene, (0, 1), 1.0, math.radians(16.0))
     assert problem is None and sheet == "kept"
-    model = PairPhasors.build(build_setup(variant), (0, 1), 11)
+    model = ChannelPhasors.build(build_setup(variant), (0, 1), 11)
     assert np.max(np.abs(model.angle_errors(np.zeros((2, 3)), "calibrated"))) < 1e-3
 
 
 @pytest.mark.parametrize("spacing_deg", [8.0, 20.0])
 def test_bin_centre_solved_later_is_the_same_model(scene, spacing_deg):
     """``evaluate_design`` builds without the bin-centre root finder and adds it
-    (``PairPhasors.solved``) only where the calibrated plan exists: the model it then has is
+    (``ChannelPhasors.solved``) only where the calibrated plan exists: the model it then has is
     the eagerly built one, bit for bit (beyond the resolution, 20 deg, the root finder runs;
     at 8 deg the closed form leaves nothing to solve)."""
     variant, _, problem = two_front_end_scene(scene, (0, 1), 1.0, math.radians(spacing_deg))
     assert problem is None
     setup = build_setup(variant)
-    eager = PairPhasors.build(setup, (0, 1), 9)
-    lazy = PairPhasors.build(setup, (0, 1), 9, solve_bin_centre=False)
+    eager = ChannelPhasors.build(setup, (0, 1), 9)
+    lazy = ChannelPhasors.build(setup, (0, 1), 9, solve_bin_centre=False)
     c0 = eager.subbin_zero
-    unsolved = ~np.isfinite(lazy.design_amplitudes[c0]).all(-1)
+    unsolved = ~np.isfinite(lazy.procedure.design_amplitudes[c0]).all(-1)
     assert unsolved.any() == (spacing_deg > 10)
     assert np.all(np.isfinite(eager.amplitudes))
-    done = lazy.solved()
-    for name in ("amplitudes", "design_amplitudes"):
-        a, b = getattr(done, name), getattr(eager, name)
-        assert np.array_equal(a, b, equal_nan=True)
+    done = lazy.procedure.solved(lazy)
+    assert np.array_equal(done.amplitudes, eager.amplitudes, equal_nan=True)
+    assert np.array_equal(done.procedure.design_amplitudes, eager.procedure.design_amplitudes,
+                          equal_nan=True)
     # only the bin centre's unsolved set-points change
-    assert np.array_equal(np.delete(done.design_amplitudes, c0, 0),
-                          np.delete(lazy.design_amplitudes, c0, 0), equal_nan=True)
+    assert np.array_equal(np.delete(done.procedure.design_amplitudes, c0, 0),
+                          np.delete(lazy.procedure.design_amplitudes, c0, 0), equal_nan=True)
 
 
 def test_variant_scene_and_sheet(scene):

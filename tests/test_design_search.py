@@ -6,8 +6,8 @@ from __future__ import annotations
 import pytest
 
 from rtsgeom.analysis.design import pilot_estimate, tolerance_search
-from rtsgeom.analysis.tolerance.driver import (PairPhasors, largest_passing_scale,
-                                               max_sigma_for_yield)
+from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
+from rtsgeom.analysis.tolerance.search import largest_passing_scale, max_sigma_for_yield
 from rtsgeom.geometry import build_setup
 
 from test_yield_search import _study
@@ -35,7 +35,7 @@ def test_a_start_near_the_answer_with_its_power_closes_in_few_evaluations(p, mis
 @pytest.fixture(scope="module")
 def model():
     from conftest import make_scene
-    return PairPhasors.build(build_setup(make_scene()), (0, 1), 5)
+    return ChannelPhasors.build(build_setup(make_scene()), (0, 1), 5)
 
 
 @pytest.mark.parametrize("case", ["calibrated", "uncalibrated"])

@@ -359,10 +359,10 @@ def test_the_tolerance_model_refuses_a_smoothed_estimator(estimator, capsys):
     peak and estimates the draws' angles there; a smoothed Capon or MUSIC peaks elsewhere
     (they had reported NaN statistics, "composite splits" and 0 mm tolerances): a named
     error, while without smoothing (rank one: they peak where Bartlett does) it runs."""
-    from rtsgeom.analysis.tolerance.driver import PairPhasors
+    from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
     smoothed = make_scene(angle_estimator=estimator, angle_subarray=5)
     with pytest.raises(SceneError, match=rf"radar.angle_estimator = {estimator} with "
                                          r"radar.angle_subarray = 5"):
-        PairPhasors.build(build_setup(smoothed), (0, 1), points=3)
+        ChannelPhasors.build(build_setup(smoothed), (0, 1), points=3)
     plain = make_scene(angle_estimator=estimator, angle_subarray=0)
-    assert np.isfinite(PairPhasors.build(build_setup(plain), (0, 1), points=3).amplitudes).all()
+    assert np.isfinite(ChannelPhasors.build(build_setup(plain), (0, 1), points=3).amplitudes).all()

@@ -111,7 +111,7 @@ def test_ratio_kernel_gives_the_definitions_bits(v, win, uneven, monkeypatch):
     phase = rng.uniform(-np.pi, np.pi, n)
     out = []
     for compiled in (True, False):
-        monkeypatch.setattr(sweep, "use_kernels", lambda n, s: compiled)
+        monkeypatch.setattr(pair_design, "use_kernels", lambda n, s: compiled)
         out.append(pair_design.ratio_from_beams(b_i, b_j, phase))
     np.testing.assert_array_equal(out[0], out[1])
     np.testing.assert_array_equal(np.signbit(out[0]), np.signbit(out[1]))

@@ -227,17 +227,18 @@ def test_plan_programs_two_channels_per_target_at_the_set_range_and_doppler(smal
 def test_tolerance_table_spans_half_a_calibration_period():
     """The delay table of the tolerance model covers +-(half a period 1/(f_rts + B/2)) in
     delay-resolution steps, plus 4 for the refinement."""
-    from rtsgeom.analysis.tolerance.driver import PairPhasors
+    from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
     scene = small_quiet([])
-    model = PairPhasors.build(build_setup(scene), (0, 1), points=3)
+    model = ChannelPhasors.build(build_setup(scene), (0, 1), points=3)
     slope = scene.rts.f_rts_hz + 0.5 * scene.radar.bandwidth_hz
-    assert model.max_steps == int(np.ceil(0.5 / (slope * scene.rts.delay_resolution_s))) + 4
+    assert model.procedure.max_steps == int(np.ceil(0.5 / (slope * scene.rts.delay_resolution_s))) + 4
 
 
 @pytest.mark.parametrize("sigma", [[-1e-4, 0, 0], [0, float("nan"), 0], [0, 0, float("inf")]])
 def test_monte_carlo_refuses_negative_or_non_finite_sigmas(sigma):
-    from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
-    model = PairPhasors.build(build_setup(small_quiet([])), (0, 1), points=3)
+    from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
+    from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
+    model = ChannelPhasors.build(build_setup(small_quiet([])), (0, 1), points=3)
     with pytest.raises(ValueError, match="sigma_m"):
         monte_carlo(model, sigma, 4, seed=0)
 
@@ -313,7 +314,7 @@ def test_linearity_sweeps_the_inner_span_and_reports_relative_amplitudes(cal_set
     assert amp_db.max() == 0.0 and np.all(amp_db <= 0.0)
     # 20 log10 of the programmed amplitudes relative to the largest
     from rtsgeom.calibration.probes import probe_angles
-    from rtsgeom.pipeline.plan import pair_design
+    from rtsgeom.pipeline.pair import pair_design
     from rtsgeom.calibration.probes import probe_ranges
     from rtsgeom.scene import TargetConfig
     rng = float(probe_ranges(setup, 1)[0])
@@ -364,7 +365,7 @@ def test_closed_forms_put_a_span_end_on_one_channel_alone(angles):
 def test_pair_amplitudes_design_for_the_channel_delay_offsets():
     """``exact`` designs J's amplitude for its calibration delay (the range offset it causes):
     an offset of a whole period changes the ratio, by the model built with that delay."""
-    from rtsgeom.pipeline.plan import pair_amplitudes
+    from rtsgeom.pipeline.pair import pair_amplitudes
     from rtsgeom.synthesis.model import ChannelModel
     from rtsgeom.scene import TargetConfig
     setup = build_setup(small_quiet([], samples_per_chirp=512))
@@ -395,8 +396,9 @@ def test_ghosts_of_a_later_front_end_when_an_earlier_one_is_idle():
 
 
 def test_monte_carlo_maps_its_chunks_through_the_mapper_and_times_itself():
-    from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
-    model = PairPhasors.build(build_setup(small_quiet([])), (0, 1), points=3)
+    from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
+    from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
+    model = ChannelPhasors.build(build_setup(small_quiet([])), (0, 1), points=3)
     calls = []
 
     def mapper(func, chunks):
@@ -413,22 +415,23 @@ def test_monte_carlo_maps_its_chunks_through_the_mapper_and_times_itself():
 
 
 def test_yield_inversion_says_when_the_nominal_setup_misses_the_spec():
-    from rtsgeom.analysis.tolerance.driver import PairPhasors, max_sigma_for_yield
-    model = PairPhasors.build(build_setup(small_quiet([])), (0, 1), points=3)
+    from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
+    from rtsgeom.analysis.tolerance.search import max_sigma_for_yield
+    model = ChannelPhasors.build(build_setup(small_quiet([])), (0, 1), points=3)
     res = max_sigma_for_yield(model, [1e-4] * 3, 20, 0, 0.95, spec_deg=1e-9,
                               case="uncalibrated")
     assert "misses the spec" in str(res.get("note"))
 
 
 def test_range_offset_is_half_c_times_the_mean_delay_mismatch():
-    """range_offset_m = c0/2 (element-mean air delay of J + its steps - that of I)."""
-    from rtsgeom.analysis.tolerance.driver import PairPhasors
-    model = PairPhasors.build(build_setup(small_quiet([])), (0, 1), points=3)
+    """range_offsets_m = c0/2 (element-mean air delay of J + its steps - that of I)."""
+    from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
+    model = ChannelPhasors.build(build_setup(small_quiet([])), (0, 1), points=3)
     off = np.zeros((2, 3))
     off[1, 0] = 2e-3  # 2 mm radial on J: both legs longer by 2 mm
     a_i, a_j = model.air_legs(off)
-    base = model.range_offset_m(np.zeros((2, 3)), 0)
-    got = model.range_offset_m(off, 7)
+    base = model.range_offsets_m(np.zeros((1, 2, 3)), [[0, 0]])[0, 1]
+    got = model.range_offsets_m(off[None], [[0, 7]])[0, 1]
     assert got - base == pytest.approx(0.5 * c * (2 * 2e-3 / c + 7 * model.delay_resolution_s),
                                        rel=1e-3)
 

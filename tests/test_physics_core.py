@@ -35,7 +35,7 @@ def test_largest_passing_scale_stops_when_the_bracket_is_within_rel_tol(t_star, 
     """A yield that passes for t <= t*: the search returns lo <= t* within rel_tol of it and
     stops as soon as the bracket is that narrow, so its cost is the doublings plus
     ceil(log2(log(hi/lo) / log(1 + rel_tol))) + 1 geometric bisections, not all of them."""
-    from rtsgeom.analysis.tolerance.driver import largest_passing_scale
+    from rtsgeom.analysis.tolerance.search import largest_passing_scale
     calls = []
 
     def yield_at(t):
@@ -55,7 +55,7 @@ def test_largest_passing_scale_stops_when_the_bracket_is_within_rel_tol(t_star, 
 
 
 def test_largest_passing_scale_caps():
-    from rtsgeom.analysis.tolerance.driver import largest_passing_scale
+    from rtsgeom.analysis.tolerance.search import largest_passing_scale
     for cap in (0.5, 3.0, 10.0):
         t, y, capped = largest_passing_scale(lambda t: 1.0, 1.0, 0.9, 0.1, cap, 0.01)
         assert capped and t == cap and y == 1.0
@@ -64,9 +64,10 @@ def test_largest_passing_scale_caps():
 def test_monte_carlo_without_draws_has_no_errors_and_no_yield():
     """Zero draws: every case's error array is empty and its yield undefined (NaN), never a
     phantom draw with zero error (a 100 % yield)."""
-    from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
+    from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
+    from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
     from rtsgeom.geometry import build_setup
-    model = PairPhasors.build(build_setup(make_scene()), (0, 1), 3)
+    model = ChannelPhasors.build(build_setup(make_scene()), (0, 1), 3)
     res = monte_carlo(model, [1e-4, 1e-4, 1e-4], 0, 1)
     for case, e in res.worst_error_deg.items():
         assert e.shape == (0,)
@@ -143,7 +144,7 @@ def test_bounds_from_tolerances_scale_every_field(distribution, level):
     """A tolerance t is a normal draw's t / sigma_level standard deviation and a uniform
     draw's bound t, for every field (front-end offsets and rotations, the RuT's position
     and yaw); a field left out is 0."""
-    from rtsgeom.analysis.tolerance.arc import Bounds
+    from rtsgeom.analysis.tolerance.draws import Bounds
     tol = {"offsets_m": (1e-4, 2e-4, 3e-4), "yaw_rad": 0.01, "pitch_rad": 0.02,
            "rut_position_m": (4e-4, 5e-4, 6e-4), "rut_yaw_rad": 0.03}
     k = 1.0 / level if distribution == "normal" else 1.0
@@ -162,13 +163,19 @@ def test_arc_draws_do_not_depend_on_the_chunk(distribution):
     """The unit draws are the same whatever the chunk size (each stream from its own
     generator), with the documented shapes; uniform ones fill [-1, 1], normal ones have unit
     variance."""
-    from rtsgeom.analysis.tolerance.arc import arc_draws
+    from rtsgeom.analysis.tolerance.draws import Bounds, draw_chunks
     draws, count = 400, 3
     ref = None
+    unit = Bounds((1.0,) * 3, 1.0, 1.0, (1.0,) * 3, 1.0)
     for chunk in (1, 37, 400, 10_000):
-        parts = list(arc_draws(5, draws, count, distribution, chunk))
+        parts = list(draw_chunks(5, draws, count, distribution, chunk, rotations=True, rut=True))
         assert len(parts) == -(-draws // chunk)
-        got = {k: np.concatenate([p[k] for p in parts]) for k in ("offsets", "rotations", "rut")}
+        errs = [p.errors(unit) for p in parts]
+        got = {"offsets": np.concatenate([e["offsets_m"] for e in errs]),
+               "rotations": np.concatenate([np.stack([e["yaw_rad"], e["pitch_rad"]], -1)
+                                            for e in errs]),
+               "rut": np.concatenate([np.column_stack([e["rut_offset_m"], e["rut_yaw_rad"]])
+                                      for e in errs])}
         assert got["offsets"].shape == (draws, count, 3)
         assert got["rotations"].shape == (draws, count, 2) and got["rut"].shape == (draws, 4)
         if ref is None:
@@ -186,15 +193,17 @@ def test_arc_draws_do_not_depend_on_the_chunk(distribution):
 def test_arc_yield_search_stops_at_zero_when_the_nominal_arc_fails():
     """When even the arc without errors misses the spec, the largest passing scale is 0 and
     its yield is the nominal one (0); with a reachable spec the scale is positive."""
-    from rtsgeom.analysis.tolerance.arc import Bounds, arc_models, max_scale_for_yield
+    from rtsgeom.analysis.tolerance.draws import Bounds
+    from rtsgeom.analysis.tolerance import ChannelPhasors, ToleranceModel
+    from rtsgeom.analysis.tolerance.search import max_scale_for_yield
     from rtsgeom.geometry import build_setup
     setup = build_setup(make_scene())
-    models = arc_models(setup, [(0, 1)], 3)
+    models = ToleranceModel.arc([ChannelPhasors.build(setup, (0, 1), 3)], 2)
     b = Bounds((1e-4, 1e-4, 1e-4))
     # the nominal calibrated synthesis is exact to ~1e-5 deg: a spec below that fails at 0
-    res = max_scale_for_yield(models, 2, b, 20, 1, 0.9, spec_deg=1e-12, case="uncalibrated")
+    res = max_scale_for_yield(models, b, 20, 1, 0.9, spec_deg=1e-12, case="uncalibrated")
     assert res["factor"] == 0.0 and res["yield"] == 0.0 and not res["capped"]
-    ok = max_scale_for_yield(models, 2, b, 20, 1, 0.9, spec_deg=0.1, case="calibrated",
+    ok = max_scale_for_yield(models, b, 20, 1, 0.9, spec_deg=0.1, case="calibrated",
                              rel_tol=0.1)
     assert ok["factor"] > 0 and ok["yield"] >= 0.9
 

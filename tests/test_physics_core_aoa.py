@@ -314,9 +314,9 @@ def test_raising_the_rut_equals_lowering_every_front_end(h_mm):
     """Only relative geometry matters: the legs with the RuT raised by h (a RuT position
     error alone, no yaw) equal those with every front end lowered by h (height offset -h),
     for both channels of the pair; and they differ from the nominal legs."""
-    from rtsgeom.analysis.tolerance.driver import PairPhasors
+    from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
     from rtsgeom.geometry import build_setup
-    model = PairPhasors.build(build_setup(make_scene()), (0, 1), 3)
+    model = ChannelPhasors.build(build_setup(make_scene()), (0, 1), 3)
     h = h_mm * 1e-3
     zero = np.zeros((2, 3))
     raised = model.air_legs(zero, {"rut_offset_m": np.array([0.0, 0.0, h])})

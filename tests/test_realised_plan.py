@@ -16,7 +16,8 @@ import pytest
 
 from conftest import make_scene
 from rtsgeom.synthesis.model import ChannelModel
-from rtsgeom.pipeline.plan import PairPlan, nearest_setting, plan_targets, residual_warning
+from rtsgeom.pipeline.pair import PairPlan, nearest_setting, residual_warning
+from rtsgeom.pipeline.plan import plan_targets
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.rts.channels import realised_delay, requested_delay

@@ -314,7 +314,8 @@ def test_malformed_dask_address_is_one_line(address, capsys):
 def test_tolerance_chunk_is_bounded_by_memory():
     import tracemalloc
 
-    from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
+    from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
+    from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
     from rtsgeom.cli.tolerance import CHUNK_MEMORY_BYTES, capped_chunk, chunk_bytes_per_draw
     from rtsgeom.geometry import build_setup
     from rtsgeom.scene import load_scene
@@ -322,7 +323,7 @@ def test_tolerance_chunk_is_bounded_by_memory():
         assert capped_chunk(1_000_000, points) * chunk_bytes_per_draw(points) <= CHUNK_MEMORY_BYTES
     # the per-draw bound holds on a measured chunk (201 points: benchmarks/redteam.py; the
     # model build alone takes 40 s there)
-    model = PairPhasors.build(build_setup(load_scene(DEFAULT_SCENE)), (0, 1), 21)
+    model = ChannelPhasors.build(build_setup(load_scene(DEFAULT_SCENE)), (0, 1), 21)
     draws = 2000
     tracemalloc.start()
     monte_carlo(model, np.full(3, 1e-4), draws, 1, chunk=draws)

@@ -111,8 +111,8 @@ def test_cli_choices_are_the_registries():
               ("linearity", "amplitudes"): SYNTHESIS_MODES}
     for k, v in expect.items():
         assert found[k] == v, (k, found[k])
-    from rtsgeom.scene.registry import MODES
-    assert MODES == SYNTHESIS_MODES
+    from rtsgeom.synthesis.model import SOLVERS
+    assert SOLVERS == SYNTHESIS_MODES
 
 
 def test_defaults_written_once_match_the_dataclasses(default_scene):

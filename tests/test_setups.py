@@ -11,8 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rtsgeom.analysis.tolerance.arc import Bounds, adjacent_pairs, arc_models, arc_monte_carlo
-from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
+from rtsgeom.analysis.tolerance.draws import Bounds
+from rtsgeom.analysis.tolerance.montecarlo import ToleranceModel
+from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
+from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
 from rtsgeom.cli import main
 from rtsgeom.geometry import build_setup
 from rtsgeom.geometry.patterns import CosinePattern
@@ -228,13 +230,13 @@ def test_arc_of_two_front_ends_equals_the_pair_study():
     position drawn per draw (the default of both) and with it at the bin centre."""
     scene = load_scene(DEFAULT)
     setup = build_setup(scene)
-    model = PairPhasors.build(setup, (0, 1), 5)
+    model = ChannelPhasors.build(setup, (0, 1), 5)
     sigma = np.array([0.1, 0.15, 0.05]) * 1e-3
     for dist in ("normal", "uniform"):
         for subbin in (True, False):
             pair = monte_carlo(model, sigma, 300, 11, dist, 0.05, chunk=120, subbin=subbin)
-            arc = arc_monte_carlo([model], 2, Bounds(tuple(sigma)), 300, 11, dist, 0.05,
-                                  chunk=70, subbin=subbin)
+            arc = monte_carlo(ToleranceModel.arc([model], 2), Bounds(tuple(sigma)), 300, 11,
+                              dist, 0.05, chunk=70, subbin=subbin)
             for case in ("uncalibrated", "calibrated"):
                 assert np.array_equal(arc.worst_error_deg[case][:, 0],
                                       pair.worst_error_deg[case])
@@ -251,14 +253,15 @@ def test_arc_yield_shares_front_ends(tmp_path):
     does; the arc yield is at most the worst pair's; the NPZ holds the per-draw errors."""
     scene = loads_scene(_with_front_ends([-8.0, 0.0, 8.0, 16.0, 24.0]), "x.toml")
     setup = build_setup(scene)
-    models = arc_models(setup, adjacent_pairs(5), 5)
+    models = [ChannelPhasors.build(setup, (i, i + 1), 5) for i in range(5 - 1)]
     b = Bounds((0.15e-3, 0.15e-3, 0.1e-3), math.radians(0.5), math.radians(0.5),
                (0.2e-3,) * 3, math.radians(0.01))
-    res = arc_monte_carlo(models, 5, b, 200, 3, "normal", 0.05, keep_errors=True, chunk=64)
+    res = monte_carlo(ToleranceModel.arc(models, 5), b, 200, 3, "normal", 0.05,
+                      keep_errors=True, chunk=64)
     for case in ("uncalibrated", "calibrated"):
         e = np.abs(res.worst_error_deg[case])
         assert res.yield_(case) == np.mean(np.all(e <= 0.05, axis=1))
-        assert res.yield_(case) <= min(res.pair_yield(case, p) for p in range(4))
+        assert res.yield_(case) <= min(res.set_yield(case, p) for p in range(4))
     # the shared front end: the same draw of front end 1 enters pairs (0, 1) and (1, 2)
     assert res.errors["offsets_m"].shape == (200, 5, 3)
     assert res.errors["yaw_rad"].shape == (200, 5)
@@ -269,8 +272,8 @@ def test_arc_yield_shares_front_ends(tmp_path):
         assert z["calibrated_deg"].shape == (200, 4)
         assert np.array_equal(z["offsets_m"], res.errors["offsets_m"])
     # rotations drawn from their own stream: the position draws do not change with them
-    res0 = arc_monte_carlo(models[:1], 5, Bounds((0.15e-3, 0.15e-3, 0.1e-3)), 200, 3,
-                           keep_errors=True, chunk=200)
+    res0 = monte_carlo(ToleranceModel.arc(models[:1], 5), Bounds((0.15e-3, 0.15e-3, 0.1e-3)),
+                       200, 3, keep_errors=True, chunk=200)
     assert np.array_equal(res0.errors["offsets_m"], res.errors["offsets_m"])
     # nor the sub-bin positions: one target, one position per draw whatever is drawn beside
     assert np.array_equal(res0.subbin_steps, res.subbin_steps)
@@ -478,8 +481,8 @@ def test_rut_pattern_enters_the_synthesis_design():
     s = _text().replace("[radar.cfar]", '[radar.pattern]\nkind = "cos"\nhpbw_deg = 30.0\n\n'
                                         "[radar.cfar]")
     pat_scene = loads_scene(s, "x.toml")
-    iso = PairPhasors.build(build_setup(iso_scene), (0, 1), 3)
-    pat = PairPhasors.build(build_setup(pat_scene), (0, 1), 3)
+    iso = ChannelPhasors.build(build_setup(iso_scene), (0, 1), 3)
+    pat = ChannelPhasors.build(build_setup(pat_scene), (0, 1), 3)
     g = CosinePattern(math.radians(30.0)).field(
         np.stack([np.sin(iso.setup.fe_azimuth_rad()), np.cos(iso.setup.fe_azimuth_rad()),
                   np.zeros(2)], -1)).real
@@ -519,9 +522,9 @@ def test_rut_yaw_error_shifts_every_synthesized_angle():
     """A RuT yaw error turns the frame it measures in: every detected angle moves by -yaw,
     which no calibration of the RTS removes (closed form, per draw)."""
     setup = build_setup(load_scene(DEFAULT))
-    model = PairPhasors.build(setup, (0, 1), 3)
+    model = ChannelPhasors.build(setup, (0, 1), 3)
     yaw = math.radians(0.05)
-    res = arc_monte_carlo([model], 2, Bounds(rut_yaw_rad=yaw), 40, 5, "uniform", 0.1,
+    res = monte_carlo(ToleranceModel.arc([model], 2), Bounds(rut_yaw_rad=yaw), 40, 5, "uniform", 0.1,
                           keep_errors=True)
     drawn = np.degrees(res.errors["rut_yaw_rad"])
     for case in ("uncalibrated", "calibrated"):

@@ -107,7 +107,7 @@ def test_rules_for_the_sphere():
 def test_all_elevations_zero_keeps_the_1d_pipeline():
     """The default scene: no N-channel planner, the azimuth-only beamformer, the arc, and a
     scene with every elevation written out as 0 builds the same bits."""
-    from rtsgeom.pipeline.plan_cells import uses_cells
+    from rtsgeom.pipeline.plan import uses_cells
     from rtsgeom.radar.steering import Steering
     scene = load_scene(SCENE)
     assert not uses_cells(scene)

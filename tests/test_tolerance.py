@@ -9,8 +9,10 @@ import numpy as np
 import pytest
 
 from rtsgeom.synthesis.model import ChannelModel
-from rtsgeom.analysis.tolerance.driver import (CASES, NOMINAL_AMPLITUDES, PairPhasors, draw_offsets,
-                                               max_sigma_for_yield, monte_carlo)
+from rtsgeom.analysis.tolerance.phasors import CASES, NOMINAL_AMPLITUDES, ChannelPhasors
+from rtsgeom.analysis.tolerance.draws import draw_offsets
+from rtsgeom.analysis.tolerance.search import max_sigma_for_yield
+from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
 from rtsgeom.cli import main
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
@@ -33,7 +35,7 @@ def scene():
 
 @pytest.fixture(scope="module")
 def model(scene):
-    return PairPhasors.build(build_setup(scene), (0, 1))
+    return ChannelPhasors.build(build_setup(scene), (0, 1))
 
 
 def worst(err):
@@ -76,7 +78,7 @@ def test_phasor_model_matches_bin_response_on_drawn_setups(scene, model):
         setup = build_setup(scene, offsets_m=off)
         paths = exact_paths(setup)
         x, shift = model.channel_phasors(off, return_shift=True)
-        k = int(model.calibration_steps(x))
+        k = int(model.calibration_steps(x)[1])
         assert k != 0
         for delta in (0.0, k * res):
             pm = ChannelModel.build(setup, paths, (0, 1), TargetConfig(model.range_m),
@@ -84,8 +86,8 @@ def test_phasor_model_matches_bin_response_on_drawn_setups(scene, model):
             exact = tdm_compensate(pm.responses[1], 0.0, setup.rut, scene.radar)
             want = x.copy()
             if delta:
-                i = k + model.max_steps
-                want[1] *= model.delay_factor[i] * np.exp(model.delay_log_slope[i] * shift[1])
+                i = k + model.procedure.max_steps
+                want[1] *= model.procedure.delay_factor[i] * np.exp(model.procedure.delay_log_slope[i] * shift[1])
             assert np.max(np.abs(want / exact - 1)) < 5e-5
             assert np.max(np.abs(np.angle(want / exact))) < 1e-7
 
@@ -96,14 +98,14 @@ def test_design_puts_the_set_points_on_their_angles(model):
     as one channel alone (the target keeps its RCS); the pair's closed form of the same
     engine (used by the calibration and the exact mode) gives the same ratios."""
     ch = model.channels
-    w = model.amplitudes * np.exp(1j * ch.coherent_phases(ch.steering.directions(model.probe_rad)))
+    w = model.amplitudes * np.exp(1j * ch.coherent_phases(ch.steering.directions(model.procedure.probe_rad)))
     assert np.max(np.abs(np.degrees(ch.direction(w) - model.set_rad))) < 1e-5
     st = ch.steering
     p_set = np.diagonal(st.power(ch.snapshot(w), st.directions(model.set_rad)))
     single = ch.snapshot(np.array([ch.unit_gain, 0.0]))
     p_one = st.power(single, st.directions(np.array([st.search(single)])))[0]
     assert np.allclose(p_set, p_one, rtol=1e-9)
-    phases = (0.0, float(ch.pair_phase(model.probe_rad)))
+    phases = (0.0, float(ch.pair_phase(model.procedure.probe_rad)))
     for m in (0, 7, 20):
         rho = ch.pair_ratio(float(model.set_rad[m]), phases)
         assert model.amplitudes[m, 1] / model.amplitudes[m, 0] == pytest.approx(rho, rel=1e-9)
@@ -119,8 +121,8 @@ def test_redesign_for_the_delay_matches_pair_model(model):
         pm = ChannelModel.build(model.setup, pm_paths, (0, 1), TargetConfig(model.range_m),
                                 (0.0, k * model.delay_resolution_s))
         delayed = tdm_compensate(pm.responses[1], 0.0, rut, radar)
-        phase = float(model.coherence_phase(delayed))
-        gain = 1 / abs(model.delay_factor[k + model.max_steps][rut.azimuth_mask].mean())
+        phase = float(model.procedure.coherence_phase(model, delayed))
+        gain = 1 / abs(model.procedure.delay_factor[k + model.procedure.max_steps][rut.azimuth_mask].mean())
         assert gain > 1.0  # the echo left the bin centre
         for m in (0, 10, 20):
             rho = pm.pair_ratio(float(model.set_rad[m]), (0.0, phase))
@@ -139,9 +141,9 @@ def test_agrees_with_the_adc_cube(scene, model):
         setup = build_setup(scene, offsets_m=off)
         paths = exact_paths(setup)
         x = model.channel_phasors(off)
-        k = int(model.calibration_steps(x))
+        k = int(model.calibration_steps(x)[1])
         g = model.gain_correction(x)
-        redesign = 1 / abs(model.delay_factor[k + model.max_steps][az].mean())
+        redesign = 1 / abs(model.procedure.delay_factor[k + model.procedure.max_steps][az].mean())
         for case in CASES + (NOMINAL_AMPLITUDES,):
             phasor = model.angle_errors(off, case)[sets]
             cal = case != "uncalibrated"
@@ -172,8 +174,8 @@ def test_sigma_zero_reproduces_the_nominal_error_exactly(model):
         # pose) and the nominal one through the shorthand: equal to rounding, not bit for bit
         assert w[0] == pytest.approx(worst(nominal), rel=1e-9, abs=1e-15)
         # the nominal error itself, with the grid-search estimator
-        steps = None if case == "uncalibrated" else model.calibration_steps(model.x_nominal)
-        snaps = model.snapshots(model.x_nominal, steps)
+        steps = None if case == "uncalibrated" else model.calibration_steps(model.x_nominal)[1]
+        snaps = model.procedure.snapshots(model, model.x_nominal, steps)
         ref = np.degrees(estimate_angles(snaps, model.setup.rut, model.setup.scene.radar)
                          - model.set_rad)
         assert np.max(np.abs(nominal - ref)) < 2e-5
@@ -187,13 +189,14 @@ def _sensitivities(model):
     """d alpha / d phi_J (first and second order) and d alpha / d ln A_J of the calibrated
     nominal synthesis, max over the set-points (deg per rad, deg per rad^2, deg)."""
     x0 = model.x_nominal
-    k0 = model.calibration_steps(x0)
+    k0 = model.calibration_steps(x0)[1]
 
     def rotated(phi=0.0, ln_a=0.0):
-        f = model.delay_factor[k0 + model.max_steps]
+        f = model.procedure.delay_factor[k0 + model.procedure.max_steps]
         a = model.amplitudes
         snaps = (a[:, 0, None] * x0[0] + a[:, 1, None] * np.exp(ln_a + 1j * phi) * x0[1] * f)
-        return model._errors(snaps)
+        ang = refine_angles(snaps, model.channels.steering, None, model.set_rad)
+        return np.degrees(ang - model.set_rad)
     h = 1e-3
     e0, ep, em = rotated(), rotated(h), rotated(-h)
     s1 = np.max(np.abs(ep - em) / (2 * h))
@@ -221,23 +224,23 @@ def test_radial_errors_are_calibrated_back_to_the_nominal(model):
     az = rut.azimuth_mask
     xv = rut.virtual_local[az, 0] - rut.virtual_local[az, 0].mean()
     slope_gain = 0.5 * np.sum(np.abs(xv)) / (2 * np.pi / rut.wavelength_m * np.sum(xv ** 2))
-    table_phase = np.angle(model.delay_factor[:, az].mean(axis=1))
+    table_phase = np.angle(model.procedure.delay_factor[:, az].mean(axis=1))
 
     def eps(x, k):
-        need = model.coherence_phase(x)
-        return np.angle(np.exp(1j * (table_phase[k + model.max_steps] - need)))
+        need = model.procedure.coherence_phase(model, x)
+        return np.angle(np.exp(1j * (table_phase[k + model.procedure.max_steps] - need)))
 
     x0 = model.x_nominal
     e_nom = model.angle_errors(ZERO, "calibrated")
-    eps0 = eps(x0, model.calibration_steps(x0))
+    eps0 = eps(x0, model.calibration_steps(x0)[1])
     assert abs(eps0) <= np.pi * model.cal_slope_hz * model.delay_resolution_s * 1.01
     off = draw_offsets(21, 300, [2e-4, 0.0, 0.0])
     x, shift = model.channel_phasors(off, return_shift=True)
-    k = model.calibration_steps(x)
+    k = model.calibration_steps(x)[..., 1]
     e = eps(x, k)
     quant = s1 * (np.abs(e) + abs(eps0)) + s2 * (e ** 2 + eps0 ** 2)
-    i = k + model.max_steps
-    ln_a = np.abs(np.log(np.abs(np.exp(model.delay_log_slope[i][:, az] * shift[:, 1][:, az])
+    i = k + model.procedure.max_steps
+    ln_a = np.abs(np.log(np.abs(np.exp(model.procedure.delay_log_slope[i][:, az] * shift[:, 1][:, az])
                                 .mean(axis=1))))
     psi = np.angle(x / x0)[..., az]
     geo = np.degrees(slope_gain * np.max(np.ptp(psi, axis=-1), axis=-1)
@@ -269,15 +272,15 @@ def test_same_seed_gives_identical_results(model):
 def test_draw_chunks_regenerate_the_streams_bit_for_bit(distribution, chunk):
     """The chunks a cluster is sent (stream states, not draws) rebuild exactly the draws of
     standard_draws / subbin_draws, whatever the chunk size."""
-    from rtsgeom.analysis.tolerance.driver import draw_chunks, standard_draws, subbin_draws
+    from rtsgeom.analysis.tolerance.draws import draw_chunks, standard_draws, subbin_draws
     sigma = np.array([1.0, 2.0, 3.0]) * 1e-4
-    parts = list(draw_chunks(5, 300, sigma, distribution, chunk, positions=9, centre=4))
+    parts = list(draw_chunks(5, 300, 2, distribution, chunk, positions=9, centre=4))
     assert [p.k for p in parts] == [min(chunk, 300 - s) for s in range(0, 300, chunk)]
-    offsets = np.concatenate([p.offsets() for p in parts])
+    offsets = np.concatenate([p.offsets() for p in parts]) * sigma
     subbin = np.concatenate([p.subbin() for p in parts])
     assert np.array_equal(offsets, np.concatenate(list(standard_draws(5, 300, distribution))) * sigma)
     assert np.array_equal(subbin, np.concatenate(list(subbin_draws(5, 300, 9))))
-    centre = draw_chunks(5, 300, sigma, distribution, chunk, 9, 4, subbin=False)
+    centre = draw_chunks(5, 300, 2, distribution, chunk, None, 4)
     assert np.array_equal(np.concatenate([p.subbin() for p in centre]), np.full(300, 4))
 
 
@@ -319,7 +322,7 @@ def test_fork_pool_is_kept_across_studies_of_one_model(model):
     from rtsgeom._lib.parallel import ForkPool, _can_fork
     if not _can_fork():
         pytest.skip("no fork on this platform")
-    other = PairPhasors.build(build_setup(make_scene()), (0, 1), points=3)
+    other = ChannelPhasors.build(build_setup(make_scene()), (0, 1), points=3)
     with ForkPool(2) as pool:
         pids = []
         for m, sigma in ((model, 1e-4), (model, 3e-4), (other, 2e-4)):
@@ -476,11 +479,12 @@ def test_dask_local_cluster_gives_bit_identical_results():
     pytest.importorskip("dask.distributed")
     import functools
 
-    from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
+    from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
+    from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
     from rtsgeom.geometry import build_setup
     from rtsgeom._lib.parallel import dask_client, map_chunks
     setup = build_setup(make_scene())
-    model = PairPhasors.build(setup, (0, 1), points=7)
+    model = ChannelPhasors.build(setup, (0, 1), points=7)
     sigma = np.array([0.2, 0.2, 0.2]) * 1e-3
     local = monte_carlo(model, sigma, 3000, 11, chunk=500)
     with dask_client(workers=2) as client:
@@ -494,10 +498,11 @@ def test_dask_local_cluster_gives_bit_identical_results():
 def test_chunk_mapper_fork_pool_every_draw_mode():
     """``--workers N``'s forked pool (chunk_mapper without a scheduler) equals one process bit
     for bit, with uneven chunks, for normal and uniform draws and both sub-bin modes."""
-    from rtsgeom.analysis.tolerance.driver import PairPhasors, monte_carlo
+    from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
+    from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
     from rtsgeom.geometry import build_setup
     from rtsgeom._lib.parallel import chunk_mapper
-    model = PairPhasors.build(build_setup(make_scene()), (0, 1), points=5)
+    model = ChannelPhasors.build(build_setup(make_scene()), (0, 1), points=5)
     sigma = np.array([0.3, 0.2, 0.5]) * 1e-3
     for distribution, subbin in (("normal", True), ("uniform", False)):
         local = monte_carlo(model, sigma, 1300, 7, distribution, chunk=300, subbin=subbin)
@@ -546,8 +551,10 @@ def test_the_scenes_own_errors_do_not_enter_the_study(scene_file, section, key, 
     assert setup_errors(clean) == []
     assert setup_errors(moved) == [(f"rts.front_ends[1].{key}" if section == "fe"
                                     else f"radar.{key}")]
-    a, b = (PairPhasors.build(build_setup(s), (0, 1), points=3) for s in (clean, moved))
-    for name in ("table", "design_amplitudes", "fe_angle_rad", "set_rad"):
+    a, b = (ChannelPhasors.build(build_setup(s), (0, 1), points=3) for s in (clean, moved))
+    for name in ("table", "set_rad"):
         assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    for name in ("design_amplitudes", "fe_angle_rad"):
+        assert np.array_equal(getattr(a.procedure, name), getattr(b.procedure, name)), name
     ra, rb = (monte_carlo(m, [2e-4] * 3, 60, seed=3) for m in (a, b))
     assert ra.to_dict() == rb.to_dict()

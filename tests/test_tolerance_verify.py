@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 from scipy.constants import c
 
-from rtsgeom.analysis.tolerance.driver import CASES, NOMINAL_AMPLITUDES, PairPhasors, draw_subbins
+from rtsgeom.analysis.tolerance.phasors import CASES, NOMINAL_AMPLITUDES, ChannelPhasors
+from rtsgeom.analysis.tolerance.draws import draw_subbins
 from rtsgeom.analysis.tolerance.verify import verify_draws
 from rtsgeom.geometry import build_setup
 
@@ -21,7 +22,7 @@ def test_fast_model_agrees_with_the_adc_cube_chain(radius_m, sigma_mm):
     """A few draws per arc radius and error size, every case, through synthesis + FFTs + CFAR
     + beamformer search: the detected angle at each draw's worst set-point as modelled."""
     scene = make_scene(lambda d: d["rts"].__setitem__("arc_radius_m", radius_m))
-    model = PairPhasors.build(build_setup(scene), (0, 1), 7)
+    model = ChannelPhasors.build(build_setup(scene), (0, 1), 7)
     res = verify_draws(model, [sigma_mm * 1e-3] * 3, 4, 17, cases=CASES + (NOMINAL_AMPLITUDES,))
     assert res.max_difference_deg < REQUIRED_DEG, res.to_dict()
     # not a test that cannot fail: the draws reach errors far beyond the agreement
@@ -31,7 +32,7 @@ def test_fast_model_agrees_with_the_adc_cube_chain(radius_m, sigma_mm):
 def test_every_set_point_and_the_worst_agree_with_the_chain():
     """``all_points``: every set-point of a draw through the chain, and the study's per-draw
     statistic (the worst error over the set-points) from both."""
-    model = PairPhasors.build(build_setup(make_scene()), (0, 1), 5)
+    model = ChannelPhasors.build(build_setup(make_scene()), (0, 1), 5)
     res = verify_draws(model, [2e-4] * 3, 2, 7, all_points=True)
     for case in CASES:
         assert res.model_deg[case].shape == (2, 5)
@@ -42,7 +43,7 @@ def test_every_set_point_and_the_worst_agree_with_the_chain():
 
 def test_subbin_positions_cover_one_bin_uniformly():
     scene = make_scene()
-    model = PairPhasors.build(build_setup(scene), (0, 1), 5)
+    model = ChannelPhasors.build(build_setup(scene), (0, 1), 5)
     radar, res = scene.radar, model.delay_resolution_s
     steps = model.subbin_steps
     bin_s = 2 * radar.range_resolution_m / c
@@ -60,7 +61,7 @@ def test_verify_200_on_the_default_study():
     sigmas 0.1 mm, the scene's seed) within 0.005 deg per draw."""
     from rtsgeom.scene import load_scene
     scene = load_scene("scenes/diewald2022.toml")
-    model = PairPhasors.build(build_setup(scene), (0, 1))
+    model = ChannelPhasors.build(build_setup(scene), (0, 1))
     res = verify_draws(model, [1e-4] * 3, 200, scene.seed)
     assert res.max_difference_deg < REQUIRED_DEG, res.to_dict()
 
@@ -99,12 +100,12 @@ def test_bin_centre_model_agrees_with_the_chain_on_a_planned_arc(radius_m):
     import math
 
     from rtsgeom.analysis import coverage
-    from rtsgeom.analysis.tolerance.arc import arc_models
+    from rtsgeom.analysis.tolerance import ChannelPhasors
     from rtsgeom.analysis.tolerance.verify import verify_draws
     from rtsgeom.geometry import build_setup
     from rtsgeom.scene import load_scene
     plan = coverage.plan_arc(load_scene("scenes/diewald2022.toml"),
                              (math.radians(-10), math.radians(10)), radius_m)
-    model = arc_models(build_setup(plan.scene), [(0, 1)], 11)[0]
+    model = ChannelPhasors.build(build_setup(plan.scene), (0, 1), 11)
     v = verify_draws(model, (0.5e-3,) * 3, 12, 0, cases=("calibrated",), subbin=False)
     assert np.max(v.difference_deg("calibrated")) < 0.005

@@ -14,7 +14,7 @@ import pytest
 
 from conftest import CoherenceShift, far_field, make_scene, quiet
 from rtsgeom.synthesis.model import ChannelModel
-from rtsgeom.analysis.tolerance.driver import CASES, PairPhasors
+from rtsgeom.analysis.tolerance.phasors import CASES, ChannelPhasors
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.radar import process, synthesize
@@ -163,7 +163,7 @@ def test_paper_mode_is_exact_only_at_the_midpoint(far_model):
 @pytest.fixture(scope="module", params=WINDOWS)
 def pair_phasors(request):
     scene = make_scene(lambda d: _quiet(d, angle_window=request.param))
-    return PairPhasors.build(build_setup(scene), (0, 1), points=5)
+    return ChannelPhasors.build(build_setup(scene), (0, 1), points=5)
 
 
 def test_tolerance_refine_matches_the_grid_search_and_calibrates_to_zero(pair_phasors):

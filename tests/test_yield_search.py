@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from rtsgeom.analysis.tolerance.driver import critical_ratio, largest_passing_scale
+from rtsgeom.analysis.tolerance.search import critical_ratio, largest_passing_scale
 
 
 def _study(p, offset, target, spec=0.1, draws=2000, seed=0, ratio=True):
@@ -87,12 +87,15 @@ def test_critical_ratio_decides_the_yield():
 def test_yield_without_errors_per_subbin_position_is_the_monte_carlos(subbin):
     """The search's sigma-0 evaluation (each sub-bin position drawn evaluated once) gives the
     Monte Carlo's worst errors bit for bit, for both cases and distributions."""
-    from rtsgeom.analysis.tolerance.driver import PairPhasors, _worst_without_errors, monte_carlo
+    from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
+    from rtsgeom.analysis.tolerance import ToleranceModel
+    from rtsgeom.analysis.tolerance.search import _zero_errors
+    from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
     from rtsgeom.geometry import build_setup
     from rtsgeom.scene import load_scene
-    model = PairPhasors.build(build_setup(load_scene("scenes/diewald2022.toml")), (0, 1), 5)
+    model = ChannelPhasors.build(build_setup(load_scene("scenes/diewald2022.toml")), (0, 1), 5)
     for case in ("uncalibrated", "calibrated"):
         for dist in ("normal", "uniform"):
             mc = monte_carlo(model, [0.0] * 3, 700, 5, dist, cases=(case,), subbin=subbin)
-            got = _worst_without_errors(model, 700, 5, case, subbin)
+            got = _zero_errors(ToleranceModel.of(model), 700, 5, case, subbin)[:, 0, 0]
             assert np.array_equal(mc.worst_error_deg[case], got)

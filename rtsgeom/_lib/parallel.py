@@ -153,7 +153,7 @@ class ForkPool:
 
     The workers inherit the studies' shared state (:func:`_split`: the model, tens of MiB of
     tables) by ``fork``; per chunk only the function's name, its keywords and the chunk (a
-    :class:`~rtsgeom.analysis.tolerance.driver.DrawChunk`: the draw streams' states, a few hundred
+    :class:`~rtsgeom.analysis.tolerance.draws.DrawChunk`: the draw streams' states, a few hundred
     bytes) are pickled, and the results back. A map with other shared state (by identity)
     forks a new pool. Chunks are handed out one at a time (dynamic balancing) and the
     results come back in chunk order, so the outcome is the in-order map's bit for bit. Each

@@ -43,7 +43,7 @@ from ..geometry.setup import nominal_scene
 from ..geometry.farfield import angular_resolution_rad
 from ..paths import exact_paths
 from ..scene import Scene
-from .tolerance.arc import Bounds, adjacent_pairs, arc_models, arc_monte_carlo, max_scale_for_yield
+from .tolerance import Bounds, ChannelPhasors, ToleranceModel, max_scale_for_yield, monte_carlo
 from .design import _fit_sheet, _problem
 
 __all__ = ["ArcPlan", "ArcDesign", "CoverageDesign", "arc_scene", "plan_arc", "evaluate_arc",
@@ -247,19 +247,19 @@ def evaluate_arc(plan: ArcPlan, spec_deg: float = 0.1, target_yield: float = 0.9
     if problem is not None:
         return ArcDesign(plan, problem=problem)
     setup = build_setup(plan.scene)
-    pairs = adjacent_pairs(setup.fe.count)
+    pairs = [(i, i + 1) for i in range(setup.fe.count - 1)]
     try:
-        models = arc_models(setup, pairs, points)
+        models = [ChannelPhasors.build(setup, p, points) for p in pairs]
     except AngleUnreachable as exc:
         return ArcDesign(plan, problem=f"synthesis failed: {exc}")
     zero = np.zeros((2, 3))
     worst = {case: max(float(np.max(np.abs(m.angle_errors(zero, case)))) for m in models)
              for case in ("calibrated", "uncalibrated")}
-    ref = arc_monte_carlo(models, setup.fe.count, Bounds((BASE_SIGMA_M,) * 3), draws, seed,
-                          "normal", spec_deg)
+    arc = ToleranceModel.arc(models, setup.fe.count)
+    ref = monte_carlo(arc, Bounds((BASE_SIGMA_M,) * 3), draws, seed, "normal", spec_deg)
     p95 = {case: float(np.percentile(np.abs(ref.arc_worst(case)), 95))
            for case in ("calibrated", "uncalibrated")}
-    inv = max_scale_for_yield(models, setup.fe.count, Bounds((BASE_SIGMA_M,) * 3), draws, seed,
+    inv = max_scale_for_yield(arc, Bounds((BASE_SIGMA_M,) * 3), draws, seed,
                               target_yield, spec_deg, "calibrated", rel_tol=0.05)
     return ArcDesign(plan, worst["calibrated"], worst["uncalibrated"],
                      inv["factor"] * BASE_SIGMA_M * 1e3, inv["capped"], None,

@@ -5,7 +5,7 @@ For each (arc radius R_c, front-end spacing) a two-front-end variant of a scene 
 pair's two front ends (their antenna separation, cables and so on kept, mounting and channel
 errors dropped) placed symmetrically about the pair's centre angle, targets dropped, the sheet
 kept, widened, or disabled where its cutouts would not fit. Per design, at phasor level
-(:class:`~rtsgeom.analysis.tolerance.driver.PairPhasors`: exact geometry, exact amplitudes, no noise):
+(:class:`~rtsgeom.analysis.tolerance.ChannelPhasors`: exact geometry, exact amplitudes, no noise):
 
 ``worst_error_deg``
     worst |synthesized - set| angle over the span after the delay calibration, nominal setup;
@@ -18,7 +18,7 @@ kept, widened, or disabled where its cutouts would not fit. Per design, at phaso
 ``sigma_calibrated_mm``, ``sigma_uncalibrated_mm``
     the mounting tolerance (one sigma, the same on the radial, tangential and height axes) that
     keeps ``target_yield`` of the setups within ``spec_deg``: a small Monte Carlo
-    (:func:`~rtsgeom.analysis.tolerance.driver.max_sigma_for_yield`);
+    (:func:`~rtsgeom.analysis.tolerance.max_sigma_for_yield`);
 
 and ``exceeds_resolution``: the spacing seen from the RuT is larger than its angular
 resolution 1.22 lambda / d_A (paper eq. 24), where the composite splits into two peaks.
@@ -42,8 +42,8 @@ from ..geometry.farfield import angular_resolution_rad
 from .._lib.parallel import available_cores, chunk_mapper, map_chunks
 from ..scene import Scene, SheetConfig
 from ..scene.rules import arc_centre_m, problems
-from .tolerance.driver import (CASES, PairPhasors, critical_ratio, largest_passing_scale,
-                               max_sigma_for_yield, monte_carlo)
+from .tolerance import CASES, ChannelPhasors, max_sigma_for_yield, monte_carlo
+from .tolerance.search import critical_ratio, largest_passing_scale
 
 __all__ = ["METRICS", "DesignGrid", "two_front_end_scene", "evaluate_design", "design_grid",
            "check_azimuth_arc"]
@@ -147,19 +147,19 @@ def evaluate_design(scene: Scene, pair: tuple[int, int], radius_m: float, spacin
     try:
         # the calibrated plan first (it does not depend on the bin-centre designs that
         # solved() adds with a root finder per set-point, most of a split design's build)
-        model = PairPhasors.build(setup, (0, 1), points, solve_bin_centre=False)
-        err, detail = model.draw_errors(zero[None], None, ("calibrated",), return_detail=True)
-        split = not np.all(np.isfinite(detail["amplitudes"]["calibrated"]))
+        model = ChannelPhasors.build(setup, (0, 1), points, solve_bin_centre=False)
+        d = model.draw(zero[None], None, ("calibrated",))["calibrated"]
+        split = not np.all(np.isfinite(d["amplitudes"]))
         if not split:
-            model = model.solved()
+            model = model.procedure.solved(model)
     except AngleUnreachable as exc:  # no ratio reaches a set angle: the composite has split
         out["problem"] = f"synthesis failed: {exc}"
         return out
-    bias = np.degrees(model.fe_angle_rad - setup.fe_azimuth_rad())
+    bias = np.degrees(model.procedure.fe_angle_rad - setup.fe_azimuth_rad())
     out["near_field_bias_deg"] = float(np.mean(bias))
-    steps = model.calibration_steps(model.x_nominal)
-    out["range_offset_mm"] = float(model.range_offset_m(zero, steps)) * 1e3
-    out["delta_tau_ps"] = float(steps * model.delay_resolution_s * 1e12)
+    steps = model.calibration_steps(model.x_nominal)  # (2,): I at 0, J calibrated
+    out["range_offset_mm"] = float(model.range_offsets_m(zero[None], steps[None])[0, 1]) * 1e3
+    out["delta_tau_ps"] = float(steps[1] * model.delay_resolution_s * 1e12)
     if split:
         # no ratio puts the composite at some set angle (its closed-form design has no root:
         # the beams are too far apart and the composite splits): an error in degrees would
@@ -167,7 +167,7 @@ def evaluate_design(scene: Scene, pair: tuple[int, int], radius_m: float, spacin
         out["problem"] = ("synthesis failed: no amplitude ratio places the target at every "
                           "set angle (the composite splits)")
         return out
-    out["worst_error_deg"] = float(np.degrees(np.max(np.abs(err["calibrated"]))))
+    out["worst_error_deg"] = float(np.degrees(np.max(np.abs(d["error_rad"]))))
     for case in CASES:
         inv = tolerance_search(model, case, draws, seed, target_yield, spec_deg, rel_tol)
         out[f"sigma_{case}_mm"] = inv["sigma_mm"]["radial"]
@@ -182,9 +182,9 @@ PILOT_REL_TOL = 0.05
 PILOT_EVALUATIONS = 3
 
 
-def tolerance_search(model: PairPhasors, case: str, draws: int, seed: int,
+def tolerance_search(model: ChannelPhasors, case: str, draws: int, seed: int,
                      target_yield: float, spec_deg: float, rel_tol: float) -> dict:
-    """:func:`~rtsgeom.analysis.tolerance.driver.max_sigma_for_yield` of ``draws`` draws (all three
+    """:func:`~rtsgeom.analysis.tolerance.max_sigma_for_yield` of ``draws`` draws (all three
     axes scaled together), started where a pilot search on the first :data:`PILOT_DRAWS` of
     the same draws (the same seed and stream) puts the tolerance, with the power law of the
     deciding draw's error in the scale that the pilot measured (:func:`pilot_estimate`): the
@@ -199,7 +199,7 @@ def tolerance_search(model: PairPhasors, case: str, draws: int, seed: int,
                                rel_tol=rel_tol, slope=slope)
 
 
-def pilot_estimate(model: PairPhasors, case: str, seed: int, target_yield: float,
+def pilot_estimate(model: ChannelPhasors, case: str, seed: int, target_yield: float,
                    spec_deg: float, draws: int = PILOT_DRAWS,
                    cap_m: float = 0.01) -> tuple[float, float]:
     """Where the deciding draw's error over the spec (:func:`critical_ratio`) reaches 1 on
@@ -277,7 +277,8 @@ def _import_for_workers() -> None:
     so that the pool's forked workers inherit the modules instead of each importing them
     again (~0.15 s CPU per worker; loading each kernel's compiled code from numba's cache,
     ~0.3 s more, still happens per worker, on its first call)."""
-    from ..synthesis import kernels  # noqa: F401
+    from ..radar import peak_kernels  # noqa: F401
+    from .tolerance import kernels  # noqa: F401
 
 
 def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
@@ -290,7 +291,7 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     ``workers`` > 1: the designs in a pool of that many processes (each design is pure: the
     same result, in the same order, however they are spread); None: as many as this process
     may run on (``parallel.available_cores``; ``rtsgeom design``'s default; one process on one
-    core). A design's time is about a sixth its ``PairPhasors.build`` (the delay tables:
+    core). A design's time is about a sixth its ``ChannelPhasors.build`` (the delay tables:
     ``bin_response`` of ~5000 delays through the FIR's whole-sample taps, ``rts.fir_taps``;
     the beam responses at the set angles) and five sixths its two tolerance searches
     (:func:`tolerance_search`: a 250-draw pilot, then ~3 Monte Carlos of ``draws`` draws x

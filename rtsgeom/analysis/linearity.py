@@ -15,7 +15,7 @@ from ..scene import TargetConfig
 from ..radar.processing import nearest_detection
 from ..calibration.pair import Calibration
 from ..calibration.probes import FrontEndProbe, simulate_detect, probe_angles, probe_ranges
-from ..pipeline.plan import pair_design
+from ..pipeline.pair import pair_design
 
 __all__ = ["Linearity", "linearity"]
 

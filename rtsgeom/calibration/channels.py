@@ -39,8 +39,8 @@ from ..scene import TargetConfig
 from ..synthesis.model import ChannelModel
 from ..errors import CalibrationFailed
 
-__all__ = ["CalibrationFailed", "ChannelCalibration", "coherence_point_nd", "crossing_columns", "calibrate_channels", "calibrate_pair_nd", "pair_edges",
-           "spanning_tree", "tree_phases"]
+__all__ = ["ChannelCalibration", "coherence_point_nd", "crossing_columns", "calibrate_channels",
+           "calibrate_pair_nd", "pair_edges", "spanning_tree", "tree_phases", "channel_offsets"]
 
 PROBE_RATIOS = (1 / 3, 3.0)
 # A loop of pair calibrations closes to within this (wrapped to one period), or the
@@ -484,3 +484,11 @@ def _set_angles(st, u):
         return (float(np.arcsin(u[0])), 0.0)
     a = st.angles(u)
     return (float(a[0]), float(a[1]))
+
+
+def channel_offsets(n_fe: int, cals: dict) -> np.ndarray:
+    """Per-channel delay offsets from pair calibrations chained along the arc."""
+    off = np.zeros(n_fe)
+    for (i, j), cal in sorted(cals.items()):
+        off[j] = off[i] + cal.delta_tau_s
+    return off

@@ -27,7 +27,6 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.constants import c
 
-from .._lib.util import use_kernels
 from ..geometry import Setup
 from ..paths import Paths
 from ..radar.processing import tdm_compensate

@@ -98,7 +98,7 @@ def _calibrate(args, stage) -> int:
         else:
             cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed,
                                  full_chain=args.full_chain)
-    from ..pipeline.plan import setup_fingerprint
+    from ..calibration.file import setup_fingerprint
     out = cal.to_dict()
     out["procedure"] = args.procedure
     out["front_end_angles_deg"] = [float(x) for x in np.degrees(probe.angle_rad)]

@@ -5,33 +5,19 @@ these functions; ``folder`` is where ``--out`` files go (None: no ``--out``)."""
 from __future__ import annotations
 
 import argparse
-import time
-from pathlib import Path
 
 import numpy as np
 
-from ..analysis.tolerance.driver import AXES, CASES, NOMINAL_AMPLITUDES
 from ..calibration.pair import calibrate_pair
 from ..calibration.probes import probe_front_ends
-from ..errors import AngleUnreachable
 from ..analysis.linearity import linearity
 from ..geometry import build_setup
 from .._lib.io import write_json
-from .._lib.parallel import chunk_mapper
 from ..paths import exact_paths
-from ..errors import UsageError
 from ._common import load_scene_checked, print_json, steps
 from .aoa import _pairs
 
-__all__ = ["prepare_all", "calibrate_all", "linearity_all", "scales", "wants_arc",
-           "save_pair_npz", "tolerance_arc", "coverage_spec", "design_coverage"]
-
-
-def wants_arc(args) -> bool:
-    """``tolerance`` goes through the arc study for ``--pair all`` or rotation / RuT-pose
-    errors (the pair study draws only the three offsets)."""
-    return list(args.pair) == ["all"] or any(
-        v for v in (args.yaw_deg, args.pitch_deg, args.rut_position_mm, args.rut_yaw_deg))
+__all__ = ["prepare_all", "calibrate_all", "linearity_all", "coverage_spec", "design_coverage"]
 
 
 def prepare_all(args):
@@ -45,7 +31,7 @@ def prepare_all(args):
 
 def calibrate_all(args, folder) -> int:
     """Every adjacent pair calibrated in one run; one JSON entry per pair plus the arc's."""
-    from ..pipeline.plan import setup_fingerprint
+    from ..calibration.file import setup_fingerprint
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
         scene, setup, pairs, paths, probe = prepare_all(args)
@@ -113,102 +99,6 @@ def linearity_all(args, folder) -> int:
               f"{lin.max_abs_error_deg:.4f} deg over {len(lin.set_deg)} set-points")
     print(f"arc ({len(pairs)} pairs): max |error| {max(worst):.4f} deg (pair "
           f"{tuple(out['arc']['worst_pair'])})")
-    return 0
-
-
-def scales(args) -> tuple[np.ndarray, dict]:
-    """The per-axis scales (m: the sigma, or the uniform bound) from the old ``--sigma-*-mm``
-    flags or the new tolerance flags (``--radial-mm 0.2 --sigma-level 3``: +-0.2 mm at 3
-    sigma), and the rotation / RuT-pose tolerances (SI) of the new flags."""
-    k = 1.0 / args.sigma_level if args.distribution == "normal" else 1.0
-    sigma = []
-    for axis in AXES:
-        old, new = getattr(args, f"sigma_{axis}_mm"), getattr(args, f"{axis}_mm")
-        if old is not None and new is not None:
-            raise UsageError(f"--sigma-{axis}-mm and --{axis}-mm: give one of them (the first is "
-                             "the scale itself, the second a tolerance at --sigma-level)")
-        sigma.append(old if old is not None else (k * new if new is not None else 0.1))
-    extra = {"yaw_rad": np.radians(args.yaw_deg), "pitch_rad": np.radians(args.pitch_deg),
-             "rut_position_m": (args.rut_position_mm * 1e-3,) * 3,
-             "rut_yaw_rad": np.radians(args.rut_yaw_deg)}
-    return np.array(sigma) * 1e-3, extra
-
-
-def save_pair_npz(path: Path, res, seed: int) -> None:
-    """Per-draw offsets (draws, 2, 3) m and worst errors (deg) of a pair study (NPZ)."""
-    from ..analysis.tolerance.driver import draw_offsets
-    off = draw_offsets(seed, res.draws, res.sigma_m, res.distribution)
-    arrays = {"offsets_m": off, "pairs": np.array([res.model.pair]),
-              "delay_s": res.delay_s[:, None], "range_offset_m": res.range_offset_m[:, None]}
-    arrays.update({f"{case}_deg": v[:, None] for case, v in res.worst_error_deg.items()})
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".part")
-    with open(tmp, "wb") as fh:
-        np.savez_compressed(fh, **arrays)
-    tmp.replace(path)
-
-
-def tolerance_arc(args, scene, sigma, extra, folder) -> int:
-    """``--pair all`` (or rotation / RuT-pose errors): every pair on shared per-front-end
-    draws (``analysis.arc``); one JSON entry per pair plus the arc's yield."""
-    from ..analysis.tolerance.arc import Bounds, arc_models, arc_monte_carlo
-    setup = build_setup(scene)
-    pairs = _pairs(setup, args.pair)
-    seed = scene.seed if args.seed is None else args.seed
-    cases = CASES + ((NOMINAL_AMPLITUDES,) if args.nominal_amplitudes else ())
-    k = 1.0 / args.sigma_level if args.distribution == "normal" else 1.0
-    bounds = Bounds(tuple(float(x) for x in sigma), k * extra["yaw_rad"],
-                    k * extra["pitch_rad"], tuple(k * x for x in extra["rut_position_m"]),
-                    k * extra["rut_yaw_rad"])
-    if args.invert_yield is not None:
-        raise UsageError("--invert-yield: only for one pair without rotation or RuT-pose errors "
-                         "so far (rtsgeom design --coverage-deg finds the arc's tolerance)")
-    t0 = time.perf_counter()
-    try:
-        models = arc_models(setup, pairs, args.points)
-    except AngleUnreachable as exc:
-        raise UsageError(f"--pair: a pair cannot synthesize its span ({exc})") from None
-    from .tolerance import _progress
-    with _progress(args.quiet) as progress, chunk_mapper(args.dask, args.workers) as mapper:
-        res = arc_monte_carlo(models, setup.fe.count, bounds, args.draws, seed,
-                              args.distribution, args.spec_deg, cases, args.chunk,
-                              keep_errors=folder is not None, progress=progress,
-                              label="Monte Carlo (arc)", mapper=mapper)
-    out = res.to_dict()
-    out["sigma_level"] = args.sigma_level if args.distribution == "normal" else None
-    elapsed = time.perf_counter() - t0
-    if folder is not None:
-        from ..viz.figures import save_figure, tolerance_histogram_figure
-        p95 = max(out["arc"][case]["angle_error_deg"]["p95"] for case in cases)
-        lim = max(5 * args.spec_deg, 1.2 * p95)
-        fig = tolerance_histogram_figure(
-            {case: np.clip(res.arc_worst(case), -lim, lim) for case in cases}, args.spec_deg,
-            f"Worst error per arc ({len(pairs)} pairs, clipped at ±{lim:.2g} deg)")
-        save_figure(fig, folder / "tolerance.png")
-        write_json(folder / "tolerance.json", out)
-        res.save_npz(folder / "tolerance_draws.npz")
-    if args.json:
-        print_json(out)
-        return 0
-    sc = out["scales"]
-    kind = "sigma" if args.distribution == "normal" else "bound"
-    print(f"arc of {setup.fe.count} front ends, {len(pairs)} pair(s), {args.draws} draws "
-          f"({args.distribution}, {kind}: radial {sc['radial_mm']:.4g}, tangential "
-          f"{sc['tangential_mm']:.4g}, height {sc['height_mm']:.4g} mm, yaw {sc['yaw_deg']:.4g}, "
-          f"pitch {sc['pitch_deg']:.4g} deg per front end; RuT position "
-          f"{sc['rut_position_mm'][0]:.4g} mm, yaw {sc['rut_yaw_deg']:.4g} deg), "
-          f"{elapsed:.2f} s")
-    print(f"  target: one per draw, at a sub-bin position drawn uniform over one range bin "
-          f"({out['subbin']['positions']} positions), the same for every pair")
-    for entry in out["pairs"]:
-        print(f"  pair {tuple(entry['pair'])}: " + "; ".join(
-            f"{case} p95 {entry[case]['angle_error_deg']['p95']:.4f} deg, yield "
-            f"{100 * entry[case]['yield']:.2f} %" for case in cases))
-    for case in cases:
-        a = out["arc"][case]
-        print(f"  ARC {case:>28}: |worst error| p50 {a['angle_error_deg']['p50']:.4f}, p95 "
-              f"{a['angle_error_deg']['p95']:.4f}, max {a['angle_error_deg']['max']:.4f} deg; "
-              f"yield {100 * a['yield']:.2f} % (every pair within {args.spec_deg:g} deg)")
     return 0
 
 

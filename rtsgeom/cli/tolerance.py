@@ -1,5 +1,6 @@
-"""``rtsgeom tolerance | design``: mounting-tolerance Monte Carlo of a front-end pair, and the
-arc design map (radius x front-end spacing)."""
+"""``rtsgeom tolerance | design``: the mounting-tolerance Monte Carlo of a front-end pair, a
+cell of front ends or a whole arc (one engine: :mod:`rtsgeom.analysis.tolerance`), and the arc
+design map (radius x front-end spacing)."""
 
 from __future__ import annotations
 
@@ -10,17 +11,18 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from ..analysis.tolerance.driver import (AXES, CASES, DISTRIBUTIONS, NOMINAL_AMPLITUDES,
-                                         PairPhasors, max_sigma_for_yield, monte_carlo)
-from ..errors import AngleUnreachable
-from ..geometry import build_setup
 from .._lib.io import write_json
-from ..errors import ClusterError
 from .._lib.parallel import check_address, chunk_mapper
-from ..errors import UsageError
+from ..analysis.tolerance import (AXES, CASES, DISTRIBUTIONS, NOMINAL_AMPLITUDES, Bounds,
+                                  ChannelPhasors, ToleranceModel, max_sigma_for_yield, monte_carlo,
+                                  verify_draws)
+from ..analysis.tolerance.draws import draw_offsets
+from ..errors import AngleUnreachable, ClusterError, ParameterError, UsageError
+from ..geometry import build_setup
+from ..radar.steering import Steering
 from ._common import (load_scene_checked, number, output_folder, output_path, print_json, scene_arg,
                       warn_scene_errors)
-from .aoa import _pair, _pair_arg
+from .aoa import _pair, _pair_arg, _pairs
 from .arc import coverage_spec
 
 #: ``tolerance``'s ``--pair`` default, by identity: left at it, a 2-D RuT gets the cell study
@@ -91,14 +93,82 @@ def _grid_spec(lo: float, hi: float, unit: str, max_n: int = 50):
     return parse
 
 
-def _model(scene, pair_arg, points: int) -> PairPhasors:
+def scales(args) -> tuple[np.ndarray, dict]:
+    """The per-axis scales (m: the sigma, or the uniform bound) from the old ``--sigma-*-mm``
+    flags or the new tolerance flags (``--radial-mm 0.2 --sigma-level 3``: +-0.2 mm at 3
+    sigma), and the rotation / RuT-pose tolerances (SI) of the new flags."""
+    k = 1.0 / args.sigma_level if args.distribution == "normal" else 1.0
+    sigma = []
+    for axis in AXES:
+        old, new = getattr(args, f"sigma_{axis}_mm"), getattr(args, f"{axis}_mm")
+        if old is not None and new is not None:
+            raise UsageError(f"--sigma-{axis}-mm and --{axis}-mm: give one of them (the first is "
+                             "the scale itself, the second a tolerance at --sigma-level)")
+        sigma.append(old if old is not None else (k * new if new is not None else 0.1))
+    extra = {"yaw_rad": np.radians(args.yaw_deg), "pitch_rad": np.radians(args.pitch_deg),
+             "rut_position_m": (args.rut_position_mm * 1e-3,) * 3,
+             "rut_yaw_rad": np.radians(args.rut_yaw_deg)}
+    return np.array(sigma) * 1e-3, extra
+
+
+
+def _wants_cell(args, scene) -> bool:
+    """``--cell`` given, or a RuT that beamforms in azimuth and elevation with ``--pair`` left
+    at its default: the cell of all front ends (3 or 4, as ``linearity --grid``)."""
+    if args.cell is not None:
+        return True
+    if args.pair is not DEFAULT_PAIR:
+        return False
     setup = build_setup(scene)
-    pair = _pair(setup, pair_arg)
+    return Steering.auto(setup.rut, scene.radar).dims == 2 and setup.fe.count in (3, 4)
+
+
+def _cell(words) -> tuple[int, ...] | None:
+    if words is None or list(words) == ["all"]:
+        return None
+    if "all" in words:
+        raise UsageError(f"--cell {' '.join(map(str, words))}: give 3 or 4 front-end indices, "
+                         "or all")
+    return tuple(int(w) for w in words)
+
+
+def _study(args, scene, bounds: Bounds) -> ToleranceModel:
+    """The study the arguments ask for: a cell (``--cell``, or a 2-D RuT by default), a whole
+    arc (``--pair all``, or rotation / RuT-pose errors: every pair on shared draws), or one
+    pair."""
+    setup = build_setup(scene)
+    if _wants_cell(args, scene):
+        if list(args.pair) == ["all"]:
+            raise UsageError("--cell and --pair all: give one of them")
+        if (bounds.rotations or bounds.rut_pose) and (args.verify or args.invert_yield is not None):
+            raise UsageError("--verify, --invert-yield: only without rotation or RuT-pose errors "
+                             "so far")
+        if args.nominal_amplitudes:
+            raise UsageError("--nominal-amplitudes: only for the pair study (the cell study "
+                             "designs its amplitudes once, at the bin centre)")
+        try:
+            cell = ChannelPhasors.build(setup, _cell(args.cell), args.points, cell=True)
+        except ParameterError as exc:
+            raise UsageError(f"--cell: {exc}") from None
+        except AngleUnreachable as exc:
+            raise UsageError(f"--cell: the cell cannot synthesize its set directions ({exc})") \
+                from None
+        return ToleranceModel.of(cell)
+    arc = list(args.pair) == ["all"] or bounds.rotations or bounds.rut_pose
+    if arc and args.verify:
+        raise UsageError("--verify: only for one pair with offsets (not --pair all, "
+                         "rotations or RuT-pose errors)")
+    if arc and args.invert_yield is not None:
+        raise UsageError("--invert-yield: only for one pair without rotation or RuT-pose errors "
+                         "so far (rtsgeom design --coverage-deg finds the arc's tolerance)")
+    pairs = _pairs(setup, args.pair)
     try:
-        return PairPhasors.build(setup, pair, points)
+        models = [ChannelPhasors.build(setup, p, args.points) for p in pairs]
     except AngleUnreachable as exc:  # the composite cannot reach a set angle
-        raise UsageError(f"--pair {pair[0]} {pair[1]}: the pair cannot synthesize its span "
+        which = "--pair" if arc else f"--pair {pairs[0][0]} {pairs[0][1]}"
+        raise UsageError(f"{which}: {'a' if arc else 'the'} pair cannot synthesize its span "
                          f"({exc})") from None
+    return ToleranceModel.arc(models, setup.fe.count) if arc else ToleranceModel.of(models[0])
 
 
 def cmd_tolerance(args) -> int:
@@ -109,29 +179,29 @@ def cmd_tolerance(args) -> int:
 
 
 def _tolerance(args, scene, stage) -> int:
-    from .arc import save_pair_npz, scales, tolerance_arc, wants_arc
     sigma, extra = scales(args)
-    from .tolerance_cell import print_study_footer, tolerance_cell, wants_cell
-    if wants_cell(args, scene, DEFAULT_PAIR):  # a 2-D cell of front ends (issue 15)
-        return tolerance_cell(args, scene, sigma, extra, stage)
-    if wants_arc(args):
-        if args.verify:
-            raise UsageError("--verify: only for one pair with offsets (not --pair all, "
-                             "rotations or RuT-pose errors)")
-        return tolerance_arc(args, scene, sigma, extra, stage)
-    model = _model(scene, args.pair, args.points)
-    chunk = capped_chunk(args.chunk, len(model.set_rad))
+    k = 1.0 / args.sigma_level if args.distribution == "normal" else 1.0
+    bounds = Bounds(tuple(float(x) for x in sigma), k * extra["yaw_rad"], k * extra["pitch_rad"],
+                    tuple(k * x for x in extra["rut_position_m"]), k * extra["rut_yaw_rad"])
+    model = _study(args, scene, bounds)
+    kind = model.kind
     seed = scene.seed if args.seed is None else args.seed
     cases = CASES + ((NOMINAL_AMPLITUDES,) if args.nominal_amplitudes else ())
+    points = sum(m.set_rad.shape[0] * (1 if kind != "cell" else len(m.front_ends))
+                 for m in model.sets[:1])
+    chunk = args.chunk if kind == "arc" else capped_chunk(args.chunk, points)
     t0 = time.perf_counter()
     with _progress(args.quiet) as progress, chunk_mapper(args.dask, args.workers) as mapper:
-        res = monte_carlo(model, sigma, args.draws, seed, args.distribution, args.spec_deg,
-                          cases, chunk, progress, "Monte Carlo", mapper)
+        res = monte_carlo(model, bounds, args.draws, seed, args.distribution, args.spec_deg,
+                          cases, chunk, progress, "Monte Carlo (arc)" if kind == "arc"
+                          else "Monte Carlo", mapper, keep_errors=stage is not None
+                          and kind == "arc")
         out = res.to_dict()
+        if kind == "arc":
+            out["sigma_level"] = args.sigma_level if args.distribution == "normal" else None
         if args.verify:
-            from ..analysis.tolerance.verify import verify_draws
-            out["verify"] = verify_draws(model, sigma, min(args.verify, args.draws), seed,
-                                         args.distribution, cases, progress=progress,
+            out["verify"] = verify_draws(model.sets[0], sigma, min(args.verify, args.draws),
+                                         seed, args.distribution, cases, progress=progress,
                                          all_points=args.verify_all_points).to_dict()
         if args.invert_yield is not None:
             out["inversion"] = {
@@ -142,31 +212,126 @@ def _tolerance(args, scene, stage) -> int:
                 for case in CASES}
     elapsed = time.perf_counter() - t0
     if stage is not None:
-        from ..viz.figures import save_figure, tolerance_cdf_figure
-        # Empirical CDFs on a log axis: the uncalibrated tail (degrees) and the calibrated
-        # case (thousandths of a degree) are both resolved; nothing is clipped.
-        fig = tolerance_cdf_figure({case: res.worst_error_deg[case] for case in cases},
-                                   args.spec_deg,
-                                   f"Worst |error| per setup, pair {tuple(model.pair)}")
-        save_figure(fig, stage / "tolerance.png")
-        write_json(stage / "tolerance.json", out)
-        save_pair_npz(stage / "tolerance_draws.npz", res, seed)
+        _write(stage, args, model, res, out, cases, seed)
     if args.json:
         print_json(out)
         return 0
     scale = "sigma" if args.distribution == "normal" else "bound"
-    print(f"pair {tuple(model.pair)}, {args.draws} draws ({args.distribution}, {scale} "
+    if kind == "arc":
+        _print_arc(args, model, out, cases, elapsed)
+        return 0
+    m = model.sets[0]
+    what = (f"pair {tuple(m.front_ends)}" if kind == "pair" else f"cell {tuple(m.front_ends)}")
+    print(f"{what}, {args.draws} draws ({args.distribution}, {scale} "
           + ", ".join(f"{a} {s * 1e3:g} mm" for a, s in zip(AXES, sigma))
-          + f"), {len(model.set_rad)} set-points, {elapsed:.2f} s ({res.cpu_s:.2f} s CPU in "
-             "the Monte Carlo)")
-    for case in cases:
-        st = out[case]
-        p = st["angle_error_deg"]
-        print(f"  {case:>30}: |error| p50 {p['p50']:.4f}, p95 {p['p95']:.4f}, p99 "
-              f"{p['p99']:.4f}, max {p['max']:.4f} deg; yield {100 * st['yield']:.2f} % within "
-              f"{args.spec_deg:g} deg")
-    print_study_footer(out, args, scale)
+          + (f"), {len(m.set_rad)} set-points" if kind == "pair" else
+             f"), {m.set_rad.shape[0]} set directions (azimuth x elevation)")
+          + f", {elapsed:.2f} s ({res.cpu_s:.2f} s CPU in the Monte Carlo)")
+    if kind == "pair":
+        for case in cases:
+            st = out[case]
+            p = st["angle_error_deg"]
+            print(f"  {case:>30}: |error| p50 {p['p50']:.4f}, p95 {p['p95']:.4f}, p99 "
+                  f"{p['p99']:.4f}, max {p['max']:.4f} deg; yield {100 * st['yield']:.2f} % "
+                  f"within {args.spec_deg:g} deg")
+    else:
+        print(f"  target at a sub-bin position drawn per draw, uniform over one range bin "
+              f"({out['subbin']['positions']} positions); the RuT's bin: set-points detected "
+              "off the set range's bin " + ", ".join(f"{case} {out[case]['detected_off_bin']}"
+                                                    for case in cases))
+        for case in cases:
+            st = out[case]
+            parts = []
+            for key, name in (("azimuth_error_deg", "az"), ("elevation_error_deg", "el"),
+                              ("angular_distance_deg", "distance")):
+                p = st[key]
+                parts.append(f"{name} p95 {p['p95']:.4f} p99 {p['p99']:.4f} max {p['max']:.4f}")
+            print(f"  {case:>12}: |error| " + "; ".join(parts) + f" deg; yield "
+                  f"{100 * st['yield']:.2f} % within {args.spec_deg:g} deg in both angles")
+    _print_footer(out, args, scale)
     return 0
+
+
+def _write(stage, args, model: ToleranceModel, res, out: dict, cases, seed: int) -> None:
+    """``--out DIR``: tolerance.png, tolerance.json and tolerance_draws.npz (per-draw errors
+    and worst angle errors, for sensitivity analysis)."""
+    from ..viz.figures import save_figure, tolerance_cdf_figure, tolerance_histogram_figure
+    m = model.sets[0]
+    if model.kind == "arc":
+        p95 = max(out["arc"][case]["angle_error_deg"]["p95"] for case in cases)
+        lim = max(5 * args.spec_deg, 1.2 * p95)
+        fig = tolerance_histogram_figure(
+            {case: np.clip(res.arc_worst(case), -lim, lim) for case in cases}, args.spec_deg,
+            f"Worst error per arc ({len(model.sets)} pairs, clipped at ±{lim:.2g} deg)")
+    elif model.kind == "cell":
+        # Empirical CDFs on a log axis of the worst angular distance per setup
+        fig = tolerance_cdf_figure({case: res.worst_error_deg[case][:, 2] for case in cases},
+                                   args.spec_deg, "Worst angular distance per setup, cell "
+                                   f"{tuple(m.front_ends)}")
+    else:  # the uncalibrated tail (degrees) and the calibrated (thousandths) both resolved
+        fig = tolerance_cdf_figure({case: res.worst_error_deg[case] for case in cases},
+                                   args.spec_deg, f"Worst |error| per setup, pair "
+                                   f"{tuple(m.front_ends)}")
+    save_figure(fig, stage / "tolerance.png")
+    write_json(stage / "tolerance.json", out)
+    if model.kind == "arc":
+        res.save_npz(stage / "tolerance_draws.npz")
+        return
+    arrays = {"offsets_m": draw_offsets(seed, res.draws, res.sigma_m, res.distribution,
+                                        len(m.front_ends))}
+    if model.kind == "pair":
+        arrays.update({"pairs": np.array([m.front_ends]), "delay_s": res.delay_s[:, None],
+                       "range_offset_m": res.range_offset_m[:, None]})
+        arrays.update({f"{case}_deg": v[:, None] for case, v in res.worst_error_deg.items()})
+    else:
+        arrays.update({"cell": np.array(m.front_ends), "delay_s": res.delay_s,
+                       "range_offset_m": res.range_offset_m,
+                       "subbin_steps": (np.zeros(res.draws, int) if res.subbin_steps is None
+                                        else np.asarray(res.subbin_steps))})
+        arrays.update({f"{case}_deg": v for case, v in res.worst_error_deg.items()})
+    path = stage / "tolerance_draws.npz"
+    tmp = path.with_name(path.name + ".part")
+    with open(tmp, "wb") as fh:
+        np.savez_compressed(fh, **arrays)
+    tmp.replace(path)
+
+
+def _print_arc(args, model, out, cases, elapsed) -> None:
+    sc = out["scales"]
+    kind = "sigma" if args.distribution == "normal" else "bound"
+    print(f"arc of {model.count} front ends, {len(model.sets)} pair(s), {args.draws} draws "
+          f"({args.distribution}, {kind}: radial {sc['radial_mm']:.4g}, tangential "
+          f"{sc['tangential_mm']:.4g}, height {sc['height_mm']:.4g} mm, yaw {sc['yaw_deg']:.4g}, "
+          f"pitch {sc['pitch_deg']:.4g} deg per front end; RuT position "
+          f"{sc['rut_position_mm'][0]:.4g} mm, yaw {sc['rut_yaw_deg']:.4g} deg), "
+          f"{elapsed:.2f} s")
+    print(f"  target: one per draw, at a sub-bin position drawn uniform over one range bin "
+          f"({out['subbin']['positions']} positions), the same for every pair")
+    for entry in out["pairs"]:
+        print(f"  pair {tuple(entry['pair'])}: " + "; ".join(
+            f"{case} p95 {entry[case]['angle_error_deg']['p95']:.4f} deg, yield "
+            f"{100 * entry[case]['yield']:.2f} %" for case in cases))
+    for case in cases:
+        a = out["arc"][case]
+        print(f"  ARC {case:>28}: |worst error| p50 {a['angle_error_deg']['p50']:.4f}, p95 "
+              f"{a['angle_error_deg']['p95']:.4f}, max {a['angle_error_deg']['max']:.4f} deg; "
+              f"yield {100 * a['yield']:.2f} % (every pair within {args.spec_deg:g} deg)")
+
+
+def _print_footer(out: dict, args, scale: str) -> None:
+    """The lines a pair study and a cell study print alike: the chain check (``--verify``),
+    the calibration's delays and range offsets, and the yield search (``--invert-yield``)."""
+    if "verify" in out:
+        v = out["verify"]
+        print(f"  verify: {v['draws']} draws through the ADC-cube chain, largest |chain - model| "
+              f"{v['max_abs_difference_deg']:.2e} deg (at {v['set_point']})")
+    cal = out["calibration"]
+    print(f"  calibration |delta tau| p95 {cal['abs_delta_tau_ps']['p95']:.0f} ps, range offset "
+          f"p95 {cal['abs_range_offset_mm']['p95']:.1f} mm")
+    for case, inv in out.get("inversion", {}).items():
+        sig = ", ".join(f"{a} {inv['sigma_mm'][a]:.4g}" for a in AXES)
+        print(f"  {100 * args.invert_yield:g} % within {args.spec_deg:g} deg, {case}: {scale} "
+              f"{sig} mm{' (search cap)' if inv['capped'] else ''}")
 
 
 def cmd_design(args) -> int:

@@ -79,7 +79,7 @@ def _reachable_cells(setup: Setup, mode: str) -> dict:
     """:func:`reachable_spans` of a scene of 2-D cells: each target's enclosing cell of front
     ends (``aoa.plan_cells.target_cells``, what ``run`` plans with); ``pairs`` is empty (the
     cells are not pairs along an arc) and ``cells`` True."""
-    from .plan_cells import target_cells
+    from .plan import target_cells
     _, _, found = target_cells(setup)
     targets = [{"index": k, "angle_deg": float(np.degrees(t.angle_rad)),
                 "elevation_deg": float(np.degrees(t.elevation_rad)),

@@ -41,7 +41,6 @@ from functools import cached_property
 
 import numpy as np
 from scipy.constants import c
-from scipy.optimize import brentq
 
 from ..errors import AngleUnreachable, ParameterError, SceneError
 from ..geometry import Setup
@@ -330,6 +329,7 @@ class ChannelModel:
             raise AngleUnreachable(
                 f"angle {np.degrees(alpha):.4f} deg is outside the span this front-end pair "
                 f"can synthesize [{np.degrees(min(lo, hi)):.4f}, {np.degrees(max(lo, hi)):.4f}] deg")
+        from scipy.optimize import brentq  # here: scipy.optimize costs ~0.3 s of imports
         x = brentq(lambda x: angle(x) - alpha, -log_span, log_span, xtol=1e-10)
         got = angle(x)
         # brentq closed in on a jump of the detected angle. Only for a smoothed estimator:

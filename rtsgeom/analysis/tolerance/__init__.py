@@ -1,0 +1,21 @@
+"""Mounting tolerance: how many built setups keep the synthesized angle within a spec, and the
+largest tolerance that keeps a target yield (paper section "Arbitrary Angle of Arrival",
+"Constraints").
+
+One engine, by concept: the draws (:mod:`.draws`: one stream of offsets, rotations, RuT pose and
+the target's sub-bin position), the model of one channel set under those errors at phasor level
+(:mod:`.phasors`, its tables :mod:`.tables`, the pair's and a cell's procedure :mod:`.pair`,
+:mod:`.cell`, their compiled kernels :mod:`.kernels`), the one Monte-Carlo driver over channel
+sets on shared draws and its result (:mod:`.montecarlo`: a pair, a cell, a whole arc), the one
+yield search (:mod:`.search`), and the check against the full ADC-cube chain (:mod:`.verify`).
+"""
+
+from .draws import AXES, DISTRIBUTIONS, Bounds
+from .montecarlo import ToleranceModel, ToleranceResult, monte_carlo
+from .phasors import ALL_CASES, CASES, NOMINAL_AMPLITUDES, ChannelPhasors
+from .search import max_scale_for_yield, max_sigma_for_yield
+from .verify import VerifyResult, verify_draws
+
+__all__ = ["AXES", "DISTRIBUTIONS", "CASES", "ALL_CASES", "NOMINAL_AMPLITUDES", "Bounds",
+           "ChannelPhasors", "ToleranceModel", "ToleranceResult", "monte_carlo",
+           "max_sigma_for_yield", "max_scale_for_yield", "VerifyResult", "verify_draws"]

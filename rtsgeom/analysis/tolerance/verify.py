@@ -1,17 +1,15 @@
-"""The tolerance study's fast model against the full ADC-cube chain (issue 13: ``rtsgeom
-tolerance --verify N``).
+"""The tolerance model against the full ADC-cube chain (``rtsgeom tolerance --verify N``).
 
 The first N draws of a study (the same seed, so the same mounting errors and sub-bin
-positions as :func:`~rtsgeom.analysis.tolerance.driver.monte_carlo`'s first N) are built as real
-setups (``geometry.build_setup`` with the draw's offsets on the pair's front ends, exact
-paths), and the programme the fast model assumes (the target's delay with its sub-bin offset
-on both channels, channel J's calibration delay, the designed amplitudes with the gain
-correction and the redesign) is synthesized as a noise-free ADC cube, processed (range-Doppler
-FFTs, CFAR, beamformer search at the detection: ``radar.process``, as ``rtsgeom run``) and
-its detected angle compared with the fast model's. One frame per draw and case, at the
-set-point that is the draw's worst in the fast model (the number the study reports), or at
-every set-point (``all_points``, ``--verify-all-points``: also the difference of the per-draw
-worst errors, the chain's worst taken over all its set-points).
+positions as :func:`~.montecarlo.monte_carlo`'s first N) are built as real setups
+(``geometry.build_setup`` with the draw's offsets on the set's front ends, exact paths), and
+the programme the model assumes (the target's delay at its sub-bin position on every channel
+plus each channel's calibration delay, the designed amplitudes with the gain correction and
+the redesign) is synthesized as a noise-free ADC cube, processed (range-Doppler FFTs, CFAR,
+the beamformer at the detection: ``radar.process``, as ``rtsgeom run``) and its detected
+direction compared with the model's. One frame per draw and case, at the set-point that is
+the draw's worst in the model (a pair: the largest |error|; a cell: the largest angular
+distance), or at every set-point (``all_points``).
 """
 
 from __future__ import annotations
@@ -28,31 +26,35 @@ from ...radar import process
 from ...radar.frame import simulate
 from ...radar.processing import nearest_detection
 from ...rts.channels import RtsProgram, requested_delay
-from .driver import CASES, draw_offsets, draw_subbins
-from .pair import PairPhasors
+from .draws import draw_offsets, draw_subbins
+from .phasors import CASES, ChannelPhasors
 
 __all__ = ["VerifyResult", "verify_draws"]
 
 
 @dataclass(frozen=True)
 class VerifyResult:
-    """Per draw and case: the fast model's and the chain's angle error (deg) at the verified
-    set-points (NaN where the chain detected nothing within 2 bins): (N,) at each draw's worst
-    set-point in the fast model, or (N, M) with ``all_points``."""
+    """Per draw and case: the model's and the chain's direction error (deg) at the verified
+    set-points (NaN where the chain detected nothing): a pair's (N,) at each draw's worst
+    set-point, (N, M) with ``all_points``; a cell's (N, P, 2) (azimuth, elevation)."""
 
-    set_index: dict  # case -> (N,) set-point verified (-1: all)
-    model_deg: dict  # case -> (N,) or (N, M)
-    chain_deg: dict  # case -> (N,) or (N, M)
+    set_index: dict  # case -> (N,) set-point verified (-1: all), (N, P) for a cell
+    model_deg: dict
+    chain_deg: dict
     elapsed_s: float
+    subbin_steps: np.ndarray  # (N,) the draws' sub-bin offsets (delay steps)
+    dims: int = 1
+    all_points: bool = False
 
     def difference_deg(self, case: str) -> np.ndarray:
-        """|chain - model| per draw (the largest over its verified set-points), (N,)."""
+        """|chain - model| per draw (the largest over its verified set-points and angles),
+        (N,); inf where the chain missed it."""
         d = np.abs(self.chain_deg[case] - self.model_deg[case])
         d = np.where(np.isfinite(d), d, np.inf)
-        return d if d.ndim == 1 else np.max(d, axis=-1)
+        return d.reshape(d.shape[0], -1).max(axis=-1) if d.ndim > 1 else d
 
     def worst_difference_deg(self, case: str) -> np.ndarray:
-        """|chain's worst - model's worst| per draw (the study's statistic), (N,)."""
+        """|chain's worst - model's worst| per draw (a pair study's statistic), (N,)."""
         def worst(e):
             e = np.abs(np.where(np.isfinite(e), e, np.inf))
             return e if e.ndim == 1 else np.max(e, axis=-1)
@@ -65,68 +67,95 @@ class VerifyResult:
         return float(np.max(d)) if d.size else 0.0
 
     def to_dict(self) -> dict:
-        cases = {}
         first = next(iter(self.model_deg.values()))
+        cases = {}
         for case in self.model_deg:
             d = self.difference_deg(case)
-            cases[case] = {"max_abs_difference_deg": float(np.max(d)) if d.size else 0.0,
-                           "max_worst_error_difference_deg": (
-                               float(np.max(self.worst_difference_deg(case))) if d.size
-                               else 0.0),
-                           "missed": int(np.count_nonzero(~np.isfinite(d)))}
-        return {"draws": int(first.shape[0]),
-                "max_abs_difference_deg": self.max_difference_deg,
-                "set_point": ("every set-point" if first.ndim == 2
-                              else "the draw's worst in the fast model"),
-                "cases": cases, "elapsed_s": self.elapsed_s}
+            cases[case] = {"max_abs_difference_deg": float(np.max(d)) if d.size else 0.0}
+            if self.dims == 1:
+                cases[case]["max_worst_error_difference_deg"] = (
+                    float(np.max(self.worst_difference_deg(case))) if d.size else 0.0)
+            cases[case]["missed"] = int(np.count_nonzero(~np.isfinite(d)))
+        if self.dims == 1:
+            return {"draws": int(first.shape[0]),
+                    "max_abs_difference_deg": self.max_difference_deg,
+                    "set_point": ("every set-point" if self.all_points
+                                  else "the draw's worst in the fast model"),
+                    "cases": cases, "elapsed_s": self.elapsed_s}
+        return {"draws": int(first.shape[0]), "subbin_steps": self.subbin_steps.tolist(),
+                "set_point": ("every set-point" if self.all_points
+                              else "the draw's worst (angular distance) in the fast model"),
+                "max_abs_difference_deg": self.max_difference_deg, "cases": cases,
+                "elapsed_s": self.elapsed_s}
 
 
-def verify_draws(model: PairPhasors, sigma_m, n: int, seed: int, distribution: str = "normal",
-                 cases=CASES, subbin: bool = True, progress=None,
-                 all_points: bool = False) -> VerifyResult:
-    """The first ``n`` draws of ``monte_carlo(model, sigma_m, ..., seed, distribution)``
-    through the full chain (see the module): one frame per draw and case at the draw's worst
-    set-point, or with ``all_points`` one per set-point (M times the frames).
-    ``progress(label, done, total)`` per draw."""
+def verify_draws(model: ChannelPhasors, sigma_m, n: int, seed: int, distribution: str = "normal",
+                 cases=CASES, subbin: bool = True, progress=None, all_points: bool = False,
+                 positions=None) -> VerifyResult:
+    """The first ``n`` draws of ``monte_carlo(model, sigma_m, n, seed, distribution)`` through
+    the full chain (see the module). ``subbin``: the sub-bin positions the study draws
+    (False: the bin centre); ``positions`` (n,): indices into ``model.subbin_steps`` to use
+    instead (e.g. a grid across the bin). ``progress(label, done, total)`` per draw."""
     t0 = time.perf_counter()
-    off = draw_offsets(seed, n, sigma_m, distribution)
-    sub = (draw_subbins(seed, n, model.subbin_steps.size) if subbin
-           else np.full(n, model.subbin_zero))
-    err, det = model.draw_errors(off, sub, tuple(cases), return_detail=True)
+    channels = list(model.front_ends)
+    n_q = len(channels)
+    off = draw_offsets(seed, n, sigma_m, distribution, n_q)
+    if positions is not None:
+        sub = np.asarray(positions, int).reshape(n)
+    elif subbin:
+        sub = draw_subbins(seed, n, model.subbin_steps.size)
+    else:
+        sub = np.full(n, model.subbin_zero)
+    d = model.draw(off, sub, tuple(cases))
     scene = model.setup.scene
     n_fe = len(scene.rts.front_ends)
     tau0 = float(requested_delay(scene, model.range_m))
     res = model.delay_resolution_s
-    pair = list(model.pair)
-    n_m = model.set_rad.size
-    shape = (n, n_m) if all_points else (n,)
-    out = {k: {case: np.full(shape, np.nan) for case in cases} for k in ("model", "chain")}
-    index = {case: np.full(n, -1) for case in cases}
+    n_m = model.set_rad.shape[0]
+    dims = model.dims
+    tail = () if dims == 1 else (2,)
+    n_p = n_m if all_points else 1
+    out = {k: {case: np.full((n, n_p) + tail, np.nan) for case in cases}
+           for k in ("model", "chain")}
+    index = {case: np.full((n, n_p), -1) for case in cases}
     for i in range(n):
         offsets = np.zeros((n_fe, 3))
-        offsets[pair] = off[i]
+        offsets[channels] = off[i]
         setup = build_setup(scene, offsets_m=offsets)
         paths = exact_paths(setup)
         d_u = int(model.subbin_steps[sub[i]])
         for case in cases:
-            e = np.degrees(err[case][i])
+            e = np.degrees(d[case]["error_rad"][i])  # (M,) or (M, 2)
             if all_points:
                 points = range(n_m)
+            elif dims == 1:
+                points = [int(np.argmax(np.abs(e)))]
             else:
-                index[case][i] = int(np.argmax(np.abs(e)))
-                points = [index[case][i]]
-            for m in points:
-                k = int(det["j_steps"][case][i, m])  # J's delay (steps), as planned
-                a_i, a_j = det["amplitudes"][case][i, m]
-                prog = RtsProgram.build([0, 0], pair, [tau0 + d_u * res, tau0 + (d_u + k) * res],
-                                        [0.0, 0.0], [a_i, a_j])
+                points = [int(np.argmax(d[case]["distance_rad"][i]))]
+            for j, m in enumerate(points):
+                if dims == 1:  # J's delay as planned (the planner's alternatives included)
+                    k = np.array([0, int(d[case]["j_steps"][i, m])])
+                else:
+                    k = d["steps"][i] if case == "calibrated" else np.zeros(n_q, int)
+                amps = d[case]["amplitudes"][i, m] * (1.0 if dims == 1
+                                                     else model.channels.unit_gain)
+                prog = RtsProgram.build([0] * n_q, channels, list(tau0 + (d_u + k) * res),
+                                        [0.0] * n_q, list(amps))
                 _, cube = simulate(setup, paths, prog)  # noise-free
                 rd, dets = process(cube)
-                j = nearest_detection(dets, rd, model.range_m + 0.5 * c * d_u * res)
-                at = (i, m) if all_points else i
-                out["model"][case][at] = e[m]
-                if j is not None:
-                    out["chain"][case][at] = np.degrees(dets.angle_rad[j] - model.set_rad[m])
+                hit = nearest_detection(dets, rd, model.range_m + 0.5 * c * d_u * res)
+                index[case][i, j] = m
+                out["model"][case][i, j] = e[m]
+                if hit is not None:
+                    got = (dets.angle_rad[hit] if dims == 1
+                           else np.array([dets.angle_rad[hit], dets.elevation_rad[hit]]))
+                    out["chain"][case][i, j] = np.degrees(got - model.set_rad[m])
         if progress:
             progress("verify (ADC-cube chain)", i + 1, n)
-    return VerifyResult(index, out["model"], out["chain"], time.perf_counter() - t0)
+    if dims == 1 and not all_points:  # a pair's worst set-point: (N,)
+        out = {k: {case: v[:, 0] for case, v in o.items()} for k, o in out.items()}
+        index = {case: v[:, 0] for case, v in index.items()}
+    elif dims == 1:
+        index = {case: np.full(n, -1) for case in cases}
+    return VerifyResult(index, out["model"], out["chain"], time.perf_counter() - t0,
+                        model.subbin_steps[sub], dims, all_points)

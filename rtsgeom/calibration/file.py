@@ -1,0 +1,92 @@
+"""The calibration file: what a lab measures once and reuses for every scenario on the same
+setup (``rtsgeom calibrate --out DIR`` writes DIR/calibration.json; ``run`` and ``adc`` read it
+with ``--calibration FILE``), and the fingerprint of the setup it was made on.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import SceneError
+from .pair import Calibration
+from .probes import FrontEndProbe
+
+__all__ = ["CALIBRATION_FORMAT", "setup_fingerprint", "calibration_mismatch",
+           "load_calibration"]
+
+CALIBRATION_FORMAT = "rtsgeom-calibration"
+
+
+def setup_fingerprint(scene) -> str:
+    """SHA-256 of what a calibration is a measurement of: the RTS's arc, front ends (their
+    mounting and channel fields) and delay hardware, and the RuT (array, pose, chirp,
+    processing). Not the scenario (targets, seed, name), not what only changes noise or
+    levels (the RuT's ``snr_db``, ``link`` and CFAR, ``rts.link``), not the calibration
+    procedure's own settings (``rts.calibration_span_ns``/``calibration_step_ps``) or the
+    AoA mode, and not the sheet or ray tracing (``calibrate`` measures on exact paths).
+    Files the scene names (antenna pattern tables) count by their content, not their path,
+    so a moved or copied project keeps its fingerprint and an edited table changes it.
+    ``calibrate`` writes it as ``setup_sha256``; ``run``/``adc --calibration`` warn when the
+    scene's differs (a calibration made before a front end was moved)."""
+    import dataclasses
+    import hashlib
+    from pathlib import Path
+
+    def canonical(v):
+        if isinstance(v, dict):
+            return {k: canonical(x) for k, x in v.items()}
+        if isinstance(v, (list, tuple)):
+            return [canonical(x) for x in v]
+        if isinstance(v, str) and Path(v).is_absolute() and Path(v).is_file():
+            return "sha256:" + hashlib.sha256(Path(v).read_bytes()).hexdigest()
+        if isinstance(v, (int, float)) and not isinstance(v, bool):
+            return float(v)  # 1, 1.0 and np.float64(1.0) alike
+        return v
+    radar = dataclasses.asdict(scene.radar)
+    for key in ("snr_db", "link", "cfar"):
+        radar.pop(key, None)
+    rts = dataclasses.asdict(scene.rts)
+    for key in ("link", "aoa_mode", "calibration_span_s", "calibration_step_s"):
+        rts.pop(key, None)
+    return hashlib.sha256(repr(canonical((radar, rts))).encode()).hexdigest()
+
+
+def calibration_mismatch(doc: dict, scene) -> str | None:
+    """The warning for a calibration file made on another setup (:func:`setup_fingerprint`),
+    None where it matches or the file predates the fingerprint."""
+    made = doc.get("setup_sha256")
+    if made is None or made == setup_fingerprint(scene):
+        return None
+    return ("--calibration: the file was made on another setup (the arc, a front end's "
+            "mounting or channel, the RuT or the RTS's delays differ from this scene's): "
+            "applied as it is; run `rtsgeom calibrate` on this scene if the setup changed")
+
+
+def load_calibration(doc: dict, setup) -> tuple[FrontEndProbe, dict]:
+    """The front-end probe and pair calibrations of a calibration file (``rtsgeom calibrate
+    --out DIR`` writes DIR/calibration.json): what a lab measures once and reuses for every
+    scenario on the same setup. Raises ``SceneError`` naming the field when the file does
+    not fit the setup."""
+    n = setup.fe.count
+    where = "calibration file"
+    try:
+        ang = np.radians(np.asarray(doc["front_end_angles_deg"], float))
+        gain = np.asarray(doc.get("gain_correction", np.ones(n)), float)
+        pairs = doc["pairs"] if "pairs" in doc else [doc]
+        cals = {}
+        for k, p in enumerate(pairs):
+            cal = Calibration.from_dict(p)
+            cals[cal.pair] = cal
+    except (KeyError, TypeError, ValueError) as exc:
+        raise SceneError(f"{where}: not an rtsgeom calibration ({exc!s}): write one with "
+                         "`rtsgeom calibrate SCENE --out DIR`") from None
+    if ang.shape != (n,) or gain.shape != (n,):
+        raise SceneError(f"{where}: front_end_angles_deg has {ang.size} entries, gain_correction "
+                         f"{gain.size}: the scene has {n} front ends (calibrated on another "
+                         "setup?)")
+    for (i, j) in cals:
+        if not (0 <= i < n and 0 <= j < n):
+            raise SceneError(f"{where}: pair ({i}, {j}): must be front-end indices in "
+                             f"[0, {n - 1}]")
+    probe = FrontEndProbe(ang, np.full(n, np.nan), gain)
+    return probe, cals
