@@ -1,10 +1,19 @@
 """rtsgeom: radar target simulator (RTS) setups as geometry.
 
-Pipeline (one direction)::
+Pipeline (one direction; each stage a subpackage, every import pointing down this list)::
 
-    Scene (scene.py) -> Setup (geometry/) -> Paths (paths/) -> Echoes (rts.py)
-      -> AdcCube (radar/fmcw.py) -> RangeDoppler, Detections (radar/processing.py)
-      -> AoA synthesis and calibration (aoa/) -> analyses (analysis/) -> figures, report (viz/)
+    scene/        Scene: the setup declared in a TOML file (fields, rules, presets)
+    geometry/     Setup: the RuT's MIMO array, the front ends on their arc, the sheet
+    paths/        Paths per element pair: exact distances, or Sionna RT's reflections
+    viz/          figures (matplotlib), the 3D view (pyvista), the HTML report
+    rts/          Echoes: the RTS channels' delays, Doppler, amplitudes, FIR, cable ghosts
+    radar/        AdcCube -> RangeDoppler, Detections: FMCW synthesis, FFTs, CFAR, beamformer
+    synthesis/    ChannelModel: the weights that put a target between front ends
+    calibration/  Calibration: probes, the delay sweep, pairs and cells of channels
+    pipeline/     the programme for the scene's targets and the main job (run_scene)
+    identify/     a built setup measured from probe captures
+    analysis/     tolerance, arc design, near field, linearity, ghosts
+    api, cli/     the jobs as functions and as commands
 
 The public API is importable from the package itself; the names load on first use (module
 ``__getattr__``, PEP 562), so ``import rtsgeom`` stays fast and Sionna or pyvista load only when

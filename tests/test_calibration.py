@@ -163,7 +163,7 @@ def _fir_scene(taps, model, snr=False):
 
 @pytest.mark.parametrize("taps", [3, 9, 33, 129])
 def test_fir_is_the_delay_it_is_set_to_at_low_frequency_and_exact_at_integer_settings(taps):
-    from rtsgeom.rts.channels import fir_error_response, fractional_delay_fir
+    from rtsgeom.rts.fir import fir_error_response, fractional_delay_fir
     mu = np.array([0.0, 0.13, 0.5, 0.87])
     h = fractional_delay_fir(mu, taps)
     assert np.allclose(h.sum(1), 1.0)
@@ -176,7 +176,7 @@ def test_fir_is_the_delay_it_is_set_to_at_low_frequency_and_exact_at_integer_set
 
 
 def test_fir_ripple_falls_with_the_number_of_taps():
-    from rtsgeom.rts.channels import fir_error_response
+    from rtsgeom.rts.fir import fir_error_response
     f = np.linspace(0.5e9, 1.5e9, 101)[None]
     worst = [np.abs(np.angle(fir_error_response([0.5], t, 4e9, f))).max() for t in (5, 17, 65)]
     assert worst[0] > worst[1] > worst[2]
@@ -418,7 +418,8 @@ def test_calibrated_delay_is_realisable_and_the_residual_is_reported(res_ps, fra
     delays, the reported residual is the fit's optimum minus the chosen delay (at most half
     a step), and the chosen delay is the realisable one nearest the coherence point."""
     from rtsgeom.calibration.steps import realisable
-    from rtsgeom.rts.channels import realised_delay, requested_delay
+    from rtsgeom.rts.fir import realised_delay
+    from rtsgeom.rts.channels import requested_delay
 
     def mutate(doc):
         doc["radar"].pop("snr_db", None)

@@ -22,7 +22,8 @@ from rtsgeom.calibration.probes import probe_angles, probe_front_ends, probe_ran
 from rtsgeom.synthesis.model import ChannelModel
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
-from rtsgeom.rts.channels import realised_delay, requested_delay
+from rtsgeom.rts.fir import realised_delay
+from rtsgeom.rts.channels import requested_delay
 from rtsgeom.scene import TargetConfig
 
 RES_PS = (1.0, 5.0, 10.0, 25.0, 50.0, 100.0)

@@ -10,7 +10,7 @@ from scipy import signal
 
 from rtsgeom._lib.util import tones
 from rtsgeom.radar.processing import range_doppler
-from rtsgeom.radar.steering import window
+from rtsgeom.radar.windows import window
 from rtsgeom.scene.registry import WINDOWS
 
 

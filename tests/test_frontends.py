@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rtsgeom.analysis.nearfield import (group_azimuth_rad, single_front_end_angles_rad,
-                                        with_arc_radius)
+from rtsgeom.analysis.nearfield_terms import group_azimuth_rad, single_front_end_angles_rad
+from rtsgeom.analysis.nearfield import with_arc_radius
 from rtsgeom.calibration.probes import probe_ranges
 from rtsgeom.geometry import Setup, build_setup
 from rtsgeom.geometry.frontends import antenna_positions, front_ends, module_axes, radial_tangent

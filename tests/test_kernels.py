@@ -14,7 +14,8 @@ from rtsgeom.synthesis import kernels
 from rtsgeom.calibration import sweep
 from rtsgeom.synthesis import pair as pair_design
 from rtsgeom.synthesis.pair import beam_derivatives, design_ratio, detected_bin_choice
-from rtsgeom.radar.steering import Steering, window
+from rtsgeom.radar.steering import Steering
+from rtsgeom.radar.windows import window
 
 WAVELENGTH = 3.9e-3
 

@@ -12,7 +12,7 @@ from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.paths.table import RUT_TO_RUT, Paths
 from rtsgeom.radar.fmcw import fast_time_s, synthesize
-from rtsgeom.radar.steering import window
+from rtsgeom.radar.windows import window
 from rtsgeom.rts.channels import build_echoes, program_nearest, setup_echoes
 
 

@@ -447,7 +447,7 @@ def test_nearfield_refuses_empty_or_non_finite_radii():
 def test_phase_residual_of_a_plane_wave_is_zero():
     """The residual after the best linear fit over the element positions vanishes for path
     lengths linear in the position (a plane wave), and is the curvature otherwise."""
-    from rtsgeom.analysis.nearfield import _residual_deg
+    from rtsgeom.analysis.nearfield_terms import _residual_deg
     from rtsgeom.radar.steering import Steering
     s = make_scene()
     st = Steering.build(build_setup(s).rut, s.radar)

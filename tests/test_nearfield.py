@@ -8,7 +8,8 @@ import json
 import numpy as np
 import pytest
 
-from rtsgeom.analysis.nearfield import default_radii, nearfield, phase_error_deg, with_arc_radius
+from rtsgeom.analysis.nearfield import default_radii, nearfield, with_arc_radius
+from rtsgeom.analysis.nearfield_terms import phase_error_deg
 from rtsgeom.cli import main
 from rtsgeom.geometry import build_setup
 from rtsgeom.geometry.farfield import curvature_phase_error_rad, fraunhofer_distance_m

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from conftest import ROOT
-from rtsgeom.analysis.nearfield import _residual_deg, nearfield
+from rtsgeom.analysis.nearfield_terms import _residual_deg
+from rtsgeom.analysis.nearfield import nearfield
 from rtsgeom.geometry import build_setup
 from rtsgeom.radar.steering import Steering
 from rtsgeom.scene import load_scene

@@ -9,8 +9,8 @@ import pytest
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.radar.phasors import bin_response
-from rtsgeom.rts.channels import (KIND_DIRECT, RtsProgram, channel_echoes, fir_error_response,
-                                  fractional_delay_fir)
+from rtsgeom.rts.channels import KIND_DIRECT, RtsProgram, channel_echoes
+from rtsgeom.rts.fir import fir_error_response, fractional_delay_fir
 
 from conftest import make_scene
 
@@ -79,7 +79,7 @@ def test_fir_response_does_not_depend_on_its_memo(taps, step_ps, monkeypatch):
     """The per-setting rows are memoised per process (``rts._FIR_ROWS``): a delay table's
     blocks give the same bits with the memo cleared before each block (every row computed
     for that block alone), warm, or overflowing (a memo that keeps restarting)."""
-    import rtsgeom.rts.channels as rts
+    import rtsgeom.rts.fir as rts
     f_s = 4e9
     grid = 77e6 + 29.98e12 * (1e-6 + np.arange(300) / 20e6)
     d = rts.realised_delay(7.3e-8 + np.arange(-700, 700) * step_ps * 1e-12, f_s, True, 1e-12)
@@ -114,7 +114,7 @@ def test_fir_taps_through_bin_response_are_the_fir_gain(taps, f_s, step_ps, radi
     synthesizes) to rounding: odd and even tap counts, settings on whole samples and next
     to them, delays over many buffer samples, two front ends' geometries in one call (the
     grouped path), a Doppler shift."""
-    from rtsgeom.rts.channels import fir_taps
+    from rtsgeom.rts.fir import fir_taps
 
     def mutate(doc, filt="windowed-sinc"):
         doc["rts"].update(arc_radius_m=radius_m, fractional_delay_filter=filt,
@@ -155,7 +155,7 @@ def test_fir_taps_through_bin_response_are_the_fir_gain(taps, f_s, step_ps, radi
 
 
 def test_fir_taps_need_one_doppler():
-    from rtsgeom.rts.channels import fir_taps
+    from rtsgeom.rts.fir import fir_taps
     scene = make_scene()
     setup = build_setup(scene)
     prog = RtsProgram.build(np.arange(2), np.zeros(2, int), np.full(2, 3e-8), np.array([0.0, 1e3]),
@@ -171,7 +171,8 @@ def test_fir_taps_refuse_what_they_do_not_model():
     """Taps for other echoes than these (a row count that differs) or for cable ghosts (a
     ghost carries its direct echo's FIR, not one set to its own delay) are an error; no
     echoes give an empty table."""
-    from rtsgeom.rts.channels import Echoes, fir_taps
+    from rtsgeom.rts.channels import Echoes
+    from rtsgeom.rts.fir import fir_taps
     scene = make_scene(lambda d: d["rts"].update(fractional_delay_filter="ideal"))
     fir_scene = make_scene()
     setup = build_setup(scene)

@@ -226,7 +226,7 @@ def test_channel_calibration_of_one_channel_is_its_own_reference():
         assert cal.gain_correction == pytest.approx(tuple(probe.gain_correction))
 
 
-# -- aoa.linearity2d: the 2-D error map through the ADC-cube chain ---------------------------
+# -- the 2-D linearity (error map) through the ADC-cube chain -------------------------------
 
 
 def test_2d_error_map_exact_mode_puts_every_grid_point_on_its_direction():
@@ -234,7 +234,7 @@ def test_2d_error_map_exact_mode_puts_every_grid_point_on_its_direction():
     every grid point inside the four front ends' cell at its (azimuth, elevation) through
     the whole chain (1e-4 deg); ``array-factor`` (closed form, no near field) is off by a
     finite amount. The n x n grid inside a rectangular cell keeps all n^2 points."""
-    from rtsgeom.analysis.linearity2d import linearity_grid
+    from rtsgeom.analysis.linearity import linearity
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     from rtsgeom.scene import load_scene
@@ -243,11 +243,11 @@ def test_2d_error_map_exact_mode_puts_every_grid_point_on_its_direction():
                                          adc_rate_hz=12.5e6))
     setup = build_setup(sc)
     paths = exact_paths(setup)
-    em = linearity_grid(setup, paths, "exact", n=2, calibrate=False, seed=1)
+    em = linearity(setup, paths, None, "exact", points=2, calibrate=False, seed=1)
     assert em.set_deg.shape == (4, 2)
-    assert max(em.max_abs_error_deg()) < 1e-4
-    af = linearity_grid(setup, paths, "array-factor", n=2, calibrate=False, seed=1)
-    assert 0.05 < max(af.max_abs_error_deg()) < 1.0
+    assert max(em.max_abs_error_deg) < 1e-4
+    af = linearity(setup, paths, None, "array-factor", points=2, calibrate=False, seed=1)
+    assert 0.05 < max(af.max_abs_error_deg) < 1.0
 
 
 # -- the N-channel closed form does not depend on a common phase -------------------------

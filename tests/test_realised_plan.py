@@ -20,7 +20,8 @@ from rtsgeom.pipeline.pair import PairPlan, nearest_setting, residual_warning
 from rtsgeom.pipeline.plan import plan_targets
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
-from rtsgeom.rts.channels import realised_delay, requested_delay
+from rtsgeom.rts.fir import realised_delay
+from rtsgeom.rts.channels import requested_delay
 from rtsgeom.geometry.warnings import scene_warnings
 
 RES_PS = (1.0, 25.0, 50.0, 100.0)

@@ -322,7 +322,7 @@ def test_every_preset_runs_end_to_end(name, tmp_path, capsys):
     scene = load_scene(p)
     setup = build_setup(scene)
     assert setup.rut.num_azimuth_unique == PRESETS[name].num_azimuth_unique
-    from rtsgeom.analysis.nearfield import single_front_end_angles_rad
+    from rtsgeom.analysis.nearfield_terms import single_front_end_angles_rad
     t = run_scene(scene).matches[0]
     assert t["detection"] is not None
     assert abs(t["detection"]["range_m"] - 20.0) < scene.radar.range_resolution_m

@@ -13,7 +13,8 @@ from rtsgeom.radar import process, synthesize
 from rtsgeom.radar.dca1000 import from_dca1000, to_dca1000
 from rtsgeom.radar.phasors import bin_response
 from rtsgeom.radar.processing import estimate_angles, tdm_compensate
-from rtsgeom.rts.channels import Echoes, RtsProgram, build_echoes, program_nearest, realised_delay
+from rtsgeom.rts.channels import Echoes, RtsProgram, build_echoes, program_nearest
+from rtsgeom.rts.fir import realised_delay
 from rtsgeom.radar.frame import simulate
 from rtsgeom.pipeline.run import match_targets
 

@@ -22,7 +22,7 @@ from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.radar import process, synthesize
 from rtsgeom.radar.fmcw import synthesize_exact
-from rtsgeom.radar.steering import window
+from rtsgeom.radar.windows import window
 from rtsgeom.rts.channels import Echoes, build_echoes, program_nearest
 
 from conftest import make_scene

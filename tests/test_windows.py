@@ -21,7 +21,7 @@ from rtsgeom.radar import process, synthesize
 from rtsgeom.radar.frame import simulate
 from rtsgeom.radar.phasors import bin_response
 from rtsgeom.radar.processing import estimate_angles, range_doppler, refine_angles
-from rtsgeom.radar.steering import window
+from rtsgeom.radar.windows import window
 from rtsgeom.scene.registry import WINDOWS as WINDOW_REGISTRY
 from rtsgeom.rts.channels import Echoes, build_echoes, program_nearest
 from rtsgeom.pipeline.run import match_targets

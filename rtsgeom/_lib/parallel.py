@@ -226,7 +226,7 @@ def fork_map(func: Callable, chunks: Sequence, workers: int = 2,
 
 
 def _fork_worker_init() -> None:
-    """One BLAS thread per forked worker (threadpoolctl, as ``_util.single_threaded_blas``);
+    """One BLAS thread per forked worker (threadpoolctl, as ``_lib.util.single_threaded_blas``);
     the default SIGTERM (the parent's handler, e.g. the CLI's, must not run in a worker that
     the pool terminates) and SIGINT ignored (Ctrl-C interrupts the parent, which ends them);
     freed memory kept for reuse (:func:`retain_freed_memory`)."""

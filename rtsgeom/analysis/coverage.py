@@ -1,4 +1,4 @@
-"""Arc design for N front ends: "a 0.5 m arc covering -10..+10 deg" (issue 14, item 5).
+"""Arc design for N front ends: "a 0.5 m arc covering -10..+10 deg".
 
 For each arc radius the design chooses the number of front ends N and their (uniform) spacing:
 
@@ -17,7 +17,7 @@ For each arc radius the design chooses the number of front ends N and their (uni
    not fit the sheet is removed (``design._fit_sheet``), widened where the front ends lie
    beyond it; the output says so.
 
-Per design (phasor level, exact geometry, no noise; ``analysis.tolerance``/``analysis.arc``):
+Per design (phasor level, exact geometry, no noise; ``analysis.tolerance``, its arcs):
 the worst |synthesized - set| over every pair's span (the whole coverage), calibrated and
 uncalibrated, on the nominal arc and as the 95th percentile over arcs built with 0.1 mm
 mounting errors (one sigma per axis; without calibration the path differences of the
@@ -45,6 +45,8 @@ from ..paths import exact_paths
 from ..scene import Scene
 from .tolerance import Bounds, ChannelPhasors, ToleranceModel, max_scale_for_yield, monte_carlo
 from .design import _fit_sheet, _problem
+from ..calibration.probes import probe_ranges
+from .nearfield_terms import single_front_end_angles_rad
 
 __all__ = ["ArcPlan", "ArcDesign", "CoverageDesign", "arc_scene", "plan_arc", "evaluate_arc",
            "coverage_designs", "best_per_radius"]
@@ -139,8 +141,6 @@ def _min_cutout_spacing_rad(scene: Scene, radius_m: float) -> float:
 def _detected_rad(variant: Scene) -> tuple[np.ndarray, np.ndarray]:
     """Each front end alone as the RuT detects it and its module's geometric azimuth, both
     seen from the RuT (radians): their difference is the near-field bias."""
-    from ..calibration.probes import probe_ranges
-    from .nearfield import single_front_end_angles_rad
     setup = build_setup(variant)
     rng = float(probe_ranges(setup, 1)[0])
     return single_front_end_angles_rad(setup, exact_paths(setup), rng), setup.fe_azimuth_rad()

@@ -1,5 +1,5 @@
 """Arc design: how arc radius and front-end spacing trade synthesis accuracy, near-field bias,
-calibration cost and mounting tolerance (issue 7, item 4).
+calibration cost and mounting tolerance.
 
 For each (arc radius R_c, front-end spacing) a two-front-end variant of a scene is built: the
 pair's two front ends (their antenna separation, cables and so on kept, mounting and channel
@@ -44,6 +44,8 @@ from ..scene import Scene, SheetConfig
 from ..scene.rules import arc_centre_m, problems
 from .tolerance import CASES, ChannelPhasors, max_sigma_for_yield, monte_carlo
 from .tolerance.search import critical_ratio, largest_passing_scale
+from ..errors import ParameterError
+from ..pipeline.plan import uses_cells
 
 __all__ = ["METRICS", "DesignGrid", "two_front_end_scene", "evaluate_design", "design_grid",
            "check_azimuth_arc"]
@@ -65,8 +67,6 @@ def check_azimuth_arc(scene: Scene, name: str = "design") -> None:
     :func:`rtsgeom.pipeline.plan.uses_cells`): the design varies a pair's azimuth spacing on an arc
     and synthesizes in azimuth only, so on a sphere it would silently design one plane of the
     cell and report that as the cell's design."""
-    from ..pipeline.plan import uses_cells
-    from ..errors import ParameterError
     if uses_cells(scene):
         raise ParameterError(
             f"{name}: this scene's front ends form 2-D cells (azimuth and elevation); the arc "

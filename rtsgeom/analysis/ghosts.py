@@ -25,9 +25,10 @@ import numpy as np
 from scipy.constants import c
 
 from ..geometry import build_setup
-from ..radar.processing import window
+from ..radar.windows import window
 from ..rts.channels import EchoKind, Echoes, cable_ghosts, program_nearest
 from ..scene import Scene
+from ..pipeline.run import run_scene
 
 __all__ = ["DEFAULT_FLOOR_DB", "ghost_orders", "predict_ghosts", "measure_ghosts",
            "GhostReport", "ghost_analysis", "ghosts_figure"]
@@ -213,7 +214,6 @@ def ghost_analysis(scene: Scene, floor_db: float = DEFAULT_FLOOR_DB, simulate: b
     tg = predict_ghosts(scene, floor_db)
     if not simulate:
         return GhostReport(scene, floor_db, fes, tg)
-    from ..pipeline.run import run_scene
     result = run_scene(scene, aoa_mode="nearest")
     return GhostReport(scene, floor_db, fes, tg, measure_ghosts(result, tg), result)
 

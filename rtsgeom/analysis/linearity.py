@@ -1,92 +1,115 @@
-"""Angle linearity of a synthesized target across a pair's span (paper Fig. "Amplitude
-attenuation and angle linearity and error"), on the simulated RuT output."""
+"""Angle linearity: targets synthesized at set directions across a pair's span (an arc, a RuT
+that beamforms in azimuth: paper Fig. "Amplitude attenuation and angle linearity and error") or
+over a grid inside a cell of front ends (a RuT that beamforms in azimuth and elevation), each
+detected on the simulated RuT output (the full ADC-cube chain)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import Delaunay
 
+from ..calibration.channels import calibrate_channels, tree_phases
+from ..calibration.pair import Calibration
+from ..calibration.probes import (FrontEndProbe, probe_angles, probe_front_ends, probe_ranges,
+                                  simulate_detect)
 from ..errors import ParameterError
 from ..geometry import Setup
-from ..paths import Paths
+from ..paths import Paths, nominal_model
+from ..pipeline.pair import pair_design
+from ..radar.processing import nearest_detection
+from ..radar.steering import Steering
 from ..rts.channels import RtsProgram, requested_delay
 from ..scene import TargetConfig
-from ..radar.processing import nearest_detection
-from ..calibration.pair import Calibration
-from ..calibration.probes import FrontEndProbe, simulate_detect, probe_angles, probe_ranges
-from ..pipeline.pair import pair_design
+from ..synthesis.closed_form import array_factor_args, ratio_array_factor, ratio_paper
+from ..synthesis.model import ChannelModel
 
-__all__ = ["Linearity", "linearity"]
+__all__ = ["Linearity", "linearity", "cell_grid", "error_map_figure", "END_ANGLES"]
+
+END_ANGLES = ("geometric", "measured")
 
 
 @dataclass(frozen=True)
 class Linearity:
+    """Set and detected directions (deg) of the synthesized targets: (P,) azimuths of a pair,
+    or (P, 2) (azimuth, elevation) over a cell (NaN: not detected)."""
+
     mode: str
     calibrated: bool
     set_deg: np.ndarray
     detected_deg: np.ndarray
-    amplitude_db: np.ndarray  # (2, n) programmed attenuation of channels I and J
-    end_angles: str = "geometric"  # front-end angles the closed forms used
+    amplitude_db: np.ndarray | None = None  # (Q, P) programmed attenuation per channel
+    end_angles: str = "geometric"  # front-end angles the closed forms used (a pair's)
+    channels: tuple[int, ...] = ()
+
+    @property
+    def dims(self) -> int:
+        return 1 if np.ndim(self.set_deg) == 1 else 2
 
     @property
     def error_deg(self) -> np.ndarray:
         return self.detected_deg - self.set_deg
 
     @property
-    def max_abs_error_deg(self) -> float:
-        return float(np.nanmax(np.abs(self.error_deg)))
+    def max_abs_error_deg(self):
+        """The worst |error| (deg): a pair's, or a cell's (azimuth, elevation)."""
+        e = np.abs(self.error_deg)
+        if self.dims == 1:
+            return float(np.nanmax(e))
+        return float(np.nanmax(e[:, 0])), float(np.nanmax(e[:, 1]))
 
     def to_dict(self) -> dict:
-        return {
-            "mode": self.mode, "calibrated": self.calibrated, "end_angles": self.end_angles,
-            "points": [{"set_deg": float(s), "detected_deg": float(d), "error_deg": float(d - s)}
-                       for s, d in zip(self.set_deg, self.detected_deg)],
-            "max_abs_error_deg": self.max_abs_error_deg,
-        }
+        if self.dims == 1:
+            return {
+                "mode": self.mode, "calibrated": self.calibrated, "end_angles": self.end_angles,
+                "points": [{"set_deg": float(s), "detected_deg": float(d),
+                            "error_deg": float(d - s)}
+                           for s, d in zip(self.set_deg, self.detected_deg)],
+                "max_abs_error_deg": self.max_abs_error_deg}
+        mx = self.max_abs_error_deg
+        return {"mode": self.mode, "calibrated": self.calibrated, "cell": list(self.channels),
+                "points": [{"set_deg": [float(x) for x in s],
+                            "detected_deg": [None if not np.isfinite(x) else float(x)
+                                             for x in d],
+                            "error_deg": [None if not np.isfinite(x) else float(x)
+                                          for x in d - s]}
+                           for s, d in zip(self.set_deg, self.detected_deg)],
+                "max_abs_error_deg": {"azimuth": mx[0], "elevation": mx[1]}}
+
+    def plot(self):
+        """The figure: a pair's detected against set angle and the amplitudes; a cell's
+        azimuth and elevation errors over the set directions."""
+        if self.dims == 2:
+            return error_map_figure(self)
+        from ..viz.figures import linearity_figure  # matplotlib: only for the figure
+        return linearity_figure(self.set_deg, {self.mode: self.detected_deg},
+                                {self.mode: self.amplitude_db}, pair=self.channels)
 
 
-END_ANGLES = ("geometric", "measured")
+def linearity(setup: Setup, paths: Paths, channels=None, mode: str = "exact",
+              probe: FrontEndProbe | None = None, calibration: Calibration | None = None,
+              points: int = 21, seed: int = 0, end_angles: str = "geometric",
+              calibrate: bool = True, progress=None) -> Linearity:
+    """Synthesize targets at set directions across ``channels`` and detect each on the
+    simulated RuT: for a RuT that beamforms in azimuth a pair of front ends (default (0, 1);
+    ``points`` set-points across its span, ``probe``: each front end alone, measured when
+    None; ``calibration``: the pair's, None: uncalibrated), for one that beamforms in azimuth
+    and elevation the cell of all front ends (3 or 4; a ``points`` x ``points`` grid of set
+    directions inside it; ``calibrate``: the channels calibrated first).
 
-
-def _closed_form_measured(setup, paths, pair, target, mode, probe, offsets, corr):
-    """``paper`` / ``array-factor`` amplitudes with the front ends' *measured* angles (each
-    alone as the RuT detects it, as the paper's angles were "determined by measurement")
-    in the closed form, instead of their geometric azimuths."""
-    from ..paths import nominal_model
-    from ..synthesis.model import ChannelModel
-    from ..synthesis.closed_form import array_factor_args, ratio_array_factor, ratio_paper
-    i, j = pair
-    th = probe.angle_rad[[i, j]]
-    alpha = target.angle_rad
-    nom, nom_paths = nominal_model(setup, paths)
-    model = ChannelModel.build(nom, nom_paths, pair, target, offsets)
-    if mode == "paper":
-        rho = float(ratio_paper(th[0], th[1], alpha))
-    else:  # the RuT's own beamformer (taper, repeated elements), as the geometric reading
-        rho = float(ratio_array_factor(th[0], th[1], alpha,
-                                       **array_factor_args(model.steering)))
-    rho = float(np.clip(rho, 0.0, 1e12))
-    phase = float(model.pair_phase(probe_angles(*th)))
-    a_i, a_j = model.amplitudes(model.pair_weights(rho, (0.0, phase)), np.sin([alpha]))
-    return a_i * corr[0], a_j * corr[1], rho
-
-
-def linearity(setup: Setup, paths: Paths, pair: tuple[int, int], mode: str,
-              probe: FrontEndProbe, calibration: Calibration | None, points: int = 21,
-              seed: int = 0, end_angles: str = "geometric") -> Linearity:
-    """Sweep the set angle across ``pair`` and detect each synthesized target on the simulated
-    RuT.
-
-    The span is where every mode can work: the intersection of the measured span (each front
-    end alone as the RuT detects it; near field and Rx/Tx separation move it) and the
+    A pair's span is where every mode can work: the intersection of the measured span (each
+    front end alone as the RuT detects it; near field and Rx/Tx separation move it) and the
     geometric span (the closed forms only reach between the front ends' geometric angles);
-    its ends are excluded, where one channel would be off.
-
-    ``end_angles``: which front-end angles the closed forms (``paper``, ``array-factor``)
-    use: ``geometric`` (module azimuths of the nominal setup) or ``measured`` (each front
-    end alone as the RuT detects it); ``exact`` ignores it.
+    its ends are excluded, where one channel would be off. ``end_angles``: which front-end
+    angles the closed forms (``paper``, ``array-factor``) use: ``geometric`` (module azimuths
+    of the nominal setup) or ``measured`` (each front end alone as the RuT detects it);
+    ``exact`` ignores it.
     """
+    if Steering.auto(setup.rut, setup.scene.radar).dims == 2:
+        return _grid(setup, paths, mode, int(points), calibrate, seed, progress)
+    pair = (0, 1) if channels is None else tuple(int(q) for q in channels)
+    probe = probe_front_ends(setup, paths, seed) if probe is None else probe
     if end_angles not in END_ANGLES:
         raise ParameterError(f"end_angles = {end_angles!r}: must be one of {END_ANGLES}")
     scene = setup.scene
@@ -121,4 +144,97 @@ def linearity(setup: Setup, paths: Paths, pair: tuple[int, int], mode: str,
             det_deg[k] = np.degrees(det.angle_rad[n])
     amp_db = 20 * np.log10(np.maximum(amp, 1e-300) / np.max(amp))
     return Linearity(mode, calibration is not None, np.degrees(sets), det_deg, amp_db,
-                     end_angles)
+                     end_angles, pair)
+
+
+def _closed_form_measured(setup, paths, pair, target, mode, probe, offsets, corr):
+    """``paper`` / ``array-factor`` amplitudes with the front ends' *measured* angles (each
+    alone as the RuT detects it, as the paper's angles were "determined by measurement")
+    in the closed form, instead of their geometric azimuths."""
+    i, j = pair
+    th = probe.angle_rad[[i, j]]
+    alpha = target.angle_rad
+    nom, nom_paths = nominal_model(setup, paths)
+    model = ChannelModel.build(nom, nom_paths, pair, target, offsets)
+    if mode == "paper":
+        rho = float(ratio_paper(th[0], th[1], alpha))
+    else:  # the RuT's own beamformer (taper, repeated elements), as the geometric reading
+        rho = float(ratio_array_factor(th[0], th[1], alpha,
+                                       **array_factor_args(model.steering)))
+    rho = float(np.clip(rho, 0.0, 1e12))
+    phase = float(model.pair_phase(probe_angles(*th)))
+    a_i, a_j = model.amplitudes(model.pair_weights(rho, (0.0, phase)), np.sin([alpha]))
+    return a_i * corr[0], a_j * corr[1], rho
+
+
+def cell_grid(steering: Steering, u_fe, n: int) -> np.ndarray:
+    """Set directions (P, 2) (azimuth, elevation) rad over a cell of front ends at direction
+    cosines ``u_fe`` (Q, 2): an n x n grid at fractions (k + 1) / (n + 1) of the corners'
+    extent in each angle (ends excluded), the points outside the cell's hull dropped."""
+    u_fe = np.asarray(u_fe, float)
+    ang_fe = steering.angles(u_fe)
+    lo, hi = ang_fe.min(0), ang_fe.max(0)
+    f = np.arange(1, n + 1) / (n + 1)
+    grid = np.stack(np.meshgrid(lo[0] + f * (hi[0] - lo[0]), lo[1] + f * (hi[1] - lo[1]),
+                                indexing="ij"), -1).reshape(-1, 2)
+    return grid[Delaunay(u_fe).find_simplex(steering.directions(grid)) >= 0]
+
+
+def _grid(setup: Setup, paths: Paths, mode: str, n: int, calibrate: bool, seed: int,
+          progress) -> Linearity:
+    """An n x n grid of set directions over the cell of all front ends (at most 4: one cell)
+    in (azimuth, elevation), fractions (k + 1) / (n + 1) of the corners' extent in each axis
+    (ends excluded, points outside the cell's hull dropped), each synthesized alone with
+    the calibrated offsets and phases and detected by the simulated RuT."""
+    if setup.fe.count > 4:
+        raise ParameterError(f"linearity --grid: the scene has {setup.fe.count} front ends; the "
+                         "error map covers one cell of 3 or 4")
+    cell = tuple(range(setup.fe.count))
+    nom, nom_paths = nominal_model(setup, paths)
+    probe = probe_front_ends(setup, paths, seed)
+    rng = float(probe_ranges(setup, 1)[0])
+    target0 = TargetConfig(rng)
+    st = Steering.auto(nom.rut, setup.scene.radar)
+    if st.dims != 2:
+        raise ParameterError("linearity --grid needs a RuT with elevation (an array with "
+                         "elevation extent, e.g. radar.use_elevation_tx = true)")
+    offsets, tree = np.zeros(setup.fe.count), None
+    if calibrate:
+        cal = calibrate_channels(setup, paths, cell, probe, seed, progress)
+        offsets, tree = cal.offsets_s, cal.tree
+    cs = ChannelModel.build(nom, nom_paths, cell, target0, offsets[list(cell)], steering=st)
+    grid = cell_grid(st, cs.fe_directions(), n)
+    phases = None if tree is None else tree_phases(cs, tree)
+    corr = probe.gain_correction[list(cell)] if calibrate else np.ones(len(cell))
+    tau = float(requested_delay(setup.scene, rng))
+    det_deg = np.full(grid.shape, np.nan)
+    for k, a in enumerate(grid):
+        u = st.directions(a)
+        w = cs.solve(u, phases, mode)
+        amps = cs.amplitudes(w, u) * corr
+        prog = RtsProgram.build([0] * len(cell), list(cell), list(tau + offsets[list(cell)]),
+                                [0.0] * len(cell), list(amps))
+        rd, det = simulate_detect(setup, paths, prog, seed)
+        j = nearest_detection(det, rd, rng)
+        if j is not None:
+            det_deg[k] = np.degrees([det.angle_rad[j], det.elevation_rad[j]])
+        if progress:
+            progress(f"set-point {k + 1}/{grid.shape[0]}")
+    return Linearity(mode, calibrate, np.degrees(grid), det_deg, channels=cell)
+
+
+def error_map_figure(em: Linearity):
+    """Two panels over (azimuth, elevation): the azimuth and the elevation error (deg)."""
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True)
+    e = em.error_deg
+    lim = max(float(np.nanmax(np.abs(e))), 1e-6)
+    for ax, k, name in zip(axes, (0, 1), ("azimuth", "elevation")):
+        sc = ax.scatter(em.set_deg[:, 0], em.set_deg[:, 1], c=e[:, k], cmap="coolwarm",
+                        vmin=-lim, vmax=lim, s=160, marker="s", edgecolors="k")
+        ax.set_xlabel("set azimuth (deg)")
+        ax.set_ylabel("set elevation (deg)")
+        ax.set_title(f"{name} error ({em.mode}, "
+                     f"{'calibrated' if em.calibrated else 'uncalibrated'})")
+        fig.colorbar(sc, ax=ax, label=f"{name} error (deg)")
+    return fig

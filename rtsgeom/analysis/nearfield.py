@@ -60,28 +60,20 @@ import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.constants import c
 
-from ..paths import nominal_model
-from ..calibration.probes import probe_angles, probe_ranges
-from ..synthesis.model import ChannelModel
-from ..errors import AngleUnreachable
+from ..calibration.probes import probe_ranges
 from ..errors import ParameterError
-from ..geometry import RutArray, Setup, build_setup
+from ..geometry import build_setup
+from ..geometry.farfield import aperture_m, apparent_azimuth_rad, fraunhofer_distance_m
 from ..geometry.setup import nominal_scene
-from ..geometry.farfield import (aperture_m, apparent_azimuth_rad, fraunhofer_distance_m,
-                                 two_way_lengths)
-from ..paths import Paths, exact_paths
+from ..paths import exact_paths
 from ..radar.steering import Steering, smoothed_estimator
-from ..rts.channels import requested_delay
-from ..scene import Scene, TargetConfig
-from .nearfield2d import _cells, cell_synthesis_errors_deg, single_front_end_directions_rad
+from ..scene import Scene
+from .nearfield_terms import (beat_frequency_azimuth_rad, echo_delay_s, group_azimuth_rad,
+                              phase_error_deg, single_front_end_angles_rad, synthesis_errors)
 
-__all__ = ["DEFAULT_DECADES", "DEFAULT_POINTS", "MIN_RADIUS_M", "max_radius_m", "default_radii", "with_arc_radius",
-           "group_azimuth_rad", "beat_frequency_azimuth_rad", "phase_error_deg",
-           "single_front_end_angles_rad", "single_front_end_directions_rad",
-           "synthesis_worst_errors_deg", "cell_synthesis_errors_deg", "NearField",
-           "nearfield", "nearfield_figure"]
+__all__ = ["DEFAULT_DECADES", "DEFAULT_POINTS", "MIN_RADIUS_M", "max_radius_m", "default_radii",
+           "with_arc_radius", "NearField", "nearfield", "nearfield_figure"]
 
 DEFAULT_DECADES = (-0.5, 1.5)  # default sweep: R_c * 10^-0.5 ... R_c * 10^1.5 (0.32 m to 32 m)
 DEFAULT_POINTS = 13  # 6 per decade, so R_c itself is one of them
@@ -112,169 +104,6 @@ def with_arc_radius(scene: Scene, radius_m: float) -> Scene:
     """The scene with another arc radius (front-end angles, offsets and cables kept)."""
     return dataclasses.replace(scene, rts=dataclasses.replace(scene.rts,
                                                               arc_radius_m=float(radius_m)))
-
-
-# ------------------------------------------------------------------------------------------
-# Closed forms of the parts of the bias
-# ------------------------------------------------------------------------------------------
-
-
-def _azimuth_from(rut: RutArray, points: np.ndarray, origin: np.ndarray) -> np.ndarray:
-    """Azimuth (rad) of world ``points`` seen from world ``origin``, in the radar frame."""
-    p = (np.asarray(points) - origin) @ rut.rotation
-    return np.arctan2(p[..., 0], p[..., 1])
-
-
-def _slope_shares(rut: RutArray, mask=None) -> tuple[float, float]:
-    """Shares of the Tx and of the Rx positions in the beamformer's least-squares slope over the
-    azimuth virtual array: ``sum_v w_v x_tx(v)`` and ``sum_v w_v x_rx(v)`` (they add up to 1).
-    ``mask``: the elements of a 2-D beamformer (all); the slope in x is then the x coefficient
-    of the least-squares plane over (x, z)."""
-    m = rut.azimuth_mask if mask is None else np.asarray(mask, bool)
-    xt = rut.tx_local[rut.virtual_tx[m], 0]
-    xr = rut.rx_local[rut.virtual_rx[m], 0]
-    xv = xt + xr
-    if mask is None:
-        w = (xv - xv.mean()) / np.sum((xv - xv.mean()) ** 2)
-    else:
-        zv = rut.tx_local[rut.virtual_tx[m], 2] + rut.rx_local[rut.virtual_rx[m], 2]
-        w = np.linalg.pinv(np.stack([np.ones_like(xv), xv, zv], axis=1))[1]
-    return float(np.sum(w * xt)), float(np.sum(w * xr))
-
-
-def group_azimuth_rad(rut: RutArray, fe_rx: np.ndarray, fe_tx: np.ndarray,
-                      mask=None) -> np.ndarray:
-    """Far-field closed form of the detected azimuth with the RuT's Tx/Rx group parallax.
-
-    Like ``apparent_azimuth_rad`` (the Tx see the front end's Rx antenna at theta_a, the Rx its
-    Tx antenna at theta_b), but each angle is taken from the centroid of the RuT's azimuth Tx
-    (resp. Rx) group instead of the virtual phase centre: each group gets a locally plane wave
-    from its own direction. For the AWR1843BOOST the groups' centroids are -4.75 d and +4.75 d
-    from the phase centre and carry 0.76 and 0.24 of the beamformer slope, which adds
-    ~ 2.5 d cos^2(theta) / R to sin(alpha): as large as the Rx/Tx-separation term at R_c = 1 m
-    and of the same order in 1/R. Shapes (..., F, 3) -> (..., F). ``mask``: the elements of
-    a 2-D beamformer (``Steering.mask``), whose groups and slope are taken over them.
-    """
-    m = rut.azimuth_mask if mask is None else np.asarray(mask, bool)
-    c_tx = rut.tx_world[rut.virtual_tx[m]].mean(axis=0)
-    c_rx = rut.rx_world[rut.virtual_rx[m]].mean(axis=0)
-    share_tx, share_rx = _slope_shares(rut, mask)
-    s = (share_tx * np.sin(_azimuth_from(rut, fe_rx, c_tx))
-         + share_rx * np.sin(_azimuth_from(rut, fe_tx, c_rx)))
-    return np.arcsin(np.clip(s, -1.0, 1.0))
-
-
-def beat_frequency_azimuth_rad(angle_rad, radar, tau_s) -> np.ndarray:
-    """The azimuth the beamformer reads for a plane wave from ``angle_rad`` when the echo's
-    total delay is ``tau_s``: the air-path phase acts at ``f_c + B/2 - S tau`` (the frequency
-    the echo has in the middle of the ADC window, eq. 8), the steering vector at ``f_c + B/2``."""
-    scale = 1.0 - radar.slope_hz_per_s * np.asarray(tau_s) / radar.f_center_hz
-    return np.arcsin(np.clip(np.sin(angle_rad) * scale, -1.0, 1.0))
-
-
-def _residual_deg(steering: Steering, lengths: np.ndarray) -> np.ndarray:
-    """Phase (deg) of path lengths (F, V_s) of the beamformer's elements minus their best
-    linear fit over the positions (azimuth: a line in x_v; D = 2: a plane in (x_v, z_v))."""
-    pos = steering.positions_m
-    if pos.shape[1] == 1:
-        x = pos[:, 0]
-        fit = np.polynomial.polynomial.polyfit(x, lengths.T, 1)  # (2, F)
-        resid = lengths - np.polynomial.polynomial.polyval(x, fit)
-    else:  # the same least squares with one slope per axis
-        design = np.concatenate([np.ones((pos.shape[0], 1)), pos], axis=1)
-        coef, *_ = np.linalg.lstsq(design, lengths.T, rcond=None)
-        resid = lengths - (design @ coef).T
-    return np.degrees(2 * np.pi * resid / steering.wavelength_m)
-
-
-def phase_error_deg(setup: Setup, steering: Steering | None = None) -> dict[str, np.ndarray]:
-    """Per front end, the exact two-way phase across the beamformer's virtual array (default
-    the azimuth row; a 2-D ``steering``: all elements, fit over x and z) minus the best-fit
-    plane wave: ``pp`` and ``rms`` (deg). ``curvature_pp``: the same for what is left after
-    each RuT group's locally plane wave to the antenna it sees (pure phase-front curvature,
-    what the Fraunhofer criterion is about)."""
-    rut, fe = setup.rut, setup.fe
-    steering = steering or Steering.build(rut, setup.scene.radar)
-    m = steering.mask
-    exact = two_way_lengths(rut, fe.rx, fe.tx)[:, m]  # (F, V_az)
-    total = _residual_deg(steering, exact)
-    # locally plane waves per group: |p - s| ~ |c - s| - (p - c) . u, u = (s - c)/|s - c|
-    tx, rx = rut.tx_world[rut.virtual_tx[m]], rut.rx_world[rut.virtual_rx[m]]
-    planar = np.zeros_like(exact)
-    for pts, src in ((tx, fe.rx), (rx, fe.tx)):
-        centre = pts.mean(axis=0)
-        d = src - centre  # (F, 3)
-        dist = np.linalg.norm(d, axis=-1)
-        planar += dist[:, None] - ((pts - centre) @ (d / dist[:, None]).T).T
-    curv = _residual_deg(steering, exact - planar)
-    return {"pp": np.ptp(total, axis=1), "rms": np.sqrt(np.mean(total ** 2, axis=1)),
-            "curvature_pp": np.ptp(curv, axis=1)}
-
-
-# ------------------------------------------------------------------------------------------
-# Phasor-level detection
-# ------------------------------------------------------------------------------------------
-
-
-def single_front_end_angles_rad(setup: Setup, paths: Paths, range_m: float) -> np.ndarray:
-    """Detected angle (rad) of each front end alone (unit amplitude, zero Doppler) at
-    ``range_m``: phasor level through the exact paths, TDM compensation and the RuT's
-    beamformer (the :class:`~rtsgeom.synthesis.model.ChannelModel` of all front ends, each alone)."""
-    n = setup.fe.count
-    model = ChannelModel.build(setup, paths, range(n), TargetConfig(float(range_m)))
-    return model.direction(np.eye(n))
-
-
-def _echo_delay_s(setup: Setup, range_m: float) -> np.ndarray:
-    """Mean total delay (air + RTS) of each front end's echo over the virtual array."""
-    air = two_way_lengths(setup.rut, setup.fe.rx, setup.fe.tx).mean(axis=1) / c
-    return air + float(requested_delay(setup.scene, range_m))
-
-
-def synthesis_worst_errors_deg(setup: Setup, paths: Paths, pair: tuple[int, int],
-                               range_m: float, single_rad: np.ndarray, points: int = 11
-                               ) -> dict:
-    """Worst |detected - set| (deg) of a pair's synthesized target, ``array-factor`` vs
-    ``exact`` amplitudes, phasor level, phase-coherent channels.
-
-    The set-points span the intersection of the pair's measured span (``single_rad``: each
-    front end alone as detected) and its geometric span, ends excluded (as
-    ``aoa.linearity``). The design (ratio) is made on the nominal setup, the detection on the
-    setup as built; each channel pair is made coherent at the set angle.
-    """
-    i, j = pair
-    target = TargetConfig(float(range_m))
-    nom, nom_paths = nominal_model(setup, paths)
-    design = ChannelModel.build(nom, nom_paths, pair, target)
-    actual = design if nom is setup else ChannelModel.build(setup, paths, pair, target)
-    geo = nom.fe_azimuth_rad()[[i, j]]
-    meas = np.sort(single_rad[[i, j]])
-    lo, hi = max(meas[0], np.min(geo)), min(meas[1], np.max(geo))
-    out = {"pair": [i, j], "span_deg": [float(np.degrees(lo)), float(np.degrees(hi))],
-           "points": points}
-    if not hi > lo:
-        out.update({"array_factor_max_abs_error_deg": None, "exact_max_abs_error_deg": None,
-                    "note": "the measured and geometric spans do not overlap"})
-        return out
-    sets = lo + np.arange(1, points + 1) / (points + 1) * (hi - lo)
-    err = {"array-factor": [], "exact": []}
-    probes = probe_angles(*single_rad[[i, j]])
-    design_phase, phase = float(design.pair_phase(probes)), float(actual.pair_phase(probes))
-    for a in sets:
-        rho_af = design.pair_ratio(a, (0.0, design_phase), "array-factor")
-        try:
-            rho_ex = design.pair_ratio(a, (0.0, design_phase))
-        except AngleUnreachable:
-            rho_ex = np.nan
-        for mode, rho in (("array-factor", rho_af), ("exact", rho_ex)):
-            det = (float(actual.direction(actual.pair_weights(rho, (0.0, phase))))
-                   if np.isfinite(rho) else np.nan)
-            err[mode].append(np.degrees(det - a))
-    worst = {m: float(np.nanmax(np.abs(e))) if np.any(np.isfinite(e)) else None
-             for m, e in err.items()}
-    out["array_factor_max_abs_error_deg"] = worst["array-factor"]
-    out["exact_max_abs_error_deg"] = worst["exact"]
-    return out
 
 
 # ------------------------------------------------------------------------------------------
@@ -434,7 +263,7 @@ def nearfield(scene: Scene, radii=None, points: int = 11) -> NearField:
         two_d = st.dims == 2
         geo = setup.fe_azimuth_rad()
         if two_d:  # (azimuth, elevation) of each front end alone, by the 2-D beamformer
-            both = single_front_end_directions_rad(setup, paths, rng, st)
+            both = single_front_end_angles_rad(setup, paths, rng, st)
             det = both[:, 0]
             geo_both = st.angles(setup.fe_direction_cosines())
             geo = geo_both[:, 0]
@@ -444,18 +273,13 @@ def nearfield(scene: Scene, radii=None, points: int = 11) -> NearField:
             det = single_front_end_angles_rad(setup, paths, rng)
         app = apparent_azimuth_rad(rut, fe.rx, fe.tx)
         grp = group_azimuth_rad(rut, fe.rx, fe.tx, st.mask if two_d else None)
-        beat = beat_frequency_azimuth_rad(grp, radar, _echo_delay_s(setup, rng))
+        beat = beat_frequency_azimuth_rad(grp, radar, echo_delay_s(setup, rng))
         ph = phase_error_deg(setup, st if two_d else None)
         for key, val in (("rng", rng), ("geo", geo), ("det", det), ("sep", app - geo),
                          ("par", grp - app), ("beat", beat - grp), ("pp", ph["pp"]),
                          ("rms", ph["rms"]), ("curv", ph["curvature_pp"])):
             cols[key].append(val)
-        if two_d:
-            synth.append([cell_synthesis_errors_deg(setup, paths, cell, rng, points)
-                          for cell in _cells(setup.fe_direction_cosines())])
-        else:
-            synth.append([synthesis_worst_errors_deg(setup, paths, (k, k + 1), rng, det,
-                                                     points) for k in range(fe.count - 1)])
+        synth.append(synthesis_errors(setup, paths, st, rng, det, points))
     deg = {k: np.degrees(np.array(cols[k])) for k in ("geo", "det", "sep", "par", "beat")}
     el = ({"geometric_el_deg": np.degrees(np.array(cols["geo_el"])),
            "detected_el_deg": np.degrees(np.array(cols["det_el"]))} if two_d else {})

@@ -1,5 +1,4 @@
-"""Calibration of N channels against a reference (issue 15; ``channel-sets.md``,
-"Choosing and calibrating channels").
+"""Calibration of N channels against a reference.
 
 A phase is always measured between two channels: each measured pair (i, j) is swept like the
 paper's pair calibration (channel j's RTS delay offset over at least one period, two probe
@@ -38,6 +37,12 @@ from ..rts.channels import RtsProgram, requested_delay
 from ..scene import TargetConfig
 from ..synthesis.model import ChannelModel
 from ..errors import CalibrationFailed
+from ..errors import AngleUnreachable
+from ..paths import nominal_model
+from .pair import calibrate_pair
+from .probes import if_phase_slope_hz, probe_ranges, probe_total_delay, simulate_detect
+from .steps import adds_noise, coarse_frames, coarse_minimum, continuous_delay_setup, fine_frames, fine_window, fit_scatter, realisable, rms_error_deg, sweep_phase
+from .sweep import fit_minimum
 
 __all__ = ["ChannelCalibration", "coherence_point_nd", "crossing_columns", "calibrate_channels",
            "calibrate_pair_nd", "pair_edges", "spanning_tree", "tree_phases", "channel_offsets"]
@@ -115,8 +120,6 @@ def _pair_probes(setup, paths, pair, probe, delta_s: float = 0.0, p_ref: dict | 
     ``p_ref``: a dict the sweep keeps across its steps, probe -> channel i's single-channel
     peak power (``ChannelModel.reference_power``; channel i does not move with delta, so one
     2-D grid search a probe instead of one a step)."""
-    from ..paths import nominal_model
-    from .probes import probe_ranges
     nom, nom_paths = nominal_model(setup, paths)
     ranges = probe_ranges(setup, 2)
     corr = probe.gain_correction[list(pair)]
@@ -168,8 +171,6 @@ def coherence_point_nd(setup, paths, pair, probe, near_s: float = 0.0,
     (``calsteps.continuous_delay_setup``). The D-dimensional counterpart of
     ``calibration.coherence_point`` (the point the sweep should find; a check, since a lab
     does not know the setup as built). Newton with slope ``2 pi if_phase_slope_hz``."""
-    from .probes import if_phase_slope_hz, probe_total_delay
-    from .steps import continuous_delay_setup
     ranges, _, predicted, _ = _pair_probes(setup, paths, pair, probe)
     f_if = float(if_phase_slope_hz(setup.scene, probe_total_delay(setup, ranges)))
     period = 1.0 / f_if
@@ -213,12 +214,6 @@ def calibrate_pair_nd(setup, paths, pair, probe, seed=0, span_s=None, step_s=Non
     again with the frames it needs); the phasor sweep's closed-form design, bin logic and
     probe placement are 1-D so far. Raises :class:`CalibrationFailed` when no probe is
     detected at any step."""
-    from .probes import simulate_detect, if_phase_slope_hz, probe_total_delay
-    from .pair import calibrate_pair
-    from ..paths import nominal_model
-    from .steps import (coarse_frames, coarse_minimum, fine_frames, fine_window, fit_scatter,
-                        realisable, rms_error_deg, sweep_phase, adds_noise)
-    from .sweep import fit_minimum
     scene = setup.scene
     rts = scene.rts
     nom, nom_paths = nominal_model(setup, paths)
@@ -356,7 +351,6 @@ def _points(t, e) -> list[dict]:
 def calibrate_channels(setup, paths, channels, probe, seed=None, progress=None,
                        span_s=None, step_s=None) -> ChannelCalibration:
     """Delay offsets of ``channels`` relative to the lowest of them (module doc)."""
-    from ..paths import nominal_model
     scene = setup.scene
     seed = scene.seed if seed is None else seed
     nom, nom_paths = nominal_model(setup, paths)
@@ -456,8 +450,6 @@ def tree_phases(cs: ChannelModel, tree, phasors=None) -> np.ndarray:
 def _residual(setup, paths, nom, nom_paths, ch, offsets, probe, st, seed, tree):
     """(azimuth, elevation) error (deg) of one target at the channels' centre, synthesized by
     all of them with the calibrated offsets (exact mode)."""
-    from .probes import simulate_detect, probe_ranges
-    from ..errors import AngleUnreachable
     r = float(probe_ranges(setup, 1)[0])
     cs = ChannelModel.build(nom, nom_paths, tuple(ch), TargetConfig(r), offsets[ch], steering=st)
     u = cs.fe_directions().mean(axis=0)

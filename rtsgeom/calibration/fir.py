@@ -1,4 +1,4 @@
-"""The fractional-delay FIR as the calibration sees it (issue 13 item 4): the filter's gain
+"""The fractional-delay FIR as the calibration sees it: the filter's gain
 at an echo's range bin (its response along the chirp's IF sweep, ``rts.fir_if_gain``,
 weighted by the range window), the phase it adds to each step of the calibration sweep, and
 the shift of the coherence point it predicts."""
@@ -7,7 +7,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..rts.channels import fir_if_gain, fir_modelled, realised_delay, requested_delay
+from ..rts.fir import fir_if_gain, fir_modelled, realised_delay
+from ..rts.channels import requested_delay
+from ..radar.windows import window
+from .probes import if_phase_slope_hz, mean_air_delay, probe_ranges, probe_total_delay
 
 __all__ = ["fir_bin_gain", "fir_effect", "fir_sweep_phase"]
 
@@ -17,7 +20,6 @@ def fir_bin_gain(scene, delays_s, tau_total_s) -> np.ndarray:
     range bin: its beat-signal gain along the chirp (``rts.fir_if_gain``, at the setting of
     each programmed delay ``delays_s`` (E,), echo total delay ``tau_total_s`` (E,)) weighted
     by the range window and the echo's tone, (E,) complex; ones for an ideal delay."""
-    from ..radar.processing import window
     delays = np.atleast_1d(np.asarray(delays_s, float))
     tau = np.atleast_1d(np.asarray(tau_total_s, float))
     g = fir_if_gain(scene, delays, tau)  # (E, N)
@@ -41,7 +43,6 @@ def fir_effect(setup, delta_tau_s: float, base_offsets=(0.0, 0.0), ranges=None) 
     predicts, the mean over the probes of ``(phi_I - phi_J) / (2 pi f_if)``, phi the
     range-window-weighted phase of each channel's beat-signal gain (what the range DFT sees
     at the target's bin, :func:`fir_bin_gain`), f_if = 1 / period."""
-    from .probes import mean_air_delay, if_phase_slope_hz, probe_ranges, probe_total_delay
     scene = setup.scene
     model = scene.rts.fractional_delay_filter if scene.rts.fractional_delay else "none"
     rng = probe_ranges(setup, 2) if ranges is None or len(ranges) == 0 else np.asarray(ranges)
@@ -71,7 +72,6 @@ def fir_sweep_phase(setup, ranges, deltas, base_offsets, continuous: bool = Fals
     model of ``calibration.continuous_delay_setup``). It cycles with the setting every
     1/f_s, which the RTS's designer knows; the fit of the sweep takes it out
     (``sweep.fit_minimum``). None for an ideal delay."""
-    from .probes import mean_air_delay
     scene = setup.scene
     rts = scene.rts
     if not fir_modelled(scene):

@@ -25,7 +25,8 @@ from .._lib.util import frozen, one_blas_thread
 from ..geometry import Setup
 from ..paths import Paths, nominal_model
 from ..radar.processing import nearest_detection
-from ..rts.channels import RtsProgram, realised_delay, requested_delay
+from ..rts.channels import RtsProgram, requested_delay
+from ..rts.fir import realised_delay
 from ..scene import TargetConfig
 from ..synthesis.closed_form import ratio_paper
 from ..synthesis.model import ChannelModel
@@ -181,7 +182,7 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
 
     1. Coarse sweep over the scene's span (``calibration_step_ps``) with the probes at their
        ranges; each step's amplitudes designed for the bin the RuT detects
-       (``aoa.sweep``); the deepest minimum nearest zero delay.
+       (:mod:`.sweep`); the deepest minimum nearest zero delay.
     2. The probes moved within their range bin so that design and detection agree on one bin
        over a window of +-period/4 around it (``sweep.place_probes``).
     3. Fine sweep over that window (``FINE_STEP_S`` rounded to whole steps of the RTS's

@@ -1,5 +1,5 @@
-"""The calibration's steps as the RTS can set them and the frames each needs (issue 13 on
-setups other than the bundled one: coarse delay steps and high noise figures).
+"""The calibration's steps as the RTS can set them and the frames each needs (coarse delay
+steps, high noise figures).
 
 * What the RTS can set: every delay it is given is rounded (``rts.realised_delay``) to its
   resolution ``rts.delay_resolution_s`` (the fractional-delay FIR's step, or 1/f_s without
@@ -17,7 +17,7 @@ setups other than the bundled one: coarse delay steps and high noise figures).
   an arc: a Monte-Carlo of the phasor model, ``calibration.calibrate_pair``; a 2-D pair: of
   its own measured sweep, :func:`fit_scatter`).
 
-``aoa.calibration`` uses these and re-exports them.
+The pair calibration (:mod:`.pair`) and the channels' (:mod:`.channels`) use these.
 """
 
 from __future__ import annotations
@@ -27,7 +27,8 @@ import warnings
 import numpy as np
 
 from ..geometry import Setup
-from ..rts.channels import realised_delay, requested_delay
+from ..rts.fir import realised_delay
+from ..rts.channels import requested_delay
 from .fir import fir_sweep_phase
 
 __all__ = ["continuous_delay_setup", "CONTINUOUS_STEP_S", "COARSE_NOISE_DEG",

@@ -1,5 +1,4 @@
-"""The calibration sweep evaluated where it is decided: the phasor model at the detected bin
-(issue 13 item 1, issue 17).
+"""The calibration sweep evaluated where it is decided: the phasor model at the detected bin.
 
 Each step of the phase calibration (paper section "Calibration") programs both probe targets
 on channels I (delay ``base``) and J (``base + delta``) with amplitudes designed for coherent
@@ -30,11 +29,15 @@ from scipy.constants import c
 from ..geometry import Setup
 from ..paths import Paths
 from ..radar.processing import tdm_compensate
-from ..radar.steering import Steering, window
+from ..radar.steering import Steering
+from ..radar.windows import window
 from ..rts.channels import KIND_DIRECT, RtsProgram, channel_echoes, requested_delay
 from ..scene import TargetConfig
 from ..synthesis.model import ChannelModel
 from ..synthesis.pair import beam_derivatives, design_ratio
+from ..radar.link import relative_noise_power
+from ..radar.processing import nearest_detection
+from .probes import probe_program, simulate_detect
 
 __all__ = ["SweepResult", "phasor_sweep", "fit_minimum", "HALF_BINS", "place_probes",
            "chain_errors"]
@@ -116,7 +119,6 @@ def _linked_noise_sigma(setup, targets, amps) -> np.ndarray:
     from the link budget, referred to the model's relative amplitudes
     (:func:`rtsgeom.radar.link.relative_noise_power`; the RTS channels' noise from every programmed
     row ``amps`` (S, P, 2), the quantisation at the weakest probe's IF response)."""
-    from ..radar.link import relative_noise_power
     scene, radar = setup.scene, setup.scene.radar
     beat = radar.slope_hz_per_s * 2.0 * np.array([t.range_m for t in targets]) / c  # (P,)
     n0 = np.max(relative_noise_power(scene, np.nansum(np.abs(amps) ** 2, axis=(1, 2))[:, None],
@@ -213,7 +215,7 @@ def fit_minimum(deltas, error_rad, period_s: float, near_s: float, harmonics: in
 
     ``extra_phase_rad`` (S, P): a phase each step adds to channel J of each probe beyond the
     delay's own ``2 pi delta / period`` and known in advance -- the fractional-delay FIR's
-    phase at the step's setting (``aoa.fir.fir_bin_gain``), which cycles with the
+    phase at the step's setting (``calibration.fir.fir_bin_gain``), which cycles with the
     setting every 1/f_s (+-3.7 deg with 5 taps) and would otherwise bend the periodic shape
     (a 33 ps bias with 5 taps). The shape is then fitted on each probe's phase axis
     ``2 pi (delta - near) / period + extra`` and searched with the extra phase interpolated
@@ -299,8 +301,6 @@ def chain_errors(setup, paths, pair, targets, res: SweepResult, base_offsets, fr
     angle): signed probe-angle errors (S, P) (NaN: not detected) and the detected candidate
     bins (S, P) (-1: not detected), with the amplitudes of ``res`` (the phasor model's
     design for the bin it predicts the RuT detects)."""
-    from ..radar.processing import nearest_detection
-    from .probes import probe_program, simulate_detect
     scene = setup.scene
     base = [(float(requested_delay(scene, t.range_m)) + base_offsets[0],
              float(requested_delay(scene, t.range_m)) + base_offsets[1]) for t in targets]

@@ -17,12 +17,13 @@ given; a path's amplitude is multiplied by the gains of both antennas of its leg
 
 from __future__ import annotations
 
-import csv
 import functools
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from ..scene.hardware import check_pattern_grid, pattern_grid, read_pattern_table
 
 __all__ = ["AntennaPatterns", "CosinePattern", "ISOTROPIC", "Isotropic", "Pattern",
            "TablePattern", "cos_power_exponent", "direction_angles", "pattern_from_config",
@@ -128,21 +129,8 @@ class TablePattern(Pattern):
     _interp: object = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        az = np.asarray(self.azimuth_rad, float)
-        el = np.asarray(self.elevation_rad, float)
-        g = np.asarray(self.gain_db, float)
-        ph = np.asarray(self.phase_rad, float)
-        for name, axis in (("azimuth_deg", az), ("elevation_deg", el)):
-            if axis.ndim != 1 or axis.size < 2 or np.any(np.diff(axis) <= 0):
-                raise ValueError(f"pattern table {name}: at least two strictly increasing values "
-                                 "needed")
-            if np.any(np.abs(axis) > np.pi + 1e-9):
-                raise ValueError(f"pattern table {name}: values must lie in [-180, 180] deg")
-        if g.shape != (az.size, el.size) or ph.shape != g.shape:
-            raise ValueError(f"pattern table: gain_db and phase_deg must cover the full "
-                             f"{az.size} x {el.size} azimuth x elevation grid")
-        if not (np.all(np.isfinite(g)) and np.all(np.isfinite(ph))):
-            raise ValueError("pattern table: gain_db and phase_deg must be finite")
+        az, el, g, ph = check_pattern_grid(self.azimuth_rad, self.elevation_rad, self.gain_db,
+                                           self.phase_rad)
         values = 10.0 ** (g / 20.0) * np.exp(1j * ph)
         # imported here: scipy.interpolate costs ~0.5 s of imports that only tables need
         from scipy.interpolate import RegularGridInterpolator
@@ -158,38 +146,15 @@ class TablePattern(Pattern):
     @classmethod
     def from_csv(cls, path: str | Path) -> "TablePattern":
         """Read a CSV with columns ``azimuth_deg, elevation_deg, gain_db, phase_deg`` (one row
-        per grid point, any order; every (azimuth, elevation) pair of the grid present once)."""
-        path = Path(path)
-        try:
-            with path.open(newline="") as fh:
-                rows = list(csv.DictReader(fh))
-        except OSError as e:
-            raise ValueError(f"pattern table {path}: cannot read ({e.strerror})") from None
-        need = ("azimuth_deg", "elevation_deg", "gain_db", "phase_deg")
-        if not rows or any(k not in rows[0] for k in need):
-            raise ValueError(f"pattern table {path}: needs the columns {', '.join(need)}")
-        try:
-            a = np.array([[float(r[k]) for k in need] for r in rows])
-        except (TypeError, ValueError):
-            raise ValueError(f"pattern table {path}: every value must be a number") from None
-        return cls.from_samples(*a.T, source=str(path))
+        per grid point, any order; every (azimuth, elevation) pair of the grid present once):
+        :func:`rtsgeom.scene.hardware.read_pattern_table`."""
+        return cls(*read_pattern_table(path))
 
     @classmethod
     def from_samples(cls, azimuth_deg, elevation_deg, gain_db, phase_deg, source="table"
                      ) -> "TablePattern":
         """Build from flat samples (degrees at this I/O edge) of a full regular grid."""
-        az_u, ia = np.unique(np.asarray(azimuth_deg, float), return_inverse=True)
-        el_u, ie = np.unique(np.asarray(elevation_deg, float), return_inverse=True)
-        n = az_u.size * el_u.size
-        if len(ia) != n or np.unique(ia * el_u.size + ie).size != n:
-            raise ValueError(f"pattern table {source}: the samples must form a full regular "
-                             f"azimuth x elevation grid, each point once ({az_u.size} x "
-                             f"{el_u.size} = {n} points expected, {len(ia)} given)")
-        g = np.empty((az_u.size, el_u.size))
-        ph = np.empty_like(g)
-        g[ia, ie] = gain_db
-        ph[ia, ie] = np.radians(np.asarray(phase_deg, float))
-        return cls(np.radians(az_u), np.radians(el_u), g, ph)
+        return cls(*pattern_grid(azimuth_deg, elevation_deg, gain_db, phase_deg, source))
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,8 @@ from ..scene.rules import arc_centre_m
 from .frontends import FrontEnds, front_ends
 from .arrays import RutArray, rut_array
 from .sheet import sheet_mesh
+from ..scene import FrontEndConfig, RadarConfig
+from ..scene.schema import specs
 
 if TYPE_CHECKING:  # trimesh loads where the mesh is built (geometry.sheet)
     import trimesh
@@ -74,8 +76,6 @@ RUT_POSE_ERRORS = ("position_offset_m", "yaw_offset_rad")
 def setup_errors(scene: Scene) -> list[str]:
     """The scene's fields that :func:`nominal_scene` zeroes and that are not zero, as file
     keys (``rts.front_ends[1].radial_offset_mm``, ``radar.yaw_offset_deg``)."""
-    from ..scene.schema import specs
-    from ..scene import FrontEndConfig, RadarConfig
     fe_key, radar_key = dict(specs(FrontEndConfig)), dict(specs(RadarConfig))
     out = [f"rts.front_ends[{q}].{fe_key[name].key}" for q, fe in enumerate(scene.rts.front_ends)
            for name in FRONT_END_ERRORS if getattr(fe, name) != 0.0]

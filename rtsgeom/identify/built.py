@@ -16,6 +16,11 @@ from ..paths import exact_paths
 from .capture import capture_probe
 from ..scene import FrontEndConfig, Scene
 from .fit import Identification
+from ..calibration.pair import coherence_delay
+from ..calibration.probes import probe_angles
+from ..geometry.frontends import front_ends
+from ..scene import TargetConfig
+from ..synthesis.model import ChannelModel
 
 __all__ = ["identified_scene", "identified_scene_toml", "setup_of", "detected_angles",
            "PredictedCalibration", "predicted_calibration", "calibrate_from_identified"]
@@ -92,15 +97,12 @@ def setup_of(scene: Scene, yaw_rad=None) -> Setup:
     setup = build_setup(scene)
     if yaw_rad is None:
         return setup
-    from ..geometry.frontends import front_ends
     return Setup(scene, setup.rut, front_ends(scene, setup.fe.arc_centre, yaw_rad=yaw_rad))
 
 
 def detected_angles(setup: Setup, paths=None) -> np.ndarray:
     """Each front end alone as the RuT's beamformer sees it (noise-free phasor model at the
     calibration's probe range): what ``calibrate``'s amplitude step measures."""
-    from ..synthesis.model import ChannelModel
-    from ..scene import TargetConfig
     paths = exact_paths(setup) if paths is None else paths
     r, _ = capture_probe(setup)
     return np.array([float(ChannelModel.build(setup, paths, [q], TargetConfig(r))
@@ -110,10 +112,8 @@ def detected_angles(setup: Setup, paths=None) -> np.ndarray:
 def predicted_calibration(setup: Setup, pair: tuple[int, int], alphas=None
                           ) -> PredictedCalibration:
     """The pair's calibration delay predicted from a setup *as identified* (no sweep): the
-    coherence point (``aoa.calibration.coherence_delay``) of the identified geometry and channel
+    coherence point (``calibration.pair.coherence_delay``) of the identified geometry and channel
     gains at the probes the sweep would use (``alphas``, default from :func:`detected_angles`)."""
-    from ..calibration.pair import coherence_delay
-    from ..calibration.probes import probe_angles
     paths = exact_paths(setup)
     i, j = pair
     if alphas is None:

@@ -17,6 +17,10 @@ from ..geometry import Setup
 from ..paths import exact_paths
 from ..rts.channels import RtsProgram, nominal_link_gain, requested_delay, target_amplitude
 from ..radar.frame import simulate
+from .._lib.io import atomic_path, write_bytes, write_json
+from ..calibration.probes import probe_ranges
+from ..radar.dca1000 import from_dca1000, to_dca1000
+from ..radar.fmcw import AdcCube
 
 __all__ = ["Capture", "capture_probe", "simulate_capture", "write_capture", "read_capture"]
 
@@ -40,8 +44,7 @@ class Capture:
 
 def capture_probe(setup: Setup, range_m: float | None = None) -> tuple[float, float]:
     """Default probe (range, programmed amplitude): the calibration's first probe range and the
-    amplitude that gives a 10 m^2 target (what :class:`aoa.model.ChannelModel` programs)."""
-    from ..calibration.probes import probe_ranges
+    amplitude that gives a 10 m^2 target (what :class:`~rtsgeom.synthesis.model.ChannelModel` programs)."""
     scene = setup.scene
     r = float(probe_ranges(setup, 1)[0]) if range_m is None else float(range_m)
     lam = setup.rut.wavelength_m
@@ -69,9 +72,6 @@ def simulate_capture(setup: Setup, active: int, range_m: float | None = None,
 def write_capture(cap: Capture, rut, out: Path, fmt: str) -> dict:
     """Write ``cap`` as ``.npy`` or DCA1000 ``.bin``; the sidecar ``out.json`` (both formats)
     records the probe and the active front end. Returns the sidecar's content."""
-    from .._lib.io import atomic_path, write_bytes, write_json
-    from ..radar.dca1000 import to_dca1000
-    from ..radar.fmcw import AdcCube
     n_l, n_v, n_s = cap.data.shape
     meta = {"kind": "rtsgeom-probe-capture", **cap.to_meta(), "shape": [n_l, n_v, n_s]}
     if fmt == "npy":
@@ -92,7 +92,6 @@ def write_capture(cap: Capture, rut, out: Path, fmt: str) -> dict:
 def read_capture(path) -> Capture:
     """Read a probe capture written by ``rtsgeom adc --active`` (``.bin`` or ``.npy`` with its
     sidecar ``PATH.json``). Errors name the file and what is missing."""
-    from ..radar.dca1000 import from_dca1000
     path = Path(path)
     side = Path(str(path) + ".json")
     if not path.is_file():

@@ -16,8 +16,11 @@ from ..paths.exact import leg_delays
 from .capture import Capture
 from ..radar.frame import noise_power
 from ..radar.phasors import bin_response
-from ..radar.processing import range_doppler, window
-from ..rts.channels import EchoKind, Echoes, fir_if_gain, realised_delay, requested_delay
+from ..radar.processing import range_doppler
+from ..radar.windows import window
+from ..rts.channels import EchoKind, Echoes, requested_delay
+from ..rts.fir import fir_if_gain, realised_delay
+from ..radar.fmcw import AdcCube
 
 __all__ = ["PARAMS", "ProbeModel", "measure"]
 
@@ -120,7 +123,6 @@ def measure(setup: Setup, cap: Capture) -> tuple[np.ndarray, float, ProbeModel]:
     of |X|^2 over the whole map / ln 2: the median of an exponential, untouched by the few
     target cells), and the probe's model at that bin (the strongest of the three range bins
     around the set range)."""
-    from ..radar.fmcw import AdcCube
     radar = setup.scene.radar
     want = (radar.chirps_per_tx, setup.rut.num_virtual, radar.samples_per_chirp)
     if cap.data.shape != want:

@@ -5,6 +5,7 @@ from importlib import import_module
 from .table import DIRECTIONS, Paths
 from ..geometry.setup import nominal_setup
 from .exact import exact_paths
+from ..scene.registry import PATH_METHODS
 
 __all__ = ["DIRECTIONS", "Paths", "exact_paths", "compute_paths", "nominal_model"]
 
@@ -17,7 +18,6 @@ def compute_paths(setup, method: str = "exact", *, for_drawing: bool = False):
     here, so Sionna loads only when ray tracing is asked for. Adding a method is one registry
     entry.
     """
-    from ..scene.registry import PATH_METHODS
     try:
         m = PATH_METHODS[method]
     except KeyError:

@@ -32,6 +32,8 @@ from scipy.optimize import brentq
 from ..geometry import Setup
 from .exact import exact_paths
 from .table import RUT_TO_RUT, TX_TO_FE, Paths
+from ..geometry import build_setup
+from ..scene import load_scene
 
 __all__ = ["crosscheck", "format_crosscheck", "smooth_path_length", "stationary_points",
            "facet_image_length", "po_sheet_response"]
@@ -404,8 +406,6 @@ def format_crosscheck(r: dict) -> str:
 def main(argv=None) -> int:  # pragma: no cover - thin wrapper
     import argparse
     import json
-    from ..geometry import build_setup
-    from ..scene import load_scene
     ap = argparse.ArgumentParser(prog="python -m rtsgeom.paths.crosscheck",
                                  description="ray tracer vs exact geometry")
     ap.add_argument("scene")

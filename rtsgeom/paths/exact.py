@@ -17,6 +17,7 @@ from scipy.constants import c
 from ..geometry import Setup
 from ..geometry.patterns import AntennaPatterns, Pattern
 from .table import FE_TO_RX, TX_TO_FE, Paths
+from ..geometry.patterns import scene_patterns
 
 __all__ = ["distances", "exact_paths", "leg_delays", "leg_pattern_gains"]
 
@@ -72,7 +73,6 @@ def exact_paths(setup: Setup, patterns: AntennaPatterns | None = None) -> Paths:
     the amplitude calibration and the synthesis.
     """
     if patterns is None:
-        from ..geometry.patterns import scene_patterns
         patterns = scene_patterns(setup.scene)
     rut, fe = setup.rut, setup.fe
     tau_tx, tau_rx = leg_delays(rut.tx_world, rut.rx_world, fe.rx, fe.tx)

@@ -10,6 +10,11 @@ from ..geometry.farfield import (angular_resolution_rad, aperture_m, apparent_az
                                  coarray_period_m, curvature_phase_error_rad, fraunhofer_distance_m,
                                  grating_lobe_directions_rad, smallest_spacing_m,
                                  unambiguous_half_width_rad)
+from ..calibration.probes import probe_front_ends
+from ..errors import SceneError
+from ..paths import exact_paths
+from ..radar.budget import format_budget
+from .plan import bracketing_pair, target_cells, uses_cells
 
 __all__ = ["scene_info", "format_info", "reachable_spans"]
 
@@ -42,9 +47,6 @@ def reachable_spans(setup: Setup, mode: str | None = None, paths=None) -> dict:
         ``hi_deg``) and ``targets`` (each ``index``, ``angle_deg``, ``pair`` or None,
         ``reachable``).
     """
-    from ..calibration.probes import probe_front_ends
-    from .plan import bracketing_pair, uses_cells
-    from ..paths import exact_paths
     scene = setup.scene
     mode = mode or scene.rts.aoa_mode
     if uses_cells(scene):
@@ -77,9 +79,8 @@ def reachable_spans(setup: Setup, mode: str | None = None, paths=None) -> dict:
 
 def _reachable_cells(setup: Setup, mode: str) -> dict:
     """:func:`reachable_spans` of a scene of 2-D cells: each target's enclosing cell of front
-    ends (``aoa.plan_cells.target_cells``, what ``run`` plans with); ``pairs`` is empty (the
+    ends (``pipeline.plan.target_cells``, what ``run`` plans with); ``pairs`` is empty (the
     cells are not pairs along an arc) and ``cells`` True."""
-    from .plan import target_cells
     _, _, found = target_cells(setup)
     targets = [{"index": k, "angle_deg": float(np.degrees(t.angle_rad)),
                 "elevation_deg": float(np.degrees(t.elevation_rad)),
@@ -157,7 +158,6 @@ def scene_info(setup: Setup, reachable: bool = False) -> dict:
         ],
     }
     if reachable:
-        from ..errors import SceneError
         try:
             out["reachable"] = reachable_spans(setup)
         except SceneError as exc:  # a setup the synthesis does not model (its message says)
@@ -253,7 +253,6 @@ def format_info(info: dict) -> str:
                     line += f"  (pair {rt['pair'][0]}-{rt['pair'][1]})"
             lines.append(line)
     if info.get("link_budget"):
-        from ..radar.budget import format_budget
         lines += format_budget(info["link_budget"])
     return "\n".join(lines)
 
@@ -267,7 +266,7 @@ def unreachable_warnings(info: dict, skip_outside_geometric: bool = False) -> li
     """One line per target outside the reachable angles (empty without ``reachable``).
 
     ``skip_outside_geometric``: leave out targets outside the front ends' geometric span,
-    which the scene check (``validate.scene_warnings``) has already warned about."""
+    which the scene check (``geometry.warnings.scene_warnings``) has already warned about."""
     reach = info.get("reachable")
     if not reach:
         return []

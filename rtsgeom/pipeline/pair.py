@@ -16,7 +16,8 @@ from ..calibration.steps import continuous_delay_setup
 from ..calibration.sweep import HALF_BINS
 from ..geometry import Setup
 from ..paths import Paths, nominal_model
-from ..rts.channels import fir_modelled, realised_delay, requested_delay
+from ..rts.fir import fir_modelled, realised_delay
+from ..rts.channels import requested_delay
 from ..scene import TargetConfig
 from ..synthesis.model import ChannelModel
 
@@ -113,7 +114,7 @@ def plan_pair(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str,
     target's IF phase either side (``m = 0, -1, 1``: the same phase, J's echo a period's
     range further), the first whose exact design the RuT detects at the bin it was designed
     for, with the largest power margin (where J's echo straddles a range-bin boundary no
-    design is consistent, issue 13 item 1).
+    design is consistent).
 
     For each ``m`` the difference the calibration makes coherent, ``offsets[1] - offsets[0]
     + residual_s + m period`` (``residual_s``: the calibration's ``quantisation_residual_s``;

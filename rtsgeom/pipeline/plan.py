@@ -69,7 +69,7 @@ def uses_cells(scene) -> bool:
 
 
 def target_cells(setup: Setup) -> tuple[Steering, np.ndarray, list]:
-    """Each target's enclosing cell of front ends (``aoa.cells.enclosing_cell`` on the front
+    """Each target's enclosing cell of front ends (``synthesis.cells.enclosing_cell`` on the front
     ends' geometric direction cosines seen from the RuT, 1-D where the RuT beamforms in
     azimuth only): the RuT's steering, the front ends' direction cosines (F, D) and per
     target ``(cell, None)`` or ``(None, why)`` (the field and the reason it is unreachable).

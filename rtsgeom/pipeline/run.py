@@ -17,6 +17,11 @@ from ..radar import AdcCube, Detections, RangeDoppler, process
 from ..radar.frame import noise_power, simulate
 from ..rts.channels import Echoes, RtsProgram, program_nearest
 from ..scene import Scene
+from ..radar.budget import link_budget, link_warnings, sheet_paths
+from ..radar.link import radar_link
+from ..rts.channels import EchoKind, setup_echoes
+from .info import scene_info
+from .plan import plan_targets
 
 __all__ = ["RunResult", "simulate", "run_scene", "match_targets", "label_detections",
            "noise_power"]
@@ -36,7 +41,7 @@ class RunResult:
     calibration: dict = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
     aoa_mode: str = "exact"  # the amplitude mode actually used
-    link_budget: object = None  # rtsgeom.radar.link.LinkBudget
+    link_budget: object = None  # rtsgeom.radar.budget.LinkBudget
 
 
 def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angle_rad=None,
@@ -136,7 +141,6 @@ def label_detections(result: "RunResult", bins: float = 2.0) -> list[str]:
     """
     from scipy.constants import c
 
-    from ..rts.channels import EchoKind
     det, rd, echoes, radar = result.detections, result.rd, result.echoes, result.scene.radar
     labels = ["unmatched"] * len(det)
     if len(det) and len(echoes):
@@ -180,7 +184,7 @@ def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = 
 
     ``aoa_mode`` overrides the scene's ``rts.aoa_mode``: ``nearest`` puts each target on its
     nearest front end; the synthesis modes calibrate the front-end pairs first, or take
-    them from ``calibration`` (a calibration file's content, ``aoa.plan.load_calibration``).
+    them from ``calibration`` (a calibration file's content, ``calibration.file.load_calibration``).
     The override is validated like the scene's own mode (``Scene.evolve``: e.g. paper eq. 24's
     spacing rule for the synthesis modes), so it cannot bypass a rule the scene file must meet.
     """
@@ -194,14 +198,12 @@ def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = 
     if mode == "nearest" or not scene.targets:
         program = program_nearest(scene, setup)
     else:
-        from .plan import plan_targets  # pairs on an arc, or cells on a sphere
         program, calibration, warnings = plan_targets(setup, paths, mode, progress=progress,
                                                        calibration=cal_file)
     echoes, cube = simulate(setup, paths, program, scene.seed, scene.radar.snr_db)
     rd, det = process(cube)
     budget = _budget(scene, setup, echoes, program)
     if scene.radar.link is not None:
-        from ..radar.budget import link_warnings
         warnings = list(warnings) + link_warnings(budget, scene.radar.cfar.threshold_db)
         if cube.clipped:
             warnings.append(f"link: the ADC clipped {cube.clipped} of {cube.data.size} samples "
@@ -214,8 +216,6 @@ def _budget(scene: Scene, setup: Setup, echoes: Echoes, program: RtsProgram):
     """The run's link budget (rtsgeom.radar.link); the snr_db override's noise where it is set; with
     ``[radar.link]``, the sheet's echo estimated by physical optics where the paths carry no
     setup reflection."""
-    from ..radar.budget import link_budget, sheet_paths
-    from ..rts.channels import EchoKind, setup_echoes
     est = None
     # the physical-optics sheet estimate costs ~1 s: only for a physical budget ([radar.link])
     if scene.radar.link is not None and not np.any(echoes.kind == EchoKind.SETUP):
@@ -225,7 +225,6 @@ def _budget(scene: Scene, setup: Setup, echoes: Echoes, program: RtsProgram):
     if scene.radar.snr_db is not None:
         override = noise_power(echoes, scene.radar.snr_db)
         if scene.radar.link is None:  # relative echoes: scale the override like the link would
-            from ..radar.link import radar_link
             rl = radar_link(scene.radar)
             override *= rl.tx_power_w * rl.tx_gain * rl.rx_gain
     return link_budget(scene, echoes, program, scene.radar.link is not None, override, est)
@@ -233,7 +232,6 @@ def _budget(scene: Scene, setup: Setup, echoes: Echoes, program: RtsProgram):
 
 def summary(result: RunResult, paths_method: str) -> dict:
     """The content of ``summary.json`` (no timestamps: same seed -> same bytes)."""
-    from .info import scene_info
     s, r, rut = result.scene, result.scene.radar, result.setup.rut
     info = scene_info(result.setup)
     return {

@@ -14,6 +14,10 @@ from scipy.constants import c
 from .link import (apply_radar_link, beat_hz, channel_noise_w, channel_table, dbm, if_response,
                    radar_link, thermal_noise_w)
 from ..rts.channels import KIND_DIRECT, KIND_SETUP, Echoes, RtsProgram
+from ..paths import exact_paths
+from ..paths.table import Paths, RUT_TO_RUT
+from ..rts.channels import build_echoes, program_nearest, setup_echoes
+from .windows import window
 
 __all__ = ["LinkBudget", "window_snr_loss", "link_budget", "link_warnings", "sheet_paths",
            "static_budget", "format_budget"]
@@ -23,7 +27,6 @@ __all__ = ["LinkBudget", "window_snr_loss", "link_budget", "link_warnings", "she
 
 def window_snr_loss(name: str, n: int) -> float:
     """SNR factor of a taper on a coherent sum of n samples: ``(sum w)^2 / (n sum w^2)``."""
-    from .processing import window
     w = np.asarray(window(name, n), float)
     return float(w.sum() ** 2 / (n * np.sum(w ** 2)))
 
@@ -197,8 +200,8 @@ def sheet_paths(setup, step_m: float | None = None):
     default), for the budget when the exact paths carry no setup reflections. The delay is the
     path via the sheet point straight ahead of the pair's midpoint (the stationary point of a
     RuT near the arc centre); the gain is the PO response with that delay's phase removed."""
+    # here: the physical-optics module imports scipy.optimize (~0.7 s), which `info` would pay
     from ..paths.crosscheck import po_sheet_response
-    from ..paths.table import RUT_TO_RUT, Paths
     scene, rut = setup.scene, setup.rut
     if not scene.sheet.enabled:
         return None
@@ -226,8 +229,6 @@ def sheet_paths(setup, step_m: float | None = None):
 def static_budget(setup) -> LinkBudget:
     """The budget without a run (``rtsgeom info``): each target on its nearest front end over
     the exact paths, the sheet by physical optics, thermal noise (``snr_db`` ignored)."""
-    from ..paths import exact_paths
-    from ..rts.channels import build_echoes, program_nearest, setup_echoes
     scene = setup.scene
     program = program_nearest(scene, setup)
     echoes = build_echoes(setup, exact_paths(setup), program)

@@ -3,7 +3,7 @@ with forward-backward spatial smoothing (``radar.angle_estimator``, ``radar.angl
 
 Used only through :class:`~rtsgeom.radar.steering.Steering` (``spectrum``, ``search``,
 ``peak``), so the detections (``radar.processing``), the ``exact`` synthesis
-(``aoa.model.ChannelModel.solve``, ``aoa.nchannel.ChannelSet``), the calibration sweep and the
+(``synthesis.model.ChannelModel.solve``), the calibration sweep and the
 analyses all see the estimator the scene names.
 
 Physics

@@ -36,8 +36,10 @@ from scipy.constants import c, k as K_BOLTZMANN
 
 from ..scene.link import FE_ANTENNA_GAIN_DBI, RADAR_LINK_PRESETS
 from ..rts.channels import Echoes, RtsProgram
-from ..errors import SceneError
 from ..errors import LinkError
+from ..geometry import build_setup
+from ..geometry.patterns import AntennaPatterns, ISOTROPIC, scene_patterns
+from ..paths.exact import leg_pattern_gains
 
 __all__ = ["RADAR_LINK_PRESETS", "RadarLink", "LinkError", "radar_link", "if_response",
            "apply_radar_link", "thermal_noise_w", "shaped_noise", "adc_convert", "channel_table",
@@ -131,16 +133,13 @@ def pattern_gains(scene, setup=None) -> dict:
     over the RuT's elements: ``rut_tx``/``rut_rx`` (the RuT's pattern toward front end q),
     ``fe_rx``/``fe_tx`` (front end q's pattern toward the RuT). Ones where isotropic (no setup
     is built then); ``setup`` defaults to ``build_setup(scene)``."""
-    from ..geometry.patterns import ISOTROPIC, AntennaPatterns, scene_patterns
     n = len(scene.rts.front_ends)
     pats = scene_patterns(scene)
     out = {k: np.ones(n) for k in ("rut_tx", "rut_rx", "fe_rx", "fe_tx")}
     if pats.isotropic:
         return out
     if setup is None:
-        from ..geometry import build_setup
         setup = build_setup(scene)
-    from ..paths.exact import leg_pattern_gains
     rut_only = AntennaPatterns(rut_tx=pats.rut_tx, rut_rx=pats.rut_rx)
     fe_only = AntennaPatterns(fe_rx=pats.fe_rx, fe_tx=pats.fe_tx, rut_tx=ISOTROPIC,
                               rut_rx=ISOTROPIC)

@@ -131,7 +131,7 @@ def lattice_phasors(lat, u):
 
 # The numpy definitions of the compiled kernels are as silent as the kernels
 # (``error_model="numpy"``: inf/NaN propagate without warnings): a warning must not depend on
-# which of the two paths a process happened to take (``_util.use_kernels``).
+# which of the two paths a process happened to take (``_lib.util.use_kernels``).
 @np.errstate(all="ignore")
 def newton_1d(k, lat, xr, xi, u, steps):
     """Newton steps on log P(u), P = |B|^2, B(u) = sum_v y_v, y_v = x_v e^{j k_v u}, for

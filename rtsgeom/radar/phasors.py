@@ -18,10 +18,11 @@ import numpy as np
 
 from .._lib.util import tones
 from ..geometry import RutArray
-from ..rts.channels import Echoes, EchoKind, FirTaps
+from ..rts.channels import Echoes, EchoKind
+from ..rts.fir import FirTaps
 from ..scene import RadarConfig
 from .fmcw import beat_phase0, chirp_start_s
-from .steering import window
+from .windows import window
 
 __all__ = ["bin_response"]
 

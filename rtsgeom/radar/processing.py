@@ -25,11 +25,12 @@ from ..geometry import RutArray
 from ..scene import CfarConfig, RadarConfig
 from .fmcw import AdcCube
 from .newton import parabolic as _parabolic
-from .steering import Steering, window
+from .steering import Steering
+from .windows import window
 
 __all__ = ["RangeDoppler", "Detections", "range_doppler", "cfar_mask", "detect",
            "nearest_detection",
-           "angle_spectrum", "estimate_angles", "range_angle_map", "process", "window"]
+           "angle_spectrum", "estimate_angles", "range_angle_map", "process"]
 
 
 @dataclass(frozen=True)

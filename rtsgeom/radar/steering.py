@@ -1,7 +1,7 @@
 """The RuT's beamformer (paper eq. 14): one steering model for every stage that forms a beam.
 
 A :class:`Steering` is built once from the RuT array and the radar configuration and carried by
-the ADC cube (``AdcCube.steering``) and by the channel models (``aoa.model.ChannelModel``):
+the ADC cube (``AdcCube.steering``) and by the channel model (``synthesis.model.ChannelModel``):
 
 * which virtual elements take part (``mask``, (V,)), today the azimuth row;
 * their positions ``positions_m`` (V_s, D) in the radar frame along the direction-cosine axes:
@@ -30,56 +30,11 @@ from ..errors import SceneError
 from .estimators import (cell_snapshots, kernel, lag_sums, quadratic, rank_one_covariance,
                          smoothed_covariance, uniform_cells)
 from .newton import lattice, newton, parabolic, peak_1d
+from .windows import taper
 
-__all__ = ["Steering", "window", "smoothed_estimator"]
+__all__ = ["Steering", "smoothed_estimator"]
 
 BLOCK = 4096  # snapshots per block of the Newton refinement (cache-sized)
-
-
-#: The cosine-sum coefficients of the registry's windows (``registry.WINDOWS``), as in
-#: ``scipy.signal.windows``.
-_COSINE_SUMS = {"hann": (0.5, 1.0 - 0.5), "hamming": (0.54, 1.0 - 0.54),  # scipy: (a, 1 - a)
-                "blackman": (0.42, 0.50, 0.08)}
-
-
-def window(name: str, n: int) -> np.ndarray:
-    """Symmetric window ``name`` (scipy.signal names, or ``none``) of n points.
-
-    The registry's cosine-sum windows are formed here with scipy's own arithmetic
-    (``scipy.signal.windows.general_cosine``: ``sum_k a_k cos(k x)``, x = linspace(-pi, pi, n)),
-    bit for bit (tested), because importing ``scipy.signal`` costs about half a second (it
-    loads ``scipy.stats``), more than the rest of ``rtsgeom info``; other names go to
-    ``scipy.signal.get_window``."""
-    if name == "none" or n <= 1:
-        return np.ones(n)
-    coeffs = _COSINE_SUMS.get(name)
-    if coeffs is None:
-        from scipy import signal
-        return signal.get_window(name, n, fftbins=False)
-    x = np.linspace(-np.pi, np.pi, n, dtype=np.float64)
-    w = np.zeros(n, dtype=np.float64)
-    for k, a in enumerate(coeffs):
-        w += a * np.cos(k * x)
-    return w
-
-
-def _taper(name: str, positions: np.ndarray) -> np.ndarray:
-    """Window over the elements in position order, separable over the D axes (D = 1: the
-    window over the elements sorted by x)."""
-    w = np.ones(positions.shape[0])
-    for d in range(positions.shape[1]):
-        x = positions[:, d]
-        if positions.shape[1] == 1:
-            wd = np.empty_like(x)
-            wd[np.argsort(x)] = window(name, x.size)
-        else:  # one window value per distinct coordinate (a row or a column of a 2-D array)
-            vals, inv = np.unique(np.round(x, 12), return_inverse=True)
-            wv = window(name, vals.size)
-            if not np.all(wv > 0):  # e.g. hann over 2 rows is (0, 0): drop the zero ends
-                wv = window(name, vals.size + 2)[1:-1]
-            wd = wv[inv]
-        w = w * wd
-    return w
 
 
 def smoothed_estimator(estimator: str, subarray: int) -> bool:
@@ -123,7 +78,7 @@ class Steering:
             # the distinct positions' span plus one cell (duplicates and gaps counted right:
             # the cascade's 144 elements span 86 cells)
             aperture = np.array([rut.aperture_m])
-        out = cls(frozen(mask), frozen(pos), frozen(_taper(radar.angle_window, pos)),
+        out = cls(frozen(mask), frozen(pos), frozen(taper(radar.angle_window, pos)),
                   float(rut.wavelength_m), frozen(aperture), kind, sub, float(rut.spacing_m))
         if out.smoothing:
             out._check_smoothing()

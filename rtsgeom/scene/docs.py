@@ -4,8 +4,8 @@
     python -m rtsgeom.scene.docs --check    # exit 1 if the committed file differs
 
 Every key, unit, default and range comes from the one declaration of each field in
-``rtsgeom/scene.py``; the named choices from ``rtsgeom/registry.py``; the rules from the
-docstrings in ``rtsgeom/rules.py``. ``tests/test_scene.py`` fails if the committed file
+``rtsgeom/scene/sections.py``; the named choices from ``rtsgeom/scene/registry.py``; the rules from the
+docstrings in ``rtsgeom/scene/rules.py``. ``tests/test_scene.py`` fails if the committed file
 and this generator drift apart.
 """
 
@@ -104,7 +104,7 @@ def render() -> str:
         fn = getattr(rules, name)
         doc = " ".join((inspect.getdoc(fn) or "").split())
         out.append(f"- `{name.strip('_')}`" + (f": {doc}" if doc else ""))
-    out += ["", "## Named choices (rtsgeom/registry.py)", ""]
+    out += ["", "## Named choices (rtsgeom/scene/registry.py)", ""]
     out.append("AoA modes (`rts.aoa_mode`, `--amplitudes`):")
     out += [f"- `{k}`: {m.doc}{' (synthesis)' if m.synthesis else ''}"
             for k, m in registry.AOA_MODES.items()]

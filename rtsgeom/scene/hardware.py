@@ -1,4 +1,4 @@
-"""Scene sections that describe a lab's hardware (issue 14): a custom RuT array
+"""Scene sections that describe a lab's hardware: a custom RuT array
 (``[radar.array]``) and antenna patterns (``[radar.pattern]``, ``[rts.pattern]``), declared once
 like every scene field (:func:`rtsgeom.scene.schema.spec`), and the two loader checks that need the
 file's own keys or its folder: a front end's layout given once (shorthand or signed offsets),
@@ -6,13 +6,16 @@ and pattern tables resolved inside the scene's folder. ``rtsgeom.scene.scene`` u
 
 from __future__ import annotations
 
+import csv
 import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
+from ..errors import SceneError
 from .registry import PATTERN_KINDS
 from .schema import Evolvable, spec
-from ..errors import SceneError
 from .schema import fmt as _fmt
 
 __all__ = ["PatternConfig", "ArrayConfig", "check_layout_keys", "resolve_pattern_tables"]
@@ -99,9 +102,8 @@ def resolve_pattern_tables(scene, source: str, base_dir: Path | None):
         if not ok:
             raise SceneError(f"{source}: {where}.table = {_fmt(rel)}: must be an existing CSV "
                              "file inside the scene's folder")
-        from ..geometry.patterns import TablePattern  # validates the table's contents
         try:
-            TablePattern.from_csv(p)
+            read_pattern_table(p)  # its contents checked
         except ValueError as exc:
             raise SceneError(f"{source}: {where}.table = {_fmt(rel)}: {exc}") from None
         return dataclasses.replace(cfg, table=str(p.resolve()))
@@ -113,3 +115,62 @@ def resolve_pattern_tables(scene, source: str, base_dir: Path | None):
     radar = dataclasses.replace(scene.radar, pattern=resolve(scene.radar.pattern, "radar.pattern"))
     rts = dataclasses.replace(scene.rts, pattern=resolve(scene.rts.pattern, "rts.pattern"))
     return dataclasses.replace(scene, radar=radar, rts=rts)
+
+
+def check_pattern_grid(azimuth_rad, elevation_rad, gain_db, phase_rad):
+    """A pattern table's grid as float arrays, checked: two strictly increasing axes of at
+    least two values within [-180, 180] deg, gain (dB) and phase (rad) finite over the full
+    grid (N_az, N_el). ``ValueError`` naming what is wrong."""
+    az = np.asarray(azimuth_rad, float)
+    el = np.asarray(elevation_rad, float)
+    g = np.asarray(gain_db, float)
+    ph = np.asarray(phase_rad, float)
+    for name, axis in (("azimuth_deg", az), ("elevation_deg", el)):
+        if axis.ndim != 1 or axis.size < 2 or np.any(np.diff(axis) <= 0):
+            raise ValueError(f"pattern table {name}: at least two strictly increasing values "
+                             "needed")
+        if np.any(np.abs(axis) > np.pi + 1e-9):
+            raise ValueError(f"pattern table {name}: values must lie in [-180, 180] deg")
+    if g.shape != (az.size, el.size) or ph.shape != g.shape:
+        raise ValueError(f"pattern table: gain_db and phase_deg must cover the full "
+                         f"{az.size} x {el.size} azimuth x elevation grid")
+    if not (np.all(np.isfinite(g)) and np.all(np.isfinite(ph))):
+        raise ValueError("pattern table: gain_db and phase_deg must be finite")
+    return az, el, g, ph
+
+
+def pattern_grid(azimuth_deg, elevation_deg, gain_db, phase_deg, source: str = "table"):
+    """The regular grid (azimuth_rad (N_az,), elevation_rad (N_el,), gain_db, phase_rad
+    (N_az, N_el)) of flat samples (degrees at this I/O edge), checked
+    (:func:`check_pattern_grid`); every (azimuth, elevation) point present once."""
+    az_u, ia = np.unique(np.asarray(azimuth_deg, float), return_inverse=True)
+    el_u, ie = np.unique(np.asarray(elevation_deg, float), return_inverse=True)
+    n = az_u.size * el_u.size
+    if len(ia) != n or np.unique(ia * el_u.size + ie).size != n:
+        raise ValueError(f"pattern table {source}: the samples must form a full regular "
+                         f"azimuth x elevation grid, each point once ({az_u.size} x "
+                         f"{el_u.size} = {n} points expected, {len(ia)} given)")
+    g = np.empty((az_u.size, el_u.size))
+    ph = np.empty_like(g)
+    g[ia, ie] = gain_db
+    ph[ia, ie] = np.radians(np.asarray(phase_deg, float))
+    return check_pattern_grid(np.radians(az_u), np.radians(el_u), g, ph)
+
+
+def read_pattern_table(path):
+    """A pattern CSV with columns ``azimuth_deg, elevation_deg, gain_db, phase_deg`` (one row
+    per grid point, any order) as its checked grid (:func:`pattern_grid`)."""
+    path = Path(path)
+    try:
+        with path.open(newline="") as fh:
+            rows = list(csv.DictReader(fh))
+    except OSError as e:
+        raise ValueError(f"pattern table {path}: cannot read ({e.strerror})") from None
+    need = ("azimuth_deg", "elevation_deg", "gain_db", "phase_deg")
+    if not rows or any(k not in rows[0] for k in need):
+        raise ValueError(f"pattern table {path}: needs the columns {', '.join(need)}")
+    try:
+        a = np.array([[float(r[k]) for k in need] for r in rows])
+    except (TypeError, ValueError):
+        raise ValueError(f"pattern table {path}: every value must be a number") from None
+    return pattern_grid(*a.T, source=str(path))

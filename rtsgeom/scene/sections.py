@@ -253,7 +253,7 @@ class FrontEndConfig(Evolvable):
     return_loss_be_db: float | None = spec("return_loss_be_db", "float", "mismatch at the back "
                                            "end; unset = no cable ghosts", None, unit="dB",
                                            lo=0.0, hi=100.0, lo_open=True)
-    # -- front ends on a sphere (issue 15): elevation on the sphere about the arc centre ------
+    # -- front ends on a sphere: elevation on the sphere about the arc centre ------------------
     elevation_rad: float = spec("elevation_deg", "float", "elevation epsilon_q on the sphere "
                                 "about the arc centre (0: on the arc; any non-zero one makes "
                                 "the sheet a spherical cap)", 0.0, unit="deg", lo=-60.0,
@@ -383,7 +383,7 @@ class TargetConfig(Evolvable):
                            lo=-100.0, hi=100.0)
     angle_rad: float = spec("angle_deg", "float", "azimuth seen from the RuT", 0.0, unit="deg",
                             lo=-90.0, hi=90.0, scale=_DEG)
-    # -- targets in elevation (issue 15): synthesized by a cell of front ends on a sphere -----
+    # -- targets in elevation: synthesized by a cell of front ends on a sphere -----------------
     elevation_rad: float = spec("elevation_deg", "float", "elevation seen from the RuT (needs "
                                 "front ends at elevations and a RuT with elevation)", 0.0,
                                 unit="deg", lo=-60.0, hi=60.0, scale=_DEG)

@@ -1,4 +1,4 @@
-"""Which front ends enclose a direction (``shared/design/channel-sets.md``, "Choosing channels").
+"""Which front ends enclose a direction.
 
 1-D (an arc, azimuth-only RuT): sorted intervals of the front ends' azimuths. 2-D (a sphere and
 a RuT with elevation): the Delaunay triangulation (``scipy.spatial.Delaunay``, ``find_simplex``)

@@ -30,7 +30,7 @@ __all__ = ["JIT", "ratio_one", "ratios", "choice_row", "bin_choice_rows", "argma
 JIT = dict(cache=True, nogil=True, error_model="numpy")
 
 
-# -- the pair's design for the bin the RuT detects (aoa.sweep, tolerance_model._Design) ----------
+# -- the pair's design for the bin the RuT detects (synthesis.pair, the tolerance model's) ------
 
 
 @njit(inline="always", **JIT)

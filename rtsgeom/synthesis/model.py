@@ -293,7 +293,7 @@ class ChannelModel:
         return self._closed_form(direction, mode)
 
     def _solve_pair_closed(self, alpha: float, phases) -> float | None:
-        """The exact ratio in closed form (``aoa.sweep.design_ratio``) at each candidate bin;
+        """The exact ratio in closed form (``synthesis.pair.design_ratio``) at each candidate bin;
         the one whose design the RuT detects at that same bin (design and detection agree on
         the bin; nearest the set range's bin first). Where none is (two bins of nearly equal
         power, each design moving the peak to the other bin), the bin's design whose

@@ -32,7 +32,7 @@ def estimator_ratio(st: Steering, x_i, x_j, alpha_rad, phase=0.0,
     """The ratio rho >= 0 (...,) for which the estimator's detected angle of
     ``x_i + rho e^{j phase} x_j`` (snapshots (..., V)) is ``alpha_rad`` (broadcast against
     (...,), as ``phase``), by bisection on
-    log rho, batched over all snapshots: what ``aoa.sweep.design_ratio`` (Bartlett's peak
+    log rho, batched over all snapshots: what ``design_ratio`` (Bartlett's peak
     condition in closed form) is for an estimator without one (a smoothed Capon or MUSIC,
     ``Steering.smoothing``). The bracket is the first sign change of (angle - alpha) on
     ``grid`` log-spaced ratios over e^{+-log_span}; NaN where there is none, or where the

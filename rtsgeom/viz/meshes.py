@@ -11,6 +11,7 @@ import pyvista as pv
 from .._lib.arcmath import radial_tangent, sphere_frame
 from ..geometry import Setup
 from ..geometry.export import COLOURS
+from ..paths.table import FE_TO_RX, RUT_TO_RUT, TX_TO_FE
 
 __all__ = ["TARGET_RADIUS_FACTOR", "rgb", "rut_scale_factor", "scaled", "board", "merge",
            "spheres", "polyline", "merge_lines", "arc_points", "angle_span", "cutout_rims",
@@ -164,7 +165,6 @@ def path_polylines(setup: Setup, paths, scale: float) -> tuple[list[np.ndarray],
 
     ``paths``: a :class:`Paths` table or a ray-tracing result; a reflection is drawn through
     its hit points (``vertices``, NaN rows past the last interaction are dropped)."""
-    from ..paths.table import FE_TO_RX, RUT_TO_RUT, TX_TO_FE
     rut, fe = setup.rut, setup.fe
     tx = scaled(rut.tx_world, rut.position, scale)
     rx = scaled(rut.rx_world, rut.position, scale)

@@ -3,7 +3,7 @@ beamforms in azimuth and elevation): its calibration along a spanning tree of pa
 design, peak-matched once on the nominal setup.
 
 The channel weights of set directions over the cell (an n x n azimuth x elevation grid inside
-it, :func:`~rtsgeom.analysis.linearity2d.cell_grid`) are designed once on the nominal setup
+it, :func:`~rtsgeom.analysis.linearity.cell_grid`) are designed once on the nominal setup
 (:meth:`ChannelModel.solve <rtsgeom.synthesis.model.ChannelModel.solve>`, ``exact``: peak
 matching on the modelled 2-D beamformer output) for the channel phases the cell's calibration
 establishes (:func:`~rtsgeom.calibration.channels.tree_phases`: each measured pair of the
@@ -41,7 +41,7 @@ from ...errors import ParameterError
 from ...paths import exact_paths
 from ...radar.steering import Steering
 from ...synthesis.model import ChannelModel
-from ..linearity2d import cell_grid
+from ..linearity import cell_grid
 from .draws import subbin_positions
 from .tables import response_table, slide
 

@@ -51,7 +51,7 @@ def _scratch(n_k):
 
 @njit(inline="always", **JIT)
 def _design_one(beams_i, beams_j, bi_row, rj, m, lo, e, power, ri, p_one, unit_gain, sc):
-    """One set-point ``m`` of ``tolerance_model._Design.__call__``: the ratio per design bin
+    """One set-point ``m`` of ``tolerance.pair._Design.__call__``: the ratio per design bin
     (:func:`ratio_one` at bins lo + 1 .. lo + K' - 2, NaN at the two outer ones, which are
     only compared), the detected-bin choice (:func:`choice_row`) and the programme
     amplitudes A_I = g sqrt(p_one / |b_I + rho e b_J|^2), A_J = rho A_I at the chosen bin
@@ -82,7 +82,7 @@ def _design_one(beams_i, beams_j, bi_row, rj, m, lo, e, power, ri, p_one, unit_g
 @njit(**JIT)
 def design_rows(beams_i, beams_j, i0, table, power, p_one, unit_gain, row_i, row_j, sub,
                 e, sp, lo, n_k, amps, k_out, ok_out, mg_out):
-    """``tolerance_model._Design.__call__``: :func:`_design_one` for every draw n (I at table
+    """``tolerance.pair._Design.__call__``: :func:`_design_one` for every draw n (I at table
     row ``row_i[n]``, J at ``row_j[n]``, sub-bin index ``sub[n]``, J's phase factor ``e[n]``)
     and every set-point (``sp`` empty) or set-point ``sp[n]``, over the ``n_k`` bins from
     ``lo``. Fills ``amps`` (n, M', 2), ``k_out`` (bin index into the table's K), ``ok_out``,
@@ -102,7 +102,7 @@ def design_rows(beams_i, beams_j, i0, table, power, p_one, unit_gain, row_i, row
 @njit(**JIT)
 def plan_rows(beams_i, beams_j, i0, table, power, p_one, unit_gain, row_i, row_j, sub, e,
               period, lo, n_k, lo_far, n_k_far, min_margin, amps, shift):
-    """``tolerance_model._Design.planned`` (``aoa.plan.pair_design``'s choice of J's delay)
+    """``tolerance.pair._Design.planned`` (the planner's choice of J's delay)
     for every draw n and set-point: the design with J at ``row_j[n]`` (``n_k`` bins from
     ``lo``), and where its bin is not consistent or its margin not above ``min_margin``, J
     at ``row_j[n] - period`` and then ``+ period`` (``n_k_far`` bins from ``lo_far``; J's
@@ -144,7 +144,7 @@ def plan_rows(beams_i, beams_j, i0, table, power, p_one, unit_gain, row_i, row_j
 
 @njit(**JIT)
 def detect_rows(x_i, x_j, sel, a_i, a_j, snaps, det):
-    """The RuT's detection of each draw n and set-point m (``PairPhasors.draw_errors``):
+    """The RuT's detection of each draw n and set-point m (``tolerance.pair.PairProcedure.draw``):
     channel I's spectra ``x_i`` (n, K, V) times ``a_i[n, m]`` plus J's ``x_j[sel[n, m], n]``
     ((S, n, K, V): J at its alternative delays) times ``a_j[n, m]``; the detected bin the
     strongest, power a_I^2 p_ii + a_J^2 p_jj + 2 a_I a_J Re(sum conj(x_i) x_j) summed over the

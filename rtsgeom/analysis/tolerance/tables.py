@@ -19,8 +19,8 @@ from ...calibration.probes import probe_ranges
 from ...geometry import Setup
 from ...radar.phasors import bin_response
 from ...radar.processing import tdm_compensate
-from ...rts.channels import (KIND_DIRECT, RtsProgram, channel_echoes, fir_modelled, fir_taps,
-                             requested_delay)
+from ...rts.channels import KIND_DIRECT, RtsProgram, channel_echoes, requested_delay
+from ...rts.fir import fir_modelled, fir_taps
 from ...scene import TargetConfig
 
 __all__ = ["response_table", "reference_target", "slide", "MAX_SLIDE", "readonly"]
