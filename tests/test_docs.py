@@ -1,6 +1,6 @@
 """The Sphinx site builds without a single warning (``-W``): API reference from the docstrings,
 the examples as a gallery that runs them and shows their figures (with their small settings
-here, RTSGEOM_EXAMPLES_QUICK=1), the scene format and the physics notes."""
+here, RTSGEOM_EXAMPLES_QUICK=1), the scene format and one page per physics topic."""
 
 from __future__ import annotations
 
@@ -46,5 +46,9 @@ def test_docs_build_without_warnings(tmp_path):
         assert f"rtsgeom.{name}" in api, name
     assert (html / "generated" / "rtsgeom.RangeDoppler.html").is_file()
     assert "to_xarray" in (html / "generated" / "rtsgeom.RangeDoppler.html").read_text()
-    assert "Near-field violation" in (html / "physics.html").read_text()
+    assert "Near-field violation" in (html / "nearfield.html").read_text()
+    for page in ("signal-model", "calibration", "link-budget", "ghosts", "tolerance", "design",
+                 "identify", "raytrace", "nchannel", "estimators", "performance", "outputs",
+                 "testing"):
+        assert (html / f"{page}.html").is_file(), page
     assert "Scene format" in (html / "scene.html").read_text()
