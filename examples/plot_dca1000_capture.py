@@ -21,7 +21,9 @@ import rtsgeom
 QUICK = os.environ.get("RTSGEOM_EXAMPLES_QUICK") == "1"
 OUT = Path(os.environ.get("RTSGEOM_EXAMPLES_OUT", "example_output"))
 OUT.mkdir(parents=True, exist_ok=True)
-SCENE = Path(__file__).resolve().parents[1] / "scenes" / "diewald2022.toml"
+# the repository's scenes/ (sphinx-gallery runs a script in examples/, without a __file__)
+HERE = Path(globals().get("__file__", "plot.py")).resolve().parent
+SCENE = HERE.parent / "scenes" / "diewald2022.toml"
 
 # %%
 # Write the capture with the command-line tool (``nearest``: each target on its nearest front
@@ -68,5 +70,5 @@ ax.plot(range_m, 20 * np.log10(profile / profile.max()))
 ax.set_xlabel("range (m)")
 ax.set_ylabel("level (dB)")
 ax.set_title("Range profile from the DCA1000 capture")
+fig.tight_layout()
 fig.savefig(OUT / "dca1000_range_profile.png", dpi=100)
-plt.close(fig)

@@ -26,7 +26,9 @@ from rtsgeom.viz.figures import save_figure
 QUICK = os.environ.get("RTSGEOM_EXAMPLES_QUICK") == "1"
 OUT = Path(os.environ.get("RTSGEOM_EXAMPLES_OUT", "example_output"))
 OUT.mkdir(parents=True, exist_ok=True)
-SCENE = Path(__file__).resolve().parents[1] / "scenes" / "diewald2022.toml"
+# the repository's scenes/ (sphinx-gallery runs a script in examples/, without a __file__)
+HERE = Path(globals().get("__file__", "plot.py")).resolve().parent
+SCENE = HERE.parent / "scenes" / "diewald2022.toml"
 
 nominal = rtsgeom.load_scene(SCENE)
 nominal = rtsgeom.replace(nominal, radar=rtsgeom.replace(nominal.radar, use_elevation_tx=True))

@@ -20,7 +20,9 @@ from rtsgeom.viz.figures import save_figure
 QUICK = os.environ.get("RTSGEOM_EXAMPLES_QUICK") == "1"
 OUT = Path(os.environ.get("RTSGEOM_EXAMPLES_OUT", "example_output"))
 OUT.mkdir(parents=True, exist_ok=True)
-SCENE = Path(__file__).resolve().parents[1] / "scenes" / "diewald2022.toml"
+# the repository's scenes/ (sphinx-gallery runs a script in examples/, without a __file__)
+HERE = Path(globals().get("__file__", "plot.py")).resolve().parent
+SCENE = HERE.parent / "scenes" / "diewald2022.toml"
 
 scene = rtsgeom.load_scene(SCENE)
 radii = np.geomspace(0.5, 8.0, 3 if QUICK else 9)

@@ -20,7 +20,9 @@ from rtsgeom.viz.figures import range_angle_figure, range_doppler_figure, save_f
 QUICK = os.environ.get("RTSGEOM_EXAMPLES_QUICK") == "1"
 OUT = Path(os.environ.get("RTSGEOM_EXAMPLES_OUT", "example_output"))
 OUT.mkdir(parents=True, exist_ok=True)
-SCENE = Path(__file__).resolve().parents[1] / "scenes" / "diewald2022.toml"
+# the repository's scenes/ (sphinx-gallery runs a script in examples/, without a __file__)
+HERE = Path(globals().get("__file__", "plot.py")).resolve().parent
+SCENE = HERE.parent / "scenes" / "diewald2022.toml"
 
 scene = rtsgeom.load_scene(SCENE)
 if QUICK:  # 16 instead of 120 chirp loops (a 7x smaller cube), a coarser calibration sweep

@@ -14,28 +14,23 @@ from pathlib import Path
 
 import rtsgeom
 
-QUICK = os.environ.get("RTSGEOM_EXAMPLES_QUICK") == "1"
 OUT = Path(os.environ.get("RTSGEOM_EXAMPLES_OUT", "example_output"))
 OUT.mkdir(parents=True, exist_ok=True)
-SCENE = Path(__file__).resolve().parents[1] / "scenes" / "diewald2022.toml"
+# the repository's scenes/ (sphinx-gallery runs a script in examples/, without a __file__)
+HERE = Path(globals().get("__file__", "plot.py")).resolve().parent
+SCENE = HERE.parent / "scenes" / "diewald2022.toml"
 
 setup = rtsgeom.build_setup(rtsgeom.load_scene(SCENE))
-size = (800, 500) if QUICK else (1600, 1000)
+size = (1600, 1000)  # the labels need the room; smaller windows overlap them
 
 # %%
 # Ray tracing needs Sionna RT and Dr.Jit's LLVM backend; ``RaytraceUnavailable`` says what to
-# install.
+# install. This is what ``rtsgeom show SCENE --paths raytrace --png setup_3d.png`` writes: left
+# the perspective view (the RuT drawn five times its size, the targets at 1.5 R_c), top right
+# the RuT's board at true scale, bottom right the plan view.
 try:
-    from rtsgeom.paths.raytrace import trace
-
-    traced = trace(setup)
-    n_refl = int((traced.paths.bounces > 0).sum())
-    print(f"{len(traced.paths)} paths, {n_refl} reflected (hit points drawn)")
-    paths = traced
+    png = rtsgeom.show(setup, paths="raytrace", png=OUT / "setup_3d.png", window_size=size)
 except rtsgeom.RaytraceUnavailable as exc:
     print(f"ray tracing unavailable here ({exc}); drawing line of sight only")
-    paths = rtsgeom.exact_paths(setup)
-
-# %%
-png = rtsgeom.show(setup, paths=paths, png=OUT / "setup_3d.png", window_size=size)
+    png = rtsgeom.show(setup, paths="exact", png=OUT / "setup_3d.png", window_size=size)
 print(f"wrote {png}")

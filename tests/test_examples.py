@@ -19,13 +19,14 @@ OUTPUTS = {
     "plot_range_doppler_table1.py": ["table1_range_doppler.png", "table1_range_angle.png"],
     "plot_calibration_sweep.py": ["calibration_sweep.png"],
     "plot_linearity.py": ["linearity.png"],
-    "plot_mounting_tolerance.py": ["mounting_tolerance.png"],
+    "plot_mounting_tolerance.py": ["mounting_offset.png", "mounting_tolerance.png"],
     "plot_arc_design.py": ["arc_design.png"],
     "plot_setup_3d.py": ["setup_3d.png"],
     "plot_cable_ghosts.py": ["cable_ghosts.png"],
     "plot_nearfield.py": ["nearfield.png"],
     "plot_dca1000_capture.py": ["adc.bin", "adc.bin.json", "dca1000_range_profile.png"],
     "plot_identify.py": ["identify_crb.png"],
+    "plot_superposition.py": ["superposition.png"],
 }
 
 
