@@ -8,10 +8,9 @@ import math
 import numpy as np
 
 from ..errors import ParameterError
-from .._lib.io import write_json
 from ..errors import UsageError
-from ._common import (load_scene_checked, number, output_folder, output_path, print_json, scene_arg,
-                      steps, warn_scene_errors)
+from ._common import (load_scene_checked, number, output_folder, output_path, print_outputs,
+                      scene_arg, steps, warn_scene_errors, write_outputs)
 
 
 def radius_sweep(text: str) -> tuple[float, float, int]:
@@ -92,28 +91,8 @@ def cmd_nearfield(args) -> int:
         except ParameterError as exc:
             raise UsageError(f"--radius-m: {exc}") from None
         out = nf.to_dict()
-        _write(stage, "nearfield", out, lambda: nearfield_figure(nf))
-    return _emit(args, "nearfield", out, _nearfield_text)
-
-
-def _write(stage, name: str, out: dict, figure) -> None:
-    """Write ``NAME.json`` and ``NAME.png`` (``figure()``) into the staging folder of
-    ``--out`` (None: nothing)."""
-    if stage is not None:
-        from ..viz.figures import save_figure
-        write_json(stage / f"{name}.json", out)
-        save_figure(figure(), stage / f"{name}.png")
-
-
-def _emit(args, name: str, out: dict, text) -> int:
-    """Print the JSON (``--json``) or ``text(out)`` once the output folder is in place."""
-    if args.json:
-        print_json(out)
-    else:
-        print(text(out))
-        if args.out:
-            print(f"wrote {args.out}/{name}.json, {name}.png")
-    return 0
+        write_outputs(stage, "nearfield", out, lambda: nearfield_figure(nf))
+    return print_outputs(args, "nearfield", out, _nearfield_text)
 
 
 def _ghosts_text(d: dict) -> str:
@@ -154,8 +133,8 @@ def cmd_ghosts(args) -> int:
     with output_folder(args.out, [args.scene]) as stage:
         rep = ghost_analysis(scene, args.floor_db, simulate=args.simulate)
         out = rep.to_dict()
-        _write(stage, "ghosts", out, lambda: ghosts_figure(rep))
-    return _emit(args, "ghosts", out, _ghosts_text)
+        write_outputs(stage, "ghosts", out, lambda: ghosts_figure(rep))
+    return print_outputs(args, "ghosts", out, _ghosts_text)
 
 
 def register(sub) -> None:

@@ -7,7 +7,6 @@ import numpy as np
 
 from ..calibration.pair import calibrate_pair, calibrate_pair_paper
 from ..calibration.fir import fir_effect
-from ..calibration.probes import probe_front_ends
 from ..analysis.linearity import linearity
 from ..errors import AngleUnreachable
 from ..errors import ParameterError
@@ -17,52 +16,8 @@ from ..paths import exact_paths
 
 from ..scene.registry import SYNTHESIS_MODES
 from ..errors import UsageError
-from ._common import (load_scene_checked, number, output_folder, output_path, print_json, scene_arg,
-                      steps)
-
-
-def _pair_arg(text: str):
-    """argparse type of one ``--pair`` word: an index in [0, 10000] or ``all``."""
-    if text == "all":
-        return text
-    return number(0, 10_000, integer=True)(text)
-
-
-def _pairs(setup, pair) -> list[tuple[int, int]]:
-    """``--pair I J`` as one pair, or ``--pair all``: every adjacent pair of the arc."""
-    if list(pair) == ["all"]:
-        n = setup.fe.count
-        if n < 2:
-            raise UsageError("--pair all: the arc needs at least two front ends")
-        return [(i, i + 1) for i in range(n - 1)]
-    return [_pair(setup, pair)]
-
-
-def _pair(setup, pair):
-    """The pair in its canonical order, the lower index first (I keeps its delay, J is
-    swept): ``--pair 1 0`` and ``--pair 0 1`` are the same measurement and give the same
-    numbers (the front ends are ordered by angle in the scene)."""
-    if len(pair) != 2 or "all" in pair:
-        raise UsageError(f"--pair {' '.join(map(str, pair))}: must be two adjacent front-end "
-                         "indices I J, or all")
-    from ..pipeline.plan import check_pair
-    from ..errors import ParameterError
-    i, j = pair
-    try:
-        return check_pair(setup, i, j, f"--pair {i} {j}")
-    except ParameterError as exc:
-        raise UsageError(str(exc)) from None
-
-
-def _prepare(args):
-    """Scene, setup, pair, exact paths and each front end alone as the RuT detects it."""
-    scene = load_scene_checked(args.scene)
-    if getattr(args, "fir", None):  # override the scene's fractional-delay filter model
-        scene = scene.evolve(rts=scene.rts.evolve(fractional_delay_filter=args.fir))
-    setup = build_setup(scene)
-    pair = _pair(setup, args.pair)
-    paths = exact_paths(setup)
-    return scene, setup, pair, paths, probe_front_ends(setup, paths, scene.seed)
+from ._common import (emit_result, load_scene_checked, number, output_folder, output_path, pair_of,
+                      pair_word, prepare_pair, print_json, scene_arg, steps)
 
 
 def cmd_calibrate(args) -> int:
@@ -72,7 +27,7 @@ def cmd_calibrate(args) -> int:
                 raise UsageError("--from-identified predicts one pair's delay: give --pair I J")
             from ..identify import calibrate_from_identified
             scene = load_scene_checked(args.from_identified)
-            out = calibrate_from_identified(scene, _pair(build_setup(scene), args.pair)).to_dict()
+            out = calibrate_from_identified(scene, pair_of(build_setup(scene), args.pair)).to_dict()
             if stage is not None:
                 write_json(stage / "calibration.json", out)
             if args.json:
@@ -90,7 +45,7 @@ def _calibrate(args, stage) -> int:
         return calibrate_all(args, stage)
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
-        scene, setup, pair, paths, probe = _prepare(args)
+        scene, setup, pair, paths, probe = prepare_pair(args)
         step(f"sweeping the delay of front end {pair[1]} on the simulated radar "
              f"({args.procedure} procedure)")
         if args.procedure == "paper":
@@ -115,7 +70,7 @@ def _calibrate(args, stage) -> int:
                                         residual_error_deg=cal.residual_error_deg,
                                         refine_delta_tau_s=cal.refine_delta_tau_s,
                                         refine_error_deg=cal.refine_error_deg)
-    _emit(args, stage, "calibration_sweep.png", "calibration", out, figure,
+    emit_result(args, stage, "calibration_sweep.png", "calibration", out, figure,
           f"pair {pair}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps (set in "
           f"{cal.delay_resolution_s * 1e12:g} ps steps; the fit's optimum "
           f"{cal.quantisation_residual_s * 1e12:+.2f} ps from it), residual angle error "
@@ -125,20 +80,6 @@ def _calibrate(args, stage) -> int:
           f"{out['fractional_delay_filter']['phase_ripple_deg']:.3f} deg p-p, moves the "
           f"coherence point by {out['fractional_delay_filter']['predicted_shift_ps']:+.2f} ps")
     return 0
-
-
-def _emit(args, stage, png: str, name: str, out: dict, figure, summary_line: str) -> None:
-    """``--out DIR``: <png> (from ``figure()``) and <name>.json into the staging folder
-    ``stage`` (swapped in as DIR when the command ends); then JSON or one summary line on
-    stdout."""
-    if stage is not None:
-        from ..viz.figures import save_figure
-        save_figure(figure(), stage / png)
-        write_json(stage / f"{name}.json", out)
-    if args.json:
-        print_json(out)
-    else:
-        print(summary_line)
 
 
 def cmd_linearity(args) -> int:
@@ -154,7 +95,7 @@ def _linearity(args, stage) -> int:
         return _linearity_grid(args, stage)
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
-        scene, setup, pair, paths, probe = _prepare(args)
+        scene, setup, pair, paths, probe = prepare_pair(args)
         cal = None
         if not args.uncalibrated:
             step("calibrating the pair")
@@ -166,7 +107,7 @@ def _linearity(args, stage) -> int:
         from ..viz.figures import linearity_figure
         return linearity_figure(lin.set_deg, {args.amplitudes: lin.detected_deg},
                                 {args.amplitudes: lin.amplitude_db}, pair=pair)
-    _emit(args, stage, "linearity.png", "linearity", lin.to_dict(), figure,
+    emit_result(args, stage, "linearity.png", "linearity", lin.to_dict(), figure,
           f"{args.amplitudes} ({'calibrated' if cal else 'uncalibrated'}, "
           f"{args.end_angles} end angles): max |error| "
           f"{lin.max_abs_error_deg:.4f} deg over {len(lin.set_deg)} set-points")
@@ -188,7 +129,7 @@ def _linearity_grid(args, stage) -> int:
         except (ParameterError, AngleUnreachable) as exc:
             raise UsageError(f"{args.scene}: {exc}") from None
     mx = em.max_abs_error_deg()
-    _emit(args, stage, "linearity_grid.png", "linearity_grid", em.to_dict(),
+    emit_result(args, stage, "linearity_grid.png", "linearity_grid", em.to_dict(),
           lambda: error_map_figure(em),
           f"{args.amplitudes} ({'calibrated' if em.calibrated else 'uncalibrated'}): max "
           f"|error| azimuth {mx[0]:.4f} deg, elevation {mx[1]:.4f} deg over "
@@ -202,7 +143,7 @@ def register(sub) -> None:
             ("linearity", cmd_linearity, "synthesized-angle linearity across a pair's span")):
         p = sub.add_parser(name, help=helptext)
         scene_arg(p)
-        p.add_argument("--pair", nargs="+", type=_pair_arg, metavar="I J | all",
+        p.add_argument("--pair", nargs="+", type=pair_word, metavar="I J | all",
                        default=[0, 1], help="adjacent front ends (default 0 1), or all: every "
                                             "adjacent pair of the arc in one run")
         p.add_argument("--json", action="store_true", help="print the result as JSON")

@@ -9,24 +9,11 @@ import argparse
 import numpy as np
 
 from ..calibration.pair import calibrate_pair
-from ..calibration.probes import probe_front_ends
 from ..analysis.linearity import linearity
-from ..geometry import build_setup
 from .._lib.io import write_json
-from ..paths import exact_paths
-from ._common import load_scene_checked, print_json, steps
-from .aoa import _pairs
+from ._common import prepare_arc, print_json, progress, steps
 
-__all__ = ["prepare_all", "calibrate_all", "linearity_all", "coverage_spec", "design_coverage"]
-
-
-def prepare_all(args):
-    """``--pair all``: scene, setup, every adjacent pair, paths, each front end alone."""
-    scene = load_scene_checked(args.scene)
-    setup = build_setup(scene)
-    pairs = _pairs(setup, args.pair)
-    paths = exact_paths(setup)
-    return scene, setup, pairs, paths, probe_front_ends(setup, paths, scene.seed)
+__all__ = ["calibrate_all", "linearity_all", "coverage_spec", "design_coverage"]
 
 
 def calibrate_all(args, folder) -> int:
@@ -34,7 +21,7 @@ def calibrate_all(args, folder) -> int:
     from ..calibration.file import setup_fingerprint
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
-        scene, setup, pairs, paths, probe = prepare_all(args)
+        scene, setup, pairs, paths, probe = prepare_arc(args)
         cals = []
         for pair in pairs:
             step(f"sweeping the delay of front end {pair[1]} (pair {pair})")
@@ -68,7 +55,7 @@ def linearity_all(args, folder) -> int:
     """Every adjacent pair's linearity in one run; one JSON entry per pair plus the arc's."""
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
-        scene, setup, pairs, paths, probe = prepare_all(args)
+        scene, setup, pairs, paths, probe = prepare_arc(args)
         lins = []
         for pair in pairs:
             cal = None
@@ -127,12 +114,11 @@ def design_coverage(args, scene, folder) -> int:
     from ..analysis.coverage import best_per_radius, coverage_designs
     seed = scene.seed if args.seed is None else args.seed
     draws = args.draws if args.draws is not None else 300
-    from .tolerance import _progress
-    with _progress(args.quiet) as progress:
+    with progress(args.quiet) as report:
         grid = coverage_designs(scene, args.coverage_deg, args.radius_m, args.spec_deg,
                                 args.yield_, draws, seed, min(args.points, 11),
-                                progress=None if progress is None else
-                                (lambda done, total: progress("designs", done, total)))
+                                progress=None if report is None else
+                                (lambda done, total: report("designs", done, total)))
     out = grid.to_dict()
     if folder is not None:
         from ..viz.figures import design_heatmap_figure, save_figure

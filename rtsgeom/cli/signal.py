@@ -15,8 +15,8 @@ from .._lib.io import atomic_path, write_bytes, write_json, write_text
 from ..scene.registry import ANGLE_ESTIMATORS, AOA_MODES, PATH_METHODS
 from ..pipeline.run import RunResult, label_detections, run_scene, summary
 from ..errors import UsageError
-from ._common import (load_scene_checked, number, output_file, output_folder, output_path,
-                      scene_arg, steps)
+from ._common import (calibration_kw, load_scene_checked, number, output_file, output_folder,
+                      output_path, scene_arg, steps)
 
 
 def detections_csv(result: RunResult) -> str:
@@ -225,28 +225,6 @@ def write_run_report(result: RunResult, out: Path, maps, paths_method: str,
     return out / "report.html"
 
 
-def _read_calibration(path) -> dict | None:
-    """``--calibration FILE``: the JSON ``rtsgeom calibrate --out DIR`` wrote
-    (DIR/calibration.json), or None."""
-    if path is None:
-        return None
-    try:
-        doc = json.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise UsageError(f"--calibration {path}: cannot read it as JSON ({exc})") from None
-    if not isinstance(doc, dict):
-        raise UsageError(f"--calibration {path}: not a calibration file (a JSON object from "
-                         "`rtsgeom calibrate SCENE --out DIR`)")
-    return doc
-
-
-def _calibration_kw(args) -> dict:
-    """``run_scene``'s calibration argument, only when ``--calibration`` was given (the
-    call without it stays as it was)."""
-    doc = _read_calibration(getattr(args, "calibration", None))
-    return {} if doc is None else {"calibration": doc}
-
-
 def _with_estimator(scene, args):
     """The scene with ``--estimator``/``--subarray`` applied (validated again, like the file:
     e.g. smoothing needs capon or music)."""
@@ -264,7 +242,7 @@ def cmd_run(args) -> int:
     out = args.out
     with output_folder(out, [args.scene]) as stage, steps(args.quiet) as step:
         step(f"simulating {scene.name} ({args.paths} paths, calibration, ADC cube, detection)")
-        result = run_scene(scene, args.paths, args.amplitudes, **_calibration_kw(args))
+        result = run_scene(scene, args.paths, args.amplitudes, **calibration_kw(args))
         step("writing detections, summary and maps")
         (stage / "detections.csv").write_text(detections_csv(result), encoding="utf-8")
         (stage / "summary.json").write_text(
@@ -310,7 +288,7 @@ def cmd_adc(args) -> int:
         return adc_probe_capture(scene, args)
     with steps(args.quiet) as step:  # the calibration sweeps take about a minute
         step(f"simulating {scene.name} (calibration, ADC cube)")
-        cube = run_scene(scene, "exact", args.amplitudes, **_calibration_kw(args)).cube
+        cube = run_scene(scene, "exact", args.amplitudes, **calibration_kw(args)).cube
     if args.format == "npy":
         with atomic_path(args.out) as tmp:
             with open(tmp, "wb") as fh:

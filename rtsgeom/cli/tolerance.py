@@ -7,7 +7,6 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from contextlib import contextmanager
 
 import numpy as np
 
@@ -20,9 +19,8 @@ from ..analysis.tolerance.draws import draw_offsets
 from ..errors import AngleUnreachable, ClusterError, ParameterError, UsageError
 from ..geometry import build_setup
 from ..radar.steering import Steering
-from ._common import (load_scene_checked, number, output_folder, output_path, print_json, scene_arg,
-                      warn_scene_errors)
-from .aoa import _pair, _pair_arg, _pairs
+from ._common import (load_scene_checked, number, output_folder, pair_of, pair_word, pairs_of,
+                      print_json, progress, study_options, warn_scene_errors)
 from .arc import coverage_spec
 
 #: ``tolerance``'s ``--pair`` default, by identity: left at it, a 2-D RuT gets the cell study
@@ -52,24 +50,6 @@ def _dask_address(text: str) -> str:
         return check_address(text)
     except ClusterError as exc:
         raise argparse.ArgumentTypeError(str(exc).split(": ", 1)[1]) from None
-
-
-@contextmanager
-def _progress(quiet: bool):
-    """A ``progress(label, done, total)`` callback drawing one rich bar on stderr, relabelled
-    at each stage (None when quiet or when stderr is not a terminal)."""
-    if quiet or not sys.stderr.isatty():
-        yield None
-        return
-    from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                  TimeElapsedColumn(), console=Console(stderr=True), transient=True) as bar:
-        task = bar.add_task("", total=None)
-
-        def update(label: str, done: int, total: int) -> None:
-            bar.update(task, description=label, completed=done, total=total)
-        yield update
 
 
 def _grid_spec(lo: float, hi: float, unit: str, max_n: int = 50):
@@ -161,7 +141,7 @@ def _study(args, scene, bounds: Bounds) -> ToleranceModel:
     if arc and args.invert_yield is not None:
         raise UsageError("--invert-yield: only for one pair without rotation or RuT-pose errors "
                          "so far (rtsgeom design --coverage-deg finds the arc's tolerance)")
-    pairs = _pairs(setup, args.pair)
+    pairs = pairs_of(setup, args.pair)
     try:
         models = [ChannelPhasors.build(setup, p, args.points) for p in pairs]
     except AngleUnreachable as exc:  # the composite cannot reach a set angle
@@ -191,9 +171,9 @@ def _tolerance(args, scene, stage) -> int:
                  for m in model.sets[:1])
     chunk = args.chunk if kind == "arc" else capped_chunk(args.chunk, points)
     t0 = time.perf_counter()
-    with _progress(args.quiet) as progress, chunk_mapper(args.dask, args.workers) as mapper:
+    with progress(args.quiet) as report, chunk_mapper(args.dask, args.workers) as mapper:
         res = monte_carlo(model, bounds, args.draws, seed, args.distribution, args.spec_deg,
-                          cases, chunk, progress, "Monte Carlo (arc)" if kind == "arc"
+                          cases, chunk, report, "Monte Carlo (arc)" if kind == "arc"
                           else "Monte Carlo", mapper, keep_errors=stage is not None
                           and kind == "arc")
         out = res.to_dict()
@@ -201,13 +181,13 @@ def _tolerance(args, scene, stage) -> int:
             out["sigma_level"] = args.sigma_level if args.distribution == "normal" else None
         if args.verify:
             out["verify"] = verify_draws(model.sets[0], sigma, min(args.verify, args.draws),
-                                         seed, args.distribution, cases, progress=progress,
+                                         seed, args.distribution, cases, progress=report,
                                          all_points=args.verify_all_points).to_dict()
         if args.invert_yield is not None:
             out["inversion"] = {
                 case: max_sigma_for_yield(model, sigma, args.draws, seed, args.invert_yield,
                                           args.spec_deg, case, args.invert_axis,
-                                          args.distribution, chunk=chunk, progress=progress,
+                                          args.distribution, chunk=chunk, progress=report,
                                           mapper=mapper)
                 for case in CASES}
     elapsed = time.perf_counter() - t0
@@ -354,13 +334,13 @@ def _design(args, scene, stage) -> int:
     if args.draws is None:
         args.draws = 2000
     from ..analysis.design import METRICS, design_grid
-    pair = _pair(build_setup(scene), args.pair)
+    pair = pair_of(build_setup(scene), args.pair)
     seed = scene.seed if args.seed is None else args.seed
-    with _progress(args.quiet) as progress:
+    with progress(args.quiet) as report:
         grid = design_grid(scene, pair, args.radius_m, args.spacing_deg, args.spec_deg,
                            args.yield_, args.draws, seed, args.points,
-                           None if progress is None else
-                           (lambda done, total: progress("designs", done, total)),
+                           None if report is None else
+                           (lambda done, total: report("designs", done, total)),
                            workers=args.workers)
     out = grid.to_dict()
     if stage is not None:
@@ -418,32 +398,10 @@ def _sheet_note(designs: list[dict]) -> str:
     return "note: " + "; ".join(parts) if parts else ""
 
 
-def _common(p, draws_default: int, allow_all: bool = False) -> None:
-    scene_arg(p)
-    if allow_all:
-        p.add_argument("--pair", nargs="+", type=_pair_arg, metavar="I J | all",
-                       default=[0, 1], help="adjacent front ends (default 0 1), or all: every "
-                                            "adjacent pair on shared per-front-end draws")
-    else:
-        p.add_argument("--pair", nargs=2, type=number(0, 10_000, integer=True),
-                       metavar=("I", "J"), default=[0, 1], help="adjacent front ends (default 0 1)")
-    p.add_argument("--spec-deg", type=number(1e-6, 90.0), default=0.1,
-                   help="angle-error spec in deg, in [1e-6, 90] (default 0.1)")
-    p.add_argument("--draws", type=number(1, 10_000_000, integer=True), default=draws_default,
-                   help=f"Monte-Carlo draws, in [1, 10000000] (default {draws_default})")
-    p.add_argument("--seed", type=number(0, 2 ** 63 - 1, integer=True), default=None,
-                   help="random seed (default: the scene's seed)")
-    p.add_argument("--points", type=number(3, 201, integer=True), default=21,
-                   help="set-points across the span, ends excluded, in [3, 201] (default 21)")
-    p.add_argument("--json", action="store_true", help="print the result as JSON")
-    p.add_argument("--out", type=output_path, default=None, help="folder for the plots and JSON")
-    p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
-
-
 def register(sub) -> None:
     p = sub.add_parser("tolerance", help="mounting-tolerance Monte Carlo of a front-end pair "
                                          "or a whole arc")
-    _common(p, 10_000, allow_all=True)
+    study_options(p, 10_000, allow_all=True)
     mm = number(0.0, MAX_SIGMA_MM)
     for axis in AXES:
         p.add_argument(f"--sigma-{axis}-mm", type=mm, default=None,
@@ -492,7 +450,7 @@ def register(sub) -> None:
     p.add_argument("--workers", type=number(1, 1024, integer=True), default=None,
                    help="run the chunks in N local worker processes (forked; a local Dask "
                         "cluster where the platform cannot fork); results identical")
-    p.add_argument("--cell", nargs="+", type=_pair_arg, metavar="Q | all", default=None,
+    p.add_argument("--cell", nargs="+", type=pair_word, metavar="Q | all", default=None,
                    help="the study for a 2-D cell: 3 or 4 front-end indices, or all (a RuT "
                         "beamforming in azimuth and elevation; its default there when --pair "
                         "is not given); --points N gives about N set directions (a "
@@ -500,7 +458,7 @@ def register(sub) -> None:
     p.set_defaults(func=cmd_tolerance, pair=DEFAULT_PAIR)
 
     p = sub.add_parser("design", help="arc radius x front-end spacing design map")
-    _common(p, 2000)
+    study_options(p, 2000)
     p.add_argument("--radius-m", type=_grid_spec(0.1, 100.0, "m"), default=np.linspace(0.5, 2.0, 4),
                    metavar="A:B:N", help="arc radii, N from A to B m (default 0.5:2:4)")
     p.add_argument("--spacing-deg", type=_grid_spec(0.1, 90.0, "deg"),
