@@ -15,17 +15,15 @@ from ..errors import Terminated
 
 __all__ = ["main", "build_parser"]
 
-_GROUPS = ("geometry", "signal", "aoa", "tolerance", "analysis", "viz", "identify")
-
 #: Every subcommand: (group module that registers it, its one-line help). ``main`` imports only
 #: the group of the command it runs (the groups import numpy, scipy, the signal chain), so
 #: ``rtsgeom --help`` and ``rtsgeom info`` start without the heavy libraries; the other
 #: commands are listed from this table. ``tests/test_lazy_cli.py`` checks it against what the
 #: groups register.
 COMMANDS: dict[str, tuple[str, str]] = {
-    "info": ("geometry", "summary of a scene: elements, front ends, far-field figures"),
-    "paths": ("geometry", "per-element propagation paths as CSV"),
-    "export-mesh": ("geometry", "export the setup as GLB/PLY/OBJ/STL"),
+    "info": ("info", "summary of a scene: elements, front ends, far-field figures"),
+    "paths": ("paths", "per-element propagation paths as CSV"),
+    "export-mesh": ("export_mesh", "export the setup as GLB/PLY/OBJ/STL"),
     "run": ("signal", "the main job: simulate the scene, detect, compare with set-points"),
     "adc": ("signal", "save the raw ADC cube (.npy) or a DCA1000 capture"),
     "calibrate": ("aoa", "phase calibration sweep of a front-end pair"),
@@ -40,6 +38,9 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "identify": ("identify", "estimate each front end's mounting errors and each channel's "
                              "gain/phase/delay from probe captures"),
 }
+
+#: the modules that register commands, in the table's order
+_MODULES = tuple(dict.fromkeys(module for module, _help in COMMANDS.values()))
 
 
 class _Parser(argparse.ArgumentParser):
@@ -70,7 +71,7 @@ def build_parser(command: str | None = None, *, lazy: bool = False) -> argparse.
     sub = ap.add_subparsers(dest="command", metavar="COMMAND", required=True)
     import importlib
     if not lazy or (command is not None and command not in COMMANDS):
-        groups = _GROUPS  # complete, or a word the table does not know: let every group try
+        groups = _MODULES  # complete, or a word the table does not know: let every group try
     else:
         groups = (COMMANDS[command][0],) if command is not None else ()
     for name in groups:
