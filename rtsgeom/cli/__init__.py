@@ -26,8 +26,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "export-mesh": ("export_mesh", "export the setup as GLB/PLY/OBJ/STL"),
     "run": ("run", "the main job: simulate the scene, detect, compare with set-points"),
     "adc": ("adc", "save the raw ADC cube (.npy) or a DCA1000 capture"),
-    "calibrate": ("aoa", "phase calibration sweep of a front-end pair"),
-    "linearity": ("aoa", "synthesized-angle linearity across a pair's span"),
+    "calibrate": ("calibrate", "phase calibration sweep of a front-end pair"),
+    "linearity": ("linearity", "synthesized-angle linearity across a pair's span"),
     "tolerance": ("tolerance", "mounting-tolerance Monte Carlo of a front-end pair or a whole arc"),
     "design": ("tolerance", "arc radius x front-end spacing design map"),
     "nearfield": ("analysis", "near-field violation: single front-end bias, phase error and "

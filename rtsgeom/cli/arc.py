@@ -1,6 +1,5 @@
-"""``--pair all`` (``calibrate``, ``linearity``, ``tolerance``) and ``design --coverage-deg``:
-whole arcs (issue 14). The commands in ``cli/aoa.py`` and ``cli/tolerance.py`` hand over to
-these functions; ``folder`` is where ``--out`` files go (None: no ``--out``)."""
+"""``design --coverage-deg``: whole arcs; ``folder`` is where ``--out`` files go (None: no
+``--out``)."""
 
 from __future__ import annotations
 
@@ -8,85 +7,10 @@ import argparse
 
 import numpy as np
 
-from ..calibration.pair import calibrate_pair
-from ..analysis.linearity import linearity
 from .._lib.io import write_json
-from ._common import prepare_arc, print_json, progress, steps
+from ._common import print_json, progress
 
-__all__ = ["calibrate_all", "linearity_all", "coverage_spec", "design_coverage"]
-
-
-def calibrate_all(args, folder) -> int:
-    """Every adjacent pair calibrated in one run; one JSON entry per pair plus the arc's."""
-    from ..calibration.file import setup_fingerprint
-    with steps(args.quiet or args.json) as step:
-        step("measuring each front end alone")
-        scene, setup, pairs, paths, probe = prepare_arc(args)
-        cals = []
-        for pair in pairs:
-            step(f"sweeping the delay of front end {pair[1]} (pair {pair})")
-            cals.append(calibrate_pair(setup, paths, pair, probe, seed=scene.seed))
-    res = [abs(c.residual_error_deg) for c in cals]
-    out = {"pairs": [c.to_dict() for c in cals],
-           "front_end_angles_deg": [float(x) for x in np.degrees(probe.angle_rad)],
-           "arc": {"pairs": [list(p) for p in pairs], "worst_residual_error_deg": max(res),
-                   "worst_pair": list(pairs[int(np.argmax(res))]),
-                   "max_abs_range_offset_mm": max(abs(c.range_offset_m) for c in cals) * 1e3},
-           "format": "rtsgeom-calibration", "setup_sha256": setup_fingerprint(scene)}
-    if folder is not None:
-        from ..viz.figures import calibration_sweep_figure, save_figure
-        for pair, cal in zip(pairs, cals):
-            save_figure(calibration_sweep_figure(cal.sweep_delta_tau_s, cal.sweep_error_deg,
-                                                 cal.delta_tau_s, cal.period_s),
-                        folder / f"calibration_sweep_{pair[0]}_{pair[1]}.png")
-        write_json(folder / "calibration.json", out)
-    if args.json:
-        print_json(out)
-        return 0
-    for pair, cal in zip(pairs, cals):
-        print(f"pair {pair}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps, residual angle error "
-              f"{cal.residual_error_deg:.4f} deg, range offset {cal.range_offset_m * 1e3:.2f} mm")
-    print(f"arc ({len(pairs)} pairs): worst residual {out['arc']['worst_residual_error_deg']:.4f} "
-          f"deg (pair {tuple(out['arc']['worst_pair'])})")
-    return 0
-
-
-def linearity_all(args, folder) -> int:
-    """Every adjacent pair's linearity in one run; one JSON entry per pair plus the arc's."""
-    with steps(args.quiet or args.json) as step:
-        step("measuring each front end alone")
-        scene, setup, pairs, paths, probe = prepare_arc(args)
-        lins = []
-        for pair in pairs:
-            cal = None
-            if not args.uncalibrated:
-                step(f"calibrating pair {pair}")
-                cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
-            step(f"pair {pair}: sweeping {args.points} set-points ({args.amplitudes} amplitudes)")
-            lins.append(linearity(setup, paths, pair, args.amplitudes, probe, cal, args.points,
-                                  scene.seed))
-    worst = [lin.max_abs_error_deg for lin in lins]
-    out = {"pairs": [lin.to_dict() for lin in lins],
-           "arc": {"pairs": [list(p) for p in pairs], "max_abs_error_deg": max(worst),
-                   "worst_pair": list(pairs[int(np.argmax(worst))]),
-                   "calibrated": not args.uncalibrated, "amplitudes": args.amplitudes}}
-    if folder is not None:
-        from ..viz.figures import linearity_figure, save_figure
-        for pair, lin in zip(pairs, lins):
-            save_figure(linearity_figure(lin.set_deg, {args.amplitudes: lin.detected_deg},
-                                         {args.amplitudes: lin.amplitude_db}),
-                        folder / f"linearity_{pair[0]}_{pair[1]}.png")
-        write_json(folder / "linearity.json", out)
-    if args.json:
-        print_json(out)
-        return 0
-    state = "uncalibrated" if args.uncalibrated else "calibrated"
-    for pair, lin in zip(pairs, lins):
-        print(f"pair {pair}: {args.amplitudes} ({state}): max |error| "
-              f"{lin.max_abs_error_deg:.4f} deg over {len(lin.set_deg)} set-points")
-    print(f"arc ({len(pairs)} pairs): max |error| {max(worst):.4f} deg (pair "
-          f"{tuple(out['arc']['worst_pair'])})")
-    return 0
+__all__ = ["coverage_spec", "design_coverage"]
 
 
 def coverage_spec(text: str) -> tuple[float, float]:
