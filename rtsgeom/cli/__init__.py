@@ -29,7 +29,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "calibrate": ("calibrate", "phase calibration sweep of a front-end pair"),
     "linearity": ("linearity", "synthesized-angle linearity across a pair's span"),
     "tolerance": ("tolerance", "mounting-tolerance Monte Carlo of a front-end pair or a whole arc"),
-    "design": ("tolerance", "arc radius x front-end spacing design map"),
+    "design": ("design", "arc radius x front-end spacing design map"),
     "nearfield": ("analysis", "near-field violation: single front-end bias, phase error and "
                               "synthesized-angle error vs arc radius"),
     "ghosts": ("analysis", "cable ghosts: predicted ranges and levels per front end and "
