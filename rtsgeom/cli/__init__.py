@@ -30,11 +30,11 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "linearity": ("linearity", "synthesized-angle linearity across a pair's span"),
     "tolerance": ("tolerance", "mounting-tolerance Monte Carlo of a front-end pair or a whole arc"),
     "design": ("design", "arc radius x front-end spacing design map"),
-    "nearfield": ("analysis", "near-field violation: single front-end bias, phase error and "
+    "nearfield": ("nearfield", "near-field violation: single front-end bias, phase error and "
                               "synthesized-angle error vs arc radius"),
-    "ghosts": ("analysis", "cable ghosts: predicted ranges and levels per front end and "
+    "ghosts": ("ghosts", "cable ghosts: predicted ranges and levels per front end and "
                            "target (and simulated with --simulate)"),
-    "show": ("viz", "3D view of the setup: PNG, interactive HTML or a window"),
+    "show": ("show", "3D view of the setup: PNG, interactive HTML or a window"),
     "identify": ("identify", "estimate each front end's mounting errors and each channel's "
                              "gain/phase/delay from probe captures"),
 }
