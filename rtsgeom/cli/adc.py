@@ -11,6 +11,7 @@ import numpy as np
 from .._lib.io import atomic_path, write_bytes, write_json
 from ..errors import CaptureError, ParameterError, UsageError
 from ..pipeline.run import run_scene
+from ..radar.dca1000 import to_dca1000
 from ..scene.registry import AOA_MODES
 from ._common import (calibration_kw, load_scene_checked, number, output_file, output_path,
                       scene_arg, steps)
@@ -35,7 +36,6 @@ def cmd_adc(args) -> int:
         print(f"wrote {args.out}: complex64 {list(cube.shape)} "
               "[chirp_loop, virtual_channel, sample]")
     else:
-        from ..radar.dca1000 import to_dca1000
         try:
             raw, scale = to_dca1000(cube)
         except ParameterError as exc:

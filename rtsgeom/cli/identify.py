@@ -4,9 +4,11 @@ gain, phase and delay) from probe captures (``rtsgeom adc --active I``) with
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 from ..errors import CaptureError, UsageError
+from ..identify import identified_scene_toml, identify, read_capture
 from ._common import load_scene_checked, output_folder, output_path, print_json, scene_arg, steps
 
 
@@ -33,7 +35,6 @@ def _text(d: dict) -> str:
 
 
 def cmd_identify(args) -> int:
-    from ..identify import identified_scene_toml, identify, read_capture
     with output_folder(args.out, [args.scene, *args.captures]) as stage:
         scene = load_scene_checked(args.scene)
         try:
@@ -49,7 +50,6 @@ def cmd_identify(args) -> int:
                 raise UsageError(f"CAPTURE: {exc}") from None
         d = ident.to_dict()
         if stage is not None:
-            import json
             text = Path(args.scene).read_text(encoding="utf-8")
             (stage / "identified.toml").write_text(identified_scene_toml(text, ident),
                                                    encoding="utf-8")
