@@ -140,8 +140,8 @@ DRAWS_REPLACE = ("draws mounting errors about the nominal setup; the scene's own
 def warn_scene_errors(scene, command: str, what: str = DRAWS_REPLACE) -> None:
     """Say on stderr that ``command`` works on the nominal setup
     (``geometry.setup.nominal_scene``) when the scene carries its own mounting, channel or RuT
-    pose errors (``geometry.setup.setup_errors``), which it does not start from (a new-user
-    trial wrote measured offsets into a scene and got the zero-offset scene's numbers).
+    pose errors (``geometry.setup.setup_errors``), which it does not start from (offsets
+    measured on a built setup and written into the scene would otherwise seem to be used).
     ``what``: the sentence after the command, ``{}`` the fields."""
     from ..geometry.setup import setup_errors
     fields = setup_errors(scene)

@@ -52,9 +52,9 @@ def _dask_address(text: str) -> str:
 
 
 def scales(args) -> tuple[np.ndarray, dict]:
-    """The per-axis scales (m: the sigma, or the uniform bound) from the old ``--sigma-*-mm``
-    flags or the new tolerance flags (``--radial-mm 0.2 --sigma-level 3``: +-0.2 mm at 3
-    sigma), and the rotation / RuT-pose tolerances (SI) of the new flags."""
+    """The per-axis scales (m: the sigma, or the uniform bound) from the scale flags
+    ``--sigma-*-mm`` or the tolerance flags (``--radial-mm 0.2 --sigma-level 3``: +-0.2 mm at 3
+    sigma), and the rotation / RuT-pose tolerances (SI) of the tolerance flags."""
     k = 1.0 / args.sigma_level if args.distribution == "normal" else 1.0
     sigma = []
     for axis in AXES:
@@ -67,7 +67,6 @@ def scales(args) -> tuple[np.ndarray, dict]:
              "rut_position_m": (args.rut_position_mm * 1e-3,) * 3,
              "rut_yaw_rad": np.radians(args.rut_yaw_deg)}
     return np.array(sigma) * 1e-3, extra
-
 
 
 def _wants_cell(args, scene) -> bool:
