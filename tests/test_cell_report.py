@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from rtsgeom.cli.signal import _targets_table
+from rtsgeom.cli._maps import targets_table
 from rtsgeom.geometry import build_setup
 from rtsgeom.pipeline.info import format_info, scene_info
 from rtsgeom.scene import load_scene
@@ -51,7 +51,7 @@ def _match(k, el=None, detected=True):
 
 @pytest.mark.parametrize("el", [None, 3.0])
 def test_targets_table_columns(el):
-    tab = _targets_table([_match(0, el), _match(1, el, detected=False)])
+    tab = targets_table([_match(0, el), _match(1, el, detected=False)])
     n = 4 if el is not None else 3
     assert len(tab["columns"]) == 1 + 3 * n == len(tab["digits"])
     assert all(len(r) == len(tab["columns"]) for r in tab["rows"])

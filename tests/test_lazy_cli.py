@@ -106,16 +106,16 @@ def _subparsers(parser):
     return next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
 
 
-def test_command_table_matches_the_groups():
-    """The lazy table (name, group, help) is what the groups register, in the same order, and
+def test_command_table_matches_the_modules():
+    """The lazy table (name, module, help) is what the modules register, in the same order, and
     each command's lazily built parser equals its parser in the complete one."""
     full = _subparsers(build_parser())
     listed = [(a.dest, a.help) for a in full._choices_actions]
     assert listed == [(name, helptext) for name, (_g, helptext) in COMMANDS.items()]
-    for name, (group, _h) in COMMANDS.items():
+    for name, (module, _h) in COMMANDS.items():
         prog_full = full.choices[name]
         lazy = _subparsers(build_parser(name, lazy=True))
         assert lazy.choices[name].format_help() == prog_full.format_help()
-        assert prog_full.get_default("func").__module__ == f"rtsgeom.cli.{group}"
+        assert prog_full.get_default("func").__module__ == f"rtsgeom.cli.{module}"
     top_lazy = build_parser(None, lazy=True).format_help()
     assert top_lazy == build_parser().format_help()

@@ -20,13 +20,13 @@ from conftest import DEFAULT_SCENE
 def run_out(tmp_path_factory):
     """One ``rtsgeom run`` of the default scene (nearest amplitudes: the fast simulation,
     injected like tests/test_reliability.py's ``fast_run``) and its in-memory result."""
-    import rtsgeom.cli.signal as sig
+    import rtsgeom.cli.run as run
     from rtsgeom.pipeline.run import run_scene
     from rtsgeom.scene import load_scene
     result = run_scene(load_scene(DEFAULT_SCENE), "exact", "nearest")
     out = tmp_path_factory.mktemp("maps") / "out"
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(sig, "run_scene", lambda *a, **k: result)
+        mp.setattr(run, "run_scene", lambda *a, **k: result)
         assert main(["run", str(DEFAULT_SCENE), "--out", str(out), "--quiet",
                      "--no-report"]) == 0
     return out, result
@@ -97,7 +97,7 @@ def test_netcdf(run_out):
 
 def test_other_outputs_unchanged(run_out):
     """detections.csv / summary.json keep their contract; the PNGs are still written."""
-    from rtsgeom.cli.signal import detections_csv
+    from rtsgeom.cli._maps import detections_csv
     from rtsgeom.pipeline.run import summary
     out, result = run_out
     assert (out / "detections.csv").read_text() == detections_csv(result)

@@ -1,45 +1,52 @@
 """Command-line interface: thin wrappers over the library, outputs written atomically.
 
-Each module of this package registers one group of subcommands. Bad input (scene files,
+One module per command (``info.py``, ``run.py``, ... as :data:`COMMANDS` lists them): each
+registers its arguments, calls the library and writes its output. What several commands share
+is in ``_common.py``; the maps and report of ``run`` in ``_maps.py``. Bad input (scene files,
 arguments) ends with one clear line on stderr and exit code 2, never a traceback.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
+import os
 import signal as _sig
 import sys
+import threading
 
 from .. import __version__
-from ..errors import Terminated
+from ..errors import (ClusterError, OutputError, RaytraceUnavailable, SceneError, Terminated,
+                      UsageError)
 
 __all__ = ["main", "build_parser"]
 
-_GROUPS = ("geometry", "signal", "aoa", "tolerance", "analysis", "viz", "identify")
-
-#: Every subcommand: (group module that registers it, its one-line help). ``main`` imports only
-#: the group of the command it runs (the groups import numpy, scipy, the signal chain), so
-#: ``rtsgeom --help`` and ``rtsgeom info`` start without the heavy libraries; the other
-#: commands are listed from this table. ``tests/test_lazy_cli.py`` checks it against what the
-#: groups register.
+#: Every subcommand: (the module of this package that registers it, its one-line help). ``main``
+#: imports only the module of the command it runs (the modules import numpy, scipy, the signal
+#: chain), so ``rtsgeom --help`` and ``rtsgeom info`` start without the heavy libraries; the
+#: other commands are listed from this table. ``tests/test_lazy_cli.py`` checks it against what
+#: the modules register.
 COMMANDS: dict[str, tuple[str, str]] = {
-    "info": ("geometry", "summary of a scene: elements, front ends, far-field figures"),
-    "paths": ("geometry", "per-element propagation paths as CSV"),
-    "export-mesh": ("geometry", "export the setup as GLB/PLY/OBJ/STL"),
-    "run": ("signal", "the main job: simulate the scene, detect, compare with set-points"),
-    "adc": ("signal", "save the raw ADC cube (.npy) or a DCA1000 capture"),
-    "calibrate": ("aoa", "phase calibration sweep of a front-end pair"),
-    "linearity": ("aoa", "synthesized-angle linearity across a pair's span"),
+    "info": ("info", "summary of a scene: elements, front ends, far-field figures"),
+    "paths": ("paths", "per-element propagation paths as CSV"),
+    "export-mesh": ("export_mesh", "export the setup as GLB/PLY/OBJ/STL"),
+    "run": ("run", "the main job: simulate the scene, detect, compare with set-points"),
+    "adc": ("adc", "save the raw ADC cube (.npy) or a DCA1000 capture"),
+    "calibrate": ("calibrate", "phase calibration sweep of a front-end pair"),
+    "linearity": ("linearity", "synthesized-angle linearity across a pair's span"),
     "tolerance": ("tolerance", "mounting-tolerance Monte Carlo of a front-end pair or a whole arc"),
-    "design": ("tolerance", "arc radius x front-end spacing design map"),
-    "nearfield": ("analysis", "near-field violation: single front-end bias, phase error and "
-                              "synthesized-angle error vs arc radius"),
-    "ghosts": ("analysis", "cable ghosts: predicted ranges and levels per front end and "
-                           "target (and simulated with --simulate)"),
-    "show": ("viz", "3D view of the setup: PNG, interactive HTML or a window"),
+    "design": ("design", "arc radius x front-end spacing design map"),
+    "nearfield": ("nearfield", "near-field violation: single front-end bias, phase error and "
+                               "synthesized-angle error vs arc radius"),
+    "ghosts": ("ghosts", "cable ghosts: predicted ranges and levels per front end and "
+                         "target (and simulated with --simulate)"),
+    "show": ("show", "3D view of the setup: PNG, interactive HTML or a window"),
     "identify": ("identify", "estimate each front end's mounting errors and each channel's "
                              "gain/phase/delay from probe captures"),
 }
+
+#: the modules that register commands, in the table's order
+_MODULES = tuple(dict.fromkeys(module for module, _help in COMMANDS.values()))
 
 
 class _Parser(argparse.ArgumentParser):
@@ -57,34 +64,33 @@ def _on_sigterm(signum, frame):
 
 
 def build_parser(command: str | None = None, *, lazy: bool = False) -> argparse.ArgumentParser:
-    """The CLI's parser. By default every group registers its subcommands (the complete
-    parser). ``lazy``: only the group that owns ``command`` does (none for ``None``; all for a
-    word not in :data:`COMMANDS`, so a command a group registers but the table misses still
-    runs); the other commands appear with their help line (enough for ``rtsgeom --help`` and
-    for argparse's choice check) and nothing of their group is imported."""
+    """The CLI's parser. By default every command's module registers its command (the complete
+    parser). ``lazy``: only the module of ``command`` does (none for ``None``; all for a word
+    not in :data:`COMMANDS`, so a command a module registers but the table misses still runs);
+    the other commands appear with their help line (enough for ``rtsgeom --help`` and for
+    argparse's choice check) and nothing of their module is imported."""
     ap = _Parser(
         prog="rtsgeom",
         description="Radar target simulator setups as geometry: per-element paths, FMCW "
                     "signal model, arbitrary angle-of-arrival synthesis and its calibration.")
     ap.add_argument("--version", action="version", version=f"rtsgeom {__version__}")
     sub = ap.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    import importlib
     if not lazy or (command is not None and command not in COMMANDS):
-        groups = _GROUPS  # complete, or a word the table does not know: let every group try
+        modules = _MODULES  # complete, or a word the table does not know: let every module try
     else:
-        groups = (COMMANDS[command][0],) if command is not None else ()
-    for name in groups:
+        modules = (COMMANDS[command][0],) if command is not None else ()
+    for name in modules:
         try:
             mod = importlib.import_module(f".{name}", __name__)
-        except ModuleNotFoundError as exc:  # a group not written yet
+        except ModuleNotFoundError as exc:  # a module not written yet
             if exc.name != f"{__name__}.{name}":
                 raise
             continue
         mod.register(sub)
-    for cmd, (_group, helptext) in COMMANDS.items():  # the commands not registered above
+    for cmd, (_module, helptext) in COMMANDS.items():  # the commands not registered above
         if cmd not in sub.choices:
             sub.add_parser(cmd, help=helptext, add_help=False)
-    # list the commands in the table's order whichever group registered first (argparse keeps
+    # list the commands in the table's order whichever module registered first (argparse keeps
     # the help lines in registration order; no public API reorders them)
     order = list(COMMANDS)
     sub._choices_actions.sort(key=lambda a: order.index(a.dest)  # noqa: SLF001
@@ -101,17 +107,10 @@ def _command_of(argv: list[str]) -> str | None:
     return None
 
 
-def _raytrace_unavailable() -> type[Exception]:
-    """The ray tracer's 'no suitable LLVM/Sionna' error, without importing Sionna."""
-    from ..errors import RaytraceUnavailable
-    return RaytraceUnavailable
-
-
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = build_parser(_command_of(argv), lazy=True)
     args = parser.parse_args(argv)
-    import threading
     old = None
     if threading.current_thread() is threading.main_thread():
         old = _sig.signal(_sig.SIGTERM, _on_sigterm)
@@ -123,17 +122,12 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _dispatch(args) -> int:
-    from ..errors import OutputError
-    from ..errors import ClusterError
-    from ..errors import SceneError
-    from ..errors import UsageError
     try:
         return int(args.func(args) or 0)
-    except (SceneError, UsageError, OutputError, ClusterError, _raytrace_unavailable()) as exc:
+    except (SceneError, UsageError, OutputError, ClusterError, RaytraceUnavailable) as exc:
         print(f"rtsgeom: error: {exc}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # the reader went away (`rtsgeom ... | head`): stop quietly
-        import os
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     except OSError as exc:  # an output path that cannot be written, a missing input file

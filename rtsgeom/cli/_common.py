@@ -1,4 +1,12 @@
-"""Shared argument helpers of the CLI."""
+"""What several commands of the CLI share: argument types and options, the front-end pair
+words, ``--out`` staging, progress output, the calibration file of ``run``/``adc`` and the way
+a result is written and printed.
+
+Every command's module imports this one, ``rtsgeom info`` included: its own imports stay the
+standard library, :mod:`rtsgeom.errors` and :mod:`rtsgeom._lib.io`; the helpers that need the
+pipeline, figures or rich import them inside the function, so that a command does not load the
+parts of the pipeline it does not use.
+"""
 
 from __future__ import annotations
 
@@ -6,12 +14,18 @@ import argparse
 import json
 import math
 import sys
+import time
 from contextlib import contextmanager
 from pathlib import Path
-from ..errors import UsageError
+
+from .._lib.io import check_output_file, staged_dir, write_json
+from ..errors import ParameterError, UsageError
 
 __all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checked", "steps",
-           "output_path", "output_folder", "output_file"]
+           "output_path", "output_folder", "output_file", "DRAWS_REPLACE", "warn_scene_errors",
+           "pair_word", "pair_of", "pairs_of", "pair_options", "prepare_pair", "prepare_arc",
+           "emit_result", "write_outputs", "print_outputs", "progress", "study_options",
+           "read_calibration", "calibration_kw"]
 
 
 def number(lo=None, hi=None, integer=False):
@@ -46,14 +60,12 @@ def output_folder(out, inputs=()):
     if out is None:
         yield None
         return
-    from .._lib.io import staged_dir
     with staged_dir(out, [i for i in inputs if i is not None]) as stage:
         yield stage
 
 
 def output_file(out, inputs=()) -> Path:
     """Check an output file path before computing (exit 2 naming it); returns it."""
-    from .._lib.io import check_output_file
     check_output_file(out, [i for i in inputs if i is not None])
     return Path(out)
 
@@ -98,7 +110,6 @@ class steps:
         return self
 
     def __call__(self, label: str) -> None:
-        import time
         self._finish()
         if self.quiet:
             return
@@ -107,7 +118,6 @@ class steps:
         self._status.start()
 
     def _finish(self, failed: bool = False) -> None:
-        import time
         if self._status is not None:
             self._status.stop()
             if failed:  # the error message follows; no duration for a step that did not finish
@@ -130,8 +140,8 @@ DRAWS_REPLACE = ("draws mounting errors about the nominal setup; the scene's own
 def warn_scene_errors(scene, command: str, what: str = DRAWS_REPLACE) -> None:
     """Say on stderr that ``command`` works on the nominal setup
     (``geometry.setup.nominal_scene``) when the scene carries its own mounting, channel or RuT
-    pose errors (``geometry.setup.setup_errors``), which it does not start from (a new-user
-    trial wrote measured offsets into a scene and got the zero-offset scene's numbers).
+    pose errors (``geometry.setup.setup_errors``), which it does not start from (offsets
+    measured on a built setup and written into the scene would otherwise seem to be used).
     ``what``: the sentence after the command, ``{}`` the fields."""
     from ..geometry.setup import setup_errors
     fields = setup_errors(scene)
@@ -139,3 +149,185 @@ def warn_scene_errors(scene, command: str, what: str = DRAWS_REPLACE) -> None:
         more = f" and {len(fields) - 3} more" if len(fields) > 3 else ""
         print(f"rtsgeom: warning: {command} " + what.format(", ".join(fields[:3]) + more),
               file=sys.stderr)
+
+
+# -- the front-end pair: --pair I J | all, --cell Q.. | all ----------------------------------
+
+def pair_word(text: str):
+    """argparse type of one ``--pair`` (or ``--cell``) word: an index in [0, 10000] or
+    ``all``."""
+    if text == "all":
+        return text
+    return number(0, 10_000, integer=True)(text)
+
+
+def pairs_of(setup, pair) -> list[tuple[int, int]]:
+    """``--pair I J`` as one pair, or ``--pair all``: every adjacent pair of the arc."""
+    if list(pair) == ["all"]:
+        n = setup.fe.count
+        if n < 2:
+            raise UsageError("--pair all: the arc needs at least two front ends")
+        return [(i, i + 1) for i in range(n - 1)]
+    return [pair_of(setup, pair)]
+
+
+def pair_of(setup, pair):
+    """The pair in its canonical order, the lower index first (I keeps its delay, J is
+    swept): ``--pair 1 0`` and ``--pair 0 1`` are the same measurement and give the same
+    numbers (the front ends are ordered by angle in the scene)."""
+    if len(pair) != 2 or "all" in pair:
+        raise UsageError(f"--pair {' '.join(map(str, pair))}: must be two adjacent front-end "
+                         "indices I J, or all")
+    from ..pipeline.plan import check_pair
+    i, j = pair
+    try:
+        return check_pair(setup, i, j, f"--pair {i} {j}")
+    except ParameterError as exc:
+        raise UsageError(str(exc)) from None
+
+
+def pair_options(p: argparse.ArgumentParser) -> None:
+    """The scene and the options ``calibrate`` and ``linearity`` share: ``--pair I J | all``,
+    ``--json``, ``--out``, ``--quiet``, ``--fir``."""
+    scene_arg(p)
+    p.add_argument("--pair", nargs="+", type=pair_word, metavar="I J | all",
+                   default=[0, 1], help="adjacent front ends (default 0 1), or all: every "
+                                        "adjacent pair of the arc in one run")
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.add_argument("--out", type=output_path, default=None, help="folder for the plot and JSON")
+    p.add_argument("--quiet", action="store_true", help="no progress output")
+    p.add_argument("--fir", choices=("windowed-sinc", "ideal"), default=None,
+                   help="fractional-delay filter model (default: the scene's "
+                        "rts.fractional_delay_filter)")
+
+
+def prepare_pair(args):
+    """``--pair I J``: scene (with ``--fir`` applied), setup, the pair, exact paths and each
+    front end alone as the RuT detects it."""
+    from ..calibration.probes import probe_front_ends
+    from ..geometry import build_setup
+    from ..paths import exact_paths
+    scene = load_scene_checked(args.scene)
+    if getattr(args, "fir", None):  # override the scene's fractional-delay filter model
+        scene = scene.evolve(rts=scene.rts.evolve(fractional_delay_filter=args.fir))
+    setup = build_setup(scene)
+    pair = pair_of(setup, args.pair)
+    paths = exact_paths(setup)
+    return scene, setup, pair, paths, probe_front_ends(setup, paths, scene.seed)
+
+
+def prepare_arc(args):
+    """``--pair all``: scene, setup, every adjacent pair, exact paths, each front end alone."""
+    from ..calibration.probes import probe_front_ends
+    from ..geometry import build_setup
+    from ..paths import exact_paths
+    scene = load_scene_checked(args.scene)
+    setup = build_setup(scene)
+    pairs = pairs_of(setup, args.pair)
+    paths = exact_paths(setup)
+    return scene, setup, pairs, paths, probe_front_ends(setup, paths, scene.seed)
+
+
+# -- writing and printing a result ------------------------------------------------------------
+
+def emit_result(args, stage, png: str, name: str, out: dict, figure, summary_line: str) -> None:
+    """``--out DIR``: <png> (from ``figure()``) and <name>.json into the staging folder
+    ``stage`` (swapped in as DIR when the command ends); then JSON or one summary line on
+    stdout."""
+    if stage is not None:
+        from ..viz.figures import save_figure
+        save_figure(figure(), stage / png)
+        write_json(stage / f"{name}.json", out)
+    if args.json:
+        print_json(out)
+    else:
+        print(summary_line)
+
+
+def write_outputs(stage, name: str, out: dict, figure) -> None:
+    """Write ``NAME.json`` and ``NAME.png`` (``figure()``) into the staging folder of
+    ``--out`` (None: nothing)."""
+    if stage is not None:
+        from ..viz.figures import save_figure
+        write_json(stage / f"{name}.json", out)
+        save_figure(figure(), stage / f"{name}.png")
+
+
+def print_outputs(args, name: str, out: dict, text) -> int:
+    """Print the JSON (``--json``) or ``text(out)`` once the output folder is in place, and
+    the files :func:`write_outputs` wrote."""
+    if args.json:
+        print_json(out)
+    else:
+        print(text(out))
+        if args.out:
+            print(f"wrote {args.out}/{name}.json, {name}.png")
+    return 0
+
+
+@contextmanager
+def progress(quiet: bool):
+    """A ``progress(label, done, total)`` callback drawing one rich bar on stderr, relabelled
+    at each stage (None when quiet or when stderr is not a terminal)."""
+    if quiet or not sys.stderr.isatty():
+        yield None
+        return
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                  TimeElapsedColumn(), console=Console(stderr=True), transient=True) as bar:
+        task = bar.add_task("", total=None)
+
+        def update(label: str, done: int, total: int) -> None:
+            bar.update(task, description=label, completed=done, total=total)
+        yield update
+
+
+# -- the Monte-Carlo studies: tolerance and design ---------------------------------------------
+
+def study_options(p, draws_default: int, allow_all: bool = False) -> None:
+    """The scene and the options ``tolerance`` and ``design`` share (``allow_all``:
+    ``--pair I J | all``, else exactly two indices)."""
+    scene_arg(p)
+    if allow_all:
+        p.add_argument("--pair", nargs="+", type=pair_word, metavar="I J | all",
+                       default=[0, 1], help="adjacent front ends (default 0 1), or all: every "
+                                            "adjacent pair on shared per-front-end draws")
+    else:
+        p.add_argument("--pair", nargs=2, type=number(0, 10_000, integer=True),
+                       metavar=("I", "J"), default=[0, 1], help="adjacent front ends (default 0 1)")
+    p.add_argument("--spec-deg", type=number(1e-6, 90.0), default=0.1,
+                   help="angle-error spec in deg, in [1e-6, 90] (default 0.1)")
+    p.add_argument("--draws", type=number(1, 10_000_000, integer=True), default=draws_default,
+                   help=f"Monte-Carlo draws, in [1, 10000000] (default {draws_default})")
+    p.add_argument("--seed", type=number(0, 2 ** 63 - 1, integer=True), default=None,
+                   help="random seed (default: the scene's seed)")
+    p.add_argument("--points", type=number(3, 201, integer=True), default=21,
+                   help="set-points across the span, ends excluded, in [3, 201] (default 21)")
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.add_argument("--out", type=output_path, default=None, help="folder for the plots and JSON")
+    p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
+
+
+# -- --calibration FILE of run and adc ---------------------------------------------------------
+
+def read_calibration(path) -> dict | None:
+    """``--calibration FILE``: the JSON ``rtsgeom calibrate --out DIR`` wrote
+    (DIR/calibration.json), or None."""
+    if path is None:
+        return None
+    try:
+        doc = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise UsageError(f"--calibration {path}: cannot read it as JSON ({exc})") from None
+    if not isinstance(doc, dict):
+        raise UsageError(f"--calibration {path}: not a calibration file (a JSON object from "
+                         "`rtsgeom calibrate SCENE --out DIR`)")
+    return doc
+
+
+def calibration_kw(args) -> dict:
+    """``run_scene``'s calibration argument, only when ``--calibration`` was given (the
+    call without it stays as it was)."""
+    doc = read_calibration(getattr(args, "calibration", None))
+    return {} if doc is None else {"calibration": doc}

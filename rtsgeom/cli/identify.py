@@ -1,35 +1,15 @@
-"""``rtsgeom identify`` and ``rtsgeom adc --active``: measure a built setup from probe captures
-(``rtsgeom.identify``)."""
+"""``rtsgeom identify``: measure a built setup (each front end's mounting errors, each channel's
+gain, phase and delay) from probe captures (``rtsgeom adc --active I``) with
+:mod:`rtsgeom.identify`."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
-from ..errors import CaptureError, ParameterError
-from ..errors import UsageError
+from ..errors import CaptureError, UsageError
+from ..identify import identified_scene_toml, identify, read_capture
 from ._common import load_scene_checked, output_folder, output_path, print_json, scene_arg, steps
-
-
-def adc_probe_capture(scene, args) -> int:
-    """``rtsgeom adc SCENE --active I``: front end I alone with a probe target, on the setup as
-    built (the scene's mounting errors), receiver noise at the scene's SNR."""
-    from ..identify import setup_of, simulate_capture, write_capture
-    setup = setup_of(scene)
-    seed = (scene.seed or 0) + args.active if args.seed is None else args.seed
-    try:
-        with steps(args.quiet) as step:
-            step(f"simulating front end {args.active} alone with a probe target")
-            cap = simulate_capture(setup, args.active, args.probe_range_m,
-                                   args.probe_velocity_mps, seed)
-            meta = write_capture(cap, setup.rut, args.out, args.format)
-    except CaptureError as exc:
-        raise UsageError(f"--active/--probe-range-m: {exc}") from None
-    except ParameterError as exc:
-        raise UsageError(f"--format {args.format}: {exc}") from None
-    if not args.quiet:
-        print(f"wrote {args.out} and {args.out}.json: front end {cap.active} alone, probe at "
-              f"{cap.range_m:.3f} m, {cap.velocity_mps:+.3f} m/s ({meta['format']})")
-    return 0
 
 
 def _text(d: dict) -> str:
@@ -55,7 +35,6 @@ def _text(d: dict) -> str:
 
 
 def cmd_identify(args) -> int:
-    from ..identify import identified_scene_toml, identify, read_capture
     with output_folder(args.out, [args.scene, *args.captures]) as stage:
         scene = load_scene_checked(args.scene)
         try:
@@ -71,7 +50,6 @@ def cmd_identify(args) -> int:
                 raise UsageError(f"CAPTURE: {exc}") from None
         d = ident.to_dict()
         if stage is not None:
-            import json
             text = Path(args.scene).read_text(encoding="utf-8")
             (stage / "identified.toml").write_text(identified_scene_toml(text, ident),
                                                    encoding="utf-8")
@@ -100,4 +78,4 @@ def register(sub) -> None:
     p.set_defaults(func=cmd_identify)
 
 
-__all__ = ["adc_probe_capture", "cmd_identify", "register"]
+__all__ = ["cmd_identify", "register"]

@@ -1,13 +1,11 @@
-"""``rtsgeom tolerance | design``: the mounting-tolerance Monte Carlo of a front-end pair, a
-cell of front ends or a whole arc (one engine: :mod:`rtsgeom.analysis.tolerance`), and the arc
-design map (radius x front-end spacing)."""
+"""``rtsgeom tolerance``: the mounting-tolerance Monte Carlo of a front-end pair, a cell of front
+ends or a whole arc (one engine: :mod:`rtsgeom.analysis.tolerance`), with the chain check
+(``--verify``) and the yield search (``--invert-yield``)."""
 
 from __future__ import annotations
 
 import argparse
-import sys
 import time
-from contextlib import contextmanager
 
 import numpy as np
 
@@ -20,19 +18,18 @@ from ..analysis.tolerance.draws import draw_offsets
 from ..errors import AngleUnreachable, ClusterError, ParameterError, UsageError
 from ..geometry import build_setup
 from ..radar.steering import Steering
-from ._common import (load_scene_checked, number, output_folder, output_path, print_json, scene_arg,
-                      warn_scene_errors)
-from .aoa import _pair, _pair_arg, _pairs
-from .arc import coverage_spec
+from ._common import (load_scene_checked, number, output_folder, pair_word, pairs_of, print_json,
+                      progress, study_options, warn_scene_errors)
 
 #: ``tolerance``'s ``--pair`` default, by identity: left at it, a 2-D RuT gets the cell study
 DEFAULT_PAIR = [0, 1]
 MAX_SIGMA_MM = 10.0  # the phasor model is first order in the errors; checked to 0.3 mm
 #: Peak memory of one Monte-Carlo chunk is at most about ``chunk * chunk_bytes_per_draw(points)``
-#: (measured with tracemalloc, all three cases, the issue-13 model: 17 kB/draw at 5 set-points,
-#: 40 kB at 21, 112 kB at 61; a chunk is evaluated in blocks of ``tolerance.BLOCK_DRAWS``, so
-#: past that the peak stops growing); ``--chunk`` is capped so that one chunk stays within this
-#: budget. The draws do not depend on the chunk size, so the cap changes no result.
+#: (measured with tracemalloc, all three cases, the target's sub-bin position drawn per draw:
+#: 17 kB/draw at 5 set-points, 40 kB at 21, 112 kB at 61; a chunk is evaluated in blocks of the
+#: procedure's ``block_draws``, so past that the peak stops growing); ``--chunk`` is capped so
+#: that one chunk stays within this budget. The draws do not depend on the chunk size, so the
+#: cap changes no result.
 CHUNK_MEMORY_BYTES = 256 * 2 ** 20
 
 
@@ -54,49 +51,10 @@ def _dask_address(text: str) -> str:
         raise argparse.ArgumentTypeError(str(exc).split(": ", 1)[1]) from None
 
 
-@contextmanager
-def _progress(quiet: bool):
-    """A ``progress(label, done, total)`` callback drawing one rich bar on stderr, relabelled
-    at each stage (None when quiet or when stderr is not a terminal)."""
-    if quiet or not sys.stderr.isatty():
-        yield None
-        return
-    from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                  TimeElapsedColumn(), console=Console(stderr=True), transient=True) as bar:
-        task = bar.add_task("", total=None)
-
-        def update(label: str, done: int, total: int) -> None:
-            bar.update(task, description=label, completed=done, total=total)
-        yield update
-
-
-def _grid_spec(lo: float, hi: float, unit: str, max_n: int = 50):
-    """argparse type for ``A:B:N``: N values from A to B (A <= B, both in [lo, hi])."""
-    def parse(text: str) -> np.ndarray:
-        parts = text.split(":")
-        try:
-            a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
-            if len(parts) != 3:
-                raise ValueError
-        except (ValueError, IndexError):
-            raise argparse.ArgumentTypeError(f"{text!r} is not A:B:N (from A to B {unit}, "
-                                             "N values, e.g. 0.5:2:4)") from None
-        if not (lo <= a <= hi and lo <= b <= hi) or a > b:
-            raise argparse.ArgumentTypeError(
-                f"{text}: A and B must lie in [{lo:g}, {hi:g}] {unit} with A <= B")
-        if not 1 <= n <= max_n or (n == 1 and a != b):
-            raise argparse.ArgumentTypeError(
-                f"{text}: N must be in [1, {max_n}] (1 only with A == B)")
-        return np.linspace(a, b, n)
-    return parse
-
-
 def scales(args) -> tuple[np.ndarray, dict]:
-    """The per-axis scales (m: the sigma, or the uniform bound) from the old ``--sigma-*-mm``
-    flags or the new tolerance flags (``--radial-mm 0.2 --sigma-level 3``: +-0.2 mm at 3
-    sigma), and the rotation / RuT-pose tolerances (SI) of the new flags."""
+    """The per-axis scales (m: the sigma, or the uniform bound) from the scale flags
+    ``--sigma-*-mm`` or the tolerance flags (``--radial-mm 0.2 --sigma-level 3``: +-0.2 mm at 3
+    sigma), and the rotation / RuT-pose tolerances (SI) of the tolerance flags."""
     k = 1.0 / args.sigma_level if args.distribution == "normal" else 1.0
     sigma = []
     for axis in AXES:
@@ -109,7 +67,6 @@ def scales(args) -> tuple[np.ndarray, dict]:
              "rut_position_m": (args.rut_position_mm * 1e-3,) * 3,
              "rut_yaw_rad": np.radians(args.rut_yaw_deg)}
     return np.array(sigma) * 1e-3, extra
-
 
 
 def _wants_cell(args, scene) -> bool:
@@ -161,7 +118,7 @@ def _study(args, scene, bounds: Bounds) -> ToleranceModel:
     if arc and args.invert_yield is not None:
         raise UsageError("--invert-yield: only for one pair without rotation or RuT-pose errors "
                          "so far (rtsgeom design --coverage-deg finds the arc's tolerance)")
-    pairs = _pairs(setup, args.pair)
+    pairs = pairs_of(setup, args.pair)
     try:
         models = [ChannelPhasors.build(setup, p, args.points) for p in pairs]
     except AngleUnreachable as exc:  # the composite cannot reach a set angle
@@ -191,9 +148,9 @@ def _tolerance(args, scene, stage) -> int:
                  for m in model.sets[:1])
     chunk = args.chunk if kind == "arc" else capped_chunk(args.chunk, points)
     t0 = time.perf_counter()
-    with _progress(args.quiet) as progress, chunk_mapper(args.dask, args.workers) as mapper:
+    with progress(args.quiet) as report, chunk_mapper(args.dask, args.workers) as mapper:
         res = monte_carlo(model, bounds, args.draws, seed, args.distribution, args.spec_deg,
-                          cases, chunk, progress, "Monte Carlo (arc)" if kind == "arc"
+                          cases, chunk, report, "Monte Carlo (arc)" if kind == "arc"
                           else "Monte Carlo", mapper, keep_errors=stage is not None
                           and kind == "arc")
         out = res.to_dict()
@@ -201,13 +158,13 @@ def _tolerance(args, scene, stage) -> int:
             out["sigma_level"] = args.sigma_level if args.distribution == "normal" else None
         if args.verify:
             out["verify"] = verify_draws(model.sets[0], sigma, min(args.verify, args.draws),
-                                         seed, args.distribution, cases, progress=progress,
+                                         seed, args.distribution, cases, progress=report,
                                          all_points=args.verify_all_points).to_dict()
         if args.invert_yield is not None:
             out["inversion"] = {
                 case: max_sigma_for_yield(model, sigma, args.draws, seed, args.invert_yield,
                                           args.spec_deg, case, args.invert_axis,
-                                          args.distribution, chunk=chunk, progress=progress,
+                                          args.distribution, chunk=chunk, progress=report,
                                           mapper=mapper)
                 for case in CASES}
     elapsed = time.perf_counter() - t0
@@ -334,116 +291,10 @@ def _print_footer(out: dict, args, scale: str) -> None:
               f"{sig} mm{' (search cap)' if inv['capped'] else ''}")
 
 
-def cmd_design(args) -> int:
-    scene = load_scene_checked(args.scene)
-    warn_scene_errors(scene, "design")
-    with output_folder(args.out, [args.scene]) as stage:
-        return _design(args, scene, stage)
-
-
-def _design(args, scene, stage) -> int:
-    from ..analysis.design import check_azimuth_arc
-    from ..errors import ParameterError
-    try:  # an arc of pairs in azimuth only (the grid and --coverage-deg alike)
-        check_azimuth_arc(scene, f"design {args.scene}")
-    except ParameterError as exc:
-        raise UsageError(str(exc)) from None
-    if args.coverage_deg is not None:
-        from .arc import design_coverage
-        return design_coverage(args, scene, stage)
-    if args.draws is None:
-        args.draws = 2000
-    from ..analysis.design import METRICS, design_grid
-    pair = _pair(build_setup(scene), args.pair)
-    seed = scene.seed if args.seed is None else args.seed
-    with _progress(args.quiet) as progress:
-        grid = design_grid(scene, pair, args.radius_m, args.spacing_deg, args.spec_deg,
-                           args.yield_, args.draws, seed, args.points,
-                           None if progress is None else
-                           (lambda done, total: progress("designs", done, total)),
-                           workers=args.workers)
-    out = grid.to_dict()
-    if stage is not None:
-        from ..viz.figures import design_heatmap_figure, design_lines_figure, save_figure
-        mask = grid.exceeds_resolution
-        # a single radius or spacing is a 1-D sweep: lines, not a heat map of one row/column
-        draw = (design_lines_figure if min(grid.radius_m.size, grid.spacing_deg.size) == 1
-                else design_heatmap_figure)
-        for name, (zlabel, title) in METRICS.items():
-            fig = draw(
-                grid.radius_m, grid.spacing_deg, grid.metrics[name], "arc radius R_c (m)",
-                "front-end spacing (deg)", zlabel,
-                f"{title} ({'hatched' if draw is design_heatmap_figure else 'hollow'}: spacing > "
-                f"{grid.angular_resolution_deg:.1f} deg, eq. 24)", mask=mask)
-            save_figure(fig, stage / f"design_{name}.png")
-        write_json(stage / "design.json", out)
-    sheet_note = _sheet_note(out["designs"])
-    if args.json:
-        print_json(out)
-        if sheet_note and not args.quiet:
-            print(f"rtsgeom: {sheet_note}", file=sys.stderr)
-        return 0
-    print(f"pair {pair}, centre {grid.centre_deg:.2f} deg, angular resolution "
-          f"{grid.angular_resolution_deg:.2f} deg; tolerance: {100 * grid.target_yield:g} % "
-          f"within {grid.spec_deg:g} deg ({grid.draws} draws)")
-    print(f"{'R_c m':>6} {'sp deg':>7} {'worst deg':>10} {'bias deg':>9} {'offset mm':>10} "
-          f"{'sigma cal mm':>13} {'sigma unc mm':>13}  note")
-    for d in out["designs"]:
-        def f(key, fmt):  # "-" in the column's width where there is no value
-            return format(d[key], fmt) if d[key] is not None else "-".rjust(int(fmt.split(".")[0]))
-        note = d["problem"] or ", ".join(
-            ([] if d["sheet"] == "kept" else [f"sheet {d['sheet']}"])
-            + (["> resolution"] if d["exceeds_resolution"] else []))
-        print(f"{d['radius_m']:6.3g} {d['spacing_deg']:7.3g} {f('worst_error_deg', '10.4f')} "
-              f"{f('near_field_bias_deg', '9.4f')} {f('range_offset_mm', '10.2f')} "
-              f"{f('sigma_calibrated_mm', '13.4f')} {f('sigma_uncalibrated_mm', '13.4f')}  "
-              f"{note}")
-    if sheet_note:
-        print(sheet_note)
-    return 0
-
-
-def _sheet_note(designs: list[dict]) -> str:
-    """One line saying where the design disabled or widened the sheet (else empty)."""
-    parts = []
-    for state, why in (("disabled", "its cutouts do not fit (they would overlap or not hold "
-                                    "both antennas); no sheet is modelled there"),
-                       ("widened", "the front ends lie beyond it")):
-        hit = [d for d in designs if d["sheet"] == state]
-        if hit:
-            cells = ", ".join(f"{d['radius_m']:g} m/{d['spacing_deg']:g} deg" for d in hit[:6])
-            more = f" and {len(hit) - 6} more" if len(hit) > 6 else ""
-            parts.append(f"sheet {state} in {len(hit)} of {len(designs)} designs "
-                         f"(R_c/spacing {cells}{more}): {why}")
-    return "note: " + "; ".join(parts) if parts else ""
-
-
-def _common(p, draws_default: int, allow_all: bool = False) -> None:
-    scene_arg(p)
-    if allow_all:
-        p.add_argument("--pair", nargs="+", type=_pair_arg, metavar="I J | all",
-                       default=[0, 1], help="adjacent front ends (default 0 1), or all: every "
-                                            "adjacent pair on shared per-front-end draws")
-    else:
-        p.add_argument("--pair", nargs=2, type=number(0, 10_000, integer=True),
-                       metavar=("I", "J"), default=[0, 1], help="adjacent front ends (default 0 1)")
-    p.add_argument("--spec-deg", type=number(1e-6, 90.0), default=0.1,
-                   help="angle-error spec in deg, in [1e-6, 90] (default 0.1)")
-    p.add_argument("--draws", type=number(1, 10_000_000, integer=True), default=draws_default,
-                   help=f"Monte-Carlo draws, in [1, 10000000] (default {draws_default})")
-    p.add_argument("--seed", type=number(0, 2 ** 63 - 1, integer=True), default=None,
-                   help="random seed (default: the scene's seed)")
-    p.add_argument("--points", type=number(3, 201, integer=True), default=21,
-                   help="set-points across the span, ends excluded, in [3, 201] (default 21)")
-    p.add_argument("--json", action="store_true", help="print the result as JSON")
-    p.add_argument("--out", type=output_path, default=None, help="folder for the plots and JSON")
-    p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
-
-
 def register(sub) -> None:
     p = sub.add_parser("tolerance", help="mounting-tolerance Monte Carlo of a front-end pair "
                                          "or a whole arc")
-    _common(p, 10_000, allow_all=True)
+    study_options(p, 10_000, allow_all=True)
     mm = number(0.0, MAX_SIGMA_MM)
     for axis in AXES:
         p.add_argument(f"--sigma-{axis}-mm", type=mm, default=None,
@@ -492,32 +343,9 @@ def register(sub) -> None:
     p.add_argument("--workers", type=number(1, 1024, integer=True), default=None,
                    help="run the chunks in N local worker processes (forked; a local Dask "
                         "cluster where the platform cannot fork); results identical")
-    p.add_argument("--cell", nargs="+", type=_pair_arg, metavar="Q | all", default=None,
+    p.add_argument("--cell", nargs="+", type=pair_word, metavar="Q | all", default=None,
                    help="the study for a 2-D cell: 3 or 4 front-end indices, or all (a RuT "
                         "beamforming in azimuth and elevation; its default there when --pair "
                         "is not given); --points N gives about N set directions (a "
                         "round(sqrt N)^2 azimuth x elevation grid, those inside the cell)")
     p.set_defaults(func=cmd_tolerance, pair=DEFAULT_PAIR)
-
-    p = sub.add_parser("design", help="arc radius x front-end spacing design map")
-    _common(p, 2000)
-    p.add_argument("--radius-m", type=_grid_spec(0.1, 100.0, "m"), default=np.linspace(0.5, 2.0, 4),
-                   metavar="A:B:N", help="arc radii, N from A to B m (default 0.5:2:4)")
-    p.add_argument("--spacing-deg", type=_grid_spec(0.1, 90.0, "deg"),
-                   default=np.linspace(4.0, 20.0, 5), metavar="A:B:N",
-                   help="front-end spacings, N from A to B deg (default 4:20:5)")
-    p.add_argument("--coverage-deg", type=coverage_spec, default=None, metavar="A:B",
-                   help="design an arc of N front ends covering A..B deg for each --radius-m "
-                        "(number of front ends and spacing chosen; --spacing-deg and --pair "
-                        "unused)")
-    p.add_argument("--yield", dest="yield_", type=number(1e-6, 1.0), default=0.95, metavar="Y",
-                   help="fraction of setups within the spec for the tolerance, in (0, 1] "
-                        "(default 0.95)")
-    p.add_argument("--workers", type=number(1, 1024, integer=True), default=None,
-                   help="evaluate the grid's designs in N processes (same result; default: "
-                        "the cores this process may run on)")
-    # "--coverage-deg -10:10": argparse takes a word starting with "-" for an option unless it
-    # looks like a negative number; teach this parser that A:B ranges are numbers too.
-    import re
-    p._negative_number_matcher = re.compile(r"^-\d+$|^-\d*\.\d+$|^-?[\d.]+(:-?[\d.]+)+$")
-    p.set_defaults(func=cmd_design, draws=None)  # 2000 for the grid, 300 with --coverage-deg

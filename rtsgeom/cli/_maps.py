@@ -1,4 +1,6 @@
-"""``rtsgeom run | adc``: the signal chain from scene to detections."""
+"""The maps and the report of ``rtsgeom run``: detections as CSV, the range-Doppler and
+range-angle maps (PNG, and as arrays in ``maps.npz|mat|nc``) and the self-contained
+``report.html``, each as bytes or text from one :class:`~rtsgeom.pipeline.run.RunResult`."""
 
 from __future__ import annotations
 
@@ -10,13 +12,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ParameterError
-from .._lib.io import atomic_path, write_bytes, write_json, write_text
-from ..scene.registry import ANGLE_ESTIMATORS, AOA_MODES, PATH_METHODS
-from ..pipeline.run import RunResult, label_detections, run_scene, summary
-from ..errors import UsageError
-from ._common import (load_scene_checked, number, output_file, output_folder, output_path,
-                      scene_arg, steps)
+from .._lib.io import write_bytes, write_text
+from ..pipeline.run import RunResult, label_detections
+
+__all__ = ["detections_csv", "figure_png", "map_dataset", "maps_arrays", "render_maps",
+           "write_maps", "targets_table", "run_report_html", "write_run_report"]
 
 
 def detections_csv(result: RunResult) -> str:
@@ -147,7 +147,7 @@ def _setup_png(result: RunResult, paths_method: str) -> bytes:
                                 paths=paths).read_bytes()
 
 
-def _targets_table(matches: list[dict]) -> dict:
+def targets_table(matches: list[dict]) -> dict:
     """The report's set-point vs detection table; with elevation columns when a target has
     an elevation (a 2-D cell scene: ``set`` carries ``elevation_deg``)."""
     el = any("elevation_deg" in m["set"] for m in matches)
@@ -185,7 +185,7 @@ def run_report_html(result: RunResult, maps: dict[str, bytes], paths_method: str
     sections.append({"heading": "Setup", "images": images,
                      "text": f"Paths: {paths_method} ({len(result.paths)} rows)."})
     sections.append({"heading": "Targets: set-points and detections",
-                     "table": _targets_table(result.matches),
+                     "table": targets_table(result.matches),
                      "images": list(maps.values())})
     cal = result.calibration
     if cal:
@@ -223,158 +223,3 @@ def write_run_report(result: RunResult, out: Path, maps, paths_method: str,
         maps = {Path(p).name: Path(p).read_bytes() for p in maps}
     write_text(out / "report.html", run_report_html(result, maps, paths_method, warnings))
     return out / "report.html"
-
-
-def _read_calibration(path) -> dict | None:
-    """``--calibration FILE``: the JSON ``rtsgeom calibrate --out DIR`` wrote
-    (DIR/calibration.json), or None."""
-    if path is None:
-        return None
-    try:
-        doc = json.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise UsageError(f"--calibration {path}: cannot read it as JSON ({exc})") from None
-    if not isinstance(doc, dict):
-        raise UsageError(f"--calibration {path}: not a calibration file (a JSON object from "
-                         "`rtsgeom calibrate SCENE --out DIR`)")
-    return doc
-
-
-def _calibration_kw(args) -> dict:
-    """``run_scene``'s calibration argument, only when ``--calibration`` was given (the
-    call without it stays as it was)."""
-    doc = _read_calibration(getattr(args, "calibration", None))
-    return {} if doc is None else {"calibration": doc}
-
-
-def _with_estimator(scene, args):
-    """The scene with ``--estimator``/``--subarray`` applied (validated again, like the file:
-    e.g. smoothing needs capon or music)."""
-    est, sub = getattr(args, "estimator", None), getattr(args, "subarray", None)
-    if est is None and sub is None:
-        return scene
-    radar = scene.radar.evolve(**{k: v for k, v in (("angle_estimator", est),
-                                                     ("angle_subarray", sub)) if v is not None})
-    return scene.evolve(radar=radar)
-
-
-def cmd_run(args) -> int:
-    from ..geometry.warnings import scene_warnings
-    scene = _with_estimator(load_scene_checked(args.scene), args)
-    out = args.out
-    with output_folder(out, [args.scene]) as stage, steps(args.quiet) as step:
-        step(f"simulating {scene.name} ({args.paths} paths, calibration, ADC cube, detection)")
-        result = run_scene(scene, args.paths, args.amplitudes, **_calibration_kw(args))
-        step("writing detections, summary and maps")
-        (stage / "detections.csv").write_text(detections_csv(result), encoding="utf-8")
-        (stage / "summary.json").write_text(
-            json.dumps(summary(result, args.paths), indent=2, allow_nan=False) + "\n",
-            encoding="utf-8")
-        ds = map_dataset(result)
-        maps = render_maps(result, ds)
-        for name, data in {**maps, **maps_arrays(ds)}.items():
-            write_bytes(stage / name, data)
-        if not args.no_report:
-            step("writing report.html (3D view, figures)")
-            (stage / "report.html").write_text(
-                run_report_html(result, maps, args.paths,
-                                list(scene_warnings(scene)) + list(result.warnings)),
-                encoding="utf-8")
-    if not args.quiet:
-        for m in result.matches:
-            d, e = m["detection"], m["error"]
-            if d is None:
-                print(f"target {m['index']}: NOT DETECTED: {m['undetected']['reason']}")
-                continue
-            el = (f" el {d['elevation_deg']:7.3f} deg" if "elevation_deg" in d else "")
-            el_e = (f", el {e['elevation_deg']:+.3f} deg" if "elevation_deg" in e else "")
-            print(f"target {m['index']}: {d['range_m']:7.3f} m {d['velocity_mps']:+7.3f} m/s "
-                  f"{d['angle_deg']:8.3f} deg{el}  (errors {e['range_m']:+.3f} m, "
-                  f"{e['velocity_mps']:+.3f} m/s, {e['angle_deg']:+.3f} deg{el_e})")
-        for w in result.warnings:
-            print(f"warning: {w}")
-        print(f"{len(result.detections)} detections; wrote {out}/detections.csv, summary.json, "
-              "range_doppler.png, range_angle.png, maps.npz|mat|nc" + ("" if args.no_report else ", report.html"))
-    return 0
-
-
-def cmd_adc(args) -> int:
-    if args.format is None:  # from the file name: a .bin is a DCA1000 capture, else .npy
-        args.format = "dca1000" if args.out.suffix.lower() == ".bin" else "npy"
-    output_file(args.out, [args.scene])
-    if args.format == "dca1000" or args.active is not None:
-        output_file(Path(str(args.out) + ".json"), [args.scene])
-    scene = load_scene_checked(args.scene)
-    if args.active is not None:  # one front end alone on a probe target (rtsgeom identify)
-        from .identify import adc_probe_capture
-        return adc_probe_capture(scene, args)
-    with steps(args.quiet) as step:  # the calibration sweeps take about a minute
-        step(f"simulating {scene.name} (calibration, ADC cube)")
-        cube = run_scene(scene, "exact", args.amplitudes, **_calibration_kw(args)).cube
-    if args.format == "npy":
-        with atomic_path(args.out) as tmp:
-            with open(tmp, "wb") as fh:
-                np.save(fh, cube.data)
-        print(f"wrote {args.out}: complex64 {list(cube.shape)} "
-              "[chirp_loop, virtual_channel, sample]")
-    else:
-        from ..radar.dca1000 import to_dca1000
-        try:
-            raw, scale = to_dca1000(cube)
-        except ParameterError as exc:
-            raise UsageError(f"--format dca1000: {exc}") from None
-        write_bytes(args.out, raw)
-        n_l, n_v, n_s = cube.shape
-        meta = {"format": "dca1000-xwr18xx-complex-2lane", "scale": scale,
-                "chirps": n_l * len(cube.rut.tx_order), "tx_order": list(cube.rut.tx_order),
-                "num_rx": cube.rut.num_rx, "samples_per_chirp": n_s, "dtype": "int16 (<i2)",
-                "order": "chirp (transmit order) > rx > sample pairs I0 I1 Q0 Q1"}
-        write_json(Path(str(args.out) + ".json"), meta)
-        print(f"wrote {args.out} ({len(raw)} bytes, scale {scale:.6g}) and {args.out}.json")
-    return 0
-
-
-def register(sub) -> None:
-    modes = tuple(AOA_MODES)
-    p = sub.add_parser("run", help="the main job: simulate the scene, detect, compare with set-points")
-    scene_arg(p)
-    p.add_argument("--out", type=output_path, required=True, help="output folder")
-    p.add_argument("--paths", choices=tuple(PATH_METHODS), default="exact",
-                   help="exact line-of-sight paths (default) or Sionna RT ray tracing")
-    p.add_argument("--amplitudes", choices=modes, default=None,
-                   help="AoA amplitude mode (default: the scene's rts.aoa_mode)")
-    p.add_argument("--estimator", choices=tuple(ANGLE_ESTIMATORS), default=None,
-                   help="the RuT's direction estimator (default: the scene's "
-                        "radar.angle_estimator); `exact` designs against it")
-    p.add_argument("--subarray", type=number(0, 4096, integer=True), default=None,
-                   metavar="L", help="spatial smoothing subarray length for capon/music "
-                                     "(default: the scene's radar.angle_subarray; 0 = none)")
-    p.add_argument("--no-report", action="store_true", help="skip report.html")
-    p.add_argument("--quiet", action="store_true", help="print nothing but errors")
-    p.add_argument("--calibration", default=None, metavar="FILE",
-                   help="use this calibration (DIR/calibration.json from `rtsgeom calibrate "
-                        "--out DIR`) instead of calibrating again")
-    p.set_defaults(func=cmd_run)
-
-    p = sub.add_parser("adc", help="save the raw ADC cube (.npy) or a DCA1000 capture")
-    scene_arg(p)
-    p.add_argument("--out", type=output_path, required=True, help="output file")
-    p.add_argument("--format", choices=("npy", "dca1000"), default=None,
-                   help="npy (complex64 cube) or dca1000 (TI's raw int16 capture + sidecar "
-                        "JSON); default: dca1000 for a .bin file, else npy")
-    p.add_argument("--amplitudes", choices=modes, default=None,
-                   help="AoA amplitude mode (default: the scene's rts.aoa_mode)")
-    p.add_argument("--quiet", action="store_true", help="no progress output on stderr")
-    p.add_argument("--active", type=number(0, 10_000, integer=True), default=None, metavar="I",
-                   help="capture front end I alone with a probe target (for rtsgeom identify; "
-                        "the sidecar OUT.json records the probe)")
-    p.add_argument("--probe-range-m", type=number(0.01, 1e4), default=None, metavar="R",
-                   help="probe range with --active (default: the calibration's probe range)")
-    p.add_argument("--probe-velocity-mps", type=number(-1e3, 1e3), default=0.0,
-                   help="probe velocity with --active (default 0)")
-    p.add_argument("--seed", type=number(0, 2**32 - 1, integer=True), default=None,
-                   help="receiver-noise seed with --active (default: the scene's seed + I)")
-    p.add_argument("--calibration", default=None, metavar="FILE",
-                   help="use this calibration (DIR/calibration.json from `rtsgeom calibrate "
-                        "--out DIR`) instead of calibrating again")
-    p.set_defaults(func=cmd_adc)

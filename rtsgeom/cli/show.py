@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 import os
 
+from ..errors import UsageError
 from ..geometry import build_setup
 from ..scene.registry import PATH_METHODS
-from ..errors import UsageError
 from ._common import load_scene_checked, output_file, output_path, scene_arg
 
 

@@ -1,4 +1,6 @@
-"""``rtsgeom nearfield | ghosts``: setup analyses (near-field violation, cable ghosts)."""
+"""``rtsgeom nearfield``: the near-field violation of the arc against its radius: each front
+end's angle bias alone (separation, parallax, beat frequency, curvature), the phase error
+across the RuT's virtual array, and the synthesized-angle error of each pair (or cell)."""
 
 from __future__ import annotations
 
@@ -7,11 +9,10 @@ import math
 
 import numpy as np
 
-from ..errors import ParameterError
-from .._lib.io import write_json
-from ..errors import UsageError
-from ._common import (load_scene_checked, number, output_folder, output_path, print_json, scene_arg,
-                      steps, warn_scene_errors)
+from ..analysis.nearfield import default_radii, nearfield, nearfield_figure
+from ..errors import ParameterError, UsageError
+from ._common import (load_scene_checked, number, output_folder, output_path, print_outputs,
+                      scene_arg, steps, warn_scene_errors, write_outputs)
 
 
 def radius_sweep(text: str) -> tuple[float, float, int]:
@@ -75,7 +76,6 @@ def _nearfield_text(d: dict) -> str:
 
 
 def cmd_nearfield(args) -> int:
-    from ..analysis.nearfield import default_radii, nearfield, nearfield_figure
     scene = load_scene_checked(args.scene)
     warn_scene_errors(scene, "nearfield", "analyses the arc's near field on the nominal setup: "
                       "the scene's own errors ({}) play no part")
@@ -92,70 +92,8 @@ def cmd_nearfield(args) -> int:
         except ParameterError as exc:
             raise UsageError(f"--radius-m: {exc}") from None
         out = nf.to_dict()
-        _write(stage, "nearfield", out, lambda: nearfield_figure(nf))
-    return _emit(args, "nearfield", out, _nearfield_text)
-
-
-def _write(stage, name: str, out: dict, figure) -> None:
-    """Write ``NAME.json`` and ``NAME.png`` (``figure()``) into the staging folder of
-    ``--out`` (None: nothing)."""
-    if stage is not None:
-        from ..viz.figures import save_figure
-        write_json(stage / f"{name}.json", out)
-        save_figure(figure(), stage / f"{name}.png")
-
-
-def _emit(args, name: str, out: dict, text) -> int:
-    """Print the JSON (``--json``) or ``text(out)`` once the output folder is in place."""
-    if args.json:
-        print_json(out)
-    else:
-        print(text(out))
-        if args.out:
-            print(f"wrote {args.out}/{name}.json, {name}.png")
-    return 0
-
-
-def _ghosts_text(d: dict) -> str:
-    lines = [f"scene {d['scene']}: cable ghosts down to {d['floor_db']:g} dB"]
-    for fe in d["front_ends"]:
-        if not fe["mismatched"]:
-            lines.append(f"front end {fe['index']}: matched (no return loss given): no ghosts")
-            continue
-        lines.append(
-            f"front end {fe['index']}: cable {fe['cable_length_m']:g} m, VF "
-            f"{fe['cable_velocity_factor']:g}, loss {fe['cable_loss_db']:g} dB, return loss "
-            f"{fe['return_loss_fe_db']:g} dB (FE) / {fe['return_loss_be_db']:g} dB (BE): "
-            f"ghosts every {fe['range_offset_per_order_m']:.4f} m at "
-            + ", ".join(f"{g['level_db']:.2f}" for g in fe["ghosts"]) + " dB")
-    sim = {s["index"]: s for s in (d["simulated"] or [])}
-    for t in d["targets"]:
-        lines.append(f"target {t['index']} ({t['range_m']:g} m, {t['velocity_mps']:+g} m/s, "
-                     f"front end {t['front_end']}):")
-        meas = {g["order"]: g for g in sim[t["index"]]["ghosts"]} if t["index"] in sim else {}
-        for g in t["ghosts"]:
-            line = f"  ghost {g['order']}: {g['range_m']:8.3f} m {g['level_db']:8.2f} dB"
-            m = meas.get(g["order"])
-            if m is not None and not m.get("beyond_max_range"):
-                line += (f" | simulated {m['range_m']:8.3f} m ({m['offset_error_bins']:+.2f} bins)"
-                         f" {m['level_db']:8.2f} dB (map cell {m['level_db_bin']:.2f} dB, "
-                         f"{m['above_map_median_db']:.1f} dB above the map median"
-                         f"{', in the noise' if m['predicted_above_map_median_db'] < 6 else ''}"
-                         f"{', CFAR detection' if m['cfar_detected'] else ''})")
-            elif m is not None:
-                line += " | beyond the radar's range"
-            lines.append(line)
-    return "\n".join(lines)
-
-
-def cmd_ghosts(args) -> int:
-    from ..analysis.ghosts import ghost_analysis, ghosts_figure
-    scene = load_scene_checked(args.scene)
-    with output_folder(args.out, [args.scene]) as stage:
-        rep = ghost_analysis(scene, args.floor_db, simulate=args.simulate)
-        out = rep.to_dict()
-        _write(stage, "ghosts", out, lambda: ghosts_figure(rep))
-    return _emit(args, "ghosts", out, _ghosts_text)
+        write_outputs(stage, "nearfield", out, lambda: nearfield_figure(nf))
+    return print_outputs(args, "nearfield", out, _nearfield_text)
 
 
 def register(sub) -> None:
@@ -172,15 +110,3 @@ def register(sub) -> None:
                    help="folder for nearfield.json and nearfield.png")
     p.add_argument("--quiet", action="store_true", help="no progress output on stderr")
     p.set_defaults(func=cmd_nearfield)
-
-    p = sub.add_parser("ghosts", help="cable ghosts: predicted ranges and levels per front end "
-                                      "and target (and simulated with --simulate)")
-    scene_arg(p)
-    p.add_argument("--floor-db", type=number(-300.0, -1.0), default=-80.0,
-                   help="list ghost orders down to this level re the target (default -80 dB)")
-    p.add_argument("--simulate", action="store_true",
-                   help="run the signal chain (targets on their nearest front ends) and read "
-                        "each predicted ghost in the range-Doppler map")
-    p.add_argument("--json", action="store_true", help="print the result as JSON")
-    p.add_argument("--out", type=output_path, default=None, help="folder for ghosts.json and ghosts.png")
-    p.set_defaults(func=cmd_ghosts)

@@ -1,0 +1,221 @@
+"""``rtsgeom design``: the arc design map of a front-end pair (arc radius x front-end spacing:
+worst angle error, near-field bias, range offset and the mounting tolerance for a yield), or
+with ``--coverage-deg A:B`` the arc of N front ends covering A..B deg for each radius."""
+
+from __future__ import annotations
+
+import argparse
+import re
+import sys
+
+import numpy as np
+
+from .._lib.io import write_json
+from ..analysis.coverage import best_per_radius, coverage_designs
+from ..analysis.design import METRICS, check_azimuth_arc, design_grid
+from ..errors import ParameterError, UsageError
+from ..geometry import build_setup
+from ._common import (load_scene_checked, number, output_folder, pair_of, print_json, progress,
+                      study_options, warn_scene_errors)
+
+
+def _grid_spec(lo: float, hi: float, unit: str, max_n: int = 50):
+    """argparse type for ``A:B:N``: N values from A to B (A <= B, both in [lo, hi])."""
+    def parse(text: str) -> np.ndarray:
+        parts = text.split(":")
+        try:
+            a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
+            if len(parts) != 3:
+                raise ValueError
+        except (ValueError, IndexError):
+            raise argparse.ArgumentTypeError(f"{text!r} is not A:B:N (from A to B {unit}, "
+                                             "N values, e.g. 0.5:2:4)") from None
+        if not (lo <= a <= hi and lo <= b <= hi) or a > b:
+            raise argparse.ArgumentTypeError(
+                f"{text}: A and B must lie in [{lo:g}, {hi:g}] {unit} with A <= B")
+        if not 1 <= n <= max_n or (n == 1 and a != b):
+            raise argparse.ArgumentTypeError(
+                f"{text}: N must be in [1, {max_n}] (1 only with A == B)")
+        return np.linspace(a, b, n)
+    return parse
+
+
+def coverage_spec(text: str) -> tuple[float, float]:
+    """argparse type for ``--coverage-deg A:B`` (A < B, both in [-80, 80] deg)."""
+    try:
+        a, b = (float(x) for x in text.split(":"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not A:B (azimuths in deg, e.g. "
+                                         "-10:10)") from None
+    if not (-80.0 <= a < b <= 80.0):
+        raise argparse.ArgumentTypeError(f"{text}: need -80 <= A < B <= 80 deg")
+    return a, b
+
+
+def cmd_design(args) -> int:
+    scene = load_scene_checked(args.scene)
+    warn_scene_errors(scene, "design")
+    with output_folder(args.out, [args.scene]) as stage:
+        return _design(args, scene, stage)
+
+
+def _design(args, scene, stage) -> int:
+    try:  # an arc of pairs in azimuth only (the grid and --coverage-deg alike)
+        check_azimuth_arc(scene, f"design {args.scene}")
+    except ParameterError as exc:
+        raise UsageError(str(exc)) from None
+    if args.coverage_deg is not None:
+        return _design_coverage(args, scene, stage)
+    if args.draws is None:
+        args.draws = 2000
+    pair = pair_of(build_setup(scene), args.pair)
+    seed = scene.seed if args.seed is None else args.seed
+    with progress(args.quiet) as report:
+        grid = design_grid(scene, pair, args.radius_m, args.spacing_deg, args.spec_deg,
+                           args.yield_, args.draws, seed, args.points,
+                           None if report is None else
+                           (lambda done, total: report("designs", done, total)),
+                           workers=args.workers)
+    out = grid.to_dict()
+    if stage is not None:
+        from ..viz.figures import design_heatmap_figure, design_lines_figure, save_figure
+        mask = grid.exceeds_resolution
+        # a single radius or spacing is a 1-D sweep: lines, not a heat map of one row/column
+        draw = (design_lines_figure if min(grid.radius_m.size, grid.spacing_deg.size) == 1
+                else design_heatmap_figure)
+        for name, (zlabel, title) in METRICS.items():
+            fig = draw(
+                grid.radius_m, grid.spacing_deg, grid.metrics[name], "arc radius R_c (m)",
+                "front-end spacing (deg)", zlabel,
+                f"{title} ({'hatched' if draw is design_heatmap_figure else 'hollow'}: spacing > "
+                f"{grid.angular_resolution_deg:.1f} deg, eq. 24)", mask=mask)
+            save_figure(fig, stage / f"design_{name}.png")
+        write_json(stage / "design.json", out)
+    sheet_note = _sheet_note(out["designs"])
+    if args.json:
+        print_json(out)
+        if sheet_note and not args.quiet:
+            print(f"rtsgeom: {sheet_note}", file=sys.stderr)
+        return 0
+    print(f"pair {pair}, centre {grid.centre_deg:.2f} deg, angular resolution "
+          f"{grid.angular_resolution_deg:.2f} deg; tolerance: {100 * grid.target_yield:g} % "
+          f"within {grid.spec_deg:g} deg ({grid.draws} draws)")
+    print(f"{'R_c m':>6} {'sp deg':>7} {'worst deg':>10} {'bias deg':>9} {'offset mm':>10} "
+          f"{'sigma cal mm':>13} {'sigma unc mm':>13}  note")
+    for d in out["designs"]:
+        def f(key, fmt):  # "-" in the column's width where there is no value
+            return format(d[key], fmt) if d[key] is not None else "-".rjust(int(fmt.split(".")[0]))
+        note = d["problem"] or ", ".join(
+            ([] if d["sheet"] == "kept" else [f"sheet {d['sheet']}"])
+            + (["> resolution"] if d["exceeds_resolution"] else []))
+        print(f"{d['radius_m']:6.3g} {d['spacing_deg']:7.3g} {f('worst_error_deg', '10.4f')} "
+              f"{f('near_field_bias_deg', '9.4f')} {f('range_offset_mm', '10.2f')} "
+              f"{f('sigma_calibrated_mm', '13.4f')} {f('sigma_uncalibrated_mm', '13.4f')}  "
+              f"{note}")
+    if sheet_note:
+        print(sheet_note)
+    return 0
+
+
+def _sheet_note(designs: list[dict]) -> str:
+    """One line saying where the design disabled or widened the sheet (else empty)."""
+    parts = []
+    for state, why in (("disabled", "its cutouts do not fit (they would overlap or not hold "
+                                    "both antennas); no sheet is modelled there"),
+                       ("widened", "the front ends lie beyond it")):
+        hit = [d for d in designs if d["sheet"] == state]
+        if hit:
+            cells = ", ".join(f"{d['radius_m']:g} m/{d['spacing_deg']:g} deg" for d in hit[:6])
+            more = f" and {len(hit) - 6} more" if len(hit) > 6 else ""
+            parts.append(f"sheet {state} in {len(hit)} of {len(designs)} designs "
+                         f"(R_c/spacing {cells}{more}): {why}")
+    return "note: " + "; ".join(parts) if parts else ""
+
+
+COVERAGE_MAPS = {
+    "worst_calibrated_deg": ("worst |angle error| (deg)", "Calibrated, over the coverage"),
+    "worst_uncalibrated_deg": ("worst |angle error| (deg)", "Uncalibrated, over the coverage"),
+    "sigma_mm": ("mounting sigma (mm)", "Tolerance for the yield (whole arc)"),
+    "front_ends": ("front ends", "Number of front ends"),
+}
+
+
+def _design_coverage(args, scene, folder) -> int:
+    """``design --coverage-deg A:B``: N front ends per radius (``analysis.coverage``)."""
+    seed = scene.seed if args.seed is None else args.seed
+    draws = args.draws if args.draws is not None else 300
+    with progress(args.quiet) as report:
+        grid = coverage_designs(scene, args.coverage_deg, args.radius_m, args.spec_deg,
+                                args.yield_, draws, seed, min(args.points, 11),
+                                progress=None if report is None else
+                                (lambda done, total: report("designs", done, total)))
+    out = grid.to_dict()
+    if folder is not None:
+        from ..viz.figures import design_heatmap_figure, save_figure
+        extras = sorted({d.plan.extra for d in grid.designs})
+        for name, (zlabel, title) in COVERAGE_MAPS.items():
+            z = np.full((len(extras), grid.radius_m.size), np.nan)
+            for d in (design.to_dict() for design in grid.designs):
+                i = int(np.argmin(np.abs(grid.radius_m - d["radius_m"])))
+                v = d.get(name)
+                z[extras.index(d["extra"]), i] = np.nan if v is None else float(v)
+            fig = design_heatmap_figure(
+                grid.radius_m, np.array(extras, float), z, "arc radius R_c (m)",
+                "front ends beyond the fewest", zlabel,
+                f"{title}, coverage {args.coverage_deg[0]:g}..{args.coverage_deg[1]:g} deg")
+            save_figure(fig, folder / f"coverage_{name}.png")
+        write_json(folder / "coverage.json", out)
+    if args.json:
+        print_json(out)
+        return 0
+    a, b = args.coverage_deg
+    print(f"coverage {a:g}..{b:g} deg; spec {grid.spec_deg:g} deg; tolerance: "
+          f"{100 * grid.target_yield:g} % of whole arcs within the spec ({draws} draws)")
+    print("worst |angle error| over the coverage (deg): on the nominal arc, and p95 over arcs "
+          "with 0.1 mm sigma mounting errors")
+    print(f"{'R_c m':>6} {'N':>3} {'sp deg':>7} {'res deg':>8} {'cal':>7} {'uncal':>7} "
+          f"{'cal p95':>8} {'unc p95':>8} {'sigma mm':>9}  binding; sheet")
+    best = {id(d) for d in best_per_radius(grid)}
+    for design in grid.designs:
+        d = design.to_dict()
+
+        def f(key, fmt):
+            v = d.get(key)
+            return format(v, fmt) if v is not None and np.isfinite(v) else "-"
+        mark = "*" if id(design) in best else " "
+        why = ", ".join(d["binding"]) or "-"
+        print(f"{d['radius_m']:6.3g}{mark}{d['front_ends']:3d} {d['spacing_deg']:7.3f} "
+              f"{d['resolution_deg']:8.3f} {f('worst_calibrated_deg', '7.4f')} "
+              f"{f('worst_uncalibrated_deg', '7.4f')} {f('p95_calibrated_at_0.1mm_deg', '8.4f')} "
+              f"{f('p95_uncalibrated_at_0.1mm_deg', '8.4f')} {f('sigma_mm', '9.4f')}"
+              f"{'+' if d.get('sigma_capped') else ' '} {why}; {d['sheet_change']}"
+              + (f"; PROBLEM: {d['problem']}" if d["problem"] else ""))
+    print("best per radius (*): the fewest front ends within the spec after calibration")
+    for p in (d.plan for d in best_per_radius(grid)):
+        print(f"  R_c {p.radius_m:g} m: {p.front_ends} front ends at "
+              + ", ".join(f"{x:.2f}" for x in p.angles_deg) + f" deg; {p.sheet_change}")
+    return 0
+
+
+def register(sub) -> None:
+    p = sub.add_parser("design", help="arc radius x front-end spacing design map")
+    study_options(p, 2000)
+    p.add_argument("--radius-m", type=_grid_spec(0.1, 100.0, "m"), default=np.linspace(0.5, 2.0, 4),
+                   metavar="A:B:N", help="arc radii, N from A to B m (default 0.5:2:4)")
+    p.add_argument("--spacing-deg", type=_grid_spec(0.1, 90.0, "deg"),
+                   default=np.linspace(4.0, 20.0, 5), metavar="A:B:N",
+                   help="front-end spacings, N from A to B deg (default 4:20:5)")
+    p.add_argument("--coverage-deg", type=coverage_spec, default=None, metavar="A:B",
+                   help="design an arc of N front ends covering A..B deg for each --radius-m "
+                        "(number of front ends and spacing chosen; --spacing-deg and --pair "
+                        "unused)")
+    p.add_argument("--yield", dest="yield_", type=number(1e-6, 1.0), default=0.95, metavar="Y",
+                   help="fraction of setups within the spec for the tolerance, in (0, 1] "
+                        "(default 0.95)")
+    p.add_argument("--workers", type=number(1, 1024, integer=True), default=None,
+                   help="evaluate the grid's designs in N processes (same result; default: "
+                        "the cores this process may run on)")
+    # "--coverage-deg -10:10": argparse takes a word starting with "-" for an option unless it
+    # looks like a negative number; teach this parser that A:B ranges are numbers too.
+    p._negative_number_matcher = re.compile(r"^-\d+$|^-\d*\.\d+$|^-?[\d.]+(:-?[\d.]+)+$")
+    p.set_defaults(func=cmd_design, draws=None)  # 2000 for the grid, 300 with --coverage-deg
