@@ -408,13 +408,12 @@ def test_the_scenes_aoa_mode_is_the_one_run(mode, monkeypatch):
     """rts.aoa_mode: run_scene plans with the scene's mode when none is given; nearest puts each
     target on one channel at its nearest front end."""
     from rtsgeom.pipeline import run as run_mod
-    from rtsgeom.pipeline import plan
     seen = []
 
     def fake_plan(setup, paths, m, **kw):
         seen.append(m)
         return program_nearest(setup.scene, setup), {}, []
-    monkeypatch.setattr(plan, "plan_targets", fake_plan)
+    monkeypatch.setattr(run_mod, "plan_targets", fake_plan)
     s = scene_with(radar=dict(chirps_per_tx=32), rts=dict(aoa_mode=mode),
                    targets=[{"range_m": 30.0, "angle_deg": 7.0}])
     res = run_mod.run_scene(s)

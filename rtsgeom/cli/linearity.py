@@ -12,6 +12,7 @@ from ..calibration.pair import calibrate_pair
 from ..errors import AngleUnreachable, ParameterError, UsageError
 from ..geometry import build_setup
 from ..paths import exact_paths
+from ..radar.steering import Steering
 from ..scene.registry import SYNTHESIS_MODES
 from ._common import (emit_result, load_scene_checked, number, output_folder, pair_options,
                       prepare_arc, prepare_pair, print_json, steps)
@@ -50,22 +51,23 @@ def _linearity(args, stage) -> int:
 
 
 def _linearity_grid(args, stage) -> int:
-    from ..analysis.linearity2d import error_map_figure, linearity_grid
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
         scene = load_scene_checked(args.scene)
         setup = build_setup(scene)
+        if Steering.auto(setup.rut, scene.radar).dims != 2:
+            raise UsageError("linearity --grid needs a RuT with elevation (an array with "
+                             "elevation extent, e.g. radar.use_elevation_tx = true)")
         paths = exact_paths(setup)
         step(f"{'calibrating the channels, then ' if not args.uncalibrated else ''}"
              f"synthesizing a {args.grid} x {args.grid} grid ({args.amplitudes} amplitudes)")
         try:
-            em = linearity_grid(setup, paths, args.amplitudes, args.grid,
-                                not args.uncalibrated, scene.seed)
+            em = linearity(setup, paths, mode=args.amplitudes, points=args.grid,
+                           seed=scene.seed, calibrate=not args.uncalibrated)
         except (ParameterError, AngleUnreachable) as exc:
             raise UsageError(f"{args.scene}: {exc}") from None
-    mx = em.max_abs_error_deg()
-    emit_result(args, stage, "linearity_grid.png", "linearity_grid", em.to_dict(),
-                lambda: error_map_figure(em),
+    mx = em.max_abs_error_deg
+    emit_result(args, stage, "linearity_grid.png", "linearity_grid", em.to_dict(), em.plot,
                 f"{args.amplitudes} ({'calibrated' if em.calibrated else 'uncalibrated'}): max "
                 f"|error| azimuth {mx[0]:.4f} deg, elevation {mx[1]:.4f} deg over "
                 f"{em.set_deg.shape[0]} set-points")

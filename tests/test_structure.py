@@ -1,0 +1,147 @@
+"""The package's shape: one pipeline, one direction, visible in the folder list.
+
+Read from the source as text (nothing imported): every import, also those inside functions,
+points down the pipeline (a subpackage imports only from the stages below it), no module
+imports itself back through others (no import circle), the top level holds only the package's
+face, no module has grown into two concepts (500 lines), and the code cites no internal issue
+tracker (a reader of the code cannot look those up)."""
+
+from __future__ import annotations
+
+import ast
+import re
+
+import pytest
+
+from conftest import ROOT
+
+PKG = ROOT / "rtsgeom"
+
+#: the pipeline's stages from the bottom up: a module may import from its own stage and the
+#: ones before it (``rtsgeom`` itself only for ``__version__``)
+LAYERS = ("errors", "_lib", "scene", "geometry", "paths", "viz", "rts", "radar", "synthesis",
+          "calibration", "pipeline", "identify", "analysis", "api", "cli", "__main__")
+MAX_LINES = 500
+
+
+def _modules() -> dict[str, object]:
+    out = {}
+    for p in sorted(PKG.rglob("*.py")):
+        name = ".".join(p.relative_to(ROOT).with_suffix("").parts)
+        out[name[: -len(".__init__")] if name.endswith(".__init__") else name] = p
+    return out
+
+
+def _imports(name: str, path, mods) -> set[str]:
+    """The package's modules ``name`` imports (the deepest module each import names)."""
+    is_pkg = path.name == "__init__.py"
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            targets = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = name.split(".") if is_pkg else name.split(".")[:-1]
+            if node.level:
+                base = base[: len(base) - node.level + 1]
+                mod = ".".join(base + ([node.module] if node.module else []))
+            else:
+                mod = node.module or ""
+            targets = [mod] + [f"{mod}.{a.name}" for a in node.names]
+        else:
+            continue
+        for t in targets:
+            while t and t not in mods:
+                t = t.rpartition(".")[0]
+            if t and t != name and t.startswith("rtsgeom"):
+                found.add(t)
+    return found
+
+
+MODS = _modules()
+EDGES = {m: _imports(m, p, MODS) for m, p in MODS.items()}
+
+
+def _stage(module: str) -> str:
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else "rtsgeom"
+
+
+def test_every_import_points_down_the_pipeline():
+    bad = []
+    for m, targets in EDGES.items():
+        if _stage(m) == "rtsgeom":
+            continue  # the package's face (__init__) names everything lazily
+        own = LAYERS.index(_stage(m))
+        for t in targets:
+            stage = _stage(t)
+            if stage == "rtsgeom":
+                continue  # __version__
+            if LAYERS.index(stage) > own:
+                bad.append(f"{m} -> {t}")
+    assert not bad, bad
+
+
+def test_no_import_circle():
+    """Tarjan's strongly connected components of the module graph: every one a single
+    module."""
+    index, low, stack, on, circles = {}, {}, [], set(), []
+    counter = [0]
+
+    def strong(v):
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on.add(v)
+        for w in EDGES[v]:
+            if w not in index:
+                strong(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                circles.append(sorted(comp))
+
+    for v in MODS:
+        if v not in index:
+            strong(v)
+    assert not circles, circles
+
+
+def test_the_top_level_is_the_packages_face():
+    loose = sorted(p.name for p in PKG.glob("*.py"))
+    assert loose == ["__init__.py", "__main__.py", "api.py", "errors.py"], loose
+    assert {p.name for p in PKG.iterdir() if p.is_dir() and p.name != "__pycache__"} \
+        == set(LAYERS) - {"errors", "api", "__main__"}
+
+
+@pytest.mark.parametrize("module", sorted(MODS))
+def test_no_module_is_two_concepts(module):
+    lines = MODS[module].read_text().count("\n")
+    assert lines <= MAX_LINES, f"{module}: {lines} lines"
+
+
+def test_the_code_cites_no_issue_tracker():
+    rx = re.compile(r"\b[Ii]ssues? \d+\b|red[- ]team")
+    hits = [f"{p.relative_to(ROOT)}:{k}" for p in PKG.rglob("*.py")
+            for k, line in enumerate(p.read_text().splitlines(), 1) if rx.search(line)]
+    assert not hits, hits
+
+
+def test_every_exception_is_defined_in_errors():
+    """scikit-learn's one ``exceptions`` module: every exception class rtsgeom raises on
+    purpose lives in rtsgeom/errors.py."""
+    where = [f"{p.relative_to(ROOT)}: {node.name}" for p in PKG.rglob("*.py")
+             if p.name != "errors.py"
+             for node in ast.walk(ast.parse(p.read_text())) if isinstance(node, ast.ClassDef)
+             and any(isinstance(b, ast.Name) and (b.id.endswith(("Error", "Exception"))
+                                                 or b.id in ("KeyboardInterrupt",))
+                     for b in node.bases)]
+    assert not where, where
