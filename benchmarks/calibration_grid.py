@@ -52,7 +52,7 @@ def variant(scene, radius_m: float, fe: int | None, dr_m: float, noiseless: bool
 
 def nominal_point(scene_path: str, radius_m: float, noiseless: bool) -> dict:
     """Coherence point of the nominal setup at this radius (phasor model)."""
-    from rtsgeom.calibration.pair import coherence_delay
+    from rtsgeom.calibration.pair import pair_coherence
     from rtsgeom.calibration.probes import probe_angles, probe_front_ends
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
@@ -63,7 +63,8 @@ def nominal_point(scene_path: str, radius_m: float, noiseless: bool) -> dict:
     probe = probe_front_ends(setup, paths, scene.seed)
     alphas = probe_angles(*probe.angle_rad[list(PAIR)])
     return {"radius_m": radius_m,
-            "coherence_s": coherence_delay(setup, paths, PAIR, alphas, 0.0),
+            "coherence_s": pair_coherence(setup, paths, PAIR, alphas=alphas,
+                                          near_s=0.0).continuous_s,
             "probe_angles_rad": [float(a) for a in alphas]}
 
 
@@ -71,7 +72,7 @@ def one_case(args: tuple) -> dict:
     scene_path, radius_m, fe, dr_m, noiseless, nominal_s, lin_points = args
     from rtsgeom.calibration.probes import (air_phase_slope_hz, if_phase_slope_hz, probe_angles,
                                             probe_front_ends, probe_ranges)
-    from rtsgeom.calibration.pair import calibrate_pair, coherence_delay
+    from rtsgeom.calibration.pair import calibrate_pair, pair_coherence
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     from rtsgeom.scene import load_scene
@@ -87,7 +88,7 @@ def one_case(args: tuple) -> dict:
     sign = 1.0 if fe == PAIR[1] else -1.0
     closed = nominal_s - sign * float(air_phase_slope_hz(scene, tau)) / f_if * 2 * dr_m / c
     alphas = probe_angles(*probe.angle_rad[list(PAIR)])
-    phasor = coherence_delay(setup, paths, PAIR, alphas, cal.delta_tau_s)
+    phasor = pair_coherence(setup, paths, PAIR, alphas=alphas, near_s=cal.delta_tau_s).continuous_s
 
     def wrap(x):
         return float((x + period / 2) % period - period / 2)

@@ -66,7 +66,7 @@ def staircase_point(setup, paths, alphas, near_s: float) -> float:
 
 
 def run(res_ps=(1, 5, 10, 25, 50, 100, 250), radii=(1.0, 3.0), offsets_mm=(0.0, 0.3, -0.6)):
-    from rtsgeom.calibration.pair import calibrate_pair, coherence_point
+    from rtsgeom.calibration.pair import calibrate_pair, pair_coherence
     from rtsgeom.calibration.probes import probe_angles, probe_front_ends
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
@@ -82,7 +82,7 @@ def run(res_ps=(1, 5, 10, 25, 50, 100, 250), radii=(1.0, 3.0), offsets_mm=(0.0, 
                 t0 = time.process_time()
                 cal = calibrate_pair(setup, paths, PAIR, probe, seed=1)
                 cpu = time.process_time() - t0
-                cp = coherence_point(setup, paths, PAIR, alphas, cal.delta_tau_s)
+                cp = pair_coherence(setup, paths, PAIR, alphas=alphas, near_s=cal.delta_tau_s)
                 row = {"resolution_ps": float(res), "radius_m": radius, "dr_mm": dr,
                        "coherence_ps": cp.continuous_s * 1e12,
                        "staircase_ps": (staircase_point(setup, paths, alphas, cp.continuous_s)

@@ -47,7 +47,7 @@ def sphere4(field: str | None = None, value: float = 0.0, fe: int = 1):
 
 def case(field: str, value: float) -> dict:
     from rtsgeom.calibration.probes import probe_front_ends
-    from rtsgeom.calibration.channels import coherence_point_nd
+    from rtsgeom.calibration.pair import pair_coherence
     from rtsgeom.errors import SceneError
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
@@ -66,7 +66,8 @@ def case(field: str, value: float) -> dict:
     probe = probe_front_ends(setup, paths, scene.seed)
     rows = []
     for p in cal["pairs"]:
-        cp = coherence_point_nd(setup, paths, tuple(p["pair"]), probe, p["delta_tau_s"])
+        cp = pair_coherence(setup, paths, tuple(p["pair"]), probe,
+                            near_s=p["delta_tau_s"]).continuous_s
         rows.append({"pair": p["pair"], "delta_tau_ps": p["delta_tau_s"] * 1e12,
                      "coherence_ps": cp * 1e12, "error_ps": (p["delta_tau_s"] - cp) * 1e12})
     out.update(pairs=rows, loop_closure_ps=[x * 1e12 for x in cal["loop_closure_s"]],

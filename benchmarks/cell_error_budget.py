@@ -109,15 +109,15 @@ class Bench:
         import dataclasses
 
         from rtsgeom.calibration.steps import realisable
-        from rtsgeom.calibration.channels import coherence_point_nd
+        from rtsgeom.calibration.pair import pair_coherence
         meas = {tuple(p["pair"]): p for p in cal.pairs}
         off = np.zeros(self.setup.fe.count)
         per = float(np.median([p["period_s"] for p in cal.pairs]))
         cps = {}
         for p, q in cal.tree:
             i, j = min(p, q), max(p, q)
-            d = coherence_point_nd(self.setup, self.paths, (i, j), self.probe,
-                                   meas[(i, j)]["delta_tau_s"])
+            d = pair_coherence(self.setup, self.paths, (i, j), self.probe, near_s=meas[(i,
+                               j)]["delta_tau_s"]).continuous_s
             cps[(i, j)] = d
             off[q] = off[p] + (d if q == j else -d)
         off = off - per * np.round(off / per)
@@ -289,10 +289,11 @@ def cases(quick: bool):
 def ideal_tree_calibration(b: Bench, tree=((0, 1), (0, 2), (1, 3))):
     """A calibration whose tree pairs sit at their continuous coherence points nearest zero
     (rounded to 1 ps), without measuring: the reference the noise study designs on."""
-    from rtsgeom.calibration.channels import ChannelCalibration, coherence_point_nd
+    from rtsgeom.calibration.channels import ChannelCalibration
+    from rtsgeom.calibration.pair import pair_coherence
     off = np.zeros(b.setup.fe.count)
     for p, q in tree:
-        off[q] = off[p] + coherence_point_nd(b.setup, b.paths, (p, q), b.probe, 0.0)
+        off[q] = off[p] + pair_coherence(b.setup, b.paths, (p, q), b.probe, near_s=0.0).continuous_s
     return ChannelCalibration(np.round(off * 1e12) * 1e-12, 0, [], list(tree))
 
 
@@ -353,7 +354,8 @@ def frames_study(doc: dict, runs) -> list[dict]:
     averages) for each ``(k, seed)`` of ``runs``; each tree pair's distance from its
     continuous coherence point and the targets' noiseless and one-frame (the scene's
     ``snr_db``) errors with that calibration."""
-    from rtsgeom.calibration.channels import calibrate_channels, coherence_point_nd
+    from rtsgeom.calibration.channels import calibrate_channels
+    from rtsgeom.calibration.pair import pair_coherence
     b0 = Bench(parse(doc))
     cps, out = {}, []
     for k, seed in runs:
@@ -365,7 +367,8 @@ def frames_study(doc: dict, runs) -> list[dict]:
         for p in cal.pairs:
             pr = tuple(p["pair"])
             if pr not in cps:
-                cps[pr] = coherence_point_nd(b0.setup, b0.paths, pr, b0.probe, p["delta_tau_s"])
+                cps[pr] = pair_coherence(b0.setup, b0.paths, pr, b0.probe,
+                                         near_s=p["delta_tau_s"]).continuous_s
             errs[f"{pr[0]}-{pr[1]}"] = (p["delta_tau_s"] - cps[pr]) * 1e12
         prog, setup, paths = b0.program(cal)
         out.append({"frames": k, "seed": seed, "pair_error_ps": errs,

@@ -65,8 +65,9 @@ _LAZY = {
     "ChannelModel": (".synthesis.model", "ChannelModel"),
     "calibrate": (".api", "calibrate"),
     "calibrate_pair": (".calibration.pair", "calibrate_pair"),
-    "probe_front_ends": (".calibration.pair", "probe_front_ends"),
-    "Calibration": (".calibration.pair", "Calibration"),
+    "probe_front_ends": (".calibration.probes", "probe_front_ends"),
+    "Calibration": (".calibration.sweep", "Calibration"),
+    "SweepConfig": (".calibration.sweep", "SweepConfig"),
     "linearity": (".api", "linearity"),
     "Linearity": (".analysis.linearity", "Linearity"),
     # analyses

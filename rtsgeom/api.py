@@ -101,7 +101,7 @@ def linearity(scene: Scene, pair=(0, 1), amplitudes: str = "exact", calibration=
         How the amplitude ratio of the two channels is designed (eqs. 21-23, or the exact model).
     calibration : bool or Calibration
         ``True``: run the phase calibration first (:func:`calibrate`); a
-        :class:`~rtsgeom.calibration.pair.Calibration` of this pair: use it (one calibration
+        :class:`~rtsgeom.calibration.sweep.Calibration` of this pair: use it (one calibration
         for several modes); ``False``: uncalibrated, delay offset 0.
     points : int
         Set-points across the span (its ends excluded).

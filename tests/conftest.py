@@ -83,10 +83,10 @@ class CoherenceShift:
     def __init__(self, nom, probe):
         from rtsgeom.calibration.probes import (air_phase_slope_hz, if_phase_slope_hz, probe_angles,
                                                 probe_ranges, probe_total_delay)
-        from rtsgeom.calibration.pair import coherence_delay
+        from rtsgeom.calibration.pair import pair_coherence
         from rtsgeom.paths import exact_paths
         self.alphas = probe_angles(*probe.angle_rad[[0, 1]])
-        self.d0 = coherence_delay(nom, exact_paths(nom), (0, 1), self.alphas)
+        self.d0 = pair_coherence(nom, exact_paths(nom), (0, 1), alphas=self.alphas).continuous_s
         tau = probe_total_delay(nom, probe_ranges(nom, 2))
         self.ratio = air_phase_slope_hz(nom.scene, tau) / if_phase_slope_hz(nom.scene, tau)
         self.period = 1 / if_phase_slope_hz(nom.scene, tau)

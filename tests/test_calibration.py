@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.constants import c
 
-from rtsgeom.calibration.pair import calibrate_pair, coherence_delay
+from rtsgeom.calibration.pair import calibrate_pair, pair_coherence
 from rtsgeom.calibration.probes import (if_phase_slope_hz, probe_angles, probe_front_ends,
                                         probe_ranges, probe_total_delay)
 from rtsgeom.cli import main
@@ -107,7 +107,8 @@ def test_coherence_point_moves_by_the_closed_form(radius):
     shift = CoherenceShift(nom, probe_front_ends(nom, exact_paths(nom), 1))
     for fe, dr_mm in ((1, 0.3), (0, -0.7), (1, -0.45)):
         s = build_setup(_noiseless(radius, offsets={fe: dr_mm}))
-        d = coherence_delay(s, exact_paths(s), (0, 1), shift.alphas, shift.d0)
+        d = pair_coherence(s, exact_paths(s), (0, 1), alphas=shift.alphas,
+                           near_s=shift.d0).continuous_s
         assert abs(shift.wrapped(d, fe, dr_mm)) < 1e-12  # 1st order in dr: 0.6 ps at 0.7 mm on 0.5 m
 
 
@@ -238,7 +239,7 @@ def test_paper_procedure_minima_are_one_period_apart_and_its_optimum_is_off_cohe
     late because a period of delay moves J's echo by 1.3 range bins and the fixed amplitudes
     do not know it (measured: 1.10 ns apart); its optimum is not the coherence point (the
     fixed design's own error is traded against phase)."""
-    from rtsgeom.calibration.pair import calibrate_pair_paper
+    from rtsgeom.calibration.paper import calibrate_pair_paper
     setup = build_setup(make_scene())
     paths = exact_paths(setup)
     probe = probe_front_ends(setup, paths, 1)
@@ -250,8 +251,8 @@ def test_paper_procedure_minima_are_one_period_apart_and_its_optimum_is_off_cohe
     step = t[1] - t[0]
     spacing = abs(t[deep[1]] - t[deep[0]])
     assert cal.period_s - step <= spacing <= cal.period_s + 0.15e-9
-    coherent = coherence_delay(setup, paths, (0, 1), probe_angles(*probe.angle_rad[[0, 1]]),
-                               cal.delta_tau_s)
+    coherent = pair_coherence(setup, paths, (0, 1), alphas=probe_angles(*probe.angle_rad[[0, 1]]),
+                              near_s=cal.delta_tau_s).continuous_s
     assert abs(cal.delta_tau_s - coherent) > 2 * step  # measured: about 200 ps
 
 
@@ -445,8 +446,9 @@ def test_calibrated_delay_is_realisable_and_the_residual_is_reported(res_ps, fra
     # the coherence point on the same geometry with a (near) continuous delay: the model of a
     # coarse RTS rounds every delay it is given, which makes its phase a staircase
     fine = build_setup(make_scene(lambda doc: doc["rts"].update(fractional_delay_step_s=1e-15)))
-    point = coherence_delay(fine, exact_paths(fine), (0, 1),
-                            probe_angles(*probe.angle_rad[[0, 1]]), cal.delta_tau_s)
+    point = pair_coherence(fine, exact_paths(fine), (0, 1),
+                           alphas=probe_angles(*probe.angle_rad[[0, 1]]),
+                           near_s=cal.delta_tau_s).continuous_s
     fitted = cal.delta_tau_s + cal.quantisation_residual_s
     assert cal.delta_tau_s == pytest.approx(float(realisable(fitted, res)), abs=1e-18)
     # the fit finds the coherence point to a few ps whatever the step; at 250 ps (3 fine

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from conftest import make_scene
-from rtsgeom.calibration.pair import calibrate_pair, coherence_point
+from rtsgeom.calibration.pair import calibrate_pair, pair_coherence
 from rtsgeom.calibration.steps import (continuous_delay_setup, fine_window, realisable,
                                        realisation_shift)
 from rtsgeom.calibration.probes import probe_angles, probe_front_ends, probe_ranges
@@ -61,10 +61,10 @@ def test_coherence_point_is_the_continuous_one_whatever_the_step(radius, dr_mm, 
     step."""
     alphas = probe_angles(*probe.angle_rad[[0, 1]])
     ref = _scene(1e-3, radius, dr_mm)
-    truth = coherence_point(ref, exact_paths(ref), (0, 1), alphas).continuous_s
+    truth = pair_coherence(ref, exact_paths(ref), (0, 1), alphas=alphas).continuous_s
     for res_ps in RES_PS:
         s = _scene(res_ps, radius, dr_mm)
-        cp = coherence_point(s, exact_paths(s), (0, 1), alphas)
+        cp = pair_coherence(s, exact_paths(s), (0, 1), alphas=alphas)
         res = res_ps * 1e-12
         assert cp.delay_resolution_s == pytest.approx(res)
         assert cp.continuous_s == pytest.approx(truth, abs=0.05e-12)
@@ -103,13 +103,14 @@ def test_continuous_model_equals_the_quantised_one_at_realisable_offsets(res_ps,
 
 
 def test_fine_window_and_realisation_shift():
-    """Sparse fine sweeps switch to the interpolating vertex fit; the quantiser's offset
-    error is zero where the step divides 1/f_s and up to a step where it does not."""
+    """The fine sweep spans +-period/4 in the RTS's steps (at least one either side) and fits
+    two harmonics, one where only 3 points remain; the quantiser's offset error is zero where
+    the step divides 1/f_s and up to a step where it does not."""
     period = 1.0038e-9
-    assert fine_window(period / 4, 5e-12) == (50, 2, "joint")
-    assert fine_window(period / 4, 50e-12) == (5, 2, "joint")
-    assert fine_window(period / 4, 100e-12) == (2, 2, "vertex")
-    assert fine_window(period / 4, 250e-12) == (1, 1, "vertex")
+    assert fine_window(period / 4, 5e-12) == (50, 5e-12, 2)
+    assert fine_window(period / 4, 50e-12) == (5, 50e-12, 2)
+    assert fine_window(period / 4, 100e-12) == (2, 100e-12, 2)
+    assert fine_window(period / 4, 250e-12) == (1, 250e-12, 1)
     d = np.arange(-5, 6) * 50e-12
     s50 = _scene(50.0)
     assert np.all(realisation_shift(s50, probe_ranges(s50, 2), d) == pytest.approx(0.0,
@@ -125,8 +126,8 @@ def _check_calibration(res_ps, radius, dr_mm, probe, fractional=True, full_chain
     paths = exact_paths(s)
     cal = calibrate_pair(s, paths, (0, 1), probe, seed=1, full_chain=full_chain)
     res = s.scene.rts.delay_resolution_s
-    cp = coherence_point(s, paths, (0, 1), probe_angles(*probe.angle_rad[[0, 1]]),
-                         cal.delta_tau_s)
+    cp = pair_coherence(s, paths, (0, 1), alphas=probe_angles(*probe.angle_rad[[0, 1]]),
+                        near_s=cal.delta_tau_s)
     fitted = cal.delta_tau_s + cal.quantisation_residual_s
     tol = _tolerance(res)
     assert abs(fitted - cp.continuous_s) <= tol, (fitted - cp.continuous_s) * 1e12

@@ -18,39 +18,69 @@ def _wrap(x, per=PERIOD):
     return (x + per / 2) % per - per / 2
 
 
-# -- the fit's columns: the zero crossings, not the biased vertices --------------------------
+# -- the fit's columns: the zero crossings across the pair's line -----------------------------
 
 @pytest.mark.parametrize("true_ps", [-230.0, 29.0, 280.0])
 @pytest.mark.parametrize("bias_deg", [0.0, 0.02, 0.04])
 def test_fit_on_the_crossing_columns_finds_the_coherence_point_despite_biased_vertices(
         true_ps, bias_deg):
-    """Signed errors as the 2-D elevation pair gives them: along the axis even about the
-    coherence point (1 - cos) but its vertex past zero by the estimator's bias (so it
-    crosses zero twice), across it odd (sin). The
-    joint fit of all columns lands on a zero crossing of a biased even curve; of the
-    crossing columns alone, on the point (to the 0.05 ps search grid)."""
-    from rtsgeom.calibration.channels import crossing_columns
-    from rtsgeom.calibration.sweep import fit_minimum
+    """Signed errors as a 2-D pair gives them: along its line even about the coherence point
+    (1 - cos), its vertex past zero by the estimator's bias, across it odd (sin) with an even
+    part: only the across columns cross zero between the window's ends, and their fit as
+    crossing columns (zero at the point, any shape) lands on the point within 0.01 ps."""
+    from rtsgeom.calibration.fit import crossing_columns, fit_centre
     near = true_ps * 1e-12 + 40e-12  # the coarse minimum, a step and a half off
     d = near + np.arange(-25, 26) * 10e-12
     th = 2 * np.pi * (d - true_ps * 1e-12) / PERIOD
-    even = np.radians(1.2) * (1 - np.cos(th)) - np.radians(bias_deg)  # crosses zero twice
-    odd = np.radians(0.03) * np.sin(th)
+    even = np.radians(1.2) * (1 - np.cos(th)) - np.radians(bias_deg)
+    odd = np.radians(0.03) * np.sin(th) + np.radians(0.01) * (1 - np.cos(th))
     e = np.stack([odd, -even, 0.8 * odd, 0.9 * even], axis=1)
-    cols = crossing_columns(e)
-    assert cols.tolist() == [0, 2]
-    got = fit_minimum(d, e[:, cols], PERIOD, near, 2, 125e-12)
-    assert abs(got - true_ps * 1e-12) < 0.1e-12
-    if bias_deg:  # the criterion over all columns is what went wrong
-        assert abs(fit_minimum(d, e, PERIOD, near, 2, 125e-12) - true_ps * 1e-12) > 5e-12
+    cross = crossing_columns(e)
+    assert cross.tolist() == [True, False, True, False]
+    got = fit_centre(d, e[:, cross], PERIOD, near, 2, 125e-12, odd=[True, True])
+    assert abs(got - true_ps * 1e-12) < 0.01e-12
+    # fitted as symmetric (no zero at the point), the odd columns' even part moves it
+    assert abs(fit_centre(d, e[:, cross], PERIOD, near, 2, 125e-12) - true_ps * 1e-12) > 5e-12
 
 
-def test_crossing_columns_are_all_columns_when_none_crosses():
-    """A pair on an arc: every probe's error even (1-D fit unchanged)."""
-    from rtsgeom.calibration.channels import crossing_columns
+def test_crossing_columns_none_where_every_error_is_even():
+    """A pair on an arc: every probe's error even about the point, none crosses over a
+    window centred near it (a column never detected does not either)."""
+    from rtsgeom.calibration.fit import crossing_columns
     th = np.linspace(-np.pi / 2, np.pi / 2, 31)
     e = np.stack([1 - np.cos(th), 0.5 * (1 - np.cos(th)), np.full(th.size, np.nan)], 1)
-    assert crossing_columns(e).tolist() == [0, 1, 2]
+    assert crossing_columns(e).tolist() == [False, False, False]
+
+
+# -- a 2-D pair's coherence point: the array's phase centre -----------------------------------
+
+def test_elevation_pairs_coherence_point_is_the_phase_centres_closed_form():
+    """sphere4's pairs stacked in elevation are coherent at +29 ps on the perfect setup: the
+    four elevated virtual elements (lambda/2 up, 4 of 12) put the array's phase centre
+    lambda/6 above the RuT's reference, and a channel from direction u sees its phase k0 u .
+    p_c: (u_J - u_I) . p_c / lambda of a period. The model's point within 0.3 ps of that, and
+    the calibration (noiseless, full chain, across-the-line columns) within 3 ps of it."""
+    from rtsgeom.calibration.pair import calibrate_pair, pair_coherence
+    from rtsgeom.calibration.probes import probe_front_ends
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    scene = sphere4()
+    scene = scene.evolve(radar=scene.radar.evolve(snr_db=None))
+    setup = build_setup(scene)
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, 0)
+    rut = setup.rut
+    centre = rut.virtual_local.mean(axis=0)  # (x lateral, y, z up), radar frame
+    assert centre[2] == pytest.approx(rut.wavelength_m / 6, rel=1e-9)
+    u = setup.fe_direction_cosines(2)
+    for pair in ((0, 1), (2, 3)):
+        du = u[pair[1]] - u[pair[0]]
+        cal = calibrate_pair(setup, paths, pair, probe, seed=0)
+        closed = (du[0] * centre[0] + du[1] * centre[2]) / rut.wavelength_m * cal.period_s
+        assert closed == pytest.approx(29.2e-12, abs=0.1e-12)
+        point = pair_coherence(setup, paths, pair, probe, near_s=cal.delta_tau_s).continuous_s
+        assert abs(point - closed) < 0.3e-12
+        assert abs(cal.delta_tau_s - point) < 3e-12 and cal.odd_columns == cal.fit_columns
 
 
 # -- the solver's start with calibrated phases ------------------------------------------------
@@ -93,13 +123,15 @@ def test_calibrated_cell_reaches_its_directions_whatever_its_channel_offsets(
 
 def _fake_pairs(monkeypatch, delays_ps, fail=()):
     import rtsgeom.calibration.channels as ncal
+    from rtsgeom.calibration.sweep import Calibration
 
-    def fake(setup, paths, pair, probe, seed=0, span_s=None, step_s=None):
+    def fake(setup, paths, pair, probe, base_offsets=(0.0, 0.0), *, config=None):
         if tuple(pair) in fail:
             raise ncal.CalibrationFailed(f"pair {tuple(pair)}: no probe detected")
-        return {"pair": list(pair), "delta_tau_s": delays_ps[tuple(pair)] * 1e-12,
-                "period_s": PERIOD}
-    monkeypatch.setattr(ncal, "calibrate_pair_nd", fake)
+        none = np.zeros(0)
+        return Calibration(tuple(pair), delays_ps[tuple(pair)] * 1e-12, 0.0, 0.0, none, none,
+                           none, none, (), PERIOD)
+    monkeypatch.setattr(ncal, "calibrate_pair", fake)
 
 
 CONSISTENT = {(0, 1): 29.0, (0, 2): 2.0, (0, 3): 31.0, (1, 3): 2.0, (2, 3): 29.0}
@@ -182,20 +214,20 @@ def test_elevation_pair_calibrates_to_its_coherence_point_with_a_front_end_off(f
 
     from rtsgeom.calibration.probes import (air_phase_slope_hz, if_phase_slope_hz, probe_front_ends,
                                             probe_ranges, probe_total_delay)
-    from rtsgeom.calibration.channels import calibrate_pair_nd, coherence_point_nd
+    from rtsgeom.calibration.pair import calibrate_pair, pair_coherence
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     scene = sphere4(field, value)
     setup = build_setup(scene)
     paths = exact_paths(setup)
     probe = probe_front_ends(setup, paths, scene.seed)
-    got = calibrate_pair_nd(setup, paths, (0, 1), probe, scene.seed)
+    got = calibrate_pair(setup, paths, (0, 1), probe, seed=scene.seed).to_dict()
     per = got["period_s"]
-    point = coherence_point_nd(setup, paths, (0, 1), probe, got["delta_tau_s"])
+    point = pair_coherence(setup, paths, (0, 1), probe, near_s=got["delta_tau_s"]).continuous_s
     assert abs(_wrap(got["delta_tau_s"] - point, per)) < 5e-12
     # the point itself moves as the closed form says (nominal point from the nominal scene)
     nom = build_setup(sphere4())
-    p0 = coherence_point_nd(nom, exact_paths(nom), (0, 1), probe, 0.0)
+    p0 = pair_coherence(nom, exact_paths(nom), (0, 1), probe, near_s=0.0).continuous_s
     tau = probe_total_delay(setup, probe_ranges(setup, 2))
     f_if = float(if_phase_slope_hz(scene, tau))
     if field == "radial_offset_mm":

@@ -10,7 +10,7 @@ import pytest
 
 from conftest import DEFAULT_SCENE
 from rtsgeom import identify as ident_mod
-from rtsgeom.calibration.pair import coherence_delay
+from rtsgeom.calibration.pair import pair_coherence
 from rtsgeom.calibration.probes import probe_angles, probe_front_ends
 from rtsgeom.cli import main
 from rtsgeom.paths import exact_paths
@@ -137,8 +137,8 @@ def test_monte_carlo_offsets_within_3_sigma_std_at_crb_and_calibration_without_s
         built = ident_mod.setup_of(ident_mod.identified_scene(ident))
         pred = ident_mod.predicted_calibration(built, (0, 1)).delta_tau_s
         probe = probe_front_ends(setup, paths, seed)
-        truth_d = coherence_delay(setup, paths, (0, 1),
-                                  probe_angles(probe.angle_rad[0], probe.angle_rad[1]))
+        truth_d = pair_coherence(setup, paths, (0, 1), alphas=probe_angles(probe.angle_rad[0],
+                                 probe.angle_rad[1])).continuous_s
         assert abs(pred - truth_d) < 10e-12, (seed, pred, truth_d)
 
 
@@ -197,7 +197,8 @@ def test_cli_adc_active_identify_json_and_corrected_scene(tmp_path, capsys):
     cal = json.loads(capsys.readouterr().out)
     nominal = ident_mod.setup_of(BASE)
     ang = ident_mod.detected_angles(nominal)
-    want = coherence_delay(nominal, exact_paths(nominal), (0, 1), probe_angles(*ang))
+    want = pair_coherence(nominal, exact_paths(nominal), (0, 1),
+                          alphas=probe_angles(*ang)).continuous_s
     assert abs(cal["delta_tau_s"] - want) < 10e-12
 
 

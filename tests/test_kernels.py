@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 
 from rtsgeom.synthesis import kernels
-from rtsgeom.calibration import sweep
 from rtsgeom.synthesis import pair as pair_design
 from rtsgeom.synthesis.pair import beam_derivatives, design_ratio, detected_bin_choice
 from rtsgeom.radar.steering import Steering

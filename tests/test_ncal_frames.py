@@ -1,7 +1,7 @@
-"""Frames per step of the 2-D pair calibration (``ncal.calibrate_pair_nd``): the fitted
-minimum's scatter estimated from the measured sweep itself (``calsteps.fit_scatter``) against
-the scatter of real refits, over a grid of noise levels and curve shapes, the one sizing
-rule (``calsteps.frames_for``) shared with the arc pair, and (slow) the frames growing as
+"""Frames per step of the 2-D pair calibration (its sweep through the full chain): the fitted
+point's scatter estimated from the measured sweep itself (``fit.fit_scatter``) against the
+scatter of real refits, over a grid of noise levels and curve shapes, the one sizing rule
+(``steps.frames_for``) shared with the arc pair, and (slow) the frames growing as
 the SNR falls while the pair stays at its coherence point."""
 
 from __future__ import annotations
@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 PERIOD = 1.0e-9
+ODD = [True, True]  # both columns cross zero at the point
 
 
 def _curves(d, true_s, amp_rad):
@@ -28,15 +29,14 @@ def test_fit_scatter_from_one_sweep_is_the_refits_scatter(sigma_rad, amp_rad, tr
     estimate is within 35 % of the std of the minima of 200 independent noisy sweeps
     (32 draws: ~13 % statistical), and the frames it asks for grow as sigma^2."""
     from rtsgeom.calibration.steps import TARGET_BIAS_PS, fine_frames
-    from rtsgeom.calibration.steps import fit_scatter
-    from rtsgeom.calibration.sweep import fit_minimum
+    from rtsgeom.calibration.fit import fit_centre, fit_scatter
     near = true_ps * 1e-12 + 30e-12
     d = near + np.arange(-25, 26) * 10e-12
     clean = _curves(d, true_ps * 1e-12, amp_rad)
     rng = np.random.default_rng(7)
 
     def fit(e):
-        return fit_minimum(d, e, PERIOD, near, 2, 125e-12, return_fit=True)
+        return fit_centre(d, e, PERIOD, near, 2, 125e-12, odd=ODD, return_fit=True)
     truth = np.std([fit(clean + sigma_rad * rng.standard_normal(clean.shape))[0]
                     for _ in range(200)])
     one = clean + sigma_rad * rng.standard_normal(clean.shape)
@@ -51,14 +51,13 @@ def test_fit_scatter_from_one_sweep_is_the_refits_scatter(sigma_rad, amp_rad, tr
 
 def test_fit_scatter_is_zero_without_noise_and_unknown_without_enough_steps():
     """No noise: no scatter. Too few steps for a residual (the curves pass through them): not
-    "no noise" but unknown (NaN), which ``calibrate_pair_nd`` answers with a second sweep."""
-    from rtsgeom.calibration.steps import fit_scatter
-    from rtsgeom.calibration.sweep import fit_minimum
+    "no noise" but unknown (NaN), which the sweep answers with a second, independent one."""
+    from rtsgeom.calibration.fit import fit_centre, fit_scatter
     d = np.arange(-25, 26) * 10e-12
     clean = _curves(d, 0.0, np.radians(0.05))
 
     def fit(e):
-        return fit_minimum(d, e, PERIOD, 0.0, 2, 125e-12, return_fit=True)
+        return fit_centre(d, e, PERIOD, 0.0, 2, 125e-12, odd=ODD, return_fit=True)
     _, fitted = fit(clean)
     assert fit_scatter(fit, fitted, clean, 2, 0, (0, 1))[0] < 1e-15
     few = np.full_like(clean, np.nan)
@@ -70,12 +69,11 @@ def test_fit_scatter_is_zero_without_noise_and_unknown_without_enough_steps():
 
 @pytest.mark.parametrize("sigma_rad", [5e-5, 3e-4])
 def test_coarse_rts_steps_measure_the_noise_from_a_repeated_sweep(sigma_rad):
-    """100 ps RTS steps leave 5 fine steps, through which 2 harmonics pass exactly: the fit's
-    residual is zero whatever the noise (the frames were sized to 1, the scatter reported 0).
+    """100 ps RTS steps leave 5 fine steps, too few for a residual beside 2 harmonics a column:
+    it is no measure of the noise (the frames were sized to 1, the scatter reported 0).
     With a second, independent sweep the noise is that of their difference: within 40 % of
     sigma on 5 steps x 2 columns, and the scatter grows with it."""
-    from rtsgeom.calibration.steps import fit_scatter
-    from rtsgeom.calibration.sweep import fit_minimum
+    from rtsgeom.calibration.fit import fit_centre, fit_scatter
     d = np.arange(-2, 3) * 100e-12
     clean = _curves(d, 20e-12, np.radians(0.05))
     rng = np.random.default_rng(11)
@@ -83,9 +81,10 @@ def test_coarse_rts_steps_measure_the_noise_from_a_repeated_sweep(sigma_rad):
     two = clean + sigma_rad * rng.standard_normal(clean.shape)
 
     def fit(e):
-        return fit_minimum(d, e, PERIOD, 0.0, 2, 250e-12, criterion="vertex", return_fit=True)
+        return fit_centre(d, e, PERIOD, 0.0, 2, 250e-12, odd=ODD, return_fit=True)
     _, fitted = fit(one)
-    assert np.allclose(fitted, one, atol=1e-12 + 1e-9 * sigma_rad)  # interpolates: no residual
+    # 4 coefficients a column and the shared point on 5 steps: less than one degree of
+    # freedom a column, no residual to measure the noise by
     assert all(np.isnan(fit_scatter(fit, fitted, one, 2, 0, (0, 1))))
     scatter, noise = fit_scatter(fit, fitted, one, 2, 0, (0, 1), repeat=two)
     assert abs(noise / sigma_rad - 1) < 0.4 and scatter > 0
@@ -111,7 +110,7 @@ def test_elevation_pair_frames_grow_as_snr_falls_and_it_stays_at_its_point(snr_d
     at the scene's SNR); the frames chosen bring it within 5 ps of the continuous coherence
     point, and grow ~10x (1/SNR) with the 10 dB."""
     from rtsgeom.calibration.probes import probe_front_ends
-    from rtsgeom.calibration.channels import calibrate_pair_nd, coherence_point_nd
+    from rtsgeom.calibration.pair import calibrate_pair, pair_coherence
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     from rtsgeom.scene import load_scene
@@ -120,8 +119,8 @@ def test_elevation_pair_frames_grow_as_snr_falls_and_it_stays_at_its_point(snr_d
     setup = build_setup(scene)
     paths = exact_paths(setup)
     probe = probe_front_ends(setup, paths, scene.seed)
-    got = calibrate_pair_nd(setup, paths, (0, 1), probe, scene.seed)
-    point = coherence_point_nd(setup, paths, (0, 1), probe, got["delta_tau_s"])
+    got = calibrate_pair(setup, paths, (0, 1), probe, seed=scene.seed).to_dict()
+    point = pair_coherence(setup, paths, (0, 1), probe, near_s=got["delta_tau_s"]).continuous_s
     assert abs(got["delta_tau_s"] - point) < 5e-12
     scatter = got["one_frame_scatter_ps"]
     assert 4.0 * 10 ** (snr_drop_db / 20) < scatter < 16.0 * 10 ** (snr_drop_db / 20)
@@ -140,7 +139,7 @@ def test_elevation_pair_30_db_below_averages_its_coarse_sweep_too():
     still lands within 5 ps of its coherence point."""
     from rtsgeom.calibration.probes import probe_front_ends
     from rtsgeom.calibration.steps import COARSE_NOISE_DEG
-    from rtsgeom.calibration.channels import calibrate_pair_nd, coherence_point_nd
+    from rtsgeom.calibration.pair import calibrate_pair, pair_coherence
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     from rtsgeom.scene import load_scene
@@ -149,10 +148,10 @@ def test_elevation_pair_30_db_below_averages_its_coarse_sweep_too():
     setup = build_setup(scene)
     paths = exact_paths(setup)
     probe = probe_front_ends(setup, paths, scene.seed)
-    got = calibrate_pair_nd(setup, paths, (0, 1), probe, scene.seed)
+    got = calibrate_pair(setup, paths, (0, 1), probe, seed=scene.seed).to_dict()
     assert got["frame_noise_deg"] > COARSE_NOISE_DEG
     assert got["coarse_frames_per_step"] == int(np.ceil((got["frame_noise_deg"]
                                                          / COARSE_NOISE_DEG) ** 2)) > 1
     assert got["frames_per_step"] > 1000
-    point = coherence_point_nd(setup, paths, (0, 1), probe, got["delta_tau_s"])
+    point = pair_coherence(setup, paths, (0, 1), probe, near_s=got["delta_tau_s"]).continuous_s
     assert abs(got["delta_tau_s"] - point) < 5e-12

@@ -33,28 +33,31 @@ def test_array_factor_of_filled_positions_is_the_dirichlet_kernel(n):
                                atol=1e-12)
 
 
-# -- aoa.sweep.fit_minimum ------------------------------------------------------------------
+# -- calibration.fit.fit_centre --------------------------------------------------------------
 
 
 @pytest.mark.parametrize("true_ps", [-3.0, 0.0, 7.4])
 @pytest.mark.parametrize("bad_rows", [(), (2,), (0, 5, 11)])
-def test_fit_minimum_finds_the_minimum_of_the_periodic_criterion_despite_lost_steps(true_ps,
-                                                                                   bad_rows):
-    """Probe errors of the criterion's shape e_p = c_p (1 - cos(theta - theta_0)) (even,
-    periodic, minimum at delta_0) over one period of steps: the fit returns delta_0 within
-    its 0.05 ps grid, also when some steps lost a probe (NaN: no detection) -- only those
-    steps are dropped."""
-    from rtsgeom.calibration.sweep import fit_minimum
+@pytest.mark.parametrize("vertex_deg", [0.0, 0.01])
+def test_fit_centre_finds_the_centre_of_symmetry_despite_lost_steps_and_biased_vertices(
+        true_ps, bad_rows, vertex_deg):
+    """Probe errors even about delta_0 with a second harmonic, e_p = c_p (1 - cos) + d_p
+    sin^2 + v_p, their vertices v_p off zero in opposite directions (a mounting offset's
+    amplitude error): the centre of symmetry is delta_0 within 0.01 ps, also when some
+    steps lost a probe (NaN: no detection; only that probe's step is dropped), while the
+    probes' RMS minimum is not (it is pulled towards the deeper vertex)."""
+    from rtsgeom.calibration.fit import fit_centre
     period, step = 1.0e-9, 25e-12
     near = 0.0
-    d = near + np.arange(-20, 21) * step
+    d = near + np.arange(-10, 11) * step
     th = 2 * np.pi * (d - true_ps * 1e-12) / period
-    e = np.stack([0.8 * (1 - np.cos(th)) + 0.05 * np.sin(th) ** 2,
-                  -0.5 * (1 - np.cos(th))], axis=1)
+    v = np.radians(vertex_deg)
+    e = np.stack([0.8 * (1 - np.cos(th)) + 0.05 * np.sin(th) ** 2 - v,
+                  -0.5 * (1 - np.cos(th)) + 2 * v], axis=1) * np.radians(0.1)
     for r in bad_rows:
         e[r, r % 2] = np.nan
-    got = fit_minimum(d, e, period, near)
-    assert got == pytest.approx(true_ps * 1e-12, abs=0.051e-12)
+    got = fit_centre(d, e, period, near, search_s=period / 8)
+    assert got == pytest.approx(true_ps * 1e-12, abs=0.01e-12)
 
 
 # -- aoa.calibration.fir_effect -------------------------------------------------------------
@@ -188,9 +191,9 @@ def test_nd_pair_calibration_lands_on_the_coherence_point(fe, dr_mm):
     phasor model's coherence point for a radial offset that puts the point half a coarse
     step (100 ps) off the sweep grid, on either front end; its period is 1/(f_rts + S t_mid
     - S tau) as the pair calibration's."""
-    from rtsgeom.calibration.pair import coherence_delay
+    from rtsgeom.calibration.pair import pair_coherence
     from rtsgeom.calibration.probes import probe_angles, probe_front_ends
-    from rtsgeom.calibration.channels import calibrate_pair_nd
+    from rtsgeom.calibration.pair import calibrate_pair
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     from rtsgeom.geometry.farfield import two_way_lengths
@@ -198,9 +201,10 @@ def test_nd_pair_calibration_lands_on_the_coherence_point(fe, dr_mm):
         lambda d: d["rts"]["front_ends"][fe].update(radial_offset_mm=dr_mm)))
     paths = exact_paths(setup)
     probe = probe_front_ends(setup, paths, 1)
-    got = calibrate_pair_nd(setup, paths, (0, 1), probe, 1, span_s=(-0.3e-9, 0.3e-9),
-                            step_s=100e-12)
-    point = coherence_delay(setup, paths, (0, 1), probe_angles(*probe.angle_rad[[0, 1]]))
+    got = calibrate_pair(setup, paths, (0, 1), probe, seed=1, span_s=(-0.3e-9, 0.3e-9),
+                         step_s=100e-12).to_dict()
+    point = pair_coherence(setup, paths, (0, 1),
+                           alphas=probe_angles(*probe.angle_rad[[0, 1]])).continuous_s
     period = got["period_s"]
     dist = (got["delta_tau_s"] - point + period / 2) % period - period / 2
     assert abs(dist) < 3e-12
@@ -335,7 +339,7 @@ def test_paper_procedure_reports_the_exact_period_at_its_target():
     1/(f_rts + S t_mid - S tau) at its target's delay, as the pair calibration does at its
     probes' (not eq. 27's 1/(f_rts + B/2))."""
     from scipy.constants import c
-    from rtsgeom.calibration.pair import calibrate_pair_paper
+    from rtsgeom.calibration.paper import calibrate_pair_paper
     from rtsgeom.calibration.probes import probe_front_ends, probe_ranges
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths

@@ -201,23 +201,23 @@ def test_unconverged_peaks_fall_back_to_the_search_and_the_others_keep_newton(an
     np.testing.assert_allclose(u[silent, 0], np.sin(st.search(full[silent])), atol=1e-12)
 
 
-# -- aoa.sweep.fit_minimum: the search half-width ----------------------------------------------
+# -- calibration.fit.fit_centre: the search half-width -----------------------------------------
 
 
 @pytest.mark.parametrize("offset_steps", [-3.2, 2.6, 4.0])
-def test_fit_minimum_searches_the_half_width_it_is_given(offset_steps):
-    """The criterion's minimum ``offset_steps`` sweep steps from the coarse minimum: the
-    default search (1.5 steps either side) stops at its edge, a ``search_s`` of 5 steps finds
-    the minimum within the 0.05 ps grid."""
-    from rtsgeom.calibration.sweep import fit_minimum
+def test_fit_centre_searches_the_half_width_it_is_given(offset_steps):
+    """The curves' centre ``offset_steps`` sweep steps from the coarse minimum: the default
+    search (1.5 steps either side) stops at its edge, a ``search_s`` of 5 steps finds the
+    centre within 0.05 ps."""
+    from rtsgeom.calibration.fit import fit_centre
     period, step = 1.0e-9, 25e-12
     d = np.arange(-20, 21) * step
     true = offset_steps * step
     th = 2 * np.pi * (d - true) / period
     e = np.stack([0.8 * (1 - np.cos(th)), -0.5 * (1 - np.cos(th))], axis=1)
-    near = fit_minimum(d, e, period, 0.0)
+    near = fit_centre(d, e, period, 0.0)
     assert near == pytest.approx(math.copysign(1.5 * step, offset_steps), abs=0.051e-12)
-    wide = fit_minimum(d, e, period, 0.0, search_s=5 * step)
+    wide = fit_centre(d, e, period, 0.0, search_s=5 * step)
     assert wide == pytest.approx(true, abs=0.051e-12)
 
 
@@ -232,7 +232,7 @@ def test_pair_calibration_places_its_probes_over_the_fine_window_and_reports_its
     from rtsgeom.calibration.pair import calibrate_pair
     from rtsgeom.paths import nominal_model
     from rtsgeom.calibration.probes import probe_angles, probe_front_ends, probe_ranges
-    from rtsgeom.calibration.sweep import place_probes
+    from rtsgeom.calibration.phasor import place_probes
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
     setup = build_setup(_small_noiseless(

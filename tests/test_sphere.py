@@ -142,13 +142,29 @@ def test_default_scene_run_unchanged_with_explicit_zero_elevations():
     assert all("elevation_deg" not in m["set"] for m in a.matches)
 
 
-@pytest.mark.parametrize("command", ["calibrate", "linearity", "tolerance"])
-@pytest.mark.parametrize("pair", [("0", "1"), ("0", "2"), ("1", "0")])
+@pytest.mark.parametrize("command", ["linearity", "tolerance"])
+@pytest.mark.parametrize("pair", [("0", "1"), ("0", "2"), ("1", "0"), ("all",)])
 def test_pair_commands_refuse_2d_cells(command, pair, capsys):
-    """A scene of 2-D cells has no pairs on an arc: the pair commands exit 2 naming the
+    """A scene of 2-D cells has no pairs on an arc: the pair studies exit 2 naming the
     argument and the cell commands (they used to exit 0 with an inf residual or a span of
-    zero width; new-user trial)."""
+    zero width; new-user trial), for one pair and for all."""
     from rtsgeom.cli import main
     assert main([command, "scenes/sphere4.toml", "--pair", *pair, "--quiet"]) == 2
     err = capsys.readouterr().err
-    assert f"--pair {pair[0]} {pair[1]}" in err and "2-D cells" in err and "--grid" in err
+    assert "--pair " in err and "2-D cells" in err and "--grid" in err
+
+
+def test_calibrate_takes_the_cells_neighbouring_pairs(capsys):
+    """The calibration is measured pair by pair in 2-D too: ``--pair 0 1`` (stacked in
+    elevation) calibrates through the full chain in the RuT's 2-D beamformer, to the
+    geometry's +29 ps (``tests/test_cell_calibration.py``); a pair that is not neighbours
+    in the cells exits 2 naming the pairs there are."""
+    import json
+    from rtsgeom.cli import main
+    assert main(["calibrate", "scenes/sphere4.toml", "--pair", "1", "2", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "--pair 1 2: not neighbours" in err and "0 1, 0 2" in err
+    assert main(["calibrate", "scenes/sphere4.toml", "--pair", "1", "0", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["pair"] == [0, 1] and out["dims"] == 2 and out["method"] == "full-chain"
+    assert abs(out["delta_tau_s"] - 29.05e-12) < 3e-12

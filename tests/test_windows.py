@@ -271,7 +271,7 @@ def test_coherence_point_moves_by_the_closed_form_for_every_taper(angle_window, 
     -(f_c + S t_mid - S tau) / (f_rts + S t_mid - S tau) * 2 dr / c0 for a radial offset dr
     of front end J (the opposite way for I), whatever the angle window: the taper weights the
     elements, not the channels' relative phase."""
-    from rtsgeom.calibration.pair import coherence_delay
+    from rtsgeom.calibration.pair import pair_coherence
     from rtsgeom.calibration.probes import probe_front_ends
 
     def scene(offsets=None):
@@ -288,5 +288,6 @@ def test_coherence_point_moves_by_the_closed_form_for_every_taper(angle_window, 
     shift = CoherenceShift(nom, probe_front_ends(nom, exact_paths(nom), 1))
     for fe, dr_mm in ((1, 0.3), (0, -0.7)):
         s = scene({fe: dr_mm})
-        d = coherence_delay(s, exact_paths(s), (0, 1), shift.alphas, shift.d0)
+        d = pair_coherence(s, exact_paths(s), (0, 1), alphas=shift.alphas,
+                           near_s=shift.d0).continuous_s
         assert abs(shift.wrapped(d, fe, dr_mm)) < 1e-12

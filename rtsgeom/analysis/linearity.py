@@ -11,7 +11,7 @@ import numpy as np
 from scipy.spatial import Delaunay
 
 from ..calibration.channels import calibrate_channels, tree_phases
-from ..calibration.pair import Calibration
+from ..calibration.sweep import Calibration
 from ..calibration.probes import (FrontEndProbe, probe_angles, probe_front_ends, probe_ranges,
                                   simulate_detect)
 from ..errors import ParameterError
@@ -195,9 +195,6 @@ def _grid(setup: Setup, paths: Paths, mode: str, n: int, calibrate: bool, seed: 
     rng = float(probe_ranges(setup, 1)[0])
     target0 = TargetConfig(rng)
     st = Steering.auto(nom.rut, setup.scene.radar)
-    if st.dims != 2:
-        raise ParameterError("linearity --grid needs a RuT with elevation (an array with "
-                         "elevation extent, e.g. radar.use_elevation_tx = true)")
     offsets, tree = np.zeros(setup.fe.count), None
     if calibrate:
         cal = calibrate_channels(setup, paths, cell, probe, seed, progress)

@@ -71,7 +71,7 @@ def fir_sweep_phase(setup, ranges, deltas, base_offsets, continuous: bool = Fals
     with ``continuous``: J at its realised base plus the unrounded delta, the continuous
     model of ``calibration.continuous_delay_setup``). It cycles with the setting every
     1/f_s, which the RTS's designer knows; the fit of the sweep takes it out
-    (``sweep.fit_minimum``). None for an ideal delay."""
+    (``fit.fit_centre``). None for an ideal delay."""
     scene = setup.scene
     rts = scene.rts
     if not fir_modelled(scene):

@@ -5,8 +5,8 @@ steps, high noise figures).
   resolution ``rts.delay_resolution_s`` (the fractional-delay FIR's step, or 1/f_s without
   one; the paper's RTS moves in 25 ps). The calibration's optimum is defined on the
   continuous model (:func:`continuous_delay_setup`) and rounded at the end
-  (:func:`realisable`); a fine sweep too sparse for the least-squares fit is fitted through
-  its points (:func:`fine_window`); what each step adds beyond its nominal offset, the FIR's
+  (:func:`realisable`); a fine sweep of few points is fitted with fewer harmonics
+  (:func:`fine_window`); what each step adds beyond its nominal offset, the FIR's
   phase and the quantiser's offset error, is known in advance (:func:`sweep_phase`).
 * The frames: one rule (:func:`frames_for`): K coherently averaged frames divide a
   one-frame scatter by sqrt(K), so a step averages ceil((scatter / target)^2) of them. Each
@@ -14,15 +14,17 @@ steps, high noise figures).
   ``COARSE_NOISE_DEG`` (:func:`predicted_angle_noise`, :func:`coarse_frames`), before the
   sweep, from the noise the link budget (or ``snr_db``) predicts; each fine-sweep step as
   many as bring the fitted minimum's 2-sigma scatter below ``TARGET_BIAS_PS`` (the pair on
-  an arc: a Monte-Carlo of the phasor model, ``calibration.calibrate_pair``; a 2-D pair: of
-  its own measured sweep, :func:`fit_scatter`).
+  an arc: a Monte-Carlo of the phasor model; a 2-D pair: of its own measured sweep,
+  ``fit.fit_scatter``).
 
-The pair calibration (:mod:`.pair`) and the channels' (:mod:`.channels`) use these.
+The sweep (:mod:`.sweep`) uses these.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
+from typing import NamedTuple
 
 import numpy as np
 
@@ -33,10 +35,9 @@ from .fir import fir_sweep_phase
 
 __all__ = ["continuous_delay_setup", "CONTINUOUS_STEP_S", "COARSE_NOISE_DEG",
            "predicted_angle_noise", "coarse_frames", "MAX_FRAMES", "realisation_shift",
-           "sweep_phase", "realisable", "FINE_STEP_S", "MIN_FIT_POINTS", "fine_window",
-           "MC_DRAWS", "SIZE_DRAWS", "TARGET_BIAS_PS", "frames_for", "fine_frames",
-           "fit_scatter", "rms_error_deg", "coarse_minimum", "adds_noise",
-           "SCATTER_DRAW_FRAMES"]
+           "sweep_phase", "realisable", "FINE_STEP_S", "fine_window",
+           "FineWindow", "SIZE_DRAWS", "TARGET_BIAS_PS", "frames_for", "fine_frames",
+           "adds_noise"]
 
 
 def continuous_delay_setup(setup: Setup) -> Setup:
@@ -47,7 +48,6 @@ def continuous_delay_setup(setup: Setup) -> Setup:
     agrees with this one at every realisable delay. The fractional-delay FIR keeps its
     modelled response (``rts.fir_if_gain``, continuous in its setting); an RTS without one
     (whole 1/f_s samples) gets none (``fractional_delay_filter = "ideal"``)."""
-    import dataclasses
     rts = setup.scene.rts
     if rts.fractional_delay and rts.fractional_delay_step_s <= CONTINUOUS_STEP_S:
         return setup
@@ -127,7 +127,7 @@ def realisation_shift(setup: Setup, ranges, deltas, base_offsets=(0.0, 0.0)) -> 
 
 def sweep_phase(setup: Setup, ranges, deltas, base_offsets, period_s: float):
     """The phase (S, P) each fine-sweep step adds to channel J of each probe beyond ``2 pi
-    delta / period`` and known in advance (``sweep.fit_minimum``'s ``extra_phase_rad``):
+    delta / period`` and known in advance (``fit.fit_centre``'s ``extra_phase_rad``):
     the FIR's (``fir.fir_sweep_phase``) and the quantiser's offset error
     (:func:`realisation_shift`), and the function that gives the FIR's on the continuous
     delays the fit searches (``search_phase``). ``(None, None)`` where both are zero (an
@@ -160,89 +160,23 @@ def realisable(delay_s, resolution_s: float):
 
 
 FINE_STEP_S = 5e-12  # step of the fitted fine sweep
-MIN_FIT_POINTS = 7  # fine-sweep points a least-squares fit of 2 harmonics (5 coefficients) needs
 
 
-def fine_window(half_s: float, step_s: float) -> tuple[int, int, str]:
-    """Steps either side of the coarse minimum for the fitted fine sweep (+-``half_s``,
-    period / 4, in steps of ``step_s``, at least one), the harmonics to fit and the fit's
-    criterion (``sweep.fit_minimum``). With ``MIN_FIT_POINTS`` or more points: 2 harmonics,
-    least squares, the joint minimum of the fitted errors (``"joint"``). An RTS with steps
-    coarser than ~period / 6 (100 ps at 1 ns: 5 points) leaves too few for that (the fit
-    fell back to the coarse minimum and the chosen delay was one 100 ps step from the
-    realisable one nearest the coherence point): the fitted curves then pass through the
-    points (2 harmonics on 5, 1 on 3) and the optimum is their common vertex
-    (``"vertex"``: each probe's error is even about the coherence point; a fitted curve
-    that interpolates may overshoot zero, which puts the joint minimum beside the vertex).
-    Widening the window instead (to a full period) fitted worse: 50 to 120 ps off."""
+class FineWindow(NamedTuple):
+    """The fitted fine sweep's layout (:func:`fine_window`)."""
+
+    steps: int  # steps either side of the coarse minimum
+    step_s: float  # the fine sweep's step
+    harmonics: int  # harmonics of each column's fitted periodic shape
+
+
+def fine_window(half_s: float, step_s: float) -> FineWindow:
+    """The fine sweep: steps either side of the coarse minimum (+-``half_s``, period / 4, in
+    steps of ``step_s``, at least one) and the harmonics of the fit (``fit.fit_centre``): 2,
+    or 1 where an RTS's coarse steps leave only 3 points (250 ps at 1 ns), so that each
+    column's coefficients and the shared centre stay fewer than its points."""
     k = max(1, int(np.floor(half_s / step_s + 1e-9)))
-    if 2 * k + 1 >= MIN_FIT_POINTS:
-        return k, 2, "joint"
-    return k, (2 if 2 * k + 1 >= 5 else 1), "vertex"
-
-
-MC_DRAWS = 32  # noise realisations that size the frames per step
-
-
-SCATTER_DRAW_FRAMES = 16  # fit_scatter draws at this many frames' noise, then scales
-
-
-def fit_scatter(fit, fitted, e, harmonics: int, seed, pair,
-                repeat=None) -> tuple[float, float]:
-    """The fitted minimum's 1-sigma scatter (s) with one frame a step, and one frame's noise
-    (rad of direction cosine, median over the columns), from a measured fine sweep: its
-    errors ``e`` (S, C) at one frame a step, the curves ``fitted`` to them (S, C) and the
-    ``fit`` (errors -> (minimum, curves); ``sweep.fit_minimum``). Each column's noise is its
-    residual about the curve (least-squares degrees of freedom); ``MC_DRAWS`` sweeps are
-    drawn as the curves plus Gaussian noise of that std / sqrt(``SCATTER_DRAW_FRAMES``)
-    (where the fit is linear in the noise, as ``calibration.calibrate_pair`` draws at its
-    coarse frames) and refitted, their minima's std scaled back to one frame. The 2-D
-    counterpart of the arc pair's Monte-Carlo of the phasor model, which a 2-D pair has not:
-    on its own data (deterministic seed; ``ncal.calibrate_pair_nd``). The seed: ``seed`` and
-    the ``pair`` (i, j) measured.
-
-    Where the fit has no residual degrees of freedom (an RTS with coarse delay steps leaves
-    3 or 5 fine steps, through which the curves pass exactly: a zero residual is no evidence
-    of no noise) the result is (NaN, NaN): measure the sweep again, independently, and give
-    it as ``repeat`` (S, C): each column's noise is then that of the two sweeps' difference,
-    var(e - repeat) = 2 sigma^2, with no fit involved."""
-    e = np.asarray(e, float)
-    if repeat is not None:
-        r = (e - np.asarray(repeat, float)) / np.sqrt(2.0)
-        ok = np.all(np.isfinite(r), axis=1)
-        dof = int(ok.sum())
-    else:
-        r = e - fitted
-        ok = np.all(np.isfinite(r), axis=1)
-        dof = int(ok.sum()) - (1 + 2 * harmonics)
-    if dof < 1:
-        return float("nan"), float("nan")
-    sigma = np.sqrt(np.sum(r[ok] ** 2, axis=0) / dof)  # (C,)
-    rng = np.random.default_rng(np.random.SeedSequence([int(seed) % 2 ** 32, 1715,
-                                                        int(pair[0]), int(pair[1])]))
-    base = np.where(np.isfinite(fitted), fitted, e)
-    draws = base[None] + (sigma / np.sqrt(SCATTER_DRAW_FRAMES)
-                          * rng.standard_normal((MC_DRAWS,) + base.shape))
-    est = np.array([fit(d)[0] for d in draws])
-    return float(np.std(est) * np.sqrt(SCATTER_DRAW_FRAMES)), float(np.median(sigma))
-
-
-def rms_error_deg(e) -> np.ndarray:
-    """The RMS over the last axis of probe angle errors ``e`` (rad), in degrees; inf where it
-    is undefined (a probe not detected), so that a sweep's minimum never lands there."""
-    out = np.degrees(np.sqrt(np.mean(np.square(e), axis=-1)))
-    return np.where(np.isfinite(out), out, np.inf)
-
-
-def coarse_minimum(grid, errs) -> float:
-    """The coarse sweep's minimum (s) from its RMS errors ``errs`` (deg) at delays ``grid``:
-    minima repeat every period; among the local minima about as deep as the deepest (within
-    2 x the deepest + 0.01 deg) the one with the smallest |delta tau|, which costs the least
-    range offset (paper, "Disadvantages"). The arc pair's and the 2-D pair's one rule."""
-    errs, grid = np.asarray(errs, float), np.asarray(grid, float)
-    is_min = (np.r_[True, errs[1:] <= errs[:-1]] & np.r_[errs[:-1] <= errs[1:], True])
-    good = np.flatnonzero(is_min & (errs <= 2 * np.min(errs) + 0.01))
-    return float(grid[int(good[np.argmin(np.abs(grid[good]))])])
+    return FineWindow(k, step_s, 2 if 2 * k + 1 >= 5 else 1)
 
 
 def adds_noise(scene) -> bool:

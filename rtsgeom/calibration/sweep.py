@@ -1,320 +1,387 @@
-"""The calibration sweep evaluated where it is decided: the phasor model at the detected bin.
+"""The phase calibration's delay sweep (paper section "Calibration", eq. 27): one engine for
+every pair, on an arc or in a 2-D beamformer, on the phasor model or the full chain.
 
-Each step of the phase calibration (paper section "Calibration") programs both probe targets
-on channels I (delay ``base``) and J (``base + delta``) with amplitudes designed for coherent
-channels, and reads the probes' angles off the RuT's detections. The RuT detects a probe at the
-range bin with the most power, and channel J's echo moves by ``c0 delta / 2`` (0.3 to 2 bins
-over the sweep): near a bin boundary two bins carry nearly equal power. The amplitudes must be
-designed **for the bin the RuT detects**; otherwise the design is right at one bin and the
-angle is read at the other, the error at the coherence point is not zero and the sweep's
-minimum moves (up to 75 ps). A lab does the same: it reads the probe's range bin off the
-detection list and designs for it (a fixed point: design at bin k, detect, redesign if the
-RuT reported another bin).
+Channel I keeps its delay, channel J's RTS delay is swept by Delta tau_rts over at least one
+period ``1 / (f_rts + B/2)`` (eq. 27; paper: [-0.5, 1] ns in 25 ps steps) while two probe
+targets synthesized by the pair are detected; the coherence point is where their errors are
+jointly smallest:
 
-Everything here is batched over all sweep steps at once (one :class:`ChannelModel` per probe
-whose channels are I once and J once per step), with the phasor model
-(``radar.phasors.bin_response``, which agrees with the ADC-cube chain to complex64
-precision), the exact amplitude design in closed form (:func:`design_ratio`) and the angle by
-Newton on the beamformer peak (:meth:`Steering.peak`). Receiver noise is added to the bins'
-spectra with the variance the windowed range and Doppler DFTs give it.
+1. coarse sweep over the span (``SweepConfig.span_s`` / ``step_s``, default the scene's
+   ``calibration_span_ns`` / ``calibration_step_ps``): the RMS minimum nearest zero delay
+   (``fit.coarse_minimum``);
+2. the probes placed for the fine window (on the phasor model: within their range bins);
+3. fine sweep over +-period/4 around it in steps the RTS can set; the coherence point is the
+   common centre of symmetry of its signed error curves (``fit.fit_centre``);
+4. the frames per step sized so that the noise moves the fitted minimum by less than
+   ``steps.TARGET_BIAS_PS`` (2 sigma): predicted before the sweep where the probes have a
+   model of their noise (the phasor model), measured on the sweep's own residual where not
+   (the full chain of a 2-D pair);
+5. the fitted optimum rounded to a delay the RTS can set and confirmed through the full
+   ADC-cube chain.
+
+What is measured is the probes' business (``phasor.PhasorProbes``, ``beam.BeamProbes``):
+``measure(deltas, frames) -> signed errors (S, C)``, their placement, their noise, which
+columns are odd about the coherence point, what each step adds beyond its offset and the
+phase mismatch the coherence point zeroes (:func:`coherence_point`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 from scipy.constants import c
 
-from ..geometry import Setup
-from ..paths import Paths
-from ..radar.processing import tdm_compensate
-from ..radar.steering import Steering
-from ..radar.windows import window
-from ..rts.channels import KIND_DIRECT, RtsProgram, channel_echoes, requested_delay
-from ..scene import TargetConfig
-from ..synthesis.model import ChannelModel
-from ..synthesis.pair import beam_derivatives, design_ratio
-from ..radar.link import relative_noise_power
-from ..radar.processing import nearest_detection
-from .probes import probe_program, simulate_detect
+from .._lib.util import frozen
+from ..errors import CalibrationFailed, ParameterError
+from .fit import coarse_minimum, fit_centre, fit_scatter, rms_error_deg
+from .probes import mean_air_delay
+from .steps import coarse_frames, continuous_delay_setup, fine_frames, fine_window, realisable
 
-__all__ = ["SweepResult", "phasor_sweep", "fit_minimum", "HALF_BINS", "place_probes",
-           "chain_errors"]
-
-HALF_BINS = 3  # candidate bins either side of the set range's bin (J moves <= ~2 bins)
+__all__ = ["SweepConfig", "Calibration", "CoherencePoint", "Probes", "run_sweep",
+           "coherence_point"]
 
 
 @dataclass(frozen=True)
-class SweepResult:
-    """Per step s and probe p (noiseless model): the spectra at the candidate bins for the
-    design the RuT's bin selects, the design's bin (index into the model's bins,
-    ``HALF_BINS`` is the set range's), the designed amplitudes (A_I, A_J), whether design and
-    detection agree on the bin, and the detected bin's power over the next strongest."""
+class SweepConfig:
+    """How the delay sweep runs.
 
-    delta_tau_s: np.ndarray  # (S,)
-    spectra: np.ndarray  # (S, P, K, V) TDM-compensated
-    bin_index: np.ndarray  # (S, P)
-    amplitudes: np.ndarray  # (S, P, 2)
-    range_bin0: np.ndarray  # (P,) absolute range bin of the set range
-    consistent: np.ndarray  # (S, P)
-    margin: np.ndarray  # (S, P)
-    noise_sigma: np.ndarray  # (S,) per-element noise std of one frame (0: noiseless scene)
-    alphas: np.ndarray  # (P,) probe angles (rad)
-    steering: Steering
+    Attributes
+    ----------
+    span_s, step_s : tuple of float, float or None
+        The coarse sweep's span (s, s) and step (s); None: the scene's
+        ``rts.calibration_span_ns`` and ``rts.calibration_step_ps``.
+    frames : int or None
+        Frames coherently averaged per step; None: as many as the noise needs.
+    full_chain : bool
+        Evaluate every step through the ADC-cube chain instead of the phasor model (a pair on
+        an arc; a pair in a 2-D beamformer is always measured through the chain).
+    seed : int
+        The receiver noise's seed.
+    """
 
-    def errors(self, frames: int = 1, rng=None, draws: int | None = None) -> np.ndarray:
-        """Signed probe-angle errors (rad) as the RuT detects them: (S, P), or (draws, S, P)
-        with ``draws`` independent noise realisations of ``frames`` coherently averaged
-        frames each (noiseless when ``rng`` is None). The detected bin is the strongest
-        candidate of the noisy spectra; its angle the beamformer peak (Newton)."""
-        x = self.spectra if draws is None else np.broadcast_to(
-            self.spectra, (draws,) + self.spectra.shape)
-        if rng is not None and np.any(self.noise_sigma > 0):
-            sig = (self.noise_sigma / np.sqrt(frames))[:, None, None, None] / np.sqrt(2)
-            x = x + sig * (rng.standard_normal(x.shape) + 1j * rng.standard_normal(x.shape))
-        power = np.sum(x.real ** 2 + x.imag ** 2, -1)
-        k = np.argmax(power, -1)
-        sel = np.take_along_axis(x, k[..., None, None], -2)[..., 0, :]
-        a = self.alphas
-        u, _ = self.steering.peak(sel, np.broadcast_to(np.sin(a)[:, None], sel.shape[:-1] + (1,)))
-        err = np.arcsin(np.clip(u[..., 0], -1, 1)) - a
-        return np.where(np.isfinite(self.amplitudes).all(-1), err, np.nan)
+    span_s: tuple[float, float] | None = None
+    step_s: float | None = None
+    frames: int | None = None
+    full_chain: bool = False
+    seed: int = 0
 
+    def __post_init__(self):
+        if self.span_s is not None:
+            lo, hi = (float(x) for x in self.span_s)
+            if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+                raise ParameterError(f"span_s: must be two finite delays, low < high; got "
+                                     f"{self.span_s}")
+            object.__setattr__(self, "span_s", (lo, hi))
+        if self.step_s is not None and not (np.isfinite(self.step_s) and self.step_s > 0):
+            raise ParameterError(f"step_s: must be a positive delay (s); got {self.step_s}")
+        if self.frames is not None and (int(self.frames) != self.frames or self.frames < 1):
+            raise ParameterError(f"frames: must be a whole number >= 1; got {self.frames}")
 
-def _models(setup, paths, pair, targets, base_offsets, deltas):
-    """One model per probe: channel I, then J at every step's delay."""
-    i, j = pair
-    ch = [i] + [j] * len(deltas)
-    dt = np.concatenate([[base_offsets[0]], base_offsets[1] + np.asarray(deltas, float)])
-    return [ChannelModel.build(setup, paths, ch, t, dt, HALF_BINS) for t in targets]
-
-
-def _range_bin(scene, range_m: float) -> int:
-    r = scene.radar
-    return int(np.round(range_m * 2 * r.slope_hz_per_s / c * r.samples_per_chirp
-                        / r.adc_rate_hz))
+    def evolve(self, **changes) -> "SweepConfig":
+        """A copy with ``changes`` (unknown names: :class:`ParameterError`)."""
+        unknown = set(changes) - {f.name for f in dataclasses.fields(self)}
+        if unknown:
+            raise ParameterError(f"{sorted(unknown)}: not a sweep setting; allowed: "
+                                 f"{[f.name for f in dataclasses.fields(self)]}")
+        return dataclasses.replace(self, **changes)
 
 
-def _noise_sigma(setup, paths, pair, targets, amps, snr_db) -> np.ndarray:
-    """Per-element noise standard deviation (complex) of the range-Doppler spectrum per step
-    (S,): the frame's noise power per sample is referred to its strongest direct echo
-    (``radar.frame.noise_power``), here the largest programmed amplitude ``amps`` (S, P, 2)
-    times its channel's strongest unit echo; the windowed DFTs add sum w_r^2 sum w_d^2."""
-    scene, radar = setup.scene, setup.scene.radar
-    tau = float(requested_delay(scene, targets[0].range_m))
-    prog = RtsProgram.build([0, 1], list(pair), [tau, tau], [0.0, 0.0], [1.0, 1.0])
-    ech = channel_echoes(setup, paths, prog)
-    ech = ech.select(ech.kind == KIND_DIRECT)
-    unit = np.array([np.max(np.abs(ech.amplitude[ech.target == q])) for q in (0, 1)])
-    a_max = np.nanmax(np.abs(amps) * unit, axis=(1, 2))  # (S,)
-    n0 = a_max ** 2 / 10 ** (snr_db / 10)
-    g = (np.sum(window(radar.range_window, radar.samples_per_chirp) ** 2)
-         * np.sum(window(radar.doppler_window, radar.chirps_per_tx) ** 2))
-    return np.sqrt(n0 * g)
+class Probes(Protocol):
+    """What a sweep measures with (module doc)."""
+
+    setup: object
+    pair: tuple[int, int]
+    base_offsets: tuple[float, float]
+    period_s: float
+    ranges: np.ndarray
+    seed: int
+    noisy: bool
+    method: str
+    dims: int
+    predicts_noise: bool
+    fine_step_s: float
+
+    def measure(self, deltas, frames: int = 1, repeat: int = 0) -> np.ndarray: ...
+    def frame_noise_deg(self, grid) -> float | None: ...
+    def placed(self, window_s) -> "Probes": ...
+    def fit_columns(self, e) -> tuple[np.ndarray, np.ndarray]: ...
+    def sweep_phase(self, deltas): ...
+    def confirm(self, delta_s: float, frames: int) -> float: ...
+    def phase(self, continuous, delta_s: float) -> float: ...
 
 
-def _linked_noise_sigma(setup, targets, amps) -> np.ndarray:
-    """As :func:`_noise_sigma` with ``[radar.link]`` and no ``snr_db``: the per-sample noise
-    from the link budget, referred to the model's relative amplitudes
-    (:func:`rtsgeom.radar.link.relative_noise_power`; the RTS channels' noise from every programmed
-    row ``amps`` (S, P, 2), the quantisation at the weakest probe's IF response)."""
-    scene, radar = setup.scene, setup.scene.radar
-    beat = radar.slope_hz_per_s * 2.0 * np.array([t.range_m for t in targets]) / c  # (P,)
-    n0 = np.max(relative_noise_power(scene, np.nansum(np.abs(amps) ** 2, axis=(1, 2))[:, None],
-                                     beat[None, :]), axis=1)  # (S,)
-    g = (np.sum(window(radar.range_window, radar.samples_per_chirp) ** 2)
-         * np.sum(window(radar.doppler_window, radar.chirps_per_tx) ** 2))
-    return np.sqrt(n0 * g)
+@dataclass(frozen=True)
+class Calibration:
+    """The phase calibration of a pair (I, J): channel J's delay offset relative to I."""
+
+    pair: tuple[int, int]
+    delta_tau_s: float  # delay offset of J relative to I (what the RTS can set)
+    residual_error_deg: float  # RMS probe error at delta_tau_s, through the full chain
+    range_offset_m: float  # c0 / 2 x the two channels' total delay mismatch
+    sweep_delta_tau_s: np.ndarray
+    sweep_error_deg: np.ndarray
+    refine_delta_tau_s: np.ndarray
+    refine_error_deg: np.ndarray
+    probe_angles_deg: tuple  # per probe: its angle (D = 1) or (azimuth, elevation) (D = 2)
+    period_s: float  # exact: 1 / (f_rts + S t_mid - S tau) at the probes (eq. 27 refined)
+    frames_per_step: int = 1  # frames averaged (coherently) per fine-sweep step
+    frame_noise_deg: float = 0.0  # 1-sigma probe noise of one frame (deg)
+    method: str = "phasor"  # what evaluated the sweep: phasor model or full-chain
+    probe_ranges_m: tuple = ()  # the probes' set ranges (placed within a bin)
+    one_frame_scatter_ps: float = 0.0  # 1-sigma of the fitted delay with one frame per step
+    # the fitted optimum minus delta_tau_s, which is quantised to what the RTS can set
+    # (rts.delay_resolution_s); |residual| <= resolution / 2
+    quantisation_residual_s: float = 0.0
+    delay_resolution_s: float = 0.0  # the RTS's delay step the chosen delay is a multiple of
+    coarse_frames_per_step: int = 1  # frames averaged per coarse-sweep step
+    coarse_minimum_s: float = float("nan")  # the coarse sweep's minimum
+    fit_columns: tuple = ()  # the columns (probe x axis) the fit used
+    odd_columns: tuple = ()  # those of them odd about the coherence point
+    dims: int = 1  # the beamformer's dimensions the probes were detected in
+
+    @property
+    def fit_s(self) -> float:
+        """The fitted optimum before rounding to a realisable delay."""
+        return self.delta_tau_s + self.quantisation_residual_s
+
+    def to_dict(self) -> dict:
+        """The calibration as JSON values (a value that is not finite, e.g. a residual where
+        the chain detected no probe, as null)."""
+        def num(x):
+            return float(x) if np.isfinite(x) else None
+
+        def pts(t, e):
+            return [{"delta_tau_s": float(a), "angle_error_deg": num(b)} for a, b in zip(t, e)]
+        return {
+            "pair": list(self.pair),
+            "delta_tau_s": self.delta_tau_s,
+            "residual_error_deg": num(self.residual_error_deg),
+            "range_offset_m": self.range_offset_m,
+            "period_s": num(self.period_s),
+            "frames_per_step": self.frames_per_step,
+            "frame_noise_deg": num(self.frame_noise_deg),
+            "method": self.method,
+            "probe_ranges_m": list(self.probe_ranges_m),
+            "one_frame_scatter_ps": num(self.one_frame_scatter_ps),
+            "quantisation_residual_s": self.quantisation_residual_s,
+            "delay_resolution_s": self.delay_resolution_s,
+            "coarse_frames_per_step": self.coarse_frames_per_step,
+            "coarse_minimum_s": num(self.coarse_minimum_s),
+            "fit_s": self.fit_s,
+            "fit_columns": list(self.fit_columns),
+            "odd_columns": list(self.odd_columns),
+            "dims": self.dims,
+            "points": int(self.sweep_delta_tau_s.size + self.refine_delta_tau_s.size + 1),
+            "probe_angles_deg": [list(a) if isinstance(a, tuple) else a
+                                 for a in self.probe_angles_deg],
+            "sweep": pts(self.sweep_delta_tau_s, self.sweep_error_deg),
+            "refinement": pts(self.refine_delta_tau_s, self.refine_error_deg),
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Calibration":
+        """Inverse of :meth:`to_dict` (a calibration file written by ``rtsgeom calibrate``)."""
+        def arr(key, field):
+            return frozen(np.array([np.nan if p[field] is None else p[field]
+                                    for p in d.get(key, [])], float))
+        def num(key, default):
+            v = d.get(key, default)
+            return np.nan if v is None else float(v)
+        angles = tuple(tuple(float(x) for x in a) if isinstance(a, (list, tuple)) else float(a)
+                       for a in d.get("probe_angles_deg", (np.nan, np.nan)))
+        return cls((int(d["pair"][0]), int(d["pair"][1])), float(d["delta_tau_s"]),
+                   num("residual_error_deg", np.nan), float(d.get("range_offset_m", 0.0)),
+                   arr("sweep", "delta_tau_s"), arr("sweep", "angle_error_deg"),
+                   arr("refinement", "delta_tau_s"), arr("refinement", "angle_error_deg"),
+                   angles, num("period_s", np.nan), int(d.get("frames_per_step", 1)),
+                   num("frame_noise_deg", 0.0), str(d.get("method", "phasor")),
+                   tuple(d.get("probe_ranges_m", ())), num("one_frame_scatter_ps", 0.0),
+                   float(d.get("quantisation_residual_s", 0.0)),
+                   float(d.get("delay_resolution_s", 0.0)),
+                   int(d.get("coarse_frames_per_step", 1)),
+                   num("coarse_minimum_s", np.nan),
+                   tuple(int(q) for q in d.get("fit_columns", ())),
+                   tuple(int(q) for q in d.get("odd_columns", ())), int(d.get("dims", 1)))
 
 
-def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair, targets,
-                 alphas, deltas, base_offsets=(0.0, 0.0), gain_correction=(1.0, 1.0),
-                 bins=None) -> SweepResult:
-    """The calibration sweep's spectra at every delay ``deltas`` (S,) of channel J, on the
-    setup as built (``setup``, ``paths``), with amplitudes designed on the ``nominal`` setup
-    for the bin the RuT detects (fixed point, see the module); ``bins`` (S, P) forces the
-    design bins (the full chain passes the bins its detection reported). Noise and angles:
-    :meth:`SweepResult.errors`."""
-    deltas = np.atleast_1d(np.asarray(deltas, float))
-    n_s, n_p = deltas.size, len(targets)
-    nom_models = _models(*nominal, pair, targets, base_offsets, deltas)
-    # no mounting errors (nominal_model returns the same objects): the same models, built once
-    real_models = (nom_models if nominal[0] is setup and nominal[1] is paths
-                   else _models(setup, paths, pair, targets, base_offsets, deltas))
-    st = nom_models[0].steering
-    radar = setup.scene.radar
-    kbin = np.empty((n_s, n_p), int)
-    amps = np.empty((n_s, n_p, 2))
-    consistent = np.empty((n_s, n_p), bool)
-    margin = np.empty((n_s, n_p))
-    snaps = []
-    steps = np.arange(n_s)
-    for p, (mn, mr, alpha) in enumerate(zip(nom_models, real_models, alphas)):
-        hn = tdm_compensate(mn.responses, mn.doppler_hz, setup.rut, radar)  # (K, 1+S, V)
-        ha = hn if mr is mn else tdm_compensate(mr.responses, mr.doppler_hz, setup.rut, radar)
-        probes_u = st.directions(np.atleast_1d(np.asarray(alphas, float)))
-        phases = mn.coherent_phases(probes_u, hn)[..., 1:]  # (K, S): J's coherent phase per bin
-        rho = design_ratio(st, hn[:, :1, :], hn[:, 1:, :], alpha, phases)  # (K, S)
-        # power normalisation (ChannelModel.amplitudes): the combined peak as strong as I alone
-        b_i, _, _ = beam_derivatives(st, hn[:, :1, :], np.sin(alpha))
-        b_j, _, _ = beam_derivatives(st, hn[:, 1:, :], np.sin(alpha))
-        p_sum = np.abs(b_i + rho * np.exp(1j * phases) * b_j) ** 2  # (K, S)
-        k_one = int(np.argmax(np.sum(np.abs(hn[:, 0]) ** 2, -1)))
-        u_one, _ = st.peak(hn[k_one, 0], np.sin(alpha))
-        p_one = float(st.power(hn[k_one, 0], u_one[None])[0])
-        scale = mn.unit_gain * np.sqrt(p_one / np.maximum(p_sum, 1e-300))
-        a_i, a_j = scale * gain_correction[0], scale * rho * gain_correction[1]  # (K, S)
-        # spectra at every candidate bin for every design bin: (K_design, S, K_bins, V)
-        x = (a_i[:, :, None, None] * ha[None, :, 0, :][:, None]
-             + a_j[:, :, None, None] * np.moveaxis(ha[:, 1:, :], 0, 1)[None])
-        power = np.sum(np.abs(x) ** 2, -1)  # (K_design, S, K_bins)
-        det = np.argmax(np.where(np.isfinite(power), power, -1), -1)  # (K_design, S)
-        if bins is None:
-            k = det[HALF_BINS, steps]  # design at the set range's bin, see what is detected
-            for _ in range(4):  # redesign at the reported bin until they agree
-                k = det[k, steps]
-        else:
-            k = np.asarray(bins)[:, p]
-        kbin[:, p] = k
-        consistent[:, p] = det[k, steps] == k
-        pw = np.sort(np.where(np.isfinite(power[k, steps]), power[k, steps], 0.0), -1)
-        margin[:, p] = pw[:, -1] / np.maximum(pw[:, -2], 1e-300)
-        amps[:, p] = np.stack([a_i[k, steps], a_j[k, steps]], -1)
-        snaps.append(x[k, steps])  # (S, K_bins, V)
-    x = np.stack(snaps, 1)  # (S, P, K_bins, V)
-    if radar.snr_db is not None:
-        sigma = _noise_sigma(setup, paths, pair, targets, amps, radar.snr_db)
-    elif radar.link is not None:  # the link budget's thermal noise (kTBF, RTS, ADC)
-        sigma = _linked_noise_sigma(setup, targets, amps)
-    else:
-        sigma = np.zeros(n_s)
-    r0 = np.array([_range_bin(setup.scene, t.range_m) for t in targets])
-    return SweepResult(deltas, x, kbin, amps, r0, consistent, margin, sigma,
-                       np.asarray(alphas, float), st)
+RECENTRE_S = 10e-12  # a fit this far from the fine sweep's centre is measured again around it
 
 
-def fit_minimum(deltas, error_rad, period_s: float, near_s: float, harmonics: int = 2,
-                search_s: float | None = None, extra_phase_rad=None,
-                criterion: str = "joint", search_phase=None, return_fit: bool = False):
-    """The delay where the probes' fitted signed angle errors are jointly smallest, from a
-    least-squares fit of the criterion's known periodic shape over one period of steps
-    centred at ``near_s`` (the sweep's coarse minimum).
+class _FineSweep:
+    """The fine sweep's delays around ``centre`` and the fit of its errors."""
 
-    Each probe's signed error is an even, smooth, periodic function of the phase mismatch
-    (the two beams' cross term goes with cos(phi)): ``e_p = sum_h a_h cos(h theta) + b_h
-    sin(h theta)``, theta = 2 pi (delta - near) / period. Fitting it uses every step of the
-    period, so receiver noise enters the chosen delay linearly through the fit, not through
-    one step's quadratically flat neighbourhood (what makes the step-minimum need ~2e4
-    frames per step). The minimum of sum_p e_p^2 on the fitted curves within one sweep step
-    of ``near_s`` (0.05 ps grid; ``search_s``: that half-width instead).
+    def __init__(self, probes, centre: float, steps, period: float):
+        self.t = centre + np.arange(-steps.steps, steps.steps + 1) * steps.step_s
+        self.centre, self.period, self.steps = centre, period, steps
+        self.extra, self.search_phase = probes.sweep_phase(self.t)
 
-    ``criterion="vertex"`` (a coarse RTS whose few realisable steps the curves interpolate,
-    ``calibration.fine_window``): the common vertex instead, the minimum of sum_p e_p'^2;
-    it needs 1 + 2 harmonics points (least squares: 2 more).
-
-    ``extra_phase_rad`` (S, P): a phase each step adds to channel J of each probe beyond the
-    delay's own ``2 pi delta / period`` and known in advance -- the fractional-delay FIR's
-    phase at the step's setting (``calibration.fir.fir_bin_gain``), which cycles with the
-    setting every 1/f_s (+-3.7 deg with 5 taps) and would otherwise bend the periodic shape
-    (a 33 ps bias with 5 taps). The shape is then fitted on each probe's phase axis
-    ``2 pi (delta - near) / period + extra`` and searched with the extra phase interpolated
-    between the steps, or, with ``search_phase`` (a function of the delays (F,) -> (F, P)),
-    evaluated there: a coarse RTS's steps are too far apart to interpolate the FIR's phase,
-    and its data axis also carries the quantiser's own offset error (where the delay step
-    does not divide 1/f_s, ``calibration.realisation_shift``), which the continuous delays
-    searched do not have.
-
-    ``return_fit``: also the fitted curves at the data's steps (S, P) (NaN at the steps left
-    out: off the period or not detected), whose residual is the steps' noise
-    (``ncal.calibrate_pair_nd`` sizes its frames per step from it); all NaN where too few
-    steps for the fit (the minimum is then ``near_s``)."""
-    d = np.asarray(deltas, float)
-    e = np.asarray(error_rad, float)
-    sel = (np.abs(d - near_s) <= period_s / 2) & np.all(np.isfinite(e), axis=1)
-    th = 2 * np.pi * (d[sel] - near_s) / period_s
-    h = np.arange(1, harmonics + 1)
-    vertex = criterion == "vertex"
-
-    def basis(theta):
-        if vertex:  # the derivative's basis: the vertex is where it is zero
-            return np.concatenate([np.zeros((theta.size, 1)), -h * np.sin(np.outer(theta, h)),
-                                   h * np.cos(np.outer(theta, h))], axis=1)
-        return np.concatenate([np.ones((theta.size, 1)), np.cos(np.outer(theta, h)),
-                               np.sin(np.outer(theta, h))], axis=1)
-
-    def values(theta):
-        return np.concatenate([np.ones((theta.size, 1)), np.cos(np.outer(theta, h)),
-                               np.sin(np.outer(theta, h))], axis=1)
-    fitted = np.full(e.shape, np.nan)
-
-    def result(best):
-        return (float(best), fitted) if return_fit else float(best)
-    if th.size < 2 * harmonics + (1 if vertex else 3):
-        return result(near_s)
-    step = np.median(np.diff(np.sort(d))) if d.size > 1 else period_s / 40
-    half = 1.5 * step if search_s is None else search_s
-    fine = near_s + np.arange(-half, half + 1e-15, 0.05e-12)
-    tf = 2 * np.pi * (fine - near_s) / period_s
-    if extra_phase_rad is None:
-        coef, *_ = np.linalg.lstsq(values(th), e[sel], rcond=None)  # (1 + 2H, P)
-        fitted[sel] = values(th) @ coef
-        crit = np.sum((basis(tf) @ coef) ** 2, axis=1)
-        return result(fine[np.argmin(crit)])
-    extra = np.asarray(extra_phase_rad, float).reshape(d.size, -1)
-    order = np.argsort(d[sel])
-    crit = np.zeros(fine.size)
-    search_x = None if search_phase is None else np.asarray(search_phase(fine), float).reshape(
-        fine.size, -1)
-    for p in range(e.shape[1]):  # each probe on its own phase axis
-        x = extra[sel, p]
-        coef, *_ = np.linalg.lstsq(values(th + x), e[sel, p], rcond=None)
-        fitted[sel, p] = values(th + x) @ coef
-        x_f = (search_x[:, p] if search_phase is not None
-               else np.interp(fine, d[sel][order], x[order]))  # smooth in the setting: 5 ps
-        crit += (basis(tf + x_f) @ coef) ** 2
-    return result(fine[np.argmin(crit)])
+    def fit(self, e, columns, selected: bool = False):
+        """(coherence point, fitted curves) of the errors ``e`` (S, C) on ``columns`` (the
+        indices, and which of them are odd: ``probes.fit_columns``; ``fit.fit_centre``);
+        ``selected``: ``e`` holds those columns only."""
+        cols, odd = columns
+        e = np.asarray(e, float) if selected else np.asarray(e, float)[:, cols]
+        w = self.steps
+        extra = None if self.extra is None else np.asarray(self.extra, float)[:, cols]
+        search = None if self.search_phase is None else (
+            lambda f: np.asarray(self.search_phase(f), float)[:, cols])
+        return fit_centre(self.t, e, self.period, self.centre,
+                          w.harmonics, max(self.period / 8, w.step_s), extra, search, odd,
+                          return_fit=True)
 
 
-def place_probes(setup, paths, nominal, pair, ranges, alphas, window_s, base_offsets,
-                 gain_correction, offsets_bins=np.linspace(-0.5, 0.4, 10)) -> np.ndarray:
-    """Probe ranges (P,) moved within a range bin so that over the delays ``window_s`` the
-    design and the detection agree on each probe's bin with the largest power margin (what
-    a lab chooses when it sets its probe targets' ranges): the sweep curve stays on one bin,
-    continuous, around the coherence point."""
-    radar = setup.scene.radar
-    bin_m = c * radar.adc_rate_hz / (2 * radar.slope_hz_per_s * radar.samples_per_chirp)
-    ranges = np.asarray(ranges, float)
-    score = np.empty((len(offsets_bins), ranges.size))
-    for n, o in enumerate(offsets_bins):
-        t = [TargetConfig(float(r + o * bin_m)) for r in ranges]
-        res = phasor_sweep(setup, paths, nominal, pair, t, alphas, window_s, base_offsets,
-                           gain_correction)
-        score[n] = np.min(np.where(res.consistent, res.margin, 0.0), axis=0)
-    best = np.asarray(offsets_bins)[np.argmax(score, axis=0)]
-    return ranges + best * bin_m
+def run_sweep(probes: Probes, config: SweepConfig = SweepConfig()) -> Calibration:
+    """The calibration of ``probes``' pair by the delay sweep (module doc). Raises
+    :class:`CalibrationFailed` when no probe is detected at any step."""
+    setup = probes.setup
+    rts = setup.scene.rts
+    res = rts.delay_resolution_s  # every delay the sweep sets and reports is a multiple
+    span = config.span_s or rts.calibration_span_s
+    step = config.step_s or rts.calibration_step_s
+    grid = np.unique(realisable(np.arange(span[0], span[1] + step / 2, step), res))
+    period = probes.period_s
+
+    def coarse(frames: int):
+        errs = rms_error_deg(probes.measure(grid, frames))
+        if not np.any(np.isfinite(errs)):
+            raise CalibrationFailed(f"pair {probes.pair}: no probe detected at any step of "
+                                    "the sweep")
+        return errs, float(realisable(coarse_minimum(grid, errs), res))
+
+    # frames per coarse step from the predicted noise (the link budget's or snr_db's), before
+    # the sweep: one frame at NF 50 dB (0.9 deg of probe-angle noise) picked a wrong minimum
+    frame_noise = probes.frame_noise_deg(grid) or 0.0  # None: measured on the fine sweep
+    k_coarse = int(config.frames) if config.frames is not None else coarse_frames(frame_noise)
+    errs, near = coarse(k_coarse)
+    if grid.size < 3:  # no sweep to speak of (e.g. only the period asked for)
+        return _calibration(probes, grid, errs, grid, errs, near, near, k_coarse, k_coarse,
+                            frame_noise, 0.0, (np.zeros(0, int), np.zeros(0, bool)))
+    half = period / 4
+    # the window's delays as the RTS realises them (a coarse RTS would round them)
+    probes = probes.placed(np.unique(realisable(near + np.arange(-half, half + 1e-15, step),
+                                                res)))
+    # fine steps the RTS can set (an RTS whose delay moves in 25 ps cannot take 5 ps ones)
+    steps = fine_window(half, res * max(1, round(probes.fine_step_s / res)))
+    fine = _FineSweep(probes, near, steps, period)
+    scatter = 0.0  # the fitted point's 1-sigma with one frame a step
+    if config.frames is not None or not probes.noisy:
+        n_frames = 1 if config.frames is None else int(config.frames)
+        e_fine = probes.measure(fine.t, n_frames)
+        columns = probes.fit_columns(e_fine)
+        if probes.noisy:  # the sweep's own scatter at its frames, referred to one frame
+            scatter = (_measured_scatter(probes, fine, e_fine, columns, config)[0]
+                       * np.sqrt(n_frames))
+    elif probes.predicts_noise:  # the model's own noise sizes the frames, then measure
+        columns = probes.fit_columns(None)
+        scatter = probes.predicted_scatter(fine.t, k_coarse, lambda e: fine.fit(e, columns))
+        n_frames = fine_frames(scatter)
+        e_fine = probes.measure(fine.t, n_frames)
+    else:  # a one-frame sweep, its residual sizes the frames, then again where needed
+        e_fine = probes.measure(fine.t, 1)
+        columns = probes.fit_columns(e_fine)
+        scatter, noise = _measured_scatter(probes, fine, e_fine, columns, config)
+        # the direction-cosine noise taken as the probe-angle noise (du = cos(theta) d theta:
+        # exact at broadside, an underestimate by cos(theta) off it)
+        frame_noise = float(np.degrees(noise))
+        n_frames = fine_frames(scatter)
+        redo = n_frames > 1
+        if coarse_frames(frame_noise) > k_coarse:  # too noisy to trust its minimum: again
+            k_coarse = coarse_frames(frame_noise)
+            errs, near_k = coarse(k_coarse)
+            redo, near = redo or near_k != near, near_k
+        if redo:
+            fine = _FineSweep(probes, near, steps, period)
+            e_fine = probes.measure(fine.t, n_frames)
+            columns = probes.fit_columns(e_fine)
+    best_fit, _ = fine.fit(e_fine, columns)
+    if abs(best_fit - fine.centre) > RECENTRE_S:  # measured again, centred on the point: on a
+        # window lopsided about it the fit drifts (5 ps at 46 ps off, sphere4's elevation pair,
+        # where a noisy coarse minimum was 50 ps from the point)
+        fine = _FineSweep(probes, float(realisable(best_fit, res)), steps, period)
+        e_fine = probes.measure(fine.t, n_frames)
+        columns = probes.fit_columns(e_fine)
+        best_fit, _ = fine.fit(e_fine, columns)
+    return _calibration(probes, grid, errs, fine.t, rms_error_deg(e_fine), near, best_fit,
+                        k_coarse, n_frames, frame_noise, scatter, columns)
 
 
-def chain_errors(setup, paths, pair, targets, res: SweepResult, base_offsets, frames, seed
-                 ) -> tuple[np.ndarray, np.ndarray]:
-    """The same steps through the full ADC-cube chain (synthesis, range-Doppler, CFAR,
-    angle): signed probe-angle errors (S, P) (NaN: not detected) and the detected candidate
-    bins (S, P) (-1: not detected), with the amplitudes of ``res`` (the phasor model's
-    design for the bin it predicts the RuT detects)."""
-    scene = setup.scene
-    base = [(float(requested_delay(scene, t.range_m)) + base_offsets[0],
-             float(requested_delay(scene, t.range_m)) + base_offsets[1]) for t in targets]
-    n_s, n_p = res.bin_index.shape
-    err = np.full((n_s, n_p), np.nan)
-    got = np.full((n_s, n_p), -1)
-    for s_, d in enumerate(res.delta_tau_s):
-        prog = probe_program(res.amplitudes[s_], pair, base, float(d))
-        step_seed = np.random.SeedSequence([int(seed) % 2 ** 32,
-                                            int(round(d * 1e15)) + 2 ** 40])
-        rd, det = simulate_detect(setup, paths, prog, step_seed, frames)
-        for p, t in enumerate(targets):
-            k = nearest_detection(det, rd, t.range_m)
-            if k is not None:
-                err[s_, p] = det.angle_rad[k] - res.alphas[p]
-                got[s_, p] = int(det.range_bin[k]) - res.range_bin0[p] + HALF_BINS
-    return err, got
+def _measured_scatter(probes, fine: _FineSweep, e, columns, config) -> tuple[float, float]:
+    """The fitted point's one-frame scatter (s) and one frame's noise (rad) from the sweep's
+    own residual (``fit.fit_scatter``); where the fit leaves none (a coarse RTS's few
+    steps), from a second, independent sweep."""
+    cols = columns[0]
+    _, fitted = fine.fit(e, columns)
+    e = np.asarray(e, float)[:, cols]
+
+    def fit(x):
+        return fine.fit(x, columns, selected=True)
+    out = fit_scatter(fit, fitted, e, fine.steps.harmonics, config.seed, probes.pair)
+    if not np.isfinite(out[0]):
+        again = probes.measure(fine.t, 1, repeat=1)[:, cols]
+        out = fit_scatter(fit, fitted, e, fine.steps.harmonics, config.seed, probes.pair,
+                          repeat=again)
+    if not np.isfinite(out[0]):
+        raise CalibrationFailed(f"pair {probes.pair}: the probes were not detected at enough "
+                                "steps of the fine sweep to measure its noise")
+    return out
+
+
+def _calibration(probes, grid, errs, fine_t, fine_e, near, best_fit, k_coarse, n_frames,
+                 frame_noise, scatter, columns) -> Calibration:
+    """The sweep's result: the fitted optimum rounded to a delay the RTS can set, confirmed
+    through the full chain."""
+    setup = probes.setup
+    res = setup.scene.rts.delay_resolution_s
+    best = float(realisable(best_fit, res))
+    air = mean_air_delay(setup)
+    i, j = probes.pair
+    b = probes.base_offsets
+    range_offset = 0.5 * c * ((air[j] + b[1] + best) - (air[i] + b[0]))
+    return Calibration(probes.pair, best, probes.confirm(best, n_frames), float(range_offset),
+                       frozen(grid), frozen(errs), frozen(np.asarray(fine_t)),
+                       frozen(np.asarray(fine_e)), probes.probe_angles_deg, probes.period_s,
+                       int(n_frames), float(frame_noise), probes.method,
+                       tuple(float(r) for r in probes.ranges), float(scatter) * 1e12,
+                       float(best_fit - best), float(res), int(k_coarse), float(near),
+                       tuple(int(q) for q in columns[0]),
+                       tuple(int(q) for q, o in zip(*columns) if o), int(probes.dims))
+
+
+@dataclass(frozen=True)
+class CoherencePoint:
+    """The pair's phase-coherence point on the continuous delay model and the delay the RTS
+    can set nearest it (``steps.realisable``)."""
+
+    continuous_s: float  # the coherence point (continuous delay offset of channel J)
+    delta_tau_s: float  # the nearest realisable offset: a whole number of resolution steps
+    quantisation_residual_s: float  # continuous_s - delta_tau_s, |.| <= resolution / 2
+    delay_resolution_s: float  # rts.delay_resolution_s
+
+
+def coherence_point(probes: Probes, near_s: float = 0.0, iterations: int = 4
+                    ) -> CoherencePoint:
+    """The delay offset of channel J that makes both channels coherent at ``probes``'
+    directions on the setup *as built*, the one nearest ``near_s``: the point the sweep
+    should find (a check: a lab does not know the setup as built).
+
+    Newton on the probes' phase mismatch (``probes.phase``), slope ``2 pi f_if`` (eq. 27),
+    on the **continuous** delay model (``steps.continuous_delay_setup``): channel J's offset
+    unrounded. On the RTS's own (quantised) model the phase is a staircase and Newton lands
+    anywhere within a step of the point (up to 7 / 18 / 27 / 18 ps off at 10 / 25 / 50 / 100
+    ps steps: ``benchmarks.calibration_resolution``); the continuous model equals it at
+    every realisable offset (when the step divides 1/f_s). Then quantised: the nearest
+    realisable offset and the residual."""
+    cont = continuous_delay_setup(probes.setup)
+    period = probes.period_s
+    d = float(near_s)
+    for _ in range(2):  # Newton, then move to the period nearest near_s and polish there
+        for _ in range(iterations):
+            d += probes.phase(cont, d) * period / (2 * np.pi)
+        d += np.round((near_s - d) / period) * period
+    res = probes.setup.scene.rts.delay_resolution_s
+    q = float(realisable(d, res))
+    return CoherencePoint(float(d), q, float(d - q), float(res))
+

@@ -161,27 +161,34 @@ def pair_word(text: str):
     return number(0, 10_000, integer=True)(text)
 
 
-def pairs_of(setup, pair) -> list[tuple[int, int]]:
-    """``--pair I J`` as one pair, or ``--pair all``: every adjacent pair of the arc."""
+def pairs_of(setup, pair, cells: bool = False) -> list[tuple[int, int]]:
+    """``--pair I J`` as one pair, or ``--pair all``: every adjacent pair of the arc (with
+    ``cells``, every measured pair of a 2-D scene's cells: ``pipeline.plan.measured_pairs``)."""
     if list(pair) == ["all"]:
         n = setup.fe.count
         if n < 2:
             raise UsageError("--pair all: the arc needs at least two front ends")
+        from ..pipeline.plan import measured_pairs, uses_cells
+        if uses_cells(setup.scene):
+            if not cells:
+                pair_of(setup, (0, 1))  # the error that says what a 2-D scene takes instead
+            return measured_pairs(setup)
         return [(i, i + 1) for i in range(n - 1)]
-    return [pair_of(setup, pair)]
+    return [pair_of(setup, pair, cells)]
 
 
-def pair_of(setup, pair):
+def pair_of(setup, pair, cells: bool = False):
     """The pair in its canonical order, the lower index first (I keeps its delay, J is
     swept): ``--pair 1 0`` and ``--pair 0 1`` are the same measurement and give the same
-    numbers (the front ends are ordered by angle in the scene)."""
+    numbers (the front ends are ordered by angle in the scene). ``cells``: a 2-D scene's
+    neighbouring front ends are pairs too (``pipeline.plan.check_pair``)."""
     if len(pair) != 2 or "all" in pair:
         raise UsageError(f"--pair {' '.join(map(str, pair))}: must be two adjacent front-end "
                          "indices I J, or all")
     from ..pipeline.plan import check_pair
     i, j = pair
     try:
-        return check_pair(setup, i, j, f"--pair {i} {j}")
+        return check_pair(setup, i, j, f"--pair {i} {j}", cells)
     except ParameterError as exc:
         raise UsageError(str(exc)) from None
 
@@ -201,9 +208,9 @@ def pair_options(p: argparse.ArgumentParser) -> None:
                         "rts.fractional_delay_filter)")
 
 
-def prepare_pair(args):
+def prepare_pair(args, cells: bool = False):
     """``--pair I J``: scene (with ``--fir`` applied), setup, the pair, exact paths and each
-    front end alone as the RuT detects it."""
+    front end alone as the RuT detects it (``cells``: :func:`pair_of`)."""
     from ..calibration.probes import probe_front_ends
     from ..geometry import build_setup
     from ..paths import exact_paths
@@ -211,19 +218,20 @@ def prepare_pair(args):
     if getattr(args, "fir", None):  # override the scene's fractional-delay filter model
         scene = scene.evolve(rts=scene.rts.evolve(fractional_delay_filter=args.fir))
     setup = build_setup(scene)
-    pair = pair_of(setup, args.pair)
+    pair = pair_of(setup, args.pair, cells)
     paths = exact_paths(setup)
     return scene, setup, pair, paths, probe_front_ends(setup, paths, scene.seed)
 
 
-def prepare_arc(args):
-    """``--pair all``: scene, setup, every adjacent pair, exact paths, each front end alone."""
+def prepare_arc(args, cells: bool = False):
+    """``--pair all``: scene, setup, every adjacent pair (``cells``: :func:`pairs_of`), exact
+    paths, each front end alone."""
     from ..calibration.probes import probe_front_ends
     from ..geometry import build_setup
     from ..paths import exact_paths
     scene = load_scene_checked(args.scene)
     setup = build_setup(scene)
-    pairs = pairs_of(setup, args.pair)
+    pairs = pairs_of(setup, args.pair, cells)
     paths = exact_paths(setup)
     return scene, setup, pairs, paths, probe_front_ends(setup, paths, scene.seed)
 

@@ -9,9 +9,11 @@ import numpy as np
 from .._lib.io import write_json
 from ..calibration.file import setup_fingerprint
 from ..calibration.fir import fir_effect
-from ..calibration.pair import calibrate_pair, calibrate_pair_paper
+from ..calibration.pair import calibrate_pair
+from ..calibration.paper import calibrate_pair_paper
 from ..errors import UsageError
 from ..geometry import build_setup
+from ..pipeline.plan import uses_cells
 from ._common import (emit_result, load_scene_checked, output_folder, output_path, pair_of,
                       pair_options, prepare_arc, prepare_pair, print_json, steps)
 
@@ -40,7 +42,10 @@ def _calibrate(args, stage) -> int:
         return _calibrate_arc(args, stage)
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
-        scene, setup, pair, paths, probe = prepare_pair(args)
+        scene, setup, pair, paths, probe = prepare_pair(args, cells=True)
+        if args.procedure == "paper" and uses_cells(scene):
+            raise UsageError("--procedure paper: the paper's sweep is a pair on an arc (one set "
+                             "angle in azimuth); this scene's front ends form 2-D cells")
         step(f"sweeping the delay of front end {pair[1]} on the simulated radar "
              f"({args.procedure} procedure)")
         if args.procedure == "paper":
@@ -82,7 +87,7 @@ def _calibrate_arc(args, folder) -> int:
     the arc's. ``folder``: where the ``--out`` files go (None: no ``--out``)."""
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
-        scene, setup, pairs, paths, probe = prepare_arc(args)
+        scene, setup, pairs, paths, probe = prepare_arc(args, cells=True)
         cals = []
         for pair in pairs:
             step(f"sweeping the delay of front end {pair[1]} (pair {pair})")
@@ -107,8 +112,10 @@ def _calibrate_arc(args, folder) -> int:
     for pair, cal in zip(pairs, cals):
         print(f"pair {pair}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps, residual angle error "
               f"{cal.residual_error_deg:.4f} deg, range offset {cal.range_offset_m * 1e3:.2f} mm")
-    print(f"arc ({len(pairs)} pairs): worst residual {out['arc']['worst_residual_error_deg']:.4f} "
-          f"deg (pair {tuple(out['arc']['worst_pair'])})")
+    where = "cells" if uses_cells(scene) else "arc"
+    print(f"{where} ({len(pairs)} pairs): worst residual "
+          f"{out['arc']['worst_residual_error_deg']:.4f} deg (pair "
+          f"{tuple(out['arc']['worst_pair'])})")
     return 0
 
 

@@ -16,7 +16,7 @@ from ..paths import exact_paths
 from .capture import capture_probe
 from ..scene import FrontEndConfig, Scene
 from .fit import Identification
-from ..calibration.pair import coherence_delay
+from ..calibration.pair import pair_coherence
 from ..calibration.probes import probe_angles
 from ..geometry.frontends import front_ends
 from ..scene import TargetConfig
@@ -112,14 +112,14 @@ def detected_angles(setup: Setup, paths=None) -> np.ndarray:
 def predicted_calibration(setup: Setup, pair: tuple[int, int], alphas=None
                           ) -> PredictedCalibration:
     """The pair's calibration delay predicted from a setup *as identified* (no sweep): the
-    coherence point (``calibration.pair.coherence_delay``) of the identified geometry and channel
+    coherence point (``calibration.pair.pair_coherence``) of the identified geometry and channel
     gains at the probes the sweep would use (``alphas``, default from :func:`detected_angles`)."""
     paths = exact_paths(setup)
     i, j = pair
     if alphas is None:
         ang = detected_angles(setup, paths)
         alphas = probe_angles(ang[i], ang[j])
-    d = coherence_delay(setup, paths, (i, j), np.asarray(alphas))
+    d = pair_coherence(setup, paths, (i, j), alphas=np.asarray(alphas)).continuous_s
     return PredictedCalibration((int(i), int(j)), float(d),
                                 frozen(np.asarray(alphas, float)))
 

@@ -13,7 +13,7 @@ from scipy.constants import c
 
 from ..calibration.probes import if_phase_slope_hz
 from ..calibration.steps import continuous_delay_setup
-from ..calibration.sweep import HALF_BINS
+from ..calibration.phasor import HALF_BINS
 from ..geometry import Setup
 from ..paths import Paths, nominal_model
 from ..rts.fir import fir_modelled, realised_delay

@@ -15,9 +15,10 @@ from __future__ import annotations
 import numpy as np
 from scipy.constants import c
 
-from ..calibration.channels import calibrate_channels, channel_offsets, tree_phases
+from ..calibration.channels import calibrate_channels, channel_offsets, pair_edges, tree_phases
 from ..calibration.file import calibration_mismatch, load_calibration
-from ..calibration.pair import Calibration, calibrate_pair
+from ..calibration.pair import calibrate_pair
+from ..calibration.sweep import Calibration
 from ..calibration.probes import probe_angles, probe_front_ends
 from ..errors import (AngleUnreachable, CalibrationFailed, CellUnreachable, ParameterError,
                       SceneError)
@@ -30,7 +31,8 @@ from ..synthesis.cells import enclosing_cell
 from ..synthesis.model import ChannelModel, target_direction
 from .pair import plan_pair, residual_warning
 
-__all__ = ["bracketing_pair", "check_pair", "uses_cells", "target_cells", "plan_targets"]
+__all__ = ["bracketing_pair", "check_pair", "measured_pairs", "uses_cells", "target_cells",
+           "plan_targets"]
 
 
 def bracketing_pair(angle_rad: float, fe_angles_rad: np.ndarray) -> tuple[int, int] | None:
@@ -43,22 +45,40 @@ def bracketing_pair(angle_rad: float, fe_angles_rad: np.ndarray) -> tuple[int, i
     return None
 
 
-def check_pair(setup: Setup, i: int, j: int, name: str) -> tuple[int, int]:
-    """A front-end pair of the arc in canonical order (the lower index first: I keeps its
-    delay, J is swept); ``name`` labels the argument in the error (``--pair 0 1``).
+def check_pair(setup: Setup, i: int, j: int, name: str, cells: bool = False
+               ) -> tuple[int, int]:
+    """A front-end pair in canonical order (the lower index first: I keeps its delay, J is
+    swept); ``name`` labels the argument in the error (``--pair 0 1``).
 
     Pairs synthesize along the arc's azimuth: two adjacent front ends of an arc. A scene of
     2-D cells (front ends off elevation 0, :func:`uses_cells`) has no such pair: the error
-    points to the commands that handle its cells."""
-    if uses_cells(setup.scene):
-        raise ParameterError(
-            f"{name}: this scene's front ends form 2-D cells (azimuth and elevation), not "
-            "pairs on an arc: use `run`, `linearity --grid N`, `nearfield` and `tolerance "
-            "--cell` for the cell")
+    points to the commands that handle its cells; with ``cells`` (what is measured pair by
+    pair there, the calibration) the pairs are its cells' edges (:func:`measured_pairs`)."""
     n = setup.fe.count
-    if not (0 <= i < n and 0 <= j < n) or abs(i - j) != 1:
+    if not (0 <= i < n and 0 <= j < n):
+        raise ParameterError(f"{name}: must be two {'neighbouring' if cells else 'adjacent'} "
+                             f"front-end indices in [0, {n - 1}]")
+    if uses_cells(setup.scene):
+        if not cells:
+            raise ParameterError(
+                f"{name}: this scene's front ends form 2-D cells (azimuth and elevation), not "
+                "pairs on an arc: use `run`, `linearity --grid N`, `nearfield` and `tolerance "
+                "--cell` for the cell")
+        edges = measured_pairs(setup)
+        if (min(i, j), max(i, j)) not in edges:
+            raise ParameterError(f"{name}: not neighbours in this scene's cells; its pairs "
+                                 f"are {', '.join(f'{a} {b}' for a, b in edges)}")
+    elif abs(i - j) != 1:
         raise ParameterError(f"{name}: must be two adjacent front-end indices in [0, {n - 1}]")
     return (min(i, j), max(i, j))
+
+
+def measured_pairs(setup: Setup) -> list[tuple[int, int]]:
+    """The pairs a channel calibration measures: adjacent front ends on an arc, the edges
+    between neighbouring front ends (side by side, stacked in elevation or across a cell's
+    diagonal; ``calibration.channels.pair_edges``) in a 2-D beamformer."""
+    st = Steering.auto(setup.rut, setup.scene.radar)
+    return pair_edges(setup.fe_direction_cosines(st.dims), range(setup.fe.count))
 
 
 def uses_cells(scene) -> bool:
@@ -158,7 +178,7 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
                 cals[pair] = loaded[pair]
                 continue
             cals[pair] = calibrate_pair(setup, paths, pair, probe, (base[pair[0]], base[pair[0]]),
-                                        seed)
+                                        seed=seed)
             if progress:
                 progress(f"calibrated pair {pair}: delta_tau {cals[pair].delta_tau_s * 1e12:.1f} ps")
     offsets = channel_offsets(setup.fe.count, cals)

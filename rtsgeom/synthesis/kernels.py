@@ -53,7 +53,7 @@ def argmax_row(a, row):
 
 @njit(inline="always", **JIT)
 def ratio_one(bi, bi1, bi2, bj, bj1, bj2, e):
-    """:func:`rtsgeom.calibration.sweep.ratio_from_beams` for one set-point: the ratio rho >= 0 that
+    """:func:`rtsgeom.synthesis.pair.ratio_from_beams` for one set-point: the ratio rho >= 0 that
     puts the peak of P(u) = |b_I + rho y|^2 (y = e b_J, e = e^{j phase} J's phase factor) at
     the set direction, from the beams and their first two derivatives in u there (complex
     scalars).
@@ -95,7 +95,7 @@ def ratios(bi, bi1, bi2, bj, bj1, bj2, e, out):
 
 @njit(inline="always", **JIT)
 def choice_row(rho, co, si, p_ii, p_jj, c_re, c_im, power, det):
-    """:func:`rtsgeom.calibration.sweep.detected_bin_choice` for one row of K design bins: ratios
+    """:func:`rtsgeom.synthesis.pair.detected_bin_choice` for one row of K design bins: ratios
     ``rho`` (K,), J's phase per design bin as cos and sin ``co``, ``si`` (K,), the channels'
     power sums over the
     elements ``p_ii``, ``p_jj`` and ``c_ij = sum conj(x_i) x_j`` (``c_re``, ``c_im``) (K,)

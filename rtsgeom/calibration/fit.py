@@ -1,0 +1,213 @@
+"""Where a delay sweep puts the coherence point: the coarse minimum, the fine sweep's centre of
+symmetry and its scatter.
+
+The sweep measures signed probe errors ``e`` (S, C) at delays ``d`` (S,) of channel J: each
+column a probe's angle error (a pair on an arc) or a probe's direction-cosine error along or
+across the pair's line (a 2-D beamformer). Every sweep, 1-D or 2-D, phasor model or full chain, is decided here:
+
+* :func:`coarse_minimum`: the coarse sweep's RMS minimum nearest zero delay;
+* :func:`fit_centre`: the coherence point, the common centre of symmetry of the fine sweep's
+  error curves;
+* :func:`crossing_columns`: which columns cross zero over the sweep;
+* :func:`fit_scatter`: the fitted point's scatter from the sweep's own residual.
+
+Why the centre of symmetry and not the minimum: a probe's error is a function of the two
+channels' phase mismatch phi = 2 pi f_if (delta - delta_c) (eq. 27) through their cross term,
+which goes with cos(phi): **even** about the coherence point delta_c along the pair's line.
+Where it is not exactly even -- channel J's echo moves by c0 delta / 2 in range and its gain
+in the bin with it, the amplitude design on the nominal setup is off under a mounting
+offset -- the probes' RMS minimum moves off the coherence point (up to 13 ps at +-1 mm radial
+offset; and a least-squares fit of two harmonics over +-period/4 to the sharper curves of an
+array with repeated virtual elements overshot zero and put the fitted minimum 15 ps to
+either side of it), while the centre about which the curves are symmetric stays on it
+(within 0.6 ps of the phasor model's coherence point on every array, radius and offset of
+``benchmarks/calibration_accuracy.py``). The fit finds that centre directly: each column a
+sum of harmonics of (delta - s) with its own coefficients, and the shared centre s where the
+residual is least (variable projection).
+
+In a 2-D beamformer the error **across** the pair's line is odd and crosses zero at the
+coherence point (0 to 3 ps from it on sphere4, noiseless), while the error along it is not
+symmetric about the point there (its vertex 14 ps off for a pair stacked in elevation, 40
+ps for a diagonal pair): such a pair is fitted on the across columns that cross zero (any
+periodic shape that is zero at s), along the line only where none does.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+__all__ = ["rms_error_deg", "coarse_minimum", "crossing_columns", "fit_centre", "fit_scatter",
+           "MC_DRAWS", "SCATTER_DRAW_FRAMES"]
+
+MC_DRAWS = 32  # noise realisations that size the frames per step
+SCATTER_DRAW_FRAMES = 16  # fit_scatter draws at this many frames' noise, then scales
+SEARCH_GRID_S = 0.5e-12  # the centre's search grid, then the residual's parabola through 3
+
+
+def rms_error_deg(e) -> np.ndarray:
+    """The RMS over the last axis of probe errors ``e`` (rad), in degrees; inf where it is
+    undefined (a probe not detected), so that a sweep's minimum never lands there."""
+    out = np.degrees(np.sqrt(np.mean(np.square(e), axis=-1)))
+    return np.where(np.isfinite(out), out, np.inf)
+
+
+def coarse_minimum(grid, errs) -> float:
+    """The coarse sweep's minimum (s) from its RMS errors ``errs`` (deg) at delays ``grid``:
+    minima repeat every period; among the local minima about as deep as the deepest (within
+    2 x the deepest + 0.01 deg) the one with the smallest |delta tau|, which costs the least
+    range offset (paper, "Disadvantages")."""
+    errs, grid = np.asarray(errs, float), np.asarray(grid, float)
+    is_min = (np.r_[True, errs[1:] <= errs[:-1]] & np.r_[errs[:-1] <= errs[1:], True])
+    good = np.flatnonzero(is_min & (errs <= 2 * np.min(errs) + 0.01))
+    return float(grid[int(good[np.argmin(np.abs(grid[good]))])])
+
+
+def crossing_columns(e_fine, edge: int = 3) -> np.ndarray:
+    """Which columns of a fine sweep's signed errors ``e_fine`` (S, C) cross zero over it
+    (C,) bool: opposite signs at its two ends, mean of ``edge`` steps each."""
+    e = np.asarray(e_fine, float)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a column never detected: NaN
+        lo = np.nanmean(e[:edge], axis=0)
+        hi = np.nanmean(e[-edge:], axis=0)
+    return np.isfinite(lo) & np.isfinite(hi) & (lo * hi < 0)
+
+
+def _basis(psi, harmonics: int, odd: bool) -> np.ndarray:
+    """(..., S, H + 1) for an even column: a constant and H cosine harmonics of the phase
+    ``psi`` (..., S), symmetric about psi = 0; (..., S, 2 H) for a crossing one: H sine and
+    H (1 - cosine) harmonics, any periodic shape that is zero at psi = 0."""
+    h = np.arange(1, harmonics + 1)
+    x = psi[..., None] * h
+    if odd:
+        return np.concatenate([np.sin(x), 1.0 - np.cos(x)], axis=-1)
+    return np.concatenate([np.ones(psi.shape + (1,)), np.cos(x)], axis=-1)
+
+
+def fit_centre(deltas, error_rad, period_s: float, near_s: float, harmonics: int = 2,
+               search_s: float | None = None, extra_phase_rad=None, search_phase=None,
+               odd=None, return_fit: bool = False):
+    """The coherence point: the common centre of symmetry of the columns of ``error_rad``
+    (S, C) measured at ``deltas`` (S,) (module doc).
+
+    Each even column c is modelled as ``a_0 + sum_h a_h cos(h psi_c)`` (symmetric about s,
+    its vertex at any value), each crossing one (``odd`` (C,) bool) as ``sum_h b_h sin(h
+    psi_c) + a_h (1 - cos(h psi_c))`` (zero at s), psi_c = 2 pi (delta - s) / period + x_c(delta), with its own
+    coefficients by least squares over its detected steps (NaN: not detected, that step
+    dropped for that column); s is the delay where the summed residual is least, searched
+    within ``search_s`` (default 1.5 steps) of ``near_s`` on a 0.5 ps grid, then at the
+    vertex of the residual's parabola through its three lowest points. Every step counts, so
+    receiver noise enters the point linearly through the fit.
+
+    ``extra_phase_rad`` (S, C): a phase each step adds to channel J beyond the delay's own
+    ``2 pi delta / period`` and known in advance, x_c above -- the fractional-delay FIR's
+    phase at the step's setting (``calibration.fir.fir_bin_gain``), which cycles with the
+    setting every 1/f_s (+-3.7 deg with 5 taps; 33 ps if ignored) and, on a coarse RTS, the
+    quantiser's own offset error (``steps.realisation_shift``). The delay returned is then
+    the one whose phase mismatch is zero, ``2 pi (delta - s) / period = -mean_c x_c(delta)``
+    with x_c on the continuous delays from ``search_phase`` (delays (F,) -> (F, C)), or
+    interpolated between the steps.
+
+    ``return_fit``: also the fitted curves at the data's steps (S, C) (NaN where not
+    fitted), whose residual is the steps' noise (:func:`fit_scatter`); the point is
+    ``near_s`` and the curves all NaN where too few steps for the fit."""
+    d = np.asarray(deltas, float)
+    e = np.asarray(error_rad, float).reshape(d.size, -1)
+    n_col = e.shape[1]
+    odd = np.zeros(n_col, bool) if odd is None else np.asarray(odd, bool)
+    x = np.zeros(e.shape) if extra_phase_rad is None else np.asarray(
+        extra_phase_rad, float).reshape(e.shape)
+    ok = np.isfinite(e)
+    fitted = np.full(e.shape, np.nan)
+    # a column detected at fewer steps than its coefficients and one more is left out
+    n_coef = np.where(odd, 2 * harmonics, harmonics + 1)
+    cols = np.flatnonzero(ok.sum(0) >= n_coef + 1)
+    if cols.size == 0:
+        return (float(near_s), fitted) if return_fit else float(near_s)
+    step = np.median(np.diff(np.sort(d))) if d.size > 1 else period_s / 40
+
+    def fits(s):
+        """Coefficients and residual per candidate centre ``s`` (K,)."""
+        s = np.atleast_1d(s)
+        total = np.zeros(s.size)
+        coefs = []
+        for c in cols:
+            m = ok[:, c]
+            psi = 2 * np.pi * (d[m][None] - s[:, None]) / period_s + x[m, c][None]  # (K, S_c)
+            b = _basis(psi, harmonics, odd[c])  # (K, S_c, 1 + H)
+            # least squares by the normal equations, batched over the candidates: the basis
+            # is a handful of well-separated harmonics over a quarter period or more
+            g = np.einsum("ksi,ksj->kij", b, b)
+            r = np.einsum("ksi,s->ki", b, e[m, c])
+            coef = np.linalg.solve(g, r[..., None])[..., 0]  # (K, 1 + H)
+            total += np.sum(e[m, c] ** 2) - np.einsum("ki,ki->k", coef, r)
+            coefs.append(coef)
+        return total, coefs
+
+    half = 1.5 * step if search_s is None else search_s
+    grid = near_s + np.arange(-half, half + 1e-15, SEARCH_GRID_S)
+    resid = fits(grid)[0]
+    k = int(np.argmin(resid))
+    centre = float(grid[k])
+    if 0 < k < grid.size - 1:  # the residual is a parabola about its minimum: its vertex
+        y0, y1, y2 = resid[k - 1:k + 2]
+        curv = y0 - 2 * y1 + y2
+        if curv > 0:
+            centre += 0.5 * (y0 - y2) / curv * SEARCH_GRID_S
+    _, coefs = fits(centre)
+    for c, coef in zip(cols, coefs):
+        m = ok[:, c]
+        psi = 2 * np.pi * (d[m] - centre) / period_s + x[m, c]
+        fitted[m, c] = _basis(psi, harmonics, odd[c]) @ coef[0]
+    best = centre
+    if extra_phase_rad is not None:  # the delay whose phase mismatch is zero (fixed point)
+        order = np.argsort(d)
+        for _ in range(4):
+            if search_phase is not None:
+                x_b = np.asarray(search_phase(np.array([best])), float).reshape(-1)[cols]
+            else:
+                x_b = np.array([np.interp(best, d[order], x[order, c]) for c in cols])
+            best = centre - period_s * float(np.mean(x_b)) / (2 * np.pi)
+    return (float(best), fitted) if return_fit else float(best)
+
+
+def fit_scatter(fit, fitted, e, harmonics: int, seed, pair,
+                repeat=None) -> tuple[float, float]:
+    """The fitted point's 1-sigma scatter (s) with one frame a step, and one frame's noise
+    (rad, median over the columns), from a measured fine sweep: its errors ``e`` (S, C) at
+    one frame a step, the curves ``fitted`` to them (S, C) and the ``fit`` (errors ->
+    (point, curves); :func:`fit_centre`). Each column's noise is its residual about the
+    curve (least-squares degrees of freedom); ``MC_DRAWS`` sweeps are drawn as the curves
+    plus Gaussian noise of that std / sqrt(``SCATTER_DRAW_FRAMES``) (where the fit is
+    linear in the noise) and refitted, their points' std scaled back to one frame. The
+    seed: ``seed`` and the ``pair`` (i, j) measured.
+
+    Where the fit has no residual degrees of freedom (an RTS with coarse delay steps leaves
+    3 or 5 fine steps, through which the curves pass exactly: a zero residual is no evidence
+    of no noise) the result is (NaN, NaN): measure the sweep again, independently, and give
+    it as ``repeat`` (S, C): each column's noise is then that of the two sweeps' difference,
+    var(e - repeat) = 2 sigma^2, with no fit involved."""
+    e = np.asarray(e, float)
+    used = np.any(np.isfinite(fitted), axis=0)  # the columns the fit used
+    if repeat is not None:
+        r = (e - np.asarray(repeat, float)) / np.sqrt(2.0)
+        ok = np.isfinite(r)
+        dof = ok.sum(0)
+    else:
+        r = e - fitted
+        ok = np.isfinite(r)
+        # each column's own coefficients (at most 2 H), and the shared centre counted once
+        dof = ok.sum(0) - 2 * harmonics - 1 / max(int(used.sum()), 1)
+    if not np.any(used) or np.any(dof[used] < 1):
+        return float("nan"), float("nan")
+    sigma = np.where(used, np.sqrt(np.sum(np.where(ok, r, 0.0) ** 2, axis=0)
+                                   / np.maximum(dof, 1)), 0.0)  # (C,)
+    rng = np.random.default_rng(np.random.SeedSequence([int(seed) % 2 ** 32, 1715,
+                                                        int(pair[0]), int(pair[1])]))
+    base = np.where(np.isfinite(fitted), fitted, e)
+    draws = base[None] + (sigma / np.sqrt(SCATTER_DRAW_FRAMES)
+                          * rng.standard_normal((MC_DRAWS,) + base.shape))
+    est = np.array([fit(x)[0] for x in draws])
+    return float(np.std(est) * np.sqrt(SCATTER_DRAW_FRAMES)), float(np.median(sigma[used]))
