@@ -8,7 +8,7 @@ The grid (one row per calibration, ``calibration.pair.calibrate_pair``):
   elements on 10 positions) and a sparse custom array (its Rx 2, 3 and 2 d apart: 12
   elements over 25 d with gaps), each pair (0, 1) on an arc; and sphere4's RuT beamforming
   in azimuth and elevation, its pair (0, 1) stacked in elevation and (0, 2) side by side;
-* arc (sphere) radii 0.5, 1 and 3 m;
+* arc (sphere) radii 0.5, 1 and 3 m (the cascade: 3 m);
 * radial offsets -1, -0.5, 0, +0.5, +1 mm on either front end of the pair;
 * noiseless, and with the scene's receiver noise (``snr_db``).
 
@@ -46,7 +46,8 @@ ROOT = Path(__file__).resolve().parents[1]
 SPARSE_RX_MM = [[32.3, 0.0], [36.1, 0.0], [41.8, 0.0], [45.6, 0.0]]  # gaps 2, 3, 2 x 1.9 mm
 # name: (scene file, radar changes or None, pairs, front end 1's spacing from 0 (deg; None:
 # the scene's), radii (None: all)). The cascade's beam (86 lambda/2 positions) is 1.2 deg
-# wide: its pair 1 deg apart, which the sheet's cutouts allow from about 2 m.
+# wide: its pair 1 deg apart, which the sheet's cutouts allow from about 2 m. sphere4's sheet
+# grows with the radius (its +-8.6 deg cap holds the +-5 deg front ends at every radius).
 ARRAYS = {
     "awr1843boost": ("diewald2022.toml", {"antenna_preset": "awr1843boost"}, [(0, 1)], None,
                      None),
@@ -81,13 +82,27 @@ def variant(array: str, radius_m: float, fe: int | None, dr_m: float, noisy: boo
     if fe is not None:
         fes[fe] = dataclasses.replace(fes[fe], radial_offset_m=float(dr_m))
     rts = scene.rts.evolve(arc_radius_m=float(radius_m), front_ends=tuple(fes))
+    sheet = scene.sheet
+    if any(f.elevation_rad for f in fes):  # the spherical cap's chord in proportion
+        sheet = sheet.evolve(height_m=sheet.height_m * float(radius_m) / scene.rts.arc_radius_m)
     # no targets: the calibration programs its own probes (and a 9-Tx TDM frame's velocity
     # limit would refuse the paper scene's 4 m/s target)
-    return scene.evolve(radar=radar, rts=rts, targets=())
+    return scene.evolve(radar=radar, rts=rts, sheet=sheet, targets=())
 
 
 def one_case(args: tuple) -> dict:
-    array, pair, radius_m, fe, dr_m, noisy, dense = args
+    """One calibration of the grid and its distances (module doc); a case that cannot run
+    is a row with its ``error``, not the end of the grid."""
+    try:
+        return _case(*args)
+    except Exception as exc:  # noqa: BLE001 (a benchmark row, reported below)
+        array, pair, radius_m, fe, dr_m, noisy, _ = args
+        return {"array": array, "pair": f"{pair[0]}-{pair[1]}", "radius_m": radius_m,
+                "front_end": fe, "radial_offset_mm": round(dr_m * 1e3, 6), "noisy": noisy,
+                "error": f"{type(exc).__name__}: {exc}"}
+
+
+def _case(array, pair, radius_m, fe, dr_m, noisy, dense) -> dict:
     from rtsgeom.calibration.fit import rms_error_deg
     from rtsgeom.calibration.pair import calibrate_pair, pair_coherence, pair_probes
     from rtsgeom.calibration.probes import (air_phase_slope_hz, if_phase_slope_hz,
@@ -169,6 +184,10 @@ def main(argv=None) -> int:
     with ProcessPoolExecutor(max(1, a.workers)) as pool:
         for row in pool.map(one_case, cases):
             rows.append(row)
+            if "error" in row:
+                print(f"{row['array']:>16} {row['pair']} R {row['radius_m']:.1f} m: {row['error']}",
+                      flush=True)
+                continue
             print(f"{row['array']:>16} {row['pair']} R {row['radius_m']:.1f} m fe "
                   f"{row['front_end']} dr {row['radial_offset_mm']:+.1f} mm "
                   f"{'noisy' if row['noisy'] else 'clean'}: delta_tau "
@@ -178,9 +197,10 @@ def main(argv=None) -> int:
                      else f", dense minimum {row['dist_dense_min_ps']:+5.1f} ps"), flush=True)
 
     def worst(key, sel):
-        got = [r for r in rows if sel(r) and r[key] is not None]
+        got = [r for r in rows if "error" not in r and sel(r) and r[key] is not None]
         return max(got, key=lambda r: abs(r[key])) if got else None
-    summary = {"cases": len(rows), "radii_m": radii, "offsets_mm": [x * 1e3 for x in offsets],
+    summary = {"cases": len(rows), "failed": [r for r in rows if "error" in r],
+               "radii_m": radii, "offsets_mm": [x * 1e3 for x in offsets],
                "seconds": time.perf_counter() - t0}
     for label, sel in (("noiseless", lambda r: not r["noisy"]), ("noisy", lambda r: r["noisy"])):
         for key in ("dist_coherence_ps", "dist_slope_ps", "dist_dense_min_ps"):
@@ -189,7 +209,9 @@ def main(argv=None) -> int:
                 if w is not None:
                     summary[f"{label}_{dims}d_max_abs_{key}"] = abs(w[key])
                     summary[f"{label}_{dims}d_worst_{key}"] = w
-    write_json_csv(stem, {"summary": summary, "rows": rows}, rows)
+    keys = list(dict.fromkeys(k for r in rows for k in r))
+    write_json_csv(stem, {"summary": summary, "rows": rows},
+                   [{k: r.get(k) for k in keys} for r in rows])
     print(json.dumps({k: v for k, v in summary.items() if "worst" not in k}, indent=1))
     return 0
 

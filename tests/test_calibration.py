@@ -388,6 +388,18 @@ def test_calibration_file_round_trip(tmp_path, capsys):
     assert main(["run", str(DEFAULT_SCENE), "--out", str(tmp_path / "d"), "--quiet",
                  "--calibration", str(bad)]) == 2
     assert "calibration" in capsys.readouterr().err
+    # values no calibration gives are refused naming the field, not run into (a gain of -1
+    # ran with targets 3 deg off, a delay of 1 s detected nothing, NaN ended in a traceback)
+    for key, value, field in (("gain_correction", [-1.0, 1.0], "gain_correction[0] = -1"),
+                              ("gain_correction", [1.0, float("nan")], "gain_correction[1]"),
+                              ("gain_correction", [1.0, 1e300], "gain_correction[1]"),
+                              ("delta_tau_s", 1.0, "pairs[0].delta_tau_s = 1 s"),
+                              ("delta_tau_s", float("nan"), "pairs[0].delta_tau_s = nan")):
+        wrong = dict(doc, **{key: value})
+        bad.write_text(json.dumps(wrong))
+        assert main(["run", str(DEFAULT_SCENE), "--out", str(tmp_path / "e"), "--quiet",
+                     "--calibration", str(bad)]) == 2, key
+        assert field in capsys.readouterr().err
 
 
 @pytest.mark.slow

@@ -105,3 +105,16 @@ def test_other_outputs_unchanged(run_out):
         json.dumps(summary(result, "exact")))
     for name in ("range_doppler.png", "range_angle.png"):
         assert (out / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_the_map_files_do_not_depend_on_when_they_were_written(run_out, monkeypatch):
+    """Two writes of one result are byte-identical in every map file: the MAT-file's header
+    text carries no creation time (scipy writes ``time.asctime()`` there)."""
+    import time
+    from rtsgeom.cli._maps import map_dataset, maps_arrays
+    _, result = run_out
+    ds = map_dataset(result)
+    first = maps_arrays(ds)
+    monkeypatch.setattr(time, "asctime", lambda *a: "Thu Jan  1 00:00:00 2099")
+    assert maps_arrays(ds) == first
+    assert first["maps.mat"].startswith(b"MATLAB 5.0 MAT-file")

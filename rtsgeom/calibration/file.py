@@ -8,13 +8,14 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SceneError
-from .pair import Calibration
+from .sweep import Calibration
 from .probes import FrontEndProbe
 
 __all__ = ["CALIBRATION_FORMAT", "setup_fingerprint", "calibration_mismatch",
            "load_calibration"]
 
 CALIBRATION_FORMAT = "rtsgeom-calibration"
+GAIN_RANGE = (0.1, 10.0)  # a gain correction beyond +-20 dB is not a front end's tolerance
 
 
 def setup_fingerprint(scene) -> str:
@@ -84,9 +85,24 @@ def load_calibration(doc: dict, setup) -> tuple[FrontEndProbe, dict]:
         raise SceneError(f"{where}: front_end_angles_deg has {ang.size} entries, gain_correction "
                          f"{gain.size}: the scene has {n} front ends (calibrated on another "
                          "setup?)")
-    for (i, j) in cals:
+    bad = np.flatnonzero(~(np.isfinite(gain) & (gain >= GAIN_RANGE[0]) & (gain <= GAIN_RANGE[1])))
+    if bad.size:
+        raise SceneError(f"{where}: gain_correction[{bad[0]}] = {gain[bad[0]]:g}: must be in "
+                         f"[{GAIN_RANGE[0]:g}, {GAIN_RANGE[1]:g}] (a front end's measured over "
+                         "modelled amplitude, +-20 dB)")
+    if not np.all(np.isfinite(ang)):
+        raise SceneError(f"{where}: front_end_angles_deg: must be finite")
+    span = setup.scene.rts.calibration_span_s
+    for k, ((i, j), cal) in enumerate(cals.items()):
         if not (0 <= i < n and 0 <= j < n):
             raise SceneError(f"{where}: pair ({i}, {j}): must be front-end indices in "
                              f"[0, {n - 1}]")
+        period = cal.period_s if np.isfinite(cal.period_s) else 1.0 / setup.scene.rts.f_rts_hz
+        lo, hi = span[0] - period, span[1] + period
+        if not (np.isfinite(cal.delta_tau_s) and lo <= cal.delta_tau_s <= hi):
+            raise SceneError(f"{where}: pairs[{k}].delta_tau_s = {cal.delta_tau_s:g} s: must be "
+                             f"in [{lo * 1e9:.3f}, {hi * 1e9:.3f}] ns (the scene's "
+                             "calibration span, rts.calibration_span_ns, and a period either "
+                             "side: what a sweep can find)")
     probe = FrontEndProbe(ang, np.full(n, np.nan), gain)
     return probe, cals

@@ -214,13 +214,18 @@ def prepare_pair(args, cells: bool = False):
     from ..calibration.probes import probe_front_ends
     from ..geometry import build_setup
     from ..paths import exact_paths
-    scene = load_scene_checked(args.scene)
-    if getattr(args, "fir", None):  # override the scene's fractional-delay filter model
-        scene = scene.evolve(rts=scene.rts.evolve(fractional_delay_filter=args.fir))
+    scene = _with_fir(load_scene_checked(args.scene), args)
     setup = build_setup(scene)
     pair = pair_of(setup, args.pair, cells)
     paths = exact_paths(setup)
     return scene, setup, pair, paths, probe_front_ends(setup, paths, scene.seed)
+
+
+def _with_fir(scene, args):
+    """The scene with ``--fir`` (the fractional-delay filter model) where it is given."""
+    if getattr(args, "fir", None):
+        scene = scene.evolve(rts=scene.rts.evolve(fractional_delay_filter=args.fir))
+    return scene
 
 
 def prepare_arc(args, cells: bool = False):
@@ -229,7 +234,7 @@ def prepare_arc(args, cells: bool = False):
     from ..calibration.probes import probe_front_ends
     from ..geometry import build_setup
     from ..paths import exact_paths
-    scene = load_scene_checked(args.scene)
+    scene = _with_fir(load_scene_checked(args.scene), args)
     setup = build_setup(scene)
     pairs = pairs_of(setup, args.pair, cells)
     paths = exact_paths(setup)

@@ -86,8 +86,18 @@ def maps_arrays(ds) -> dict[str, bytes]:
     np.savez(npz, **arrays, units=json.dumps(units))
     mat = io.BytesIO()
     scipy.io.savemat(mat, {**arrays, "units": units}, oned_as="column")
-    return {"maps.npz": npz.getvalue(), "maps.mat": mat.getvalue(),
+    return {"maps.npz": npz.getvalue(), "maps.mat": _without_timestamp(mat.getvalue()),
             "maps.nc": ds.to_netcdf(engine="scipy")}
+
+
+MAT_DESCRIPTION = b"MATLAB 5.0 MAT-file, rtsgeom run maps"
+
+
+def _without_timestamp(mat: bytes) -> bytes:
+    """A MAT-file with its 116-byte header text fixed: scipy writes the creation time there,
+    so two runs of one scene differed in ``maps.mat`` alone (the text is free-form; MATLAB
+    reads the version and byte-order fields after it)."""
+    return MAT_DESCRIPTION.ljust(116, b"\0") + mat[116:]
 
 
 def render_maps(result: RunResult, ds=None) -> dict[str, bytes]:

@@ -23,6 +23,9 @@ def cmd_calibrate(args) -> int:
         if getattr(args, "from_identified", None) is not None:  # no sweep (rtsgeom.identify)
             if list(args.pair) == ["all"]:
                 raise UsageError("--from-identified predicts one pair's delay: give --pair I J")
+            if args.full_chain or args.procedure != "exact" or args.fir:
+                raise UsageError("--from-identified predicts the delay without a sweep: "
+                                 "--full-chain, --procedure and --fir do not apply")
             from ..identify import calibrate_from_identified
             scene = load_scene_checked(args.from_identified)
             out = calibrate_from_identified(scene, pair_of(build_setup(scene), args.pair)).to_dict()
@@ -88,15 +91,25 @@ def _calibrate_arc(args, folder) -> int:
     with steps(args.quiet or args.json) as step:
         step("measuring each front end alone")
         scene, setup, pairs, paths, probe = prepare_arc(args, cells=True)
+        if args.procedure == "paper" and uses_cells(scene):
+            raise UsageError("--procedure paper: the paper's sweep is a pair on an arc (one set "
+                             "angle in azimuth); this scene's front ends form 2-D cells")
         cals = []
         for pair in pairs:
             step(f"sweeping the delay of front end {pair[1]} (pair {pair})")
-            cals.append(calibrate_pair(setup, paths, pair, probe, seed=scene.seed))
-    res = [abs(c.residual_error_deg) for c in cals]
-    out = {"pairs": [c.to_dict() for c in cals],
+            cals.append(calibrate_pair_paper(setup, paths, pair, probe, seed=scene.seed)
+                        if args.procedure == "paper" else
+                        calibrate_pair(setup, paths, pair, probe, seed=scene.seed,
+                                       full_chain=args.full_chain))
+    res = np.abs([c.residual_error_deg for c in cals])  # inf: a probe the chain missed
+    worst = int(np.argmax(np.where(np.isnan(res), np.inf, res)))
+    out = {"pairs": [dict(c.to_dict(), procedure=args.procedure) for c in cals],
+           "gain_correction": [float(x) for x in probe.gain_correction],
            "front_end_angles_deg": [float(x) for x in np.degrees(probe.angle_rad)],
-           "arc": {"pairs": [list(p) for p in pairs], "worst_residual_error_deg": max(res),
-                   "worst_pair": list(pairs[int(np.argmax(res))]),
+           "arc": {"pairs": [list(p) for p in pairs],
+                   "worst_residual_error_deg": (float(res[worst]) if np.isfinite(res[worst])
+                                                else None),
+                   "worst_pair": list(pairs[worst]),
                    "max_abs_range_offset_mm": max(abs(c.range_offset_m) for c in cals) * 1e3},
            "format": "rtsgeom-calibration", "setup_sha256": setup_fingerprint(scene)}
     if folder is not None:
@@ -113,8 +126,7 @@ def _calibrate_arc(args, folder) -> int:
         print(f"pair {pair}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps, residual angle error "
               f"{cal.residual_error_deg:.4f} deg, range offset {cal.range_offset_m * 1e3:.2f} mm")
     where = "cells" if uses_cells(scene) else "arc"
-    print(f"{where} ({len(pairs)} pairs): worst residual "
-          f"{out['arc']['worst_residual_error_deg']:.4f} deg (pair "
+    print(f"{where} ({len(pairs)} pairs): worst residual {res[worst]:.4f} deg (pair "
           f"{tuple(out['arc']['worst_pair'])})")
     return 0
 

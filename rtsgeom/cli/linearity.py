@@ -88,7 +88,7 @@ def _linearity_arc(args, folder) -> int:
                 cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
             step(f"pair {pair}: sweeping {args.points} set-points ({args.amplitudes} amplitudes)")
             lins.append(linearity(setup, paths, pair, args.amplitudes, probe, cal, args.points,
-                                  scene.seed))
+                                  scene.seed, args.end_angles))
     worst = [lin.max_abs_error_deg for lin in lins]
     out = {"pairs": [lin.to_dict() for lin in lins],
            "arc": {"pairs": [list(p) for p in pairs], "max_abs_error_deg": max(worst),

@@ -2,19 +2,7 @@
 (numba): the same arithmetic as its numpy definition :func:`rtsgeom.radar.newton.peak_1d`, bit
 for bit (tested), for the large batches of the Monte-Carlo studies.
 
-Why compiled: each is a few dozen flops per snapshot or set-point, applied to tens of millions
-of them; written with numpy, every intermediate is a temporary array as large as the batch, and
-the loops over Newton steps, design bins and plan alternatives run in Python over ever smaller
-subsets. A scalar loop per snapshot avoids both.
-
-Rules: ``cache=True`` (compiled once per machine into ``__pycache__``), ``nogil=True`` (threads
-may share them), no ``fastmath`` (IEEE arithmetic: the results agree with the numpy definitions
-to rounding, tested), ``error_model="numpy"`` (0/0 is NaN, as in numpy); the small per-snapshot
-helpers ``inline="always"`` (numba-level inlining drops the reference counting of the arrays
-passed down). numba is imported only with this module, which the callers import inside the
-functions that need it (``rtsgeom --help`` and ``info`` do not load it); small batches run the
-numpy definitions instead (``rtsgeom._lib.util.use_kernels``: importing numba and setting up its
-target costs about 0.5 s per process).
+Compiled by the kernels' rules (:mod:`rtsgeom._lib.jit`).
 """
 
 from __future__ import annotations
@@ -24,11 +12,11 @@ import math
 import numpy as np
 from numba import njit
 
+from .._lib.jit import JIT
 from .newton import P_SLACK, STEP_CLIP, STEP_TOL
 
 __all__ = ["peak_1d", "newton_1d"]
 
-_JIT = dict(cache=True, nogil=True, error_model="numpy")
 # (numba's cache is keyed on this file: after changing the constants in newton.py, touch this
 # file or clear __pycache__/peak_kernels.*.nb*)
 
@@ -36,7 +24,7 @@ _JIT = dict(cache=True, nogil=True, error_model="numpy")
 # -- the beamformer's peak (Steering.peak, D = 1) ------------------------------------------------
 
 
-@njit(inline="always", **_JIT)
+@njit(inline="always", **JIT)
 def _phasors(lat, u, pw, e):
     """e^{j k_v u} (V_s,) into ``e`` for the wavenumbers of lattice ``lat`` (``radar.newton.lattice``):
     ``e^{j k_0 u} z^{m_v} e^{j r_v u}``, z = e^{j kappa u}, the powers by products (``pw``:
@@ -55,7 +43,7 @@ def _phasors(lat, u, pw, e):
         e[v] = ev
 
 
-@njit(inline="always", **_JIT)
+@njit(inline="always", **JIT)
 def newton_1d(k, lat, x, u, steps, pw, e):
     """Newton steps on log P(u), P = |B|^2, B(u) = sum_v y_v, y_v = x_v e^{j k_v u}, for one
     tapered snapshot ``x`` (V_s,) (wavenumbers times positions ``k`` (V_s,), their lattice
@@ -94,7 +82,7 @@ def newton_1d(k, lat, x, u, steps, pw, e):
     return u, False, p
 
 
-@njit(**_JIT)
+@njit(**JIT)
 def _mirrored(gc, gs):
     """Whether the grid's tables are exactly mirror-symmetric: column G-1-g is column g with
     the sine negated (a grid symmetric about u = 0, as :meth:`Steering.grid`'s)."""
@@ -106,7 +94,7 @@ def _mirrored(gc, gs):
     return True
 
 
-@njit(inline="always", **_JIT)
+@njit(inline="always", **JIT)
 def _grid_bound(xn, gc, gs, sa, sb, sc, sd):
     """An upper bound on the largest of the grid's powers as :func:`peak_1d` computes them,
     on a mirror-symmetric grid (:func:`_mirrored`): B(u_g) and B(-u_g) share their four
@@ -151,7 +139,7 @@ def _grid_bound(xn, gc, gs, sa, sb, sc, sd):
     return p_max + (64.0 * (n_v + 2) * 2.0 ** -53) * (s1 * s1)
 
 
-@njit(**_JIT)
+@njit(**JIT)
 def peak_1d(k, lat, x, u0, gc, gs, grid, iterations, u_out, ok_out):
     """:meth:`Steering.peak` for D = 1, per tapered snapshot ``x[n]`` (n, V_s): Newton
     (:func:`newton_1d`, ``iterations`` steps) from ``u0[n]``, accepted when it converged and

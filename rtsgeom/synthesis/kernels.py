@@ -3,19 +3,7 @@ ratio (:func:`ratio_one`, bit for bit :func:`rtsgeom.synthesis.pair._ratios`) an
 (:func:`choice_row`, :func:`rtsgeom.synthesis.pair.detected_bin_choice`'s rule), and their
 batched loops.
 
-Why compiled: each is a few dozen flops per snapshot or set-point, applied to tens of millions
-of them; written with numpy, every intermediate is a temporary array as large as the batch, and
-the loops over Newton steps, design bins and plan alternatives run in Python over ever smaller
-subsets. A scalar loop per snapshot avoids both.
-
-Rules: ``cache=True`` (compiled once per machine into ``__pycache__``), ``nogil=True`` (threads
-may share them), no ``fastmath`` (IEEE arithmetic: the results agree with the numpy definitions
-to rounding, tested), ``error_model="numpy"`` (0/0 is NaN, as in numpy); the small per-snapshot
-helpers ``inline="always"`` (numba-level inlining drops the reference counting of the arrays
-passed down). numba is imported only with this module, which the callers import inside the
-functions that need it (``rtsgeom --help`` and ``info`` do not load it); small batches run the
-numpy definitions instead (``rtsgeom._lib.util.use_kernels``: importing numba and setting up its
-target costs about 0.5 s per process).
+Compiled by the kernels' rules (:mod:`rtsgeom._lib.jit`).
 """
 
 from __future__ import annotations
@@ -25,9 +13,9 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["JIT", "ratio_one", "ratios", "choice_row", "bin_choice_rows", "argmax_row"]
+from .._lib.jit import JIT
 
-JIT = dict(cache=True, nogil=True, error_model="numpy")
+__all__ = ["ratio_one", "ratios", "choice_row", "bin_choice_rows", "argmax_row"]
 
 
 # -- the pair's design for the bin the RuT detects (synthesis.pair, the tolerance model's) ------

@@ -3,19 +3,7 @@ set-point the pair's exact design at the bin the RuT detects (:func:`design_rows
 planner's choice among J's alternative delays (:func:`plan_rows`) and the detected bin's
 snapshot (:func:`detect_rows`), built on the pair's kernels (:mod:`rtsgeom.synthesis.kernels`).
 
-Why compiled: each is a few dozen flops per snapshot or set-point, applied to tens of millions
-of them; written with numpy, every intermediate is a temporary array as large as the batch, and
-the loops over Newton steps, design bins and plan alternatives run in Python over ever smaller
-subsets. A scalar loop per snapshot avoids both.
-
-Rules: ``cache=True`` (compiled once per machine into ``__pycache__``), ``nogil=True`` (threads
-may share them), no ``fastmath`` (IEEE arithmetic: the results agree with the numpy definitions
-to rounding, tested), ``error_model="numpy"`` (0/0 is NaN, as in numpy); the small per-snapshot
-helpers ``inline="always"`` (numba-level inlining drops the reference counting of the arrays
-passed down). numba is imported only with this module, which the callers import inside the
-functions that need it (``rtsgeom --help`` and ``info`` do not load it); small batches run the
-numpy definitions instead (``rtsgeom._lib.util.use_kernels``: importing numba and setting up its
-target costs about 0.5 s per process).
+Compiled by the kernels' rules (:mod:`rtsgeom._lib.jit`).
 """
 
 from __future__ import annotations
@@ -25,7 +13,8 @@ import math
 import numpy as np
 from numba import njit
 
-from ...synthesis.kernels import JIT, argmax_row, choice_row, ratio_one
+from ..._lib.jit import JIT
+from ...synthesis.kernels import argmax_row, choice_row, ratio_one
 
 __all__ = ["design_rows", "plan_rows", "detect_rows"]
 
