@@ -2,7 +2,7 @@
 times (wall and CPU) and as ratios to a reference measured in the same run, so a noisy machine
 matters less. Not part of the test suite.
 
-* Every command of issue 17 (``commands``): the simulation phase of ``run`` (``run_scene`` on
+* Every command (``commands``): the simulation phase of ``run`` (``run_scene`` on
   the default scene), one full-chain frame (synthesis + range-Doppler + CFAR + angle),
   ``calibrate --pair 0 1``, ``adc --format dca1000``, ``design`` (default grid; also with
   ``--workers 2``, and its CPU split into model builds and tolerance searches),
@@ -168,14 +168,14 @@ def _time_inproc(f, repeat: int = 1) -> tuple[dict, object]:
     return best, out
 
 
-#: issue 17's targets (quiet 2-core machine), seconds
+#: wall-time targets per command (quiet 2-core machine), seconds
 TARGETS = {"run_simulation": 1.0, "frame": 0.030, "calibrate": 1.0, "adc_dca1000": 2.0,
            "design_default_grid": 5.0, "design_default_grid_2_workers": 5.0, "nearfield": 2.0,
            "tolerance": 20.0, "tolerance_2_workers": 20.0, "help": 0.5}
 
 
 def bench_commands(scene_path: Path, quick: bool, repeat: int, workers: int) -> dict:
-    """Every command of the issue's table: wall, CPU and wall / reference."""
+    """Every command: wall, CPU and wall / reference."""
     import tempfile
     from rtsgeom.radar.fmcw import synthesize, synthesize_exact
     from rtsgeom.radar.processing import cfar_mask, detect, range_doppler

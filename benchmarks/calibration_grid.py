@@ -1,5 +1,5 @@
 """``python -m benchmarks.calibration_grid [--quick]``: does the calibration land on the
-phase-coherence point for every setup? (issue 13, "Done when").
+phase-coherence point for every setup?
 
 For radial mounting offsets dr from -1 to +1 mm in 0.05 mm steps on either front end of the
 pair (0, 1), at arc radii R_c = 0.5, 1 and 3 m, run the full-chain calibration

@@ -1,4 +1,4 @@
-"""``python -m benchmarks.mutation``: mutation testing of the physics core with mutmut (issue 22).
+"""``python -m benchmarks.mutation``: mutation testing of the physics core with mutmut.
 
 Not part of the test suite (minutes to hours). mutmut 3 rewrites every function of the mutated
 modules into a trampoline that dispatches to the original or to one of its mutants (an operator,

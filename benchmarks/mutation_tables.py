@@ -1,4 +1,4 @@
-"""Per-mutant tables of ``python -m benchmarks.mutation`` (issue 22): the equivalent mutants
+"""Per-mutant tables of ``python -m benchmarks.mutation``: the equivalent mutants
 with the reason, the test that kills each survivor of a fresh sample, the survivors renamed in
 today's code, and the survivors neither killed nor shown equivalent with why."""
 

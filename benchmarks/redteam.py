@@ -1,4 +1,4 @@
-"""Red team of the output promises (issue 18): ``python -m benchmarks.redteam [--quick]``.
+"""Adversarial checks of the output promises: ``python -m benchmarks.redteam [--quick]``.
 
 1. Interruption: ``rtsgeom run`` into a folder that holds an earlier run (of a different seed,
    so old and new differ) is sent SIGINT, SIGTERM or SIGKILL at several fractions of its

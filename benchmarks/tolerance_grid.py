@@ -1,9 +1,9 @@
 """``python -m benchmarks.tolerance_grid [--draws N] [--verify N]``: the mounting-tolerance study
-across arc radii and the target's sub-bin position (issue 13, "What to build" bullet 3).
+across arc radii and the target's sub-bin position.
 
 For R_c = 0.5, 1 and 3 m (the default scene otherwise, pair (0, 1), 21 set-points, 0.1 mm
-sigma on every axis, seed 1), with the target at the range-bin centre (the study before issue
-13) and at a sub-bin position drawn per draw (uniform over one bin), report per case the worst
+sigma on every axis, seed 1), with the target at the range-bin centre (the study's earlier
+model) and at a sub-bin position drawn per draw (uniform over one bin), report per case the worst
 |error| p50/p95/p99/max and the yield within 0.1 deg; the calibrated sigma that keeps 95 % of
 the setups within 0.1 deg (all axes scaled together, and the radial axis alone); the
 calibrated p99 per sub-bin band (|offset| in tenths of a bin); and the largest difference of

@@ -1,6 +1,6 @@
 """Absorbers per surface: ``sheet.reflection_loss_db`` and ``[[structure]] reflection_loss_db``
 lower every ray-traced path by their loss once per bounce off the surface that carries them,
-and leave every other path as it was (issue 20, absorbers).
+and leave every other path as it was.
 
 Skipped, like ``test_raytrace.py``, where Sionna RT or a usable LLVM backend is missing.
 """

@@ -1,4 +1,4 @@
-"""Arbitrary angle of arrival: synthesis modes and calibration (issue: AoA)."""
+"""Arbitrary angle of arrival: synthesis modes and calibration."""
 
 from __future__ import annotations
 
@@ -96,8 +96,8 @@ def test_calibration_sweep_period(default_cal):
     # minima one period apart; the second is pulled by up to ~2 steps because the delay also
     # moves channel J by c dtau / 2 = one range bin per period (the paper's range offset)
     assert abs(abs(t[deep[1]] - t[deep[0]]) - period) <= 1.5 * step
-    # maxima are broad and noisy (one frame per step since the sweep's minimum is fitted,
-    # issue 17): the two highest at least half a period apart
+    # maxima are broad and noisy (one frame per step since the sweep's minimum is fitted):
+    # the two highest at least half a period apart
     top = sorted(maxs, key=lambda i: -e[i])
     top = [top[0], next(i for i in top if abs(t[i] - t[top[0]]) > period / 2)]
     # the later one sits 1.4 range bins off: looser

@@ -85,7 +85,7 @@ def test_bad_pair_names_field():
 
 
 def test_raytrace_kernel_cache_is_outside_the_checkout(monkeypatch, tmp_path):
-    """Issue 16 defect 7: Dr.Jit's kernels went to <repo>/.drjit_cache."""
+    """Dr.Jit's kernel cache lies outside the checkout (it used to be <repo>/.drjit_cache)."""
     from pathlib import Path
 
     from rtsgeom.paths import raytrace

@@ -1,5 +1,5 @@
-"""The whole-arc tolerance study draws the target's sub-bin position (issue 13's pair-study
-model, shared by every pair of the arc): on arcs of different radii and front-end counts."""
+"""The whole-arc tolerance study draws the target's sub-bin position (the pair study's model,
+shared by every pair of the arc): on arcs of different radii and front-end counts."""
 
 from __future__ import annotations
 

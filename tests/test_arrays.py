@@ -1,5 +1,5 @@
 """RuT arrays: presets against their documented layouts, custom sparse/non-uniform arrays,
-duplicate virtual positions, aperture, resolution and grating lobes (issue 14, item 1)."""
+duplicate virtual positions, aperture, resolution and grating lobes."""
 
 from __future__ import annotations
 

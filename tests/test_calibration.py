@@ -1,5 +1,5 @@
-"""Calibration that holds across setups (issue 13), the pair order (issue 18 item 4), the
-gain offset and the calibration period (issue 22)."""
+"""Calibration that holds across setups, the pair order, the gain offset and the calibration
+period."""
 
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ def _noiseless(radius_m=1.0, f_rts_hz=None, offsets=None):
     return make_scene(mutate)
 
 
-# ---------------------------------------------------------------- height warning (item 5)
+# ---------------------------------------------------------------- height warning
 
 @pytest.mark.parametrize("r", [0.3, 1.0, 3.0])
 @pytest.mark.parametrize("dz_mm", [0.5, 2.0, 10.0, 40.0])
@@ -64,7 +64,7 @@ def test_height_warning_only_where_the_second_order_phase_is_large():
     assert f"{expected:.4g} deg" in hits[0]
 
 
-# ---------------------------------------------------------------- pair order (issue 18.4)
+# ---------------------------------------------------------------- pair order
 
 def test_pair_order_does_not_change_the_result(tmp_path, capsys):
     outs = []
@@ -75,7 +75,7 @@ def test_pair_order_does_not_change_the_result(tmp_path, capsys):
     assert outs[0] == outs[1]
 
 
-# ---------------------------------------------------------------- gain offset (issue 22)
+# ---------------------------------------------------------------- gain offset
 
 @pytest.mark.parametrize("fe, offset_db", [(1, 6.0), (0, -6.0)])
 def test_gain_offset_scales_the_echo_and_comes_back_as_gain_correction(fe, offset_db):
@@ -137,8 +137,8 @@ def test_period_is_the_exact_closed_form(radius, f_rts):
 def test_minima_are_one_exact_period_apart(radius, f_rts):
     """Two calibrations, one near the first minimum and one a period later (noiseless, each
     refined to 1 ps): their distance is the reported period. (At f_rts = 250 MHz a period
-    moves channel J by 1.3 range bins and the second minimum lands 8 ps late: the
-    bin-straddling of issue 13 item 1, left to its fix.)"""
+    moves channel J by 1.3 range bins and the second minimum lands 8 ps late, J's echo
+    straddling a range-bin boundary; hence 500 MHz here.)"""
     setup = build_setup(_noiseless(radius, f_rts))
     paths = exact_paths(setup)
     probe = probe_front_ends(setup, paths, 1)
@@ -151,7 +151,7 @@ def test_minima_are_one_exact_period_apart(radius, f_rts):
     assert spacing == pytest.approx(p, abs=2e-12)
 
 
-# ---------------------------------------------------------------- fractional-delay FIR (item 4)
+# ---------------------------------------------------------------- fractional-delay FIR
 
 def _fir_scene(taps, model, snr=False):
     def mutate(doc):
@@ -230,7 +230,7 @@ def test_fir_moves_the_coherence_point_by_its_phase_ripple(taps):
     assert fir_effect(ideal, 0.1e-9)["predicted_shift_ps"] == 0.0
 
 
-# ---------------------------------------------------------------- paper procedure (item 6)
+# ---------------------------------------------------------------- paper procedure
 
 @pytest.mark.slow
 def test_paper_procedure_minima_are_one_period_apart_and_its_optimum_is_off_coherence():
@@ -337,7 +337,7 @@ def test_exact_linearity_after_calibration_on_straddling_setups(radius, fe, dr_m
 @pytest.mark.slow
 @pytest.mark.parametrize("offsets", [None, (0, 0.75, 0.5)])
 def test_fast_calibration_agrees_with_the_full_chain(offsets):
-    """Issue 17: the phasor-model sweep and every step through the ADC-cube chain choose
+    """The phasor-model sweep and every step through the ADC-cube chain choose
     the same delay (default scene, and one with radial and tangential mounting offsets)."""
     scene = make_scene() if offsets is None else _offset_scene(1.0, *offsets)
     setup = build_setup(scene)
@@ -552,7 +552,7 @@ def test_fir_changes_linearity_by_no_more_than_its_phase_ripple_explains(taps):
     assert np.max(np.abs(change)) > 0  # the filter is in the chain
 
 
-# --------------------------------- the 0.05 mm offset grid, sampled (issue 13 "Done when")
+# --------------------------------- the 0.05 mm offset grid, sampled
 
 def _grid_sample(n_random=2):
     """Setups of the committed full grid (``python -m benchmarks.calibration_grid
@@ -613,7 +613,7 @@ def test_calibration_file_names_the_setup_it_was_made_on():
     """A calibration is a measurement of one setup: its fingerprint (``setup_sha256``) moves
     with the arc, a front end's mounting or channel and the RuT's chirp, not with the
     scenario (targets, seed, SNR); a file made before a front end was moved is applied with
-    a warning (a new-user trial applied one silently: -3.7 deg errors, exit 0)."""
+    a warning (applied silently, such a file gave -3.7 deg errors and exit 0)."""
     from rtsgeom.calibration.file import calibration_mismatch, setup_fingerprint
     from rtsgeom.pipeline.plan import plan_targets
 

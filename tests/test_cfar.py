@@ -1,4 +1,4 @@
-"""CA/OS-CFAR window (issue 22) and its cost for any ring the schema accepts (issue 18 s. 3).
+"""CA/OS-CFAR window and its cost for any ring the schema accepts.
 
 The cell-averaging estimate at a cell under test is the mean of the training ring: the
 (2(g_r+t_r)+1) x (2(g_d+t_d)+1) window minus the (2g_r+1) x (2g_d+1) guard window, both axes

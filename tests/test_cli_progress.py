@@ -1,5 +1,5 @@
-"""Issue 16 defect 5 (part): the long waits of ``adc`` and ``nearfield`` say what they do on
-stderr, as ``run`` does; ``--quiet`` and ``--json`` keep them silent there."""
+"""The long waits of ``adc`` and ``nearfield`` say what they do on stderr, as ``run`` does;
+``--quiet`` and ``--json`` keep them silent there."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Arc design map (issue 7, item 4): radius x front-end spacing."""
+"""Arc design map: radius x front-end spacing."""
 
 from __future__ import annotations
 
@@ -48,7 +48,7 @@ def test_spacing_above_the_angular_resolution_is_flagged(scene, grid):
     # tolerates more than the uncalibrated one
     m = grid.metrics
     assert np.all(m["worst_error_deg"][0] < 1e-3)
-    # (by less with the target's sub-bin position drawn per draw, issue 13: where the
+    # (by less with the target's sub-bin position drawn per draw: where the
     # calibration delay moves J's echo across a bin boundary the design misses; 3x measured)
     assert np.all(m["sigma_calibrated_mm"][0] > 2 * m["sigma_uncalibrated_mm"][0])
 

@@ -1,4 +1,4 @@
-"""``design``'s tolerance search (issue 17): the full search started where a pilot on a prefix
+"""``design``'s tolerance search: the full search started where a pilot on a prefix
 of the same draws puts the answer, with the power law the pilot measured."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The RuT's 2-D beamformer (issue 15): the D = 2 grid search and detections' elevation."""
+"""The RuT's 2-D beamformer: the D = 2 grid search and detections' elevation."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""The RuT's direction estimator is a choice (issue 15): Bartlett (eq. 14), Capon (MVDR) and
+"""The RuT's direction estimator is a choice: Bartlett (eq. 14), Capon (MVDR) and
 MUSIC, with forward-backward spatial smoothing (``radar.angle_estimator``,
 ``radar.angle_subarray``; ``rtsgeom/radar/estimators.py``).
 

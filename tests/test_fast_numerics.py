@@ -1,4 +1,4 @@
-"""The fast paths of issue 17 compute what the plain formulas compute: windows bit for bit
+"""The fast numerical paths compute what the plain formulas compute: windows bit for bit
 with scipy, the factored fast-time tones to rounding, the range-Doppler map to a plain
 double-precision FFT chain, on grids of sizes."""
 

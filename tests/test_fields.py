@@ -1,4 +1,4 @@
-"""Every scene field that changes the physics has a test that changes it (issue 22).
+"""Every scene field that changes the physics has a test that changes it.
 
 Each test below changes one or a few fields and checks that the physical output moves by the
 closed-form amount, so a field that the code ignored (or applied wrongly) fails. The map from

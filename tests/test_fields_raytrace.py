@@ -1,4 +1,4 @@
-"""The ``[raytrace]`` and ``sheet.material`` fields change what Sionna RT returns (issue 22).
+"""The ``[raytrace]`` and ``sheet.material`` fields change what Sionna RT returns.
 
 Skipped, like ``test_raytrace.py``, where Sionna RT or a usable LLVM backend is missing. One
 solve of the default scene takes ~0.1 s once the kernels are compiled.

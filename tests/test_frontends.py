@@ -1,5 +1,5 @@
-"""Front-end antenna layout and orientation on the arc (issue 14, item 2) and the sign of the
-single-front-end near-field bias it implies."""
+"""Front-end antenna layout and orientation on the arc and the sign of the single-front-end
+near-field bias it implies."""
 
 from __future__ import annotations
 

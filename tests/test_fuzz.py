@@ -1,4 +1,4 @@
-"""Fuzzing (issue 10): the scene loader and the CLI never fail in an unplanned way.
+"""Fuzzing: the scene loader and the CLI never fail in an unplanned way.
 
 Contract checked on every input: a valid :class:`Scene` with finite numbers (on which
 ``scene_warnings`` runs) or a :class:`SceneError` naming the source, within a deadline; for the

@@ -1,4 +1,4 @@
-"""Geometry and exact paths against closed forms (issue: foundation)."""
+"""Geometry and exact paths against closed forms."""
 
 from __future__ import annotations
 

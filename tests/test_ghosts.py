@@ -1,4 +1,4 @@
-"""Cable ghosts (issue 7, item 3): predicted ghost ranges and levels against the simulated
+"""Cable ghosts: predicted ghost ranges and levels against the simulated
 range-Doppler map."""
 
 from __future__ import annotations

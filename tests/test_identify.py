@@ -1,4 +1,4 @@
-"""Issue 19: measuring a built setup from probe captures (rtsgeom.identify, rtsgeom identify,
+"""Measuring a built setup from probe captures (rtsgeom.identify, rtsgeom identify,
 rtsgeom adc --active, rtsgeom calibrate --from-identified)."""
 
 from __future__ import annotations
@@ -111,10 +111,10 @@ def _scale():
 @pytest.mark.slow
 @pytest.mark.parametrize("radius_m", [0.8, 1.0, 1.6])
 def test_monte_carlo_offsets_within_3_sigma_std_at_crb_and_calibration_without_sweep(radius_m):
-    """Done-when of issue 19, over seeds and arc radii: offsets within +-0.5 mm and yaw within
-    +-1 deg, channel gain/phase errors, default SNR: tangential and height within 3 std of the
-    truth, the std within a factor 1.5 of the Cramer-Rao bound at the truth, and the pair's
-    calibration delay predicted from the identified parameters alone within 10 ps of the
+    """The identification's accuracy, over seeds and arc radii: offsets within +-0.5 mm and
+    yaw within +-1 deg, channel gain/phase errors, default SNR: tangential and height within 3
+    std of the truth, the std within a factor 1.5 of the Cramer-Rao bound at the truth, and the
+    pair's calibration delay predicted from the identified parameters alone within 10 ps of the
     coherence point the sweep converges to on the true setup (with the front-end angles the
     calibration measures)."""
     scene = _scene(radius_m)

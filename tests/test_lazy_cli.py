@@ -1,4 +1,4 @@
-"""The CLI starts without the heavy libraries (issue 17): which modules a command imports, not
+"""The CLI starts without the heavy libraries: which modules a command imports, not
 how long it takes (robust on a loaded machine), and the lazy parser is the complete one."""
 
 from __future__ import annotations
@@ -84,7 +84,7 @@ def test_commands_without_kernels_skip_numba(tmp_path, args):
 
 
 def test_calibrate_imports_only_what_it_uses(tmp_path):
-    """``calibrate --pair 0 1`` (issue 17: a new process under a second): matplotlib for its
+    """``calibrate --pair 0 1`` (target: a new process under a second): matplotlib for its
     figure, none of the other optional libraries (numba: see above) and none of scipy's
     optimize/signal/interpolate/stats."""
     code, mods = _imported(["calibrate", str(SCENE), "--pair", "0", "1", "--quiet",

@@ -266,8 +266,8 @@ def test_if_lowpass_is_scipys_butterworth(order):
 def test_info_budget_says_whether_the_scene_models_the_link(linked):
     """``rtsgeom info``'s budget (``static_budget``, computed from relative echoes) reports
     ``modelled`` from the scene: with [radar.link] the link is in the signal, its noise
-    thermal; without, a prediction (found by a new-user trial: it said "no [radar.link]" on a
-    linked scene). The target's ADC power is the same prediction either way."""
+    thermal; without, a prediction (it used to say "no [radar.link]" on a linked scene). The
+    target's ADC power is the same prediction either way."""
     def mut(doc):
         linked_doc(doc)
         if not linked:
@@ -281,8 +281,8 @@ def test_info_budget_says_whether_the_scene_models_the_link(linked):
 
 def test_a_front_end_lost_to_clipping_says_so():
     """A linked scene whose probe frame clips (ADC full scale far below the echoes): the
-    probe's note names the clipping and its remedies, and the planner's error carries it (a
-    new-user trial got 'blocked line of sight' for a sheet reflection that clipped the ADC)."""
+    probe's note names the clipping and its remedies, and the planner's error carries it (it
+    used to say 'blocked line of sight' for a sheet reflection that clipped the ADC)."""
     import warnings
 
     from rtsgeom.calibration.probes import probe_front_ends
@@ -300,8 +300,8 @@ def test_a_front_end_lost_to_clipping_says_so():
 
 def test_info_budget_names_front_ends_without_a_target():
     """``info`` puts each target on its nearest front end; a front end carrying none says so
-    instead of ``attenuation - dB`` (a new-user trial read that as a missing attenuation on a
-    front end the synthesis does use)."""
+    instead of ``attenuation - dB`` (which read as a missing attenuation on a front end the
+    synthesis does use)."""
     from conftest import DEFAULT_SCENE
     from rtsgeom.scene import load_scene
     setup = build_setup(load_scene(DEFAULT_SCENE.parent / "custom-array.toml"))

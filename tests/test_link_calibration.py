@@ -1,4 +1,4 @@
-"""Calibration under the link budget's thermal noise (issue 20 with issue 13's 2 ps target).
+"""Calibration under the link budget's thermal noise.
 
 With ``[radar.link]`` and no ``snr_db`` the noise is k T F f_adc (+ the RTS channels' and the
 ADC's): the calibration's phasor sweep takes that noise (``rtsgeom.radar.link.relative_noise_power``),

@@ -1,5 +1,5 @@
 """Each ``[radar.link]`` and ``[rts.link]`` field, varied, moves the physics it should, by the
-closed form (issue 20; docs/testing.md's field table).
+closed form (docs/testing.md's field table).
 
 ``[radar.link]``: transmit power and antenna gains move a target's power at the ADC dB for dB
 (SNR and clip margin with it); noise figure and temperature set the simulated noise floor

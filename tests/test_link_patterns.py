@@ -1,4 +1,4 @@
-"""Antenna gains from the patterns toward each front end (issue 20, item 5 of the link work).
+"""Antenna gains from the patterns toward each front end.
 
 Without a pattern the link's antenna gains are scalars (the preset's RuT gain, 10 dBi front
 ends). With ``[radar.pattern]`` / ``[rts.pattern]`` the paths carry each antenna's field gain

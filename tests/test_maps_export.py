@@ -1,4 +1,4 @@
-"""``rtsgeom run --out DIR`` saves the maps as arrays: maps.npz, maps.mat, maps.nc (issue 16).
+"""``rtsgeom run --out DIR`` saves the maps as arrays: maps.npz, maps.mat, maps.nc.
 
 The files are read back with the readers a user would use (numpy, scipy.io.loadmat, xarray's
 scipy engine) and compared with maps computed here from the in-memory run result, independently

@@ -460,7 +460,7 @@ def test_phase_residual_of_a_plane_wave_is_zero():
 
 
 def test_ghost_reports_name_their_fields_and_cfar_misses_the_first_ghost():
-    """The ghost analysis of the default scene (issue: cable ghosts): the first ghost lies in its
+    """The ghost analysis of the default scene: the first ghost lies in its
     target's CA-CFAR ring (9.5 bins behind, ring 2 + 8), so CFAR does not report it."""
     from rtsgeom.analysis.ghosts import ghost_analysis, ghost_orders, predict_ghosts
     s = make_scene(lambda d: d.update(targets=[{"range_m": 30.0, "angle_deg": 3.4}]))
@@ -474,7 +474,7 @@ def test_ghost_reports_name_their_fields_and_cfar_misses_the_first_ghost():
 
 
 def test_steering_search_in_two_dimensions_returns_azimuth_and_elevation():
-    """The D = 2 grid search (issue 15) returns (az, el) per snapshot: a plane wave from
+    """The D = 2 grid search returns (az, el) per snapshot: a plane wave from
     (5, 3) deg is found there (tests/test_elevation.py checks a grid of directions)."""
     from rtsgeom.radar.steering import Steering
     s = make_scene(use_elevation_tx=True)

@@ -1,4 +1,4 @@
-"""N-channel synthesis in azimuth and elevation (issue 15): cells, closed form vs exact,
+"""N-channel synthesis in azimuth and elevation: cells, closed form vs exact,
 the pair as the N = 2 case, and the bundled sphere4 scene end to end."""
 
 import dataclasses
@@ -144,7 +144,7 @@ def test_exact_model_hits_cell_points(sphere):
 
 @pytest.mark.slow
 def test_sphere4_run_within_0_05_deg():
-    """Done-when: targets at several (az, el) inside the cell, detected within 0.05 deg in both
+    """Targets at several (az, el) inside the cell, detected within 0.05 deg in both
     angles after calibration (exact mode), for the bundled targets and a second set."""
     from rtsgeom.pipeline.run import run_scene
     scene = load_scene(SPHERE)

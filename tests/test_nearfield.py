@@ -1,4 +1,4 @@
-"""Near-field violation (issue 7, item 2): single front-end bias, phase error, synthesized angle
+"""Near-field violation: single front-end bias, phase error, synthesized angle
 over arc radius, against closed forms."""
 
 from __future__ import annotations

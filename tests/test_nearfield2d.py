@@ -1,4 +1,4 @@
-"""The near-field analysis of a 2-D cell (issue 15): ``rtsgeom nearfield`` on a RuT that
+"""The near-field analysis of a 2-D cell: ``rtsgeom nearfield`` on a RuT that
 beamforms in azimuth and elevation (``scenes/sphere4.toml``) generalises the 1-D one."""
 
 from __future__ import annotations

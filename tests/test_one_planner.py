@@ -1,4 +1,4 @@
-"""One planner and one pair calibration (issue 21 item 2, issue 15): the pair on an arc is the
+"""One planner and one pair calibration: the pair on an arc is the
 N = 2, D = 1 case of the channel calibration, and ``plan_targets`` plans both pairs on an arc
 and cells on a sphere."""
 

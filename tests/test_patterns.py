@@ -1,4 +1,4 @@
-"""Antenna patterns (issue 14, item 3): closed forms of the cos^q model, table interpolation,
+"""Antenna patterns: closed forms of the cos^q model, table interpolation,
 and their entry into the exact paths (isotropic unchanged)."""
 
 from __future__ import annotations

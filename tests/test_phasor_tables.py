@@ -1,5 +1,5 @@
-"""Delay tables through ``bin_response`` and the FIR's response (issue 17, the `design`
-target): the shortcuts for echoes that share their geometry agree with the direct sums."""
+"""Delay tables through ``bin_response`` and the FIR's response (for the speed of
+``design``): the shortcuts for echoes that share their geometry agree with the direct sums."""
 
 from __future__ import annotations
 

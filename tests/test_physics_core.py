@@ -1,5 +1,5 @@
 """Tests written for the survivors of a *fresh* mutation sample (``python -m benchmarks.mutation
---sample 160 --seed 3``, issue 22): behaviour of the physics core that no earlier test checked.
+--sample 160 --seed 3``): behaviour of the physics core that no earlier test checked.
 
 Each test checks a closed form or an invariant on a grid of inputs through public functions.
 No module-scoped fixtures: mutmut runs, per mutant, only the tests that reached the mutated

@@ -1,5 +1,5 @@
 """Tests written for the survivors of a fresh mutation sample in ``aoa/`` (``python -m
-benchmarks.mutation --sample 160 --seed 3``, issue 22); the other modules' are in
+benchmarks.mutation --sample 160 --seed 3``); the other modules' are in
 ``test_physics_core.py``, whose docstring says how these tests are built (closed forms and
 invariants on grids, through public functions, no module-scoped fixtures).
 """

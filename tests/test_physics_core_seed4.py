@@ -1,5 +1,5 @@
 """Tests written for the survivors of the second fresh mutation sample (``python -m
-benchmarks.mutation --sample 160 --seed 4``, issue 22), built as ``test_physics_core.py``'s
+benchmarks.mutation --sample 160 --seed 4``), built as ``test_physics_core.py``'s
 (closed forms and invariants on grids, through public functions, no module-scoped fixtures:
 mutmut attributes a shared fixture to the first test that built it).
 """

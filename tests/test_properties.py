@@ -1,4 +1,4 @@
-"""Geometric invariants of the setup and its exact paths (issue 10), checked with hypothesis.
+"""Geometric invariants of the setup and its exact paths, checked with hypothesis.
 
 * reciprocity: ``distances(a, b) == distances(b, a).T``, bit for bit, with broadcasting;
 * mirror symmetry in azimuth: front-end angles negated and reversed, sheet extent mirrored, RuT

@@ -1,4 +1,4 @@
-"""Issue 16 defect 4: ``info`` reports each pair's reachable angles -- the same numbers that
+"""``info`` reports each pair's reachable angles -- the same numbers that
 ``run`` then enforces -- and warns about a target outside them."""
 
 from __future__ import annotations
@@ -69,7 +69,7 @@ def test_info_span_is_the_span_run_enforces(radius_m, separation_m, mode):
 
 
 def test_info_cli_reports_spans_and_warns(tmp_path, capsys):
-    """The issue's case: a target at 3.6 deg lies between the front ends' geometric angles
+    """A target at 3.6 deg lies between the front ends' geometric angles
     (3.4, 12.2) but outside the measured span; ``info`` says so, ``run`` refuses it, both with
     the same numbers."""
     from conftest import DEFAULT_SCENE

@@ -4,7 +4,7 @@ The RTS rounds every delay to its settings (``rts.realised_delay``); where the f
 step does not divide 1/f_s (100 ps at 4 GSPS: 0/100/200 ps in each 250 ps sample) the delay
 difference a pair realises depends on where the target's delay falls in the sample. Before
 the fix J was requested at the calibrated offset (plus a period where the bin is ambiguous)
-and the design took the realised setting for coherent: at 100 ps steps the red-team's 7 deg
+and the design took the realised setting for coherent: at 100 ps steps a 7 deg
 target at 33.5 m realised 95 ps off the plan (-0.173 deg). Grids: delay resolution x f_s x target
 range (x a hardware phase and a radial mounting error the calibration must absorb).
 """
@@ -153,7 +153,7 @@ def test_validate_warns_when_the_step_does_not_divide_the_sample_period(f_s, res
 
 @pytest.mark.parametrize("res_ps,f_s,range_m", [(100.0, 4e9, 33.5), (25.0, 3e9, 21.7)])
 def test_full_chain_run_on_coarse_steps(res_ps, f_s, range_m):
-    """Through the ADC cube and the RuT's processing (``run_scene``): the red-team's case
+    """Through the ADC cube and the RuT's processing (``run_scene``): the case above
     (100 ps steps at 4 GSPS, 33.5 m: -0.173 deg before) and a step that does not divide
     1/f_s at 3 GSPS, with the bundled scene's other targets; every target within spec. At a
     per-sample SNR of 30 dB: at the scene's 10 dB a target 0 at 21.7 m is so much stronger

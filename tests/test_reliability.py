@@ -1,4 +1,5 @@
-"""Outputs that can be trusted (issue 18 s. 1, 2, parts of 3 and 4; issue 16's rough edges).
+"""Outputs that can be trusted: an output folder is one run or nothing, writing a file never
+destroys something else, no traceback or memory bomb, no silent wrong answer.
 
 One test per fixed defect; each fails on the code before its fix. The heavy versions (signals
 at many points, memory limits, concurrent full runs) are in ``benchmarks/redteam.py``.

@@ -1,5 +1,5 @@
-"""Any lab's setup from a scene (issue 14): the new keys, their wiring through the pipeline,
-whole arcs, and the done-when scene ``scenes/custom-array.toml``."""
+"""Any lab's setup from a scene: the new keys, their wiring through the pipeline, whole arcs,
+and the bundled scene that combines them, ``scenes/custom-array.toml``."""
 
 from __future__ import annotations
 
@@ -300,7 +300,7 @@ def test_tolerance_pair_all_cli(tmp_path, capsys):
 
 
 # ------------------------------------------------------------------------------------------
-# Presets end to end, and the done-when scene
+# Presets end to end, and the custom-array scene
 # ------------------------------------------------------------------------------------------
 
 
@@ -336,7 +336,8 @@ def test_every_preset_runs_end_to_end(name, tmp_path, capsys):
 
 @pytest.mark.slow
 def test_custom_array_scene_runs_and_finds_its_targets(tmp_path):
-    """Done-when: custom non-uniform 3 x 4 array, mirrored front ends, 2 deg yaw error."""
+    """``scenes/custom-array.toml``: custom non-uniform 3 x 4 array, mirrored front ends,
+    2 deg yaw error."""
     from rtsgeom.pipeline.run import run_scene
     scene = load_scene(CUSTOM)
     for t in run_scene(scene).matches:

@@ -1,4 +1,4 @@
-"""Signal chain against closed forms (issue: signal chain)."""
+"""Signal chain against closed forms."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Front ends on a sphere (issue 15): positions, the spherical-cap sheet, elevation 0 unchanged."""
+"""Front ends on a sphere: positions, the spherical-cap sheet, elevation 0 unchanged."""
 
 import numpy as np
 import pytest
@@ -147,7 +147,7 @@ def test_default_scene_run_unchanged_with_explicit_zero_elevations():
 def test_pair_commands_refuse_2d_cells(command, pair, capsys):
     """A scene of 2-D cells has no pairs on an arc: the pair studies exit 2 naming the
     argument and the cell commands (they used to exit 0 with an inf residual or a span of
-    zero width; new-user trial), for one pair and for all."""
+    zero width), for one pair and for all."""
     from rtsgeom.cli import main
     assert main([command, "scenes/sphere4.toml", "--pair", *pair, "--quiet"]) == 2
     err = capsys.readouterr().err

@@ -1,4 +1,4 @@
-"""One steering model (issue 21): the beamformer's closed forms on grids of directions, windows
+"""One steering model: the beamformer's closed forms on grids of directions, windows
 and arrays (1-D azimuth, 2-D azimuth + elevation, a custom planar array), and the one coherent
 phase that the tolerance study and the channel model share for every angle window."""
 
@@ -111,8 +111,8 @@ def windowed(request):
 def test_tolerance_and_channel_model_share_the_coherent_phase(windowed):
     """The phase the tolerance study calibrates to and the one the channel model (ChannelModel,
     used by the calibration and the exact mode) designs for are the same for every angle
-    window (before issue 21 only the tolerance model applied the taper: 0.030 deg apart with
-    hamming on the default scene)."""
+    window (only the tolerance model used to apply the taper: 0.030 deg apart with hamming on
+    the default scene)."""
     tol, pm = windowed
     a = float(tol.procedure.coherence_phase(tol, tol.x_nominal))
     b = float(pm.pair_phase(tol.procedure.probe_rad))

@@ -1,4 +1,4 @@
-"""Mounting-tolerance Monte Carlo (issue 7, item 1): the phasor model against the exact
+"""Mounting-tolerance Monte Carlo: the phasor model against the exact
 spectrum and the ADC cube, calibration physics, reproducibility, the CLI."""
 
 from __future__ import annotations

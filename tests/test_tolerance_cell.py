@@ -1,4 +1,4 @@
-"""The mounting-tolerance study of a 2-D cell (issue 15, ``rtsgeom tolerance --cell``;
+"""The mounting-tolerance study of a 2-D cell (``rtsgeom tolerance --cell``;
 ``analysis/tolerance_cell.py``): invariants of the phasor-level model on a grid of cells
 (radii, spans in azimuth and elevation, quadrilaterals and a triangle), the driver's
 reproducibility and the full ADC-cube chain."""

@@ -1,4 +1,4 @@
-"""Validation at every edge (issue 10): malformed scenes, hostile files, CLI exit codes, warnings.
+"""Validation at every edge: malformed scenes, hostile files, CLI exit codes, warnings.
 
 Every malformed scene is the default scene's TOML document with one mistake; the error must be a
 :class:`SceneError` whose message names the file, the field and (where there is one) the value.
@@ -494,7 +494,7 @@ def test_cli_output_into_a_closed_pipe_stops_quietly():
 
 
 # --------------------------------------------------------------------------------------------
-# Issue 18: no hang, the right field blamed, limits that the processing resolves
+# No hang, the right field blamed, limits that the processing resolves
 # --------------------------------------------------------------------------------------------
 
 

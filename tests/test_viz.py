@@ -1,4 +1,4 @@
-"""Visualisation (issue 8): the 3D setup view, the result figures and the HTML report.
+"""Visualisation: the 3D setup view, the result figures and the HTML report.
 
 Images are checked for content (not blank, the requested size), the report for being one
 self-contained file (no scripts, no links out, every image embedded) that a browser can load.
@@ -111,7 +111,8 @@ def test_plain_table_with_reflections_warns_in_the_view():
 
 @pytest.mark.raytrace
 def test_show_raytrace_draws_every_reflection(tmp_path):
-    """Issue 16 defect 2: ``show --paths raytrace`` drew only the line-of-sight rays."""
+    """``show --paths raytrace`` draws the reflections too (it used to draw only the
+    line-of-sight rays)."""
     from rtsgeom.paths import raytrace
     ok, msg = raytrace.preflight()
     if not ok:
@@ -258,9 +259,9 @@ def _legend_entries_without_artist(fig):
 
 
 def test_calibration_figure_shows_the_residual_of_the_json_and_no_empty_legend_entry():
-    """Issue 16 defect 6: the plot quoted the sweep interpolated at the chosen delay (0.008
-    deg) while the JSON's residual (0.0048 deg) comes from the refinement; and the legend
-    listed 'chosen + k periods' when no such line fell inside the sweep."""
+    """The plot quotes the JSON's residual, which comes from the refinement (it used to quote
+    the sweep interpolated at the chosen delay: 0.008 deg against the JSON's 0.0048 deg), and
+    the legend lists 'chosen + k periods' only when such a line falls inside the sweep."""
     tau = np.arange(-0.4e-9, 0.4e-9 + 1e-15, 50e-12)  # less than one period: no repeat line
     err = np.abs(np.sin(np.pi * (tau - 0.21e-9) / 1e-9))
     for residual in (0.0048, 0.0123, 1e-5):
@@ -282,7 +283,8 @@ def test_calibration_figure_shows_the_residual_of_the_json_and_no_empty_legend_e
 
 
 def test_linearity_figure_numbers_channels_like_the_cli():
-    """Issue 16 defect 6: the plot said channel 1/2 where the CLI's --pair says 0 1."""
+    """The plot numbers channels as the CLI's --pair does (it used to say channel 1/2 for
+    --pair 0 1)."""
     s = np.linspace(3.4, 12.2, 5)
     for pair in ((0, 1), (2, 3)):
         fig = F.linearity_figure(s, {"exact": s}, {"exact": np.stack([-s, s])}, pair=pair)
@@ -291,7 +293,7 @@ def test_linearity_figure_numbers_channels_like_the_cli():
 
 
 def test_tolerance_figure_resolves_both_cases():
-    """Issue 16 defect 6: a common-bin histogram put the calibrated case (errors ~1e-3 deg)
+    """A common-bin histogram put the calibrated case (errors ~1e-3 deg)
     into one bin next to the uncalibrated one (~1 deg). The empirical CDF resolves both."""
     rng = np.random.default_rng(0)
     for scale_unc, scale_cal in ((1.0, 1e-3), (0.3, 1e-2), (5.0, 1e-4)):
@@ -309,8 +311,9 @@ def test_tolerance_figure_resolves_both_cases():
 
 def test_design_with_one_radius_draws_lines_and_says_the_sheet_is_off(tmp_path, capsys,
                                                                       monkeypatch):
-    """Issue 16 defect 3: ``--radius-m 0.5:0.5:1`` drew five empty heat maps, and the sheet
-    being disabled at small spacings was only in the JSON."""
+    """With one radius (``--radius-m 0.5:0.5:1``) the five figures are drawn as lines (they
+    used to be empty heat maps), and the output says that the sheet is disabled at small
+    spacings (that used to be only in the JSON)."""
     saved = {}
 
     def record(fig, path):
@@ -338,7 +341,7 @@ def test_design_with_one_radius_draws_lines_and_says_the_sheet_is_off(tmp_path, 
 
 @pytest.mark.parametrize("name", [r"$\undefinedcmd{x}$", "cost $5 and $", r"a_b^c $\frac{1}$"])
 def test_user_text_in_titles_never_crashes_a_figure(tmp_path, name):
-    """Issue 16 defect 6: a scene name with TeX in it crashed every figure."""
+    """A scene name with TeX in it crashes no figure (it used to crash every one)."""
     r, v = np.arange(4.0), np.arange(3.0)
     fig = F.range_doppler_figure(np.zeros((4, 3)), r, v, title=f"{name}: range-Doppler map")
     F.save_figure(fig, tmp_path / "rd.png")

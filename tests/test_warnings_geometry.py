@@ -1,9 +1,9 @@
-"""Warnings that depend on the distance of each front end (issue 22, survivor 4).
+"""Warnings that depend on the distance of each front end.
 
 Every warning test in ``test_validation.py`` has the front ends at equal distances from the RuT,
-so a Fraunhofer check taken at the *farthest* front end instead of the nearest survived. Here
-the arc centre is moved off the RuT so the front ends sit at different distances, chosen in
-closed form around the Fraunhofer distance 2 d_A^2 / lambda of the RuT.
+so a mutant that took the Fraunhofer check at the *farthest* front end instead of the nearest
+survived them. Here the arc centre is moved off the RuT so the front ends sit at different
+distances, chosen in closed form around the Fraunhofer distance 2 d_A^2 / lambda of the RuT.
 
 Off-centre arc of radius R and centre c = rho (sin phi, cos phi, 0), RuT at the origin: the
 module at azimuth theta (on the arc) is at distance

@@ -1,4 +1,4 @@
-"""Results that claim to hold for any taper, checked for every window (issue 22).
+"""Results that claim to hold for any taper, checked for every window.
 
 The windows are ``none``, ``hann``, ``hamming``, ``blackman`` (``registry.WINDOWS``) and appear
 three times in a scene: ``radar.range_window``, ``radar.doppler_window``, ``radar.angle_window``.
