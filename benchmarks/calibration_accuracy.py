@@ -9,7 +9,8 @@ The grid (one row per calibration, ``calibration.pair.calibrate_pair``):
   elements over 25 d with gaps), each pair (0, 1) on an arc; and sphere4's RuT beamforming
   in azimuth and elevation, its pair (0, 1) stacked in elevation and (0, 2) side by side;
 * arc (sphere) radii 0.5, 1 and 3 m (the cascade: 3 m);
-* radial offsets -1, -0.5, 0, +0.5, +1 mm on either front end of the pair;
+* radial offsets -1, -0.5, 0, +0.5, +1 mm on either front end of the pair (sphere4's pairs
+  also tangential offsets of +-1 mm: across an elevation pair's line);
 * noiseless, and with the scene's receiver noise (``snr_db``).
 
 Per row, the calibrated delay's distance (ps, wrapped into one period) from
@@ -18,7 +19,8 @@ Per row, the calibrated delay's distance (ps, wrapped into one period) from
   Newton on the probes' phase mismatch, continuous delay; no sweep);
 * ``dist_slope_ps``: the closed form, the nominal setup's coherence point shifted by the
   slope law ``-(f_c + S t_mid - S tau) / (f_rts + S t_mid - S tau) * 2 dr / c0`` (sign
-  reversed for an offset of front end I: the calibration delays J);
+  reversed for an offset of front end I: the calibration delays J; a tangential offset does
+  not move it to first order);
 * ``dist_dense_min_ps`` (noiseless rows; ``--dense``): the minimum of a dense noiseless sweep
   (0.5 ps steps on the arc, 1 ps in 2-D) of the probes' RMS error. Not the coherence point
   under a mounting offset: the probes' RMS minimum moves off it (``calibration.fit``).
@@ -61,9 +63,10 @@ ARRAYS = {
 }
 
 
-def variant(array: str, radius_m: float, fe: int | None, dr_m: float, noisy: bool):
-    """The scene of ``array`` at radius ``radius_m``, front end ``fe`` moved radially by
-    ``dr_m``, with or without its receiver noise."""
+def variant(array: str, radius_m: float, fe: int | None, dr_m: float, noisy: bool,
+            field: str = "radial_offset_m"):
+    """The scene of ``array`` at radius ``radius_m``, front end ``fe`` moved by ``dr_m``
+    (``field``: radially, or tangentially), with or without its receiver noise."""
     from rtsgeom.scene import load_scene
     name, change, _, spacing_deg, _ = ARRAYS[array]
     scene = load_scene(ROOT / "scenes" / name)
@@ -80,7 +83,7 @@ def variant(array: str, radius_m: float, fe: int | None, dr_m: float, noisy: boo
         fes[1] = dataclasses.replace(fes[1], angle_rad=fes[0].angle_rad
                                      + float(np.radians(spacing_deg)))
     if fe is not None:
-        fes[fe] = dataclasses.replace(fes[fe], radial_offset_m=float(dr_m))
+        fes[fe] = dataclasses.replace(fes[fe], **{field: float(dr_m)})
     rts = scene.rts.evolve(arc_radius_m=float(radius_m), front_ends=tuple(fes))
     sheet = scene.sheet
     if any(f.elevation_rad for f in fes):  # the spherical cap's chord in proportion
@@ -96,13 +99,13 @@ def one_case(args: tuple) -> dict:
     try:
         return _case(*args)
     except Exception as exc:  # noqa: BLE001 (a benchmark row, reported below)
-        array, pair, radius_m, fe, dr_m, noisy, _ = args
+        array, pair, radius_m, fe, dr_m, noisy, _, _ = args
         return {"array": array, "pair": f"{pair[0]}-{pair[1]}", "radius_m": radius_m,
-                "front_end": fe, "radial_offset_mm": round(dr_m * 1e3, 6), "noisy": noisy,
+                "front_end": fe, "offset_mm": round(dr_m * 1e3, 6), "noisy": noisy,
                 "error": f"{type(exc).__name__}: {exc}"}
 
 
-def _case(array, pair, radius_m, fe, dr_m, noisy, dense) -> dict:
+def _case(array, pair, radius_m, fe, dr_m, noisy, dense, field) -> dict:
     from rtsgeom.calibration.fit import rms_error_deg
     from rtsgeom.calibration.pair import calibrate_pair, pair_coherence, pair_probes
     from rtsgeom.calibration.probes import (air_phase_slope_hz, if_phase_slope_hz,
@@ -116,7 +119,7 @@ def _case(array, pair, radius_m, fe, dr_m, noisy, dense) -> dict:
         paths = exact_paths(setup)
         return setup, paths, probe_front_ends(setup, paths, scene.seed)
 
-    scene = variant(array, radius_m, fe, dr_m, noisy)
+    scene = variant(array, radius_m, fe, dr_m, noisy, field)
     setup, paths, probe = built(scene)
     cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
     period = cal.period_s
@@ -132,9 +135,11 @@ def _case(array, pair, radius_m, fe, dr_m, noisy, dense) -> dict:
     tau = float(np.mean(2 * probe_ranges(setup, 2) / c))
     sign = 1.0 if fe == pair[1] else -1.0
     slope = float(air_phase_slope_hz(scene, tau)) / float(if_phase_slope_hz(scene, tau))
-    closed = n_point - sign * slope * 2 * dr_m / c
+    # the slope law of a radial offset; a tangential one leaves the point (second order)
+    closed = n_point - (sign * slope * 2 * dr_m / c if field == "radial_offset_m" else 0.0)
     row = {"array": array, "pair": f"{pair[0]}-{pair[1]}", "dims": cal.dims,
-           "radius_m": radius_m, "front_end": fe, "radial_offset_mm": round(dr_m * 1e3, 6),
+           "radius_m": radius_m, "front_end": fe, "offset": field.replace("_offset_m", ""),
+           "offset_mm": round(dr_m * 1e3, 6),
            "noisy": noisy, "delta_tau_ps": cal.delta_tau_s * 1e12,
            "fit_ps": cal.fit_s * 1e12, "coherence_ps": point * 1e12,
            "closed_form_ps": closed * 1e12,
@@ -174,9 +179,12 @@ def main(argv=None) -> int:
         for pair in ARRAYS[array][2]:
             for r in ARRAYS[array][4] or radii:
                 for noisy in (False, True):
-                    cases.append((array, pair, r, None, 0.0, noisy, a.dense))
-                    cases += [(array, pair, r, fe, dr, noisy, a.dense) for fe in pair
-                              for dr in offsets]
+                    cases.append((array, pair, r, None, 0.0, noisy, a.dense, "radial_offset_m"))
+                    cases += [(array, pair, r, fe, dr, noisy, a.dense, "radial_offset_m")
+                              for fe in pair for dr in offsets]
+                    if array == "sphere4":  # a 2-D pair: also off across its line
+                        cases += [(array, pair, r, fe, dr, noisy, a.dense,
+                                   "tangential_offset_m") for fe in pair for dr in (-1e-3, 1e-3)]
     stem = a.out or ROOT / "benchmarks" / ("calibration_accuracy"
                                            + ("_quick" if a.quick else ""))
     t0 = time.perf_counter()
@@ -189,7 +197,7 @@ def main(argv=None) -> int:
                       flush=True)
                 continue
             print(f"{row['array']:>16} {row['pair']} R {row['radius_m']:.1f} m fe "
-                  f"{row['front_end']} dr {row['radial_offset_mm']:+.1f} mm "
+                  f"{row['front_end']} {row['offset']} {row['offset_mm']:+.1f} mm "
                   f"{'noisy' if row['noisy'] else 'clean'}: delta_tau "
                   f"{row['delta_tau_ps']:+8.1f} ps, from the coherence point "
                   f"{row['dist_coherence_ps']:+5.1f} ps, slope law {row['dist_slope_ps']:+5.1f} ps"

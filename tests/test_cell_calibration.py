@@ -59,7 +59,8 @@ def test_elevation_pairs_coherence_point_is_the_phase_centres_closed_form():
     four elevated virtual elements (lambda/2 up, 4 of 12) put the array's phase centre
     lambda/6 above the RuT's reference, and a channel from direction u sees its phase k0 u .
     p_c: (u_J - u_I) . p_c / lambda of a period. The model's point within 0.3 ps of that, and
-    the calibration (noiseless, full chain, across-the-line columns) within 3 ps of it."""
+    the calibration (noiseless, full chain, the errors along the pair's line) within 2 ps of
+    it (1.8 ps: where the fit's window sits about the point moves it that much)."""
     from rtsgeom.calibration.pair import calibrate_pair, pair_coherence
     from rtsgeom.calibration.probes import probe_front_ends
     from rtsgeom.geometry import build_setup
@@ -80,7 +81,8 @@ def test_elevation_pairs_coherence_point_is_the_phase_centres_closed_form():
         assert closed == pytest.approx(29.2e-12, abs=0.1e-12)
         point = pair_coherence(setup, paths, pair, probe, near_s=cal.delta_tau_s).continuous_s
         assert abs(point - closed) < 0.3e-12
-        assert abs(cal.delta_tau_s - point) < 3e-12 and cal.odd_columns == cal.fit_columns
+        assert abs(cal.fit_s - point) < 2e-12
+        assert cal.fit_columns == (0, 2) and cal.odd_columns == ()  # along the line, even
 
 
 # -- the solver's start with calibrated phases ------------------------------------------------

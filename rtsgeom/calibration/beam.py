@@ -11,6 +11,8 @@ sweep's own residual (``fit.fit_scatter``).
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 
 from ..geometry import Setup
@@ -23,11 +25,12 @@ from ..synthesis.model import ChannelModel
 from .fit import crossing_columns, rms_error_deg
 from .probes import (FrontEndProbe, if_phase_slope_hz, probe_ranges, probe_total_delay,
                      simulate_detect)
-from .steps import adds_noise, sweep_phase
+from .steps import adds_noise, reference_setup, sweep_phase
 
 __all__ = ["BeamProbes", "PROBE_RATIOS"]
 
 PROBE_RATIOS = (1 / 3, 3.0)  # the probes' amplitude ratios A_J / A_I
+AXIS_TOLERANCE_RAD = np.radians(10.0)  # a pair's line this close to an axis is an axis pair
 
 
 class BeamProbes:
@@ -66,6 +69,8 @@ class BeamProbes:
         along = (u[1] - u[0]) / np.linalg.norm(u[1] - u[0])
         self.frame = (along[None] if self.dims == 1
                       else np.stack([along, [-along[1], along[0]]]))  # (D, D) rows
+        # side by side or stacked in elevation (not across a cell's diagonal)
+        self.axis_pair = bool(np.min(np.abs(along)) <= np.sin(AXIS_TOLERANCE_RAD))
 
     def design(self, delta_s: float = 0.0):
         """Per probe: the programme amplitudes (2,) (the nominal model's design with channel
@@ -132,15 +137,27 @@ class BeamProbes:
         """The probes stay at their ranges (the bin logic of :class:`PhasorProbes` is 1-D)."""
         return self
 
+    def reference(self, phase_rad: float = 0.0) -> "BeamProbes":
+        """The same probes on the nominal setup as the sweep's reference
+        (``steps.reference_setup``: noiseless, channel J given the hardware phase
+        ``phase_rad``): what the sweep's fit gives where the coherence point is known
+        (``sweep.run_sweep`` subtracts its offset)."""
+        out = copy.copy(self)
+        out.setup = reference_setup(self.nominal[0], self.pair[1], phase_rad)
+        out.paths, out.noisy = self.nominal[1], False
+        return out
+
     def fit_columns(self, e):
-        """The columns the fit uses and which of them are odd (``fit`` module doc): in a 2-D
-        beamformer the probes' errors across the pair's line that cross zero over the sweep
-        ``e``; along it where none does (and on an arc)."""
+        """The columns the fit uses and which of them are odd (``fit`` module doc): the
+        probes' errors along the pair's line (even about the coherence point) for a pair on
+        an arc, side by side or stacked in elevation; for a pair across a cell's diagonal the
+        errors across its line that cross zero over the sweep ``e`` (along it where none
+        does)."""
         across = np.tile(np.arange(self.dims) == 1, len(self.ranges))
-        odd = across & crossing_columns(e)
-        if np.any(odd):
-            return np.flatnonzero(odd), np.ones(int(odd.sum()), bool)
         along = np.flatnonzero(~across)
+        odd = across & crossing_columns(e)
+        if self.dims == 2 and not self.axis_pair and np.any(odd):
+            return np.flatnonzero(odd), np.ones(int(odd.sum()), bool)
         return along, np.zeros(along.size, bool)
 
     def sweep_phase(self, deltas):

@@ -19,17 +19,25 @@ in the bin with it, the amplitude design on the nominal setup is off under a mou
 offset -- the probes' RMS minimum moves off the coherence point (up to 13 ps at +-1 mm radial
 offset; and a least-squares fit of two harmonics over +-period/4 to the sharper curves of an
 array with repeated virtual elements overshot zero and put the fitted minimum 15 ps to
-either side of it), while the centre about which the curves are symmetric stays on it
-(within 0.6 ps of the phasor model's coherence point on every array, radius and offset of
-``benchmarks/calibration_accuracy.py``). The fit finds that centre directly: each column a
-sum of harmonics of (delta - s) with its own coefficients, and the shared centre s where the
-residual is least (variable projection).
+either side of it), while the centre about which the curves are symmetric stays near it.
+The fit finds that centre directly: each column a sum of harmonics of (delta - s) with its
+own coefficients, and the shared centre s where the residual is least (variable projection).
+Near, not on: the phase between the two channels' beam outputs varies across the probes'
+directions (an array that is not centro-symmetric, front ends inside its far field), so each
+probe's curve is centred a little to either side of the point (custom array -3.2 / +2.5 ps)
+and their joint centre sits off it: within 1.1 ps of the phasor model's coherence point for
+the presets, the custom and a sparse array at 0.5-3 m with +-1 mm of radial offset
+(``benchmarks/calibration_accuracy.py``), but 4 ps for the awr2944 at 0.5 m and 9 ps for the
+86-element cascade at 3 m (front ends inside its 14 m far field).
 
-In a 2-D beamformer the error **across** the pair's line is odd and crosses zero at the
-coherence point (0 to 3 ps from it on sphere4, noiseless), while the error along it is not
-symmetric about the point there (its vertex 14 ps off for a pair stacked in elevation, 40
-ps for a diagonal pair): such a pair is fitted on the across columns that cross zero (any
-periodic shape that is zero at s), along the line only where none does.
+In a 2-D beamformer the error **across** the pair's line crosses zero at the coherence point
+but moves with any fixed error across it: a tangential offset of 0.2 mm moved the crossing
+for sphere4's elevation pair by 55 ps. A pair side by side or stacked in elevation is
+therefore fitted on its errors along the line (even; their centre 14 ps off the point for
+the elevation pair, an offset the nominal model gives and the sweep subtracts,
+``sweep._fit_offset``), a pair across a cell's diagonal, whose errors
+along its line are not symmetric (40 ps), on the across columns that cross zero (any
+periodic shape that is zero at s).
 """
 
 from __future__ import annotations
@@ -111,8 +119,8 @@ def fit_centre(deltas, error_rad, period_s: float, near_s: float, harmonics: int
     interpolated between the steps.
 
     ``return_fit``: also the fitted curves at the data's steps (S, C) (NaN where not
-    fitted), whose residual is the steps' noise (:func:`fit_scatter`); the point is
-    ``near_s`` and the curves all NaN where too few steps for the fit."""
+    fitted), whose residual is the steps' noise (:func:`fit_scatter`); the point and the
+    curves are NaN where too few steps were detected for the fit."""
     d = np.asarray(deltas, float)
     e = np.asarray(error_rad, float).reshape(d.size, -1)
     n_col = e.shape[1]
@@ -125,7 +133,7 @@ def fit_centre(deltas, error_rad, period_s: float, near_s: float, harmonics: int
     n_coef = np.where(odd, 2 * harmonics, harmonics + 1)
     cols = np.flatnonzero(ok.sum(0) >= n_coef + 1)
     if cols.size == 0:
-        return (float(near_s), fitted) if return_fit else float(near_s)
+        return (float("nan"), fitted) if return_fit else float("nan")
     step = np.median(np.diff(np.sort(d))) if d.size > 1 else period_s / 40
 
     def fits(s):
@@ -173,8 +181,8 @@ def fit_centre(deltas, error_rad, period_s: float, near_s: float, harmonics: int
     return (float(best), fitted) if return_fit else float(best)
 
 
-def fit_scatter(fit, fitted, e, harmonics: int, seed, pair,
-                repeat=None) -> tuple[float, float]:
+def fit_scatter(fit, fitted, e, harmonics: int, seed, pair, repeat=None,
+                odd=None) -> tuple[float, float]:
     """The fitted point's 1-sigma scatter (s) with one frame a step, and one frame's noise
     (rad, median over the columns), from a measured fine sweep: its errors ``e`` (S, C) at
     one frame a step, the curves ``fitted`` to them (S, C) and the ``fit`` (errors ->
@@ -182,7 +190,8 @@ def fit_scatter(fit, fitted, e, harmonics: int, seed, pair,
     curve (least-squares degrees of freedom); ``MC_DRAWS`` sweeps are drawn as the curves
     plus Gaussian noise of that std / sqrt(``SCATTER_DRAW_FRAMES``) (where the fit is
     linear in the noise) and refitted, their points' std scaled back to one frame. The
-    seed: ``seed`` and the ``pair`` (i, j) measured.
+    seed: ``seed`` and the ``pair`` (i, j) measured; ``odd`` (C,): the crossing columns, which
+    have 2 H coefficients (even ones H + 1).
 
     Where the fit has no residual degrees of freedom (an RTS with coarse delay steps leaves
     3 or 5 fine steps, through which the curves pass exactly: a zero residual is no evidence
@@ -198,8 +207,9 @@ def fit_scatter(fit, fitted, e, harmonics: int, seed, pair,
     else:
         r = e - fitted
         ok = np.isfinite(r)
-        # each column's own coefficients (at most 2 H), and the shared centre counted once
-        dof = ok.sum(0) - 2 * harmonics - 1 / max(int(used.sum()), 1)
+        # each column's own coefficients (H + 1 even, 2 H crossing), the shared centre once
+        n_coef = harmonics + 1 if odd is None else np.where(odd, 2 * harmonics, harmonics + 1)
+        dof = ok.sum(0) - n_coef - 1 / max(int(used.sum()), 1)
     if not np.any(used) or np.any(dof[used] < 1):
         return float("nan"), float("nan")
     sigma = np.where(used, np.sqrt(np.sum(np.where(ok, r, 0.0) ** 2, axis=0)
@@ -210,4 +220,5 @@ def fit_scatter(fit, fitted, e, harmonics: int, seed, pair,
     draws = base[None] + (sigma / np.sqrt(SCATTER_DRAW_FRAMES)
                           * rng.standard_normal((MC_DRAWS,) + base.shape))
     est = np.array([fit(x)[0] for x in draws])
-    return float(np.std(est) * np.sqrt(SCATTER_DRAW_FRAMES)), float(np.median(sigma[used]))
+    return (float(np.nanstd(est) * np.sqrt(SCATTER_DRAW_FRAMES)),
+            float(np.median(sigma[used])))

@@ -259,6 +259,8 @@ class PhasorProbes:
 
     dims = 1
     predicts_noise = True
+    reference = None  # the fit's centre is the coherence point within 1 ps (``fit``): no
+    # reference sweep (on the 86-element cascade at 3 m, inside its far field, 9 ps)
     fine_step_s = FINE_STEP_S  # the model evaluates every step at once: fine steps are cheap
 
     def __init__(self, setup: Setup, paths: Paths, pair, probe: FrontEndProbe,
@@ -316,7 +318,7 @@ class PhasorProbes:
         noise; drawn at one frame, the scatter compressed above ~30 ps and too few frames
         followed), each fitted (``fit``: errors -> (point, curves)), scaled to one frame."""
         draws = self.sweep(deltas).errors(frames, self._rng, MC_DRAWS)
-        return float(np.std([fit(e)[0] for e in draws])) * np.sqrt(frames)
+        return float(np.nanstd([fit(e)[0] for e in draws])) * np.sqrt(frames)
 
     def placed(self, window_s) -> "PhasorProbes":
         """These probes moved within their range bins so that design and detection agree on

@@ -37,7 +37,7 @@ __all__ = ["continuous_delay_setup", "CONTINUOUS_STEP_S", "COARSE_NOISE_DEG",
            "predicted_angle_noise", "coarse_frames", "MAX_FRAMES", "realisation_shift",
            "sweep_phase", "realisable", "FINE_STEP_S", "fine_window",
            "FineWindow", "SIZE_DRAWS", "TARGET_BIAS_PS", "frames_for", "fine_frames",
-           "adds_noise"]
+           "adds_noise", "reference_setup"]
 
 
 def continuous_delay_setup(setup: Setup) -> Setup:
@@ -177,6 +177,18 @@ def fine_window(half_s: float, step_s: float) -> FineWindow:
     column's coefficients and the shared centre stay fewer than its points."""
     k = max(1, int(np.floor(half_s / step_s + 1e-9)))
     return FineWindow(k, step_s, 2 if 2 * k + 1 >= 5 else 1)
+
+
+def reference_setup(setup: Setup, channel: int, phase_rad: float = 0.0) -> Setup:
+    """The (nominal) setup as the sweep's reference: no receiver noise and front end
+    ``channel``'s hardware phase set to ``phase_rad`` (the RTS's channels read it from the
+    scene when they synthesize, ``rts.channels``)."""
+    scene = setup.scene
+    fes = list(scene.rts.front_ends)
+    fes[channel] = dataclasses.replace(fes[channel], phase_offset_rad=float(phase_rad))
+    rts = scene.rts.evolve(front_ends=tuple(fes))
+    radar = scene.radar.evolve(snr_db=None, link=None)
+    return dataclasses.replace(setup, scene=scene.evolve(rts=rts, radar=radar))
 
 
 def adds_noise(scene) -> bool:

@@ -108,6 +108,7 @@ class Probes(Protocol):
     def frame_noise_deg(self, grid) -> float | None: ...
     def placed(self, window_s) -> "Probes": ...
     def fit_columns(self, e) -> tuple[np.ndarray, np.ndarray]: ...
+    reference: object  # (phase_rad) -> Probes on the nominal setup, or None: no offset taken
     def sweep_phase(self, deltas): ...
     def confirm(self, delta_s: float, frames: int) -> float: ...
     def phase(self, continuous, delta_s: float) -> float: ...
@@ -292,20 +293,54 @@ def run_sweep(probes: Probes, config: SweepConfig = SweepConfig()) -> Calibratio
             k_coarse = coarse_frames(frame_noise)
             errs, near_k = coarse(k_coarse)
             redo, near = redo or near_k != near, near_k
-        if redo:
+        if redo:  # the same columns (a recentred 2-D sweep switching to the along ones jumped)
             fine = _FineSweep(probes, near, steps, period)
             e_fine = probes.measure(fine.t, n_frames)
-            columns = probes.fit_columns(e_fine)
     best_fit, _ = fine.fit(e_fine, columns)
     if abs(best_fit - fine.centre) > RECENTRE_S:  # measured again, centred on the point: on a
         # window lopsided about it the fit drifts (5 ps at 46 ps off, sphere4's elevation pair,
-        # where a noisy coarse minimum was 50 ps from the point)
-        fine = _FineSweep(probes, float(realisable(best_fit, res)), steps, period)
+        # where a noisy coarse minimum was 50 ps from the point); the same columns
+        centre = float(realisable(best_fit, res))
+        probes = probes.placed(np.unique(realisable(
+            centre + np.arange(-half, half + 1e-15, step), res)))
+        fine = _FineSweep(probes, centre, steps, period)
         e_fine = probes.measure(fine.t, n_frames)
-        columns = probes.fit_columns(e_fine)
         best_fit, _ = fine.fit(e_fine, columns)
+    if not np.isfinite(best_fit):
+        raise CalibrationFailed(f"pair {probes.pair}: the probes were detected at too few "
+                                "steps of the fine sweep to fit it")
+    if probes.reference is not None:
+        best_fit -= _fit_offset(probes, steps, period, fine.centre, best_fit, columns)
     return _calibration(probes, grid, errs, fine.t, rms_error_deg(e_fine), near, best_fit,
                         k_coarse, n_frames, frame_noise, scatter, columns)
+
+
+def _fit_offset(probes, steps, period: float, centre_s: float, fit_s: float, columns) -> float:
+    """The fit's own offset from the coherence point (s), for probes that have a reference
+    (a pair in a 2-D beamformer, fitted along its line, whose curves' centre is 14 ps off the
+    point for sphere4's elevation pair): the same fit on the same probes on the nominal setup,
+    noiseless, minus the nominal point (:func:`coherence_point`). The reference is set up as
+    the measurement was: channel J given the hardware phase that puts its point where the
+    measured fit is (where J's echo sits in its range bin shapes the curves: a 90 deg phase
+    offset on a front end moved the offset by 23 ps), its fine sweep placed about that point
+    as the measured sweep (centred at ``centre_s``) was about the point it found (``fit_s``
+    less the offset: placed once without, then with it; the fit moves with the window by 2
+    ps)."""
+    # the reference's point where the measured one is (channel J's echo at the same delay:
+    # where it sits in its range bin shapes the curves): J given the phase that moves it there
+    nominal = coherence_point(probes.reference(), 0.0).continuous_s
+    ref = probes.reference(2 * np.pi * (fit_s - nominal) / period)
+    point = coherence_point(ref, fit_s).continuous_s
+    res = probes.setup.scene.rts.delay_resolution_s
+    offset = 0.0
+    for _ in range(2):
+        centre = float(realisable(point + centre_s - (fit_s - offset), res))
+        fine = _FineSweep(ref, centre, steps, period)
+        got, _ = fine.fit(ref.measure(fine.t, 1), columns)
+        if not np.isfinite(got):
+            return 0.0
+        offset = got - point
+    return offset
 
 
 def _measured_scatter(probes, fine: _FineSweep, e, columns, config) -> tuple[float, float]:
@@ -318,11 +353,12 @@ def _measured_scatter(probes, fine: _FineSweep, e, columns, config) -> tuple[flo
 
     def fit(x):
         return fine.fit(x, columns, selected=True)
-    out = fit_scatter(fit, fitted, e, fine.steps.harmonics, config.seed, probes.pair)
+    out = fit_scatter(fit, fitted, e, fine.steps.harmonics, config.seed, probes.pair,
+                      odd=columns[1])
     if not np.isfinite(out[0]):
         again = probes.measure(fine.t, 1, repeat=1)[:, cols]
         out = fit_scatter(fit, fitted, e, fine.steps.harmonics, config.seed, probes.pair,
-                          repeat=again)
+                          repeat=again, odd=columns[1])
     if not np.isfinite(out[0]):
         raise CalibrationFailed(f"pair {probes.pair}: the probes were not detected at enough "
                                 "steps of the fine sweep to measure its noise")
