@@ -25,6 +25,11 @@ Per row, the calibrated delay's distance (ps, wrapped into one period) from
   (0.5 ps steps on the arc, 1 ps in 2-D) of the probes' RMS error. Not the coherence point
   under a mounting offset: the probes' RMS minimum moves off it (``calibration.fit``).
 
+``--bundled``: instead of the grid, every bundled scene (``scenes/*.toml``) as shipped and
+with its mounting offsets removed, every pair its calibration measures (adjacent on an arc; the
+edges of the cells in 2-D), noiseless, with the distance from the coherence point and from the
+dense sweep's minimum (``benchmarks/calibration_bundled.json``).
+
 Writes ``benchmarks/calibration_accuracy[_quick].json`` and ``.csv`` and prints the worst
 rows. ``--quick``: offsets 0 and +-1 mm, radius 1 m and 3 m. About 25 min on 2 cores in
 full with ``--workers 2`` (the 2-D rows run the full chain at every sweep step).
@@ -91,6 +96,101 @@ def variant(array: str, radius_m: float, fe: int | None, dr_m: float, noisy: boo
     # no targets: the calibration programs its own probes (and a 9-Tx TDM frame's velocity
     # limit would refuse the paper scene's 4 m/s target)
     return scene.evolve(radar=radar, rts=rts, sheet=sheet, targets=())
+
+
+MOUNTING = ("radial_offset_m", "tangential_offset_m", "height_offset_m", "yaw_offset_rad",
+            "pitch_offset_rad")
+
+
+def bundled_scene(name: str, perfect: bool):
+    """A bundled scene, noiseless, no targets; ``perfect``: its front ends' mounting offsets
+    removed (those :data:`MOUNTING` names that the front end has)."""
+    from rtsgeom.scene import load_scene
+    scene = load_scene(ROOT / "scenes" / name)
+    fes = scene.rts.front_ends
+    if perfect:
+        fes = tuple(dataclasses.replace(f, **{k: 0.0 for k in MOUNTING if hasattr(f, k)})
+                    for f in fes)
+    return scene.evolve(radar=scene.radar.evolve(snr_db=None), targets=(),
+                        rts=scene.rts.evolve(front_ends=fes))
+
+
+def bundled_cases() -> list[tuple]:
+    """(scene file, pair, perfect) for every bundled scene and measured pair."""
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.pipeline.plan import measured_pairs
+    out = []
+    for path in sorted((ROOT / "scenes").glob("*.toml")):
+        pairs = measured_pairs(build_setup(bundled_scene(path.name, False)))
+        out += [(path.name, tuple(map(int, p)), perfect) for perfect in (False, True)
+                for p in pairs]
+    return out
+
+
+def one_bundled(args: tuple) -> dict:
+    """One bundled scene's pair (:func:`bundled_cases`): calibrated delay against the
+    coherence point and the dense noiseless sweep's RMS minimum."""
+    from rtsgeom.calibration.fit import rms_error_deg
+    from rtsgeom.calibration.pair import calibrate_pair, pair_coherence, pair_probes
+    from rtsgeom.calibration.probes import probe_front_ends
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    name, pair, perfect = args
+    t0 = time.perf_counter()
+    row = {"scene": name, "pair": f"{pair[0]}-{pair[1]}", "perfect": perfect}
+    try:
+        scene = bundled_scene(name, perfect)
+        setup = build_setup(scene)
+        paths = exact_paths(setup)
+        probe = probe_front_ends(setup, paths, scene.seed)
+        cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
+    except Exception as exc:  # noqa: BLE001 (a benchmark row, reported below)
+        return {**row, "error": f"{type(exc).__name__}: {exc}"}
+    period = cal.period_s
+
+    def wrap(x):
+        return float((x + period / 2) % period - period / 2)
+    point = pair_coherence(setup, paths, pair, probe, near_s=cal.delta_tau_s).continuous_s
+    probes = pair_probes(setup, paths, pair, probe).placed(
+        cal.coarse_minimum_s + np.arange(-period / 4, period / 4, 25e-12))
+    step = 0.5e-12 if cal.dims == 1 else 1e-12
+    t = point + np.arange(-30e-12, 30e-12 + 1e-15, step)
+    rms = rms_error_deg(probes.measure(t))
+    dense = float(t[int(np.argmin(rms))])
+    return {**row, "dims": cal.dims, "delta_tau_ps": cal.delta_tau_s * 1e12,
+            "fit_ps": cal.fit_s * 1e12, "coherence_ps": point * 1e12,
+            "dense_min_ps": dense * 1e12,
+            "dist_coherence_ps": wrap(cal.delta_tau_s - point) * 1e12,
+            "dist_dense_min_ps": wrap(cal.delta_tau_s - dense) * 1e12,
+            "dense_min_minus_coherence_ps": wrap(dense - point) * 1e12,
+            "resolution_ps": cal.delay_resolution_s * 1e12,
+            "residual_deg": cal.residual_error_deg,
+            "seconds": time.perf_counter() - t0}
+
+
+def run_bundled(workers: int) -> int:
+    """``--bundled`` (module doc)."""
+    cases = bundled_cases()
+    t0 = time.perf_counter()
+    with ProcessPoolExecutor(max(1, workers)) as pool:
+        rows = list(pool.map(one_bundled, cases))
+    for r in rows:
+        print(r["scene"], r["pair"], "perfect" if r["perfect"] else "as shipped",
+              r.get("error") or f"dims {r['dims']}: delta_tau {r['delta_tau_ps']:+8.1f} ps, "
+              f"from the coherence point {r['dist_coherence_ps']:+5.2f} ps, from the dense "
+              f"minimum {r['dist_dense_min_ps']:+5.2f} ps", flush=True)
+    good = [r for r in rows if "error" not in r]
+    summary = {"cases": len(rows), "failed": [r for r in rows if "error" in r],
+               "seconds": time.perf_counter() - t0}
+    for key in ("dist_coherence_ps", "dist_dense_min_ps"):
+        w = max(good, key=lambda r: abs(r[key]))
+        summary[f"max_abs_{key}"], summary[f"worst_{key}"] = abs(w[key]), w
+    keys = list(dict.fromkeys(k for r in rows for k in r))
+    write_json_csv(ROOT / "benchmarks" / "calibration_bundled", {"summary": summary,
+                                                                "rows": rows},
+                   [{k: r.get(k) for k in keys} for r in rows])
+    print(json.dumps({k: v for k, v in summary.items() if "worst" not in k}, indent=1))
+    return 0
 
 
 def one_case(args: tuple) -> dict:
@@ -169,9 +269,13 @@ def main(argv=None) -> int:
     ap.add_argument("--dense", action="store_true",
                     help="also the dense noiseless sweep's RMS minimum (slower)")
     ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--bundled", action="store_true",
+                    help="every bundled scene's measured pairs instead of the grid")
     ap.add_argument("--out", type=Path, default=None,
                     help="file stem (default benchmarks/calibration_accuracy[_quick])")
     a = ap.parse_args(argv)
+    if a.bundled:
+        return run_bundled(a.workers)
     radii = [1.0, 3.0] if a.quick else [0.5, 1.0, 3.0]
     offsets = [-1e-3, 1e-3] if a.quick else [-1e-3, -0.5e-3, 0.5e-3, 1e-3]
     cases = []

@@ -130,11 +130,13 @@ def test_no_module_is_two_concepts(module):
 
 
 def test_the_code_cites_no_issue_tracker():
-    """The package, its tests, benchmarks and examples say what they do and check, not which
-    ticket asked for it."""
+    """The package, its tests, benchmarks, examples, scenes and docs say what they do and
+    check, not which ticket asked for it."""
     rx = re.compile(r"\b[Ii]ssues? \d+\b|red[- ]team")
     files = [*PKG.rglob("*.py"), *(ROOT / "tests").glob("*.py"),
-             *(ROOT / "benchmarks").glob("*.py"), *(ROOT / "examples").glob("*.py")]
+             *(ROOT / "benchmarks").glob("*.py"), *(ROOT / "examples").glob("*.py"),
+             *(ROOT / "scenes").glob("*.toml"), *(ROOT / "docs").glob("*.md"),
+             ROOT / "README.md"]
     hits = [f"{p.relative_to(ROOT)}:{k}" for p in files if p != Path(__file__)
             for k, line in enumerate(p.read_text().splitlines(), 1) if rx.search(line)]
     assert not hits, hits
