@@ -318,3 +318,27 @@ def test_transfer_study_matches_the_chain_for_a_few_draws():
             n = nearest_detection(det, rd, res.range_m)
             err = np.degrees(det.angle_rad[n]) - res.set_deg[p]
             assert err == pytest.approx(res.error_deg[b, p], abs=2e-3)
+
+
+def test_transfer_command_reports_the_distribution(tmp_path, capsys):
+    """``rtsgeom transfer``: the JSON's percentiles and verdict, the output folder whole, and a
+    bad spread refused with the option's range (exit 2)."""
+    import json
+    from conftest import DEFAULT_SCENE
+    from rtsgeom.cli import main
+    out = tmp_path / "tr"
+    assert main(["transfer", str(DEFAULT_SCENE), "--radars", "30", "--sigma-phase-deg", "2",
+                 "--points", "3", "--spec-deg", "0.05", "--json", "--out", str(out)]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    for key in ("angle_error_deg", "compensated_angle_error_deg", "own_angle_error_deg"):
+        e = doc[key]
+        assert 0 <= e["p50"] <= e["p95"] <= e["max"]
+    assert doc["radars"] == 30 and doc["set_points"] == 3 and doc["pairs"] == [[0, 1]]
+    # the scene's radar is ideal: its calibration absorbed nothing
+    assert doc["absorbed_offset_ps"] == [0.0] and doc["absorbed_deg"]["max"] == 0.0
+    assert doc["verdict"] in ("transfers", "boresight", "recalibrate", "radar")
+    assert {"transfer.json", "transfer.png"} <= {p.name for p in out.iterdir()}
+    with pytest.raises(SystemExit) as exc:
+        main(["transfer", str(DEFAULT_SCENE), "--sigma-phase-deg", "-1"])
+    assert exc.value.code == 2
+    assert "--sigma-phase-deg" in capsys.readouterr().err
