@@ -39,7 +39,8 @@ from ..pipeline.pair import pair_design
 from ..scene import TargetConfig
 from ..synthesis.model import ChannelModel
 
-__all__ = ["TransferStudy", "Transfer", "draw_channel_gains", "percentiles"]
+__all__ = ["TransferStudy", "Transfer", "draw_channel_gains", "percentiles", "snapshot_angles",
+           "own_angle_errors"]
 
 
 def percentiles(x) -> dict:
@@ -161,10 +162,11 @@ class Transfer:
             ax.plot(x, e, color="0.75", lw=0.6)
         lo, hi = np.nanpercentile(self.error_deg, [5, 95], axis=0)
         ax.fill_between(x, lo, hi, color="C0", alpha=0.25, label="radars B, 5-95 %")
-        clo, chi = np.nanpercentile(self.compensated_error_deg, [5, 95], axis=0)
-        ax.fill_between(x, clo, chi, color="C2", alpha=0.35,
-                        label="radars B with boresight compensation, 5-95 %")
         ax.plot(x, self.golden_error_deg, "k", lw=2, label="golden radar A (calibrated with)")
+        clo, chi = np.nanpercentile(self.compensated_error_deg, [5, 95], axis=0)
+        ax.fill_between(x, clo, chi, color="C2", alpha=0.6, zorder=3)
+        ax.plot(x, np.nanmedian(self.compensated_error_deg, axis=0), color="C2", lw=1.5,
+                ls="--", zorder=4, label="radars B with boresight compensation, 5-95 %")
         if self.spec_deg:
             for s in (-self.spec_deg, self.spec_deg):
                 ax.axhline(s, color="C3", ls="--", lw=1)
@@ -259,7 +261,7 @@ class TransferStudy:
         e = np.degrees(np.stack(errs, axis=1))  # (1 + 2B, P)
         b = self.radars
         sets = np.asarray(sets)
-        own = _own_error(st, g_b, sets)
+        own = own_angle_errors(st, g_b, sets)
         return Transfer(tuple(tuple(p) for p in pairs), np.asarray(idx), np.degrees(sets),
                         e[0], np.degrees(np.asarray(errs0)), e[1:1 + b], e[1 + b:],
                         np.degrees(own), tuple(shifts), np.asarray(progs), ph_b, gd_b, rng_m,
@@ -312,7 +314,7 @@ def snapshot_angles(model: ChannelModel, w, gains) -> np.ndarray:
     return model.steering.search(sel)
 
 
-def _own_error(st: Steering, gains, angles_rad) -> np.ndarray:
+def own_angle_errors(st: Steering, gains, angles_rad) -> np.ndarray:
     """Each radar's error (B, P) rad on a real far-field point target at each set angle: the
     beamformer's peak of the plane wave e^{-j k p_v u} times its gains."""
     wave = np.ones((angles_rad.size, st.mask.size), complex)
