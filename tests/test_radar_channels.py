@@ -366,3 +366,74 @@ def test_drawn_radars_angle_bias_has_the_closed_form_spread():
         e = own_angle_errors(st, g, np.array([theta]))[:, 0]
         assert abs(np.mean(e)) < 4 * sigma / np.sqrt(e.size)
         assert np.std(e) == pytest.approx(sigma, rel=0.05)
+
+
+# -- mutual coupling between neighbouring Rx -----------------------------------------------------
+
+def test_coupling_mixes_the_neighbouring_rx_of_one_chirp():
+    from rtsgeom.radar.channels import channel_coupling
+    ideal, coupled = with_channels(None), with_channels({"rx_coupling_db": -20.0,
+                                                         "rx_coupling_phase_deg": 45.0})
+    s0, s1 = build_setup(ideal), build_setup(coupled)
+    m = channel_coupling(coupled.radar, s1.rut)
+    c = 0.1 * np.exp(1j * np.pi / 4)
+    vt, vr = s1.rut.virtual_slot, s1.rut.virtual_rx
+    want = np.where((vt[:, None] == vt[None]) & (np.abs(vr[:, None] - vr[None]) == 1), c, 0.0)
+    assert np.allclose(m, np.eye(vt.size) + want)  # the AWR1843's Rx in a row at lambda / 2
+    p0 = exact_paths(s0)
+    e0 = build_echoes(s0, p0, program_nearest(ideal, s0))
+    c0 = synthesize(e0, ideal.radar, s0.rut).data
+    c1 = synthesize(e0, coupled.radar, s1.rut).data
+    # the cube mixed by M; to the neighbours' beat-frequency difference, which the model
+    # takes as the element's own (S x picoseconds: 2e-4 of the signal here)
+    assert np.abs(c1 - np.einsum("vw,lwn->lvn", m, c0)).max() < 1e-3 * np.abs(c0).max()
+
+
+def test_coupling_angle_error_and_what_a_boresight_compensation_leaves():
+    """Coupling is an angle-dependent channel error: on a plane wave the virtual channels see
+    phases phi_v(u) = arg((M s(u))_v / s_v(u)), and the first-order closed form of those
+    phases gives the angle error at every angle; a compensation measured at boresight removes
+    phi_v(0) (the error there, to 1e-6 deg), and leaves phi_v(u) - phi_v(0) elsewhere."""
+    from rtsgeom.analysis.transfer import own_angle_errors
+    from rtsgeom.radar.channels import channel_coupling
+    for comp in ("none", "boresight"):
+        scene = with_channels({"rx_coupling_db": -30.0, "rx_coupling_phase_deg": 60.0,
+                               "compensation": comp}, small=False)
+        setup = build_setup(scene)
+        st = Steering.build(setup.rut, scene.radar)
+        m = channel_coupling(scene.radar, setup.rut)
+        g = channel_gain(scene.radar, setup.rut)
+        theta = np.radians(np.arange(-40.0, 41.0, 10.0))
+        got = own_angle_errors(st, g[None], theta, m)[0]
+        s = np.conj(st.steer(st.directions(theta)))  # (P, V): the plane waves
+        phi = np.angle((s @ m.T) * g / s)
+        pred = closed_form_shift(st, phi, theta)
+        assert np.max(np.abs(pred)) > np.radians(0.01)
+        assert np.allclose(got, pred, rtol=0.05, atol=np.radians(2e-4)), \
+            np.degrees(np.c_[got, pred])
+        if comp == "boresight":
+            assert abs(got[theta.size // 2]) < np.radians(1e-6)
+            assert np.max(np.abs(got)) > np.radians(0.01)
+
+
+def test_the_study_couples_like_a_scene_with_coupling():
+    """With the type's Rx coupling the study's shortcut (the ideal radar's spectra coupled,
+    then times each radar's gains) is the phasor model of the scene that carries both."""
+    from rtsgeom.analysis.transfer import snapshot_angles
+    from rtsgeom.radar.channels import channel_coupling
+    ch = {"rx_coupling_db": -20.0, "rx_coupling_phase_deg": 30.0, "rx_phase_deg": [0, 5, 0, 2]}
+    ideal = build_setup(with_channels(None, small=False))
+    s = build_setup(with_channels(ch, small=False))
+    t = TargetConfig(33.5, 0.0, 10.0, np.radians(7.0))
+    w = np.array([1.0, 0.8])
+    m = channel_coupling(s.scene.radar, s.rut)
+    g = channel_gain(s.scene.radar, s.rut)
+    got = snapshot_angles(ChannelModel.build(ideal, exact_paths(ideal), (0, 1), t), w, g[None],
+                          m)[0]
+    want = ChannelModel.build(s, exact_paths(s), (0, 1), t).direction(w)
+    # the scene couples the echoes taking a neighbour's beat frequency as the element's own,
+    # the study couples the spectra: 9e-4 deg apart here
+    assert got == pytest.approx(want, abs=np.radians(2e-3))
+    plain = snapshot_angles(ChannelModel.build(ideal, exact_paths(ideal), (0, 1), t), w,
+                            g[None])[0]
+    assert abs(plain - want) > np.radians(0.01)  # the coupling matters here

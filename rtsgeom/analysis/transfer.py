@@ -32,7 +32,8 @@ from ..calibration.probes import FrontEndProbe, probe_angles, probe_front_ends, 
 from ..errors import ParameterError
 from ..geometry import Setup, build_setup
 from ..paths import Paths
-from ..radar.channels import antenna_gains, channel_gain, compensation_vector, virtual_gain
+from ..radar.channels import (antenna_gains, channel_coupling, channel_gain, compensation_vector,
+                              virtual_gain)
 from ..radar.processing import tdm_compensate
 from ..radar.steering import Steering
 from ..pipeline.pair import pair_design
@@ -229,13 +230,14 @@ class TransferStudy:
         probe0 = probe_front_ends(ideal, paths, self.seed) if ideal is not setup else probe
         rng_m = float(probe_ranges(setup, 1)[0])
         st = Steering.build(setup.rut, setup.scene.radar)
+        coupling = channel_coupling(setup.scene.radar, setup.rut)  # the type's: every radar's
         g_gold = channel_gain(setup.scene.radar, setup.rut)
         g_gold = np.ones(setup.rut.num_virtual, complex) if g_gold is None else g_gold
         g_b, ph_b, gd_b = draw_channel_gains(setup.rut, self.radars, np.radians(self.sigma_phase_deg),
                                     self.sigma_gain_db, self.seed)
         comp = setup.scene.radar.channels
         c_range = None if comp is None else comp.compensation_range_m
-        g_comp = g_b * compensation_vector(g_b, setup.rut, c_range)
+        g_comp = g_b * compensation_vector(g_b, setup.rut, c_range, coupling)
         if comp is not None and comp.compensation == "boresight":
             g_b = g_comp  # every radar of the type runs the scene's compensation
         gains = np.concatenate([g_gold[None], g_b, g_comp])  # golden, B, B compensated
@@ -250,9 +252,10 @@ class TransferStudy:
             alphas = _set_angles(setup, probe, pair, self.points)
             for a in alphas:
                 t = TargetConfig(rng_m, 0.0, 10.0, float(a))
-                e, prog = _measure(ideal, paths, pair, t, probe, cal, gains, st, self.mode)
+                e, prog = _measure(ideal, paths, pair, t, probe, cal, gains, st, self.mode,
+                                   coupling)
                 e0, _ = _measure(ideal, paths, pair, t, probe0, cal0, g_gold[None], st,
-                                 self.mode)
+                                 self.mode, coupling)
                 idx.append(k)
                 sets.append(a)
                 errs.append(e)
@@ -261,7 +264,7 @@ class TransferStudy:
         e = np.degrees(np.stack(errs, axis=1))  # (1 + 2B, P)
         b = self.radars
         sets = np.asarray(sets)
-        own = own_angle_errors(st, g_b, sets)
+        own = own_angle_errors(st, g_b, sets, coupling)
         return Transfer(tuple(tuple(p) for p in pairs), np.asarray(idx), np.degrees(sets),
                         e[0], np.degrees(np.asarray(errs0)), e[1:1 + b], e[1 + b:],
                         np.degrees(own), tuple(shifts), np.asarray(progs), ph_b, gd_b, rng_m,
@@ -288,7 +291,7 @@ def _set_angles(setup: Setup, probe: FrontEndProbe, pair, points: int) -> np.nda
 
 
 def _measure(ideal: Setup, paths: Paths, pair, target: TargetConfig, probe, cal, gains, st,
-             mode: str) -> tuple[np.ndarray, np.ndarray]:
+             mode: str, coupling=None) -> tuple[np.ndarray, np.ndarray]:
     """The synthesized target's angle error (rad) per radar (gains (B, V)) for the RTS
     programme the calibration ``cal`` plans, and that programme (a_i, a_j, off_i, off_j)."""
     i, j = pair
@@ -298,15 +301,18 @@ def _measure(ideal: Setup, paths: Paths, pair, target: TargetConfig, probe, cal,
                                      probe_angles(*probe.angle_rad[[i, j]]), off, corr,
                                      cal.quantisation_residual_s)
     model = ChannelModel.build(ideal, paths, pair, target, (0.0, off_j), steering=st)
-    return (snapshot_angles(model, np.array([a_i, a_j]), gains) - target.angle_rad,
+    return (snapshot_angles(model, np.array([a_i, a_j]), gains, coupling) - target.angle_rad,
             np.array([a_i, a_j, 0.0, off_j]))
 
 
-def snapshot_angles(model: ChannelModel, w, gains) -> np.ndarray:
+def snapshot_angles(model: ChannelModel, w, gains, coupling=None) -> np.ndarray:
     """Detected azimuths (B,) rad of programme weights ``w`` (Q,) on ``model`` (an ideal
-    radar's) seen by radars of virtual gains ``gains`` (B, V): each radar's snapshot at its
-    strongest candidate bin, TDM-compensated, searched by the beamformer."""
+    radar's) seen by radars of virtual gains ``gains`` (B, V) after the coupling ``coupling``
+    (V, V) (``radar.channels``; None: none): each radar's snapshot at its strongest candidate
+    bin, TDM-compensated, searched by the beamformer."""
     x = np.tensordot(w, model.responses, axes=([0], [1]))  # (K, V)
+    if coupling is not None:
+        x = x @ coupling.T
     xb = x[None] * np.asarray(gains)[:, None, :]  # (B, K, V)
     k = np.argmax(np.sum(np.abs(xb) ** 2, axis=-1), axis=-1)
     sel = np.take_along_axis(xb, k[:, None, None], axis=1)[:, 0]
@@ -314,9 +320,14 @@ def snapshot_angles(model: ChannelModel, w, gains) -> np.ndarray:
     return model.steering.search(sel)
 
 
-def own_angle_errors(st: Steering, gains, angles_rad) -> np.ndarray:
+def own_angle_errors(st: Steering, gains, angles_rad, coupling=None) -> np.ndarray:
     """Each radar's error (B, P) rad on a real far-field point target at each set angle: the
-    beamformer's peak of the plane wave e^{-j k p_v u} times its gains."""
+    beamformer's peak of the plane wave e^{-j k p_v u} through the coupling ``coupling``
+    (V, V), times its gains (B, V). The elements outside the beamformer's row get 1 (the
+    coupling mixes the Rx of one chirp, a Tx slot's elements, which share a row)."""
+    angles_rad = np.asarray(angles_rad, float)
     wave = np.ones((angles_rad.size, st.mask.size), complex)
-    wave[:, st.mask] = np.conj(st.steer(st.directions(np.asarray(angles_rad))))  # (P, V)
+    wave[:, st.mask] = np.conj(st.steer(st.directions(angles_rad)))  # (P, V)
+    if coupling is not None:
+        wave = wave @ coupling.T
     return st.search(np.asarray(gains)[:, None, :] * wave[None]) - angles_rad[None]

@@ -14,6 +14,10 @@ frame is multiplied by ``c_v = 1 / m_v``. The net per-channel gain is ``g_v c_v`
 far-field measurement of angle-independent errors, ``1 / h_v`` (the curvature taken for an error)
 for a near one.
 
+Mutual coupling between neighbouring Rx antennas (``rx_coupling_db``) mixes the virtual
+channels of one chirp before the chains' gains, ``x' = diag(g) M x``: an error that depends on
+the direction, so a compensation measured at boresight removes it there only.
+
 Applied at one place, :func:`received_amplitude`, which every engine that turns echoes into
 per-virtual-channel data goes through (the ADC-cube chain ``radar.fmcw.synthesize`` and
 ``synthesize_exact``, the phasor model ``radar.phasors.bin_response``): the ChannelModel, the
@@ -31,7 +35,7 @@ from ..geometry import RutArray
 from ..scene import RadarConfig
 
 __all__ = ["antenna_gains", "virtual_gain", "boresight_reference", "compensation_vector",
-           "channel_gain", "received_amplitude"]
+           "rx_coupling_matrix", "channel_coupling", "channel_gain", "received_amplitude"]
 
 
 def antenna_gains(gain_db, phase_rad, n: int) -> np.ndarray:
@@ -61,15 +65,47 @@ def boresight_reference(rut: RutArray, range_m: float | None) -> np.ndarray:
     return np.exp(2j * np.pi / rut.wavelength_m * (d_t + d_r - 2 * float(range_m)))
 
 
-def compensation_vector(g_virtual, rut: RutArray, range_m: float | None) -> np.ndarray:
+def compensation_vector(g_virtual, rut: RutArray, range_m: float | None,
+                        coupling=None) -> np.ndarray:
     """The radar's boresight compensation (..., V): 1 / (what it measured on the boresight
-    reflector), ``1 / (g_v h_v)``, for virtual gains ``g_virtual`` (..., V)."""
-    return 1.0 / (np.asarray(g_virtual) * boresight_reference(rut, range_m))
+    reflector), ``1 / (g_v (M h)_v)``, for virtual gains ``g_virtual`` (..., V) and the
+    coupling ``M`` (V, V) (None: none)."""
+    h = boresight_reference(rut, range_m)
+    if coupling is not None:
+        h = coupling @ h
+    return 1.0 / (np.asarray(g_virtual) * h)
+
+
+def rx_coupling_matrix(rut: RutArray, coefficient: complex) -> np.ndarray:
+    """``C = I + c A`` (N_rx, N_rx): each Rx receives ``c`` times the signals of its
+    neighbours ``A`` (the Rx one smallest spacing apart)."""
+    p = np.asarray(rut.rx_local, float)
+    n = p.shape[0]
+    if n < 2:
+        return np.eye(n, dtype=complex)
+    d = np.linalg.norm(p[:, None] - p[None], axis=-1)
+    near = d[~np.eye(n, dtype=bool)].min()
+    adj = (d <= near * (1 + 1e-6)) & ~np.eye(n, dtype=bool)
+    return np.eye(n, dtype=complex) + complex(coefficient) * adj
+
+
+def channel_coupling(radar: RadarConfig, rut: RutArray) -> np.ndarray | None:
+    """The virtual channels' coupling ``M`` (V, V): element (slot s, Rx r) receives
+    ``sum_r' C[r, r'] x(s, r')`` (the Rx of one chirp mix, :func:`rx_coupling_matrix`), or
+    None without ``rx_coupling_db``."""
+    ch = getattr(radar, "channels", None)
+    if ch is None or ch.rx_coupling_db is None:
+        return None
+    c = 10 ** (ch.rx_coupling_db / 20) * np.exp(1j * ch.rx_coupling_phase_rad)
+    cr = rx_coupling_matrix(rut, c)
+    same_slot = rut.virtual_slot[:, None] == rut.virtual_slot[None, :]
+    return np.where(same_slot, cr[rut.virtual_rx[:, None], rut.virtual_rx[None, :]], 0.0)
 
 
 def channel_gain(radar: RadarConfig, rut: RutArray) -> np.ndarray | None:
     """The net complex gain (V,) of each virtual channel as the radar processes it (errors
-    times its compensation), or None for an ideal radar (nothing to multiply)."""
+    times its compensation; after the coupling :func:`channel_coupling`), or None for an
+    ideal radar (nothing to multiply)."""
     ch = getattr(radar, "channels", None)
     if ch is None or ch.ideal:
         return None
@@ -77,12 +113,25 @@ def channel_gain(radar: RadarConfig, rut: RutArray) -> np.ndarray | None:
     g = virtual_gain(rut, antenna_gains(ch.tx_gain_db, ch.tx_phase_rad, n_tx),
                      antenna_gains(ch.rx_gain_db, ch.rx_phase_rad, n_rx))
     if ch.compensation == "boresight":
-        g = g * compensation_vector(g, rut, ch.compensation_range_m)
+        g = g * compensation_vector(g, rut, ch.compensation_range_m,
+                                    channel_coupling(radar, rut))
     return g
 
 
-def received_amplitude(amplitude, radar: RadarConfig, rut: RutArray) -> np.ndarray:
-    """Echo amplitudes (E, V) as the radar's channels deliver them: times
-    :func:`channel_gain` (the array itself for an ideal radar)."""
+def received_amplitude(amplitude, radar: RadarConfig, rut: RutArray,
+                       phase0=None) -> np.ndarray:
+    """Echo amplitudes (E, V) as the radar's channels deliver them: coupled
+    (:func:`channel_coupling`), then times :func:`channel_gain` (the array itself for an
+    ideal radar). The coupling mixes the elements' signals, phases included: ``phase0``
+    (E, V) is the beat phase the caller multiplies in afterwards (``fmcw.beat_phase0``), so
+    element v gets ``sum_w M_vw a_w e^{j (phi0_w - phi0_v)}``. The neighbour's beat frequency
+    (S times a delay difference of picoseconds: a milliradian over the chirp) is taken as the
+    element's own."""
     g = channel_gain(radar, rut)
-    return amplitude if g is None else amplitude * g
+    if g is None:
+        return amplitude
+    m = channel_coupling(radar, rut)
+    if m is not None:
+        rot = 1.0 if phase0 is None else np.exp(1j * np.asarray(phase0))
+        amplitude = ((amplitude * rot) @ m.T) / rot
+    return amplitude * g

@@ -85,7 +85,8 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
     tau = echoes.tau_s  # (E, V)
     f_d = echoes.doppler_hz
     # (E, V), through the RuT's own channels (radar.channels)
-    amp = received_amplitude(echoes.amplitude, radar, rut) * np.exp(1j * beat_phase0(echoes, radar))
+    phi0 = beat_phase0(echoes, radar)
+    amp = received_amplitude(echoes.amplitude, radar, rut, phi0) * np.exp(1j * phi0)
     # fast time: sum_n w_n exp(j 2 pi (S tau + f_D) t_n) exp(-j 2 pi r n / N)
     w_r = window(radar.range_window, n_s)
     n = np.arange(n_s)

@@ -37,9 +37,11 @@ def _per_antenna(key: str, what: str, unit: str, lo: float, hi: float, scale: fl
 class RadarChannelsConfig(Evolvable):
     """The RuT's per-antenna complex gain errors and its own compensation: virtual element
     (Tx t, Rx r) receives ``g_tx[t] g_rx[r]`` times the ideal signal, ``g = 10^(gain_db / 20)
-    e^(j phase)``; ``compensation = "boresight"`` divides each virtual channel by what the
-    radar measured on a reflector at boresight (the SDK's range-bias and Rx-channel phase
-    compensation), at ``compensation_range_m`` (unset: in the far field)."""
+    e^(j phase)``, after the Rx antennas' mutual coupling (``rx_coupling_db``: each Rx also
+    receives that fraction of its nearest neighbours' signals); ``compensation = "boresight"``
+    divides each virtual channel by what the radar measured on a reflector at boresight (the
+    SDK's range-bias and Rx-channel phase compensation), at ``compensation_range_m`` (unset:
+    in the far field)."""
 
     tx_gain_db: tuple[float, ...] = _per_antenna("tx_gain_db", "gain error", "dB",
                                                  -MAX_GAIN_ERROR_DB, MAX_GAIN_ERROR_DB)
@@ -49,6 +51,13 @@ class RadarChannelsConfig(Evolvable):
                                                  -MAX_GAIN_ERROR_DB, MAX_GAIN_ERROR_DB)
     rx_phase_rad: tuple[float, ...] = _per_antenna("rx_phase_deg", "phase error", "deg",
                                                    -180.0, 180.0, _DEG)
+    rx_coupling_db: float | None = spec(
+        "rx_coupling_db", "float", "mutual coupling between neighbouring Rx antennas (those "
+        "one smallest spacing apart): each receives this fraction of its neighbours' signals; "
+        "unset = none", None, unit="dB", lo=-80.0, hi=-3.0)
+    rx_coupling_phase_rad: float = spec("rx_coupling_phase_deg", "float", "phase of the Rx "
+                                        "coupling coefficient", 0.0, unit="deg", lo=-180.0,
+                                        hi=180.0, scale=_DEG)
     compensation: str = spec(
         "compensation", "str", "the radar's own channel compensation: none, or boresight (the "
         "vector measured on a reflector at boresight, applied by the radar's processing)",
@@ -64,7 +73,8 @@ class RadarChannelsConfig(Evolvable):
         add one (a far-field boresight compensation of an ideal radar is 1)."""
         zero = not any(any(v) for v in (self.tx_gain_db, self.tx_phase_rad, self.rx_gain_db,
                                         self.rx_phase_rad))
-        return zero and (self.compensation == "none" or self.compensation_range_m is None)
+        return (zero and self.rx_coupling_db is None
+                and (self.compensation == "none" or self.compensation_range_m is None))
 
 
 def antenna_counts(radar) -> tuple[int, int]:
