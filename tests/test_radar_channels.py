@@ -437,3 +437,72 @@ def test_the_study_couples_like_a_scene_with_coupling():
     plain = snapshot_angles(ChannelModel.build(ideal, exact_paths(ideal), (0, 1), t), w,
                             g[None])[0]
     assert abs(plain - want) > np.radians(0.01)  # the coupling matters here
+
+
+# -- what one radar's probe captures cannot separate ----------------------------------------------
+
+def test_probe_captures_cannot_separate_the_named_combinations():
+    """The identification's forward model (``identify.ProbeModel``) of both front ends, with
+    the radar's antenna phases as extra parameters (the response times e^{j phi_v}): the
+    Fisher information has the null directions docs/radar-channels.md names. A phase moved
+    from every Rx to every Tx, and a phase common to every virtual channel against each front
+    end's channel phase, change nothing (exactly); a phase ramp across the array is undone
+    to 0.4 % by the front ends' parameters, which move them tangentially by R_c du /
+    cos(theta) (within 1 %): the rest is the near field's trace."""
+    from rtsgeom.identify import PARAMS, ProbeModel
+    scene = with_channels(None, small=False)
+    setup = build_setup(scene)
+    rut, radar = setup.rut, scene.radar
+    rng_m = 20.0
+    rb = int(np.round(rng_m * 2 * radar.slope_hz_per_s / c * radar.samples_per_chirp
+                      / radar.adc_rate_hz))
+    tx = np.unique(rut.virtual_tx)  # the transmitting Tx (not the elevated one)
+    n_rx = rut.rx_local.shape[0]
+    n_p = len(PARAMS)
+    blocks = []
+    for q in (0, 1):
+        m = ProbeModel(setup, q, rng_m, 0.0, 1e-3, rb, radar.chirps_per_tx // 2)
+        y, jac = m.jacobian(m.nominal(), range(n_p))
+        radar_cols = np.concatenate([1j * y[:, None] * (rut.virtual_tx[:, None] == tx),
+                                     1j * y[:, None] * (rut.virtual_rx[:, None]
+                                                        == np.arange(n_rx))], axis=1)
+        fe = np.zeros((y.size, 2 * n_p), complex)
+        fe[:, q * n_p:(q + 1) * n_p] = jac
+        blocks.append(np.concatenate([fe, radar_cols], axis=1) / np.abs(y).max())
+    j = np.concatenate(blocks)  # (2V, 2 x 7 + N_tx + N_rx)
+    n_fe = 2 * n_p
+    ph, tang = PARAMS.index("phase"), PARAMS.index("tangential_offset")
+
+    def response_change(v):
+        return np.linalg.norm(j @ v)
+
+    # a phase from every Rx to every (transmitting) Tx
+    v = np.zeros(j.shape[1])
+    v[n_fe:n_fe + tx.size], v[n_fe + tx.size:] = 1.0, -1.0
+    assert response_change(v) < 1e-12 * np.linalg.norm(j[:, n_fe:] @ np.abs(v[n_fe:]))
+    # a phase on every virtual channel (on every Rx) against each front end's channel phase
+    v = np.zeros(j.shape[1])
+    v[n_fe + tx.size:] = 1.0
+    v[[ph, n_p + ph]] = 1.0  # the beat carries conj of the channel's gain
+    alone = v.copy()
+    alone[[ph, n_p + ph]] = 0.0
+    assert response_change(v) < 1e-9 * response_change(alone)
+    # a ramp phi = -k x du across the array against both front ends turned by du
+    du = 1e-3
+    k = 2 * np.pi / rut.wavelength_m
+    ramp = np.zeros(j.shape[1])
+    ramp[n_fe:n_fe + tx.size] = -k * rut.tx_local[tx, 0] * du
+    ramp[n_fe + tx.size:] = -k * rut.rx_local[:, 0] * du
+    both = ramp.copy()
+    for q in (0, 1):
+        theta = setup.fe_azimuth_rad()[q]
+        both[q * n_p + tang] = -scene.rts.arc_radius_m * du / np.cos(theta)
+    # the best the front ends' (real) parameters can do against the ramp: least squares
+    a_re = np.concatenate([j[:, :n_fe].real, j[:, :n_fe].imag])
+    r = j @ ramp
+    x, *_ = np.linalg.lstsq(a_re, -np.concatenate([r.real, r.imag]), rcond=None)
+    best = ramp.copy()
+    best[:n_fe] = x
+    assert response_change(best) < 1e-2 * response_change(ramp)  # 0.4 %: the near field
+    assert response_change(both) < 3e-2 * response_change(ramp)  # the closed-form turn: 1.4 %
+    assert np.allclose(x[[tang, n_p + tang]], both[[tang, n_p + tang]], rtol=0.01)
