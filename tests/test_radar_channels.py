@@ -320,6 +320,7 @@ def test_transfer_study_matches_the_chain_for_a_few_draws():
             assert err == pytest.approx(res.error_deg[b, p], abs=2e-3)
 
 
+@pytest.mark.slow
 def test_transfer_command_reports_the_distribution(tmp_path, capsys):
     """``rtsgeom transfer``: the JSON's percentiles and verdict, the output folder whole, and a
     bad spread refused with the option's range (exit 2)."""

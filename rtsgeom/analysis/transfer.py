@@ -233,8 +233,9 @@ class TransferStudy:
         coupling = channel_coupling(setup.scene.radar, setup.rut)  # the type's: every radar's
         g_gold = channel_gain(setup.scene.radar, setup.rut)
         g_gold = np.ones(setup.rut.num_virtual, complex) if g_gold is None else g_gold
-        g_b, ph_b, gd_b = draw_channel_gains(setup.rut, self.radars, np.radians(self.sigma_phase_deg),
-                                    self.sigma_gain_db, self.seed)
+        g_b, ph_b, gd_b = draw_channel_gains(setup.rut, self.radars,
+                                             np.radians(self.sigma_phase_deg),
+                                             self.sigma_gain_db, self.seed)
         comp = setup.scene.radar.channels
         c_range = None if comp is None else comp.compensation_range_m
         g_comp = g_b * compensation_vector(g_b, setup.rut, c_range, coupling)

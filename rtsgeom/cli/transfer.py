@@ -43,8 +43,10 @@ def _summary(out: dict) -> str:
     lines = [f"{out['radars']} radars (antenna phase sigma {out['sigma_phase_deg']:g} deg, "
              f"gain sigma {out['sigma_gain_db']:g} dB) x {out['set_points']} set-points, RTS "
              "calibrated with the scene's radar:",
-             f"  |angle error|       p50 {e['p50']:.4f}  p95 {e['p95']:.4f}  max {e['max']:.4f} deg",
-             f"  with boresight comp p50 {c['p50']:.4f}  p95 {c['p95']:.4f}  max {c['max']:.4f} deg",
+             f"  |angle error|       p50 {e['p50']:.4f}  p95 {e['p95']:.4f}  max "
+             f"{e['max']:.4f} deg",
+             f"  with boresight comp p50 {c['p50']:.4f}  p95 {c['p95']:.4f}  max "
+             f"{c['max']:.4f} deg",
              f"  on a real target    p50 {own['p50']:.4f}  p95 {own['p95']:.4f}  max "
              f"{own['max']:.4f} deg (each radar's own error)",
              f"  absorbed by the golden radar's calibration: max "
