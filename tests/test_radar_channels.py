@@ -507,3 +507,20 @@ def test_probe_captures_cannot_separate_the_named_combinations():
     assert response_change(best) < 1e-2 * response_change(ramp)  # 0.4 %: the near field
     assert response_change(both) < 3e-2 * response_change(ramp)  # the closed-form turn: 1.4 %
     assert np.allclose(x[[tang, n_p + tang]], both[[tang, n_p + tang]], rtol=0.01)
+
+
+def test_info_states_the_radars_own_bias():
+    """``rtsgeom info``: the radar's own angle error at each front end's azimuth (the closed
+    form's, to first order); nothing for an ideal radar."""
+    from rtsgeom.pipeline.info import format_info, scene_info
+    ch = {"rx_phase_deg": [0.0, 2.0, -1.0, 1.5]}
+    setup = build_setup(with_channels(ch))
+    info = scene_info(setup)
+    st = Steering.build(setup.rut, setup.scene.radar)
+    phi = np.angle(channel_gain(setup.scene.radar, setup.rut))
+    for q, fe in enumerate(info["front_ends"]):
+        pred = closed_form_shift(st, phi, setup.fe_azimuth_rad()[q])
+        assert fe["radar_channel_bias_deg"] == pytest.approx(np.degrees(pred), rel=0.03)
+    assert "no RTS calibration removes it" in format_info(info)
+    plain = scene_info(build_setup(with_channels(None)))
+    assert all("radar_channel_bias_deg" not in fe for fe in plain["front_ends"])

@@ -33,7 +33,7 @@ from ..errors import ParameterError
 from ..geometry import Setup, build_setup
 from ..paths import Paths
 from ..radar.channels import (antenna_gains, channel_coupling, channel_gain, compensation_vector,
-                              virtual_gain)
+                              plane_wave_errors, virtual_gain)
 from ..radar.processing import tdm_compensate
 from ..radar.steering import Steering
 from ..pipeline.pair import pair_design
@@ -322,13 +322,6 @@ def snapshot_angles(model: ChannelModel, w, gains, coupling=None) -> np.ndarray:
 
 
 def own_angle_errors(st: Steering, gains, angles_rad, coupling=None) -> np.ndarray:
-    """Each radar's error (B, P) rad on a real far-field point target at each set angle: the
-    beamformer's peak of the plane wave e^{-j k p_v u} through the coupling ``coupling``
-    (V, V), times its gains (B, V). The elements outside the beamformer's row get 1 (the
-    coupling mixes the Rx of one chirp, a Tx slot's elements, which share a row)."""
-    angles_rad = np.asarray(angles_rad, float)
-    wave = np.ones((angles_rad.size, st.mask.size), complex)
-    wave[:, st.mask] = np.conj(st.steer(st.directions(angles_rad)))  # (P, V)
-    if coupling is not None:
-        wave = wave @ coupling.T
-    return st.search(np.asarray(gains)[:, None, :] * wave[None]) - angles_rad[None]
+    """Each radar's error (B, P) rad on a real far-field point target at each set angle
+    (``radar.channels.plane_wave_errors``)."""
+    return plane_wave_errors(st, gains, angles_rad, coupling)

@@ -35,7 +35,8 @@ from ..geometry import RutArray
 from ..scene import RadarConfig
 
 __all__ = ["antenna_gains", "virtual_gain", "boresight_reference", "compensation_vector",
-           "rx_coupling_matrix", "channel_coupling", "channel_gain", "received_amplitude"]
+           "rx_coupling_matrix", "channel_coupling", "channel_gain", "received_amplitude",
+           "plane_wave_errors"]
 
 
 def antenna_gains(gain_db, phase_rad, n: int) -> np.ndarray:
@@ -135,3 +136,19 @@ def received_amplitude(amplitude, radar: RadarConfig, rut: RutArray,
         rot = 1.0 if phase0 is None else np.exp(1j * np.asarray(phase0))
         amplitude = ((amplitude * rot) @ m.T) / rot
     return amplitude * g
+
+
+def plane_wave_errors(steering, gains, angles_rad, coupling=None) -> np.ndarray:
+    """Angle errors (B, P) rad of radars of virtual gains ``gains`` (B, V) after the coupling
+    ``coupling`` (V, V) (None: none) on a far-field point target at each azimuth
+    ``angles_rad`` (P,): the ``steering``'s peak (``radar.steering.Steering``, D = 1) of the
+    plane wave ``e^{-j k p_v u}`` less the set angle. What the radar shows on a real target,
+    which no RTS calibration changes. Elements outside the beamformer's row get 1 (the
+    coupling mixes a Tx slot's elements, which share a row)."""
+    angles_rad = np.asarray(angles_rad, float)
+    st = steering
+    wave = np.ones((angles_rad.size, st.mask.size), complex)
+    wave[:, st.mask] = np.conj(st.steer(st.directions(angles_rad)))  # (P, V)
+    if coupling is not None:
+        wave = wave @ coupling.T
+    return st.search(np.asarray(gains)[:, None, :] * wave[None]) - angles_rad[None]
