@@ -55,6 +55,9 @@ def with_channels(channels=None, small=True, angles=None, far=False, separation=
     ({"rx_gain_db": [0.0, 25.0, 0.0, 0.0]}, ["rx_gain_db[1]", "[-20, 20] dB"]),
     ({"compensation": "factory"}, ["radar.channels.compensation", "none, boresight"]),
     ({"compensation_range_m": 0.0}, ["radar.channels.compensation_range_m", "[0.1, 10000]"]),
+    ({"compensation_range_m": 1.0}, ["radar.channels.compensation_range_m", "left out",
+                                     'compensation = "none"']),
+    ({"rx_coupling_db": 0.0}, ["radar.channels.rx_coupling_db", "[-80, -3] dB"]),
     ({"rx_phase": [1.0]}, ["radar.channels.rx_phase", "not a known field", "rx_phase_deg"]),
 ])
 def test_section_errors_name_the_field_and_the_range(channels, words):

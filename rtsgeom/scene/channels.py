@@ -91,6 +91,10 @@ def channel_rules(scene, fail) -> None:
     ch = scene.radar.channels
     if ch is None:
         return
+    if ch.compensation_range_m is not None and ch.compensation == "none":
+        fail("radar.channels.compensation_range_m", ch.compensation_range_m,
+             'left out with radar.channels.compensation = "none" (it is the range of the '
+             'boresight compensation\'s reflector)')
     n_tx, n_rx = antenna_counts(scene.radar)
     board = ("[radar.array]" if scene.radar.array is not None
              else f"the {scene.radar.antenna_preset} preset")
