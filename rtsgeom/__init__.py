@@ -83,6 +83,10 @@ _LAZY = {
     "NearField": (".analysis.nearfield", "NearField"),
     "ghosts": (".api", "ghosts"),
     "GhostReport": (".analysis.ghosts", "GhostReport"),
+    "transfer": (".api", "transfer"),
+    "TransferStudy": (".analysis.transfer", "TransferStudy"),
+    "Transfer": (".analysis.transfer", "Transfer"),
+    "RadarChannelsConfig": (".scene.channels", "RadarChannelsConfig"),
     "Identification": (".identify", "Identification"),
     # views
     "show": (".api", "show"),

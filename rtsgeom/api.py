@@ -18,7 +18,7 @@ from .errors import ParameterError
 from .scene import Scene
 
 __all__ = ["replace", "calibrate", "linearity", "tolerance", "design", "nearfield", "ghosts",
-           "show"]
+           "transfer", "show"]
 
 
 def replace(obj, **changes):
@@ -215,6 +215,40 @@ def nearfield(scene: Scene, radius_m=None, points: int = 11):
     """
     from .analysis.nearfield import nearfield as _nearfield
     return _nearfield(scene, radius_m, points)
+
+
+def transfer(scene: Scene, radars: int = 100, sigma_phase_deg: float = 5.0,
+             sigma_gain_db: float = 0.0, points: int = 11, spec_deg: float | None = None,
+             seed: int | None = None):
+    """Calibration transfer: every adjacent pair calibrated with the scene's radar (its
+    ``[radar.channels]``), its synthesized targets measured by ``radars`` radars drawn with
+    the stated per-antenna spreads (``analysis.transfer``).
+
+    Parameters
+    ----------
+    scene : Scene
+    radars : int
+        Radars drawn.
+    sigma_phase_deg, sigma_gain_db : float
+        Spread of each Tx and Rx antenna's phase (deg) and gain (dB) error.
+    points : int
+        Set-points across each pair's span (its ends excluded).
+    spec_deg : float, optional
+        Angle spec (p95) for :meth:`Transfer.verdict`.
+    seed : int, optional
+        The draws' seed (default: the scene's).
+
+    Returns
+    -------
+    Transfer
+        ``error_deg`` (radars, points), ``compensated_error_deg``, ``own_error_deg``,
+        ``golden_error_deg``, ``absorbed_deg``; ``to_dict()``, ``to_dataframe()``, ``plot()``.
+    """
+    from .analysis.transfer import TransferStudy
+    setup, paths = _setup_paths(scene)
+    return TransferStudy(radars=radars, sigma_phase_deg=sigma_phase_deg,
+                         sigma_gain_db=sigma_gain_db, points=points, spec_deg=spec_deg,
+                         seed=scene.seed if seed is None else seed)(setup, paths)
 
 
 def ghosts(scene: Scene, floor_db: float = -80.0, simulate: bool = False):

@@ -46,6 +46,9 @@ def setup_fingerprint(scene) -> str:
     radar = dataclasses.asdict(scene.radar)
     for key in ("snr_db", "link", "cfar"):
         radar.pop(key, None)
+    ch = scene.radar.channels
+    if ch is None or ch.ideal:  # an ideal radar: the fingerprint it always had
+        radar.pop("channels", None)
     rts = dataclasses.asdict(scene.rts)
     for key in ("link", "aoa_mode", "calibration_span_s", "calibration_step_s"):
         rts.pop(key, None)

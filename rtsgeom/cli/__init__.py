@@ -43,6 +43,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "show": ("show", "3D view of the setup: PNG, interactive HTML or a window"),
     "identify": ("identify", "estimate each front end's mounting errors and each channel's "
                              "gain/phase/delay from probe captures"),
+    "transfer": ("transfer", "calibration transfer: an RTS calibrated with one radar, tested "
+                             "with drawn radars of the type"),
 }
 
 #: the modules that register commands, in the table's order

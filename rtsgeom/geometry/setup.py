@@ -79,7 +79,14 @@ def setup_errors(scene: Scene) -> list[str]:
     fe_key, radar_key = dict(specs(FrontEndConfig)), dict(specs(RadarConfig))
     out = [f"rts.front_ends[{q}].{fe_key[name].key}" for q, fe in enumerate(scene.rts.front_ends)
            for name in FRONT_END_ERRORS if getattr(fe, name) != 0.0]
-    return out + [f"radar.{radar_key[name].key}" for name in _rut_pose_errors(scene.radar)]
+    out += [f"radar.{radar_key[name].key}" for name in _rut_pose_errors(scene.radar)]
+    return out + (["radar.channels"] if _channel_errors(scene.radar) else [])
+
+
+def _channel_errors(radar) -> bool:
+    """Whether the RuT's own channels (``[radar.channels]``) are not ideal."""
+    ch = getattr(radar, "channels", None)
+    return ch is not None and not ch.ideal
 
 
 def _rut_pose_errors(radar) -> list[str]:
@@ -89,7 +96,8 @@ def _rut_pose_errors(radar) -> list[str]:
 
 def nominal_scene(scene: Scene, validate: bool = True) -> Scene:
     """The scene as designed: every field of :data:`FRONT_END_ERRORS` and
-    :data:`RUT_POSE_ERRORS` zero (``scene`` itself where they already are). ``validate``
+    :data:`RUT_POSE_ERRORS` zero and the RuT's channels ideal (no ``[radar.channels]``: the
+    lab does not know its radar's errors) (``scene`` itself where they already are). ``validate``
     False: not validated again (a study's internal variant, checked by its own rules: zeroing
     a radial offset lengthens the air path, which can put a valid scene's target, one the
     study drops anyway, beyond the range the rules allow)."""
@@ -97,6 +105,8 @@ def nominal_scene(scene: Scene, validate: bool = True) -> Scene:
     radar = scene.radar
     if _rut_pose_errors(radar):  # (zeroing every field of RUT_POSE_ERRORS)
         radar = radar.evolve(position_offset_m=(0.0, 0.0, 0.0), yaw_offset_rad=0.0)
+    if _channel_errors(radar):
+        radar = replace(radar, channels=None)
     if fes == scene.rts.front_ends and radar is scene.radar:
         return scene
     rts = scene.rts.evolve(front_ends=fes)

@@ -3,7 +3,9 @@
 from importlib import import_module
 
 from .table import DIRECTIONS, Paths
-from ..geometry.setup import nominal_setup
+from dataclasses import replace
+
+from ..geometry.setup import nominal_scene, nominal_setup
 from .exact import exact_paths
 from ..scene.registry import PATH_METHODS
 
@@ -32,6 +34,11 @@ def nominal_model(setup, paths: Paths) -> tuple:
     nom = nominal_setup(setup)
     if nom is setup:
         return setup, paths
+    s = setup.scene
+    if s.radar.channels is not None:  # the radar's channels do not move a path
+        bare = replace(s, radar=replace(s.radar, channels=None))
+        if nominal_scene(bare) is bare:
+            return nom, paths
     if paths.method == "exact":
         return nom, exact_paths(nom)
     from .raytrace import raytrace_paths  # here: Sionna RT loads only for ray tracing

@@ -14,6 +14,8 @@ from ..calibration.probes import probe_front_ends
 from ..errors import SceneError
 from ..paths import exact_paths
 from ..radar.budget import format_budget
+from ..radar.channels import channel_coupling, channel_gain, plane_wave_errors
+from ..radar.steering import Steering
 from .plan import bracketing_pair, target_cells, uses_cells
 
 __all__ = ["scene_info", "format_info", "reachable_spans"]
@@ -157,12 +159,29 @@ def scene_info(setup: Setup, reachable: bool = False) -> dict:
             for t in s.targets
         ],
     }
+    bias = _channel_bias_deg(setup)
+    if bias is not None:
+        for q, b in enumerate(bias):
+            out["front_ends"][q]["radar_channel_bias_deg"] = b
     if reachable:
         try:
             out["reachable"] = reachable_spans(setup)
         except SceneError as exc:  # a setup the synthesis does not model (its message says)
             out["reachable_unavailable"] = str(exc)
     return out
+
+
+def _channel_bias_deg(setup: Setup) -> list[float] | None:
+    """The radar's own angle error (deg) from its ``[radar.channels]`` on a far-field target at
+    each front end's azimuth (``radar.channels.plane_wave_errors``), None for an ideal radar
+    or a 2-D beamformer."""
+    radar, rut = setup.scene.radar, setup.rut
+    g = channel_gain(radar, rut)
+    st = Steering.auto(rut, radar)
+    if g is None or st.dims != 1:
+        return None
+    err = plane_wave_errors(st, g[None], setup.fe_azimuth_rad(), channel_coupling(radar, rut))
+    return [float(x) for x in np.degrees(err[0])]
 
 
 def _virtual_array(rut) -> dict:
@@ -217,6 +236,12 @@ def format_info(info: dict) -> str:
                      f" {fe['curvature_phase_error_deg']:18.2f}"
                      + (f"  {fe['elevation_deg']:8.3f} {fe['elevation_from_rut_deg']:9.4f}"
                         if el else ""))
+    if info["front_ends"] and "radar_channel_bias_deg" in info["front_ends"][0]:
+        lines.append("  the radar's own channel errors ([radar.channels]) move a real target at "
+                     "each front end's azimuth by "
+                     + ", ".join(f"{fe['radar_channel_bias_deg']:+.4f}"
+                                 for fe in info["front_ends"])
+                     + " deg (no RTS calibration removes it)")
     # consecutive indices' arc angles: a spacing along an arc, not between a 2-D cell's corners
     for i, (sp, ok) in enumerate(zip(info["front_end_spacing_deg"] if not el else (),
                                      info["spacing_within_resolution"])):

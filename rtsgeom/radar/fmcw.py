@@ -39,6 +39,7 @@ import numpy as np
 from .._lib.util import single_threaded_blas
 from ..geometry import RutArray
 from ..rts.channels import Echoes
+from .channels import received_amplitude
 from ..scene import RadarConfig
 from .steering import Steering
 
@@ -116,7 +117,8 @@ def synthesize(echoes: Echoes, radar: RadarConfig, rut: RutArray) -> AdcCube:
     phi0 = beat_phase0(echoes, radar)
     # slow time: A[v, l, e] = a[e, v] exp(j (phi0[e, v] + 2 pi f_D[e] t_c[l, v]))
     slow = phi0.T[:, None, :] + 2 * np.pi * f_d[None, None, :] * t_c.T[:, :, None]
-    a = (echoes.amplitude.T[:, None, :] * np.exp(1j * slow)).astype(np.complex64)
+    amp = received_amplitude(echoes.amplitude, radar, rut, phi0)  # the RuT's own channels
+    a = (amp.T[:, None, :] * np.exp(1j * slow)).astype(np.complex64)
     # fast time: F[v, e, n] = exp(j 2 pi (S tau[e, v] + f_D[e]) t_n)
     beat = s * tau.T + f_d[None, :]  # (V, E)
     f = np.exp(2j * np.pi * beat[:, :, None] * t_n[None, None, :])
@@ -144,6 +146,8 @@ def synthesize_exact(echoes: Echoes, radar: RadarConfig, rut: RutArray,
     t_c = chirp_start_s(radar, rut)[:, :, None]  # (L, V, 1)
     rate = np.zeros(len(echoes)) if delay_rate is None else np.asarray(delay_rate, float)
     out = np.zeros((radar.chirps_per_tx, rut.num_virtual, radar.samples_per_chirp), np.complex64)
+    # the RuT's own channels
+    amp = received_amplitude(echoes.amplitude, radar, rut, beat_phase0(echoes, radar))
     for e in range(len(echoes)):
         tau_air = echoes.tau_air_s[e][None, :, None]  # (1, V, 1)
         tau_if = echoes.tau_if_s[e] + rate[e] * (t_c + t_n)
@@ -152,7 +156,7 @@ def synthesize_exact(echoes: Echoes, radar: RadarConfig, rut: RutArray,
                              + s * tau * t_n - 0.5 * s * tau ** 2
                              + echoes.doppler_hz[e] * (t_c + t_n))
         g = 1.0 if echoes.fast_gain is None else echoes.fast_gain[e][None, None, :]
-        out += (echoes.amplitude[e][None, :, None] * g * np.exp(1j * phase)).astype(np.complex64)
+        out += (amp[e][None, :, None] * g * np.exp(1j * phase)).astype(np.complex64)
     return AdcCube(out, radar, rut)
 
 

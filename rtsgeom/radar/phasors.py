@@ -21,6 +21,7 @@ from ..geometry import RutArray
 from ..rts.channels import Echoes, EchoKind
 from ..rts.fir import FirTaps
 from ..scene import RadarConfig
+from .channels import received_amplitude
 from .fmcw import beat_phase0, chirp_start_s
 from .windows import window
 
@@ -83,7 +84,9 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
     s = radar.slope_hz_per_s
     tau = echoes.tau_s  # (E, V)
     f_d = echoes.doppler_hz
-    amp = echoes.amplitude * np.exp(1j * beat_phase0(echoes, radar))  # (E, V)
+    # (E, V), through the RuT's own channels (radar.channels)
+    phi0 = beat_phase0(echoes, radar)
+    amp = received_amplitude(echoes.amplitude, radar, rut, phi0) * np.exp(1j * phi0)
     # fast time: sum_n w_n exp(j 2 pi (S tau + f_D) t_n) exp(-j 2 pi r n / N)
     w_r = window(radar.range_window, n_s)
     n = np.arange(n_s)

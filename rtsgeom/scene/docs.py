@@ -60,6 +60,8 @@ def _allowed(s: Spec) -> str:
                 f"in [{s.lo:g}, {s.hi:g}]")
     if s.kind == "ints":
         return f"{s.min_items} to {s.max_items} integers in [{s.lo}, {s.hi}]"
+    if s.kind == "floats":
+        return f"{s.min_items} to {s.max_items} numbers, each in [{s.lo:g}, {s.hi:g}]"
     if s.kind == "float":
         r = s.range_text().removeprefix("in ")
         return r.replace(f" {s.unit}", "") if s.unit else r

@@ -90,3 +90,10 @@ CFAR_KINDS: dict[str, str] = {
     "ca": "cell averaging: the mean of the training ring",
     "os": "ordered statistic: the os_rank quantile of the training ring",
 }
+
+#: The RuT's own channel compensation (``[radar.channels] compensation``; ``radar.channels``).
+COMPENSATIONS: dict[str, str] = {
+    "none": "the virtual channels are processed as received",
+    "boresight": "each virtual channel divided by what the radar measured on a reflector at "
+                 "boresight (the SDK's Rx-channel phase and gain compensation)",
+}

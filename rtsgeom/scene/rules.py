@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from .._lib.arcmath import antenna_positions
+from .channels import channel_rules
 from .presets import ArraySpec
 from .registry import RADAR_PRESETS, WINDOWS, AOA_MODES
 from ..errors import SceneError
@@ -69,7 +70,8 @@ def problems(scene) -> list[str]:
         out.append(f"{src}: {fieldname} = {fmt(value)}: must be {allowed}")
 
     for rule in (_array_rules, _radar_rules, _rts_rules, _sheet_rules, _placement_rules, _calibration_rules,
-                 _target_rules, _spacing_rules, _elevation_rules, _estimator_rules):
+                 _target_rules, _spacing_rules, _elevation_rules, _estimator_rules,
+                 channel_rules):
         rule(scene, fail)
     return out
 

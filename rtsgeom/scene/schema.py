@@ -47,7 +47,7 @@ class Spec:
     """One field's declaration (see :func:`spec`)."""
 
     key: str
-    kind: str  # float, int, bool, str, material, vec, points, ints, table, tables
+    kind: str  # float, int, bool, str, material, vec, floats, points, ints, table, tables
     doc: str
     unit: str = ""
     lo: float | None = None
@@ -282,7 +282,7 @@ def check_value(s: Spec, v: Any, ctx: _Ctx, path: str, context: dict | None = No
                 ctx.fail(path, list(out), f"{s.n} whole numbers of {unit}")
             return tuple(int(x) for x in out)
         return out
-    if k in ("points", "ints"):
+    if k in ("points", "ints", "floats"):
         return _check_list(s, v, ctx, path)
     if k == "table":
         if isinstance(v, s.cls):
@@ -309,9 +309,20 @@ def check_value(s: Spec, v: Any, ctx: _Ctx, path: str, context: dict | None = No
 
 def _check_list(s: Spec, v: Any, ctx: _Ctx, path: str) -> tuple:
     """``points``: a list of [a, b, ...] (``s.n`` numbers each); ``ints``: a list of integers;
-    both with ``s.min_items``..``s.max_items`` entries and every number in [lo, hi]."""
+    ``floats``: a list of numbers; each with ``s.min_items``..``s.max_items`` entries and every
+    number finite and in [lo, hi]."""
     unit = f" {s.unit}" if s.unit else ""
     count = (f"at least {s.min_items}" + (f" and at most {s.max_items}" if s.max_items else ""))
+    if s.kind == "floats":
+        what = f"a list ({count} entries) of numbers in [{s.lo:g}, {s.hi:g}]{unit}"
+        if (not isinstance(v, (list, tuple)) or len(v) < s.min_items
+                or (s.max_items and len(v) > s.max_items) or any(not _is_num(x) for x in v)):
+            ctx.fail(path, v, what)
+        out = tuple(_as_float(x) for x in v)
+        for i, x in enumerate(out):
+            if x is None or not math.isfinite(x) or not s.lo <= x <= s.hi:
+                ctx.fail(f"{path}[{i}]", v[i], f"a finite number in [{s.lo:g}, {s.hi:g}]{unit}")
+        return out
     if s.kind == "points":
         what = f"a list ({count} entries) of [{'x, z' if s.n == 2 else ', '.join('xyz'[:s.n])}] pairs of numbers in " \
                f"[{s.lo:g}, {s.hi:g}]{unit}"

@@ -22,10 +22,11 @@ from scipy.constants import c
 
 from .registry import ANGLE_ESTIMATORS, AOA_MODES, CFAR_KINDS, RADAR_PRESETS, WINDOWS
 from .hardware import ArrayConfig, PatternConfig
+from .channels import RadarChannelsConfig
 from .link import RadarLinkConfig, RtsLinkConfig
 from .schema import Derived, Evolvable, spec
 
-__all__ = ["RadarConfig", "CfarConfig", "FrontEndConfig", "RtsConfig", "SheetConfig",
+__all__ = ["RadarChannelsConfig", "RadarConfig", "CfarConfig", "FrontEndConfig", "RtsConfig", "SheetConfig",
            "TargetConfig", "RaytraceConfig", "PatternConfig", "ArrayConfig", "StructureConfig"]
 
 # Resource limits (the file-level ones live in file.py).
@@ -149,6 +150,10 @@ class RadarConfig(Evolvable):
     link: RadarLinkConfig | None = spec(
         "link", "table", "[radar.link] physical link budget (optional: absent = relative "
         "amplitudes, noise from snr_db)", None, cls=RadarLinkConfig)
+    channels: RadarChannelsConfig | None = spec(
+        "channels", "table", "[radar.channels] the RuT's own per-antenna gain and phase errors "
+        "and its compensation (optional: absent = ideal channels)", None,
+        cls=RadarChannelsConfig)
 
     @property
     def slope_hz_per_s(self) -> float:
