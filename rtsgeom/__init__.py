@@ -84,6 +84,9 @@ _LAZY = {
     "ghosts": (".api", "ghosts"),
     "GhostReport": (".analysis.ghosts", "GhostReport"),
     "Identification": (".identify", "Identification"),
+    "play": (".api", "play"),
+    "Playback": (".analysis.playback", "Playback"),
+    "PlaybackResult": (".analysis.playback", "PlaybackResult"),
     # views
     "show": (".api", "show"),
     "render_setup_png": (".viz.scene3d", "render_setup_png"),
