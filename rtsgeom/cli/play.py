@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 
+from ..errors import ParameterError, UsageError
 from ..scene.registry import AOA_MODES, PATH_METHODS
 from ._common import load_scene_checked, output_folder, output_path, scene_arg, steps
 
@@ -15,10 +16,16 @@ def cmd_play(args) -> int:
     from ..analysis.playback import Playback
     from ..viz.figures import save_figure
     scene = load_scene_checked(args.scene)
+    if scene.scenario is None:
+        raise UsageError(f"{args.scene}: has no [scenario] to play (add [scenario] with "
+                         "[[scenario.targets]], docs/scenario.md)")
     study = Playback(args.amplitudes, args.paths, baseline=not args.no_baseline)
     with output_folder(args.out, [args.scene]) as stage, steps(args.quiet) as step:
         step(f"playing {scene.name} (calibration once, then every frame through the chain)")
-        result = study(scene)
+        try:
+            result = study(scene)
+        except ParameterError as exc:
+            raise UsageError(str(exc)) from None
         step("writing programme.csv, tracks.csv, summary.json, playback.png")
         (stage / "programme.csv").write_text(result.programme_csv(), encoding="utf-8")
         (stage / "tracks.csv").write_text(result.tracks_csv(), encoding="utf-8")
