@@ -27,6 +27,7 @@ OUTPUTS = {
     "plot_dca1000_capture.py": ["adc.bin", "adc.bin.json", "dca1000_range_profile.png"],
     "plot_identify.py": ["identify_crb.png"],
     "plot_superposition.py": ["superposition.png"],
+    "plot_scenario_crossing.py": ["scenario_crossing.png"],
 }
 
 

@@ -72,7 +72,7 @@ class ScenarioConfig(Evolvable):
 def frame_times(frame_period_s: float, duration_s: float) -> np.ndarray:
     """The frames' times ``k * frame_period_s``, ``k = 0 .. floor(duration_s / period)`` (s)."""
     n = int(math.floor(duration_s / frame_period_s * (1 + 1e-12))) + 1
-    return np.arange(n) * frame_period_s
+    return np.round(np.arange(n) * frame_period_s, 12)  # 0.3, not 0.30000000000000004
 
 
 @dataclass(frozen=True)
