@@ -267,7 +267,7 @@ def show(scene_or_setup, paths=None, png: str | Path | None = None,
 
 
 def play(scene: Scene, amplitudes: str | None = None, paths: str = "exact",
-         baseline: bool = True):
+         baseline: bool = True, workers: int = 1):
     """Play the scene's ``[scenario]`` frame by frame (``rtsgeom play``).
 
     Parameters
@@ -279,6 +279,8 @@ def play(scene: Scene, amplitudes: str | None = None, paths: str = "exact",
     paths : {'exact', 'raytrace'}
     baseline : bool
         Also play the switched baseline on the same drive (``result.baseline``).
+    workers : int
+        Forked processes for the frames (the same result for any number).
 
     Returns
     -------
@@ -286,4 +288,4 @@ def play(scene: Scene, amplitudes: str | None = None, paths: str = "exact",
         ``summary()``, ``to_dataframe()`` (tracks), ``programme_dataframe()``, ``plot()``.
     """
     from .analysis.playback import play as _play
-    return _play(scene, amplitudes, paths, baseline)
+    return _play(scene, amplitudes, paths, baseline, workers)

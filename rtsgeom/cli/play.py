@@ -9,7 +9,8 @@ import json
 
 from ..errors import ParameterError, UsageError
 from ..scene.registry import AOA_MODES, PATH_METHODS
-from ._common import load_scene_checked, output_folder, output_path, scene_arg, steps
+from ._common import (load_scene_checked, number, output_folder, output_path, scene_arg,
+                      steps)
 
 
 def cmd_play(args) -> int:
@@ -19,7 +20,8 @@ def cmd_play(args) -> int:
     if scene.scenario is None:
         raise UsageError(f"{args.scene}: has no [scenario] to play (add [scenario] with "
                          "[[scenario.targets]], docs/scenario.md)")
-    study = Playback(args.amplitudes, args.paths, baseline=not args.no_baseline)
+    study = Playback(args.amplitudes, args.paths, baseline=not args.no_baseline,
+                     workers=args.workers)
     with output_folder(args.out, [args.scene]) as stage, steps(args.quiet) as step:
         step(f"playing {scene.name} (calibration once, then every frame through the chain)")
         try:
@@ -62,5 +64,7 @@ def register(sub) -> None:
                    help="exact line-of-sight paths (default) or Sionna RT ray tracing")
     p.add_argument("--no-baseline", action="store_true",
                    help="do not also play the switched baseline for the figure")
+    p.add_argument("--workers", type=number(1, 256, integer=True), default=1, metavar="N",
+                   help="play the frames in N forked processes (the same result)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(func=cmd_play)

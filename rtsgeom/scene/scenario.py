@@ -172,7 +172,7 @@ def check_scenario(scene, fail, limits, air_extra_m: float) -> None:
             w = max(int(np.searchsorted(wp[:, 0], times[k], side="right")) - 1, 0)
             w = min(w, len(wp) - 1)
             row = [wp[w, 0], wp[w, 1], math.degrees(wp[w, 2]), math.degrees(wp[w, 3])]
-            fail(f"{where}[{w}]", [round(x, 6) for x in row],
+            fail(f"{where}[{w}]", [round(float(x), 6) for x in row],
                  f"{allowed} (at t = {times[k]:g} s, on the way from it, {what})")
 
         bad = np.flatnonzero(sp.range_m >= r_max)

@@ -85,15 +85,15 @@ class FramePlanner:
             "channel_delay_offsets_s": [float(x) for x in self.offsets],
             "pairs": [cal.to_dict() for cal in self.cals.values()]})
 
-    def program(self, f: int, scene_f: Scene) -> RtsProgram:
-        """Frame ``f``'s programme for ``scene_f`` (the scene with the frame's targets)."""
+    def program(self, f: int, scene_f: Scene) -> tuple[RtsProgram, list[str]]:
+        """Frame ``f``'s programme for ``scene_f`` (the scene with the frame's targets) and
+        the planner's warnings about it."""
         if self.mode == "nearest":
-            return program_nearest(scene_f, self.setup)
+            return program_nearest(scene_f, self.setup), []
         program, _, notes = program_pairs(self.setup, self.paths, self.mode, scene_f.targets,
                                           self.pairs[f], self.probe, self.cals, self.offsets,
                                           where=f"frame {f}: targets")
-        self.warnings += [n for n in notes if n not in self.warnings]
-        return program
+        return program, notes
 
 
 def detect_frame(setup: Setup, paths: Paths, program: RtsProgram, scene_f: Scene, seed: int,
