@@ -246,9 +246,12 @@ def test_play_writes_one_whole_folder(tmp_path):
     src = tmp_path / "drive.toml"
     src.write_text(doc)
     out = tmp_path / "out"
-    assert main(["play", str(src), "--out", str(out), "--quiet", "--amplitudes", "nearest"]) == 0
-    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == ["playback.png", "programme.csv",
-                                                     "summary.json", "tracks.csv"]
+    assert main(["play", str(src), "--out", str(out), "--quiet", "--amplitudes", "nearest",
+                 "--gif"]) == 0
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
+        "playback.gif", "playback.png", "programme.csv", "summary.json", "tracks.csv"]
+    from PIL import Image
+    assert Image.open(out / "playback.gif").n_frames == 3
     tracks = list(csv.DictReader((out / "tracks.csv").open()))
     assert list(tracks[0]) == list(TRACK_COLUMNS) and len(tracks) == 3
     prog = list(csv.DictReader((out / "programme.csv").open()))

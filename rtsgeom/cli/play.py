@@ -35,6 +35,9 @@ def cmd_play(args) -> int:
             json.dumps(result.summary_json(), indent=2, allow_nan=False) + "\n",
             encoding="utf-8")
         save_figure(result.plot(), stage / "playback.png")
+        if args.gif:
+            step("writing playback.gif")
+            result.animate(stage / "playback.gif")
     if not args.quiet:
         s = result.summary()
         for r, v in (("", s), ("baseline ", s.get("baseline"))):
@@ -49,7 +52,8 @@ def cmd_play(args) -> int:
                   f"hand-overs (largest jump {jump})")
         for w in result.warnings:
             print(f"warning: {w}")
-        print(f"wrote {args.out}/programme.csv, tracks.csv, summary.json, playback.png")
+        print(f"wrote {args.out}/programme.csv, tracks.csv, summary.json, playback.png"
+              + (", playback.gif" if args.gif else ""))
     return 0
 
 
@@ -64,6 +68,8 @@ def register(sub) -> None:
                    help="exact line-of-sight paths (default) or Sionna RT ray tracing")
     p.add_argument("--no-baseline", action="store_true",
                    help="do not also play the switched baseline for the figure")
+    p.add_argument("--gif", action="store_true",
+                   help="also write playback.gif: the arc from above, frame by frame")
     p.add_argument("--workers", type=number(1, 256, integer=True), default=1, metavar="N",
                    help="play the frames in N forked processes (the same result)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")

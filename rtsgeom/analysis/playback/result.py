@@ -175,6 +175,24 @@ class PlaybackResult:
             {r.mode: [self.time_s[f] for f, _ in r.handovers()] for r in runs},
             title=self.scene.name)
 
+    def animate(self, path, fps: int = 5):
+        """Write the drive as an animated GIF (matplotlib's PillowWriter): the arc from above
+        with the front ends that carry a target, the set and detected directions, and the
+        targets' paths (:func:`rtsgeom.viz.playback.playback_animation`)."""
+        from ...geometry import build_setup
+        from ...viz.playback import playback_animation  # matplotlib: only for the figure
+        setup = build_setup(self.scene)
+        n_f, n_q = len(self.time_s), setup.fe.count
+        amp = np.zeros((n_f, n_q))
+        p = self.programme
+        np.add.at(amp, (p[:, 0].astype(int), p[:, 2].astype(int)), p[:, 5])
+        az = np.radians(self.set["azimuth_deg"])
+        xy = self.set["range_m"][..., None] * np.stack([np.sin(az), np.cos(az)], axis=-1)
+        return playback_animation(path, self.time_s, np.degrees(setup.fe_azimuth_rad()), amp,
+                                  xy, self.set["azimuth_deg"], self.detected["azimuth_deg"],
+                                  self.scene.rts.arc_radius_m, f"{self.scene.name}: {self.mode}",
+                                  fps)
+
 
 def _csv(cols: dict, names) -> str:
     """Rows of ``cols`` in the order ``names``: integers as such, floats in full precision
