@@ -59,8 +59,8 @@ def _allowed(s: Spec) -> str:
         return (f"{s.min_items} to {s.max_items} [{'x, z' if s.n == 2 else ', '.join('xyz'[:s.n])}] pairs, each number "
                 f"in [{s.lo:g}, {s.hi:g}]")
     if s.kind == "rows":
-        return rows_text(s).removeprefix("a list (") .replace(" entries) of", "") + "; " + \
-            ", ".join(f"{n} in [{lo:g}, {hi:g}]" for n, _, lo, hi, _ in s.columns)
+        cols = ", ".join(f"{n} in [{lo:g}, {hi:g}]" for n, _, lo, hi, _ in s.columns)
+        return f"{s.min_items} to {s.max_items} {rows_text(s, inner=True)} rows; {cols}"
     if s.kind == "ints":
         return f"{s.min_items} to {s.max_items} integers in [{s.lo}, {s.hi}]"
     if s.kind == "float":

@@ -344,13 +344,16 @@ def _check_list(s: Spec, v: Any, ctx: _Ctx, path: str) -> tuple:
     return tuple(int(x) for x in v)
 
 
-def rows_text(s: Spec) -> str:
-    """What a ``rows`` field allows: ``[t_s, range_m, azimuth_deg(, elevation_deg)]`` rows."""
+def rows_text(s: Spec, inner: bool = False) -> str:
+    """What a ``rows`` field allows: ``[t_s, range_m, azimuth_deg(, elevation_deg)]`` rows
+    (``inner``: only the bracket)."""
     names = [c[0] for c in s.columns]
-    inner = ", ".join(names[:s.n]) + "".join(f"(, {x}" for x in names[s.n:]) \
-        + ")" * (len(names) - s.n)
+    row = "[" + ", ".join(names[:s.n]) + "".join(f"(, {x}" for x in names[s.n:]) \
+        + ")" * (len(names) - s.n) + "]"
+    if inner:
+        return row
     count = f"at least {s.min_items}" + (f" and at most {s.max_items}" if s.max_items else "")
-    return f"a list ({count} entries) of [{inner}] rows"
+    return f"a list ({count} entries) of {row} rows"
 
 
 def _check_rows(s: Spec, v: Any, ctx: _Ctx, path: str) -> tuple:
