@@ -87,6 +87,7 @@ _LAZY = {
     "play": (".api", "play"),
     "Playback": (".analysis.playback", "Playback"),
     "PlaybackResult": (".analysis.playback", "PlaybackResult"),
+    "drive_tolerance": (".analysis.playback", "drive_tolerance"),
     # views
     "show": (".api", "show"),
     "render_setup_png": (".viz.scene3d", "render_setup_png"),

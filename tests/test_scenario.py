@@ -290,3 +290,22 @@ def test_forked_workers_play_the_same_frames():
     for k in one.detected:
         np.testing.assert_array_equal(one.detected[k], two.detected[k])
     assert one.summary() == two.summary()
+
+
+def test_drive_tolerance_through_the_tolerance_engine():
+    """Mounting errors over the whole drive: the drive's azimuths are the engine's set-points
+    (pair by pair), a perfect setup stays on the nominal design, and the yield falls as the
+    errors grow, the calibration keeping more setups within the spec."""
+    scene = rtsgeom.load_scene(CROSSING)
+    exact = rtsgeom.drive_tolerance(scene, sigma_mm=(0.0, 0.0, 0.0), draws=10)
+    sets = np.sort(np.concatenate([m.set_rad for m in exact.model.sets]))
+    times = scene.scenario.frame_times()
+    want = trajectory(scene.scenario.targets[0].waypoints, times).azimuth_rad
+    np.testing.assert_allclose(sets, np.sort(want), atol=1e-12)
+    assert np.abs(exact.arc_worst("calibrated")).max() < 1e-3
+    small = rtsgeom.drive_tolerance(scene, sigma_mm=(0.05, 0.05, 0.05), draws=300, spec_deg=0.05)
+    large = rtsgeom.drive_tolerance(scene, sigma_mm=(0.5, 0.5, 0.5), draws=300, spec_deg=0.05)
+    assert small.yield_("calibrated") > large.yield_("calibrated")
+    assert large.yield_("calibrated") >= large.yield_("uncalibrated")
+    assert np.median(np.abs(large.arc_worst("uncalibrated"))) > np.median(
+        np.abs(small.arc_worst("uncalibrated")))
