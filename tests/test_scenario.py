@@ -247,7 +247,7 @@ def test_play_writes_one_whole_folder(tmp_path):
     src.write_text(doc)
     out = tmp_path / "out"
     assert main(["play", str(src), "--out", str(out), "--quiet", "--amplitudes", "nearest",
-                 "--gif"]) == 0
+                 "--gif", "--tolerance-draws", "50", "--sigma-mm", "0.2", "0.2", "0"]) == 0
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
         "playback.gif", "playback.png", "programme.csv", "summary.json", "tracks.csv"]
     from PIL import Image
@@ -259,6 +259,8 @@ def test_play_writes_one_whole_folder(tmp_path):
     s = json.loads((out / "summary.json").read_text())
     assert s["frames"] == 3 and s["mode"] == "nearest" and set(s["angle_error_deg"]) == {
         "max", "p95"}
+    assert s["tolerance"]["draws"] == 50 and s["tolerance"]["sigma_mm"] == [0.2, 0.2, 0.0]
+    assert 0.0 <= s["tolerance"]["yield"]["calibrated"] <= 1.0
     bare = tmp_path / "bare.toml"
     bare.write_text(doc.split("[scenario]")[0])
     assert main(["play", str(bare), "--out", str(tmp_path / "none"), "--quiet"]) == 2
