@@ -246,21 +246,16 @@ def test_play_writes_one_whole_folder(tmp_path):
     src = tmp_path / "drive.toml"
     src.write_text(doc)
     out = tmp_path / "out"
-    assert main(["play", str(src), "--out", str(out), "--quiet", "--amplitudes", "nearest",
-                 "--gif", "--tolerance-draws", "50", "--sigma-mm", "0.2", "0.2", "0"]) == 0
+    assert main(["play", str(src), "--out", str(out), "--quiet", "--amplitudes", "nearest"]) == 0
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
-        "playback.gif", "playback.png", "programme.csv", "summary.json", "tracks.csv"]
-    from PIL import Image
-    assert Image.open(out / "playback.gif").n_frames == 3
+        "playback.png", "programme.csv", "summary.json", "tracks.csv"]
     tracks = list(csv.DictReader((out / "tracks.csv").open()))
     assert list(tracks[0]) == list(TRACK_COLUMNS) and len(tracks) == 3
     prog = list(csv.DictReader((out / "programme.csv").open()))
     assert len(prog) == 3 and {r["channel"] for r in prog} <= {"0", "1", "2", "3", "4"}
     s = json.loads((out / "summary.json").read_text())
     assert s["frames"] == 3 and s["mode"] == "nearest" and set(s["angle_error_deg"]) == {
-        "max", "p95"}
-    assert s["tolerance"]["draws"] == 50 and s["tolerance"]["sigma_mm"] == [0.2, 0.2, 0.0]
-    assert 0.0 <= s["tolerance"]["yield"]["calibrated"] <= 1.0
+        "max", "p95"} and "tolerance" not in s
     bare = tmp_path / "bare.toml"
     bare.write_text(doc.split("[scenario]")[0])
     assert main(["play", str(bare), "--out", str(tmp_path / "none"), "--quiet"]) == 2
@@ -311,3 +306,19 @@ def test_drive_tolerance_through_the_tolerance_engine():
     assert large.yield_("calibrated") >= large.yield_("uncalibrated")
     assert np.median(np.abs(large.arc_worst("uncalibrated"))) > np.median(
         np.abs(small.arc_worst("uncalibrated")))
+
+
+@pytest.mark.slow
+def test_play_animates_and_adds_the_drive_tolerance(tmp_path):
+    """`--gif`: one animation frame per drive frame; `--tolerance-draws`: the drive's yield
+    in summary.json with the sigma and the pairs the drive visits."""
+    src = tmp_path / "drive.toml"
+    src.write_text(CROSSING.read_text().replace("frame_period_s = 0.1 ", "frame_period_s = 1.0 "))
+    out = tmp_path / "out"
+    assert main(["play", str(src), "--out", str(out), "--quiet", "--amplitudes", "nearest",
+                 "--gif", "--tolerance-draws", "50", "--sigma-mm", "0.2", "0.2", "0"]) == 0
+    from PIL import Image
+    assert Image.open(out / "playback.gif").n_frames == 3
+    t = json.loads((out / "summary.json").read_text())["tolerance"]
+    assert t["draws"] == 50 and t["sigma_mm"] == [0.2, 0.2, 0.0]
+    assert t["pairs"] and 0.0 <= t["yield"]["calibrated"] <= 1.0
