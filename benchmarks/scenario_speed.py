@@ -53,7 +53,7 @@ def main(argv=None) -> int:
 
     t0 = time.perf_counter()
     scene = drive(args.frames)
-    setup = build_setup(scene)
+    setup = build_setup(dataclasses.replace(scene, scenario=None))  # as Playback does
     paths = compute_paths(setup, "exact")
     times, frames = frame_targets(scene)
     t_set = time.perf_counter()
@@ -63,7 +63,7 @@ def main(argv=None) -> int:
     worst = 0.0
     for f, targets in enumerate(frames):
         a = time.perf_counter()
-        scene_f = dataclasses.replace(scene, targets=targets)
+        scene_f = dataclasses.replace(setup.scene, targets=targets)
         program, _ = planner.program(f, scene_f)
         b = time.perf_counter()
         matches, _ = detect_frame(setup, paths, program, scene_f, scene.seed + f)

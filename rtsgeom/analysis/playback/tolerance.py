@@ -14,6 +14,7 @@ target within its range bin): the range a drive changes within a pair is taken a
 
 from __future__ import annotations
 
+import dataclasses
 from collections import defaultdict
 
 import numpy as np
@@ -62,7 +63,7 @@ def drive_tolerance(scene: Scene, sigma_mm=(0.1, 0.1, 0.1), draws: int = 2000,
     if any(t.elevation_rad for tg in frames for t in tg):
         raise ParameterError("drive tolerance: targets in elevation need cells; a drive's "
                              "tolerance is modelled on pairs of an arc only")
-    setup = build_setup(scene)
+    setup = build_setup(dataclasses.replace(scene, scenario=None))  # the bench, not the drive
     probe = probe_front_ends(setup, exact_paths(setup), scene.seed)
     visits: dict = defaultdict(list)
     for f, targets in enumerate(frames):
