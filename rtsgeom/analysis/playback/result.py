@@ -49,8 +49,10 @@ class PlaybackResult:
         err = s["angle_error_deg"]["max"]
         base = (f", baseline max {self.baseline.summary()['angle_error_deg']['max']:.3g} deg"
                 if self.baseline is not None else "")
-        return (f"PlaybackResult({self.mode}, {s['frames']} frames x {self.num_targets} "
-                f"targets: max |angle error| {err if err is None else f'{err:.3g}'} deg, "
+        n = self.num_targets
+        return (f"PlaybackResult({self.mode}, {s['frames']} frames x {n} "
+                f"target{'s' if n != 1 else ''}: max |angle error| "
+                f"{err if err is None else f'{err:.3g}'} deg, "
                 f"{s['lost_frames']} lost, {s['split_frames']} split, {s['handovers']} "
                 f"hand-overs{base})")
 
