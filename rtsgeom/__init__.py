@@ -88,6 +88,10 @@ _LAZY = {
     "Transfer": (".analysis.transfer", "Transfer"),
     "RadarChannelsConfig": (".scene.channels", "RadarChannelsConfig"),
     "Identification": (".identify", "Identification"),
+    "play": (".api", "play"),
+    "Playback": (".analysis.playback", "Playback"),
+    "PlaybackResult": (".analysis.playback", "PlaybackResult"),
+    "drive_tolerance": (".analysis.playback", "drive_tolerance"),
     # views
     "show": (".api", "show"),
     "render_setup_png": (".viz.scene3d", "render_setup_png"),

@@ -18,7 +18,7 @@ from .errors import ParameterError
 from .scene import Scene
 
 __all__ = ["replace", "calibrate", "linearity", "tolerance", "design", "nearfield", "ghosts",
-           "transfer", "show"]
+           "transfer", "show", "play"]
 
 
 def replace(obj, **changes):
@@ -298,3 +298,28 @@ def show(scene_or_setup, paths=None, png: str | Path | None = None,
     if png is not None:
         return render_setup_png(setup, png, paths=paths, window_size=window_size)
     return show_setup(setup, paths=paths, interactive=False, window_size=window_size)
+
+
+def play(scene: Scene, amplitudes: str | None = None, paths: str = "exact",
+         baseline: bool = True, workers: int = 1):
+    """Play the scene's ``[scenario]`` frame by frame (``rtsgeom play``).
+
+    Parameters
+    ----------
+    scene : Scene
+        With a ``[scenario]`` (moving targets; its ``[[targets]]`` stay static beside them).
+    amplitudes : str, optional
+        AoA mode (default: ``rts.aoa_mode``); ``'nearest'``: the switched baseline.
+    paths : {'exact', 'raytrace'}
+    baseline : bool
+        Also play the switched baseline on the same drive (``result.baseline``).
+    workers : int
+        Forked processes for the frames (the same result for any number).
+
+    Returns
+    -------
+    PlaybackResult
+        ``summary()``, ``to_dataframe()`` (tracks), ``programme_dataframe()``, ``plot()``.
+    """
+    from .analysis.playback import play as _play
+    return _play(scene, amplitudes, paths, baseline, workers)

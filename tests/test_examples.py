@@ -28,6 +28,7 @@ OUTPUTS = {
     "plot_identify.py": ["identify_crb.png"],
     "plot_superposition.py": ["superposition.png"],
     "plot_calibration_transfer.py": ["calibration_transfer.png"],
+    "plot_scenario_crossing.py": ["scenario_crossing.png"],
 }
 
 

@@ -31,6 +31,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "paths": ("paths", "per-element propagation paths as CSV"),
     "export-mesh": ("export_mesh", "export the setup as GLB/PLY/OBJ/STL"),
     "run": ("run", "the main job: simulate the scene, detect, compare with set-points"),
+    "play": ("play", "play the scene's [scenario]: programme, tracks per frame"),
     "adc": ("adc", "save the raw ADC cube (.npy) or a DCA1000 capture"),
     "calibrate": ("calibrate", "phase calibration sweep of a front-end pair"),
     "linearity": ("linearity", "synthesized-angle linearity across a pair's span"),

@@ -32,7 +32,7 @@ from ..synthesis.model import ChannelModel, target_direction
 from .pair import plan_pair, residual_warning
 
 __all__ = ["bracketing_pair", "check_pair", "measured_pairs", "uses_cells", "target_cells",
-           "plan_targets"]
+           "plan_targets", "target_pairs", "calibrate_pairs", "program_pairs"]
 
 
 def bracketing_pair(angle_rad: float, fe_angles_rad: np.ndarray) -> tuple[int, int] | None:
@@ -136,73 +136,23 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
                              "calibrations; front ends on a sphere are calibrated per channel "
                              "by the run itself")
         return _plan_cells(setup, paths, mode, calibrate, progress)
-    seed = scene.seed
     loaded: dict = {}
     if calibration is not None:
         probe, loaded = load_calibration(calibration, setup)
     else:
-        probe = probe_front_ends(setup, paths, seed)
+        probe = probe_front_ends(setup, paths, scene.seed)
     warnings = []
     if calibration is not None and (mismatch := calibration_mismatch(calibration, scene)):
         warnings.append(mismatch)
-    lost = np.flatnonzero(~np.isfinite(probe.angle_rad))
-    if lost.size:
-        raise SceneError(f"{scene.source}: rts.front_ends[{lost[0]}]: the RuT does not detect "
-                         "this front end alone (blocked line of sight, or an echo far weaker "
-                         "than the noise" + probe.clipping_note() + "): cannot synthesize "
-                         "angles with it")
-    res = angular_resolution_rad(setup.rut)
-    pairs = {}
-    for k, t in enumerate(scene.targets):
-        pair = bracketing_pair(t.angle_rad, probe.angle_rad)
-        if pair is None:
-            lo, hi = np.degrees(np.nanmin(probe.angle_rad)), np.degrees(np.nanmax(probe.angle_rad))
-            raise SceneError(f"{scene.source}: targets[{k}].angle_deg = "
-                             f"{np.degrees(t.angle_rad):g}: must be within the measured span of "
-                             f"the front ends [{lo:.4f}, {hi:.4f}] deg (no pair can reach it)")
-        pairs[k] = pair
-        spacing = abs(probe.angle_rad[pair[1]] - probe.angle_rad[pair[0]])
-        if spacing > res:
-            warnings.append(f"targets[{k}]: front ends {pair} are {np.degrees(spacing):.2f} deg "
-                            f"apart, more than the RuT's angular resolution "
-                            f"{np.degrees(res):.2f} deg (eq. 24): expect two peaks")
-    cals: dict[tuple[int, int], Calibration] = {}
-    if calibrate:
-        for pair in sorted(set(pairs.values())):
-            base = channel_offsets(setup.fe.count, cals)
-            if calibration is not None:
-                if pair not in loaded:
-                    raise SceneError(f"calibration file: has no pair {pair} (it has "
-                                     f"{sorted(loaded)}): run `rtsgeom calibrate SCENE --pair "
-                                     f"{pair[0]} {pair[1]} --out DIR`")
-                cals[pair] = loaded[pair]
-                continue
-            cals[pair] = calibrate_pair(setup, paths, pair, probe, (base[pair[0]], base[pair[0]]),
-                                        seed=seed)
-            if progress:
-                progress(f"calibrated pair {pair}: delta_tau {cals[pair].delta_tau_s * 1e12:.1f} ps")
+    pairs, notes = target_pairs(setup, probe, scene.targets)
+    warnings += notes
+    cals = (calibrate_pairs(setup, paths, sorted(set(pairs)), probe,
+                            loaded if calibration is not None else None, progress)
+            if calibrate else {})
     offsets = channel_offsets(setup.fe.count, cals)
-    rows, realised = [], []
-    for k, t in enumerate(scene.targets):
-        i, j = pairs[k]
-        probes = probe_angles(probe.angle_rad[i], probe.angle_rad[j])
-        cal = cals.get((i, j))
-        try:
-            plan = plan_pair(setup, paths, (i, j), t, mode, probes, (offsets[i], offsets[j]),
-                             probe.gain_correction[[i, j]],
-                             cal.quantisation_residual_s if cal is not None else 0.0)
-        except AngleUnreachable as exc:
-            raise SceneError(f"{scene.source}: targets[{k}].angle_deg = "
-                             f"{np.degrees(t.angle_rad):g}: {exc}") from None
-        tau = float(requested_delay(scene, t.range_m))
-        f_d = 2 * scene.radar.f_c_hz * t.velocity_mps / c
-        rows += [(k, i, tau + offsets[i], f_d, plan.a_i), (k, j, tau + plan.offset_j_s, f_d,
-                                                           plan.a_j)]
-        realised.append({"target": k, "pair": [i, j], **plan.to_dict()})
-        note = residual_warning(scene, k, plan)
-        if note:
-            warnings.append(note)
-    program = RtsProgram.build(*zip(*rows)) if rows else RtsProgram.build([], [], [], [], [])
+    program, realised, notes = program_pairs(setup, paths, mode, scene.targets, pairs, probe,
+                                             cals, offsets)
+    warnings += notes
     record = {
         "mode": mode,
         "source": "file" if calibration is not None else "measured",
@@ -213,6 +163,92 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
         "targets": realised,  # each target's J delay as realised (PairPlan.to_dict)
     }
     return program, record, warnings
+
+
+def target_pairs(setup: Setup, probe, targets, where: str = "targets"
+                 ) -> tuple[list[tuple[int, int]], list[str]]:
+    """Each target's pair of front ends: the adjacent pair whose *measured* span (``probe``,
+    each front end alone as the RuT detects it) holds its angle, and a warning per pair wider
+    than the RuT's angular resolution (eq. 24). ``where`` names the targets in messages.
+    Raises ``SceneError`` for a front end the RuT does not detect or a target outside the
+    measured span."""
+    scene = setup.scene
+    lost = np.flatnonzero(~np.isfinite(probe.angle_rad))
+    if lost.size:
+        raise SceneError(f"{scene.source}: rts.front_ends[{lost[0]}]: the RuT does not detect "
+                         "this front end alone (blocked line of sight, or an echo far weaker "
+                         "than the noise" + probe.clipping_note() + "): cannot synthesize "
+                         "angles with it")
+    res = angular_resolution_rad(setup.rut)
+    pairs, warnings = [], []
+    for k, t in enumerate(targets):
+        pair = bracketing_pair(t.angle_rad, probe.angle_rad)
+        if pair is None:
+            lo, hi = np.degrees(np.nanmin(probe.angle_rad)), np.degrees(np.nanmax(probe.angle_rad))
+            raise SceneError(f"{scene.source}: {where}[{k}].angle_deg = "
+                             f"{np.degrees(t.angle_rad):g}: must be within the measured span of "
+                             f"the front ends [{lo:.4f}, {hi:.4f}] deg (no pair can reach it)")
+        pairs.append(pair)
+        spacing = abs(probe.angle_rad[pair[1]] - probe.angle_rad[pair[0]])
+        if spacing > res:
+            warnings.append(f"{where}[{k}]: front ends {pair} are {np.degrees(spacing):.2f} deg "
+                            f"apart, more than the RuT's angular resolution "
+                            f"{np.degrees(res):.2f} deg (eq. 24): expect two peaks")
+    return pairs, warnings
+
+
+def calibrate_pairs(setup: Setup, paths: Paths, pairs, probe, loaded: dict | None = None,
+                    progress=None) -> dict[tuple[int, int], Calibration]:
+    """The pairs' calibrations, in the given order, each with channel I at the delay offset
+    the pairs before it chained (``channel_offsets``); taken from ``loaded`` (a calibration
+    file's pairs) where it is given."""
+    cals: dict[tuple[int, int], Calibration] = {}
+    for pair in pairs:
+        base = channel_offsets(setup.fe.count, cals)
+        if loaded is not None:
+            if pair not in loaded:
+                raise SceneError(f"calibration file: has no pair {pair} (it has "
+                                 f"{sorted(loaded)}): run `rtsgeom calibrate SCENE --pair "
+                                 f"{pair[0]} {pair[1]} --out DIR`")
+            cals[pair] = loaded[pair]
+            continue
+        cals[pair] = calibrate_pair(setup, paths, pair, probe, (base[pair[0]], base[pair[0]]),
+                                    seed=setup.scene.seed)
+        if progress:
+            progress(f"calibrated pair {pair}: delta_tau {cals[pair].delta_tau_s * 1e12:.1f} ps")
+    return cals
+
+
+def program_pairs(setup: Setup, paths: Paths, mode: str, targets, pairs, probe, cals: dict,
+                  offsets, where: str = "targets") -> tuple[RtsProgram, list[dict], list[str]]:
+    """The RTS programme of ``targets`` on their ``pairs`` with the calibration fixed
+    (``cals`` and the channels' delay offsets ``offsets``): per target channel I at the
+    target's delay plus its offset, channel J at the delay :func:`~.pair.plan_pair` chose, both
+    amplitudes from it. Returns the programme, each target's realised plan (for summary.json)
+    and warnings; ``SceneError`` for an angle the pair cannot reach."""
+    scene = setup.scene
+    rows, realised, warnings = [], [], []
+    for k, t in enumerate(targets):
+        i, j = pairs[k]
+        probes = probe_angles(probe.angle_rad[i], probe.angle_rad[j])
+        cal = cals.get((i, j))
+        try:
+            plan = plan_pair(setup, paths, (i, j), t, mode, probes, (offsets[i], offsets[j]),
+                             probe.gain_correction[[i, j]],
+                             cal.quantisation_residual_s if cal is not None else 0.0)
+        except AngleUnreachable as exc:
+            raise SceneError(f"{scene.source}: {where}[{k}].angle_deg = "
+                             f"{np.degrees(t.angle_rad):g}: {exc}") from None
+        tau = float(requested_delay(scene, t.range_m))
+        f_d = 2 * scene.radar.f_c_hz * t.velocity_mps / c
+        rows += [(k, i, tau + offsets[i], f_d, plan.a_i), (k, j, tau + plan.offset_j_s, f_d,
+                                                           plan.a_j)]
+        realised.append({"target": k, "pair": [i, j], **plan.to_dict()})
+        note = residual_warning(scene, k, plan)
+        if note:
+            warnings.append(note)
+    program = RtsProgram.build(*zip(*rows)) if rows else RtsProgram.build([], [], [], [], [])
+    return program, realised, warnings
 
 
 def _plan_cells(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, progress=None

@@ -110,6 +110,7 @@ def _fir_rows(uniq: np.ndarray, taps: int, f_s_hz: float, grid: np.ndarray):
         new = uniq[~hit]
         if mus.size + new.size > _FIR_ROWS_MAX:
             mus, h, phase = np.zeros(0), np.zeros((0, taps)), np.zeros((0, grid.size), complex)
+            new = uniq  # the settings found in the old memo went with it
         order = np.argsort(np.concatenate([mus, new]), kind="stable")
         mus = np.concatenate([mus, new])[order]
         h = np.concatenate([h, fractional_delay_fir(new, taps)])[order]

@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 
 from . import file, registry, rules, scene, sections
-from .schema import REQUIRED, Derived, Spec, specs
+from .schema import REQUIRED, Derived, Spec, rows_text, specs
 
 __all__ = ["render", "DOC_PATH"]
 
@@ -58,6 +58,9 @@ def _allowed(s: Spec) -> str:
     if s.kind == "points":
         return (f"{s.min_items} to {s.max_items} [{'x, z' if s.n == 2 else ', '.join('xyz'[:s.n])}] pairs, each number "
                 f"in [{s.lo:g}, {s.hi:g}]")
+    if s.kind == "rows":
+        cols = ", ".join(f"{n} in [{lo:g}, {hi:g}]" for n, _, lo, hi, _ in s.columns)
+        return f"{s.min_items} to {s.max_items} {rows_text(s, inner=True)} rows; {cols}"
     if s.kind == "ints":
         return f"{s.min_items} to {s.max_items} integers in [{s.lo}, {s.hi}]"
     if s.kind == "floats":
@@ -102,7 +105,7 @@ def render() -> str:
             "Checked on load and by `Scene.evolve` (`rtsgeom.scene.rules.problems(scene)` lists all "
             "of them a scene violates):", ""]
     for name in ("_array_rules", "_radar_rules", "_rts_rules", "_sheet_rules", "_placement_rules",
-                 "_calibration_rules", "_target_rules", "_spacing_rules"):
+                 "_calibration_rules", "_target_rules", "_spacing_rules", "_scenario_rules"):
         fn = getattr(rules, name)
         doc = " ".join((inspect.getdoc(fn) or "").split())
         out.append(f"- `{name.strip('_')}`" + (f": {doc}" if doc else ""))

@@ -25,6 +25,7 @@ from .channels import channel_rules
 from .presets import ArraySpec
 from .registry import RADAR_PRESETS, WINDOWS, AOA_MODES
 from ..errors import SceneError
+from .scenario import check_scenario
 from .schema import fmt, specs
 from .sections import FrontEndConfig, RadarConfig, RtsConfig
 
@@ -71,7 +72,7 @@ def problems(scene) -> list[str]:
 
     for rule in (_array_rules, _radar_rules, _rts_rules, _sheet_rules, _placement_rules, _calibration_rules,
                  _target_rules, _spacing_rules, _elevation_rules, _estimator_rules,
-                 channel_rules):
+                 channel_rules, _scenario_rules):
         rule(scene, fail)
     return out
 
@@ -421,8 +422,7 @@ def _target_rules(scene, fail) -> None:
     rts, radar = scene.rts, scene.radar
     if not scene.targets:
         return
-    d_air = max(math.dist(radar.position_m, m) for m in _modules(scene))
-    extra = max(0.0, d_air - rts.arc_radius_m) if rts.compensate_air_path else d_air
+    extra = _air_extra_m(scene)
     r_lim, v_lim, why_r, why_v = resolvable_limits(radar)
     r_max = r_lim - extra
     for i, tg in enumerate(scene.targets):
@@ -438,6 +438,21 @@ def _target_rules(scene, fail) -> None:
             fail(f"targets[{i}].range_m", tg.range_m,
                  f"> rts.arc_radius_m ({rts.arc_radius_m:g} m): the RTS cannot emit before the "
                  "radar signal reached it")
+
+
+def _air_extra_m(scene) -> float:
+    """The air path to the farthest front end that the RTS does not subtract (m)."""
+    d_air = max(math.dist(scene.radar.position_m, m) for m in _modules(scene))
+    rts = scene.rts
+    return max(0.0, d_air - rts.arc_radius_m) if rts.compensate_air_path else d_air
+
+
+def _scenario_rules(scene, fail) -> None:
+    """``[scenario]``: waypoint times from 0, strictly increasing, the last at or after
+    duration_s; at most MAX_FRAMES frames; in every frame each moving target's range, radial
+    velocity (and elevation) within what the processing resolves, as for ``[[targets]]``."""
+    if getattr(scene, "scenario", None) is not None:
+        check_scenario(scene, fail, resolvable_limits(scene.radar), _air_extra_m(scene))
 
 
 def angular_resolution_rad(radar: "RadarConfig") -> float:

@@ -17,6 +17,7 @@ from pathlib import Path
 from .file import decode_toml, read_scene_bytes, resolve_meshes
 from .hardware import check_layout_keys, resolve_pattern_tables
 from .rules import problems
+from .scenario import ScenarioConfig
 from .schema import Derived, Evolvable, check_fields, read, spec
 from ..errors import SceneError
 from .sections import (MAX_NAME_CHARS, MAX_TARGETS, RadarConfig, RaytraceConfig, RtsConfig,
@@ -47,6 +48,9 @@ class Scene(Evolvable):
     extra_meshes: tuple[tuple[str, str, float], ...] = spec(  # (absolute path, material, loss dB)
         "structure", "tables", "[[structure]] extra meshes for ray tracing", [],
         cls=StructureConfig, max_items=MAX_TARGETS, item="structure")
+    scenario: ScenarioConfig | None = spec(
+        "scenario", "table", "[scenario] moving targets played frame by frame (`rtsgeom play`)",
+        None, cls=ScenarioConfig)
 
     def evolve(self, **changes) -> "Scene":
         """``dataclasses.replace`` that validates the variant again (fields and rules)."""

@@ -27,7 +27,7 @@ from typing import Any, Callable
 from ..errors import SceneError
 
 __all__ = ["SceneError", "REQUIRED", "Derived", "Spec", "spec", "specs", "read", "check_fields",
-           "Evolvable", "fmt", "range_text"]
+           "Evolvable", "fmt", "range_text", "rows_text"]
 
 
 REQUIRED = object()
@@ -47,7 +47,7 @@ class Spec:
     """One field's declaration (see :func:`spec`)."""
 
     key: str
-    kind: str  # float, int, bool, str, material, vec, floats, points, ints, table, tables
+    kind: str  # float, int, bool, str, material, vec, floats, points, ints, rows, table, tables
     doc: str
     unit: str = ""
     lo: float | None = None
@@ -65,8 +65,13 @@ class Spec:
     max_items: int = 0  # tables: at most this many entries
     min_items: int = 0
     item: str = ""  # tables: what one entry is called in messages (``front end``)
+    # rows: each row's columns (name, unit, lo, hi, scale); the first ``n`` are required, a
+    # missing trailing one is 0
+    columns: tuple[tuple[str, str, float, float, float], ...] = ()
 
     def to_si(self, v: Any) -> Any:
+        if self.kind == "rows" and v is not None:
+            return tuple(tuple(x * col[4] for x, col in zip(row, self.columns)) for row in v)
         if v is None or self.scale == 1.0:
             return v
         if isinstance(v, tuple):
@@ -284,6 +289,8 @@ def check_value(s: Spec, v: Any, ctx: _Ctx, path: str, context: dict | None = No
         return out
     if k in ("points", "ints", "floats"):
         return _check_list(s, v, ctx, path)
+    if k == "rows":
+        return _check_rows(s, v, ctx, path)
     if k == "table":
         if isinstance(v, s.cls):
             return v
@@ -348,6 +355,38 @@ def _check_list(s: Spec, v: Any, ctx: _Ctx, path: str) -> tuple:
     return tuple(int(x) for x in v)
 
 
+def rows_text(s: Spec, inner: bool = False) -> str:
+    """What a ``rows`` field allows: ``[t_s, range_m, azimuth_deg(, elevation_deg)]`` rows
+    (``inner``: only the bracket)."""
+    names = [c[0] for c in s.columns]
+    row = "[" + ", ".join(names[:s.n]) + "".join(f"(, {x}" for x in names[s.n:]) \
+        + ")" * (len(names) - s.n) + "]"
+    if inner:
+        return row
+    count = f"at least {s.min_items}" + (f" and at most {s.max_items}" if s.max_items else "")
+    return f"a list ({count} entries) of {row} rows"
+
+
+def _check_rows(s: Spec, v: Any, ctx: _Ctx, path: str) -> tuple:
+    """``rows``: a list of rows of ``s.n`` to ``len(s.columns)`` numbers, each column in its own
+    range; returned in file units, every row padded to all columns (a missing one is 0)."""
+    cols = s.columns
+    if (not isinstance(v, (list, tuple)) or len(v) < s.min_items
+            or (s.max_items and len(v) > s.max_items)
+            or any(not isinstance(r, (list, tuple)) or not s.n <= len(r) <= len(cols)
+                   or any(not _is_num(x) for x in r) for r in v)):
+        ctx.fail(path, v, rows_text(s))
+    out = []
+    for i, r in enumerate(v):
+        row = [_as_float(x) for x in r] + [0.0] * (len(cols) - len(r))
+        for j, (x, (name, unit, lo, hi, _)) in enumerate(zip(row, cols)):
+            if x is None or not math.isfinite(x) or not lo <= x <= hi:
+                ctx.fail(f"{path}[{i}][{j}]", r[j] if j < len(r) else x,
+                         f"a finite {name} in [{lo:g}, {hi:g}]{' ' + unit if unit else ''}")
+        out.append(tuple(row))
+    return tuple(out)
+
+
 # --------------------------------------------------------------------------------------------
 # Re-checking values set in code (evolve)
 # --------------------------------------------------------------------------------------------
@@ -369,6 +408,12 @@ def check_fields(obj: Any, source: str, where: str = "") -> None:
             check_value(s, v, ctx, path)
             for i, item in enumerate(v):
                 check_fields(item, source, f"{path}[{i}]")
+            continue
+        if s.kind == "rows":  # back to file units, column by column (as rounded: see below)
+            fv = tuple(tuple(x / col[4] for x, col in zip(row, s.columns)) for row in v)
+            cols = tuple((n, u, lo - 1e-9 * max(1.0, abs(lo)), hi + 1e-9 * max(1.0, abs(hi)), f)
+                         for n, u, lo, hi, f in s.columns)
+            check_value(dataclasses.replace(s, columns=cols), fv, ctx, path)
             continue
         if s.scale != 1.0 and v is not None:
             # back to file units; allow the rounding of the unit conversion at the bounds

@@ -293,10 +293,11 @@ class PairProcedure:
         }
 
 
-def build_pair(nom, pair: tuple[int, int], points: int, target) -> dict:
+def build_pair(nom, pair: tuple[int, int], points: int, target, set_rad=None) -> dict:
     """The fields of a pair's :class:`~.phasors.ChannelPhasors` on the nominal setup ``nom``:
     the set-points divide the span between the two front ends' detected angles into
-    ``points + 1`` parts (ends excluded, as the linearity study), the tables over J's delay
+    ``points + 1`` parts (ends excluded, as the linearity study), or are ``set_rad`` (the
+    azimuths a drive visits), the tables over J's delay
     (every sub-bin position, calibration delay and planner alternative), the design per
     sub-bin position (NaN where the closed form has none: ``PairProcedure.solved``)."""
     radar, rts = nom.scene.radar, nom.scene.rts
@@ -305,7 +306,8 @@ def build_pair(nom, pair: tuple[int, int], points: int, target) -> dict:
     st = model.steering
     th = st.search(model.phasors)
     frac = np.arange(1, points + 1) / (points + 1)
-    sets = th[0] + frac * (th[1] - th[0])
+    sets = (th[0] + frac * (th[1] - th[0]) if set_rad is None
+            else np.asarray(set_rad, float).reshape(-1))
     probes = th[0] + np.asarray(PROBE_FRACTIONS) * (th[1] - th[0])
     res = rts.delay_resolution_s
     slope = rts.f_rts_hz + 0.5 * radar.bandwidth_hz

@@ -78,7 +78,8 @@ class ChannelPhasors:
 
     @classmethod
     def build(cls, setup: Setup, channels=None, points: int = 21, range_m: float | None = None,
-              solve_bin_centre: bool = True, cell: bool = False) -> "ChannelPhasors":
+              solve_bin_centre: bool = True, cell: bool = False, set_rad=None
+              ) -> "ChannelPhasors":
         """Design on the nominal setup of ``setup`` (its mounting and channel errors dropped)
         for the front ends ``channels`` (default all): a pair in azimuth (``points`` set-points
         across its span, ends excluded) or a cell of 3 or 4 in azimuth and elevation (about
@@ -87,7 +88,8 @@ class ChannelPhasors:
         calibration's first probe range), velocity 0; a draw moves it within the bin.
 
         ``cell``: a cell's procedure whatever the number of channels (it asks for 3 or 4, and
-        a RuT that beamforms in elevation). ``solve_bin_centre`` False: a pair's set-points without a closed-form design at the bin
+        a RuT that beamforms in elevation). ``set_rad``: a pair's set-points themselves
+        (azimuths, rad) instead of ``points`` across its span. ``solve_bin_centre`` False: a pair's set-points without a closed-form design at the bin
         centre are left NaN (:meth:`PairProcedure.solved` designs them; the arc design first
         checks whether the calibrated plan exists at all). BLAS single-threaded: the tables'
         products are many and small.
@@ -110,7 +112,7 @@ class ChannelPhasors:
         target = reference_target(nom, range_m)
         with single_threaded_blas():
             if len(ch) == 2 and not cell:  # a pair on the arc: its closed form (fast path)
-                model = cls(**build_pair(nom, ch, int(points), target))
+                model = cls(**build_pair(nom, ch, int(points), target, set_rad))
             else:
                 grid = max(2, int(round(np.sqrt(points))))
                 model = cls(**build_cell(nom, tuple(sorted(ch)), grid, target))

@@ -1,0 +1,115 @@
+"""A drive frame by frame: the set-points, the RTS programme and the RuT's detections.
+
+The setup is calibrated once, as a lab does (every pair the drive visits, in order along the
+arc, :func:`rtsgeom.pipeline.plan.calibrate_pairs`); each frame is then one static scene (the
+``[[targets]]`` and the moving targets at their set-points at the frame's time) planned with that
+calibration by the planner of ``rtsgeom run`` (:func:`~rtsgeom.pipeline.plan.program_pairs`,
+or ``program_nearest`` for the switched baseline) and run through the full signal chain
+(ADC cube, range-Doppler, CFAR, the RuT's angle estimate). Within a frame the target is
+static in range (its Doppler is programmed): the range it moves in one frame (v T_frame) is
+what the frame period resolves.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...errors import ParameterError
+from ...geometry import Setup
+from ...paths import Paths
+from ...pipeline.plan import calibrate_pairs, program_pairs, target_pairs, uses_cells
+from ...pipeline.run import match_targets
+from ...radar import process
+from ...radar.frame import simulate
+from ...calibration.channels import channel_offsets
+from ...calibration.probes import probe_front_ends
+from ...rts.channels import RtsProgram, program_nearest
+from ...scene import Scene, TargetConfig
+from ...scene.scenario import trajectory
+
+__all__ = ["frame_targets", "FramePlanner", "detect_frame"]
+
+
+def frame_targets(scene: Scene) -> tuple[np.ndarray, list[tuple[TargetConfig, ...]]]:
+    """The frames' times and each frame's targets: the scene's ``[[targets]]`` (indices 0..S-1)
+    then the ``[[scenario.targets]]`` at their set-points (S..), as ``TargetConfig``."""
+    sc = scene.scenario
+    times = sc.frame_times()
+    moving = [(trajectory(t.waypoints, times), t.rcs_dbsm) for t in sc.targets]
+    static = tuple(scene.targets)
+    frames = []
+    for f in range(times.size):
+        frames.append(static + tuple(
+            TargetConfig(range_m=float(sp.range_m[f]), velocity_mps=float(sp.velocity_mps[f]),
+                         rcs_dbsm=rcs, angle_rad=float(sp.azimuth_rad[f]),
+                         elevation_rad=float(sp.elevation_rad[f]))
+            for sp, rcs in moving))
+    return times, frames
+
+
+class FramePlanner:
+    """The RTS programme per frame with the setup calibrated once.
+
+    ``mode`` ``nearest``: each target on its nearest front end (no calibration); a synthesis
+    mode: the probe of every front end and the calibration of every pair any frame visits,
+    once; then :meth:`program` per frame."""
+
+    def __init__(self, setup: Setup, paths: Paths, mode: str, frames, progress=None):
+        self.setup, self.paths, self.mode = setup, paths, mode
+        scene = setup.scene
+        self.record: dict = {"mode": mode}
+        self.warnings: list[str] = []
+        if mode == "nearest":
+            return
+        if uses_cells(scene) or any(t.elevation_rad for tg in frames for t in tg):
+            raise ParameterError(
+                "play: targets in elevation or front ends off the arc need cells of front ends "
+                "calibrated per channel; playing a drive on cells is not implemented (use "
+                "--amplitudes nearest, or targets at elevation 0 on an arc)")
+        self.probe = probe_front_ends(setup, paths, scene.seed)
+        self.pairs, seen = [], set()
+        for f, targets in enumerate(frames):
+            pairs, notes = target_pairs(setup, self.probe, targets, where=f"frame {f}: targets")
+            self.pairs.append(pairs)
+            for n in notes:  # a pair too wide: once, at the first frame it is used
+                if n.split("]: ", 1)[-1] not in seen:
+                    seen.add(n.split("]: ", 1)[-1])
+                    self.warnings.append(n)
+        used = sorted({p for pairs in self.pairs for p in pairs})
+        self.cals = calibrate_pairs(setup, paths, used, self.probe, progress=progress)
+        self.offsets = channel_offsets(setup.fe.count, self.cals)
+        self.record.update({
+            "source": "measured",
+            "front_end_angles_deg": [float(x) for x in np.degrees(self.probe.angle_rad)],
+            "gain_correction": [float(x) for x in self.probe.gain_correction],
+            "channel_delay_offsets_s": [float(x) for x in self.offsets],
+            "pairs": [cal.to_dict() for cal in self.cals.values()]})
+
+    def program(self, f: int, scene_f: Scene) -> tuple[RtsProgram, list[str]]:
+        """Frame ``f``'s programme for ``scene_f`` (the scene with the frame's targets) and
+        the planner's warnings about it."""
+        if self.mode == "nearest":
+            return program_nearest(scene_f, self.setup), []
+        program, _, notes = program_pairs(self.setup, self.paths, self.mode, scene_f.targets,
+                                          self.pairs[f], self.probe, self.cals, self.offsets,
+                                          where=f"frame {f}: targets")
+        return program, notes
+
+
+def detect_frame(setup: Setup, paths: Paths, program: RtsProgram, scene_f: Scene, seed: int,
+                 bins: int = 2) -> tuple[list[dict], np.ndarray]:
+    """One frame through the full chain: the matches of ``match_targets`` and, per target,
+    the number of other detections within ``bins`` range and Doppler bins of its set-point
+    that no target claimed (a split: the RuT sees the target twice)."""
+    _, cube = simulate(setup, paths, program, seed, scene_f.radar.snr_db)
+    rd, det = process(cube)
+    matches = match_targets(scene_f, det, rd, bins=bins)
+    claimed = {m.get("detection_index") for m in matches}
+    dr = rd.range_m[1] - rd.range_m[0]
+    dv = rd.velocity_mps[1] - rd.velocity_mps[0]
+    extra = np.zeros(len(matches), int)
+    for k, t in enumerate(scene_f.targets):
+        near = np.flatnonzero((np.abs(det.range_m - t.range_m) <= bins * dr)
+                              & (np.abs(det.velocity_mps - t.velocity_mps) <= bins * dv))
+        extra[k] = sum(1 for j in near if j not in claimed)
+    return matches, extra

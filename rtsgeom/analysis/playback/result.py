@@ -1,0 +1,214 @@
+"""A played drive: per frame and target the set-points, the detections and the programme;
+the tables ``programme.csv`` and ``tracks.csv``, the summary and the figure of ``rtsgeom play``.
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass
+
+import numpy as np
+
+from ... import __version__
+from ...scene import Scene
+
+__all__ = ["PlaybackResult", "PROGRAMME_COLUMNS", "TRACK_COLUMNS"]
+
+PROGRAMME_COLUMNS = ("frame", "time_s", "target", "channel", "delay_s", "doppler_hz",
+                     "amplitude_db", "phase_rad")
+TRACK_COLUMNS = ("frame", "time_s", "target", "set_range_m", "set_azimuth_deg",
+                 "set_velocity_mps", "range_m", "azimuth_deg", "velocity_mps")
+
+
+@dataclass(frozen=True)
+class PlaybackResult:
+    """A drive played frame by frame (``Playback``).
+
+    ``set`` and ``detected``: ``range_m``, ``azimuth_deg``, ``velocity_mps`` arrays (frames,
+    targets), detected NaN where the target was lost; ``split`` (frames, targets) the other
+    detections near a target's set-point that no target claimed; ``channels`` (frames,
+    targets) the front ends that carry each target; ``programme`` (rows, 7): frame, target,
+    channel, delay_s, doppler_hz, |amplitude|, phase_rad; ``baseline`` the switched baseline
+    (``nearest``) on the same drive, or None.
+    """
+
+    scene: Scene
+    mode: str
+    time_s: np.ndarray
+    set: dict
+    detected: dict
+    split: np.ndarray
+    channels: np.ndarray
+    programme: np.ndarray
+    calibration: dict
+    warnings: tuple[str, ...] = ()
+    baseline: "PlaybackResult | None" = None
+
+    def __repr__(self) -> str:
+        s = self.summary()
+        err = s["angle_error_deg"]["max"]
+        base = (f", baseline max {self.baseline.summary()['angle_error_deg']['max']:.3g} deg"
+                if self.baseline is not None else "")
+        n = self.num_targets
+        return (f"PlaybackResult({self.mode}, {s['frames']} frames x {n} "
+                f"target{'s' if n != 1 else ''}: max |angle error| "
+                f"{err if err is None else f'{err:.3g}'} deg, "
+                f"{s['lost_frames']} lost, {s['split_frames']} split, {s['handovers']} "
+                f"hand-overs{base})")
+
+    @property
+    def num_targets(self) -> int:
+        return int(self.split.shape[1])
+
+    @property
+    def angle_error_deg(self) -> np.ndarray:
+        """Detected minus set azimuth (frames, targets), NaN where lost."""
+        return self.detected["azimuth_deg"] - self.set["azimuth_deg"]
+
+    def handovers(self) -> list[tuple[int, int]]:
+        """(frame, target) where the channels carrying the target differ from the frame before."""
+        return [(f, k) for k in range(self.num_targets) for f in range(1, len(self.time_s))
+                if self.channels[f, k] != self.channels[f - 1, k]]
+
+    def handover_jumps_deg(self) -> np.ndarray:
+        """At each hand-over, how far the angle error moved from the frame before (deg; NaN
+        where either frame lost the target)."""
+        e = self.angle_error_deg
+        return np.array([abs(e[f, k] - e[f - 1, k]) for f, k in self.handovers()])
+
+    def summary(self) -> dict:
+        """The content of ``summary.json``: ``frames``, ``angle_error_deg`` {max, p95} of the
+        absolute error over every detected frame and target, ``lost_frames`` and
+        ``split_frames`` (frames where any target was lost, or seen twice),
+        ``handover_jump_deg`` (the largest change of a target's angle error at a hand-over),
+        per target the same, and the baseline's where it was played."""
+        err = np.abs(self.angle_error_deg)
+        lost = ~np.isfinite(self.detected["azimuth_deg"])
+        jumps = self.handover_jumps_deg()
+
+        def stats(e):
+            e = e[np.isfinite(e)]
+            return ({"max": float(e.max()), "p95": float(np.percentile(e, 95))} if e.size
+                    else {"max": None, "p95": None})
+
+        def jump(j):
+            j = j[np.isfinite(j)]
+            return float(j.max()) if j.size else None
+
+        hk = np.array([k for _, k in self.handovers()], int)
+        out = {
+            "mode": self.mode,
+            "frames": int(len(self.time_s)),
+            "angle_error_deg": stats(err),
+            "lost_frames": int(np.any(lost, axis=1).sum()),
+            "split_frames": int(np.any(self.split > 0, axis=1).sum()),
+            "handover_jump_deg": jump(jumps),
+            "handovers": int(len(hk)),
+            "targets": [{"target": k, "angle_error_deg": stats(err[:, k]),
+                         "lost_frames": int(lost[:, k].sum()),
+                         "split_frames": int((self.split[:, k] > 0).sum()),
+                         "handovers": int((hk == k).sum()),
+                         "handover_jump_deg": jump(jumps[hk == k])}
+                        for k in range(self.num_targets)],
+        }
+        if self.baseline is not None:
+            out["baseline"] = {k: v for k, v in self.baseline.summary().items()
+                               if k != "targets"}
+        return out
+
+    def summary_json(self) -> dict:
+        """:meth:`summary` with the run's context (scene, drive, calibration, warnings)."""
+        sc = self.scene.scenario
+        return {"rtsgeom_version": __version__, "scene": self.scene.name,
+                "scene_sha256": self.scene.sha256, "seed": self.scene.seed,
+                "frame_period_s": sc.frame_period_s, "duration_s": sc.duration_s,
+                "static_targets": len(self.scene.targets),
+                **self.summary(), "calibration": self.calibration,
+                "warnings": list(self.warnings)}
+
+    def to_dataframe(self):
+        """The tracks (one row per frame and target, :data:`TRACK_COLUMNS` plus
+        ``azimuth_error_deg`` and ``channels``) as a pandas DataFrame."""
+        import pandas as pd
+        cols = self._track_columns()
+        cols["azimuth_error_deg"] = self.angle_error_deg.ravel()
+        cols["channels"] = [" ".join(map(str, c)) for c in self.channels.ravel()]
+        return pd.DataFrame(cols)
+
+    def programme_dataframe(self):
+        """The RTS programme (:data:`PROGRAMME_COLUMNS`) as a pandas DataFrame."""
+        import pandas as pd
+        return pd.DataFrame(self._programme_columns())
+
+    def _track_columns(self) -> dict:
+        n_f, n_t = self.split.shape
+        return {"frame": np.repeat(np.arange(n_f), n_t), "time_s": np.repeat(self.time_s, n_t),
+                "target": np.tile(np.arange(n_t), n_f),
+                **{f"set_{k}": self.set[k].ravel() for k in ("range_m", "azimuth_deg",
+                                                             "velocity_mps")},
+                **{k: self.detected[k].ravel() for k in ("range_m", "azimuth_deg",
+                                                         "velocity_mps")}}
+
+    def _programme_columns(self) -> dict:
+        p = self.programme
+        frame = p[:, 0].astype(int)
+        with np.errstate(divide="ignore"):
+            amp_db = 20 * np.log10(p[:, 5])
+        return {"frame": frame, "time_s": self.time_s[frame], "target": p[:, 1].astype(int),
+                "channel": p[:, 2].astype(int), "delay_s": p[:, 3], "doppler_hz": p[:, 4],
+                "amplitude_db": amp_db, "phase_rad": p[:, 6]}
+
+    def tracks_csv(self) -> str:
+        """``tracks.csv``: :data:`TRACK_COLUMNS`, the detected columns empty where lost."""
+        return _csv(self._track_columns(), TRACK_COLUMNS)
+
+    def programme_csv(self) -> str:
+        """``programme.csv``: :data:`PROGRAMME_COLUMNS`, one row per frame, target, channel."""
+        return _csv(self._programme_columns(), PROGRAMME_COLUMNS)
+
+    def plot(self):
+        """Set and detected azimuth over time, the hand-overs marked, and the angle error;
+        the switched baseline beside it where it was played."""
+        from ...viz.playback import playback_figure  # matplotlib: only for the figure
+        runs = [self] + ([self.baseline] if self.baseline is not None else [])
+        return playback_figure(
+            self.time_s, self.set["azimuth_deg"],
+            {r.mode: r.detected["azimuth_deg"] for r in runs},
+            {r.mode: [self.time_s[f] for f, _ in r.handovers()] for r in runs},
+            title=self.scene.name)
+
+    def animate(self, path, fps: int = 5):
+        """Write the drive as an animated GIF (matplotlib's PillowWriter): the arc from above
+        with the front ends that carry a target, the set and detected directions, and the
+        targets' paths (:func:`rtsgeom.viz.playback.playback_animation`)."""
+        from ...geometry import build_setup
+        from ...viz.playback import playback_animation  # matplotlib: only for the figure
+        setup = build_setup(self.scene)
+        n_f, n_q = len(self.time_s), setup.fe.count
+        amp = np.zeros((n_f, n_q))
+        p = self.programme
+        np.add.at(amp, (p[:, 0].astype(int), p[:, 2].astype(int)), p[:, 5])
+        az = np.radians(self.set["azimuth_deg"])
+        xy = self.set["range_m"][..., None] * np.stack([np.sin(az), np.cos(az)], axis=-1)
+        return playback_animation(path, self.time_s, np.degrees(setup.fe_azimuth_rad()), amp,
+                                  xy, self.set["azimuth_deg"], self.detected["azimuth_deg"],
+                                  self.scene.rts.arc_radius_m, f"{self.scene.name}: {self.mode}",
+                                  fps)
+
+
+def _csv(cols: dict, names) -> str:
+    """Rows of ``cols`` in the order ``names``: integers as such, floats in full precision
+    (``repr``), NaN as an empty field."""
+    buf = io.StringIO()
+    buf.write(",".join(names) + "\n")
+    data = [cols[n] for n in names]
+    for row in zip(*data):
+        buf.write(",".join(_cell(v) for v in row) + "\n")
+    return buf.getvalue()
+
+
+def _cell(v) -> str:
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    v = float(v)
+    return repr(v) if np.isfinite(v) else ""

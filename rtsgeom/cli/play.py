@@ -1,0 +1,112 @@
+"""``rtsgeom play``: a scene's ``[scenario]`` played frame by frame. Writes the output folder
+(one whole run or nothing): programme.csv (what the RTS is told per frame, target and
+channel), tracks.csv (set-points and what the RuT detected), summary.json and playback.png
+(docs/scenario.md)."""
+
+from __future__ import annotations
+
+import json
+
+from ..errors import ParameterError, UsageError
+from ..scene.registry import AOA_MODES, PATH_METHODS
+from ._common import (load_scene_checked, number, output_folder, output_path, scene_arg,
+                      steps)
+
+
+def cmd_play(args) -> int:
+    from ..analysis.playback import Playback
+    from ..viz.figures import save_figure
+    scene = load_scene_checked(args.scene)
+    if scene.scenario is None:
+        raise UsageError(f"{args.scene}: has no [scenario] to play (add [scenario] with "
+                         "[[scenario.targets]], docs/scenario.md)")
+    study = Playback(args.amplitudes, args.paths, baseline=not args.no_baseline,
+                     workers=args.workers)
+    with output_folder(args.out, [args.scene]) as stage, steps(args.quiet) as step:
+        step(f"playing {scene.name} (calibration once, then every frame through the chain)")
+        try:
+            result = study(scene)
+        except ParameterError as exc:
+            raise UsageError(str(exc)) from None
+        summary = result.summary_json()
+        if args.tolerance_draws:
+            step(f"mounting tolerance over the drive ({args.tolerance_draws} setups)")
+            summary["tolerance"] = _tolerance(scene, args)
+        step("writing programme.csv, tracks.csv, summary.json, playback.png")
+        (stage / "programme.csv").write_text(result.programme_csv(), encoding="utf-8")
+        (stage / "tracks.csv").write_text(result.tracks_csv(), encoding="utf-8")
+        (stage / "summary.json").write_text(
+            json.dumps(summary, indent=2, allow_nan=False) + "\n", encoding="utf-8")
+        save_figure(result.plot(), stage / "playback.png")
+        if args.gif:
+            step("writing playback.gif")
+            result.animate(stage / "playback.gif")
+    if not args.quiet:
+        s = result.summary()
+        for r, v in (("", s), ("baseline ", s.get("baseline"))):
+            if v is None:
+                continue
+            e = v["angle_error_deg"]
+            worst = "n/a" if e["max"] is None else f"{e['max']:.4f} deg (p95 {e['p95']:.4f})"
+            jump = ("n/a" if v["handover_jump_deg"] is None
+                    else f"{v['handover_jump_deg']:.4f} deg")
+            print(f"{r}{v['mode']}: {v['frames']} frames, max |angle error| {worst}, "
+                  f"{v['lost_frames']} lost, {v['split_frames']} split, {v['handovers']} "
+                  f"hand-overs (largest jump {jump})")
+        if "tolerance" in summary:
+            t = summary["tolerance"]
+            print(f"tolerance over the drive ({t['draws']} setups, sigma {t['sigma_mm']} mm, "
+                  f"spec {t['spec_deg']:g} deg): yield calibrated "
+                  f"{t['yield']['calibrated']:.3f}, uncalibrated "
+                  f"{t['yield']['uncalibrated']:.3f}")
+        for w in result.warnings:
+            print(f"warning: {w}")
+        print(f"wrote {args.out}/programme.csv, tracks.csv, summary.json, playback.png"
+              + (", playback.gif" if args.gif else ""))
+    return 0
+
+
+def _tolerance(scene, args) -> dict:
+    """summary.json's ``tolerance``: the drive's yield and worst errors over the setups."""
+    import numpy as np
+    from ..analysis.playback import drive_tolerance
+    try:
+        res = drive_tolerance(scene, args.sigma_mm, args.tolerance_draws,
+                              spec_deg=args.spec_deg)
+    except ParameterError as exc:
+        raise UsageError(f"--tolerance-draws: {exc}") from None
+    worst = {case: np.abs(res.arc_worst(case)) for case in ("uncalibrated", "calibrated")}
+    return {"draws": args.tolerance_draws, "sigma_mm": list(args.sigma_mm),
+            "spec_deg": args.spec_deg, "distribution": "normal",
+            "pairs": [list(m.front_ends) for m in res.model.sets],
+            "yield": {k: res.yield_(k) for k in worst},
+            "worst_error_deg": {k: {"p50": float(np.percentile(w, 50)),
+                                    "p95": float(np.percentile(w, 95)),
+                                    "max": float(w.max())} for k, w in worst.items()}}
+
+
+def register(sub) -> None:
+    p = sub.add_parser("play", help="play the scene's [scenario]: programme, tracks per frame")
+    scene_arg(p)
+    p.add_argument("--out", type=output_path, required=True, help="output folder")
+    p.add_argument("--amplitudes", choices=tuple(AOA_MODES), default=None,
+                   help="AoA amplitude mode (default: the scene's rts.aoa_mode); nearest: the "
+                        "switched baseline, each target on its nearest front end")
+    p.add_argument("--paths", choices=tuple(PATH_METHODS), default="exact",
+                   help="exact line-of-sight paths (default) or Sionna RT ray tracing")
+    p.add_argument("--no-baseline", action="store_true",
+                   help="do not also play the switched baseline for the figure")
+    p.add_argument("--gif", action="store_true",
+                   help="also write playback.gif: the arc from above, frame by frame")
+    p.add_argument("--tolerance-draws", type=number(0, 10_000_000, integer=True), default=0,
+                   metavar="N", help="also the mounting-tolerance yield over the drive: N "
+                   "drawn setups (summary.json's tolerance)")
+    p.add_argument("--sigma-mm", type=number(0, 50), nargs=3, default=(0.1, 0.1, 0.1),
+                   metavar=("RADIAL", "TANGENTIAL", "HEIGHT"),
+                   help="mounting error per front end, standard deviation (default 0.1 each)")
+    p.add_argument("--spec-deg", type=number(1e-6, 90), default=0.1,
+                   help="angle-error spec of the tolerance yield (default 0.1 deg)")
+    p.add_argument("--workers", type=number(1, 256, integer=True), default=1, metavar="N",
+                   help="play the frames in N forked processes (the same result)")
+    p.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    p.set_defaults(func=cmd_play)

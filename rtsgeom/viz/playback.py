@@ -1,0 +1,138 @@
+"""The figure of a played drive (``rtsgeom play``): set and detected azimuth over time with
+the hand-overs marked, and the angle error, per AoA mode side by side."""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from .figures import _styled, new_figure
+
+__all__ = ["playback_figure"]
+
+
+@_styled
+def playback_figure(time_s, set_deg, detected_deg: Mapping[str, np.ndarray],
+                    handovers_s: Mapping[str, list], title: str = "") -> Figure:
+    """One column per AoA mode: top, the set azimuth (lines) and the detected one (dots) of
+    every target over time; bottom, the detected minus set azimuth. Dotted vertical lines:
+    the frames where a target changed the front ends that carry it (hand-overs).
+
+    Parameters
+    ----------
+    time_s : (F,) frame times
+    set_deg : (F, T) set azimuths
+    detected_deg : mode -> (F, T) detected azimuths (NaN where lost)
+    handovers_s : mode -> times of the hand-overs
+    """
+    t = np.asarray(time_s, float)
+    s = np.asarray(set_deg, float).reshape(t.size, -1)
+    modes = list(detected_deg)
+    fig, axes = new_figure(figsize=(4.2 * len(modes) + 0.6, 5.6), nrows=2, ncols=len(modes),
+                           sharex=True)
+    axes = np.asarray(axes).reshape(2, len(modes))
+    for col, mode in enumerate(modes):
+        d = np.asarray(detected_deg[mode], float).reshape(t.size, -1)
+        top, bottom = axes[0, col], axes[1, col]
+        for k in range(s.shape[1]):
+            line, = top.plot(t, s[:, k], lw=1.0, label=f"target {k} set")
+            top.plot(t, d[:, k], "o", ms=3.5, color=line.get_color(), label=f"target {k} "
+                     "detected")
+            bottom.plot(t, d[:, k] - s[:, k], "o-", ms=3, lw=0.8, color=line.get_color())
+            lost = ~np.isfinite(d[:, k])
+            if np.any(lost):
+                top.plot(t[lost], s[lost, k], "x", color="red", ms=6,
+                         label=f"target {k} lost")
+        for i, th in enumerate(handovers_s.get(mode, [])):
+            for ax in (top, bottom):
+                ax.axvline(th, color="0.4", ls=":", lw=0.9,
+                           label="hand-over" if (i == 0 and ax is top) else None)
+        top.set_title(f"{title + ': ' if title else ''}{mode}")
+        top.set_ylabel("azimuth (deg)")
+        bottom.set_ylabel("detected - set azimuth (deg)")
+        bottom.set_xlabel("time (s)")
+        top.legend(loc="best")
+    return fig
+
+
+def playback_animation(path, time_s, fe_azimuth_deg, amplitude, target_xy_m, set_deg,
+                       detected_deg, arc_radius_m: float, title: str = "", fps: int = 5):
+    """An animated GIF of a drive (matplotlib's ``PillowWriter``): left, the arc
+    seen from above with the RuT at its centre, every front end (filled and sized by its
+    programmed amplitude when it carries a target) and each target's set (line) and detected
+    (dashed) direction; right, the targets' paths in the plane at true scale, where they are.
+
+    Parameters
+    ----------
+    path : where the GIF goes (written atomically)
+    time_s : (F,) frame times
+    fe_azimuth_deg : (Q,) front-end azimuths
+    amplitude : (F, Q) the programmed amplitude per frame and channel (0: off)
+    target_xy_m : (F, T, 2) the targets' set positions (x right, y along the boresight)
+    set_deg, detected_deg : (F, T) azimuths (detected NaN where lost)
+    arc_radius_m : the arc's radius
+    """
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    from .._lib.io import atomic_path
+    from .figures import STYLE
+    import matplotlib as mpl
+
+    t = np.asarray(time_s, float)
+    az = np.radians(np.asarray(fe_azimuth_deg, float))
+    amp = np.asarray(amplitude, float)
+    xy = np.asarray(target_xy_m, float)
+    s_rad, d_rad = np.radians(set_deg), np.radians(detected_deg)
+    with mpl.rc_context(STYLE):
+        fig, (ax, ax2) = new_figure(figsize=(9.0, 4.4), ncols=2)
+        r = arc_radius_m
+        arc = np.linspace(az.min() - 0.1, az.max() + 0.1, 100)
+        ax.plot(r * np.sin(arc), r * np.cos(arc), color="0.6", lw=1)
+        ax.plot(0, 0, "ks", ms=6)
+        fe = ax.scatter(r * np.sin(az), r * np.cos(az), s=20, c="0.7", zorder=3)
+        n_t = xy.shape[1]
+        colors = [f"C{k}" for k in range(n_t)]
+        rays = [ax.plot([], [], color=colors[k], lw=1.2)[0] for k in range(n_t)]
+        drays = [ax.plot([], [], color=colors[k], lw=1.2, ls="--")[0] for k in range(n_t)]
+        ax.set_aspect("equal")
+        lim = 1.25 * r
+        ax.set_xlim(-lim * max(np.sin(np.abs(az)).max() + 0.3, 0.5), lim *
+                    max(np.sin(np.abs(az)).max() + 0.3, 0.5))
+        ax.set_ylim(-0.1 * r, lim)
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+        for k in range(n_t):
+            ax2.plot(xy[:, k, 0], xy[:, k, 1], color=colors[k], lw=0.8, alpha=0.5)
+        dots = [ax2.plot([], [], "o", color=colors[k], ms=6)[0] for k in range(n_t)]
+        ax2.plot(0, 0, "ks", ms=6)
+        ax2.set_aspect("equal", adjustable="datalim")
+        ax2.set_xlabel("x (m)")
+        ax2.set_ylabel("y (m)")
+        ax2.set_title("set positions")
+        ax.plot([], [], color="0.3", lw=1.2, label="set direction")
+        ax.plot([], [], color="0.3", lw=1.2, ls="--", label="detected")
+        ax.scatter([], [], s=60, c="C3", label="front end carrying a target")
+        ax.legend(loc="lower right")
+        head = ax.set_title("")
+        peak = max(float(amp.max()), 1e-300)
+
+        def draw(f):
+            on = amp[f] > 0
+            fe.set_sizes(np.where(on, 20 + 180 * amp[f] / peak, 20))
+            fe.set_color(np.where(on[:, None], mpl.colors.to_rgba_array(["C3"]),
+                                  mpl.colors.to_rgba_array(["0.7"])))
+            for k in range(n_t):
+                rays[k].set_data([0, lim * np.sin(s_rad[f, k])], [0, lim * np.cos(s_rad[f, k])])
+                d = d_rad[f, k]
+                drays[k].set_data(([0, lim * np.sin(d)], [0, lim * np.cos(d)])
+                                  if np.isfinite(d) else ([], []))
+                dots[k].set_data([xy[f, k, 0]], [xy[f, k, 1]])
+            head.set_text(f"{title + ': ' if title else ''}t = {t[f]:.2f} s")
+            return [fe, head, *rays, *drays, *dots]
+
+        anim = FuncAnimation(fig, draw, frames=len(t), blit=False)
+        with atomic_path(path) as tmp:
+            anim.save(tmp, writer=PillowWriter(fps=fps))
+    return path
