@@ -10,12 +10,15 @@ library's own result objects; they add no physics. Import them from the package:
 
 from __future__ import annotations
 
+import dataclasses
+import difflib
 from pathlib import Path
 
 import numpy as np
 
-from .errors import ParameterError
+from .errors import ParameterError, SceneError
 from .scene import Scene
+from .scene.schema import fmt, specs
 
 __all__ = ["replace", "calibrate", "linearity", "tolerance", "design", "nearfield", "ghosts",
            "show"]
@@ -48,10 +51,6 @@ def replace(obj, **changes):
     >>> fes = tuple(replace(f, radial_offset_mm=0.2) for f in scene.rts.front_ends)
     >>> scene = replace(scene, rts=replace(scene.rts, front_ends=fes))  # doctest: +SKIP
     """
-    import dataclasses
-    import difflib
-    from .errors import SceneError
-    from .scene.schema import fmt, specs
     if not dataclasses.is_dataclass(obj) or isinstance(obj, type):
         raise ParameterError(f"replace: {type(obj).__name__} is not a scene or a scene section")
     names = {f.name for f in dataclasses.fields(obj) if f.init}

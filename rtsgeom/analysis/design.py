@@ -306,6 +306,10 @@ class DesignGrid(Result):
         head = f"{self.scene_name}: " if self.scene_name else ""
         title = (f"{head}{what}\npair {self.pair}, spec {self.spec_deg:g} deg, "
                  f"{100 * self.target_yield:g} % yield, {self.draws} draws")
+        floor = CONTOUR_FLOOR[metric](self)
+        z = np.asarray(self.metrics[metric], float)
+        if np.isfinite(z).any() and np.nanmax(np.abs(z)) < floor:
+            title += f"; every value below {floor:g} (colours 0..{floor:g})"
         if mask.any():
             title += (f"; {'hollow' if lines else 'hatched'}: spacing > "
                       f"{self.angular_resolution_deg:.1f} deg (eq. 24)")
@@ -313,7 +317,7 @@ class DesignGrid(Result):
                 "front-end spacing (deg)", zlabel, title)
         if lines:
             return design_lines_figure(*args, mask=mask)
-        return design_heatmap_figure(*args, mask=mask, contour_floor=CONTOUR_FLOOR[metric](self))
+        return design_heatmap_figure(*args, mask=mask, contour_floor=floor)
 
     def to_dict(self) -> dict:
         def clean(v):

@@ -67,7 +67,14 @@ def _design(args, scene, stage) -> int:
         return _design_coverage(args, scene, stage)
     if args.draws is None:
         args.draws = 2000
-    pair = pair_of(build_setup(scene), args.pair)
+    setup = build_setup(scene)
+    pair = pair_of(setup, args.pair)
+    if setup.fe.count > 2 and not args.quiet:  # say which pair of the arc this is
+        others = ", ".join(f"{i} {i + 1}" for i in range(setup.fe.count - 1) if i != pair[0])
+        print(f"rtsgeom: note: design studies the pair {pair} of the scene's {setup.fe.count} "
+              f"front ends (its centre angle, spacing and radius varied); --pair I J for "
+              f"another adjacent pair ({others}), --coverage-deg A:B for the whole arc",
+              file=sys.stderr)
     seed = scene.seed if args.seed is None else args.seed
     with progress(args.quiet) as report:
         grid = design_grid(scene, pair, args.radius_m, args.spacing_deg, args.spec_deg,

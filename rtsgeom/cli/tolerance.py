@@ -12,7 +12,8 @@ import numpy as np
 from .._lib.io import write_json
 from .._lib.parallel import check_address, chunk_mapper
 from ..analysis.tolerance import (AXES, CASES, DISTRIBUTIONS, NOMINAL_AMPLITUDES, Bounds,
-                                  ChannelPhasors, ToleranceModel, max_sigma_for_yield, monte_carlo,
+                                  ChannelPhasors, ToleranceModel, max_scale_for_yield,
+                                  max_sigma_for_yield, monte_carlo,
                                   verify_draws)
 from ..analysis.tolerance.draws import draw_offsets
 from ..errors import AngleUnreachable, ClusterError, ParameterError, UsageError
@@ -115,9 +116,6 @@ def _study(args, scene, bounds: Bounds) -> ToleranceModel:
     if arc and args.verify:
         raise UsageError("--verify: only for one pair with offsets (not --pair all, "
                          "rotations or RuT-pose errors)")
-    if arc and args.invert_yield is not None:
-        raise UsageError("--invert-yield: only for one pair without rotation or RuT-pose errors "
-                         "so far (rtsgeom design --coverage-deg finds the arc's tolerance)")
     pairs = pairs_of(setup, args.pair)
     try:
         models = [ChannelPhasors.build(setup, p, args.points) for p in pairs]
@@ -160,7 +158,13 @@ def _tolerance(args, scene, stage) -> int:
             out["verify"] = verify_draws(model.sets[0], sigma, min(args.verify, args.draws),
                                          seed, args.distribution, cases, progress=report,
                                          all_points=args.verify_all_points).to_dict()
-        if args.invert_yield is not None:
+        if args.invert_yield is not None and kind == "arc":  # every drawn scale, one factor
+            out["inversion"] = {
+                case: max_scale_for_yield(model, bounds, args.draws, seed, args.invert_yield,
+                                          args.spec_deg, case, args.distribution, chunk=chunk,
+                                          progress=report, mapper=mapper)
+                for case in CASES}
+        elif args.invert_yield is not None:
             out["inversion"] = {
                 case: max_sigma_for_yield(model, sigma, args.draws, seed, args.invert_yield,
                                           args.spec_deg, case, args.invert_axis,
@@ -273,6 +277,13 @@ def _print_arc(args, model, out, cases, elapsed) -> None:
         print(f"  ARC {case:>28}: |worst error| p50 {a['angle_error_deg']['p50']:.4f}, p95 "
               f"{a['angle_error_deg']['p95']:.4f}, max {a['angle_error_deg']['max']:.4f} deg; "
               f"yield {100 * a['yield']:.2f} % (every pair within {args.spec_deg:g} deg)")
+    for case, inv in out.get("inversion", {}).items():
+        s = inv["scales"]
+        print(f"  {100 * args.invert_yield:g} % of arcs within {args.spec_deg:g} deg, {case}: "
+              f"the drawn scales x {inv['factor']:.4g}{' (search cap)' if inv['capped'] else ''}"
+              f" = {kind} radial {s['radial_mm']:.4g}, tangential {s['tangential_mm']:.4g}, "
+              f"height {s['height_mm']:.4g} mm, yaw {s['yaw_deg']:.4g}, pitch "
+              f"{s['pitch_deg']:.4g} deg")
 
 
 def _print_footer(out: dict, args, scale: str) -> None:

@@ -371,14 +371,18 @@ def design_heatmap_figure(x, y, z, xlabel: str, ylabel: str, zlabel: str, title:
     Contour lines only at levels >= ``contour_floor`` (a level below it, e.g. 1e-5 deg of a
     0.1 deg spec, is the noise of the evaluation, not a design contour; None: any level) and
     none when fewer than two such levels exist. A small map (<= :data:`ANNOTATE_CELLS` cells)
-    writes each value in its cell. ``integer_y``/``integer_z``: whole-number ticks on the y
-    axis / colour bar (a count)."""
+    writes each value in its cell. A map whose every |value| is below ``contour_floor`` is
+    coloured over [0, floor] (its differences are noise). ``integer_y``/``integer_z``:
+    whole-number ticks on the y axis / colour bar (a count)."""
     from matplotlib.ticker import MaxNLocator
     xv, yv, zv, m = _design_arrays(x, y, z, mask)
     shown = np.ma.masked_array(zv, mask=m | ~np.isfinite(zv))
     fig, ax = new_figure()
     ax.set_facecolor("0.85")
     kw = {}
+    if contour_floor is not None and shown.count() and float(np.abs(shown).max()) < contour_floor:
+        # every value below the meaningful level: colours over [0, floor], not over the noise
+        kw = dict(vmin=0.0, vmax=float(contour_floor))
     if integer_z and shown.count():
         lo, hi = float(shown.min()), float(shown.max())
         kw = dict(vmin=lo - 0.5, vmax=max(hi, lo + 1) + 0.5)
