@@ -216,23 +216,9 @@ def _tolerance(args, scene, stage) -> int:
 def _write(stage, args, model: ToleranceModel, res, out: dict, cases, seed: int) -> None:
     """``--out DIR``: tolerance.png, tolerance.json and tolerance_draws.npz (per-draw errors
     and worst angle errors, for sensitivity analysis)."""
-    from ..viz.figures import save_figure, tolerance_cdf_figure, tolerance_histogram_figure
+    from ..viz.figures import save_figure
     m = model.sets[0]
-    if model.kind == "arc":
-        p95 = max(out["arc"][case]["angle_error_deg"]["p95"] for case in cases)
-        lim = max(5 * args.spec_deg, 1.2 * p95)
-        fig = tolerance_histogram_figure(
-            {case: np.clip(res.arc_worst(case), -lim, lim) for case in cases}, args.spec_deg,
-            f"Worst error per arc ({len(model.sets)} pairs, clipped at ±{lim:.2g} deg)")
-    elif model.kind == "cell":
-        # Empirical CDFs on a log axis of the worst angular distance per setup
-        fig = tolerance_cdf_figure({case: res.worst_error_deg[case][:, 2] for case in cases},
-                                   args.spec_deg, "Worst angular distance per setup, cell "
-                                   f"{tuple(m.front_ends)}")
-    else:  # the uncalibrated tail (degrees) and the calibrated (thousandths) both resolved
-        fig = tolerance_cdf_figure({case: res.worst_error_deg[case] for case in cases},
-                                   args.spec_deg, f"Worst |error| per setup, pair "
-                                   f"{tuple(m.front_ends)}")
+    fig = res.plot()  # the study, the drawn scales and the spec in its title
     save_figure(fig, stage / "tolerance.png")
     write_json(stage / "tolerance.json", out)
     if model.kind == "arc":
