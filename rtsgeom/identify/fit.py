@@ -262,7 +262,7 @@ class Identification(Result):
 
     def plot(self, title: str = ""):
         """Each front end's fitted radial, tangential and height offset (mm) with 1 sigma."""
-        from ..viz.figures import STYLE, _title, new_figure  # matplotlib: only for the figure
+        from ..viz.figures import STYLE, new_figure  # matplotlib: only for the figure
         import matplotlib as mpl
         cols = self._columns()
         with mpl.rc_context(STYLE):
@@ -277,7 +277,8 @@ class Identification(Result):
             ax.set_xlabel("front end")
             ax.set_ylabel("fitted offset (mm), 1 sigma bars")
             ax.legend(loc="best")
-            _title(ax, title or f"{self.scene.name}: identified mounting offsets")
+            ax.set_title(title or f"{self.scene.name}: identified mounting offsets",
+                         parse_math=False)
         return fig
 
     def to_dict(self) -> dict:

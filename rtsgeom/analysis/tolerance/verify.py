@@ -191,7 +191,7 @@ def verify_draws(model: ChannelPhasors, sigma_m, n: int, seed: int, distribution
 def _verify_figure(res: VerifyResult, title: str = ""):
     """The chain's worst error against the model's per draw and case (deg)."""
     import matplotlib as mpl
-    from ...viz.figures import STYLE, _title, new_figure
+    from ...viz.figures import STYLE, new_figure
     with mpl.rc_context(STYLE):
         fig, ax = new_figure(figsize=(5.2, 4.4))
         lim = 0.0
@@ -206,5 +206,5 @@ def _verify_figure(res: VerifyResult, title: str = ""):
         ax.set_xlabel("phasor model error (deg)")
         ax.set_ylabel("full-chain error (deg)")
         ax.legend(loc="upper left")
-        _title(ax, title or "Tolerance draws through the full chain")
+        ax.set_title(title or "Tolerance draws through the full chain", parse_math=False)
     return fig
