@@ -308,11 +308,14 @@ class DesignGrid(Result):
                  f"{100 * self.target_yield:g} % yield, {self.draws} draws")
         floor = CONTOUR_FLOOR[metric](self)
         z = np.asarray(self.metrics[metric], float)
+        notes = []
         if np.isfinite(z).any() and np.nanmax(np.abs(z)) < floor:
-            title += f"; every value below {floor:g} (colours 0..{floor:g})"
+            notes.append(f"every value below {floor:g} (colours 0..{floor:g})")
         if mask.any():
-            title += (f"; {'hollow' if lines else 'hatched'}: spacing > "
-                      f"{self.angular_resolution_deg:.1f} deg (eq. 24)")
+            notes.append(f"{'hollow' if lines else 'hatched'}: spacing > "
+                         f"{self.angular_resolution_deg:.1f} deg (eq. 24)")
+        if notes:
+            title += "\n" + "; ".join(notes)
         args = (self.radius_m, self.spacing_deg, self.metrics[metric], "arc radius R_c (m)",
                 "front-end spacing (deg)", zlabel, title)
         if lines:
