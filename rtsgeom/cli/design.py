@@ -77,6 +77,8 @@ def _design(args, scene, stage) -> int:
               file=sys.stderr)
     seed = scene.seed if args.seed is None else args.seed
     with progress(args.quiet) as report:
+        if report is not None:  # the bar from the start, labelled with the count to come
+            report("designs", 0, len(args.radius_m) * len(args.spacing_deg))
         grid = design_grid(scene, pair, args.radius_m, args.spacing_deg, args.spec_deg,
                            args.yield_, args.draws, seed, args.points,
                            None if report is None else
@@ -136,6 +138,8 @@ def _design_coverage(args, scene, folder) -> int:
     seed = scene.seed if args.seed is None else args.seed
     draws = args.draws if args.draws is not None else 300
     with progress(args.quiet) as report:
+        if report is not None:  # two candidate arcs per radius
+            report("designs", 0, 2 * len(args.radius_m))
         grid = coverage_designs(scene, args.coverage_deg, args.radius_m, args.spec_deg,
                                 args.yield_, draws, seed, min(args.points, 11),
                                 progress=None if report is None else
