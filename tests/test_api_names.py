@@ -4,6 +4,7 @@ studies' warnings are Python warnings, which the commands print."""
 from __future__ import annotations
 
 import math
+import re
 import warnings
 
 import pytest
@@ -68,6 +69,13 @@ def test_the_command_prints_the_library_warning_once(tmp_path, capsys):
     path = tmp_path / "moved.toml"
     path.write_text(doc)
     assert main(["tolerance", str(path), "--draws", "20", "--points", "5", "--quiet"]) == 0
-    err = capsys.readouterr().err
-    assert err.count("rtsgeom: warning: tolerance draws mounting errors") == 1, err
-    assert "rts.front_ends[0].radial_offset_mm" in err
+    cap = capsys.readouterr()
+    assert cap.err.count("rtsgeom: warning: tolerance draws mounting errors") == 1, cap.err
+    assert "rts.front_ends[0].radial_offset_mm" in cap.err
+    # and says what the offset does: the pair as built, uncalibrated and calibrated
+    m = re.search(r"the scene's own offsets \(rts.front_ends\[0\].radial_offset_mm\), one "
+                  r"setup at the bin centre: worst \|error\| uncalibrated ([\d.]+), calibrated "
+                  r"([\d.]+) deg", cap.out)
+    assert m, cap.out
+    uncal, cal = float(m.group(1)), float(m.group(2))
+    assert uncal > 0.1 and cal < 0.01  # 0.3 mm radial: ~0.5 deg until calibrated
