@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 import rtsgeom
-from rtsgeom.viz.figures import design_heatmap_figure, design_lines_figure, save_figure
+from rtsgeom.viz.figures import save_figure
 
 QUICK = os.environ.get("RTSGEOM_EXAMPLES_QUICK") == "1"
 OUT = Path(os.environ.get("RTSGEOM_EXAMPLES_OUT", "example_output"))
@@ -30,18 +30,15 @@ spacings = np.array([8.0]) if QUICK else np.array([4.0, 8.0, 12.0])
 grid = rtsgeom.design(scene, radii, spacings, pair=(0, 1), draws=100 if QUICK else 1000)
 
 # %%
-# One row per design; the sheet is kept, widened, or disabled where its cutouts do not fit.
-import pandas as pd  # noqa: E402
-
-df = pd.DataFrame(grid.to_dict()["designs"])
-print(df[["radius_m", "spacing_deg", "sheet", "worst_error_deg", "near_field_bias_deg",
+# The result prints a summary; ``to_dataframe()`` has one row per design (the JSON's
+# ``designs`` also say where the sheet is kept, widened, or disabled).
+print(grid)
+df = grid.to_dataframe()
+print(df[["radius_m", "spacing_deg", "worst_error_deg", "near_field_bias_deg",
           "sigma_calibrated_mm", "sigma_uncalibrated_mm"]].round(4).to_string(index=False))
 
 # %%
 # The calibrated tolerance grows with the radius (a tangential error dt turns a front end by
 # dt / R_c). A single spacing is a 1-D sweep: lines; a grid: a heat map.
-draw = design_lines_figure if min(radii.size, spacings.size) == 1 else design_heatmap_figure
-fig = draw(grid.radius_m, grid.spacing_deg, grid.metrics["sigma_calibrated_mm"],
-           "arc radius R_c (m)", "front-end spacing (deg)", "mounting sigma (mm)",
-           "Tolerance for 95 % within 0.1 deg, calibrated", mask=grid.exceeds_resolution)
+fig = grid.plot("sigma_calibrated_mm")
 save_figure(fig, OUT / "arc_design.png")

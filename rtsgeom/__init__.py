@@ -104,6 +104,8 @@ _LAZY = {
     "AngleUnreachable": (".synthesis.model", "AngleUnreachable"),
     "RaytraceUnavailable": (".paths.raytrace", "RaytraceUnavailable"),
     "VizError": (".viz.render_backend", "VizError"),
+    # warnings (warnings.warn; the CLI prints them as "rtsgeom: warning: ...")
+    "NominalSetupWarning": (".errors", "NominalSetupWarning"),
 }
 
 __all__ = ["__version__", *_LAZY]

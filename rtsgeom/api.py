@@ -10,12 +10,15 @@ library's own result objects; they add no physics. Import them from the package:
 
 from __future__ import annotations
 
+import dataclasses
+import difflib
 from pathlib import Path
 
 import numpy as np
 
-from .errors import ParameterError
+from .errors import ParameterError, SceneError
 from .scene import Scene
+from .scene.schema import fmt, specs
 
 __all__ = ["replace", "calibrate", "linearity", "tolerance", "design", "nearfield", "ghosts",
            "transfer", "show", "play"]
@@ -24,25 +27,76 @@ __all__ = ["replace", "calibrate", "linearity", "tolerance", "design", "nearfiel
 def replace(obj, **changes):
     """A copy of a scene (or of one of its sections) with ``changes`` applied.
 
-    Uses ``obj.evolve(**changes)`` where the object has it (a :class:`Scene` that validates the
-    variant again), else :func:`dataclasses.replace`.
+    A field is named as in Python, in SI units (``radial_offset_m=5e-4``, ``angle_rad``), or
+    as in the scene file, in the file's units (``radial_offset_mm=0.5``, ``angle_deg``): the
+    file's key converts by its declared unit (``scene.schema``), so both set the same field.
+    Uses ``obj.evolve(**changes)`` where the object has it (validated again), else
+    :func:`dataclasses.replace`. Errors name the key as written.
 
     Parameters
     ----------
     obj : Scene, RadarConfig, RtsConfig, FrontEndConfig, SheetConfig or TargetConfig
     **changes
-        Fields to change, in SI units (``arc_radius_m``, ``angle_rad``, ...).
+        Fields to change: SI attribute names or the scene file's keys.
+
+    Raises
+    ------
+    ParameterError
+        An unknown key (with the nearest names), or one field given twice (by both names).
+    SceneError
+        A value outside its allowed range; the message starts with the key as written.
 
     Examples
     --------
-    >>> fes = tuple(replace(f, radial_offset_m=0.2e-3) for f in scene.rts.front_ends)
+    >>> fes = tuple(replace(f, radial_offset_mm=0.2) for f in scene.rts.front_ends)
     >>> scene = replace(scene, rts=replace(scene.rts, front_ends=fes))  # doctest: +SKIP
     """
-    import dataclasses
+    if not dataclasses.is_dataclass(obj) or isinstance(obj, type):
+        raise ParameterError(f"replace: {type(obj).__name__} is not a scene or a scene section")
+    names = {f.name for f in dataclasses.fields(obj) if f.init}
+    by_key = {s.key: (name, s) for name, s in specs(type(obj))}
+    fields, written = {}, {}  # attribute -> SI value, attribute -> (key, value) as written
+    for key, value in changes.items():
+        if key in names:
+            name, si = key, value
+        elif key in by_key:
+            name, s = by_key[key]
+            si = s.to_si(value) if _is_number(value) else value
+        else:
+            near = difflib.get_close_matches(key, sorted(names | set(by_key)), n=3)
+            hint = f"; did you mean {', '.join(near)}?" if near else ""
+            raise ParameterError(
+                f"replace: {type(obj).__name__} has no field {key!r}{hint} (Python's SI names "
+                "such as radial_offset_m or the scene file's keys such as radial_offset_mm)")
+        if name in fields:
+            raise ParameterError(f"replace: {key} and {written[name][0]} set the same field "
+                                 f"({name}); give one")
+        fields[name], written[name] = si, (key, value)
     evolve = getattr(obj, "evolve", None)
-    if callable(evolve):
-        return evolve(**changes)
-    return dataclasses.replace(obj, **changes)
+    if not callable(evolve):
+        return dataclasses.replace(obj, **fields)
+    try:
+        return evolve(**fields)
+    except SceneError as exc:
+        message = str(exc)
+        if message.startswith("<evolve>: "):
+            message = "replace: " + message[len("<evolve>: "):]
+        for name, (key, value) in written.items():
+            s = dict(specs(type(obj))).get(name)
+            if s is not None and key != s.key and message.startswith(f"replace: {s.key} = "):
+                # the check speaks the file's key and units: say which key was written
+                head, tail = message[len("replace: "):].split(": ", 1)
+                message = f"replace: {key} = {fmt(value)} (the scene file's {head}): {tail}"
+        raise SceneError(message, exc.problems) from None
+
+
+def _is_number(value) -> bool:
+    """A number or a tuple of them (what a unit converts)."""
+    if isinstance(value, bool):
+        return False
+    if isinstance(value, (int, float, np.number)):
+        return True
+    return isinstance(value, tuple) and all(_is_number(v) for v in value)
 
 
 def _setup_paths(scene: Scene):
@@ -154,9 +208,17 @@ def tolerance(scene: Scene, pair=(0, 1), sigma_mm=(0.1, 0.1, 0.1), draws: int = 
     ToleranceResult
         ``worst_error_deg[case]`` per draw for ``'uncalibrated'`` and ``'calibrated'``,
         ``yield_(case)``, ``stats(case)`` and ``to_dict()``.
+
+    Warns
+    -----
+    NominalSetupWarning
+        The scene carries mounting, channel or RuT pose errors of its own: the draws start
+        from the nominal setup, not from them.
     """
     from .analysis.tolerance import ChannelPhasors, monte_carlo
     from .geometry import build_setup
+    from .geometry.setup import warn_setup_errors
+    warn_setup_errors(scene, "tolerance", stacklevel=3)  # NominalSetupWarning
     setup = build_setup(scene)
     pair = _check_pair(setup, pair)
     model = ChannelPhasors.build(setup, pair, points)

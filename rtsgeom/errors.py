@@ -11,7 +11,8 @@ from __future__ import annotations
 
 __all__ = ["SceneError", "LinkError", "ParameterError", "UsageError", "CaptureError",
            "OutputError", "AngleUnreachable", "CellUnreachable", "CalibrationFailed",
-           "ClusterError", "RaytraceUnavailable", "VizError", "Terminated"]
+           "ClusterError", "RaytraceUnavailable", "VizError", "Terminated", "RtsgeomWarning",
+           "NominalSetupWarning"]
 
 
 # -- input out of range (ValueError) ---------------------------------------------------------
@@ -82,3 +83,15 @@ class VizError(RuntimeError):
 class Terminated(KeyboardInterrupt):
     """SIGTERM, raised like Ctrl-C so that every cleanup (staging folders, temporary files)
     runs the same way."""
+
+
+# -- warnings (warnings.warn: the result is computed, but the user should know) ---------------
+
+
+class RtsgeomWarning(UserWarning):
+    """Base of the warnings rtsgeom emits; the CLI prints each as ``rtsgeom: warning: ...``."""
+
+
+class NominalSetupWarning(RtsgeomWarning):
+    """A study works on the nominal setup although the scene carries its own mounting,
+    channel or RuT pose errors (the message names the fields and what shows their effect)."""

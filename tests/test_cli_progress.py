@@ -44,3 +44,34 @@ def test_failed_step_reports_no_duration(tmp_path, capsys):
     assert main(["calibrate", str(missing), "--pair", "0", "1"]) == 2
     err = capsys.readouterr().err
     assert "cannot read scene file" in err and not _STEP.findall(err), err
+
+
+def test_progress_off_a_terminal_prints_plain_lines():
+    """Off a terminal (a log file, ``2> file``) the Monte-Carlo studies' progress is plain
+    lines with counts, percentages and an ETA: one per 10 % or 5 s, and one at the end."""
+    import io
+
+    from rtsgeom.cli._common import LineProgress
+    t = [0.0]
+    stream = io.StringIO()
+    report = LineProgress(stream, clock=lambda: t[0])
+    for done in range(1, 41):
+        t[0] = done * 0.5  # 0.5 s per design: 2 s per 10 %
+        report("designs", done, 40)
+    lines = stream.getvalue().splitlines()
+    assert len(lines) == 10, lines  # every 4 of 40, the last one the end
+    assert lines[0] == "rtsgeom: designs 4/40 (10 %), 2.0 s, ETA 18.0 s"
+    assert lines[-1] == "rtsgeom: designs 40/40 (100 %), 20.0 s"
+    stream, t[0] = io.StringIO(), 0.0
+    slow = LineProgress(stream, clock=lambda: t[0])
+    for done in range(1, 1001):  # 1000 draws at 0.1 s: a line every 5 s before each 10 %
+        t[0] = done * 0.1
+        slow("draws", done, 1000)
+    counts = [int(re.search(r" (\d+)/1000", x).group(1)) for x in stream.getvalue().splitlines()]
+    assert counts[:3] == [50, 100, 150] and counts[-1] == 1000
+
+
+def test_progress_quiet_is_none():
+    from rtsgeom.cli._common import progress
+    with progress(True) as report:
+        assert report is None

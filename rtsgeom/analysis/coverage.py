@@ -37,9 +37,10 @@ from typing import Callable
 
 import numpy as np
 
-from ..errors import AngleUnreachable
+from .._lib.results import Result
+from ..errors import AngleUnreachable, ParameterError
 from ..geometry import build_setup
-from ..geometry.setup import nominal_scene
+from ..geometry.setup import nominal_scene, warn_setup_errors
 from ..geometry.farfield import angular_resolution_rad
 from ..paths import exact_paths
 from ..scene import Scene
@@ -51,7 +52,15 @@ from .nearfield_terms import single_front_end_angles_rad
 __all__ = ["ArcPlan", "ArcDesign", "CoverageDesign", "arc_scene", "plan_arc", "evaluate_arc",
            "coverage_designs", "best_per_radius"]
 
+MAX_BEST_ROWS = 15  # radii listed in a summary
 BASE_SIGMA_M = 1e-4  # the tolerance search scales 0.1 mm sigmas
+# the coverage maps (``design --coverage-deg --out``): name -> (colour label, title)
+COVERAGE_MAPS = {
+    "worst_calibrated_deg": ("worst |angle error| (deg)", "Calibrated, over the coverage"),
+    "worst_uncalibrated_deg": ("worst |angle error| (deg)", "Uncalibrated, over the coverage"),
+    "sigma_mm": ("mounting sigma (mm)", "Tolerance for the yield (whole arc)"),
+    "front_ends": ("front ends", "Number of front ends"),
+}
 
 
 @dataclass(frozen=True)
@@ -267,14 +276,61 @@ def evaluate_arc(plan: ArcPlan, spec_deg: float = 0.1, target_yield: float = 0.9
                      ref.yield_("uncalibrated"), inv["yield"])
 
 
-@dataclass(frozen=True)
-class CoverageDesign:
+@dataclass(frozen=True, repr=False)
+class CoverageDesign(Result):
+    """The candidate arcs per radius. ``print(grid)`` is a summary; ``to_dataframe()`` one
+    row per candidate; ``plot(name)`` one of :data:`COVERAGE_MAPS` over (radius, front ends
+    beyond the fewest)."""
+
     coverage_deg: tuple[float, float]
     radius_m: np.ndarray
     spec_deg: float
     target_yield: float
     draws: int
     designs: tuple[ArcDesign, ...]  # radius-major, candidates N_min, N_min + 1
+    scene_name: str = ""  # the template scene's, for the figures' titles
+
+    def _summary(self):
+        a, b = self.coverage_deg
+        title = (f"arcs covering {a:g}..{b:g} deg: {self.radius_m.size} radii x "
+                 f"{len(self.designs) // max(self.radius_m.size, 1)} candidates")
+        rows = [("spec", f"{self.spec_deg:g} deg, {100 * self.target_yield:g} % of whole arcs, "
+                         f"{self.draws} draws")]
+        for d in best_per_radius(self)[:MAX_BEST_ROWS]:
+            rows.append((f"R_c {d.plan.radius_m:g} m", (
+                f"{d.plan.front_ends} front ends {d.plan.spacing_deg:.3g} deg apart, worst "
+                f"{d.worst_calibrated_deg:.3g} deg calibrated "
+                f"({d.worst_uncalibrated_deg:.3g} uncalibrated), sigma {d.sigma_mm:.3g} mm")))
+        return title, rows
+
+    def _columns(self) -> dict:
+        rows = [d.to_dict() for d in self.designs]
+        keys = ("radius_m", "front_ends", "extra", "spacing_deg", "sheet",
+                "worst_calibrated_deg", "worst_uncalibrated_deg", "sigma_mm", "problem")
+        return {k: [r.get(k) for r in rows] for k in keys}
+
+    def plot(self, name: str = "worst_calibrated_deg"):
+        """One of :data:`COVERAGE_MAPS` over arc radius and the front ends beyond the fewest
+        (whole numbers), each cell's value written in it."""
+        from ..viz.figures import design_heatmap_figure
+        if name not in COVERAGE_MAPS:
+            raise ParameterError(f"map {name!r}: one of {', '.join(COVERAGE_MAPS)}")
+        zlabel, what = COVERAGE_MAPS[name]
+        extras = sorted({d.plan.extra for d in self.designs})
+        z = np.full((len(extras), self.radius_m.size), np.nan)
+        for d in (design.to_dict() for design in self.designs):
+            i = int(np.argmin(np.abs(self.radius_m - d["radius_m"])))
+            v = d.get(name)
+            z[extras.index(d["extra"]), i] = np.nan if v is None else float(v)
+        a, b = self.coverage_deg
+        head = f"{self.scene_name}: " if self.scene_name else ""
+        return design_heatmap_figure(
+            self.radius_m, np.array(extras, float), z, "arc radius R_c (m)",
+            "front ends beyond the fewest", zlabel,
+            f"{head}{what}\ncoverage {a:g}..{b:g} deg, spec {self.spec_deg:g} deg, "
+            f"{100 * self.target_yield:g} % yield, {self.draws} draws",
+            contour_floor=0.01 * self.spec_deg if name.endswith("_deg") else None,
+            integer_y=True, integer_z=name == "front_ends")
 
     def to_dict(self) -> dict:
         def clean(v):
@@ -308,6 +364,7 @@ def coverage_designs(scene: Scene, coverage_deg: tuple[float, float], radius_m,
                      seed: int = 0, points: int = 11, extras=(0, 1),
                      progress: Callable[[int, int], None] | None = None) -> CoverageDesign:
     """Plan and evaluate the candidate arcs for every radius."""
+    warn_setup_errors(scene, "design")
     cov = tuple(math.radians(x) for x in coverage_deg)
     radii = np.asarray(radius_m, float).ravel()
     designs, total = [], radii.size * len(extras)
@@ -318,4 +375,4 @@ def coverage_designs(scene: Scene, coverage_deg: tuple[float, float], radius_m,
             if progress:
                 progress(len(designs), total)
     return CoverageDesign(tuple(float(x) for x in coverage_deg), radii, float(spec_deg),
-                          float(target_yield), int(draws), tuple(designs))
+                          float(target_yield), int(draws), tuple(designs), scene.name)

@@ -34,10 +34,11 @@ from typing import Callable
 
 import numpy as np
 
+from .._lib.results import Result
 from .._lib.util import frozen
 from ..errors import AngleUnreachable
 from ..geometry import build_setup
-from ..geometry.setup import nominal_scene
+from ..geometry.setup import nominal_scene, warn_setup_errors
 from ..geometry.farfield import angular_resolution_rad
 from .._lib.parallel import available_cores, chunk_mapper, map_chunks
 from ..scene import Scene, SheetConfig
@@ -57,6 +58,15 @@ METRICS = {
     "range_offset_mm": ("range offset (mm)", "Calibration range offset"),
     "sigma_calibrated_mm": ("mounting sigma (mm)", "Tolerance for the spec, calibrated"),
     "sigma_uncalibrated_mm": ("mounting sigma (mm)", "Tolerance for the spec, uncalibrated"),
+}
+# a design map's lowest contour level: below it differences are the evaluation's noise
+# (~1e-5 deg of a closed form that is exact to that) or too small to build to
+CONTOUR_FLOOR = {
+    "worst_error_deg": lambda g: 0.01 * g.spec_deg,
+    "near_field_bias_deg": lambda g: 0.01 * g.spec_deg,
+    "range_offset_mm": lambda g: 0.01,
+    "sigma_calibrated_mm": lambda g: 0.001,
+    "sigma_uncalibrated_mm": lambda g: 0.001,
 }
 SHEET_MARGIN_RAD = math.radians(2.0)  # sheet beyond the outer cutouts when it is widened
 
@@ -236,9 +246,13 @@ def _evaluate_cell(scene, pair, spec_deg, target_yield, draws, seed, points, cel
                            points)
 
 
-@dataclass(frozen=True)
-class DesignGrid:
-    """Metrics over radius (columns) x spacing (rows): each grid has shape (spacings, radii)."""
+@dataclass(frozen=True, repr=False)
+class DesignGrid(Result):
+    """Metrics over radius (columns) x spacing (rows): each grid has shape (spacings, radii).
+
+    ``print(grid)`` is a summary; ``to_dataframe()`` one row per design (``radius_m``,
+    ``spacing_deg``, the metrics, ``exceeds_resolution``); ``plot(metric)`` one metric's map,
+    the figures of ``rtsgeom design --out``."""
 
     pair: tuple[int, int]
     centre_deg: float
@@ -252,6 +266,61 @@ class DesignGrid:
     metrics: dict  # name -> (S, R)
     exceeds_resolution: np.ndarray  # (S, R) bool
     designs: tuple  # per cell, row-major: evaluate_design's dict
+    scene_name: str = ""  # the template scene's, for the figures' titles
+
+    def _summary(self):
+        title = (f"arc design of pair {self.pair} (centre {self.centre_deg:.2f} deg): "
+                 f"{self.spacing_deg.size} spacings x {self.radius_m.size} radii")
+        rows = [("radius_m", self.radius_m), ("spacing_deg", self.spacing_deg),
+                ("tolerance", f"{100 * self.target_yield:g} % within {self.spec_deg:g} deg, "
+                              f"{self.draws} draws, seed {self.seed}"),
+                ("exceeds_resolution", f"{int(np.sum(self.exceeds_resolution))} of "
+                                       f"{self.exceeds_resolution.size} designs (spacing > "
+                                       f"{self.angular_resolution_deg:.2f} deg, eq. 24)")]
+        rows += [(name, self.metrics[name]) for name in METRICS]
+        sigma = np.where(np.isfinite(self.metrics["sigma_calibrated_mm"]),
+                         self.metrics["sigma_calibrated_mm"], -np.inf)
+        if np.isfinite(sigma).any():
+            j, i = np.unravel_index(int(np.argmax(sigma)), sigma.shape)
+            rows.append(("widest tolerance", f"{sigma[j, i]:.3g} mm calibrated at R_c "
+                                             f"{self.radius_m[i]:g} m, spacing "
+                                             f"{self.spacing_deg[j]:g} deg"))
+        return title, rows
+
+    def _columns(self) -> dict:
+        s, r = np.meshgrid(self.spacing_deg, self.radius_m, indexing="ij")
+        cols = {"radius_m": r.ravel(), "spacing_deg": s.ravel()}
+        cols.update({name: np.ravel(v) for name, v in self.metrics.items()})
+        cols["exceeds_resolution"] = np.ravel(self.exceeds_resolution)
+        return cols
+
+    def plot(self, metric: str = "worst_error_deg"):
+        """One metric's map over (radius, spacing) (lines when one of them is a single value);
+        the title names the scene, the pair, the spec and the yield."""
+        from ..viz.figures import design_heatmap_figure, design_lines_figure
+        if metric not in METRICS:
+            raise ParameterError(f"metric {metric!r}: one of {', '.join(METRICS)}")
+        zlabel, what = METRICS[metric]
+        mask = np.asarray(self.exceeds_resolution, bool)
+        lines = min(self.radius_m.size, self.spacing_deg.size) == 1
+        head = f"{self.scene_name}: " if self.scene_name else ""
+        title = (f"{head}{what}\npair {self.pair}, spec {self.spec_deg:g} deg, "
+                 f"{100 * self.target_yield:g} % yield, {self.draws} draws")
+        floor = CONTOUR_FLOOR[metric](self)
+        z = np.asarray(self.metrics[metric], float)
+        notes = []
+        if np.isfinite(z).any() and np.nanmax(np.abs(z)) < floor:
+            notes.append(f"every value below {floor:g} (colours 0..{floor:g})")
+        if mask.any():
+            notes.append(f"{'hollow' if lines else 'hatched'}: spacing > "
+                         f"{self.angular_resolution_deg:.1f} deg (eq. 24)")
+        if notes:
+            title += "\n" + "; ".join(notes)
+        args = (self.radius_m, self.spacing_deg, self.metrics[metric], "arc radius R_c (m)",
+                "front-end spacing (deg)", zlabel, title)
+        if lines:
+            return design_lines_figure(*args, mask=mask)
+        return design_heatmap_figure(*args, mask=mask, contour_floor=floor)
 
     def to_dict(self) -> dict:
         def clean(v):
@@ -300,6 +369,7 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     kernels once (~0.3 s CPU each) and keep the memory they free
     (``parallel.retain_freed_memory``)."""
     check_azimuth_arc(scene)
+    warn_setup_errors(scene, "design")
     radii = np.asarray(radius_m, float).ravel()
     spacings = np.asarray(spacing_deg, float).ravel()
     fes = scene.rts.front_ends
@@ -324,4 +394,4 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     res = math.degrees(angular_resolution_rad(build_setup(scene).rut))
     return DesignGrid((int(pair[0]), int(pair[1])), math.degrees(centre), frozen(radii),
                       frozen(spacings), res, float(spec_deg), float(target_yield), int(draws),
-                      int(seed), metrics, frozen(exceeds), tuple(designs))
+                      int(seed), metrics, frozen(exceeds), tuple(designs), scene.name)

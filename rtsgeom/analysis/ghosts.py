@@ -24,12 +24,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.constants import c
 
+from .._lib.results import Result
 from ..geometry import build_setup
 from ..radar.windows import window
 from ..rts.channels import EchoKind, Echoes, cable_ghosts, program_nearest
 from ..scene import Scene
 from ..pipeline.run import run_scene
 
+MAX_SUMMARY_TARGETS = 12  # targets listed in a summary
 __all__ = ["DEFAULT_FLOOR_DB", "ghost_orders", "predict_ghosts", "measure_ghosts",
            "GhostReport", "ghost_analysis", "ghosts_figure"]
 
@@ -187,14 +189,48 @@ def measure_ghosts(result, predicted: list[dict]) -> list[dict]:
     return out
 
 
-@dataclass(frozen=True)
-class GhostReport:
+@dataclass(frozen=True, repr=False)
+class GhostReport(Result):
+    """Predicted (and simulated) cable ghosts. ``print(rep)`` is a summary;
+    ``to_dataframe()`` one row per (target, ghost order); ``plot()`` the figure of
+    ``rtsgeom ghosts --out``."""
+
     scene: Scene
     floor_db: float
     front_ends: list
     targets: list
     simulated: list | None = None
     result: object = None  # run.RunResult when simulated
+
+    def _summary(self):
+        title = (f"{self.scene.name}: cable ghosts above {self.floor_db:g} dB"
+                 f"{', simulated' if self.simulated is not None else ''}")
+        rows = [("mismatched front ends", str([f["index"] for f in self.front_ends
+                                               if f["mismatched"]]))]
+        for t in self.targets[:MAX_SUMMARY_TARGETS]:
+            g = t["ghosts"]
+            text = (", ".join(f"order {x['order']} at {x['range_m']:.3g} m {x['level_db']:.1f} dB"
+                              for x in g[:3]) + (f" and {len(g) - 3} more" if len(g) > 3 else "")
+                    if g else "none above the floor")
+            rows.append((f"target {t['index']} ({t['range_m']:g} m, FE {t['front_end']})", text))
+        if len(self.targets) > MAX_SUMMARY_TARGETS:
+            rows.append(("...", f"{len(self.targets) - MAX_SUMMARY_TARGETS} more targets"))
+        return title, rows
+
+    def _columns(self) -> dict:
+        keys = ("target", "front_end", "target_range_m", "order", "range_m", "level_db")
+        rows = [(t["index"], t["front_end"], t["range_m"], g["order"], g["range_m"],
+                 g["level_db"]) for t in self.targets for g in t["ghosts"]]
+        cols = {k: [r[i] for r in rows] for i, k in enumerate(keys)}
+        if self.simulated is not None:
+            sim = {(s["index"] if "index" in s else k, m.get("order")): m.get("level_db")
+                   for k, s in enumerate(self.simulated) for m in s.get("ghosts", [])}
+            cols["simulated_level_db"] = [sim.get((r[0], r[3])) for r in rows]
+        return cols
+
+    def plot(self, title: str = ""):
+        """Per target, its range profile with the predicted (and simulated) ghosts."""
+        return ghosts_figure(self, title)
 
     def to_dict(self) -> dict:
         r = self.scene.radar

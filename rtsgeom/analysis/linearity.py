@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay
 
+from .._lib.results import Result
 from ..calibration.channels import calibrate_channels, tree_phases
 from ..calibration.sweep import Calibration
 from ..calibration.probes import (FrontEndProbe, probe_angles, probe_front_ends, probe_ranges,
@@ -30,10 +31,12 @@ __all__ = ["Linearity", "linearity", "cell_grid", "error_map_figure", "END_ANGLE
 END_ANGLES = ("geometric", "measured")
 
 
-@dataclass(frozen=True)
-class Linearity:
+@dataclass(frozen=True, repr=False)
+class Linearity(Result):
     """Set and detected directions (deg) of the synthesized targets: (P,) azimuths of a pair,
-    or (P, 2) (azimuth, elevation) over a cell (NaN: not detected)."""
+    or (P, 2) (azimuth, elevation) over a cell (NaN: not detected). ``print(lin)`` is a
+    summary; ``to_dataframe()`` one row per set-point; ``plot()`` the figure of
+    ``rtsgeom linearity --out``."""
 
     mode: str
     calibrated: bool
@@ -58,6 +61,38 @@ class Linearity:
         if self.dims == 1:
             return float(np.nanmax(e))
         return float(np.nanmax(e[:, 0])), float(np.nanmax(e[:, 1]))
+
+    def _summary(self):
+        what = "pair" if self.dims == 1 else "cell"
+        title = (f"{self.mode} synthesis over {what} {tuple(self.channels)}, "
+                 f"{'calibrated' if self.calibrated else 'uncalibrated'}")
+        det = np.isfinite(self.detected_deg).reshape(len(self.set_deg), -1).all(axis=-1)
+        mx = self.max_abs_error_deg
+        rows = [("set-points", f"{len(self.set_deg)} ({int(det.sum())} detected)"),
+                ("max_abs_error_deg", mx if self.dims == 1 else
+                 f"azimuth {mx[0]:.4g}, elevation {mx[1]:.4g}")]
+        if self.dims == 1:
+            rows += [("set_deg", self.set_deg), ("error_deg", self.error_deg),
+                     ("end_angles", self.end_angles)]
+        else:
+            rows += [("set azimuth_deg", self.set_deg[:, 0]),
+                     ("set elevation_deg", self.set_deg[:, 1])]
+        return title, rows
+
+    def _columns(self) -> dict:
+        if self.dims == 1:
+            cols = {"set_deg": self.set_deg, "detected_deg": self.detected_deg,
+                    "error_deg": self.error_deg}
+            if self.amplitude_db is not None:
+                for q, a in zip(self.channels or range(len(self.amplitude_db)),
+                                np.asarray(self.amplitude_db)):
+                    cols[f"amplitude_{q}_db"] = a
+            return cols
+        e = self.error_deg
+        return {"set_azimuth_deg": self.set_deg[:, 0], "set_elevation_deg": self.set_deg[:, 1],
+                "detected_azimuth_deg": self.detected_deg[:, 0],
+                "detected_elevation_deg": self.detected_deg[:, 1],
+                "azimuth_error_deg": e[:, 0], "elevation_error_deg": e[:, 1]}
 
     def to_dict(self) -> dict:
         if self.dims == 1:

@@ -63,9 +63,10 @@ import numpy as np
 
 from ..calibration.probes import probe_ranges
 from ..errors import ParameterError
+from .._lib.results import Result
 from ..geometry import build_setup
 from ..geometry.farfield import aperture_m, apparent_azimuth_rad, fraunhofer_distance_m
-from ..geometry.setup import nominal_scene
+from ..geometry.setup import nominal_scene, warn_setup_errors
 from ..paths import exact_paths
 from ..radar.steering import Steering, smoothed_estimator
 from ..scene import Scene
@@ -111,9 +112,11 @@ def with_arc_radius(scene: Scene, radius_m: float) -> Scene:
 # ------------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class NearField:
-    """Near-field figures of merit over arc radius (arrays (R, F) unless noted, degrees)."""
+@dataclass(frozen=True, repr=False)
+class NearField(Result):
+    """Near-field figures of merit over arc radius (arrays (R, F) unless noted, degrees).
+    ``print(nf)`` is a summary; ``to_dataframe()`` one row per (radius, front end);
+    ``plot()`` the figure of ``rtsgeom nearfield --out``."""
 
     scene: Scene
     radius_m: np.ndarray  # (R,)
@@ -174,6 +177,39 @@ class NearField:
         if self._smoothed():
             return np.median(self.bias_deg * self.radius_m[:, None], axis=0)
         return (self.separation_deg[-1] + self.parallax_deg[-1]) * self.radius_m[-1]
+
+    def _summary(self):
+        title = (f"{self.scene.name}: near field over {self.radius_m.size} arc radii "
+                 f"({self.radius_m.min():g} to {self.radius_m.max():g} m), "
+                 f"{self.geometric_deg.shape[1]} front ends")
+        coef = self.bias_times_radius_deg_m()
+        rows = [("radius_m", self.radius_m), ("bias_deg", self.bias_deg),
+                ("separation_deg", self.separation_deg), ("parallax_deg", self.parallax_deg),
+                ("curvature_deg", self.curvature_deg), ("phase_pp_deg", self.phase_pp_deg),
+                ("bias x R", f"{np.max(np.abs(coef)):.3g} deg m (largest |.| over the front "
+                             f"ends): below 0.01 deg from R_c "
+                             f"{np.max(np.abs(coef)) / 0.01:.3g} m"),
+                ("fraunhofer_m", self.fraunhofer_m), ("aperture_m", self.aperture_m)]
+        k = self.scene_index()
+        if k is not None:
+            rows.append((f"at R_c {self.radius_m[k]:g} m",
+                         f"|bias| up to {np.max(np.abs(self.bias_deg[k])):.4g} deg"))
+        return title, rows
+
+    def _columns(self) -> dict:
+        r, f = self.geometric_deg.shape
+        cols = {"radius_m": np.repeat(self.radius_m, f), "front_end": np.tile(np.arange(f), r)}
+        for name in ("geometric_deg", "detected_deg", "bias_deg", "separation_deg",
+                     "parallax_deg", "beat_frequency_deg", "curvature_deg", "phase_pp_deg",
+                     "phase_rms_deg", "curvature_pp_deg"):
+            cols[name] = np.ravel(getattr(self, name))
+        if self.detected_el_deg is not None:
+            cols["elevation_bias_deg"] = np.ravel(self.elevation_bias_deg)
+        return cols
+
+    def plot(self, title: str = ""):
+        """The bias and its parts over arc radius, the phase errors and the synthesis."""
+        return nearfield_figure(self, title)
 
     def to_dict(self) -> dict:
         fl = lambda a: [float(x) for x in a]  # noqa: E731
@@ -239,6 +275,8 @@ def nearfield(scene: Scene, radii=None, points: int = 11) -> NearField:
 
     ``points``: synthesized set-points per pair for (c).
     """
+    warn_setup_errors(scene, "nearfield", "analyses the arc's near field on the nominal "
+                      "setup: the scene's own errors ({}) play no part")
     radii = default_radii(scene) if radii is None else np.asarray(radii, float)
     _check_radii(scene, radii)
     cols = {k: [] for k in ("rng", "geo", "det", "sep", "par", "beat", "pp", "rms", "curv",

@@ -34,6 +34,7 @@ from typing import Protocol
 import numpy as np
 from scipy.constants import c
 
+from .._lib.results import Result
 from .._lib.util import frozen
 from ..errors import CalibrationFailed, ParameterError
 from .fit import coarse_minimum, fit_centre, fit_scatter, rms_error_deg
@@ -114,9 +115,13 @@ class Probes(Protocol):
     def phase(self, continuous, delta_s: float) -> float: ...
 
 
-@dataclass(frozen=True)
-class Calibration:
-    """The phase calibration of a pair (I, J): channel J's delay offset relative to I."""
+@dataclass(frozen=True, repr=False)
+class Calibration(Result):
+    """The phase calibration of a pair (I, J): channel J's delay offset relative to I.
+
+    ``print(cal)`` is a summary; ``to_dataframe()`` the sweep (one row per evaluated delay:
+    ``stage`` coarse or fine, ``delta_tau_ps``, ``angle_error_deg``); ``plot()`` the figure
+    of ``rtsgeom calibrate --out``."""
 
     pair: tuple[int, int]
     delta_tau_s: float  # delay offset of J relative to I (what the RTS can set)
@@ -147,6 +152,35 @@ class Calibration:
     def fit_s(self) -> float:
         """The fitted optimum before rounding to a realisable delay."""
         return self.delta_tau_s + self.quantisation_residual_s
+
+    def _summary(self):
+        return (f"pair {tuple(self.pair)} phase calibration ({self.method}, {self.dims}-D)", [
+            ("delta_tau", f"{self.delta_tau_s * 1e12:.2f} ps (fit {self.fit_s * 1e12:.2f} ps, "
+                          f"{self.delay_resolution_s * 1e12:g} ps steps)"),
+            ("residual_error", f"{self.residual_error_deg:.4g} deg"),
+            ("range_offset", f"{self.range_offset_m * 1e3:.3g} mm"),
+            ("period", f"{self.period_s * 1e12:.1f} ps (eq. 27)"),
+            ("sweep", f"{self.sweep_delta_tau_s.size} coarse + {self.refine_delta_tau_s.size} "
+                      f"fine steps, {self.frames_per_step} frame(s) a fine step"),
+            ("frame_noise", f"{self.frame_noise_deg:.3g} deg (1 sigma, one frame)"),
+            ("one_frame_scatter", f"{self.one_frame_scatter_ps:.3g} ps"),
+            ("probe_angles_deg", self.probe_angles_deg)])
+
+    def _columns(self) -> dict:
+        n, m = self.sweep_delta_tau_s.size, self.refine_delta_tau_s.size
+        return {"stage": ["coarse"] * n + ["fine"] * m,
+                "delta_tau_ps": 1e12 * np.r_[self.sweep_delta_tau_s, self.refine_delta_tau_s],
+                "angle_error_deg": np.r_[np.ravel(self.sweep_error_deg),
+                                         np.ravel(self.refine_error_deg)]}
+
+    def plot(self, title: str = ""):
+        """The angle error over the swept delay, the chosen delay and its residual."""
+        from ..viz.figures import calibration_sweep_figure  # matplotlib: only for the figure
+        return calibration_sweep_figure(
+            self.sweep_delta_tau_s, self.sweep_error_deg, self.delta_tau_s, self.period_s,
+            title or f"Phase calibration, pair {tuple(self.pair)}",
+            residual_error_deg=self.residual_error_deg,
+            refine_delta_tau_s=self.refine_delta_tau_s, refine_error_deg=self.refine_error_deg)
 
     def to_dict(self) -> dict:
         """The calibration as JSON values (a value that is not finite, e.g. a residual where

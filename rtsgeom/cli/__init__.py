@@ -14,10 +14,11 @@ import os
 import signal as _sig
 import sys
 import threading
+import warnings
 
 from .. import __version__
-from ..errors import (ClusterError, OutputError, RaytraceUnavailable, SceneError, Terminated,
-                      UsageError)
+from ..errors import (ClusterError, OutputError, RaytraceUnavailable, RtsgeomWarning, SceneError,
+                      Terminated, UsageError)
 
 __all__ = ["main", "build_parser"]
 
@@ -125,8 +126,12 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _dispatch(args) -> int:
+    from ._common import show_warning
     try:
-        return int(args.func(args) or 0)
+        with warnings.catch_warnings():  # the library's warnings, each call's, on stderr
+            warnings.simplefilter("always", RtsgeomWarning)
+            warnings.showwarning = show_warning
+            return int(args.func(args) or 0)
     except (SceneError, UsageError, OutputError, ClusterError, RaytraceUnavailable) as exc:
         print(f"rtsgeom: error: {exc}", file=sys.stderr)
         return 2

@@ -15,6 +15,7 @@ import json
 import math
 import sys
 import time
+import warnings
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -22,7 +23,7 @@ from .._lib.io import check_output_file, staged_dir, write_json
 from ..errors import ParameterError, UsageError
 
 __all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checked", "steps",
-           "output_path", "output_folder", "output_file", "DRAWS_REPLACE", "warn_scene_errors",
+           "output_path", "output_folder", "output_file", "warn_scene_errors", "show_warning",
            "pair_word", "pair_of", "pairs_of", "pair_options", "prepare_pair", "prepare_arc",
            "emit_result", "write_outputs", "print_outputs", "progress", "study_options",
            "read_calibration", "calibration_kw"]
@@ -132,23 +133,21 @@ class steps:
         return False
 
 
-#: what ``tolerance`` and ``design`` do with the scene's own errors (warn_scene_errors)
-DRAWS_REPLACE = ("draws mounting errors about the nominal setup; the scene's own errors ({}) "
-                 "are not its starting point: each draw replaces them")
+def warn_scene_errors(scene, command: str, what: str | None = None) -> None:
+    """The library's :func:`~rtsgeom.geometry.setup.warn_setup_errors` for a command that
+    calls no study that warns itself (``main`` prints the warning on stderr)."""
+    from ..geometry.setup import DRAWS_REPLACE, warn_setup_errors
+    warn_setup_errors(scene, command, DRAWS_REPLACE if what is None else what)
 
 
-def warn_scene_errors(scene, command: str, what: str = DRAWS_REPLACE) -> None:
-    """Say on stderr that ``command`` works on the nominal setup
-    (``geometry.setup.nominal_scene``) when the scene carries its own mounting, channel or RuT
-    pose errors (``geometry.setup.setup_errors``), which it does not start from (offsets
-    measured on a built setup and written into the scene would otherwise seem to be used).
-    ``what``: the sentence after the command, ``{}`` the fields."""
-    from ..geometry.setup import setup_errors
-    fields = setup_errors(scene)
-    if fields:
-        more = f" and {len(fields) - 3} more" if len(fields) > 3 else ""
-        print(f"rtsgeom: warning: {command} " + what.format(", ".join(fields[:3]) + more),
-              file=sys.stderr)
+def show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """``warnings.showwarning`` of the commands: rtsgeom's own warnings as
+    ``rtsgeom: warning: <message>`` on stderr, any other as Python prints it."""
+    from ..errors import RtsgeomWarning
+    if issubclass(category, RtsgeomWarning):
+        print(f"rtsgeom: warning: {message}", file=sys.stderr)
+    else:
+        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
 
 
 # -- the front-end pair: --pair I J | all, --cell Q.. | all ----------------------------------
@@ -280,20 +279,61 @@ def print_outputs(args, name: str, out: dict, text) -> int:
 
 @contextmanager
 def progress(quiet: bool):
-    """A ``progress(label, done, total)`` callback drawing one rich bar on stderr, relabelled
-    at each stage (None when quiet or when stderr is not a terminal)."""
-    if quiet or not sys.stderr.isatty():
+    """A ``progress(label, done, total)`` callback on stderr (None when quiet): on a terminal
+    one rich bar, relabelled at each stage, that appears with the first count; elsewhere (a
+    log file, a pipe) plain lines ``rtsgeom: <label> 12/40 (30 %), 4.1 s, ETA 9.6 s``, one
+    every 10 % or 5 s and one at each stage's end."""
+    if quiet:
         yield None
+        return
+    if not sys.stderr.isatty():
+        yield LineProgress(sys.stderr)
         return
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                   TimeElapsedColumn(), console=Console(stderr=True), transient=True) as bar:
-        task = bar.add_task("", total=None)
+        task = None
 
         def update(label: str, done: int, total: int) -> None:
+            nonlocal task
+            if task is None:  # no bar before the first count (was an unlabelled "0/?")
+                task = bar.add_task(label, total=total)
             bar.update(task, description=label, completed=done, total=total)
         yield update
+
+
+class LineProgress:
+    """``progress(label, done, total)`` as plain lines on ``stream``: one every ``step`` of
+    the total or ``every_s`` seconds, whichever comes first, and one when a stage ends; the
+    ETA from the stage's mean rate so far."""
+
+    def __init__(self, stream, step: float = 0.1, every_s: float = 5.0, clock=time.monotonic):
+        self.stream, self.step, self.every_s, self.clock = stream, step, every_s, clock
+        self.label, self.last_frac = None, 0.0
+        self.start = self.last_t = self.previous = clock()  # a stage starts where the last ended
+
+    def __call__(self, label: str, done: int, total: int) -> None:
+        now = self.clock()
+        if label != self.label:
+            self.label, self.last_frac = label, 0.0
+            self.start = self.last_t = self.previous
+        self.previous = now
+        frac = done / total if total else 0.0
+        end = bool(total) and done >= total
+        if not (end or frac - self.last_frac >= self.step - 1e-12
+                or now - self.last_t >= self.every_s):
+            return
+        self.last_t, self.last_frac = now, frac
+        elapsed = now - self.start
+        line = f"rtsgeom: {label} {done}/{total}" if total else f"rtsgeom: {label} {done}"
+        if total:
+            line += f" ({100 * frac:.0f} %), {elapsed:.1f} s"
+            if 0 < done < total:
+                line += f", ETA {elapsed * (total - done) / done:.1f} s"
+        print(line, file=self.stream, flush=True)
+        if end:
+            self.label = None  # a stage counted again from zero prints afresh
 
 
 # -- the Monte-Carlo studies: tolerance and design ---------------------------------------------

@@ -114,7 +114,8 @@ def render_maps(result: RunResult, ds=None) -> dict[str, bytes]:
                                  if result.cube.clipped else ""))
     sets = np.array([[t.range_m, np.degrees(t.angle_rad)] for t in scene.targets]).reshape(-1, 2)
     f2 = range_angle_figure(ds.range_angle_db.values, rd.range_m, ds.angle_deg.values,
-                            detections=np.c_[det.range_m, det.angle_deg], set_points=sets)
+                            detections=np.c_[det.range_m, det.angle_deg], set_points=sets,
+                            title=f"{scene.name}: range-angle map")
     return {"range_doppler.png": figure_png(f1), "range_angle.png": figure_png(f2)}
 
 

@@ -11,12 +11,12 @@ import sys
 import numpy as np
 
 from .._lib.io import write_json
-from ..analysis.coverage import best_per_radius, coverage_designs
+from ..analysis.coverage import COVERAGE_MAPS, best_per_radius, coverage_designs
 from ..analysis.design import METRICS, check_azimuth_arc, design_grid
 from ..errors import ParameterError, UsageError
 from ..geometry import build_setup
 from ._common import (load_scene_checked, number, output_folder, pair_of, print_json, progress,
-                      study_options, warn_scene_errors)
+                      study_options)
 
 
 def _grid_spec(lo: float, hi: float, unit: str, max_n: int = 50):
@@ -53,8 +53,7 @@ def coverage_spec(text: str) -> tuple[float, float]:
 
 
 def cmd_design(args) -> int:
-    scene = load_scene_checked(args.scene)
-    warn_scene_errors(scene, "design")
+    scene = load_scene_checked(args.scene)  # the studies warn of the scene's own errors
     with output_folder(args.out, [args.scene]) as stage:
         return _design(args, scene, stage)
 
@@ -68,9 +67,18 @@ def _design(args, scene, stage) -> int:
         return _design_coverage(args, scene, stage)
     if args.draws is None:
         args.draws = 2000
-    pair = pair_of(build_setup(scene), args.pair)
+    setup = build_setup(scene)
+    pair = pair_of(setup, args.pair)
+    if setup.fe.count > 2 and not args.quiet:  # say which pair of the arc this is
+        others = ", ".join(f"{i} {i + 1}" for i in range(setup.fe.count - 1) if i != pair[0])
+        print(f"rtsgeom: note: design studies the pair {pair} of the scene's {setup.fe.count} "
+              f"front ends (its centre angle, spacing and radius varied); --pair I J for "
+              f"another adjacent pair ({others}), --coverage-deg A:B for the whole arc",
+              file=sys.stderr)
     seed = scene.seed if args.seed is None else args.seed
     with progress(args.quiet) as report:
+        if report is not None:  # the bar from the start, labelled with the count to come
+            report("designs", 0, len(args.radius_m) * len(args.spacing_deg))
         grid = design_grid(scene, pair, args.radius_m, args.spacing_deg, args.spec_deg,
                            args.yield_, args.draws, seed, args.points,
                            None if report is None else
@@ -78,18 +86,9 @@ def _design(args, scene, stage) -> int:
                            workers=args.workers)
     out = grid.to_dict()
     if stage is not None:
-        from ..viz.figures import design_heatmap_figure, design_lines_figure, save_figure
-        mask = grid.exceeds_resolution
-        # a single radius or spacing is a 1-D sweep: lines, not a heat map of one row/column
-        draw = (design_lines_figure if min(grid.radius_m.size, grid.spacing_deg.size) == 1
-                else design_heatmap_figure)
-        for name, (zlabel, title) in METRICS.items():
-            fig = draw(
-                grid.radius_m, grid.spacing_deg, grid.metrics[name], "arc radius R_c (m)",
-                "front-end spacing (deg)", zlabel,
-                f"{title} ({'hatched' if draw is design_heatmap_figure else 'hollow'}: spacing > "
-                f"{grid.angular_resolution_deg:.1f} deg, eq. 24)", mask=mask)
-            save_figure(fig, stage / f"design_{name}.png")
+        from ..viz.figures import save_figure
+        for name in METRICS:
+            save_figure(grid.plot(name), stage / f"design_{name}.png")
         write_json(stage / "design.json", out)
     sheet_note = _sheet_note(out["designs"])
     if args.json:
@@ -132,12 +131,6 @@ def _sheet_note(designs: list[dict]) -> str:
     return "note: " + "; ".join(parts) if parts else ""
 
 
-COVERAGE_MAPS = {
-    "worst_calibrated_deg": ("worst |angle error| (deg)", "Calibrated, over the coverage"),
-    "worst_uncalibrated_deg": ("worst |angle error| (deg)", "Uncalibrated, over the coverage"),
-    "sigma_mm": ("mounting sigma (mm)", "Tolerance for the yield (whole arc)"),
-    "front_ends": ("front ends", "Number of front ends"),
-}
 
 
 def _design_coverage(args, scene, folder) -> int:
@@ -145,25 +138,17 @@ def _design_coverage(args, scene, folder) -> int:
     seed = scene.seed if args.seed is None else args.seed
     draws = args.draws if args.draws is not None else 300
     with progress(args.quiet) as report:
+        if report is not None:  # two candidate arcs per radius
+            report("designs", 0, 2 * len(args.radius_m))
         grid = coverage_designs(scene, args.coverage_deg, args.radius_m, args.spec_deg,
                                 args.yield_, draws, seed, min(args.points, 11),
                                 progress=None if report is None else
                                 (lambda done, total: report("designs", done, total)))
     out = grid.to_dict()
     if folder is not None:
-        from ..viz.figures import design_heatmap_figure, save_figure
-        extras = sorted({d.plan.extra for d in grid.designs})
-        for name, (zlabel, title) in COVERAGE_MAPS.items():
-            z = np.full((len(extras), grid.radius_m.size), np.nan)
-            for d in (design.to_dict() for design in grid.designs):
-                i = int(np.argmin(np.abs(grid.radius_m - d["radius_m"])))
-                v = d.get(name)
-                z[extras.index(d["extra"]), i] = np.nan if v is None else float(v)
-            fig = design_heatmap_figure(
-                grid.radius_m, np.array(extras, float), z, "arc radius R_c (m)",
-                "front ends beyond the fewest", zlabel,
-                f"{title}, coverage {args.coverage_deg[0]:g}..{args.coverage_deg[1]:g} deg")
-            save_figure(fig, folder / f"coverage_{name}.png")
+        from ..viz.figures import save_figure
+        for name in COVERAGE_MAPS:
+            save_figure(grid.plot(name), folder / f"coverage_{name}.png")
         write_json(folder / "coverage.json", out)
     if args.json:
         print_json(out)

@@ -12,7 +12,7 @@ import numpy as np
 from ..analysis.nearfield import default_radii, nearfield, nearfield_figure
 from ..errors import ParameterError, UsageError
 from ._common import (load_scene_checked, number, output_folder, output_path, print_outputs,
-                      scene_arg, steps, warn_scene_errors, write_outputs)
+                      scene_arg, steps, write_outputs)
 
 
 def radius_sweep(text: str) -> tuple[float, float, int]:
@@ -77,8 +77,6 @@ def _nearfield_text(d: dict) -> str:
 
 def cmd_nearfield(args) -> int:
     scene = load_scene_checked(args.scene)
-    warn_scene_errors(scene, "nearfield", "analyses the arc's near field on the nominal setup: "
-                      "the scene's own errors ({}) play no part")
     if args.radius_m is None:
         radii = default_radii(scene)
     else:  # log-spaced with the ends exactly as given (logspace put 0.05 at 0.04999...)

@@ -12,7 +12,8 @@ import numpy as np
 from .._lib.io import write_json
 from .._lib.parallel import check_address, chunk_mapper
 from ..analysis.tolerance import (AXES, CASES, DISTRIBUTIONS, NOMINAL_AMPLITUDES, Bounds,
-                                  ChannelPhasors, ToleranceModel, max_sigma_for_yield, monte_carlo,
+                                  ChannelPhasors, ToleranceModel, max_scale_for_yield,
+                                  max_sigma_for_yield, monte_carlo,
                                   verify_draws)
 from ..analysis.tolerance.draws import draw_offsets
 from ..errors import AngleUnreachable, ClusterError, ParameterError, UsageError
@@ -115,9 +116,6 @@ def _study(args, scene, bounds: Bounds) -> ToleranceModel:
     if arc and args.verify:
         raise UsageError("--verify: only for one pair with offsets (not --pair all, "
                          "rotations or RuT-pose errors)")
-    if arc and args.invert_yield is not None:
-        raise UsageError("--invert-yield: only for one pair without rotation or RuT-pose errors "
-                         "so far (rtsgeom design --coverage-deg finds the arc's tolerance)")
     pairs = pairs_of(setup, args.pair)
     try:
         models = [ChannelPhasors.build(setup, p, args.points) for p in pairs]
@@ -126,6 +124,26 @@ def _study(args, scene, bounds: Bounds) -> ToleranceModel:
         raise UsageError(f"{which}: {'a' if arc else 'the'} pair cannot synthesize its span "
                          f"({exc})") from None
     return ToleranceModel.arc(models, setup.fe.count) if arc else ToleranceModel.of(models[0])
+
+
+def _scene_offsets_effect(scene, model) -> dict | None:
+    """The worst error the pair's own mounting offsets in the scene cause (the model's one
+    setup, the target at the bin centre), uncalibrated and calibrated: what the warning about
+    them means in degrees. None where the pair's front ends have no offsets (or errors the
+    phasor model does not take as an offset: rotations, gain or phase)."""
+    m = model.sets[0]
+    fes = [scene.rts.front_ends[q] for q in m.front_ends]
+    off = np.array([[f.radial_offset_m, f.tangential_offset_m, f.height_offset_m] for f in fes])
+    if not off.any() or any(getattr(f, name) != 0.0 for f in fes for name in
+                            ("yaw_offset_rad", "pitch_offset_rad", "gain_offset_db",
+                             "phase_offset_rad")):
+        return None
+    worst = m.evaluate(off[None], CASES)
+    keys = ("radial_offset_mm", "tangential_offset_mm", "height_offset_mm")
+    return {"fields": [f"rts.front_ends[{q}].{k}" for q, o in zip(m.front_ends, off)
+                       for k, v in zip(keys, o) if v != 0.0],
+            "model": "phasor level, one setup with the scene's offsets, target at the bin centre",
+            **{f"{case}_deg": float(np.max(np.abs(worst[case][0]))) for case in CASES}}
 
 
 def cmd_tolerance(args) -> int:
@@ -160,7 +178,13 @@ def _tolerance(args, scene, stage) -> int:
             out["verify"] = verify_draws(model.sets[0], sigma, min(args.verify, args.draws),
                                          seed, args.distribution, cases, progress=report,
                                          all_points=args.verify_all_points).to_dict()
-        if args.invert_yield is not None:
+        if args.invert_yield is not None and kind == "arc":  # every drawn scale, one factor
+            out["inversion"] = {
+                case: max_scale_for_yield(model, bounds, args.draws, seed, args.invert_yield,
+                                          args.spec_deg, case, args.distribution, chunk=chunk,
+                                          progress=report, mapper=mapper)
+                for case in CASES}
+        elif args.invert_yield is not None:
             out["inversion"] = {
                 case: max_sigma_for_yield(model, sigma, args.draws, seed, args.invert_yield,
                                           args.spec_deg, case, args.invert_axis,
@@ -168,6 +192,9 @@ def _tolerance(args, scene, stage) -> int:
                                           mapper=mapper)
                 for case in CASES}
     elapsed = time.perf_counter() - t0
+    own = _scene_offsets_effect(scene, model) if kind == "pair" else None
+    if own is not None:
+        out["scene_offsets"] = own
     if stage is not None:
         _write(stage, args, model, res, out, cases, seed)
     if args.json:
@@ -191,6 +218,10 @@ def _tolerance(args, scene, stage) -> int:
             print(f"  {case:>30}: |error| p50 {p['p50']:.4f}, p95 {p['p95']:.4f}, p99 "
                   f"{p['p99']:.4f}, max {p['max']:.4f} deg; yield {100 * st['yield']:.2f} % "
                   f"within {args.spec_deg:g} deg")
+        if own is not None:
+            print(f"  the scene's own offsets ({', '.join(own['fields'])}), one setup at the bin "
+                  f"centre: worst |error| uncalibrated {own['uncalibrated_deg']:.4f}, "
+                  f"calibrated {own['calibrated_deg']:.4f} deg")
     else:
         print(f"  target at a sub-bin position drawn per draw, uniform over one range bin "
               f"({out['subbin']['positions']} positions); the RuT's bin: set-points detected "
@@ -212,23 +243,9 @@ def _tolerance(args, scene, stage) -> int:
 def _write(stage, args, model: ToleranceModel, res, out: dict, cases, seed: int) -> None:
     """``--out DIR``: tolerance.png, tolerance.json and tolerance_draws.npz (per-draw errors
     and worst angle errors, for sensitivity analysis)."""
-    from ..viz.figures import save_figure, tolerance_cdf_figure, tolerance_histogram_figure
+    from ..viz.figures import save_figure
     m = model.sets[0]
-    if model.kind == "arc":
-        p95 = max(out["arc"][case]["angle_error_deg"]["p95"] for case in cases)
-        lim = max(5 * args.spec_deg, 1.2 * p95)
-        fig = tolerance_histogram_figure(
-            {case: np.clip(res.arc_worst(case), -lim, lim) for case in cases}, args.spec_deg,
-            f"Worst error per arc ({len(model.sets)} pairs, clipped at ±{lim:.2g} deg)")
-    elif model.kind == "cell":
-        # Empirical CDFs on a log axis of the worst angular distance per setup
-        fig = tolerance_cdf_figure({case: res.worst_error_deg[case][:, 2] for case in cases},
-                                   args.spec_deg, "Worst angular distance per setup, cell "
-                                   f"{tuple(m.front_ends)}")
-    else:  # the uncalibrated tail (degrees) and the calibrated (thousandths) both resolved
-        fig = tolerance_cdf_figure({case: res.worst_error_deg[case] for case in cases},
-                                   args.spec_deg, f"Worst |error| per setup, pair "
-                                   f"{tuple(m.front_ends)}")
+    fig = res.plot()  # the study, the drawn scales and the spec in its title
     save_figure(fig, stage / "tolerance.png")
     write_json(stage / "tolerance.json", out)
     if model.kind == "arc":
@@ -273,6 +290,13 @@ def _print_arc(args, model, out, cases, elapsed) -> None:
         print(f"  ARC {case:>28}: |worst error| p50 {a['angle_error_deg']['p50']:.4f}, p95 "
               f"{a['angle_error_deg']['p95']:.4f}, max {a['angle_error_deg']['max']:.4f} deg; "
               f"yield {100 * a['yield']:.2f} % (every pair within {args.spec_deg:g} deg)")
+    for case, inv in out.get("inversion", {}).items():
+        s = inv["scales"]
+        print(f"  {100 * args.invert_yield:g} % of arcs within {args.spec_deg:g} deg, {case}: "
+              f"the drawn scales x {inv['factor']:.4g}{' (search cap)' if inv['capped'] else ''}"
+              f" = {kind} radial {s['radial_mm']:.4g}, tangential {s['tangential_mm']:.4g}, "
+              f"height {s['height_mm']:.4g} mm, yaw {s['yaw_deg']:.4g}, pitch "
+              f"{s['pitch_deg']:.4g} deg")
 
 
 def _print_footer(out: dict, args, scale: str) -> None:

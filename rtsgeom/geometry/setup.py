@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import TYPE_CHECKING
@@ -15,12 +16,13 @@ from .arrays import RutArray, rut_array
 from .sheet import sheet_mesh
 from ..scene import FrontEndConfig, RadarConfig
 from ..scene.schema import specs
+from ..errors import NominalSetupWarning
 
 if TYPE_CHECKING:  # trimesh loads where the mesh is built (geometry.sheet)
     import trimesh
 
 __all__ = ["Setup", "build_setup", "nominal_setup", "nominal_scene", "setup_errors",
-           "FRONT_END_ERRORS", "RUT_POSE_ERRORS"]
+           "warn_setup_errors", "DRAWS_REPLACE", "FRONT_END_ERRORS", "RUT_POSE_ERRORS"]
 
 
 @dataclass(frozen=True)
@@ -87,6 +89,26 @@ def _channel_errors(radar) -> bool:
     """Whether the RuT's own channels (``[radar.channels]``) are not ideal."""
     ch = getattr(radar, "channels", None)
     return ch is not None and not ch.ideal
+
+
+#: what ``tolerance`` and ``design`` do with the scene's own errors (:func:`warn_setup_errors`)
+DRAWS_REPLACE = ("draws mounting errors about the nominal setup; the scene's own errors ({}) "
+                 "are not its starting point: each draw replaces them. Their effect on the "
+                 "synthesized angle: `rtsgeom linearity SCENE --uncalibrated` (and without "
+                 "the flag, calibrated), in Python rtsgeom.linearity(scene, calibration=False)")
+
+
+def warn_setup_errors(scene: Scene, study: str, what: str = DRAWS_REPLACE,
+                      stacklevel: int = 3) -> list[str]:
+    """Warn (:class:`~rtsgeom.errors.NominalSetupWarning`) that ``study`` works on the
+    nominal setup when the scene carries errors of its own (:func:`setup_errors`; ``what``:
+    the sentence after the study's name, ``{}`` the fields); return those fields."""
+    fields = setup_errors(scene)
+    if fields:
+        more = f" and {len(fields) - 3} more" if len(fields) > 3 else ""
+        warnings.warn(f"{study} " + what.format(", ".join(fields[:3]) + more),
+                      NominalSetupWarning, stacklevel=stacklevel)
+    return fields
 
 
 def _rut_pose_errors(radar) -> list[str]:

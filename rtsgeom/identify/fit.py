@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
+from .._lib.results import Result
 from ..geometry.setup import build_setup
 from ..scene import Scene
 from .model import PARAMS, ProbeModel, measure
@@ -219,15 +220,66 @@ def cramer_rao(models, theta, sigma2, free) -> np.ndarray:
     return std
 
 
-@dataclass(frozen=True)
-class Identification:
-    """Every front end's fit; :meth:`to_dict` is ``rtsgeom identify --json``."""
+# the fitted parameters as shown: (PARAMS index, name with its unit, SI -> that unit)
+SHOWN = ((0, "radial_offset_mm", 1e3), (1, "tangential_offset_mm", 1e3),
+         (2, "height_offset_mm", 1e3), (3, "yaw_offset_deg", 180 / np.pi),
+         (4, "delay_offset_ps", 1e12), (5, "gain_db", 20 / np.log(10)),
+         (6, "phase_deg", 180 / np.pi))
+
+
+@dataclass(frozen=True, repr=False)
+class Identification(Result):
+    """Every front end's fit; :meth:`to_dict` is ``rtsgeom identify --json``. ``print(ident)``
+    is a summary; ``to_dataframe()`` one row per front end (each parameter and its std, NaN
+    where not identifiable); ``plot()`` the mounting offsets with their 1-sigma bars."""
 
     scene: Scene
     fits: tuple[FrontEndFit, ...]
 
     def fit(self, q: int) -> FrontEndFit | None:
         return next((f for f in self.fits if f.index == q), None)
+
+    def _summary(self):
+        rows = []
+        for f in self.fits:
+            parts = [f"{short} {f.estimate[i] * k:.3g}+-{f.std[i] * k:.2g}"
+                     for (i, _, k), short in zip(SHOWN[:4], ("r", "t", "h", "yaw"))
+                     if f.reasons[i] is None]
+            rows.append((f"front end {f.index}", (" ".join(parts) + " (mm, yaw deg)" if parts
+                                                  else "nothing identifiable")
+                         + f", residual {f.residual_rms:.2f}, {f.captures} captures"))
+        return f"{self.scene.name}: {len(self.fits)} front ends identified", rows
+
+    def _columns(self) -> dict:
+        cols = {"front_end": [f.index for f in self.fits]}
+        for i, name, k in SHOWN:
+            ok = [f.reasons[i] is None for f in self.fits]
+            cols[name] = [f.estimate[i] * k if o else np.nan for f, o in zip(self.fits, ok)]
+            cols[name.rsplit("_", 1)[0] + "_std_" + name.rsplit("_", 1)[1]] = [
+                f.std[i] * k if o else np.nan for f, o in zip(self.fits, ok)]
+        cols["residual_rms"] = [f.residual_rms for f in self.fits]
+        return cols
+
+    def plot(self, title: str = ""):
+        """Each front end's fitted radial, tangential and height offset (mm) with 1 sigma."""
+        from ..viz.figures import STYLE, new_figure  # matplotlib: only for the figure
+        import matplotlib as mpl
+        cols = self._columns()
+        with mpl.rc_context(STYLE):
+            fig, ax = new_figure(figsize=(6.4, 3.6))
+            q = np.asarray(cols["front_end"], float)
+            for k, (_, name, _) in enumerate(SHOWN[:3]):
+                std = name.rsplit("_", 1)[0] + "_std_mm"
+                ax.errorbar(q + (k - 1) * 0.12, cols[name], yerr=cols[std], fmt="o",
+                            capsize=3, label=name.replace("_offset_mm", ""))
+            ax.axhline(0.0, color="0.4", linewidth=0.8)
+            ax.set_xticks(q)
+            ax.set_xlabel("front end")
+            ax.set_ylabel("fitted offset (mm), 1 sigma bars")
+            ax.legend(loc="best")
+            ax.set_title(title or f"{self.scene.name}: identified mounting offsets",
+                         parse_math=False)
+        return fig
 
     def to_dict(self) -> dict:
         out_fe, out_ch, keys = [], [], []

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import __version__
+from .._lib.results import Result
 from ..geometry import Setup, build_setup
 from ..paths import Paths, compute_paths
 from ..radar import AdcCube, Detections, RangeDoppler, process
@@ -23,12 +24,18 @@ from ..rts.channels import EchoKind, setup_echoes
 from .info import scene_info
 from .plan import plan_targets
 
+MAX_SUMMARY_TARGETS = 12  # targets listed in a summary
+
 __all__ = ["RunResult", "simulate", "run_scene", "match_targets", "label_detections",
            "noise_power"]
 
 
-@dataclass(frozen=True)
-class RunResult:
+@dataclass(frozen=True, repr=False)
+class RunResult(Result):
+    """One simulated frame of a scene and what the RuT detected. ``print(result)`` is a
+    summary; ``to_dataframe()`` one row per target (set, detected, error);
+    ``detections.to_dataframe()`` every detection; ``plot()`` the range-Doppler map."""
+
     scene: Scene
     setup: Setup
     paths: Paths
@@ -42,6 +49,43 @@ class RunResult:
     warnings: tuple[str, ...] = ()
     aoa_mode: str = "exact"  # the amplitude mode actually used
     link_budget: object = None  # rtsgeom.radar.budget.LinkBudget
+
+    def _summary(self):
+        title = (f"{self.scene.name}: one frame, {len(self.scene.targets)} targets, "
+                 f"{self.aoa_mode} amplitudes")
+        rows = [("cube", f"{'x'.join(str(n) for n in self.cube.data.shape)} ADC samples"
+                         + (f", {self.cube.clipped} CLIPPED" if self.cube.clipped else "")),
+                ("detections", len(self.detections.range_m))]
+        for m in self.matches[:MAX_SUMMARY_TARGETS]:
+            e = m.get("error")
+            rows.append((f"target {m['index']}", "not detected" if e is None else
+                         f"error {e['range_m'] * 1e3:+.1f} mm, {e['velocity_mps']:+.3g} m/s, "
+                         f"{e['angle_deg']:+.4f} deg"))
+        if len(self.matches) > MAX_SUMMARY_TARGETS:
+            rows.append(("...", f"{len(self.matches) - MAX_SUMMARY_TARGETS} more targets"))
+        rows += [("warnings", f"{len(self.warnings)}: {self.warnings[0]}" if self.warnings
+                  else "none")]
+        return title, rows
+
+    def _columns(self) -> dict:
+        cols: dict = {"target": [m["index"] for m in self.matches]}
+        for key in ("range_m", "velocity_mps", "angle_deg"):
+            cols[f"set_{key}"] = [m["set"][key] for m in self.matches]
+            cols[f"detected_{key}"] = [np.nan if m["detection"] is None
+                                       else m["detection"][key] for m in self.matches]
+            cols[f"error_{key}"] = [np.nan if m["error"] is None else m["error"][key]
+                                    for m in self.matches]
+        cols["snr_db"] = [np.nan if m["detection"] is None else m["detection"]["snr_db"]
+                          for m in self.matches]
+        return cols
+
+    def plot(self, title: str = ""):
+        """The range-Doppler map with the detections circled (as ``run`` writes it)."""
+        from ..viz.figures import range_doppler_figure  # matplotlib: only for the figure
+        det = self.detections
+        return range_doppler_figure(self.rd.power_db, self.rd.range_m, self.rd.velocity_mps,
+                                    detections=np.c_[det.range_m, det.velocity_mps],
+                                    title=title or f"{self.scene.name}: range-Doppler map")
 
 
 def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angle_rad=None,

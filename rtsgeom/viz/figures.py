@@ -313,7 +313,7 @@ def tolerance_cdf_figure(errors_deg_by_case: Mapping[str, object],
     floor = float(positive.min()) if positive.size else 1e-6
     if spec_deg is not None:
         floor = min(floor, abs(spec_deg))
-    fig, ax = new_figure(figsize=(6.4, 3.8))
+    fig, ax = new_figure(figsize=(6.4, 4.8))
     for name, a in cases.items():
         if not a.size:
             continue
@@ -333,7 +333,8 @@ def tolerance_cdf_figure(errors_deg_by_case: Mapping[str, object],
     ax.set_xlabel("|angle error| (deg)")
     ax.set_ylabel("fraction of setups")
     _title(ax, title or "Angle error distribution (empirical CDF)")
-    ax.legend(loc="best")
+    # below the axes: on them it covered a curve (every corner holds one of the CDFs)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncols=1, frameon=False)
     return fig
 
 
@@ -355,18 +356,41 @@ def _design_arrays(x, y, z, mask):
     return xv, yv, zv, m
 
 
+ANNOTATE_CELLS = 150  # a heat map of at most this many cells writes each value in its cell
+
+
 @_styled
 def design_heatmap_figure(x, y, z, xlabel: str, ylabel: str, zlabel: str, title: str,
-                          mask=None) -> Figure:
+                          mask=None, contour_floor: float | None = None,
+                          integer_y: bool = False, integer_z: bool = False) -> Figure:
     """Heat map of a figure of merit ``z`` (shape (len(y), len(x))) over two design parameters,
     e.g. arc radius vs front-end spacing with colour = worst angle error. ``mask`` (same shape,
-    True = excluded, e.g. infeasible) greys out and hatches cells. Labels should carry units."""
+    True = excluded, e.g. infeasible) greys out and hatches cells (and the legend says so only
+    where a cell is hatched). Labels should carry units.
+
+    Contour lines only at levels >= ``contour_floor`` (a level below it, e.g. 1e-5 deg of a
+    0.1 deg spec, is the noise of the evaluation, not a design contour; None: any level) and
+    none when fewer than two such levels exist. A small map (<= :data:`ANNOTATE_CELLS` cells)
+    writes each value in its cell. A map whose every |value| is below ``contour_floor`` is
+    coloured over [0, floor] (its differences are noise). ``integer_y``/``integer_z``:
+    whole-number ticks on the y axis / colour bar (a count)."""
+    from matplotlib.ticker import MaxNLocator
     xv, yv, zv, m = _design_arrays(x, y, z, mask)
     shown = np.ma.masked_array(zv, mask=m | ~np.isfinite(zv))
     fig, ax = new_figure()
     ax.set_facecolor("0.85")
-    mesh = ax.pcolormesh(xv, yv, shown, shading="nearest", rasterized=True)
-    fig.colorbar(mesh, ax=ax, label=zlabel)
+    kw = {}
+    if contour_floor is not None and shown.count() and float(np.abs(shown).max()) < contour_floor:
+        # every value below the meaningful level: colours over [0, floor], not over the noise
+        kw = dict(vmin=0.0, vmax=float(contour_floor))
+    if integer_z and shown.count():
+        lo, hi = float(shown.min()), float(shown.max())
+        kw = dict(vmin=lo - 0.5, vmax=max(hi, lo + 1) + 0.5)
+    mesh = ax.pcolormesh(xv, yv, shown, shading="nearest", rasterized=True, **kw)
+    bar = fig.colorbar(mesh, ax=ax, label=zlabel)
+    if integer_z:
+        bar.locator = MaxNLocator(integer=True)
+        bar.update_ticks()
     if m.any():
         xe, ye = _cell_edges(xv), _cell_edges(yv)
         for j, i in zip(*np.nonzero(m)):
@@ -375,14 +399,38 @@ def design_heatmap_figure(x, y, z, xlabel: str, ylabel: str, zlabel: str, title:
         ax.add_patch(Rectangle((0, 0), 0, 0, facecolor="0.85", hatch="//", edgecolor="0.55",
                                label="excluded", visible=True))
         ax.legend(loc="upper right")
-    if min(xv.size, yv.size) >= 3 and shown.count() >= 4:
-        cs = ax.contour(xv, yv, shown, levels=5, colors="white", linewidths=0.7)
-        ax.clabel(cs, fontsize=7, fmt="%.3g")
+    if zv.size <= ANNOTATE_CELLS:
+        norm = mesh.norm
+        for j, i in zip(*np.nonzero(~np.ma.getmaskarray(shown))):
+            v = float(zv[j, i])
+            dark = norm(v) < 0.55 if np.isfinite(norm(v)) else True
+            ax.text(xv[i], yv[j], f"{v:.0f}" if integer_z else f"{v:.3g}", ha="center",
+                    va="center", fontsize=7, color="white" if dark else "black")
+    elif min(xv.size, yv.size) >= 3 and shown.count() >= 4:
+        _contours(ax, xv, yv, shown, contour_floor)
+    if integer_y:
+        ax.set_yticks(yv)
+        ax.set_yticklabels([f"{v:.0f}" for v in yv])
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     _title(ax, title)
     ax.grid(False)
     return fig
+
+
+def _contours(ax, xv, yv, shown, floor: float | None) -> None:
+    """White contour lines at 'nice' levels within the data, those below ``floor`` left out."""
+    from matplotlib.ticker import MaxNLocator
+    lo, hi = float(shown.min()), float(shown.max())
+    if floor is not None:
+        lo = max(lo, float(floor))
+    if not hi > lo:
+        return
+    levels = [v for v in MaxNLocator(6).tick_values(lo, hi) if lo <= v <= hi]
+    if len(levels) < 2:
+        return
+    cs = ax.contour(xv, yv, shown, levels=levels, colors="white", linewidths=0.7)
+    ax.clabel(cs, fontsize=7, fmt="%.3g")
 
 
 @_styled

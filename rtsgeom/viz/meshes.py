@@ -16,7 +16,7 @@ from ..paths.table import FE_TO_RX, RUT_TO_RUT, TX_TO_FE
 __all__ = ["TARGET_RADIUS_FACTOR", "rgb", "rut_scale_factor", "scaled", "board", "merge",
            "spheres", "polyline", "merge_lines", "arc_points", "angle_span", "cutout_rims",
            "modules", "target_positions", "split_paths", "hit_points",
-           "undrawable_reflections", "path_polylines"]
+           "undrawable_reflections", "path_polylines", "REFLECTION_BY_BOUNCES"]
 
 TARGET_RADIUS_FACTOR = 1.5  # targets are drawn at this multiple of the arc radius
 
@@ -25,9 +25,11 @@ PANEL_BACKGROUND = "#e8eaee"
 SHEET = "#aab1ba"
 SHEET_LEGEND = "#6b7280"  # the legend writes its text in the entry colour
 RIM = "#2b2f36"
-ARC = "#1f6fb4"
-LOS = "#12a150"
-REFLECTION = "#d62f8c"
+ARC = "#8c564b"  # brown: blue is the RuT's Rx, green the front ends' Rx
+LOS = "#00a6c8"  # cyan: distinct from every element's colour (geometry.export.COLOURS)
+REFLECTION = "#d62f8c"  # a single bounce; more bounces lighter (REFLECTION_BY_BOUNCES)
+#: reflections coloured by their bounce count: 1, 2, 3 or more
+REFLECTION_BY_BOUNCES = (REFLECTION, "#ee8fc2", "#f6c7df")
 TARGET = "#7b3fb8"
 MODULE = "#5c6670"
 
@@ -160,16 +162,18 @@ def undrawable_reflections(paths) -> int:
     return int(sum(len(hit_points(vertices, i)) == 0 for i in refl))
 
 
-def path_polylines(setup: Setup, paths, scale: float) -> tuple[list[np.ndarray], list[np.ndarray]]:
+def path_polylines(setup: Setup, paths, scale: float, bounces: bool = False
+                   ) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """Line-of-sight and reflected path polylines; RuT ends at the drawn (scaled) elements.
 
     ``paths``: a :class:`Paths` table or a ray-tracing result; a reflection is drawn through
-    its hit points (``vertices``, NaN rows past the last interaction are dropped)."""
+    its hit points (``vertices``, NaN rows past the last interaction are dropped).
+    ``bounces``: the reflections as a dict bounce count -> polylines instead of a list."""
     rut, fe = setup.rut, setup.fe
     tx = scaled(rut.tx_world, rut.position, scale)
     rx = scaled(rut.rx_world, rut.position, scale)
     paths, vertices = split_paths(paths)
-    los, refl = [], []
+    los, refl, counts = [], [], []
     for i in range(len(paths)):
         d, f = int(paths.direction[i]), int(paths.front_end[i])
         if d == TX_TO_FE:
@@ -189,6 +193,12 @@ def path_polylines(setup: Setup, paths, scale: float) -> tuple[list[np.ndarray],
             continue  # no hit points: counted by undrawable_reflections and noted in the view
         pts = [start] + [p for p in v if not (np.allclose(p, start) or np.allclose(p, end))] + [end]
         refl.append(np.array(pts))
+        counts.append(int(paths.bounces[i]))
+    if bounces:
+        by: dict[int, list] = {}
+        for n, poly in zip(counts, refl):
+            by.setdefault(n, []).append(poly)
+        return los, dict(sorted(by.items()))
     return los, refl
 
 

@@ -18,7 +18,9 @@ started only as a last resort (see :func:`ensure_render_backend`).
 
 from __future__ import annotations
 
+import html
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -26,8 +28,8 @@ import pyvista as pv
 
 from ..geometry import Setup
 from .._lib.io import atomic_path, write_text
-from .meshes import (ARC, BACKGROUND, LOS, MODULE, PANEL_BACKGROUND, REFLECTION, RIM, SHEET,
-                     SHEET_LEGEND, TARGET, TARGET_RADIUS_FACTOR, angle_span, arc_points, board,
+from .meshes import (ARC, BACKGROUND, LOS, MODULE, PANEL_BACKGROUND, REFLECTION_BY_BOUNCES,
+                     RIM, SHEET, SHEET_LEGEND, TARGET, TARGET_RADIUS_FACTOR, angle_span, arc_points, board,
                      cutout_rims, merge, merge_lines, modules, path_polylines, polyline, rgb,
                      rut_scale_factor, scaled, spheres, split_paths, target_positions,
                      undrawable_reflections)
@@ -87,13 +89,26 @@ def _add_setup(pl, setup: Setup, paths, scale: float, labels: str) -> list:
 
     # propagation paths
     if paths is not None and len(split_paths(paths)[0]):
-        los, refl = path_polylines(setup, paths, scale)
+        los, refl = path_polylines(setup, paths, scale, bounces=True)
         if los:
             pl.add_mesh(merge_lines(los), color=LOS, line_width=2, opacity=0.8)
-            legend.append(["line of sight", LOS])
-        if refl:
-            pl.add_mesh(merge_lines(refl), color=REFLECTION, line_width=2, opacity=0.8)
-            legend.append(["reflections", REFLECTION])
+            legend.append([f"line of sight ({len(los)})", LOS])
+        # by bounce count (the last colour: that many or more), the fainter drawn first
+        top = len(REFLECTION_BY_BOUNCES)
+        groups: dict[int, list] = {}
+        for n, polys in refl.items():
+            groups.setdefault(min(n, top), []).extend(polys)
+        for n in sorted(groups, reverse=True):
+            # hundreds of rays (ray tracing: ~1000 off the sheet) drawn faint enough that the
+            # elements behind them stay visible; a few stay bold
+            k = len(groups[n])
+            pl.add_mesh(merge_lines(groups[n]), color=REFLECTION_BY_BOUNCES[n - 1],
+                        line_width=2 if k <= 50 else 1,
+                        opacity=float(np.clip(30.0 / k, 0.1, 0.8)))
+        for n in sorted(groups):
+            word = f"{n}{'+' if n == top else ''} bounce{'s' if n > 1 else ''}"
+            legend.append([f"reflections, {word} ({len(groups[n])})",
+                           REFLECTION_BY_BOUNCES[n - 1]])
 
     if labels != "none":
         _add_labels(pl, setup, scale, text3d=labels == "3d")
@@ -264,8 +279,10 @@ def build_plotter(setup: Setup, paths=None, window_size=(1600, 1000), off_screen
             warnings.warn(msg, stacklevel=2)
             note += f"; {missing} reflected paths not drawn (no hit points)"
     pl.add_text(note, position="lower_left", font_size=9, color="#333333")
-    pl.add_legend(legend, bcolor="white", background_opacity=0.8, border=True, size=(0.25, 0.22),
-                  loc="upper right", face="rectangle")
+    pl.add_legend(legend, bcolor="white", background_opacity=0.8, border=True,
+                  size=(0.25, 0.22 + 0.02 * max(len(legend) - 8, 0)), loc="upper right",
+                  face="rectangle")
+    pl._rtsgeom_legend = legend  # the HTML export writes it into the page (no screen text there)
     _set_overview_camera(pl, setup, scale, shift_left=0.1 if side_panels else 0.0)
     if side_panels:
         pl.subplot(0, 2)
@@ -327,7 +344,8 @@ def export_setup_html(setup: Setup, path: str | Path, paths=None) -> Path:
 
     Needs optional packages (with pyvista >= 0.49: ``trame-pyvista`` and ``nest-asyncio2``);
     without them :class:`VizError` names what to install. Screen-space text does not survive
-    the export, so the labels are drawn as flat text meshes and there is no legend.
+    the export, so the labels are drawn as flat text meshes and the legend is an HTML box;
+    the page's title is ``rtsgeom — <scene name>``.
     """
     import importlib.util
     need = _html_requirements()
@@ -342,10 +360,27 @@ def export_setup_html(setup: Setup, path: str | Path, paths=None) -> Path:
     try:
         component = getattr(pl, "trame", None)
         buf = component.export_html(None) if component is not None else pl.export_html(None)
+        legend = getattr(pl, "_rtsgeom_legend", [])
     finally:
         pl.close()
-    write_text(path, buf.getvalue())
+    write_text(path, _html_page(buf.getvalue(), setup.scene.name, legend))
     return path
+
+
+def _html_page(page: str, scene_name: str, legend) -> str:
+    """The exported page titled ``rtsgeom — <scene>`` (was the viewer's example title) with
+    the view's legend as an HTML box (screen-space text does not survive the export)."""
+    from matplotlib.colors import to_hex  # matplotlib: only for the HTML page
+    name = html.escape(scene_name)
+    page = re.sub(r"<title>.*?</title>", lambda m: f"<title>rtsgeom — {name}</title>", page,
+                  count=1, flags=re.S)
+    rows = "".join(f'<div><span style="display:inline-block;width:12px;height:12px;'
+                   f'margin-right:6px;background:{to_hex(colour)}"></span>'
+                   f"{html.escape(text)}</div>" for text, colour in legend)
+    box = (f'<div id="rtsgeom-legend" style="position:fixed;top:8px;right:8px;z-index:10;'
+           f'background:rgba(255,255,255,0.85);border:1px solid #888;padding:6px 8px;'
+           f'font:12px sans-serif"><b>rtsgeom — {name}</b>{rows}</div>')
+    return re.sub(r"<body([^>]*)>", lambda m: m.group(0) + box, page, count=1)
 
 
 def show_setup(setup: Setup, paths=None, interactive: bool = True, window_size=(1600, 1000)):

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.constants import c
 
+from ..._lib.results import Result
 from ...geometry import build_setup
 from ...paths import exact_paths
 from ...radar import process
@@ -32,8 +33,8 @@ from .phasors import CASES, ChannelPhasors
 __all__ = ["VerifyResult", "verify_draws"]
 
 
-@dataclass(frozen=True)
-class VerifyResult:
+@dataclass(frozen=True, repr=False)
+class VerifyResult(Result):
     """Per draw and case: the model's and the chain's direction error (deg) at the verified
     set-points (NaN where the chain detected nothing): a pair's (N,) at each draw's worst
     set-point, (N, M) with ``all_points``; a cell's (N, P, 2) (azimuth, elevation)."""
@@ -45,6 +46,32 @@ class VerifyResult:
     subbin_steps: np.ndarray  # (N,) the draws' sub-bin offsets (delay steps)
     dims: int = 1
     all_points: bool = False
+
+    def _summary(self):
+        n = int(next(iter(self.model_deg.values())).shape[0]) if self.model_deg else 0
+        rows = []
+        for case in self.model_deg:
+            d = self.difference_deg(case)
+            fin = d[np.isfinite(d)]
+            rows.append((case, f"|chain - model| max {np.max(fin, initial=0):.3g} deg, "
+                               f"{int(np.sum(~np.isfinite(d)))} missed"))
+        rows.append(("elapsed_s", self.elapsed_s))
+        return f"{n} draws through the full ADC-cube chain against the phasor model", rows
+
+    def _columns(self) -> dict:
+        cols = {}
+        for case in self.model_deg:
+            d = self.difference_deg(case)
+            cols.setdefault("draw", np.arange(d.size))
+            cols[f"{case}_difference_deg"] = d
+            if self.dims == 1 and not self.all_points:
+                cols[f"{case}_model_deg"] = self.model_deg[case]
+                cols[f"{case}_chain_deg"] = self.chain_deg[case]
+        return cols
+
+    def plot(self, title: str = ""):
+        """Per case, the chain's error against the model's (deg) and the line of agreement."""
+        return _verify_figure(self, title)
 
     def difference_deg(self, case: str) -> np.ndarray:
         """|chain - model| per draw (the largest over its verified set-points and angles),
@@ -159,3 +186,25 @@ def verify_draws(model: ChannelPhasors, sigma_m, n: int, seed: int, distribution
         index = {case: np.full(n, -1) for case in cases}
     return VerifyResult(index, out["model"], out["chain"], time.perf_counter() - t0,
                         model.subbin_steps[sub], dims, all_points)
+
+
+def _verify_figure(res: VerifyResult, title: str = ""):
+    """The chain's worst error against the model's per draw and case (deg)."""
+    import matplotlib as mpl
+    from ...viz.figures import STYLE, new_figure
+    with mpl.rc_context(STYLE):
+        fig, ax = new_figure(figsize=(5.2, 4.4))
+        lim = 0.0
+        for case in res.model_deg:
+            m = np.asarray(res.model_deg[case], float).ravel()
+            ch = np.asarray(res.chain_deg[case], float).ravel()
+            ok = np.isfinite(m) & np.isfinite(ch)
+            ax.plot(m[ok], ch[ok], "o", mfc="none", label=f"{case} ({int(ok.sum())} of {m.size})")
+            lim = max(lim, float(np.max(np.abs(np.r_[m[ok], ch[ok]]), initial=0)))
+        lim = lim * 1.05 or 1.0
+        ax.plot([-lim, lim], [-lim, lim], color="0.4", linewidth=0.8, label="agreement")
+        ax.set_xlabel("phasor model error (deg)")
+        ax.set_ylabel("full-chain error (deg)")
+        ax.legend(loc="upper left")
+        ax.set_title(title or "Tolerance draws through the full chain", parse_math=False)
+    return fig
