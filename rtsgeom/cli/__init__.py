@@ -16,8 +16,9 @@ import sys
 import threading
 
 from .. import __version__
-from ..errors import (ClusterError, OutputError, RaytraceUnavailable, SceneError, Terminated,
-                      UsageError)
+from ..errors import (AngleUnreachable, CalibrationFailed, CaptureError, CellUnreachable,
+                      ClusterError, OutputError, ParameterError, RaytraceUnavailable,
+                      SceneError, Terminated, UsageError, VizError)
 
 __all__ = ["main", "build_parser"]
 
@@ -124,7 +125,9 @@ def main(argv: list[str] | None = None) -> int:
 def _dispatch(args) -> int:
     try:
         return int(args.func(args) or 0)
-    except (SceneError, UsageError, OutputError, ClusterError, RaytraceUnavailable) as exc:
+    except (SceneError, UsageError, OutputError, ClusterError, RaytraceUnavailable,
+            ParameterError, CaptureError, AngleUnreachable, CellUnreachable,
+            CalibrationFailed, VizError) as exc:  # every error rtsgeom raises on purpose
         print(f"rtsgeom: error: {exc}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # the reader went away (`rtsgeom ... | head`): stop quietly
