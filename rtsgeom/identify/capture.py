@@ -61,8 +61,7 @@ SIDECAR_DCA1000 = {
     "chirps": Spec("chirps", "int", "chirps in the file", lo=1, hi=4096 * 64),
     "tx_order": Spec("tx_order", "ints", "Tx per TDM slot", lo=0, hi=63, min_items=1,
                      max_items=64),
-    "scale": Spec("scale", "float", "int16 counts per capture unit", lo=0.0, hi=1e30,
-                  lo_open=True),
+    "scale": Spec("scale", "float", "int16 counts per capture unit", lo=1e-30, hi=1e30),
 }
 
 
