@@ -93,6 +93,21 @@ def test_info_json_of_degenerate_custom_arrays_is_finite(kind, tmp_path, capsys)
         assert "fewer than two" in info["apparent_azimuth_unavailable"]
 
 
+@pytest.mark.parametrize("kind", list(_ARRAYS))
+def test_run_refuses_an_array_without_azimuth_aperture_naming_it(kind, tmp_path, capsys):
+    """run on the diagonal array ended in a traceback (CalibrationFailed after an All-NaN
+    RuntimeWarning); single and vertical arrays in a span of [-90, -90] deg."""
+    tx, rx, order = _ARRAYS[kind]
+    text = (ROOT / "scenes" / "custom-array.toml").read_text()
+    text = re.sub(r"^tx_mm = .*$", f"tx_mm = {tx}", text, flags=re.M)
+    text = re.sub(r"^rx_mm = .*$", f"rx_mm = {rx}", text, flags=re.M)
+    text = re.sub(r"^tx_order = .*$", f"tx_order = {order}", text, flags=re.M)
+    p = _with(text, tmp_path)
+    assert main(["run", str(p), "--out", str(tmp_path / "out"), "--no-report"]) == 2
+    _clean_error(capsys.readouterr().err, "radar.array", "at least 2")
+    assert not (tmp_path / "out").exists()
+
+
 def _pattern(tmp_path, gain):
     rows = ["azimuth_deg,elevation_deg,gain_db,phase_deg"]
     rows += [f"{a},{e},{gain if a == 0 else 0},0" for a in range(-90, 91, 10) for e in (-10, 0, 10)]
@@ -285,6 +300,12 @@ def test_from_identified_writes_a_calibration_file_run_reads(tmp_path, capsys):
     probe, cals = load_calibration(doc, build_setup(rtsgeom.load_scene(DEFAULT_SCENE)))
     assert list(cals) == [(0, 1)] and np.all(np.isfinite(probe.angle_rad))
     assert np.allclose(probe.gain_correction, 1.0)  # the bundled scene has no gain errors
+    capsys.readouterr()
+    assert main(["run", str(DEFAULT_SCENE), "--calibration", str(out / "calibration.json"),
+                 "--out", str(tmp_path / "run"), "--no-report"]) == 0
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert all(t["detection"] is not None and abs(t["error"]["angle_deg"]) < 0.05
+               for t in summary["targets"])
 
 
 # -- Python arguments -------------------------------------------------------------------------
