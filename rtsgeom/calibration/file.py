@@ -88,7 +88,7 @@ def load_calibration(doc: dict, setup) -> tuple[FrontEndProbe, dict]:
                              "calibrations")
         cals = {}
         for k, p in enumerate(pairs):
-            check_record(PAIR_FIELDS, p, f"{where}: pairs[{k}]")
+            check_record(PAIR_FIELDS, p, where, where=f"pairs[{k}]")
             cal = Calibration.from_dict(p)
             cals[cal.pair] = cal
     except SceneError:

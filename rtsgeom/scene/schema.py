@@ -344,24 +344,25 @@ def _check_list(s: Spec, v: Any, ctx: _Ctx, path: str) -> tuple:
 # --------------------------------------------------------------------------------------------
 
 
-def check_record(declared: dict[str, Spec], data: Any, source: str, error: type = SceneError
-                 ) -> dict[str, Any]:
+def check_record(declared: dict[str, Spec], data: Any, source: str, error: type = SceneError,
+                 where: str = "") -> dict[str, Any]:
     """A plain record (a capture's sidecar, a calibration file's JSON) against declared fields
     ``{key: Spec}``: the values normalised (file units), ``None`` for an absent optional one.
     Keys not declared are ignored (files carry descriptive extras); a missing required key and
     every value out of its declaration raise ``error`` as ``<source>: <key> = <value>: must be
-    <allowed>``, like the scene file's."""
-    ctx = _Ctx(source, "", error)
+    <allowed>``, like the scene file's; ``where``: the record's place in its file
+    (``pairs[0]``), prefixed to each key."""
+    ctx = _Ctx(source, where, error)
     if not isinstance(data, dict):
-        ctx.fail("<top level>", data, "a JSON object")
+        ctx.fail(where or "<top level>", data, "a JSON object")
     out: dict[str, Any] = {}
     for key, s in declared.items():
         if key not in data or (data[key] is None and s.default is None):
             if s.default is REQUIRED:
-                raise error(f"{source}: {key} is missing (required)")
+                raise error(f"{source}: {ctx.path(key)} is missing (required)")
             out[key] = s.default
             continue
-        out[key] = check_value(s, data[key], ctx, key)
+        out[key] = check_value(s, data[key], ctx, ctx.path(key))
     return out
 
 
