@@ -106,9 +106,15 @@ def _command_of(argv: list[str]) -> str | None:
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
-    parser = build_parser(_command_of(argv), lazy=True)
-    args = parser.parse_args(argv)
-    with honoured_signals():
+    with honoured_signals():  # from the start: the command's module loads the heavy libraries
+        try:
+            args = build_parser(_command_of(argv), lazy=True).parse_args(argv)
+        except Terminated:
+            print("rtsgeom: terminated", file=sys.stderr)
+            return 143
+        except KeyboardInterrupt:
+            print("rtsgeom: interrupted", file=sys.stderr)
+            return 130
         code = _dispatch(args)
         if code not in (130, 143) and received() is not None:
             # the signal's exception was swallowed (a callback printed "Exception ignored"):
