@@ -176,12 +176,12 @@ def tolerance(scene: Scene, pair=(0, 1), sigma_mm=(0.1, 0.1, 0.1), draws: int = 
         ``worst_error_deg[case]`` per draw for ``'uncalibrated'`` and ``'calibrated'``,
         ``yield_(case)``, ``stats(case)`` and ``to_dict()``.
     """
-    from .analysis.tolerance import ChannelPhasors, monte_carlo
+    from .analysis.tolerance import MAX_SIGMA_MM, ChannelPhasors, monte_carlo
     from .geometry import build_setup
     check_scene_arg(scene, "tolerance")
     _study_args("tolerance", draws, seed, distribution, spec_deg, points)
     sigma = np.asarray(check_arg(sigma_mm, "sigma_mm", "vec", "tolerance", ParameterError,
-                                 n=3, lo=0.0, hi=100.0, unit="mm"), float) * 1e-3
+                                 n=3, lo=0.0, hi=MAX_SIGMA_MM, unit="mm"), float) * 1e-3
     setup = build_setup(scene)
     pair = _check_pair(setup, pair)
     model = ChannelPhasors.build(setup, pair, points)

@@ -322,7 +322,7 @@ _API = [  # call, exception, words of the message
     (lambda s: rtsgeom.replace(s, radar={"f_c_hz": 77e9}), SceneError, "a RadarConfig"),
     (lambda s: rtsgeom.tolerance(s, sigma_mm=math.nan), ParameterError, "sigma_mm = nan"),
     (lambda s: rtsgeom.tolerance(s, sigma_mm=(0.1, math.nan, 0.1)), ParameterError,
-     "finite numbers in [0, 100] mm"),
+     "finite numbers in [0, 10] mm"),
     (lambda s: rtsgeom.tolerance(s, sigma_mm=0.1), ParameterError, "a list of 3 numbers"),
     (lambda s: rtsgeom.tolerance(s, draws=0), ParameterError, "draws = 0: must be in [1, 1e+07]"),
     (lambda s: rtsgeom.tolerance(s, draws=-5), ParameterError, "draws = -5"),
