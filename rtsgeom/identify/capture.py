@@ -30,8 +30,6 @@ __all__ = ["Capture", "capture_probe", "simulate_capture", "write_capture", "rea
            "check_capture_radar"]
 
 
-
-
 #: the radar fields a capture records and ``identify`` compares with the scene's (a capture made
 #: with another chirp or carrier reads as a silently wrong phase: 0.5 GHz of f_c turned a
 #: channel's phase by 121 deg at a residual of 1.06 x noise)
@@ -224,7 +222,8 @@ def read_capture(path, shape=None, max_bytes: int = MAX_CAPTURE_BYTES) -> Captur
                      CaptureError)
     radar = None
     if meta.get("radar") is not None:
-        radar = check_record(_radar_fields(), meta["radar"], f"{side}: radar", CaptureError)
+        radar = check_record(_radar_fields(), meta["radar"], str(side), CaptureError,
+                             where="radar")
     probe = (v["active_front_end"], v["probe_range_m"], v["probe_velocity_mps"],
              v["probe_amplitude"])
     # numpy's own errors for a file that is no .npy / a .bin of the wrong size (ValueError,
