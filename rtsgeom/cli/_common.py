@@ -57,7 +57,7 @@ def output_file_path(text: str) -> Path:
     """argparse type of an ``--out`` that names one file (``adc``, ``paths``): a trailing
     slash names a folder, which ``Path`` would drop (``newdir/`` became a *file* newdir)."""
     path = output_path(text)
-    if text.endswith(("/", os.sep)) or (path.exists() and path.is_dir()):
+    if text.endswith(("/", os.sep)):  # an existing folder: check_output_file names it
         raise argparse.ArgumentTypeError(f"{text!r} names a folder: give the file to write "
                                          f"(e.g. {text.rstrip('/' + os.sep) or '.'}/out.csv)")
     return path
