@@ -185,8 +185,8 @@ def _npy_header(path: Path, shape, max_bytes: int) -> None:
     except (ValueError, OSError, EOFError, SyntaxError) as exc:
         raise CaptureError(f"{path}: not a .npy array ({str(exc)[:120]})") from None
     if len(got) != 3 or dtype.kind != "c":
-        raise CaptureError(f"{path}: {dtype} {list(got)}: must be a complex [loop, virtual, "
-                           "sample] cube")
+        raise CaptureError(f"{path}: expected a complex [loop, virtual, sample] cube, got "
+                           f"{dtype} {list(got)}")
     if shape is not None and tuple(got) != tuple(shape):
         raise CaptureError(f"{path}: shape {list(got)}: must be the scene's radar "
                            f"{list(shape)} [loop, virtual, sample]")
