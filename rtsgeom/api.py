@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from .errors import ParameterError, SceneError
-from .scene import Scene
-from .scene.schema import fmt, specs
+from .scene import Scene, check_scene_arg
+from .scene.schema import check_arg, fmt, specs
 
 __all__ = ["replace", "calibrate", "linearity", "tolerance", "design", "nearfield", "ghosts",
            "transfer", "show", "play"]
@@ -99,7 +99,8 @@ def _is_number(value) -> bool:
     return isinstance(value, tuple) and all(_is_number(v) for v in value)
 
 
-def _setup_paths(scene: Scene):
+def _setup_paths(scene: Scene, fn: str):
+    check_scene_arg(scene, fn)
     from .geometry import build_setup
     from .paths import exact_paths
     setup = build_setup(scene)
@@ -108,8 +109,23 @@ def _setup_paths(scene: Scene):
 
 def _check_pair(setup, pair) -> tuple[int, int]:
     from .pipeline.plan import check_pair
+    if (not isinstance(pair, (tuple, list, np.ndarray)) or len(pair) != 2
+            or not all(isinstance(p, (int, np.integer)) and not isinstance(p, bool)
+                       for p in pair)):
+        raise ParameterError(f"pair = {fmt(pair)}: must be two front-end indices (i, j)")
     i, j = (int(p) for p in pair)
-    return check_pair(setup, i, j, f"pair {tuple(pair)}")
+    return check_pair(setup, i, j, f"pair {(i, j)}")
+
+
+def _study_args(fn: str, draws, seed, distribution, spec_deg, points) -> None:
+    """The Monte-Carlo studies' arguments, with the CLI's ranges (``cli._common.study_options``)."""
+    check_arg(draws, "draws", "int", fn, ParameterError, lo=1, hi=10_000_000)
+    if seed is not None:
+        check_arg(seed, "seed", "int", fn, ParameterError, lo=0, hi=2 ** 63 - 1)
+    check_arg(distribution, "distribution", "str", fn, ParameterError,
+              choices=("normal", "uniform"))
+    check_arg(spec_deg, "spec_deg", "float", fn, ParameterError, lo=1e-6, hi=90.0, unit="deg")
+    check_arg(points, "points", "int", fn, ParameterError, lo=3, hi=201)
 
 
 def calibrate(scene: Scene, pair=(0, 1)):
@@ -130,14 +146,14 @@ def calibrate(scene: Scene, pair=(0, 1)):
         ``rtsgeom calibrate``.
     """
     from .calibration.pair import calibrate_pair
-    setup, paths, pair, probe = _pair_setup(scene, pair)
+    setup, paths, pair, probe = _pair_setup(scene, pair, "calibrate")
     return calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
 
 
-def _pair_setup(scene: Scene, pair):
+def _pair_setup(scene: Scene, pair, fn: str):
     """Setup, exact paths, the checked pair and each front end alone as the RuT detects it."""
     from .calibration.probes import probe_front_ends
-    setup, paths = _setup_paths(scene)
+    setup, paths = _setup_paths(scene, fn)
     pair = _check_pair(setup, pair)
     return setup, paths, pair, probe_front_ends(setup, paths, scene.seed)
 
@@ -168,7 +184,11 @@ def linearity(scene: Scene, pair=(0, 1), amplitudes: str = "exact", calibration=
     """
     from .calibration.pair import calibrate_pair
     from .analysis.linearity import linearity as _linearity
-    setup, paths, pair, probe = _pair_setup(scene, pair)
+    from .scene.registry import SYNTHESIS_MODES
+    check_arg(amplitudes, "amplitudes", "str", "linearity", ParameterError,
+              choices=SYNTHESIS_MODES)
+    check_arg(points, "points", "int", "linearity", ParameterError, lo=3, hi=1001)
+    setup, paths, pair, probe = _pair_setup(scene, pair, "linearity")
     if calibration is True:
         cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
     elif calibration is False or calibration is None:
@@ -215,14 +235,17 @@ def tolerance(scene: Scene, pair=(0, 1), sigma_mm=(0.1, 0.1, 0.1), draws: int = 
         The scene carries mounting, channel or RuT pose errors of its own: the draws start
         from the nominal setup, not from them.
     """
-    from .analysis.tolerance import ChannelPhasors, monte_carlo
+    from .analysis.tolerance import MAX_SIGMA_MM, ChannelPhasors, monte_carlo
     from .geometry import build_setup
+    check_scene_arg(scene, "tolerance")
     from .geometry.setup import warn_setup_errors
     warn_setup_errors(scene, "tolerance", stacklevel=3)  # NominalSetupWarning
+    _study_args("tolerance", draws, seed, distribution, spec_deg, points)
+    sigma = np.asarray(check_arg(sigma_mm, "sigma_mm", "vec", "tolerance", ParameterError,
+                                 n=3, lo=0.0, hi=MAX_SIGMA_MM, unit="mm"), float) * 1e-3
     setup = build_setup(scene)
     pair = _check_pair(setup, pair)
     model = ChannelPhasors.build(setup, pair, points)
-    sigma = np.asarray(sigma_mm, float).reshape(3) * 1e-3
     return monte_carlo(model, sigma, draws, scene.seed if seed is None else seed, distribution,
                        spec_deg)
 
@@ -254,6 +277,10 @@ def design(scene: Scene, radius_m, spacing_deg, pair=(0, 1), spec_deg: float = 0
     """
     from .analysis.design import design_grid
     from .geometry import build_setup
+    check_scene_arg(scene, "design")
+    _study_args("design", draws, seed, "normal", spec_deg, points)
+    check_arg(target_yield, "target_yield", "float", "design", ParameterError, lo=0.0, hi=1.0,
+              lo_open=True, hi_open=True)
     pair = _check_pair(build_setup(scene), pair)
     return design_grid(scene, pair, np.atleast_1d(radius_m), np.atleast_1d(spacing_deg),
                        spec_deg, target_yield, draws, scene.seed if seed is None else seed,
@@ -276,6 +303,8 @@ def nearfield(scene: Scene, radius_m=None, points: int = 11):
     NearField
     """
     from .analysis.nearfield import nearfield as _nearfield
+    check_scene_arg(scene, "nearfield")
+    check_arg(points, "points", "int", "nearfield", ParameterError, lo=1, hi=201)
     return _nearfield(scene, radius_m, points)
 
 
@@ -329,6 +358,9 @@ def ghosts(scene: Scene, floor_db: float = -80.0, simulate: bool = False):
     GhostReport
     """
     from .analysis.ghosts import ghost_analysis
+    check_scene_arg(scene, "ghosts")
+    check_arg(floor_db, "floor_db", "float", "ghosts", ParameterError, lo=-300.0, hi=-1.0,
+              unit="dB")
     return ghost_analysis(scene, floor_db, simulate)
 
 

@@ -54,9 +54,10 @@ def test_help_imports_no_numeric_library(tmp_path):
     assert code == 0
     heavy = _loaded(mods, ("numpy", "scipy", *OPTIONAL))
     assert heavy == [], f"rtsgeom --help imports {heavy}"
-    # the CLI and the exceptions it reports (rtsgeom.errors imports nothing), no pipeline stage
+    # the CLI, its signal handling and the exceptions it reports (rtsgeom.errors imports
+    # nothing), no pipeline stage
     assert not [m for m in mods if m.startswith("rtsgeom.")
-                and m not in ("rtsgeom.cli", "rtsgeom.errors")], (
+                and m not in ("rtsgeom.cli", "rtsgeom.cli._signals", "rtsgeom.errors")], (
         "rtsgeom --help imports parts of the pipeline")
 
 

@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 from rtsgeom.cli import main
+from rtsgeom.errors import Terminated
 
 from conftest import DEFAULT_SCENE, ROOT
 
@@ -423,3 +424,64 @@ def test_report_tables_are_readable(nearest_result):
                 "scene_sha256"):
         assert raw not in body, raw
     assert "yes" in body and "range resolution" in body
+
+
+def _wait_for_the_signal(limit_s: float = 2.0) -> None:
+    """Idle until the deferred signal's exception comes (within a few ms); fail after."""
+    t = time.monotonic()
+    while time.monotonic() - t < limit_s:
+        time.sleep(0.005)
+    raise AssertionError("the signal was not raised")
+
+
+def test_a_signal_during_an_import_is_raised_after_it(tmp_path, monkeypatch):
+    """SIGTERM arriving while a module is imported (the heavy libraries' start-up) is raised
+    once the import is done: the module is whole (an exception inside VTK's or trimesh's
+    import left them half-initialised: a segmentation fault, a TypeError)."""
+    from rtsgeom.cli._signals import honoured_signals, received
+    (tmp_path / "slow_mod_sig.py").write_text(
+        "import os, signal, time\nos.kill(os.getpid(), signal.SIGTERM)\n"
+        "t = time.monotonic()\nwhile time.monotonic() - t < 0.1:\n    pass\nDONE = True\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    with pytest.raises(Terminated):
+        with honoured_signals():
+            import slow_mod_sig
+            _wait_for_the_signal()
+    assert slow_mod_sig.DONE and received() == signal.SIGTERM
+    sys.modules.pop("slow_mod_sig", None)
+
+
+def test_a_signal_in_a_finalizer_is_not_swallowed():
+    """SIGINT arriving in a __del__ used to be printed as 'Exception ignored' and dropped (the
+    run went on and exited 0): it is raised after the finalizer."""
+    from rtsgeom.cli._signals import honoured_signals
+
+    class Sends:
+        def __del__(self):
+            os.kill(os.getpid(), signal.SIGINT)
+            t = time.monotonic()
+            while time.monotonic() - t < 0.05:
+                pass
+
+    with pytest.raises(KeyboardInterrupt):
+        with honoured_signals():
+            Sends()  # collected at once: the signal arrives inside __del__
+            _wait_for_the_signal()
+
+
+def test_a_swallowed_signal_still_ends_the_command_with_its_code(monkeypatch, capsys):
+    """Whatever swallowed the exception, a command that received SIGTERM exits 143, not 0."""
+    import rtsgeom.cli as cli
+    from rtsgeom.cli import _signals
+
+    def swallowed(args):
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.05)
+        except Terminated:  # what "Exception ignored in ..." amounts to
+            pass
+        return 0
+    monkeypatch.setattr(cli, "_dispatch", lambda args: swallowed(args))
+    assert cli.main(["info", str(DEFAULT_SCENE)]) == 143
+    assert "rtsgeom: terminated" in capsys.readouterr().err
+    assert _signals.received() == signal.SIGTERM

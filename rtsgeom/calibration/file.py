@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SceneError
+from ..scene.schema import Spec, check_record
 from .sweep import Calibration
 from .probes import FrontEndProbe
 
@@ -16,6 +17,14 @@ __all__ = ["CALIBRATION_FORMAT", "setup_fingerprint", "calibration_mismatch",
 
 CALIBRATION_FORMAT = "rtsgeom-calibration"
 GAIN_RANGE = (0.1, 10.0)  # a gain correction beyond +-20 dB is not a front end's tolerance
+#: one pair's entry of a calibration file, declared like the scene's fields (the delay's range
+#: is the scene's calibration span, checked below)
+PAIR_FIELDS = {
+    "pair": Spec("pair", "ints", "the two front ends", lo=0, hi=10_000, min_items=2,
+                 max_items=2),
+    "delta_tau_s": Spec("delta_tau_s", "float", "the pair's calibration delay", unit="s",
+                        lo=-1.0, hi=1.0),
+}
 
 
 def setup_fingerprint(scene) -> str:
@@ -77,11 +86,17 @@ def load_calibration(doc: dict, setup) -> tuple[FrontEndProbe, dict]:
         ang = np.radians(np.asarray(doc["front_end_angles_deg"], float))
         gain = np.asarray(doc.get("gain_correction", np.ones(n)), float)
         pairs = doc["pairs"] if "pairs" in doc else [doc]
+        if not isinstance(pairs, list) or not pairs:
+            raise SceneError(f"{where}: pairs = {pairs!r:.60}: must be a list of pair "
+                             "calibrations")
         cals = {}
         for k, p in enumerate(pairs):
+            check_record(PAIR_FIELDS, p, where, where=f"pairs[{k}]")
             cal = Calibration.from_dict(p)
             cals[cal.pair] = cal
-    except (KeyError, TypeError, ValueError) as exc:
+    except SceneError:
+        raise
+    except (KeyError, TypeError, ValueError, IndexError, AttributeError, OverflowError) as exc:
         raise SceneError(f"{where}: not an rtsgeom calibration ({exc!s}): write one with "
                          "`rtsgeom calibrate SCENE --out DIR`") from None
     if ang.shape != (n,) or gain.shape != (n,):

@@ -13,12 +13,13 @@ import importlib
 import os
 import signal as _sig
 import sys
-import threading
 import warnings
 
 from .. import __version__
-from ..errors import (ClusterError, OutputError, RaytraceUnavailable, RtsgeomWarning, SceneError,
-                      Terminated, UsageError)
+from ..errors import (AngleUnreachable, CalibrationFailed, CaptureError, CellUnreachable,
+                      ClusterError, OutputError, ParameterError, RaytraceUnavailable,
+                      RtsgeomWarning, SceneError, Terminated, UsageError, VizError)
+from ._signals import honoured_signals, received
 
 __all__ = ["main", "build_parser"]
 
@@ -61,10 +62,6 @@ class _Parser(argparse.ArgumentParser):
         sub = self.prog.split(" ", 1)[1] if " " in self.prog else ""
         where = f"{sub}: " if sub else ""
         self.exit(2, f"rtsgeom: error: {where}{message} (see '{self.prog} --help')\n")
-
-
-def _on_sigterm(signum, frame):
-    raise Terminated()
 
 
 def build_parser(command: str | None = None, *, lazy: bool = False) -> argparse.ArgumentParser:
@@ -113,16 +110,23 @@ def _command_of(argv: list[str]) -> str | None:
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
-    parser = build_parser(_command_of(argv), lazy=True)
-    args = parser.parse_args(argv)
-    old = None
-    if threading.current_thread() is threading.main_thread():
-        old = _sig.signal(_sig.SIGTERM, _on_sigterm)
-    try:
-        return _dispatch(args)
-    finally:
-        if old is not None:
-            _sig.signal(_sig.SIGTERM, old)
+    with honoured_signals():  # from the start: the command's module loads the heavy libraries
+        try:
+            args = build_parser(_command_of(argv), lazy=True).parse_args(argv)
+        except Terminated:
+            print("rtsgeom: terminated", file=sys.stderr)
+            return 143
+        except KeyboardInterrupt:
+            print("rtsgeom: interrupted", file=sys.stderr)
+            return 130
+        code = _dispatch(args)
+        if code not in (130, 143) and received() is not None:
+            # the signal's exception was swallowed (a callback printed "Exception ignored"):
+            # the command still does not end as if nothing happened
+            term = received() == _sig.SIGTERM
+            print(f"rtsgeom: {'terminated' if term else 'interrupted'}", file=sys.stderr)
+            code = 143 if term else 130
+    return code
 
 
 def _dispatch(args) -> int:
@@ -132,7 +136,9 @@ def _dispatch(args) -> int:
             warnings.simplefilter("always", RtsgeomWarning)
             warnings.showwarning = show_warning
             return int(args.func(args) or 0)
-    except (SceneError, UsageError, OutputError, ClusterError, RaytraceUnavailable) as exc:
+    except (SceneError, UsageError, OutputError, ClusterError, RaytraceUnavailable,
+            ParameterError, CaptureError, AngleUnreachable, CellUnreachable,
+            CalibrationFailed, VizError) as exc:  # every error rtsgeom raises on purpose
         print(f"rtsgeom: error: {exc}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # the reader went away (`rtsgeom ... | head`): stop quietly

@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import sys
 import time
 import warnings
@@ -23,7 +24,8 @@ from .._lib.io import check_output_file, staged_dir, write_json
 from ..errors import ParameterError, UsageError
 
 __all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checked", "steps",
-           "output_path", "output_folder", "output_file", "warn_scene_errors", "show_warning",
+           "output_path", "output_file_path", "output_folder", "output_file",
+           "warn_scene_errors", "show_warning",
            "pair_word", "pair_of", "pairs_of", "pair_options", "prepare_pair", "prepare_arc",
            "emit_result", "write_outputs", "print_outputs", "progress", "study_options",
            "read_calibration", "calibration_kw"]
@@ -51,6 +53,16 @@ def output_path(text: str) -> Path:
     if text == "":
         raise argparse.ArgumentTypeError("'' names no file or folder")
     return Path(text)
+
+
+def output_file_path(text: str) -> Path:
+    """argparse type of an ``--out`` that names one file (``adc``, ``paths``): a trailing
+    slash names a folder, which ``Path`` would drop (``newdir/`` became a *file* newdir)."""
+    path = output_path(text)
+    if text.endswith(("/", os.sep)):  # an existing folder: check_output_file names it
+        raise argparse.ArgumentTypeError(f"{text!r} names a folder: give the file to write "
+                                         f"(e.g. {text.rstrip('/' + os.sep) or '.'}/out.csv)")
+    return path
 
 
 @contextmanager

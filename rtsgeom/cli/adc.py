@@ -13,7 +13,7 @@ from ..errors import CaptureError, ParameterError, UsageError
 from ..pipeline.run import run_scene
 from ..radar.dca1000 import to_dca1000
 from ..scene.registry import AOA_MODES
-from ._common import (calibration_kw, load_scene_checked, number, output_file, output_path,
+from ._common import (calibration_kw, load_scene_checked, number, output_file, output_file_path,
                       scene_arg, steps)
 
 
@@ -76,7 +76,7 @@ def _probe_capture(scene, args) -> int:
 def register(sub) -> None:
     p = sub.add_parser("adc", help="save the raw ADC cube (.npy) or a DCA1000 capture")
     scene_arg(p)
-    p.add_argument("--out", type=output_path, required=True, help="output file")
+    p.add_argument("--out", type=output_file_path, required=True, help="output file")
     p.add_argument("--format", choices=("npy", "dca1000"), default=None,
                    help="npy (complex64 cube) or dca1000 (TI's raw int16 capture + sidecar "
                         "JSON); default: dca1000 for a .bin file, else npy")

@@ -26,9 +26,7 @@ def cmd_calibrate(args) -> int:
             if args.full_chain or args.procedure != "exact" or args.fir:
                 raise UsageError("--from-identified predicts the delay without a sweep: "
                                  "--full-chain, --procedure and --fir do not apply")
-            from ..identify import calibrate_from_identified
-            scene = load_scene_checked(args.from_identified)
-            out = calibrate_from_identified(scene, pair_of(build_setup(scene), args.pair)).to_dict()
+            out = _from_identified(args)
             if stage is not None:
                 write_json(stage / "calibration.json", out)
             if args.json:
@@ -38,6 +36,37 @@ def cmd_calibrate(args) -> int:
                       f"(predicted from {args.from_identified}, no sweep)")
             return 0
         return _calibrate(args, stage)
+
+
+#: the fields ``rtsgeom identify --out`` writes into a scene (all else is SCENE's)
+IDENTIFIED_FIELDS = ("radial_offset_m", "tangential_offset_m", "height_offset_m",
+                     "yaw_offset_rad", "gain_offset_db", "phase_offset_rad")
+
+
+def _from_identified(args) -> dict:
+    """``--from-identified FILE``: the pair's delay predicted on FILE (SCENE as identified),
+    as a calibration file ``run --calibration`` reads: the front ends' detected angles and
+    the gain corrections of the identified channel gains. FILE must be SCENE apart from the
+    fields identify writes (:data:`IDENTIFIED_FIELDS`), else it is refused."""
+    from ..identify import calibrate_from_identified, detected_angles, setup_of
+    scene = load_scene_checked(args.scene)
+    ident = load_scene_checked(args.from_identified)
+    fes, own = ident.rts.front_ends, scene.rts.front_ends
+    same = len(fes) == len(own) and setup_fingerprint(ident.evolve(rts=ident.rts.evolve(
+        front_ends=tuple(f.evolve(**{k: getattr(g, k) for k in IDENTIFIED_FIELDS})
+                         for f, g in zip(fes, own))))) == setup_fingerprint(scene)
+    if not same:
+        raise UsageError(f"--from-identified {args.from_identified}: not SCENE {args.scene} "
+                         "as identified (its radar, arc, front ends or RTS differ beyond the "
+                         "mounting and channel fields `rtsgeom identify --out` writes)")
+    pair = pair_of(build_setup(ident), args.pair)
+    out = calibrate_from_identified(ident, pair).to_dict()
+    gain = [10 ** (-f.gain_offset_db / 20) for f in fes]  # what the probe step would measure
+    out.update({"front_end_angles_deg": [float(x) for x in
+                                         np.degrees(detected_angles(setup_of(ident)))],
+                "gain_correction": gain, "format": "rtsgeom-calibration",
+                "setup_sha256": setup_fingerprint(ident)})
+    return out
 
 
 def _calibrate(args, stage) -> int:

@@ -5,10 +5,12 @@ gain, phase and delay) from probe captures (``rtsgeom adc --active I``) with
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 from ..errors import CaptureError, UsageError
 from ..identify import identified_scene_toml, identify, read_capture
+from ..identify.fit import RESIDUAL_LIMIT
 from ._common import load_scene_checked, output_folder, output_path, print_json, scene_arg, steps
 
 
@@ -20,7 +22,7 @@ def _text(d: dict) -> str:
 
     for fe, ch in zip(d["front_ends"], d["channels"]):
         lines.append(f"front end {fe['index']} ({fe['captures']} capture(s), residual "
-                     f"{fe['residual_rms']:.2f} x noise):")
+                     f"{fe['residual_rms']:.2f} x noise{', MISFIT' if fe.get('misfit') else ''}):")
         for key, unit in (("radial_offset_mm", "mm"), ("tangential_offset_mm", "mm"),
                           ("height_offset_mm", "mm"), ("yaw_offset_deg", "deg")):
             lines.append(f"  {key:22s} {val(fe[key], unit)}")
@@ -34,20 +36,30 @@ def _text(d: dict) -> str:
     return "\n".join(lines)
 
 
+#: captures one ``identify`` reads (each is reduced to its probe's bin as it is read)
+MAX_CAPTURES = 1024
+
+
 def cmd_identify(args) -> int:
+    if len(args.captures) > MAX_CAPTURES:
+        raise UsageError(f"CAPTURE: {len(args.captures)} captures: must be at most "
+                         f"{MAX_CAPTURES}")
     with output_folder(args.out, [args.scene, *args.captures]) as stage:
         scene = load_scene_checked(args.scene)
-        try:
-            caps = [read_capture(p) for p in args.captures]
-        except (OSError, CaptureError) as exc:
-            raise UsageError(f"CAPTURE: {exc}") from None
+        from ..geometry import build_setup
+        rut = build_setup(scene).rut
+        shape = (scene.radar.chirps_per_tx, rut.num_virtual, scene.radar.samples_per_chirp)
+        caps = (read_capture(p, shape) for p in args.captures)  # one cube in memory at a time
         with steps(args.quiet or args.json) as step:
-            step(f"fitting {len(caps)} capture(s) of front end(s) "
-                 f"{sorted({c.active for c in caps})}")
+            step(f"fitting {len(args.captures)} capture(s)")
             try:
-                ident = identify(scene, caps)
-            except CaptureError as exc:
+                ident = identify(scene, caps, accept_misfit=args.accept_misfit)
+            except (OSError, CaptureError) as exc:
                 raise UsageError(f"CAPTURE: {exc}") from None
+        for f in ident.fits:
+            if f.misfit is not None:
+                print(f"rtsgeom: warning: {f.misfit}; accepted (--accept-misfit), its "
+                      "estimates are flagged misfit in the output", file=sys.stderr)
         d = ident.to_dict()
         if stage is not None:
             text = Path(args.scene).read_text(encoding="utf-8")
@@ -75,6 +87,9 @@ def register(sub) -> None:
     p.add_argument("--out", type=output_path, default=None,
                    help="folder for identified.toml (the corrected scene) and identified.json")
     p.add_argument("--quiet", action="store_true", help="no progress output")
+    p.add_argument("--accept-misfit", action="store_true",
+                   help="write the estimates of a fit whose residual exceeds "
+                        f"{RESIDUAL_LIMIT:g} x noise (flagged misfit) instead of refusing them")
     p.set_defaults(func=cmd_identify)
 
 

@@ -6,7 +6,7 @@ from .._lib.io import write_text
 from ..geometry import build_setup
 from ..paths import compute_paths
 from ..scene.registry import PATH_METHODS
-from ._common import load_scene_checked, output_file, output_path, scene_arg
+from ._common import load_scene_checked, output_file, output_file_path, scene_arg
 
 
 def cmd_paths(args) -> int:
@@ -21,7 +21,7 @@ def cmd_paths(args) -> int:
 def register(sub) -> None:
     p = sub.add_parser("paths", help="per-element propagation paths as CSV")
     scene_arg(p)
-    p.add_argument("--out", type=output_path, required=True, help="CSV file to write")
+    p.add_argument("--out", type=output_file_path, required=True, help="CSV file to write")
     p.add_argument("--method", choices=tuple(PATH_METHODS), default="exact",
                    help="exact line-of-sight distances (default) or Sionna RT ray tracing")
     p.set_defaults(func=cmd_paths)

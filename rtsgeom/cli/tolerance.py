@@ -15,7 +15,7 @@ from ..analysis.tolerance import (AXES, CASES, DISTRIBUTIONS, NOMINAL_AMPLITUDES
                                   ChannelPhasors, ToleranceModel, max_scale_for_yield,
                                   max_sigma_for_yield, monte_carlo,
                                   verify_draws)
-from ..analysis.tolerance.draws import draw_offsets
+from ..analysis.tolerance.draws import MAX_SIGMA_MM, draw_offsets
 from ..errors import AngleUnreachable, ClusterError, ParameterError, UsageError
 from ..geometry import build_setup
 from ..radar.steering import Steering
@@ -24,7 +24,6 @@ from ._common import (load_scene_checked, number, output_folder, pair_word, pair
 
 #: ``tolerance``'s ``--pair`` default, by identity: left at it, a 2-D RuT gets the cell study
 DEFAULT_PAIR = [0, 1]
-MAX_SIGMA_MM = 10.0  # the phasor model is first order in the errors; checked to 0.3 mm
 #: Peak memory of one Monte-Carlo chunk is at most about ``chunk * chunk_bytes_per_draw(points)``
 #: (measured with tracemalloc, all three cases, the target's sub-bin position drawn per draw:
 #: 17 kB/draw at 5 set-points, 40 kB at 21, 112 kB at 61; a chunk is evaluated in blocks of the

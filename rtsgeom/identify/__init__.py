@@ -40,7 +40,8 @@ from .capture import Capture, capture_probe, read_capture, simulate_capture, wri
 from .built import (PredictedCalibration, calibrate_from_identified, detected_angles,
                     identified_scene, identified_scene_toml, predicted_calibration, setup_of)
 from .crb import crb_figure, crb_grid
-from .fit import (MIN_EIGENVALUE, SEPARATE_BY, STD_LIMIT, FrontEndFit, Identification, cramer_rao,
+from .fit import (ESTIMATE_LIMITS, MIN_EIGENVALUE, RESIDUAL_LIMIT, SEPARATE_BY, STD_LIMIT,
+                  FrontEndFit, Identification, check_fit, cramer_rao,
                   fisher, fit_front_end, free_parameters, identify)
 from .model import PARAMS, ProbeModel, measure
 
@@ -49,4 +50,5 @@ __all__ = ["PARAMS", "Capture", "ProbeModel", "FrontEndFit", "Identification", "
            "free_parameters", "fit_front_end", "identify", "cramer_rao", "STD_LIMIT",
            "MIN_EIGENVALUE", "SEPARATE_BY", "identified_scene", "identified_scene_toml",
            "setup_of", "detected_angles", "PredictedCalibration", "predicted_calibration",
-           "calibrate_from_identified", "crb_grid", "crb_figure"]
+           "calibrate_from_identified", "crb_grid", "crb_figure", "RESIDUAL_LIMIT",
+           "ESTIMATE_LIMITS", "check_fit"]

@@ -5,6 +5,7 @@ plus a sidecar ``FILE.json`` recording the active front end and the probe), the 
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from dataclasses import dataclass
 from pathlib import Path
@@ -13,6 +14,8 @@ import numpy as np
 from scipy.constants import c
 
 from ..errors import CaptureError
+from ..scene import RadarConfig
+from ..scene.schema import Spec, check_record, specs
 from ..geometry import Setup
 from ..paths import exact_paths
 from ..rts.channels import RtsProgram, nominal_link_gain, requested_delay, target_amplitude
@@ -22,9 +25,49 @@ from ..calibration.probes import probe_ranges
 from ..radar.dca1000 import from_dca1000, to_dca1000
 from ..radar.fmcw import AdcCube
 
-__all__ = ["Capture", "capture_probe", "simulate_capture", "write_capture", "read_capture"]
+__all__ = ["Capture", "capture_probe", "simulate_capture", "write_capture", "read_capture",
+           "SIDECAR", "SIDECAR_DCA1000", "RADAR_KEYS", "MAX_CAPTURE_BYTES", "radar_record",
+           "check_capture_radar"]
 
 
+#: the radar fields a capture records and ``identify`` compares with the scene's (a capture made
+#: with another chirp or carrier reads as a silently wrong phase: 0.5 GHz of f_c turned a
+#: channel's phase by 121 deg at a residual of 1.06 x noise)
+RADAR_KEYS = ("f_c_hz", "bandwidth_hz", "chirp_duration_s", "chirp_repetition_s",
+              "samples_per_chirp", "adc_rate_hz", "adc_start_s", "chirps_per_tx")
+#: the largest capture read without a scene to size it by (bytes); with one, its exact size
+MAX_CAPTURE_BYTES = 4 << 30
+MAX_SIDECAR_BYTES = 1 << 20
+
+
+#: a capture's sidecar, declared like the scene's fields (``scene.schema``): ranges, kinds,
+#: sizes; the DCA1000 fields only for a ``.bin`` capture
+SIDECAR = {
+    "active_front_end": Spec("active_front_end", "int", "the front end alone on the probe",
+                             lo=0, hi=10_000),
+    "probe_range_m": Spec("probe_range_m", "float", "the probe's range", unit="m", lo=0.0,
+                          hi=1e4, lo_open=True),
+    "probe_velocity_mps": Spec("probe_velocity_mps", "float", "the probe's radial velocity",
+                               unit="m/s", lo=-1e3, hi=1e3),
+    "probe_amplitude": Spec("probe_amplitude", "float", "programmed amplitude of the probe's "
+                            "channel", lo=0.0, hi=1e12, lo_open=True),
+}
+SIDECAR_DCA1000 = {
+    "num_rx": Spec("num_rx", "int", "receivers", lo=1, hi=64),
+    "samples_per_chirp": Spec("samples_per_chirp", "int", "samples per chirp", lo=16,
+                              hi=8192),
+    "chirps": Spec("chirps", "int", "chirps in the file", lo=1, hi=4096 * 64),
+    "tx_order": Spec("tx_order", "ints", "Tx per TDM slot", lo=0, hi=63, min_items=1,
+                     max_items=64),
+    "scale": Spec("scale", "float", "int16 counts per capture unit", lo=1e-30, hi=1e30),
+}
+
+
+def _radar_fields() -> dict:
+    """The scene's own declarations of :data:`RADAR_KEYS` (optional in a sidecar: captures
+    written before they were recorded have none)."""
+    own = dict((s.key, s) for _, s in specs(RadarConfig))
+    return {k: dataclasses.replace(own[k], default=None) for k in RADAR_KEYS}
 
 
 @dataclass(frozen=True)
@@ -36,10 +79,35 @@ class Capture:
     range_m: float
     velocity_mps: float
     amplitude: float  # programmed amplitude of the probe's channel
+    radar: dict | None = None  # RADAR_KEYS of the radar that recorded it (None: not recorded)
+    source: str = "capture"  # what messages call it (its file)
 
     def to_meta(self) -> dict:
-        return {"active_front_end": self.active, "probe_range_m": self.range_m,
+        meta = {"active_front_end": self.active, "probe_range_m": self.range_m,
                 "probe_velocity_mps": self.velocity_mps, "probe_amplitude": self.amplitude}
+        if self.radar is not None:
+            meta["radar"] = dict(self.radar)
+        return meta
+
+
+def radar_record(radar) -> dict:
+    """:data:`RADAR_KEYS` of a scene's ``RadarConfig`` in the scene file's units."""
+    return {k: getattr(radar, k) for k in RADAR_KEYS}
+
+
+def check_capture_radar(cap: Capture, radar) -> None:
+    """A capture's recorded radar against the scene's (relative 1e-6): raise naming the first
+    field that differs. Captures without the record pass (older files)."""
+    if cap.radar is None:
+        return
+    for k in RADAR_KEYS:
+        have, want = cap.radar.get(k), getattr(radar, k)
+        if have is None:
+            continue
+        if not abs(have - want) <= 1e-6 * abs(want):
+            raise CaptureError(f"{cap.source}: radar.{k} = {have:g}: must be the scene's "
+                               f"{want:g} (the capture was recorded with another radar "
+                               "configuration; identify it against a scene with that radar)")
 
 
 def capture_probe(setup: Setup, range_m: float | None = None) -> tuple[float, float]:
@@ -66,7 +134,8 @@ def simulate_capture(setup: Setup, active: int, range_m: float | None = None,
     f_d = 2 * scene.radar.f_c_hz * velocity_mps / c
     prog = RtsProgram.build([0], [active], [float(requested_delay(scene, r))], [f_d], [amp])
     _, cube = simulate(setup, paths, prog, seed, scene.radar.snr_db)
-    return Capture(cube.data, int(active), r, float(velocity_mps), amp)
+    return Capture(cube.data, int(active), r, float(velocity_mps), amp,
+                   radar_record(scene.radar))
 
 
 def write_capture(cap: Capture, rut, out: Path, fmt: str) -> dict:
@@ -89,9 +158,51 @@ def write_capture(cap: Capture, rut, out: Path, fmt: str) -> dict:
     return meta
 
 
-def read_capture(path) -> Capture:
+def _read_sidecar(side: Path) -> dict:
+    """The sidecar's JSON, bounded: size, nesting and integer length errors become the
+    capture's error instead of a RecursionError or a huge allocation."""
+    if side.stat().st_size > MAX_SIDECAR_BYTES:
+        raise CaptureError(f"{side}: {side.stat().st_size} bytes: must be a sidecar of at most "
+                           f"{MAX_SIDECAR_BYTES} bytes")
+    try:
+        return json.loads(side.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError, ValueError) as exc:
+        raise CaptureError(f"{side}: not JSON ({str(exc)[:120]})") from None
+    except RecursionError:
+        raise CaptureError(f"{side}: not a probe capture's sidecar (JSON nested too deeply)") \
+            from None
+
+
+def _npy_header(path: Path, shape, max_bytes: int) -> None:
+    """Refuse a ``.npy`` whose header promises another shape or more than ``max_bytes``
+    before numpy allocates it."""
+    try:
+        with open(path, "rb") as fh:
+            version = np.lib.format.read_magic(fh)
+            read = (np.lib.format.read_array_header_1_0 if version == (1, 0)
+                    else np.lib.format.read_array_header_2_0)
+            got, _, dtype = read(fh, max_header_size=10_000)
+    except (ValueError, OSError, EOFError, SyntaxError) as exc:
+        raise CaptureError(f"{path}: not a .npy array ({str(exc)[:120]})") from None
+    if len(got) != 3 or dtype.kind != "c":
+        raise CaptureError(f"{path}: expected a complex [loop, virtual, sample] cube, got "
+                           f"{dtype} {list(got)}")
+    if shape is not None and tuple(got) != tuple(shape):
+        raise CaptureError(f"{path}: shape {list(got)}: must be the scene's radar "
+                           f"{list(shape)} [loop, virtual, sample]")
+    nbytes = int(np.prod(got, dtype=object)) * dtype.itemsize
+    if nbytes > max_bytes:
+        raise CaptureError(f"{path}: shape {list(got)} ({nbytes / 2**30:.3g} GiB): must be at "
+                           f"most {max_bytes / 2**30:.3g} GiB")
+
+
+def read_capture(path, shape=None, max_bytes: int = MAX_CAPTURE_BYTES) -> Capture:
     """Read a probe capture written by ``rtsgeom adc --active`` (``.bin`` or ``.npy`` with its
-    sidecar ``PATH.json``). Errors name the file and what is missing."""
+    sidecar ``PATH.json``). Errors name the file and the field (:data:`SIDECAR`).
+
+    ``shape``: the cube the scene's radar records, (loops, virtual, samples); a file of
+    another size is refused before it is read, so memory stays what the scene needs. Without
+    it a capture larger than ``max_bytes`` is refused."""
     path = Path(path)
     side = Path(str(path) + ".json")
     if not path.is_file():
@@ -99,36 +210,59 @@ def read_capture(path) -> Capture:
     if not side.is_file():
         raise CaptureError(f"{path}: no sidecar {side.name} (write captures with rtsgeom adc "
                            "--active I)")
-    try:
-        meta = json.loads(side.read_text(encoding="utf-8"))
-    except json.JSONDecodeError as exc:
-        raise CaptureError(f"{side}: not JSON ({exc})") from None
+    meta = _read_sidecar(side)
     if not isinstance(meta, dict):
         raise CaptureError(f"{side}: not a probe capture's sidecar (a JSON object)")
-    keys = ["active_front_end", "probe_range_m", "probe_velocity_mps", "probe_amplitude"]
     npy = meta.get("format") == "npy" or path.suffix == ".npy"
-    for key in keys + ([] if npy else ["num_rx", "samples_per_chirp", "chirps", "tx_order",
-                                       "scale"]):
+    for key in list(SIDECAR) + ([] if npy else list(SIDECAR_DCA1000)):
         if key not in meta:
             raise CaptureError(f"{side}: no {key!r}: not a probe capture (rtsgeom adc "
                                "--active I)")
+    v = check_record({**SIDECAR, **({} if npy else SIDECAR_DCA1000)}, meta, str(side),
+                     CaptureError)
+    radar = None
+    if meta.get("radar") is not None:
+        radar = check_record(_radar_fields(), meta["radar"], str(side), CaptureError,
+                             where="radar")
+    probe = (v["active_front_end"], v["probe_range_m"], v["probe_velocity_mps"],
+             v["probe_amplitude"])
     # numpy's own errors for a file that is no .npy / a .bin of the wrong size (ValueError,
-    # EOFError) and a sidecar value of the wrong type become the capture's error
+    # EOFError) become the capture's error
     try:
-        probe = (int(meta["active_front_end"]), float(meta["probe_range_m"]),
-                 float(meta["probe_velocity_mps"]), float(meta["probe_amplitude"]))
         if npy:
+            _npy_header(path, shape, max_bytes)
             data = np.load(path, allow_pickle=False)
         else:
-            n_rx, n_s, chirps = (int(meta["num_rx"]), int(meta["samples_per_chirp"]),
-                                 int(meta["chirps"]))
+            n_rx, n_s, chirps = v["num_rx"], v["samples_per_chirp"], v["chirps"]
+            n_tx = len(v["tx_order"])
+            if chirps % n_tx:
+                raise CaptureError(f"{side}: chirps = {chirps}: must be a multiple of the "
+                                   f"{n_tx} TDM slots of tx_order")
+            got = (chirps // n_tx, n_tx * n_rx, n_s)
+            if shape is not None and got != tuple(shape):
+                raise CaptureError(f"{side}: chirps, tx_order, num_rx, samples_per_chirp "
+                                   f"describe {list(got)}: must be the scene's radar "
+                                   f"{list(shape)} [loop, virtual, sample]")
+            want = chirps * n_rx * n_s * 4
+            if want * 2 > max_bytes:
+                raise CaptureError(f"{side}: {list(got)} ({want * 2 / 2**30:.3g} GiB): must be "
+                                   f"at most {max_bytes / 2**30:.3g} GiB")
+            if path.stat().st_size != want:
+                raise CaptureError(f"{path}: {path.stat().st_size} bytes: must be the "
+                                   f"{want} bytes its sidecar describes")
             raw = from_dca1000(path.read_bytes(), chirps, n_rx, n_s)
-            n_tx = len(meta["tx_order"])
-            data = raw.reshape(chirps // n_tx, n_tx * n_rx, n_s) / float(meta["scale"])
+            data = raw.reshape(got) / np.float32(v["scale"])
     except (ValueError, TypeError, EOFError) as exc:
+        if isinstance(exc, CaptureError):
+            raise
         raise CaptureError(f"{path}: cannot read the capture its sidecar describes ({exc})") \
             from None
     if data.ndim != 3 or not np.iscomplexobj(data):
         raise CaptureError(f"{path}: expected a complex [loop, virtual, sample] cube, got "
                            f"{data.dtype} {list(data.shape)}")
-    return Capture(np.asarray(data), *probe)
+    bad = int(np.count_nonzero(~np.isfinite(data)))
+    if bad:
+        raise CaptureError(f"{path}: {bad} sample(s) not finite (NaN or inf): must be finite")
+    if not np.any(data):
+        raise CaptureError(f"{path}: every sample is 0: must hold the probe's echo")
+    return Capture(np.asarray(data), *probe, radar=radar, source=str(path))

@@ -4,6 +4,7 @@ element as a function of one front end's mounting and channel parameters (:data:
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -13,7 +14,7 @@ from .._lib.arcmath import antenna_positions, layout_offsets
 from ..errors import CaptureError
 from ..geometry import Setup
 from ..paths.exact import leg_delays
-from .capture import Capture
+from .capture import Capture, check_capture_radar
 from ..radar.frame import noise_power
 from ..radar.phasors import bin_response
 from ..radar.processing import range_doppler
@@ -122,20 +123,78 @@ def measure(setup: Setup, cap: Capture) -> tuple[np.ndarray, float, ProbeModel]:
     the probe's bin per virtual element (V,), the noise variance of one spectrum value (median
     of |X|^2 over the whole map / ln 2: the median of an exponential, untouched by the few
     target cells), and the probe's model at that bin (the strongest of the three range bins
-    around the set range)."""
+    around the set range).
+
+    The capture is checked against the scene first: its shape and recorded radar
+    (:func:`~rtsgeom.identify.capture.check_capture_radar`), the probe inside the radar's
+    range and velocity, and the strongest echo of its range-Doppler map at the probe's bin
+    (within one bin): a sidecar that does not describe its capture is refused, not fitted."""
     radar = setup.scene.radar
     want = (radar.chirps_per_tx, setup.rut.num_virtual, radar.samples_per_chirp)
     if cap.data.shape != want:
         raise CaptureError(f"capture of front end {cap.active}: shape {list(cap.data.shape)} "
                            f"does not match the scene's radar {list(want)} [loop, virtual, sample]")
     if not 0 <= cap.active < setup.fe.count:
-        raise CaptureError(f"capture: active front end {cap.active} not in the scene "
-                           f"(0..{setup.fe.count - 1})")
-    rd = range_doppler(AdcCube(cap.data.astype(np.complex64), radar, setup.rut))
+        raise CaptureError(f"{cap.source}: active_front_end = {cap.active}: must be a front "
+                           f"end of the scene (0..{setup.fe.count - 1})")
+    check_capture_radar(cap, radar)
+    if not cap.range_m < radar.max_range_m:
+        raise CaptureError(f"{cap.source}: probe_range_m = {cap.range_m:g}: must be below the "
+                           f"scene's radar range {radar.max_range_m:g} m")
+    if not abs(cap.velocity_mps) < radar.max_velocity_mps:
+        raise CaptureError(f"{cap.source}: probe_velocity_mps = {cap.velocity_mps:g}: must be "
+                           f"within the scene's unambiguous +-{radar.max_velocity_mps:g} m/s")
+    # processed at unit peak (complex64 keeps a capture of any scale finite), read back in the
+    # capture's units in float64
+    scale = float(np.max(np.abs(cap.data)))
+    rd = range_doppler(AdcCube((cap.data / scale).astype(np.complex64), radar, setup.rut))
     model = ProbeModel.of(setup, cap)
+    _check_peak(rd.power, model, radar, cap)
     rbs = (model.range_bin + np.arange(-1, 2)) % radar.samples_per_chirp
     best = int(rbs[np.argmax(rd.power[rbs, model.doppler_bin])])
     model = ProbeModel.of(setup, cap, best)
     x = rd.spectrum
     sigma2 = float(np.median(x.real.astype(float) ** 2 + x.imag.astype(float) ** 2) / np.log(2))
-    return rd.spectrum[best, model.doppler_bin].astype(complex), sigma2, model
+    if not sigma2 > 0:
+        raise CaptureError(f"{cap.source}: no receiver noise in the capture (the median "
+                           "range-Doppler power is 0): must be a recorded or simulated "
+                           "capture with noise")
+    y = rd.spectrum[best, model.doppler_bin].astype(complex)
+    _check_front_end(setup, model, y, cap)
+    return y * scale, sigma2 * scale ** 2, model
+
+
+def _check_front_end(setup: Setup, model: ProbeModel, y: np.ndarray, cap: Capture) -> None:
+    """The probe's spectrum across the virtual array (its direction) matches the named front
+    end's nominal response better than, or as well as (within 0.02 of |cos|), every other
+    front end's: a sidecar naming another front end fits with a low residual, since the
+    tangential offset moves the response to the other front end."""
+    cos = np.empty(setup.fe.count)
+    for q in range(setup.fe.count):
+        m = dataclasses.replace(model, active=q)
+        h = m.response(m.nominal()[None])[0]
+        cos[q] = abs(np.vdot(h, y)) / (np.linalg.norm(h) * np.linalg.norm(y))
+    best = int(np.argmax(cos))
+    if best != cap.active and cos[best] - cos[cap.active] > 0.02:
+        raise CaptureError(f"{cap.source}: active_front_end = {cap.active}: must be the front "
+                           f"end the capture shows: its probe's direction matches front end "
+                           f"{best} (|cos| {cos[best]:.3f}), not {cap.active} "
+                           f"(|cos| {cos[cap.active]:.3f})")
+
+
+def _check_peak(power: np.ndarray, model: ProbeModel, radar, cap: Capture) -> None:
+    """The strongest cell of the range-Doppler map lies within one bin of the sidecar's probe
+    (range and Doppler, the latter circular)."""
+    n_s, n_l = power.shape
+    ri, di = np.unravel_index(int(np.argmax(power)), power.shape)
+    dd = abs(int(di) - model.doppler_bin)
+    if abs(int(ri) - model.range_bin) <= 1 and min(dd, n_l - dd) <= 1:
+        return
+    r_bin = c * radar.adc_rate_hz / (2 * radar.slope_hz_per_s * n_s)
+    v_bin = c / (2 * radar.f_c_hz * radar.tdm_cycle_s * n_l)
+    raise CaptureError(
+        f"{cap.source}: probe_range_m = {cap.range_m:g}, probe_velocity_mps = "
+        f"{cap.velocity_mps:g}: must be where the capture's strongest echo is, "
+        f"{ri * r_bin:.4g} m and {(int(di) - n_l // 2) * v_bin:+.4g} m/s (range bin {ri}, "
+        f"Doppler bin {di}; the sidecar's probe is at bins {model.range_bin}, "
+        f"{model.doppler_bin}): the sidecar does not describe this capture")

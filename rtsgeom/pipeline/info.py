@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from .. import __version__
@@ -53,8 +55,16 @@ def reachable_spans(setup: Setup, mode: str | None = None, paths=None) -> dict:
     mode = mode or scene.rts.aoa_mode
     if uses_cells(scene):
         return _reachable_cells(setup, mode)
-    probe = probe_front_ends(setup, exact_paths(setup) if paths is None else paths, scene.seed)
+    with warnings.catch_warnings():  # a front end not detected: said below, as the reason
+        warnings.simplefilter("ignore", RuntimeWarning)
+        probe = probe_front_ends(setup, exact_paths(setup) if paths is None else paths,
+                                 scene.seed)
     meas = probe.angle_rad
+    missed = [int(q) for q in np.flatnonzero(~np.isfinite(meas))]
+    if missed:  # no span to state (it would be NaN): why instead
+        raise SceneError(f"front end(s) {missed} not detected alone by the RuT at their probe "
+                         "ranges (below the CFAR threshold with this link and noise, or "
+                         f"clipped){probe.clipping_note()}: the angles between them cannot be measured")
     geo = setup.fe_azimuth_rad()
     order = np.argsort(meas)
     pairs = []
@@ -97,7 +107,11 @@ def scene_info(setup: Setup, reachable: bool = False) -> dict:
     :func:`reachable_spans` (one simulated frame)."""
     s, r, rut, fe = setup.scene, setup.scene.radar, setup.rut, setup.fe
     geo = np.degrees(setup.fe_azimuth_rad())
-    app = np.degrees(apparent_azimuth_rad(rut, fe.rx, fe.tx))
+    one_position = rut.azimuth_positions_m.size < 2
+    if one_position:  # no azimuth aperture: a single front end's azimuth is not measured
+        app = np.full(fe.count, np.nan)
+    else:
+        app = np.degrees(apparent_azimuth_rad(rut, fe.rx, fe.tx))
     curv = np.degrees(curvature_phase_error_rad(setup))
     spacing = np.degrees(np.diff(fe.angle_rad))
     res = np.degrees(angular_resolution_rad(rut))
@@ -140,7 +154,7 @@ def scene_info(setup: Setup, reachable: bool = False) -> dict:
                 "index": i,
                 "arc_angle_deg": float(np.degrees(fe.angle_rad[i])),
                 "azimuth_from_rut_deg": float(geo[i]),
-                "apparent_azimuth_deg": float(app[i]),
+                "apparent_azimuth_deg": _finite(app[i]),
                 "distance_m": float(np.linalg.norm(fe.module[i] - rut.position)),
                 "rx_tx_separation_m": float(fe.separation_m[i]),
                 "mounting_offsets_mm": [float(x) for x in fe.offsets_m[i] * 1e3],
@@ -162,7 +176,9 @@ def scene_info(setup: Setup, reachable: bool = False) -> dict:
     bias = _channel_bias_deg(setup)
     if bias is not None:
         for q, b in enumerate(bias):
-            out["front_ends"][q]["radar_channel_bias_deg"] = b
+            out["front_ends"][q]["radar_channel_bias_deg"] = _finite(b)
+    if one_position:
+        out["apparent_azimuth_unavailable"] = NO_AZIMUTH_APERTURE
     if reachable:
         try:
             out["reachable"] = reachable_spans(setup)
@@ -184,6 +200,17 @@ def _channel_bias_deg(setup: Setup) -> list[float] | None:
     return [float(x) for x in np.degrees(err[0])]
 
 
+NO_AZIMUTH_APERTURE = ("the azimuth virtual array has fewer than two distinct positions "
+                       "(a single element, or elements stacked in elevation): no azimuth is "
+                       "measured, so the apparent azimuth and the smallest gap are null")
+
+
+def _finite(x) -> float | None:
+    """A value for the JSON: None where it is undefined (the reason is stated beside it)."""
+    x = float(x)
+    return x if np.isfinite(x) else None
+
+
 def _virtual_array(rut) -> dict:
     """The azimuth virtual array as the beamformer sees it: distinct positions (duplicates
     combined), smallest gap, co-array period, grating lobes at boresight, unambiguous field."""
@@ -197,7 +224,7 @@ def _virtual_array(rut) -> dict:
         "num_azimuth_unique": int(x.size),
         "azimuth_positions_mm": [float(v) for v in x * 1e3],
         "azimuth_positions_wavelengths": [float(v) for v in x / rut.wavelength_m],
-        "smallest_spacing_m": smallest_spacing_m(rut),
+        "smallest_spacing_m": _finite(smallest_spacing_m(rut)),
         "coarray_period_m": period,
         "uniform": bool(x.size > 1 and np.allclose(np.diff(x), np.diff(x)[0], atol=1e-9)),
         "grating_lobes_deg": [float(v) for v in gl if abs(v) > 1e-9],
@@ -232,7 +259,7 @@ def format_info(info: dict) -> str:
         lines[-1] += "  elevation deg (sphere, from RuT)"
     for fe in info["front_ends"]:
         lines.append(f"  {fe['index']:2d} {fe['arc_angle_deg']:8.3f} {fe['azimuth_from_rut_deg']:17.4f}"
-                     f" {fe['apparent_azimuth_deg']:23.4f} {fe['distance_m']:11.5f}"
+                     f" {_num(fe['apparent_azimuth_deg'], 23, 4)} {fe['distance_m']:11.5f}"
                      f" {fe['curvature_phase_error_deg']:18.2f}"
                      + (f"  {fe['elevation_deg']:8.3f} {fe['elevation_from_rut_deg']:9.4f}"
                         if el else ""))
@@ -282,6 +309,10 @@ def format_info(info: dict) -> str:
     return "\n".join(lines)
 
 
+def _num(x, width: int, digits: int) -> str:
+    return f"{'n/a':>{width}}" if x is None else f"{x:{width}.{digits}f}"
+
+
 def _has_elevation(info: dict) -> bool:
     """Whether a front end or a target of ``info`` is off elevation 0 (a 2-D cell scene)."""
     return any(x.get("elevation_deg", 0.0) for x in info["front_ends"] + info["targets"])
@@ -317,6 +348,8 @@ def _format_virtual(va: dict, lam: float) -> str:
     return (f"virtual array  {va['num_azimuth_elements']} azimuth elements on "
             f"{va['num_azimuth_unique']} distinct positions "
             f"({'uniform' if va['uniform'] else 'NON-UNIFORM'}), at x/lambda = [{pos}]; "
-            f"smallest gap {va['smallest_spacing_m'] * 1e3:.3f} mm; grating lobes at boresight: "
+            + (f"smallest gap {va['smallest_spacing_m'] * 1e3:.3f} mm; "
+               if va["smallest_spacing_m"] is not None else "no gap (one position); ")
+            + "grating lobes at boresight: "
             + (", ".join(f"{v:+.2f}" for v in gl) + " deg" if gl else "none")
             + f"; unambiguous +-{va['unambiguous_half_width_deg']:.1f} deg")

@@ -136,6 +136,13 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
                              "calibrations; front ends on a sphere are calibrated per channel "
                              "by the run itself")
         return _plan_cells(setup, paths, mode, calibrate, progress)
+    n_az = setup.rut.azimuth_positions_m.size
+    if n_az < 2 and not scene.radar.elevation_processing:  # no azimuth aperture to measure
+        raise SceneError(f"{scene.source}: radar.array: the azimuth row of the virtual array "
+                         f"(its row with the most elements) has {n_az} distinct position: must "
+                         "have at least 2 for the RuT to measure an azimuth (put Tx and Rx "
+                         "elements side by side at one height, or set "
+                         "radar.elevation_processing = true)")
     loaded: dict = {}
     if calibration is not None:
         probe, loaded = load_calibration(calibration, setup)

@@ -17,7 +17,10 @@ from ..paths import Paths, compute_paths
 from ..radar import AdcCube, Detections, RangeDoppler, process
 from ..radar.frame import noise_power, simulate
 from ..rts.channels import Echoes, RtsProgram, program_nearest
-from ..scene import Scene
+from ..errors import ParameterError
+from ..scene import Scene, check_scene_arg
+from ..scene.registry import AOA_MODES, PATH_METHODS
+from ..scene.schema import check_arg
 from ..radar.budget import link_budget, link_warnings, sheet_paths
 from ..radar.link import radar_link
 from ..rts.channels import EchoKind, setup_echoes
@@ -232,6 +235,16 @@ def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = 
     The override is validated like the scene's own mode (``Scene.evolve``: e.g. paper eq. 24's
     spacing rule for the synthesis modes), so it cannot bypass a rule the scene file must meet.
     """
+    check_scene_arg(scene, "run_scene")
+    check_arg(paths_method, "paths_method", "str", "run_scene", ParameterError,
+              choices=tuple(PATH_METHODS))
+    if aoa_mode is not None:
+        check_arg(aoa_mode, "aoa_mode", "str", "run_scene", ParameterError,
+                  choices=tuple(AOA_MODES))
+    if calibration is not None and not isinstance(calibration, dict):
+        raise ParameterError(f"run_scene: calibration = {type(calibration).__name__}: must be "
+                             "a calibration file's content (a dict, json.load of "
+                             "calibration.json)")
     if aoa_mode is not None and aoa_mode != scene.rts.aoa_mode:
         scene = scene.evolve(rts=scene.rts.evolve(aoa_mode=aoa_mode))
     setup = build_setup(scene)

@@ -6,11 +6,11 @@ the named choices in :mod:`.registry`, the radar presets in :mod:`.presets`, and
 """
 
 from .hardware import ArrayConfig, PatternConfig
-from .scene import Scene, load_scene, loads_scene, parse_scene
+from .scene import Scene, check_scene_arg, load_scene, loads_scene, parse_scene
 from ..errors import SceneError
 from .sections import (CfarConfig, FrontEndConfig, RadarConfig, RaytraceConfig, RtsConfig,
                        SheetConfig, StructureConfig, TargetConfig)
 
-__all__ = ["Scene", "SceneError", "RadarConfig", "CfarConfig", "FrontEndConfig", "RtsConfig",
+__all__ = ["Scene", "SceneError", "check_scene_arg", "RadarConfig", "CfarConfig", "FrontEndConfig", "RtsConfig",
            "SheetConfig", "TargetConfig", "RaytraceConfig", "PatternConfig", "ArrayConfig",
            "StructureConfig", "load_scene", "loads_scene", "parse_scene"]

@@ -11,11 +11,12 @@ from __future__ import annotations
 
 import hashlib
 import re
+import os
 import stat
 import tomllib
 from pathlib import Path
 
-from ..errors import SceneError
+from ..errors import ParameterError, SceneError
 from .schema import fmt as _fmt
 
 __all__ = ["MAX_SCENE_BYTES", "MAX_KEY_PARTS", "MAX_KEY_CHARS", "decode_toml", "read_scene_bytes",
@@ -75,6 +76,9 @@ def decode_toml(raw: bytes | str, source: str) -> tuple[dict, str]:
 def read_scene_bytes(path: str | Path) -> tuple[bytes, Path]:
     """A scene file's bytes (at most one more than the limit, so the size check sees it) and
     its folder."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise ParameterError(f"load_scene: path = {_fmt(path)}: must be a scene file's path "
+                             "(str or os.PathLike)")
     p = Path(path)
     try:
         st = p.stat()

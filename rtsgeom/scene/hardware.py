@@ -18,7 +18,12 @@ from .registry import PATTERN_KINDS
 from .schema import Evolvable, spec
 from .schema import fmt as _fmt
 
-__all__ = ["PatternConfig", "ArrayConfig", "check_layout_keys", "resolve_pattern_tables"]
+__all__ = ["PatternConfig", "ArrayConfig", "check_layout_keys", "resolve_pattern_tables",
+           "PATTERN_GAIN_RANGE_DB", "MAX_PATTERN_BYTES"]
+
+#: a pattern table's gain_db values (dB), and its file's size
+PATTERN_GAIN_RANGE_DB = (-300.0, 100.0)
+MAX_PATTERN_BYTES = 64 << 20
 
 
 @dataclass(frozen=True)
@@ -136,6 +141,11 @@ def check_pattern_grid(azimuth_rad, elevation_rad, gain_db, phase_rad):
                          f"{az.size} x {el.size} azimuth x elevation grid")
     if not (np.all(np.isfinite(g)) and np.all(np.isfinite(ph))):
         raise ValueError("pattern table: gain_db and phase_deg must be finite")
+    lo, hi = PATTERN_GAIN_RANGE_DB
+    if np.any((g < lo) | (g > hi)):  # 1e5 dB overflowed the amplitudes to inf, then NaN
+        k = int(np.argmax((g < lo) | (g > hi)))
+        raise ValueError(f"pattern table: gain_db = {g.flat[k]:g}: must be in [{lo:g}, {hi:g}] "
+                         "dB (an antenna's gain relative to its peak or in dBi)")
     return az, el, g, ph
 
 
@@ -162,10 +172,15 @@ def read_pattern_table(path):
     per grid point, any order) as its checked grid (:func:`pattern_grid`)."""
     path = Path(path)
     try:
-        with path.open(newline="") as fh:
+        if path.stat().st_size > MAX_PATTERN_BYTES:
+            raise ValueError(f"pattern table {path}: {path.stat().st_size} bytes: must be at "
+                             f"most {MAX_PATTERN_BYTES} bytes")
+        with path.open(newline="", encoding="utf-8") as fh:
             rows = list(csv.DictReader(fh))
     except OSError as e:
         raise ValueError(f"pattern table {path}: cannot read ({e.strerror})") from None
+    except (csv.Error, UnicodeDecodeError) as e:  # a field over csv's limit, binary bytes
+        raise ValueError(f"pattern table {path}: not a CSV table ({str(e)[:100]})") from None
     need = ("azimuth_deg", "elevation_deg", "gain_db", "phase_deg")
     if not rows or any(k not in rows[0] for k in need):
         raise ValueError(f"pattern table {path}: needs the columns {', '.join(need)}")

@@ -19,11 +19,11 @@ from .hardware import check_layout_keys, resolve_pattern_tables
 from .rules import problems
 from .scenario import ScenarioConfig
 from .schema import Derived, Evolvable, check_fields, read, spec
-from ..errors import SceneError
+from ..errors import ParameterError, SceneError
 from .sections import (MAX_NAME_CHARS, MAX_TARGETS, RadarConfig, RaytraceConfig, RtsConfig,
                        SheetConfig, StructureConfig, TargetConfig)
 
-__all__ = ["Scene", "SceneError", "load_scene", "loads_scene", "parse_scene"]
+__all__ = ["Scene", "SceneError", "load_scene", "loads_scene", "parse_scene", "check_scene_arg"]
 
 
 @dataclass(frozen=True)
@@ -102,3 +102,14 @@ def load_scene(path: str | Path, allow_external_meshes: bool = False) -> Scene:
     """Load and validate a scene file (TOML, parsed with the standard library's safe loader)."""
     raw, base = read_scene_bytes(path)
     return loads_scene(raw, str(Path(path)), base, allow_external_meshes)
+
+
+def check_scene_arg(scene, source: str) -> Scene:
+    """A function's ``scene`` argument: a :class:`Scene`, else ``ParameterError`` saying how
+    to make one (a path is the common mistake)."""
+    if not isinstance(scene, Scene):
+        from .schema import fmt
+        hint = (": load it with rtsgeom.load_scene(path)" if isinstance(scene, (str, Path))
+                else "")
+        raise ParameterError(f"{source}: scene = {fmt(scene)}: must be a Scene{hint}")
+    return scene

@@ -24,10 +24,12 @@ import math
 import reprlib
 from dataclasses import dataclass
 from typing import Any, Callable
+
+import numpy as np
 from ..errors import SceneError
 
 __all__ = ["SceneError", "REQUIRED", "Derived", "Spec", "spec", "specs", "read", "check_fields",
-           "Evolvable", "fmt", "range_text", "rows_text"]
+           "check_record", "check_arg", "Evolvable", "fmt", "range_text", "rows_text"]
 
 
 REQUIRED = object()
@@ -151,15 +153,15 @@ def _is_num(v: Any) -> bool:
 
 
 class _Ctx:
-    def __init__(self, source: str, where: str):
-        self.source, self.where = source, where
+    def __init__(self, source: str, where: str, error: type = SceneError):
+        self.source, self.where, self.error = source, where, error
 
     def path(self, key: str) -> str:
         return f"{self.where}.{key}" if self.where else key
 
     def fail(self, fieldname: str, value: Any, allowed: str) -> None:
-        raise SceneError(f"{self.source}: {fieldname} = {value if isinstance(value, _Written) else fmt(value)}: "
-                         f"must be {allowed}")
+        raise self.error(f"{self.source}: {fieldname} = "
+                         f"{value if isinstance(value, _Written) else fmt(value)}: must be {allowed}")
 
 
 class _Written(str):
@@ -388,6 +390,47 @@ def _check_rows(s: Spec, v: Any, ctx: _Ctx, path: str) -> tuple:
 
 
 # --------------------------------------------------------------------------------------------
+# The same declarations for the other inputs: files beside the scene, Python arguments
+# --------------------------------------------------------------------------------------------
+
+
+def check_record(declared: dict[str, Spec], data: Any, source: str, error: type = SceneError,
+                 where: str = "") -> dict[str, Any]:
+    """A plain record (a capture's sidecar, a calibration file's JSON) against declared fields
+    ``{key: Spec}``: the values normalised (file units), ``None`` for an absent optional one.
+    Keys not declared are ignored (files carry descriptive extras); a missing required key and
+    every value out of its declaration raise ``error`` as ``<source>: <key> = <value>: must be
+    <allowed>``, like the scene file's; ``where``: the record's place in its file
+    (``pairs[0]``), prefixed to each key."""
+    ctx = _Ctx(source, where, error)
+    if not isinstance(data, dict):
+        ctx.fail(where or "<top level>", data, "a JSON object")
+    out: dict[str, Any] = {}
+    for key, s in declared.items():
+        if key not in data or (data[key] is None and s.default is None):
+            if s.default is REQUIRED:
+                raise error(f"{source}: {ctx.path(key)} is missing (required)")
+            out[key] = s.default
+            continue
+        out[key] = check_value(s, data[key], ctx, ctx.path(key))
+    return out
+
+
+def check_arg(value: Any, name: str, kind: str, source: str, error: type = SceneError,
+              **declaration) -> Any:
+    """One argument of a function or command against an inline declaration (``kind`` and the
+    keywords of :class:`Spec`: ``lo``, ``hi``, ``choices``, ``n``, ``unit`` ...): returns it
+    normalised, or raises ``error`` as ``<source>: <name> = <value>: must be <allowed>``."""
+    if kind == "vec" and isinstance(value, np.ndarray):
+        value = value.tolist()
+    if kind == "int" and isinstance(value, np.integer):
+        value = int(value)
+    if kind == "float" and isinstance(value, np.floating):
+        value = float(value)
+    return check_value(Spec(name, kind, "", **declaration), value, _Ctx(source, "", error), name)
+
+
+# --------------------------------------------------------------------------------------------
 # Re-checking values set in code (evolve)
 # --------------------------------------------------------------------------------------------
 
@@ -402,10 +445,17 @@ def check_fields(obj: Any, source: str, where: str = "") -> None:
             continue
         if s.kind == "table":
             if v is not None:
+                if not isinstance(v, s.cls):
+                    ctx.fail(path, v, f"a {s.cls.__name__} (a table set in code is the "
+                                      f"section's object, not a {type(v).__name__})")
                 check_fields(v, source, path)
             continue
         if s.kind == "tables":
-            check_value(s, v, ctx, path)
+            if not isinstance(v, (tuple, list)) or not all(isinstance(t, s.cls) for t in v):
+                ctx.fail(path, v, f"a tuple of {s.cls.__name__} (entries set in code are "
+                                  f"the section's objects, e.g. replace(scene.{path}[0], ...), "
+                                  "not dicts)")
+            check_value(s, tuple(v), ctx, path)
             for i, item in enumerate(v):
                 check_fields(item, source, f"{path}[{i}]")
             continue

@@ -10,12 +10,12 @@ sets on shared draws and its result (:mod:`.montecarlo`: a pair, a cell, a whole
 yield search (:mod:`.search`), and the check against the full ADC-cube chain (:mod:`.verify`).
 """
 
-from .draws import AXES, DISTRIBUTIONS, Bounds
+from .draws import AXES, DISTRIBUTIONS, MAX_SIGMA_MM, Bounds
 from .montecarlo import ToleranceModel, ToleranceResult, monte_carlo
 from .phasors import ALL_CASES, CASES, NOMINAL_AMPLITUDES, ChannelPhasors
 from .search import max_scale_for_yield, max_sigma_for_yield
 from .verify import VerifyResult, verify_draws
 
-__all__ = ["AXES", "DISTRIBUTIONS", "CASES", "ALL_CASES", "NOMINAL_AMPLITUDES", "Bounds",
+__all__ = ["AXES", "DISTRIBUTIONS", "MAX_SIGMA_MM", "CASES", "ALL_CASES", "NOMINAL_AMPLITUDES", "Bounds",
            "ChannelPhasors", "ToleranceModel", "ToleranceResult", "monte_carlo",
            "max_sigma_for_yield", "max_scale_for_yield", "VerifyResult", "verify_draws"]

@@ -36,9 +36,13 @@ from scipy.constants import c
 
 from ...errors import ParameterError
 
-__all__ = ["AXES", "DISTRIBUTIONS", "DEFAULT_CHUNK", "Bounds", "check_distribution",
+__all__ = ["AXES", "DISTRIBUTIONS", "DEFAULT_CHUNK", "MAX_SIGMA_MM", "Bounds", "check_distribution",
            "unit_block", "subbin_positions", "centre_index", "DrawChunk", "draw_chunks",
            "standard_draws", "subbin_draws", "draw_offsets", "draw_subbins"]
+
+#: the largest mounting sigma (mm) a study takes, in the CLI and in Python: the phasor model
+#: is first order in the errors (checked to 0.3 mm)
+MAX_SIGMA_MM = 10.0
 
 AXES = ("radial", "tangential", "height")
 DISTRIBUTIONS = ("normal", "uniform")
