@@ -37,6 +37,15 @@ def _transfer(args, stage) -> dict:
     return out
 
 
+#: what each verdict asks of the lab (``Transfer.verdict``)
+VERDICTS = {
+    "transfers": "the golden radar's RTS calibration serves every radar of the type",
+    "boresight": "each radar needs its own boresight channel compensation to meet the spec",
+    "recalibrate": "the RTS must be calibrated again with each radar",
+    "radar": "the radars miss the spec on real targets too: their channels need calibrating",
+}
+
+
 def _summary(out: dict) -> str:
     e, c, own = (out["angle_error_deg"], out["compensated_angle_error_deg"],
                  out["own_angle_error_deg"])
@@ -53,7 +62,8 @@ def _summary(out: dict) -> str:
              f"{out['absorbed_deg']['max']:.2g} deg, offsets "
              + ", ".join(f"{x:+.1f}" for x in out["absorbed_offset_ps"]) + " ps"]
     if out["verdict"] is not None:
-        lines.append(f"  spec {out['spec_deg']:g} deg (p95): {out['verdict']}")
+        lines.append(f"  spec {out['spec_deg']:g} deg (p95): {out['verdict']} -- "
+                     + VERDICTS.get(out["verdict"], ""))
     return "\n".join(lines)
 
 

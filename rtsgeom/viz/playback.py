@@ -53,7 +53,16 @@ def playback_figure(time_s, set_deg, detected_deg: Mapping[str, np.ndarray],
         top.set_ylabel("azimuth (deg)")
         bottom.set_ylabel("detected - set azimuth (deg)")
         bottom.set_xlabel("time (s)")
-        top.legend(loc="best")
+    # one legend for the figure, below the plots (inside, with a few targets, it covered the
+    # tracks); constrained layout makes room for it
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    for ax in axes[0, 1:]:  # a hand-over or loss only in another column
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            if lab not in labels:
+                handles.append(h)
+                labels.append(lab)
+    fig.legend(handles, labels, loc="outside lower center", ncol=min(4, len(labels)),
+               fontsize=8, frameon=False)
     return fig
 
 

@@ -260,7 +260,12 @@ def build_plotter(setup: Setup, paths=None, window_size=(1600, 1000), off_screen
     pl.set_background(BACKGROUND)
     legend = _add_setup(pl, setup, paths, scale, labels="2d" if side_panels else "3d")
     s = setup.scene
-    title = f"{s.name}" + (f": {s.description}" if s.description else "")
+    # the title from the geometry drawn, not the scene's description (a copied scene's text
+    # kept the template's "1.5 m arc" over a 1.2 m one)
+    n = setup.fe.count
+    title = (f"{s.name}: {n} front end{'s' if n != 1 else ''} on a "
+             f"{s.rts.arc_radius_m:g} m arc, "
+             f"{'custom array' if s.radar.array is not None else s.radar.antenna_preset} RuT")
     # user text is plain text: VTK hands "$...$" to matplotlib's mathtext; "\$" keeps a
     # literal dollar (vtkTextRenderer strips the escape before FreeType draws it)
     title = title.replace("$", "\\$")
@@ -280,7 +285,7 @@ def build_plotter(setup: Setup, paths=None, window_size=(1600, 1000), off_screen
             note += f"; {missing} reflected paths not drawn (no hit points)"
     pl.add_text(note, position="lower_left", font_size=9, color="#333333")
     pl.add_legend(legend, bcolor="white", background_opacity=0.8, border=True,
-                  size=(0.25, 0.22 + 0.02 * max(len(legend) - 8, 0)), loc="upper right",
+                  size=(0.25, 0.22 + 0.02 * max(len(legend) - 8, 0)), loc="lower right",
                   face="rectangle")
     pl._rtsgeom_legend = legend  # the HTML export writes it into the page (no screen text there)
     _set_overview_camera(pl, setup, scale, shift_left=0.1 if side_panels else 0.0)
