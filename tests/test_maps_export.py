@@ -1,4 +1,5 @@
-"""``rtsgeom run --out DIR`` saves the maps as arrays: maps.npz, maps.mat, maps.nc.
+"""``rtsgeom run --out DIR --maps npz,mat,nc`` saves the maps as arrays: maps.npz, maps.mat,
+maps.nc (only maps.npz without ``--maps``).
 
 The files are read back with the readers a user would use (numpy, scipy.io.loadmat, xarray's
 scipy engine) and compared with maps computed here from the in-memory run result, independently
@@ -28,7 +29,7 @@ def run_out(tmp_path_factory):
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(run, "run_scene", lambda *a, **k: result)
         assert main(["run", str(DEFAULT_SCENE), "--out", str(out), "--quiet",
-                     "--no-report"]) == 0
+                     "--no-report", "--maps", "npz,mat,nc"]) == 0
     return out, result
 
 
@@ -118,3 +119,23 @@ def test_the_map_files_do_not_depend_on_when_they_were_written(run_out, monkeypa
     monkeypatch.setattr(time, "asctime", lambda *a: "Thu Jan  1 00:00:00 2099")
     assert maps_arrays(ds) == first
     assert first["maps.mat"].startswith(b"MATLAB 5.0 MAT-file")
+
+
+def test_run_writes_only_the_maps_formats_asked_for(tmp_path):
+    """npz alone by default (each format costs its writing time), ``--maps`` chooses; an
+    unknown format is refused naming the allowed ones."""
+    import rtsgeom.cli.run as run
+    from rtsgeom.pipeline.run import run_scene
+    from rtsgeom.scene import load_scene
+    result = run_scene(load_scene(DEFAULT_SCENE), "exact", "nearest")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(run, "run_scene", lambda *a, **k: result)
+        for args, want in (([], {"maps.npz"}), (["--maps", "mat"], {"maps.mat"}),
+                           (["--maps", "nc,npz"], {"maps.nc", "maps.npz"})):
+            out = tmp_path / "-".join(args or ["default"])
+            assert main(["run", str(DEFAULT_SCENE), "--out", str(out), "--quiet",
+                         "--no-report", *args]) == 0
+            assert {p.name for p in out.glob("maps.*")} == want, args
+    with pytest.raises(SystemExit) as exc:
+        main(["run", str(DEFAULT_SCENE), "--out", str(tmp_path / "x"), "--maps", "csv"])
+    assert exc.value.code == 2

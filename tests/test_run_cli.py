@@ -19,7 +19,7 @@ def two_runs(tmp_path_factory):
     for k in range(2):
         out = tmp_path_factory.mktemp(f"run{k}")
         assert main(["run", str(DEFAULT_SCENE), "--out", str(out), "--quiet",
-                     *(["--no-report"] if k else [])]) == 0
+                     "--maps", "npz,mat,nc", *(["--no-report"] if k else [])]) == 0
         outs.append(out)
     return outs
 

@@ -4,6 +4,7 @@ summary.json, the maps (PNG and arrays) and report.html."""
 
 from __future__ import annotations
 
+import argparse
 import json
 
 from .._lib.io import write_bytes
@@ -12,7 +13,8 @@ from ..pipeline.run import run_scene, summary
 from ..scene.registry import ANGLE_ESTIMATORS, AOA_MODES, PATH_METHODS
 from ._common import (calibration_kw, load_scene_checked, number, output_folder, output_path,
                       scene_arg, steps)
-from ._maps import detections_csv, map_dataset, maps_arrays, render_maps, run_report_html
+from ._maps import (MAP_FORMATS, detections_csv, map_dataset, maps_arrays, render_maps,
+                    run_report_html)
 
 
 def _with_estimator(scene, args):
@@ -39,7 +41,7 @@ def cmd_run(args) -> int:
             encoding="utf-8")
         ds = map_dataset(result)
         maps = render_maps(result, ds)
-        for name, data in {**maps, **maps_arrays(ds)}.items():
+        for name, data in {**maps, **maps_arrays(ds, args.maps)}.items():
             write_bytes(stage / name, data)
         if not args.no_report:
             step("writing report.html (3D view, figures)")
@@ -61,9 +63,20 @@ def cmd_run(args) -> int:
         for w in result.warnings:
             print(f"warning: {w}")
         print(f"{len(result.detections)} detections; wrote {out}/detections.csv, summary.json, "
-              "range_doppler.png, range_angle.png, maps.npz|mat|nc" + ("" if args.no_report else ", report.html"))
+              "range_doppler.png, range_angle.png, "
+              + ", ".join(f"maps.{f}" for f in args.maps) + ("" if args.no_report else ", report.html"))
     return 0
 
+
+
+def _map_formats(text: str) -> tuple[str, ...]:
+    """``--maps``: a comma-separated subset of :data:`MAP_FORMATS`."""
+    got = tuple(dict.fromkeys(x.strip().lower() for x in text.split(",") if x.strip()))
+    bad = [x for x in got if x not in MAP_FORMATS]
+    if not got or bad:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be one or more of "
+                                         f"{', '.join(MAP_FORMATS)}, comma-separated")
+    return got
 
 
 def register(sub) -> None:
@@ -80,6 +93,9 @@ def register(sub) -> None:
     p.add_argument("--subarray", type=number(0, 4096, integer=True), default=None,
                    metavar="L", help="spatial smoothing subarray length for capon/music "
                                      "(default: the scene's radar.angle_subarray; 0 = none)")
+    p.add_argument("--maps", type=_map_formats, default=("npz",), metavar="npz,mat,nc",
+                   help="the maps' array formats, comma-separated: npz (numpy), mat (MATLAB), "
+                        "nc (NetCDF); default npz")
     p.add_argument("--no-report", action="store_true", help="skip report.html")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.add_argument("--calibration", default=None, metavar="FILE",
