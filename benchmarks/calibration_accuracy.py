@@ -25,6 +25,9 @@ Per row, the calibrated delay's distance (ps, wrapped into one period) from
   (0.5 ps steps on the arc, 1 ps in 2-D) of the probes' RMS error. Not the coherence point
   under a mounting offset: the probes' RMS minimum moves off it (``calibration.fit``).
 
+``--arrays A B --keep benchmarks/calibration_accuracy.json``: re-measure arrays A and B, keep
+the other arrays' rows as they were measured.
+
 ``--bundled``: instead of the grid, every bundled scene (``scenes/*.toml``) as shipped and
 with its mounting offsets removed, every pair its calibration measures (adjacent on an arc; the
 edges of the cells in 2-D), noiseless, with the distance from the coherence point and from the
@@ -269,6 +272,8 @@ def main(argv=None) -> int:
     ap.add_argument("--dense", action="store_true",
                     help="also the dense noiseless sweep's RMS minimum (slower)")
     ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--keep", type=Path, default=None, metavar="JSON",
+                    help="re-measure only --arrays; keep the other arrays' rows from JSON")
     ap.add_argument("--bundled", action="store_true",
                     help="every bundled scene's measured pairs instead of the grid")
     ap.add_argument("--out", type=Path, default=None,
@@ -308,12 +313,17 @@ def main(argv=None) -> int:
                   + ("" if row["dist_dense_min_ps"] is None
                      else f", dense minimum {row['dist_dense_min_ps']:+5.1f} ps"), flush=True)
 
+    kept = []
+    if a.keep is not None:  # the other arrays' rows as measured before
+        kept = [r for r in json.loads(a.keep.read_text())["rows"] if r["array"] not in a.arrays]
+        rows = kept + rows
+
     def worst(key, sel):
         got = [r for r in rows if "error" not in r and sel(r) and r[key] is not None]
         return max(got, key=lambda r: abs(r[key])) if got else None
     summary = {"cases": len(rows), "failed": [r for r in rows if "error" in r],
                "radii_m": radii, "offsets_mm": [x * 1e3 for x in offsets],
-               "seconds": time.perf_counter() - t0}
+               "seconds": time.perf_counter() - t0, "kept_rows": len(kept)}
     for label, sel in (("noiseless", lambda r: not r["noisy"]), ("noisy", lambda r: r["noisy"])):
         for key in ("dist_coherence_ps", "dist_slope_ps", "dist_dense_min_ps"):
             for dims in (1, 2):

@@ -336,7 +336,7 @@ def transfer(scene: Scene, radars: int = 100, sigma_phase_deg: float = 5.0,
         ``golden_error_deg``, ``absorbed_deg``; ``to_dict()``, ``to_dataframe()``, ``plot()``.
     """
     from .analysis.transfer import TransferStudy
-    setup, paths = _setup_paths(scene)
+    setup, paths = _setup_paths(scene, "transfer")
     return TransferStudy(radars=radars, sigma_phase_deg=sigma_phase_deg,
                          sigma_gain_db=sigma_gain_db, points=points, spec_deg=spec_deg,
                          seed=scene.seed if seed is None else seed)(setup, paths)
@@ -416,4 +416,5 @@ def play(scene: Scene, amplitudes: str | None = None, paths: str = "exact",
         ``summary()``, ``to_dataframe()`` (tracks), ``programme_dataframe()``, ``plot()``.
     """
     from .analysis.playback import play as _play
+    check_scene_arg(scene, "play")
     return _play(scene, amplitudes, paths, baseline, workers)

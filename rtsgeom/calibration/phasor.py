@@ -43,7 +43,8 @@ from ..rts.fir import realised_delay
 from .fit import MC_DRAWS, rms_error_deg
 from .probes import (FrontEndProbe, if_phase_slope_hz, probe_angles, probe_program,
                      probe_ranges, probe_total_delay, simulate_detect)
-from .steps import FINE_STEP_S, adds_noise, predicted_angle_noise, sweep_phase
+from .steps import (FINE_STEP_S, adds_noise, predicted_angle_noise, reference_setup,
+                    sweep_phase)
 
 __all__ = ["SweepResult", "phasor_sweep", "HALF_BINS", "place_probes", "chain_errors",
            "PhasorProbes"]
@@ -259,8 +260,6 @@ class PhasorProbes:
 
     dims = 1
     predicts_noise = True
-    reference = None  # the fit's centre is the coherence point within 1 ps (``fit``): no
-    # reference sweep (on the 86-element cascade at 3 m, inside its far field, 9 ps)
     fine_step_s = FINE_STEP_S  # the model evaluates every step at once: fine steps are cheap
 
     def __init__(self, setup: Setup, paths: Paths, pair, probe: FrontEndProbe,
@@ -328,6 +327,20 @@ class PhasorProbes:
         out.ranges = place_probes(self.setup, self.paths, self.nominal, self.pair, self.ranges,
                                   self.alphas, window_s, self.base_offsets,
                                   self.gain_correction)
+        out._last = None
+        return out
+
+    def reference(self, phase_rad: float = 0.0) -> "PhasorProbes":
+        """The same probes on the phasor model of the nominal setup, the sweep's reference
+        (``steps.reference_setup``: noiseless, channel J given the hardware phase
+        ``phase_rad``): what the sweep's fit gives where the coherence point is known
+        (``sweep.run_sweep`` subtracts its offset: 9 ps on the 86-element cascade at 3 m,
+        inside its far field)."""
+        out = copy.copy(self)
+        out.setup = reference_setup(self.nominal[0], self.pair[1], phase_rad)
+        out.paths, out.noisy = self.nominal[1], False
+        out.full_chain, out.method = False, "phasor"
+        out._rng = np.random.default_rng(np.random.SeedSequence([self.seed % 2 ** 32, 1713]))
         out._last = None
         return out
 
