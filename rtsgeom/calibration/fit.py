@@ -25,10 +25,11 @@ own coefficients, and the shared centre s where the residual is least (variable 
 Near, not on: the phase between the two channels' beam outputs varies across the probes'
 directions (an array that is not centro-symmetric, front ends inside its far field), so each
 probe's curve is centred a little to either side of the point (custom array -3.2 / +2.5 ps)
-and their joint centre sits off it: within 1.1 ps of the phasor model's coherence point for
-the presets, the custom and a sparse array at 0.5-3 m with +-1 mm of radial offset
-(``benchmarks/calibration_accuracy.py``), but 4 ps for the awr2944 at 0.5 m and 9 ps for the
-86-element cascade at 3 m (front ends inside its 14 m far field).
+and their joint centre sits off it: by up to 1.1 ps for the presets, the custom and a sparse
+array at 0.5-3 m, 4 ps for the awr2944 at 0.5 m and 9 ps for the 86-element cascade at 3 m
+(front ends inside its 14 m far field). The offset is the geometry's, not the mounting
+errors': the sweep measures it on the nominal setup, where the point is known, and subtracts
+it (``sweep._fit_offset``; ``benchmarks/calibration_accuracy.py``).
 
 In a 2-D beamformer the error **across** the pair's line crosses zero at the coherence point
 but moves with any fixed error across it: a tangential offset of 0.2 mm moved the crossing
@@ -46,7 +47,8 @@ import warnings
 
 import numpy as np
 
-__all__ = ["rms_error_deg", "coarse_minimum", "crossing_columns", "fit_centre", "fit_scatter",
+__all__ = ["rms_error_deg", "coarse_minimum", "crossing_columns", "continuous_steps",
+           "fit_centre", "fit_scatter",
            "MC_DRAWS", "SCATTER_DRAW_FRAMES"]
 
 MC_DRAWS = 32  # noise realisations that size the frames per step
@@ -81,6 +83,45 @@ def crossing_columns(e_fine, edge: int = 3) -> np.ndarray:
         lo = np.nanmean(e[:edge], axis=0)
         hi = np.nanmean(e[-edge:], axis=0)
     return np.isfinite(lo) & np.isfinite(hi) & (lo * hi < 0)
+
+
+JUMP_FACTOR = 10.0  # a step's change this many times the sweep's typical bend is a jump
+
+
+def continuous_steps(e, centre: int, min_steps: int = 7) -> np.ndarray:
+    """``e`` (S, C) with every step beyond a jump NaN, per column: the fine sweep's curves
+    are smooth in the delay, but where the design or the detection changes its range bin
+    part-way through the window a probe's error jumps (sphere4's side-by-side pair at 3 m
+    with 1 mm on a front end: 0.013 and 0.021 in direction cosine between adjacent 10 ps
+    steps, against 0.0001 of bend), and the curve beyond it, a different one, pulled the
+    fitted centre 18 ps. A jump: a step's first difference departing from its neighbours'
+    mean by more than :data:`JUMP_FACTOR` x the column's median departure; the steps kept
+    run from the ``centre`` step to the nearest jump on either side. Sweeps of fewer than
+    ``min_steps`` steps are returned as they are."""
+    e = np.array(e, float, copy=True)
+    if e.ndim != 2 or e.shape[0] < min_steps:
+        return e
+    d = np.diff(e, axis=0)  # (S - 1, C)
+    dev = np.full(d.shape, np.nan)
+    dev[1:-1] = np.abs(d[1:-1] - 0.5 * (d[:-2] + d[2:]))
+    dev[0], dev[-1] = np.abs(d[0] - d[1]), np.abs(d[-1] - d[-2])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a column never detected
+        typical = np.nanmedian(dev, axis=0)
+    jump = np.isfinite(dev) & (dev > JUMP_FACTOR * typical) & (dev > 0)
+    # a jump between steps k and k + 1 shows in dev at k - 1, k and k + 1: the largest marks it
+    for c in range(e.shape[1]):
+        ks = np.flatnonzero(jump[:, c])
+        if ks.size == 0:
+            continue
+        peaks = [k for k in ks if dev[k, c] >= np.nanmax(dev[max(k - 1, 0):k + 2, c])]
+        lo = [k for k in peaks if k < centre]
+        hi = [k for k in peaks if k >= centre]
+        if lo:
+            e[:max(lo) + 1, c] = np.nan
+        if hi:
+            e[min(hi) + 1:, c] = np.nan
+    return e
 
 
 def _basis(psi, harmonics: int, odd: bool) -> np.ndarray:

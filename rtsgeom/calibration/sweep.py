@@ -37,7 +37,7 @@ from scipy.constants import c
 from .._lib.results import Result
 from .._lib.util import frozen
 from ..errors import CalibrationFailed, ParameterError
-from .fit import coarse_minimum, fit_centre, fit_scatter, rms_error_deg
+from .fit import coarse_minimum, continuous_steps, fit_centre, fit_scatter, rms_error_deg
 from .probes import mean_air_delay
 from .steps import coarse_frames, continuous_delay_setup, fine_frames, fine_window, realisable
 
@@ -259,6 +259,7 @@ class _FineSweep:
         ``selected``: ``e`` holds those columns only."""
         cols, odd = columns
         e = np.asarray(e, float) if selected else np.asarray(e, float)[:, cols]
+        e = continuous_steps(e, self.t.size // 2)  # one curve: up to a jump either side
         w = self.steps
         extra = None if self.extra is None else np.asarray(self.extra, float)[:, cols]
         search = None if self.search_phase is None else (
@@ -350,9 +351,9 @@ def run_sweep(probes: Probes, config: SweepConfig = SweepConfig()) -> Calibratio
 
 
 def _fit_offset(probes, steps, period: float, centre_s: float, fit_s: float, columns) -> float:
-    """The fit's own offset from the coherence point (s), for probes that have a reference
-    (a pair in a 2-D beamformer, fitted along its line, whose curves' centre is 14 ps off the
-    point for sphere4's elevation pair): the same fit on the same probes on the nominal setup,
+    """The fit's own offset from the coherence point (s): the geometry's (a pair in a 2-D
+    beamformer fitted along its line, 14 ps for sphere4's elevation pair; the 86-element
+    cascade at 3 m, 9 ps), found by the same fit on the same probes on the nominal setup,
     noiseless, minus the nominal point (:func:`coherence_point`). The reference is set up as
     the measurement was: channel J given the hardware phase that puts its point where the
     measured fit is (where J's echo sits in its range bin shapes the curves: a 90 deg phase
