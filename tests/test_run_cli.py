@@ -51,8 +51,13 @@ def test_run_writes_the_contract(two_runs):
 
 @pytest.mark.slow
 def test_same_seed_same_bytes(two_runs):
+    """Two runs of one scene, seconds apart, are byte-identical in every file both wrote (the
+    maps' arrays and PNGs included; the second skipped report.html)."""
     a, b = two_runs
-    for name in ("detections.csv", "summary.json"):
+    names = sorted(p.name for p in b.iterdir())
+    assert {"detections.csv", "summary.json", "maps.npz", "maps.mat", "maps.nc",
+            "range_angle.png"} <= set(names)
+    for name in names:
         assert (a / name).read_bytes() == (b / name).read_bytes(), name
 
 
