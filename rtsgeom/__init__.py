@@ -97,6 +97,7 @@ _LAZY = {
     "render_setup_png": (".viz.scene3d", "render_setup_png"),
     "scene_info": (".pipeline.info", "scene_info"),
     # errors a user's input can cause (rtsgeom.errors lists them all)
+    "RtsgeomError": (".errors", "RtsgeomError"),
     "SceneError": (".scene.scene", "SceneError"),
     "ParameterError": (".errors", "ParameterError"),
     "CaptureError": (".errors", "CaptureError"),

@@ -9,16 +9,21 @@ what it is: a bug). This module imports nothing, so that any module can raise th
 
 from __future__ import annotations
 
-__all__ = ["SceneError", "LinkError", "ParameterError", "UsageError", "CaptureError",
+__all__ = ["RtsgeomError", "SceneError", "LinkError", "ParameterError", "UsageError", "CaptureError",
            "OutputError", "AngleUnreachable", "CellUnreachable", "CalibrationFailed",
            "ClusterError", "RaytraceUnavailable", "VizError", "Terminated", "RtsgeomWarning",
            "NominalSetupWarning"]
 
 
+class RtsgeomError(Exception):
+    """Base of every error below that ends a command with one line (``rtsgeom: error: ...``,
+    exit 2): the CLI catches this one class, so a new error needs no second list there."""
+
+
 # -- input out of range (ValueError) ---------------------------------------------------------
 
 
-class SceneError(ValueError):
+class SceneError(RtsgeomError, ValueError):
     """A scene file (or a value derived from one) is invalid. The message names the field.
 
     ``problems`` holds every violated rule when the error came from the cross-field rules."""
@@ -32,31 +37,31 @@ class LinkError(SceneError):
     """A target the RTS cannot produce with its gains and dynamic range (names the field)."""
 
 
-class ParameterError(ValueError):
+class ParameterError(RtsgeomError, ValueError):
     """An argument (not a scene field) is outside its allowed range; the message names it."""
 
 
-class UsageError(ValueError):
+class UsageError(RtsgeomError, ValueError):
     """A command-line argument is invalid (exit code 2)."""
 
 
-class CaptureError(ValueError):
+class CaptureError(RtsgeomError, ValueError):
     """A probe capture does not fit the scene, or its file or sidecar cannot be read."""
 
 
-class OutputError(ValueError):
+class OutputError(RtsgeomError, ValueError):
     """An output path that cannot or must not be written (exit code 2 in the CLI)."""
 
 
-class AngleUnreachable(ValueError):
+class AngleUnreachable(RtsgeomError, ValueError):
     """The set direction lies outside what the channels can synthesize."""
 
 
-class CellUnreachable(ValueError):
+class CellUnreachable(RtsgeomError, ValueError):
     """No cell of front ends encloses the direction."""
 
 
-class CalibrationFailed(ValueError):
+class CalibrationFailed(RtsgeomError, ValueError):
     """A pair's calibration found no coherence point (no probe detected over the sweep), or
     the calibrated channels do not synthesize the cell's centre."""
 
@@ -64,16 +69,16 @@ class CalibrationFailed(ValueError):
 # -- a capability this machine lacks (RuntimeError) ------------------------------------------
 
 
-class ClusterError(RuntimeError):
+class ClusterError(RtsgeomError, RuntimeError):
     """A Dask scheduler address that is malformed or cannot be reached (one line, exit 2)."""
 
 
-class RaytraceUnavailable(RuntimeError):
+class RaytraceUnavailable(RtsgeomError, RuntimeError):
     """Sionna RT cannot run here (package missing, no usable LLVM/CUDA backend). The message
     says what to install."""
 
 
-class VizError(RuntimeError):
+class VizError(RtsgeomError, RuntimeError):
     """Rendering is not possible here (no OpenGL context, no display, a missing package)."""
 
 

@@ -74,16 +74,21 @@ _ARRAYS = {"diagonal": ("[[0,0],[1.9,1.9],[3.8,3.8]]",
                         "[0, 1, 2]")}
 
 
-@pytest.mark.parametrize("kind", list(_ARRAYS))
-def test_info_json_of_degenerate_custom_arrays_is_finite(kind, tmp_path, capsys):
-    """A custom array without azimuth aperture: the undefined quantities are null with the
-    reason, the rest as for any array."""
+def _custom_array_scene(kind, tmp_path):
+    """custom-array.toml with the Tx, Rx and Tx order of ``_ARRAYS[kind]``, written beside it."""
     tx, rx, order = _ARRAYS[kind]
     text = (ROOT / "scenes" / "custom-array.toml").read_text()
     text = re.sub(r"^tx_mm = .*$", f"tx_mm = {tx}", text, flags=re.M)
     text = re.sub(r"^rx_mm = .*$", f"rx_mm = {rx}", text, flags=re.M)
     text = re.sub(r"^tx_order = .*$", f"tx_order = {order}", text, flags=re.M)
-    p = _with(text, tmp_path)
+    return _with(text, tmp_path)
+
+
+@pytest.mark.parametrize("kind", list(_ARRAYS))
+def test_info_json_of_degenerate_custom_arrays_is_finite(kind, tmp_path, capsys):
+    """A custom array without azimuth aperture: the undefined quantities are null with the
+    reason, the rest as for any array."""
+    p = _custom_array_scene(kind, tmp_path)
     assert main(["info", str(p), "--json"]) == 0
     info = _finite_json(capsys.readouterr().out)
     one_position = kind != "diagonal"
@@ -98,12 +103,7 @@ def test_info_json_of_degenerate_custom_arrays_is_finite(kind, tmp_path, capsys)
 def test_run_refuses_an_array_without_azimuth_aperture_naming_it(kind, tmp_path, capsys):
     """run on the diagonal array ended in a traceback (CalibrationFailed after an All-NaN
     RuntimeWarning); single and vertical arrays in a span of [-90, -90] deg."""
-    tx, rx, order = _ARRAYS[kind]
-    text = (ROOT / "scenes" / "custom-array.toml").read_text()
-    text = re.sub(r"^tx_mm = .*$", f"tx_mm = {tx}", text, flags=re.M)
-    text = re.sub(r"^rx_mm = .*$", f"rx_mm = {rx}", text, flags=re.M)
-    text = re.sub(r"^tx_order = .*$", f"tx_order = {order}", text, flags=re.M)
-    p = _with(text, tmp_path)
+    p = _custom_array_scene(kind, tmp_path)
     assert main(["run", str(p), "--out", str(tmp_path / "out"), "--no-report"]) == 2
     _clean_error(capsys.readouterr().err, "radar.array", "at least 2")
     assert not (tmp_path / "out").exists()

@@ -152,3 +152,13 @@ def test_every_exception_is_defined_in_errors():
                                                  or b.id in ("KeyboardInterrupt",))
                      for b in node.bases)]
     assert not where, where
+
+
+def test_every_error_is_one_the_cli_reports():
+    """The CLI reports one class (``RtsgeomError``, exit 2): every error in errors.py derives
+    from it, the control-flow ``Terminated`` and the warnings aside."""
+    import rtsgeom.errors as errors
+    classes = [getattr(errors, n) for n in errors.__all__]
+    errs = [c for c in classes if issubclass(c, Exception) and not issubclass(c, Warning)]
+    assert errs and all(issubclass(c, errors.RtsgeomError) for c in errs)
+    assert not issubclass(errors.Terminated, errors.RtsgeomError)

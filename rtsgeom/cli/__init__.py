@@ -16,9 +16,7 @@ import sys
 import warnings
 
 from .. import __version__
-from ..errors import (AngleUnreachable, CalibrationFailed, CaptureError, CellUnreachable,
-                      ClusterError, OutputError, ParameterError, RaytraceUnavailable,
-                      RtsgeomWarning, SceneError, Terminated, UsageError, VizError)
+from ..errors import RtsgeomError, RtsgeomWarning, Terminated
 from ._signals import honoured_signals, received
 
 __all__ = ["main", "build_parser"]
@@ -113,20 +111,20 @@ def main(argv: list[str] | None = None) -> int:
     with honoured_signals():  # from the start: the command's module loads the heavy libraries
         try:
             args = build_parser(_command_of(argv), lazy=True).parse_args(argv)
-        except Terminated:
-            print("rtsgeom: terminated", file=sys.stderr)
-            return 143
-        except KeyboardInterrupt:
-            print("rtsgeom: interrupted", file=sys.stderr)
-            return 130
+        except KeyboardInterrupt as exc:  # Terminated too
+            return _stopped(isinstance(exc, Terminated))
         code = _dispatch(args)
         if code not in (130, 143) and received() is not None:
             # the signal's exception was swallowed (a callback printed "Exception ignored"):
             # the command still does not end as if nothing happened
-            term = received() == _sig.SIGTERM
-            print(f"rtsgeom: {'terminated' if term else 'interrupted'}", file=sys.stderr)
-            code = 143 if term else 130
+            code = _stopped(received() == _sig.SIGTERM)
     return code
+
+
+def _stopped(terminated: bool) -> int:
+    """The line and exit code of a command ended by SIGTERM (143) or Ctrl-C/SIGINT (130)."""
+    print(f"rtsgeom: {'terminated' if terminated else 'interrupted'}", file=sys.stderr)
+    return 143 if terminated else 130
 
 
 def _dispatch(args) -> int:
@@ -136,9 +134,7 @@ def _dispatch(args) -> int:
             warnings.simplefilter("always", RtsgeomWarning)
             warnings.showwarning = show_warning
             return int(args.func(args) or 0)
-    except (SceneError, UsageError, OutputError, ClusterError, RaytraceUnavailable,
-            ParameterError, CaptureError, AngleUnreachable, CellUnreachable,
-            CalibrationFailed, VizError) as exc:  # every error rtsgeom raises on purpose
+    except RtsgeomError as exc:  # every error rtsgeom raises on purpose
         print(f"rtsgeom: error: {exc}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # the reader went away (`rtsgeom ... | head`): stop quietly
@@ -148,12 +144,8 @@ def _dispatch(args) -> int:
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"rtsgeom: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return 2
-    except Terminated:
-        print("rtsgeom: terminated", file=sys.stderr)
-        return 143
-    except KeyboardInterrupt:
-        print("rtsgeom: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:  # Terminated too
+        return _stopped(isinstance(exc, Terminated))
 
 
 if __name__ == "__main__":  # pragma: no cover
