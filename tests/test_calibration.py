@@ -668,3 +668,26 @@ def test_calibration_fingerprint_follows_file_contents_not_paths(tmp_path):
     for mut in (lambda d: d["sheet"].update(enabled=False),
                 lambda d: d["rts"].update(calibration_step_ps=10.0)):
         assert setup_fingerprint(make_scene(mut)) == base
+
+
+def test_fine_sweep_is_fitted_up_to_its_first_jump_either_side():
+    """``continuous_steps``: a column that jumps (a probe's bin changing part-way) keeps the
+    steps between the jumps around the centre, a smooth column (any curvature) all of them;
+    the fitted centre of the kept curve is its centre of symmetry again."""
+    from rtsgeom.calibration.fit import continuous_steps, fit_centre
+    period = 1e-9
+    d = np.arange(-25, 26) * 10e-12  # +-period/4 in 10 ps steps, centre at index 25
+    s0 = 7e-12
+    smooth = 0.02 * (1 - np.cos(2 * np.pi * (d - s0) / period)) + 1e-3
+    jumped = smooth.copy()
+    jumped[:8] += 0.013  # a jump between steps 7 and 8 and one between 41 and 42
+    jumped[42:] -= 0.021
+    e = np.column_stack([smooth, jumped])
+    kept = continuous_steps(e, 25)
+    np.testing.assert_array_equal(kept[:, 0], smooth)
+    assert np.isnan(kept[:8, 1]).all() and np.isnan(kept[42:, 1]).all()
+    np.testing.assert_array_equal(kept[8:42, 1], jumped[8:42])
+    assert fit_centre(d, kept, period, 0.0, search_s=30e-12) == pytest.approx(s0, abs=0.3e-12)
+    # without the cut the jumps pull the fitted centre off
+    assert abs(fit_centre(d, e, period, 0.0, search_s=30e-12) - s0) > 1e-12
+    assert continuous_steps(e[:5], 2).shape == (5, 2)  # too few steps: as they are
