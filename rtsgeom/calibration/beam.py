@@ -11,8 +11,6 @@ sweep's own residual (``fit.fit_scatter``).
 
 from __future__ import annotations
 
-import copy
-
 import numpy as np
 
 from ..geometry import Setup
@@ -25,7 +23,7 @@ from ..synthesis.model import ChannelModel
 from .fit import crossing_columns, rms_error_deg
 from .probes import (FrontEndProbe, if_phase_slope_hz, probe_ranges, probe_total_delay,
                      simulate_detect)
-from .steps import adds_noise, reference_setup, sweep_phase
+from .steps import adds_noise, reference_probes, sweep_phase
 
 __all__ = ["BeamProbes", "PROBE_RATIOS"]
 
@@ -142,9 +140,7 @@ class BeamProbes:
         (``steps.reference_setup``: noiseless, channel J given the hardware phase
         ``phase_rad``): what the sweep's fit gives where the coherence point is known
         (``sweep.run_sweep`` subtracts its offset)."""
-        out = copy.copy(self)
-        out.setup = reference_setup(self.nominal[0], self.pair[1], phase_rad)
-        out.paths, out.noisy = self.nominal[1], False
+        out = reference_probes(self, phase_rad)
         return out
 
     def fit_columns(self, e):

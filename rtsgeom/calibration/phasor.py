@@ -43,7 +43,7 @@ from ..rts.fir import realised_delay
 from .fit import MC_DRAWS, rms_error_deg
 from .probes import (FrontEndProbe, if_phase_slope_hz, probe_angles, probe_program,
                      probe_ranges, probe_total_delay, simulate_detect)
-from .steps import (FINE_STEP_S, adds_noise, predicted_angle_noise, reference_setup,
+from .steps import (FINE_STEP_S, adds_noise, predicted_angle_noise, reference_probes,
                     sweep_phase)
 
 __all__ = ["SweepResult", "phasor_sweep", "HALF_BINS", "place_probes", "chain_errors",
@@ -336,9 +336,7 @@ class PhasorProbes:
         ``phase_rad``): what the sweep's fit gives where the coherence point is known
         (``sweep.run_sweep`` subtracts its offset: 9 ps on the 86-element cascade at 3 m,
         inside its far field)."""
-        out = copy.copy(self)
-        out.setup = reference_setup(self.nominal[0], self.pair[1], phase_rad)
-        out.paths, out.noisy = self.nominal[1], False
+        out = reference_probes(self, phase_rad)
         out.full_chain, out.method = False, "phasor"
         out._rng = np.random.default_rng(np.random.SeedSequence([self.seed % 2 ** 32, 1713]))
         out._last = None

@@ -22,6 +22,7 @@ The sweep (:mod:`.sweep`) uses these.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import warnings
 from typing import NamedTuple
@@ -37,7 +38,7 @@ __all__ = ["continuous_delay_setup", "CONTINUOUS_STEP_S", "COARSE_NOISE_DEG",
            "predicted_angle_noise", "coarse_frames", "MAX_FRAMES", "realisation_shift",
            "sweep_phase", "realisable", "FINE_STEP_S", "fine_window",
            "FineWindow", "SIZE_DRAWS", "TARGET_BIAS_PS", "frames_for", "fine_frames",
-           "adds_noise", "reference_setup"]
+           "adds_noise", "reference_setup", "reference_probes"]
 
 
 def continuous_delay_setup(setup: Setup) -> Setup:
@@ -189,6 +190,16 @@ def reference_setup(setup: Setup, channel: int, phase_rad: float = 0.0) -> Setup
     rts = scene.rts.evolve(front_ends=tuple(fes))
     radar = scene.radar.evolve(snr_db=None, link=None)
     return dataclasses.replace(setup, scene=scene.evolve(rts=rts, radar=radar))
+
+
+def reference_probes(probes, phase_rad: float = 0.0):
+    """A copy of ``probes`` (``sweep.Probes``) on their nominal setup and paths as the sweep's
+    reference (:func:`reference_setup`: noiseless, channel J at the hardware phase
+    ``phase_rad``); the probes' own state beyond that is theirs to reset."""
+    out = copy.copy(probes)
+    out.setup = reference_setup(probes.nominal[0], probes.pair[1], phase_rad)
+    out.paths, out.noisy = probes.nominal[1], False
+    return out
 
 
 def adds_noise(scene) -> bool:
