@@ -92,7 +92,7 @@ def _nearfield(scene):
 
 
 def _identification(scene):
-    from rtsgeom.identify.fit import FrontEndFit, Identification
+    from rtsgeom.identify import FrontEndFit, Identification
     fits = tuple(FrontEndFit(q, np.r_[1e-4 * (q + 1), -2e-4, 0.0, 0.0, 0.0, 0.0, 0.0],
                              np.full(7, 2e-5), (None,) * 4 + ("not free",) * 3, np.eye(7), 1.1,
                              1.0, 2) for q in range(2))

@@ -33,6 +33,16 @@ def _text(d: dict) -> str:
         lines.append(f"  {'channel phase_deg':22s} {val(ch['phase_deg'], 'deg', 3)}")
         for key, why in list(fe["not_identifiable"].items()) + list(ch["not_identifiable"].items()):
             lines.append(f"  why not {key}: {why}")
+    r = d.get("radar_channels")
+    if r is not None:
+        ref = r["references"]
+        lines.append(f"radar channels (reference Tx {ref['tx']}, Rx {ref['rx']}, front end "
+                     f"{ref['front_end']}):")
+        for side in ("tx", "rx"):
+            for a, (g, p) in enumerate(zip(r[f"{side}_gain_db"], r[f"{side}_phase_deg"])):
+                lines.append(f"  {side} {a}  gain {val(g, 'dB', 3)}, phase {val(p, 'deg', 3)}")
+        for key, why in r["not_identifiable"].items():
+            lines.append(f"  why not {key}: {why}")
     return "\n".join(lines)
 
 
@@ -44,6 +54,9 @@ def cmd_identify(args) -> int:
     if len(args.captures) > MAX_CAPTURES:
         raise UsageError(f"CAPTURE: {len(args.captures)} captures: must be at most "
                          f"{MAX_CAPTURES}")
+    if args.reference_front_end is not None and not args.radar_channels:
+        raise UsageError(f"--reference-front-end {args.reference_front_end}: only with "
+                         "--radar-channels (it fixes the radar's phase ramp)")
     with output_folder(args.out, [args.scene, *args.captures]) as stage:
         scene = load_scene_checked(args.scene)
         from ..geometry import build_setup
@@ -53,7 +66,9 @@ def cmd_identify(args) -> int:
         with steps(args.quiet or args.json) as step:
             step(f"fitting {len(args.captures)} capture(s)")
             try:
-                ident = identify(scene, caps, accept_misfit=args.accept_misfit)
+                ident = identify(scene, caps, accept_misfit=args.accept_misfit,
+                                 radar_channels=args.radar_channels,
+                                 reference=args.reference_front_end)
             except (OSError, CaptureError) as exc:
                 raise UsageError(f"CAPTURE: {exc}") from None
         for f in ident.fits:
@@ -90,6 +105,14 @@ def register(sub) -> None:
     p.add_argument("--accept-misfit", action="store_true",
                    help="write the estimates of a fit whose residual exceeds "
                         f"{RESIDUAL_LIMIT:g} x noise (flagged misfit) instead of refusing them")
+    p.add_argument("--radar-channels", action="store_true",
+                   help="also estimate the radar's own per-antenna gain and phase errors, "
+                        "jointly with every captured front end (a reference Tx, Rx and front "
+                        "end fix what no capture can tell apart)")
+    p.add_argument("--reference-front-end", type=int, default=None, metavar="Q",
+                   help="with --radar-channels: the front end whose tangential offset (and "
+                        "height) stays the scene's; the others are measured relative to it "
+                        "(default: the first captured)")
     p.set_defaults(func=cmd_identify)
 
 

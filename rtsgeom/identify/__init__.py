@@ -29,7 +29,9 @@ delay offset) is measured: :func:`predicted_calibration` gives the pair's calibr
 without a sweep.
 
 The package, by concept: :mod:`.model` (the forward model and the measurement),
-:mod:`.fit` (identifiability, the fit, the Cramer-Rao bound), :mod:`.built` (the setup as
+:mod:`.fit` (identifiability, the fit, the Cramer-Rao bound), :mod:`.joint` (the radar's
+own antenna gains and phases fitted with every front end), :mod:`.identification` (the
+entry point and its result), :mod:`.built` (the setup as
 built: corrected scene, calibration without a sweep), :mod:`.crb` (the bound versus SNR and
 arc radius). Everything is importable from ``rtsgeom.identify``.
 """
@@ -41,8 +43,9 @@ from .built import (PredictedCalibration, calibrate_from_identified, detected_an
                     identified_scene, identified_scene_toml, predicted_calibration, setup_of)
 from .crb import crb_figure, crb_grid
 from .fit import (ESTIMATE_LIMITS, MIN_EIGENVALUE, RESIDUAL_LIMIT, SEPARATE_BY, STD_LIMIT,
-                  FrontEndFit, Identification, check_fit, cramer_rao,
-                  fisher, fit_front_end, free_parameters, identify)
+                  FrontEndFit, check_fit, cramer_rao, fisher, fit_front_end, free_parameters)
+from .identification import Identification, identify
+from .joint import GAUGES, JointModel, RadarChannelsFit, identify_joint, joint_cramer_rao
 from .model import PARAMS, ProbeModel, measure
 
 __all__ = ["PARAMS", "Capture", "ProbeModel", "FrontEndFit", "Identification", "capture_probe",
@@ -51,4 +54,5 @@ __all__ = ["PARAMS", "Capture", "ProbeModel", "FrontEndFit", "Identification", "
            "MIN_EIGENVALUE", "SEPARATE_BY", "identified_scene", "identified_scene_toml",
            "setup_of", "detected_angles", "PredictedCalibration", "predicted_calibration",
            "calibrate_from_identified", "crb_grid", "crb_figure", "RESIDUAL_LIMIT",
-           "ESTIMATE_LIMITS", "check_fit"]
+           "ESTIMATE_LIMITS", "check_fit", "GAUGES", "JointModel", "RadarChannelsFit",
+           "identify_joint", "joint_cramer_rao"]

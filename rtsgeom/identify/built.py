@@ -15,7 +15,8 @@ from ..geometry.setup import build_setup
 from ..paths import exact_paths
 from .capture import capture_probe
 from ..scene import FrontEndConfig, Scene
-from .fit import Identification
+from ..scene.channels import RadarChannelsConfig
+from .identification import Identification
 from ..calibration.pair import pair_coherence
 from ..calibration.probes import probe_angles
 from ..geometry.frontends import front_ends
@@ -47,7 +48,8 @@ def _has_field(name: str) -> bool:
 
 def identified_scene(ident: Identification) -> Scene:
     """The scene with its mounting fields (and channel gain/phase errors) set to the
-    estimates; parameters not identified keep the scene's values. Yaw only where the schema
+    estimates, and with a joint fit the radar's ``[radar.channels]`` antenna gains and phases;
+    parameters not identified keep the scene's values. Yaw only where the schema
     has a per-front-end ``yaw_offset_rad``."""
     scene = ident.scene
     fes = list(scene.rts.front_ends)
@@ -63,7 +65,24 @@ def identified_scene(ident: Identification) -> Scene:
         kw["gain_offset_db"] = float(e[5] * 20 / np.log(10))
         kw["phase_offset_rad"] = float(np.angle(np.exp(1j * e[6])))
         fes[f.index] = fes[f.index].evolve(**kw)
-    return scene.evolve(rts=scene.rts.evolve(front_ends=tuple(fes)))
+    scene = scene.evolve(rts=scene.rts.evolve(front_ends=tuple(fes)))
+    if ident.radar is None:
+        return scene
+    return scene.evolve(radar=scene.radar.evolve(channels=_radar_channels(scene, ident.radar)))
+
+
+def _radar_channels(scene: Scene, r) -> RadarChannelsConfig:
+    """The scene's ``[radar.channels]`` with every antenna's gain and phase set to the joint
+    fit's estimates (the references and the antennas that do not act keep the scene's: the
+    fit holds them there)."""
+    k = 20 / np.log(10)
+    tx_lg, tx_ph, *_ = r.side("tx")
+    rx_lg, rx_ph, *_ = r.side("rx")
+    ch = scene.radar.channels or RadarChannelsConfig()
+    return ch.evolve(tx_gain_db=tuple(float(x) for x in tx_lg * k),
+                     tx_phase_rad=tuple(float(x) for x in tx_ph),
+                     rx_gain_db=tuple(float(x) for x in rx_lg * k),
+                     rx_phase_rad=tuple(float(x) for x in rx_ph))
 
 
 def identified_scene_toml(scene_text: str, ident: Identification) -> str:
@@ -88,6 +107,19 @@ def identified_scene_toml(scene_text: str, ident: Identification) -> str:
         for attr, key, unit in keys:
             if f.reasons[owner[attr]] is None:  # not identified: the scene's value stays
                 tables[f.index][key] = round(float(getattr(cfg, attr)) * unit, 6)
+    if ident.radar is not None:
+        ch = new.radar.channels
+        created = "channels" not in doc["radar"]
+        if created:
+            doc["radar"]["channels"] = tomlkit.table()
+        table = doc["radar"]["channels"]
+        for key, vals, unit in (("tx_gain_db", ch.tx_gain_db, 1.0),
+                                ("tx_phase_deg", ch.tx_phase_rad, 180 / np.pi),
+                                ("rx_gain_db", ch.rx_gain_db, 1.0),
+                                ("rx_phase_deg", ch.rx_phase_rad, 180 / np.pi)):
+            table[key] = [round(float(v) * unit, 6) for v in vals]
+        if created:
+            table.add(tomlkit.nl())
     doc["name"] = f"{new.name}-identified"
     return tomlkit.dumps(doc)
 

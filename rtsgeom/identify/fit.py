@@ -1,7 +1,8 @@
 """The fit of one front end's parameters to its probe captures: which parameters the captures
 separate (:func:`free_parameters`, from the Fisher information), the whitened nonlinear least
-squares (:func:`fit_front_end`), the Cramer-Rao bound (:func:`cramer_rao`) and the result of all
-front ends (:class:`Identification`, ``rtsgeom identify --json``)."""
+squares (:func:`fit_front_end`, on :func:`solve_whitened`, which the joint fit of
+:mod:`.joint` shares), the Cramer-Rao bound (:func:`cramer_rao`) and the checks of an
+estimate (:func:`check_fit`)."""
 
 from __future__ import annotations
 
@@ -10,16 +11,13 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.optimize import least_squares
 
-from .._lib.results import Result
 from ..errors import CaptureError
-from ..geometry.setup import build_setup
-from ..scene import Scene
 from ..scene.schema import Spec, check_arg
-from .model import PARAMS, ProbeModel, measure
+from .model import PARAMS, ProbeModel
 
 __all__ = ["STD_LIMIT", "MIN_EIGENVALUE", "SEPARATE_BY", "RESIDUAL_LIMIT", "ESTIMATE_LIMITS",
-           "check_fit", "fisher", "free_parameters",
-           "FrontEndFit", "fit_front_end", "cramer_rao", "Identification", "identify"]
+           "check_fit", "fisher", "free_parameters", "solve_whitened",
+           "FrontEndFit", "fit_front_end", "cramer_rao"]
 
 # optimiser scales (SI), per parameter
 _SCALE = np.array([1e-3, 1e-3, 1e-3, 1e-2, 1e-11, 0.1, 0.1])
@@ -51,16 +49,28 @@ def fisher(jac_white: np.ndarray) -> np.ndarray:
     return 2 * np.real(jac_white.conj().T @ jac_white)
 
 
-def free_parameters(fim: np.ndarray, candidates=range(7)) -> tuple[list[int], dict[int, str]]:
-    """Which parameters the Fisher matrix ``fim`` (7, 7) separates. Returns the free indices and
+def free_parameters(fim: np.ndarray, candidates=None, kinds=None, names=None
+                    ) -> tuple[list[int], dict[int, str]]:
+    """Which parameters the Fisher matrix ``fim`` (P, P) separates. Returns the free indices and
     a reason for each one left out.
 
-    Normalised to unit diagonal, the Fisher matrix is the matrix of cosines between the
+    ``kinds`` (P,): the :data:`PARAMS` index of each parameter (default: one front end's
+    seven in order; the joint fit stacks several front ends and the radar's antennas, an
+    antenna's ln-gain and phase counting as a channel's), ``names`` their labels in the
+    reasons (default :data:`PARAMS`), ``candidates`` the indices that may be free (default
+    all). Normalised to unit diagonal, the Fisher matrix is the matrix of cosines between the
     response's derivatives; an eigenvalue below :data:`MIN_EIGENVALUE` is a direction in which
     the response hardly changes. Of the parameters that carry it (component > 0.2), the first
     in :data:`_DROP_ORDER` is fixed, and so on; then a parameter whose Cramer-Rao std exceeds
     :data:`STD_LIMIT` is fixed too."""
-    free = [int(i) for i in candidates]
+    n = fim.shape[0]
+    kinds = np.arange(n) if kinds is None else np.asarray(kinds)
+    names = PARAMS if names is None else names
+    free = [int(i) for i in (range(n) if candidates is None else candidates)]
+
+    def rank(i):
+        return _DROP_ORDER.index(int(kinds[i])), i
+
     why: dict[int, str] = {}
     for i in list(free):
         if not fim[i, i] > 0:
@@ -73,26 +83,26 @@ def free_parameters(fim: np.ndarray, candidates=range(7)) -> tuple[list[int], di
         w, v = np.linalg.eigh(cos)
         if w[0] >= MIN_EIGENVALUE:
             std = np.sqrt(np.diag(np.linalg.inv(f)))
-            over = [k for k in range(len(free)) if std[k] > STD_LIMIT[free[k]]]
+            over = [k for k in range(len(free)) if std[k] > STD_LIMIT[kinds[free[k]]]]
             if not over:
                 break
-            k = min(over, key=lambda k: _DROP_ORDER.index(free[k]))
+            k = min(over, key=lambda k: rank(free[k]))
             i = free.pop(k)
-            why[i] = (f"too weak in these captures: its Cramer-Rao std would be {_fmt(i, std[k])}"
-                      f" (limit {_fmt(i, STD_LIMIT[i])})")
+            why[i] = (f"too weak in these captures: its Cramer-Rao std would be "
+                      f"{_fmt(kinds[i], std[k])} (limit {_fmt(kinds[i], STD_LIMIT[kinds[i]])})")
             continue
         involved = [free[k] for k in range(len(free)) if abs(v[k, 0]) > 0.2]
-        i = min(involved, key=_DROP_ORDER.index)
-        others = [j for j in involved if j != i]
+        i = min(involved, key=rank)
         k = free.index(i)
-        sim = {j: abs(cos[k, free.index(j)]) for j in others}
+        sim = {j: abs(cos[k, free.index(j)]) for j in involved if j != i}
+        others = [j for j in sim if sim[j] > 1e-3] or list(sim)
         free.remove(i)
         why[i] = ("inseparable in these captures from "
-                  + ", ".join(f"{PARAMS[j]} (|cos| {sim[j]:.6f})" for j in others)
+                  + ", ".join(f"{names[j]} (|cos| {sim[j]:.6f})" for j in others)
                   + " (the response changes alike)")
     for i in why:
-        if i in SEPARATE_BY:
-            why[i] += "; separate it with " + SEPARATE_BY[i]
+        if int(kinds[i]) in SEPARATE_BY:
+            why[i] += "; separate it with " + SEPARATE_BY[int(kinds[i])]
     return sorted(free), why
 
 
@@ -130,6 +140,45 @@ def _weighted_gain(h: np.ndarray, y: np.ndarray, w: np.ndarray) -> complex:
     return complex(np.sum(w[:, None] * np.conj(h) * y) / np.sum(w[:, None] * np.abs(h) ** 2))
 
 
+def solve_whitened(y, sw, respond, jac_all, theta, scale, choose_free):
+    """The whitened nonlinear least squares of :func:`fit_front_end` and the joint fit:
+    measurements ``y`` (C, V) with whitening ``sw`` (C, 1), model ``respond(theta)`` (C, V) and
+    ``jac_all(theta, free) -> (response (C, V), whitened Jacobian (C V, P))``; the free set
+    from ``choose_free(fisher)`` at the start, checked again at the estimate (refit once if it
+    changed). Returns (estimate, free, reasons, covariance of the free ones (inverse Fisher),
+    the response at the estimate)."""
+    n = theta.size
+
+    def solve(th, free):
+        def fun(x):
+            t = th.copy()
+            t[free] = x
+            r = (y - respond(t)) * sw
+            return np.concatenate([r.real.ravel(), r.imag.ravel()])
+
+        def jac(x):
+            t = th.copy()
+            t[free] = x
+            j = -jac_all(t, free)[1]
+            return np.concatenate([j.real, j.imag], 0)
+
+        sol = least_squares(fun, th[free], jac=jac, x_scale=scale[free], method="trf",
+                            xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=200)
+        out = th.copy()
+        out[free] = sol.x
+        return out
+
+    free, why = choose_free(fisher(jac_all(theta, range(n))[1]))
+    for _ in range(2):  # fit, then check the free set at the estimate (refit if it changed)
+        theta = solve(theta, free)
+        free2, why2 = choose_free(fisher(jac_all(theta, range(n))[1]))
+        if free2 == free:
+            break
+        free, why = free2, why2
+    resp, jac = jac_all(theta, free)
+    return theta, free, why, np.linalg.inv(fisher(jac)), resp
+
+
 def fit_front_end(meas: list[tuple[np.ndarray, float, ProbeModel]], grid_m: float = 50e-3
                   ) -> FrontEndFit:
     """Fit one front end's parameters to its measurements ``(y (V,), sigma2, model)``.
@@ -161,40 +210,17 @@ def fit_front_end(meas: list[tuple[np.ndarray, float, ProbeModel]], grid_m: floa
     g = _weighted_gain(np.stack([m.response(with_gain(theta)[None])[0] for m in models]), y, w)
     theta[5], theta[6] = np.log(abs(g)), np.angle(g)
 
+    def respond(th):
+        return np.stack([m.response(th[None])[0] for m in models])
+
     def jac_all(th, free):
         parts = [m.jacobian(th, free) for m in models]
         r = np.stack([p[0] for p in parts])
         jac = np.concatenate([p[1] * s for p, s in zip(parts, sw[:, 0])], 0)
         return r, jac
 
-    def solve(th, free):
-        def fun(x):
-            t = th.copy()
-            t[free] = x
-            r = (y - np.stack([m.response(t[None])[0] for m in models])) * sw
-            return np.concatenate([r.real.ravel(), r.imag.ravel()])
-
-        def jac(x):
-            t = th.copy()
-            t[free] = x
-            j = -jac_all(t, free)[1]
-            return np.concatenate([j.real, j.imag], 0)
-
-        sol = least_squares(fun, th[free], jac=jac, x_scale=_SCALE[free], method="trf",
-                            xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=200)
-        out = th.copy()
-        out[free] = sol.x
-        return out
-
-    free, why = free_parameters(fisher(jac_all(theta, range(7))[1]))
-    for _ in range(2):  # fit, then check the free set at the estimate (refit if it changed)
-        theta = solve(theta, free)
-        free2, why2 = free_parameters(fisher(jac_all(theta, range(7))[1]))
-        if free2 == free:
-            break
-        free, why = free2, why2
-    resp, jac = jac_all(theta, free)
-    cov = np.linalg.inv(fisher(jac))
+    theta, free, why, cov, resp = solve_whitened(y, sw, respond, jac_all, theta, _SCALE,
+                                                 free_parameters)
     std = np.full(7, np.nan)
     std[free] = np.sqrt(np.diag(cov))
     corr = np.full((7, 7), np.nan)
@@ -224,108 +250,6 @@ def cramer_rao(models, theta, sigma2, free) -> np.ndarray:
     return std
 
 
-# the fitted parameters as shown: (PARAMS index, name with its unit, SI -> that unit)
-SHOWN = ((0, "radial_offset_mm", 1e3), (1, "tangential_offset_mm", 1e3),
-         (2, "height_offset_mm", 1e3), (3, "yaw_offset_deg", 180 / np.pi),
-         (4, "delay_offset_ps", 1e12), (5, "gain_db", 20 / np.log(10)),
-         (6, "phase_deg", 180 / np.pi))
-
-
-@dataclass(frozen=True, repr=False)
-class Identification(Result):
-    """Every front end's fit; :meth:`to_dict` is ``rtsgeom identify --json``. ``print(ident)``
-    is a summary; ``to_dataframe()`` one row per front end (each parameter and its std, NaN
-    where not identifiable); ``plot()`` the mounting offsets with their 1-sigma bars."""
-
-    scene: Scene
-    fits: tuple[FrontEndFit, ...]
-
-    def fit(self, q: int) -> FrontEndFit | None:
-        return next((f for f in self.fits if f.index == q), None)
-
-    def _summary(self):
-        rows = []
-        for f in self.fits:
-            parts = [f"{short} {f.estimate[i] * k:.3g}+-{f.std[i] * k:.2g}"
-                     for (i, _, k), short in zip(SHOWN[:4], ("r", "t", "h", "yaw"))
-                     if f.reasons[i] is None]
-            rows.append((f"front end {f.index}", (" ".join(parts) + " (mm, yaw deg)" if parts
-                                                  else "nothing identifiable")
-                         + f", residual {f.residual_rms:.2f}, {f.captures} captures"))
-        return f"{self.scene.name}: {len(self.fits)} front ends identified", rows
-
-    def _columns(self) -> dict:
-        cols = {"front_end": [f.index for f in self.fits]}
-        for i, name, k in SHOWN:
-            ok = [f.reasons[i] is None for f in self.fits]
-            cols[name] = [f.estimate[i] * k if o else np.nan for f, o in zip(self.fits, ok)]
-            cols[name.rsplit("_", 1)[0] + "_std_" + name.rsplit("_", 1)[1]] = [
-                f.std[i] * k if o else np.nan for f, o in zip(self.fits, ok)]
-        cols["residual_rms"] = [f.residual_rms for f in self.fits]
-        return cols
-
-    def plot(self, title: str = ""):
-        """Each front end's fitted radial, tangential and height offset (mm) with 1 sigma."""
-        from ..viz.figures import STYLE, new_figure  # matplotlib: only for the figure
-        import matplotlib as mpl
-        cols = self._columns()
-        with mpl.rc_context(STYLE):
-            fig, ax = new_figure(figsize=(6.4, 3.6))
-            q = np.asarray(cols["front_end"], float)
-            for k, (_, name, _) in enumerate(SHOWN[:3]):
-                std = name.rsplit("_", 1)[0] + "_std_mm"
-                ax.errorbar(q + (k - 1) * 0.12, cols[name], yerr=cols[std], fmt="o",
-                            capsize=3, label=name.replace("_offset_mm", ""))
-            ax.axhline(0.0, color="0.4", linewidth=0.8)
-            ax.set_xticks(q)
-            ax.set_xlabel("front end")
-            ax.set_ylabel("fitted offset (mm), 1 sigma bars")
-            ax.legend(loc="best")
-            ax.set_title(title or f"{self.scene.name}: identified mounting offsets",
-                         parse_math=False)
-        return fig
-
-    def to_dict(self) -> dict:
-        out_fe, out_ch, keys = [], [], []
-
-        def entry(f, i, unit, why, name):
-            if f.reasons[i] is not None:
-                why[name] = f.reasons[i]
-                return None
-            return {"value": float(f.estimate[i] * unit), "std": float(f.std[i] * unit)}
-
-        for f in self.fits:
-            why: dict = {}
-            d = {"index": f.index}
-            for i, name, unit in ((0, "radial_offset_mm", 1e3), (1, "tangential_offset_mm", 1e3),
-                                  (2, "height_offset_mm", 1e3),
-                                  (3, "yaw_offset_deg", 180 / np.pi)):
-                d[name] = entry(f, i, unit, why, name)
-            d["not_identifiable"] = why
-            fr = [i for i in f.free if i < 4]
-            d["correlations"] = [{"a": PARAMS[a], "b": PARAMS[b], "r": float(f.correlation[a, b])}
-                                 for k, a in enumerate(f.free) for b in f.free[k + 1:]
-                                 if (a in fr or b in fr) and abs(f.correlation[a, b]) > 0.5]
-            d["residual_rms"] = f.residual_rms
-            d["misfit"] = f.misfit
-            d["captures"] = f.captures
-            out_fe.append(d)
-            why = {}
-            ch = {"index": f.index, "front_end": f.index,
-                  "delay_offset_s": entry(f, 4, 1.0, why, "delay_offset_s")}
-            g = entry(f, 5, 20 / np.log(10), why, "gain_db")
-            ch["gain_db"] = g
-            ch["phase_deg"] = entry(f, 6, 180 / np.pi, why, "phase_deg")
-            ch["not_identifiable"] = why
-            out_ch.append(ch)
-            keys.append(f.residual_rms)
-        return {"scene": self.scene.name, "front_ends": out_fe, "channels": out_ch,
-                "residual_rms": float(np.sqrt(np.mean(np.square(keys)))) if keys else None,
-                "residual_rms_unit": "measured noise std of one range-Doppler value",
-                "residual_limit": RESIDUAL_LIMIT,
-                "model_fits": all(f.misfit is None for f in self.fits)}
-
-
 #: a fit whose whitened residual exceeds this many noise std does not explain its captures
 #: (a clean fit reads 0.5-1.6; a capture of an arc of 1.2 m fitted on 1 m read 9.4)
 RESIDUAL_LIMIT = 3.0
@@ -342,7 +266,8 @@ ESTIMATE_LIMITS = tuple(
                               (5, "gain_db", 20 / np.log(10), "dB", 40.0)))
 _WHAT_TO_CHECK = ("check that the sidecar's active_front_end, probe_range_m, probe_amplitude "
                   "and scale are the capture's and that the scene's arc and radar are the "
-                  "setup's")
+                  "setup's; a radar with its own per-antenna phase errors needs "
+                  "--radar-channels")
 
 
 def check_fit(f: FrontEndFit, accept_misfit: bool = False) -> FrontEndFit:
@@ -368,21 +293,3 @@ def check_fit(f: FrontEndFit, accept_misfit: bool = False) -> FrontEndFit:
     if not accept_misfit:
         raise CaptureError(why)
     return replace(f, misfit=why)
-
-
-def identify(scene: Scene, captures, accept_misfit: bool = False) -> Identification:
-    """Fit the nominal ``scene``'s free parameters to probe ``captures`` (:class:`Capture`,
-    any number per front end; the captures of one front end are fitted jointly).
-
-    ``captures`` may be a generator (``read_capture`` per file): each is reduced to its
-    probe's bin when it arrives, so memory holds one cube at a time. Each capture is checked
-    against the scene (:func:`~rtsgeom.identify.model.measure`) and each fit by
-    :func:`check_fit`: a misfit raises ``CaptureError`` unless ``accept_misfit``, which keeps
-    it flagged (``misfit`` in the JSON)."""
-    setup = build_setup(scene)
-    groups: dict[int, list] = {}
-    for cap in captures:
-        groups.setdefault(cap.active, []).append(measure(setup, cap))
-        del cap
-    return Identification(scene, tuple(check_fit(fit_front_end(groups[q]), accept_misfit)
-                                       for q in sorted(groups)))

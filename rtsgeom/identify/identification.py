@@ -1,0 +1,151 @@
+"""The identification of a built setup: :func:`identify` (``rtsgeom identify``) fits every
+captured front end alone (:func:`~rtsgeom.identify.fit.fit_front_end`) or, with
+``radar_channels``, together with the radar's own antenna gains and phases
+(:func:`~rtsgeom.identify.joint.identify_joint`); :class:`Identification` is the result."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._lib.results import Result
+from ..geometry.setup import build_setup
+from ..scene import Scene
+from .fit import RESIDUAL_LIMIT, FrontEndFit, check_fit, fit_front_end
+from .joint import RadarChannelsFit, identify_joint
+from .model import PARAMS, measure
+
+__all__ = ["Identification", "identify"]
+
+
+# the fitted parameters as shown: (PARAMS index, name with its unit, SI -> that unit)
+SHOWN = ((0, "radial_offset_mm", 1e3), (1, "tangential_offset_mm", 1e3),
+         (2, "height_offset_mm", 1e3), (3, "yaw_offset_deg", 180 / np.pi),
+         (4, "delay_offset_ps", 1e12), (5, "gain_db", 20 / np.log(10)),
+         (6, "phase_deg", 180 / np.pi))
+
+
+@dataclass(frozen=True, repr=False)
+class Identification(Result):
+    """Every front end's fit; :meth:`to_dict` is ``rtsgeom identify --json``. ``print(ident)``
+    is a summary; ``to_dataframe()`` one row per front end (each parameter and its std, NaN
+    where not identifiable); ``plot()`` the mounting offsets with their 1-sigma bars."""
+
+    scene: Scene
+    fits: tuple[FrontEndFit, ...]
+    radar: RadarChannelsFit | None = None  # the radar's antennas (identify_joint), or None
+
+    def fit(self, q: int) -> FrontEndFit | None:
+        return next((f for f in self.fits if f.index == q), None)
+
+    def _summary(self):
+        rows = []
+        for f in self.fits:
+            parts = [f"{short} {f.estimate[i] * k:.3g}+-{f.std[i] * k:.2g}"
+                     for (i, _, k), short in zip(SHOWN[:4], ("r", "t", "h", "yaw"))
+                     if f.reasons[i] is None]
+            rows.append((f"front end {f.index}", (" ".join(parts) + " (mm, yaw deg)" if parts
+                                                  else "nothing identifiable")
+                         + f", residual {f.residual_rms:.2f}, {f.captures} captures"))
+        return f"{self.scene.name}: {len(self.fits)} front ends identified", rows
+
+    def _columns(self) -> dict:
+        cols = {"front_end": [f.index for f in self.fits]}
+        for i, name, k in SHOWN:
+            ok = [f.reasons[i] is None for f in self.fits]
+            cols[name] = [f.estimate[i] * k if o else np.nan for f, o in zip(self.fits, ok)]
+            cols[name.rsplit("_", 1)[0] + "_std_" + name.rsplit("_", 1)[1]] = [
+                f.std[i] * k if o else np.nan for f, o in zip(self.fits, ok)]
+        cols["residual_rms"] = [f.residual_rms for f in self.fits]
+        return cols
+
+    def plot(self, title: str = ""):
+        """Each front end's fitted radial, tangential and height offset (mm) with 1 sigma."""
+        from ..viz.figures import STYLE, new_figure  # matplotlib: only for the figure
+        import matplotlib as mpl
+        cols = self._columns()
+        with mpl.rc_context(STYLE):
+            fig, ax = new_figure(figsize=(6.4, 3.6))
+            q = np.asarray(cols["front_end"], float)
+            for k, (_, name, _) in enumerate(SHOWN[:3]):
+                std = name.rsplit("_", 1)[0] + "_std_mm"
+                ax.errorbar(q + (k - 1) * 0.12, cols[name], yerr=cols[std], fmt="o",
+                            capsize=3, label=name.replace("_offset_mm", ""))
+            ax.axhline(0.0, color="0.4", linewidth=0.8)
+            ax.set_xticks(q)
+            ax.set_xlabel("front end")
+            ax.set_ylabel("fitted offset (mm), 1 sigma bars")
+            ax.legend(loc="best")
+            ax.set_title(title or f"{self.scene.name}: identified mounting offsets",
+                         parse_math=False)
+        return fig
+
+    def to_dict(self) -> dict:
+        out_fe, out_ch, keys = [], [], []
+
+        def entry(f, i, unit, why, name):
+            if f.reasons[i] is not None:
+                why[name] = f.reasons[i]
+                return None
+            return {"value": float(f.estimate[i] * unit), "std": float(f.std[i] * unit)}
+
+        for f in self.fits:
+            why: dict = {}
+            d = {"index": f.index}
+            for i, name, unit in ((0, "radial_offset_mm", 1e3), (1, "tangential_offset_mm", 1e3),
+                                  (2, "height_offset_mm", 1e3),
+                                  (3, "yaw_offset_deg", 180 / np.pi)):
+                d[name] = entry(f, i, unit, why, name)
+            d["not_identifiable"] = why
+            fr = [i for i in f.free if i < 4]
+            d["correlations"] = [{"a": PARAMS[a], "b": PARAMS[b], "r": float(f.correlation[a, b])}
+                                 for k, a in enumerate(f.free) for b in f.free[k + 1:]
+                                 if (a in fr or b in fr) and abs(f.correlation[a, b]) > 0.5]
+            d["residual_rms"] = f.residual_rms
+            d["misfit"] = f.misfit
+            d["captures"] = f.captures
+            out_fe.append(d)
+            why = {}
+            ch = {"index": f.index, "front_end": f.index,
+                  "delay_offset_s": entry(f, 4, 1.0, why, "delay_offset_s")}
+            g = entry(f, 5, 20 / np.log(10), why, "gain_db")
+            ch["gain_db"] = g
+            ch["phase_deg"] = entry(f, 6, 180 / np.pi, why, "phase_deg")
+            ch["not_identifiable"] = why
+            out_ch.append(ch)
+            keys.append(f.residual_rms)
+        out = {"scene": self.scene.name, "front_ends": out_fe, "channels": out_ch,
+                "residual_rms": float(np.sqrt(np.mean(np.square(keys)))) if keys else None,
+                "residual_rms_unit": "measured noise std of one range-Doppler value",
+                "residual_limit": RESIDUAL_LIMIT,
+                "model_fits": all(f.misfit is None for f in self.fits)}
+        if self.radar is not None:
+            out["radar_channels"] = self.radar.to_dict()
+        return out
+
+
+def identify(scene: Scene, captures, accept_misfit: bool = False, radar_channels: bool = False,
+             reference: int | None = None) -> Identification:
+    """Fit the nominal ``scene``'s free parameters to probe ``captures`` (:class:`Capture`,
+    any number per front end; the captures of one front end are fitted jointly). With
+    ``radar_channels`` the radar's antenna gains and phases are fitted too, together with
+    every front end (:func:`~rtsgeom.identify.joint.identify_joint`; ``reference``: the front
+    end whose tangential offset fixes the array's phase ramp).
+
+    ``captures`` may be a generator (``read_capture`` per file): each is reduced to its
+    probe's bin when it arrives, so memory holds one cube at a time. Each capture is checked
+    against the scene (:func:`~rtsgeom.identify.model.measure`) and each fit by
+    :func:`check_fit`: a misfit raises ``CaptureError`` unless ``accept_misfit``, which keeps
+    it flagged (``misfit`` in the JSON)."""
+    setup = build_setup(scene)
+    groups: dict[int, list] = {}
+    for cap in captures:
+        groups.setdefault(cap.active, []).append(measure(setup, cap))
+        del cap
+    if radar_channels:
+        meas = [m for q in sorted(groups) for m in groups[q]]
+        fits, radar = identify_joint(scene, meas, reference, accept_misfit)
+        return Identification(scene, fits, radar)
+    return Identification(scene, tuple(check_fit(fit_front_end(groups[q]), accept_misfit)
+                                       for q in sorted(groups)))
