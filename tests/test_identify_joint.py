@@ -146,6 +146,8 @@ def test_joint_fit_recovers_radar_and_mounting_within_the_crb(path, radius_m, el
         q = float(err @ fisher(jac * w) @ err)
         assert q < chi2.ppf(0.999, len(free)), (seed, q, len(free))
         assert all(0.5 < f.residual_rms < 1.6 for f in ident.fits)
+    fig = ident.plot()  # the mounting offsets and the antennas' phases
+    assert len(fig.axes) == 2 and "radar channels" in fig._suptitle.get_text()
 
 
 def test_the_gauges_change_no_capture_and_the_ramp_is_a_common_turn():

@@ -61,12 +61,17 @@ class Identification(Result):
         return cols
 
     def plot(self, title: str = ""):
-        """Each front end's fitted radial, tangential and height offset (mm) with 1 sigma."""
+        """Each front end's fitted radial, tangential and height offset (mm) with 1 sigma; with
+        the radar's channels identified, a second panel: each antenna's phase error (deg)."""
         from ..viz.figures import STYLE, new_figure  # matplotlib: only for the figure
         import matplotlib as mpl
         cols = self._columns()
         with mpl.rc_context(STYLE):
-            fig, ax = new_figure(figsize=(6.4, 3.6))
+            if self.radar is None:
+                fig, ax = new_figure(figsize=(6.4, 3.6))
+            else:
+                fig, (ax, ax_r) = new_figure(figsize=(10.0, 3.8), ncols=2)
+                self._plot_antennas(ax_r)
             q = np.asarray(cols["front_end"], float)
             for k, (_, name, _) in enumerate(SHOWN[:3]):
                 std = name.rsplit("_", 1)[0] + "_std_mm"
@@ -77,9 +82,32 @@ class Identification(Result):
             ax.set_xlabel("front end")
             ax.set_ylabel("fitted offset (mm), 1 sigma bars")
             ax.legend(loc="best")
-            ax.set_title(title or f"{self.scene.name}: identified mounting offsets",
-                         parse_math=False)
+            what = "mounting offsets" if self.radar is None else "mounting and radar channels"
+            head = title or f"{self.scene.name}: identified {what}"
+            if self.radar is None:
+                ax.set_title(head, parse_math=False)
+            else:
+                fig.suptitle(head, parse_math=False)
         return fig
+
+    def _plot_antennas(self, ax) -> None:
+        """The radar's antenna phase errors with 1 sigma (references and unseen antennas as
+        open markers at the scene's value)."""
+        r = self.radar
+        labels, x = [], 0
+        for side in ("tx", "rx"):
+            _, ph, _, std, reasons = r.side(side)
+            for a, (p, s, why) in enumerate(zip(ph, std, reasons)):
+                fixed = why[1] is not None
+                ax.errorbar([x], [np.degrees(p)], yerr=None if fixed else [np.degrees(s)],
+                            fmt="o", mfc="none" if fixed else None, capsize=3,
+                            color="0.5" if fixed else ("C0" if side == "tx" else "C1"))
+                labels.append(f"{side.upper()}{a}" + ("*" if fixed else ""))
+                x += 1
+        ax.axhline(0.0, color="0.4", linewidth=0.8)
+        ax.set_xticks(range(x), labels)
+        ax.set_xlabel("antenna (* fixed: reference or unseen)")
+        ax.set_ylabel("phase error rel. to the references (deg)")
 
     def to_dict(self) -> dict:
         out_fe, out_ch, keys = [], [], []
