@@ -205,6 +205,9 @@ def test_cli_adc_active_identify_json_and_corrected_scene(tmp_path, capsys):
 @pytest.mark.parametrize("argv", [
     ["adc", str(DEFAULT_SCENE), "--active", "5", "--out", "X"],
     ["adc", str(DEFAULT_SCENE), "--active", "0", "--probe-range-m", "900", "--out", "X"],
+    # a probe capture has one front end: these were ignored
+    ["adc", str(DEFAULT_SCENE), "--active", "0", "--amplitudes", "paper", "--out", "X"],
+    ["adc", str(DEFAULT_SCENE), "--active", "0", "--calibration", "cal.json", "--out", "X"],
 ])
 def test_adc_active_bad_input_exits_2(argv, tmp_path, capsys):
     argv = [str(tmp_path / "c.npy") if a == "X" else a for a in argv]

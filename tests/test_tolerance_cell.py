@@ -208,6 +208,7 @@ def test_cli_sphere4_defaults_to_the_cell(tmp_path):
     (["--cell", "0", "1", "7"], "3 or 4"),
     (["--cell", "all", "--yaw-deg", "0.1", "--verify", "1"], "rotation"),
     (["--cell", "all", "--pair", "all"], "--pair all"),
+    (["--cell", "all", "--pair", "0", "1"], "--pair 0 1"),  # was ignored: the cell's study
 ])
 def test_cli_bad_cell_exits_2(args, word):
     p = _cli(str(SPHERE), "--draws", "5", *args)

@@ -14,7 +14,7 @@ For each arc radius the design chooses the number of front ends N and their (uni
    ``N_min + 1`` (closer spacing, more hardware).
 3. **Cutout fit.** With the sheet, neighbouring cutouts must not overlap:
    ``spacing >= 2 asin(d_cutout / (2 R_sheet))``, and each must hold its antennas. Where they do
-   not fit the sheet is removed (``design._fit_sheet``), widened where the front ends lie
+   not fit the sheet is removed (``design.fit_sheet``), widened where the front ends lie
    beyond it; the output says so.
 
 Per design (phasor level, exact geometry, no noise; ``analysis.tolerance``, its arcs):
@@ -31,12 +31,14 @@ coverage would), ``cutout fit`` (the sheet had to be removed).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 
+from .._lib.parallel import available_cores, chunk_mapper, map_chunks
 from .._lib.results import Result
 from ..errors import AngleUnreachable, ParameterError
 from ..geometry import build_setup
@@ -45,7 +47,7 @@ from ..geometry.farfield import angular_resolution_rad
 from ..paths import exact_paths
 from ..scene import Scene
 from .tolerance import Bounds, ChannelPhasors, ToleranceModel, max_scale_for_yield, monte_carlo
-from .design import _fit_sheet, _problem
+from .design import build_problem, fit_sheet
 from ..calibration.probes import probe_ranges
 from .nearfield_terms import single_front_end_angles_rad
 
@@ -129,13 +131,13 @@ def arc_scene(scene: Scene, radius_m: float, angles_rad) -> tuple[Scene, str]:
     """``scene`` with N front ends (copies of its first: layout, cables) at ``angles_rad`` on
     an arc of ``radius_m``, no targets, no mounting, channel or RuT pose errors
     (``geometry.setup.nominal_scene``); the sheet kept, widened or removed so its cutouts fit
-    (``design._fit_sheet``). Returns the scene and the sheet's fate."""
+    (``design.fit_sheet``). Returns the scene and the sheet's fate."""
     scene = nominal_scene(scene, validate=False)  # (the variant: its own rules below)
     tmpl = scene.rts.front_ends[0]
     fes = tuple(dataclasses.replace(tmpl, angle_rad=float(a)) for a in angles_rad)
     rts = dataclasses.replace(scene.rts, arc_radius_m=float(radius_m), front_ends=fes)
     variant = dataclasses.replace(scene, rts=rts, targets=())
-    sheet, state = _fit_sheet(variant)
+    sheet, state = fit_sheet(variant)
     return dataclasses.replace(variant, sheet=sheet), state
 
 
@@ -252,7 +254,7 @@ def evaluate_arc(plan: ArcPlan, spec_deg: float = 0.1, target_yield: float = 0.9
                  draws: int = 200, seed: int = 0, points: int = 11) -> ArcDesign:
     """Worst calibrated / uncalibrated angle error over the coverage and the mounting tolerance
     for the yield of one planned arc (NaN and ``problem`` where it cannot be built)."""
-    problem = plan.problem or _problem(plan.scene)
+    problem = plan.problem or build_problem(plan.scene)
     if problem is not None:
         return ArcDesign(plan, problem=problem)
     setup = build_setup(plan.scene)
@@ -359,20 +361,31 @@ def best_per_radius(grid: CoverageDesign) -> list[ArcDesign]:
     return out
 
 
+def _evaluate_planned(scene: Scene, cov, spec_deg, target_yield, draws, seed, points,
+                      cell) -> ArcDesign:
+    """One candidate arc ``cell = (radius, extra front ends)``, planned and evaluated."""
+    r, extra = cell
+    return evaluate_arc(plan_arc(scene, cov, r, extra), spec_deg, target_yield, draws, seed,
+                        points)
+
+
 def coverage_designs(scene: Scene, coverage_deg: tuple[float, float], radius_m,
                      spec_deg: float = 0.1, target_yield: float = 0.95, draws: int = 200,
                      seed: int = 0, points: int = 11, extras=(0, 1),
-                     progress: Callable[[int, int], None] | None = None) -> CoverageDesign:
-    """Plan and evaluate the candidate arcs for every radius."""
+                     progress: Callable[[int, int], None] | None = None,
+                     workers: int | None = 1) -> CoverageDesign:
+    """Plan and evaluate the candidate arcs for every radius; ``workers`` as
+    :func:`~rtsgeom.analysis.design.design_grid` (each arc is pure: the same result however
+    they are spread)."""
     warn_setup_errors(scene, "design")
     cov = tuple(math.radians(x) for x in coverage_deg)
     radii = np.asarray(radius_m, float).ravel()
-    designs, total = [], radii.size * len(extras)
-    for r in radii:
-        for e in extras:
-            designs.append(evaluate_arc(plan_arc(scene, cov, float(r), e), spec_deg,
-                                        target_yield, draws, seed, points))
-            if progress:
-                progress(len(designs), total)
+    cells = [(float(r), e) for r in radii for e in extras]
+    workers = available_cores() if workers is None else int(workers)
+    one = functools.partial(_evaluate_planned, scene, cov, spec_deg, target_yield, draws, seed,
+                            points)
+    with chunk_mapper(None, min(workers, len(cells))) as mapper:
+        designs = (map_chunks(one, cells, progress=progress) if mapper is None
+                   else mapper(one, cells, progress=progress))
     return CoverageDesign(tuple(float(x) for x in coverage_deg), radii, float(spec_deg),
                           float(target_yield), int(draws), tuple(designs), scene.name)

@@ -103,12 +103,12 @@ def two_front_end_scene(scene: Scene, pair: tuple[int, int], radius_m: float,
            dataclasses.replace(hi, angle_rad=centre + 0.5 * spacing_rad))
     rts = dataclasses.replace(scene.rts, arc_radius_m=float(radius_m), front_ends=new)
     variant = dataclasses.replace(scene, rts=rts, targets=())
-    sheet, state = _fit_sheet(variant)
+    sheet, state = fit_sheet(variant)
     variant = dataclasses.replace(variant, sheet=sheet)
-    return variant, state, _problem(variant)
+    return variant, state, build_problem(variant)
 
 
-def _fit_sheet(scene: Scene) -> tuple[SheetConfig, str]:
+def fit_sheet(scene: Scene) -> tuple[SheetConfig, str]:
     """The scene's sheet for the variant: kept if the cutouts fit, widened if the front ends
     lie beyond it, disabled if cutouts would overlap, not hold both antennas, cut the sheet in
     two, or the RuT would sit outside it."""
@@ -134,7 +134,7 @@ def _fit_sheet(scene: Scene) -> tuple[SheetConfig, str]:
     return wide, "widened"
 
 
-def _problem(scene: Scene) -> str | None:
+def build_problem(scene: Scene) -> str | None:
     """Why the variant cannot be built: the first rule of the scene schema it violates."""
     found = problems(scene)
     return found[0] if found else None

@@ -55,6 +55,10 @@ def _probe_capture(scene, args) -> int:
     """``rtsgeom adc SCENE --active I``: front end I alone with a probe target, on the setup as
     built (the scene's mounting errors), receiver noise at the scene's SNR."""
     from ..identify import setup_of, simulate_capture, write_capture  # only for --active
+    for flag, given in (("--amplitudes", args.amplitudes), ("--calibration", args.calibration)):
+        if given is not None:  # a probe capture has one front end: nothing to synthesize
+            raise UsageError(f"{flag} {given}: not with --active (front end {args.active} "
+                             "alone on a probe target: no pair, no calibration)")
     setup = setup_of(scene)
     seed = (scene.seed or 0) + args.active if args.seed is None else args.seed
     try:

@@ -80,7 +80,8 @@ def _design(args, scene, stage) -> int:
         if report is not None:  # the bar from the start, labelled with the count to come
             report("designs", 0, len(args.radius_m) * len(args.spacing_deg))
         grid = design_grid(scene, pair, args.radius_m, args.spacing_deg, args.spec_deg,
-                           args.yield_, args.draws, seed, args.points,
+                           args.yield_, args.draws, seed,
+                           21 if args.points is None else args.points,
                            None if report is None else
                            (lambda done, total: report("designs", done, total)),
                            workers=args.workers)
@@ -141,9 +142,11 @@ def _design_coverage(args, scene, folder) -> int:
         if report is not None:  # two candidate arcs per radius
             report("designs", 0, 2 * len(args.radius_m))
         grid = coverage_designs(scene, args.coverage_deg, args.radius_m, args.spec_deg,
-                                args.yield_, draws, seed, min(args.points, 11),
+                                args.yield_, draws, seed,
+                                11 if args.points is None else args.points,
                                 progress=None if report is None else
-                                (lambda done, total: report("designs", done, total)))
+                                (lambda done, total: report("designs", done, total)),
+                                workers=args.workers)
     out = grid.to_dict()
     if folder is not None:
         from ..viz.figures import save_figure
@@ -185,6 +188,7 @@ def _design_coverage(args, scene, folder) -> int:
 def register(sub) -> None:
     p = sub.add_parser("design", help="arc radius x front-end spacing design map")
     study_options(p, 2000)
+    p.set_defaults(points=None)  # 21 for the grid, 11 per pair with --coverage-deg
     p.add_argument("--radius-m", type=_grid_spec(0.1, 100.0, "m"), default=np.linspace(0.5, 2.0, 4),
                    metavar="A:B:N", help="arc radii, N from A to B m (default 0.5:2:4)")
     p.add_argument("--spacing-deg", type=_grid_spec(0.1, 90.0, "deg"),
@@ -193,7 +197,7 @@ def register(sub) -> None:
     p.add_argument("--coverage-deg", type=coverage_spec, default=None, metavar="A:B",
                    help="design an arc of N front ends covering A..B deg for each --radius-m "
                         "(number of front ends and spacing chosen; --spacing-deg and --pair "
-                        "unused)")
+                        "unused; --points per pair, default 11 here)")
     p.add_argument("--yield", dest="yield_", type=number(1e-6, 1.0), default=0.95, metavar="Y",
                    help="fraction of setups within the spec for the tolerance, in (0, 1] "
                         "(default 0.95)")

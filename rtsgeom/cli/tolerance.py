@@ -73,6 +73,9 @@ def _wants_cell(args, scene) -> bool:
     """``--cell`` given, or a RuT that beamforms in azimuth and elevation with ``--pair`` left
     at its default: the cell of all front ends (3 or 4, as ``linearity --grid``)."""
     if args.cell is not None:
+        if args.pair is not DEFAULT_PAIR:
+            raise UsageError(f"--cell and --pair {' '.join(map(str, args.pair))}: give one of "
+                             "them (the cell study is of the --cell front ends)")
         return True
     if args.pair is not DEFAULT_PAIR:
         return False
