@@ -144,8 +144,10 @@ def test_exact_model_hits_cell_points(sphere):
 
 @pytest.mark.slow
 def test_sphere4_run_within_0_05_deg():
-    """Targets at several (az, el) inside the cell, detected within 0.05 deg in both
-    angles after calibration (exact mode), for the bundled targets and a second set."""
+    """Targets at several (az, el) inside the cell (not the bundled ones), detected within
+    0.05 deg in both angles after calibration (exact mode) on a setup with channel phase and
+    gain errors the calibration has to find. (The bundled scene's run is the golden record's,
+    ``python -m benchmarks.golden``; one run here, two took 130 s of the suite.)"""
     from rtsgeom.pipeline.run import run_scene
     scene = load_scene(SPHERE)
     moved = tuple(t.evolve(angle_rad=np.radians(a), elevation_rad=np.radians(e))
@@ -155,15 +157,14 @@ def test_sphere4_run_within_0_05_deg():
     fes[1] = fes[1].evolve(phase_offset_rad=np.radians(30.0))
     fes[3] = fes[3].evolve(phase_offset_rad=np.radians(-50.0), gain_offset_db=1.0)
     wrong = scene.evolve(targets=moved, rts=scene.rts.evolve(front_ends=tuple(fes)))
-    for sc in (scene, wrong):
-        result = run_scene(sc)
-        ch = result.calibration["channels"]
-        assert len(ch["spanning_tree"]) == 3 and len(ch["loop_closure_s"]) == 2
-        # loops close within a few of the 25 ps sweep steps (noise on a flat-bottomed minimum)
-        assert max(abs(x) for x in ch["loop_closure_s"]) < 50e-12
-        assert abs(ch["residual_deg"]["azimuth"]) < 0.05
-        assert abs(ch["residual_deg"]["elevation"]) < 0.05
-        for m in result.matches:
-            e = m["error"]
-            assert e is not None, m
-            assert abs(e["angle_deg"]) < 0.05 and abs(e["elevation_deg"]) < 0.05, m
+    result = run_scene(wrong)
+    ch = result.calibration["channels"]
+    assert len(ch["spanning_tree"]) == 3 and len(ch["loop_closure_s"]) == 2
+    # loops close within a few of the 25 ps sweep steps (noise on a flat-bottomed minimum)
+    assert max(abs(x) for x in ch["loop_closure_s"]) < 50e-12
+    assert abs(ch["residual_deg"]["azimuth"]) < 0.05
+    assert abs(ch["residual_deg"]["elevation"]) < 0.05
+    for m in result.matches:
+        e = m["error"]
+        assert e is not None, m
+        assert abs(e["angle_deg"]) < 0.05 and abs(e["elevation_deg"]) < 0.05, m
