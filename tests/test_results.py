@@ -99,6 +99,42 @@ def _identification(scene):
     return Identification(scene, fits)
 
 
+def _joint_identification(scene):
+    from rtsgeom.identify import RadarChannelsFit
+    ident = _identification(scene)
+    n = 7  # 3 Tx, 4 Rx
+    why = ((None, None),) * n
+    radar = RadarChannelsFit(np.linspace(-0.1, 0.1, n), np.linspace(-0.3, 0.3, n),
+                             np.full(n, 1e-3), np.full(n, 1e-3), (("reference", "reference"),)
+                             + why[1:], 3, 0, 0, 0)
+    return type(ident)(ident.scene, ident.fits, radar)
+
+
+def _transfer():
+    from rtsgeom.analysis.transfer import Transfer
+    b, p = 6, 5
+    rng = np.random.default_rng(0)
+    e = rng.normal(0, 0.1, (b, p))
+    return Transfer(((0, 1),), np.zeros(p, int), np.linspace(-4, 4, p), 0.05 * np.ones(p),
+                    0.06 * np.ones(p), e, 0.01 * e, 0.9 * e, (0.0,), np.zeros((p, 4)),
+                    np.zeros((b, 7)), np.zeros((b, 7)), 15.0, 3.0, 0.3, 0.1, "unit")
+
+
+def _playback(scene):
+    from rtsgeom.analysis.playback.result import PlaybackResult
+    f, t = 4, 2
+    az = np.linspace(-3, 3, f)[:, None] + np.zeros((f, t))
+    track = {"range_m": np.full((f, t), 10.0), "azimuth_deg": az,
+             "velocity_mps": np.zeros((f, t))}
+    seen = dict(track, azimuth_deg=az + 0.01)
+    channels = np.empty((f, t), object)
+    for i in range(f):
+        for k in range(t):
+            channels[i, k] = (0, 1) if i < 2 else (1, 2)
+    return PlaybackResult(scene, "exact", np.arange(f) * 0.1, track, seen, np.zeros((f, t)),
+                          channels, np.zeros((0, 7)), {})
+
+
 @pytest.fixture(scope="module")
 def results(scene, tolerance_pair):
     from rtsgeom.analysis.ghosts import ghost_analysis
@@ -107,6 +143,8 @@ def results(scene, tolerance_pair):
             "VerifyResult": _verify(), "DesignGrid": _design(), "CoverageDesign": _coverage(),
             "NearField": _nearfield(scene), "GhostReport": ghost_analysis(scene),
             "Identification": _identification(scene),
+            "Identification with radar": _joint_identification(scene),
+            "Transfer": _transfer(), "PlaybackResult": _playback(scene),
             "RunResult": rtsgeom.run_scene(scene, aoa_mode="nearest")}
 
 

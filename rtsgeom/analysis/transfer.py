@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._lib.results import Result
 from ..calibration.pair import calibrate_pair
 from ..calibration.probes import FrontEndProbe, probe_angles, probe_front_ends, probe_ranges
 from ..errors import ParameterError
@@ -68,9 +69,11 @@ def draw_channel_gains(rut, radars: int, sigma_phase_rad: float, sigma_gain_db: 
     return g, ph, gd
 
 
-@dataclass(frozen=True)
-class Transfer:
-    """The study's result: per set-point (P,) over every pair, per radar draw (B, P)."""
+@dataclass(frozen=True, repr=False)
+class Transfer(Result):
+    """The study's result: per set-point (P,) over every pair, per radar draw (B, P).
+    ``print(res)`` is a summary, ``to_dict()`` the JSON, ``to_dataframe()`` one row per
+    (radar, set-point), ``plot()`` the error over the arc."""
 
     pairs: tuple[tuple[int, int], ...]
     pair_index: np.ndarray  # (P,) which pair synthesizes each set-point
@@ -88,12 +91,24 @@ class Transfer:
     sigma_phase_deg: float
     sigma_gain_db: float
     spec_deg: float | None = None
+    scene_name: str = ""
 
-    def __repr__(self) -> str:
-        e = percentiles(self.error_deg)
-        return (f"Transfer({self.error_deg.shape[0]} radars x {self.set_deg.size} set-points, "
-                f"sigma {self.sigma_phase_deg:g} deg / {self.sigma_gain_db:g} dB: |error| p50 "
-                f"{e['p50']:.4f}, p95 {e['p95']:.4f}, max {e['max']:.4f} deg)")
+    def _summary(self):
+        e, c, o = (percentiles(x) for x in (self.error_deg, self.compensated_error_deg,
+                                            self.own_error_deg))
+        title = (f"{self.scene_name + ': ' if self.scene_name else ''}{self.error_deg.shape[0]} "
+                 f"radars x {self.set_deg.size} set-points, sigma {self.sigma_phase_deg:g} deg "
+                 f"/ {self.sigma_gain_db:g} dB")
+
+        def row(p):
+            return f"p50 {p['p50']:.4f}, p95 {p['p95']:.4f}, max {p['max']:.4f}"
+        rows = [("|angle error| (deg)", row(e)),
+                ("with boresight compensation", row(c)),
+                ("on a real target", row(o)),
+                ("calibration absorbed (ps)", self.offset_shift_ps)]
+        if self.spec_deg is not None:
+            rows.append((f"verdict for {self.spec_deg:g} deg", self.verdict()))
+        return title, rows
 
     @property
     def absorbed_deg(self) -> np.ndarray:
@@ -155,9 +170,14 @@ class Transfer:
     def plot(self):
         """Error over the arc: each radar's (thin), their 5-95 % band, the golden radar's and
         the compensated radars' band; right: the distribution of |error|."""
-        import matplotlib.pyplot as plt
-        fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True,
-                                     gridspec_kw={"width_ratios": [2, 1]})
+        import matplotlib as mpl
+        from ..viz.figures import STYLE, new_figure  # matplotlib: only for the figure
+        with mpl.rc_context(STYLE):
+            fig, (ax, bx) = new_figure((11, 4.2), ncols=2, gridspec_kw={"width_ratios": [2, 1]})
+            self._draw(ax, bx)
+        return fig
+
+    def _draw(self, ax, bx) -> None:
         x = self.set_deg
         for e in self.error_deg[:40]:
             ax.plot(x, e, color="0.75", lw=0.6)
@@ -173,8 +193,9 @@ class Transfer:
                 ax.axhline(s, color="C3", ls="--", lw=1)
         ax.set_xlabel("set angle (deg)")
         ax.set_ylabel("synthesized-angle error (deg)")
-        ax.set_title(f"Calibrated with radar A, testing radar B (sigma "
-                     f"{self.sigma_phase_deg:g} deg, {self.sigma_gain_db:g} dB)")
+        ax.set_title(f"{self.scene_name + ': ' if self.scene_name else ''}calibrated with radar "
+                     f"A, testing radar B (sigma {self.sigma_phase_deg:g} deg, "
+                     f"{self.sigma_gain_db:g} dB)", parse_math=False)
         ax.legend(fontsize=8)
         top = max(float(np.nanmax(np.abs(self.error_deg))), 1e-6)
         bins = np.linspace(0, top, 30)
@@ -186,7 +207,6 @@ class Transfer:
         bx.set_xlabel("|error| (deg)")
         bx.set_ylabel("radar x set-point count")
         bx.legend(fontsize=8)
-        return fig
 
 
 @dataclass(frozen=True)
@@ -269,7 +289,8 @@ class TransferStudy:
         return Transfer(tuple(tuple(p) for p in pairs), np.asarray(idx), np.degrees(sets),
                         e[0], np.degrees(np.asarray(errs0)), e[1:1 + b], e[1 + b:],
                         np.degrees(own), tuple(shifts), np.asarray(progs), ph_b, gd_b, rng_m,
-                        float(self.sigma_phase_deg), float(self.sigma_gain_db), self.spec_deg)
+                        float(self.sigma_phase_deg), float(self.sigma_gain_db), self.spec_deg,
+                        setup.scene.name)
 
 
 def _ideal_radar(setup: Setup) -> Setup:

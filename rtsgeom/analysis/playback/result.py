@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ... import __version__
+from ..._lib.results import Result
 from ...scene import Scene
 
 __all__ = ["PlaybackResult", "PROGRAMME_COLUMNS", "TRACK_COLUMNS"]
@@ -20,8 +21,8 @@ TRACK_COLUMNS = ("frame", "time_s", "target", "set_range_m", "set_azimuth_deg",
                  "set_velocity_mps", "range_m", "azimuth_deg", "velocity_mps")
 
 
-@dataclass(frozen=True)
-class PlaybackResult:
+@dataclass(frozen=True, repr=False)
+class PlaybackResult(Result):
     """A drive played frame by frame (``Playback``).
 
     ``set`` and ``detected``: ``range_m``, ``azimuth_deg``, ``velocity_mps`` arrays (frames,
@@ -44,17 +45,27 @@ class PlaybackResult:
     warnings: tuple[str, ...] = ()
     baseline: "PlaybackResult | None" = None
 
-    def __repr__(self) -> str:
+    def _summary(self):
         s = self.summary()
-        err = s["angle_error_deg"]["max"]
-        base = (f", baseline max {self.baseline.summary()['angle_error_deg']['max']:.3g} deg"
-                if self.baseline is not None else "")
+        err = s["angle_error_deg"]
         n = self.num_targets
-        return (f"PlaybackResult({self.mode}, {s['frames']} frames x {n} "
-                f"target{'s' if n != 1 else ''}: max |angle error| "
-                f"{err if err is None else f'{err:.3g}'} deg, "
-                f"{s['lost_frames']} lost, {s['split_frames']} split, {s['handovers']} "
-                f"hand-overs{base})")
+
+        def deg(x):
+            return "none detected" if x is None else f"{x:.3g} deg"
+        title = (f"{self.scene.name}: {self.mode}, {s['frames']} frames x {n} "
+                 f"target{'s' if n != 1 else ''}, {s['lost_frames']} lost, "
+                 f"{s['split_frames']} split")
+        rows = [("max |angle error|", deg(err["max"])), ("p95 |angle error|", deg(err["p95"])),
+                ("hand-overs", s["handovers"]),
+                ("largest jump at a hand-over", deg(s["handover_jump_deg"]))]
+        if self.baseline is not None:
+            b = self.baseline.summary()
+            rows.append((f"baseline ({self.baseline.mode}) max |angle error|",
+                         deg(b["angle_error_deg"]["max"])))
+        rows += [(f"target {t['target']}", f"max {deg(t['angle_error_deg']['max'])}, "
+                  f"{t['lost_frames']} lost, {t['handovers']} hand-overs")
+                 for t in s["targets"]]
+        return title, rows
 
     @property
     def num_targets(self) -> int:
