@@ -61,46 +61,53 @@ def free_parameters(fim: np.ndarray, candidates=None, kinds=None, names=None
     reasons (default :data:`PARAMS`), ``candidates`` the indices that may be free (default
     all). Normalised to unit diagonal, the Fisher matrix is the matrix of cosines between the
     response's derivatives; an eigenvalue below :data:`MIN_EIGENVALUE` is a direction in which
-    the response hardly changes. Of the parameters that carry it (component > 0.2), the first
-    in :data:`_DROP_ORDER` is fixed, and so on; then a parameter whose Cramer-Rao std exceeds
-    :data:`STD_LIMIT` is fixed too."""
+    the response hardly changes. The parameters are taken in the reverse of
+    :data:`_DROP_ORDER` (the channels' gains and phases first, the delay last), each kept
+    only if the kept set stays above that eigenvalue, else fixed as inseparable from the
+    kept parameters its direction involves; then a kept parameter whose Cramer-Rao std
+    exceeds :data:`STD_LIMIT` is fixed too, the first in :data:`_DROP_ORDER` first.
+    (Forward, not by elimination: with many front ends, each with its near-null pairs, the
+    nearly equal small eigenvalues mix their eigenvectors, and an elimination picked an
+    identifiable front end's phase or tangential offset from the mixture.)"""
     n = fim.shape[0]
     kinds = np.arange(n) if kinds is None else np.asarray(kinds)
     names = PARAMS if names is None else names
-    free = [int(i) for i in (range(n) if candidates is None else candidates)]
 
     def rank(i):
         return _DROP_ORDER.index(int(kinds[i])), i
 
-    why: dict[int, str] = {}
-    for i in list(free):
-        if not fim[i, i] > 0:
-            free.remove(i)
-            why[i] = "does not change the response at this bin"
-    while free:
-        f = fim[np.ix_(free, free)]
+    def cosines(idx):
+        f = fim[np.ix_(idx, idx)]
         d = 1 / np.sqrt(np.diag(f))
-        cos = f * d[:, None] * d[None, :]
+        return f * d[:, None] * d[None, :]
+
+    why: dict[int, str] = {}
+    free: list[int] = []
+    for i in sorted((int(i) for i in (range(n) if candidates is None else candidates)),
+                    key=rank, reverse=True):
+        if not fim[i, i] > 0:
+            why[i] = "does not change the response at this bin"
+            continue
+        cos = cosines(free + [i])
         w, v = np.linalg.eigh(cos)
         if w[0] >= MIN_EIGENVALUE:
-            std = np.sqrt(np.diag(np.linalg.inv(f)))
-            over = [k for k in range(len(free)) if std[k] > STD_LIMIT[kinds[free[k]]]]
-            if not over:
-                break
-            k = min(over, key=lambda k: rank(free[k]))
-            i = free.pop(k)
-            why[i] = (f"too weak in these captures: its Cramer-Rao std would be "
-                      f"{_fmt(kinds[i], std[k])} (limit {_fmt(kinds[i], STD_LIMIT[kinds[i]])})")
+            free.append(i)
             continue
-        involved = [free[k] for k in range(len(free)) if abs(v[k, 0]) > 0.2]
-        i = min(involved, key=rank)
-        k = free.index(i)
-        sim = {j: abs(cos[k, free.index(j)]) for j in involved if j != i}
+        sim = ({j: abs(cos[-1, k]) for k, j in enumerate(free) if abs(v[k, 0]) > 0.2}
+               or {free[k]: abs(cos[-1, k]) for k in np.argsort(-np.abs(v[:-1, 0]))[:3]})
         others = [j for j in sim if sim[j] > 1e-3] or list(sim)
-        free.remove(i)
         why[i] = ("inseparable in these captures from "
                   + ", ".join(f"{names[j]} (|cos| {sim[j]:.6f})" for j in others)
                   + " (the response changes alike)")
+    while free:
+        std = np.sqrt(np.diag(np.linalg.inv(fim[np.ix_(free, free)])))
+        over = [k for k in range(len(free)) if std[k] > STD_LIMIT[kinds[free[k]]]]
+        if not over:
+            break
+        k = min(over, key=lambda k: rank(free[k]))
+        i = free.pop(k)
+        why[i] = (f"too weak in these captures: its Cramer-Rao std would be "
+                  f"{_fmt(kinds[i], std[k])} (limit {_fmt(kinds[i], STD_LIMIT[kinds[i]])})")
     for i in why:
         if int(kinds[i]) in SEPARATE_BY:
             why[i] += "; separate it with " + SEPARATE_BY[int(kinds[i])]

@@ -169,7 +169,7 @@ def identify(scene: Scene, captures, accept_misfit: bool = False, radar_channels
     setup = build_setup(scene)
     groups: dict[int, list] = {}
     for cap in captures:
-        groups.setdefault(cap.active, []).append(measure(setup, cap))
+        groups.setdefault(cap.active, []).append(measure(setup, cap, not radar_channels))
         del cap
     if radar_channels:
         meas = [m for q in sorted(groups) for m in groups[q]]

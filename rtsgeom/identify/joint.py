@@ -245,6 +245,11 @@ def _gauges(model: JointModel, setup: Setup, reference: int) -> dict[int, str]:
             out[model.antenna_index("tx", int(a), what)] = (
                 "transmits in no chirp of this radar's configuration (the elevated Tx without "
                 "radar.use_elevation_tx): no capture sees it; keeps the scene's value")
+    for a in np.setdiff1d(np.arange(model.n_rx), model.virtual_rx):
+        for what in (_LOG_GAIN, _PHASE):
+            out[model.antenna_index("rx", int(a), what)] = (
+                "in no virtual element of this radar: no capture sees it; keeps the scene's "
+                "value")
     b = model.fronts.index(reference)
     ramp = f"the reference front end: keeps the scene's value ({GAUGES[2][1]}; {GAUGES[2][2]})"
     out[_N * b + _TANG] = ramp
@@ -253,48 +258,59 @@ def _gauges(model: JointModel, setup: Setup, reference: int) -> dict[int, str]:
     return out
 
 
-def _start(model: JointModel, y: np.ndarray, nominal: np.ndarray) -> np.ndarray:
+def _start(model: JointModel, y: np.ndarray, nominal: np.ndarray,
+           iterations: int = 200) -> np.ndarray:
     """The fit's start: the front ends' mounting at the scene's values, and the antennas' and
-    front ends' complex gains from the logarithm of the measured response over the nominal
-    one, ``ln(y_cv / h_cv) = e_tx[t] + e_rx[r] + conj-gain of the front end`` (linear least
-    squares in the complex logarithm, each capture's mean phase taken out first so that the
-    element phases do not wrap), moved to the references' scene values. A start from each
-    front end fitted alone would take the radar's phase errors for mounting errors (a
-    tangential grid search lands on another lobe under +-20 deg of antenna phase)."""
+    the captures' complex gains by alternating least squares on ``y_cv = G_c A[t_v] B[r_v]
+    h_cv`` (``h``: the nominal response on an ideal radar): each factor in closed form given
+    the others, from all ones. Phases of any size (an uncalibrated radar's +-180 deg) need no
+    unwrapping, as a logarithm's would; the result is moved to the references' scene values.
+    A start from each front end fitted alone would take the radar's phase errors for
+    mounting errors (a tangential grid search lands on another lobe under +-20 deg of antenna
+    phase)."""
     theta = nominal.copy()
     for k in range(len(model.fronts)):
         theta[_N * k + _LOG_GAIN] = theta[_N * k + _PHASE] = 0.0
     n_fe = _N * len(model.fronts)
     theta[n_fe:] = 0.0
     h = model.respond(theta)  # (C, V) the ideal radar, unit channel gains
-    ratio = y / h
-    turn = np.exp(1j * np.angle(np.sum(ratio, axis=1)))
-    z = np.log(np.abs(ratio)) + 1j * np.angle(ratio / turn[:, None])  # (C, V)
-    n_c, v = z.shape
-    a = np.zeros((n_c, v, model.n_ant + len(model.fronts)))
-    a[:, np.arange(v), model.virtual_tx] = 1.0
-    a[:, np.arange(v), model.n_tx + model.virtual_rx] = 1.0
-    a[np.arange(n_c), :, model.n_ant + model.block] = 1.0
-    sol, *_ = np.linalg.lstsq(a.reshape(n_c * v, -1), z.ravel(), rcond=None)
-    ant = sol[:model.n_ant].copy()
-    fe = sol[model.n_ant:].copy()
-    # each capture's mean phase back into its front end's gain (captures of one front end
-    # turn alike up to noise: their mean)
-    for k in range(len(model.fronts)):
-        fe[k] += 1j * np.angle(np.mean(turn[model.block == k]))
-    # the references keep the scene's values; a non-transmitting antenna too
+    tx, rx = model.virtual_tx, model.virtual_rx
+    n_c = y.shape[0]
+    g = np.ones(n_c, complex)
+    a = np.ones(model.n_tx, complex)
+    b = np.ones(model.n_rx, complex)
+
+    def solve(basis, index, n):
+        """Per index value, the factor x minimising sum |y - x basis|^2 over its elements."""
+        num = np.zeros(n, complex)
+        den = np.zeros(n)
+        np.add.at(num, index.ravel(), (np.conj(basis) * y).ravel())
+        np.add.at(den, index.ravel(), (np.abs(basis) ** 2).ravel())
+        out = np.ones(n, complex)
+        out[den > 0] = num[den > 0] / den[den > 0]
+        return out
+
+    cap = np.repeat(np.arange(n_c)[:, None], tx.size, axis=1)
+    for _ in range(iterations):
+        g = solve(a[tx] * b[rx] * h, cap, n_c)
+        a = solve(g[:, None] * b[rx] * h, np.broadcast_to(tx, y.shape), model.n_tx)
+        b = solve(g[:, None] * a[tx] * h, np.broadcast_to(rx, y.shape), model.n_rx)
+    # the references keep the scene's values (the captures' gains take the difference); an
+    # antenna no capture sees keeps the scene's too
     scene_ant = nominal[n_fe:n_fe + model.n_ant] + 1j * nominal[n_fe + model.n_ant:]
-    ref_tx, ref_rx = int(np.min(model.virtual_tx)), model.n_tx
-    d_tx, d_rx = ant[ref_tx] - scene_ant[ref_tx], ant[ref_rx] - scene_ant[ref_rx]
-    ant[:model.n_tx] -= d_tx
-    ant[model.n_tx:] -= d_rx
-    fe += d_tx + d_rx
-    idle = np.setdiff1d(np.arange(model.n_tx), model.virtual_tx)
-    ant[idle] = scene_ant[idle]
+    ref_tx = int(np.min(tx))
+    d_a = np.exp(scene_ant[ref_tx]) / a[ref_tx]
+    d_b = np.exp(scene_ant[model.n_tx]) / b[0]
+    a, b, g = a * d_a, b * d_b, g / (d_a * d_b)
+    ant = np.log(np.r_[a, b])
+    held = np.r_[ref_tx, model.n_tx, np.setdiff1d(np.arange(model.n_tx), tx),
+                 model.n_tx + np.setdiff1d(np.arange(model.n_rx), rx)]
+    ant[held] = scene_ant[held]
     theta[n_fe:n_fe + model.n_ant], theta[n_fe + model.n_ant:] = ant.real, ant.imag
     for k in range(len(model.fronts)):
-        # y carries conj(G): ln|G| = Re, arg G = -Im
-        theta[_N * k + _LOG_GAIN], theta[_N * k + _PHASE] = fe[k].real, -fe[k].imag
+        # y carries conj(G) of the front end's channel: ln|G| = ln|g|, arg G = -arg g
+        gk = np.mean(g[model.block == k])
+        theta[_N * k + _LOG_GAIN], theta[_N * k + _PHASE] = np.log(abs(gk)), -np.angle(gk)
     return theta
 
 
