@@ -4,9 +4,10 @@ A phase is measured between two channels as on an arc (paper section "Calibratio
 probe targets synthesized by the pair at amplitude ratios 1:3 and 3:1, designed at every step
 on the nominal model, the probes' detected direction cosines compared with the design's. In
 a 2-D beamformer (front ends side by side or stacked in elevation) each probe has an error in
-each axis: its columns are (probe, along or across the pair's line). Every step is one full ADC-cube simulation (no
-phasor model of a 2-D detection yet), so the noise is measured, not predicted: from the fine
-sweep's own residual (``fit.fit_scatter``).
+each axis: its columns are (probe, along or across the pair's line). Every step is one full
+ADC-cube simulation (no phasor model of a 2-D detection yet), so the noise is measured, not
+predicted: from the fine sweep's own residual (``fit.fit_scatter``). As on an arc, the probes
+are placed within their range bins for the fine sweep's window (:meth:`BeamProbes.placed`).
 """
 
 from __future__ import annotations
