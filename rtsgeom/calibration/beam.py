@@ -160,7 +160,8 @@ class BeamProbes:
         a probe whose two channels' echoes straddle a bin boundary (sphere4's side-by-side
         pair at 3 m: bins within 0.002 to 0.15 dB) was detected in either bin from step to
         step and its error jumped by 0.018 in direction cosine with the bin; the receiver
-        noise moved which steps jumped, and the fit by 7 ps."""
+        noise moved which steps jumped, and the fit by 7 ps. Placed, the worst margins over
+        the window rose from 0.012 and 0.09 dB to 5.0 and 2.9 dB."""
         out = copy.copy(self)
         out.ranges = place_in_bins(self.setup.scene, self.ranges,
                                    lambda r: self.bin_margin(r, window_s))
