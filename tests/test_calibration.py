@@ -691,3 +691,23 @@ def test_fine_sweep_is_fitted_up_to_its_first_jump_either_side():
     # without the cut the jumps pull the fitted centre off
     assert abs(fit_centre(d, e, period, 0.0, search_s=30e-12) - s0) > 1e-12
     assert continuous_steps(e[:5], 2).shape == (5, 2)  # too few steps: as they are
+
+
+def test_fine_sweep_cut_drops_a_one_step_excursion_whatever_the_noise():
+    """``continuous_steps``: a probe detected in the other bin at one step only is a one-step
+    excursion, two jumps in a row whose departures are equal but for the noise; the cut starts
+    at the excursion's step on either side of the centre, never one step later (which kept
+    it and moved the fitted centre by 5 ps on sphere4's side-by-side pair), for every draw
+    of noise far below the excursion."""
+    from rtsgeom.calibration.fit import continuous_steps
+    period = 1e-9
+    d = np.arange(-25, 26) * 10e-12
+    smooth = 0.02 * (1 - np.cos(2 * np.pi * (d - 7e-12) / period))
+    rng = np.random.default_rng(5)
+    for _ in range(40):
+        e = smooth + 1e-4 * rng.standard_normal(smooth.size)
+        e[28] += 0.018  # above the centre (index 25)
+        e[20] -= 0.018  # below it
+        kept = continuous_steps(e[:, None], 25)[:, 0]
+        assert np.isnan(kept[28:]).all() and np.isfinite(kept[21:28]).all()
+        assert np.isnan(kept[:21]).all()

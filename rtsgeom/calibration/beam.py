@@ -4,12 +4,15 @@ A phase is measured between two channels as on an arc (paper section "Calibratio
 probe targets synthesized by the pair at amplitude ratios 1:3 and 3:1, designed at every step
 on the nominal model, the probes' detected direction cosines compared with the design's. In
 a 2-D beamformer (front ends side by side or stacked in elevation) each probe has an error in
-each axis: its columns are (probe, along or across the pair's line). Every step is one full ADC-cube simulation (no
-phasor model of a 2-D detection yet), so the noise is measured, not predicted: from the fine
-sweep's own residual (``fit.fit_scatter``).
+each axis: its columns are (probe, along or across the pair's line). Every step is one full
+ADC-cube simulation (no phasor model of a 2-D detection yet), so the noise is measured, not
+predicted: from the fine sweep's own residual (``fit.fit_scatter``). As on an arc, the probes
+are placed within their range bins for the fine sweep's window (:meth:`BeamProbes.placed`).
 """
 
 from __future__ import annotations
+
+import copy
 
 import numpy as np
 
@@ -21,8 +24,8 @@ from ..rts.channels import RtsProgram, requested_delay
 from ..scene import TargetConfig
 from ..synthesis.model import ChannelModel
 from .fit import crossing_columns, rms_error_deg
-from .probes import (FrontEndProbe, if_phase_slope_hz, probe_ranges, probe_total_delay,
-                     simulate_detect)
+from .probes import (FrontEndProbe, if_phase_slope_hz, place_in_bins, probe_ranges,
+                     probe_total_delay, simulate_detect)
 from .steps import adds_noise, reference_probes, sweep_phase
 
 __all__ = ["BeamProbes", "PROBE_RATIOS"]
@@ -70,24 +73,43 @@ class BeamProbes:
         # side by side or stacked in elevation (not across a cell's diagonal)
         self.axis_pair = bool(np.min(np.abs(along)) <= np.sin(AXIS_TOLERANCE_RAD))
 
+    def _model(self, r: float, rho: float, delta_s: float):
+        """A probe's design on the nominal model at range ``r``, amplitude ratio ``rho`` and
+        channel J at ``delta_s``: the pair's model and its weights, coherent at the front
+        ends' midpoint ``u_mid``."""
+        nom, nom_paths = self.nominal
+        cs = ChannelModel.build(nom, nom_paths, self.pair, TargetConfig(float(r)),
+                                (self.base_offsets[0], self.base_offsets[1] + delta_s),
+                                steering=self.steering)
+        u_mid = cs.fe_directions().mean(axis=0)
+        return cs, cs.weights([1.0, rho], cs.coherent_phases(u_mid[None])), u_mid
+
     def design(self, delta_s: float = 0.0):
         """Per probe: the programme amplitudes (2,) (the nominal model's design with channel
         J at ``delta_s``, coherent at the front ends' midpoint, the probe's amplitude ratio,
         times the gain correction) and the direction cosines (D,) the design puts it at."""
-        nom, nom_paths = self.nominal
         designs, predicted = [], []
         for p, (r, rho) in enumerate(zip(self.ranges, PROBE_RATIOS)):
-            cs = ChannelModel.build(nom, nom_paths, self.pair, TargetConfig(float(r)),
-                                    (self.base_offsets[0], self.base_offsets[1] + delta_s),
-                                    steering=self.steering)
-            u_mid = cs.fe_directions().mean(axis=0)
-            w = cs.weights([1.0, rho], cs.coherent_phases(u_mid[None]))
+            cs, w, u_mid = self._model(r, rho, delta_s)
             u_pred = cs.direction_cosines(w, u_mid)
             if p not in self._p_ref:
                 self._p_ref[p] = cs.reference_power()
             designs.append(cs.amplitudes(w, u_pred, self._p_ref[p]) * self.gain_correction)
             predicted.append(u_pred)
         return designs, predicted
+
+    def bin_margin(self, ranges, window_s) -> np.ndarray:
+        """Per probe at ``ranges`` (P,): the smallest power ratio, over channel J's delays
+        ``window_s``, of the candidate range bin the design's target is strongest in (the
+        bin the RuT detects it in, :meth:`ChannelModel.snapshot`) over the next strongest."""
+        out = np.full(len(ranges), np.inf)
+        for p, (r, rho) in enumerate(zip(ranges, PROBE_RATIOS)):
+            for d in np.atleast_1d(window_s):
+                cs, w, _ = self._model(r, rho, float(d))
+                pw = np.sort(np.sum(np.abs(np.einsum("q,kqv->kv", w, cs.responses)) ** 2,
+                                    axis=-1))
+                out[p] = min(out[p], pw[-1] / max(pw[-2], 1e-300))
+        return out
 
     @property
     def probe_angles_deg(self) -> tuple:
@@ -132,8 +154,20 @@ class BeamProbes:
         return None
 
     def placed(self, window_s) -> "BeamProbes":
-        """The probes stay at their ranges (the bin logic of :class:`PhasorProbes` is 1-D)."""
-        return self
+        """These probes moved within their range bins so that over the delays ``window_s``
+        the bin the design's target is strongest in keeps the largest power margin over its
+        neighbours (``probes.place_in_bins``, :meth:`bin_margin`), as on an arc. Unplaced,
+        a probe whose two channels' echoes straddle a bin boundary (sphere4's side-by-side
+        pair at 3 m: bins within 0.002 to 0.15 dB) was detected in either bin from step to
+        step and its error jumped by 0.018 in direction cosine with the bin; the receiver
+        noise moved which steps jumped, and the fit by 7 ps. Placed, the worst margins over
+        the window rose from 0.012 and 0.09 dB to 5.0 and 2.9 dB."""
+        out = copy.copy(self)
+        out.ranges = place_in_bins(self.setup.scene, self.ranges,
+                                   lambda r: self.bin_margin(r, window_s))
+        out._p_ref = {}  # the single-channel peak power is the probe's range's
+        out._base = [float(requested_delay(self.setup.scene, r)) for r in out.ranges]
+        return out
 
     def reference(self, phase_rad: float = 0.0) -> "BeamProbes":
         """The same probes on the nominal setup as the sweep's reference

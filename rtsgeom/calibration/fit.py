@@ -90,17 +90,24 @@ JUMP_FACTOR = 10.0  # a step's change this many times the sweep's typical bend i
 
 def continuous_steps(e, centre: int, min_steps: int = 7) -> np.ndarray:
     """``e`` (S, C) with every step beyond a jump NaN, per column: the fine sweep's curves
-    are smooth in the delay, but where the design or the detection changes its range bin
-    part-way through the window a probe's error jumps (sphere4's side-by-side pair at 3 m
-    with 1 mm on a front end: 0.013 and 0.021 in direction cosine between adjacent 10 ps
-    steps, against 0.0001 of bend), and the curve beyond it, a different one, pulled the
-    fitted centre 18 ps. A jump: a step's first difference departing from its neighbours'
-    mean by more than :data:`JUMP_FACTOR` x the column's median departure; the steps kept
-    run from the ``centre`` step to the nearest jump on either side. Sweeps of fewer than
-    ``min_steps`` steps are returned as they are."""
+    are smooth in the delay, but where a probe's detection changes its range bin part-way
+    through the window (a combined echo straddling two bins of nearly equal power, which the
+    2-D probes' placement avoids where it can: ``beam.BeamProbes.placed``) its error jumps
+    (sphere4's side-by-side pair at 3 m with 1 mm on a front end, unplaced: 0.013 to 0.021 in
+    direction cosine between adjacent 10 ps steps, against 0.0001 of bend), and the curve
+    beyond it, a different one, pulled the fitted centre 18 ps. A jump: a step's first
+    difference departing from its neighbours' mean (half the third difference) by more than
+    :data:`JUMP_FACTOR` x the column's median departure; the steps kept run from the
+    ``centre`` step to the nearest jump on either side, the first step that leaves the curve
+    not kept. A jump shows in three departures, the largest marks it; a one-step excursion
+    (detected in the other bin at one step only) is two jumps in a row whose departures are
+    equal but for the noise, so which step is the first off the curve is asked of the curve
+    itself: the step the kept steps' quadratic continuation misses by more than the
+    threshold. Sweeps of fewer than ``min_steps`` steps are returned as they are."""
     e = np.array(e, float, copy=True)
     if e.ndim != 2 or e.shape[0] < min_steps:
         return e
+    n = e.shape[0]
     d = np.diff(e, axis=0)  # (S - 1, C)
     dev = np.full(d.shape, np.nan)
     dev[1:-1] = np.abs(d[1:-1] - 0.5 * (d[:-2] + d[2:]))
@@ -109,6 +116,18 @@ def continuous_steps(e, centre: int, min_steps: int = 7) -> np.ndarray:
         warnings.simplefilter("ignore", RuntimeWarning)  # a column never detected
         typical = np.nanmedian(dev, axis=0)
     jump = np.isfinite(dev) & (dev > JUMP_FACTOR * typical) & (dev > 0)
+
+    def leaves(c, k, back):
+        """Whether step ``k`` misses the quadratic through the three steps before it (towards
+        the centre: ``back`` = -1 below it, +1 above) by more than the jump threshold (the
+        departure's own scale: twice the third difference's half)."""
+        seed = k + back * np.arange(1, 4)
+        if seed.min() < 0 or seed.max() >= n:
+            return False
+        y = e[seed, c]
+        miss = abs(e[k, c] - 3 * y[0] + 3 * y[1] - y[2])
+        return bool(np.isfinite(miss) and miss > 2 * JUMP_FACTOR * typical[c])
+
     # a jump between steps k and k + 1 shows in dev at k - 1, k and k + 1: the largest marks it
     for c in range(e.shape[1]):
         ks = np.flatnonzero(jump[:, c])
@@ -117,10 +136,12 @@ def continuous_steps(e, centre: int, min_steps: int = 7) -> np.ndarray:
         peaks = [k for k in ks if dev[k, c] >= np.nanmax(dev[max(k - 1, 0):k + 2, c])]
         lo = [k for k in peaks if k < centre]
         hi = [k for k in peaks if k >= centre]
-        if lo:
-            e[:max(lo) + 1, c] = np.nan
-        if hi:
-            e[min(hi) + 1:, c] = np.nan
+        if lo:  # the first step off the curve below the centre: k, or k + 1 (an excursion)
+            k = max(lo)
+            e[:k + 2 if k + 1 < centre and leaves(c, k + 1, +1) else k + 1, c] = np.nan
+        if hi:  # above it: k + 1, or k (an excursion)
+            k = min(hi)
+            e[k if k > centre and leaves(c, k, -1) else k + 1:, c] = np.nan
     return e
 
 

@@ -41,8 +41,9 @@ from ..radar.processing import nearest_detection
 from ..paths import nominal_model
 from ..rts.fir import realised_delay
 from .fit import MC_DRAWS, rms_error_deg
-from .probes import (FrontEndProbe, if_phase_slope_hz, probe_angles, probe_program,
-                     probe_ranges, probe_total_delay, simulate_detect)
+from .probes import (PLACEMENT_OFFSETS_BINS, FrontEndProbe, if_phase_slope_hz,
+                     place_in_bins, probe_angles, probe_program, probe_ranges,
+                     probe_total_delay, simulate_detect)
 from .steps import (FINE_STEP_S, adds_noise, predicted_angle_noise, reference_probes,
                     sweep_phase)
 
@@ -204,22 +205,16 @@ def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair,
 
 
 def place_probes(setup, paths, nominal, pair, ranges, alphas, window_s, base_offsets,
-                 gain_correction, offsets_bins=np.linspace(-0.5, 0.4, 10)) -> np.ndarray:
+                 gain_correction, offsets_bins=PLACEMENT_OFFSETS_BINS) -> np.ndarray:
     """Probe ranges (P,) moved within a range bin so that over the delays ``window_s`` the
-    design and the detection agree on each probe's bin with the largest power margin (what
-    a lab chooses when it sets its probe targets' ranges): the sweep curve stays on one bin,
-    continuous, around the coherence point."""
-    radar = setup.scene.radar
-    bin_m = c * radar.adc_rate_hz / (2 * radar.slope_hz_per_s * radar.samples_per_chirp)
-    ranges = np.asarray(ranges, float)
-    score = np.empty((len(offsets_bins), ranges.size))
-    for n, o in enumerate(offsets_bins):
-        t = [TargetConfig(float(r + o * bin_m)) for r in ranges]
-        res = phasor_sweep(setup, paths, nominal, pair, t, alphas, window_s, base_offsets,
-                           gain_correction)
-        score[n] = np.min(np.where(res.consistent, res.margin, 0.0), axis=0)
-    best = np.asarray(offsets_bins)[np.argmax(score, axis=0)]
-    return ranges + best * bin_m
+    design and the detection agree on each probe's bin with the largest power margin
+    (``probes.place_in_bins``): the sweep curve stays on one bin, continuous, around the
+    coherence point."""
+    def margin(r):
+        res = phasor_sweep(setup, paths, nominal, pair, [TargetConfig(float(x)) for x in r],
+                           alphas, window_s, base_offsets, gain_correction)
+        return np.min(np.where(res.consistent, res.margin, 0.0), axis=0)
+    return place_in_bins(setup.scene, ranges, margin, offsets_bins)
 
 
 def chain_errors(setup, paths, pair, targets, res: SweepResult, base_offsets, frames, seed

@@ -7,6 +7,8 @@ phase slopes that turn a measured phase into a delay (eqs. 8 and 27).
   power (the amplitude calibration).
 * :func:`probe_ranges` / :func:`probe_angles`: where a pair's two probe targets sit (apart,
   clear of each other's cable ghosts; at a quarter and three quarters of the span).
+* :func:`place_in_bins`: the probes' ranges moved within their range bins so that the bin
+  the RuT detects them in stays clear of its neighbours over the fine sweep's window.
 * :func:`simulate_detect`: one radar output, the coherent average of K frames of a static
   programme, through the full ADC-cube chain.
 """
@@ -32,7 +34,8 @@ from ..synthesis.model import ChannelModel
 
 __all__ = ["FrontEndProbe", "clipping_note", "probe_front_ends", "probe_ranges", "probe_angles",
            "probe_total_delay", "probe_program", "simulate_detect", "if_phase_slope_hz",
-           "air_phase_slope_hz", "mean_air_delay"]
+           "air_phase_slope_hz", "mean_air_delay", "place_in_bins", "PLACEMENT_OFFSETS_BINS",
+           "range_bin_m"]
 
 
 @dataclass(frozen=True)
@@ -47,6 +50,29 @@ class FrontEndProbe:
     def clipping_note(self) -> str:
         """Why a front end may be missing: the probe frame's ADC clipping, if any."""
         return clipping_note(self.adc_clipped)
+
+
+PLACEMENT_OFFSETS_BINS = np.linspace(-0.5, 0.4, 10)  # candidate moves of a probe (bins)
+
+
+def range_bin_m(scene) -> float:
+    """One range bin of the RuT (m)."""
+    radar = scene.radar
+    return float(c * radar.adc_rate_hz / (2 * radar.slope_hz_per_s * radar.samples_per_chirp))
+
+
+def place_in_bins(scene, ranges, margin, offsets_bins=PLACEMENT_OFFSETS_BINS) -> np.ndarray:
+    """Probe ranges (P,) moved within a range bin by the candidate ``offsets_bins`` (bins)
+    to the one with the largest ``margin`` (ranges (P,) -> (P,)): each probe's worst margin,
+    over the fine sweep's window, of the bin the RuT detects it in over the next strongest
+    (0 where design and detection disagree). What a lab chooses when it sets its probe
+    targets' ranges: a combined echo that straddles two bins of nearly equal power is
+    detected in either, and its angle jumps with the bin (the two channels' echoes sit at
+    different ranges, so their ratio differs from bin to bin)."""
+    ranges = np.asarray(ranges, float)
+    bin_m = range_bin_m(scene)
+    score = np.array([margin(ranges + o * bin_m) for o in offsets_bins])  # (O, P)
+    return ranges + np.asarray(offsets_bins)[np.argmax(score, axis=0)] * bin_m
 
 
 def clipping_note(clipped: int) -> str:

@@ -9,7 +9,8 @@ jointly smallest:
 1. coarse sweep over the span (``SweepConfig.span_s`` / ``step_s``, default the scene's
    ``calibration_span_ns`` / ``calibration_step_ps``): the RMS minimum nearest zero delay
    (``fit.coarse_minimum``);
-2. the probes placed for the fine window (on the phasor model: within their range bins);
+2. the probes placed for the fine window: within their range bins, so that the bin the RuT
+   detects each in keeps a power margin over its neighbours (``probes.place_in_bins``);
 3. fine sweep over +-period/4 around it in steps the RTS can set; the coherence point is the
    common centre of symmetry of its signed error curves (``fit.fit_centre``);
 4. the frames per step sized so that the noise moves the fitted minimum by less than
