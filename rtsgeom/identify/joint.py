@@ -18,13 +18,13 @@ antenna's ``ln|g|`` and ``arg g``. Three combinations change no capture, whateve
   the reference Rx keeps the scene's;
 * a phase ramp across the array turns every direction like all front ends moved together (a
   yaw of the radar against the arc); the reference front end keeps the scene's tangential
-  offset (and, with elevation elements, its height): the others are measured relative to it.
+  offset (and, with elevation elements, its height): the others are read turned with it.
 
 What is left is separable where the captures see it (:func:`~rtsgeom.identify.fit.free_parameters`
 on the joint Fisher information, as for one front end): the per-antenna pattern that no front
 end's smooth mounting errors (a ramp and a curvature) can mimic. The fit is the whitened
-least squares of :func:`~rtsgeom.identify.fit.solve_whitened` from the per-front-end fits
-(:func:`~rtsgeom.identify.fit.fit_front_end`); its covariance is the inverse Fisher
+least squares of :func:`~rtsgeom.identify.fit.solve_whitened` from an alternating least
+squares on the complex factors (:func:`_start`); its covariance is the inverse Fisher
 information, at the truth the Cramer-Rao bound (:func:`joint_cramer_rao`).
 """
 
@@ -63,7 +63,8 @@ GAUGES = (
      "(and in height) together: a yaw of the radar against the arc",
      "a reflector at a surveyed angle (the radar's own boresight measurement) or a surveyed "
      "position of the reference front end; without one the reference front end keeps the "
-     "scene's tangential offset (and height) and the others are relative to it"),
+     "scene's tangential offset (and height) and the others are read turned with it (by "
+     "R_c du / cos(theta_q))"),
 )
 
 
