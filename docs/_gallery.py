@@ -60,12 +60,14 @@ class OutputScraper:
         return Path(os.environ["RTSGEOM_EXAMPLES_OUT"])
 
     def reset(self, gallery_conf, fname) -> None:
-        """Before each example: an empty output folder, no figure open in pyplot."""
+        """Before each example: an empty output folder (the previous example's files moved
+        into its ``written/``, where the docs test checks them), no figure open in pyplot."""
         out = self.folder()
         if out.is_dir():
+            (out / "written").mkdir(exist_ok=True)
             for p in out.iterdir():
                 if p.is_file():
-                    p.unlink()
+                    p.replace(out / "written" / p.name)
         self.seen.clear()
         if "matplotlib.pyplot" in sys.modules:
             sys.modules["matplotlib.pyplot"].close("all")

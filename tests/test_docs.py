@@ -40,6 +40,14 @@ def test_docs_build_without_warnings(tmp_path):
                               % page.stem, page.read_text()))
         figures[page.stem] = [s for s in srcs if (html / "_images" / s).stat().st_size > 1000]
     assert all(figures.values()), {k: v for k, v in figures.items() if not v}
+    # and wrote every file it promises (the gallery is where the examples run:
+    # tests/test_examples.py runs them only where this build cannot)
+    from test_examples import OUTPUTS
+    out = tmp_path / "doctrees" / "example_output"
+    written = {p.name: p.stat().st_size for d in (out, out / "written") for p in d.glob("*")
+               if p.is_file()}
+    missing = [n for names in OUTPUTS.values() for n in names if written.get(n, 0) <= 100]
+    assert not missing, missing
     assert sum(len(v) for v in figures.values()) >= 8, figures
     api = (html / "api.html").read_text()
     for name in ("run_scene", "load_scene", "calibrate", "tolerance", "design", "show"):

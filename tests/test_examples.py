@@ -1,8 +1,11 @@
 """Every script in examples/ runs top to bottom with small settings (RTSGEOM_EXAMPLES_QUICK=1),
-off screen (matplotlib Agg, pyvista off-screen), and writes the figures it promises."""
+off screen (matplotlib Agg, pyvista off-screen), and writes the figures it promises: run by
+the docs build's gallery (tests/test_docs.py, which checks the files) where Sphinx is
+installed, else here, one process each."""
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import subprocess
 import sys
@@ -36,12 +39,24 @@ def test_every_example_is_listed():
     assert sorted(OUTPUTS) == [p.name for p in EXAMPLES]
 
 
-@pytest.mark.slow
+#: the docs build (tests/test_docs.py) runs every example in its gallery and checks the files
+#: each writes (:data:`OUTPUTS`); where it can run, the examples are not run a second time here
+DOCS_BUILD_RUNS_THEM = all(importlib.util.find_spec(m) is not None for m in (
+    "sphinx", "sphinx_gallery", "myst_parser", "pydata_sphinx_theme"))
+
+
 @pytest.mark.parametrize("path", EXAMPLES, ids=[p.stem for p in EXAMPLES])
-def test_example_runs(path: Path, tmp_path):
+def test_example_layout(path: Path):
     text = path.read_text()
     assert text.startswith('"""') and "\n# %%" in text  # sphinx-gallery layout
     assert "rtsgeom._" not in text and "import _" not in text  # public API only
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(DOCS_BUILD_RUNS_THEM, reason="the docs build runs every example "
+                    "(tests/test_docs.py)")
+@pytest.mark.parametrize("path", EXAMPLES, ids=[p.stem for p in EXAMPLES])
+def test_example_runs(path: Path, tmp_path):
     env = dict(os.environ, RTSGEOM_EXAMPLES_QUICK="1", RTSGEOM_EXAMPLES_OUT=str(tmp_path),
                MPLBACKEND="Agg", PYVISTA_OFF_SCREEN="true",
                PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
