@@ -278,10 +278,12 @@ def main(argv=None) -> int:
                     help="every bundled scene's measured pairs instead of the grid")
     ap.add_argument("--out", type=Path, default=None,
                     help="file stem (default benchmarks/calibration_accuracy[_quick])")
+    ap.add_argument("--radii", type=float, nargs="+", default=None, metavar="R",
+                    help="arc radii (m) instead of the grid's (0.5 1 3; --quick: 1 3)")
     a = ap.parse_args(argv)
     if a.bundled:
         return run_bundled(a.workers)
-    radii = [1.0, 3.0] if a.quick else [0.5, 1.0, 3.0]
+    radii = a.radii or ([1.0, 3.0] if a.quick else [0.5, 1.0, 3.0])
     offsets = [-1e-3, 1e-3] if a.quick else [-1e-3, -0.5e-3, 0.5e-3, 1e-3]
     cases = []
     for array in a.arrays:
