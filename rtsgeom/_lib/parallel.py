@@ -113,6 +113,23 @@ def chunk_mapper(scheduler: str | None = None, workers: int | None = None):
         yield functools.partial(map_chunks, client=client)
 
 
+def local_map(func: Callable, chunks: Sequence, workers: int | None = None,
+              progress: Callable[[int, int], None] | None = None,
+              before_fork: Callable[[], None] | None = None) -> list:
+    """``[func(c) for c in chunks]`` in order: in ``workers`` local processes (None: the cores
+    this process may run on, :func:`available_cores`) where more than one is asked and there
+    are chunks to share, else here; ``before_fork()`` first where a pool starts (imports its
+    forked workers should inherit). The same bits however they are spread."""
+    chunks = list(chunks)
+    workers = available_cores() if workers is None else int(workers)
+    with chunk_mapper(None, min(workers, len(chunks))) as mapper:
+        if mapper is None:
+            return map_chunks(func, chunks, progress=progress)
+        if before_fork is not None:
+            before_fork()
+        return mapper(func, chunks, progress=progress)
+
+
 def available_cores() -> int:
     """The cores this process may run on (its CPU affinity where the OS reports one, as a
     container's CPU set limits it; else ``os.cpu_count()``)."""

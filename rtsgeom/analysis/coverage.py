@@ -38,7 +38,7 @@ from typing import Callable
 
 import numpy as np
 
-from .._lib.parallel import available_cores, chunk_mapper, map_chunks
+from .._lib.parallel import local_map
 from .._lib.results import Result
 from ..errors import AngleUnreachable, ParameterError
 from ..geometry import build_setup
@@ -47,7 +47,7 @@ from ..geometry.farfield import angular_resolution_rad
 from ..paths import exact_paths
 from ..scene import Scene
 from .tolerance import Bounds, ChannelPhasors, ToleranceModel, max_scale_for_yield, monte_carlo
-from .design import build_problem, fit_sheet
+from .design import build_problem, fit_sheet, import_for_workers
 from ..calibration.probes import probe_ranges
 from .nearfield_terms import single_front_end_angles_rad
 
@@ -381,11 +381,8 @@ def coverage_designs(scene: Scene, coverage_deg: tuple[float, float], radius_m,
     cov = tuple(math.radians(x) for x in coverage_deg)
     radii = np.asarray(radius_m, float).ravel()
     cells = [(float(r), e) for r in radii for e in extras]
-    workers = available_cores() if workers is None else int(workers)
     one = functools.partial(_evaluate_planned, scene, cov, spec_deg, target_yield, draws, seed,
                             points)
-    with chunk_mapper(None, min(workers, len(cells))) as mapper:
-        designs = (map_chunks(one, cells, progress=progress) if mapper is None
-                   else mapper(one, cells, progress=progress))
+    designs = local_map(one, cells, workers, progress, before_fork=import_for_workers)
     return CoverageDesign(tuple(float(x) for x in coverage_deg), radii, float(spec_deg),
                           float(target_yield), int(draws), tuple(designs), scene.name)

@@ -40,7 +40,7 @@ from ..errors import AngleUnreachable
 from ..geometry import build_setup
 from ..geometry.setup import nominal_scene, warn_setup_errors
 from ..geometry.farfield import angular_resolution_rad
-from .._lib.parallel import available_cores, chunk_mapper, map_chunks
+from .._lib.parallel import local_map
 from ..scene import Scene, SheetConfig
 from ..scene.rules import arc_centre_m, problems
 from .tolerance import CASES, ChannelPhasors, max_sigma_for_yield, monte_carlo
@@ -341,7 +341,7 @@ class DesignGrid(Result):
         }
 
 
-def _import_for_workers() -> None:
+def import_for_workers() -> None:
     """Import here what every design imports on its first use (the compiled kernels: numba),
     so that the pool's forked workers inherit the modules instead of each importing them
     again (~0.15 s CPU per worker; loading each kernel's compiled code from numba's cache,
@@ -375,18 +375,11 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     fes = scene.rts.front_ends
     centre = 0.5 * (fes[pair[0]].angle_rad + fes[pair[1]].angle_rad)
     cells = [(float(r), math.radians(s)) for s in spacings for r in radii]
-    total = len(cells)
-    workers = available_cores() if workers is None else int(workers)
     one = functools.partial(_evaluate_cell, scene, pair, spec_deg, target_yield, draws, seed,
                             points)
     # the studies' own pool (parallel.chunk_mapper: forked workers inheriting the scene, one
     # BLAS thread each; results in order, so the same bits however they are spread)
-    with chunk_mapper(None, min(workers, total)) as mapper:
-        if mapper is None:
-            designs = map_chunks(one, cells, progress=progress)
-        else:
-            _import_for_workers()
-            designs = mapper(one, cells, progress=progress)
+    designs = local_map(one, cells, workers, progress, before_fork=import_for_workers)
     shape = (spacings.size, radii.size)
     metrics = {name: frozen(np.array([d[name] for d in designs], float).reshape(shape))
                for name in METRICS}

@@ -106,8 +106,7 @@ class BeamProbes:
         for p, (r, rho) in enumerate(zip(ranges, PROBE_RATIOS)):
             for d in np.atleast_1d(window_s):
                 cs, w, _ = self._model(r, rho, float(d))
-                pw = np.sort(np.sum(np.abs(np.einsum("q,kqv->kv", w, cs.responses)) ** 2,
-                                    axis=-1))
+                pw = np.sort(np.sum(np.abs(cs.combined(w)) ** 2, axis=-1))  # per bin
                 out[p] = min(out[p], pw[-1] / max(pw[-2], 1e-300))
         return out
 

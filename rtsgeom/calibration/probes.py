@@ -34,8 +34,7 @@ from ..synthesis.model import ChannelModel
 
 __all__ = ["FrontEndProbe", "clipping_note", "probe_front_ends", "probe_ranges", "probe_angles",
            "probe_total_delay", "probe_program", "simulate_detect", "if_phase_slope_hz",
-           "air_phase_slope_hz", "mean_air_delay", "place_in_bins", "PLACEMENT_OFFSETS_BINS",
-           "range_bin_m"]
+           "air_phase_slope_hz", "mean_air_delay", "place_in_bins", "PLACEMENT_OFFSETS_BINS"]
 
 
 @dataclass(frozen=True)
@@ -55,12 +54,6 @@ class FrontEndProbe:
 PLACEMENT_OFFSETS_BINS = np.linspace(-0.5, 0.4, 10)  # candidate moves of a probe (bins)
 
 
-def range_bin_m(scene) -> float:
-    """One range bin of the RuT (m)."""
-    radar = scene.radar
-    return float(c * radar.adc_rate_hz / (2 * radar.slope_hz_per_s * radar.samples_per_chirp))
-
-
 def place_in_bins(scene, ranges, margin, offsets_bins=PLACEMENT_OFFSETS_BINS) -> np.ndarray:
     """Probe ranges (P,) moved within a range bin by the candidate ``offsets_bins`` (bins)
     to the one with the largest ``margin`` (ranges (P,) -> (P,)): each probe's worst margin,
@@ -70,7 +63,7 @@ def place_in_bins(scene, ranges, margin, offsets_bins=PLACEMENT_OFFSETS_BINS) ->
     detected in either, and its angle jumps with the bin (the two channels' echoes sit at
     different ranges, so their ratio differs from bin to bin)."""
     ranges = np.asarray(ranges, float)
-    bin_m = range_bin_m(scene)
+    bin_m = scene.radar.range_resolution_m  # one range bin
     score = np.array([margin(ranges + o * bin_m) for o in offsets_bins])  # (O, P)
     return ranges + np.asarray(offsets_bins)[np.argmax(score, axis=0)] * bin_m
 

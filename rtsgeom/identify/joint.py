@@ -39,6 +39,7 @@ from .._lib.util import frozen
 from ..errors import ParameterError, SceneError
 from ..geometry import Setup
 from ..geometry.setup import build_setup
+from ..radar.channels import antenna_gains
 from ..scene import Scene
 from .fit import _SCALE, FrontEndFit, check_fit, fisher, free_parameters, solve_whitened
 from .model import PARAMS
@@ -139,6 +140,28 @@ class JointModel:
         k = a + (self.n_tx if side == "rx" else 0)
         return _N * len(self.fronts) + (0 if what == _LOG_GAIN else self.n_ant) + k
 
+    @property
+    def reference_tx(self) -> int:
+        """The reference Tx: the first that transmits (the reference Rx is Rx 0)."""
+        return int(np.min(self.virtual_tx))
+
+    def unseen(self) -> np.ndarray:
+        """The antennas no virtual element uses (indices in the Tx-then-Rx order)."""
+        return np.r_[np.setdiff1d(np.arange(self.n_tx), self.virtual_tx),
+                     self.n_tx + np.setdiff1d(np.arange(self.n_rx), self.virtual_rx)]
+
+    def nominal(self, scene: Scene) -> np.ndarray:
+        """The scene's values of every parameter: each front end's (``ProbeModel.nominal``),
+        the antennas' ln|g| and phases (``[radar.channels]``, 0 where unset)."""
+        ch = scene.radar.channels
+        fe = [next(m for m in self.models if m.active == q).nominal() for q in self.fronts]
+        g = np.log(np.r_[
+            antenna_gains(() if ch is None else ch.tx_gain_db,
+                          () if ch is None else ch.tx_phase_rad, self.n_tx),
+            antenna_gains(() if ch is None else ch.rx_gain_db,
+                          () if ch is None else ch.rx_phase_rad, self.n_rx)])
+        return np.r_[np.concatenate(fe), g.real, g.imag]
+
     def kinds(self) -> np.ndarray:
         """PARAMS index of each parameter (an antenna's ln-gain and phase as a channel's)."""
         return np.r_[np.tile(np.arange(_N), len(self.fronts)),
@@ -198,20 +221,6 @@ def _ideal_gain_setup(setup: Setup) -> Setup:
     return dataclasses.replace(setup, scene=scene)
 
 
-def _scene_antennas(scene: Scene, n_tx: int, n_rx: int) -> np.ndarray:
-    """The scene's antenna ln-gains and phases, (2 (N_tx + N_rx),)."""
-    ch = scene.radar.channels
-
-    def vals(x, n, k):
-        return np.zeros(n) if ch is None or len(x) == 0 else np.asarray(x, float) * k
-
-    k = np.log(10) / 20
-    if ch is None:
-        return np.zeros(2 * (n_tx + n_rx))
-    return np.r_[vals(ch.tx_gain_db, n_tx, k), vals(ch.rx_gain_db, n_rx, k),
-                 vals(ch.tx_phase_rad, n_tx, 1.0), vals(ch.rx_phase_rad, n_rx, 1.0)]
-
-
 def _has_elevation(setup: Setup) -> bool:
     """Whether the transmitting virtual array spans heights (then a height ramp acts)."""
     rut = setup.rut
@@ -234,23 +243,16 @@ def joint_model(setup: Setup, measurements) -> JointModel:
 def _gauges(model: JointModel, setup: Setup, reference: int) -> dict[int, str]:
     """The parameters fixed by :data:`GAUGES` (and the Tx antennas that never transmit), with
     the reason each output gives."""
-    ref_tx = int(np.min(model.virtual_tx))
     out = {}
     for what, name in ((_LOG_GAIN, "gain"), (_PHASE, "phase")):
-        out[model.antenna_index("tx", ref_tx, what)] = (
+        out[model.antenna_index("tx", model.reference_tx, what)] = (
             f"the reference Tx: keeps the scene's {name} ({GAUGES[0][1]})")
         out[model.antenna_index("rx", 0, what)] = (
             f"the reference Rx: keeps the scene's {name} ({GAUGES[1][1]})")
-    for a in np.setdiff1d(np.arange(model.n_tx), model.virtual_tx):
-        for what in (_LOG_GAIN, _PHASE):
+        for a in model.unseen():  # (Tx-then-Rx order: the Tx side's index is the plain one)
             out[model.antenna_index("tx", int(a), what)] = (
-                "transmits in no chirp of this radar's configuration (the elevated Tx without "
-                "radar.use_elevation_tx): no capture sees it; keeps the scene's value")
-    for a in np.setdiff1d(np.arange(model.n_rx), model.virtual_rx):
-        for what in (_LOG_GAIN, _PHASE):
-            out[model.antenna_index("rx", int(a), what)] = (
-                "in no virtual element of this radar: no capture sees it; keeps the scene's "
-                "value")
+                "in no virtual element of this radar's configuration (e.g. the elevated Tx "
+                "without radar.use_elevation_tx): no capture sees it; keeps the scene's value")
     b = model.fronts.index(reference)
     ramp = f"the reference front end: keeps the scene's value ({GAUGES[2][1]}; {GAUGES[2][2]})"
     out[_N * b + _TANG] = ramp
@@ -299,13 +301,11 @@ def _start(model: JointModel, y: np.ndarray, nominal: np.ndarray,
     # the references keep the scene's values (the captures' gains take the difference); an
     # antenna no capture sees keeps the scene's too
     scene_ant = nominal[n_fe:n_fe + model.n_ant] + 1j * nominal[n_fe + model.n_ant:]
-    ref_tx = int(np.min(tx))
-    d_a = np.exp(scene_ant[ref_tx]) / a[ref_tx]
+    d_a = np.exp(scene_ant[model.reference_tx]) / a[model.reference_tx]
     d_b = np.exp(scene_ant[model.n_tx]) / b[0]
     a, b, g = a * d_a, b * d_b, g / (d_a * d_b)
     ant = np.log(np.r_[a, b])
-    held = np.r_[ref_tx, model.n_tx, np.setdiff1d(np.arange(model.n_tx), tx),
-                 model.n_tx + np.setdiff1d(np.arange(model.n_rx), rx)]
+    held = np.r_[model.reference_tx, model.n_tx, model.unseen()]
     ant[held] = scene_ant[held]
     theta[n_fe:n_fe + model.n_ant], theta[n_fe + model.n_ant:] = ant.real, ant.imag
     for k in range(len(model.fronts)):
@@ -325,17 +325,15 @@ def identify_joint(scene: Scene, measurements, reference: int | None = None,
     ch = scene.radar.channels
     if ch is not None and ch.compensation != "none":
         raise SceneError(f"radar.channels.compensation = {ch.compensation!r}: must be "
-                           "\"none\" to identify the radar's channels (the radar's compensation "
-                           "divides its own channel errors out of every capture)")
+                         "\"none\" to identify the radar's channels (the radar's compensation "
+                         "divides its own channel errors out of every capture)")
     model = joint_model(setup, measurements)
     reference = model.fronts[0] if reference is None else int(reference)
     if reference not in model.fronts:
         raise ParameterError(f"reference front end {reference}: must be one of the captured "
-                           f"front ends {list(model.fronts)}")
+                             f"front ends {list(model.fronts)}")
     y = np.stack([m[0] for m in measurements])
-    nominal = [next(m for m in model.models if m.active == q).nominal() for q in model.fronts]
-    theta = _start(model, y, np.r_[np.concatenate(nominal),
-                                   _scene_antennas(scene, model.n_tx, model.n_rx)])
+    theta = _start(model, y, model.nominal(scene))
     sw = np.sqrt(1 / np.array([m[1] for m in measurements]))[:, None]
     fixed = _gauges(model, setup, reference)
     kinds, names = model.kinds(), model.names()
@@ -375,7 +373,7 @@ def identify_joint(scene: Scene, measurements, reference: int | None = None,
         frozen(theta[a]), frozen(np.angle(np.exp(1j * theta[p]))), frozen(std[a]),
         frozen(std[p]),
         tuple((why.get(n_fe + i), why.get(n_fe + model.n_ant + i)) for i in range(model.n_ant)),
-        model.n_tx, int(np.min(model.virtual_tx)), 0, reference)
+        model.n_tx, model.reference_tx, 0, reference)
     return tuple(fits), radar
 
 

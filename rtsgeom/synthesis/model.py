@@ -30,8 +30,8 @@ D = 2). Programme weights ``w`` (Q,) (amplitude times e^{j phase}) combine them 
     the pair only: paper eq. (23) as printed (with its sign fixed).
 
 :meth:`ChannelModel.perturbed` applies mounting errors of the front ends at phasor level (the
-changed two-way air delay's phase and free-space amplitude), which is what the tolerance
-study draws.
+changed two-way air delay's phase and free-space amplitude), which is what the tolerance study
+draws.
 """
 
 from __future__ import annotations
@@ -173,13 +173,17 @@ class ChannelModel:
 
     # -- the synthesized target -------------------------------------------------------------
 
-    def snapshot(self, w) -> np.ndarray:
-        """Spectrum of the combined target for programme weights ``w`` (..., Q) at its
-        strongest candidate bin, TDM-compensated: (..., V)."""
+    def combined(self, w) -> np.ndarray:
+        """The combined target in every candidate bin (..., K, V) for weights ``w`` (..., Q)."""
         w = np.asarray(w)
         x = self.responses[:, 0] * w[..., 0, None, None]
         for q in range(1, self.count):  # Q terms, summed in channel order (not over draws)
             x = x + w[..., q, None, None] * self.responses[:, q]
+        return x
+
+    def snapshot(self, w) -> np.ndarray:
+        """The combined target at its strongest candidate bin, TDM-compensated: (..., V)."""
+        x = self.combined(w)
         k = np.argmax(np.sum(np.abs(x) ** 2, axis=-1), axis=-1)  # (...)
         x = np.take_along_axis(x, k[..., None, None], axis=-2)[..., 0, :]
         return tdm_compensate(x, self.doppler_hz, self.setup.rut, self.setup.scene.radar)
