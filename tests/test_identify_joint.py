@@ -259,3 +259,22 @@ def test_a_compensated_radar_is_refused_with_the_field_named():
         compensation="boresight")))
     with pytest.raises(SceneError, match="radar.channels.compensation"):
         ident_mod.identify(comp, caps, radar_channels=True)
+
+
+def test_an_antenna_gain_beyond_the_schema_is_refused_naming_it():
+    """An estimated antenna gain beyond [radar.channels]' +-20 dB (a broken chain, or captures
+    that are not this radar's) is refused naming the antenna, not written into an
+    identified.toml that would not load; within it the fit passes unchanged."""
+    from rtsgeom.errors import CaptureError
+    from rtsgeom.identify import RadarChannelsFit
+    from rtsgeom.identify.joint import check_radar_fit
+    n = 7
+    ok = ((None, None),) * n
+    lg = np.zeros(n)
+    lg[5] = 19.0 * np.log(10) / 20
+    fit = RadarChannelsFit(lg, np.zeros(n), np.ones(n), np.ones(n), ok, 3, 0, 0, 0)
+    assert check_radar_fit(fit) is fit
+    lg[5] = 25.0 * np.log(10) / 20
+    with pytest.raises(CaptureError, match=r"rx_gain_db\[2\] = 25"):
+        check_radar_fit(RadarChannelsFit(lg, np.zeros(n), np.ones(n), np.ones(n), ok, 3, 0,
+                                         0, 0))

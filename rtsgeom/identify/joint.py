@@ -36,15 +36,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._lib.util import frozen
-from ..errors import ParameterError, SceneError
+from ..errors import CaptureError, ParameterError, SceneError
 from ..geometry import Setup
 from ..geometry.setup import build_setup
 from ..radar.channels import antenna_gains
 from ..scene import Scene
+from ..scene.channels import MAX_GAIN_ERROR_DB
+from ..scene.schema import check_arg
 from .fit import _SCALE, FrontEndFit, check_fit, fisher, free_parameters, solve_whitened
 from .model import PARAMS
 
-__all__ = ["GAUGES", "RadarChannelsFit", "JointModel", "identify_joint", "joint_cramer_rao"]
+__all__ = ["GAUGES", "RadarChannelsFit", "JointModel", "identify_joint", "joint_cramer_rao",
+           "check_radar_fit"]
 
 _N = len(PARAMS)
 _LOG_GAIN, _PHASE = PARAMS.index("log_gain"), PARAMS.index("phase")
@@ -369,12 +372,26 @@ def identify_joint(scene: Scene, measurements, reference: int | None = None,
     n_fe = _N * len(model.fronts)
     a = slice(n_fe, n_fe + model.n_ant)
     p = slice(n_fe + model.n_ant, None)
-    radar = RadarChannelsFit(
+    radar = check_radar_fit(RadarChannelsFit(
         frozen(theta[a]), frozen(np.angle(np.exp(1j * theta[p]))), frozen(std[a]),
         frozen(std[p]),
         tuple((why.get(n_fe + i), why.get(n_fe + model.n_ant + i)) for i in range(model.n_ant)),
-        model.n_tx, model.reference_tx, 0, reference)
+        model.n_tx, model.reference_tx, 0, reference))
     return tuple(fits), radar
+
+
+def check_radar_fit(r: RadarChannelsFit) -> RadarChannelsFit:
+    """Refuse antenna gain estimates beyond the scene's ``[radar.channels]`` limit
+    (``MAX_GAIN_ERROR_DB``: a chain that far off is broken, or the captures are not this
+    radar's): ``CaptureError`` naming the antenna, so that ``identified.toml`` always loads."""
+    for side in ("tx", "rx"):
+        lg, _, _, _, reasons = r.side(side)
+        for a, (x, why) in enumerate(zip(lg, reasons)):
+            if why[0] is None:
+                check_arg(float(x * 20 / np.log(10)), f"{side}_gain_db[{a}]", "float",
+                          "radar channels: estimated", CaptureError, lo=-MAX_GAIN_ERROR_DB,
+                          hi=MAX_GAIN_ERROR_DB, unit="dB")
+    return r
 
 
 def joint_cramer_rao(model: JointModel, theta, sigma2, free) -> np.ndarray:
