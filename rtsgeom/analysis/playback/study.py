@@ -20,6 +20,7 @@ from ...geometry import build_setup
 from ...paths import compute_paths
 from ...scene import Scene
 from ...scene.registry import AOA_MODES, PATH_METHODS
+from ...pipeline.cells import shared_cell_warnings
 from .frames import FramePlanner, detect_frame, frame_targets
 from .result import PlaybackResult
 
@@ -91,6 +92,7 @@ def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1, t
     if progress:
         progress(f"{mode}: calibrating and planning {len(frames)} frames")
     planner = FramePlanner(setup, paths, mode, frames, progress)
+    shared = _shared_cells(setup, frames)
     n_f, n_t = len(frames), len(frames[0])
     shape = (n_f, n_t)
     det = {k: np.full(shape, np.nan) for k in ("range_m", "azimuth_deg", "velocity_mps")}
@@ -98,7 +100,7 @@ def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1, t
     status = np.full(shape, "not_detected", dtype=object)
     split = np.zeros(shape, int)
     channels = np.empty(shape, object)
-    programme, warnings = [], list(planner.warnings)
+    programme, warnings = [], list(planner.warnings) + shared
     work = functools.partial(_frames, (scene, setup, paths, planner, frames, bins, truth))
     chunks = np.array_split(np.arange(n_f), max(1, min(n_f, 4 * int(workers))))
     outs = (fork_map(work, chunks, int(workers)) if workers > 1 and n_f > 1
@@ -122,6 +124,17 @@ def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1, t
                           split=split, channels=channels, programme=np.concatenate(programme),
                           calibration=planner.record, warnings=tuple(warnings),
                           truth=tru if truth else None, status=status)
+
+
+def _shared_cells(setup, frames) -> list[str]:
+    """The drive's targets that share a range-Doppler cell (:func:`shared_cell_warnings`), one
+    line per situation with the frames it holds in."""
+    seen: dict[str, list[int]] = {}
+    for f, targets in enumerate(frames):
+        for w in shared_cell_warnings(setup, targets):
+            seen.setdefault(w, []).append(f)
+    return [f"frames {fs[0]}..{fs[-1]} ({len(fs)} frames): {w}" if len(fs) > 1 else
+            f"frame {fs[0]}: {w}" for w, fs in seen.items()]
 
 
 def _frames(ctx, chunk) -> list:
