@@ -118,3 +118,18 @@ def test_the_package_called_is_its_entry_point(monkeypatch):
     monkeypatch.setattr(package, "identify", lambda *a, **k: ("called", a, k))
     assert rtsgeom.identify("scene", ["cap"], accept_misfit=True) == (
         "called", ("scene", ["cap"]), {"accept_misfit": True})
+
+
+@pytest.mark.parametrize("study, call", [
+    ("tolerance", lambda s: rtsgeom.tolerance(s, draws=20, points=5)),
+    ("design", lambda s: rtsgeom.design(s, [1.0], [8.0], draws=20, points=5)),
+    ("nearfield", lambda s: rtsgeom.nearfield(s, [1.0], points=3)),
+])
+def test_each_api_warning_points_at_the_callers_line(scene, study, call):
+    """Every warning the API raises names the caller's line, whatever the depth of the call
+    inside the package (``rtsgeom.design()``'s pointed at rtsgeom/api.py:285)."""
+    with pytest.warns(NominalSetupWarning, match=f"^{study} ") as caught:
+        call(_with_offset(scene))
+    ours = [w for w in caught if issubclass(w.category, NominalSetupWarning)]
+    assert len(ours) == 1 and ours[0].filename == __file__, [(w.filename, w.lineno)
+                                                             for w in ours]
