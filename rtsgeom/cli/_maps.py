@@ -154,7 +154,8 @@ def _calibration_figures(result: RunResult) -> list[bytes]:
             refine_delta_tau_s=[p["delta_tau_s"] for p in rf],
             refine_error_deg=[np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
                               for p in rf],
-            title=f"Phase coherency calibration, front ends {cal['pair'][0]}-{cal['pair'][1]}")
+            title=f"{result.scene.name}: phase coherency calibration, front ends "
+                  f"{cal['pair'][0]}-{cal['pair'][1]}")
         out.append(figure_png(fig))
     return out
 
