@@ -25,6 +25,7 @@ from ...calibration.channels import channel_offsets
 from ...calibration.probes import probe_front_ends
 from ...rts.channels import RtsProgram, program_nearest
 from ...scene import Scene, TargetConfig
+from ...scene.objects import frame_objects
 from ...scene.scenario import trajectory
 
 __all__ = ["frame_targets", "FramePlanner", "detect_frame"]
@@ -32,10 +33,14 @@ __all__ = ["frame_targets", "FramePlanner", "detect_frame"]
 
 def frame_targets(scene: Scene) -> tuple[np.ndarray, list[tuple[TargetConfig, ...]]]:
     """The frames' times and each frame's targets: the scene's ``[[targets]]`` (indices 0..S-1)
-    then the ``[[scenario.targets]]`` at their set-points (S..), as ``TargetConfig``."""
+    then the ``[[scenario.targets]]`` at their set-points (S..), as ``TargetConfig``, then the
+    moving objects' scatterers (:func:`rtsgeom.scene.objects.frame_objects`)."""
     sc = scene.scenario
     times = sc.frame_times()
-    moving = [(trajectory(t.waypoints, times), t.rcs_dbsm) for t in sc.targets]
+    sps = {i: trajectory(t.waypoints, times) for i, t in enumerate(sc.targets)}
+    moving = [(sps[i], t.rcs_dbsm) for i, t in enumerate(sc.targets)
+              if t.scatterers is None and t.mesh is None]
+    objects = frame_objects(scene, sps, times.size)  # an object's scatterers, each frame
     static = tuple(scene.targets)
     frames = []
     for f in range(times.size):
@@ -43,7 +48,7 @@ def frame_targets(scene: Scene) -> tuple[np.ndarray, list[tuple[TargetConfig, ..
             TargetConfig(range_m=float(sp.range_m[f]), velocity_mps=float(sp.velocity_mps[f]),
                          rcs_dbsm=rcs, angle_rad=float(sp.azimuth_rad[f]),
                          elevation_rad=float(sp.elevation_rad[f]))
-            for sp, rcs in moving))
+            for sp, rcs in moving) + tuple(objects[f]))
     return times, frames
 
 
