@@ -9,6 +9,7 @@ import json
 
 from .._lib.io import write_bytes
 from ..geometry.warnings import scene_warnings
+from ..analysis.objects import run_objects
 from ..pipeline.run import run_scene, summary
 from ..scene.registry import ANGLE_ESTIMATORS, AOA_MODES, PATH_METHODS
 from ._common import (calibration_kw, load_scene_checked, number, output_folder, output_path,
@@ -39,6 +40,8 @@ def cmd_run(args) -> int:
         (stage / "summary.json").write_text(
             json.dumps(summary(result, args.paths), indent=2, allow_nan=False) + "\n",
             encoding="utf-8")
+        if scene.objects:  # extended objects: what the radar sees of them, truth and RTS
+            write_objects(stage, scene, *run_objects(result))
         ds = map_dataset(result)
         maps = render_maps(result, ds)
         for name, data in {**maps, **maps_arrays(ds, args.maps)}.items():
@@ -59,6 +62,15 @@ def cmd_run(args) -> int:
               + ", ".join(f"maps.{f}" for f in args.maps) + ("" if args.no_report else ", report.html"))
     return 0
 
+
+def write_objects(stage, scene, rows, section: dict) -> None:
+    """clouds.csv, objects.json and objects.png of a scene with extended objects."""
+    from ..analysis.objects import clouds_csv, objects_figure
+    from ..viz.figures import save_figure
+    (stage / "clouds.csv").write_text(clouds_csv(rows), encoding="utf-8")
+    (stage / "objects.json").write_text(json.dumps(section, indent=2, allow_nan=False) + "\n",
+                                        encoding="utf-8")
+    save_figure(objects_figure(scene, rows, section), stage / "objects.png")
 
 
 def target_line(m: dict) -> str:

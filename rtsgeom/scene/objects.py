@@ -67,6 +67,28 @@ class ObjectModel:
     heading_rad: float = 0.0
     along_velocity: bool = False
     moving: bool = False
+    origin: tuple[float, float, float] | None = None  # a static object's origin (radar frame)
+
+    def __repr__(self) -> str:
+        what = (f"{len(self.points)} scatterers" if self.points is not None
+                else f"mesh of {len(self.faces)} facets")
+        return f"ObjectModel({self.where}: {what}{', moving' if self.moving else ''})"
+
+    def outline_at(self, origin, velocity_vec=None) -> np.ndarray:
+        """The footprint (K, 2) in the radar frame's (x, y) with the origin at ``origin``."""
+        turn = _turn(self.heading(None if velocity_vec is None else np.asarray(velocity_vec)))
+        xy = np.c_[self.outline, np.zeros(len(self.outline))] @ turn.T
+        return xy[:, :2] + np.asarray(origin, float)[None, :2]
+
+    def pose(self, scene, f: int = 0) -> tuple[np.ndarray, np.ndarray]:
+        """The origin (3,) and velocity (3,) in the radar frame at frame ``f`` (a static
+        object: its origin, at rest)."""
+        if not self.moving:
+            return np.asarray(self.origin, float), np.zeros(3)
+        from .scenario import trajectory
+        i = int(self.where.split("[")[1].rstrip("]"))
+        sp = trajectory(scene.scenario.targets[i].waypoints, scene.scenario.frame_times())
+        return sp.position_m[f], sp.velocity_vec_mps[f]
 
     def heading(self, velocity_vec=None) -> float:
         """The heading (rad) in a pose: along ``velocity_vec`` (the radar frame's x, y) where
@@ -276,7 +298,7 @@ def expand_objects(scene, mesh_paths: dict[str, str]):
             pts = place(m, t.range_m * u, t.velocity_mps * u, scene.radar, len(models))
         except SceneError as exc:
             raise SceneError(f"{src}: {exc}") from None
-        models.append(m)
+        models.append(dataclasses.replace(m, origin=tuple(t.range_m * u)))
         targets += pts
     sc = scene.scenario
     if sc is not None:
