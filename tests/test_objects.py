@@ -25,6 +25,7 @@ from rtsgeom.errors import SceneError
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import compute_paths
 from rtsgeom.pipeline.merge import budget_targets
+from rtsgeom.pipeline.plan import bracketing_pair
 from rtsgeom.pipeline.run import run_scene
 from rtsgeom.scene import parse_scene
 from rtsgeom.scene.objects import MAX_MESH_FACETS
@@ -123,7 +124,7 @@ def test_dynamic_resolution_kept_grows_on_approach():
     _, frames = frame_targets(s)
     setup = build_setup(rtsgeom.replace(s, scenario=None))
     probe = probe_front_ends(setup, compute_paths(setup, "exact"), s.seed)
-    kept = [budget_targets(setup, tg, probe).counts["kept"] for tg in frames]
+    kept = [budget_targets(setup, tg, probe, bracketing_pair).counts["kept"] for tg in frames]
     assert kept[-1] > kept[0] and kept[-1] == max(kept), kept
 
 
@@ -211,3 +212,34 @@ def test_mesh_object_scatterers_face_the_radar(tmp_path):
     r = np.array([t.range_m for t in s.targets])
     assert 3 <= len(r) <= 32 and np.all(np.abs(r - 15.0) <= 2.5)
     assert np.median(r) < 15.0  # the near half of the car returns most
+
+
+# ------------------------------------------------------------------------------------------
+# The design study
+# ------------------------------------------------------------------------------------------
+
+def test_object_design_study_smallest_design():
+    """The turned box on boresight at 10 m: without a limit the RTS reproduces every truth
+    detection (share 1); a budget of one target per channel keeps fewer targets than the
+    box's four scatterers; the smallest design is the unlimited one."""
+    from rtsgeom.analysis.object_design import ObjectDesign
+    s = parse_scene(with_object(bench_doc(), scatterers=BOX, heading_deg=30.0), "box.toml")
+    res = ObjectDesign(ranges_m=(10.0,), spacings_deg=(16.0,), budgets=(None, 1))(s)
+    assert res.share[0, 0, 0] == 1.0 and res.kept[0, 0, 0] == 4
+    assert res.kept[0, 1, 0] < 4
+    assert res.best() == {"front_ends": int(res.front_ends[0]), "spacing_deg": 16.0,
+                          "max_targets_per_channel": None}
+    df = res.to_dataframe()
+    assert len(df) == 2 and "reproduced_share" in df
+    assert "smallest design" in repr(res)
+
+
+def test_object_design_refuses_bad_grid():
+    from rtsgeom.analysis.object_design import ObjectDesign
+    from rtsgeom.errors import ParameterError
+    with pytest.raises(ParameterError, match="budgets"):
+        ObjectDesign(budgets=(0,))
+    with pytest.raises(ParameterError, match="ranges_m"):
+        ObjectDesign(ranges_m=(float("nan"),))
+    with pytest.raises(ParameterError, match="has no extended object"):
+        ObjectDesign()(rtsgeom.load_scene(SCENES / "crossing.toml"))

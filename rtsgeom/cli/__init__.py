@@ -46,6 +46,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
                              "gain/phase/delay from probe captures"),
     "transfer": ("transfer", "calibration transfer: an RTS calibrated with one radar, tested "
                              "with drawn radars of the type"),
+    "objects": ("objects", "extended object: the smallest front-end arc and per-channel "
+                           "budget that reproduce it over its ranges"),
 }
 
 #: the modules that register commands, in the table's order

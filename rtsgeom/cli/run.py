@@ -9,7 +9,6 @@ import json
 
 from .._lib.io import write_bytes
 from ..geometry.warnings import scene_warnings
-from ..analysis.objects import run_objects
 from ..pipeline.run import run_scene, summary
 from ..scene.registry import ANGLE_ESTIMATORS, AOA_MODES, PATH_METHODS
 from ._common import (calibration_kw, load_scene_checked, number, output_folder, output_path,
@@ -41,6 +40,7 @@ def cmd_run(args) -> int:
             json.dumps(summary(result, args.paths), indent=2, allow_nan=False) + "\n",
             encoding="utf-8")
         if scene.objects:  # extended objects: what the radar sees of them, truth and RTS
+            from ..analysis.objects import run_objects
             write_objects(stage, scene, *run_objects(result))
         ds = map_dataset(result)
         maps = render_maps(result, ds)

@@ -141,13 +141,13 @@ def _merged(targets, group, det, scale, wavelength_m) -> tuple[TargetConfig, flo
             centroid, found)
 
 
-def budget_targets(setup: Setup, targets, probe, limit: int | None = None) -> Budgeted:
+def budget_targets(setup: Setup, targets, probe, pair_of, limit: int | None = None
+                   ) -> Budgeted:
     """The targets the RTS synthesizes under ``limit`` targets per channel (default the
     scene's ``rts.max_targets_per_channel``): merged where the RuT cannot resolve them, then
     the weakest dropped on every channel over the limit (module docstring). ``probe``: the
-    front ends as the RuT measures them (each target's channels: the pair whose measured span
-    holds it)."""
-    from .plan import bracketing_pair  # the planner's own pair rule
+    front ends as the RuT measures them; ``pair_of(angle_rad, probe_angles_rad)`` a target's
+    channels (the planner's ``bracketing_pair``: the pair whose measured span holds it)."""
     scene = setup.scene
     limit = scene.rts.max_targets_per_channel if limit is None else limit
     targets = tuple(targets)
@@ -160,7 +160,7 @@ def budget_targets(setup: Setup, targets, probe, limit: int | None = None) -> Bu
     made = [_merged(targets, g, det, scale, scene.radar.wavelength_m) for g in groups]
     keep = np.ones(len(groups), bool)
     power = _power([m[0] for m in made])
-    pairs = [bracketing_pair(m[0].angle_rad, probe.angle_rad) for m in made]
+    pairs = [pair_of(m[0].angle_rad, probe.angle_rad) for m in made]
     n_ch = len(probe.angle_rad)
     while True:
         load = np.zeros(n_ch, int)

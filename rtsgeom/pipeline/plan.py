@@ -159,7 +159,7 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
         warnings.append(mismatch)
     targets, budget = scene.targets, None
     if scene.rts.max_targets_per_channel is not None:  # dynamic resolution (.merge)
-        budget = budget_targets(setup, scene.targets, probe)
+        budget = budget_targets(setup, scene.targets, probe, bracketing_pair)
         targets = budget.targets
     pairs, notes = target_pairs(setup, probe, targets)
     warnings += notes

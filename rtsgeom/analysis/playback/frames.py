@@ -18,7 +18,8 @@ from ...errors import ParameterError
 from ...geometry import Setup
 from ...paths import Paths
 from ...pipeline.merge import budget_targets
-from ...pipeline.plan import (calibrate_pairs, lead_program, program_pairs, target_pairs,
+from ...pipeline.plan import (bracketing_pair, calibrate_pairs, lead_program, program_pairs,
+                              target_pairs,
                               uses_cells)
 from ...pipeline.run import association_scale, match_targets, truth_twin
 from ...radar import process
@@ -76,7 +77,8 @@ class FramePlanner:
                 "--amplitudes nearest, or targets at elevation 0 on an arc)")
         self.probe = probe_front_ends(setup, paths, scene.seed)
         if scene.rts.max_targets_per_channel is not None:  # each frame's merged targets
-            self.budgets = [budget_targets(setup, tg, self.probe) for tg in frames]
+            self.budgets = [budget_targets(setup, tg, self.probe, bracketing_pair)
+                            for tg in frames]
             frames = [b.targets for b in self.budgets]
         self.pairs, seen = [], set()
         for f, targets in enumerate(frames):
