@@ -107,10 +107,34 @@ def test_budget_merges_at_the_truth_twins_detection():
         k = np.argmin(np.abs(td.range_m - r.detections.range_m[j]))
         assert abs(r.detections.range_m[j] - td.range_m[k]) <= bin_m
         assert abs(r.detections.angle_deg[j] - td.angle_deg[k]) <= 0.2
+        if len(t["members"]) > 1:  # the cell's power too, not the coherent sum's at f_c
+            assert abs(r.detections.power_db[j] - td.power_db[k]) <= 0.5
     # the summary says so
     from rtsgeom.analysis.objects import run_objects
     _, section = run_objects(r)
     assert section["frames"][0]["merged"] == b["merged"]
+
+
+@pytest.mark.parametrize("quarter", [0.0, 1.0])
+def test_merge_follows_the_glint_not_the_power_centroid(quarter):
+    """Two scatterers 6.1 deg apart in one cell, the weaker a quarter wavelength further
+    (anti-phase): the truth twin sees the pair outside their span (glint); the merged target
+    goes there, not to the power centroid, and the RTS's detection with it."""
+    s0 = parse_scene(with_object(bench_doc(max_targets_per_channel=1), scatterers=[
+        [0.8, 0.0, 0.0, 10.0], [-0.8, 0.0, 0.0, 6.0]]), "g.toml")
+    lam = s0.radar.wavelength_m
+    s = parse_scene(with_object(bench_doc(max_targets_per_channel=1), scatterers=[
+        [0.8, 0.0, 0.0, 10.0], [-0.8, quarter * lam / 4, 0.0, 6.0]]), "g.toml")
+    r = run_scene(s)
+    b = r.calibration["budget"]["targets"][0]
+    k = np.argmax(r.truth_detections.power_db)
+    j = np.argmax(r.detections.power_db)
+    assert b["azimuth_deg"] == pytest.approx(r.truth_detections.angle_deg[k], abs=1e-9)
+    assert abs(r.detections.angle_deg[j] - r.truth_detections.angle_deg[k]) <= 0.2
+    span = max(abs(math.degrees(t.angle_rad)) for t in s.targets)
+    if quarter:  # anti-phase: outside the pair's span, far from the power centroid
+        assert r.truth_detections.angle_deg[k] > span
+        assert abs(b["azimuth_deg"] - b["power_centroid_azimuth_deg"]) > 3.0
 
 
 def test_dynamic_resolution_kept_grows_on_approach():

@@ -11,11 +11,13 @@ over the budget.
 A merged target reproduces what the RuT sees from the scatterers' *coherent* sum, not their
 power centroid (a radar does not see a power centroid): its range and direction are the truth
 twin's (:func:`rtsgeom.radar.truth.simulate_truth`, noiseless) detection of that cell -- glint
-included: two scatterers half a wavelength apart in range pull the detected angle outside
-their span -- and its RCS the coherent sum at the carrier,
-``sigma = |sum_i sqrt(sigma_i) (r0 / r_i)^2 exp(-j 4 pi r_i / lambda)|^2`` at ``r0`` the
-detected range. Where the truth twin has no detection of the cell (weaker than its CFAR
-threshold) the strongest member's range and direction stand in.
+included: two scatterers a quarter wavelength apart in range pull the detected angle outside
+their span -- and its RCS the one a single point there needs for the truth twin's detected
+power (the power of the cell's detection minus that of a 0 dBsm point at the detected range,
+velocity and direction, through the same radar). Where the truth twin has no detection of
+the cell (weaker than its CFAR threshold) the strongest member's range and direction stand
+in, with the scatterers' coherent sum at the carrier,
+``sigma = |sum_i sqrt(sigma_i) (r0 / r_i)^2 exp(-j 4 pi r_i / lambda)|^2`` at ``r0`` its range.
 """
 
 from __future__ import annotations
@@ -109,9 +111,19 @@ def resolution_clusters(targets, scale) -> list[list[int]]:
     return sorted(groups, key=lambda g: g[0])
 
 
-def _merged(targets, group, det, scale, wavelength_m) -> tuple[TargetConfig, float, bool]:
+def _reference_power_db(setup: Setup, ref: TargetConfig, scale) -> float | None:
+    """The truth twin's detected power (dB) of one point target ``ref`` alone (noiseless)."""
+    _, cube = simulate_truth(setup, [ref], setup.scene.seed, 0.0)
+    det = process(cube)[1]
+    near = ((np.abs(det.range_m - ref.range_m) <= scale[0])
+            & (np.abs(det.velocity_mps - ref.velocity_mps) <= scale[1]))
+    return float(det.power_db[near].max()) if near.any() else None
+
+
+def _merged(setup, targets, group, det, scale) -> tuple[TargetConfig, float, bool]:
     """One synthesized target for ``group`` (module docstring): (target, power-centroid
     azimuth in deg, whether the truth twin's detection set it)."""
+    wavelength_m = setup.scene.radar.wavelength_m
     ts = [targets[j] for j in group]
     p = _power(ts)
     r = np.array([x.range_m for x in ts])
@@ -135,6 +147,10 @@ def _merged(targets, group, det, scale, wavelength_m) -> tuple[TargetConfig, flo
     amp = np.sqrt([x.rcs_m2 for x in ts]) * (rng / r) ** 2 * np.exp(
         -4j * np.pi * r / wavelength_m)
     rcs_db = float(10 * np.log10(max(abs(amp.sum()) ** 2, 1e-10)))
+    if found:  # the single point the truth twin would detect with the cell's power
+        ref = _reference_power_db(setup, TargetConfig(range_m=rng, velocity_mps=v,
+                                                      rcs_dbsm=0.0, angle_rad=az), scale)
+        rcs_db = rcs_db if ref is None else float(det.power_db[j]) - ref
     objs = {x.object_index for x in ts}
     return (TargetConfig(range_m=rng, velocity_mps=v, rcs_dbsm=float(np.clip(rcs_db, -100, 100)),
                          angle_rad=az, object_index=objs.pop() if len(objs) == 1 else -1),
@@ -157,7 +173,7 @@ def budget_targets(setup: Setup, targets, probe, pair_of, limit: int | None = No
     if any(len(g) > 1 for g in groups):  # the truth twin's view of every cell, noiseless
         _, cube = simulate_truth(setup, targets, scene.seed, 0.0)
         det = process(cube)[1]
-    made = [_merged(targets, g, det, scale, scene.radar.wavelength_m) for g in groups]
+    made = [_merged(setup, targets, g, det, scale) for g in groups]
     keep = np.ones(len(groups), bool)
     power = _power([m[0] for m in made])
     pairs = [pair_of(m[0].angle_rad, probe.angle_rad) for m in made]

@@ -19,8 +19,7 @@ from ...geometry import Setup
 from ...paths import Paths
 from ...pipeline.merge import budget_targets
 from ...pipeline.plan import (bracketing_pair, calibrate_pairs, lead_program, program_pairs,
-                              target_pairs,
-                              uses_cells)
+                              target_pairs, uses_cells)
 from ...pipeline.run import association_scale, match_targets, truth_twin
 from ...radar import process
 from ...radar.frame import simulate
