@@ -32,6 +32,7 @@ OUTPUTS = {
     "plot_superposition.py": ["superposition.png"],
     "plot_calibration_transfer.py": ["calibration_transfer.png"],
     "plot_scenario_crossing.py": ["scenario_crossing.png"],
+    "plot_extended_object.py": ["extended_object.png"],
 }
 
 

@@ -73,6 +73,9 @@ def object_figure(outlines, scatterers, rows, frame: int, table=None, title: str
             if "kept" in rows_o[0]:
                 bx.plot(f, [t["kept"] for t in rows_o], "s--", color="C2", ms=3,
                         label="targets the RTS kept (budget)")
+        from matplotlib.ticker import MaxNLocator
+        bx.xaxis.set_major_locator(MaxNLocator(integer=True))
+        bx.yaxis.set_major_locator(MaxNLocator(integer=True))
         bx.set_xlabel("frame")
         bx.set_ylabel("count")
         tx = bx.twinx()
