@@ -33,6 +33,7 @@ OUTPUTS = {
     "plot_calibration_transfer.py": ["calibration_transfer.png"],
     "plot_scenario_crossing.py": ["scenario_crossing.png"],
     "plot_two_targets_resolution.py": ["two_targets_resolution.png"],
+    "plot_extended_object.py": ["extended_object.png"],
 }
 
 

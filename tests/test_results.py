@@ -135,6 +135,14 @@ def _playback(scene):
                           channels, np.zeros((0, 7)), {})
 
 
+def _object_design():
+    from rtsgeom.analysis.object_design import ObjectDesign, ObjectDesignResult
+    st = ObjectDesign(ranges_m=(5.0, 10.0, 20.0), spacings_deg=(8.0, 16.0), budgets=(None, 2))
+    share = np.linspace(0.4, 1.0, 12).reshape(2, 2, 3)
+    return ObjectDesignResult(st, "unit", "targets[0]", np.array([9, 5]), share,
+                              0.1 * share, 4 + 0 * share, 5 + 0 * share, 4 + 0 * share)
+
+
 @pytest.fixture(scope="module")
 def results(scene, tolerance_pair):
     from rtsgeom.analysis.ghosts import ghost_analysis
@@ -145,6 +153,7 @@ def results(scene, tolerance_pair):
             "Identification": _identification(scene),
             "Identification with radar": _joint_identification(scene),
             "Transfer": _transfer(), "PlaybackResult": _playback(scene),
+            "ObjectDesignResult": _object_design(),
             "RunResult": rtsgeom.run_scene(scene, aoa_mode="nearest"),
             "Resolution": _resolution()}
 

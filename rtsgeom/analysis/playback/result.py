@@ -33,7 +33,10 @@ class PlaybackResult(Result):
     channel, delay_s, doppler_hz, |amplitude|, phase_rad; ``baseline`` the switched baseline
     (``nearest``) on the same drive, or None; ``truth`` the truth twin's detections (the same
     keys, NaN where the real scene gives the target no detection of its own; None: not run);
-    ``status`` (frames, targets) ``detected``, ``merged`` or ``not_detected``.
+    ``status`` (frames, targets) ``detected``, ``merged`` or ``not_detected``; ``clouds``
+    (a scene with extended objects) the truth twin's and the RTS's detections of each object
+    (:mod:`rtsgeom.analysis.objects`) and the resolution cell they are compared in;
+    ``budget`` per frame the planner's counts under ``[rts] max_targets_per_channel``.
     """
 
     scene: Scene
@@ -49,6 +52,8 @@ class PlaybackResult(Result):
     baseline: "PlaybackResult | None" = None
     truth: dict | None = None
     status: np.ndarray | None = None
+    clouds: tuple | None = None  # (clouds.csv rows, resolution cell) of a scene with objects
+    budget: tuple | None = None  # per frame the planner's kept/merged/dropped counts
 
     def _summary(self):
         s = self.summary()
