@@ -89,6 +89,9 @@ _LAZY = {
     "resolution": (".analysis.resolution", "resolution"),
     "ResolutionStudy": (".analysis.resolution", "ResolutionStudy"),
     "Resolution": (".analysis.resolution", "Resolution"),
+    "object_design": (".analysis.object_design", "object_design"),
+    "ObjectDesign": (".analysis.object_design", "ObjectDesign"),
+    "ObjectDesignResult": (".analysis.object_design", "ObjectDesignResult"),
     "RadarChannelsConfig": (".scene.channels", "RadarChannelsConfig"),
     "identify": (".identify", None),  # the package, callable as identify(scene, captures)
     "Identification": (".identify", "Identification"),

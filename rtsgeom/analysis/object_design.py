@@ -28,7 +28,7 @@ from ..scene import Scene
 from ..scene.objects import place
 from ..scene.schema import check_arg
 
-__all__ = ["ObjectDesign", "ObjectDesignResult", "MAX_RUNS"]
+__all__ = ["ObjectDesign", "ObjectDesignResult", "object_design", "MAX_RUNS"]
 
 MAX_RUNS = 200  # ranges x spacings x budgets of one study (each a full run)
 _MARGIN_DEG = 1.0  # the arc extends this beyond the object's azimuth extent
@@ -117,6 +117,12 @@ class ObjectDesign:
                     out["truth"][i, j, k] = frame["truth_detections"]
                     out["rts"][i, j, k] = frame["rts_detections"]
         return ObjectDesignResult(self, scene.name, model.where, n_fe, **out)
+
+
+def object_design(scene: Scene, **kwargs) -> "ObjectDesignResult":
+    """Run :class:`ObjectDesign` (``kwargs`` its parameters) on ``scene``, the function of
+    ``rtsgeom objects``."""
+    return ObjectDesign(**kwargs)(scene)
 
 
 def _nan(x):

@@ -24,20 +24,20 @@ def detections_csv(result: RunResult) -> str:
     """One row per detection, sorted by range then velocity; the last column ``label`` says
     what the simulation put there (:func:`rtsgeom.pipeline.run.label_detections`); ``elevation_deg``
     (0 for an azimuth-only array) sits after ``snr_db``, so the earlier columns keep their
-    places; ``angle_peak`` after ``label``: the direction's rank among its cell's angle peaks
+    places; ``angle_peak`` before ``label``: the direction's rank among its cell's angle peaks
     (0 the strongest; ``[radar] angle_peaks_max``)."""
     det = result.detections
     labels = label_detections(result)
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(["range_m", "velocity_mps", "angle_deg", "power_db", "snr_db", "elevation_deg",
-                "label", "angle_peak"])
+                "angle_peak", "label"])
     order = np.lexsort((det.velocity_mps, det.range_m))
     el = det.elevation_deg
     for i in order:
         w.writerow([f"{det.range_m[i]:.4f}", f"{det.velocity_mps[i]:.4f}",
                     f"{det.angle_deg[i]:.4f}", f"{det.power_db[i]:.2f}", f"{det.snr_db[i]:.2f}",
-                    f"{el[i]:.4f}", labels[i], int(det.peak_rank[i])])
+                    f"{el[i]:.4f}", int(det.peak_rank[i]), labels[i]])
     return buf.getvalue()
 
 
