@@ -117,15 +117,11 @@ def _check_pair(setup, pair) -> tuple[int, int]:
     return check_pair(setup, i, j, f"pair {(i, j)}")
 
 
-def _study_args(fn: str, draws, seed, distribution, spec_deg, points) -> None:
-    """The Monte-Carlo studies' arguments, with the CLI's ranges (``cli._common.study_options``)."""
-    check_arg(draws, "draws", "int", fn, ParameterError, lo=1, hi=10_000_000)
-    if seed is not None:
-        check_arg(seed, "seed", "int", fn, ParameterError, lo=0, hi=2 ** 63 - 1)
-    check_arg(distribution, "distribution", "str", fn, ParameterError,
-              choices=("normal", "uniform"))
-    check_arg(spec_deg, "spec_deg", "float", fn, ParameterError, lo=1e-6, hi=90.0, unit="deg")
-    check_arg(points, "points", "int", fn, ParameterError, lo=3, hi=201)
+def _study_args(fn: str, draws, seed, distribution, spec_deg, points, sigma_mm=None) -> tuple:
+    """The Monte-Carlo studies' arguments, with the CLI's ranges
+    (``analysis.tolerance.draws.check_study_args``, which ``drive_tolerance`` shares)."""
+    from .analysis.tolerance.draws import check_study_args
+    return check_study_args(fn, draws, seed, distribution, spec_deg, points, sigma_mm)
 
 
 def calibrate(scene: Scene, pair=(0, 1)):
@@ -235,14 +231,14 @@ def tolerance(scene: Scene, pair=(0, 1), sigma_mm=(0.1, 0.1, 0.1), draws: int = 
         The scene carries mounting, channel or RuT pose errors of its own: the draws start
         from the nominal setup, not from them.
     """
-    from .analysis.tolerance import MAX_SIGMA_MM, ChannelPhasors, monte_carlo
+    from .analysis.tolerance import ChannelPhasors, monte_carlo
     from .geometry import build_setup
     check_scene_arg(scene, "tolerance")
     from .geometry.setup import warn_setup_errors
     warn_setup_errors(scene, "tolerance", stacklevel=3)  # NominalSetupWarning
-    _study_args("tolerance", draws, seed, distribution, spec_deg, points)
-    sigma = np.asarray(check_arg(sigma_mm, "sigma_mm", "vec", "tolerance", ParameterError,
-                                 n=3, lo=0.0, hi=MAX_SIGMA_MM, unit="mm"), float) * 1e-3
+    draws, seed, distribution, spec_deg, points, sigma = _study_args(
+        "tolerance", draws, seed, distribution, spec_deg, points, sigma_mm)
+    sigma = np.asarray(sigma)
     setup = build_setup(scene)
     pair = _check_pair(setup, pair)
     model = ChannelPhasors.build(setup, pair, points)
