@@ -16,7 +16,7 @@ from ..geometry import Setup, build_setup
 from ..paths import Paths, compute_paths
 from ..radar import AdcCube, Detections, RangeDoppler, process
 from ..radar.frame import noise_power, simulate
-from ..rts.channels import Echoes, RtsProgram, program_nearest
+from ..rts.channels import Echoes, RtsProgram, apparent_range, program_nearest
 from ..errors import ParameterError
 from ..scene import Scene, check_scene_arg
 from ..scene.registry import AOA_MODES, PATH_METHODS
@@ -104,8 +104,9 @@ def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angl
     dr = rd.range_m[1] - rd.range_m[0]
     dv = rd.velocity_mps[1] - rd.velocity_mps[0]
     pairs = []
+    seen_at = [float(apparent_range(scene, t.range_m)) for t in scene.targets]
     for i, t in enumerate(scene.targets):
-        er = (det.range_m - t.range_m) / dr
+        er = (det.range_m - seen_at[i]) / dr
         ev = (det.velocity_mps - t.velocity_mps) / dv
         for j in np.flatnonzero((np.abs(er) <= bins) & (np.abs(ev) <= bins)):
             pairs.append((-float(det.power_db[j]), float(er[j] ** 2 + ev[j] ** 2), i, int(j)))
@@ -129,11 +130,11 @@ def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angl
                  "snr_db": float(det.snr_db[j])}
             entry["detection"] = d
             entry["detection_index"] = j
-            entry["error"] = {
-                "range_m": d["range_m"] - t.range_m,
+            entry["error"] = {  # from where the RuT sees it (rts.channels.apparent_range)
+                "range_m": d["range_m"] - seen_at[i],
                 "velocity_mps": d["velocity_mps"] - t.velocity_mps,
                 "angle_deg": d["angle_deg"] - entry["set"]["angle_deg"],
-                "range_bins": (d["range_m"] - t.range_m) / dr,
+                "range_bins": (d["range_m"] - seen_at[i]) / dr,
                 "doppler_bins": (d["velocity_mps"] - t.velocity_mps) / dv,
             }
             if det.elevation_rad is not None:  # a RuT with elevation: both angles
@@ -154,7 +155,8 @@ def undetected_reason(scene: Scene, det: Detections, rd: RangeDoppler, target,
     cell over the map's noise (the median of the channel-summed power, a Gamma(V) variable,
     referred to its mean), against the CFAR threshold; or that a detection within ``bins``
     went to another target (two targets in one cell). ``snr_db`` None: a noiseless map."""
-    ri = int(np.argmin(np.abs(rd.range_m - target.range_m)))
+    r_t = float(apparent_range(scene, target.range_m))
+    ri = int(np.argmin(np.abs(rd.range_m - r_t)))
     vi = int(np.argmin(np.abs(rd.velocity_mps - target.velocity_mps)))
     cell = rd.power[max(ri - 1, 0):ri + 2, max(vi - 1, 0):vi + 2]
     v = rd.spectrum.shape[-1]
@@ -164,7 +166,7 @@ def undetected_reason(scene: Scene, det: Detections, rd: RangeDoppler, target,
     snr = None if noise <= 0 else float(10 * np.log10(max(float(cell.max()), 1e-300) / noise))
     dr = rd.range_m[1] - rd.range_m[0]
     dv = rd.velocity_mps[1] - rd.velocity_mps[0]
-    near = ((np.abs(det.range_m - target.range_m) <= bins * dr)
+    near = ((np.abs(det.range_m - r_t) <= bins * dr)
             & (np.abs(det.velocity_mps - target.velocity_mps) <= bins * dv))
     if np.any(near):
         why = "its cell's detection went to another target (two targets in one cell)"

@@ -30,7 +30,7 @@ from .fir import fir_if_gain, realised_delay
 
 __all__ = ["RtsProgram", "EchoKind", "Echoes", "target_amplitude", "requested_delay",
            "channel_echoes", "setup_echoes", "cable_ghosts", "program_nearest", "build_echoes",
-           "nominal_link_gain"]
+           "nominal_link_gain", "apparent_range"]
 
 
 class EchoKind(IntEnum):
@@ -206,6 +206,14 @@ def requested_delay(scene: Scene, range_m) -> np.ndarray:
     if scene.rts.compensate_air_path:
         tau = tau - 2.0 * scene.rts.arc_radius_m / c
     return tau
+
+
+def apparent_range(scene: Scene, range_m) -> np.ndarray:
+    """Where the RuT sees a target of set range ``range_m`` (m): the set range when the RTS
+    compensates the nominal air path, else the air path's R_c further (``requested_delay``
+    then delays by 2 R_t / c0 on top of it)."""
+    r = np.asarray(range_m, float)
+    return r if scene.rts.compensate_air_path else r + scene.rts.arc_radius_m
 
 
 def program_nearest(scene: Scene, setup: Setup) -> RtsProgram:
