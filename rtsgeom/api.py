@@ -57,6 +57,7 @@ def replace(obj, **changes):
     by_key = {s.key: (name, s) for name, s in specs(type(obj))}
     fields, written = {}, {}  # attribute -> SI value, attribute -> (key, value) as written
     for key, value in changes.items():
+        value = _tuples(value)
         if key in names:
             name, si = key, value
         elif key in by_key:
@@ -88,6 +89,18 @@ def replace(obj, **changes):
                 head, tail = message[len("replace: "):].split(": ", 1)
                 message = f"replace: {key} = {fmt(value)} (the scene file's {head}): {tail}"
         raise SceneError(message, exc.problems) from None
+
+
+def _tuples(value):
+    """A list (or a 1-D/2-D array) of numbers as the tuple a scene field holds (the file's
+    lists are read as tuples; a list set in code was a TypeError in the re-check)."""
+    if isinstance(value, np.ndarray) and value.ndim in (1, 2) and value.dtype.kind in "iuf":
+        value = value.tolist()
+    if isinstance(value, list) and all(_is_number(v) or isinstance(v, (list, tuple))
+                                       for v in value):
+        out = tuple(_tuples(v) if isinstance(v, list) else v for v in value)
+        return out if _is_number(out) else value
+    return value
 
 
 def _is_number(value) -> bool:

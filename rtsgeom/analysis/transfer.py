@@ -23,6 +23,7 @@ error on its own calibration, and the shift of the calibrated delay offset).
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -291,8 +292,8 @@ class TransferStudy:
         pairs = self.pairs or tuple((i, i + 1) for i in range(n - 1))
         self.set_points(len(pairs))
         ideal = _ideal_radar(setup)
-        probe = probe_front_ends(setup, paths, self.seed)
-        probe0 = probe_front_ends(ideal, paths, self.seed) if ideal is not setup else probe
+        probe = _probe(setup, paths, self.seed)
+        probe0 = _probe(ideal, paths, self.seed) if ideal is not setup else probe
         rng_m = float(probe_ranges(setup, 1)[0])
         st = Steering.build(setup.rut, setup.scene.radar)
         coupling = channel_coupling(setup.scene.radar, setup.rut)  # the type's: every radar's
@@ -336,6 +337,28 @@ class TransferStudy:
                         np.degrees(own), tuple(shifts), np.asarray(progs), ph_b, gd_b, rng_m,
                         float(self.sigma_phase_deg), float(self.sigma_gain_db), self.spec_deg,
                         setup.scene.name)
+
+
+def _probe(setup: Setup, paths: Paths, seed) -> FrontEndProbe:
+    """Each front end alone as the radar detects it; every one must be detected (a front end
+    the radar does not see has no measured angle to calibrate the pair by)."""
+    with warnings.catch_warnings():  # said below, naming what to change
+        warnings.simplefilter("ignore", RuntimeWarning)
+        probe = probe_front_ends(setup, paths, seed)
+    missed = [int(q) for q in np.flatnonzero(~np.isfinite(probe.angle_rad))]
+    if missed:
+        ch = setup.scene.radar.channels
+        gains = () if ch is None else (*ch.tx_gain_db, *ch.rx_gain_db)
+        why = ""
+        if gains and min(gains) < 0:
+            why = (f"; radar.channels.tx_gain_db / rx_gain_db lower the channels by up to "
+                   f"{-min(ch.tx_gain_db or (0,)) - min(ch.rx_gain_db or (0,)):g} dB")
+        raise ParameterError(
+            f"front end(s) {missed} not detected alone by the scene's "
+            f"radar at their probe ranges (below the CFAR threshold, or clipped)"
+            f"{probe.clipping_note()}{why}: transfer calibrates each pair on its front ends' "
+            "measured angles")
+    return probe
 
 
 def _ideal_radar(setup: Setup) -> Setup:

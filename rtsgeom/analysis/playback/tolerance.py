@@ -27,7 +27,7 @@ from ...pipeline.plan import target_pairs, uses_cells
 from ...scene import Scene, check_scene_arg
 from ..tolerance import ChannelPhasors, ToleranceModel, ToleranceResult, monte_carlo
 from ..tolerance.draws import check_study_args
-from .frames import frame_targets
+from .frames import frame_target_names, frame_targets
 
 __all__ = ["drive_tolerance"]
 
@@ -72,7 +72,7 @@ def drive_tolerance(scene: Scene, sigma_mm=(0.1, 0.1, 0.1), draws: int = 2000,
     probe = probe_front_ends(setup, exact_paths(setup), scene.seed)
     visits: dict = defaultdict(list)
     for f, targets in enumerate(frames):
-        pairs, _ = target_pairs(setup, probe, targets, where=f"frame {f}: targets")
+        pairs, _ = target_pairs(setup, probe, targets, where=frame_target_names(scene, f))
         for pair, t in zip(pairs, targets):
             visits[pair].append((t.angle_rad, t.range_m))
     models = []
