@@ -57,6 +57,7 @@ def replace(obj, **changes):
     by_key = {s.key: (name, s) for name, s in specs(type(obj))}
     fields, written = {}, {}  # attribute -> SI value, attribute -> (key, value) as written
     for key, value in changes.items():
+        value = _tuples(value)
         if key in names:
             name, si = key, value
         elif key in by_key:
@@ -90,6 +91,18 @@ def replace(obj, **changes):
         raise SceneError(message, exc.problems) from None
 
 
+def _tuples(value):
+    """A list (or a 1-D/2-D array) of numbers as the tuple a scene field holds (the file's
+    lists are read as tuples; a list set in code was a TypeError in the re-check)."""
+    if isinstance(value, np.ndarray) and value.ndim in (1, 2) and value.dtype.kind in "iuf":
+        value = value.tolist()
+    if isinstance(value, list) and all(_is_number(v) or isinstance(v, (list, tuple))
+                                       for v in value):
+        out = tuple(_tuples(v) if isinstance(v, list) else v for v in value)
+        return out if _is_number(out) else value
+    return value
+
+
 def _is_number(value) -> bool:
     """A number or a tuple of them (what a unit converts)."""
     if isinstance(value, bool):
@@ -117,15 +130,11 @@ def _check_pair(setup, pair) -> tuple[int, int]:
     return check_pair(setup, i, j, f"pair {(i, j)}")
 
 
-def _study_args(fn: str, draws, seed, distribution, spec_deg, points) -> None:
-    """The Monte-Carlo studies' arguments, with the CLI's ranges (``cli._common.study_options``)."""
-    check_arg(draws, "draws", "int", fn, ParameterError, lo=1, hi=10_000_000)
-    if seed is not None:
-        check_arg(seed, "seed", "int", fn, ParameterError, lo=0, hi=2 ** 63 - 1)
-    check_arg(distribution, "distribution", "str", fn, ParameterError,
-              choices=("normal", "uniform"))
-    check_arg(spec_deg, "spec_deg", "float", fn, ParameterError, lo=1e-6, hi=90.0, unit="deg")
-    check_arg(points, "points", "int", fn, ParameterError, lo=3, hi=201)
+def _study_args(fn: str, draws, seed, distribution, spec_deg, points, sigma_mm=None) -> tuple:
+    """The Monte-Carlo studies' arguments, with the CLI's ranges
+    (``analysis.tolerance.draws.check_study_args``, which ``drive_tolerance`` shares)."""
+    from .analysis.tolerance.draws import check_study_args
+    return check_study_args(fn, draws, seed, distribution, spec_deg, points, sigma_mm)
 
 
 def calibrate(scene: Scene, pair=(0, 1)):
@@ -235,14 +244,14 @@ def tolerance(scene: Scene, pair=(0, 1), sigma_mm=(0.1, 0.1, 0.1), draws: int = 
         The scene carries mounting, channel or RuT pose errors of its own: the draws start
         from the nominal setup, not from them.
     """
-    from .analysis.tolerance import MAX_SIGMA_MM, ChannelPhasors, monte_carlo
+    from .analysis.tolerance import ChannelPhasors, monte_carlo
     from .geometry import build_setup
     check_scene_arg(scene, "tolerance")
     from .geometry.setup import warn_setup_errors
-    warn_setup_errors(scene, "tolerance")  # NominalSetupWarning
-    _study_args("tolerance", draws, seed, distribution, spec_deg, points)
-    sigma = np.asarray(check_arg(sigma_mm, "sigma_mm", "vec", "tolerance", ParameterError,
-                                 n=3, lo=0.0, hi=MAX_SIGMA_MM, unit="mm"), float) * 1e-3
+    warn_setup_errors(scene, "tolerance", stacklevel=3)  # NominalSetupWarning
+    draws, seed, distribution, spec_deg, points, sigma = _study_args(
+        "tolerance", draws, seed, distribution, spec_deg, points, sigma_mm)
+    sigma = np.asarray(sigma)
     setup = build_setup(scene)
     pair = _check_pair(setup, pair)
     model = ChannelPhasors.build(setup, pair, points)

@@ -216,6 +216,25 @@ _SIDECARS = [  # name, variant keywords, the words the one-line error must hold
     ("huge header", dict(header=_npy_header((100000, 100000, 1000))),
      ["[100000, 100000, 1000]", "[120, 8, 512]"]),
     ("short .bin", dict(meta={"chirps": 120}, binary=True), ["must be the scene's radar"]),
+    # within one bin of the echo: passed the strongest-cell check and fitted a wrong phase
+    ("range +0.11 m", dict(meta={"probe_range_m": 15.6}), ["probe_range_m = 15.6",
+                                                          "-0.74 bins", "15.488 m"]),
+    ("range -0.09 m", dict(meta={"probe_range_m": 15.4}), ["probe_range_m = 15.4", "bins"]),
+    ("velocity 0.2", dict(meta={"probe_velocity_mps": 0.2}), ["probe_velocity_mps = 0.2",
+                                                             "at most 0.05 bin"]),
+    ("velocity 0.05", dict(meta={"probe_velocity_mps": 0.05}), ["probe_velocity_mps = 0.05"]),
+    ("no radar record", dict(raw_side=lambda t: json.dumps(
+        {k: v for k, v in json.loads(t).items() if k != "radar"})),
+     ["radar is missing (required)", "carrier"]),
+    ("radar without f_c", dict(raw_side=lambda t: json.dumps(
+        {**json.loads(t), "radar": {k: v for k, v in json.loads(t)["radar"].items()
+                                    if k != "f_c_hz"}})), ["radar.f_c_hz is missing"]),
+    ("other tx_order", dict(meta={"tx_order": [2, 0]}, binary=True),
+     ["tx_order = [2, 0]", "the scene's radar's [0, 2]"]),
+    ("other shape", dict(meta={"shape": [120, 8, 256]}), ["shape = [120, 8, 256]",
+                                                          "[120, 8, 512]"]),
+    ("other kind", dict(meta={"kind": "my-capture"}), ["kind = 'my-capture'",
+                                                       "rtsgeom-probe-capture"]),
 ]
 
 
@@ -357,3 +376,233 @@ def test_fuzzed_sidecars_and_calibration_files_keep_the_contract(capsys):
     an OverflowError, a sidecar scale of 5e-324 a division by zero)."""
     from benchmarks.fuzz_inputs import main as fuzz
     assert fuzz(["--inputs", "40", "--seed", "7"]) == 0, capsys.readouterr().out
+
+
+# -- identify: the captures as a whole, and Python's arguments ----------------------------------
+
+def test_identify_refuses_one_recording_given_twice(captures, tmp_path, capsys):
+    """cap.bin twice, or one recording as .bin and .npy, counted as independent evidence
+    (1024 links to one file read +-0.0023 mm, 10 sigma from the truth)."""
+    for pair in (("cap.npy", "cap.npy"), ("cap.npy", "cap.bin")):
+        assert main(["identify", str(DEFAULT_SCENE), *(str(captures / p) for p in pair)]) == 2
+        _clean_error(capsys.readouterr().err, "the same recording as", "independent")
+
+
+def test_identify_refuses_a_folder_or_fifo_as_capture(tmp_path, capsys):
+    import os
+    (tmp_path / "d.npy").mkdir()
+    assert main(["identify", str(DEFAULT_SCENE), str(tmp_path / "d.npy")]) == 2
+    _clean_error(capsys.readouterr().err, "a folder", "must be a capture file")
+    os.mkfifo(tmp_path / "f.npy")
+    assert main(["identify", str(DEFAULT_SCENE), str(tmp_path / "f.npy")]) == 2
+    _clean_error(capsys.readouterr().err, "not a regular file")
+
+
+def test_capture_repr_is_one_line(captures):
+    text = repr(read_capture(captures / "cap.npy"))
+    assert "\n" not in text and len(text) < 200 and "120x8x512" in text
+
+
+def test_identify_python_counts_and_kinds(captures, scene):
+    from rtsgeom.identify import identify
+    cap = read_capture(captures / "cap.npy")
+    for caps, words in (([], "captures = []"), (None, "captures = None"),
+                        ("cap.npy", "captures = 'cap.npy'"), (["cap.npy"], "captures[0]"),
+                        ([cap] * 1025, "must be at most 1024")):
+        with pytest.raises(ParameterError, match=re.escape(words)):
+            identify(scene, caps)
+    for bad in (None, "scenes/diewald2022.toml"):
+        with pytest.raises(ParameterError, match="must be a Scene"):
+            identify(bad, [cap])
+    with pytest.raises(CaptureError, match="the same recording"):
+        identify(scene, [cap, cap])
+
+
+# -- the newer entry points: Python arguments ------------------------------------------------
+
+_X = ROOT / "scenes" / "crossing.toml"
+_NEW_API = [  # (entry, keywords), words of the ParameterError
+    ("transfer", dict(radars=5.5), "radars = 5.5: must be an integer in [1, 100000]"),
+    ("transfer", dict(radars=True), "radars = True"),
+    ("transfer", dict(radars="5"), "radars = '5'"),
+    ("transfer", dict(radars=None), "radars = None"),
+    ("transfer", dict(radars=10 ** 6), "radars = 1000000: must be in [1, 100000]"),
+    ("transfer", dict(radars=100_000, points=201, sigma_phase_deg=1.0), None),  # (see below)
+    ("transfer", dict(sigma_phase_deg="5"), "sigma_phase_deg = '5': must be a number"),
+    ("transfer", dict(sigma_phase_deg=None), "sigma_phase_deg = None"),
+    ("transfer", dict(sigma_phase_deg=1j), "sigma_phase_deg = 1j"),
+    ("transfer", dict(sigma_phase_deg=np.array([1.0, 2.0])), "sigma_phase_deg = array"),
+    ("transfer", dict(sigma_phase_deg=math.nan), "sigma_phase_deg = nan"),
+    ("transfer", dict(sigma_gain_db=7.0), "sigma_gain_db = 7: must be in [0, 6] dB"),
+    ("transfer", dict(spec_deg="0.1"), "spec_deg = '0.1'"),
+    ("transfer", dict(seed=-1), "seed = -1"),
+    ("transfer", dict(seed="x"), "seed = 'x'"),
+    ("transfer", dict(seed=1.5), "seed = 1.5"),
+    ("drive_tolerance", dict(draws=None), "draws = None: must be an integer in [1, 1e+07]"),
+    ("drive_tolerance", dict(draws=0), "draws = 0: must be in [1, 1e+07]"),
+    ("drive_tolerance", dict(draws=-5), "draws = -5"),
+    ("drive_tolerance", dict(draws=10 ** 12), "draws = 1000000000000"),
+    ("drive_tolerance", dict(spec_deg=math.nan), "spec_deg = nan"),
+    ("drive_tolerance", dict(spec_deg=-1), "spec_deg = -1: must be in [1e-06, 90] deg"),
+    ("drive_tolerance", dict(sigma_mm=(1e6, 0.1, 0.1)), "finite numbers in [0, 10] mm"),
+    ("drive_tolerance", dict(sigma_mm=0.1), "sigma_mm = 0.1: must be a list of 3 numbers"),
+    ("drive_tolerance", dict(sigma_mm=(0.1, 0.1)), "sigma_mm = (0.1, 0.1)"),
+    ("drive_tolerance", dict(sigma_mm="abc"), "sigma_mm = 'abc'"),
+    ("drive_tolerance", dict(seed=-1), "seed = -1"),
+    ("drive_tolerance", dict(seed="x"), "seed = 'x'"),
+    ("drive_tolerance", dict(distribution="cauchy"), "normal, uniform"),
+    ("drive_tolerance", dict(scene=None), "drive_tolerance: scene = None: must be a Scene"),
+    ("Playback", dict(scene=None), "Playback: scene = None: must be a Scene"),
+    ("Playback", dict(workers=0), "workers = 0"),
+    ("Playback", dict(bins=True), "bins = True"),
+    ("Playback", dict(amplitudes=3), "amplitudes = 3"),
+]
+_NEW_API = [c for c in _NEW_API if c[2] is not None]
+
+
+@pytest.mark.parametrize("entry, kw, words", _NEW_API, ids=[c[2][:40] for c in _NEW_API])
+def test_new_entry_points_raise_the_named_error(entry, kw, words, scene):
+    """37 such calls raised a TypeError, ValueError, AttributeError or IndexError (or
+    returned a NaN yield); each now names the argument and its range, before any work."""
+    kw = dict(kw)
+    if entry == "transfer":
+        call = lambda: rtsgeom.transfer(scene, **kw)  # noqa: E731
+    elif entry == "drive_tolerance":
+        target = kw.pop("scene", rtsgeom.load_scene(_X))
+        call = lambda: rtsgeom.drive_tolerance(target, **kw)  # noqa: E731
+    else:
+        target = kw.pop("scene", rtsgeom.load_scene(_X))
+        call = lambda: rtsgeom.Playback(**kw)(target)  # noqa: E731
+    with pytest.raises(ParameterError) as info:
+        call()
+    assert words in str(info.value)
+
+
+def test_transfer_caps_radars_times_set_points(scene):
+    """The (B, P) results are held whole: radars x set-points beyond 2.01e7 are refused
+    before any work (10**6 radars tried 21.5 GiB)."""
+    from rtsgeom.analysis.transfer import MAX_RADAR_POINTS, TransferStudy
+    study = TransferStudy(radars=100_000, points=201)
+    assert study.set_points(1) == 201
+    with pytest.raises(ParameterError, match="radar set-points"):
+        study.set_points(2)
+    assert MAX_RADAR_POINTS == 100_000 * 201
+
+
+def test_minus_zero_spreads_read_as_zero(tmp_path, capsys):
+    """--sigma-phase-deg -0 ended in numpy's "ValueError: scale < 0"."""
+    assert main(["transfer", str(DEFAULT_SCENE), "--radars", "3", "--points", "3",
+                 "--sigma-phase-deg", "-0", "--sigma-gain-db", "-0", "--json"]) == 0
+    out = _finite_json(capsys.readouterr().out)
+    assert out["sigma_phase_deg"] == 0.0 and math.copysign(1, out["sigma_phase_deg"]) == 1
+
+
+def test_replace_takes_a_list_for_a_tuple_field():
+    from rtsgeom.scene.channels import RadarChannelsConfig
+    ch = rtsgeom.replace(RadarChannelsConfig(), rx_phase_deg=[0, 10, 0, 0])
+    assert np.allclose(np.degrees(ch.rx_phase_rad), [0, 10, 0, 0])
+
+
+def _channels_scene(tmp_path, text):
+    return _with(DEFAULT_SCENE.read_text(), tmp_path, add="[radar.channels]\n" + text)
+
+
+def test_transfer_names_the_channels_when_no_front_end_is_seen(tmp_path, capsys):
+    """Every antenna at -20 dB: raw 'All-NaN slice' warnings, then an error naming no field."""
+    p = _channels_scene(tmp_path, "tx_gain_db = [-20, -20, -20]\nrx_gain_db = [-20, -20, -20, -20]\n")
+    assert main(["transfer", str(p), "--radars", "3", "--points", "3"]) == 2
+    _clean_error(capsys.readouterr().err, "not detected", "radar.channels.tx_gain_db")
+
+
+def test_reference_phase_of_a_radar_with_half_turn_antennas_is_wrapped():
+    """rx_phase_deg = [0, 180, -180, 0] failed naming '<evolve>: front_ends[1].
+    phase_offset_deg = 447.803', a field nobody wrote: the sweep's reference phase wraps."""
+    from rtsgeom.calibration.steps import reference_setup
+    setup = build_setup(rtsgeom.load_scene(DEFAULT_SCENE))
+    for phase in (np.radians(447.803), -7.0, 100.0):
+        ref = reference_setup(setup, 1, phase)
+        got = ref.scene.rts.front_ends[1].phase_offset_rad
+        assert -np.pi < got <= np.pi and np.isclose(np.exp(1j * got), np.exp(1j * phase))
+
+
+def test_coupling_phase_without_coupling_is_refused(tmp_path, capsys):
+    p = _channels_scene(tmp_path, "rx_coupling_phase_deg = 30\n")
+    assert main(["info", str(p)]) == 2
+    _clean_error(capsys.readouterr().err, "rx_coupling_phase_deg = 30", "rx_coupling_db")
+
+
+def test_a_large_scene_file_is_named_by_its_own_size(tmp_path, capsys):
+    p = tmp_path / "big.toml"
+    p.write_bytes(b"# " + b"x" * (20 << 20))
+    assert main(["info", str(p)]) == 2
+    _clean_error(capsys.readouterr().err, f"({(20 << 20) + 2} bytes")
+
+
+@pytest.mark.parametrize("kind", ["single", "vertical"])
+def test_info_json_reachable_spans_null_without_azimuth_aperture(kind, tmp_path, capsys):
+    """measured_angle_deg -90 and pair spans [-90, -90] were written instead of null."""
+    p = _custom_array_scene(kind, tmp_path)
+    assert main(["info", str(p), "--json"]) == 0
+    info = _finite_json(capsys.readouterr().out)
+    assert "reachable" not in info and "fewer than two" in info["reachable_unavailable"]
+
+
+def test_nearest_without_air_path_compensation_finds_its_targets(tmp_path, capsys):
+    """compensate_air_path = false with run --amplitudes nearest: every target 'lost', exit 0,
+    the echoes R_c further out labelled unmatched with a wrong reason."""
+    text = re.sub(r"^compensate_air_path = .*$", "compensate_air_path = false",
+                  DEFAULT_SCENE.read_text(), flags=re.M)
+    p = _with(text, tmp_path)
+    assert main(["run", str(p), "--amplitudes", "nearest", "--out", str(tmp_path / "o"),
+                 "--no-report"]) == 0
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert all(t["detection"] is not None and abs(t["error"]["range_m"]) < 0.05
+               for t in summary["targets"])
+
+
+def test_play_refuses_tolerance_flags_without_draws(tmp_path, capsys):
+    for flags in (["--sigma-mm", "1", "1", "1"], ["--spec-deg", "0.2"]):
+        assert main(["play", str(_X), "--out", str(tmp_path / "o"), *flags]) == 2
+        _clean_error(capsys.readouterr().err, flags[0], "--tolerance-draws")
+        assert not (tmp_path / "o").exists()
+
+
+def test_a_drive_target_is_named_as_the_file_names_it(tmp_path):
+    """A scenario azimuth outside every pair was reported as targets[N] with N shifted by the
+    static [[targets]] (one static target: targets[1], not in the file)."""
+    from rtsgeom.analysis.playback.frames import frame_target_names
+    scene = rtsgeom.load_scene(_X)
+    names = frame_target_names(scene, 3, static=1)
+    assert names(0) == "frame 3: targets[0]" and names(1) == "frame 3: scenario.targets[0]"
+
+
+def test_a_drive_beyond_the_target_frames_cap_is_refused(monkeypatch, capsys):
+    """(Here with the cap lowered to 10: crossing.toml's 21 frames of one target.)"""
+    import rtsgeom.scene.scenario as scenario
+    monkeypatch.setattr(scenario, "MAX_TARGET_FRAMES", 10)
+    assert main(["info", str(_X)]) == 2
+    _clean_error(capsys.readouterr().err, "scenario.frame_period_s", "21 target-frames",
+                 "at most 10")
+
+
+def test_play_figure_of_many_targets_keeps_a_short_legend():
+    """64 targets: a legend of 192 entries covering the figure, and matplotlib's warning."""
+    import warnings
+    from rtsgeom.viz.playback import LEGEND_TARGETS, playback_figure
+    t = np.arange(5.0)
+    s = np.tile(np.linspace(-5, 5, 64), (5, 1))
+    d = s.copy()
+    d[2, 3] = np.nan
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fig = playback_figure(t, s, {"exact": d}, {"exact": [1.0]})
+    labels = [x.get_text() for x in fig.legends[0].get_texts()]
+    assert len(labels) <= LEGEND_TARGETS and len(set(labels)) == len(labels)
+
+
+def test_fuzzed_entry_points_keep_the_contract(capsys):
+    """transfer, drive_tolerance, Playback and identify(radar_channels=True) with one hostile
+    argument (or a mutated sidecar): a finite result or an RtsgeomError."""
+    from benchmarks.fuzz_inputs import main as fuzz
+    assert fuzz(["--inputs", "12", "--seed", "3", "--kind", "entry"]) == 0, \
+        capsys.readouterr().out

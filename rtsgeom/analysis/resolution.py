@@ -193,7 +193,7 @@ def _cases(setup: Setup, paths, planner, f: int, targets, phases_deg) -> list[di
     for ph in phases_deg:
         for source, cube in _cubes(setup, paths, planner, f, targets, ph):
             rd, det = process(cube)
-            m = match_targets(scene, det, rd, steering=cube.steering)
+            m = match_targets(scene, det, rd, steering=cube.steering, real=source == "truth")
             ang = [x["detection"]["angle_deg"] if x["status"] == "detected" else np.nan
                    for x in m]
             rows.append({"phase_deg": float(ph), "source": source,

@@ -23,6 +23,7 @@ error on its own calibration, and the shift of the calibrated delay offset).
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -39,10 +40,22 @@ from ..radar.processing import tdm_compensate
 from ..radar.steering import Steering
 from ..pipeline.pair import pair_design
 from ..scene import TargetConfig
+from ..scene.registry import SYNTHESIS_MODES
+from ..scene.schema import check_arg, fmt
 from ..synthesis.model import ChannelModel
 
 __all__ = ["TransferStudy", "Transfer", "draw_channel_gains", "percentiles", "snapshot_angles",
-           "own_angle_errors"]
+           "own_angle_errors", "MAX_RADARS", "MAX_POINTS", "MAX_RADAR_POINTS"]
+
+#: radars one study draws (``rtsgeom transfer --radars``, ``rtsgeom.transfer(radars=...)``)
+MAX_RADARS = 100_000
+#: set-points per pair
+MAX_POINTS = 201
+#: radars x set-points over every pair: the (B, P) results (three float64 arrays) hold 3 x 8
+#: bytes each, 480 MB at this cap (100 000 radars x 201 set-points of one pair)
+MAX_RADAR_POINTS = 20_100_000
+#: snapshots searched at once (the beamformer's grid of 721 angles per snapshot: ~100 MB)
+CHUNK_SNAPSHOTS = 8192
 
 
 def percentiles(x) -> dict:
@@ -228,14 +241,46 @@ class TransferStudy:
     seed: int = 0
 
     def __post_init__(self):
-        checks = (("radars", self.radars, 1, 1_000_000), ("sigma_phase_deg",
-                  self.sigma_phase_deg, 0.0, 90.0), ("sigma_gain_db", self.sigma_gain_db, 0.0,
-                  6.0), ("points", self.points, 1, 1001))
-        for name, v, lo, hi in checks:
-            if not (np.isfinite(v) and lo <= v <= hi):
-                raise ParameterError(f"{name} = {v}: must be in [{lo:g}, {hi:g}]")
-        if self.spec_deg is not None and not (np.isfinite(self.spec_deg) and self.spec_deg > 0):
-            raise ParameterError(f"spec_deg = {self.spec_deg}: must be a positive number of deg")
+        src = "transfer"
+        radars = check_arg(self.radars, "radars", "int", src, ParameterError, lo=1,
+                           hi=MAX_RADARS)
+        values = {"radars": radars,
+                  "sigma_phase_deg": check_arg(self.sigma_phase_deg, "sigma_phase_deg", "float",
+                                               src, ParameterError, lo=0.0, hi=90.0,
+                                               unit="deg"),
+                  "sigma_gain_db": check_arg(self.sigma_gain_db, "sigma_gain_db", "float", src,
+                                             ParameterError, lo=0.0, hi=6.0, unit="dB"),
+                  "points": check_arg(self.points, "points", "int", src, ParameterError, lo=1,
+                                      hi=MAX_POINTS),
+                  "mode": check_arg(self.mode, "mode", "str", src, ParameterError,
+                                    choices=SYNTHESIS_MODES),
+                  "seed": check_arg(self.seed, "seed", "int", src, ParameterError, lo=0,
+                                    hi=2 ** 63 - 1)}
+        if self.spec_deg is not None:
+            values["spec_deg"] = check_arg(self.spec_deg, "spec_deg", "float", src,
+                                           ParameterError, lo=1e-6, hi=90.0, unit="deg")
+        if self.pairs is not None:
+            pairs = self.pairs
+            if (not isinstance(pairs, (tuple, list)) or not pairs
+                    or not all(isinstance(p, (tuple, list)) for p in pairs)):
+                raise ParameterError(f"{src}: pairs = {fmt(pairs)}: must be a non-empty tuple "
+                                     "of front-end pairs (i, i + 1)")
+            values["pairs"] = tuple(check_arg(list(p), f"pairs[{k}]", "ints", src,
+                                              ParameterError, lo=0, hi=10_000, min_items=2,
+                                              max_items=2) for k, p in enumerate(pairs))
+        for name, v in values.items():  # normalised: -0.0 as 0, numpy scalars as int/float
+            object.__setattr__(self, name, v)
+
+    def set_points(self, pairs: int) -> int:
+        """Set-points over ``pairs`` pairs; with :attr:`radars` the size of each (B, P) output,
+        capped at :data:`MAX_RADAR_POINTS` radar set-points (the memory it holds)."""
+        total = self.points * pairs
+        if self.radars * total > MAX_RADAR_POINTS:
+            raise ParameterError(
+                f"transfer: radars = {self.radars} x {total} set-points ({self.points} points x "
+                f"{pairs} pairs): must be at most {MAX_RADAR_POINTS:.3g} radar set-points (the "
+                f"study's results hold 3 x 8 bytes each; fewer radars or points)")
+        return total
 
     def __call__(self, setup: Setup, paths: Paths, progress=None) -> Transfer:
         if Steering.auto(setup.rut, setup.scene.radar).dims != 1:
@@ -245,9 +290,10 @@ class TransferStudy:
         if n < 2:
             raise ParameterError("transfer: the arc needs at least two front ends")
         pairs = self.pairs or tuple((i, i + 1) for i in range(n - 1))
+        self.set_points(len(pairs))
         ideal = _ideal_radar(setup)
-        probe = probe_front_ends(setup, paths, self.seed)
-        probe0 = probe_front_ends(ideal, paths, self.seed) if ideal is not setup else probe
+        probe = _probe(setup, paths, self.seed)
+        probe0 = _probe(ideal, paths, self.seed) if ideal is not setup else probe
         rng_m = float(probe_ranges(setup, 1)[0])
         st = Steering.build(setup.rut, setup.scene.radar)
         coupling = channel_coupling(setup.scene.radar, setup.rut)  # the type's: every radar's
@@ -293,6 +339,28 @@ class TransferStudy:
                         setup.scene.name)
 
 
+def _probe(setup: Setup, paths: Paths, seed) -> FrontEndProbe:
+    """Each front end alone as the radar detects it; every one must be detected (a front end
+    the radar does not see has no measured angle to calibrate the pair by)."""
+    with warnings.catch_warnings():  # said below, naming what to change
+        warnings.simplefilter("ignore", RuntimeWarning)
+        probe = probe_front_ends(setup, paths, seed)
+    missed = [int(q) for q in np.flatnonzero(~np.isfinite(probe.angle_rad))]
+    if missed:
+        ch = setup.scene.radar.channels
+        gains = () if ch is None else (*ch.tx_gain_db, *ch.rx_gain_db)
+        why = ""
+        if gains and min(gains) < 0:
+            why = (f"; radar.channels.tx_gain_db / rx_gain_db lower the channels by up to "
+                   f"{-min(ch.tx_gain_db or (0,)) - min(ch.rx_gain_db or (0,)):g} dB")
+        raise ParameterError(
+            f"front end(s) {missed} not detected alone by the scene's "
+            f"radar at their probe ranges (below the CFAR threshold, or clipped)"
+            f"{probe.clipping_note()}{why}: transfer calibrates each pair on its front ends' "
+            "measured angles")
+    return probe
+
+
 def _ideal_radar(setup: Setup) -> Setup:
     """The setup as built with an ideal radar (the same paths: channels move none)."""
     if setup.scene.radar.channels is None:
@@ -335,14 +403,28 @@ def snapshot_angles(model: ChannelModel, w, gains, coupling=None) -> np.ndarray:
     x = np.tensordot(w, model.responses, axes=([0], [1]))  # (K, V)
     if coupling is not None:
         x = x @ coupling.T
-    xb = x[None] * np.asarray(gains)[:, None, :]  # (B, K, V)
-    k = np.argmax(np.sum(np.abs(xb) ** 2, axis=-1), axis=-1)
-    sel = np.take_along_axis(xb, k[:, None, None], axis=1)[:, 0]
-    sel = tdm_compensate(sel, model.doppler_hz, model.setup.rut, model.setup.scene.radar)
-    return model.steering.search(sel)
+    gains = np.asarray(gains)
+    out = np.empty(gains.shape[0])
+    for rows in _chunks(gains.shape[0], max(1, CHUNK_SNAPSHOTS // x.shape[0])):
+        xb = x[None] * gains[rows, None, :]  # (b, K, V)
+        k = np.argmax(np.sum(np.abs(xb) ** 2, axis=-1), axis=-1)
+        sel = np.take_along_axis(xb, k[:, None, None], axis=1)[:, 0]
+        sel = tdm_compensate(sel, model.doppler_hz, model.setup.rut, model.setup.scene.radar)
+        out[rows] = model.steering.search(sel)
+    return out
+
+
+def _chunks(n: int, size: int):
+    """Slices of ``range(n)`` of at most ``size`` (memory: one chunk's snapshots at a time)."""
+    return (slice(a, min(a + size, n)) for a in range(0, n, size))
 
 
 def own_angle_errors(st: Steering, gains, angles_rad, coupling=None) -> np.ndarray:
     """Each radar's error (B, P) rad on a real far-field point target at each set angle
-    (``radar.channels.plane_wave_errors``)."""
-    return plane_wave_errors(st, gains, angles_rad, coupling)
+    (``radar.channels.plane_wave_errors``), a chunk of radars at a time."""
+    gains = np.asarray(gains)
+    p = np.size(angles_rad)
+    out = np.empty((gains.shape[0], p))
+    for rows in _chunks(gains.shape[0], max(1, CHUNK_SNAPSHOTS // max(p, 1))):
+        out[rows] = plane_wave_errors(st, gains[rows], angles_rad, coupling)
+    return out

@@ -183,10 +183,14 @@ def fine_window(half_s: float, step_s: float) -> FineWindow:
 def reference_setup(setup: Setup, channel: int, phase_rad: float = 0.0) -> Setup:
     """The (nominal) setup as the sweep's reference: no receiver noise and front end
     ``channel``'s hardware phase set to ``phase_rad`` (the RTS's channels read it from the
-    scene when they synthesize, ``rts.channels``)."""
+    scene when they synthesize, ``rts.channels``), wrapped to (-pi, pi]: the same phasor, and
+    inside the scene's declared range (a radar's own antenna phases of +-180 deg put the
+    unwrapped phase at 448 deg, which the scene's re-check refused naming a field nobody
+    wrote)."""
     scene = setup.scene
     fes = list(scene.rts.front_ends)
-    fes[channel] = dataclasses.replace(fes[channel], phase_offset_rad=float(phase_rad))
+    wrapped = float(np.angle(np.exp(1j * float(phase_rad))))
+    fes[channel] = dataclasses.replace(fes[channel], phase_offset_rad=wrapped)
     rts = scene.rts.evolve(front_ends=tuple(fes))
     radar = scene.radar.evolve(snr_db=None, link=None)
     return dataclasses.replace(setup, scene=scene.evolve(rts=rts, radar=radar))

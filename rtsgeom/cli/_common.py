@@ -44,7 +44,7 @@ def number(lo=None, hi=None, integer=False):
             raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
         if (lo is not None and v < lo) or (hi is not None and v > hi):
             raise argparse.ArgumentTypeError(f"{text} is outside the allowed range [{lo}, {hi}]")
-        return v
+        return v if integer else v + 0.0  # -0 reads as 0 (numpy refuses a scale of -0.0)
     return parse
 
 

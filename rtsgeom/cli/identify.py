@@ -9,9 +9,10 @@ import re
 import sys
 from pathlib import Path
 
-from ..errors import CaptureError, UsageError
+from ..errors import CaptureError, ParameterError, UsageError
 from ..identify import identified_scene_toml, identify, read_capture
 from ..identify.fit import RESIDUAL_LIMIT
+from ..identify.identification import MAX_CAPTURES
 from ._common import load_scene_checked, output_folder, output_path, print_json, scene_arg, steps
 
 
@@ -72,10 +73,6 @@ def _text(d: dict) -> str:
     return "\n".join(lines)
 
 
-#: captures one ``identify`` reads (each is reduced to its probe's bin as it is read)
-MAX_CAPTURES = 1024
-
-
 def cmd_identify(args) -> int:
     if len(args.captures) > MAX_CAPTURES:
         raise UsageError(f"CAPTURE: {len(args.captures)} captures: must be at most "
@@ -95,7 +92,7 @@ def cmd_identify(args) -> int:
                 ident = identify(scene, caps, accept_misfit=args.accept_misfit,
                                  radar_channels=args.radar_channels,
                                  reference=args.reference_front_end)
-            except (OSError, CaptureError) as exc:
+            except (OSError, CaptureError, ParameterError) as exc:
                 raise UsageError(f"CAPTURE: {exc}") from None
         for f in ident.fits:
             if f.misfit is not None:

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 
+from ..analysis.tolerance.draws import MAX_SIGMA_MM
 from ..errors import ParameterError, UsageError
 from ..scene.registry import AOA_MODES, PATH_METHODS
 from ._common import (load_scene_checked, number, output_folder, output_path, scene_arg,
@@ -16,6 +17,14 @@ from ._common import (load_scene_checked, number, output_folder, output_path, sc
 def cmd_play(args) -> int:
     from ..analysis.playback import Playback
     from ..viz.figures import save_figure
+    if not args.tolerance_draws:
+        for flag, value in (("--sigma-mm", args.sigma_mm), ("--spec-deg", args.spec_deg)):
+            if value is not None:
+                raise UsageError(f"{flag}: only with --tolerance-draws N (it sets the "
+                                 "mounting-tolerance study over the drive, which runs only "
+                                 "then)")
+    args.sigma_mm = (0.1, 0.1, 0.1) if args.sigma_mm is None else tuple(args.sigma_mm)
+    args.spec_deg = 0.1 if args.spec_deg is None else args.spec_deg
     scene = load_scene_checked(args.scene)
     if scene.scenario is None:
         raise UsageError(f"{args.scene}: has no [scenario] to play (add [scenario] with "
@@ -23,6 +32,8 @@ def cmd_play(args) -> int:
     study = Playback(args.amplitudes, args.paths, baseline=not args.no_baseline,
                      workers=args.workers)
     with output_folder(args.out, [args.scene]) as stage, steps(args.quiet) as step:
+        if not args.quiet:
+            step(_estimate(scene, study))
         step(f"playing {scene.name} (calibration once, then every frame through the chain)")
         try:
             result = study(scene)
@@ -70,6 +81,36 @@ def cmd_play(args) -> int:
     return 0
 
 
+def _estimate(scene, study) -> str:
+    """The drive's expected time, before it starts: frame 0 through the chain on its nearest
+    front ends (what every frame costs, the calibration aside), times the frames and modes,
+    over the workers."""
+    import dataclasses
+    import time
+    from ..analysis.playback.frames import detect_frame, frame_targets
+    from ..geometry import build_setup
+    from ..paths import exact_paths
+    from ..rts.channels import program_nearest
+    setup = build_setup(dataclasses.replace(scene, scenario=None))
+    paths = exact_paths(setup)
+    times, frames = frame_targets(scene)
+    scene_0 = dataclasses.replace(setup.scene, targets=frames[0])
+    t0 = time.perf_counter()
+    detect_frame(setup, paths, program_nearest(scene_0, setup), scene_0, scene.seed)
+    per = time.perf_counter() - t0
+    modes = 1 if (not study.baseline or (study.amplitudes or scene.rts.aoa_mode) == "nearest") \
+        else 2
+    total = per * len(frames) * modes / study.workers
+    return (f"{len(frames)} frames x {modes} mode(s) of {len(frames[0])} targets: about "
+            f"{_duration(total)} ({per:.2g} s a frame measured on frame 0, {study.workers} "
+            "worker(s); the calibration comes on top)")
+
+
+def _duration(s: float) -> str:
+    return (f"{s:.0f} s" if s < 120 else f"{s / 60:.0f} min" if s < 7200
+            else f"{s / 3600:.1f} h")
+
+
 def _tolerance(scene, args) -> dict:
     """summary.json's ``tolerance``: the drive's yield and worst errors over the setups."""
     import numpy as np
@@ -105,11 +146,13 @@ def register(sub) -> None:
     p.add_argument("--tolerance-draws", type=number(0, 10_000_000, integer=True), default=0,
                    metavar="N", help="also the mounting-tolerance yield over the drive: N "
                    "drawn setups (summary.json's tolerance)")
-    p.add_argument("--sigma-mm", type=number(0, 50), nargs=3, default=(0.1, 0.1, 0.1),
+    p.add_argument("--sigma-mm", type=number(0, MAX_SIGMA_MM), nargs=3, default=None,
                    metavar=("RADIAL", "TANGENTIAL", "HEIGHT"),
-                   help="mounting error per front end, standard deviation (default 0.1 each)")
-    p.add_argument("--spec-deg", type=number(1e-6, 90), default=0.1,
-                   help="angle-error spec of the tolerance yield (default 0.1 deg)")
+                   help="with --tolerance-draws: mounting error per front end, standard "
+                        f"deviation in [0, {MAX_SIGMA_MM:g}] mm (default 0.1 each)")
+    p.add_argument("--spec-deg", type=number(1e-6, 90), default=None,
+                   help="with --tolerance-draws: angle-error spec of the tolerance yield "
+                        "(default 0.1 deg)")
     p.add_argument("--workers", type=number(1, 256, integer=True), default=1, metavar="N",
                    help="play the frames in N forked processes (the same result)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")

@@ -15,7 +15,7 @@ from scipy.constants import c
 
 from ..errors import CaptureError
 from ..scene import RadarConfig
-from ..scene.schema import Spec, check_record, specs
+from ..scene.schema import REQUIRED, Spec, check_record, specs
 from ..geometry import Setup
 from ..paths import exact_paths
 from ..rts.channels import RtsProgram, nominal_link_gain, requested_delay, target_amplitude
@@ -51,6 +51,12 @@ SIDECAR = {
                                unit="m/s", lo=-1e3, hi=1e3),
     "probe_amplitude": Spec("probe_amplitude", "float", "programmed amplitude of the probe's "
                             "channel", lo=0.0, hi=1e12, lo_open=True),
+    "kind": Spec("kind", "str", "what the file is", choices=("rtsgeom-probe-capture",),
+                 default=None),
+    "shape": Spec("shape", "ints", "the cube's [loop, virtual, sample]", lo=1, hi=1 << 20,
+                  min_items=3, max_items=3, default=None),
+    "tx_order": Spec("tx_order", "ints", "Tx per TDM slot", lo=0, hi=63, min_items=1,
+                     max_items=64, default=None),
 }
 SIDECAR_DCA1000 = {
     "num_rx": Spec("num_rx", "int", "receivers", lo=1, hi=64),
@@ -81,6 +87,13 @@ class Capture:
     amplitude: float  # programmed amplitude of the probe's channel
     radar: dict | None = None  # RADAR_KEYS of the radar that recorded it (None: not recorded)
     source: str = "capture"  # what messages call it (its file)
+    tx_order: tuple[int, ...] | None = None  # the TDM order it was recorded in (None: the scene's)
+
+    def __repr__(self) -> str:
+        shape = "x".join(str(n) for n in np.shape(self.data))
+        return (f"Capture({self.source!r}, front end {self.active}, probe {self.range_m:g} m "
+                f"{self.velocity_mps:+g} m/s, {shape} {np.asarray(self.data).dtype}"
+                f"{'' if self.radar is not None else ', no radar record'})")
 
     def to_meta(self) -> dict:
         meta = {"active_front_end": self.active, "probe_range_m": self.range_m,
@@ -97,13 +110,24 @@ def radar_record(radar) -> dict:
 
 def check_capture_radar(cap: Capture, radar) -> None:
     """A capture's recorded radar against the scene's (relative 1e-6): raise naming the first
-    field that differs. Captures without the record pass (older files)."""
+    field that differs or is missing. The record is required: what the capture itself shows
+    of the radar is checked too (its shape, the probe's range and Doppler in its own
+    spectrum), but not the carrier: a static probe's echo is the same tone at any f_c, and
+    the carrier's phase over the RTS's air path (f_c tau_air, 3.3 turns for 0.5 GHz at 1 m)
+    is a common phase the channel phase takes up (a 76.5 GHz capture without the record read
+    a channel phase 121 deg off at residual 1.03)."""
     if cap.radar is None:
-        return
+        raise CaptureError(
+            f"{cap.source}: radar is missing (required): the sidecar must record the radar "
+            f"that made the capture ({', '.join(RADAR_KEYS)}; rtsgeom adc --active writes "
+            "it): the carrier does not show in a static probe's capture, only in its "
+            "channel phase; for a capture made with the scene's radar, copy the scene's "
+            "[radar] values")
     for k in RADAR_KEYS:
         have, want = cap.radar.get(k), getattr(radar, k)
         if have is None:
-            continue
+            raise CaptureError(f"{cap.source}: radar.{k} is missing (required): must be the "
+                               f"radar's that made the capture (the scene's is {want:g})")
         if not abs(have - want) <= 1e-6 * abs(want):
             raise CaptureError(f"{cap.source}: radar.{k} = {have:g}: must be the scene's "
                                f"{want:g} (the capture was recorded with another radar "
@@ -206,7 +230,10 @@ def read_capture(path, shape=None, max_bytes: int = MAX_CAPTURE_BYTES) -> Captur
     path = Path(path)
     side = Path(str(path) + ".json")
     if not path.is_file():
-        raise CaptureError(f"{path}: no such capture file")
+        what = ("a folder" if path.is_dir() else "not a regular file (a FIFO, socket or "
+                "device)" if path.exists() else "no such file")
+        raise CaptureError(f"{path}: {what}: must be a capture file (.bin or .npy with its "
+                           "sidecar FILE.json)")
     if not side.is_file():
         raise CaptureError(f"{path}: no sidecar {side.name} (write captures with rtsgeom adc "
                            "--active I)")
@@ -214,7 +241,8 @@ def read_capture(path, shape=None, max_bytes: int = MAX_CAPTURE_BYTES) -> Captur
     if not isinstance(meta, dict):
         raise CaptureError(f"{side}: not a probe capture's sidecar (a JSON object)")
     npy = meta.get("format") == "npy" or path.suffix == ".npy"
-    for key in list(SIDECAR) + ([] if npy else list(SIDECAR_DCA1000)):
+    for key in [k for k, d in SIDECAR.items() if d.default is REQUIRED] + (
+            [] if npy else list(SIDECAR_DCA1000)):
         if key not in meta:
             raise CaptureError(f"{side}: no {key!r}: not a probe capture (rtsgeom adc "
                                "--active I)")
@@ -260,9 +288,13 @@ def read_capture(path, shape=None, max_bytes: int = MAX_CAPTURE_BYTES) -> Captur
     if data.ndim != 3 or not np.iscomplexobj(data):
         raise CaptureError(f"{path}: expected a complex [loop, virtual, sample] cube, got "
                            f"{data.dtype} {list(data.shape)}")
+    if v["shape"] is not None and tuple(v["shape"]) != data.shape:
+        raise CaptureError(f"{side}: shape = {list(v['shape'])}: must be the capture's "
+                           f"{list(data.shape)} [loop, virtual, sample]")
     bad = int(np.count_nonzero(~np.isfinite(data)))
     if bad:
         raise CaptureError(f"{path}: {bad} sample(s) not finite (NaN or inf): must be finite")
     if not np.any(data):
         raise CaptureError(f"{path}: every sample is 0: must hold the probe's echo")
-    return Capture(np.asarray(data), *probe, radar=radar, source=str(path))
+    return Capture(np.asarray(data), *probe, radar=radar, source=str(path),
+                   tx_order=None if v["tx_order"] is None else tuple(v["tx_order"]))

@@ -6,17 +6,21 @@ captured front end alone (:func:`~rtsgeom.identify.fit.fit_front_end`) or, with
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from .._lib.results import Result
 from ..geometry.setup import build_setup
-from ..scene import Scene
+from ..errors import CaptureError, ParameterError
+from ..scene import Scene, check_scene_arg
+from ..scene.schema import check_arg, fmt
+from .capture import Capture
 from .fit import RESIDUAL_LIMIT, FrontEndFit, check_fit, fit_front_end
 from .joint import RadarChannelsFit, identify_joint
 from .model import PARAMS, measure
 
-__all__ = ["Identification", "identify"]
+__all__ = ["Identification", "identify", "MAX_CAPTURES", "noise_fingerprint"]
 
 
 # the fitted parameters as shown: (PARAMS index, name with its unit, SI -> that unit)
@@ -153,10 +157,84 @@ class Identification(Result):
         return out
 
 
+#: captures one ``identify`` reads (each is reduced to its probe's bin as it is read); the CLI
+#: and Python share it
+MAX_CAPTURES = 1024
+#: two captures whose noise agrees better than this (|cos| of :func:`noise_fingerprint`; two
+#: independent recordings read about 1/sqrt(samples), 0.04 for 512) are one recording
+SAME_RECORDING = 0.5
+
+
+def noise_fingerprint(cap: Capture) -> np.ndarray:
+    """The receiver noise of a capture, unit norm: virtual channel 0's chirps transformed at
+    the Doppler bin farthest from both the probe's and zero Doppler (Hann-windowed, as the
+    radar's range-Doppler map, where no echo leaks: ~-120 dB of the probe). Two files of one
+    recording (a copy, the same cube as .bin and .npy, a scaled copy) share it to their
+    quantisation; independent recordings do not, whatever they show."""
+    from ..radar.windows import window
+    x = np.asarray(cap.data)[:, 0, :]  # (L, N)
+    n_l = x.shape[0]
+    # the probe's Doppler bin (unshifted: 0 is zero Doppler)
+    probe = int(np.argmax(np.sum(np.abs(np.fft.fft(x, axis=0)) ** 2, axis=1)))
+    d = np.arange(n_l)
+
+    def dist(k):
+        return np.minimum(np.abs(d - k), n_l - np.abs(d - k))
+    far = int(np.argmax(np.minimum(dist(probe), dist(0))))
+    w = window("hann", n_l) * np.exp(-2j * np.pi * far * d / n_l)
+    f = w @ x
+    norm = np.linalg.norm(f)
+    return f / norm if norm > 0 else f
+
+
+def _check_captures(scene, captures, reference):
+    """``identify``'s arguments: the scene, the captures (an iterable of :class:`Capture`,
+    not a path or a string; read them with ``read_capture``) and the reference front end."""
+    check_scene_arg(scene, "identify")
+    if captures is None or isinstance(captures, (str, bytes, Path, Capture)) or not hasattr(
+            captures, "__iter__"):
+        raise ParameterError(f"identify: captures = {fmt(captures)}: must be a list (or an "
+                             "iterable) of Capture (rtsgeom.identify.read_capture(path) reads "
+                             "one)")
+    if reference is not None:
+        check_arg(reference, "reference", "int", "identify", ParameterError, lo=0, hi=10_000)
+
+
+def _captures(captures):
+    """Each capture checked as it arrives: a :class:`Capture`, at most :data:`MAX_CAPTURES`,
+    no recording twice (:func:`noise_fingerprint`: a copy would count as independent
+    evidence and shrink the standard deviations by sqrt(copies)). Only captures of one front
+    end are compared: simulated captures of several front ends share their noise when made
+    with one seed (``rtsgeom adc --active``), and are still independent measurements of
+    different front ends."""
+    if hasattr(captures, "__len__") and len(captures) > MAX_CAPTURES:
+        raise ParameterError(f"identify: captures: {len(captures)}: must be at most "
+                             f"{MAX_CAPTURES}")
+    seen: list[tuple[int, str, np.ndarray]] = []
+    for k, cap in enumerate(captures):
+        if not isinstance(cap, Capture):
+            raise ParameterError(f"identify: captures[{k}] = {fmt(cap)}: must be a Capture "
+                                 "(rtsgeom.identify.read_capture(path) reads one)")
+        if k >= MAX_CAPTURES:
+            raise ParameterError(f"identify: captures: more than {MAX_CAPTURES}: must be at "
+                                 f"most {MAX_CAPTURES}")
+        f = noise_fingerprint(cap)
+        for q, src, g in seen:
+            if q == cap.active and f.shape == g.shape and abs(np.vdot(f, g)) > SAME_RECORDING:
+                raise CaptureError(f"{cap.source}: the same recording as {src} (their receiver "
+                                   f"noise agrees, |cos| {abs(np.vdot(f, g)):.3f}): must be an "
+                                   "independent capture (a copy counts its noise twice)")
+        seen.append((cap.active, cap.source, f))
+        yield cap
+    if not seen:
+        raise ParameterError("identify: captures = []: must hold at least one capture")
+
+
 def identify(scene: Scene, captures, accept_misfit: bool = False, radar_channels: bool = False,
              reference: int | None = None) -> Identification:
     """Fit the nominal ``scene``'s free parameters to probe ``captures`` (:class:`Capture`,
-    any number per front end; the captures of one front end are fitted jointly). With
+    any number per front end up to :data:`MAX_CAPTURES`, each an independent recording; the
+    captures of one front end are fitted jointly). With
     ``radar_channels`` the radar's antenna gains and phases are fitted too, together with
     every front end (:func:`~rtsgeom.identify.joint.identify_joint`; ``reference``: the front
     end whose tangential offset fixes the array's phase ramp).
@@ -166,9 +244,14 @@ def identify(scene: Scene, captures, accept_misfit: bool = False, radar_channels
     against the scene (:func:`~rtsgeom.identify.model.measure`) and each fit by
     :func:`check_fit`: a misfit raises ``CaptureError`` unless ``accept_misfit``, which keeps
     it flagged (``misfit`` in the JSON)."""
+    _check_captures(scene, captures, reference)
+    accept_misfit = check_arg(accept_misfit, "accept_misfit", "bool", "identify",
+                              ParameterError)
+    radar_channels = check_arg(radar_channels, "radar_channels", "bool", "identify",
+                               ParameterError)
     setup = build_setup(scene)
     groups: dict[int, list] = {}
-    for cap in captures:
+    for cap in _captures(captures):
         groups.setdefault(cap.active, []).append(measure(setup, cap, not radar_channels))
         del cap
     if radar_channels:

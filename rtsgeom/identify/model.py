@@ -23,7 +23,7 @@ from ..rts.channels import EchoKind, Echoes, requested_delay
 from ..rts.fir import fir_if_gain, realised_delay
 from ..radar.fmcw import AdcCube
 
-__all__ = ["PARAMS", "ProbeModel", "measure"]
+__all__ = ["PARAMS", "ProbeModel", "measure", "probe_offset_bins", "SUBBIN_LIMIT"]
 
 #: the fitted parameters per front end / channel, SI inside (m, rad, s; gain as ln|G|)
 PARAMS = ("radial_offset", "tangential_offset", "height_offset", "yaw_offset", "delay_offset",
@@ -142,6 +142,11 @@ def measure(setup: Setup, cap: Capture, check_direction: bool = True
     if not 0 <= cap.active < setup.fe.count:
         raise CaptureError(f"{cap.source}: active_front_end = {cap.active}: must be a front "
                            f"end of the scene (0..{setup.fe.count - 1})")
+    order = tuple(int(t) for t in setup.rut.tx_order)
+    if cap.tx_order is not None and tuple(cap.tx_order) != order:
+        raise CaptureError(f"{cap.source}: tx_order = {list(cap.tx_order)}: must be the "
+                           f"scene's radar's {list(order)} (another TDM order puts other "
+                           "antennas in each virtual channel)")
     check_capture_radar(cap, radar)
     if not cap.range_m < radar.max_range_m:
         raise CaptureError(f"{cap.source}: probe_range_m = {cap.range_m:g}: must be below the "
@@ -155,6 +160,7 @@ def measure(setup: Setup, cap: Capture, check_direction: bool = True
     rd = range_doppler(AdcCube((cap.data / scale).astype(np.complex64), radar, setup.rut))
     model = ProbeModel.of(setup, cap)
     _check_peak(rd.power, model, radar, cap)
+    _check_subbin(rd.power, model, radar, cap)
     rbs = (model.range_bin + np.arange(-1, 2)) % radar.samples_per_chirp
     best = int(rbs[np.argmax(rd.power[rbs, model.doppler_bin])])
     model = ProbeModel.of(setup, cap, best)
@@ -186,6 +192,73 @@ def _check_front_end(setup: Setup, model: ProbeModel, y: np.ndarray, cap: Captur
                            f"end the capture shows: its probe's direction matches front end "
                            f"{best} (|cos| {cos[best]:.3f}), not {cap.active} "
                            f"(|cos| {cos[cap.active]:.3f})")
+
+
+#: the largest distance (bins) between the probe's echo as measured in the capture's own
+#: range-Doppler map and where the sidecar's probe_range_m / probe_velocity_mps put it on the
+#: nominal setup (3-bin interpolation of both; a clean capture reads within 0.001 bin).
+#: Range: a radial mounting offset of 5 mm moves the echo 0.03 bin, a channel delay offset of
+#: 100 ps 0.1 bin (diewald2022); a sidecar range wrong by 0.11 m (0.5 bin) fitted a channel
+#: phase 90 deg off at residual 1.02. Doppler: nothing of the setup moves a probe's Doppler; a
+#: sidecar velocity wrong by 0.2 m/s (0.9 bin) read a tangential offset of +2.3 mm for +0.3
+SUBBIN_LIMIT = {"range": 0.25, "doppler": 0.05}
+
+
+def _interpolated(p_lo: np.ndarray, p_0: np.ndarray, p_hi: np.ndarray) -> np.ndarray:
+    """The peak's fractional offset from the centre bin of three powers (Gaussian
+    interpolation: exact for a Gaussian main lobe, the same estimator for measurement and
+    model, so their difference is the echo's shift)."""
+    a, b, c_ = (np.log(np.maximum(x, 1e-300)) for x in (p_lo, p_0, p_hi))
+    den = a - 2 * b + c_
+    return np.where(den < 0, 0.5 * (a - c_) / np.where(den < 0, den, -1.0), 0.0)
+
+
+def probe_offset_bins(power: np.ndarray, model: ProbeModel) -> tuple[float, float]:
+    """(range, Doppler) offset in bins of the probe's echo in the capture's power map
+    ``power`` (R, D) from where the nominal setup puts the sidecar's probe (``model``, at the
+    bins the sidecar names): each interpolated over the three bins around its own strongest
+    cell (the measurement's within one bin of the model's)."""
+    n_r, n_d = power.shape
+    rb, db = model.range_bin, model.doppler_bin
+    radar, rut = model.setup.scene.radar, model.setup.rut
+    near_r, near_d = (rb + np.arange(-1, 2)) % n_r, (db + np.arange(-1, 2)) % n_d
+    block = power[np.ix_(near_r, near_d)]
+    i, j = np.unravel_index(int(np.argmax(block)), block.shape)
+    mr, md = int(near_r[i]), int(near_d[j])
+
+    def three(centre, n):
+        return (centre + np.arange(-1, 2)) % n
+    resp = bin_response(model.echoes(model.nominal()[None]), radar, rut,
+                        np.r_[three(rb, n_r), np.full(3, rb)],
+                        np.r_[np.full(3, db), three(db, n_d)]).sum(axis=1)
+    p_model = np.sum(np.abs(resp) ** 2, axis=-1)  # (6,)
+    p_meas = np.r_[power[three(mr, n_r), md], power[mr, three(md, n_d)]]
+    got = _interpolated(p_meas[[0, 3]], p_meas[[1, 4]], p_meas[[2, 5]])
+    want = _interpolated(p_model[[0, 3]], p_model[[1, 4]], p_model[[2, 5]])
+    dd = (md - db + n_d // 2) % n_d - n_d // 2  # circular
+    return float(mr - rb + got[0] - want[0]), float(dd + got[1] - want[1])
+
+
+def _check_subbin(power: np.ndarray, model: ProbeModel, radar, cap: Capture) -> None:
+    """The sidecar's probe range and velocity against the echo in the capture within
+    :data:`SUBBIN_LIMIT` of a bin (:func:`probe_offset_bins`): a probe range wrong by less than a
+    bin passes the strongest-cell check but fits a wrong channel phase and gain (the range
+    shift of the model's bin response), a wrong velocity a wrong Doppler phase ramp across
+    the TDM slots (a tangential offset)."""
+    dr, dd = probe_offset_bins(power, model)
+    r_bin = c * radar.adc_rate_hz / (2 * radar.slope_hz_per_s * radar.samples_per_chirp)
+    v_bin = c / (2 * radar.f_c_hz * radar.tdm_cycle_s * radar.chirps_per_tx)
+    for name, have, off, step, unit, axis, also in (
+            ("probe_range_m", cap.range_m, dr, r_bin, "m", "range",
+             "or a radial or channel delay offset larger than that moves the echo"),
+            ("probe_velocity_mps", cap.velocity_mps, dd, v_bin, "m/s", "doppler", "")):
+        limit = SUBBIN_LIMIT[axis]
+        if not abs(off) <= limit:
+            raise CaptureError(
+                f"{cap.source}: {name} = {have:g}: must be where the capture's echo is, "
+                f"{have + off * step:.5g} {unit} ({off:+.2f} bins of {step:.4g} {unit} away, "
+                f"at most {limit:g} bin on the nominal setup): the sidecar does not describe "
+                f"this capture{', ' + also if also else ''}")
 
 
 def _check_peak(power: np.ndarray, model: ProbeModel, radar, cap: Capture) -> None:

@@ -180,7 +180,9 @@ def scene_info(setup: Setup, reachable: bool = False) -> dict:
             out["front_ends"][q]["radar_channel_bias_deg"] = _finite(b)
     if one_position:
         out["apparent_azimuth_unavailable"] = NO_AZIMUTH_APERTURE
-    if reachable:
+    if reachable and one_position:  # every angle would read -90 deg: no span to state
+        out["reachable_unavailable"] = NO_AZIMUTH_APERTURE
+    elif reachable:
         try:
             out["reachable"] = reachable_spans(setup)
         except SceneError as exc:  # a setup the synthesis does not model (its message says)

@@ -193,6 +193,12 @@ def lead_program(program: RtsProgram, budget) -> RtsProgram:
                             program.doppler_hz, program.amplitude)
 
 
+def target_name(where, k: int) -> str:
+    """Target ``k`` as messages name it: ``where[k]`` for a prefix (``targets``), or
+    ``where(k)`` (a drive's frames name static and moving targets apart)."""
+    return where(k) if callable(where) else f"{where}[{k}]"
+
+
 def target_pairs(setup: Setup, probe, targets, where: str = "targets"
                  ) -> tuple[list[tuple[int, int]], list[str]]:
     """Each target's pair of front ends: the adjacent pair whose *measured* span (``probe``,
@@ -213,13 +219,13 @@ def target_pairs(setup: Setup, probe, targets, where: str = "targets"
         pair = bracketing_pair(t.angle_rad, probe.angle_rad)
         if pair is None:
             lo, hi = np.degrees(np.nanmin(probe.angle_rad)), np.degrees(np.nanmax(probe.angle_rad))
-            raise SceneError(f"{scene.source}: {where}[{k}].angle_deg = "
+            raise SceneError(f"{scene.source}: {target_name(where, k)}.angle_deg = "
                              f"{np.degrees(t.angle_rad):g}: must be within the measured span of "
                              f"the front ends [{lo:.4f}, {hi:.4f}] deg (no pair can reach it)")
         pairs.append(pair)
         spacing = abs(probe.angle_rad[pair[1]] - probe.angle_rad[pair[0]])
         if spacing > res:
-            warnings.append(f"{where}[{k}]: front ends {pair} are {np.degrees(spacing):.2f} deg "
+            warnings.append(f"{target_name(where, k)}: front ends {pair} are {np.degrees(spacing):.2f} deg "
                             f"apart, more than the RuT's angular resolution "
                             f"{np.degrees(res):.2f} deg (eq. 24): expect two peaks")
     return pairs, warnings
@@ -265,7 +271,7 @@ def program_pairs(setup: Setup, paths: Paths, mode: str, targets, pairs, probe, 
                              probe.gain_correction[[i, j]],
                              cal.quantisation_residual_s if cal is not None else 0.0)
         except AngleUnreachable as exc:
-            raise SceneError(f"{scene.source}: {where}[{k}].angle_deg = "
+            raise SceneError(f"{scene.source}: {target_name(where, k)}.angle_deg = "
                              f"{np.degrees(t.angle_rad):g}: {exc}") from None
         tau = float(requested_delay(scene, t.range_m))
         f_d = 2 * scene.radar.f_c_hz * t.velocity_mps / c

@@ -21,7 +21,7 @@ from ..radar.peaks import two_target_resolution
 from ..radar.steering import Steering
 from ..radar.truth import simulate_truth
 from ..radar.frame import noise_power, simulate
-from ..rts.channels import Echoes, RtsProgram, program_nearest
+from ..rts.channels import Echoes, RtsProgram, apparent_range, program_nearest
 from ..errors import ParameterError
 from ..scene import Scene, check_scene_arg
 from ..scene.registry import AOA_MODES, PATH_METHODS
@@ -107,14 +107,16 @@ def association_scale(scene: Scene, rd: RangeDoppler, steering=None) -> np.ndarr
                  two_target_resolution(st)]
 
 
-def target_points(targets, dims: int) -> np.ndarray:
-    """Set-points (T, 2 + dims) as the association compares them: range, velocity and the
-    direction cosines (sin az; with ``dims`` 2 also sin el, az scaled by cos el)."""
+def target_points(targets, dims: int, range_m=None) -> np.ndarray:
+    """Set-points (T, 2 + dims) as the association compares them: range (``range_m`` (T,),
+    where the radar sees them, default the set ranges), velocity and the direction cosines
+    (sin az; with ``dims`` 2 also sin el, az scaled by cos el)."""
     t = list(targets)
     az = np.array([x.angle_rad for x in t], float)
     el = np.array([x.elevation_rad for x in t], float)
     u = np.sin(az)[:, None] if dims == 1 else np.c_[np.sin(az) * np.cos(el), np.sin(el)]
-    return np.c_[[x.range_m for x in t], [x.velocity_mps for x in t], u].reshape(len(t), -1)
+    r = [x.range_m for x in t] if range_m is None else range_m
+    return np.c_[r, [x.velocity_mps for x in t], u].reshape(len(t), -1)
 
 
 def detection_points(det: Detections, dims: int) -> np.ndarray:
@@ -125,19 +127,25 @@ def detection_points(det: Detections, dims: int) -> np.ndarray:
 
 
 def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angle_rad=None,
-                  bins: int = 2, steering=None, targets=None) -> list[dict]:
+                  bins: int = 2, steering=None, targets=None, real: bool = False
+                  ) -> list[dict]:
     """Each target's detection by the one association (:func:`rtsgeom.radar.association.associate`):
     an optimal assignment in resolution cells, never a detection that lies nearer another
     target; ``status`` ``detected``, ``merged`` (one detection serves several targets the
     radar cannot resolve: ``merged_with``) or ``not_detected``.
 
     ``targets`` defaults to the scene's; ``steering`` (the cube's) to the scene radar's
-    beamformer; ``bins`` is the range and Doppler gate.
+    beamformer; ``bins`` is the range and Doppler gate. The RTS's targets are compared where
+    the radar sees them (:func:`rtsgeom.rts.channels.apparent_range`: R_c further without
+    ``rts.compensate_air_path``); ``real`` targets (the truth twin's) at their set range.
     """
     targets = tuple(scene.targets if targets is None else targets)
+    seen_at = [t.range_m if real else float(apparent_range(scene, t.range_m))
+               for t in targets]
     scale = association_scale(scene, rd, steering)
     dims = scale.size - 2
-    assoc = associate(target_points(targets, dims), detection_points(det, dims), scale, bins)
+    assoc = associate(target_points(targets, dims, seen_at), detection_points(det, dims),
+                      scale, bins)
     dr, dv = scale[0], scale[1]
     out = []
     for i, t in enumerate(targets):
@@ -154,11 +162,11 @@ def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angl
                  "snr_db": float(det.snr_db[j])}
             entry["detection"] = d
             entry["detection_index"] = j
-            entry["error"] = {
-                "range_m": d["range_m"] - t.range_m,
+            entry["error"] = {  # from where the RuT sees it (rts.channels.apparent_range)
+                "range_m": d["range_m"] - seen_at[i],
                 "velocity_mps": d["velocity_mps"] - t.velocity_mps,
                 "angle_deg": d["angle_deg"] - entry["set"]["angle_deg"],
-                "range_bins": (d["range_m"] - t.range_m) / dr,
+                "range_bins": (d["range_m"] - seen_at[i]) / dr,
                 "doppler_bins": (d["velocity_mps"] - t.velocity_mps) / dv,
             }
             if det.elevation_rad is not None:  # a RuT with elevation: both angles
@@ -168,18 +176,20 @@ def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angl
         else:
             entry["detection"] = None
             entry["error"] = None
-            entry["undetected"] = undetected_reason(scene, det, rd, t, bins, assoc.owner)
+            entry["undetected"] = undetected_reason(scene, det, rd, t, bins, assoc.owner,
+                                                    seen_at[i])
         out.append(entry)
     return out
 
 
 def undetected_reason(scene: Scene, det: Detections, rd: RangeDoppler, target,
-                      bins: int = 2, owner=None) -> dict:
+                      bins: int = 2, owner=None, seen_at: float | None = None) -> dict:
     """Why a target has no detection: the map's strongest cell within one bin of the target's
     cell over the map's noise (the median of the channel-summed power, a Gamma(V) variable,
     referred to its mean), against the CFAR threshold; or that a detection within ``bins``
     went to another target (two targets in one cell). ``snr_db`` None: a noiseless map."""
-    ri = int(np.argmin(np.abs(rd.range_m - target.range_m)))
+    r_t = float(apparent_range(scene, target.range_m)) if seen_at is None else seen_at
+    ri = int(np.argmin(np.abs(rd.range_m - r_t)))
     vi = int(np.argmin(np.abs(rd.velocity_mps - target.velocity_mps)))
     cell = rd.power[max(ri - 1, 0):ri + 2, max(vi - 1, 0):vi + 2]
     v = rd.spectrum.shape[-1]
@@ -189,7 +199,7 @@ def undetected_reason(scene: Scene, det: Detections, rd: RangeDoppler, target,
     snr = None if noise <= 0 else float(10 * np.log10(max(float(cell.max()), 1e-300) / noise))
     dr = rd.range_m[1] - rd.range_m[0]
     dv = rd.velocity_mps[1] - rd.velocity_mps[0]
-    near = ((np.abs(det.range_m - target.range_m) <= bins * dr)
+    near = ((np.abs(det.range_m - r_t) <= bins * dr)
             & (np.abs(det.velocity_mps - target.velocity_mps) <= bins * dv))
     if np.any(near):
         mine = np.flatnonzero(near)
@@ -325,7 +335,7 @@ def truth_twin(setup: Setup, targets, echoes: Echoes, matches: list[dict], bins:
     _, t_cube = simulate_truth(setup, targets, seed, noise_w)
     t_rd, t_det = process(t_cube)
     t_matches = match_targets(scene, t_det, t_rd, bins=bins, steering=t_cube.steering,
-                              targets=targets)
+                              targets=targets, real=True)
     keys = ("range_m", "velocity_mps", "angle_deg", "elevation_deg")
     out = []
     for m, t in zip(matches, t_matches):

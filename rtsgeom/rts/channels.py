@@ -30,7 +30,8 @@ from .fir import fir_if_gain, realised_delay
 
 __all__ = ["RtsProgram", "EchoKind", "Echoes", "target_amplitude", "requested_delay",
            "channel_echoes", "setup_echoes", "cable_ghosts", "program_nearest",
-           "nearest_front_ends", "NEAREST_TIE_RAD", "build_echoes", "nominal_link_gain"]
+           "nearest_front_ends", "NEAREST_TIE_RAD", "build_echoes", "nominal_link_gain",
+           "apparent_range"]
 
 
 class EchoKind(IntEnum):
@@ -224,6 +225,14 @@ def nearest_front_ends(fe_azimuth_rad, angle_rad) -> np.ndarray:
     d = np.abs(np.asarray(fe_azimuth_rad, float)[None, :]
                - np.atleast_1d(np.asarray(angle_rad, float))[:, None])  # (T, F)
     return np.argmax(d <= d.min(axis=1, keepdims=True) + NEAREST_TIE_RAD, axis=1)
+
+
+def apparent_range(scene: Scene, range_m) -> np.ndarray:
+    """Where the RuT sees a target of set range ``range_m`` (m): the set range when the RTS
+    compensates the nominal air path, else the air path's R_c further (``requested_delay``
+    then delays by 2 R_t / c0 on top of it)."""
+    r = np.asarray(range_m, float)
+    return r if scene.rts.compensate_air_path else r + scene.rts.arc_radius_m
 
 
 def program_nearest(scene: Scene, setup: Setup) -> RtsProgram:

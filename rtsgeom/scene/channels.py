@@ -95,6 +95,11 @@ def channel_rules(scene, fail) -> None:
         fail("radar.channels.compensation_range_m", ch.compensation_range_m,
              'left out with radar.channels.compensation = "none" (it is the range of the '
              'boresight compensation\'s reflector)')
+    if ch.rx_coupling_phase_rad != 0.0 and ch.rx_coupling_db is None:
+        fail("radar.channels.rx_coupling_phase_deg", round(math.degrees(ch.rx_coupling_phase_rad),
+                                                           9),
+             "left out without radar.channels.rx_coupling_db (it is the phase of that "
+             "coupling, which is unset: no coupling)")
     n_tx, n_rx = antenna_counts(scene.radar)
     board = ("[radar.array]" if scene.radar.array is not None
              else f"the {scene.radar.antenna_preset} preset")

@@ -55,8 +55,10 @@ def decode_toml(raw: bytes | str, source: str) -> tuple[dict, str]:
     SHA-256 of the bytes)."""
     if isinstance(raw, str):
         raw = raw.encode("utf-8", "surrogatepass")
-    if len(raw) > MAX_SCENE_BYTES:
-        raise SceneError(f"{source}: scene file too large ({len(raw)} bytes; at most "
+    if len(raw) > MAX_SCENE_BYTES:  # (a file grown since its size was read: read one over)
+        raise SceneError(f"{source}: scene file too large (more than {MAX_SCENE_BYTES} bytes; "
+                         f"at most {MAX_SCENE_BYTES})" if len(raw) == MAX_SCENE_BYTES + 1 else
+                         f"{source}: scene file too large ({len(raw)} bytes; at most "
                          f"{MAX_SCENE_BYTES})")
     try:
         text = raw.decode("utf-8-sig")
@@ -86,6 +88,9 @@ def read_scene_bytes(path: str | Path) -> tuple[bytes, Path]:
             raise SceneError(f"{p}: cannot read scene file (it is a directory)")
         if not stat.S_ISREG(st.st_mode):
             raise SceneError(f"{p}: cannot read scene file (not a regular file)")
+        if st.st_size > MAX_SCENE_BYTES:  # its own size, not the bytes read to see it
+            raise SceneError(f"{p}: scene file too large ({st.st_size} bytes; at most "
+                             f"{MAX_SCENE_BYTES})")
         with p.open("rb") as fh:
             raw = fh.read(MAX_SCENE_BYTES + 1)
         return raw, p.resolve().parent

@@ -19,11 +19,14 @@ from .schema import Evolvable, spec
 from .sections import HEADING_DOC, MAX_SCATTERERS, SCATTERER_COLUMNS
 
 __all__ = ["ScenarioTargetConfig", "ScenarioConfig", "SetPoints", "trajectory", "frame_times",
-           "check_scenario", "MAX_FRAMES", "MAX_WAYPOINTS"]
+           "check_scenario", "MAX_FRAMES", "MAX_WAYPOINTS", "MAX_TARGET_FRAMES"]
 
 MAX_FRAMES = 100_000
 MAX_WAYPOINTS = 10_000
 MAX_SCENARIO_TARGETS = 64
+#: frames x targets (static and moving) of one drive: a played drive holds ~600 bytes per
+#: target and frame (tracks, programme and channels of the mode and its baseline), 600 MB here
+MAX_TARGET_FRAMES = 1_000_000
 _DEG = math.pi / 180.0
 
 #: a waypoint's columns: (name, unit, lo, hi, scale to SI); elevation may be left out (0)
@@ -160,6 +163,14 @@ def check_scenario(scene, fail, limits, air_extra_m: float) -> None:
         fail("scenario.frame_period_s", sc.frame_period_s,
              f">= {sc.duration_s / (MAX_FRAMES - 1):g} s: scenario.duration_s = "
              f"{sc.duration_s:g} s would take {sc.num_frames} frames (at most {MAX_FRAMES})")
+        return
+    n_t = len(sc.targets) + len(scene.targets)
+    if sc.num_frames * n_t > MAX_TARGET_FRAMES:
+        fail("scenario.frame_period_s", sc.frame_period_s,
+             f">= {sc.duration_s * n_t / (MAX_TARGET_FRAMES - n_t):g} s: {sc.num_frames} frames "
+             f"x {n_t} targets would be {sc.num_frames * n_t} target-frames (at most "
+             f"{MAX_TARGET_FRAMES}: the played drive's memory; a shorter scenario.duration_s "
+             "or fewer targets)")
         return
     r_lim, v_lim, why_r, why_v = limits
     r_max = r_lim - air_extra_m

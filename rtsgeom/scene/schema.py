@@ -246,7 +246,7 @@ def check_value(s: Spec, v: Any, ctx: _Ctx, path: str, context: dict | None = No
         if ((s.lo is not None and (f < s.lo or (s.lo_open and f == s.lo)))
                 or (s.hi is not None and (f > s.hi or (s.hi_open and f == s.hi)))):
             ctx.fail(path, f, rng)
-        return f
+        return f + 0.0  # -0.0 reads as 0 (numpy refuses a scale of -0.0: "scale < 0")
     if k == "int":
         rng = s.range_text()
         if isinstance(v, bool) or not isinstance(v, int):

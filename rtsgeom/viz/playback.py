@@ -12,6 +12,11 @@ from .figures import _styled, new_figure
 
 __all__ = ["playback_figure"]
 
+#: targets named one by one in the legend; beyond, the legend names the marks (set, detected,
+#: lost) once and each target is a colour (64 targets gave a legend of 192 entries, larger
+#: than the figure, and matplotlib's warning about it)
+LEGEND_TARGETS = 8
+
 
 @_styled
 def playback_figure(time_s, set_deg, detected_deg: Mapping[str, np.ndarray],
@@ -36,15 +41,19 @@ def playback_figure(time_s, set_deg, detected_deg: Mapping[str, np.ndarray],
     for col, mode in enumerate(modes):
         d = np.asarray(detected_deg[mode], float).reshape(t.size, -1)
         top, bottom = axes[0, col], axes[1, col]
+        named = s.shape[1] <= LEGEND_TARGETS
         for k in range(s.shape[1]):
-            line, = top.plot(t, s[:, k], lw=1.0, label=f"target {k} set")
-            top.plot(t, d[:, k], "o", ms=3.5, color=line.get_color(), label=f"target {k} "
-                     "detected")
+            line, = top.plot(t, s[:, k], lw=1.0,
+                             label=f"target {k} set" if named else
+                             ("set (one colour per target)" if k == 0 else None))
+            top.plot(t, d[:, k], "o", ms=3.5, color=line.get_color(),
+                     label=f"target {k} detected" if named else
+                     ("detected" if k == 0 else None))
             bottom.plot(t, d[:, k] - s[:, k], "o-", ms=3, lw=0.8, color=line.get_color())
             lost = ~np.isfinite(d[:, k])
             if np.any(lost):
                 top.plot(t[lost], s[lost, k], "x", color="red", ms=6,
-                         label=f"target {k} lost")
+                         label=f"target {k} lost" if named else "lost")
         for i, th in enumerate(handovers_s.get(mode, [])):
             for ax in (top, bottom):
                 ax.axvline(th, color="0.4", ls=":", lw=0.9,
@@ -55,8 +64,8 @@ def playback_figure(time_s, set_deg, detected_deg: Mapping[str, np.ndarray],
         bottom.set_xlabel("time (s)")
     # one legend for the figure, below the plots (inside, with a few targets, it covered the
     # tracks); constrained layout makes room for it
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    for ax in axes[0, 1:]:  # a hand-over or loss only in another column
+    handles, labels = [], []
+    for ax in axes[0]:  # a hand-over or loss only in another column; each label once
         for h, lab in zip(*ax.get_legend_handles_labels()):
             if lab not in labels:
                 handles.append(h)

@@ -30,7 +30,7 @@ from ...scene import Scene, TargetConfig
 from ...scene.objects import frame_objects
 from ...scene.scenario import trajectory
 
-__all__ = ["frame_targets", "FramePlanner", "detect_frame"]
+__all__ = ["frame_targets", "frame_target_names", "FramePlanner", "detect_frame"]
 
 
 def frame_targets(scene: Scene) -> tuple[np.ndarray, list[tuple[TargetConfig, ...]]]:
@@ -52,6 +52,15 @@ def frame_targets(scene: Scene) -> tuple[np.ndarray, list[tuple[TargetConfig, ..
                          elevation_rad=float(sp.elevation_rad[f]))
             for sp, rcs in moving) + tuple(objects[f]))
     return times, frames
+
+
+def frame_target_names(scene: Scene, f: int, static: int | None = None):
+    """Frame ``f``'s target ``k`` as the scene file names it (``frame_targets`` puts the
+    ``[[targets]]`` first): ``frame f: targets[k]`` or ``frame f: scenario.targets[k - S]``
+    (``static``: S, default the scene's own count)."""
+    s = len(scene.targets) if static is None else static
+    return lambda k: (f"frame {f}: targets[{k}]" if k < s
+                      else f"frame {f}: scenario.targets[{k - s}]")
 
 
 class FramePlanner:
@@ -81,7 +90,8 @@ class FramePlanner:
             frames = [b.targets for b in self.budgets]
         self.pairs, seen = [], set()
         for f, targets in enumerate(frames):
-            pairs, notes = target_pairs(setup, self.probe, targets, where=f"frame {f}: targets")
+            pairs, notes = target_pairs(setup, self.probe, targets,
+                                        where=frame_target_names(scene, f))
             self.pairs.append(pairs)
             for n in notes:  # a pair too wide: once, at the first frame it is used
                 if n.split("]: ", 1)[-1] not in seen:
@@ -106,7 +116,8 @@ class FramePlanner:
         program, _, notes = program_pairs(self.setup, self.paths, self.mode,
                                           budget.targets if budget else scene_f.targets,
                                           self.pairs[f], self.probe, self.cals, self.offsets,
-                                          where=f"frame {f}: targets")
+                                          where=frame_target_names(scene_f, f,
+                                                                   len(self.setup.scene.targets)))
         return (lead_program(program, budget) if budget else program), notes
 
 

@@ -18,7 +18,8 @@ from ..._lib.parallel import fork_map
 from ...errors import ParameterError
 from ...geometry import build_setup
 from ...paths import compute_paths
-from ...scene import Scene
+from ...scene import Scene, check_scene_arg
+from ...scene.schema import check_arg
 from ...scene.registry import AOA_MODES, PATH_METHODS
 from ...pipeline.cells import shared_cell_warnings
 from ...pipeline.merge import cell_scale
@@ -56,18 +57,16 @@ class Playback:
     workers: int = 1
 
     def __post_init__(self):
-        if self.amplitudes is not None and self.amplitudes not in AOA_MODES:
-            raise ParameterError(f"amplitudes = {self.amplitudes!r}: must be one of "
-                                 f"{', '.join(AOA_MODES)}")
-        if self.paths not in PATH_METHODS:
-            raise ParameterError(f"paths = {self.paths!r}: must be one of "
-                                 f"{', '.join(PATH_METHODS)}")
-        if not (isinstance(self.bins, (int, np.integer)) and 0 <= self.bins <= 64):
-            raise ParameterError(f"bins = {self.bins!r}: must be an integer in [0, 64]")
-        if not (isinstance(self.workers, (int, np.integer)) and 1 <= self.workers <= 256):
-            raise ParameterError(f"workers = {self.workers!r}: must be an integer in [1, 256]")
+        if self.amplitudes is not None:
+            check_arg(self.amplitudes, "amplitudes", "str", "Playback", ParameterError,
+                      choices=AOA_MODES)
+        check_arg(self.paths, "paths", "str", "Playback", ParameterError, choices=PATH_METHODS)
+        check_arg(self.baseline, "baseline", "bool", "Playback", ParameterError)
+        check_arg(self.bins, "bins", "int", "Playback", ParameterError, lo=0, hi=64)
+        check_arg(self.workers, "workers", "int", "Playback", ParameterError, lo=1, hi=256)
 
     def __call__(self, scene: Scene, progress=None) -> PlaybackResult:
+        check_scene_arg(scene, "Playback")
         if scene.scenario is None:
             raise ParameterError(f"{scene.source}: has no [scenario] to play (add "
                                  "[scenario] with [[scenario.targets]], docs/scenario.md)")

@@ -24,9 +24,10 @@ from ...errors import ParameterError
 from ...geometry import build_setup
 from ...paths import exact_paths
 from ...pipeline.plan import target_pairs, uses_cells
-from ...scene import Scene
+from ...scene import Scene, check_scene_arg
 from ..tolerance import ChannelPhasors, ToleranceModel, ToleranceResult, monte_carlo
-from .frames import frame_targets
+from ..tolerance.draws import check_study_args
+from .frames import frame_target_names, frame_targets
 
 __all__ = ["drive_tolerance"]
 
@@ -44,7 +45,8 @@ def drive_tolerance(scene: Scene, sigma_mm=(0.1, 0.1, 0.1), draws: int = 2000,
         Radial, tangential and height mounting error per front end (mm): the standard
         deviation (``normal``) or the bound (``uniform``).
     draws, seed, distribution, spec_deg
-        As for :func:`rtsgeom.tolerance` (``seed`` default: the scene's).
+        As for :func:`rtsgeom.tolerance` (``seed`` default: the scene's), with its ranges
+        (``analysis.tolerance.draws.check_study_args``: draws in [1, 1e7], sigma 0 to 10 mm).
 
     Returns
     -------
@@ -54,6 +56,9 @@ def drive_tolerance(scene: Scene, sigma_mm=(0.1, 0.1, 0.1), draws: int = 2000,
         worst signed error over the drive; ``model.sets[p].set_rad`` the set-points of pair
         ``model.sets[p].front_ends``.
     """
+    check_scene_arg(scene, "drive_tolerance")
+    draws, seed, distribution, spec_deg, _, sigma = check_study_args(
+        "drive_tolerance", draws, seed, distribution, spec_deg, sigma_mm=sigma_mm)
     if scene.scenario is None:
         raise ParameterError(f"{scene.source}: has no [scenario] (docs/scenario.md)")
     if uses_cells(scene):
@@ -67,7 +72,7 @@ def drive_tolerance(scene: Scene, sigma_mm=(0.1, 0.1, 0.1), draws: int = 2000,
     probe = probe_front_ends(setup, exact_paths(setup), scene.seed)
     visits: dict = defaultdict(list)
     for f, targets in enumerate(frames):
-        pairs, _ = target_pairs(setup, probe, targets, where=f"frame {f}: targets")
+        pairs, _ = target_pairs(setup, probe, targets, where=frame_target_names(scene, f))
         for pair, t in zip(pairs, targets):
             visits[pair].append((t.angle_rad, t.range_m))
     models = []
@@ -76,6 +81,5 @@ def drive_tolerance(scene: Scene, sigma_mm=(0.1, 0.1, 0.1), draws: int = 2000,
         models.append(ChannelPhasors.build(setup, pair, set_rad=np.unique(v[:, 0]),
                                            range_m=float(v[:, 1].mean())))
     model = ToleranceModel.arc(models, setup.fe.count)
-    sigma = np.asarray(sigma_mm, float).reshape(3) * 1e-3
-    return monte_carlo(model, sigma, int(draws), scene.seed if seed is None else int(seed),
+    return monte_carlo(model, np.asarray(sigma), draws, scene.seed if seed is None else seed,
                        distribution, spec_deg)
