@@ -136,7 +136,7 @@ def check_spec(kpi_spec: KpiSpec, values: dict) -> list[SpecCheck]:
                                  note or "not available for this scene"))
             continue
         if name == "azimuth_deg":  # the uncovered part must be 0
-            margin = -float(value)
+            margin = 0.0 - float(value) if value > 0 else 0.0
             out.append(SpecCheck(name, float(value), list(limit), margin, value <= 1e-9, note))
             continue
         sense = SPEC_SENSE[name][0]

@@ -106,6 +106,7 @@ class KpiStudy:
         paths = exact_paths(setup)
         step("field of view")
         fov = field_of_view(setup, paths)
+        step(None)
         sigma_mm = self.mounting_sigma_mm()
         phase_deg, phase_from = self.phase_sigma_deg(scene)
         seed = scene.seed if self.seed is None else self.seed
