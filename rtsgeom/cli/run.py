@@ -51,15 +51,7 @@ def cmd_run(args) -> int:
                 encoding="utf-8")
     if not args.quiet:
         for m in result.matches:
-            d, e = m["detection"], m["error"]
-            if d is None:
-                print(f"target {m['index']}: NOT DETECTED: {m['undetected']['reason']}")
-                continue
-            el = (f" el {d['elevation_deg']:7.3f} deg" if "elevation_deg" in d else "")
-            el_e = (f", el {e['elevation_deg']:+.3f} deg" if "elevation_deg" in e else "")
-            print(f"target {m['index']}: {d['range_m']:7.3f} m {d['velocity_mps']:+7.3f} m/s "
-                  f"{d['angle_deg']:8.3f} deg{el}  (errors {e['range_m']:+.3f} m, "
-                  f"{e['velocity_mps']:+.3f} m/s, {e['angle_deg']:+.3f} deg{el_e})")
+            print(target_line(m))
         for w in result.warnings:
             print(f"warning: {w}")
         print(f"{len(result.detections)} detections; wrote {out}/detections.csv, summary.json, "
@@ -67,6 +59,32 @@ def cmd_run(args) -> int:
               + ", ".join(f"maps.{f}" for f in args.maps) + ("" if args.no_report else ", report.html"))
     return 0
 
+
+
+def target_line(m: dict) -> str:
+    """One printed line per target: the RTS's detection and its errors against the set-point,
+    then the truth twin's detection and the RTS's difference from it."""
+    d, e = m["detection"], m["error"]
+    if d is None:
+        line = f"target {m['index']}: NOT DETECTED: {m['undetected']['reason']}"
+    else:
+        el = (f" el {d['elevation_deg']:7.3f} deg" if "elevation_deg" in d else "")
+        el_e = (f", el {e['elevation_deg']:+.3f} deg" if "elevation_deg" in e else "")
+        merged = (f" MERGED with target {', '.join(map(str, m['merged_with']))}:"
+                  if m.get("status") == "merged" else "")
+        line = (f"target {m['index']}:{merged} {d['range_m']:7.3f} m {d['velocity_mps']:+7.3f} "
+                f"m/s {d['angle_deg']:8.3f} deg{el}  (errors {e['range_m']:+.3f} m, "
+                f"{e['velocity_mps']:+.3f} m/s, {e['angle_deg']:+.3f} deg{el_e})")
+    if "truth_status" not in m:
+        return line
+    t, vs = m["truth"], m["vs_truth"]
+    if t is None:
+        return line + f"; truth twin: {m['truth_status'].replace('_', ' ')}"
+    line += f"; truth {t['angle_deg']:8.3f} deg"
+    if vs is not None:
+        line += (f" (RTS - truth {vs['range_m']:+.3f} m, {vs['velocity_mps']:+.3f} m/s, "
+                 f"{vs['angle_deg']:+.3f} deg)")
+    return line
 
 
 def _map_formats(text: str) -> tuple[str, ...]:

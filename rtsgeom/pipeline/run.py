@@ -14,7 +14,12 @@ from .. import __version__
 from .._lib.results import Result
 from ..geometry import Setup, build_setup
 from ..paths import Paths, compute_paths
+from ..geometry.arrays import rut_array
 from ..radar import AdcCube, Detections, RangeDoppler, process
+from ..radar.association import associate
+from ..radar.peaks import two_target_resolution
+from ..radar.steering import Steering
+from ..radar.truth import simulate_truth
 from ..radar.frame import noise_power, simulate
 from ..rts.channels import Echoes, RtsProgram, program_nearest
 from ..errors import ParameterError
@@ -52,6 +57,7 @@ class RunResult(Result):
     warnings: tuple[str, ...] = ()
     aoa_mode: str = "exact"  # the amplitude mode actually used
     link_budget: object = None  # rtsgeom.radar.budget.LinkBudget
+    truth_detections: Detections | None = None  # the truth twin's (None: not run)
 
     def _summary(self):
         title = (f"{self.scene.name}: one frame, {len(self.scene.targets)} targets, "
@@ -91,39 +97,57 @@ class RunResult(Result):
                                     title=title or f"{self.scene.name}: range-Doppler map")
 
 
-def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angle_rad=None,
-                  bins: int = 2) -> list[dict]:
-    """For each target, the strongest detection within ``bins`` range and Doppler bins, each
-    detection matched to at most one target.
+def association_scale(scene: Scene, rd: RangeDoppler, steering=None) -> np.ndarray:
+    """The association's resolution cell: range bin, velocity bin and the RuT's two-target
+    resolution per direction-cosine axis (:func:`rtsgeom.radar.peaks.two_target_resolution`)."""
+    st = steering if steering is not None else Steering.auto(rut_array(scene.radar),
+                                                             scene.radar)
+    return np.r_[rd.range_m[1] - rd.range_m[0], rd.velocity_mps[1] - rd.velocity_mps[0],
+                 two_target_resolution(st)]
 
-    Two targets in one range-Doppler cell produce one detection: it goes to the target closest
-    to it (in bins; ties to the lower index) and the other target is reported not detected
-    (``detection`` None). Pairs are assigned greedily by (detection power, closeness), which
-    for well-separated targets is the strongest detection near each one.
+
+def target_points(targets, dims: int) -> np.ndarray:
+    """Set-points (T, 2 + dims) as the association compares them: range, velocity and the
+    direction cosines (sin az; with ``dims`` 2 also sin el, az scaled by cos el)."""
+    t = list(targets)
+    az = np.array([x.angle_rad for x in t], float)
+    el = np.array([x.elevation_rad for x in t], float)
+    u = np.sin(az)[:, None] if dims == 1 else np.c_[np.sin(az) * np.cos(el), np.sin(el)]
+    return np.c_[[x.range_m for x in t], [x.velocity_mps for x in t], u].reshape(len(t), -1)
+
+
+def detection_points(det: Detections, dims: int) -> np.ndarray:
+    """Detections (D, 2 + dims) in the columns of :func:`target_points`."""
+    az, el = np.asarray(det.angle_rad, float), np.radians(det.elevation_deg)
+    u = np.sin(az)[:, None] if dims == 1 else np.c_[np.sin(az) * np.cos(el), np.sin(el)]
+    return np.c_[det.range_m, det.velocity_mps, u].reshape(len(det), -1)
+
+
+def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angle_rad=None,
+                  bins: int = 2, steering=None, targets=None) -> list[dict]:
+    """Each target's detection by the one association (:func:`rtsgeom.radar.association.associate`):
+    an optimal assignment in resolution cells, never a detection that lies nearer another
+    target; ``status`` ``detected``, ``merged`` (one detection serves several targets the
+    radar cannot resolve: ``merged_with``) or ``not_detected``.
+
+    ``targets`` defaults to the scene's; ``steering`` (the cube's) to the scene radar's
+    beamformer; ``bins`` is the range and Doppler gate.
     """
-    dr = rd.range_m[1] - rd.range_m[0]
-    dv = rd.velocity_mps[1] - rd.velocity_mps[0]
-    pairs = []
-    for i, t in enumerate(scene.targets):
-        er = (det.range_m - t.range_m) / dr
-        ev = (det.velocity_mps - t.velocity_mps) / dv
-        for j in np.flatnonzero((np.abs(er) <= bins) & (np.abs(ev) <= bins)):
-            pairs.append((-float(det.power_db[j]), float(er[j] ** 2 + ev[j] ** 2), i, int(j)))
-    chosen: dict[int, int] = {}
-    used: set[int] = set()
-    for _, _, i, j in sorted(pairs):
-        if i not in chosen and j not in used:
-            chosen[i] = j
-            used.add(j)
+    targets = tuple(scene.targets if targets is None else targets)
+    scale = association_scale(scene, rd, steering)
+    dims = scale.size - 2
+    assoc = associate(target_points(targets, dims), detection_points(det, dims), scale, bins)
+    dr, dv = scale[0], scale[1]
     out = []
-    for i, t in enumerate(scene.targets):
-        j = chosen.get(i)
+    for i, t in enumerate(targets):
+        j = int(assoc.detection[i])
         entry = {"index": i, "set": {"range_m": t.range_m, "velocity_mps": t.velocity_mps,
                                      "angle_deg": float(np.degrees(t.angle_rad)),
-                                     "rcs_dbsm": t.rcs_dbsm}}
+                                     "rcs_dbsm": t.rcs_dbsm},
+                 "status": assoc.status[i], "merged_with": list(assoc.merged_with[i])}
         if det.elevation_rad is not None:
             entry["set"]["elevation_deg"] = float(np.degrees(t.elevation_rad))
-        if j is not None:
+        if j >= 0:
             d = {"range_m": float(det.range_m[j]), "velocity_mps": float(det.velocity_mps[j]),
                  "angle_deg": float(det.angle_deg[j]), "power_db": float(det.power_db[j]),
                  "snr_db": float(det.snr_db[j])}
@@ -143,13 +167,13 @@ def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angl
         else:
             entry["detection"] = None
             entry["error"] = None
-            entry["undetected"] = undetected_reason(scene, det, rd, t, bins)
+            entry["undetected"] = undetected_reason(scene, det, rd, t, bins, assoc.owner)
         out.append(entry)
     return out
 
 
 def undetected_reason(scene: Scene, det: Detections, rd: RangeDoppler, target,
-                      bins: int = 2) -> dict:
+                      bins: int = 2, owner=None) -> dict:
     """Why a target has no detection: the map's strongest cell within one bin of the target's
     cell over the map's noise (the median of the channel-summed power, a Gamma(V) variable,
     referred to its mean), against the CFAR threshold; or that a detection within ``bins``
@@ -167,7 +191,12 @@ def undetected_reason(scene: Scene, det: Detections, rd: RangeDoppler, target,
     near = ((np.abs(det.range_m - target.range_m) <= bins * dr)
             & (np.abs(det.velocity_mps - target.velocity_mps) <= bins * dv))
     if np.any(near):
-        why = "its cell's detection went to another target (two targets in one cell)"
+        mine = np.flatnonzero(near)
+        others = sorted({int(owner[j]) for j in mine if owner is not None and owner[j] >= 0})
+        why = ("the detection(s) in its cell lie nearer " + (
+            "target " + ", ".join(map(str, others)) if others else "another target")
+            + ", more than one angular resolution cell from it (two targets in one cell: "
+            "see the truth twin)")
     elif snr is not None and snr < thr:
         why = (f"{snr:.1f} dB over the noise at its cell, under the CFAR threshold "
                f"{thr:g} dB (radar.snr_db, when set, is the SNR of the strongest echo)")
@@ -214,10 +243,13 @@ def label_detections(result: "RunResult", bins: float = 2.0) -> list[str]:
                 labels[j] = f"cable ghost of target {int(echoes.target[e])}"
             else:
                 labels[j] = f"target {int(echoes.target[e])}"
-    for m in result.matches:  # the matching decides which detection is the target itself
+    served: dict[int, list[int]] = {}
+    for m in result.matches:  # the association decides which detection is the target itself
         j = m.get("detection_index")
         if j is not None:
-            labels[j] = f"target {m['index']}"
+            served.setdefault(j, []).append(m["index"])
+    for j, ts in served.items():
+        labels[j] = "target " + "+".join(map(str, sorted(ts)))
     for j, lab in enumerate(labels):  # a target's second detection is not the target
         if lab.startswith("target ") and not any(m.get("detection_index") == j
                                                  for m in result.matches):
@@ -226,12 +258,14 @@ def label_detections(result: "RunResult", bins: float = 2.0) -> list[str]:
 
 
 def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = None,
-              progress=None, calibration: dict | None = None) -> RunResult:
+              progress=None, calibration: dict | None = None, truth: bool = True) -> RunResult:
     """Run the whole pipeline on ``scene``.
 
     ``aoa_mode`` overrides the scene's ``rts.aoa_mode``: ``nearest`` puts each target on its
     nearest front end; the synthesis modes calibrate the front-end pairs first, or take
     them from ``calibration`` (a calibration file's content, ``calibration.file.load_calibration``).
+    ``truth``: also run the truth twin (:func:`truth_twin`: the same radar on the real
+    targets) and add ``truth``, ``truth_status`` and ``vs_truth`` to every match.
     The override is validated like the scene's own mode (``Scene.evolve``: e.g. paper eq. 24's
     spacing rule for the synthesis modes), so it cannot bypass a rule the scene file must meet.
     """
@@ -259,14 +293,48 @@ def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = 
                                                        calibration=cal_file)
     echoes, cube = simulate(setup, paths, program, scene.seed, scene.radar.snr_db)
     rd, det = process(cube)
+    matches = match_targets(scene, det, rd, steering=cube.steering)
+    truth_det = None
+    if truth and scene.targets:
+        truth_det, matches = truth_twin(setup, scene.targets, echoes, matches)
     budget = _budget(scene, setup, echoes, program)
     if scene.radar.link is not None:
         warnings = list(warnings) + link_warnings(budget, scene.radar.cfar.threshold_db)
         if cube.clipped:
             warnings.append(f"link: the ADC clipped {cube.clipped} of {cube.data.size} samples "
                             "of this frame")
-    return RunResult(scene, setup, paths, program, echoes, cube, rd, det,
-                     match_targets(scene, det, rd), calibration, tuple(warnings), mode, budget)
+    return RunResult(scene, setup, paths, program, echoes, cube, rd, det, matches,
+                     calibration, tuple(warnings), mode, budget, truth_det)
+
+
+def truth_twin(setup: Setup, targets, echoes: Echoes, matches: list[dict], bins: int = 2,
+               seed: int | None = None) -> tuple[Detections, list[dict]]:
+    """The same radar on the real scene (:mod:`rtsgeom.radar.truth`), with the RTS frame's
+    noise seed and power, and each target's match completed with ``truth`` (the truth twin's
+    own detection of it: range, velocity, angle, elevation where 2-D; None where the real
+    scene gives it none of its own either), ``truth_status`` and ``vs_truth`` (the RTS's
+    detection minus the truth's, same keys; None unless both exist).
+
+    Returns the truth twin's detections and the completed matches (new dicts)."""
+    scene = setup.scene
+    seed = scene.seed if seed is None else seed
+    snr = scene.radar.snr_db
+    noise_w = noise_power(echoes, snr) if snr is not None else None
+    _, t_cube = simulate_truth(setup, targets, seed, noise_w)
+    t_rd, t_det = process(t_cube)
+    t_matches = match_targets(scene, t_det, t_rd, bins=bins, steering=t_cube.steering,
+                              targets=targets)
+    keys = ("range_m", "velocity_mps", "angle_deg", "elevation_deg")
+    out = []
+    for m, t in zip(matches, t_matches):
+        truth = None
+        if t["status"] == "detected":
+            truth = {k: t["detection"][k] for k in keys if k in t["detection"]}
+        rts = m.get("detection")
+        vs = (None if truth is None or rts is None
+              else {k: rts[k] - truth[k] for k in truth if k in rts})
+        out.append({**m, "truth": truth, "truth_status": t["status"], "vs_truth": vs})
+    return t_det, out
 
 
 def _budget(scene: Scene, setup: Setup, echoes: Echoes, program: RtsProgram):

@@ -25,6 +25,7 @@ from ..geometry import RutArray
 from ..scene import CfarConfig, RadarConfig
 from .fmcw import AdcCube
 from .newton import parabolic as _parabolic
+from .peaks import angle_peaks
 from .steering import Steering
 from .windows import window
 
@@ -89,6 +90,10 @@ class Detections:
     doppler_bin: np.ndarray
     # elevation of the 2-D beamformer's peak (arrays with elevation extent); None: azimuth-only
     elevation_rad: np.ndarray | None = None
+    # rank of the direction among its cell's angle peaks (0: the strongest; radar.peaks) and
+    # its spectrum relative to the strongest (dB); None: one direction per cell
+    angle_peak: np.ndarray | None = None
+    angle_level_db: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.range_m.size)
@@ -107,13 +112,25 @@ class Detections:
     def to_dataframe(self):
         """One row per detection as a ``pandas.DataFrame`` (columns ``range_m``,
         ``velocity_mps``, ``angle_deg``, ``elevation_deg``, ``power_db``, ``snr_db``,
-        ``range_bin``, ``doppler_bin``)."""
+        ``range_bin``, ``doppler_bin``, ``angle_peak``)."""
         import pandas as pd
         return pd.DataFrame({"range_m": self.range_m, "velocity_mps": self.velocity_mps,
                              "angle_deg": self.angle_deg, "elevation_deg": self.elevation_deg,
                              "power_db": self.power_db,
                              "snr_db": self.snr_db, "range_bin": self.range_bin,
-                             "doppler_bin": self.doppler_bin})
+                             "doppler_bin": self.doppler_bin, "angle_peak": self.peak_rank})
+
+    @property
+    def peak_rank(self) -> np.ndarray:
+        """Rank of each detection's direction among its cell's angle peaks (0: strongest)."""
+        if self.angle_peak is None:
+            return np.zeros(len(self), int)
+        return np.asarray(self.angle_peak)
+
+    @property
+    def primary(self) -> np.ndarray:
+        """Mask of the detections that are their cell's strongest angle peak."""
+        return self.peak_rank == 0
 
 
 def range_doppler(cube: AdcCube) -> RangeDoppler:
@@ -299,28 +316,36 @@ def detect(rd: RangeDoppler, cube: AdcCube) -> Detections:
     nu = rd.doppler_hz[d_i] + dd * nu_step
     snaps = tdm_compensate(rd.spectrum[r_i, d_i, :], nu, rut, radar)
     st = cube.steering
-    ang = st.search(snaps) if r_i.size else (np.zeros((0, 2)) if st.dims == 2 else np.zeros(0))
+    k_max = int(getattr(radar, "angle_peaks_max", 1))
+    ang, level = angle_peaks(st, snaps, k_max, float(getattr(radar, "angle_peak_threshold",
+                                                                  0.5)))
+    # one row per direction, each cell's rows together, strongest first
+    cell, rank = np.nonzero(np.isfinite(level))
+    ang = ang[cell, rank]
     elev = None
     if st.dims == 2:  # 2-D beamforming (array with elevation extent)
         ang, elev = ang[..., 0], frozen(ang[..., 1])
+    r_i, d_i = r_i[cell], d_i[cell]
     return Detections(
-        range_m=frozen(rd.range_m[r_i] + dr * range_step),
-        velocity_mps=frozen(nu * c / (2 * radar.f_c_hz)),
+        range_m=frozen(rd.range_m[r_i] + dr[cell] * range_step),
+        velocity_mps=frozen(nu[cell] * c / (2 * radar.f_c_hz)),
         angle_rad=frozen(ang),
         power_db=frozen(10 * np.log10(rd.power[r_i, d_i])),
         snr_db=frozen(10 * np.log10(rd.power[r_i, d_i] / noise[r_i, d_i])),
         range_bin=frozen(r_i), doppler_bin=frozen(d_i), elevation_rad=elev,
+        angle_peak=frozen(rank) if k_max > 1 else None,
+        angle_level_db=frozen(level[cell, rank]) if k_max > 1 else None,
     )
 
 
 def nearest_detection(det: Detections, rd: RangeDoppler, range_m: float,
                       velocity_mps: float = 0.0, bins: int = 2) -> int | None:
-    """Index of the strongest detection within ``bins`` range and Doppler bins of a set-point,
-    or None."""
+    """Index of the strongest detection within ``bins`` range and Doppler bins of a set-point
+    (its cell's strongest direction), or None."""
     dr = rd.range_m[1] - rd.range_m[0]
     dv = rd.velocity_mps[1] - rd.velocity_mps[0]
     near = ((np.abs(det.range_m - range_m) <= bins * dr)
-            & (np.abs(det.velocity_mps - velocity_mps) <= bins * dv))
+            & (np.abs(det.velocity_mps - velocity_mps) <= bins * dv) & det.primary)
     if not np.any(near):
         return None
     return int(np.flatnonzero(near)[np.argmax(det.power_db[near])])

@@ -141,6 +141,15 @@ class RadarConfig(Evolvable):
         "many elements of the azimuth row (capon, music; 1-D uniform arrays); 0 = none (one "
         "snapshot, rank-1 covariance); about 2/3 of the row's elements is the usual choice",
         0, unit="", lo=0, hi=4096)
+    angle_peaks_max: int = spec(
+        "angle_peaks_max", "int", "directions reported per range-Doppler detection at most: "
+        "every local peak of the cell's angle spectrum above angle_peak_threshold, strongest "
+        "first (TI's multiObjBeamForming reports two); 1 = the global peak only", 2, unit="",
+        lo=1, hi=8)
+    angle_peak_threshold: float = spec(
+        "angle_peak_threshold", "float", "a further angle peak of a detection is reported when "
+        "its amplitude is at least this fraction of the strongest peak's (TI's example "
+        "profiles: 0.5)", 0.5, unit="", lo=0.0, hi=1.0, lo_open=True)
     cfar: CfarConfig = spec("cfar", "table", "[radar.cfar] detection settings", {},
                             cls=CfarConfig)
     snr_db: float | None = spec("snr_db", "float", "per-sample SNR of the strongest echo; "

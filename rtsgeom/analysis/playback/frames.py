@@ -18,7 +18,7 @@ from ...errors import ParameterError
 from ...geometry import Setup
 from ...paths import Paths
 from ...pipeline.plan import calibrate_pairs, program_pairs, target_pairs, uses_cells
-from ...pipeline.run import match_targets
+from ...pipeline.run import match_targets, truth_twin
 from ...radar import process
 from ...radar.frame import simulate
 from ...calibration.channels import channel_offsets
@@ -97,13 +97,16 @@ class FramePlanner:
 
 
 def detect_frame(setup: Setup, paths: Paths, program: RtsProgram, scene_f: Scene, seed: int,
-                 bins: int = 2) -> tuple[list[dict], np.ndarray]:
-    """One frame through the full chain: the matches of ``match_targets`` and, per target,
-    the number of other detections within ``bins`` range and Doppler bins of its set-point
-    that no target claimed (a split: the RuT sees the target twice)."""
-    _, cube = simulate(setup, paths, program, seed, scene_f.radar.snr_db)
+                 bins: int = 2, truth: bool = True) -> tuple[list[dict], np.ndarray]:
+    """One frame through the full chain: the matches of ``match_targets`` (with the truth
+    twin's detections where ``truth``: :func:`rtsgeom.pipeline.run.truth_twin`, same seed) and,
+    per target, the number of other detections within ``bins`` range and Doppler bins of its
+    set-point that no target claimed (a split: the RuT sees the target twice)."""
+    echoes, cube = simulate(setup, paths, program, seed, scene_f.radar.snr_db)
     rd, det = process(cube)
-    matches = match_targets(scene_f, det, rd, bins=bins)
+    matches = match_targets(scene_f, det, rd, bins=bins, steering=cube.steering)
+    if truth and scene_f.targets:
+        _, matches = truth_twin(setup, scene_f.targets, echoes, matches, bins, seed)
     claimed = {m.get("detection_index") for m in matches}
     dr = rd.range_m[1] - rd.range_m[0]
     dv = rd.velocity_mps[1] - rd.velocity_mps[0]

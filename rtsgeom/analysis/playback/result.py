@@ -18,7 +18,8 @@ __all__ = ["PlaybackResult", "PROGRAMME_COLUMNS", "TRACK_COLUMNS"]
 PROGRAMME_COLUMNS = ("frame", "time_s", "target", "channel", "delay_s", "doppler_hz",
                      "amplitude_db", "phase_rad")
 TRACK_COLUMNS = ("frame", "time_s", "target", "set_range_m", "set_azimuth_deg",
-                 "set_velocity_mps", "range_m", "azimuth_deg", "velocity_mps")
+                 "set_velocity_mps", "range_m", "azimuth_deg", "velocity_mps",
+                 "truth_range_m", "truth_azimuth_deg", "truth_velocity_mps", "status")
 
 
 @dataclass(frozen=True, repr=False)
@@ -30,7 +31,9 @@ class PlaybackResult(Result):
     detections near a target's set-point that no target claimed; ``channels`` (frames,
     targets) the front ends that carry each target; ``programme`` (rows, 7): frame, target,
     channel, delay_s, doppler_hz, |amplitude|, phase_rad; ``baseline`` the switched baseline
-    (``nearest``) on the same drive, or None.
+    (``nearest``) on the same drive, or None; ``truth`` the truth twin's detections (the same
+    keys, NaN where the real scene gives the target no detection of its own; None: not run);
+    ``status`` (frames, targets) ``detected``, ``merged`` or ``not_detected``.
     """
 
     scene: Scene
@@ -44,6 +47,8 @@ class PlaybackResult(Result):
     calibration: dict
     warnings: tuple[str, ...] = ()
     baseline: "PlaybackResult | None" = None
+    truth: dict | None = None
+    status: np.ndarray | None = None
 
     def _summary(self):
         s = self.summary()
@@ -75,6 +80,14 @@ class PlaybackResult(Result):
     def angle_error_deg(self) -> np.ndarray:
         """Detected minus set azimuth (frames, targets), NaN where lost."""
         return self.detected["azimuth_deg"] - self.set["azimuth_deg"]
+
+    @property
+    def vs_truth_deg(self) -> np.ndarray:
+        """Detected minus the truth twin's azimuth (frames, targets), NaN where either has
+        none (all NaN without the truth twin)."""
+        if self.truth is None:
+            return np.full(self.split.shape, np.nan)
+        return self.detected["azimuth_deg"] - self.truth["azimuth_deg"]
 
     def handovers(self) -> list[tuple[int, int]]:
         """(frame, target) where the channels carrying the target differ from the frame before."""
@@ -115,6 +128,8 @@ class PlaybackResult(Result):
             "split_frames": int(np.any(self.split > 0, axis=1).sum()),
             "handover_jump_deg": jump(jumps),
             "handovers": int(len(hk)),
+            "vs_truth_deg": stats(np.abs(self.vs_truth_deg)),
+            "merged_frames": int(np.any(self._status == "merged", axis=1).sum()),
             "targets": [{"target": k, "angle_error_deg": stats(err[:, k]),
                          "lost_frames": int(lost[:, k].sum()),
                          "split_frames": int((self.split[:, k] > 0).sum()),
@@ -126,6 +141,12 @@ class PlaybackResult(Result):
             out["baseline"] = {k: v for k, v in self.baseline.summary().items()
                                if k != "targets"}
         return out
+
+    @property
+    def _status(self) -> np.ndarray:
+        if self.status is not None:
+            return np.asarray(self.status)
+        return np.where(np.isfinite(self.detected["azimuth_deg"]), "detected", "not_detected")
 
     def summary_json(self) -> dict:
         """:meth:`summary` with the run's context (scene, drive, calibration, warnings)."""
@@ -158,7 +179,11 @@ class PlaybackResult(Result):
                 **{f"set_{k}": self.set[k].ravel() for k in ("range_m", "azimuth_deg",
                                                              "velocity_mps")},
                 **{k: self.detected[k].ravel() for k in ("range_m", "azimuth_deg",
-                                                         "velocity_mps")}}
+                                                         "velocity_mps")},
+                **{f"truth_{k}": (self.truth[k] if self.truth is not None
+                                  else np.full((n_f, n_t), np.nan)).ravel()
+                   for k in ("range_m", "azimuth_deg", "velocity_mps")},
+                "status": self._status.ravel()}
 
     def _programme_columns(self) -> dict:
         p = self.programme
@@ -219,6 +244,8 @@ def _csv(cols: dict, names) -> str:
 
 
 def _cell(v) -> str:
+    if isinstance(v, str):
+        return v
     if isinstance(v, (int, np.integer)):
         return str(int(v))
     v = float(v)

@@ -78,14 +78,15 @@ class Playback:
         times, frames = frame_targets(scene)
         result = _play(scene, setup, paths, mode, times, frames, self.bins, progress,
                        self.workers)
-        if self.baseline and mode != "nearest":
+        if self.baseline and mode != "nearest":  # the same drive: the same truth twin
             base = _play(scene, setup, paths, "nearest", times, frames, self.bins, progress,
-                         self.workers)
+                         self.workers, truth=False)
+            base = dataclasses.replace(base, truth=result.truth)
             result = dataclasses.replace(result, baseline=base)
         return result
 
 
-def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1
+def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1, truth=True
           ) -> PlaybackResult:
     if progress:
         progress(f"{mode}: calibrating and planning {len(frames)} frames")
@@ -93,18 +94,23 @@ def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1
     n_f, n_t = len(frames), len(frames[0])
     shape = (n_f, n_t)
     det = {k: np.full(shape, np.nan) for k in ("range_m", "azimuth_deg", "velocity_mps")}
+    tru = {k: np.full(shape, np.nan) for k in det}
+    status = np.full(shape, "not_detected", dtype=object)
     split = np.zeros(shape, int)
     channels = np.empty(shape, object)
     programme, warnings = [], list(planner.warnings)
-    work = functools.partial(_frames, (scene, setup, paths, planner, frames, bins))
+    work = functools.partial(_frames, (scene, setup, paths, planner, frames, bins, truth))
     chunks = np.array_split(np.arange(n_f), max(1, min(n_f, 4 * int(workers))))
     outs = (fork_map(work, chunks, int(workers)) if workers > 1 and n_f > 1
             else [work(c) for c in chunks])
-    for f, (rows, found, extra, notes) in enumerate(o for out in outs for o in out):
+    for f, (rows, found, extra, notes, seen, stat) in enumerate(o for out in outs for o in out):
         split[f] = extra
-        for k, d in enumerate(found):
-            if d is not None:
-                det["range_m"][f, k], det["azimuth_deg"][f, k], det["velocity_mps"][f, k] = d
+        status[f] = stat
+        for into, got in ((det, found), (tru, seen)):
+            for k, d in enumerate(got):
+                if d is not None:
+                    into["range_m"][f, k], into["azimuth_deg"][f, k], into["velocity_mps"][
+                        f, k] = d
         for k in range(n_t):
             channels[f, k] = tuple(sorted(int(q) for q in rows[rows[:, 1] == k, 2]))
         programme.append(rows)
@@ -114,28 +120,30 @@ def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1
             "velocity_mps": np.array([[t.velocity_mps for t in tg] for tg in frames])}
     return PlaybackResult(scene=scene, mode=mode, time_s=times, set=set_, detected=det,
                           split=split, channels=channels, programme=np.concatenate(programme),
-                          calibration=planner.record, warnings=tuple(warnings))
+                          calibration=planner.record, warnings=tuple(warnings),
+                          truth=tru if truth else None, status=status)
 
 
 def _frames(ctx, chunk) -> list:
     """Frames ``chunk`` (indices) played: per frame the programme rows (frame, target,
     channel, delay_s, doppler_hz, |amplitude|, phase_rad), each target's detection (range,
-    azimuth, velocity) or None, its unclaimed detections nearby and the planner's notes.
+    azimuth, velocity) or None, its unclaimed detections nearby, the planner's notes, the
+    truth twin's detection of each target (or None) and each target's status.
     A pure function of the frame (its noise seeded by it): the same in a forked worker."""
-    scene, setup, paths, planner, frames, bins = ctx
+    scene, setup, paths, planner, frames, bins, truth = ctx
     out = []
     for f in chunk:
         scene_f = dataclasses.replace(setup.scene, targets=frames[f])  # checked on load
         program, notes = planner.program(int(f), scene_f)
         seed = (scene.seed + int(f)) % (2 ** 63)  # frame 0: the scene's own noise, as `run`
-        matches, extra = detect_frame(setup, paths, program, scene_f, seed, bins)
-        found = [None if m["detection"] is None else
-                 (m["detection"]["range_m"], m["detection"]["angle_deg"],
-                  m["detection"]["velocity_mps"]) for m in matches]
+        matches, extra = detect_frame(setup, paths, program, scene_f, seed, bins, truth)
+        found, seen = ([None if m.get(key) is None else
+                        (m[key]["range_m"], m[key]["angle_deg"], m[key]["velocity_mps"])
+                        for m in matches] for key in ("detection", "truth"))
         rows = np.column_stack([
             np.full(len(program), f), program.target, program.front_end, program.delay_s,
             program.doppler_hz, np.abs(program.amplitude), np.angle(program.amplitude)])
-        out.append((rows, found, extra, notes))
+        out.append((rows, found, extra, notes, seen, [m["status"] for m in matches]))
     return out
 
 

@@ -1,0 +1,104 @@
+"""Which detection is which target: one optimal assignment, explained.
+
+Detections and targets are compared in the radar's own resolution cells: range over the range
+bin, velocity over the velocity bin, direction (direction cosine u = sin az, and sin el for a
+2-D beamformer) over the beamformer's two-target resolution
+(:func:`rtsgeom.radar.peaks.two_target_resolution`). In those units:
+
+* a detection is a candidate for a target within ``gate`` range and Doppler bins of it;
+* a target is never given a detection that lies nearer (in the normalised distance) to another
+  target;
+* among the remaining candidates one optimal assignment (``scipy.optimize.linear_sum_assignment``,
+  the most pairs, then the least summed distance) gives each target at most one detection of its
+  own: status ``detected``;
+* a target left without one whose range-Doppler cell holds a detection within one angular
+  resolution cell of it is ``merged``: that detection serves it and the target that owns it
+  (``merged_with`` lists the others), as when the radar cannot resolve two targets;
+* every other target is ``not_detected``.
+
+The same function serves ``run``, ``play``, the truth twin, the resolution study and the API.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+__all__ = ["Association", "associate", "STATUSES"]
+
+#: the statuses of a target
+STATUSES = ("detected", "merged", "not_detected")
+
+_FORBIDDEN = 1e12  # the cost of a pair the rules exclude (never kept)
+
+
+@dataclass(frozen=True)
+class Association:
+    """Per target the detection that serves it and how.
+
+    ``detection`` (T,) the index of the serving detection, -1 for none; ``status`` (T,) one of
+    :data:`STATUSES`; ``merged_with`` the other targets a merged detection serves (empty
+    otherwise); ``owner`` (D,) the target each detection was assigned to, -1 for none.
+    """
+
+    detection: np.ndarray
+    status: tuple[str, ...]
+    merged_with: tuple[tuple[int, ...], ...]
+    owner: np.ndarray
+
+
+def associate(targets: np.ndarray, detections: np.ndarray, scale, gate: float = 2.0
+              ) -> Association:
+    """Assign detections to targets (see the module's docstring for the rules).
+
+    Parameters
+    ----------
+    targets : ndarray, shape (T, K)
+        Set-points ``(range_m, velocity_mps, u[, u_el])``.
+    detections : ndarray, shape (D, K)
+        Detections in the same columns.
+    scale : array_like, shape (K,)
+        One resolution cell per column: range bin (m), velocity bin (m/s), two-target
+        resolution in u (and in u_el).
+    gate : float
+        A detection is a candidate for a target within this many range and Doppler bins.
+
+    Returns
+    -------
+    Association
+    """
+    t = np.asarray(targets, float).reshape(-1, np.size(scale))
+    d = np.asarray(detections, float).reshape(-1, np.size(scale))
+    scale = np.asarray(scale, float)
+    n_t, n_d = len(t), len(d)
+    det_of = np.full(n_t, -1)
+    owner = np.full(n_d, -1)
+    if n_t and n_d:
+        diff = (d[None, :, :] - t[:, None, :]) / scale  # (T, D, K) in resolution cells
+        dist = np.sqrt(np.sum(diff ** 2, axis=-1))
+        in_gate = np.all(np.abs(diff[..., :2]) <= gate, axis=-1)
+        nearest = dist <= dist.min(axis=0, keepdims=True)  # no other target is nearer
+        allowed = in_gate & nearest
+        cost = np.where(allowed, dist, _FORBIDDEN)
+        rows, cols = linear_sum_assignment(cost)
+        ok = allowed[rows, cols]
+        det_of[rows[ok]], owner[cols[ok]] = cols[ok], rows[ok]
+        status = ["detected" if j >= 0 else "not_detected" for j in det_of]
+        shared = in_gate & (np.abs(diff[..., 2:]) <= 1.0).all(axis=-1) & (owner >= 0)[None]
+        merged: dict[int, set[int]] = {}
+        for i in np.flatnonzero(det_of < 0):
+            cand = np.flatnonzero(shared[i])
+            if cand.size:
+                j = int(cand[np.argmin(dist[i, cand])])
+                det_of[i] = j
+                merged.setdefault(j, {int(owner[j])}).add(int(i))
+        with_ = [()] * n_t
+        for group in merged.values():
+            for i in group:
+                status[i] = "merged"
+                with_[i] = tuple(sorted(group - {i}))
+    else:
+        status, with_ = ["not_detected"] * n_t, [()] * n_t
+    return Association(det_of, tuple(status), tuple(with_), owner)
