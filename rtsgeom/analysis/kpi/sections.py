@@ -22,7 +22,11 @@ from ..ghosts import ghost_analysis
 from ..nearfield import nearfield
 
 __all__ = ["field_of_view", "uncovered_deg", "range_velocity", "targets_section",
-           "ghosts_section", "nearfield_section"]
+           "ghosts_section", "nearfield_section", "resolution_section", "RESOLUTION_STEP_DEG",
+           "RESOLUTION_PHASES_DEG"]
+
+RESOLUTION_STEP_DEG = 2.0  # the separations' grid: coarse, for the runtime
+RESOLUTION_PHASES_DEG = (0.0, 90.0, 180.0)  # the second target's phase at the RuT
 
 
 def field_of_view(setup, paths) -> dict:
@@ -201,3 +205,43 @@ def nearfield_section(setup):
             "fraunhofer_note": d["fraunhofer_note"], "front_ends": fes,
             "pairs": at.get("synthesis", []),
             "bias_1_over_r_coefficient_deg_m": d["bias_1_over_r_coefficient_deg_m"]}, nf
+
+
+def resolution_section(setup, progress=None) -> dict:
+    """The minimum resolvable separation of two equal targets about the arc's middle, the
+    truth twin's beside the RTS's, per relative phase (``analysis.resolution``) on a coarse
+    grid (every :data:`RESOLUTION_STEP_DEG` up to what the arc reaches); ``rts_deg`` the
+    RTS's worst over the phases (None where a phase is not resolved on the grid)."""
+    try:
+        from ..resolution import ResolutionStudy
+    except ModuleNotFoundError as exc:  # the study is not part of this version
+        if exc.name != f"{__package__.rsplit('.', 1)[0]}.resolution":
+            raise
+        return {"min_separation_deg": None, "rts_deg": None, "truth_deg": None,
+                "note": "the resolution study is not part of this version: no minimum "
+                        "resolvable separation"}
+    geo = np.degrees(setup.fe_azimuth_rad())
+    centre = 0.5 * (geo.min() + geo.max())
+    reach = 2 * min(centre - geo.min(), geo.max() - centre) - 1.0
+    seps = tuple(float(s) for s in np.arange(RESOLUTION_STEP_DEG, reach + 1e-9,
+                                             RESOLUTION_STEP_DEG))
+    if not seps:
+        return {"min_separation_deg": None, "rts_deg": None, "truth_deg": None,
+                "note": f"the arc spans {geo.max() - geo.min():.2f} deg: no two targets "
+                        f"{RESOLUTION_STEP_DEG:g} deg apart fit between its front ends"}
+    say = None if progress is None else (lambda label, *_: progress(label, 0, 1))
+    res = ResolutionStudy(centre_deg=float(centre), separations_deg=seps,
+                          phases_deg=RESOLUTION_PHASES_DEG)(setup.scene, say)
+    ms = res.min_separation_deg
+
+    def worst(per_phase):
+        v = list(per_phase.values())
+        return None if not v or any(x is None for x in v) else max(v)
+    out = {"min_separation_deg": ms, "rts_deg": worst(ms["rts"]),
+           "truth_deg": worst(ms["truth"]), "centre_deg": float(centre),
+           "range_m": res.range_m, "separations_deg": list(seps),
+           "phases_deg": list(RESOLUTION_PHASES_DEG)}
+    out["note"] = ("the RTS's worst over the phases" if out["rts_deg"] is not None else
+                   f"the RTS does not resolve two targets at every phase up to {seps[-1]:g} "
+                   "deg (the largest separation the arc reaches)")
+    return out

@@ -25,7 +25,7 @@ from ...scene import Scene, check_scene_arg
 from ..tolerance import MAX_SIGMA_MM
 from .accuracy import AccuracyInputs, AnglePoint, effective_snr, pair_accuracy, set_angles
 from .sections import (field_of_view, ghosts_section, nearfield_section, range_velocity,
-                       targets_section, uncovered_deg)
+                       resolution_section, targets_section, uncovered_deg)
 from .spec import KpiSpec, SpecCheck, check_spec
 
 __all__ = ["KpiStudy", "Datasheet", "DEFAULT_SIGMA_MM"]
@@ -121,7 +121,10 @@ class KpiStudy:
         step("range, velocity, targets, ghosts, near field")
         rv = range_velocity(setup, run)
         tg = targets_section(setup, run, fov)
-        tg["resolution"] = _resolution_unavailable()
+        step("resolution (two targets, truth beside RTS)")
+        tg["resolution"] = resolution_section(setup, progress) if not fov["cells"] else {
+            "min_separation_deg": None, "rts_deg": None, "truth_deg": None,
+            "note": "a scene of 2-D cells: the resolution test covers an arc"}
         gh = ghosts_section(scene, run)
         nf, nf_result = nearfield_section(setup)
         step(None)
@@ -186,12 +189,6 @@ def _ideal_radar(setup):
     scene = setup.scene
     return build_setup(dataclasses.replace(scene, radar=dataclasses.replace(scene.radar,
                                                                             channels=None)))
-
-
-def _resolution_unavailable() -> dict:
-    return {"min_separation_deg": None,
-            "note": "the resolution study is not part of this version: no minimum resolvable "
-                    "separation"}
 
 
 @dataclass(frozen=True, repr=False)
