@@ -97,6 +97,7 @@ _LAZY = {
     "Datasheet": (".analysis.kpi", "Datasheet"),
     "KpiSpec": (".analysis.kpi", "KpiSpec"),
     "load_spec": (".analysis.kpi", "load_spec"),
+    "loads_spec": (".analysis.kpi", "loads_spec"),
     # views
     "show": (".api", "show"),
     "render_setup_png": (".viz.scene3d", "render_setup_png"),

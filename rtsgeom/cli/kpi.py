@@ -59,16 +59,20 @@ def summary(out: dict) -> str:
     worst = acc["worst_accuracy_deg"]
     lines = [f"{out['scene']}: datasheet",
              f"  field of view      {fov['azimuth_deg'][0]:.2f} .. {fov['azimuth_deg'][1]:.2f} "
-             f"deg ({fov['mode']}), gaps: {gaps}",
-             "  angle accuracy     " + ("-" if worst is None else
+             f"deg ({fov['mode']}), gaps: {gaps}"
+             + (", elevation {:.2f} .. {:.2f} deg".format(*fov["elevation_deg"])
+                if fov["cells"] else ""),
+             "  angle accuracy     " + (acc["note"] if worst is None else
                                         f"|error| + U (k = 2) worst {worst:.4f} deg; "
                                         f"{acc['gum_validation']}"),
              f"  range              {rv['min_range_m']:.3f} .. {rv['max_range_m']:.2f} m, "
              f"resolution {rv['range_resolution_m']:.4f} m, accuracy "
-             f"{_num(rv['range_accuracy_m'])} m on the scene's targets",
+             + ("- (no targets)" if rv["range_accuracy_m"] is None else
+                f"{rv['range_accuracy_m']:.4g} m on the scene's targets"),
              f"  velocity           +-{rv['max_velocity_mps']:.3f} m/s, resolution "
              f"{rv['velocity_resolution_mps']:.4f} m/s, accuracy "
-             f"{_num(rv['velocity_accuracy_mps'])} m/s",
+             + ("-" if rv["velocity_accuracy_mps"] is None else
+                f"{rv['velocity_accuracy_mps']:.4g} m/s"),
              f"  targets            {tg['per_channel']} per channel, {tg['total']} in total",
              f"  ghosts             strongest {gh['ghost_suppression_db']:.1f} dB below its "
              "target"]

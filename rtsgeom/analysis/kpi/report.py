@@ -96,8 +96,8 @@ def budget_figure(sheet) -> Figure:
             ax.bar(x, v ** 2, bottom=bottom, color=f"C{k}", label=name)
             bottom += v ** 2
         ax.plot(x, [p.combined_deg ** 2 for p in pts], "k.", label="u_c^2 (GUM)")
-        ax.plot(x, [(p.mc_half_width_deg / 2) ** 2 for p in pts], "x", color="C5",
-                label="(Monte Carlo half-width / 2)^2")
+        ax.plot(x, [(p.mc_half_width_deg / 1.96) ** 2 for p in pts], "x", color="C5",
+                label="(Monte Carlo half-width / 1.96)^2")
         step = max(1, len(pts) // 12)
         ax.set_xticks(x[::step], [f"{p.set_deg:.1f}" for p in pts][::step])
         ax.set_xlabel("set angle (deg)")
@@ -174,6 +174,7 @@ def nearfield_ghosts_figure(sheet) -> Figure:
                        label="spec ghost_suppression_db")
             bx.legend(fontsize=7)
         bx.set_ylim(gh["floor_db"], 5)
+        bx.set_xlim(left=0.0)
         bx.set_xlabel("range offset behind the target (m)")
         bx.set_ylabel("level relative to the target (dB)")
         bx.set_title("cable ghosts", parse_math=False)

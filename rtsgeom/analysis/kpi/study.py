@@ -117,7 +117,8 @@ class KpiStudy:
         run = None
         if scene.targets:
             from ...pipeline.run import run_scene  # the whole chain: only where there are targets
-            run = run_scene(scene)
+            say = None if progress is None else (lambda label, *_: progress(label, 0, 1))
+            run = run_scene(scene, progress=say, truth=False)
         step("range, velocity, targets, ghosts, near field")
         rv = range_velocity(setup, run)
         tg = targets_section(setup, run, fov)
