@@ -296,3 +296,13 @@ def test_bad_input_exits_2_naming_the_field(tmp_path, capsys):
     assert "angle_accuracy_deg = 0" in capsys.readouterr().err
     assert main(["kpi", str(DEFAULT_SCENE), "--sigma-mm", "0.1", "0.2", "--quiet"]) == 2
     assert "--sigma-mm" in capsys.readouterr().err
+
+
+def test_every_spec_key_is_documented():
+    from rtsgeom.analysis.kpi.spec import SPEC_SENSE
+    from rtsgeom.scene.schema import specs
+    page = (DEFAULT_SCENE.parents[1] / "docs" / "kpi.md").read_text()
+    keys = [s.key for _, s in specs(KpiSpec)]
+    assert keys == list(SPEC_SENSE)
+    for key in keys:
+        assert re.search(rf"^{key} = ", page, re.M), key
