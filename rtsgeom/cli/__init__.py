@@ -46,6 +46,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
                              "gain/phase/delay from probe captures"),
     "transfer": ("transfer", "calibration transfer: an RTS calibrated with one radar, tested "
                              "with drawn radars of the type"),
+    "resolution": ("resolution", "angular resolution test: two targets in one cell, the truth "
+                                 "twin beside the RTS over separation x phase"),
     "kpi": ("kpi", "the setup's datasheet: KPIs with an uncertainty budget, checked against a "
                    "spec"),
 }

@@ -45,8 +45,10 @@ def target_positions(setup: Setup, targets) -> np.ndarray:
         radar.yaw_rad).T
 
 
-def truth_echoes(setup: Setup, targets) -> Echoes:
-    """The echoes (T echoes x V virtual channels) of point targets at their set positions."""
+def truth_echoes(setup: Setup, targets, phase_rad=None) -> Echoes:
+    """The echoes (T echoes x V virtual channels) of point targets at their set positions;
+    ``phase_rad`` (T,), optional: an extra reflection phase per target (two real targets at
+    one range are in phase at the RuT's phase centre; a scatterer's own phase moves that)."""
     scene, rut = setup.scene, setup.rut
     radar = scene.radar
     t = list(targets)
@@ -62,6 +64,8 @@ def truth_echoes(setup: Setup, targets) -> Echoes:
         g_tx = pat.rut_tx.field(d_tx @ rut.rotation)  # (T, N_tx), radar frame
         g_rx = pat.rut_rx.field(d_rx @ rut.rotation)
         amp = amp * np.conj(g_tx[:, rut.virtual_tx] * g_rx[:, rut.virtual_rx])
+    if phase_rad is not None:
+        amp = amp * np.exp(-1j * np.asarray(phase_rad, float))[:, None]  # beat: conjugate
     tau = path / c
     vel = np.array([x.velocity_mps for x in t], float)
     t_mid = radar.adc_start_s + 0.5 * (radar.samples_per_chirp - 1) / radar.adc_rate_hz
@@ -71,7 +75,7 @@ def truth_echoes(setup: Setup, targets) -> Echoes:
 
 
 def simulate_truth(setup: Setup, targets, seed: int | None = None,
-                   noise_w: float | None = None) -> tuple[Echoes, AdcCube]:
+                   noise_w: float | None = None, phase_rad=None) -> tuple[Echoes, AdcCube]:
     """Echoes and ADC cube of the real targets (:func:`truth_echoes`).
 
     Parameters
@@ -85,13 +89,15 @@ def simulate_truth(setup: Setup, targets, seed: int | None = None,
     noise_w : float, optional
         Noise power per complex sample in the cube's units (the RTS frame's); None: the
         radar's thermal noise with ``[radar.link]``, else noiseless.
+    phase_rad : array_like, optional
+        An extra reflection phase per target (:func:`truth_echoes`).
 
     Returns
     -------
     echoes, cube
     """
     scene = setup.scene
-    echoes = truth_echoes(setup, targets)
+    echoes = truth_echoes(setup, targets, phase_rad)
     rng = np.random.default_rng(seed)
     if scene.radar.link is None:
         cube = synthesize(echoes, scene.radar, setup.rut)
