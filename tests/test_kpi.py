@@ -145,6 +145,16 @@ def test_a_met_spec_passes_and_tightening_one_kpi_fails_exactly_it(sheet):
         assert bad.margin < 0
 
 
+def test_a_kpi_without_a_value_is_reported_and_not_met(sheet):
+    """The paper's two front ends span 8.8 deg: two targets within it are not resolved at every
+    phase (the RuT's resolution is 17.5 deg), so a resolution spec has no value to meet."""
+    res = sheet.targets["resolution"]
+    assert res["rts_deg"] is None and "does not resolve" in res["note"]
+    asked = dataclasses.replace(sheet, spec=KpiSpec(resolution_deg=12.0))
+    (check,) = asked.checks
+    assert check.passed is None and check.note == res["note"] and asked.exit_code == 1
+
+
 def test_the_json_contract(sheet):
     d = json.loads(json.dumps(sheet.to_dict(), allow_nan=False))
     for entry in d["angle_accuracy"]:

@@ -73,7 +73,8 @@ def summary(out: dict) -> str:
              f"{rv['velocity_resolution_mps']:.4f} m/s, accuracy "
              + ("-" if rv["velocity_accuracy_mps"] is None else
                 f"{rv['velocity_accuracy_mps']:.4g} m/s"),
-             f"  targets            {tg['per_channel']} per channel, {tg['total']} in total",
+             f"  targets            {tg['per_channel']} per channel, {tg['total']} in total; "
+             + _resolution(tg["resolution"]),
              f"  ghosts             strongest {gh['ghost_suppression_db']:.1f} dB below its "
              "target"]
     if out["spec"]:
@@ -86,6 +87,14 @@ def summary(out: dict) -> str:
                          f"{_num(c['value'])}, limit {_num(c['limit'])}, margin "
                          f"{_num(c['margin'])}")
     return "\n".join(lines)
+
+
+def _resolution(res: dict) -> str:
+    if res.get("rts_deg") is None:
+        return "minimum separation: - (" + res["note"] + ")"
+    truth = res.get("truth_deg")
+    return (f"minimum separation {res['rts_deg']:g} deg on the RTS, "
+            f"{'-' if truth is None else f'{truth:g}'} deg on real targets")
 
 
 def _num(v) -> str:

@@ -20,6 +20,7 @@ from ...scene.rules import resolvable_limits
 from ...scene.sections import MAX_TARGETS
 from ..ghosts import ghost_analysis
 from ..nearfield import nearfield
+from ..resolution import ResolutionStudy
 
 __all__ = ["field_of_view", "uncovered_deg", "range_velocity", "targets_section",
            "ghosts_section", "nearfield_section", "resolution_section", "RESOLUTION_STEP_DEG",
@@ -212,14 +213,6 @@ def resolution_section(setup, progress=None) -> dict:
     truth twin's beside the RTS's, per relative phase (``analysis.resolution``) on a coarse
     grid (every :data:`RESOLUTION_STEP_DEG` up to what the arc reaches); ``rts_deg`` the
     RTS's worst over the phases (None where a phase is not resolved on the grid)."""
-    try:
-        from ..resolution import ResolutionStudy
-    except ModuleNotFoundError as exc:  # the study is not part of this version
-        if exc.name != f"{__package__.rsplit('.', 1)[0]}.resolution":
-            raise
-        return {"min_separation_deg": None, "rts_deg": None, "truth_deg": None,
-                "note": "the resolution study is not part of this version: no minimum "
-                        "resolvable separation"}
     geo = np.degrees(setup.fe_azimuth_rad())
     centre = 0.5 * (geo.min() + geo.max())
     reach = 2 * min(centre - geo.min(), geo.max() - centre) - 1.0
