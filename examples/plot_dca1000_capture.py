@@ -52,10 +52,24 @@ print("read", cube.shape, "[chirp loop, virtual channel, sample]")
 
 # %%
 # The same cube from the Python API, to int16 precision.
-ref = rtsgeom.run_scene(rtsgeom.load_scene(SCENE), aoa_mode="nearest").cube.to_xarray()
+run = rtsgeom.run_scene(rtsgeom.load_scene(SCENE), aoa_mode="nearest")
+ref = run.cube.to_xarray()
 err = np.max(np.abs(cube - ref.values)) * meta["scale"]
 print(f"largest difference {err:.2f} LSB")
 assert err <= 1.0
+
+# %%
+# The capture processed as the radar does, its detections assigned to the set-points by the
+# same association as ``run`` and ``play`` (one optimal assignment in resolution cells).
+from rtsgeom.pipeline.run import match_targets  # noqa: E402
+from rtsgeom.radar import AdcCube, process  # noqa: E402
+
+read_back = AdcCube(cube, run.cube.radar, run.cube.rut)
+rd, det = process(read_back)
+for m in match_targets(run.scene, det, rd, steering=read_back.steering):
+    d = m["detection"]
+    print(f"target {m['index']}: {m['status']}"
+          + ("" if d is None else f" at {d['range_m']:.3f} m, {d['angle_deg']:.3f} deg"))
 
 # %%
 # A range profile of virtual channel 0, summed over the chirps, with the range axis from the

@@ -90,6 +90,7 @@ _LAZY = {
     "ResolutionStudy": (".analysis.resolution", "ResolutionStudy"),
     "Resolution": (".analysis.resolution", "Resolution"),
     "RadarChannelsConfig": (".scene.channels", "RadarChannelsConfig"),
+    "identify": (".identify", None),  # the package, callable as identify(scene, captures)
     "Identification": (".identify", "Identification"),
     "play": (".api", "play"),
     "Playback": (".analysis.playback", "Playback"),
@@ -104,6 +105,7 @@ _LAZY = {
     # views
     "show": (".api", "show"),
     "render_setup_png": (".viz.scene3d", "render_setup_png"),
+    "export_setup": (".geometry.export", "export_setup"),
     "scene_info": (".pipeline.info", "scene_info"),
     # errors a user's input can cause (rtsgeom.errors lists them all)
     "RtsgeomError": (".errors", "RtsgeomError"),
@@ -126,7 +128,9 @@ def __getattr__(name: str):
         module, attr = _LAZY[name]
     except KeyError:
         raise AttributeError(f"module 'rtsgeom' has no attribute {name!r}") from None
-    value = getattr(importlib.import_module(module, __name__), attr)
+    value = importlib.import_module(module, __name__)
+    if attr is not None:
+        value = getattr(value, attr)
     globals()[name] = value  # later look-ups skip __getattr__
     return value
 

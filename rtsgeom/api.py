@@ -239,7 +239,7 @@ def tolerance(scene: Scene, pair=(0, 1), sigma_mm=(0.1, 0.1, 0.1), draws: int = 
     from .geometry import build_setup
     check_scene_arg(scene, "tolerance")
     from .geometry.setup import warn_setup_errors
-    warn_setup_errors(scene, "tolerance", stacklevel=3)  # NominalSetupWarning
+    warn_setup_errors(scene, "tolerance")  # NominalSetupWarning
     _study_args("tolerance", draws, seed, distribution, spec_deg, points)
     sigma = np.asarray(check_arg(sigma_mm, "sigma_mm", "vec", "tolerance", ParameterError,
                                  n=3, lo=0.0, hi=MAX_SIGMA_MM, unit="mm"), float) * 1e-3

@@ -79,3 +79,57 @@ def test_the_command_prints_the_library_warning_once(tmp_path, capsys):
     assert m, cap.out
     uncal, cal = float(m.group(1)), float(m.group(2))
     assert uncal > 0.1 and cal < 0.01  # 0.3 mm radial: ~0.5 deg until calibrated
+
+
+#: each command and the top-level function that does its job (a new command needs a line)
+COMMAND_FUNCTIONS = {
+    "info": "scene_info", "paths": "exact_paths", "export-mesh": "export_setup",
+    "run": "run_scene", "play": "play", "adc": "run_scene", "calibrate": "calibrate",
+    "linearity": "linearity", "tolerance": "tolerance", "design": "design",
+    "nearfield": "nearfield", "ghosts": "ghosts", "show": "show", "identify": "identify",
+    "transfer": "transfer",
+}
+
+
+def test_every_command_has_its_function_at_the_top_level():
+    """What each command does is importable from ``rtsgeom`` in a fresh interpreter, and
+    callable (``rtsgeom.identify`` raised AttributeError until the subpackage happened to be
+    imported; it is the package, callable as ``identify(scene, captures)``)."""
+    import subprocess
+    import sys
+
+    from rtsgeom.cli import COMMANDS
+    assert set(COMMAND_FUNCTIONS) == set(COMMANDS)
+    names = sorted(set(COMMAND_FUNCTIONS.values()))
+    assert set(names) <= set(rtsgeom.__all__)
+    code = ("import rtsgeom\n"
+            f"for n in {names!r}:\n"
+            "    assert callable(getattr(rtsgeom, n)), n\n"
+            "from rtsgeom.identify import identify, read_capture\n"
+            "assert rtsgeom.identify.read_capture is read_capture\n"
+            "import inspect\n"
+            "assert list(inspect.signature(identify).parameters)[:2] == ['scene', 'captures']\n")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr[-2000:]
+
+
+def test_the_package_called_is_its_entry_point(monkeypatch):
+    import rtsgeom.identify as package
+    monkeypatch.setattr(package, "identify", lambda *a, **k: ("called", a, k))
+    assert rtsgeom.identify("scene", ["cap"], accept_misfit=True) == (
+        "called", ("scene", ["cap"]), {"accept_misfit": True})
+
+
+@pytest.mark.parametrize("study, call", [
+    ("tolerance", lambda s: rtsgeom.tolerance(s, draws=20, points=5)),
+    ("design", lambda s: rtsgeom.design(s, [1.0], [8.0], draws=20, points=5)),
+    ("nearfield", lambda s: rtsgeom.nearfield(s, [1.0], points=3)),
+])
+def test_each_api_warning_points_at_the_callers_line(scene, study, call):
+    """Every warning the API raises names the caller's line, whatever the depth of the call
+    inside the package (``rtsgeom.design()``'s pointed at rtsgeom/api.py:285)."""
+    with pytest.warns(NominalSetupWarning, match=f"^{study} ") as caught:
+        call(_with_offset(scene))
+    ours = [w for w in caught if issubclass(w.category, NominalSetupWarning)]
+    assert len(ours) == 1 and ours[0].filename == __file__, [(w.filename, w.lineno)
+                                                             for w in ours]

@@ -292,3 +292,32 @@ def test_pose_errors_broadcast_and_match_a_posed_array():
 def test_bad_array_specs_name_the_field(kwargs, field):
     with pytest.raises(ValueError, match=field.replace(".", r"\.")):
         ArraySpec(**kwargs)
+
+
+def test_the_preset_list_and_info_say_how_many_tx_transmit():
+    """The awr2944 is a 4 Tx x 4 Rx board with 12 virtual elements: its elevated Tx is off
+    unless radar.use_elevation_tx (the list said "4 Tx x 4 Rx" only, info "12 virtual
+    elements"; only the 3D view's "Tx3 (off)" explained it)."""
+    import tomllib
+
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.pipeline.info import format_info, scene_info
+    from rtsgeom.scene import parse_scene
+    from rtsgeom.scene.presets import PRESETS
+    from conftest import DEFAULT_SCENE
+    assert PRESETS["awr2944"].doc.startswith(
+        "4 Tx x 4 Rx board: 12 virtual elements (3 Tx in TDM x 4 Rx), 16 with the 1 elevated Tx")
+    assert PRESETS["awr1843boost"].doc.startswith(
+        "3 Tx x 4 Rx board: 8 virtual elements (2 Tx in TDM x 4 Rx), 12 with the 1 elevated Tx")
+    for elevation, line in ((False, "RuT  awr2944: 4 Tx (Tx order [0, 1, 2]; Tx 3 off: "),
+                            (True, "RuT  awr2944: 4 Tx (Tx order [0, 1, 2, 3]), 4 Rx: 16 "
+                                   "virtual elements (4 Tx x 4 Rx; ")):
+        doc = tomllib.loads(DEFAULT_SCENE.read_text())
+        doc["radar"].update(antenna_preset="awr2944", use_elevation_tx=elevation)
+        doc["targets"] = doc["targets"][:1]
+        info = scene_info(build_setup(parse_scene(doc, "awr2944.toml")))
+        assert info["radar"]["num_tx"] == 4
+        text = format_info(info)
+        assert line in text, text.splitlines()[1]
+        if not elevation:
+            assert "4 Rx: 12 virtual elements (3 Tx x 4 Rx; 12 in azimuth)" in text

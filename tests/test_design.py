@@ -121,6 +121,24 @@ def test_cli(tmp_path, capsys):
     assert json.loads((tmp_path / "design.json").read_text()) == out
 
 
+def test_the_table_names_the_calibration_range_offset_and_the_map_is_the_tolerance(grid,
+                                                                                    capsys):
+    """The text table's offset column is the calibration's range offset (it read "offset mm",
+    taken for a mounting offset), its values under it; ``DesignGrid.plot()`` draws the
+    calibrated mounting tolerance (it drew worst_error_deg, about 1e-5 deg everywhere)."""
+    assert main(["design", str(DEFAULT_SCENE), "--radius-m", "1:2:2", "--spacing-deg", "8:8:1",
+                 "--draws", "100", "--points", "5", "--quiet"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    head = lines[1]
+    assert "cal range offset mm" in head and "offset mm" not in head.replace(
+        "cal range offset mm", "")
+    col = head.index("cal range offset mm") + len("cal range offset mm")
+    for row in lines[2:4]:  # right-aligned under the header
+        assert row[col - 1] != " " and row[col] == " "
+    title = grid.plot().axes[0].get_title()
+    assert METRICS["sigma_calibrated_mm"][1] in title, title
+
+
 @pytest.mark.parametrize("arg", ["2:1:3", "1:2", "1:2:x", "0:2:3", "1:2:1"])
 def test_cli_rejects_bad_grids(arg, capsys):
     with pytest.raises(SystemExit) as exc:
@@ -226,4 +244,6 @@ def test_a_valid_scene_whose_nominal_would_break_a_target_rule_is_still_designed
     d = evaluate_design(scene, (0, 1), 1.0, math.radians(8), draws=40, points=3)
     assert d["problem"] is None and math.isfinite(d["sigma_calibrated_mm"])
     arc_scene(scene, 1.0, np.radians([-8.0, 0.0, 8.0]))
-    assert nearfield(scene, [1.0], points=3).radius_m.size == 1
+    from rtsgeom.errors import NominalSetupWarning
+    with pytest.warns(NominalSetupWarning, match=r"radial_offset_mm\) play no part"):
+        assert nearfield(scene, [1.0], points=3).radius_m.size == 1

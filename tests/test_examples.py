@@ -32,6 +32,8 @@ OUTPUTS = {
     "plot_superposition.py": ["superposition.png"],
     "plot_calibration_transfer.py": ["calibration_transfer.png"],
     "plot_scenario_crossing.py": ["scenario_crossing.png"],
+    "plot_two_targets_resolution.py": ["two_targets_resolution.png"],
+    "plot_extended_object.py": ["extended_object.png"],
     "plot_kpi_datasheet.py": ["kpi_angle_accuracy.png", "kpi_uncertainty_budget.png"],
 }
 

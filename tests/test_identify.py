@@ -86,6 +86,34 @@ def test_identifiability_says_what_one_capture_cannot_separate():
             assert 0.5 < fe["residual_rms"] < 1.6
 
 
+def test_the_text_gives_each_reason_once_and_under_a_front_end_only_what_differs():
+    """Six front ends with the same four reasons (numbers differing) print each reason once,
+    not six times (about 60 lines for six captures); a reason of another kind is printed
+    under its own front end."""
+    from rtsgeom.cli.identify import _text
+    est = {"value": 0.1, "std": 0.01}
+
+    def fe(q, yaw_why):
+        return ({"index": q, "captures": 1, "residual_rms": 1.0, "radial_offset_mm": None,
+                 "tangential_offset_mm": est, "height_offset_mm": None, "yaw_offset_deg": None,
+                 "not_identifiable": {
+                     "radial_offset_mm": "inseparable from phase (|cos| 0.999999); at f_c",
+                     "height_offset_mm": "does not change the response at this bin",
+                     "yaw_offset_deg": yaw_why}},
+                {"delay_offset_s": None, "gain_db": est, "phase_deg": est,
+                 "not_identifiable": {"delay_offset_s": f"inseparable from phase (|cos| "
+                                                       f"0.99{q}); another RTS channel"}})
+    rows = [fe(q, f"Cramer-Rao std would be {900 + 20 * q:g} deg (limit 5 deg)")
+            for q in range(5)] + [fe(5, "a reason of another kind")]
+    text = _text({"front_ends": [a for a, _ in rows], "channels": [b for _, b in rows]})
+    for needle in ("at f_c", "at this bin", "another RTS channel", "Cramer-Rao"):
+        assert text.count(needle) == 1, text
+    lines = text.splitlines()
+    k = lines.index("front end 5 (1 capture(s), residual 1.00 x noise):")
+    assert lines[k + 8] == "  why not yaw_offset_deg: a reason of another kind"
+    assert text.count("another kind") == 1 and len(lines) == 6 * 8 + 1 + 1 + 4
+
+
 def test_free_parameters_on_constructed_fisher_matrices():
     """Two identical columns: one of them is fixed, the priority order decides which; a weak
     but separate column is fixed by the std limit; well-conditioned ones all stay."""
@@ -242,3 +270,15 @@ def test_from_identified_with_pair_all_says_what_to_give(capsys):
     scene = "scenes/diewald2022.toml"
     assert main(["calibrate", scene, "--pair", "all", "--from-identified", scene]) == 2
     assert "give --pair I J" in capsys.readouterr().err
+
+
+def test_the_page_simulates_the_captures_from_the_bench_as_built():
+    """docs/identify.md's commands capture from another scene than the one identified (the
+    same scene holds no error to find: front end 2's phase read +0.008 deg)."""
+    import re
+    from conftest import ROOT
+    text = (ROOT / "docs" / "identify.md").read_text()
+    block = re.search(r"```bash\n(.*?)```", text, re.S).group(1)
+    adc = {m.group(1) for m in re.finditer(r"rtsgeom adc (\S+) --active", block)}
+    ident = {m.group(1) for m in re.finditer(r"rtsgeom identify (\S+) ", block)}
+    assert adc and ident and not adc & ident, block

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from rtsgeom.synthesis import kernels
+from rtsgeom.synthesis.kernels import SAME_DESIGN_LN
 from rtsgeom.synthesis import pair as pair_design
 from rtsgeom.synthesis.pair import beam_derivatives, design_ratio, detected_bin_choice
 from rtsgeom.radar.steering import Steering
@@ -139,8 +140,12 @@ def _choice_loop(rho, ph, p_ii, p_jj, c_ij):
     agree = [k for k in order if fin[k] and det[k] == k]
     if agree:
         k = agree[0]
-        pw = np.sort(power[k])
-        return rho[k], k, True, pw[-1] / max(pw[-2], 1e-300)
+        same = [b == k or (fin[b] and abs(np.log(rho[b] / rho[k])) <= SAME_DESIGN_LN)
+                for b in range(n_k)]
+        if np.isnan(power[k]).any():
+            return rho[k], k, True, np.nan
+        others = [power[k, b] for b in range(n_k) if not same[b]]
+        return rho[k], k, True, (power[k, k] / max(max(others), 1e-300) if others else np.inf)
     k = det[n_k // 2]
     for _ in range(4):
         k = det[k]
@@ -152,6 +157,9 @@ def test_bin_choice_equals_the_rule(n_k):
     rng = np.random.default_rng(n_k)
     n = 3000
     rho = rng.uniform(-0.2, 2, (n, n_k))
+    # a third of the rows one design at every bin (within +-1.5 %: most bins equivalent)
+    same = rng.random(n) < 0.3
+    rho[same] = rho[same, n_k // 2, None] * (1 + rng.uniform(-0.015, 0.015, (same.sum(), n_k)))
     rho[rng.random((n, n_k)) < 0.15] = np.nan
     ph = rng.uniform(-np.pi, np.pi, (n, 1))
     p_ii, p_jj = rng.uniform(0, 1, (2, n, n_k)) ** 3
@@ -159,6 +167,7 @@ def test_bin_choice_equals_the_rule(n_k):
         1j * rng.uniform(-np.pi, np.pi, (n, n_k)))
     got = detected_bin_choice(rho, ph, p_ii, p_jj, c_ij)
     assert 0.05 < got[2].mean() < 0.999  # both branches taken
+    assert 0 < np.isinf(got[3]).sum() < got[2].sum()  # every other bin equivalent, or not
     for i in range(n):
         ref = _choice_loop(rho[i], np.full(n_k, ph[i, 0]), p_ii[i], p_jj[i], c_ij[i])
         assert got[1][i] == ref[1] and got[2][i] == ref[2]

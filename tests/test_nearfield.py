@@ -4,6 +4,7 @@ over arc radius, against closed forms."""
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -11,6 +12,7 @@ import pytest
 from rtsgeom.analysis.nearfield import default_radii, nearfield, with_arc_radius
 from rtsgeom.analysis.nearfield_terms import phase_error_deg
 from rtsgeom.cli import main
+from rtsgeom.errors import NominalSetupWarning
 from rtsgeom.geometry import build_setup
 from rtsgeom.geometry.farfield import curvature_phase_error_rad, fraunhofer_distance_m
 
@@ -166,10 +168,12 @@ def test_default_sweep_stops_at_the_radar_limit_and_ignores_targets_and_sheet():
     assert full[-1] > max_radius_m(scene)  # the unclipped sweep would leave the radar's range
     assert r[-1] == max_radius_m(scene) and np.all(np.diff(r) > 0)
     assert np.array_equal(r[:-1], full[full < max_radius_m(scene)])
-    nf = nearfield(scene, r[[0, -1]], points=3)
+    with pytest.warns(NominalSetupWarning, match=r"own errors \(rts.front_ends\[1\]"):
+        nf = nearfield(scene, r[[0, -1]], points=3)  # the scene's own yaw, left out
     assert np.all(np.isfinite(nf.bias_deg))
     assert abs(nf.bias_deg[-1]).max() < abs(nf.bias_deg[0]).max()  # ~1/R
-    with pytest.raises(Exception, match=r"must lie in \[0.05, 28.98\] m .*got 40 m"):
+    with pytest.raises(Exception, match=r"must lie in \[0.05, 28.98\] m .*got 40 m"), \
+            pytest.warns(NominalSetupWarning):
         nearfield(scene, np.array([1.0, 40.0]), points=3)
 
 
@@ -189,8 +193,11 @@ def test_the_scenes_own_errors_do_not_enter_the_near_field(section, key, value):
     not the synthesis's set-points: 0.5 deg of yaw read as 0.5 deg of "exact" synthesis
     error), and the CLI names the errors it leaves out."""
     clean, moved = scenes_with_and_without_error(DEFAULT_SCENE, section, key, value)
-    a, b = (nearfield(s, [0.7, 2.0], points=3).to_dict() for s in (clean, moved))
+    a = nearfield(clean, [0.7, 2.0], points=3).to_dict()
+    with pytest.warns(NominalSetupWarning, match=re.escape(key)) as caught:
+        b = nearfield(moved, [0.7, 2.0], points=3).to_dict()
     assert a == b
+    assert [w.filename for w in caught] == [__file__]  # at this line, not in the package
 
 
 def test_nearfield_cli_names_the_errors_it_leaves_out(tmp_path, capsys):

@@ -485,3 +485,45 @@ def test_a_swallowed_signal_still_ends_the_command_with_its_code(monkeypatch, ca
     assert cli.main(["info", str(DEFAULT_SCENE)]) == 143
     assert "rtsgeom: terminated" in capsys.readouterr().err
     assert _signals.received() == signal.SIGTERM
+
+
+class _SignalInFinalizer:
+    """Sends ``sig`` from its __del__: the handler defers the exception (a finalizer cannot
+    take it) and raises it about 20 ms later, wherever the command then is."""
+
+    def __init__(self, sig):
+        self.sig = sig
+
+    def __del__(self):
+        os.kill(os.getpid(), self.sig)
+
+
+@pytest.mark.parametrize("sig, exc", [(signal.SIGTERM, Terminated),
+                                      (signal.SIGINT, KeyboardInterrupt)])
+@pytest.mark.parametrize("how", ["swallowed", "deferred"])
+def test_a_signal_between_the_last_write_and_the_swap_keeps_the_old_folder(tmp_path, sig, exc,
+                                                                          how):
+    """The window between a command's last write and the folder exchange: a signal whose
+    exception something swallowed, or one still deferred (it arrived in a finalizer and is
+    raised ~20 ms later), used to let the staged run, possibly cut short, replace the old
+    folder. The received signal is checked immediately before the exchange: the old folder
+    stays whole and the signal's exception ends the command."""
+    from rtsgeom.cli._common import output_folder
+    from rtsgeom.cli._signals import honoured_signals
+    out = tmp_path / "out"
+    _old_folder(out)
+    with pytest.raises(exc):
+        with honoured_signals():
+            with output_folder(out) as stage:
+                (stage / "detections.csv").write_text("new, cut short")  # the last write
+                if how == "swallowed":
+                    try:
+                        os.kill(os.getpid(), sig)
+                        _wait_for_the_signal()
+                    except exc:  # e.g. "Exception ignored in ..."
+                        pass
+                else:
+                    _SignalInFinalizer(sig)  # collected at once: the signal is deferred
+            _wait_for_the_signal()  # (not reached where the swap was refused)
+    _assert_old(out)
+    _no_leftovers(tmp_path)

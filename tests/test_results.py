@@ -152,6 +152,14 @@ def _datasheet():
                      {"ghost_suppression_db": 26.0}, {}, spec=KpiSpec(targets=4))
 
 
+def _object_design():
+    from rtsgeom.analysis.object_design import ObjectDesign, ObjectDesignResult
+    st = ObjectDesign(ranges_m=(5.0, 10.0, 20.0), spacings_deg=(8.0, 16.0), budgets=(None, 2))
+    share = np.linspace(0.4, 1.0, 12).reshape(2, 2, 3)
+    return ObjectDesignResult(st, "unit", "targets[0]", np.array([9, 5]), share,
+                              0.1 * share, 4 + 0 * share, 5 + 0 * share, 4 + 0 * share)
+
+
 @pytest.fixture(scope="module")
 def results(scene, tolerance_pair):
     from rtsgeom.analysis.ghosts import ghost_analysis
@@ -162,8 +170,24 @@ def results(scene, tolerance_pair):
             "Identification": _identification(scene),
             "Identification with radar": _joint_identification(scene),
             "Transfer": _transfer(), "PlaybackResult": _playback(scene),
-            "Datasheet": _datasheet(),
-            "RunResult": rtsgeom.run_scene(scene, aoa_mode="nearest")}
+            "ObjectDesignResult": _object_design(), "Datasheet": _datasheet(),
+            "RunResult": rtsgeom.run_scene(scene, aoa_mode="nearest"),
+            "Resolution": _resolution()}
+
+
+def _resolution():
+    from rtsgeom.analysis.resolution import Resolution, ResolutionStudy
+    seps = np.repeat(np.arange(10.0, 30.0, 0.5), 4)
+    n = seps.size
+    table = {"separation_deg": seps, "phase_deg": np.tile([0.0, 0.0, 180.0, 180.0], n // 4),
+             "source": np.tile(["truth", "rts"], n // 2), "resolved": seps > 20,
+             "angle_1_deg": np.where(seps > 20, -seps / 2, np.nan),
+             "angle_2_deg": np.where(seps > 20, seps / 2, np.nan)}
+    grid = np.linspace(-60, 60, 121)
+    spectra = {"angle_deg": grid, "separation_deg": np.array([12.0, 24.0]),
+               "truth": [-np.abs(grid) / 3] * 2, "rts": [-np.abs(grid) / 2] * 2}
+    return Resolution("bench", ResolutionStudy(phases_deg=(0.0, 180.0)), 20.0, 0.0, table,
+                      spectra)
 
 
 def _result_classes() -> set[str]:

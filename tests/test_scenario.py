@@ -169,6 +169,24 @@ def test_a_crossing_plays_on_the_straight_line_within_the_spec(crossing):
                   < scene.radar.velocity_resolution_mps)
 
 
+def test_the_track_keeps_its_range_where_two_bins_carry_nearly_equal_power(crossing):
+    """The crossing's frames at 0.6 s and 1.4 s sit midway between two range bins (margin 1.1
+    over the neighbour): the pair's design is the same at both bins, so the planner keeps J at
+    its calibrated delay instead of moving it by one IF period (one range bin), which put the
+    detected range 73 and 42 mm off. summary.json carries the range and velocity errors."""
+    scene, res = crossing
+    s = res.summary()
+    r_err = np.abs(res.detected["range_m"] - res.set["range_m"])
+    v_err = np.abs(res.detected["velocity_mps"] - res.set["velocity_mps"])
+    assert s["range_error_m"]["max"] == pytest.approx(r_err.max(), rel=1e-12)
+    assert s["range_error_m"]["p95"] == pytest.approx(np.percentile(r_err, 95), rel=1e-12)
+    assert s["velocity_error_mps"]["max"] == pytest.approx(v_err.max(), rel=1e-12)
+    assert s["targets"][0]["range_error_m"]["max"] == s["range_error_m"]["max"]
+    assert s["range_error_m"]["max"] < 0.01, r_err.ravel()  # a bin is 150 mm
+    assert s["velocity_error_mps"]["max"] < 0.05 * scene.radar.velocity_resolution_mps
+    assert set(s["baseline"]) >= {"range_error_m", "velocity_error_mps"}
+
+
 def test_the_programme_carries_each_target_on_two_adjacent_channels(crossing):
     """Per frame two adjacent channels at the target's delay (2 R / c0 less the arc, plus
     the channel's calibrated offset) and Doppler 2 f_c v / c0."""
@@ -202,6 +220,26 @@ def test_the_switched_baseline_shows_its_staircase(crossing):
     worst = base.summary()["angle_error_deg"]["max"]
     assert 0.3 * 8.0 < worst < 0.7 * 8.0
     assert base.summary()["handover_jump_deg"] > 0.5 * 8.0
+
+
+def test_the_switched_baseline_keeps_a_target_midway_between_two_front_ends():
+    """A target at the exact midpoint of two front ends (4 deg between 0 and 8 deg) whose set
+    azimuth rounds to 4 deg +- 1 ulp frame by frame stays on one front end: no hand-over
+    (``argmin`` alternated: 8 hand-overs and 8-deg jumps). Over a grid of midpoints and
+    roundings the tie goes to the lower index; a front end nearer by 1e-6 rad wins."""
+    from rtsgeom.rts.channels import nearest_front_ends
+    doc = crossing_doc(duration_s=2.0, frame_period_s=0.1)
+    doc["scenario"]["targets"][0]["waypoints"] = [[0.0, 35.0, 4.0], [5.0, 15.0, 4.0]]
+    res = rtsgeom.Playback(amplitudes="nearest")(scene_of(doc))
+    assert res.summary()["handovers"] == 0
+    assert {c for c in res.channels.ravel()} == {(2,)}
+    az = np.radians(np.arange(-16.0, 16.1, 8.0))
+    for k in range(az.size - 1):
+        mid = 0.5 * (az[k] + az[k + 1])
+        a = mid + np.arange(-8, 9) * np.spacing(mid)  # roundings of the midpoint
+        np.testing.assert_array_equal(nearest_front_ends(az, a), k)
+        assert nearest_front_ends(az, mid + 1e-6)[0] == k + 1
+        assert nearest_front_ends(az, mid - 1e-6)[0] == k
 
 
 def test_a_static_scenario_reproduces_run():

@@ -162,3 +162,38 @@ def test_every_error_is_one_the_cli_reports():
     errs = [c for c in classes if issubclass(c, Exception) and not issubclass(c, Warning)]
     assert errs and all(issubclass(c, errors.RtsgeomError) for c in errs)
     assert not issubclass(errors.Terminated, errors.RtsgeomError)
+
+
+def _user_docs() -> list[Path]:
+    return [*(ROOT / "docs").glob("*.md"), ROOT / "README.md"]
+
+
+def test_the_user_docs_say_what_is():
+    """docs/*.md and the README describe the current state; the history, with its before and
+    after numbers, is CHANGELOG.md's ("The calibration used to fit ..." was history)."""
+    rx = re.compile(r"(?<!\bis )(?<!\bare )(?<!\bbe )\bused to\b")
+    hits = [f"{p.relative_to(ROOT)}:{k}" for p in _user_docs()
+            for k, line in enumerate(p.read_text().splitlines(), 1) if rx.search(line)]
+    assert not hits, hits
+
+
+def test_the_docs_run_the_tests_with_the_checkouts_interpreter():
+    """Every pytest command in the docs is the README's (``.venv/bin/python -m pytest``), not a
+    bare ``python3``, which is another interpreter without the package's dependencies."""
+    rx = re.compile(r"(^|[\s;&|(])python3? -m pytest")
+    hits = [f"{p.relative_to(ROOT)}:{k}" for p in _user_docs()
+            for k, line in enumerate(p.read_text().splitlines(), 1) if rx.search(line)]
+    assert not hits, hits
+
+
+def test_running_the_examples_from_a_checkout_leaves_git_status_clean():
+    """The examples write into ``example_output/`` of the working folder; run from the
+    checkout's root or from ``examples/``, git ignores it."""
+    import shutil
+    import subprocess
+    if shutil.which("git") is None or not (ROOT / ".git").exists():
+        pytest.skip("not a git checkout")
+    for where in ("example_output/calibration_sweep.png",
+                  "examples/example_output/calibration_sweep.png"):
+        r = subprocess.run(["git", "check-ignore", "-q", where], cwd=ROOT)
+        assert r.returncode == 0, f"{where} is not ignored"

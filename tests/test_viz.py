@@ -201,7 +201,8 @@ def _figures():
         "range_angle": F.range_angle_figure(ra, r, a, detections=[[33.5, 7.2]],
                                             set_points=[[33.5, 7.0]]),
         "calibration": F.calibration_sweep_figure(tau, np.abs(np.sin(np.pi * (tau - 2e-10) / 1e-9)),
-                                                  2e-10, period_s=1e-9),
+                                                  2e-10, period_s=1e-9,
+                                                  residual_error_deg=0.001),
         "linearity": F.linearity_figure(s, {"paper": s + 0.2 * np.sin(s), "exact": s + 0.01},
                                         {"paper": np.stack([-(s - 3.4), -(12.2 - s)]),
                                          "exact": np.stack([-(s - 3.4), -(12.2 - s)]) / 2}),
@@ -276,7 +277,8 @@ def test_calibration_figure_shows_the_residual_of_the_json_and_no_empty_legend_e
         assert _legend_entries_without_artist(fig) == []
     # a sweep over two periods draws the repeat lines, and then lists them
     tau = np.arange(-1.2e-9, 1.2e-9 + 1e-15, 50e-12)
-    fig = F.calibration_sweep_figure(tau, np.abs(np.sin(np.pi * tau / 1e-9)), 0.0, 1e-9)
+    fig = F.calibration_sweep_figure(tau, np.abs(np.sin(np.pi * tau / 1e-9)), 0.0, 1e-9,
+                                     residual_error_deg=None)
     labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
     assert any("periods" in lab for lab in labels)
     assert _legend_entries_without_artist(fig) == []

@@ -273,7 +273,7 @@ def glob_escape(text: str) -> str:
 
 
 @contextmanager
-def staged_dir(path, inputs: Iterable = ()) -> Iterator[Path]:
+def staged_dir(path, inputs: Iterable = (), before_swap=None) -> Iterator[Path]:
     """The one way a command writes an output folder: one run or nothing.
 
     Checks ``path`` (:func:`check_output_dir`), takes the folder's lock (another run holding it
@@ -282,6 +282,11 @@ def staged_dir(path, inputs: Iterable = ()) -> Iterator[Path]:
     staging folder replaces ``path`` as a whole (atomically where the kernel can exchange two
     paths); on any exception (KeyboardInterrupt, the CLI's SIGTERM included) it is removed and
     ``path`` stays as it was. Enter it before computing, so that a bad path fails at once.
+
+    ``before_swap``: called immediately before the swap, after the block's last write; it
+    raises to keep the old folder (the CLI's: a signal the command received, whose exception
+    something swallowed or has not raised yet, so that the staged run, possibly cut short, is
+    never swapped in).
     """
     target = check_output_dir(path, inputs)
     target.parent.mkdir(parents=True, exist_ok=True)
@@ -298,6 +303,8 @@ def staged_dir(path, inputs: Iterable = ()) -> Iterator[Path]:
             os.chmod(stage, mode)
             (stage / MARKER).write_bytes(b"")
             yield stage
+            if before_swap is not None:
+                before_swap()
             if not target.exists():
                 os.rename(stage, target)
             elif _exchange(stage, target):

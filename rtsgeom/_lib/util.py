@@ -78,3 +78,20 @@ def tones(freq_hz: np.ndarray, t0_s: float, dt_s: float, n: int) -> np.ndarray:
     inner = np.exp(2j * np.pi * f * (np.arange(block) * dt_s))
     out = outer[..., :, None] * inner[..., None, :]
     return out.reshape(out.shape[:-2] + (-1,))[..., :n]
+
+
+_PACKAGE_DIR = str(__import__("pathlib").Path(__file__).resolve().parents[1])
+
+
+def warn_caller(message: str, category: type[Warning]) -> None:
+    """``warnings.warn`` attributed to the first frame outside the rtsgeom package: the
+    user's line that called the API, however deep inside the package the warning is raised
+    (a fixed ``stacklevel`` pointed ``rtsgeom.design()``'s warning at ``rtsgeom/api.py``).
+    Python 3.12's ``skip_file_prefixes`` does this; 3.11 needs the walk."""
+    import os
+    import warnings
+    level, f = 2, sys._getframe(1)  # stacklevel 2: warn_caller's caller
+    while f is not None and os.path.abspath(f.f_code.co_filename).startswith(
+            _PACKAGE_DIR + os.sep):
+        f, level = f.f_back, level + 1
+    warnings.warn(message, category, stacklevel=level)

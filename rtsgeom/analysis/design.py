@@ -294,9 +294,11 @@ class DesignGrid(Result):
         cols["exceeds_resolution"] = np.ravel(self.exceeds_resolution)
         return cols
 
-    def plot(self, metric: str = "worst_error_deg"):
+    def plot(self, metric: str = "sigma_calibrated_mm"):
         """One metric's map over (radius, spacing) (lines when one of them is a single value);
-        the title names the scene, the pair, the spec and the yield."""
+        the title names the scene, the pair, the spec and the yield. By default the map a
+        designer reads: the calibrated mounting tolerance for the spec (``worst_error_deg``
+        is the exact synthesis's residual, about 1e-5 deg everywhere)."""
         from ..viz.figures import design_heatmap_figure, design_lines_figure
         if metric not in METRICS:
             raise ParameterError(f"metric {metric!r}: one of {', '.join(METRICS)}")

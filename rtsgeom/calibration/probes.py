@@ -15,13 +15,12 @@ phase slopes that turn a measured phase into a delay (eqs. 8 and 27).
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.constants import c
 
-from .._lib.util import one_blas_thread
+from .._lib.util import one_blas_thread, warn_caller
 from ..geometry import Setup
 from ..geometry.farfield import two_way_lengths
 from ..paths import Paths, nominal_model
@@ -169,11 +168,10 @@ def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe
             ang[q], pw[q] = det.angle_rad[k], det.power_db[k]
     missed = [q for q in range(n) if not np.isfinite(ang[q])]
     if missed:  # not silently: its angle is NaN and its gain correction falls back to 1
-        warnings.warn(f"front end(s) {missed} not detected alone at the probe range(s) "
+        warn_caller(f"front end(s) {missed} not detected alone at the probe range(s) "
                       f"{np.round(ranges[missed], 3).tolist()} m (below the CFAR threshold or "
                       "beyond the range axis): their measured angle is NaN and their gain "
-                      "correction 1" + clipping_note(n_clip),
-                      RuntimeWarning, stacklevel=2)
+                    "correction 1" + clipping_note(n_clip), RuntimeWarning)
     meas = 10 ** (pw / 10) / amps ** 2
     corr = np.sqrt(model_p / meas)
     return FrontEndProbe(ang, pw, np.where(np.isfinite(corr), corr, 1.0), n_clip)

@@ -48,6 +48,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
                              "with drawn radars of the type"),
     "resolution": ("resolution", "angular resolution test: two targets in one cell, the truth "
                                  "twin beside the RTS over separation x phase"),
+    "objects": ("objects", "extended object: the smallest front-end arc and per-channel "
+                           "budget that reproduce it over its ranges"),
     "kpi": ("kpi", "the setup's datasheet: KPIs with an uncertainty budget, checked against a "
                    "spec"),
 }

@@ -22,6 +22,7 @@ from pathlib import Path
 
 from .._lib.io import check_output_file, staged_dir, write_json
 from ..errors import ParameterError, UsageError
+from ._signals import raise_received
 
 __all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checked", "steps",
            "output_path", "output_file_path", "output_folder", "output_file",
@@ -73,7 +74,8 @@ def output_folder(out, inputs=()):
     if out is None:
         yield None
         return
-    with staged_dir(out, [i for i in inputs if i is not None]) as stage:
+    with staged_dir(out, [i for i in inputs if i is not None],
+                    before_swap=raise_received) as stage:
         yield stage
 
 

@@ -24,19 +24,20 @@ def detections_csv(result: RunResult) -> str:
     """One row per detection, sorted by range then velocity; the last column ``label`` says
     what the simulation put there (:func:`rtsgeom.pipeline.run.label_detections`); ``elevation_deg``
     (0 for an azimuth-only array) sits after ``snr_db``, so the earlier columns keep their
-    places."""
+    places; ``angle_peak`` after ``label``: the direction's rank among its cell's angle peaks
+    (0 the strongest; ``[radar] angle_peaks_max``)."""
     det = result.detections
     labels = label_detections(result)
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(["range_m", "velocity_mps", "angle_deg", "power_db", "snr_db", "elevation_deg",
-                "label"])
+                "label", "angle_peak"])
     order = np.lexsort((det.velocity_mps, det.range_m))
     el = det.elevation_deg
     for i in order:
         w.writerow([f"{det.range_m[i]:.4f}", f"{det.velocity_mps[i]:.4f}",
                     f"{det.angle_deg[i]:.4f}", f"{det.power_db[i]:.2f}", f"{det.snr_db[i]:.2f}",
-                    f"{el[i]:.4f}", labels[i]])
+                    f"{el[i]:.4f}", labels[i], int(det.peak_rank[i])])
     return buf.getvalue()
 
 
@@ -153,7 +154,8 @@ def _calibration_figures(result: RunResult) -> list[bytes]:
             refine_delta_tau_s=[p["delta_tau_s"] for p in rf],
             refine_error_deg=[np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
                               for p in rf],
-            title=f"Phase coherency calibration, front ends {cal['pair'][0]}-{cal['pair'][1]}")
+            title=f"{result.scene.name}: phase coherency calibration, front ends "
+                  f"{cal['pair'][0]}-{cal['pair'][1]}")
         out.append(figure_png(fig))
     return out
 

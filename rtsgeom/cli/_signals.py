@@ -18,7 +18,7 @@ from contextlib import contextmanager
 
 from ..errors import Terminated
 
-__all__ = ["honoured_signals", "received"]
+__all__ = ["honoured_signals", "received", "raise_received"]
 
 _RETRY_S = 0.02
 _received: list[int] = []  # the signals of this command, first one first
@@ -27,6 +27,15 @@ _received: list[int] = []  # the signals of this command, first one first
 def received() -> int | None:
     """The first signal received inside :func:`honoured_signals`, or None."""
     return _received[0] if _received else None
+
+
+def raise_received() -> None:
+    """Raise the first signal received inside :func:`honoured_signals` (:class:`Terminated`,
+    :class:`KeyboardInterrupt`), if any: what an output folder checks immediately before it
+    is swapped in (a signal whose exception was swallowed, or is still deferred, must not let
+    a run it cut short replace the old folder)."""
+    if _received:
+        _raise(_received[0])
 
 
 #: code that C calls back into, where an exception is printed and dropped ("Exception ignored

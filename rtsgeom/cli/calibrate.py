@@ -95,12 +95,7 @@ def _calibrate(args, stage) -> int:
                                                 ranges=cal.probe_ranges_m)
 
     def figure():
-        from ..viz.figures import calibration_sweep_figure
-        return calibration_sweep_figure(cal.sweep_delta_tau_s, cal.sweep_error_deg,
-                                        cal.delta_tau_s, cal.period_s,
-                                        residual_error_deg=cal.residual_error_deg,
-                                        refine_delta_tau_s=cal.refine_delta_tau_s,
-                                        refine_error_deg=cal.refine_error_deg)
+        return cal.plot(sweep_title(scene, pair))
     emit_result(args, stage, "calibration_sweep.png", "calibration", out, figure,
                 f"pair {pair}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps (set in "
                 f"{cal.delay_resolution_s * 1e12:g} ps steps; the fit's optimum "
@@ -142,10 +137,9 @@ def _calibrate_arc(args, folder) -> int:
                    "max_abs_range_offset_mm": max(abs(c.range_offset_m) for c in cals) * 1e3},
            "format": "rtsgeom-calibration", "setup_sha256": setup_fingerprint(scene)}
     if folder is not None:
-        from ..viz.figures import calibration_sweep_figure, save_figure
+        from ..viz.figures import save_figure
         for pair, cal in zip(pairs, cals):
-            save_figure(calibration_sweep_figure(cal.sweep_delta_tau_s, cal.sweep_error_deg,
-                                                 cal.delta_tau_s, cal.period_s),
+            save_figure(cal.plot(sweep_title(scene, pair)),
                         folder / f"calibration_sweep_{pair[0]}_{pair[1]}.png")
         write_json(folder / "calibration.json", out)
     if args.json:
@@ -158,6 +152,12 @@ def _calibrate_arc(args, folder) -> int:
     print(f"{where} ({len(pairs)} pairs): worst residual {res[worst]:.4f} deg (pair "
           f"{tuple(out['arc']['worst_pair'])})")
     return 0
+
+
+def sweep_title(scene, pair) -> str:
+    """The calibration figure's title: the scene and the pair (every pair's figure of
+    ``--pair all`` says which it is)."""
+    return f"{scene.name}: phase coherency calibration, front ends {pair[0]}-{pair[1]}"
 
 
 def register(sub) -> None:

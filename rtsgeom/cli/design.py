@@ -100,7 +100,8 @@ def _design(args, scene, stage) -> int:
     print(f"pair {pair}, centre {grid.centre_deg:.2f} deg, angular resolution "
           f"{grid.angular_resolution_deg:.2f} deg; tolerance: {100 * grid.target_yield:g} % "
           f"within {grid.spec_deg:g} deg ({grid.draws} draws)")
-    print(f"{'R_c m':>6} {'sp deg':>7} {'worst deg':>10} {'bias deg':>9} {'offset mm':>10} "
+    print(f"{'R_c m':>6} {'sp deg':>7} {'worst deg':>10} {'bias deg':>9} "
+          f"{'cal range offset mm':>19} "
           f"{'sigma cal mm':>13} {'sigma unc mm':>13}  note")
     for d in out["designs"]:
         def f(key, fmt):  # "-" in the column's width where there is no value
@@ -109,7 +110,7 @@ def _design(args, scene, stage) -> int:
             ([] if d["sheet"] == "kept" else [f"sheet {d['sheet']}"])
             + (["> resolution"] if d["exceeds_resolution"] else []))
         print(f"{d['radius_m']:6.3g} {d['spacing_deg']:7.3g} {f('worst_error_deg', '10.4f')} "
-              f"{f('near_field_bias_deg', '9.4f')} {f('range_offset_mm', '10.2f')} "
+              f"{f('near_field_bias_deg', '9.4f')} {f('range_offset_mm', '19.2f')} "
               f"{f('sigma_calibrated_mm', '13.4f')} {f('sigma_uncalibrated_mm', '13.4f')}  "
               f"{note}")
     if sheet_note:

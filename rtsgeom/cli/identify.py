@@ -5,6 +5,7 @@ gain, phase and delay) from probe captures (``rtsgeom adc --active I``) with
 from __future__ import annotations
 
 import json
+import re
 import sys
 from pathlib import Path
 
@@ -14,12 +15,31 @@ from ..identify.fit import RESIDUAL_LIMIT
 from ._common import load_scene_checked, output_folder, output_path, print_json, scene_arg, steps
 
 
+def _whys(fe: dict, ch: dict) -> list[tuple[str, str]]:
+    """A front end's and its channel's (parameter, why not identifiable)."""
+    return list(fe["not_identifiable"].items()) + list(ch["not_identifiable"].items())
+
+
+def _kind(why: str) -> str:
+    """A reason with its numbers taken out: two front ends' reasons of one kind (a Cramer-Rao
+    std of 989 and 1e+03 deg) are one paragraph."""
+    return re.sub(r"[-+]?\d[\d.]*(e[-+]?\d+)?", "#", why)
+
+
 def _text(d: dict) -> str:
+    """The human summary: per front end its estimates, "not identifiable" where fixed; the
+    reasons once for all front ends (the first front end's wording), and under a front end
+    only a reason of another kind than that one (the four paragraphs were repeated under
+    every front end: about 60 lines for six captures)."""
     lines = []
 
     def val(x, unit, digits=4):
         return "not identifiable" if x is None else f"{x['value']:+.{digits}f} +- {x['std']:.{digits}f} {unit}"
 
+    common: dict = {}  # key -> (its reason's kind, the reason, the front end it is from)
+    for fe, ch in zip(d["front_ends"], d["channels"]):
+        for key, why in _whys(fe, ch):
+            common.setdefault(key, (_kind(why), why, fe["index"]))
     for fe, ch in zip(d["front_ends"], d["channels"]):
         lines.append(f"front end {fe['index']} ({fe['captures']} capture(s), residual "
                      f"{fe['residual_rms']:.2f} x noise{', MISFIT' if fe.get('misfit') else ''}):")
@@ -31,8 +51,14 @@ def _text(d: dict) -> str:
                         f"{ch['delay_offset_s']['value']:+.4g} +- {ch['delay_offset_s']['std']:.2g} s"))
         lines.append(f"  {'channel gain_db':22s} {val(ch['gain_db'], 'dB')}")
         lines.append(f"  {'channel phase_deg':22s} {val(ch['phase_deg'], 'deg', 3)}")
-        for key, why in list(fe["not_identifiable"].items()) + list(ch["not_identifiable"].items()):
-            lines.append(f"  why not {key}: {why}")
+        for key, why in _whys(fe, ch):
+            if _kind(why) != common[key][0]:  # only what differs from the shared reason
+                lines.append(f"  why not {key}: {why}")
+    if common:
+        lines.append("why not identifiable (for every front end above; the numbers are the "
+                     "named front end's, each one's with --json):")
+        for key, (_, why, q) in common.items():
+            lines.append(f"  {key} (front end {q}): {why}")
     r = d.get("radar_channels")
     if r is not None:
         ref = r["references"]

@@ -6,6 +6,7 @@ from __future__ import annotations
 import sys
 
 from ..geometry import build_setup
+from ..pipeline.cells import shared_cell_warnings
 from ..pipeline.info import format_info, scene_info, unreachable_warnings
 from ..radar.budget import static_budget
 from ._common import load_scene_checked, print_json, scene_arg
@@ -15,7 +16,9 @@ def cmd_info(args) -> int:
     setup = build_setup(load_scene_checked(args.scene))
     info = scene_info(setup, reachable=True)
     info["link_budget"] = static_budget(setup).to_dict()
-    for w in unreachable_warnings(info, skip_outside_geometric=True):  # those: validate's
+    info["shared_cells"] = shared_cell_warnings(setup, setup.scene.targets)
+    for w in (unreachable_warnings(info, skip_outside_geometric=True)  # others: validate's
+              + info["shared_cells"]):
         print(f"rtsgeom: warning: {args.scene}: {w}", file=sys.stderr)
     if args.json:
         print_json(info)

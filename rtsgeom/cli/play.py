@@ -38,6 +38,10 @@ def cmd_play(args) -> int:
         (stage / "summary.json").write_text(
             json.dumps(summary, indent=2, allow_nan=False) + "\n", encoding="utf-8")
         save_figure(result.plot(), stage / "playback.png")
+        if result.clouds is not None:  # extended objects: clouds.csv, objects.json/png
+            from ..analysis.objects import play_objects
+            from .run import write_objects
+            write_objects(stage, scene, *play_objects(result))
         if args.gif:
             step("writing playback.gif")
             result.animate(stage / "playback.gif")

@@ -70,7 +70,8 @@ def cmd_resolution(args) -> int:
 
 def register(sub) -> None:
     p = sub.add_parser("resolution", help="angular resolution test: two targets in one cell, "
-                                          "the truth twin beside the RTS")
+                                          "the truth twin beside the RTS over separation x "
+                                          "phase")
     scene_arg(p)
     p.add_argument("--out", type=str, default=None, help="output folder (resolution.csv, "
                    "summary.json, resolution.png)")

@@ -39,6 +39,9 @@ def cmd_run(args) -> int:
         (stage / "summary.json").write_text(
             json.dumps(summary(result, args.paths), indent=2, allow_nan=False) + "\n",
             encoding="utf-8")
+        if scene.objects:  # extended objects: what the radar sees of them, truth and RTS
+            from ..analysis.objects import run_objects
+            write_objects(stage, scene, *run_objects(result))
         ds = map_dataset(result)
         maps = render_maps(result, ds)
         for name, data in {**maps, **maps_arrays(ds, args.maps)}.items():
@@ -59,6 +62,15 @@ def cmd_run(args) -> int:
               + ", ".join(f"maps.{f}" for f in args.maps) + ("" if args.no_report else ", report.html"))
     return 0
 
+
+def write_objects(stage, scene, rows, section: dict) -> None:
+    """clouds.csv, objects.json and objects.png of a scene with extended objects."""
+    from ..analysis.objects import clouds_csv, objects_figure
+    from ..viz.figures import save_figure
+    (stage / "clouds.csv").write_text(clouds_csv(rows), encoding="utf-8")
+    (stage / "objects.json").write_text(json.dumps(section, indent=2, allow_nan=False) + "\n",
+                                        encoding="utf-8")
+    save_figure(objects_figure(scene, rows, section), stage / "objects.png")
 
 
 def target_line(m: dict) -> str:

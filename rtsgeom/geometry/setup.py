@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import TYPE_CHECKING
@@ -16,6 +15,7 @@ from .arrays import RutArray, rut_array
 from .sheet import sheet_mesh
 from ..scene import FrontEndConfig, RadarConfig
 from ..scene.schema import specs
+from .._lib.util import warn_caller
 from ..errors import NominalSetupWarning
 
 if TYPE_CHECKING:  # trimesh loads where the mesh is built (geometry.sheet)
@@ -98,16 +98,16 @@ DRAWS_REPLACE = ("draws mounting errors about the nominal setup; the scene's own
                  "the flag, calibrated), in Python rtsgeom.linearity(scene, calibration=False)")
 
 
-def warn_setup_errors(scene: Scene, study: str, what: str = DRAWS_REPLACE,
-                      stacklevel: int = 3) -> list[str]:
-    """Warn (:class:`~rtsgeom.errors.NominalSetupWarning`) that ``study`` works on the
-    nominal setup when the scene carries errors of its own (:func:`setup_errors`; ``what``:
-    the sentence after the study's name, ``{}`` the fields); return those fields."""
+def warn_setup_errors(scene: Scene, study: str, what: str = DRAWS_REPLACE) -> list[str]:
+    """Warn (:class:`~rtsgeom.errors.NominalSetupWarning`, at the caller's line outside the
+    package: ``_lib.util.warn_caller``) that ``study`` works on the nominal setup when the
+    scene carries errors of its own (:func:`setup_errors`; ``what``: the sentence after the
+    study's name, ``{}`` the fields); return those fields."""
     fields = setup_errors(scene)
     if fields:
         more = f" and {len(fields) - 3} more" if len(fields) > 3 else ""
-        warnings.warn(f"{study} " + what.format(", ".join(fields[:3]) + more),
-                      NominalSetupWarning, stacklevel=stacklevel)
+        warn_caller(f"{study} " + what.format(", ".join(fields[:3]) + more),
+                    NominalSetupWarning)
     return fields
 
 

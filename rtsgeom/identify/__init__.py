@@ -38,6 +38,9 @@ arc radius). Everything is importable from ``rtsgeom.identify``.
 
 from __future__ import annotations
 
+import sys
+import types
+
 from .capture import Capture, capture_probe, read_capture, simulate_capture, write_capture
 from .built import (PredictedCalibration, calibrate_from_identified, detected_angles,
                     identified_scene, identified_scene_toml, predicted_calibration, setup_of)
@@ -47,6 +50,20 @@ from .fit import (ESTIMATE_LIMITS, MIN_EIGENVALUE, RESIDUAL_LIMIT, SEPARATE_BY, 
 from .identification import Identification, identify
 from .joint import GAUGES, JointModel, RadarChannelsFit, identify_joint, joint_cramer_rao
 from .model import PARAMS, ProbeModel, measure
+
+
+class _Package(types.ModuleType):
+    """This package, callable as its entry point: ``rtsgeom.identify(scene, captures)`` is
+    :func:`identify` (the name of the command and of the function), while
+    ``rtsgeom.identify.read_capture`` and ``from rtsgeom.identify import ...`` stay the
+    package's. (A plain function of that name at the top level would be shadowed by the
+    package as soon as it is imported.)"""
+
+    def __call__(self, *args, **kwargs):
+        return identify(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _Package
 
 __all__ = ["PARAMS", "Capture", "ProbeModel", "FrontEndFit", "Identification", "capture_probe",
            "simulate_capture", "write_capture", "read_capture", "measure", "fisher",

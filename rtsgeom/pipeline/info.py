@@ -129,6 +129,7 @@ def scene_info(setup: Setup, reachable: bool = False) -> dict:
             "f_c_hz": r.f_c_hz, "bandwidth_hz": r.bandwidth_hz,
             "f_center_hz": r.f_center_hz, "wavelength_m": rut.wavelength_m,
             "slope_hz_per_s": r.slope_hz_per_s,
+            "num_tx": int(len(rut.tx_local)),
             "tx_order": list(rut.tx_order), "num_rx": rut.num_rx,
             "num_virtual": rut.num_virtual,
             "num_virtual_azimuth": int(np.count_nonzero(rut.azimuth_mask)),
@@ -232,13 +233,22 @@ def _virtual_array(rut) -> dict:
     }
 
 
+def _tx_line(r: dict) -> str:
+    """The board's Tx and which transmit: "4 Tx (Tx order [0, 1, 2]; Tx 3 off: ...)", so the
+    virtual element count (the Tx in the order times the Rx) reads against the board's."""
+    off = [t for t in range(r["num_tx"]) if t not in r["tx_order"]]
+    note = (f"; Tx {', '.join(map(str, off))} off: not in the TDM order, a preset's elevated "
+            "Tx transmits with radar.use_elevation_tx = true" if off else "")
+    return f"{r['num_tx']} Tx (Tx order {r['tx_order']}{note})"
+
+
 def format_info(info: dict) -> str:
     r, ff, rts = info["radar"], info["far_field"], info["rts"]
     lines = [
         f"scene {info['scene']}  ({info['source']})",
-        f"RuT  {r['antenna_preset']}: Tx order {r['tx_order']}, {r['num_rx']} Rx, "
-        f"{r['num_virtual']} virtual elements ({r['num_virtual_azimuth']} in azimuth) at "
-        f"{r['element_spacing_m'] * 1e3:.3f} mm",
+        f"RuT  {r['antenna_preset']}: {_tx_line(r)}, {r['num_rx']} Rx: "
+        f"{r['num_virtual']} virtual elements ({len(r['tx_order'])} Tx x {r['num_rx']} Rx; "
+        f"{r['num_virtual_azimuth']} in azimuth) at {r['element_spacing_m'] * 1e3:.3f} mm",
         f"     f_c {r['f_c_hz'] / 1e9:.3f} GHz, B {r['bandwidth_hz'] / 1e9:.3f} GHz, "
         f"lambda {r['wavelength_m'] * 1e3:.3f} mm at {r['f_center_hz'] / 1e9:.3f} GHz",
         f"     range resolution {r['range_resolution_m']:.4f} m, max range "

@@ -29,6 +29,7 @@ from ..radar.steering import Steering
 from ..rts.channels import RtsProgram, requested_delay
 from ..synthesis.cells import enclosing_cell
 from ..synthesis.model import ChannelModel, target_direction
+from .merge import budget_targets
 from .pair import plan_pair, residual_warning
 
 __all__ = ["bracketing_pair", "check_pair", "measured_pairs", "uses_cells", "target_cells",
@@ -131,6 +132,11 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
     """
     scene = setup.scene
     if uses_cells(scene):
+        if scene.rts.max_targets_per_channel is not None:
+            raise SceneError(f"{scene.source}: rts.max_targets_per_channel = "
+                             f"{scene.rts.max_targets_per_channel}: must be left out for "
+                             "front ends on a sphere or targets in elevation (the budget "
+                             "merges targets on an arc's pairs)")
         if calibration is not None:
             raise SceneError(f"{scene.source}: --calibration: a calibration file holds pair "
                              "calibrations; front ends on a sphere are calibrated per channel "
@@ -151,15 +157,21 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
     warnings = []
     if calibration is not None and (mismatch := calibration_mismatch(calibration, scene)):
         warnings.append(mismatch)
-    pairs, notes = target_pairs(setup, probe, scene.targets)
+    targets, budget = scene.targets, None
+    if scene.rts.max_targets_per_channel is not None:  # dynamic resolution (.merge)
+        budget = budget_targets(setup, scene.targets, probe, bracketing_pair)
+        targets = budget.targets
+    pairs, notes = target_pairs(setup, probe, targets)
     warnings += notes
     cals = (calibrate_pairs(setup, paths, sorted(set(pairs)), probe,
                             loaded if calibration is not None else None, progress)
             if calibrate else {})
     offsets = channel_offsets(setup.fe.count, cals)
-    program, realised, notes = program_pairs(setup, paths, mode, scene.targets, pairs, probe,
+    program, realised, notes = program_pairs(setup, paths, mode, targets, pairs, probe,
                                              cals, offsets)
     warnings += notes
+    if budget is not None:
+        program = lead_program(program, budget)
     record = {
         "mode": mode,
         "source": "file" if calibration is not None else "measured",
@@ -169,7 +181,16 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
         "pairs": [cal.to_dict() for cal in cals.values()],
         "targets": realised,  # each target's J delay as realised (PairPlan.to_dict)
     }
+    if budget is not None:
+        record["budget"] = budget.to_dict()
     return program, record, warnings
+
+
+def lead_program(program: RtsProgram, budget) -> RtsProgram:
+    """A budgeted programme's rows labelled with the scene's target each synthesized target
+    stands for (its strongest member, :meth:`~.merge.Budgeted.lead`)."""
+    return RtsProgram.build(budget.lead()[program.target], program.front_end, program.delay_s,
+                            program.doppler_hz, program.amplitude)
 
 
 def target_pairs(setup: Setup, probe, targets, where: str = "targets"

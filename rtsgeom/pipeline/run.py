@@ -29,6 +29,7 @@ from ..scene.schema import check_arg
 from ..radar.budget import link_budget, link_warnings, sheet_paths
 from ..radar.link import radar_link
 from ..rts.channels import EchoKind, setup_echoes
+from .cells import shared_cell_warnings
 from .info import scene_info
 from .plan import plan_targets
 
@@ -291,6 +292,7 @@ def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = 
     else:
         program, calibration, warnings = plan_targets(setup, paths, mode, progress=progress,
                                                        calibration=cal_file)
+    warnings = list(warnings) + shared_cell_warnings(setup, scene.targets)
     echoes, cube = simulate(setup, paths, program, scene.seed, scene.radar.snr_db)
     rd, det = process(cube)
     matches = match_targets(scene, det, rd, steering=cube.steering)

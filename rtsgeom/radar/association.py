@@ -24,7 +24,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 __all__ = ["Association", "associate", "STATUSES"]
 
@@ -69,6 +68,8 @@ def associate(targets: np.ndarray, detections: np.ndarray, scale, gate: float = 
     -------
     Association
     """
+    # here: scipy.optimize costs `rtsgeom run --help` 0.3 s of imports it does not need
+    from scipy.optimize import linear_sum_assignment
     t = np.asarray(targets, float).reshape(-1, np.size(scale))
     d = np.asarray(detections, float).reshape(-1, np.size(scale))
     scale = np.asarray(scale, float)

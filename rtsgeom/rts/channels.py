@@ -29,8 +29,8 @@ from ..scene import Scene
 from .fir import fir_if_gain, realised_delay
 
 __all__ = ["RtsProgram", "EchoKind", "Echoes", "target_amplitude", "requested_delay",
-           "channel_echoes", "setup_echoes", "cable_ghosts", "program_nearest", "build_echoes",
-           "nominal_link_gain"]
+           "channel_echoes", "setup_echoes", "cable_ghosts", "program_nearest",
+           "nearest_front_ends", "NEAREST_TIE_RAD", "build_echoes", "nominal_link_gain"]
 
 
 class EchoKind(IntEnum):
@@ -208,13 +208,32 @@ def requested_delay(scene: Scene, range_m) -> np.ndarray:
     return tau
 
 
+#: front ends whose angular distances to a target differ by less than this are equally near
+#: (rad, about 6e-8 deg: far above the rounding of a set angle, 1e-16 rad, far below any
+#: spacing); of them the lowest index carries the target
+NEAREST_TIE_RAD = 1e-9
+
+
+def nearest_front_ends(fe_azimuth_rad, angle_rad) -> np.ndarray:
+    """Index of the front end nearest each set angle ``angle_rad`` (T,) among
+    ``fe_azimuth_rad`` (F,), deterministic at a tie: distances within
+    :data:`NEAREST_TIE_RAD` of the smallest count as equal and the lowest index wins, so a
+    target midway between two front ends stays on one of them whatever its angle's rounding
+    (``argmin`` alternated between them frame by frame: 8-deg jumps at no change of the
+    target), and a drive hands over only where another front end is nearer by more."""
+    d = np.abs(np.asarray(fe_azimuth_rad, float)[None, :]
+               - np.atleast_1d(np.asarray(angle_rad, float))[:, None])  # (T, F)
+    return np.argmax(d <= d.min(axis=1, keepdims=True) + NEAREST_TIE_RAD, axis=1)
+
+
 def program_nearest(scene: Scene, setup: Setup) -> RtsProgram:
-    """Each target on the single front end nearest its set angle (no AoA synthesis)."""
+    """Each target on the single front end nearest its set angle (no AoA synthesis; a tie
+    to the lower index, :func:`nearest_front_ends`)."""
     if not scene.targets:
         return RtsProgram.build([], [], [], [], [])
     az = setup.fe_azimuth_rad()
     tg = scene.targets
-    fe = np.array([int(np.argmin(np.abs(az - t.angle_rad))) for t in tg])
+    fe = nearest_front_ends(az, [t.angle_rad for t in tg])
     rng = np.array([t.range_m for t in tg])
     rcs = np.array([t.rcs_m2 for t in tg])
     vel = np.array([t.velocity_mps for t in tg])

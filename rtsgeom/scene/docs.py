@@ -18,6 +18,7 @@ from pathlib import Path
 
 from . import file, registry, rules, scene, sections
 from .schema import REQUIRED, Derived, Spec, rows_text, specs
+from .objects import MAX_MESH_BYTES, MAX_MESH_FACETS, MAX_MESH_SCATTERERS
 
 __all__ = ["render", "DOC_PATH"]
 
@@ -137,7 +138,10 @@ def render() -> str:
             f"({rules.MAX_ADC_SAMPLES * 8 / 2**20:.0f} MiB per cube; the run's peak "
             "memory is about 2 GiB at this limit)",
             f"- calibration sweep: at most {rules.MAX_CALIBRATION_STEPS} steps",
-            f"- front ends: at most {sections.MAX_FRONT_ENDS}; targets: at most {sections.MAX_TARGETS}",
+            f"- front ends: at most {sections.MAX_FRONT_ENDS}; targets: at most {sections.MAX_TARGETS}"
+            " (an object's scatterers count, each one point target); scatterers of one object: at "
+            f"most {sections.MAX_SCATTERERS}; a `mesh`: at most {MAX_MESH_FACETS} facets in "
+            f"{MAX_MESH_BYTES >> 20} MiB, reduced to at most {MAX_MESH_SCATTERERS} scatterers",
             "- `[[structure]] mesh`: a relative path inside the scene's folder (no absolute "
             "path, no `..`, no link out of it) unless the loader is called with "
             "`allow_external_meshes=True`", ""]

@@ -20,7 +20,7 @@ from ..errors import ParameterError, SceneError
 from .schema import fmt as _fmt
 
 __all__ = ["MAX_SCENE_BYTES", "MAX_KEY_PARTS", "MAX_KEY_CHARS", "decode_toml", "read_scene_bytes",
-           "resolve_meshes"]
+           "resolve_meshes", "resolve_mesh"]
 
 MAX_SCENE_BYTES = 4 << 20  # size of a scene file
 MAX_KEY_PARTS = 16  # dotted parts of one TOML key (tomllib is quadratic in them)
@@ -103,28 +103,36 @@ def resolve_meshes(structures, source: str, base_dir: Path | None,
 
     A path outside the folder is refused before the file system is asked anything, so the
     error cannot reveal whether some file elsewhere exists."""
-    base = (base_dir or Path.cwd())
     out = []
     for i, st in enumerate(structures):
-        rel, where = st.mesh, f"structure[{i}].mesh"
-        p = Path(rel)
-        if not allow_external_meshes:
-            if p.is_absolute() or ".." in p.parts or "\0" in rel:
-                raise SceneError(f"{source}: {where} = {_fmt(rel)}: must be a relative path "
-                                 "inside the scene's folder (no absolute path, no '..'; "
-                                 "pass allow_external_meshes to load one from elsewhere)")
-        if not p.is_absolute():
-            p = base / p
-        try:
-            exists = p.is_file()
-            inside = allow_external_meshes or p.resolve().is_relative_to(base.resolve())
-        except (OSError, ValueError, RuntimeError):  # a name too long, a symlink loop
-            exists = inside = False
-        if not inside:
-            raise SceneError(f"{source}: {where} = {_fmt(rel)}: must be a file inside the "
-                             "scene's folder (a link leads out of it)")
-        if not exists:
-            raise SceneError(f"{source}: {where} = {_fmt(rel)}: must be an existing mesh file "
-                             f"in the scene's folder (resolved to {_fmt(str(p))})")
-        out.append((str(p), st.material, float(st.reflection_loss_db)))
+        p = resolve_mesh(st.mesh, f"structure[{i}].mesh", source, base_dir,
+                         allow_external_meshes)
+        out.append((p, st.material, float(st.reflection_loss_db)))
     return tuple(out)
+
+
+def resolve_mesh(rel: str, where: str, source: str, base_dir: Path | None,
+                 allow_external_meshes: bool) -> str:
+    """One mesh path (the field ``where``), resolved against the scene's folder and (unless
+    allowed) kept inside it."""
+    base = (base_dir or Path.cwd())
+    p = Path(rel)
+    if not allow_external_meshes:
+        if p.is_absolute() or ".." in p.parts or "\0" in rel:
+            raise SceneError(f"{source}: {where} = {_fmt(rel)}: must be a relative path "
+                             "inside the scene's folder (no absolute path, no '..'; "
+                             "pass allow_external_meshes to load one from elsewhere)")
+    if not p.is_absolute():
+        p = base / p
+    try:
+        exists = p.is_file()
+        inside = allow_external_meshes or p.resolve().is_relative_to(base.resolve())
+    except (OSError, ValueError, RuntimeError):  # a name too long, a symlink loop
+        exists = inside = False
+    if not inside:
+        raise SceneError(f"{source}: {where} = {_fmt(rel)}: must be a file inside the "
+                         "scene's folder (a link leads out of it)")
+    if not exists:
+        raise SceneError(f"{source}: {where} = {_fmt(rel)}: must be an existing mesh file "
+                         f"in the scene's folder (resolved to {_fmt(str(p))})")
+    return str(p)

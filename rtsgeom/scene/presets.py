@@ -171,7 +171,12 @@ class ArrayPreset:
     def doc(self) -> str:
         """One line for registries and generated docs."""
         n_tx, n_rx = len(self.tx_units), len(self.rx_units)
-        return f"{n_tx} Tx x {n_rx} Rx ({self.source.split(';')[0]})"
+        n_az, n_all = len(self.tx_order), len(self.tx_order_elevation)
+        virtual = f"{n_az * n_rx} virtual elements ({n_az} Tx in TDM x {n_rx} Rx)"
+        if n_all > n_az:
+            virtual += (f", {n_all * n_rx} with the {n_all - n_az} elevated Tx "
+                        "(radar.use_elevation_tx = true)")
+        return f"{n_tx} Tx x {n_rx} Rx board: {virtual} ({self.source.split(';')[0]})"
 
     @property
     def num_rx(self) -> int:

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .schema import Evolvable, spec
+from .sections import HEADING_DOC, MAX_SCATTERERS, SCATTERER_COLUMNS
 
 __all__ = ["ScenarioTargetConfig", "ScenarioConfig", "SetPoints", "trajectory", "frame_times",
            "check_scenario", "MAX_FRAMES", "MAX_WAYPOINTS"]
@@ -42,6 +43,21 @@ class ScenarioTargetConfig(Evolvable):
         max_items=MAX_WAYPOINTS)
     rcs_dbsm: float = spec("rcs_dbsm", "float", "radar cross-section", 10.0, unit="dBsm",
                            lo=-100.0, hi=100.0)
+    scatterers: tuple[tuple[float, float, float, float], ...] | None = spec(
+        "scatterers", "rows", "an extended object: [x_m, y_m, z_m, rcs_dbsm] per scatterer in "
+        "its own frame (x right, y away from the RuT, z up, at heading 0), placed at the "
+        "waypoints' position each frame (docs/objects.md)", None, n=4,
+        columns=SCATTERER_COLUMNS, min_items=1, max_items=MAX_SCATTERERS)
+    mesh: str | None = spec(
+        "mesh", "str", "an extended object from a mesh file (relative to the scene's folder), "
+        "its scatterers derived from the facets facing the RuT at the first frame, then moving "
+        "with it", None,
+        max_chars=1000)
+    heading: str = spec("heading", "str", "how the object is turned: fixed (heading_deg) or "
+                        "velocity (along its motion on the segment)", "fixed",
+                        choices=("fixed", "velocity"))
+    heading_rad: float = spec("heading_deg", "float", HEADING_DOC + " (heading = fixed)", 0.0,
+                              unit="deg", lo=-180.0, hi=180.0, scale=_DEG)
 
     @property
     def rcs_m2(self) -> float:

@@ -14,6 +14,7 @@ import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
+from .objects import expand_objects, object_paths
 from .file import decode_toml, read_scene_bytes, resolve_meshes
 from .hardware import check_layout_keys, resolve_pattern_tables
 from .rules import problems
@@ -51,6 +52,9 @@ class Scene(Evolvable):
     scenario: ScenarioConfig | None = spec(
         "scenario", "table", "[scenario] moving targets played frame by frame (`rtsgeom play`)",
         None, cls=ScenarioConfig)
+    #: the extended objects (``scatterers`` or ``mesh`` entries; :mod:`.objects`), their
+    #: static ones expanded into ``targets`` on load
+    objects: tuple = ()
 
     def evolve(self, **changes) -> "Scene":
         """``dataclasses.replace`` that validates the variant again (fields and rules)."""
@@ -80,6 +84,7 @@ def parse_scene(data: dict, source: str = "<scene>", base_dir: Path | None = Non
     meshes = resolve_meshes(scene.extra_meshes, source, base_dir, allow_external_meshes)
     scene = dataclasses.replace(scene, extra_meshes=meshes)
     scene = resolve_pattern_tables(scene, source, base_dir)
+    scene = expand_objects(scene, object_paths(scene, source, base_dir, allow_external_meshes))
     found = problems(scene)
     if found:
         raise SceneError(found[0], found)

@@ -33,6 +33,12 @@ __all__ = ["RadarChannelsConfig", "RadarConfig", "CfarConfig", "FrontEndConfig",
 MAX_NAME_CHARS = 200  # ``name`` (printed, may end up in file names)
 MAX_FRONT_ENDS = 256
 MAX_TARGETS = 1024
+MAX_SCATTERERS = 256  # scatterers of one object (an entry's ``scatterers``, a mesh's reduction)
+HEADING_DOC = ("the object's heading about the vertical in the sense of azimuth (+y towards "
+                "+x), from the RuT's boresight")
+#: an object's scatterer row in its own frame (x right, y away from the RuT, z up, heading 0)
+SCATTERER_COLUMNS = (("x_m", "m", -50.0, 50.0, 1.0), ("y_m", "m", -50.0, 50.0, 1.0),
+                     ("z_m", "m", -50.0, 50.0, 1.0), ("rcs_dbsm", "dBsm", -100.0, 100.0, 1.0))
 _DEG = math.pi / 180.0  # x * _DEG == math.radians(x), bit for bit
 
 
@@ -323,6 +329,12 @@ class RtsConfig(Evolvable):
         (-0.5, 1.0), n=2, unit="ns", lo=-1e3, hi=1e3, scale=1e-9)
     calibration_step_s: float = spec("calibration_step_ps", "float", "step of the calibration "
                                      "sweep", 25.0, unit="ps", lo=0.001, hi=1e4, scale=1e-12)
+    max_targets_per_channel: int | None = spec(
+        "max_targets_per_channel", "int", "targets one channel (front end) can synthesize at "
+        "once; unset = no limit. Under a budget the planner merges the targets the RuT cannot "
+        "resolve (one range-Doppler cell, within its angular resolution) into one, as the "
+        "truth twin sees their coherent sum, then drops the weakest (docs/objects.md)", None,
+        unit="", lo=1, hi=MAX_TARGETS)
     allow_wide_spacing: bool = spec(
         "allow_wide_spacing", "bool", "force synthesis modes with targets between front ends "
         "wider apart than the RuT's angular resolution (paper eq. 24 violated)", False)
@@ -401,6 +413,22 @@ class TargetConfig(Evolvable):
     elevation_rad: float = spec("elevation_deg", "float", "elevation seen from the RuT (needs "
                                 "front ends at elevations and a RuT with elevation)", 0.0,
                                 unit="deg", lo=-60.0, hi=60.0, scale=_DEG)
+    # -- an extended object: many scatterers placed at the entry's range and azimuth -----------
+    scatterers: tuple[tuple[float, float, float, float], ...] | None = spec(
+        "scatterers", "rows", "an extended object: [x_m, y_m, z_m, rcs_dbsm] per scatterer in "
+        "its own frame (x right, y away from the RuT, z up, at heading 0), placed at this "
+        "entry's range and azimuth and turned by heading_deg; the entry's rcs_dbsm is then "
+        "unused (docs/objects.md)", None, n=4, columns=SCATTERER_COLUMNS, min_items=1,
+        max_items=MAX_SCATTERERS)
+    mesh: str | None = spec(
+        "mesh", "str", "an extended object from a mesh file (any format trimesh reads, metres, "
+        "in the object's frame; relative to the scene's folder): its facets facing the RuT, "
+        "each one's physical-optics return, merged to the radar's resolution", None,
+        max_chars=1000)
+    heading_rad: float = spec("heading_deg", "float", HEADING_DOC, 0.0, unit="deg",
+                              lo=-180.0, hi=180.0, scale=_DEG)
+    #: the extended object (index into ``Scene.objects``) this point belongs to; -1: none
+    object_index: int = -1
 
     @property
     def rcs_m2(self) -> float:

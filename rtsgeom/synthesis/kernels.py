@@ -15,7 +15,13 @@ from numba import njit
 
 from .._lib.jit import JIT
 
-__all__ = ["ratio_one", "ratios", "choice_row", "bin_choice_rows", "argmax_row"]
+__all__ = ["ratio_one", "ratios", "choice_row", "bin_choice_rows", "argmax_row",
+           "SAME_DESIGN_LN"]
+
+#: design ratios of two bins this close (|ln(rho_b / rho_k)|, 1 %) are one design: the RuT
+#: detecting either reports the set angle to about 0.03 deg on an 8 deg pair (d alpha / d ln
+#: rho is about a quarter of the span)
+SAME_DESIGN_LN = 0.01
 
 
 # -- the pair's design for the bin the RuT detects (synthesis.pair, the tolerance model's) ------
@@ -95,7 +101,12 @@ def choice_row(rho, co, si, p_ii, p_jj, c_re, c_im, power, det):
     not exist detects nothing); design k's detected bin the strongest; of the designs
     detected at their own bin the one nearest the middle (ties to the lower bin); where none
     is, the fixed point of "design at the reported bin" from the middle bin (4 steps).
-    margin: the detected bin's power over the next strongest (1 where not consistent)."""
+    margin: the detected bin's power over the strongest other bin whose own design differs
+    from the chosen one (1 where not consistent): a bin whose design ratio is within
+    ``SAME_DESIGN_LN`` of the chosen (``|ln(rho_b / rho_k)|``) is the same programme's design
+    there, so detecting it instead reports the same angle and is no ambiguity (a target
+    midway between two bins with I and J coherent at both: margin 1.1 over an equivalent bin
+    while every other bin is 11 dB down); inf where every other bin is equivalent."""
     n_k = rho.size
     mid = n_k // 2
     best, best_rank = 0, 4 * n_k
@@ -117,18 +128,20 @@ def choice_row(rho, co, si, p_ii, p_jj, c_re, c_im, power, det):
         for _ in range(4):
             k = det[k]
     margin = 1.0
-    if consistent:  # the largest over the second largest (numpy's sort: NaN last)
-        m1 = m2 = -np.inf
+    if consistent:  # the detected bin's power over the strongest bin of another design
+        m1 = power[k, k]
+        m2 = -np.inf
         for kb in range(n_k):
             p = power[k, kb]
             if p != p:
                 m1 = np.nan
                 break
-            if p > m1:
-                m1, m2 = p, m1
-            elif p > m2:
+            if kb == k or (math.isfinite(rho[kb]) and rho[kb] > 0
+                           and abs(math.log(rho[kb] / rho[k])) <= SAME_DESIGN_LN):
+                continue
+            if p > m2:
                 m2 = p
-        margin = m1 / max(m2, 1e-300)
+        margin = m1 / max(m2, 1e-300) if m2 > -np.inf else np.inf
     return rho[k], k, consistent, margin
 
 

@@ -181,15 +181,16 @@ def range_angle_figure(power_db, range_m, angle_deg, detections=None, set_points
 
 @_styled
 def calibration_sweep_figure(delta_tau_s, angle_error_deg, chosen_delta_tau_s: float,
-                             period_s: float | None = None, title: str = "",
-                             residual_error_deg: float | None = None,
+                             period_s: float | None = None, title: str = "", *,
+                             residual_error_deg: float | None,
                              refine_delta_tau_s=None, refine_error_deg=None) -> Figure:
     """Phase-coherency calibration: angle error (deg) over the swept RTS delay offset (ns).
 
-    The chosen offset is marked at ``residual_error_deg`` (the calibration's own residual, as
-    in its JSON; it comes from the refinement around the sweep's best grid point, drawn when
-    ``refine_delta_tau_s`` and ``refine_error_deg`` are given). Without it the marker sits on
-    the sweep, interpolated, and says so. With ``period_s`` (the phase period
+    The chosen offset is marked at ``residual_error_deg``, the calibration's one residual (as
+    in its JSON and on stdout; it comes from the refinement around the sweep's best grid
+    point, drawn when ``refine_delta_tau_s`` and ``refine_error_deg`` are given); None (the
+    chain detected no probe there) draws the chosen offset's line without a value. With
+    ``period_s`` (the phase period
     1/(f_rts + B/2), eq. 27) the offsets whole periods away, where the same minimum repeats,
     are marked where they fall inside the sweep.
     """
@@ -220,13 +221,14 @@ def calibration_sweep_figure(delta_tau_s, angle_error_deg, chosen_delta_tau_s: f
         for n, x in enumerate(chosen_ns + p_ns * k):  # the legend entry only with a line
             ax.axvline(x, color="C2", linestyle=":", linewidth=1.2,
                        label=f"chosen + k periods ({p_ns:.4f} ns)" if n == 0 else None)
-    if residual_error_deg is not None:
-        y_chosen, how = float(residual_error_deg), "residual"
+    if residual_error_deg is not None and np.isfinite(residual_error_deg):
+        y = float(residual_error_deg)
+        ax.axvline(chosen_ns, color="C3", linestyle="--", linewidth=1.2)
+        ax.plot([chosen_ns], [y], marker="o", markersize=7, color="C3", linestyle="none",
+                label=f"chosen: {chosen_ns * 1e3:.1f} ps (residual {y:.4f} deg)")
     else:
-        y_chosen, how = float(np.interp(chosen_ns, t_ns, err)), "sweep, interpolated"
-    ax.axvline(chosen_ns, color="C3", linestyle="--", linewidth=1.2)
-    ax.plot([chosen_ns], [y_chosen], marker="o", markersize=7, color="C3", linestyle="none",
-            label=f"chosen: {chosen_ns * 1e3:.1f} ps ({how} {y_chosen:.4f} deg)")
+        ax.axvline(chosen_ns, color="C3", linestyle="--", linewidth=1.2,
+                   label=f"chosen: {chosen_ns * 1e3:.1f} ps (residual not measured)")
     ax.set_xlabel("RTS delay offset $\\Delta\\tau_{rts}$ (ns)")
     ax.set_ylabel("angle error (deg)")
     _title(ax, title or "Phase coherency calibration")

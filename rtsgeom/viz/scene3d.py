@@ -33,7 +33,8 @@ from .meshes import (ARC, BACKGROUND, LOS, MODULE, PANEL_BACKGROUND, REFLECTION_
                      cutout_rims, merge, merge_lines, modules, path_polylines, polyline, rgb,
                      rut_scale_factor, scaled, spheres, split_paths, target_positions,
                      undrawable_reflections)
-from ..errors import VizError
+from .._lib.util import warn_caller
+from ..errors import RtsgeomWarning, VizError
 from .render_backend import ensure_render_backend
 
 __all__ = ["VizError", "ensure_render_backend", "build_plotter", "render_setup_png",
@@ -278,10 +279,9 @@ def build_plotter(setup: Setup, paths=None, window_size=(1600, 1000), off_screen
         note += f"; paths: {table.method} ({len(table) - n_refl} direct, {n_refl} reflected)"
         missing = undrawable_reflections(paths)
         if missing:
-            import warnings
             msg = (f"{missing} of {n_refl} reflected paths carry no hit points and are not "
                    "drawn (pass the ray-tracing result, paths.raytrace.trace(setup))")
-            warnings.warn(msg, stacklevel=2)
+            warn_caller(msg, RtsgeomWarning)
             note += f"; {missing} reflected paths not drawn (no hit points)"
     pl.add_text(note, position="lower_left", font_size=9, color="#333333")
     pl.add_legend(legend, bcolor="white", background_opacity=0.8, border=True,

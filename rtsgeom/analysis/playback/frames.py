@@ -17,14 +17,17 @@ import numpy as np
 from ...errors import ParameterError
 from ...geometry import Setup
 from ...paths import Paths
-from ...pipeline.plan import calibrate_pairs, program_pairs, target_pairs, uses_cells
-from ...pipeline.run import match_targets, truth_twin
+from ...pipeline.merge import budget_targets
+from ...pipeline.plan import (bracketing_pair, calibrate_pairs, lead_program, program_pairs,
+                              target_pairs, uses_cells)
+from ...pipeline.run import association_scale, match_targets, truth_twin
 from ...radar import process
 from ...radar.frame import simulate
 from ...calibration.channels import channel_offsets
 from ...calibration.probes import probe_front_ends
 from ...rts.channels import RtsProgram, program_nearest
 from ...scene import Scene, TargetConfig
+from ...scene.objects import frame_objects
 from ...scene.scenario import trajectory
 
 __all__ = ["frame_targets", "FramePlanner", "detect_frame"]
@@ -32,10 +35,14 @@ __all__ = ["frame_targets", "FramePlanner", "detect_frame"]
 
 def frame_targets(scene: Scene) -> tuple[np.ndarray, list[tuple[TargetConfig, ...]]]:
     """The frames' times and each frame's targets: the scene's ``[[targets]]`` (indices 0..S-1)
-    then the ``[[scenario.targets]]`` at their set-points (S..), as ``TargetConfig``."""
+    then the ``[[scenario.targets]]`` at their set-points (S..), as ``TargetConfig``, then the
+    moving objects' scatterers (:func:`rtsgeom.scene.objects.frame_objects`)."""
     sc = scene.scenario
     times = sc.frame_times()
-    moving = [(trajectory(t.waypoints, times), t.rcs_dbsm) for t in sc.targets]
+    sps = {i: trajectory(t.waypoints, times) for i, t in enumerate(sc.targets)}
+    moving = [(sps[i], t.rcs_dbsm) for i, t in enumerate(sc.targets)
+              if t.scatterers is None and t.mesh is None]
+    objects = frame_objects(scene, sps, times.size)  # an object's scatterers, each frame
     static = tuple(scene.targets)
     frames = []
     for f in range(times.size):
@@ -43,7 +50,7 @@ def frame_targets(scene: Scene) -> tuple[np.ndarray, list[tuple[TargetConfig, ..
             TargetConfig(range_m=float(sp.range_m[f]), velocity_mps=float(sp.velocity_mps[f]),
                          rcs_dbsm=rcs, angle_rad=float(sp.azimuth_rad[f]),
                          elevation_rad=float(sp.elevation_rad[f]))
-            for sp, rcs in moving))
+            for sp, rcs in moving) + tuple(objects[f]))
     return times, frames
 
 
@@ -59,6 +66,7 @@ class FramePlanner:
         scene = setup.scene
         self.record: dict = {"mode": mode}
         self.warnings: list[str] = []
+        self.budgets: list = []  # per frame the Budgeted targets (pipeline.merge), if any
         if mode == "nearest":
             return
         if uses_cells(scene) or any(t.elevation_rad for tg in frames for t in tg):
@@ -67,6 +75,10 @@ class FramePlanner:
                 "calibrated per channel; playing a drive on cells is not implemented (use "
                 "--amplitudes nearest, or targets at elevation 0 on an arc)")
         self.probe = probe_front_ends(setup, paths, scene.seed)
+        if scene.rts.max_targets_per_channel is not None:  # each frame's merged targets
+            self.budgets = [budget_targets(setup, tg, self.probe, bracketing_pair)
+                            for tg in frames]
+            frames = [b.targets for b in self.budgets]
         self.pairs, seen = [], set()
         for f, targets in enumerate(frames):
             pairs, notes = target_pairs(setup, self.probe, targets, where=f"frame {f}: targets")
@@ -90,23 +102,28 @@ class FramePlanner:
         the planner's warnings about it."""
         if self.mode == "nearest":
             return program_nearest(scene_f, self.setup), []
-        program, _, notes = program_pairs(self.setup, self.paths, self.mode, scene_f.targets,
+        budget = self.budgets[f] if self.budgets else None
+        program, _, notes = program_pairs(self.setup, self.paths, self.mode,
+                                          budget.targets if budget else scene_f.targets,
                                           self.pairs[f], self.probe, self.cals, self.offsets,
                                           where=f"frame {f}: targets")
-        return program, notes
+        return (lead_program(program, budget) if budget else program), notes
 
 
 def detect_frame(setup: Setup, paths: Paths, program: RtsProgram, scene_f: Scene, seed: int,
-                 bins: int = 2, truth: bool = True) -> tuple[list[dict], np.ndarray]:
+                 bins: int = 2, truth: bool = True, detections: bool = False) -> tuple:
     """One frame through the full chain: the matches of ``match_targets`` (with the truth
     twin's detections where ``truth``: :func:`rtsgeom.pipeline.run.truth_twin`, same seed) and,
     per target, the number of other detections within ``bins`` range and Doppler bins of its
-    set-point that no target claimed (a split: the RuT sees the target twice)."""
+    set-point that no target claimed (a split: the RuT sees the target twice). With
+    ``detections`` also ``(detections, truth twin's detections or None, association scale)``
+    (the frame's clouds, :mod:`rtsgeom.analysis.objects`)."""
     echoes, cube = simulate(setup, paths, program, seed, scene_f.radar.snr_db)
     rd, det = process(cube)
     matches = match_targets(scene_f, det, rd, bins=bins, steering=cube.steering)
+    t_det = None
     if truth and scene_f.targets:
-        _, matches = truth_twin(setup, scene_f.targets, echoes, matches, bins, seed)
+        t_det, matches = truth_twin(setup, scene_f.targets, echoes, matches, bins, seed)
     claimed = {m.get("detection_index") for m in matches}
     dr = rd.range_m[1] - rd.range_m[0]
     dv = rd.velocity_mps[1] - rd.velocity_mps[0]
@@ -115,4 +132,6 @@ def detect_frame(setup: Setup, paths: Paths, program: RtsProgram, scene_f: Scene
         near = np.flatnonzero((np.abs(det.range_m - t.range_m) <= bins * dr)
                               & (np.abs(det.velocity_mps - t.velocity_mps) <= bins * dv))
         extra[k] = sum(1 for j in near if j not in claimed)
+    if detections:
+        return matches, extra, (det, t_det, association_scale(scene_f, rd, cube.steering))
     return matches, extra

@@ -33,7 +33,10 @@ class PlaybackResult(Result):
     channel, delay_s, doppler_hz, |amplitude|, phase_rad; ``baseline`` the switched baseline
     (``nearest``) on the same drive, or None; ``truth`` the truth twin's detections (the same
     keys, NaN where the real scene gives the target no detection of its own; None: not run);
-    ``status`` (frames, targets) ``detected``, ``merged`` or ``not_detected``.
+    ``status`` (frames, targets) ``detected``, ``merged`` or ``not_detected``; ``clouds``
+    (a scene with extended objects) the truth twin's and the RTS's detections of each object
+    (:mod:`rtsgeom.analysis.objects`) and the resolution cell they are compared in;
+    ``budget`` per frame the planner's counts under ``[rts] max_targets_per_channel``.
     """
 
     scene: Scene
@@ -49,6 +52,8 @@ class PlaybackResult(Result):
     baseline: "PlaybackResult | None" = None
     truth: dict | None = None
     status: np.ndarray | None = None
+    clouds: tuple | None = None  # (clouds.csv rows, resolution cell) of a scene with objects
+    budget: tuple | None = None  # per frame the planner's kept/merged/dropped counts
 
     def _summary(self):
         s = self.summary()
@@ -101,12 +106,16 @@ class PlaybackResult(Result):
         return np.array([abs(e[f, k] - e[f - 1, k]) for f, k in self.handovers()])
 
     def summary(self) -> dict:
-        """The content of ``summary.json``: ``frames``, ``angle_error_deg`` {max, p95} of the
-        absolute error over every detected frame and target, ``lost_frames`` and
+        """The content of ``summary.json``: ``frames``, ``angle_error_deg``, ``range_error_m``
+        and ``velocity_error_mps`` {max, p95} of the absolute error over every detected frame
+        and target, ``lost_frames`` and
         ``split_frames`` (frames where any target was lost, or seen twice),
         ``handover_jump_deg`` (the largest change of a target's angle error at a hand-over),
         per target the same, and the baseline's where it was played."""
         err = np.abs(self.angle_error_deg)
+        # the track's range and radial velocity against the set-points
+        r_err = np.abs(self.detected["range_m"] - self.set["range_m"])
+        v_err = np.abs(self.detected["velocity_mps"] - self.set["velocity_mps"])
         lost = ~np.isfinite(self.detected["azimuth_deg"])
         jumps = self.handover_jumps_deg()
 
@@ -124,6 +133,7 @@ class PlaybackResult(Result):
             "mode": self.mode,
             "frames": int(len(self.time_s)),
             "angle_error_deg": stats(err),
+            "range_error_m": stats(r_err), "velocity_error_mps": stats(v_err),
             "lost_frames": int(np.any(lost, axis=1).sum()),
             "split_frames": int(np.any(self.split > 0, axis=1).sum()),
             "handover_jump_deg": jump(jumps),
@@ -131,6 +141,8 @@ class PlaybackResult(Result):
             "vs_truth_deg": stats(np.abs(self.vs_truth_deg)),
             "merged_frames": int(np.any(self._status == "merged", axis=1).sum()),
             "targets": [{"target": k, "angle_error_deg": stats(err[:, k]),
+                         "range_error_m": stats(r_err[:, k]),
+                         "velocity_error_mps": stats(v_err[:, k]),
                          "lost_frames": int(lost[:, k].sum()),
                          "split_frames": int((self.split[:, k] > 0).sum()),
                          "handovers": int((hk == k).sum()),

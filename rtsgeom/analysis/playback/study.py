@@ -20,6 +20,9 @@ from ...geometry import build_setup
 from ...paths import compute_paths
 from ...scene import Scene
 from ...scene.registry import AOA_MODES, PATH_METHODS
+from ...pipeline.cells import shared_cell_warnings
+from ...pipeline.merge import cell_scale
+from ..objects import cloud_rows
 from .frames import FramePlanner, detect_frame, frame_targets
 from .result import PlaybackResult
 
@@ -91,6 +94,7 @@ def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1, t
     if progress:
         progress(f"{mode}: calibrating and planning {len(frames)} frames")
     planner = FramePlanner(setup, paths, mode, frames, progress)
+    shared = _shared_cells(setup, frames)
     n_f, n_t = len(frames), len(frames[0])
     shape = (n_f, n_t)
     det = {k: np.full(shape, np.nan) for k in ("range_m", "azimuth_deg", "velocity_mps")}
@@ -98,12 +102,16 @@ def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1, t
     status = np.full(shape, "not_detected", dtype=object)
     split = np.zeros(shape, int)
     channels = np.empty(shape, object)
-    programme, warnings = [], list(planner.warnings)
+    programme, warnings = [], list(planner.warnings) + shared
+    scale = cell_scale(setup)  # the clouds' comparison cell (pipeline.merge)
     work = functools.partial(_frames, (scene, setup, paths, planner, frames, bins, truth))
     chunks = np.array_split(np.arange(n_f), max(1, min(n_f, 4 * int(workers))))
     outs = (fork_map(work, chunks, int(workers)) if workers > 1 and n_f > 1
             else [work(c) for c in chunks])
-    for f, (rows, found, extra, notes, seen, stat) in enumerate(o for out in outs for o in out):
+    clouds = []
+    for f, (rows, found, extra, notes, seen, stat, cloud) in enumerate(o for out in outs
+                                                                        for o in out):
+        clouds += cloud
         split[f] = extra
         status[f] = stat
         for into, got in ((det, found), (tru, seen)):
@@ -121,7 +129,20 @@ def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1, t
     return PlaybackResult(scene=scene, mode=mode, time_s=times, set=set_, detected=det,
                           split=split, channels=channels, programme=np.concatenate(programme),
                           calibration=planner.record, warnings=tuple(warnings),
-                          truth=tru if truth else None, status=status)
+                          truth=tru if truth else None, status=status,
+                          clouds=(tuple(clouds), scale) if scene.objects and truth else None,
+                          budget=tuple(b.counts for b in planner.budgets) or None)
+
+
+def _shared_cells(setup, frames) -> list[str]:
+    """The drive's targets that share a range-Doppler cell (:func:`shared_cell_warnings`), one
+    line per situation with the frames it holds in."""
+    seen: dict[str, list[int]] = {}
+    for f, targets in enumerate(frames):
+        for w in shared_cell_warnings(setup, targets):
+            seen.setdefault(w, []).append(f)
+    return [f"frames {fs[0]}..{fs[-1]} ({len(fs)} frames): {w}" if len(fs) > 1 else
+            f"frame {fs[0]}: {w}" for w, fs in seen.items()]
 
 
 def _frames(ctx, chunk) -> list:
@@ -136,14 +157,18 @@ def _frames(ctx, chunk) -> list:
         scene_f = dataclasses.replace(setup.scene, targets=frames[f])  # checked on load
         program, notes = planner.program(int(f), scene_f)
         seed = (scene.seed + int(f)) % (2 ** 63)  # frame 0: the scene's own noise, as `run`
-        matches, extra = detect_frame(setup, paths, program, scene_f, seed, bins, truth)
+        matches, extra, (det, t_det, scale) = detect_frame(
+            setup, paths, program, scene_f, seed, bins, truth, detections=True)
+        cloud = [] if not scene.objects or t_det is None else (
+            cloud_rows(f, "truth", t_det, frames[f], scale)
+            + cloud_rows(f, "rts", det, frames[f], scale))
         found, seen = ([None if m.get(key) is None else
                         (m[key]["range_m"], m[key]["angle_deg"], m[key]["velocity_mps"])
                         for m in matches] for key in ("detection", "truth"))
         rows = np.column_stack([
             np.full(len(program), f), program.target, program.front_end, program.delay_s,
             program.doppler_hz, np.abs(program.amplitude), np.angle(program.amplitude)])
-        out.append((rows, found, extra, notes, seen, [m["status"] for m in matches]))
+        out.append((rows, found, extra, notes, seen, [m["status"] for m in matches], cloud))
     return out
 
 

@@ -1,0 +1,340 @@
+"""Extended objects: a car is many scatterers.
+
+A ``[[targets]]`` or ``[[scenario.targets]]`` entry with ``scatterers`` (points in the object's
+own frame: x right, y away from the RuT, z up, at heading 0) or ``mesh`` (a mesh file in that
+frame) is an object. It is placed with its origin at the entry's range and azimuth (a moving
+one on its waypoints) and turned by its heading about the vertical in the sense of azimuth
+(+y towards +x); a moving object with ``heading = "velocity"`` is turned along its motion.
+
+The scene expands every object into point targets (:class:`~rtsgeom.scene.sections.TargetConfig`,
+one per scatterer, ``object_index`` naming the object): the planner, the truth twin and the
+association then work per scatterer, as for any point target. A static object is expanded on
+load (``Scene.targets``); a moving one per frame (:func:`place`, by the playback).
+
+A mesh's scatterers come from its geometry as the RuT sees it: the facets facing the RuT whose
+centre it sees (no other facet in between), each facet's physical-optics return as a flat plate
+of its area ``A`` at the angle ``theta`` off its normal,
+``sigma = 4 pi A^2 cos^2(theta) / lambda^2 / (1 + 2 (k sqrt(A) sin theta)^2)`` (the plate's
+``sinc^2`` lobe, averaged over its side lobes beyond the main lobe), summed in power over cells
+of the radar's range resolution and its virtual aperture's Rayleigh cell in direction cosine
+``2 / N_virtual``, each cell one scatterer at the power centroid of its facets; the strongest
+:data:`MAX_MESH_SCATTERERS` within :data:`MESH_DYNAMIC_DB` of the strongest are kept.
+
+An RuT that beamforms in azimuth only sees no elevation: a scatterer off the horizontal plane
+keeps its 3-D range and azimuth and is placed at elevation 0.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import SceneError
+from .schema import fmt
+from .sections import MAX_TARGETS, TargetConfig
+
+__all__ = ["ObjectModel", "load_mesh", "mesh_scatterers", "place", "expand_objects",
+           "frame_objects", "object_paths",
+           "MAX_MESH_FACETS", "MAX_MESH_BYTES", "MAX_MESH_SCATTERERS"]
+
+MAX_MESH_FACETS = 4096  # facets of one mesh (a car's outline needs a few hundred)
+MAX_MESH_BYTES = 4 << 20  # a mesh file's size (read before it is parsed: memory bounded)
+MAX_MESH_SCATTERERS = 32  # scatterers kept from a mesh per pose
+MESH_DYNAMIC_DB = 40.0  # a mesh's scatterers within this of its strongest
+_RAY_CHUNK = 256  # facets per block of the visibility test (memory: chunk x facets)
+
+
+@dataclass(frozen=True)
+class ObjectModel:
+    """One extended object of a scene.
+
+    ``where`` names its entry (``targets[2]``, ``scenario.targets[0]``); ``points`` (N, 3)
+    and ``rcs_dbsm`` (N,) its scatterers in its own frame (a mesh: None, derived per pose);
+    ``vertices`` (V, 3) and ``faces`` (F, 3) its mesh or None; ``outline`` (K, 2) its
+    footprint's convex hull in its own frame (x, y); ``heading_rad`` its fixed heading;
+    ``along_velocity`` turns it along its motion; ``moving``: a scenario target."""
+
+    where: str
+    points: np.ndarray | None
+    rcs_dbsm: np.ndarray | None
+    vertices: np.ndarray | None
+    faces: np.ndarray | None
+    outline: np.ndarray
+    heading_rad: float = 0.0
+    along_velocity: bool = False
+    moving: bool = False
+    origin: tuple[float, float, float] | None = None  # a static object's origin (radar frame)
+
+    def __repr__(self) -> str:
+        what = (f"{len(self.points)} scatterers" if self.points is not None
+                else f"mesh of {len(self.faces)} facets")
+        return f"ObjectModel({self.where}: {what}{', moving' if self.moving else ''})"
+
+    def outline_at(self, origin, velocity_vec=None) -> np.ndarray:
+        """The footprint (K, 2) in the radar frame's (x, y) with the origin at ``origin``."""
+        turn = _turn(self.heading(None if velocity_vec is None else np.asarray(velocity_vec)))
+        xy = np.c_[self.outline, np.zeros(len(self.outline))] @ turn.T
+        return xy[:, :2] + np.asarray(origin, float)[None, :2]
+
+    def pose(self, scene, f: int = 0) -> tuple[np.ndarray, np.ndarray]:
+        """The origin (3,) and velocity (3,) in the radar frame at frame ``f`` (a static
+        object: its origin, at rest)."""
+        if not self.moving:
+            return np.asarray(self.origin, float), np.zeros(3)
+        from .scenario import trajectory
+        i = int(self.where.split("[")[1].rstrip("]"))
+        sp = trajectory(scene.scenario.targets[i].waypoints, scene.scenario.frame_times())
+        return sp.position_m[f], sp.velocity_vec_mps[f]
+
+    def heading(self, velocity_vec=None) -> float:
+        """The heading (rad) in a pose: along ``velocity_vec`` (the radar frame's x, y) where
+        the object turns with its motion and moves, else the fixed one."""
+        if self.along_velocity and velocity_vec is not None and np.hypot(*velocity_vec[:2]) > 0:
+            return float(math.atan2(velocity_vec[0], velocity_vec[1]))
+        return self.heading_rad
+
+
+def _turn(heading_rad: float) -> np.ndarray:
+    """Rotation about z in the sense of azimuth: the object's +y goes to (sin h, cos h)."""
+    ch, sh = math.cos(heading_rad), math.sin(heading_rad)
+    return np.array([[ch, sh, 0.0], [-sh, ch, 0.0], [0.0, 0.0, 1.0]])
+
+
+def _hull(xy: np.ndarray) -> np.ndarray:
+    """Convex hull (K, 2) of points in the plane (a point or a segment: themselves)."""
+    from scipy.spatial import ConvexHull, QhullError
+    pts = np.unique(np.round(xy, 9), axis=0)
+    if len(pts) < 3:
+        return pts
+    try:
+        return pts[ConvexHull(pts).vertices]
+    except QhullError:  # collinear
+        return pts[[np.argmin(pts[:, 0] + pts[:, 1]), np.argmax(pts[:, 0] + pts[:, 1])]]
+
+
+def load_mesh(path: str, where: str, source: str) -> tuple[np.ndarray, np.ndarray]:
+    """A mesh file's vertices (V, 3) and triangular faces (F, 3), at most
+    :data:`MAX_MESH_FACETS` facets in a file of at most :data:`MAX_MESH_BYTES`; every failure
+    one ``SceneError`` naming ``where``."""
+    p = Path(path)
+    shown = fmt(p.name)
+    size = p.stat().st_size
+    if size > MAX_MESH_BYTES:
+        raise SceneError(f"{source}: {where} = {shown}: must be a mesh file of at most "
+                         f"{MAX_MESH_BYTES >> 20} MiB and {MAX_MESH_FACETS} facets (it has "
+                         f"{size} bytes): decimate it (a car's outline needs a few hundred "
+                         "facets)")
+    import trimesh  # only for a scene with a mesh
+    try:
+        m = trimesh.load(str(p), force="mesh", process=True)
+        v = np.asarray(m.vertices, float)
+        f = np.asarray(m.faces, np.int64)
+    except Exception as exc:  # trimesh raises many kinds for a file it cannot read
+        raise SceneError(f"{source}: {where} = {shown}: must be a mesh file trimesh reads "
+                         f"(PLY, STL, OBJ, GLB ...): {type(exc).__name__}: "
+                         f"{str(exc)[:120]}") from None
+    if f.ndim != 2 or f.shape[1] != 3 or not len(f):
+        raise SceneError(f"{source}: {where} = {shown}: must be a mesh of triangles (it has "
+                         "no facets)")
+    if len(f) > MAX_MESH_FACETS:
+        raise SceneError(f"{source}: {where} = {shown}: must be a mesh of at most "
+                         f"{MAX_MESH_FACETS} facets (it has {len(f)}): decimate it")
+    if not np.all(np.isfinite(v)) or np.abs(v).max() > 50.0:
+        raise SceneError(f"{source}: {where} = {shown}: must have finite vertices within "
+                         "50 m of the object's origin (metres)")
+    return v, f
+
+
+def _visible(centres: np.ndarray, tri: np.ndarray, radar: np.ndarray) -> np.ndarray:
+    """Whether the RuT sees each facet's centre: no other facet crosses the segment from the
+    centre to the RuT (Moeller-Trumbore, vectorised in blocks of facets)."""
+    a, b, cc = tri[:, 0], tri[:, 1], tri[:, 2]
+    e1, e2 = b - a, cc - a
+    out = np.ones(len(centres), bool)
+    for s in range(0, len(centres), _RAY_CHUNK):
+        o = centres[s:s + _RAY_CHUNK]  # (R, 3)
+        d = radar[None] - o  # segment to the RuT, t in (0, 1)
+        pv = np.cross(d[:, None, :], e2[None])  # (R, F, 3)
+        det = np.einsum("fk,rfk->rf", e1, pv)
+        ok = np.abs(det) > 1e-12
+        inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+        tv = o[:, None, :] - a[None]
+        u = np.einsum("rfk,rfk->rf", tv, pv) * inv
+        qv = np.cross(tv, e1[None])
+        v = np.einsum("rk,rfk->rf", d, qv) * inv
+        t = np.einsum("fk,rfk->rf", e2, qv) * inv
+        hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 1e-6) & (t < 1.0)
+        own = np.arange(s, s + len(o))
+        hit[np.arange(len(o)), own] = False
+        out[s:s + len(o)] = ~hit.any(axis=1)
+    return out
+
+
+def mesh_scatterers(vertices: np.ndarray, faces: np.ndarray, radar_obj: np.ndarray,
+                    wavelength_m: float, cell_m: float, cell_u: float
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """A mesh's scatterers seen from ``radar_obj`` (the RuT in the object's frame): points
+    (N, 3) in the object's frame and their RCS (N,) in dBsm (module docstring). An empty
+    result: no facet faces the RuT."""
+    tri = vertices[faces]  # (F, 3, 3)
+    cen = tri.mean(axis=1)
+    nrm = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    area = 0.5 * np.linalg.norm(nrm, axis=1)
+    nrm = nrm / np.maximum(2.0 * area, 1e-300)[:, None]
+    los = radar_obj[None] - cen
+    dist = np.linalg.norm(los, axis=1)
+    cos_t = np.einsum("fk,fk->f", nrm, los) / dist
+    facing = (cos_t > 1e-6) & (area > 0)
+    if not facing.any():
+        return np.zeros((0, 3)), np.zeros(0)
+    idx = np.flatnonzero(facing)
+    idx = idx[_visible(cen[idx], tri, radar_obj)]
+    k = 2.0 * math.pi / wavelength_m
+    sin_t = np.sqrt(np.clip(1.0 - cos_t[idx] ** 2, 0.0, 1.0))
+    sigma = (4.0 * math.pi * area[idx] ** 2 * cos_t[idx] ** 2 / wavelength_m ** 2
+             / (1.0 + 2.0 * (k * np.sqrt(area[idx]) * sin_t) ** 2))
+    # cells of range and direction cosine seen from the RuT (its lateral axis: the object
+    # frame's x turned with the RuT's line of sight to the object's origin)
+    rel = cen[idx] - radar_obj[None]
+    r = np.linalg.norm(rel, axis=1)
+    axis = np.cross(-radar_obj, [0.0, 0.0, 1.0])
+    axis = axis / max(np.linalg.norm(axis), 1e-12)
+    u = rel @ axis / r
+    key = np.c_[np.floor(r / cell_m), np.floor(u / cell_u)]
+    _, cell = np.unique(key, axis=0, return_inverse=True)
+    cell = cell.ravel()
+    power = np.bincount(cell, sigma)
+    pos = np.stack([np.bincount(cell, sigma * cen[idx, j]) for j in range(3)], axis=1)
+    keep = power > 0
+    pos, power = pos[keep] / power[keep, None], power[keep]
+    order = np.argsort(power)[::-1][:MAX_MESH_SCATTERERS]
+    order = order[power[order] >= power[order[0]] * 10 ** (-MESH_DYNAMIC_DB / 10)]
+    return pos[order], 10.0 * np.log10(power[order])
+
+
+def place(model: ObjectModel, origin: np.ndarray, velocity_vec, radar, index: int,
+          ) -> list[TargetConfig]:
+    """The object's scatterers as point targets with the origin at ``origin`` (3,) and moving
+    at ``velocity_vec`` (3,) (the radar frame: x right, y boresight, z up; m, m/s), each
+    ``TargetConfig`` carrying ``object_index = index``. ``radar``: the RadarConfig (its
+    wavelength and resolution shape a mesh's scatterers; without elevation processing the
+    scatterers lie at elevation 0). Raises ``SceneError`` for a mesh with no facet facing the
+    RuT, or a scatterer at the RuT."""
+    origin = np.asarray(origin, float)
+    vel = np.zeros(3) if velocity_vec is None else np.asarray(velocity_vec, float)
+    turn = _turn(model.heading(vel))
+    if model.points is not None:
+        pts, rcs = model.points, model.rcs_dbsm
+    else:
+        n_virtual = radar.num_tx_active * radar.num_rx
+        pts, rcs = mesh_scatterers(model.vertices, model.faces, turn.T @ (-origin),
+                                   radar.wavelength_m, radar.range_resolution_m,
+                                   2.0 / max(n_virtual, 1))
+        if not len(pts):
+            raise SceneError(f"{model.where}.mesh: no facet faces the RuT from "
+                             f"{np.linalg.norm(origin):.3g} m (are its normals pointing "
+                             "inwards, or is it open towards the RuT?)")
+    p = origin[None] + pts @ turn.T  # (N, 3) radar frame
+    rng = np.linalg.norm(p, axis=1)
+    if np.any(rng <= 1e-3):
+        raise SceneError(f"{model.where}.scatterers[{int(np.argmin(rng))}]: lies at the RuT "
+                         "(range 0): move the object or its scatterer")
+    az = np.arctan2(p[:, 0], p[:, 1])
+    el = np.arcsin(np.clip(p[:, 2] / rng, -1, 1)) if radar.elevation_processing else 0 * rng
+    v_r = p @ vel / rng
+    return [TargetConfig(range_m=float(r), velocity_mps=float(v), rcs_dbsm=float(s),
+                         angle_rad=float(a), elevation_rad=float(e), object_index=index)
+            for r, v, s, a, e in zip(rng, v_r, rcs, az, el)]
+
+
+def _model(entry, where: str, mesh_path: str | None, source: str, moving: bool
+           ) -> ObjectModel:
+    """An entry's object (its scatterers or its mesh), checked."""
+    along = getattr(entry, "heading", "fixed") == "velocity"
+    if entry.scatterers is not None and entry.mesh is not None:
+        raise SceneError(f"{source}: {where}.mesh = {fmt(entry.mesh)}: must be left out where "
+                         f"{where}.scatterers is given (an object is one or the other)")
+    if entry.scatterers is not None:
+        s = np.asarray(entry.scatterers, float).reshape(-1, 4)
+        return ObjectModel(where, s[:, :3], s[:, 3], None, None, _hull(s[:, :2]),
+                           entry.heading_rad, along, moving)
+    v, f = load_mesh(mesh_path, f"{where}.mesh", source)
+    return ObjectModel(where, None, None, v, f, _hull(v[:, :2]), entry.heading_rad, along,
+                       moving)
+
+
+def object_paths(scene, source: str, base_dir, allow_external: bool) -> dict[str, str]:
+    """Each object entry with a mesh (``targets[1]``) -> its path, resolved like a
+    ``[[structure]]``'s (inside the scene's folder unless ``allow_external``)."""
+    from .file import resolve_mesh
+    entries = [(f"targets[{i}]", t) for i, t in enumerate(scene.targets)]
+    if scene.scenario is not None:
+        entries += [(f"scenario.targets[{i}]", t) for i, t in enumerate(scene.scenario.targets)]
+    return {w: resolve_mesh(t.mesh, f"{w}.mesh", source, base_dir, allow_external)
+            for w, t in entries if t.mesh is not None and t.scatterers is None}
+
+
+def expand_objects(scene, mesh_paths: dict[str, str]):
+    """The scene with every static object expanded into its scatterers (``targets``, each
+    ``object_index`` into ``objects``) and every object's model in ``objects`` (static ones
+    first, in file order, then the scenario's). ``mesh_paths``: each ``where`` (``targets[1]``)
+    with a mesh -> its resolved path."""
+    src = scene.source or "<scene>"
+    models, targets = [], []
+    for i, t in enumerate(scene.targets):
+        where = f"targets[{i}]"
+        if t.scatterers is None and t.mesh is None:
+            targets.append(t)
+            continue
+        m = _model(t, where, mesh_paths.get(where), src, False)
+        u = np.array([math.sin(t.angle_rad) * math.cos(t.elevation_rad),
+                      math.cos(t.angle_rad) * math.cos(t.elevation_rad),
+                      math.sin(t.elevation_rad)])
+        try:
+            pts = place(m, t.range_m * u, t.velocity_mps * u, scene.radar, len(models))
+        except SceneError as exc:
+            raise SceneError(f"{src}: {exc}") from None
+        models.append(dataclasses.replace(m, origin=tuple(t.range_m * u)))
+        targets += pts
+    sc = scene.scenario
+    if sc is not None:
+        for i, t in enumerate(sc.targets):
+            where = f"scenario.targets[{i}]"
+            if t.scatterers is not None or t.mesh is not None:
+                models.append(_model(t, where, mesh_paths.get(where), src, True))
+    if not models:
+        return scene
+    if len(targets) > MAX_TARGETS:
+        raise SceneError(f"{src}: targets: must expand to at most {MAX_TARGETS} point targets "
+                         f"(its objects' scatterers make {len(targets)})")
+    return dataclasses.replace(scene, targets=tuple(targets), objects=tuple(models))
+
+
+def frame_objects(scene, sp_by_target: dict, num_frames: int) -> list[list[TargetConfig]]:
+    """Each frame's scatterers of the scenario's objects: ``sp_by_target`` maps a scenario
+    target's index to its :class:`~rtsgeom.scene.scenario.SetPoints`. A mesh's scatterers
+    are derived once, at the drive's first frame, and move with the object (so a frame's
+    targets are the same scatterers throughout the drive)."""
+    out: list[list[TargetConfig]] = [[] for _ in range(num_frames)]
+    for k, m in enumerate(scene.objects):
+        if not m.moving:
+            continue
+        sp = sp_by_target[int(m.where.split("[")[1].rstrip("]"))]
+        try:
+            if m.points is None:  # the mesh as the RuT sees it at the first frame
+                first = place(m, sp.position_m[0], sp.velocity_vec_mps[0], scene.radar, k)
+                turn = _turn(m.heading(sp.velocity_vec_mps[0]))
+                local = np.array([[math.sin(t.angle_rad), math.cos(t.angle_rad), 0.0]
+                                  for t in first]) * np.array([t.range_m for t in first])[:, None]
+                pts = (local - sp.position_m[0][None]) @ turn
+                m = dataclasses.replace(m, points=pts,
+                                        rcs_dbsm=np.array([t.rcs_dbsm for t in first]))
+            for f in range(num_frames):
+                out[f] += place(m, sp.position_m[f], sp.velocity_vec_mps[f], scene.radar, k)
+        except SceneError as exc:
+            raise SceneError(f"{scene.source}: {exc}") from None
+    return out
