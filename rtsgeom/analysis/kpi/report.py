@@ -8,6 +8,7 @@ import base64
 import html
 import io
 import math
+import textwrap
 
 import matplotlib as mpl
 import numpy as np
@@ -347,19 +348,26 @@ def _text_page(sheet) -> Figure:
         for c in sheet.checks:
             verdict = "no value" if c.passed is None else ("pass" if c.passed else "FAIL")
             line = (f"{c.kpi}: value {_fmt(c.value)}, limit {_fmt(c.limit)}, margin "
-                    f"{_fmt(c.margin)}: {verdict}")
-            page.text(0.08, y, line, fontsize=8.5, color="k" if c.passed else "red")
-            y -= 0.022
+                    f"{_fmt(c.margin)}: {verdict}" + (f" ({c.note})" if c.passed is None
+                                                      else ""))
+            for part in textwrap.wrap(line, 110):
+                page.text(0.08, y, part, fontsize=8.5, color="k" if c.passed else "red")
+                y -= 0.018
+            y -= 0.004
         y -= 0.02
     page.text(0.06, y, "Key figures", fontsize=12, weight="bold")
     y -= 0.03
     for name, value in key_rows(sheet):
         page.text(0.08, y, f"{name}:", fontsize=8.5)
-        page.text(0.45, y, value[:90], fontsize=8.5)
-        y -= 0.022
+        for line in textwrap.wrap(value, 62) or [""]:
+            page.text(0.45, y, line, fontsize=8.5)
+            y -= 0.018
+        y -= 0.004
     y -= 0.02
     page.text(0.06, y, "Uncertainty: GUM (JCGM 100) budget per set angle, k = 2, validated by "
                        "a Monte Carlo (JCGM 101)", fontsize=8.5)
     y -= 0.022
-    page.text(0.06, y, "Inputs: " + _fmt(sheet.inputs)[:140], fontsize=7)
+    for line in textwrap.wrap("Inputs: " + _fmt(sheet.inputs), 130):
+        page.text(0.06, y, line, fontsize=7)
+        y -= 0.016
     return page
