@@ -139,11 +139,12 @@ def range_velocity(setup, run) -> dict:
 
 
 def targets_section(setup, run, fov: dict) -> dict:
-    """Simultaneous targets: per channel, as many echoes of the strongest target's level as
-    the RuT's ADC takes before clipping (their amplitudes adding in phase: 10^(margin/20)),
-    in total that per channel times the channels over the channels a target uses (2 in the
-    synthesis modes), both at most the scene's limit of targets; the resolution KPI where the
-    resolution study provides it."""
+    """Simultaneous targets: per channel, the back end's ``[rts] max_targets_per_channel``
+    where declared, and at most as many echoes of the strongest target's level as the RuT's
+    ADC takes before clipping (their amplitudes adding in phase: 10^(margin/20)); in total
+    that per channel times the channels over the channels a target uses (2 in the synthesis
+    modes); both at most the scene's limit of targets. The resolution KPI is added by the
+    study (:func:`resolution_section`)."""
     scene = setup.scene
     margins = []
     if run is not None and run.link_budget is not None:
@@ -151,18 +152,25 @@ def targets_section(setup, run, fov: dict) -> dict:
         margins = [m for m in margins if m is not None]
     n_fe = setup.fe.count
     per_target = 2 if AOA_MODES[fov["mode"]].synthesis and not fov["cells"] else 1
-    if margins:
-        margin = min(margins)
-        per_channel = int(min(MAX_TARGETS, math.floor(10 ** (margin / 20))))
-        note = (f"the RuT's ADC clips {margin:.1f} dB above the strongest target's echo: "
-                "that many equal echoes adding in phase")
-    else:
-        margin, per_channel = None, MAX_TARGETS
-        note = "no clip margin known (no targets to budget): the scene's limit"
+    budget = getattr(scene.rts, "max_targets_per_channel", None)
+    notes, per_channel = [], MAX_TARGETS
+    margin = min(margins) if margins else None
+    if margin is not None:
+        per_channel = int(min(per_channel, math.floor(10 ** (margin / 20))))
+        notes.append(f"the RuT's ADC clips {margin:.1f} dB above the strongest target's echo: "
+                     "that many equal echoes adding in phase")
+    if budget is not None:
+        per_channel = min(per_channel, int(budget))
+        notes.append(f"the back end synthesizes {budget} per channel "
+                     "(rts.max_targets_per_channel)")
+    if not notes:
+        notes.append("no clip margin known (no targets to budget) and no "
+                     "rts.max_targets_per_channel: the scene's limit")
     total = int(min(MAX_TARGETS, per_channel * n_fe // per_target))
     return {"per_channel": per_channel, "total": total, "channels": n_fe,
             "channels_per_target": per_target, "clip_margin_db": margin,
-            "scene_limit": MAX_TARGETS, "note": note}
+            "max_targets_per_channel": budget, "scene_limit": MAX_TARGETS,
+            "note": "; ".join(notes)}
 
 
 def ghosts_section(scene, run) -> dict:
