@@ -99,6 +99,12 @@ _LAZY = {
     "Playback": (".analysis.playback", "Playback"),
     "PlaybackResult": (".analysis.playback", "PlaybackResult"),
     "drive_tolerance": (".analysis.playback", "drive_tolerance"),
+    "kpi": (".api", "kpi"),
+    "KpiStudy": (".analysis.kpi", "KpiStudy"),
+    "Datasheet": (".analysis.kpi", "Datasheet"),
+    "KpiSpec": (".analysis.kpi", "KpiSpec"),
+    "load_spec": (".analysis.kpi", "load_spec"),
+    "loads_spec": (".analysis.kpi", "loads_spec"),
     # views
     "show": (".api", "show"),
     "render_setup_png": (".viz.scene3d", "render_setup_png"),

@@ -21,7 +21,7 @@ from .scene import Scene, check_scene_arg
 from .scene.schema import check_arg, fmt, specs
 
 __all__ = ["replace", "calibrate", "linearity", "tolerance", "design", "nearfield", "ghosts",
-           "transfer", "show", "play"]
+           "transfer", "show", "play", "kpi"]
 
 
 def replace(obj, **changes):
@@ -427,3 +427,37 @@ def play(scene: Scene, amplitudes: str | None = None, paths: str = "exact",
     from .analysis.playback import play as _play
     check_scene_arg(scene, "play")
     return _play(scene, amplitudes, paths, baseline, workers)
+
+
+def kpi(scene: Scene, spec=None, sigma_mm=None, sigma_phase_deg: float | None = None,
+        points: int = 11, draws: int = 2000, seed: int | None = None, progress=None):
+    """The setup's datasheet (``rtsgeom kpi``): field of view, angle accuracy with its GUM
+    budget validated by a Monte Carlo, range and velocity, targets, ghosts, near field,
+    checked against ``spec`` (``analysis.kpi``).
+
+    Parameters
+    ----------
+    scene : Scene
+    spec : KpiSpec, str or Path, optional
+        The spec (:func:`~rtsgeom.analysis.kpi.load_spec` reads a file).
+    sigma_mm : float or sequence of 3 float, optional
+        Mounting offsets' sigma (radial, tangential, height), mm; default 0.1.
+    sigma_phase_deg : float, optional
+        Each RuT antenna's phase spread, deg; default the RMS of ``[radar.channels]``' phases.
+    points, draws, seed
+        Set angles per pair, Monte Carlo draws per set angle, their seed (default the scene's).
+    progress : callable, optional
+        ``progress(label, done, total)``.
+
+    Returns
+    -------
+    Datasheet
+        ``to_dict()`` (the JSON of ``rtsgeom kpi``), ``checks``, ``passed``, ``plot()``,
+        ``figures()``.
+    """
+    from .analysis.kpi import KpiStudy, load_spec
+    if isinstance(spec, (str, Path)):
+        spec = load_spec(spec)
+    study = KpiStudy(sigma_mm=sigma_mm, sigma_phase_deg=sigma_phase_deg, points=points,
+                     draws=draws, seed=seed, spec=spec)
+    return study(scene, progress=progress)

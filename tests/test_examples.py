@@ -34,6 +34,7 @@ OUTPUTS = {
     "plot_scenario_crossing.py": ["scenario_crossing.png"],
     "plot_two_targets_resolution.py": ["two_targets_resolution.png"],
     "plot_extended_object.py": ["extended_object.png"],
+    "plot_kpi_datasheet.py": ["kpi_angle_accuracy.png", "kpi_uncertainty_budget.png"],
 }
 
 

@@ -135,6 +135,23 @@ def _playback(scene):
                           channels, np.zeros((0, 7)), {})
 
 
+def _datasheet():
+    """A datasheet of two set angles, its sections as the study writes their keys."""
+    from rtsgeom.analysis.kpi import BudgetRow, Datasheet, KpiSpec, KpiStudy
+    from rtsgeom.analysis.kpi.accuracy import AnglePoint
+    rows = (BudgetRow("front end 0 tangential offset", 0.1, "mm", "normal", 0.02),
+            BudgetRow("receiver noise", 0.002, "1", "normal", 3.0))
+    pts = tuple(AnglePoint((0, 1), a, 0.001, rows, 0.006, 0.012, (-0.011, 0.013), 0.001,
+                           0.006, True, 0.03) for a in (5.0, 8.0))
+    fov = {"mode": "exact", "azimuth_deg": [4.0, 12.0], "gaps_deg": [], "covered_deg":
+           [[4.0, 12.0]]}
+    rv = {"min_range_m": 1.6, "max_range_m": 75.0, "max_velocity_mps": 9.0,
+          "range_accuracy_m": 0.05, "velocity_accuracy_mps": 0.01, "accuracy_note": ""}
+    return Datasheet("unit", KpiStudy(), fov, pts, "", {}, rv,
+                     {"total": 8, "resolution": {"rts_deg": None, "note": "none"}},
+                     {"ghost_suppression_db": 26.0}, {}, spec=KpiSpec(targets=4))
+
+
 def _object_design():
     from rtsgeom.analysis.object_design import ObjectDesign, ObjectDesignResult
     st = ObjectDesign(ranges_m=(5.0, 10.0, 20.0), spacings_deg=(8.0, 16.0), budgets=(None, 2))
@@ -153,7 +170,7 @@ def results(scene, tolerance_pair):
             "Identification": _identification(scene),
             "Identification with radar": _joint_identification(scene),
             "Transfer": _transfer(), "PlaybackResult": _playback(scene),
-            "ObjectDesignResult": _object_design(),
+            "ObjectDesignResult": _object_design(), "Datasheet": _datasheet(),
             "RunResult": rtsgeom.run_scene(scene, aoa_mode="nearest"),
             "Resolution": _resolution()}
 

@@ -46,7 +46,7 @@ OUTPUT_NAMES = re.compile(
     r"(detections\.csv|summary\.json|report\.html|range_(doppler|angle)\.png|maps\.(npz|mat|nc)|"
     r"calibration(_\d+|_sweep)?\.(png|json)|linearity\.(png|json)|tolerance\.(png|json)|"
     r"design(_\w+)?\.(png|json)|nearfield\.(png|json)|ghosts\.(png|json)|"
-    r"programme\.csv|tracks\.csv|playback\.(png|gif)|"
+    r"programme\.csv|tracks\.csv|playback\.(png|gif)|kpi\.(json|html|pdf)|"
     r"\.rtsgeom-output)")
 MARKER = ".rtsgeom-output"
 

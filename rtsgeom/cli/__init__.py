@@ -50,6 +50,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
                                  "twin beside the RTS over separation x phase"),
     "objects": ("objects", "extended object: the smallest front-end arc and per-channel "
                            "budget that reproduce it over its ranges"),
+    "kpi": ("kpi", "the setup's datasheet: KPIs with an uncertainty budget, checked against a "
+                   "spec"),
 }
 
 #: the modules that register commands, in the table's order

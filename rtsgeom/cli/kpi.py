@@ -1,0 +1,128 @@
+"""``rtsgeom kpi``: the setup's datasheet (``analysis.kpi``): ``kpi.json``, a self-contained
+``kpi.html`` and ``kpi.pdf`` in ``--out``, checked against ``--spec``; exit 0 when every KPI
+of the spec is met (or no spec), 1 when one is missed, 2 on bad input."""
+
+from __future__ import annotations
+
+from ..errors import AngleUnreachable, ParameterError, UsageError
+from ._common import (load_scene_checked, number, output_folder, output_path, print_json,
+                      progress, scene_arg)
+
+
+def cmd_kpi(args) -> int:
+    from .._lib.io import write_bytes, write_json, write_text
+    from ..analysis.kpi import KpiStudy, load_spec
+    scene = load_scene_checked(args.scene)
+    spec = None if args.spec is None else load_spec(args.spec)
+    sigma = args.sigma_mm
+    if sigma is not None and len(sigma) not in (1, 3):
+        raise UsageError(f"--sigma-mm {' '.join(map(str, sigma))}: give one number (every "
+                         "axis) or three (radial, tangential, height)")
+    try:
+        study = KpiStudy(sigma_mm=None if sigma is None else (sigma[0] if len(sigma) == 1
+                                                              else tuple(sigma)),
+                         sigma_phase_deg=args.sigma_phase_deg, points=args.points,
+                         draws=args.draws, seed=args.seed, spec=spec)
+    except ParameterError as exc:
+        raise UsageError(str(exc)) from None
+    with output_folder(args.out, [args.scene, args.spec]) as stage:
+        with progress(args.quiet or args.json) as report:
+            try:
+                sheet = study(scene, progress=report)
+            except AngleUnreachable as exc:
+                raise UsageError(f"{args.scene}: {exc}") from None
+        out = sheet.to_dict()
+        if stage is not None:
+            import io
+            from ..analysis.kpi.report import figures, to_html, write_pdf
+            figs = figures(sheet)
+            write_json(stage / "kpi.json", out)
+            write_text(stage / "kpi.html", to_html(sheet, figs))
+            buf = io.BytesIO()
+            write_pdf(sheet, buf, figs)
+            write_bytes(stage / "kpi.pdf", buf.getvalue())
+    if args.json:
+        print_json(out)
+    else:
+        print(summary(out))
+        if args.out:
+            print(f"wrote {args.out}/kpi.json, kpi.html, kpi.pdf")
+    return sheet.exit_code
+
+
+def summary(out: dict) -> str:
+    """The datasheet's headline numbers and the spec's verdicts, with margins."""
+    fov, rv, tg, gh = (out["field_of_view"], out["range_velocity"], out["targets"],
+                       out["ghosts_leakage"])
+    acc = out["angle_accuracy_summary"]
+    gaps = ", ".join(f"{a:.2f}..{b:.2f}" for a, b in fov["gaps_deg"]) or "none"
+    worst = acc["worst_accuracy_deg"]
+    lines = [f"{out['scene']}: datasheet",
+             f"  field of view      {fov['azimuth_deg'][0]:.2f} .. {fov['azimuth_deg'][1]:.2f} "
+             f"deg ({fov['mode']}), gaps: {gaps}"
+             + (", elevation {:.2f} .. {:.2f} deg".format(*fov["elevation_deg"])
+                if fov["cells"] else ""),
+             "  angle accuracy     " + (acc["note"] if worst is None else
+                                        f"|error| + U (k = 2) worst {worst:.4f} deg; "
+                                        f"{acc['gum_validation']}"),
+             f"  range              {rv['min_range_m']:.3f} .. {rv['max_range_m']:.2f} m, "
+             f"resolution {rv['range_resolution_m']:.4f} m, accuracy "
+             + ("- (no targets)" if rv["range_accuracy_m"] is None else
+                f"{rv['range_accuracy_m']:.4g} m on the scene's targets"),
+             f"  velocity           +-{rv['max_velocity_mps']:.3f} m/s, resolution "
+             f"{rv['velocity_resolution_mps']:.4f} m/s, accuracy "
+             + ("-" if rv["velocity_accuracy_mps"] is None else
+                f"{rv['velocity_accuracy_mps']:.4g} m/s"),
+             f"  targets            {tg['per_channel']} per channel, {tg['total']} in total; "
+             + _resolution(tg["resolution"]),
+             f"  ghosts             strongest {gh['ghost_suppression_db']:.1f} dB below its "
+             "target"]
+    if out["spec"]:
+        lines.append("spec: " + ("PASS" if out["passed"] else "FAIL"))
+        for c in out["spec"]:
+            if c["pass"] is None:
+                lines.append(f"  {c['kpi']:<22} no value: {c['note']}")
+                continue
+            lines.append(f"  {c['kpi']:<22} {'pass' if c['pass'] else 'FAIL'}  value "
+                         f"{_num(c['value'])}, limit {_num(c['limit'])}, margin "
+                         f"{_num(c['margin'])}")
+    return "\n".join(lines)
+
+
+def _resolution(res: dict) -> str:
+    if res.get("rts_deg") is None:
+        return "minimum separation: - (" + res["note"] + ")"
+    truth = res.get("truth_deg")
+    return (f"minimum separation {res['rts_deg']:g} deg on the RTS, "
+            f"{'-' if truth is None else f'{truth:g}'} deg on real targets")
+
+
+def _num(v) -> str:
+    if isinstance(v, list):
+        return "[" + ", ".join(_num(x) for x in v) + "]"
+    return f"{v:.4g}" if isinstance(v, float) else str(v)
+
+
+def register(sub) -> None:
+    p = sub.add_parser("kpi", help="the setup's datasheet: KPIs with an uncertainty budget, "
+                                   "checked against a spec")
+    scene_arg(p)
+    p.add_argument("--spec", default=None, help="spec file (TOML, every key optional: "
+                                                "docs/kpi.md); exit 1 when a KPI misses it")
+    p.add_argument("--sigma-mm", type=number(0.0, 10.0), nargs="+", default=None,
+                   help="mounting offsets' sigma in mm: one number, or radial tangential "
+                        "height, each in [0, 10] (default 0.1)")
+    p.add_argument("--sigma-phase-deg", type=number(0.0, 90.0), default=None,
+                   help="each RuT antenna's phase spread over radars of the type, deg, in "
+                        "[0, 90] (default: the RMS of [radar.channels]' phases, else 0)")
+    p.add_argument("--points", type=number(1, 201, integer=True), default=11,
+                   help="set angles across each pair's span, ends excluded (default 11)")
+    p.add_argument("--draws", type=number(100, 1_000_000, integer=True), default=2000,
+                   help="Monte Carlo draws per set angle, in [100, 1000000] (default 2000)")
+    p.add_argument("--seed", type=number(0, 2 ** 63 - 1, integer=True), default=None,
+                   help="the Monte Carlo's seed (default: the scene's seed)")
+    p.add_argument("--json", action="store_true", help="print the datasheet as JSON")
+    p.add_argument("--out", type=output_path, default=None,
+                   help="folder for kpi.json, kpi.html and kpi.pdf")
+    p.add_argument("--quiet", action="store_true", help="no progress output")
+    p.set_defaults(func=cmd_kpi)

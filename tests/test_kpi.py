@@ -1,0 +1,318 @@
+"""The setup's datasheet (``rtsgeom kpi``, ``analysis.kpi``): the GUM budget's arithmetic, its
+sensitivity coefficients against finite differences of the full model, the spec's pass/fail
+with margins, and the three outputs."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import re
+
+import numpy as np
+import pytest
+
+import rtsgeom
+from conftest import DEFAULT_SCENE
+from rtsgeom.analysis.kpi import KpiSpec, KpiStudy, check_spec, loads_spec
+from rtsgeom.analysis.kpi.budget import (K_COVERAGE, BudgetRow, combined, coverage_interval,
+                                         validate)
+from rtsgeom.cli import main
+from rtsgeom.errors import SceneError
+
+
+# -- the GUM arithmetic -----------------------------------------------------------------------
+
+@pytest.mark.parametrize("c", [(0.5, -2.0, 0.0), (1e-3, 3.0, 0.7), (4.0,)])
+@pytest.mark.parametrize("u", [0.1, 2.5])
+def test_gum_combination_of_a_linear_model_matches_its_monte_carlo(c, u):
+    """y = sum c_i x_i, x_i ~ N(0, u): u_c = u sqrt(sum c_i^2) (JCGM 100 eq. 10), and the
+    Monte Carlo's 95 % interval is +-1.96 u_c (JCGM 101), which U = 2 u_c meets within 10 %."""
+    rows = [BudgetRow(f"x{i}", u, "1", "normal", ci) for i, ci in enumerate(c)]
+    u_c = combined(rows)
+    assert u_c == pytest.approx(u * math.sqrt(sum(ci * ci for ci in c)))
+    rng = np.random.default_rng(3)
+    y = rng.standard_normal((200_000, len(c))) * u @ np.asarray(c)
+    lo, hi = coverage_interval(y)
+    assert (hi - lo) / 2 == pytest.approx(1.96 * u_c, rel=0.02)
+    ok, diff = validate(0.0, K_COVERAGE * u_c, (lo, hi))
+    assert ok and diff < 0.05
+
+
+def test_a_nonlinear_input_fails_the_validation():
+    """y = x^2 (zero derivative at the estimate: U = 0 by the GUM's first order) is not
+    validated by its Monte Carlo (JCGM 101 8.2)."""
+    y = np.random.default_rng(0).standard_normal(10_000) ** 2
+    ok, _ = validate(0.0, K_COVERAGE * combined([BudgetRow("x", 1.0, "1", "normal", 0.0)]),
+                     coverage_interval(y))
+    assert not ok
+
+
+def test_rectangular_and_triangular_standard_uncertainties():
+    """u of a rectangular half-width a is a/sqrt3, of a triangular one a/sqrt6 (JCGM 100
+    4.3.7, 4.3.9): checked against draws."""
+    from rtsgeom.analysis.kpi.budget import RECTANGULAR, TRIANGULAR
+    rng = np.random.default_rng(1)
+    a = 0.7
+    rect = rng.uniform(-a, a, 400_000)
+    tri = rng.uniform(-a / 2, a / 2, 400_000) - rng.uniform(-a / 2, a / 2, 400_000)
+    assert np.std(rect) == pytest.approx(a * RECTANGULAR, rel=0.01)
+    assert np.std(tri) == pytest.approx(a * TRIANGULAR, rel=0.01)
+
+
+# -- the spec file ----------------------------------------------------------------------------
+
+@pytest.mark.parametrize("text, where", [
+    ("angle_accuracy_deg = -1.0", "angle_accuracy_deg = -1"),
+    ("targets = 2.5", "targets = 2.5"),
+    ("azimuth_deg = [1.0]", "azimuth_deg"),
+    ("ghost_supression_db = 3.0", "ghost_supression_db"),
+    ("max_range_m = 'far'", "max_range_m"),
+])
+def test_a_bad_spec_names_its_key(text, where):
+    with pytest.raises(SceneError, match=re.escape(where)):
+        loads_spec(text, "spec.toml")
+
+
+def test_every_spec_key_is_optional():
+    assert loads_spec("") == KpiSpec()
+    assert not check_spec(KpiSpec(), {"angle_accuracy_deg": 0.1})
+
+
+# -- one datasheet of the paper's scene ---------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def sheet():
+    scene = rtsgeom.load_scene(DEFAULT_SCENE)
+    return KpiStudy(points=3, draws=2000, sigma_phase_deg=1.0)(scene)
+
+
+def test_the_gum_budget_holds_against_its_monte_carlo_on_the_paper_scene(sheet):
+    """At three set angles of the paper's pair, U (k = 2) and the Monte Carlo's 95 % interval
+    agree within 10 % of U; U covers every input's contribution."""
+    assert len(sheet.accuracy) == 3
+    for p in sheet.accuracy:
+        assert p.validated, (p.set_deg, p.end_difference)
+        assert p.mc_half_width_deg == pytest.approx(p.expanded_deg, rel=0.1)
+        assert p.expanded_deg >= K_COVERAGE * max(r.contribution_deg for r in p.budget)
+        assert p.accuracy_deg == pytest.approx(abs(p.error_deg) + p.expanded_deg)
+
+
+def _values(sheet) -> dict:
+    return {c.kpi: c.value for c in dataclasses.replace(sheet, spec=_met(sheet)).checks}
+
+
+def _met(sheet) -> KpiSpec:
+    """A spec the setup meets, every key given a limit with room."""
+    v = sheet.spec_values()
+    lo, hi = sheet.fov["azimuth_deg"]
+    return KpiSpec(angle_accuracy_deg=2 * v["angle_accuracy_deg"],
+                   azimuth_deg=(lo + 0.5, hi - 0.5), min_range_m=v["min_range_m"] + 1.0,
+                   max_range_m=v["max_range_m"] - 1.0,
+                   max_velocity_mps=v["max_velocity_mps"] / 2,
+                   range_accuracy_m=2 * v["range_accuracy_m"],
+                   velocity_accuracy_mps=2 * v["velocity_accuracy_mps"],
+                   targets=1, ghost_suppression_db=v["ghost_suppression_db"] - 3.0)
+
+
+#: per key: a limit the setup misses, from its value (what "tightening" means for the key)
+TIGHTEN = {
+    "angle_accuracy_deg": lambda v, s: v / 2,
+    "azimuth_deg": lambda v, s: (s.fov["azimuth_deg"][0] - 1.0, s.fov["azimuth_deg"][1]),
+    "min_range_m": lambda v, s: v / 2,
+    "max_range_m": lambda v, s: v * 2,
+    "max_velocity_mps": lambda v, s: v * 2,
+    "range_accuracy_m": lambda v, s: v / 2,
+    "velocity_accuracy_mps": lambda v, s: v / 2,
+    "targets": lambda v, s: int(v) + 1,
+    "ghost_suppression_db": lambda v, s: v + 3.0,
+}
+
+
+def test_a_met_spec_passes_and_tightening_one_kpi_fails_exactly_it(sheet):
+    met = dataclasses.replace(sheet, spec=_met(sheet))
+    assert met.passed and met.exit_code == 0
+    assert all(c.margin >= 0 for c in met.checks)
+    values = _values(sheet)
+    for key, tighten in TIGHTEN.items():
+        limit = tighten(values[key], sheet)
+        spec = dataclasses.replace(_met(sheet), **{key: limit})
+        tight = dataclasses.replace(sheet, spec=spec)
+        failed = [c.kpi for c in tight.checks if not c.passed]
+        assert failed == [key], (key, failed)
+        assert tight.exit_code == 1
+        bad = next(c for c in tight.checks if c.kpi == key)
+        assert bad.margin < 0
+
+
+def test_a_kpi_without_a_value_is_reported_and_not_met(sheet):
+    """The paper's two front ends span 8.8 deg: two targets within it are not resolved at every
+    phase (the RuT's resolution is 17.5 deg), so a resolution spec has no value to meet."""
+    res = sheet.targets["resolution"]
+    assert res["rts_deg"] is None and "does not resolve" in res["note"]
+    asked = dataclasses.replace(sheet, spec=KpiSpec(resolution_deg=12.0))
+    (check,) = asked.checks
+    assert check.passed is None and check.note == res["note"] and asked.exit_code == 1
+
+
+def test_the_json_contract(sheet):
+    d = json.loads(json.dumps(sheet.to_dict(), allow_nan=False))
+    for entry in d["angle_accuracy"]:
+        for key in ("set_angle_deg", "error_deg", "expanded_uncertainty_deg",
+                    "monte_carlo_half_width_deg", "budget"):
+            assert key in entry
+        for row in entry["budget"]:
+            assert {"quantity", "standard_uncertainty", "unit", "sensitivity",
+                    "contribution_deg"} <= set(row)
+    for section in ("field_of_view", "range_velocity", "targets", "ghosts_leakage",
+                    "near_field", "spec"):
+        assert section in d
+    assert {"min_range_m", "max_range_m", "max_velocity_mps", "range_resolution_m",
+            "velocity_resolution_mps", "range_accuracy_m"} <= set(d["range_velocity"])
+    assert "resolution" in d["targets"] and "note" in d["targets"]["resolution"]
+    fes = d["near_field"]["front_ends"]
+    assert all(f["distance_m"] > f["fraunhofer_distance_m"] for f in fes)
+
+
+# -- the sensitivity coefficients against the full model -------------------------------------
+
+def _chain_error_deg(scene, pair, alpha, off_j, amps) -> float:
+    """The RuT's error on a programme (J's delay offset ``off_j``, amplitudes ``amps``)
+    through the full ADC-cube chain (noise-free): synthesis, FFTs, CFAR, the beamformer."""
+    from rtsgeom.calibration.probes import probe_ranges
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    from rtsgeom.radar import process
+    from rtsgeom.radar.frame import simulate
+    from rtsgeom.radar.processing import nearest_detection
+    from rtsgeom.rts.channels import RtsProgram, requested_delay
+    setup = build_setup(scene)
+    rng_m = float(probe_ranges(setup, 1)[0])
+    tau = float(requested_delay(scene, rng_m))
+    prog = RtsProgram.build([0, 0], list(pair), [tau, tau + off_j], [0.0, 0.0], list(amps))
+    _, cube = simulate(setup, exact_paths(setup), prog)
+    rd, dets = process(cube)
+    hit = nearest_detection(dets, rd, rng_m)
+    return math.degrees(dets.angle_rad[hit] - alpha)
+
+
+@pytest.mark.slow
+def test_sensitivity_coefficients_match_finite_differences_of_the_full_model():
+    """The budget's coefficients (phasor model) against central differences of the full
+    chain: J's delay and an Rx antenna's phase through the ADC-cube chain (the programme
+    fixed), a front end's tangential offset through the whole lab procedure (``run``:
+    calibrated on the setup as built, planned, synthesized, detected)."""
+    from rtsgeom.analysis.kpi.accuracy import AccuracyInputs, pair_accuracy, set_angles
+    from rtsgeom.calibration.probes import probe_front_ends, probe_angles
+    from rtsgeom.calibration.pair import calibrate_pair
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    from rtsgeom.pipeline.pair import pair_design
+    from rtsgeom.scene import TargetConfig
+    from rtsgeom.calibration.probes import probe_ranges
+    scene = rtsgeom.replace(rtsgeom.load_scene(DEFAULT_SCENE), radar=rtsgeom.replace(
+        rtsgeom.load_scene(DEFAULT_SCENE).radar, snr_db=None))
+    setup, pair = build_setup(scene), (0, 1)
+    paths = exact_paths(setup)
+    probe = probe_front_ends(setup, paths, scene.seed)
+    angles = set_angles(setup, probe, pair, 3)[1:2]  # the span's middle
+    alpha = float(angles[0])
+    inputs = AccuracyInputs((1e-4, 1e-4, 1e-4), math.radians(2.0), None, 100, 1)
+    point = pair_accuracy(setup, setup, paths, pair, probe, angles, inputs)[0]
+    coef = {r.quantity: r.sensitivity for r in point.budget}
+    # the programme the budget's operating point uses
+    cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
+    t = TargetConfig(float(probe_ranges(setup, 1)[0]), 0.0, 10.0, alpha)
+    a_i, a_j, _, off_j = pair_design(setup, paths, pair, t, scene.rts.aoa_mode,
+                                     probe_angles(*probe.angle_rad[list(pair)]),
+                                     (0.0, cal.delta_tau_s), probe.gain_correction[list(pair)],
+                                     cal.quantisation_residual_s)
+    # J's delay, deg/ps
+    h = 0.5e-12
+    e = [_chain_error_deg(scene, pair, alpha, off_j + s * h, (a_i, a_j)) for s in (1, -1)]
+    c_tau = (e[0] - e[1]) / (2 * h * 1e12)
+    assert coef["RTS delay quantisation (J against I)"] == pytest.approx(c_tau, rel=0.05,
+                                                                        abs=1e-5)
+    # an Rx antenna's phase, deg/deg
+    n_rx = setup.rut.rx_local.shape[0]
+    for k in (0, n_rx - 1):
+        e = []
+        for s in (1, -1):
+            ph = [0.0] * n_rx
+            ph[k] = s * 2.0
+            radar = rtsgeom.replace(scene.radar, channels=rtsgeom.RadarChannelsConfig(
+                rx_phase_rad=tuple(math.radians(p) for p in ph)))
+            e.append(_chain_error_deg(rtsgeom.replace(scene, radar=radar), pair, alpha,
+                                      off_j, (a_i, a_j)))
+        c_ph = (e[0] - e[1]) / 4.0
+        assert coef[f"RuT Rx {k} phase"] == pytest.approx(c_ph, rel=0.05, abs=1e-4)
+    # front end 1's tangential offset through the lab's procedure, deg/mm
+    h_mm = 0.3
+    e = []
+    for s in (1, -1):
+        fes = list(scene.rts.front_ends)
+        fes[1] = rtsgeom.replace(fes[1], tangential_offset_mm=s * h_mm)
+        moved = rtsgeom.replace(scene, rts=rtsgeom.replace(scene.rts, front_ends=tuple(fes)),
+                                targets=(rtsgeom.replace(scene.targets[0],
+                                                         angle_deg=math.degrees(alpha)),))
+        run = rtsgeom.run_scene(moved)
+        e.append(run.matches[0]["error"]["angle_deg"])
+    c_t = (e[0] - e[1]) / (2 * h_mm)
+    assert coef["front end 1 tangential offset"] == pytest.approx(c_t, rel=0.15)
+
+
+# -- the command ------------------------------------------------------------------------------
+
+def _count_pdf_pages(data: bytes) -> int:
+    return len(re.findall(rb"/Type\s*/Page[^s]", data))
+
+
+@pytest.mark.slow
+def test_the_command_writes_three_self_contained_outputs_and_exits_by_the_spec(tmp_path,
+                                                                               capsys):
+    met = tmp_path / "met.toml"
+    met.write_text("angle_accuracy_deg = 0.5\nazimuth_deg = [5.0, 10.0]\nmax_range_m = 50.0\n"
+                   "ghost_suppression_db = 20.0\n")
+    out = tmp_path / "o"
+    args = ["kpi", str(DEFAULT_SCENE), "--points", "3", "--draws", "500", "--quiet"]
+    assert main(args + ["--out", str(out), "--spec", str(met)]) == 0
+    d = json.loads((out / "kpi.json").read_text())
+    assert d["passed"] is True and all(c["pass"] for c in d["spec"])
+    page = (out / "kpi.html").read_text()
+    assert page.count("src='data:image/png;base64,") >= 4
+    # nothing fetched: every image inline; besides them no URL, stylesheet, script or frame
+    assert all(s.startswith("data:image/png;base64,")
+               for s in re.findall(r"src=['\"]([^'\"]*)", page))
+    text = re.sub(r"data:image/png;base64,[A-Za-z0-9+/=]*", "", page)
+    assert not re.search(r"https?:|//[a-z]|<link|<script|<iframe|<object|url\(|@import",
+                         text, re.I)
+    assert "PASS" in page and "Uncertainty budget" in page
+    assert 1 <= _count_pdf_pages((out / "kpi.pdf").read_bytes()) <= 3
+    capsys.readouterr()
+    # tighten one KPI below the setup's value: exactly it fails, its margin printed
+    tight = tmp_path / "tight.toml"
+    tight.write_text(met.read_text().replace("ghost_suppression_db = 20.0",
+                                             "ghost_suppression_db = 30.0"))
+    assert main(args + ["--spec", str(tight)]) == 1
+    text = capsys.readouterr().out
+    assert re.search(r"ghost_suppression_db\s+FAIL .*margin -4\.0\d", text), text
+    assert text.count("FAIL") == 2  # the verdict line and the KPI
+
+
+def test_bad_input_exits_2_naming_the_field(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("angle_accuracy_deg = 0.0\n")
+    assert main(["kpi", str(DEFAULT_SCENE), "--spec", str(bad), "--quiet"]) == 2
+    assert "angle_accuracy_deg = 0" in capsys.readouterr().err
+    assert main(["kpi", str(DEFAULT_SCENE), "--sigma-mm", "0.1", "0.2", "--quiet"]) == 2
+    assert "--sigma-mm" in capsys.readouterr().err
+
+
+def test_every_spec_key_is_documented():
+    from rtsgeom.analysis.kpi.spec import SPEC_SENSE
+    from rtsgeom.scene.schema import specs
+    page = (DEFAULT_SCENE.parents[1] / "docs" / "kpi.md").read_text()
+    keys = [s.key for _, s in specs(KpiSpec)]
+    assert keys == list(SPEC_SENSE)
+    for key in keys:
+        assert re.search(rf"^{key} = ", page, re.M), key
