@@ -248,7 +248,7 @@ def tolerance(scene: Scene, pair=(0, 1), sigma_mm=(0.1, 0.1, 0.1), draws: int = 
     from .geometry import build_setup
     check_scene_arg(scene, "tolerance")
     from .geometry.setup import warn_setup_errors
-    warn_setup_errors(scene, "tolerance", stacklevel=3)  # NominalSetupWarning
+    warn_setup_errors(scene, "tolerance")  # NominalSetupWarning
     draws, seed, distribution, spec_deg, points, sigma = _study_args(
         "tolerance", draws, seed, distribution, spec_deg, points, sigma_mm)
     sigma = np.asarray(sigma)

@@ -87,7 +87,7 @@ COMMAND_FUNCTIONS = {
     "run": "run_scene", "play": "play", "adc": "run_scene", "calibrate": "calibrate",
     "linearity": "linearity", "tolerance": "tolerance", "design": "design",
     "nearfield": "nearfield", "ghosts": "ghosts", "show": "show", "identify": "identify",
-    "transfer": "transfer", "resolution": "resolution", "objects": "object_design",
+    "transfer": "transfer", "resolution": "resolution", "objects": "object_design", "kpi": "kpi",
 }
 
 

@@ -343,17 +343,21 @@ def test_one_detection_matches_at_most_one_target(nearest_result):
     det, rd = nearest_result.detections, nearest_result.rd
     j = 0
     t = SimpleNamespace(range_m=float(det.range_m[j]), velocity_mps=float(det.velocity_mps[j]),
-                        angle_rad=0.1, rcs_dbsm=10.0)
+                        angle_rad=float(det.angle_rad[j]), elevation_rad=0.0, rcs_dbsm=10.0)
     t2 = SimpleNamespace(**vars(t))
     t2.range_m += 0.3 * (rd.range_m[1] - rd.range_m[0])  # the same range-Doppler cell
-    radar = nearest_result.scene.radar
-    scene = SimpleNamespace(targets=[t, t2], radar=radar)
+    radar, rts = nearest_result.scene.radar, nearest_result.scene.rts
+    scene = SimpleNamespace(targets=[t, t2], radar=radar, rts=rts)
     m = match_targets(scene, det, rd)
-    assert m[0]["detection"] is not None and m[1]["detection"] is None
-    assert "another target" in m[1]["undetected"]["reason"]  # run says why
-    # the order of the targets does not decide which one gets it: the closer one does
-    m = match_targets(SimpleNamespace(targets=[t2, t], radar=radar), det, rd)
-    assert m[0]["detection"] is None and m[1]["detection"] is not None
+    # one detection serves both (the radar cannot resolve them): both 'merged', one index
+    assert [x["status"] for x in m] == ["merged", "merged"]
+    assert m[0]["detection_index"] == m[1]["detection_index"] == j
+    assert m[0]["merged_with"] == [1] and m[1]["merged_with"] == [0]
+    # a target far off in angle in the same cell is not served by it: not detected, and why
+    t3 = SimpleNamespace(**{**vars(t2), "angle_rad": t.angle_rad + 0.8})
+    m = match_targets(SimpleNamespace(targets=[t3, t], radar=radar, rts=rts), det, rd)
+    assert m[0]["detection"] is None and m[1]["status"] == "detected"
+    assert "nearer target 1" in m[0]["undetected"]["reason"]  # run says why
 
 
 def test_synthesis_bytes_do_not_depend_on_the_thread_count():

@@ -172,7 +172,10 @@ def noise_fingerprint(cap: Capture) -> np.ndarray:
     recording (a copy, the same cube as .bin and .npy, a scaled copy) share it to their
     quantisation; independent recordings do not, whatever they show."""
     from ..radar.windows import window
-    x = np.asarray(cap.data)[:, 0, :]  # (L, N)
+    x = np.asarray(cap.data)[:, 0, :].astype(complex)  # (L, N)
+    top = np.max(np.abs(x))
+    if top > 0 and np.isfinite(top):  # a capture scaled by 1e30 must not overflow |X|^2
+        x = x / top
     n_l = x.shape[0]
     # the probe's Doppler bin (unshifted: 0 is zero Doppler)
     probe = int(np.argmax(np.sum(np.abs(np.fft.fft(x, axis=0)) ** 2, axis=1)))
