@@ -145,9 +145,10 @@ def calibrate(scene: Scene, pair=(0, 1)):
         the sweep (``sweep_delta_tau_s``, ``sweep_error_deg``); ``to_dict()`` gives the JSON of
         ``rtsgeom calibrate``.
     """
-    from .calibration.pair import calibrate_pair
-    setup, paths, pair, probe = _pair_setup(scene, pair, "calibrate")
-    return calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
+    from .analysis.calibration_study import CalibrationStudy
+    check_scene_arg(scene, "calibrate")
+    pair = _check_pair(_setup_paths(scene, "calibrate")[0], pair)
+    return CalibrationStudy(pair)(scene).calibration
 
 
 def _pair_setup(scene: Scene, pair, fn: str):
@@ -182,21 +183,21 @@ def linearity(scene: Scene, pair=(0, 1), amplitudes: str = "exact", calibration=
         ``set_deg``, ``detected_deg``, ``error_deg``, ``amplitude_db`` (2, points) and
         ``max_abs_error_deg``.
     """
-    from .calibration.pair import calibrate_pair
     from .analysis.linearity import linearity as _linearity
+    from .geometry import build_setup
     from .scene.registry import SYNTHESIS_MODES
     check_arg(amplitudes, "amplitudes", "str", "linearity", ParameterError,
               choices=SYNTHESIS_MODES)
     check_arg(points, "points", "int", "linearity", ParameterError, lo=3, hi=1001)
+    if calibration is True or calibration is False or calibration is None:
+        from .analysis.linearity_study import LinearityStudy
+        check_scene_arg(scene, "linearity")
+        pair = _check_pair(build_setup(scene), pair)
+        return LinearityStudy(pair, amplitudes, bool(calibration), points)(scene)
     setup, paths, pair, probe = _pair_setup(scene, pair, "linearity")
-    if calibration is True:
-        cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
-    elif calibration is False or calibration is None:
-        cal = None
-    else:
-        cal = calibration
-        if tuple(cal.pair) != pair:
-            raise ParameterError(f"calibration is for pair {tuple(cal.pair)}, not {pair}")
+    cal = calibration
+    if tuple(cal.pair) != pair:
+        raise ParameterError(f"calibration is for pair {tuple(cal.pair)}, not {pair}")
     return _linearity(setup, paths, pair, amplitudes, probe, cal, points, scene.seed)
 
 
@@ -235,19 +236,17 @@ def tolerance(scene: Scene, pair=(0, 1), sigma_mm=(0.1, 0.1, 0.1), draws: int = 
         The scene carries mounting, channel or RuT pose errors of its own: the draws start
         from the nominal setup, not from them.
     """
-    from .analysis.tolerance import MAX_SIGMA_MM, ChannelPhasors, monte_carlo
+    from .analysis.tolerance import MAX_SIGMA_MM, Bounds, MonteCarlo, ToleranceStudy
     from .geometry import build_setup
     check_scene_arg(scene, "tolerance")
-    from .geometry.setup import warn_setup_errors
-    warn_setup_errors(scene, "tolerance", stacklevel=3)  # NominalSetupWarning
     _study_args("tolerance", draws, seed, distribution, spec_deg, points)
     sigma = np.asarray(check_arg(sigma_mm, "sigma_mm", "vec", "tolerance", ParameterError,
                                  n=3, lo=0.0, hi=MAX_SIGMA_MM, unit="mm"), float) * 1e-3
-    setup = build_setup(scene)
-    pair = _check_pair(setup, pair)
-    model = ChannelPhasors.build(setup, pair, points)
-    return monte_carlo(model, sigma, draws, scene.seed if seed is None else seed, distribution,
-                       spec_deg)
+    _check_pair(build_setup(scene), pair)
+    study = ToleranceStudy(Bounds(tuple(float(s) for s in sigma)), tuple(pair),
+                           mc=MonteCarlo(draws, seed, distribution), spec_deg=spec_deg,
+                           points=points)
+    return study(scene).run
 
 
 def design(scene: Scene, radius_m, spacing_deg, pair=(0, 1), spec_deg: float = 0.1,
@@ -275,16 +274,14 @@ def design(scene: Scene, radius_m, spacing_deg, pair=(0, 1), spec_deg: float = 0
         ``metrics[name]`` (spacings, radii) arrays for each name in
         :data:`rtsgeom.analysis.design.METRICS`, ``exceeds_resolution`` and ``to_dict()``.
     """
-    from .analysis.design import design_grid
-    from .geometry import build_setup
+    from .analysis.design_study import DesignStudy
+    from .analysis.tolerance import MonteCarlo
     check_scene_arg(scene, "design")
     _study_args("design", draws, seed, "normal", spec_deg, points)
     check_arg(target_yield, "target_yield", "float", "design", ParameterError, lo=0.0, hi=1.0,
               lo_open=True, hi_open=True)
-    pair = _check_pair(build_setup(scene), pair)
-    return design_grid(scene, pair, np.atleast_1d(radius_m), np.atleast_1d(spacing_deg),
-                       spec_deg, target_yield, draws, scene.seed if seed is None else seed,
-                       points)
+    return DesignStudy(tuple(np.atleast_1d(radius_m)), tuple(np.atleast_1d(spacing_deg)), pair,
+                       None, spec_deg, target_yield, MonteCarlo(draws, seed), points)(scene)
 
 
 def nearfield(scene: Scene, radius_m=None, points: int = 11):

@@ -145,7 +145,28 @@ def results(scene, tolerance_pair):
             "Identification": _identification(scene),
             "Identification with radar": _joint_identification(scene),
             "Transfer": _transfer(), "PlaybackResult": _playback(scene),
-            "RunResult": rtsgeom.run_scene(scene, aoa_mode="nearest")}
+            "RunResult": rtsgeom.run_scene(scene, aoa_mode="nearest"),
+            "ToleranceReport": _tolerance_report(scene), "CalibrationReport": _cal_report(),
+            "ArcLinearity": _arc_linearity()}
+
+
+def _tolerance_report(scene):
+    study = rtsgeom.ToleranceStudy(rtsgeom.Bounds((1e-4,) * 3), pair=(0, 1), points=5,
+                                   mc=rtsgeom.MonteCarlo(40, 1))
+    return study(scene)
+
+
+def _cal_report():
+    from types import SimpleNamespace
+    from rtsgeom.analysis.calibration_study import CalibrationReport
+    probe = SimpleNamespace(angle_rad=np.radians([-4.0, 4.0, 12.0]), gain_correction=np.ones(3))
+    return CalibrationReport(((0, 1), (1, 2)), (_calibration(), _calibration()), probe,
+                             "exact", "unit", arc=True)
+
+
+def _arc_linearity():
+    from rtsgeom.analysis.linearity_study import ArcLinearity
+    return ArcLinearity(((0, 1), (1, 2)), (_linearity(1), _linearity(1)), True, "exact")
 
 
 def _result_classes() -> set[str]:

@@ -78,3 +78,16 @@ def tones(freq_hz: np.ndarray, t0_s: float, dt_s: float, n: int) -> np.ndarray:
     inner = np.exp(2j * np.pi * f * (np.arange(block) * dt_s))
     out = outer[..., :, None] * inner[..., None, :]
     return out.reshape(out.shape[:-2] + (-1,))[..., :n]
+
+
+_PACKAGE_DIR = __file__[: -len("_lib/util.py")]  # .../rtsgeom/
+
+
+def user_stacklevel() -> int:
+    """The ``stacklevel`` that makes a warning raised one call below the caller (e.g. in
+    ``warn_setup_errors``) point at the first line outside rtsgeom: the user's call of a study,
+    however many of the package's functions lie between."""
+    frame, level = sys._getframe(1), 2
+    while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE_DIR):
+        frame, level = frame.f_back, level + 1
+    return level

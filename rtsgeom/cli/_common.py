@@ -14,6 +14,7 @@ import argparse
 import json
 import math
 import os
+import re
 import sys
 import time
 import warnings
@@ -28,7 +29,7 @@ __all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checke
            "warn_scene_errors", "show_warning",
            "pair_word", "pair_of", "pairs_of", "pair_options", "prepare_pair", "prepare_arc",
            "emit_result", "write_outputs", "print_outputs", "progress", "study_options",
-           "read_calibration", "calibration_kw"]
+           "read_calibration", "calibration_kw", "flag_words"]
 
 
 def number(lo=None, hi=None, integer=False):
@@ -45,6 +46,20 @@ def number(lo=None, hi=None, integer=False):
             raise argparse.ArgumentTypeError(f"{text} is outside the allowed range [{lo}, {hi}]")
         return v
     return parse
+
+
+def flag_words(message: str, args: dict) -> str:
+    """A library error in the words of the command line: the argument names before its first
+    ``': '`` that are options of the command (``args``: the parsed namespace's dict) as their
+    flags (``verify`` -> ``--verify``, ``invert_yield`` -> ``--invert-yield``)."""
+    head, sep, tail = message.partition(": ")
+    if not sep:
+        return message
+    names = {k for k in args if k not in ("scene", "func", "command")}
+
+    def flag(m):
+        return "--" + m.group(0).replace("_", "-") if m.group(0) in names else m.group(0)
+    return re.sub(r"(?<![-\w./])[a-z][a-z_]*\b(?![-/.])", flag, head) + sep + tail
 
 
 def output_path(text: str) -> Path:
