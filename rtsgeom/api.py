@@ -118,14 +118,11 @@ def _check_pair(setup, pair) -> tuple[int, int]:
 
 
 def _study_args(fn: str, draws, seed, distribution, spec_deg, points) -> None:
-    """The Monte-Carlo studies' arguments, with the CLI's ranges (``cli._common.study_options``)."""
-    check_arg(draws, "draws", "int", fn, ParameterError, lo=1, hi=10_000_000)
-    if seed is not None:
-        check_arg(seed, "seed", "int", fn, ParameterError, lo=0, hi=2 ** 63 - 1)
-    check_arg(distribution, "distribution", "str", fn, ParameterError,
-              choices=("normal", "uniform"))
-    check_arg(spec_deg, "spec_deg", "float", fn, ParameterError, lo=1e-6, hi=90.0, unit="deg")
-    check_arg(points, "points", "int", fn, ParameterError, lo=3, hi=201)
+    """The Monte-Carlo studies' arguments against their one declaration
+    (``analysis.tolerance.config.STUDY_ARGS``, which the CLI's options are made from)."""
+    from .analysis.tolerance.config import check_study_args
+    check_study_args(fn, draws=draws, seed=seed, distribution=distribution, spec_deg=spec_deg,
+                     points=points)
 
 
 def calibrate(scene: Scene, pair=(0, 1)):

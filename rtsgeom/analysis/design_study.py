@@ -23,7 +23,7 @@ from ..scene.schema import check_arg
 from .coverage import CoverageDesign, coverage_designs
 from .design import DesignGrid, check_azimuth_arc, design_grid
 from .pairs import study_pairs
-from .tolerance.config import MonteCarlo
+from .tolerance.config import MonteCarlo, check_study_args
 
 __all__ = ["DesignStudy"]
 
@@ -95,12 +95,9 @@ class DesignStudy:
                 raise ParameterError(f"{fn}: coverage_deg = ({a:g}, {b:g}): need -80 <= A < B "
                                      "<= 80 deg")
             object.__setattr__(self, "coverage_deg", (a, b))
-        check_arg(self.spec_deg, "spec_deg", "float", fn, ParameterError, lo=1e-6, hi=90.0,
-                  unit="deg")
+        check_study_args(fn, spec_deg=self.spec_deg, points=self.points)
         check_arg(self.target_yield, "target_yield", "float", fn, ParameterError, lo=0.0,
                   hi=1.0, lo_open=True)
-        if self.points is not None:
-            check_arg(self.points, "points", "int", fn, ParameterError, lo=3, hi=201)
         if self.workers is not None:
             check_arg(self.workers, "workers", "int", fn, ParameterError, lo=1, hi=1024)
         if self.mc is not None and not isinstance(self.mc, MonteCarlo):

@@ -29,6 +29,7 @@ __all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checke
            "warn_scene_errors", "show_warning",
            "pair_word", "pair_of", "pairs_of", "pair_options", "prepare_pair", "prepare_arc",
            "emit_result", "write_outputs", "print_outputs", "progress", "study_options",
+           "declared_option",
            "read_calibration", "calibration_kw", "flag_words"]
 
 
@@ -365,9 +366,27 @@ class LineProgress:
 
 # -- the Monte-Carlo studies: tolerance and design ---------------------------------------------
 
-def study_options(p, draws_default: int, allow_all: bool = False) -> None:
+def declared_option(p, name: str, arg, default, default_text: str | None = None, **kw) -> None:
+    """``--name`` (underscores as dashes) made from a declared argument ``arg`` (kind, range or
+    choices, help: ``analysis.tolerance.config.Arg``): its type checks the range and names it,
+    its help states the range and the default."""
+    def num(v):
+        return str(int(v)) if arg.kind == "int" or float(v).is_integer() else f"{v:g}"
+    if arg.choices is not None:
+        kw.setdefault("choices", arg.choices)
+        span = ""
+    else:
+        kw.setdefault("type", number(arg.lo, arg.hi, integer=arg.kind == "int"))
+        span = f", in [{num(arg.lo)}, {num(arg.hi)}]" if arg.lo is not None else ""
+    shown = default_text if default_text is not None else default
+    p.add_argument(f"--{name.replace('_', '-')}", default=default,
+                   help=f"{arg.help}{span} (default {shown})", **kw)
+
+
+def study_options(p, declared: dict, draws_default: int, allow_all: bool = False) -> None:
     """The scene and the options ``tolerance`` and ``design`` share (``allow_all``:
-    ``--pair I J | all``, else exactly two indices)."""
+    ``--pair I J | all``, else exactly two indices); ``declared``: the studies' arguments
+    (``analysis.tolerance.config.STUDY_ARGS``), each option made from its declaration."""
     scene_arg(p)
     if allow_all:
         p.add_argument("--pair", nargs="+", type=pair_word, metavar="I J | all",
@@ -376,14 +395,10 @@ def study_options(p, draws_default: int, allow_all: bool = False) -> None:
     else:
         p.add_argument("--pair", nargs=2, type=number(0, 10_000, integer=True),
                        metavar=("I", "J"), default=[0, 1], help="adjacent front ends (default 0 1)")
-    p.add_argument("--spec-deg", type=number(1e-6, 90.0), default=0.1,
-                   help="angle-error spec in deg, in [1e-6, 90] (default 0.1)")
-    p.add_argument("--draws", type=number(1, 10_000_000, integer=True), default=draws_default,
-                   help=f"Monte-Carlo draws, in [1, 10000000] (default {draws_default})")
-    p.add_argument("--seed", type=number(0, 2 ** 63 - 1, integer=True), default=None,
-                   help="random seed (default: the scene's seed)")
-    p.add_argument("--points", type=number(3, 201, integer=True), default=21,
-                   help="set-points across the span, ends excluded, in [3, 201] (default 21)")
+    declared_option(p, "spec_deg", declared["spec_deg"], 0.1)
+    declared_option(p, "draws", declared["draws"], draws_default)
+    declared_option(p, "seed", declared["seed"], None, "the scene's seed")
+    declared_option(p, "points", declared["points"], 21)
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--out", type=output_path, default=None, help="folder for the plots and JSON")
     p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")

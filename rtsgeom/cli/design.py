@@ -13,6 +13,7 @@ import numpy as np
 from ..analysis.coverage import best_per_radius
 from ..analysis.design_study import DesignStudy
 from ..analysis.tolerance import MonteCarlo
+from ..analysis.tolerance.config import STUDY_ARGS
 from ..errors import ParameterError, UsageError
 from ._common import (flag_words, load_scene_checked, number, output_folder, print_json,
                       progress, study_options)
@@ -163,7 +164,7 @@ def _print_coverage(args, grid) -> int:
 
 def register(sub) -> None:
     p = sub.add_parser("design", help="arc radius x front-end spacing design map")
-    study_options(p, 2000)
+    study_options(p, STUDY_ARGS, 2000)
     p.set_defaults(points=None)  # 21 for the grid, 11 per pair with --coverage-deg
     p.add_argument("--radius-m", type=_grid_spec(0.1, 100.0, "m"), default=np.linspace(0.5, 2.0, 4),
                    metavar="A:B:N", help="arc radii, N from A to B m (default 0.5:2:4)")

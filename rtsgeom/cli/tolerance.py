@@ -9,13 +9,14 @@ import argparse
 import numpy as np
 
 from .._lib.parallel import check_address, chunk_mapper
-from ..analysis.tolerance import (AXES, DISTRIBUTIONS, NOMINAL_AMPLITUDES, Bounds, MonteCarlo,
+from ..analysis.tolerance import (AXES, NOMINAL_AMPLITUDES, Bounds, MonteCarlo,
                                   ToleranceStudy)
+from ..analysis.tolerance.config import STUDY_ARGS
 from ..analysis.tolerance.draws import MAX_SIGMA_MM
 from ..analysis.tolerance.study import CHUNK_MEMORY_BYTES, capped_chunk, chunk_bytes_per_draw
 from ..errors import ClusterError, ParameterError, UsageError
-from ._common import (flag_words, load_scene_checked, number, output_folder, pair_word,
-                      print_json, progress, study_options)
+from ._common import (declared_option, flag_words, load_scene_checked, number, output_folder,
+                      pair_word, print_json, progress, study_options)
 
 __all__ = ["cmd_tolerance", "register", "scales", "study_of", "CHUNK_MEMORY_BYTES",
            "capped_chunk", "chunk_bytes_per_draw"]
@@ -191,7 +192,7 @@ def _print_footer(out: dict, args, scale: str) -> None:
 def register(sub) -> None:
     p = sub.add_parser("tolerance", help="mounting-tolerance Monte Carlo of a front-end pair "
                                          "or a whole arc")
-    study_options(p, 10_000, allow_all=True)
+    study_options(p, STUDY_ARGS, 10_000, allow_all=True)
     mm = number(0.0, MAX_SIGMA_MM)
     for axis in AXES:
         p.add_argument(f"--sigma-{axis}-mm", type=mm, default=None,
@@ -213,8 +214,7 @@ def register(sub) -> None:
     p.add_argument("--sigma-level", type=number(0.1, 10.0), default=3.0,
                    help="the tolerances above are this many sigmas of a normal distribution "
                         "(default 3: '+-0.2 mm at 3 sigma'); ignored for uniform")
-    p.add_argument("--distribution", choices=DISTRIBUTIONS, default="normal",
-                   help="error distribution (default normal)")
+    declared_option(p, "distribution", STUDY_ARGS["distribution"], "normal")
     p.add_argument("--invert-yield", type=number(1e-6, 1.0), default=None, metavar="Y",
                    help="also find the largest sigma keeping the fraction Y, in (0, 1], of the "
                         "setups within the spec (secant search on the scale, same seed)")
@@ -231,10 +231,9 @@ def register(sub) -> None:
     p.add_argument("--verify-all-points", action="store_true",
                    help="with --verify: every set-point of each draw through the chain, not "
                         "only its worst (--points times the frames)")
-    p.add_argument("--chunk", type=number(100, 1_000_000, integer=True), default=10_000,
-                   help="draws per chunk (memory), in [100, 1000000] (default 10000); capped "
-                        f"so that one chunk needs at most {CHUNK_MEMORY_BYTES >> 20} MiB "
-                        "(results do not depend on it)")
+    declared_option(p, "chunk", STUDY_ARGS["chunk"], 10_000,
+                    f"10000; capped so that one chunk needs at most {CHUNK_MEMORY_BYTES >> 20} "
+                    "MiB; results do not depend on it")
     p.add_argument("--dask", metavar="ADDRESS", default=None, type=_dask_address,
                    help="run the chunks on an existing Dask scheduler (tcp://host:8786)")
     p.add_argument("--workers", type=number(1, 1024, integer=True), default=None,

@@ -19,10 +19,54 @@ from ...errors import ParameterError
 from ...scene.schema import check_arg
 from .draws import DEFAULT_CHUNK, DISTRIBUTIONS
 
-__all__ = ["MonteCarlo", "Progress", "Mapper", "MC_FIELDS"]
+__all__ = ["MonteCarlo", "Progress", "Mapper", "MC_FIELDS", "Arg", "STUDY_ARGS",
+           "check_study_args"]
 
 Progress = Callable[[str, int, int], None]  # (label, draws done, draws total)
 Mapper = Callable[[Callable, list], Iterable]  # ordered map of a pure function over chunks
+
+
+@dataclass(frozen=True)
+class Arg:
+    """One study argument declared once: its kind (``int``, ``float``, ``str``), range or
+    choices and unit, and the text of its help. The studies check it with :meth:`check`
+    (the configs, ``rtsgeom.tolerance`` ...); the commands generate their option from it
+    (``cli._common.declared_option``)."""
+
+    kind: str
+    help: str
+    lo: float | None = None
+    hi: float | None = None
+    choices: tuple | None = None
+    unit: str | None = None
+
+    def check(self, value, name: str, source: str, lo: float | None = None):
+        """``value`` checked (``lo``: a lower bound of the caller's own, e.g. the engine's 0
+        draws); :class:`~rtsgeom.errors.ParameterError` naming ``name`` and the range."""
+        decl = {k: v for k, v in (("lo", self.lo if lo is None else lo), ("hi", self.hi),
+                                  ("choices", self.choices), ("unit", self.unit))
+                if v is not None}
+        return check_arg(value, name, self.kind, source, ParameterError, **decl)
+
+
+#: The Monte-Carlo studies' arguments (tolerance, design, the API's functions and the CLI's
+#: options alike).
+STUDY_ARGS: dict[str, Arg] = {
+    "draws": Arg("int", "Monte-Carlo draws", 1, 10_000_000),
+    "seed": Arg("int", "random seed", 0, 2 ** 63 - 1),
+    "distribution": Arg("str", "error distribution", choices=DISTRIBUTIONS),
+    "spec_deg": Arg("float", "angle-error spec in deg", 1e-6, 90.0, unit="deg"),
+    "points": Arg("int", "set-points across the span, ends excluded", 3, 201),
+    "chunk": Arg("int", "draws per chunk (memory)", 100, 1_000_000),
+}
+
+
+def check_study_args(source: str, **values) -> None:
+    """Each of ``values`` (names of :data:`STUDY_ARGS`; None: not given) against its
+    declaration."""
+    for name, value in values.items():
+        if value is not None:
+            STUDY_ARGS[name].check(value, name, source)
 
 
 @dataclass(frozen=True)
@@ -32,7 +76,7 @@ class MonteCarlo:
     Parameters
     ----------
     draws : int
-        Setups drawn, in [1, 10 000 000].
+        Setups drawn, in [1, 10 000 000] (:data:`STUDY_ARGS`; the engine also takes 0).
     seed : int, optional
         Random seed in [0, 2**63 - 1]; None: the scene's seed (:meth:`seeded`).
     distribution : {'normal', 'uniform'}
@@ -70,12 +114,9 @@ class MonteCarlo:
 
     def __post_init__(self):
         fn = "MonteCarlo"
-        check_arg(self.draws, "draws", "int", fn, ParameterError, lo=0, hi=10_000_000)
-        if self.seed is not None:
-            check_arg(self.seed, "seed", "int", fn, ParameterError, lo=0, hi=2 ** 63 - 1)
-        check_arg(self.distribution, "distribution", "str", fn, ParameterError,
-                  choices=DISTRIBUTIONS)
-        check_arg(self.chunk, "chunk", "int", fn, ParameterError, lo=1, hi=10_000_000)
+        STUDY_ARGS["draws"].check(self.draws, "draws", fn, lo=0)  # the engine: 0, no result
+        check_study_args(fn, seed=self.seed, distribution=self.distribution)
+        STUDY_ARGS["chunk"].check(self.chunk, "chunk", fn, lo=1)  # any chunk: the same draws
 
     def __repr__(self) -> str:
         seed = "scene's" if self.seed is None else self.seed

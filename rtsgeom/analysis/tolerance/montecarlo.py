@@ -27,7 +27,7 @@ from ..._lib.results import Result
 from ..._lib.util import frozen
 from ...errors import ParameterError
 from .config import Mapper, MonteCarlo, Progress
-from .draws import AXES, DEFAULT_CHUNK, Bounds, DrawChunk, draw_chunks
+from .draws import AXES, Bounds, DrawChunk, draw_chunks
 from .present import columns as _columns, figure as _figure, summary as _summary
 from .phasors import CASES, ChannelPhasors
 

@@ -26,7 +26,7 @@ from ...radar.steering import Steering
 from ...scene import Scene, check_scene_arg
 from ...scene.schema import check_arg
 from ..pairs import is_all, study_pairs
-from .config import MonteCarlo
+from .config import MonteCarlo, check_study_args
 from .draws import AXES, Bounds, draw_offsets
 from .montecarlo import ToleranceModel, ToleranceResult, simulate
 from .phasors import CASES, NOMINAL_AMPLITUDES, ChannelPhasors
@@ -128,9 +128,7 @@ class ToleranceStudy:
         self.bounds.check()
         if not isinstance(self.mc, MonteCarlo):
             raise ParameterError(f"{fn}: mc must be a MonteCarlo")
-        check_arg(self.spec_deg, "spec_deg", "float", fn, ParameterError, lo=1e-6, hi=90.0,
-                  unit="deg")
-        check_arg(self.points, "points", "int", fn, ParameterError, lo=3, hi=201)
+        check_study_args(fn, spec_deg=self.spec_deg, points=self.points)
         check_arg(self.verify, "verify", "int", fn, ParameterError, lo=0, hi=10_000)
         if self.invert_yield is not None:
             check_arg(self.invert_yield, "invert_yield", "float", fn, ParameterError, lo=0.0,
