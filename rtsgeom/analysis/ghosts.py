@@ -20,6 +20,7 @@ loss of each peak), and the peak of the range spectrum zoomed off the bin grid a
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy.constants import c
@@ -231,6 +232,14 @@ class GhostReport(Result):
     def plot(self, title: str = ""):
         """Per target, its range profile with the predicted (and simulated) ghosts."""
         return ghosts_figure(self, title)
+
+    def write(self, folder) -> list[str]:
+        """``rtsgeom ghosts --out``: ghosts.json and ghosts.png into ``folder``; returns the
+        names."""
+        from ..viz.figures import save_figure  # matplotlib: only where a figure is written
+        self.to_json(Path(folder) / "ghosts.json")
+        save_figure(self.plot(), Path(folder) / "ghosts.png")
+        return ["ghosts.json", "ghosts.png"]
 
     def to_dict(self) -> dict:
         r = self.scene.radar

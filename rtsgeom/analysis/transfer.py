@@ -24,6 +24,7 @@ error on its own calibration, and the shift of the calibrated delay offset).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -137,6 +138,14 @@ class Transfer(Result):
             if percentiles(err)["p95"] <= spec:
                 return name
         return "radar"
+
+    def write(self, folder) -> list[str]:
+        """``rtsgeom transfer --out``: transfer.json and transfer.png into ``folder``; returns the
+        names."""
+        from ..viz.figures import save_figure  # matplotlib: only where a figure is written
+        self.to_json(Path(folder) / "transfer.json")
+        save_figure(self.plot(), Path(folder) / "transfer.png")
+        return ["transfer.json", "transfer.png"]
 
     def to_dict(self) -> dict:
         return {

@@ -21,14 +21,13 @@ import warnings
 from contextlib import contextmanager
 from pathlib import Path
 
-from .._lib.io import check_output_file, staged_dir, write_json
+from .._lib.io import check_output_file, staged_dir
 from ..errors import ParameterError, UsageError
 
 __all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checked", "steps",
            "output_path", "output_file_path", "output_folder", "output_file",
            "warn_scene_errors", "show_warning",
-           "pair_word", "pair_of", "pairs_of", "pair_options", "prepare_pair", "prepare_arc",
-           "emit_result", "write_outputs", "print_outputs", "progress", "study_options",
+           "pair_word", "pair_of", "pair_options", "print_outputs", "progress", "study_options",
            "declared_option",
            "read_calibration", "calibration_kw", "flag_words"]
 
@@ -188,22 +187,6 @@ def pair_word(text: str):
     return number(0, 10_000, integer=True)(text)
 
 
-def pairs_of(setup, pair, cells: bool = False) -> list[tuple[int, int]]:
-    """``--pair I J`` as one pair, or ``--pair all``: every adjacent pair of the arc (with
-    ``cells``, every measured pair of a 2-D scene's cells: ``pipeline.plan.measured_pairs``)."""
-    if list(pair) == ["all"]:
-        n = setup.fe.count
-        if n < 2:
-            raise UsageError("--pair all: the arc needs at least two front ends")
-        from ..pipeline.plan import measured_pairs, uses_cells
-        if uses_cells(setup.scene):
-            if not cells:
-                pair_of(setup, (0, 1))  # the error that says what a 2-D scene takes instead
-            return measured_pairs(setup)
-        return [(i, i + 1) for i in range(n - 1)]
-    return [pair_of(setup, pair, cells)]
-
-
 def pair_of(setup, pair, cells: bool = False):
     """The pair in its canonical order, the lower index first (I keeps its delay, J is
     swept): ``--pair 1 0`` and ``--pair 0 1`` are the same measurement and give the same
@@ -235,67 +218,11 @@ def pair_options(p: argparse.ArgumentParser) -> None:
                         "rts.fractional_delay_filter)")
 
 
-def prepare_pair(args, cells: bool = False):
-    """``--pair I J``: scene (with ``--fir`` applied), setup, the pair, exact paths and each
-    front end alone as the RuT detects it (``cells``: :func:`pair_of`)."""
-    from ..calibration.probes import probe_front_ends
-    from ..geometry import build_setup
-    from ..paths import exact_paths
-    scene = _with_fir(load_scene_checked(args.scene), args)
-    setup = build_setup(scene)
-    pair = pair_of(setup, args.pair, cells)
-    paths = exact_paths(setup)
-    return scene, setup, pair, paths, probe_front_ends(setup, paths, scene.seed)
-
-
-def _with_fir(scene, args):
-    """The scene with ``--fir`` (the fractional-delay filter model) where it is given."""
-    if getattr(args, "fir", None):
-        scene = scene.evolve(rts=scene.rts.evolve(fractional_delay_filter=args.fir))
-    return scene
-
-
-def prepare_arc(args, cells: bool = False):
-    """``--pair all``: scene, setup, every adjacent pair (``cells``: :func:`pairs_of`), exact
-    paths, each front end alone."""
-    from ..calibration.probes import probe_front_ends
-    from ..geometry import build_setup
-    from ..paths import exact_paths
-    scene = _with_fir(load_scene_checked(args.scene), args)
-    setup = build_setup(scene)
-    pairs = pairs_of(setup, args.pair, cells)
-    paths = exact_paths(setup)
-    return scene, setup, pairs, paths, probe_front_ends(setup, paths, scene.seed)
-
-
 # -- writing and printing a result ------------------------------------------------------------
-
-def emit_result(args, stage, png: str, name: str, out: dict, figure, summary_line: str) -> None:
-    """``--out DIR``: <png> (from ``figure()``) and <name>.json into the staging folder
-    ``stage`` (swapped in as DIR when the command ends); then JSON or one summary line on
-    stdout."""
-    if stage is not None:
-        from ..viz.figures import save_figure
-        save_figure(figure(), stage / png)
-        write_json(stage / f"{name}.json", out)
-    if args.json:
-        print_json(out)
-    else:
-        print(summary_line)
-
-
-def write_outputs(stage, name: str, out: dict, figure) -> None:
-    """Write ``NAME.json`` and ``NAME.png`` (``figure()``) into the staging folder of
-    ``--out`` (None: nothing)."""
-    if stage is not None:
-        from ..viz.figures import save_figure
-        write_json(stage / f"{name}.json", out)
-        save_figure(figure(), stage / f"{name}.png")
-
 
 def print_outputs(args, name: str, out: dict, text) -> int:
     """Print the JSON (``--json``) or ``text(out)`` once the output folder is in place, and
-    the files :func:`write_outputs` wrote."""
+    the files the result's ``write(folder)`` wrote (NAME.json, NAME.png)."""
     if args.json:
         print_json(out)
     else:

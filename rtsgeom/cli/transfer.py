@@ -8,7 +8,7 @@ from __future__ import annotations
 from ..analysis.transfer import TransferStudy
 from ..errors import AngleUnreachable, ParameterError, UsageError
 from ._common import (load_scene_checked, number, output_folder, output_path, print_outputs,
-                      scene_arg, steps, write_outputs)
+                      scene_arg, steps)
 
 
 def cmd_transfer(args) -> int:
@@ -33,7 +33,8 @@ def _transfer(args, stage) -> dict:
         except (ParameterError, AngleUnreachable) as exc:
             raise UsageError(f"{args.scene}: {exc}") from None
     out = res.to_dict()
-    write_outputs(stage, "transfer", out, res.plot)
+    if stage is not None:
+        res.write(stage)
     return out
 
 
