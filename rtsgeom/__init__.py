@@ -83,7 +83,6 @@ _LAZY = {
     "Bounds": (".analysis.tolerance", "Bounds"),
     "monte_carlo": (".analysis.tolerance", "monte_carlo"),
     "ChannelPhasors": (".analysis.tolerance", "ChannelPhasors"),
-    "PairPhasors": (".analysis.tolerance", "ChannelPhasors"),  # its former name (a pair's)
     "ToleranceResult": (".analysis.tolerance", "ToleranceResult"),
     "design": (".api", "design"),
     "DesignStudy": (".analysis.design_study", "DesignStudy"),

@@ -22,7 +22,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .._lib.io import check_output_file, staged_dir
-from ..errors import ParameterError, UsageError
+from ..errors import ParameterError, RtsgeomWarning, UsageError
 
 __all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checked", "steps",
            "output_path", "output_file_path", "output_folder", "output_file",
@@ -170,7 +170,6 @@ def warn_scene_errors(scene, command: str, what: str | None = None) -> None:
 def show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     """``warnings.showwarning`` of the commands: rtsgeom's own warnings as
     ``rtsgeom: warning: <message>`` on stderr, any other as Python prints it."""
-    from ..errors import RtsgeomWarning
     if issubclass(category, RtsgeomWarning):
         print(f"rtsgeom: warning: {message}", file=sys.stderr)
     else:

@@ -17,7 +17,9 @@ import dataclasses
 import importlib
 import re
 
+from ..analysis.tolerance.config import STUDY_ARGS, MonteCarlo
 from ..errors import ParameterError, UsageError
+from . import COMMANDS
 from ._common import (declared_option, flag_words, load_scene_checked, output_folder, output_path,
                       print_json, scene_arg)
 
@@ -65,7 +67,6 @@ def _add_field(p, f, cls, helps: dict) -> None:
 
 
 def _study_parser(sub, name: str, helptext: str, path: str) -> None:
-    from ..analysis.tolerance.config import STUDY_ARGS, MonteCarlo
     cls = study_class(path)
     p = sub.add_parser(name, help=helptext, description=(cls.__doc__ or "").split("\n\n")[0])
     scene_arg(p)
@@ -89,14 +90,12 @@ def _study_parser(sub, name: str, helptext: str, path: str) -> None:
 
 def register(sub) -> None:
     """Every study command of :data:`~rtsgeom.cli.COMMANDS` made from its config."""
-    from . import COMMANDS
     for name, entry in COMMANDS.items():
         if entry[0] == "study":
             _study_parser(sub, name, entry[1], entry[2])
 
 
 def cmd_study(args) -> int:
-    from ..analysis.tolerance.config import MonteCarlo
     cls = study_class(args.study)
     names = {f.name for f in dataclasses.fields(cls)}
     kw = {k: v for k, v in vars(args).items() if k in names and k not in ("mc",)}

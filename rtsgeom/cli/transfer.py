@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from ..analysis.transfer import TransferStudy
 from ..errors import AngleUnreachable, ParameterError, UsageError
+from ..geometry import build_setup
+from ..paths import exact_paths
 from ._common import (load_scene_checked, number, output_folder, output_path, print_outputs,
                       scene_arg, steps)
 
@@ -18,8 +20,6 @@ def cmd_transfer(args) -> int:
 
 
 def _transfer(args, stage) -> dict:
-    from ..geometry import build_setup
-    from ..paths import exact_paths
     scene = load_scene_checked(args.scene)
     seed = scene.seed if args.seed is None else args.seed
     study = TransferStudy(radars=args.radars, sigma_phase_deg=args.sigma_phase_deg,

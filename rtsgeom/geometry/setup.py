@@ -87,7 +87,7 @@ def setup_errors(scene: Scene) -> list[str]:
 
 def _channel_errors(radar) -> bool:
     """Whether the RuT's own channels (``[radar.channels]``) are not ideal."""
-    ch = getattr(radar, "channels", None)
+    ch = radar.channels
     return ch is not None and not ch.ideal
 
 

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from .._lib.io import write_bytes, write_json, write_text
+from ..paths import compute_paths
 from .info import scene_info
 from .run import RunResult, label_detections, summary
 
@@ -164,7 +165,7 @@ def _setup_png(result: RunResult, paths_method: str) -> bytes:
     from ..viz.scene3d import render_setup_png
     paths = result.paths
     if paths_method != "exact":  # the view draws reflections through their hit points,
-        from ..paths import compute_paths  # which the table alone does not carry
+        # which the table alone does not carry
         paths = compute_paths(result.setup, paths_method, for_drawing=True)
     with tempfile.TemporaryDirectory(prefix="rtsgeom-3d-") as tmp:  # private to this run
         return render_setup_png(result.setup, Path(tmp) / "setup.png",

@@ -18,7 +18,7 @@ from .file import decode_toml, read_scene_bytes, resolve_meshes
 from .hardware import check_layout_keys, resolve_pattern_tables
 from .rules import problems
 from .scenario import ScenarioConfig
-from .schema import Derived, Evolvable, check_fields, read, spec
+from .schema import Derived, Evolvable, check_fields, fmt, read, spec
 from ..errors import ParameterError, SceneError
 from .sections import (MAX_NAME_CHARS, MAX_TARGETS, RadarConfig, RaytraceConfig, RtsConfig,
                        SheetConfig, StructureConfig, TargetConfig)
@@ -108,7 +108,6 @@ def check_scene_arg(scene, source: str) -> Scene:
     """A function's ``scene`` argument: a :class:`Scene`, else ``ParameterError`` saying how
     to make one (a path is the common mistake)."""
     if not isinstance(scene, Scene):
-        from .schema import fmt
         hint = (": load it with rtsgeom.load_scene(path)" if isinstance(scene, (str, Path))
                 else "")
         raise ParameterError(f"{source}: scene = {fmt(scene)}: must be a Scene{hint}")

@@ -81,7 +81,7 @@ def require_air_path_compensation(scene) -> None:
 
 def target_direction(steering: Steering, target: TargetConfig) -> np.ndarray:
     """A target's set direction cosines (D,) for ``steering``."""
-    el = getattr(target, "elevation_rad", 0.0)
+    el = target.elevation_rad
     if steering.dims == 1:
         return np.array([np.sin(target.angle_rad)])
     return steering.directions(np.array([target.angle_rad, el]))

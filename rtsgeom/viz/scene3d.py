@@ -142,7 +142,7 @@ def _add_labels(pl, setup: Setup, scale: float, text3d: bool = False) -> None:
             a = pos[j] + (0.06 + 0.045 * k) * z_hat
             anchors.append(a)
             leaders.append(np.array([pos[j], a]))
-            el = getattr(t, "elevation_rad", 0.0)
+            el = t.elevation_rad
             texts.append(f"T{j}: {t.range_m:g} m, {np.degrees(t.angle_rad):g} deg"
                          + (f" el {np.degrees(el):g} deg" if el else "")
                          + f", {t.velocity_mps:+g} m/s")
