@@ -129,7 +129,16 @@ class CalibrationReport(Result):
     ``to_dict()`` is the calibration file (``calibrate --out DIR`` writes it as
     DIR/calibration.json; ``run --calibration`` reads it); ``write(folder)`` that file and
     the sweep figures; ``to_dataframe()`` one row per pair; ``plot()`` the first pair's
-    sweep."""
+    sweep.
+
+    Attributes
+    ----------
+    pairs : tuple of (int, int)
+    calibrations : tuple of Calibration
+    probe : FrontEndProbe
+    procedure : str
+    setup_sha256 : str
+    """
 
     pairs: tuple[tuple[int, int], ...]
     calibrations: tuple

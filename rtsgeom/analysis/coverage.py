@@ -233,8 +233,18 @@ def plan_arc(scene: Scene, coverage_rad: tuple[float, float], radius_m: float,
         binding.append("near-field bias" if n > n_bare else "resolution")
     if scene.sheet.enabled and sheet == "disabled":
         binding.append("cutout fit")
+    sheet_text = _sheet_text(scene, variant, sheet, spacing, cut)
+    return ArcPlan(variant, float(radius_m), int(n), tuple(float(x) for x in np.degrees(angles)),
+                   math.degrees(spacing), math.degrees(res), math.degrees(cut),
+                   tuple(float(x) for x in np.degrees(bias)), sheet, sheet_text,
+                   tuple(binding), extra, problem)
+
+
+def _sheet_text(scene: Scene, variant: Scene, sheet: str, spacing: float, cut: float) -> str:
+    """What an arc design did to the scene's sheet (``sheet``: kept, widened, disabled), in
+    words."""
     sh = variant.sheet
-    sheet_text = {
+    return {
         "kept": "sheet kept",
         "widened": f"sheet widened to [{math.degrees(sh.angle_min_rad):.2f}, "
                    f"{math.degrees(sh.angle_max_rad):.2f}] deg",
@@ -244,10 +254,6 @@ def plan_arc(scene: Scene, coverage_rad: tuple[float, float], radius_m: float,
                      else "sheet REMOVED (its cutouts cannot hold the antennas or it would not "
                           "enclose the RuT)" if scene.sheet.enabled else "no sheet in the scene"),
     }[sheet]
-    return ArcPlan(variant, float(radius_m), int(n), tuple(float(x) for x in np.degrees(angles)),
-                   math.degrees(spacing), math.degrees(res), math.degrees(cut),
-                   tuple(float(x) for x in np.degrees(bias)), sheet, sheet_text,
-                   tuple(binding), extra, problem)
 
 
 def evaluate_arc(plan: ArcPlan, spec_deg: float = 0.1, target_yield: float = 0.95,

@@ -252,7 +252,17 @@ class DesignGrid(Result):
 
     ``print(grid)`` is a summary; ``to_dataframe()`` one row per design (``radius_m``,
     ``spacing_deg``, the metrics, ``exceeds_resolution``); ``plot(metric)`` one metric's map,
-    the figures of ``rtsgeom design --out``."""
+    the figures of ``rtsgeom design --out``.
+
+    Attributes
+    ----------
+    pair : (int, int)
+    radius_m, spacing_deg : arrays
+    metrics : dict
+        Name -> (spacings, radii) array, one per :data:`METRICS`.
+    exceeds_resolution : (spacings, radii) bool
+    designs : tuple of dict
+    """
 
     pair: tuple[int, int]
     centre_deg: float

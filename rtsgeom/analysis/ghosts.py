@@ -194,7 +194,17 @@ def measure_ghosts(result, predicted: list[dict]) -> list[dict]:
 class GhostReport(Result):
     """Predicted (and simulated) cable ghosts. ``print(rep)`` is a summary;
     ``to_dataframe()`` one row per (target, ghost order); ``plot()`` the figure of
-    ``rtsgeom ghosts --out``."""
+    ``rtsgeom ghosts --out``.
+
+    Attributes
+    ----------
+    scene : Scene
+    floor_db : float
+    front_ends, targets : list of dict
+        The predicted ghosts per front end and per target.
+    simulated : list of dict or None
+        Each ghost as read in the simulated range-Doppler map (``simulate``).
+    """
 
     scene: Scene
     floor_db: float

@@ -37,7 +37,16 @@ class Linearity(Result):
     """Set and detected directions (deg) of the synthesized targets: (P,) azimuths of a pair,
     or (P, 2) (azimuth, elevation) over a cell (NaN: not detected). ``print(lin)`` is a
     summary; ``to_dataframe()`` one row per set-point; ``plot()`` the figure of
-    ``rtsgeom linearity --out``."""
+    ``rtsgeom linearity --out``.
+
+    Attributes
+    ----------
+    mode : str
+    calibrated : bool
+    set_deg, detected_deg : (P,) or (P, 2) float
+    amplitude_db : (Q, P) float, optional
+    channels : tuple of int
+    """
 
     mode: str
     calibrated: bool

@@ -152,7 +152,15 @@ class LinearityStudy:
 class ArcLinearity(Result):
     """Every adjacent pair's :class:`~.linearity.Linearity` of one arc. ``to_dict()`` one
     entry per pair plus the arc's; ``to_dataframe()`` one row per (pair, set-point);
-    ``write(folder)`` linearity.json and linearity_I_J.png per pair."""
+    ``write(folder)`` linearity.json and linearity_I_J.png per pair.
+
+    Attributes
+    ----------
+    pairs : tuple of (int, int)
+    linearities : tuple of Linearity
+    calibrated : bool
+    amplitudes : str
+    """
 
     pairs: tuple[tuple[int, int], ...]
     linearities: tuple[Linearity, ...]

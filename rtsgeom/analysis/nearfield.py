@@ -117,7 +117,17 @@ def with_arc_radius(scene: Scene, radius_m: float) -> Scene:
 class NearField(Result):
     """Near-field figures of merit over arc radius (arrays (R, F) unless noted, degrees).
     ``print(nf)`` is a summary; ``to_dataframe()`` one row per (radius, front end);
-    ``plot()`` the figure of ``rtsgeom nearfield --out``."""
+    ``plot()`` the figure of ``rtsgeom nearfield --out``.
+
+    Attributes
+    ----------
+    radius_m : (R,) float
+    geometric_deg, detected_deg : (R, F) float
+        Each front end's geometric and detected azimuth per radius.
+    synthesis : list
+        The synthesized-angle errors per radius.
+    fraunhofer_m : float
+    """
 
     scene: Scene
     radius_m: np.ndarray  # (R,)

@@ -96,6 +96,16 @@ class ChannelModel:
     ``u`` (D,): ``sin(azimuth)`` for a RuT that beamforms in azimuth (D = 1), ``(sin az cos
     el, sin el)`` for one that beamforms in both (D = 2); :meth:`direction` returns the
     detected angles, :meth:`angles` converts.
+
+    Attributes
+    ----------
+    setup : Setup
+    channels : tuple of int
+        The front ends that synthesize.
+    responses : (K, Q, V) complex
+        Each channel's snapshot per candidate bin.
+    steering : Steering
+    range_m : float
     """
 
     setup: Setup

@@ -309,7 +309,24 @@ def _render_image(setup: Setup, paths, window_size) -> np.ndarray:
 
 def render_setup_png(setup: Setup, path: str | Path, paths=None,
                      window_size=(1600, 1000)) -> Path:
-    """Render the setup off screen to a PNG file (written atomically); return its path."""
+    """Render the setup off screen to a PNG file (written atomically); return its path.
+
+    Parameters
+    ----------
+    setup : Setup
+    path : str or Path
+    paths : Paths, optional
+    window_size : (int, int)
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    VizError
+        No off-screen rendering here.
+    """
     from matplotlib.image import imsave
     path = Path(path)
     img = _render_image(setup, paths, window_size)

@@ -131,7 +131,18 @@ class ToleranceResult(Result):
     back to the grid search; both count (draw, set-point) pairs, so their largest value is
     ``draws`` x the set's set-points (2330 of 2000 x 21 = 42 000 is 5.5 % of the set-points,
     not more than one per draw). ``print(result)`` is a summary; ``to_dataframe()`` one row
-    per draw; ``plot()`` the figure of ``rtsgeom tolerance --out``."""
+    per draw; ``plot()`` the figure of ``rtsgeom tolerance --out``.
+
+    Attributes
+    ----------
+    model : ToleranceModel
+    bounds : Bounds
+    distribution : str
+    draws, seed : int
+    spec_deg : float
+    errors_deg : dict
+        Case -> (draws, P, C) worst signed errors.
+    """
 
     model: ToleranceModel
     bounds: Bounds

@@ -249,7 +249,17 @@ class ToleranceReport(Result):
 
     ``to_dict()`` is the JSON of ``rtsgeom tolerance``; ``write(folder)`` its ``--out`` files
     (tolerance.json, tolerance.png, tolerance_draws.npz); ``to_dataframe()`` one row per
-    draw; ``plot()`` the CDF of each draw's worst error."""
+    draw; ``plot()`` the CDF of each draw's worst error.
+
+    Attributes
+    ----------
+    study : ToleranceStudy
+    run : ToleranceResult
+    verify : VerifyResult or None
+    inversion : dict or None
+    scene_offsets : dict or None
+    elapsed_s : float
+    """
 
     study: ToleranceStudy
     run: ToleranceResult
