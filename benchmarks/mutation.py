@@ -8,10 +8,14 @@ which function, and then runs, per mutant, only the tests that reach its functio
 
 What this driver adds to ``mutmut run``:
 
-* **the physics core only** (``MODULES``): geometry/, paths/exact.py, rts.py, radar/, aoa/,
-  analysis/; ``--modules`` picks some of them (names as in ``MODULES``);
-* **targeted fast tests**: each module maps to the test files that exercise it
-  (``MODULES``); the selection is their union for the chosen modules, without the ``slow``
+* **every physics subpackage** (``SOURCES``): geometry/, paths/ (exact, table), rts/, radar/,
+  synthesis/, calibration/, pipeline/ (plan, pair, run), identify/, the scenario code
+  (scene/scenario.py, analysis/playback/), the calibration transfer, analysis/; ``--modules``
+  picks some of them (names as in ``SOURCES``); a file in two modules' globs belongs to the
+  more specific one;
+* **targeted fast tests**: each module's tests are the test files that import it and the
+  core's (``tests_for``, ``CORE_TESTS``, found at every run: ``MODULES``); the selection is
+  their union for the chosen modules, without the ``slow``
   marker, the ray tracer, and the tests that run a subprocess or a dask cluster (a mutant is
   switched by an environment variable inside the forked test process, so a subprocess or a
   dask worker would run the unmutated code anyway, and they are slow);
@@ -36,9 +40,9 @@ are listed in ``EQUIVALENT`` with the reason; they are reported apart and left o
     python -m benchmarks.mutation --rerun-survivors      # after new tests: the survivors again
     python -m benchmarks.mutation --rerun-survivors --names NAME ...   # only these survivors
 
-Keep ``MODULES`` in step with the tests: a module whose tests are not mapped shows its
-mutants as "no tests" (the seed-3 sample found 21 such mutants in modules added after the map
-was written). New tests for a sample's survivors go to ``tests/test_physics_core.py`` / ``_aoa.py``
+A module's tests are found from their imports, so a new module or test needs no entry; a new
+physics subpackage needs one line in ``SOURCES`` (and ``[tool.mutmut]`` ``only_mutate`` in
+pyproject.toml, which ``tests/test_mutation_driver.py`` keeps equal to it). New tests for a sample's survivors go to ``tests/test_physics_core.py`` / ``_aoa.py``
 (seed 3), ``tests/test_physics_core_seed4.py`` (seed 4); ``KILLED_BY`` names the test per
 mutant, ``RENAMED`` a mutant's name in today's code where its function moved or was
 renumbered (``benchmarks/mutation_tables.py``); judge the suite on a sample it was not
@@ -67,41 +71,50 @@ ROOT = Path(__file__).resolve().parents[1]
 REPORT_MD = ROOT / "benchmarks" / "mutation-report.md"
 REPORT_JSON = ROOT / "benchmarks" / "mutation-report.json"
 
-# module (source glob, relative to the repository) -> the fast test files that exercise it
-MODULES: dict[str, tuple[str, tuple[str, ...]]] = {
-    "geometry": ("rtsgeom/geometry/*", (
-        "tests/test_geometry.py", "tests/test_frontends.py", "tests/test_arrays.py",
-        "tests/test_patterns.py", "tests/test_properties.py", "tests/test_warnings_geometry.py",
-        "tests/test_fields.py", "tests/test_mutants.py", "tests/test_sphere.py",
-        "tests/test_setups.py", "tests/test_elevation.py", "tests/test_physics_core.py",
-        "tests/test_physics_core_seed4.py")),
-    "paths.exact": ("rtsgeom/paths/exact.py", (
-        "tests/test_geometry.py", "tests/test_patterns.py", "tests/test_properties.py",
-        "tests/test_frontends.py", "tests/test_mutants.py", "tests/test_sphere.py",
-        "tests/test_setups.py", "tests/test_physics_core.py")),
-    "rts": ("rtsgeom/rts.py", (
-        "tests/test_signal.py", "tests/test_signal_properties.py", "tests/test_ghosts.py",
-        "tests/test_fields.py", "tests/test_mutants.py", "tests/test_calibration.py",
-        "tests/test_link.py", "tests/test_windows.py", "tests/test_physics_core.py",
-        "tests/test_physics_core_seed4.py")),
-    "radar": ("rtsgeom/radar/*", (
-        "tests/test_signal.py", "tests/test_signal_properties.py", "tests/test_steering.py",
-        "tests/test_windows.py", "tests/test_fields.py", "tests/test_mutants.py",
-        "tests/test_cfar.py", "tests/test_elevation.py", "tests/test_link.py",
-        "tests/test_fast_numerics.py", "tests/test_identify.py", "tests/test_physics_core.py",
-        "tests/test_physics_core_seed4.py")),
-    "aoa": ("rtsgeom/aoa/*", (
-        "tests/test_aoa.py", "tests/test_steering.py", "tests/test_windows.py",
-        "tests/test_fields.py", "tests/test_mutants.py", "tests/test_calibration.py",
-        "tests/test_nchannel.py", "tests/test_sphere.py", "tests/test_elevation.py",
-        "tests/test_setups.py", "tests/test_reachable.py", "tests/test_physics_core.py",
-        "tests/test_physics_core_aoa.py", "tests/test_physics_core_seed4.py")),
-    "analysis": ("rtsgeom/analysis/*", (
-        "tests/test_tolerance.py", "tests/test_nearfield.py", "tests/test_ghosts.py",
-        "tests/test_design.py", "tests/test_mutants.py", "tests/test_setups.py",
-        "tests/test_windows.py", "tests/test_physics_core.py",
-        "tests/test_physics_core_seed4.py")),
+#: the tests every physics module's sample runs besides its own importers: the closed forms
+#: and invariants of the core and the tests written for earlier samples' survivors
+CORE_TESTS = ("tests/test_physics_core.py", "tests/test_physics_core_aoa.py",
+              "tests/test_physics_core_seed4.py", "tests/test_mutants.py",
+              "tests/test_properties.py", "tests/test_signal_properties.py")
+
+#: module -> its source globs (relative to the repository; ``*`` spans subfolders): every
+#: physics subpackage as it stands. Each module's tests are the fast test files that import it
+#: (:func:`tests_for`) and :data:`CORE_TESTS`, found anew at every run, so a new module or test
+#: needs no entry here.
+SOURCES: dict[str, tuple[str, ...]] = {
+    "geometry": ("rtsgeom/geometry/*",),
+    "paths": ("rtsgeom/paths/exact.py", "rtsgeom/paths/table.py"),
+    "rts": ("rtsgeom/rts/*",),
+    "radar": ("rtsgeom/radar/*",),
+    "synthesis": ("rtsgeom/synthesis/*",),
+    "calibration": ("rtsgeom/calibration/*",),
+    "pipeline": ("rtsgeom/pipeline/plan.py", "rtsgeom/pipeline/pair.py",
+                 "rtsgeom/pipeline/run.py"),
+    "identify": ("rtsgeom/identify/*",),
+    "scenario": ("rtsgeom/scene/scenario.py", "rtsgeom/analysis/playback/*"),
+    "transfer": ("rtsgeom/analysis/transfer.py", "rtsgeom/radar/channels.py"),
+    "analysis": ("rtsgeom/analysis/*",),
 }
+
+
+def tests_for(module: str) -> tuple[str, ...]:
+    """The test files that import ``module``'s sources (``rtsgeom.<package>`` or one of its
+    modules), and :data:`CORE_TESTS`."""
+    names = set()
+    for glob in SOURCES[module]:
+        stem = glob.removesuffix("/*").removesuffix(".py").replace("/", ".")
+        names.add(stem)
+    found = set(CORE_TESTS)
+    for t in sorted((ROOT / "tests").glob("test_*.py")):
+        text = t.read_text()
+        if any(n in text for n in names):
+            found.add(str(t.relative_to(ROOT)))
+    return tuple(sorted(found))
+
+
+# module -> (source globs, the fast test files that exercise it)
+MODULES: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
+    m: (globs, tests_for(m)) for m, globs in SOURCES.items()}
 
 # Functions outside the physics core although they sit in its modules: plotting, mesh export
 # and JSON serialisation (their contracts are the CLI tests', which run subprocesses and are
@@ -118,7 +131,7 @@ def _toml_list(xs) -> str:
 
 def selection(modules: list[str]) -> tuple[list[str], list[str]]:
     """(source globs, existing test files) of the chosen modules."""
-    globs = [MODULES[m][0] for m in modules]
+    globs = list(dict.fromkeys(g for m in modules for g in MODULES[m][0]))
     tests = sorted({t for m in modules for t in MODULES[m][1] if (ROOT / t).exists()})
     return globs, tests
 
@@ -196,11 +209,11 @@ def all_mutants(workdir: Path) -> dict[str, list[str]]:
 
 
 def module_of(path: str) -> str | None:
-    import fnmatch
-    for m, (glob, _) in MODULES.items():
-        if fnmatch.fnmatch(path, glob):
-            return m
-    return None
+    """The module of ``MODULES`` a source file belongs to: of the globs it matches, the most
+    specific (the longest: ``rtsgeom/radar/channels.py`` is ``transfer``'s, not ``radar``'s)."""
+    hits = [(len(g), m) for m, (globs, _) in MODULES.items() for g in globs
+            if fnmatch.fnmatch(path, g)]
+    return max(hits)[1] if hits else None
 
 
 def sample(names: dict[str, list[str]], n: int | None, seed: int) -> list[str]:

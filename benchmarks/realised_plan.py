@@ -6,8 +6,8 @@ among them), the default scene with a 35 deg phase offset and a 0.3 mm radial of
 front end 1 (what the calibration absorbs): probe, calibrate and plan (``plan_targets``, the
 run's planner), then each target's angle on the phasor model of the setup as built. Per
 case: the largest |angle error|, the largest |quantisation_residual_s| of J's realised delay
-difference and the run warnings about it. Writes ``benchmarks/realised_plan.json``
-(``realised_plan_before.json``: the same run before the fix, max 0.16 / 0.11 deg at 100 ps).
+difference and the run warnings about it. Writes ``benchmarks/realised_plan.json`` (before
+the fix the same run gave max 0.16 / 0.11 deg at 100 ps: CHANGELOG).
 """
 
 from __future__ import annotations

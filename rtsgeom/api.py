@@ -16,8 +16,23 @@ from pathlib import Path
 
 import numpy as np
 
+from .analysis.calibration_study import CalibrationStudy
+from .analysis.design_study import DesignStudy
+from .analysis.ghosts import ghost_analysis
+from .analysis.linearity import linearity as _linearity
+from .analysis.linearity_study import LinearityStudy
+from .analysis.nearfield import nearfield as _nearfield
+from .analysis.playback import play as _play
+from .analysis.tolerance import MAX_SIGMA_MM, Bounds, MonteCarlo, ToleranceStudy
+from .analysis.tolerance.config import check_study_args
+from .analysis.transfer import TransferStudy
+from .calibration.probes import probe_front_ends
 from .errors import ParameterError, SceneError
+from .geometry import Setup, build_setup
+from .paths import compute_paths, exact_paths
+from .pipeline.plan import check_pair
 from .scene import Scene, check_scene_arg
+from .scene.registry import SYNTHESIS_MODES
 from .scene.schema import check_arg, fmt, specs
 
 __all__ = ["replace", "calibrate", "linearity", "tolerance", "design", "nearfield", "ghosts",
@@ -114,14 +129,11 @@ def _is_number(value) -> bool:
 
 def _setup_paths(scene: Scene, fn: str):
     check_scene_arg(scene, fn)
-    from .geometry import build_setup
-    from .paths import exact_paths
     setup = build_setup(scene)
     return setup, exact_paths(setup)
 
 
 def _check_pair(setup, pair) -> tuple[int, int]:
-    from .pipeline.plan import check_pair
     if (not isinstance(pair, (tuple, list, np.ndarray)) or len(pair) != 2
             or not all(isinstance(p, (int, np.integer)) and not isinstance(p, bool)
                        for p in pair)):
@@ -130,11 +142,11 @@ def _check_pair(setup, pair) -> tuple[int, int]:
     return check_pair(setup, i, j, f"pair {(i, j)}")
 
 
-def _study_args(fn: str, draws, seed, distribution, spec_deg, points, sigma_mm=None) -> tuple:
-    """The Monte-Carlo studies' arguments, with the CLI's ranges
-    (``analysis.tolerance.draws.check_study_args``, which ``drive_tolerance`` shares)."""
-    from .analysis.tolerance.draws import check_study_args
-    return check_study_args(fn, draws, seed, distribution, spec_deg, points, sigma_mm)
+def _study_args(fn: str, draws, seed, distribution, spec_deg, points) -> None:
+    """The Monte-Carlo studies' arguments against their one declaration
+    (``analysis.tolerance.config.STUDY_ARGS``, which the CLI's options are made from)."""
+    check_study_args(fn, draws=draws, seed=seed, distribution=distribution, spec_deg=spec_deg,
+                     points=points)
 
 
 def calibrate(scene: Scene, pair=(0, 1)):
@@ -154,14 +166,13 @@ def calibrate(scene: Scene, pair=(0, 1)):
         the sweep (``sweep_delta_tau_s``, ``sweep_error_deg``); ``to_dict()`` gives the JSON of
         ``rtsgeom calibrate``.
     """
-    from .calibration.pair import calibrate_pair
-    setup, paths, pair, probe = _pair_setup(scene, pair, "calibrate")
-    return calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
+    check_scene_arg(scene, "calibrate")
+    pair = _check_pair(_setup_paths(scene, "calibrate")[0], pair)
+    return CalibrationStudy(pair)(scene).calibration
 
 
 def _pair_setup(scene: Scene, pair, fn: str):
     """Setup, exact paths, the checked pair and each front end alone as the RuT detects it."""
-    from .calibration.probes import probe_front_ends
     setup, paths = _setup_paths(scene, fn)
     pair = _check_pair(setup, pair)
     return setup, paths, pair, probe_front_ends(setup, paths, scene.seed)
@@ -191,21 +202,17 @@ def linearity(scene: Scene, pair=(0, 1), amplitudes: str = "exact", calibration=
         ``set_deg``, ``detected_deg``, ``error_deg``, ``amplitude_db`` (2, points) and
         ``max_abs_error_deg``.
     """
-    from .calibration.pair import calibrate_pair
-    from .analysis.linearity import linearity as _linearity
-    from .scene.registry import SYNTHESIS_MODES
     check_arg(amplitudes, "amplitudes", "str", "linearity", ParameterError,
               choices=SYNTHESIS_MODES)
     check_arg(points, "points", "int", "linearity", ParameterError, lo=3, hi=1001)
+    if calibration is True or calibration is False or calibration is None:
+        check_scene_arg(scene, "linearity")
+        pair = _check_pair(build_setup(scene), pair)
+        return LinearityStudy(pair, amplitudes, bool(calibration), points)(scene)
     setup, paths, pair, probe = _pair_setup(scene, pair, "linearity")
-    if calibration is True:
-        cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
-    elif calibration is False or calibration is None:
-        cal = None
-    else:
-        cal = calibration
-        if tuple(cal.pair) != pair:
-            raise ParameterError(f"calibration is for pair {tuple(cal.pair)}, not {pair}")
+    cal = calibration
+    if tuple(cal.pair) != pair:
+        raise ParameterError(f"calibration is for pair {tuple(cal.pair)}, not {pair}")
     return _linearity(setup, paths, pair, amplitudes, probe, cal, points, scene.seed)
 
 
@@ -244,19 +251,15 @@ def tolerance(scene: Scene, pair=(0, 1), sigma_mm=(0.1, 0.1, 0.1), draws: int = 
         The scene carries mounting, channel or RuT pose errors of its own: the draws start
         from the nominal setup, not from them.
     """
-    from .analysis.tolerance import ChannelPhasors, monte_carlo
-    from .geometry import build_setup
     check_scene_arg(scene, "tolerance")
-    from .geometry.setup import warn_setup_errors
-    warn_setup_errors(scene, "tolerance")  # NominalSetupWarning
-    draws, seed, distribution, spec_deg, points, sigma = _study_args(
-        "tolerance", draws, seed, distribution, spec_deg, points, sigma_mm)
-    sigma = np.asarray(sigma)
-    setup = build_setup(scene)
-    pair = _check_pair(setup, pair)
-    model = ChannelPhasors.build(setup, pair, points)
-    return monte_carlo(model, sigma, draws, scene.seed if seed is None else seed, distribution,
-                       spec_deg)
+    _study_args("tolerance", draws, seed, distribution, spec_deg, points)
+    sigma = np.asarray(check_arg(sigma_mm, "sigma_mm", "vec", "tolerance", ParameterError,
+                                 n=3, lo=0.0, hi=MAX_SIGMA_MM, unit="mm"), float) * 1e-3
+    _check_pair(build_setup(scene), pair)
+    study = ToleranceStudy(Bounds(tuple(float(s) for s in sigma)), tuple(pair),
+                           mc=MonteCarlo(draws, seed, distribution), spec_deg=spec_deg,
+                           points=points)
+    return study(scene).run
 
 
 def design(scene: Scene, radius_m, spacing_deg, pair=(0, 1), spec_deg: float = 0.1,
@@ -284,16 +287,12 @@ def design(scene: Scene, radius_m, spacing_deg, pair=(0, 1), spec_deg: float = 0
         ``metrics[name]`` (spacings, radii) arrays for each name in
         :data:`rtsgeom.analysis.design.METRICS`, ``exceeds_resolution`` and ``to_dict()``.
     """
-    from .analysis.design import design_grid
-    from .geometry import build_setup
     check_scene_arg(scene, "design")
     _study_args("design", draws, seed, "normal", spec_deg, points)
     check_arg(target_yield, "target_yield", "float", "design", ParameterError, lo=0.0, hi=1.0,
               lo_open=True, hi_open=True)
-    pair = _check_pair(build_setup(scene), pair)
-    return design_grid(scene, pair, np.atleast_1d(radius_m), np.atleast_1d(spacing_deg),
-                       spec_deg, target_yield, draws, scene.seed if seed is None else seed,
-                       points)
+    return DesignStudy(tuple(np.atleast_1d(radius_m)), tuple(np.atleast_1d(spacing_deg)), pair,
+                       None, spec_deg, target_yield, MonteCarlo(draws, seed), points)(scene)
 
 
 def nearfield(scene: Scene, radius_m=None, points: int = 11):
@@ -311,7 +310,6 @@ def nearfield(scene: Scene, radius_m=None, points: int = 11):
     -------
     NearField
     """
-    from .analysis.nearfield import nearfield as _nearfield
     check_scene_arg(scene, "nearfield")
     check_arg(points, "points", "int", "nearfield", ParameterError, lo=1, hi=201)
     return _nearfield(scene, radius_m, points)
@@ -344,7 +342,6 @@ def transfer(scene: Scene, radars: int = 100, sigma_phase_deg: float = 5.0,
         ``error_deg`` (radars, points), ``compensated_error_deg``, ``own_error_deg``,
         ``golden_error_deg``, ``absorbed_deg``; ``to_dict()``, ``to_dataframe()``, ``plot()``.
     """
-    from .analysis.transfer import TransferStudy
     setup, paths = _setup_paths(scene, "transfer")
     return TransferStudy(radars=radars, sigma_phase_deg=sigma_phase_deg,
                          sigma_gain_db=sigma_gain_db, points=points, spec_deg=spec_deg,
@@ -366,7 +363,6 @@ def ghosts(scene: Scene, floor_db: float = -80.0, simulate: bool = False):
     -------
     GhostReport
     """
-    from .analysis.ghosts import ghost_analysis
     check_scene_arg(scene, "ghosts")
     check_arg(floor_db, "floor_db", "float", "ghosts", ParameterError, lo=-300.0, hi=-1.0,
               unit="dB")
@@ -392,11 +388,9 @@ def show(scene_or_setup, paths=None, png: str | Path | None = None,
     pathlib.Path or numpy.ndarray
         The PNG's path, or the image (H, W, 3) uint8 when ``png`` is None.
     """
-    from .geometry import Setup, build_setup
     from .viz.scene3d import render_setup_png, show_setup
     setup = scene_or_setup if isinstance(scene_or_setup, Setup) else build_setup(scene_or_setup)
     if isinstance(paths, str):
-        from .paths import compute_paths
         paths = compute_paths(setup, paths, for_drawing=True)  # reflections with hit points
     if png is not None:
         return render_setup_png(setup, png, paths=paths, window_size=window_size)
@@ -424,7 +418,6 @@ def play(scene: Scene, amplitudes: str | None = None, paths: str = "exact",
     PlaybackResult
         ``summary()``, ``to_dataframe()`` (tracks), ``programme_dataframe()``, ``plot()``.
     """
-    from .analysis.playback import play as _play
     check_scene_arg(scene, "play")
     return _play(scene, amplitudes, paths, baseline, workers)
 

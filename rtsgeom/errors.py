@@ -17,7 +17,15 @@ __all__ = ["RtsgeomError", "SceneError", "LinkError", "ParameterError", "UsageEr
 
 class RtsgeomError(Exception):
     """Base of every error below that ends a command with one line (``rtsgeom: error: ...``,
-    exit 2): the CLI catches this one class, so a new error needs no second list there."""
+    exit 2): the CLI catches this one class, so a new error needs no second list there.
+
+    Examples
+    --------
+    >>> try:
+    ...     rtsgeom.tolerance(scene, draws=0)
+    ... except rtsgeom.RtsgeomError as exc:  # every input error rtsgeom raises on purpose
+    ...     print(exc)                                               # doctest: +SKIP
+    """
 
 
 # -- input out of range (ValueError) ---------------------------------------------------------
@@ -26,7 +34,13 @@ class RtsgeomError(Exception):
 class SceneError(RtsgeomError, ValueError):
     """A scene file (or a value derived from one) is invalid. The message names the field.
 
-    ``problems`` holds every violated rule when the error came from the cross-field rules."""
+    ``problems`` holds every violated rule when the error came from the cross-field rules.
+
+    Attributes
+    ----------
+    problems : list of str
+        Every violated rule (one entry, the message, for a single field).
+    """
 
     def __init__(self, message: str, problems: list[str] | None = None):
         super().__init__(message)
@@ -38,7 +52,13 @@ class LinkError(SceneError):
 
 
 class ParameterError(RtsgeomError, ValueError):
-    """An argument (not a scene field) is outside its allowed range; the message names it."""
+    """An argument (not a scene field) is outside its allowed range; the message names it.
+
+    Examples
+    --------
+    >>> rtsgeom.MonteCarlo(draws=-1)                 # doctest: +SKIP
+    ParameterError: MonteCarlo: draws = -1: must be an integer in [0, 10000000]
+    """
 
 
 class UsageError(RtsgeomError, ValueError):
@@ -46,15 +66,33 @@ class UsageError(RtsgeomError, ValueError):
 
 
 class CaptureError(RtsgeomError, ValueError):
-    """A probe capture does not fit the scene, or its file or sidecar cannot be read."""
+    """A probe capture does not fit the scene, or its file or sidecar cannot be read.
+
+    Examples
+    --------
+    >>> rtsgeom.identify(scene, ["wrong_shape.npy"])  # doctest: +SKIP
+    CaptureError: ...: shape ... does not fit the scene's ...
+    """
 
 
 class OutputError(RtsgeomError, ValueError):
-    """An output path that cannot or must not be written (exit code 2 in the CLI)."""
+    """An output path that cannot or must not be written (exit code 2 in the CLI).
+
+    Examples
+    --------
+    An output folder that is the scene's own folder, or a file inside the inputs, is refused
+    before anything is computed (``rtsgeom._lib.io.check_output_dir``).
+    """
 
 
 class AngleUnreachable(RtsgeomError, ValueError):
-    """The set direction lies outside what the channels can synthesize."""
+    """The set direction lies outside what the channels can synthesize.
+
+    Examples
+    --------
+    A set angle beyond the pair's measured span (``ChannelModel.solve``, ``ChannelPhasors.build``)
+    raises it; the message names the angle and the span.
+    """
 
 
 class CellUnreachable(RtsgeomError, ValueError):
@@ -75,11 +113,23 @@ class ClusterError(RtsgeomError, RuntimeError):
 
 class RaytraceUnavailable(RtsgeomError, RuntimeError):
     """Sionna RT cannot run here (package missing, no usable LLVM/CUDA backend). The message
-    says what to install."""
+    says what to install.
+
+    Examples
+    --------
+    >>> rtsgeom.raytrace_paths(setup)   # doctest: +SKIP
+    RaytraceUnavailable: Sionna RT is not installed: pip install -e '.[raytrace]'
+    """
 
 
 class VizError(RtsgeomError, RuntimeError):
-    """Rendering is not possible here (no OpenGL context, no display, a missing package)."""
+    """Rendering is not possible here (no OpenGL context, no display, a missing package).
+
+    Examples
+    --------
+    >>> rtsgeom.show(scene, png="setup.png")   # doctest: +SKIP
+    VizError: no off-screen OpenGL context ...
+    """
 
 
 # -- control flow ------------------------------------------------------------------------------
@@ -99,4 +149,10 @@ class RtsgeomWarning(UserWarning):
 
 class NominalSetupWarning(RtsgeomWarning):
     """A study works on the nominal setup although the scene carries its own mounting,
-    channel or RuT pose errors (the message names the fields and what shows their effect)."""
+    channel or RuT pose errors (the message names the fields and what shows their effect).
+
+    Examples
+    --------
+    >>> import warnings
+    >>> warnings.simplefilter("error", rtsgeom.NominalSetupWarning)  # make it an error
+    """

@@ -288,9 +288,8 @@ def _calibrated_off_coherence(radius_m, fe, dr_mm):
     return setup, paths, probe, cal, (cal.delta_tau_s - point + period / 2) % period - period / 2
 
 
-# the grid's worst cases before the fix (benchmarks/calibration_grid_quick_partial.txt: 75 ps
-# off at +-0.75 mm on 0.5 and 1 m) and a 3 m arc; the full grid: python -m
-# benchmarks.calibration_grid
+# the grid's worst cases (75 ps off at +-0.75 mm on 0.5 and 1 m before the fix: CHANGELOG) and
+# a 3 m arc; the full grid: python -m benchmarks.calibration_grid
 @pytest.mark.slow
 @pytest.mark.parametrize("radius, fe, dr_mm", [(0.5, 0, 0.75), (0.5, 1, -0.75), (1.0, 0, 0.75),
                                                (1.0, 1, -0.75), (3.0, 0, -0.6), (3.0, 1, 1.0)])

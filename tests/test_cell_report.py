@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from rtsgeom.cli._maps import targets_table
+from rtsgeom.pipeline.output import targets_table
 from rtsgeom.geometry import build_setup
 from rtsgeom.pipeline.info import format_info, scene_info
 from rtsgeom.scene import load_scene

@@ -112,8 +112,8 @@ def test_command_table_matches_the_modules():
     each command's lazily built parser equals its parser in the complete one."""
     full = _subparsers(build_parser())
     listed = [(a.dest, a.help) for a in full._choices_actions]
-    assert listed == [(name, helptext) for name, (_g, helptext) in COMMANDS.items()]
-    for name, (module, _h) in COMMANDS.items():
+    assert listed == [(name, entry[1]) for name, entry in COMMANDS.items()]
+    for name, (module, *_h) in COMMANDS.items():
         prog_full = full.choices[name]
         lazy = _subparsers(build_parser(name, lazy=True))
         assert lazy.choices[name].format_help() == prog_full.format_help()

@@ -98,7 +98,7 @@ def test_netcdf(run_out):
 
 def test_other_outputs_unchanged(run_out):
     """detections.csv / summary.json keep their contract; the PNGs are still written."""
-    from rtsgeom.cli._maps import detections_csv
+    from rtsgeom.pipeline.output import detections_csv
     from rtsgeom.pipeline.run import summary
     out, result = run_out
     assert (out / "detections.csv").read_text() == detections_csv(result)
@@ -112,7 +112,7 @@ def test_the_map_files_do_not_depend_on_when_they_were_written(run_out, monkeypa
     """Two writes of one result are byte-identical in every map file: the MAT-file's header
     text carries no creation time (scipy writes ``time.asctime()`` there)."""
     import time
-    from rtsgeom.cli._maps import map_dataset, maps_arrays
+    from rtsgeom.pipeline.output import map_dataset, maps_arrays
     _, result = run_out
     ds = map_dataset(result)
     first = maps_arrays(ds)

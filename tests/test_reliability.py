@@ -90,11 +90,11 @@ def _no_leftovers(parent: Path) -> None:
 def test_failed_run_leaves_the_old_folder_untouched(tmp_path, monkeypatch, fast_run):
     out = tmp_path / "out"
     _old_folder(out)
-    import rtsgeom.cli.run as run
+    import rtsgeom.pipeline.output as output
 
     def crash(*a, **k):  # a crash in a late stage (after the CSV and JSON were written)
         raise RuntimeError("late stage crashed")
-    monkeypatch.setattr(run, "render_maps", crash)
+    monkeypatch.setattr(output, "render_maps", crash)
     with pytest.raises(RuntimeError):
         main(["run", str(DEFAULT_SCENE), "--out", str(out), "--quiet"])
     _assert_old(out)
@@ -104,11 +104,11 @@ def test_failed_run_leaves_the_old_folder_untouched(tmp_path, monkeypatch, fast_
 def test_keyboard_interrupt_leaves_the_old_folder(tmp_path, monkeypatch, fast_run):
     out = tmp_path / "out"
     _old_folder(out)
-    import rtsgeom.cli.run as run
+    import rtsgeom.pipeline.output as output
 
     def interrupted(*a, **k):
         raise KeyboardInterrupt
-    monkeypatch.setattr(run, "render_maps", interrupted)
+    monkeypatch.setattr(output, "render_maps", interrupted)
     assert main(["run", str(DEFAULT_SCENE), "--out", str(out), "--quiet"]) == 130
     _assert_old(out)
     _no_leftovers(tmp_path)
@@ -188,7 +188,7 @@ def test_sigkill_mid_run_leaves_the_old_folder_and_the_next_run_cleans_up(tmp_pa
 def test_report_embeds_this_runs_images_not_the_folders(nearest_result):
     import base64
 
-    from rtsgeom.cli._maps import render_maps, run_report_html
+    from rtsgeom.pipeline.output import render_maps, run_report_html
     maps = render_maps(nearest_result)
     html = run_report_html(nearest_result, maps, "exact", [])
     for data in maps.values():
@@ -390,7 +390,7 @@ def test_detections_csv_labels_each_detection(nearest_result):
 
     from scipy.constants import c
 
-    from rtsgeom.cli._maps import detections_csv
+    from rtsgeom.pipeline.output import detections_csv
     from rtsgeom.radar.processing import Detections
     from rtsgeom.rts.channels import KIND_GHOST, KIND_SETUP
     from rtsgeom.pipeline.run import label_detections
@@ -421,7 +421,7 @@ def test_detections_csv_labels_each_detection(nearest_result):
 
 
 def test_report_tables_are_readable(nearest_result):
-    from rtsgeom.cli._maps import run_report_html
+    from rtsgeom.pipeline.output import run_report_html
     html = run_report_html(nearest_result, {}, "exact", [])
     body = html.split("<style>")[0] + html.split("</style>")[1]
     for raw in ("True", "False", "e-06", "e-07", "f_c_hz", "range_resolution", "arc_angle",

@@ -172,7 +172,9 @@ def results(scene, tolerance_pair):
             "Transfer": _transfer(), "PlaybackResult": _playback(scene),
             "ObjectDesignResult": _object_design(), "Datasheet": _datasheet(),
             "RunResult": rtsgeom.run_scene(scene, aoa_mode="nearest"),
-            "Resolution": _resolution()}
+            "Resolution": _resolution(),
+            "ToleranceReport": _tolerance_report(scene), "CalibrationReport": _cal_report(),
+            "ArcLinearity": _arc_linearity()}
 
 
 def _resolution():
@@ -190,6 +192,25 @@ def _resolution():
                       spectra)
 
 
+def _tolerance_report(scene):
+    study = rtsgeom.ToleranceStudy(rtsgeom.Bounds((1e-4,) * 3), pair=(0, 1), points=5,
+                                   mc=rtsgeom.MonteCarlo(40, 1))
+    return study(scene)
+
+
+def _cal_report():
+    from types import SimpleNamespace
+    from rtsgeom.analysis.calibration_study import CalibrationReport
+    probe = SimpleNamespace(angle_rad=np.radians([-4.0, 4.0, 12.0]), gain_correction=np.ones(3))
+    return CalibrationReport(((0, 1), (1, 2)), (_calibration(), _calibration()), probe,
+                             "exact", "unit", arc=True)
+
+
+def _arc_linearity():
+    from rtsgeom.analysis.linearity_study import ArcLinearity
+    return ArcLinearity(((0, 1), (1, 2)), (_linearity(1), _linearity(1)), True, "exact")
+
+
 def _result_classes() -> set[str]:
     """Every class deriving from Result in the package (imported module by module)."""
     for mod in pkgutil.walk_packages(rtsgeom.__path__, "rtsgeom."):
@@ -202,7 +223,7 @@ def _result_classes() -> set[str]:
         for sub in cls.__subclasses__():
             yield sub
             yield from walk(sub)
-    return {c.__name__ for c in walk(Result)}
+    return {c.__name__ for c in walk(Result) if c.__module__.startswith("rtsgeom.")}
 
 
 def test_every_result_class_is_covered(results):

@@ -354,7 +354,7 @@ def test_user_text_in_titles_never_crashes_a_figure(tmp_path, name):
     F.save_figure(fig, tmp_path / "rd2.png")
     # the whole run with such a scene name writes its figures
     scene = make_scene(lambda doc: doc.__setitem__("name", name))
-    from rtsgeom.cli._maps import write_maps
+    from rtsgeom.pipeline.output import write_maps
     from rtsgeom.pipeline.run import run_scene
     paths = write_maps(run_scene(scene, aoa_mode="nearest"), tmp_path)
     assert all(p.stat().st_size > 1000 for p in paths)

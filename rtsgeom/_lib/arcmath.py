@@ -4,7 +4,7 @@
 A front end sits at azimuth theta and elevation epsilon (default 0: on the arc) on the sphere of
 radius R_c about the arc centre, radial unit vector ``(sin th cos el, cos th cos el, sin el)``
 (its x and z components are the direction cosines ``u`` of ``radar.steering``). Elevation 0 (or
-None) takes exactly today's arithmetic, so positions on the arc stay bit-identical.
+None) takes the arc's own arithmetic (no elevation terms), so positions on the arc are exact.
 
 Each front end is a module tangent to the arc carrying an Rx and a Tx antenna at signed offsets
 (by default the Rx towards larger azimuth, the Tx towards smaller). Mounting errors move the
@@ -107,7 +107,7 @@ def antenna_positions(centre: np.ndarray, radius_m: float, angle_rad: np.ndarray
         (tangential, positive towards larger azimuth; height).
     yaw_rad, pitch_rad : (..., F) mounting rotations of the module about its centre.
     elevation_rad : (F,) nominal elevations epsilon_q on the sphere (None or all 0: the arc,
-        today's arithmetic). The height offset and the antennas' ``h`` then run along the
+        the arc's arithmetic). The height offset and the antennas' ``h`` then run along the
         sphere's elevation direction, the radial offset along the sphere's radius.
 
     Returns
@@ -115,7 +115,7 @@ def antenna_positions(centre: np.ndarray, radius_m: float, angle_rad: np.ndarray
     rx, tx, module_centre : (..., F, 3)
     """
     if elevation_rad is not None and not np.any(np.asarray(elevation_rad, float)):
-        elevation_rad = None  # all on the arc: today's arithmetic, bit-identical
+        elevation_rad = None  # all on the arc: the arc's arithmetic, no elevation terms
     if elevation_rad is None:
         r_hat, t_hat = radial_tangent(angle_rad)
         z_hat = np.array([0.0, 0.0, 1.0])
@@ -128,7 +128,7 @@ def antenna_positions(centre: np.ndarray, radius_m: float, angle_rad: np.ndarray
     mod = (nominal + off[..., 0:1] * r_hat + off[..., 1:2] * t_hat + off[..., 2:3] * z_hat)
     simple = (rx_offset_m is None and tx_offset_m is None and yaw_rad is None
               and pitch_rad is None)
-    if simple:  # today's layout, same arithmetic (results stay bit-identical)
+    if simple:  # the symmetric layout: each antenna half the separation from the centre
         half = 0.5 * np.asarray(separation_m, float)[..., None] * t_hat
         return mod + half, mod - half, mod
     if rx_offset_m is None or tx_offset_m is None:

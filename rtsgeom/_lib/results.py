@@ -11,14 +11,22 @@ says three things:
 * ``_columns()``: equal-length columns (name -> 1-D values) of its per-item numbers, the
   table :meth:`Result.to_dataframe` returns (a :class:`pandas.DataFrame`);
 * ``plot()``: its figure (matplotlib, imported by the figure functions only).
+
+Every result writes itself in one place: :meth:`Result.to_json` (its ``to_dict()``),
+:meth:`Result.to_csv` (its table) and, where a command has an ``--out`` folder, its own
+``write(folder)`` (the files of that folder); a command only chooses which.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import html
 import math
+from pathlib import Path
 
 import numpy as np
+
+from .io import write_json, write_text
 
 __all__ = ["Result", "brief", "MAX_LINES"]
 
@@ -74,7 +82,6 @@ class Result:
     def _summary(self) -> tuple[str, list[tuple[str, object]]]:
         """(title, rows): what was studied and its headline numbers (values as they are, or
         already formatted strings)."""
-        import dataclasses
         rows = [(f.name, getattr(self, f.name)) for f in dataclasses.fields(self)]
         return type(self).__name__, rows
 
@@ -116,3 +123,14 @@ class Result:
     def plot(self):
         """The result's figure (a :class:`matplotlib.figure.Figure`)."""
         raise NotImplementedError(f"{type(self).__name__} has no figure")
+
+    def to_json(self, path: str | Path) -> Path:
+        """Write ``to_dict()`` as a JSON file (atomically); returns the path."""
+        write_json(Path(path), self.to_dict())
+        return Path(path)
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Write :meth:`to_dataframe` (one row per item) as a CSV file (atomically); returns
+        the path."""
+        write_text(Path(path), self.to_dataframe().to_csv(index=False))
+        return Path(path)

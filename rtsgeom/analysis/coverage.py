@@ -34,7 +34,7 @@ import dataclasses
 import functools
 import math
 from dataclasses import dataclass
-from typing import Callable
+from pathlib import Path
 
 import numpy as np
 
@@ -233,8 +233,18 @@ def plan_arc(scene: Scene, coverage_rad: tuple[float, float], radius_m: float,
         binding.append("near-field bias" if n > n_bare else "resolution")
     if scene.sheet.enabled and sheet == "disabled":
         binding.append("cutout fit")
+    sheet_text = _sheet_text(scene, variant, sheet, spacing, cut)
+    return ArcPlan(variant, float(radius_m), int(n), tuple(float(x) for x in np.degrees(angles)),
+                   math.degrees(spacing), math.degrees(res), math.degrees(cut),
+                   tuple(float(x) for x in np.degrees(bias)), sheet, sheet_text,
+                   tuple(binding), extra, problem)
+
+
+def _sheet_text(scene: Scene, variant: Scene, sheet: str, spacing: float, cut: float) -> str:
+    """What an arc design did to the scene's sheet (``sheet``: kept, widened, disabled), in
+    words."""
     sh = variant.sheet
-    sheet_text = {
+    return {
         "kept": "sheet kept",
         "widened": f"sheet widened to [{math.degrees(sh.angle_min_rad):.2f}, "
                    f"{math.degrees(sh.angle_max_rad):.2f}] deg",
@@ -244,10 +254,6 @@ def plan_arc(scene: Scene, coverage_rad: tuple[float, float], radius_m: float,
                      else "sheet REMOVED (its cutouts cannot hold the antennas or it would not "
                           "enclose the RuT)" if scene.sheet.enabled else "no sheet in the scene"),
     }[sheet]
-    return ArcPlan(variant, float(radius_m), int(n), tuple(float(x) for x in np.degrees(angles)),
-                   math.degrees(spacing), math.degrees(res), math.degrees(cut),
-                   tuple(float(x) for x in np.degrees(bias)), sheet, sheet_text,
-                   tuple(binding), extra, problem)
 
 
 def evaluate_arc(plan: ArcPlan, spec_deg: float = 0.1, target_yield: float = 0.95,
@@ -344,6 +350,16 @@ class CoverageDesign(Result):
                 "best": [{k: clean(v) for k, v in d.to_dict().items()}
                          for d in best_per_radius(self)]}
 
+    def write(self, folder) -> list[str]:
+        """``rtsgeom design --coverage-deg --out``: coverage_<map>.png per map of
+        :data:`COVERAGE_MAPS` and coverage.json into ``folder``; returns the names."""
+        from ..viz.figures import save_figure  # matplotlib: only where a figure is written
+        names = [f"coverage_{name}.png" for name in COVERAGE_MAPS]
+        for name, file in zip(COVERAGE_MAPS, names):
+            save_figure(self.plot(name), Path(folder) / file)
+        self.to_json(Path(folder) / "coverage.json")
+        return names + ["coverage.json"]
+
 
 def best_per_radius(grid: CoverageDesign) -> list[ArcDesign]:
     """Per radius: the fewest front ends meeting the spec after calibration (largest
@@ -371,12 +387,37 @@ def _evaluate_planned(scene: Scene, cov, spec_deg, target_yield, draws, seed, po
 
 def coverage_designs(scene: Scene, coverage_deg: tuple[float, float], radius_m,
                      spec_deg: float = 0.1, target_yield: float = 0.95, draws: int = 200,
-                     seed: int = 0, points: int = 11, extras=(0, 1),
-                     progress: Callable[[int, int], None] | None = None,
-                     workers: int | None = 1) -> CoverageDesign:
-    """Plan and evaluate the candidate arcs for every radius; ``workers`` as
-    :func:`~rtsgeom.analysis.design.design_grid` (each arc is pure: the same result however
-    they are spread)."""
+                     seed: int = 0, **options) -> CoverageDesign:
+    """Plan and evaluate the candidate arcs for every radius
+    (:class:`~.design_study.DesignStudy` with ``coverage_deg`` calls it).
+
+    Parameters
+    ----------
+    scene : Scene
+        The template scene.
+    coverage_deg : (float, float)
+        The azimuths to cover (deg).
+    radius_m : array_like
+        Arc radii (m).
+    spec_deg, target_yield, draws, seed
+        As :func:`~rtsgeom.analysis.design.design_grid`.
+    **options
+        ``points`` per pair (default 11), ``extras`` (front ends beyond the fewest, default
+        (0, 1)), ``progress(done, total)``, ``workers`` as
+        :func:`~rtsgeom.analysis.design.design_grid` (each arc is pure: the same result
+        however they are spread).
+
+    Returns
+    -------
+    CoverageDesign
+    """
+    points = options.pop("points", 11)
+    extras = options.pop("extras", (0, 1))
+    progress = options.pop("progress", None)
+    workers = options.pop("workers", 1)
+    if options:
+        raise ParameterError(f"coverage_designs: no option {', '.join(options)} (points, "
+                             "extras, progress, workers)")
     warn_setup_errors(scene, "design")
     cov = tuple(math.radians(x) for x in coverage_deg)
     radii = np.asarray(radius_m, float).ravel()

@@ -30,7 +30,7 @@ import dataclasses
 import functools
 import math
 from dataclasses import dataclass
-from typing import Callable
+from pathlib import Path
 
 import numpy as np
 
@@ -252,7 +252,17 @@ class DesignGrid(Result):
 
     ``print(grid)`` is a summary; ``to_dataframe()`` one row per design (``radius_m``,
     ``spacing_deg``, the metrics, ``exceeds_resolution``); ``plot(metric)`` one metric's map,
-    the figures of ``rtsgeom design --out``."""
+    the figures of ``rtsgeom design --out``.
+
+    Attributes
+    ----------
+    pair : (int, int)
+    radius_m, spacing_deg : arrays
+    metrics : dict
+        Name -> (spacings, radii) array, one per :data:`METRICS`.
+    exceeds_resolution : (spacings, radii) bool
+    designs : tuple of dict
+    """
 
     pair: tuple[int, int]
     centre_deg: float
@@ -342,6 +352,16 @@ class DesignGrid(Result):
             "designs": [{k: clean(v) for k, v in d.items()} for d in self.designs],
         }
 
+    def write(self, folder) -> list[str]:
+        """``rtsgeom design --out``: design_<metric>.png per metric of :data:`METRICS` and
+        design.json into ``folder``; returns the names."""
+        from ..viz.figures import save_figure  # matplotlib: only where a figure is written
+        names = [f"design_{name}.png" for name in METRICS]
+        for name, file in zip(METRICS, names):
+            save_figure(self.plot(name), Path(folder) / file)
+        self.to_json(Path(folder) / "design.json")
+        return names + ["design.json"]
+
 
 def import_for_workers() -> None:
     """Import here what every design imports on its first use (the compiled kernels: numba),
@@ -354,11 +374,35 @@ def import_for_workers() -> None:
 
 def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
                 spec_deg: float = 0.1, target_yield: float = 0.95, draws: int = 2000,
-                seed: int = 0, points: int = 21,
-                progress: Callable[[int, int], None] | None = None,
-                workers: int | None = 1) -> DesignGrid:
-    """Evaluate every (spacing, radius) design; ``progress(done, total)`` after each.
+                seed: int = 0, **options) -> DesignGrid:
+    """Evaluate every (spacing, radius) design (:class:`~.design_study.DesignStudy` calls it).
 
+    Parameters
+    ----------
+    scene : Scene
+        The template (radar, sheet, RTS); the pair's centre angle is kept.
+    pair : tuple of 2 int
+    radius_m, spacing_deg : array_like
+        Arc radii (m) and front-end spacings (deg).
+    spec_deg, target_yield : float
+        The tolerance per design keeps ``target_yield`` of the setups within ``spec_deg``.
+    draws, seed : int
+        Monte-Carlo draws per tolerance search and their seed.
+    **options
+        ``points`` (set-points per design, default 21), ``progress(done, total)`` after each
+        design, ``workers`` (default 1).
+
+    Returns
+    -------
+    DesignGrid
+
+    Raises
+    ------
+    ParameterError
+        A scene of 2-D cells (:func:`check_azimuth_arc`).
+
+    Notes
+    -----
     ``workers`` > 1: the designs in a pool of that many processes (each design is pure: the
     same result, in the same order, however they are spread); None: as many as this process
     may run on (``parallel.available_cores``; ``rtsgeom design``'s default; one process on one
@@ -370,6 +414,12 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     whose composite splits costs one build. The forked workers each load the compiled
     kernels once (~0.3 s CPU each) and keep the memory they free
     (``parallel.retain_freed_memory``)."""
+    points = options.pop("points", 21)
+    progress = options.pop("progress", None)
+    workers = options.pop("workers", 1)
+    if options:
+        raise ParameterError(f"design_grid: no option {', '.join(options)} (points, progress, "
+                             "workers)")
     check_azimuth_arc(scene)
     warn_setup_errors(scene, "design")
     radii = np.asarray(radius_m, float).ravel()

@@ -20,6 +20,7 @@ loss of each peak), and the peak of the range spectrum zoomed off the bin grid a
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy.constants import c
@@ -193,7 +194,17 @@ def measure_ghosts(result, predicted: list[dict]) -> list[dict]:
 class GhostReport(Result):
     """Predicted (and simulated) cable ghosts. ``print(rep)`` is a summary;
     ``to_dataframe()`` one row per (target, ghost order); ``plot()`` the figure of
-    ``rtsgeom ghosts --out``."""
+    ``rtsgeom ghosts --out``.
+
+    Attributes
+    ----------
+    scene : Scene
+    floor_db : float
+    front_ends, targets : list of dict
+        The predicted ghosts per front end and per target.
+    simulated : list of dict or None
+        Each ghost as read in the simulated range-Doppler map (``simulate``).
+    """
 
     scene: Scene
     floor_db: float
@@ -231,6 +242,14 @@ class GhostReport(Result):
     def plot(self, title: str = ""):
         """Per target, its range profile with the predicted (and simulated) ghosts."""
         return ghosts_figure(self, title)
+
+    def write(self, folder) -> list[str]:
+        """``rtsgeom ghosts --out``: ghosts.json and ghosts.png into ``folder``; returns the
+        names."""
+        from ..viz.figures import save_figure  # matplotlib: only where a figure is written
+        self.to_json(Path(folder) / "ghosts.json")
+        save_figure(self.plot(), Path(folder) / "ghosts.png")
+        return ["ghosts.json", "ghosts.png"]
 
     def to_dict(self) -> dict:
         r = self.scene.radar

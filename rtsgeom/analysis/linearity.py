@@ -6,6 +6,7 @@ detected on the simulated RuT output (the full ADC-cube chain)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy.spatial import Delaunay
@@ -36,7 +37,16 @@ class Linearity(Result):
     """Set and detected directions (deg) of the synthesized targets: (P,) azimuths of a pair,
     or (P, 2) (azimuth, elevation) over a cell (NaN: not detected). ``print(lin)`` is a
     summary; ``to_dataframe()`` one row per set-point; ``plot()`` the figure of
-    ``rtsgeom linearity --out``."""
+    ``rtsgeom linearity --out``.
+
+    Attributes
+    ----------
+    mode : str
+    calibrated : bool
+    set_deg, detected_deg : (P,) or (P, 2) float
+    amplitude_db : (Q, P) float, optional
+    channels : tuple of int
+    """
 
     mode: str
     calibrated: bool
@@ -120,6 +130,16 @@ class Linearity(Result):
         from ..viz.figures import linearity_figure  # matplotlib: only for the figure
         return linearity_figure(self.set_deg, {self.mode: self.detected_deg},
                                 {self.mode: self.amplitude_db}, pair=self.channels)
+
+    def write(self, folder) -> list[str]:
+        """``rtsgeom linearity --out``: linearity.png and linearity.json (a pair's), or
+        linearity_grid.png and linearity_grid.json (a cell's) into ``folder``; returns the
+        names."""
+        from ..viz.figures import save_figure  # matplotlib: only where a figure is written
+        stem = "linearity" if self.dims == 1 else "linearity_grid"
+        save_figure(self.plot(), Path(folder) / f"{stem}.png")
+        self.to_json(Path(folder) / f"{stem}.json")
+        return [f"{stem}.png", f"{stem}.json"]
 
 
 def linearity(setup: Setup, paths: Paths, channels=None, mode: str = "exact",

@@ -58,6 +58,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -116,7 +117,17 @@ def with_arc_radius(scene: Scene, radius_m: float) -> Scene:
 class NearField(Result):
     """Near-field figures of merit over arc radius (arrays (R, F) unless noted, degrees).
     ``print(nf)`` is a summary; ``to_dataframe()`` one row per (radius, front end);
-    ``plot()`` the figure of ``rtsgeom nearfield --out``."""
+    ``plot()`` the figure of ``rtsgeom nearfield --out``.
+
+    Attributes
+    ----------
+    radius_m : (R,) float
+    geometric_deg, detected_deg : (R, F) float
+        Each front end's geometric and detected azimuth per radius.
+    synthesis : list
+        The synthesized-angle errors per radius.
+    fraunhofer_m : float
+    """
 
     scene: Scene
     radius_m: np.ndarray  # (R,)
@@ -210,6 +221,14 @@ class NearField(Result):
     def plot(self, title: str = ""):
         """The bias and its parts over arc radius, the phase errors and the synthesis."""
         return nearfield_figure(self, title)
+
+    def write(self, folder) -> list[str]:
+        """``rtsgeom nearfield --out``: nearfield.json and nearfield.png into ``folder``; returns the
+        names."""
+        from ..viz.figures import save_figure  # matplotlib: only where a figure is written
+        self.to_json(Path(folder) / "nearfield.json")
+        save_figure(self.plot(), Path(folder) / "nearfield.png")
+        return ["nearfield.json", "nearfield.png"]
 
     def to_dict(self) -> dict:
         fl = lambda a: [float(x) for x in a]  # noqa: E731

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -86,7 +87,16 @@ def draw_channel_gains(rut, radars: int, sigma_phase_rad: float, sigma_gain_db: 
 class Transfer(Result):
     """The study's result: per set-point (P,) over every pair, per radar draw (B, P).
     ``print(res)`` is a summary, ``to_dict()`` the JSON, ``to_dataframe()`` one row per
-    (radar, set-point), ``plot()`` the error over the arc."""
+    (radar, set-point), ``plot()`` the error over the arc.
+
+    Attributes
+    ----------
+    pairs : tuple of (int, int)
+    set_deg : (P,) float
+    error_deg, compensated_error_deg, own_error_deg : (B, P) float
+    golden_error_deg : (P,) float
+    offset_shift_ps : tuple of float
+    """
 
     pairs: tuple[tuple[int, int], ...]
     pair_index: np.ndarray  # (P,) which pair synthesizes each set-point
@@ -150,6 +160,14 @@ class Transfer(Result):
             if percentiles(err)["p95"] <= spec:
                 return name
         return "radar"
+
+    def write(self, folder) -> list[str]:
+        """``rtsgeom transfer --out``: transfer.json and transfer.png into ``folder``; returns the
+        names."""
+        from ..viz.figures import save_figure  # matplotlib: only where a figure is written
+        self.to_json(Path(folder) / "transfer.json")
+        save_figure(self.plot(), Path(folder) / "transfer.png")
+        return ["transfer.json", "transfer.png"]
 
     def to_dict(self) -> dict:
         return {
@@ -229,7 +247,20 @@ class TransferStudy:
     ``sigma_phase_deg`` / ``sigma_gain_db``: the spread of each antenna's phase / gain error
     over radars of the type; ``points``: set-points across each pair's span (ends excluded);
     ``pairs``: the pairs (default every adjacent pair of the arc); ``spec_deg``: the angle
-    spec the verdict is for; ``seed``: the draws' (and the calibration's noise)."""
+    spec the verdict is for; ``seed``: the draws' (and the calibration's noise).
+
+    Parameters
+    ----------
+    radars : int
+        Radars drawn.
+    sigma_phase_deg, sigma_gain_db : float
+        Spread of each antenna's phase and gain error.
+    points : int
+        Set-points across each pair's span.
+    spec_deg : float, optional
+        The angle spec of the verdict.
+    seed : int
+    """
 
     radars: int = 100
     sigma_phase_deg: float = 5.0

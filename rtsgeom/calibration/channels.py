@@ -37,11 +37,9 @@ __all__ = ["ChannelCalibration", "calibrate_channels", "pair_edges", "spanning_t
            "tree_phases", "channel_offsets", "LOOP_CLOSURE_TOL_S"]
 
 # A loop of pair calibrations closes to within this (wrapped to one period), or the
-# calibration is reported as failed, naming the loop's pair: sphere4's loops close to 0 to 5
-# ps with the frames per step sized (3 seeds; also with 180 deg on a front end and the front
-# ends at +-3 deg), 2 to 25 ps with one frame a step (the elevation pairs' fits scatter ~10
-# ps; 37 / 41 ps at +-3 deg); 29 and 37 ps before the 2-D fit was the 1-D one (run's
-# elevation errors up to 0.10 deg against <= 0.03 deg).
+# calibration is reported as failed, naming the loop's pair. It bounds the scatter of the
+# pairs' fits: on the bundled 2-D scene the loops close to 0-5 ps with the frames per step
+# sized, 2-25 ps with one frame a step (the elevation pairs' fits scatter ~10 ps).
 LOOP_CLOSURE_TOL_S = 25e-12
 
 
@@ -135,11 +133,10 @@ def calibrate_channels(setup, paths, channels, probe, seed=None, progress=None,
         i, j = min(p, q), max(p, q)
         d = meas[(i, j)].delta_tau_s  # j relative to i
         offsets[q] = offsets[p] + (d if q == j else -d)
-    # Each channel's offset to the period nearest zero: the pair delays add up along the
-    # tree to beyond half a period (sphere4 with 180 deg on front end 1: channel 3 at -984
-    # ps, its echo a whole range bin (15 cm) from the others, and the cell no longer
-    # synthesized (5, 3) deg); one period is the same phase at the probes' range (at another
-    # range, 0.6 % of a turn per period at 40 m: what any calibration offset costs there).
+    # Each channel's offset to the period nearest zero: the pair delays can add up along the
+    # tree to beyond half a period, which would put a channel's echo a range bin from the
+    # others; one period is the same phase at the probes' range (at another range it costs
+    # 0.6 % of a turn per period at 40 m, as any calibration offset does).
     per = float(np.median([m.period_s for m in meas.values()]))
     offsets = offsets - per * np.round(offsets / per)
     on_tree = {tuple(sorted(e)) for e in tree_edges}

@@ -122,7 +122,19 @@ class Calibration(Result):
 
     ``print(cal)`` is a summary; ``to_dataframe()`` the sweep (one row per evaluated delay:
     ``stage`` coarse or fine, ``delta_tau_ps``, ``angle_error_deg``); ``plot()`` the figure
-    of ``rtsgeom calibrate --out``."""
+    of ``rtsgeom calibrate --out``.
+
+    Attributes
+    ----------
+    pair : tuple of int
+    delta_tau_s : float
+        The delay offset of channel J (eq. 27's coherence point).
+    residual_error_deg : float
+    range_offset_m : float
+    period_s : float
+    sweep_delta_tau_s, sweep_error_deg : arrays
+        The coarse sweep.
+    """
 
     pair: tuple[int, int]
     delta_tau_s: float  # delay offset of J relative to I (what the RTS can set)

@@ -25,8 +25,9 @@ __all__ = ["main", "build_parser"]
 #: imports only the module of the command it runs (the modules import numpy, scipy, the signal
 #: chain), so ``rtsgeom --help`` and ``rtsgeom info`` start without the heavy libraries; the
 #: other commands are listed from this table. ``tests/test_lazy_cli.py`` checks it against what
-#: the modules register.
-COMMANDS: dict[str, tuple[str, str]] = {
+#: the modules register. A study whose command is made from its config is one line here:
+#: ``"name": ("study", "help", "rtsgeom.analysis.module:NameStudy")`` (``cli/study.py``).
+COMMANDS: dict[str, tuple[str, ...]] = {
     "info": ("info", "summary of a scene: elements, front ends, far-field figures"),
     "paths": ("paths", "per-element propagation paths as CSV"),
     "export-mesh": ("export_mesh", "export the setup as GLB/PLY/OBJ/STL"),
@@ -54,8 +55,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
                    "spec"),
 }
 
-#: the modules that register commands, in the table's order
-_MODULES = tuple(dict.fromkeys(module for module, _help in COMMANDS.values()))
+
+def _modules() -> tuple[str, ...]:
+    """The modules that register commands, in the table's order."""
+    return tuple(dict.fromkeys(entry[0] for entry in COMMANDS.values()))
 
 
 class _Parser(argparse.ArgumentParser):
@@ -81,7 +84,7 @@ def build_parser(command: str | None = None, *, lazy: bool = False) -> argparse.
     ap.add_argument("--version", action="version", version=f"rtsgeom {__version__}")
     sub = ap.add_subparsers(dest="command", metavar="COMMAND", required=True)
     if not lazy or (command is not None and command not in COMMANDS):
-        modules = _MODULES  # complete, or a word the table does not know: let every module try
+        modules = _modules()  # complete, or a word the table does not know: every module tries
     else:
         modules = (COMMANDS[command][0],) if command is not None else ()
     for name in modules:
@@ -92,9 +95,9 @@ def build_parser(command: str | None = None, *, lazy: bool = False) -> argparse.
                 raise
             continue
         mod.register(sub)
-    for cmd, (_module, helptext) in COMMANDS.items():  # the commands not registered above
+    for cmd, entry in COMMANDS.items():  # the commands not registered above
         if cmd not in sub.choices:
-            sub.add_parser(cmd, help=helptext, add_help=False)
+            sub.add_parser(cmd, help=entry[1], add_help=False)
     # list the commands in the table's order whichever module registered first (argparse keeps
     # the help lines in registration order; no public API reorders them)
     order = list(COMMANDS)

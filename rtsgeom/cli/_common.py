@@ -14,6 +14,7 @@ import argparse
 import json
 import math
 import os
+import re
 import sys
 import time
 import warnings
@@ -21,15 +22,15 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .._lib.io import check_output_file, staged_dir, write_json
-from ..errors import ParameterError, UsageError
+from ..errors import ParameterError, RtsgeomWarning, UsageError
 from ._signals import raise_received
 
 __all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checked", "steps",
            "output_path", "output_file_path", "output_folder", "output_file",
            "warn_scene_errors", "show_warning",
-           "pair_word", "pair_of", "pairs_of", "pair_options", "prepare_pair", "prepare_arc",
-           "emit_result", "write_outputs", "print_outputs", "progress", "study_options",
-           "read_calibration", "calibration_kw"]
+           "pair_word", "pair_of", "pair_options", "print_outputs", "progress", "study_options",
+           "declared_option",
+           "read_calibration", "calibration_kw", "flag_words"]
 
 
 def number(lo=None, hi=None, integer=False):
@@ -46,6 +47,20 @@ def number(lo=None, hi=None, integer=False):
             raise argparse.ArgumentTypeError(f"{text} is outside the allowed range [{lo}, {hi}]")
         return v if integer else v + 0.0  # -0 reads as 0 (numpy refuses a scale of -0.0)
     return parse
+
+
+def flag_words(message: str, args: dict) -> str:
+    """A library error in the words of the command line: the argument names before its first
+    ``': '`` that are options of the command (``args``: the parsed namespace's dict) as their
+    flags (``verify`` -> ``--verify``, ``invert_yield`` -> ``--invert-yield``)."""
+    head, sep, tail = message.partition(": ")
+    if not sep:
+        return message
+    names = {k for k in args if k not in ("scene", "func", "command")}
+
+    def flag(m):
+        return "--" + m.group(0).replace("_", "-") if m.group(0) in names else m.group(0)
+    return re.sub(r"(?<![-\w./])[a-z][a-z_]*\b(?![-/.])", flag, head) + sep + tail
 
 
 def output_path(text: str) -> Path:
@@ -157,7 +172,6 @@ def warn_scene_errors(scene, command: str, what: str | None = None) -> None:
 def show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     """``warnings.showwarning`` of the commands: rtsgeom's own warnings as
     ``rtsgeom: warning: <message>`` on stderr, any other as Python prints it."""
-    from ..errors import RtsgeomWarning
     if issubclass(category, RtsgeomWarning):
         print(f"rtsgeom: warning: {message}", file=sys.stderr)
     else:
@@ -172,22 +186,6 @@ def pair_word(text: str):
     if text == "all":
         return text
     return number(0, 10_000, integer=True)(text)
-
-
-def pairs_of(setup, pair, cells: bool = False) -> list[tuple[int, int]]:
-    """``--pair I J`` as one pair, or ``--pair all``: every adjacent pair of the arc (with
-    ``cells``, every measured pair of a 2-D scene's cells: ``pipeline.plan.measured_pairs``)."""
-    if list(pair) == ["all"]:
-        n = setup.fe.count
-        if n < 2:
-            raise UsageError("--pair all: the arc needs at least two front ends")
-        from ..pipeline.plan import measured_pairs, uses_cells
-        if uses_cells(setup.scene):
-            if not cells:
-                pair_of(setup, (0, 1))  # the error that says what a 2-D scene takes instead
-            return measured_pairs(setup)
-        return [(i, i + 1) for i in range(n - 1)]
-    return [pair_of(setup, pair, cells)]
 
 
 def pair_of(setup, pair, cells: bool = False):
@@ -221,67 +219,11 @@ def pair_options(p: argparse.ArgumentParser) -> None:
                         "rts.fractional_delay_filter)")
 
 
-def prepare_pair(args, cells: bool = False):
-    """``--pair I J``: scene (with ``--fir`` applied), setup, the pair, exact paths and each
-    front end alone as the RuT detects it (``cells``: :func:`pair_of`)."""
-    from ..calibration.probes import probe_front_ends
-    from ..geometry import build_setup
-    from ..paths import exact_paths
-    scene = _with_fir(load_scene_checked(args.scene), args)
-    setup = build_setup(scene)
-    pair = pair_of(setup, args.pair, cells)
-    paths = exact_paths(setup)
-    return scene, setup, pair, paths, probe_front_ends(setup, paths, scene.seed)
-
-
-def _with_fir(scene, args):
-    """The scene with ``--fir`` (the fractional-delay filter model) where it is given."""
-    if getattr(args, "fir", None):
-        scene = scene.evolve(rts=scene.rts.evolve(fractional_delay_filter=args.fir))
-    return scene
-
-
-def prepare_arc(args, cells: bool = False):
-    """``--pair all``: scene, setup, every adjacent pair (``cells``: :func:`pairs_of`), exact
-    paths, each front end alone."""
-    from ..calibration.probes import probe_front_ends
-    from ..geometry import build_setup
-    from ..paths import exact_paths
-    scene = _with_fir(load_scene_checked(args.scene), args)
-    setup = build_setup(scene)
-    pairs = pairs_of(setup, args.pair, cells)
-    paths = exact_paths(setup)
-    return scene, setup, pairs, paths, probe_front_ends(setup, paths, scene.seed)
-
-
 # -- writing and printing a result ------------------------------------------------------------
-
-def emit_result(args, stage, png: str, name: str, out: dict, figure, summary_line: str) -> None:
-    """``--out DIR``: <png> (from ``figure()``) and <name>.json into the staging folder
-    ``stage`` (swapped in as DIR when the command ends); then JSON or one summary line on
-    stdout."""
-    if stage is not None:
-        from ..viz.figures import save_figure
-        save_figure(figure(), stage / png)
-        write_json(stage / f"{name}.json", out)
-    if args.json:
-        print_json(out)
-    else:
-        print(summary_line)
-
-
-def write_outputs(stage, name: str, out: dict, figure) -> None:
-    """Write ``NAME.json`` and ``NAME.png`` (``figure()``) into the staging folder of
-    ``--out`` (None: nothing)."""
-    if stage is not None:
-        from ..viz.figures import save_figure
-        write_json(stage / f"{name}.json", out)
-        save_figure(figure(), stage / f"{name}.png")
-
 
 def print_outputs(args, name: str, out: dict, text) -> int:
     """Print the JSON (``--json``) or ``text(out)`` once the output folder is in place, and
-    the files :func:`write_outputs` wrote."""
+    the files the result's ``write(folder)`` wrote (NAME.json, NAME.png)."""
     if args.json:
         print_json(out)
     else:
@@ -352,9 +294,27 @@ class LineProgress:
 
 # -- the Monte-Carlo studies: tolerance and design ---------------------------------------------
 
-def study_options(p, draws_default: int, allow_all: bool = False) -> None:
+def declared_option(p, name: str, arg, default, default_text: str | None = None, **kw) -> None:
+    """``--name`` (underscores as dashes) made from a declared argument ``arg`` (kind, range or
+    choices, help: ``analysis.tolerance.config.Arg``): its type checks the range and names it,
+    its help states the range and the default."""
+    def num(v):
+        return str(int(v)) if arg.kind == "int" or float(v).is_integer() else f"{v:g}"
+    if arg.choices is not None:
+        kw.setdefault("choices", arg.choices)
+        span = ""
+    else:
+        kw.setdefault("type", number(arg.lo, arg.hi, integer=arg.kind == "int"))
+        span = f", in [{num(arg.lo)}, {num(arg.hi)}]" if arg.lo is not None else ""
+    shown = default_text if default_text is not None else default
+    p.add_argument(f"--{name.replace('_', '-')}", default=default,
+                   help=f"{arg.help}{span} (default {shown})", **kw)
+
+
+def study_options(p, declared: dict, draws_default: int, allow_all: bool = False) -> None:
     """The scene and the options ``tolerance`` and ``design`` share (``allow_all``:
-    ``--pair I J | all``, else exactly two indices)."""
+    ``--pair I J | all``, else exactly two indices); ``declared``: the studies' arguments
+    (``analysis.tolerance.config.STUDY_ARGS``), each option made from its declaration."""
     scene_arg(p)
     if allow_all:
         p.add_argument("--pair", nargs="+", type=pair_word, metavar="I J | all",
@@ -363,14 +323,10 @@ def study_options(p, draws_default: int, allow_all: bool = False) -> None:
     else:
         p.add_argument("--pair", nargs=2, type=number(0, 10_000, integer=True),
                        metavar=("I", "J"), default=[0, 1], help="adjacent front ends (default 0 1)")
-    p.add_argument("--spec-deg", type=number(1e-6, 90.0), default=0.1,
-                   help="angle-error spec in deg, in [1e-6, 90] (default 0.1)")
-    p.add_argument("--draws", type=number(1, 10_000_000, integer=True), default=draws_default,
-                   help=f"Monte-Carlo draws, in [1, 10000000] (default {draws_default})")
-    p.add_argument("--seed", type=number(0, 2 ** 63 - 1, integer=True), default=None,
-                   help="random seed (default: the scene's seed)")
-    p.add_argument("--points", type=number(3, 201, integer=True), default=21,
-                   help="set-points across the span, ends excluded, in [3, 201] (default 21)")
+    declared_option(p, "spec_deg", declared["spec_deg"], 0.1)
+    declared_option(p, "draws", declared["draws"], draws_default)
+    declared_option(p, "seed", declared["seed"], None, "the scene's seed")
+    declared_option(p, "points", declared["points"], 21)
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--out", type=output_path, default=None, help="folder for the plots and JSON")
     p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")

@@ -7,15 +7,12 @@ from __future__ import annotations
 import numpy as np
 
 from .._lib.io import write_json
+from ..analysis.calibration_study import PROCEDURES, CalibrationStudy
 from ..calibration.file import setup_fingerprint
-from ..calibration.fir import fir_effect
-from ..calibration.pair import calibrate_pair
-from ..calibration.paper import calibrate_pair_paper
-from ..errors import UsageError
+from ..errors import ParameterError, UsageError
 from ..geometry import build_setup
-from ..pipeline.plan import uses_cells
-from ._common import (emit_result, load_scene_checked, output_folder, output_path, pair_of,
-                      pair_options, prepare_arc, prepare_pair, print_json, steps)
+from ._common import (flag_words, load_scene_checked, output_folder, output_path, pair_of,
+                      pair_options, print_json, steps)
 
 
 def cmd_calibrate(args) -> int:
@@ -69,89 +66,46 @@ def _from_identified(args) -> dict:
     return out
 
 
+def study_of(args, step=None) -> CalibrationStudy:
+    """The :class:`~rtsgeom.analysis.calibration_study.CalibrationStudy` the flags ask for."""
+    pair = "all" if list(args.pair) == ["all"] else tuple(args.pair)
+    return CalibrationStudy(pair, args.procedure, args.full_chain, args.fir, step)
+
+
 def _calibrate(args, stage) -> int:
-    if list(args.pair) == ["all"]:
-        return _calibrate_arc(args, stage)
     with steps(args.quiet or args.json) as step:
-        step("measuring each front end alone")
-        scene, setup, pair, paths, probe = prepare_pair(args, cells=True)
-        if args.procedure == "paper" and uses_cells(scene):
-            raise UsageError("--procedure paper: the paper's sweep is a pair on an arc (one set "
-                             "angle in azimuth); this scene's front ends form 2-D cells")
-        step(f"sweeping the delay of front end {pair[1]} on the simulated radar "
-             f"({args.procedure} procedure)")
-        if args.procedure == "paper":
-            cal = calibrate_pair_paper(setup, paths, pair, probe, seed=scene.seed)
-        else:
-            cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed,
-                                 full_chain=args.full_chain)
-    out = cal.to_dict()
-    out["procedure"] = args.procedure
-    out["front_end_angles_deg"] = [float(x) for x in np.degrees(probe.angle_rad)]
-    out["gain_correction"] = [float(x) for x in probe.gain_correction]
-    out["format"] = "rtsgeom-calibration"  # `run/adc --calibration DIR/calibration.json`
-    out["setup_sha256"] = setup_fingerprint(scene)  # run/adc warn when used on another setup
-    out["fractional_delay_filter"] = fir_effect(setup, cal.delta_tau_s,
-                                                ranges=cal.probe_ranges_m)
-
-    def figure():
-        return cal.plot(sweep_title(scene, pair))
-    emit_result(args, stage, "calibration_sweep.png", "calibration", out, figure,
-                f"pair {pair}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps (set in "
-                f"{cal.delay_resolution_s * 1e12:g} ps steps; the fit's optimum "
-                f"{cal.quantisation_residual_s * 1e12:+.2f} ps from it), residual angle error "
-                f"{cal.residual_error_deg:.4f} deg, range offset "
-                f"{cal.range_offset_m * 1e3:.2f} mm (period {cal.period_s * 1e9:.4f} ns); "
-                "fractional-delay filter "
-                f"{out['fractional_delay_filter']['model']}: phase ripple over the IF sweep "
-                f"{out['fractional_delay_filter']['phase_ripple_deg']:.3f} deg p-p, moves the "
-                f"coherence point by {out['fractional_delay_filter']['predicted_shift_ps']:+.2f} ps")
-    return 0
-
-
-def _calibrate_arc(args, folder) -> int:
-    """``--pair all``: every adjacent pair calibrated in one run; one JSON entry per pair plus
-    the arc's. ``folder``: where the ``--out`` files go (None: no ``--out``)."""
-    with steps(args.quiet or args.json) as step:
-        step("measuring each front end alone")
-        scene, setup, pairs, paths, probe = prepare_arc(args, cells=True)
-        if args.procedure == "paper" and uses_cells(scene):
-            raise UsageError("--procedure paper: the paper's sweep is a pair on an arc (one set "
-                             "angle in azimuth); this scene's front ends form 2-D cells")
-        cals = []
-        for pair in pairs:
-            step(f"sweeping the delay of front end {pair[1]} (pair {pair})")
-            cals.append(calibrate_pair_paper(setup, paths, pair, probe, seed=scene.seed)
-                        if args.procedure == "paper" else
-                        calibrate_pair(setup, paths, pair, probe, seed=scene.seed,
-                                       full_chain=args.full_chain))
-    res = np.abs([c.residual_error_deg for c in cals])  # inf: a probe the chain missed
-    worst = int(np.argmax(np.where(np.isnan(res), np.inf, res)))
-    out = {"pairs": [dict(c.to_dict(), procedure=args.procedure) for c in cals],
-           "gain_correction": [float(x) for x in probe.gain_correction],
-           "front_end_angles_deg": [float(x) for x in np.degrees(probe.angle_rad)],
-           "arc": {"pairs": [list(p) for p in pairs],
-                   "worst_residual_error_deg": (float(res[worst]) if np.isfinite(res[worst])
-                                                else None),
-                   "worst_pair": list(pairs[worst]),
-                   "max_abs_range_offset_mm": max(abs(c.range_offset_m) for c in cals) * 1e3},
-           "format": "rtsgeom-calibration", "setup_sha256": setup_fingerprint(scene)}
-    if folder is not None:
-        from ..viz.figures import save_figure
-        for pair, cal in zip(pairs, cals):
-            save_figure(cal.plot(sweep_title(scene, pair)),
-                        folder / f"calibration_sweep_{pair[0]}_{pair[1]}.png")
-        write_json(folder / "calibration.json", out)
+        try:
+            report = study_of(args, step)(load_scene_checked(args.scene))
+        except ParameterError as exc:
+            raise UsageError(flag_words(str(exc), vars(args))) from None
+    if stage is not None:
+        report.write(stage)
+    out = report.to_dict()
     if args.json:
         print_json(out)
-        return 0
-    for pair, cal in zip(pairs, cals):
+    elif report.arc:
+        _print_arc(report)
+    else:
+        cal, fir = report.calibration, out["fractional_delay_filter"]
+        print(f"pair {report.pairs[0]}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps (set in "
+              f"{cal.delay_resolution_s * 1e12:g} ps steps; the fit's optimum "
+              f"{cal.quantisation_residual_s * 1e12:+.2f} ps from it), residual angle error "
+              f"{cal.residual_error_deg:.4f} deg, range offset "
+              f"{cal.range_offset_m * 1e3:.2f} mm (period {cal.period_s * 1e9:.4f} ns); "
+              f"fractional-delay filter {fir['model']}: phase ripple over the IF sweep "
+              f"{fir['phase_ripple_deg']:.3f} deg p-p, moves the coherence point by "
+              f"{fir['predicted_shift_ps']:+.2f} ps")
+    return 0
+
+
+def _print_arc(report) -> None:
+    """``--pair all``: one line per pair, then the worst."""
+    for pair, cal in zip(report.pairs, report.calibrations):
         print(f"pair {pair}: delta_tau {cal.delta_tau_s * 1e12:.1f} ps, residual angle error "
               f"{cal.residual_error_deg:.4f} deg, range offset {cal.range_offset_m * 1e3:.2f} mm")
-    where = "cells" if uses_cells(scene) else "arc"
-    print(f"{where} ({len(pairs)} pairs): worst residual {res[worst]:.4f} deg (pair "
-          f"{tuple(out['arc']['worst_pair'])})")
-    return 0
+    worst = report.worst()
+    print(f"{'cells' if report.cells else 'arc'} ({len(report.pairs)} pairs): worst residual "
+          f"{report.residuals_deg()[worst]:.4f} deg (pair {tuple(report.pairs[worst])})")
 
 
 def sweep_title(scene, pair) -> str:
@@ -163,7 +117,7 @@ def sweep_title(scene, pair) -> str:
 def register(sub) -> None:
     p = sub.add_parser("calibrate", help="phase calibration sweep of a front-end pair")
     pair_options(p)
-    p.add_argument("--procedure", choices=("exact", "paper"), default="exact",
+    p.add_argument("--procedure", choices=PROCEDURES, default="exact",
                    help="exact: two probes, amplitudes re-designed at every step, "
                         "refined to the delay resolution (default); paper: the "
                         "paper's sweep as written (fixed eq. 23 amplitudes, one set "

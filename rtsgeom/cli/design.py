@@ -10,13 +10,13 @@ import sys
 
 import numpy as np
 
-from .._lib.io import write_json
-from ..analysis.coverage import COVERAGE_MAPS, best_per_radius, coverage_designs
-from ..analysis.design import METRICS, check_azimuth_arc, design_grid
+from ..analysis.coverage import best_per_radius
+from ..analysis.design_study import DesignStudy
+from ..analysis.tolerance import MonteCarlo
+from ..analysis.tolerance.config import STUDY_ARGS
 from ..errors import ParameterError, UsageError
-from ..geometry import build_setup
-from ._common import (load_scene_checked, number, output_folder, pair_of, print_json, progress,
-                      study_options)
+from ._common import (flag_words, load_scene_checked, number, output_folder, print_json,
+                      progress, study_options)
 
 
 def _grid_spec(lo: float, hi: float, unit: str, max_n: int = 50):
@@ -52,52 +52,45 @@ def coverage_spec(text: str) -> tuple[float, float]:
     return a, b
 
 
+def study_of(args, report=None) -> DesignStudy:
+    """The :class:`~rtsgeom.analysis.design_study.DesignStudy` the flags ask for."""
+    mc = None
+    if args.draws is not None or args.seed is not None or report is not None:
+        draws = args.draws or (300 if args.coverage_deg is not None else 2000)
+        mc = MonteCarlo(draws, args.seed, progress=report)
+    return DesignStudy(tuple(args.radius_m), tuple(args.spacing_deg), tuple(args.pair),
+                       args.coverage_deg, args.spec_deg, args.yield_, mc, args.points,
+                       args.workers)
+
+
 def cmd_design(args) -> int:
     scene = load_scene_checked(args.scene)  # the studies warn of the scene's own errors
     with output_folder(args.out, [args.scene]) as stage:
-        return _design(args, scene, stage)
-
-
-def _design(args, scene, stage) -> int:
-    try:  # an arc of pairs in azimuth only (the grid and --coverage-deg alike)
-        check_azimuth_arc(scene, f"design {args.scene}")
-    except ParameterError as exc:
-        raise UsageError(str(exc)) from None
+        n = len(scene.rts.front_ends)
+        i, j = sorted(args.pair)
+        if args.coverage_deg is None and n > 2 and j == i + 1 < n and not args.quiet:
+            others = ", ".join(f"{k} {k + 1}" for k in range(n - 1) if k != i)
+            print(f"rtsgeom: note: design studies the pair {(i, j)} of the scene's {n} front "
+                  f"ends (its centre angle, spacing and radius varied); --pair I J for another "
+                  f"adjacent pair ({others}), --coverage-deg A:B for the whole arc",
+                  file=sys.stderr)
+        with progress(args.quiet) as report:
+            try:
+                grid = study_of(args, report)(scene)
+            except ParameterError as exc:
+                raise UsageError(flag_words(str(exc), vars(args))) from None
+        if stage is not None:
+            grid.write(stage)
     if args.coverage_deg is not None:
-        return _design_coverage(args, scene, stage)
-    if args.draws is None:
-        args.draws = 2000
-    setup = build_setup(scene)
-    pair = pair_of(setup, args.pair)
-    if setup.fe.count > 2 and not args.quiet:  # say which pair of the arc this is
-        others = ", ".join(f"{i} {i + 1}" for i in range(setup.fe.count - 1) if i != pair[0])
-        print(f"rtsgeom: note: design studies the pair {pair} of the scene's {setup.fe.count} "
-              f"front ends (its centre angle, spacing and radius varied); --pair I J for "
-              f"another adjacent pair ({others}), --coverage-deg A:B for the whole arc",
-              file=sys.stderr)
-    seed = scene.seed if args.seed is None else args.seed
-    with progress(args.quiet) as report:
-        if report is not None:  # the bar from the start, labelled with the count to come
-            report("designs", 0, len(args.radius_m) * len(args.spacing_deg))
-        grid = design_grid(scene, pair, args.radius_m, args.spacing_deg, args.spec_deg,
-                           args.yield_, args.draws, seed,
-                           21 if args.points is None else args.points,
-                           None if report is None else
-                           (lambda done, total: report("designs", done, total)),
-                           workers=args.workers)
+        return _print_coverage(args, grid)
     out = grid.to_dict()
-    if stage is not None:
-        from ..viz.figures import save_figure
-        for name in METRICS:
-            save_figure(grid.plot(name), stage / f"design_{name}.png")
-        write_json(stage / "design.json", out)
     sheet_note = _sheet_note(out["designs"])
     if args.json:
         print_json(out)
         if sheet_note and not args.quiet:
             print(f"rtsgeom: {sheet_note}", file=sys.stderr)
         return 0
-    print(f"pair {pair}, centre {grid.centre_deg:.2f} deg, angular resolution "
+    print(f"pair {grid.pair}, centre {grid.centre_deg:.2f} deg, angular resolution "
           f"{grid.angular_resolution_deg:.2f} deg; tolerance: {100 * grid.target_yield:g} % "
           f"within {grid.spec_deg:g} deg ({grid.draws} draws)")
     print(f"{'R_c m':>6} {'sp deg':>7} {'worst deg':>10} {'bias deg':>9} "
@@ -135,28 +128,12 @@ def _sheet_note(designs: list[dict]) -> str:
 
 
 
-def _design_coverage(args, scene, folder) -> int:
+def _print_coverage(args, grid) -> int:
     """``design --coverage-deg A:B``: N front ends per radius (``analysis.coverage``)."""
-    seed = scene.seed if args.seed is None else args.seed
-    draws = args.draws if args.draws is not None else 300
-    with progress(args.quiet) as report:
-        if report is not None:  # two candidate arcs per radius
-            report("designs", 0, 2 * len(args.radius_m))
-        grid = coverage_designs(scene, args.coverage_deg, args.radius_m, args.spec_deg,
-                                args.yield_, draws, seed,
-                                11 if args.points is None else args.points,
-                                progress=None if report is None else
-                                (lambda done, total: report("designs", done, total)),
-                                workers=args.workers)
-    out = grid.to_dict()
-    if folder is not None:
-        from ..viz.figures import save_figure
-        for name in COVERAGE_MAPS:
-            save_figure(grid.plot(name), folder / f"coverage_{name}.png")
-        write_json(folder / "coverage.json", out)
     if args.json:
-        print_json(out)
+        print_json(grid.to_dict())
         return 0
+    draws = grid.draws
     a, b = args.coverage_deg
     print(f"coverage {a:g}..{b:g} deg; spec {grid.spec_deg:g} deg; tolerance: "
           f"{100 * grid.target_yield:g} % of whole arcs within the spec ({draws} draws)")
@@ -188,7 +165,7 @@ def _design_coverage(args, scene, folder) -> int:
 
 def register(sub) -> None:
     p = sub.add_parser("design", help="arc radius x front-end spacing design map")
-    study_options(p, 2000)
+    study_options(p, STUDY_ARGS, 2000)
     p.set_defaults(points=None)  # 21 for the grid, 11 per pair with --coverage-deg
     p.add_argument("--radius-m", type=_grid_spec(0.1, 100.0, "m"), default=np.linspace(0.5, 2.0, 4),
                    metavar="A:B:N", help="arc radii, N from A to B m (default 0.5:2:4)")

@@ -4,9 +4,9 @@ target, and with ``--simulate`` each ghost as the simulated range-Doppler map sh
 
 from __future__ import annotations
 
-from ..analysis.ghosts import ghost_analysis, ghosts_figure
+from ..analysis.ghosts import ghost_analysis
 from ._common import (load_scene_checked, number, output_folder, output_path, print_outputs,
-                      scene_arg, write_outputs)
+                      scene_arg)
 
 
 def _ghosts_text(d: dict) -> str:
@@ -46,7 +46,8 @@ def cmd_ghosts(args) -> int:
     with output_folder(args.out, [args.scene]) as stage:
         rep = ghost_analysis(scene, args.floor_db, simulate=args.simulate)
         out = rep.to_dict()
-        write_outputs(stage, "ghosts", out, lambda: ghosts_figure(rep))
+        if stage is not None:
+            rep.write(stage)
     return print_outputs(args, "ghosts", out, _ghosts_text)
 
 

@@ -9,10 +9,10 @@ import math
 
 import numpy as np
 
-from ..analysis.nearfield import default_radii, nearfield, nearfield_figure
+from ..analysis.nearfield import default_radii, nearfield
 from ..errors import ParameterError, UsageError
 from ._common import (load_scene_checked, number, output_folder, output_path, print_outputs,
-                      scene_arg, steps, write_outputs)
+                      scene_arg, steps)
 
 
 def radius_sweep(text: str) -> tuple[float, float, int]:
@@ -90,7 +90,8 @@ def cmd_nearfield(args) -> int:
         except ParameterError as exc:
             raise UsageError(f"--radius-m: {exc}") from None
         out = nf.to_dict()
-        write_outputs(stage, "nearfield", out, lambda: nearfield_figure(nf))
+        if stage is not None:
+            nf.write(stage)
     return print_outputs(args, "nearfield", out, _nearfield_text)
 
 

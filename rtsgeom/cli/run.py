@@ -5,16 +5,13 @@ summary.json, the maps (PNG and arrays) and report.html."""
 from __future__ import annotations
 
 import argparse
-import json
 
-from .._lib.io import write_bytes
 from ..geometry.warnings import scene_warnings
-from ..pipeline.run import run_scene, summary
+from ..pipeline.output import MAP_FORMATS, write_run
+from ..pipeline.run import run_scene
 from ..scene.registry import ANGLE_ESTIMATORS, AOA_MODES, PATH_METHODS
 from ._common import (calibration_kw, load_scene_checked, number, output_folder, output_path,
                       scene_arg, steps)
-from ._maps import (MAP_FORMATS, detections_csv, map_dataset, maps_arrays, render_maps,
-                    run_report_html)
 
 
 def _with_estimator(scene, args):
@@ -34,24 +31,13 @@ def cmd_run(args) -> int:
     with output_folder(out, [args.scene]) as stage, steps(args.quiet) as step:
         step(f"simulating {scene.name} ({args.paths} paths, calibration, ADC cube, detection)")
         result = run_scene(scene, args.paths, args.amplitudes, **calibration_kw(args))
-        step("writing detections, summary and maps")
-        (stage / "detections.csv").write_text(detections_csv(result), encoding="utf-8")
-        (stage / "summary.json").write_text(
-            json.dumps(summary(result, args.paths), indent=2, allow_nan=False) + "\n",
-            encoding="utf-8")
+        step("writing detections, summary, maps" + ("" if args.no_report else
+                                                      " and report.html (3D view, figures)"))
+        write_run(result, stage, args.paths, args.maps, not args.no_report,
+                  scene_warnings(scene))
         if scene.objects:  # extended objects: what the radar sees of them, truth and RTS
             from ..analysis.objects import run_objects
             write_objects(stage, scene, *run_objects(result))
-        ds = map_dataset(result)
-        maps = render_maps(result, ds)
-        for name, data in {**maps, **maps_arrays(ds, args.maps)}.items():
-            write_bytes(stage / name, data)
-        if not args.no_report:
-            step("writing report.html (3D view, figures)")
-            (stage / "report.html").write_text(
-                run_report_html(result, maps, args.paths,
-                                list(scene_warnings(scene)) + list(result.warnings)),
-                encoding="utf-8")
     if not args.quiet:
         for m in result.matches:
             print(target_line(m))

@@ -7,8 +7,10 @@ from __future__ import annotations
 
 from ..analysis.transfer import TransferStudy
 from ..errors import AngleUnreachable, ParameterError, UsageError
+from ..geometry import build_setup
+from ..paths import exact_paths
 from ._common import (load_scene_checked, number, output_folder, output_path, print_outputs,
-                      scene_arg, steps, write_outputs)
+                      scene_arg, steps)
 
 
 def cmd_transfer(args) -> int:
@@ -18,8 +20,6 @@ def cmd_transfer(args) -> int:
 
 
 def _transfer(args, stage) -> dict:
-    from ..geometry import build_setup
-    from ..paths import exact_paths
     scene = load_scene_checked(args.scene)
     seed = scene.seed if args.seed is None else args.seed
     study = TransferStudy(radars=args.radars, sigma_phase_deg=args.sigma_phase_deg,
@@ -33,7 +33,8 @@ def _transfer(args, stage) -> dict:
         except (ParameterError, AngleUnreachable) as exc:
             raise UsageError(f"{args.scene}: {exc}") from None
     out = res.to_dict()
-    write_outputs(stage, "transfer", out, res.plot)
+    if stage is not None:
+        res.write(stage)
     return out
 
 

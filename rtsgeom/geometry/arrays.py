@@ -134,19 +134,19 @@ class RutArray:
 
 def array_spec(radar: RadarConfig, *, array: ArraySpec | None = None,
                board_gap_m: float | None = None) -> ArraySpec:
-    """The :class:`ArraySpec` of ``radar``: ``array`` (or a ``radar.array`` field: an ArraySpec,
-    or any object with ``tx_mm``, ``rx_mm``, ``tx_order``) if given, else
+    """The :class:`ArraySpec` of ``radar``: ``array`` (or ``radar.array``: an ArraySpec, or a
+    config with ``tx_mm``, ``rx_mm``, ``tx_order``) if given, else
     its preset (``radar.antenna_preset``) at ``d = radar.element_spacing_m`` or lambda/2 at the
-    centre frequency, azimuth Tx only unless ``radar.use_elevation_tx``; ``board_gap_m`` (or a
-    ``radar.board_gap_m`` field) overrides the preset's board gap."""
-    custom = array if array is not None else getattr(radar, "array", None)
+    centre frequency, azimuth Tx only unless ``radar.use_elevation_tx``; ``board_gap_m`` (or
+    ``radar.board_gap_m``) overrides the preset's board gap."""
+    custom = array if array is not None else radar.array
     if custom is not None and not isinstance(custom, ArraySpec):  # a config with mm fields
         custom = ArraySpec.from_mm(custom.tx_mm, custom.rx_mm, custom.tx_order)
     if custom is not None:
         return custom
     lam = c / radar.f_center_hz
     d = radar.element_spacing_m or lam / 2.0
-    gap = board_gap_m if board_gap_m is not None else getattr(radar, "board_gap_m", None)
+    gap = board_gap_m if board_gap_m is not None else radar.board_gap_m
     return preset(radar.antenna_preset).spec(d, radar.use_elevation_tx, gap)
 
 
@@ -197,12 +197,11 @@ def rut_array(radar: RadarConfig, spec: ArraySpec | None = None, *,
               position_offset_m=None, yaw_offset_rad: float | None = None) -> RutArray:
     """Build the RuT array of ``radar`` (its :func:`array_spec` unless ``spec`` is given) at its
     pose plus the pose errors ``position_offset_m`` (world, metres) and ``yaw_offset_rad``
-    (default: ``radar.position_offset_m`` / ``radar.yaw_offset_rad`` if the scene has them,
-    else none). The RuT measures in its own (erroneous) frame."""
+    (default: ``radar.position_offset_m`` / ``radar.yaw_offset_rad``). The RuT measures in its
+    own (erroneous) frame."""
     spec = array_spec(radar) if spec is None else spec
-    off = (position_offset_m if position_offset_m is not None
-           else getattr(radar, "position_offset_m", None))
-    dyaw = yaw_offset_rad if yaw_offset_rad is not None else getattr(radar, "yaw_offset_rad", 0.0)
+    off = position_offset_m if position_offset_m is not None else radar.position_offset_m
+    dyaw = yaw_offset_rad if yaw_offset_rad is not None else radar.yaw_offset_rad
     pos = np.asarray(radar.position_m, dtype=float)
     if off is not None:
         pos = pos + np.asarray(off, float)

@@ -71,14 +71,14 @@ def front_ends(scene: Scene, arc_centre: np.ndarray, *, rx_offset_m=None, tx_off
 
     The layout and rotations come from the explicit arguments ((F, 2) and (F,) arrays), else
     from the front-end configs' ``rx_offset_m``/``tx_offset_m`` ((t, h) pairs) and
-    ``yaw_offset_rad``/``pitch_offset_rad`` fields where the scene has them, else today's
+    ``yaw_offset_rad``/``pitch_offset_rad`` fields where set, else the
     shorthand ``rx_tx_separation_m`` with no rotation. ``offsets_m`` (F, 3) overrides the
     mounting errors (radial, tangential, height), e.g. for a tolerance draw.
     """
     fes = scene.rts.front_ends
     ang = np.array([f.angle_rad for f in fes])
-    elev = np.array([getattr(f, "elevation_rad", 0.0) for f in fes], float)
-    elev = elev if np.any(elev) else None  # all on the arc: today's arithmetic
+    elev = np.array([f.elevation_rad for f in fes], float)
+    elev = elev if np.any(elev) else None  # all on the arc: the arc's arithmetic
     sep = np.array([f.rx_tx_separation_m for f in fes])
     off = (np.array([[f.radial_offset_m, f.tangential_offset_m, f.height_offset_m] for f in fes])
            if offsets_m is None else np.asarray(offsets_m, float))
@@ -101,7 +101,7 @@ def front_ends(scene: Scene, arc_centre: np.ndarray, *, rx_offset_m=None, tx_off
     to = field(tx_offset_m, "tx_offset_m", (n, 2))
     yaw = field(yaw_rad, "yaw_offset_rad", (n,))
     pitch = field(pitch_rad, "pitch_offset_rad", (n,))
-    # no rotation at all keeps today's arithmetic (bit-identical positions)
+    # no rotation at all: the positions without the rotation terms
     yaw = None if yaw is not None and yaw_rad is None and not np.any(yaw) else yaw
     pitch = None if pitch is not None and pitch_rad is None and not np.any(pitch) else pitch
     if ro is not None or to is not None:

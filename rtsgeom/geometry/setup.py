@@ -27,7 +27,16 @@ __all__ = ["Setup", "build_setup", "nominal_setup", "nominal_scene", "setup_erro
 
 @dataclass(frozen=True)
 class Setup:
-    """Geometry of one scene (world frame, metres). The sheet mesh is built on first use."""
+    """Geometry of one scene (world frame, metres). The sheet mesh is built on first use.
+
+    Attributes
+    ----------
+    scene : Scene
+    rut : RutArray
+        The RuT's Tx and Rx elements in world coordinates.
+    fe : FrontEnds
+        The front ends' Rx and Tx antennas and module centres.
+    """
 
     scene: Scene
     rut: RutArray
@@ -61,7 +70,23 @@ def build_setup(scene: Scene, offsets_m: np.ndarray | None = None, *, yaw_rad=No
     errors (radial, tangential, height), ``yaw_rad``/``pitch_rad`` (F,) its mounting rotations,
     ``rut_offset_m`` (3,)/``rut_yaw_rad`` the RuT's pose errors, e.g. for a tolerance draw; the
     antenna layouts (signed offsets) are kept. The arc stays centred on the RuT's nominal
-    position (``radar.position_m``) when ``rts.arc_center_m`` is unset."""
+    position (``radar.position_m``) when ``rts.arc_center_m`` is unset.
+
+    Parameters
+    ----------
+    scene : Scene
+    offsets_m : (F, 3) array, optional
+        Mounting errors (radial, tangential, height) instead of the scene's.
+    yaw_rad, pitch_rad : (F,) array, optional
+        Mounting rotations instead of the scene's.
+    rut_offset_m : (3,) array, optional
+    rut_yaw_rad : float, optional
+        The RuT's pose errors instead of the scene's.
+
+    Returns
+    -------
+    Setup
+    """
     rut = rut_array(scene.radar, position_offset_m=rut_offset_m, yaw_offset_rad=rut_yaw_rad)
     centre = np.asarray(arc_centre_m(scene), float)
     fe = front_ends(scene, centre, yaw_rad=yaw_rad, pitch_rad=pitch_rad, offsets_m=offsets_m)
@@ -87,7 +112,7 @@ def setup_errors(scene: Scene) -> list[str]:
 
 def _channel_errors(radar) -> bool:
     """Whether the RuT's own channels (``[radar.channels]``) are not ideal."""
-    ch = getattr(radar, "channels", None)
+    ch = radar.channels
     return ch is not None and not ch.ideal
 
 

@@ -33,14 +33,29 @@ def height_phase_deg(dz_m: float, range_m: float, wavelength_m: float) -> float:
 def scene_warnings(scene: Scene) -> list[str]:
     """Physically doubtful but legal settings of a validated scene (empty list: none)."""
     setup = build_setup(scene)
-    rut, fe, radar, rts = setup.rut, setup.fe, scene.radar, scene.rts
+    radar = scene.radar
     src = scene.source or "<scene>"
     out: list[str] = []
 
     def warn(fieldname: str, value, text: str) -> None:
         out.append(f"{src}: {fieldname} = {_fmt(value)}: {text}")
 
-    lam = rut.wavelength_m
+    _arc_warnings(setup, warn)
+    _mounting_warnings(setup, warn)
+    _back_end_warnings(setup, warn)
+    if radar.snr_db is None and radar.link is None:
+        out.append(f"{src}: radar.snr_db is not set: the simulation is noiseless")
+    if radar.snr_db is not None and radar.link is not None:
+        out.append(f"{src}: radar.snr_db = {radar.snr_db:g} overrides the thermal noise of "
+                   "[radar.link] (a fixed per-sample SNR of the strongest target echo)")
+    return out
+
+
+def _arc_warnings(setup, warn) -> None:
+    """The arc seen from the RuT: neighbours within a resolution cell, the far field, the
+    targets within the front ends' span."""
+    scene, rut, fe = setup.scene, setup.rut, setup.fe
+    rts = scene.rts
     az = setup.fe_azimuth_rad()  # radar frame, module centres
     res = angular_resolution_rad(rut)
 
@@ -72,6 +87,16 @@ def scene_warnings(scene: Scene) -> list[str]:
                  f"outside the span of the front ends seen from the RuT "
                  f"[{math.degrees(lo):.4g}, {math.degrees(hi):.4g}] deg: the RTS can only "
                  "interpolate between front ends")
+
+
+
+def _mounting_warnings(setup, warn) -> None:
+    """Each front end's mounting: offsets beyond lambda/4, a height offset's phase, the
+    antennas within their cutouts."""
+    scene, rut, fe = setup.scene, setup.rut, setup.fe
+    rts = scene.rts
+    lam = rut.wavelength_m
+    dist = np.linalg.norm(fe.module - rut.position, axis=1)
 
     # Mounting errors: lambda/4 radially is already half a wavelength of two-way path.
     for i, f in enumerate(rts.front_ends):
@@ -113,11 +138,18 @@ def scene_warnings(scene: Scene) -> list[str]:
                      f"up to {max(off[k] for k in outside) * 1e3:.3g} mm from the centre of the "
                      f"cutout (radius {r_cut * 1e3:.3g} mm): looking at the RuT through the sheet")
 
+
+
+def _back_end_warnings(setup, warn) -> None:
+    """The RuT's element spacing and the RTS back end: the IF band, the calibration and
+    fractional-delay steps."""
+    radar, rts, rut = setup.scene.radar, setup.scene.rts, setup.rut
+    lam = rut.wavelength_m
     # Element spacing above lambda/2: grating lobes fold angles beyond +-asin(lambda/2d).
     d = rut.spacing_m
     if d > 0.5 * lam * (1.0 + 1e-9):
         fov = math.degrees(math.asin(min(1.0, lam / (2.0 * d))))
-        custom = getattr(radar, "array", None) is not None
+        custom = radar.array is not None
         warn("radar.array.rx_mm" if custom else "radar.element_spacing_m",
              d if custom else radar.element_spacing_m,
              f"{'the grid unit (smallest virtual gap) ' if custom else ''}more than lambda/2 = "
@@ -154,10 +186,3 @@ def scene_warnings(scene: Scene) -> list[str]:
                  "realised delays and designs the amplitudes for what is left (summary.json "
                  "calibration.targets; cells on a sphere are not planned so yet); "
                  f"a step that divides 1/f_s, e.g. {finer * 1e12:.6g} ps, leaves none")
-
-    if radar.snr_db is None and radar.link is None:
-        out.append(f"{src}: radar.snr_db is not set: the simulation is noiseless")
-    if radar.snr_db is not None and radar.link is not None:
-        out.append(f"{src}: radar.snr_db = {radar.snr_db:g} overrides the thermal noise of "
-                   "[radar.link] (a fixed per-sample SNR of the strongest target echo)")
-    return out

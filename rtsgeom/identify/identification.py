@@ -34,7 +34,15 @@ SHOWN = ((0, "radial_offset_mm", 1e3), (1, "tangential_offset_mm", 1e3),
 class Identification(Result):
     """Every front end's fit; :meth:`to_dict` is ``rtsgeom identify --json``. ``print(ident)``
     is a summary; ``to_dataframe()`` one row per front end (each parameter and its std, NaN
-    where not identifiable); ``plot()`` the mounting offsets with their 1-sigma bars."""
+    where not identifiable); ``plot()`` the mounting offsets with their 1-sigma bars.
+
+    Attributes
+    ----------
+    scene : Scene
+    fits : tuple of FrontEndFit
+        One per front end identified.
+    radar : RadarChannelsFit or None
+    """
 
     scene: Scene
     fits: tuple[FrontEndFit, ...]

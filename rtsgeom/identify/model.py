@@ -59,7 +59,7 @@ class ProbeModel:
     def nominal(self) -> np.ndarray:
         """The scene's own values of the parameters (its offsets, gain and phase errors)."""
         f = self.setup.scene.rts.front_ends[self.active]
-        yaw = getattr(f, "yaw_offset_rad", None) or 0.0
+        yaw = f.yaw_offset_rad
         return np.array([f.radial_offset_m, f.tangential_offset_m, f.height_offset_m, yaw, 0.0,
                          f.gain_offset_db * np.log(10) / 20, f.phase_offset_rad])
 

@@ -71,6 +71,17 @@ def exact_paths(setup: Setup, patterns: AntennaPatterns | None = None) -> Paths:
     bit-identical to the pattern-free model). Every caller (the run, the calibration, the
     synthesis design, the tolerance model) takes its paths from here, so the patterns reach
     the amplitude calibration and the synthesis.
+
+    Parameters
+    ----------
+    setup : Setup
+    patterns : AntennaPatterns, optional
+        The antennas' patterns (default: the scene's).
+
+    Returns
+    -------
+    Paths
+        One line-of-sight row per element pair.
     """
     if patterns is None:
         patterns = scene_patterns(setup.scene)

@@ -380,7 +380,24 @@ def raytrace_paths(setup: Setup, config: RaytraceConfig | None = None) -> Paths:
     scene's ``[raytrace]`` section. Raises :class:`RaytraceUnavailable` when Sionna RT cannot run
     here and :class:`SceneError` for an unknown or out-of-band material, or for antenna
     patterns (``[radar.pattern]``/``[rts.pattern]`` other than isotropic: not yet handed to
-    Sionna RT, so they are refused rather than silently dropped)."""
+    Sionna RT, so they are refused rather than silently dropped).
+
+    Parameters
+    ----------
+    setup : Setup
+    config : RaytraceConfig, optional
+        Default: the scene's ``[raytrace]``.
+
+    Returns
+    -------
+    Paths
+        Line of sight and reflections.
+
+    Raises
+    ------
+    RaytraceUnavailable
+        Sionna RT cannot run here.
+    """
     for cfg, where in ((setup.scene.radar.pattern, "radar.pattern.kind"),
                        (setup.scene.rts.pattern, "rts.pattern.kind")):
         if cfg.kind != "isotropic":

@@ -31,6 +31,24 @@ TX_TO_FE, FE_TO_RX, RUT_TO_RUT = 0, 1, 2
 
 @dataclass(frozen=True)
 class Paths:
+    """The propagation paths of a setup, one row per element pair and path (a table of equal-
+    length arrays; ``to_csv()`` is ``rtsgeom paths``'s output).
+
+    Attributes
+    ----------
+    front_end, rut_tx, rut_rx : (P,) int
+        The front end (-1 for RuT to RuT) and the RuT's elements (-1 where not applicable).
+    direction : (P,) int8
+        Index into ``DIRECTIONS`` (RuT to front end, front end to RuT, RuT to RuT).
+    delay_s : (P,) float
+    gain : (P,) complex
+        Free-space amplitude and antenna gains, without the propagation phase.
+    bounces : (P,) int
+        0: line of sight; a reflection counts its bounces (ray tracing).
+    method : str
+        ``exact`` or ``raytrace``.
+    """
+
     front_end: np.ndarray  # (P,) int, -1 for rut_to_rut
     direction: np.ndarray  # (P,) int8 index into DIRECTIONS
     rut_tx: np.ndarray  # (P,) int, -1 where not applicable

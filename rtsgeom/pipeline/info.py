@@ -104,40 +104,29 @@ def _reachable_cells(setup: Setup, mode: str) -> dict:
 
 def scene_info(setup: Setup, reachable: bool = False) -> dict:
     """What a setup is, in numbers (``rtsgeom info --json``); with ``reachable`` also
-    :func:`reachable_spans` (one simulated frame)."""
+    :func:`reachable_spans` (one simulated frame).
+
+    Parameters
+    ----------
+    setup : Setup
+    reachable : bool
+        Also the set directions each target can reach.
+
+    Returns
+    -------
+    dict
+        What ``rtsgeom info --json`` prints.
+    """
     s, r, rut, fe = setup.scene, setup.scene.radar, setup.rut, setup.fe
-    geo = np.degrees(setup.fe_azimuth_rad())
     one_position = rut.azimuth_positions_m.size < 2
-    if one_position:  # no azimuth aperture: a single front end's azimuth is not measured
-        app = np.full(fe.count, np.nan)
-    else:
-        app = np.degrees(apparent_azimuth_rad(rut, fe.rx, fe.tx))
-    curv = np.degrees(curvature_phase_error_rad(setup))
     spacing = np.degrees(np.diff(fe.angle_rad))
     res = np.degrees(angular_resolution_rad(rut))
-    # elevation of each module centre seen from the RuT: u_el = sin(el) (radar frame)
-    fe_el = np.zeros(fe.count) if fe.elevation_rad is None else fe.elevation_rad  # None: an arc
-    el_rut = np.degrees(np.arcsin(np.clip(setup.fe_direction_cosines()[:, 1], -1.0, 1.0)))
     out = {
         "rtsgeom_version": __version__,
         "scene": s.name,
         "source": s.source,
         "scene_sha256": s.sha256,
-        "radar": {
-            "antenna_preset": r.antenna_preset if r.array is None else "custom",
-            "array": rut.name,
-            "f_c_hz": r.f_c_hz, "bandwidth_hz": r.bandwidth_hz,
-            "f_center_hz": r.f_center_hz, "wavelength_m": rut.wavelength_m,
-            "slope_hz_per_s": r.slope_hz_per_s,
-            "num_tx": int(len(rut.tx_local)),
-            "tx_order": list(rut.tx_order), "num_rx": rut.num_rx,
-            "num_virtual": rut.num_virtual,
-            "num_virtual_azimuth": int(np.count_nonzero(rut.azimuth_mask)),
-            "element_spacing_m": rut.spacing_m,
-            "range_resolution_m": r.range_resolution_m, "max_range_m": r.max_range_m,
-            "velocity_resolution_mps": r.velocity_resolution_mps,
-            "max_velocity_mps": r.max_velocity_mps,
-        },
+        "radar": _radar_info(setup),
         "far_field": {
             "aperture_m": aperture_m(rut),
             "angular_resolution_deg": res,
@@ -150,21 +139,7 @@ def scene_info(setup: Setup, reachable: bool = False) -> dict:
             "delay_resolution_s": s.rts.delay_resolution_s,
             "calibration_period_s": 1.0 / (s.rts.f_rts_hz + r.bandwidth_hz / 2.0),
         },
-        "front_ends": [
-            {
-                "index": i,
-                "arc_angle_deg": float(np.degrees(fe.angle_rad[i])),
-                "azimuth_from_rut_deg": float(geo[i]),
-                "apparent_azimuth_deg": _finite(app[i]),
-                "distance_m": float(np.linalg.norm(fe.module[i] - rut.position)),
-                "rx_tx_separation_m": float(fe.separation_m[i]),
-                "mounting_offsets_mm": [float(x) for x in fe.offsets_m[i] * 1e3],
-                "curvature_phase_error_deg": float(curv[i]),
-                "elevation_deg": float(np.degrees(fe_el[i])),
-                "elevation_from_rut_deg": float(el_rut[i]),
-            }
-            for i in range(fe.count)
-        ],
+        "front_ends": _front_ends_info(setup, one_position),
         "front_end_spacing_deg": [float(x) for x in spacing],
         "spacing_within_resolution": [bool(x <= res) for x in spacing],
         "targets": [
@@ -188,6 +163,55 @@ def scene_info(setup: Setup, reachable: bool = False) -> dict:
         except SceneError as exc:  # a setup the synthesis does not model (its message says)
             out["reachable_unavailable"] = str(exc)
     return out
+
+
+def _radar_info(setup: Setup) -> dict:
+    """``scene_info``'s ``radar``: the chirp, the array and the resolutions."""
+    r, rut = setup.scene.radar, setup.rut
+    return {
+        "antenna_preset": r.antenna_preset if r.array is None else "custom",
+        "array": rut.name,
+        "f_c_hz": r.f_c_hz, "bandwidth_hz": r.bandwidth_hz,
+        "f_center_hz": r.f_center_hz, "wavelength_m": rut.wavelength_m,
+        "slope_hz_per_s": r.slope_hz_per_s,
+        "num_tx": int(len(rut.tx_local)),
+        "tx_order": list(rut.tx_order), "num_rx": rut.num_rx,
+        "num_virtual": rut.num_virtual,
+        "num_virtual_azimuth": int(np.count_nonzero(rut.azimuth_mask)),
+        "element_spacing_m": rut.spacing_m,
+        "range_resolution_m": r.range_resolution_m, "max_range_m": r.max_range_m,
+        "velocity_resolution_mps": r.velocity_resolution_mps,
+        "max_velocity_mps": r.max_velocity_mps,
+    }
+
+
+def _front_ends_info(setup: Setup, one_position: bool) -> list[dict]:
+    """``scene_info``'s ``front_ends``: where each is and how the RuT sees it alone."""
+    rut, fe = setup.rut, setup.fe
+    geo = np.degrees(setup.fe_azimuth_rad())
+    if one_position:  # no azimuth aperture: a single front end's azimuth is not measured
+        app = np.full(fe.count, np.nan)
+    else:
+        app = np.degrees(apparent_azimuth_rad(rut, fe.rx, fe.tx))
+    curv = np.degrees(curvature_phase_error_rad(setup))
+    # elevation of each module centre seen from the RuT: u_el = sin(el) (radar frame)
+    fe_el = np.zeros(fe.count) if fe.elevation_rad is None else fe.elevation_rad  # None: an arc
+    el_rut = np.degrees(np.arcsin(np.clip(setup.fe_direction_cosines()[:, 1], -1.0, 1.0)))
+    return [
+        {
+            "index": i,
+            "arc_angle_deg": float(np.degrees(fe.angle_rad[i])),
+            "azimuth_from_rut_deg": float(geo[i]),
+            "apparent_azimuth_deg": _finite(app[i]),
+            "distance_m": float(np.linalg.norm(fe.module[i] - rut.position)),
+            "rx_tx_separation_m": float(fe.separation_m[i]),
+            "mounting_offsets_mm": [float(x) for x in fe.offsets_m[i] * 1e3],
+            "curvature_phase_error_deg": float(curv[i]),
+            "elevation_deg": float(np.degrees(fe_el[i])),
+            "elevation_from_rut_deg": float(el_rut[i]),
+        }
+        for i in range(fe.count)
+    ]
 
 
 def _channel_bias_deg(setup: Setup) -> list[float] | None:

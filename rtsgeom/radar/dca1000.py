@@ -21,7 +21,19 @@ __all__ = ["to_dca1000", "from_dca1000"]
 
 
 def to_dca1000(cube: AdcCube) -> tuple[bytes, float]:
-    """Encode a cube as DCA1000 bytes; returns (bytes, scale)."""
+    """Encode a cube as DCA1000 bytes; returns (bytes, scale).
+
+    Parameters
+    ----------
+    cube : AdcCube
+
+    Returns
+    -------
+    bytes
+        The capture, as the DCA1000 writes it.
+    float
+        The scale applied (32767 over the largest |I| or |Q|) to fit the 16-bit samples.
+    """
     data = cube.data
     n_l, n_v, n_s = data.shape
     if n_s % 2:
@@ -39,7 +51,19 @@ def to_dca1000(cube: AdcCube) -> tuple[bytes, float]:
 
 
 def from_dca1000(raw: bytes, chirps: int, num_rx: int, samples: int) -> np.ndarray:
-    """Decode DCA1000 bytes to complex samples ``[chirp (transmit order), rx, sample]``."""
+    """Decode DCA1000 bytes to complex samples ``[chirp (transmit order), rx, sample]``.
+
+    Parameters
+    ----------
+    raw : bytes
+    chirps, num_rx, samples : int
+        The capture's shape.
+
+    Returns
+    -------
+    numpy.ndarray
+        (chirps, num_rx, samples) complex.
+    """
     a = np.frombuffer(raw, dtype="<i2").astype(np.float32)
     a = a.reshape(chirps, num_rx, samples // 2, 4)
     i = a[..., 0:2].reshape(chirps, num_rx, samples)

@@ -48,7 +48,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["CAPON_LOADING", "SIGNAL_EIGEN_DB", "smoothed_covariance", "rank_one_covariance",
+__all__ = ["CAPON_LOADING", "SIGNAL_EIGEN_DB", "KERNELS", "smoothed_covariance", "rank_one_covariance",
            "kernel", "quadratic", "lag_sums", "uniform_cells"]
 
 #: Capon's diagonal loading relative to the mean eigenvalue tr(R)/L (-30 dB: a noise-free
@@ -97,25 +97,41 @@ def rank_one_covariance(x) -> np.ndarray:
     return x[..., :, None] * np.conj(x[..., None, :])
 
 
+def _bartlett(r: np.ndarray) -> np.ndarray:
+    """Bartlett's kernel: -R (its power a^H R a is largest at its peak)."""
+    return -r
+
+
+def _capon(r: np.ndarray) -> np.ndarray:
+    """Capon's kernel (R + delta I)^{-1}, delta = ``CAPON_LOADING`` tr(R) / L."""
+    n = r.shape[-1]
+    tr = np.real(np.einsum("...ii->...", r))[..., None, None] / n
+    return np.linalg.inv(r + CAPON_LOADING * tr * np.eye(n))
+
+
+def _music(r: np.ndarray) -> np.ndarray:
+    """MUSIC's kernel E_n E_n^H on the noise subspace (module doc)."""
+    n = r.shape[-1]
+    lam, vec = np.linalg.eigh(r)  # ascending
+    signal = lam > lam[..., -1:] * 10 ** (-SIGNAL_EIGEN_DB / 10)
+    k = np.clip(signal.sum(-1), 1, n - 1)  # (...,) sources
+    noise = np.arange(n) < (n - k)[..., None]  # the n - k smallest eigenvectors
+    en = vec * noise[..., None, :]
+    return en @ np.conj(np.swapaxes(en, -1, -2))
+
+
+#: Each estimator of ``scene.registry.ANGLE_ESTIMATORS`` (the names a scene may give) with its
+#: kernel: the registry's names, each with its callable (a test keeps the two in step).
+KERNELS = {"bartlett": _bartlett, "capon": _capon, "music": _music}
+
+
 def kernel(cov, estimator: str) -> np.ndarray:
     """The matrix K (..., L, L) whose quadratic form a^H K a the estimator makes *smallest* at
     its peak: Capon (R + delta I)^{-1}, MUSIC E_n E_n^H (module doc). Bartlett is -R."""
-    r = np.asarray(cov)
-    n = r.shape[-1]
-    if estimator == "bartlett":
-        return -r
-    if estimator == "capon":
-        tr = np.real(np.einsum("...ii->...", r))[..., None, None] / n
-        return np.linalg.inv(r + CAPON_LOADING * tr * np.eye(n))
-    if estimator == "music":
-        lam, vec = np.linalg.eigh(r)  # ascending
-        signal = lam > lam[..., -1:] * 10 ** (-SIGNAL_EIGEN_DB / 10)
-        k = np.clip(signal.sum(-1), 1, n - 1)  # (...,) sources
-        noise = np.arange(n) < (n - k)[..., None]  # the n - k smallest eigenvectors
-        en = vec * noise[..., None, :]
-        return en @ np.conj(np.swapaxes(en, -1, -2))
-    raise ValueError(f"radar.angle_estimator = {estimator!r}: must be one of bartlett, capon, "
-                     "music")
+    if estimator not in KERNELS:
+        raise ValueError(f"radar.angle_estimator = {estimator!r}: must be one of "
+                         f"{', '.join(KERNELS)}")
+    return KERNELS[estimator](np.asarray(cov))
 
 
 def quadratic(k, a) -> np.ndarray:

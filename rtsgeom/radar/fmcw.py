@@ -49,7 +49,17 @@ __all__ = ["AdcCube", "fast_time_s", "chirp_start_s", "beat_phase0", "synthesize
 
 @dataclass(frozen=True)
 class AdcCube:
-    """Complex IF samples ``data[loop, virtual_channel, sample]`` (complex64)."""
+    """Complex IF samples ``data[loop, virtual_channel, sample]`` (complex64).
+
+    Attributes
+    ----------
+    data : (loops, V, samples) complex64
+        The IF samples per chirp loop, virtual channel and fast-time sample.
+    radar : RadarConfig
+    rut : RutArray
+    clipped : int
+        Samples the ADC clipped (with [radar.link]).
+    """
 
     data: np.ndarray
     radar: RadarConfig

@@ -7,6 +7,7 @@ import numpy as np
 from ..geometry import Setup
 from ..paths import Paths
 from ..rts.channels import EchoKind, Echoes, RtsProgram, build_echoes
+from . import link as lk
 from .fmcw import AdcCube, add_noise, synthesize
 
 __all__ = ["noise_power", "simulate"]
@@ -48,7 +49,6 @@ def simulate(setup: Setup, paths: Paths, program: RtsProgram, seed: int | None =
 
 def _simulate_linked(setup: Setup, echoes: Echoes, program: RtsProgram, seed, snr_db,
                      noise_frames: int = 1):
-    from . import link as lk
     scene = setup.scene
     rl = lk.radar_link(scene.radar)
     lk.check_channels(scene, program, rl, setup)

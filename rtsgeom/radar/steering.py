@@ -50,6 +50,18 @@ class Steering:
 
     Directions are direction cosines ``u`` (..., D); angles (rad) only at :meth:`search` and in
     the ``radar.processing`` wrappers.
+
+    Attributes
+    ----------
+    mask : (V,) bool
+        The virtual elements that take part.
+    positions_m : (V, D) float
+    taper : (V,) float
+    wavelength_m, aperture_m : float
+    estimator : str
+        ``bartlett``, ``capon`` or ``music``.
+    subarray : int
+        Spatial smoothing subarray length (0: none).
     """
 
     mask: np.ndarray  # (V,) virtual elements that take part

@@ -36,7 +36,14 @@ __all__ = ["RtsProgram", "EchoKind", "Echoes", "target_amplitude", "requested_de
 
 class EchoKind(IntEnum):
     """What an echo is (``Echoes.kind``; an ``int`` subclass, so ``echoes.kind == EchoKind.GHOST``
-    compares the stored integers)."""
+    compares the stored integers).
+
+    Attributes
+    ----------
+    DIRECT, GHOST, SETUP
+        A target's echo through its channel, a cable ghost of one, the RuT's own chirp
+        reflected by the setup; ``Echoes.kind`` holds one per echo.
+    """
 
     DIRECT = 0  # a target's echo through its RTS channel
     GHOST = 1  # a cable ghost of a direct echo (``cable_ghosts``)
@@ -60,6 +67,16 @@ class RtsProgram:
     ADC window's middle instead; README "Velocity and the carrier frequency"), ``amplitude`` the complex channel
     gain the RTS applies (attenuation and AoA weight). Hardware offsets of the scene are *not* in here: they
     belong to the channel, not to what the RTS is told.
+
+    Attributes
+    ----------
+    target, front_end : (K,) int
+        Which target each channel entry synthesizes, on which front end.
+    delay_s : (K,) float
+        The programmed delay.
+    doppler_hz : (K,) float
+    amplitude : (K,) complex
+        The channel's weight (the AoA synthesis).
     """
 
     target: np.ndarray  # (K,) int
@@ -94,6 +111,16 @@ class Echoes:
     Construct it with every field (positional or keyword) or with :meth:`build` (keywords,
     per-echo fields broadcast from scalars). The shapes are checked on construction (a
     ``ValueError`` names the field and the shape it must have) and the arrays stored read-only.
+
+    Attributes
+    ----------
+    tau_air_s, tau_if_s : (E,) float
+        Air and IF delays of each echo.
+    f_if_hz, doppler_hz : (E,) float
+    amplitude : (E,) complex
+    target, front_end : (E,) int
+    kind : (E,) EchoKind
+        Direct echo, cable ghost or setup echo.
     """
 
     tau_air_s: np.ndarray  # (E, V) over-the-air delay, acts at RF (f_c tau_c of eq. 8)

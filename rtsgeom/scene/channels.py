@@ -41,7 +41,16 @@ class RadarChannelsConfig(Evolvable):
     receives that fraction of its nearest neighbours' signals); ``compensation = "boresight"``
     divides each virtual channel by what the radar measured on a reflector at boresight (the
     SDK's range-bias and Rx-channel phase compensation), at ``compensation_range_m`` (unset:
-    in the far field)."""
+    in the far field).
+
+    Attributes
+    ----------
+    tx_gain_db, tx_phase_rad, rx_gain_db, rx_phase_rad : tuple of float
+        Per antenna.
+    rx_coupling_db, rx_coupling_phase_rad : optional
+    compensation : str
+        ``none`` or ``boresight``.
+    """
 
     tx_gain_db: tuple[float, ...] = _per_antenna("tx_gain_db", "gain error", "dB",
                                                  -MAX_GAIN_ERROR_DB, MAX_GAIN_ERROR_DB)

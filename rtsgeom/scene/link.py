@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .presets import PRESETS
 from .schema import Derived, Evolvable, spec
 
 __all__ = ["RadarLinkConfig", "RtsLinkConfig", "RADAR_LINK_PRESETS", "FE_ANTENNA_GAIN_DBI"]
@@ -90,104 +91,8 @@ class RtsLinkConfig(Evolvable):
                          "echo must stay above the DAC's quantisation floor)", 14, lo=2, hi=24)
 
 
-# The RuT presets' link values and where each comes from (rtsgeom.radar.link.radar_link fills the
-# unset [radar.link] fields from them). Checked against the TI datasheets' HTML editions in the
-# project's search corpus (ti.com document viewer) on 2026-11-23: a value with a document and
-# section is verified there; "[re-check]" marks one that could not be (what was tried is said);
-# "[assumed]" one that no datasheet states. The RF specification tables of the AWR1843
-# (SWRS222D), IWR6843 (SWRS219E/F), AWR2243 (SWRS223D) and AWR2944 (SWRS273D) were listed in the
-# corpus but their table text was not retrievable (only the contents came back, queries on the
-# table rows included), so those devices' Tx power and noise figure stay [re-check].
-_RECHECK_RF = ("[re-check]: the device's RF Specification table was not retrievable from the "
-               "search corpus (only its table of contents)")
-_HPF = ("HPF1 corner, one of 175/235/350/700 kHz (hpfCornerFreq1 of rlProfileCfg_t, TI mmWave "
-        "DFP; the codes 0-3 as listed in TI mmWave Studio's cascade Lua scripts); the "
-        "datasheets' receive-subsystem section: 'configurable lower cutoff frequencies above "
-        "175 kHz'; the lowest is taken. Modelled as one first-order stage (HPF2, 350 kHz and "
-        "up, is not modelled)")
-_FS = ("[assumed] receiver-input power of a full-scale tone at a mid Rx gain (~30 dB of the "
-       "24-48 dB range): not in the datasheet; check with the device's Rx saturation monitor")
-_LPF_ORDER = "[assumed] 4th-order Butterworth anti-alias response"
-_ADC_CFG = ("[re-check] 12 bits: the mmWave SDK's adcCfg numADCBits (0 = 12, 1 = 14, 2 = 16 "
-            "bit output formats); the datasheet's ADC resolution row was not retrievable")
+#: Each antenna preset's link values and where each comes from: the ``link`` of its entry in
+#: :data:`rtsgeom.scene.presets.PRESETS` (one entry per radar: its array and its link together;
+#: rtsgeom.radar.link.radar_link fills the unset [radar.link] fields from them).
+RADAR_LINK_PRESETS: dict[str, dict] = {name: p.link for name, p in PRESETS.items()}
 
-# One entry per antenna preset: the values and where each comes from.
-RADAR_LINK_PRESETS: dict[str, dict] = {
-    "awr1843boost": {
-        "values": {"tx_power_dbm": 12.0, "tx_antenna_gain_dbi": 10.5,
-                   "rx_antenna_gain_dbi": 10.5, "noise_figure_db": 15.0,
-                   "if_highpass_hz": 175e3, "if_lowpass_hz": 10e6, "if_lowpass_order": 4,
-                   "adc_bits": 12, "adc_full_scale_dbm": -25.0},
-        "sources": {"tx_power_dbm": "TI AWR1843 datasheet (SWRS222), RF Specification: TX "
-                                    f"power 12 dBm {_RECHECK_RF}",
-                    "tx_antenna_gain_dbi": "TI xWR1843BOOST user's guide (SPRUIM4): antenna peak "
-                                           "gain > 10.5 dBi (76-81 GHz) [re-check: not in the "
-                                           "corpus]",
-                    "rx_antenna_gain_dbi": "as tx_antenna_gain_dbi",
-                    "noise_figure_db": "TI AWR1843 datasheet (SWRS222), RF Specification: RX "
-                                       "noise figure 14 dB (76-77 GHz), 15 dB (77-81 GHz); 15 "
-                                       f"dB taken {_RECHECK_RF}",
-                    "if_highpass_hz": _HPF,
-                    "if_lowpass_hz": "10 MHz: TI IWR1843AOP datasheet (JAJSRC0), Receive "
-                                     "Subsystem: 'bandwidths up to 10 MHz' (the AWR1843's own "
-                                     "section was not retrievable [re-check])",
-                    "if_lowpass_order": _LPF_ORDER,
-                    "adc_bits": _ADC_CFG,
-                    "adc_full_scale_dbm": _FS}},
-    "iwr6843isk": {
-        "values": {"tx_power_dbm": 12.0, "tx_antenna_gain_dbi": 7.0, "rx_antenna_gain_dbi": 7.0,
-                   "noise_figure_db": 12.0, "if_highpass_hz": 175e3, "if_lowpass_hz": 10e6,
-                   "if_lowpass_order": 4, "adc_bits": 12, "adc_full_scale_dbm": -25.0},
-        "sources": {"tx_power_dbm": f"TI IWR6843 datasheet (SWRS219): TX power 12 dBm {_RECHECK_RF}",
-                    "tx_antenna_gain_dbi": "[assumed] ~7 dBi patch array of the ISK module",
-                    "rx_antenna_gain_dbi": "[assumed] as tx_antenna_gain_dbi",
-                    "noise_figure_db": "TI IWR6843 datasheet (SWRS219): RX noise figure 12 dB "
-                                       + _RECHECK_RF,
-                    "if_highpass_hz": _HPF + "; TI IWR6843 datasheet (SWRS219E), Receive "
-                                             "Subsystem: 'lower cutoff frequencies above 175 kHz'",
-                    "if_lowpass_hz": "TI IWR6843 datasheet (SWRS219E), Receive Subsystem: "
-                                     "'bandwidths up to 10 MHz'",
-                    "if_lowpass_order": _LPF_ORDER, "adc_bits": _ADC_CFG,
-                    "adc_full_scale_dbm": _FS}},
-    "awr2944": {
-        # A real-only receiver (SWRS273/JAJSNB2A, Receive Subsystem): the signal model's complex
-        # baseband is an approximation for it (no image band, the noise of one rail).
-        "values": {"tx_power_dbm": 13.5, "tx_antenna_gain_dbi": 10.0,
-                   "rx_antenna_gain_dbi": 10.0, "noise_figure_db": 12.0,
-                   "if_highpass_hz": 350e3, "if_lowpass_hz": 15e6, "if_lowpass_order": 4,
-                   "adc_bits": 16, "adc_full_scale_dbm": -25.0},
-        "sources": {"tx_power_dbm": "13.5 dBm: TI IWR2944 datasheet (SWRS330), RF "
-                                    "Specifications table, Transmitter output power (the "
-                                    "industrial variant; the AWR2944's own table, SWRS273D "
-                                    "6.8, was not retrievable [re-check])",
-                    "tx_antenna_gain_dbi": "[assumed]", "rx_antenna_gain_dbi": "[assumed]",
-                    "noise_figure_db": "12 dB: TI IWR2944 datasheet (SWRS330), RF Specifications "
-                                       "table, Receiver noise figure (as tx_power_dbm "
-                                       "[re-check] for the AWR2944)",
-                    "if_highpass_hz": "350 kHz: TI AWR2944 datasheet (JAJSNB2A), Receive "
-                                      "Subsystem: 'configurable cutoff frequencies above 350 "
-                                      "kHz' (the IWR2944's table, SWRS330, note 2: a "
-                                      "second-order HPF, -6 dB corners 300/350/700/1400 kHz; "
-                                      "modelled as one first-order stage)",
-                    "if_lowpass_hz": "TI AWR2944 datasheet (JAJSNB2A), Receive Subsystem: "
-                                     "'bandwidths up to 15 MHz'",
-                    "if_lowpass_order": _LPF_ORDER,
-                    "adc_bits": "16 bits: TI IWR2944 datasheet (SWRS330), RF Specifications "
-                                "table, ADC resolution [re-check] for the AWR2944",
-                    "adc_full_scale_dbm": _FS}},
-    "awr2243-cascade": {
-        "values": {"tx_power_dbm": 13.0, "tx_antenna_gain_dbi": 10.0,
-                   "rx_antenna_gain_dbi": 10.0, "noise_figure_db": 14.0,
-                   "if_highpass_hz": 175e3, "if_lowpass_hz": 20e6, "if_lowpass_order": 4,
-                   "adc_bits": 12, "adc_full_scale_dbm": -25.0},
-        "sources": {"tx_power_dbm": f"TI AWR2243 datasheet (SWRS223): TX power 13 dBm {_RECHECK_RF}",
-                    "tx_antenna_gain_dbi": "[assumed]", "rx_antenna_gain_dbi": "[assumed]",
-                    "noise_figure_db": "TI AWR2243 datasheet (SWRS223): RX noise figure "
-                                       f"12-14 dB; 14 dB taken {_RECHECK_RF}",
-                    "if_highpass_hz": _HPF + "; TI AWR2243 datasheet (SWRS223D), Receive "
-                                             "Subsystem: 'lower cutoff frequencies above 175 kHz'",
-                    "if_lowpass_hz": "TI AWR2243 datasheet (SWRS223D), Receive Subsystem: "
-                                     "'bandwidths up to 20 MHz'",
-                    "if_lowpass_order": _LPF_ORDER, "adc_bits": _ADC_CFG,
-                    "adc_full_scale_dbm": _FS}},
-}

@@ -45,7 +45,7 @@ def front_end_module_m(centre, radius_m: float, fe: "FrontEndConfig") -> tuple[f
     off = (fe.radial_offset_m, fe.tangential_offset_m, fe.height_offset_m)
     _, _, mod = antenna_positions(np.asarray(centre, float), radius_m, fe.angle_rad,
                                   fe.rx_tx_separation_m, off,
-                                  elevation_rad=getattr(fe, "elevation_rad", 0.0) or None)
+                                  elevation_rad=fe.elevation_rad or None)
     return tuple(float(x) for x in mod)
 
 
@@ -451,7 +451,7 @@ def _scenario_rules(scene, fail) -> None:
     """``[scenario]``: waypoint times from 0, strictly increasing, the last at or after
     duration_s; at most MAX_FRAMES frames; in every frame each moving target's range, radial
     velocity (and elevation) within what the processing resolves, as for ``[[targets]]``."""
-    if getattr(scene, "scenario", None) is not None:
+    if scene.scenario is not None:
         check_scenario(scene, fail, resolvable_limits(scene.radar), _air_extra_m(scene))
 
 

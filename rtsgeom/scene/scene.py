@@ -19,7 +19,7 @@ from .file import decode_toml, read_scene_bytes, resolve_meshes
 from .hardware import check_layout_keys, resolve_pattern_tables
 from .rules import problems
 from .scenario import ScenarioConfig
-from .schema import Derived, Evolvable, check_fields, read, spec
+from .schema import Derived, Evolvable, check_fields, fmt, read, spec
 from ..errors import ParameterError, SceneError
 from .sections import (MAX_NAME_CHARS, MAX_TARGETS, RadarConfig, RaytraceConfig, RtsConfig,
                        SheetConfig, StructureConfig, TargetConfig)
@@ -29,7 +29,27 @@ __all__ = ["Scene", "SceneError", "load_scene", "loads_scene", "parse_scene", "c
 
 @dataclass(frozen=True)
 class Scene(Evolvable):
-    """A validated scene. ``evolve(**changes)`` builds a variant and checks it again."""
+    """A validated scene. ``evolve(**changes)`` builds a variant and checks it again.
+
+    Attributes
+    ----------
+    name : str
+    radar : RadarConfig
+        The radar under test ([radar]).
+    rts : RtsConfig
+        The RTS: its arc, front ends and channels ([rts]).
+    sheet : SheetConfig
+    targets : tuple of TargetConfig
+    raytrace : RaytraceConfig
+    seed : int
+        The noise and Monte-Carlo seed.
+    source : str
+        Where the scene was read from.
+    sha256 : str
+        The file's hash (calibration files record it).
+    scenario : ScenarioConfig or None
+        A drive ([scenario]), if any.
+    """
 
     name: str = spec("name", "str", "scene name (printed, used in titles)",
                      Derived("the file name without .toml", lambda v: v["_stem"]),
@@ -77,7 +97,30 @@ def parse_scene(data: dict, source: str = "<scene>", base_dir: Path | None = Non
     """Build a validated :class:`Scene` from a parsed TOML document.
 
     Raises :class:`SceneError` naming the first problem; its ``problems`` lists all the
-    violated cross-field rules (:func:`problems`)."""
+    violated cross-field rules (:func:`problems`).
+
+    Parameters
+    ----------
+    data : dict
+        The scene as a parsed TOML document.
+    source : str
+        Where it came from (named in errors).
+    base_dir : Path, optional
+        The folder relative paths (meshes, pattern tables) are read from.
+    sha256 : str
+        The file's hash, recorded with the scene.
+    allow_external_meshes : bool
+        Accept mesh files outside ``base_dir``.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    SceneError
+        A field outside its range or a violated rule; the message names the field.
+    """
     stem = Path(source).stem if source != "<scene>" else "scene"
     scene = read(Scene, data, source, "", {"_stem": stem, "source": source, "sha256": sha256})
     check_layout_keys(data, source)  # the file's keys (a read scene cannot tell them apart)
@@ -98,13 +141,50 @@ def loads_scene(raw: bytes | str, source: str = "<scene>", base_dir: Path | None
     ``base_dir`` is the folder relative mesh paths are resolved against (default: the current
     directory); meshes must lie inside it unless ``allow_external_meshes``. A UTF-8 byte-order
     mark is accepted.
+
+    Parameters
+    ----------
+    raw : bytes or str
+        The TOML text.
+    source, base_dir, allow_external_meshes
+        As :func:`parse_scene`.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    SceneError
+        Not TOML, or an invalid field (named).
     """
     data, sha256 = decode_toml(raw, source)
     return parse_scene(data, source, base_dir, sha256, allow_external_meshes)
 
 
 def load_scene(path: str | Path, allow_external_meshes: bool = False) -> Scene:
-    """Load and validate a scene file (TOML, parsed with the standard library's safe loader)."""
+    """Load and validate a scene file (TOML, parsed with the standard library's safe loader).
+
+    Parameters
+    ----------
+    path : str or Path
+        The scene file (TOML).
+    allow_external_meshes : bool
+        Accept mesh files outside the scene's folder.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    SceneError
+        A missing or unreadable file, not TOML, or an invalid field (named).
+
+    Examples
+    --------
+    >>> scene = rtsgeom.load_scene("scenes/diewald2022.toml")
+    """
     raw, base = read_scene_bytes(path)
     return loads_scene(raw, str(Path(path)), base, allow_external_meshes)
 
@@ -113,7 +193,6 @@ def check_scene_arg(scene, source: str) -> Scene:
     """A function's ``scene`` argument: a :class:`Scene`, else ``ParameterError`` saying how
     to make one (a path is the common mistake)."""
     if not isinstance(scene, Scene):
-        from .schema import fmt
         hint = (": load it with rtsgeom.load_scene(path)" if isinstance(scene, (str, Path))
                 else "")
         raise ParameterError(f"{source}: scene = {fmt(scene)}: must be a Scene{hint}")

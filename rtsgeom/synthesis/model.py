@@ -81,7 +81,7 @@ def require_air_path_compensation(scene) -> None:
 
 def target_direction(steering: Steering, target: TargetConfig) -> np.ndarray:
     """A target's set direction cosines (D,) for ``steering``."""
-    el = getattr(target, "elevation_rad", 0.0)
+    el = target.elevation_rad
     if steering.dims == 1:
         return np.array([np.sin(target.angle_rad)])
     return steering.directions(np.array([target.angle_rad, el]))
@@ -96,6 +96,11 @@ class ChannelModel:
     ``u`` (D,): ``sin(azimuth)`` for a RuT that beamforms in azimuth (D = 1), ``(sin az cos
     el, sin el)`` for one that beamforms in both (D = 2); :meth:`direction` returns the
     detected angles, :meth:`angles` converts.
+
+    Attributes
+    ----------
+    setup, channels, responses, doppler_hz, unit_gain, range_m, steering, fe_u
+        As the fields say (``responses[k, q, v]``: the module doc).
     """
 
     setup: Setup
@@ -105,8 +110,7 @@ class ChannelModel:
     unit_gain: float  # program amplitude of one channel that gives the target's amplitude
     range_m: float
     steering: Steering
-    fe_u: np.ndarray | None = None  # (Q, D) front-end directions for the closed form (None:
-    #                                  the geometric ones seen from the RuT)
+    fe_u: np.ndarray | None = None  # (Q, D) closed form's front-end directions (None: geometric)
 
     @classmethod
     def build(cls, setup: Setup, paths: Paths, channels, target: TargetConfig,
@@ -254,11 +258,8 @@ class ChannelModel:
             return self.weights(a0, phases)
         # The start of the peak matching: the closed form with the phases the weighted
         # channels have at u_set relative to coherence there (the given phases are programme
-        # phases on this model, whose channels carry their own: delays, calibration offsets;
-        # handed to the closed form as they are, a calibrated channel 87 deg off its
-        # geometric phase (a 0.5 mm radial offset) gave a start the Gauss-Newton did not
-        # recover from, sphere4), then coherent; each start tried in turn until one reaches
-        # u_set.
+        # phases; this model's channels carry their own delays and calibration offsets), then
+        # coherent; each start tried in turn until one reaches u_set.
         starts = []
         for ph in ((None if phases is None else self._coherence_offsets(u_set, phases)), None):
             try:
@@ -267,9 +268,8 @@ class ChannelModel:
             except AngleUnreachable:
                 pass
         # a channel the closed form leaves at 0 stays there (its log-amplitude's column of
-        # the Jacobian vanishes): the same starts with every channel at 0.1 or more next
-        # (sphere4 with a 180 deg phase on a front end, (5, 3) deg: the triangle's start
-        # stopped 0.008 off in elevation), then equal amplitudes
+        # the Jacobian vanishes): the same starts with every channel at 0.1 or more next,
+        # then equal amplitudes
         starts += [np.maximum(a, 0.1) for a in starts] + [np.ones(self.count)]
         for n, a0 in enumerate(starts):
             try:

@@ -128,7 +128,7 @@ def target_positions(setup: Setup) -> tuple[np.ndarray, np.ndarray]:
     """Drawn positions (T, 3) and outward directions (T, 3) of the virtual targets."""
     rut = setup.rut
     ang = np.array([t.angle_rad for t in setup.scene.targets], float)
-    el = np.array([getattr(t, "elevation_rad", 0.0) for t in setup.scene.targets], float)
+    el = np.array([t.elevation_rad for t in setup.scene.targets], float)
     local = sphere_frame(ang, el if np.any(el) else None)[0]
     direction = local @ rut.rotation.T
     return rut.position + TARGET_RADIUS_FACTOR * setup.fe.arc_radius_m * direction, direction

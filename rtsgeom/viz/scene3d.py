@@ -143,7 +143,7 @@ def _add_labels(pl, setup: Setup, scale: float, text3d: bool = False) -> None:
             a = pos[j] + (0.06 + 0.045 * k) * z_hat
             anchors.append(a)
             leaders.append(np.array([pos[j], a]))
-            el = getattr(t, "elevation_rad", 0.0)
+            el = t.elevation_rad
             texts.append(f"T{j}: {t.range_m:g} m, {np.degrees(t.angle_rad):g} deg"
                          + (f" el {np.degrees(el):g} deg" if el else "")
                          + f", {t.velocity_mps:+g} m/s")
@@ -309,7 +309,24 @@ def _render_image(setup: Setup, paths, window_size) -> np.ndarray:
 
 def render_setup_png(setup: Setup, path: str | Path, paths=None,
                      window_size=(1600, 1000)) -> Path:
-    """Render the setup off screen to a PNG file (written atomically); return its path."""
+    """Render the setup off screen to a PNG file (written atomically); return its path.
+
+    Parameters
+    ----------
+    setup : Setup
+    path : str or Path
+    paths : Paths, optional
+    window_size : (int, int)
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    VizError
+        No off-screen rendering here.
+    """
     from matplotlib.image import imsave
     path = Path(path)
     img = _render_image(setup, paths, window_size)

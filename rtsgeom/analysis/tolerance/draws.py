@@ -62,7 +62,15 @@ class Bounds:
 
     ``offsets_m`` (3,) radial, tangential, height of every front end; ``yaw_rad``,
     ``pitch_rad`` its mounting rotations; ``rut_position_m`` (3,) and ``rut_yaw_rad`` the
-    RuT's pose."""
+    RuT's pose.
+
+    Attributes
+    ----------
+    offsets_m : (float, float, float)
+    yaw_rad, pitch_rad : float
+    rut_position_m : (float, float, float)
+    rut_yaw_rad : float
+    """
 
     offsets_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     yaw_rad: float = 0.0

@@ -21,22 +21,18 @@ import functools
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Iterable
-
 import numpy as np
 
 from ..._lib.results import Result
 from ..._lib.util import frozen
 from ...errors import ParameterError
-from .draws import AXES, DEFAULT_CHUNK, Bounds, DrawChunk, draw_chunks
+from .config import Mapper, MonteCarlo, Progress
+from .draws import AXES, Bounds, DrawChunk, draw_chunks
 from .present import columns as _columns, figure as _figure, summary as _summary
 from .phasors import CASES, ChannelPhasors
 
-__all__ = ["ToleranceModel", "ToleranceResult", "monte_carlo", "percentiles", "as_bounds",
-           "Progress", "Mapper"]
-
-Progress = Callable[[str, int, int], None]  # (label, draws done, draws total)
-Mapper = Callable[[Callable, list], Iterable]  # ordered map of a pure function over chunks
+__all__ = ["ToleranceModel", "ToleranceResult", "monte_carlo", "simulate", "percentiles",
+           "as_bounds", "Progress", "Mapper", "MonteCarlo"]
 KINDS = ("pair", "cell", "arc")
 STAT_KEYS = ("azimuth_error_deg", "elevation_error_deg", "angular_distance_deg")
 
@@ -135,7 +131,18 @@ class ToleranceResult(Result):
     back to the grid search; both count (draw, set-point) pairs, so their largest value is
     ``draws`` x the set's set-points (2330 of 2000 x 21 = 42 000 is 5.5 % of the set-points,
     not more than one per draw). ``print(result)`` is a summary; ``to_dataframe()`` one row
-    per draw; ``plot()`` the figure of ``rtsgeom tolerance --out``."""
+    per draw; ``plot()`` the figure of ``rtsgeom tolerance --out``.
+
+    Attributes
+    ----------
+    model : ToleranceModel
+    bounds : Bounds
+    distribution : str
+    draws, seed : int
+    spec_deg : float
+    errors_deg : dict
+        Case -> (draws, P, C) worst signed errors.
+    """
 
     model: ToleranceModel
     bounds: Bounds
@@ -350,17 +357,60 @@ def _evaluate(model, part: DrawChunk, bounds: Bounds, cases, keep: bool) -> dict
 
 
 def monte_carlo(model, bounds, draws: int, seed: int, distribution: str = "normal",
-                spec_deg: float = 0.1, cases=CASES, chunk: int = DEFAULT_CHUNK,
-                progress: Progress | None = None, label: str = "tolerance",
-                mapper: Mapper | None = None, subbin: bool = True,
-                keep_errors: bool = False) -> ToleranceResult:
-    """``draws`` setups of ``model`` (a :class:`ToleranceModel`, or one
-    :class:`~.phasors.ChannelPhasors` alone) with errors of scale ``bounds`` (:class:`Bounds`,
-    or the three offsets' scales (3,) m: the standard deviation, or the uniform bound) and,
-    with ``subbin``, the target at a sub-bin position drawn per draw (False: at the bin
-    centre), evaluated chunk by chunk: in this process, one chunk in memory at a time, or by
-    ``mapper(func, chunks)`` (results in chunk order). ``keep_errors``: the per-draw errors in
-    the result (:meth:`ToleranceResult.save_npz`)."""
+                spec_deg: float = 0.1, cases=CASES, **options) -> ToleranceResult:
+    """``draws`` setups of ``model`` drawn from ``seed``: :func:`simulate` with a
+    :class:`~.config.MonteCarlo` of these.
+
+    Parameters
+    ----------
+    model : ToleranceModel or ChannelPhasors
+        The channel sets (one alone: a pair's or a cell's study).
+    bounds : Bounds or array_like of 3 float
+        The error scales (SI), or the three offsets' scales (m) alone.
+    draws, seed, distribution
+        As :class:`~.config.MonteCarlo`.
+    spec_deg : float
+        The angle spec of the yield (deg).
+    cases : tuple of str
+        The cases evaluated (``uncalibrated``, ``calibrated``, ...).
+    **options
+        :class:`~.config.MonteCarlo`'s ``chunk``, ``mapper``, ``progress``, ``subbin``, and
+        :func:`simulate`'s ``label``, ``keep_errors``.
+
+    Returns
+    -------
+    ToleranceResult
+
+    Raises
+    ------
+    ParameterError
+        A draw count, seed, distribution or scale outside its range.
+    """
+    mc, rest = MonteCarlo.split(dict(options, draws=int(draws), seed=int(seed),
+                                     distribution=distribution))
+    return simulate(model, bounds, mc, spec_deg, cases, **rest)
+
+
+def simulate(model, bounds, mc: MonteCarlo, spec_deg: float = 0.1, cases=CASES,
+             label: str = "tolerance", keep_errors: bool = False) -> ToleranceResult:
+    """The one Monte-Carlo driver: ``mc.draws`` setups of ``model`` (a
+    :class:`ToleranceModel`, or one :class:`~.phasors.ChannelPhasors` alone) with errors of
+    scale ``bounds`` (:class:`Bounds`, or the three offsets' scales (3,) m: the standard
+    deviation, or the uniform bound) and, with ``mc.subbin``, the target at a sub-bin
+    position drawn per draw (False: at the bin centre), evaluated chunk by chunk: in this
+    process, one chunk in memory at a time, or by ``mc.mapper(func, chunks)`` (results in
+    chunk order). ``keep_errors``: the per-draw errors in the result
+    (:meth:`ToleranceResult.save_npz`). ``mc.seed`` must be set (:meth:`MonteCarlo.seeded`).
+
+    Returns
+    -------
+    ToleranceResult
+    """
+    if mc.seed is None:
+        raise ParameterError("simulate: MonteCarlo.seed is None (give a seed, or "
+                             "mc.seeded(scene.seed))")
+    draws, seed, distribution = mc.draws, mc.seed, mc.distribution
+    chunk, progress, mapper, subbin = mc.chunk, mc.progress, mc.mapper, mc.subbin
     t0, c0 = time.perf_counter(), time.process_time()
     shared = model  # what a process pool keeps across the studies of one model (by identity)
     model = _study(model)

@@ -63,7 +63,18 @@ class ChannelPhasors:
     candidate bins (middle: the set range's). ``subbin_steps`` (U,): the target's possible
     sub-bin positions (delay steps, one range bin, centred on 0). ``set_rad``: (M,) azimuths
     (D = 1) or (M, 2) (azimuth, elevation); ``amplitudes`` (M, Q) the design at the bin
-    centre."""
+    centre.
+
+    Attributes
+    ----------
+    channels : ChannelModel
+        The nominal setup's channel set.
+    set_rad : (M,) or (M, 2) float
+        The set directions.
+    subbin_steps : (S,) int
+        The target's sub-bin positions (delay steps).
+    delay_resolution_s : float
+    """
 
     channels: ChannelModel  # on the nominal setup, target at the bin centre
     set_rad: np.ndarray

@@ -17,11 +17,15 @@ import math
 
 import numpy as np
 
+import dataclasses
+from dataclasses import dataclass
+
+from .config import MonteCarlo
 from .draws import AXES, DEFAULT_CHUNK, Bounds, draw_subbins
-from .montecarlo import Mapper, Progress, ToleranceModel, as_bounds, monte_carlo
+from .montecarlo import ToleranceModel, as_bounds, simulate
 from .phasors import ChannelPhasors
 
-__all__ = ["critical_ratio", "search_direction", "largest_passing_scale",
+__all__ = ["critical_ratio", "search_direction", "largest_passing_scale", "YieldSearch",
            "max_sigma_for_yield", "max_scale_for_yield"]
 
 
@@ -93,23 +97,93 @@ def _zero_errors(model: ToleranceModel, draws: int, seed: int, case: str, subbin
     return out[np.ravel(inv)]
 
 
-def _search(model, line, start: float, cap: float, draws: int, seed: int, target_yield: float,
-            spec_deg: float, case: str, distribution: str, rel_tol: float, chunk: int,
-            progress: Progress | None, mapper: Mapper | None, subbin: bool, slope: float,
-            label) -> tuple[list, tuple]:
+@dataclass(frozen=True)
+class YieldSearch:
+    """The yield search's question: the largest scale that keeps ``target_yield`` of the
+    setups within ``spec_deg`` for ``case``, to ``rel_tol``, stopping at ``cap``.
+
+    Parameters
+    ----------
+    target_yield : float
+        Fraction of setups within the spec, in (0, 1].
+    spec_deg : float
+        Angle-error spec (deg).
+    case : str
+        The case the spec applies to (``calibrated``, ``uncalibrated`` ...).
+    rel_tol : float, optional
+        The result lies within ``rel_tol`` of the smallest failing scale evaluated (default:
+        0.01 for the sigmas, 0.02 for a factor).
+    cap : float, optional
+        The search stops there (``capped``): metres for the sigmas (default 0.01), a factor
+        otherwise (default 100).
+    slope : float
+        The power of the scale the deciding draw's error is taken to follow until two
+        evaluations measure it (:func:`largest_passing_scale`).
+    """
+
+    target_yield: float
+    spec_deg: float = 0.1
+    case: str = "calibrated"
+    rel_tol: float | None = None
+    cap: float | None = None
+    slope: float = 1.0
+
+    def sigma(self, model, sigma_m, mc: MonteCarlo, axis: str = "all",
+              bounds: Bounds | None = None) -> dict:
+        """The largest mounting tolerance (the offsets' sigmas) that keeps the target yield.
+        ``axis="all"`` scales the three sigmas together (their ratios as given by
+        ``sigma_m``; all ones where all are zero); an axis name varies that axis alone, the
+        other two held at ``sigma_m``. ``bounds``: rotations and RuT pose errors drawn at
+        every scale (held). Returns the sigmas found (m), the yield there, the evaluations."""
+        base = np.asarray(sigma_m, float).reshape(3)
+        direction, fixed = search_direction(base, axis)
+        held = bounds if bounds is not None else Bounds()
+        cap_m = 0.01 if self.cap is None else self.cap
+        search = dataclasses.replace(self, cap=cap_m,
+                                     rel_tol=0.01 if self.rel_tol is None else self.rel_tol)
+
+        def line(t: float) -> Bounds:
+            return held.with_offsets(fixed + t * direction)
+
+        start = min(float(np.max(base * direction)) or 1e-4, cap_m)
+        history, (t, y, capped, note) = _search(
+            model, line, start, mc, search, lambda t: f"{self.case}: sigma {t * 1e3:.4g} mm")
+        sig = fixed + t * direction
+        return {"case": self.case, "axis": axis, "target_yield": self.target_yield,
+                "spec_deg": self.spec_deg,
+                "sigma_mm": {a: float(s * 1e3) for a, s in zip(AXES, sig)},
+                "yield": y, "capped": capped, "note": note,
+                "evaluations": [{"scale_mm": s * 1e3, "yield": v} for s, v in history]}
+
+    def scale(self, model, bounds, mc: MonteCarlo) -> dict:
+        """The largest factor s on ``bounds`` (every bound of the study: offsets, rotations,
+        RuT pose) that keeps the target yield (for an arc: every pair). Returns the factor,
+        the scaled bounds, the yield there and whether the search hit the cap."""
+        bounds = as_bounds(bounds)
+        search = dataclasses.replace(self, cap=100.0 if self.cap is None else self.cap,
+                                     rel_tol=0.02 if self.rel_tol is None else self.rel_tol)
+        history, (s, y, capped, _) = _search(
+            model, bounds.scaled, 1.0, mc, search, lambda s: f"{self.case}: factor {s:.4g}")
+        return {"case": self.case, "factor": s, "scales": bounds.scaled(s).to_dict(),
+                "yield": y, "capped": capped,
+                "evaluations": [{"scale": t, "yield": v} for t, v in history]}
+
+
+def _search(model, line, start: float, mc: MonteCarlo, search: YieldSearch, label
+            ) -> tuple[list, tuple]:
     """The largest passing scale t on the line ``line(t) -> Bounds``: (evaluations [(t,
     yield)], (t, yield, capped, note))."""
     if isinstance(model, ChannelPhasors):
         model = ToleranceModel.of(model)
     history = []
+    case, spec_deg, target_yield = search.case, search.spec_deg, search.target_yield
 
     def yield_at(t: float) -> tuple[float, float]:
         bounds = line(t)
         if bounds.zero:
-            e = _zero_errors(model, draws, seed, case, subbin)
+            e = _zero_errors(model, mc.draws, mc.seed, case, mc.subbin)
         else:
-            e = monte_carlo(model, bounds, draws, seed, distribution, spec_deg, (case,), chunk,
-                            progress, label(t), mapper, subbin).errors_deg[case]
+            e = simulate(model, bounds, mc, spec_deg, (case,), label(t)).errors_deg[case]
         a = np.abs(_angles(e)).reshape(e.shape[0], -1)
         y = float(np.mean(np.all(a <= spec_deg, axis=-1))) if a.size else float("nan")
         history.append((t, y))
@@ -119,61 +193,69 @@ def _search(model, line, start: float, cap: float, draws: int, seed: int, target
     if y0 < target_yield:
         return history, (0.0, y0, False, "the setup misses the spec even without the varied "
                                          "errors")
-    t, y, capped = largest_passing_scale(yield_at, y0, target_yield, start, cap, rel_tol,
-                                         slope=slope)
+    t, y, capped = largest_passing_scale(yield_at, y0, target_yield, start, search.cap,
+                                         search.rel_tol, slope=search.slope)
     return history, (t, y, capped, None)
 
 
 def max_sigma_for_yield(model, sigma_m, draws: int, seed: int, target_yield: float,
                         spec_deg: float = 0.1, case: str = "calibrated", axis: str = "all",
-                        distribution: str = "normal", rel_tol: float = 0.01,
-                        cap_m: float = 0.01, chunk: int = DEFAULT_CHUNK,
-                        progress: Progress | None = None, mapper: Mapper | None = None,
-                        subbin: bool = True, slope: float = 1.0,
-                        bounds: Bounds | None = None) -> dict:
+                        **options) -> dict:
     """The largest mounting tolerance (the offsets' sigmas) that keeps ``target_yield`` of the
-    setups within ``spec_deg`` for ``case``. ``axis="all"`` scales the three sigmas together
-    (their ratios as given by ``sigma_m``; all ones where all are zero); an axis name varies
-    that axis alone, the other two held at ``sigma_m``. ``bounds``: rotations and RuT pose
-    errors drawn at every scale (held). Returns the sigmas found (m), the yield there, the
-    evaluations; the search stops at ``cap_m`` (``capped``). The result is the largest passing
-    scale evaluated, within ``rel_tol`` of the smallest failing one. ``slope``: the power of
-    the scale the deciding draw's error is taken to follow until two evaluations measure it
-    (:func:`largest_passing_scale`)."""
-    base = np.asarray(sigma_m, float).reshape(3)
-    direction, fixed = search_direction(base, axis)
-    held = bounds if bounds is not None else Bounds()
+    setups within ``spec_deg`` for ``case``: :meth:`YieldSearch.sigma`.
 
-    def line(t: float) -> Bounds:
-        return held.with_offsets(fixed + t * direction)
+    Parameters
+    ----------
+    model : ToleranceModel or ChannelPhasors
+    sigma_m : array_like of 3 float
+        The sigmas' ratios (``axis="all"``), or the held sigmas (an axis name), m.
+    draws, seed
+        As :class:`~.config.MonteCarlo`.
+    target_yield, spec_deg, case
+        As :class:`YieldSearch`.
+    axis : {'all', 'radial', 'tangential', 'height'}
+    **options
+        :class:`~.config.MonteCarlo`'s ``distribution``, ``chunk``, ``mapper``, ``progress``,
+        ``subbin``; :class:`YieldSearch`'s ``rel_tol``, ``slope``; ``cap_m`` (the cap, m);
+        ``bounds`` (rotations and RuT pose, held).
 
-    start = min(float(np.max(base * direction)) or 1e-4, cap_m)
-    history, (t, y, capped, note) = _search(
-        model, line, start, cap_m, draws, seed, target_yield, spec_deg, case, distribution,
-        rel_tol, chunk, progress, mapper, subbin, slope,
-        lambda t: f"{case}: sigma {t * 1e3:.4g} mm")
-    sig = fixed + t * direction
-    return {"case": case, "axis": axis, "target_yield": target_yield, "spec_deg": spec_deg,
-            "sigma_mm": {a: float(s * 1e3) for a, s in zip(AXES, sig)},
-            "yield": y, "capped": capped, "note": note,
-            "evaluations": [{"scale_mm": s * 1e3, "yield": v} for s, v in history]}
+    Returns
+    -------
+    dict
+        ``sigma_mm`` per axis, ``yield``, ``capped``, ``note``, ``evaluations``.
+    """
+    mc, rest = MonteCarlo.split(dict(options, draws=int(draws), seed=int(seed)))
+    bounds = rest.pop("bounds", None)
+    search = YieldSearch(target_yield, spec_deg, case, rest.pop("rel_tol", 0.01),
+                         rest.pop("cap_m", 0.01), **rest)
+    return search.sigma(model, sigma_m, mc, axis, bounds)
 
 
 def max_scale_for_yield(model, bounds, draws: int, seed: int, target_yield: float,
-                        spec_deg: float = 0.1, case: str = "calibrated",
-                        distribution: str = "normal", rel_tol: float = 0.02, cap: float = 100.0,
-                        chunk: int = DEFAULT_CHUNK, subbin: bool = True,
-                        progress: Progress | None = None, mapper: Mapper | None = None) -> dict:
-    """The largest factor s on ``bounds`` (every bound of the study: offsets, rotations, RuT
-    pose) that keeps ``target_yield`` of the setups within ``spec_deg`` (for an arc: every
-    pair). Returns the factor, the scaled bounds, the yield there and whether the search hit
-    ``cap``."""
-    bounds = as_bounds(bounds)
-    history, (s, y, capped, _) = _search(
-        model, bounds.scaled, 1.0, cap, draws, seed, target_yield, spec_deg, case, distribution,
-        rel_tol, chunk, progress, mapper, subbin, 1.0, lambda s: f"{case}: factor {s:.4g}")
-    return {"case": case, "factor": s, "scales": bounds.scaled(s).to_dict(), "yield": y,
-            "capped": capped, "evaluations": [{"scale": t, "yield": v} for t, v in history]}
+                        spec_deg: float = 0.1, case: str = "calibrated", **options) -> dict:
+    """The largest factor s on ``bounds`` that keeps ``target_yield`` of the setups within
+    ``spec_deg``: :meth:`YieldSearch.scale`.
+
+    Parameters
+    ----------
+    model : ToleranceModel or ChannelPhasors
+    bounds : Bounds or array_like of 3 float
+        Every bound of the study (SI), scaled together.
+    draws, seed
+        As :class:`~.config.MonteCarlo`.
+    target_yield, spec_deg, case
+        As :class:`YieldSearch`.
+    **options
+        :class:`~.config.MonteCarlo`'s ``distribution``, ``chunk``, ``mapper``, ``progress``,
+        ``subbin``; :class:`YieldSearch`'s ``rel_tol`` (default 0.02), ``cap`` (default 100).
+
+    Returns
+    -------
+    dict
+        ``factor``, ``scales``, ``yield``, ``capped``, ``evaluations``.
+    """
+    mc, rest = MonteCarlo.split(dict(options, draws=int(draws), seed=int(seed)))
+    return YieldSearch(target_yield, spec_deg, case, **rest).scale(model, bounds, mc)
 
 
 def largest_passing_scale(evaluate, y0: float, target_yield: float, start: float, cap: float,

@@ -1,6 +1,7 @@
-"""The maps and the report of ``rtsgeom run``: detections as CSV, the range-Doppler and
+"""The output folder of ``rtsgeom run``: detections as CSV, the summary, the range-Doppler and
 range-angle maps (PNG, and as arrays in ``maps.npz|mat|nc``) and the self-contained
-``report.html``, each as bytes or text from one :class:`~rtsgeom.pipeline.run.RunResult`."""
+``report.html``, each as bytes or text from one :class:`~rtsgeom.pipeline.run.RunResult`, and
+:func:`write_run`, the whole folder (what ``run`` writes, callable from Python)."""
 
 from __future__ import annotations
 
@@ -12,12 +13,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .._lib.io import write_bytes, write_text
-from ..pipeline.run import RunResult, label_detections
+from .._lib.io import write_bytes, write_json, write_text
+from ..paths import compute_paths
+from .info import scene_info
+from .run import RunResult, label_detections, summary
 
 __all__ = ["detections_csv", "figure_png", "map_dataset", "maps_arrays", "MAP_FORMATS",
-           "render_maps",
-           "write_maps", "targets_table", "run_report_html", "write_run_report"]
+           "render_maps", "write_maps", "targets_table", "run_report_html", "write_run_report",
+           "write_run"]
 
 
 def detections_csv(result: RunResult) -> str:
@@ -164,7 +167,7 @@ def _setup_png(result: RunResult, paths_method: str) -> bytes:
     from ..viz.scene3d import render_setup_png
     paths = result.paths
     if paths_method != "exact":  # the view draws reflections through their hit points,
-        from ..paths import compute_paths  # which the table alone does not carry
+        # which the table alone does not carry
         paths = compute_paths(result.setup, paths_method, for_drawing=True)
     with tempfile.TemporaryDirectory(prefix="rtsgeom-3d-") as tmp:  # private to this run
         return render_setup_png(result.setup, Path(tmp) / "setup.png",
@@ -197,7 +200,6 @@ def run_report_html(result: RunResult, maps: dict[str, bytes], paths_method: str
     """``report.html`` of a run: scene summary, 3D view, figures, detections vs set-points,
     calibration, warnings; self-contained. Every image is bytes this run produced (``maps``
     from :func:`render_maps`), never a file read back from the output folder."""
-    from ..pipeline.info import scene_info
     from ..viz.report import render_report
     sections = []
     images = []
@@ -247,3 +249,44 @@ def write_run_report(result: RunResult, out: Path, maps, paths_method: str,
         maps = {Path(p).name: Path(p).read_bytes() for p in maps}
     write_text(out / "report.html", run_report_html(result, maps, paths_method, warnings))
     return out / "report.html"
+
+
+def write_run(result: RunResult, folder: str | Path, paths_method: str = "exact",
+              maps=("npz",), report: bool = True, warnings=()) -> list[str]:
+    """The output folder of ``rtsgeom run`` for ``result``.
+
+    Parameters
+    ----------
+    result : RunResult
+    folder : path
+        An existing folder (``rtsgeom run`` writes into a staging folder swapped in whole).
+    paths_method : str
+        How the paths were computed (the summary and the report say it).
+    maps : sequence of str
+        The maps' array formats, a subset of :data:`MAP_FORMATS`.
+    report : bool
+        Also write report.html (3D view, figures).
+    warnings : sequence of str
+        The scene's warnings for the report (the run's own are added).
+
+    Returns
+    -------
+    list of str
+        The names written: detections.csv, summary.json, the map PNGs and arrays,
+        report.html.
+    """
+    folder = Path(folder)
+    write_text(folder / "detections.csv", detections_csv(result))
+    write_json(folder / "summary.json", summary(result, paths_method))
+    ds = map_dataset(result)
+    pngs = render_maps(result, ds)
+    files = {**pngs, **maps_arrays(ds, tuple(maps))}
+    for name, data in files.items():
+        write_bytes(folder / name, data)
+    names = ["detections.csv", "summary.json", *files]
+    if report:
+        write_text(folder / "report.html",
+                   run_report_html(result, pngs, paths_method,
+                                   list(warnings) + list(result.warnings)))
+        names.append("report.html")
+    return names

@@ -1,0 +1,44 @@
+"""The mutation driver covers every physics subpackage as it stands: its sources name existing
+files, every subpackage of the pipeline below the commands is sampled, each module has tests,
+and pyproject's ``[tool.mutmut]`` (what ``mutmut run`` in the repository uses) is the driver's
+selection."""
+
+from __future__ import annotations
+
+import fnmatch
+import tomllib
+
+from benchmarks.mutation import CORE_TESTS, MODULES, SOURCES, module_of, selection
+from conftest import ROOT
+
+SOURCE_FILES = [str(p.relative_to(ROOT)) for p in (ROOT / "rtsgeom").rglob("*.py")]
+
+
+def test_every_glob_names_files_and_every_module_has_tests():
+    for m, (globs, tests) in MODULES.items():
+        for g in globs:
+            assert any(fnmatch.fnmatch(f, g) for f in SOURCE_FILES), (m, g)
+        assert set(CORE_TESTS) < set(tests), m
+        assert all((ROOT / t).is_file() for t in tests), m
+
+
+def test_every_physics_subpackage_is_sampled():
+    for pkg in ("geometry", "paths", "rts", "radar", "synthesis", "calibration", "pipeline",
+                "identify", "analysis"):
+        files = [f for f in SOURCE_FILES if f.startswith(f"rtsgeom/{pkg}/")]
+        assert any(module_of(f) for f in files), pkg
+    assert module_of("rtsgeom/scene/scenario.py") == "scenario"
+    assert module_of("rtsgeom/analysis/playback/study.py") == "scenario"
+    assert module_of("rtsgeom/analysis/transfer.py") == "transfer"
+    assert module_of("rtsgeom/analysis/tolerance/montecarlo.py") == "analysis"
+    assert module_of("rtsgeom/paths/raytrace.py") is None  # Sionna: not in the fast tests
+
+
+def test_pyproject_holds_the_drivers_selection():
+    cfg = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["mutmut"]
+    globs, tests = selection(sorted(SOURCES))
+    assert sorted(cfg["only_mutate"]) == sorted(globs)
+    # the tests: every one exists and the core's are there (the driver finds its own anew)
+    listed = set(cfg["pytest_add_cli_args_test_selection"])
+    assert set(CORE_TESTS) <= listed <= set(tests) | listed
+    assert all((ROOT / t).is_file() for t in listed)
