@@ -16,7 +16,6 @@ import math
 import os
 import sys
 import time
-import warnings
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -154,12 +153,13 @@ def warn_scene_errors(scene, command: str, what: str | None = None) -> None:
 
 def show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     """``warnings.showwarning`` of the commands: rtsgeom's own warnings as
-    ``rtsgeom: warning: <message>`` on stderr, any other as Python prints it."""
+    ``rtsgeom: warning: <message>`` on stderr, any other (numpy's, a library's) as the same
+    one line with its category: a user of the CLI never sees a source line."""
     from ..errors import RtsgeomWarning
     if issubclass(category, RtsgeomWarning):
         print(f"rtsgeom: warning: {message}", file=sys.stderr)
     else:
-        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+        print(f"rtsgeom: warning: {category.__name__}: {message}", file=sys.stderr)
 
 
 # -- the front-end pair: --pair I J | all, --cell Q.. | all ----------------------------------
