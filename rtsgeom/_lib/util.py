@@ -78,3 +78,18 @@ def tones(freq_hz: np.ndarray, t0_s: float, dt_s: float, n: int) -> np.ndarray:
     inner = np.exp(2j * np.pi * f * (np.arange(block) * dt_s))
     out = outer[..., :, None] * inner[..., None, :]
     return out.reshape(out.shape[:-2] + (-1,))[..., :n]
+
+
+def tell(progress, message: str | None, stage: str | None = None, done: int = 0,
+         total: int = 0) -> None:
+    """Report to a ``progress`` callback (None: nothing): a count ``progress.count(stage,
+    done, total)`` where it has one (the CLI's ``steps``: a bar on a terminal, plain lines
+    elsewhere), else the ``message`` as ``progress(message)`` (a list's ``append`` keeps the
+    messages; None sends nothing: a count per frame is no message)."""
+    if progress is None:
+        return
+    count = getattr(progress, "count", None)
+    if count is not None and stage is not None:
+        count(stage, done, total)
+    elif message is not None:
+        progress(message)

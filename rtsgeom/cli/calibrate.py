@@ -124,12 +124,13 @@ def _calibrate_arc(args, folder) -> int:
             raise UsageError("--procedure paper: the paper's sweep is a pair on an arc (one set "
                              "angle in azimuth); this scene's front ends form 2-D cells")
         cals = []
-        for pair in pairs:
-            step(f"sweeping the delay of front end {pair[1]} (pair {pair})")
+        step(f"sweeping the delay of front end J of each of {len(pairs)} pairs")
+        for n_done, pair in enumerate(pairs, 1):
             cals.append(calibrate_pair_paper(setup, paths, pair, probe, seed=scene.seed)
                         if args.procedure == "paper" else
                         calibrate_pair(setup, paths, pair, probe, seed=scene.seed,
                                        full_chain=args.full_chain))
+            step.count("pairs calibrated", n_done, len(pairs))
     res = np.abs([c.residual_error_deg for c in cals])  # inf: a probe the chain missed
     worst = int(np.argmax(np.where(np.isnan(res), np.inf, res)))
     out = {"pairs": [dict(c.to_dict(), procedure=args.procedure) for c in cals],

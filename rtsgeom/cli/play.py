@@ -25,7 +25,7 @@ def cmd_play(args) -> int:
     with output_folder(args.out, [args.scene]) as stage, steps(args.quiet) as step:
         step(f"playing {scene.name} (calibration once, then every frame through the chain)")
         try:
-            result = study(scene)
+            result = study(scene, progress=step)
         except ParameterError as exc:
             raise UsageError(str(exc)) from None
         summary = result.summary_json()

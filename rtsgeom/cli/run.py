@@ -33,7 +33,8 @@ def cmd_run(args) -> int:
     out = args.out
     with output_folder(out, [args.scene]) as stage, steps(args.quiet) as step:
         step(f"simulating {scene.name} ({args.paths} paths, calibration, ADC cube, detection)")
-        result = run_scene(scene, args.paths, args.amplitudes, **calibration_kw(args))
+        result = run_scene(scene, args.paths, args.amplitudes, progress=step,
+                           **calibration_kw(args))
         step("writing detections, summary and maps")
         (stage / "detections.csv").write_text(detections_csv(result), encoding="utf-8")
         (stage / "summary.json").write_text(
