@@ -4,9 +4,12 @@ scene (``--from-identified``, no sweep)."""
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from .._lib.io import write_json
+from .._lib.parallel import local_map
 from ..calibration.file import setup_fingerprint
 from ..calibration.fir import fir_effect
 from ..calibration.pair import calibrate_pair
@@ -14,8 +17,8 @@ from ..calibration.paper import calibrate_pair_paper
 from ..errors import UsageError
 from ..geometry import build_setup
 from ..pipeline.plan import uses_cells
-from ._common import (emit_result, load_scene_checked, output_folder, output_path, pair_of,
-                      pair_options, prepare_arc, prepare_pair, print_json, steps)
+from ._common import (emit_result, load_scene_checked, number, output_folder, output_path,
+                      pair_of, pair_options, prepare_arc, prepare_pair, print_json, steps)
 
 
 def cmd_calibrate(args) -> int:
@@ -123,14 +126,11 @@ def _calibrate_arc(args, folder) -> int:
         if args.procedure == "paper" and uses_cells(scene):
             raise UsageError("--procedure paper: the paper's sweep is a pair on an arc (one set "
                              "angle in azimuth); this scene's front ends form 2-D cells")
-        cals = []
         step(f"sweeping the delay of front end J of each of {len(pairs)} pairs")
-        for n_done, pair in enumerate(pairs, 1):
-            cals.append(calibrate_pair_paper(setup, paths, pair, probe, seed=scene.seed)
-                        if args.procedure == "paper" else
-                        calibrate_pair(setup, paths, pair, probe, seed=scene.seed,
-                                       full_chain=args.full_chain))
-            step.count("pairs calibrated", n_done, len(pairs))
+        one = functools.partial(_calibrate_one, setup, paths, probe, scene.seed, args.procedure,
+                                args.full_chain)
+        cals = local_map(one, pairs, args.workers,
+                         progress=lambda done, total: step.count("pairs calibrated", done, total))
     res = np.abs([c.residual_error_deg for c in cals])  # inf: a probe the chain missed
     worst = int(np.argmax(np.where(np.isnan(res), np.inf, res)))
     out = {"pairs": [dict(c.to_dict(), procedure=args.procedure) for c in cals],
@@ -161,6 +161,14 @@ def _calibrate_arc(args, folder) -> int:
     return 0
 
 
+def _calibrate_one(setup, paths, probe, seed, procedure, full_chain, pair):
+    """One pair of ``--pair all``: a pure function of the pair (its noise from the scene's
+    seed), so the pairs may be calibrated in any process and order with the same result."""
+    if procedure == "paper":
+        return calibrate_pair_paper(setup, paths, pair, probe, seed=seed)
+    return calibrate_pair(setup, paths, pair, probe, seed=seed, full_chain=full_chain)
+
+
 def register(sub) -> None:
     p = sub.add_parser("calibrate", help="phase calibration sweep of a front-end pair")
     pair_options(p)
@@ -175,4 +183,7 @@ def register(sub) -> None:
     p.add_argument("--full-chain", action="store_true",
                    help="evaluate every sweep step through the full ADC-cube chain "
                         "instead of the phasor model (validation; about a minute)")
+    p.add_argument("--workers", type=number(1, 1024, integer=True), default=None,
+                   metavar="N", help="--pair all: calibrate the pairs in N processes (the same "
+                                     "result; default: the cores this process may run on)")
     p.set_defaults(func=cmd_calibrate)
