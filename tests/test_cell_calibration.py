@@ -54,6 +54,7 @@ def test_crossing_columns_none_where_every_error_is_even():
 
 # -- a 2-D pair's coherence point: the array's phase centre -----------------------------------
 
+@pytest.mark.heavy
 def test_elevation_pairs_coherence_point_is_the_phase_centres_closed_form():
     """sphere4's pairs stacked in elevation are coherent at +29 ps on the perfect setup: the
     four elevated virtual elements (lambda/2 up, 4 of 12) put the array's phase centre
@@ -202,6 +203,7 @@ def test_run_says_the_calibration_failed_when_it_is_why_a_target_is_unreachable(
 # -- the elevation pair against its coherence point (full chain at every step) -----------------
 
 @pytest.mark.slow
+@pytest.mark.heavy
 @pytest.mark.parametrize("field, value", [("radial_offset_mm", 0.5), ("radial_offset_mm", 1.0),
                                           ("phase_offset_deg", 90.0),
                                           ("phase_offset_deg", 180.0)])

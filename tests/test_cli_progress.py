@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import re
+from pathlib import Path
 
 import numpy as np
 
@@ -48,7 +49,7 @@ def test_failed_step_reports_no_duration(tmp_path, capsys):
 
 def test_progress_off_a_terminal_prints_plain_lines():
     """Off a terminal (a log file, ``2> file``) the Monte-Carlo studies' progress is plain
-    lines with counts, percentages and an ETA: one per 10 % or 5 s, and one at the end."""
+    lines with counts, percentages and the time left: one per 10 % or 5 s, and one at the end."""
     import io
 
     from rtsgeom.cli._common import LineProgress
@@ -60,7 +61,7 @@ def test_progress_off_a_terminal_prints_plain_lines():
         report("designs", done, 40)
     lines = stream.getvalue().splitlines()
     assert len(lines) == 10, lines  # every 4 of 40, the last one the end
-    assert lines[0] == "rtsgeom: designs 4/40 (10 %), 2.0 s, ETA 18.0 s"
+    assert lines[0] == "rtsgeom: designs 4/40 (10 %), 2.0 s, about 18.0 s left"
     assert lines[-1] == "rtsgeom: designs 40/40 (100 %), 20.0 s"
     stream, t[0] = io.StringIO(), 0.0
     slow = LineProgress(stream, clock=lambda: t[0])
@@ -75,3 +76,43 @@ def test_progress_quiet_is_none():
     from rtsgeom.cli._common import progress
     with progress(True) as report:
         assert report is None
+
+
+def test_steps_count_within_a_step_off_a_terminal(capsys):
+    """``steps.count`` off a terminal: plain lines with the count and the time left, then the
+    step's duration; ``tell`` sends a count to an object with ``count`` and the message to a
+    plain callback (a list's append), no message for a count alone."""
+    from rtsgeom._lib.util import tell
+    from rtsgeom.cli._common import steps
+    with steps() as step:
+        step("playing 4 frames")
+        for f in range(1, 5):
+            tell(step, None, "frame", f, 4)
+    err = capsys.readouterr().err
+    assert re.search(r"^rtsgeom: frame 1/4 \(25 %\), [0-9.]+ s, about [0-9.]+ s left$", err,
+                     re.M), err
+    assert re.search(r"^rtsgeom: frame 4/4 \(100 %\), [0-9.]+ s$", err, re.M), err
+    assert re.search(r"^  playing 4 frames: [0-9.]+ s$", err, re.M), err
+    got: list = []
+    tell(got.append, "calibrated pair (0, 1)", "calibrating pairs", 1, 2)
+    tell(got.append, None, "frame", 1, 2)
+    assert got == ["calibrated pair (0, 1)"]
+
+
+def test_play_counts_every_frame():
+    """``Playback`` tells a counting progress each frame (1..N, in order) for each mode."""
+    from rtsgeom.analysis.playback import Playback
+    from rtsgeom.scene import load_scene
+
+    class Seen(list):
+        def __call__(self, message):
+            self.append((message, None, None))
+
+        def count(self, stage, done, total):
+            self.append((stage, done, total))
+    scene = load_scene(Path(__file__).resolve().parents[1] / "scenes" / "crossing.toml")
+    seen = Seen()
+    result = Playback(baseline=False)(scene, progress=seen)
+    n = len(result.time_s)
+    frames = [(d, t) for s, d, t in seen if s.endswith(": frame")]
+    assert frames == [(f, n) for f in range(1, n + 1)]

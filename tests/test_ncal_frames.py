@@ -103,6 +103,7 @@ def test_frames_for_is_the_square_of_the_scatter_over_the_target(scatter, target
 
 
 @pytest.mark.slow
+@pytest.mark.heavy
 @pytest.mark.parametrize("snr_drop_db", [0.0, 10.0])
 def test_elevation_pair_frames_grow_as_snr_falls_and_it_stays_at_its_point(snr_drop_db):
     """sphere4's elevation pair (0, 1) at its SNR and 10 dB below: fitted along the pair's
@@ -129,6 +130,7 @@ def test_elevation_pair_frames_grow_as_snr_falls_and_it_stays_at_its_point(snr_d
 
 
 @pytest.mark.slow
+@pytest.mark.heavy
 # 30 dB below, front end 3 alone falls under the CFAR threshold at the probe range (it warns;
 # the pair calibrated here is (0, 1))
 @pytest.mark.filterwarnings("ignore:front end\\(s\\) \\[3\\] not detected alone")

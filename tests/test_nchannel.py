@@ -143,6 +143,7 @@ def test_exact_model_hits_cell_points(sphere):
 
 
 @pytest.mark.slow
+@pytest.mark.heavy
 def test_sphere4_run_within_0_05_deg():
     """Targets at several (az, el) inside the cell (not the bundled ones), detected within
     0.05 deg in both angles after calibration (exact mode) on a setup with channel phase and

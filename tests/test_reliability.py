@@ -43,7 +43,7 @@ def fast_run(monkeypatch, nearest_result):
     import rtsgeom.cli.run as run
     calls = []
 
-    def fake(scene, paths="exact", amplitudes=None):
+    def fake(scene, paths="exact", amplitudes=None, **kwargs):  # progress, calibration
         calls.append(scene)
         return nearest_result
     monkeypatch.setattr(run, "run_scene", fake)

@@ -164,6 +164,14 @@ def test_calibrate_takes_the_cells_neighbouring_pairs(capsys):
     assert main(["calibrate", "scenes/sphere4.toml", "--pair", "1", "2", "--quiet"]) == 2
     err = capsys.readouterr().err
     assert "--pair 1 2: not neighbours" in err and "0 1, 0 2" in err
+
+
+@pytest.mark.heavy
+def test_calibrate_measures_a_cells_pair_through_the_full_chain(capsys):
+    """``--pair 1 0`` of sphere4 (stacked in elevation): calibrated through the full chain in
+    the RuT's 2-D beamformer to the geometry's +29 ps (a minute of 2-D sweeps)."""
+    import json
+    from rtsgeom.cli import main
     assert main(["calibrate", "scenes/sphere4.toml", "--pair", "1", "0", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["pair"] == [0, 1] and out["dims"] == 2 and out["method"] == "full-chain"

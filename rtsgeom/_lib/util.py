@@ -107,3 +107,18 @@ def user_stacklevel() -> int:
             _PACKAGE_DIR + os.sep):
         frame, level = frame.f_back, level + 1
     return level
+
+
+def tell(progress, message: str | None, stage: str | None = None, done: int = 0,
+         total: int = 0) -> None:
+    """Report to a ``progress`` callback (None: nothing): a count ``progress.count(stage,
+    done, total)`` where it has one (the CLI's ``steps``: a bar on a terminal, plain lines
+    elsewhere), else the ``message`` as ``progress(message)`` (a list's ``append`` keeps the
+    messages; None sends nothing: a count per frame is no message)."""
+    if progress is None:
+        return
+    count = getattr(progress, "count", None)
+    if count is not None and stage is not None:
+        count(stage, done, total)
+    elif message is not None:
+        progress(message)

@@ -22,6 +22,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import breadth_first_order, minimum_spanning_tree
 from scipy.spatial import Delaunay
 
+from .._lib.util import tell
 from ..radar.processing import nearest_detection
 from ..radar.steering import Steering
 from ..rts.channels import RtsProgram, requested_delay
@@ -115,14 +116,14 @@ def calibrate_channels(setup, paths, channels, probe, seed=None, progress=None,
     edges = pair_edges(u_fe, ch)
     config = SweepConfig(span_s, step_s, seed=seed)
     meas, notes = {}, []
-    for e in edges:
+    for n_done, e in enumerate(edges, 1):
         try:
             meas[e] = calibrate_pair(setup, paths, e, probe, config=config)
         except CalibrationFailed as exc:
             notes.append(f"channel calibration: {exc}")
             continue
-        if progress:
-            progress(f"calibrated pair {e}: delta_tau {meas[e].delta_tau_s * 1e12:.1f} ps")
+        tell(progress, f"calibrated pair {e}: delta_tau {meas[e].delta_tau_s * 1e12:.1f} ps",
+             "calibrating pairs", n_done, len(edges))
     edges = [e for e in edges if e in meas]
     tree_edges = spanning_tree(u_fe, edges, ref) if edges else []
     cut = sorted(set(ch) - {ref} - {q for _, q in tree_edges})

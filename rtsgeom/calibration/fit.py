@@ -44,6 +44,7 @@ periodic shape that is zero at s).
 from __future__ import annotations
 
 import warnings
+from functools import lru_cache
 
 import numpy as np
 
@@ -156,6 +157,25 @@ def _basis(psi, harmonics: int, odd: bool) -> np.ndarray:
     return np.concatenate([np.ones(psi.shape + (1,)), np.cos(x)], axis=-1)
 
 
+@lru_cache(maxsize=256)
+def _basis_gram(d_bytes: bytes, s_bytes: bytes, x_bytes: bytes, period_s: float,
+                harmonics: int, odd: bool) -> tuple[np.ndarray, np.ndarray]:
+    """A column's basis (K, S_c, 1 + H) at the candidate centres (K,) and its Gram matrices
+    (K, 1 + H, 1 + H), from the steps' delays, the candidates and the extra phases as bytes:
+    they do not depend on the measured errors, so the Monte-Carlo draws of a sweep (the same
+    steps, candidates and phases, other noise) share them (the basis' trigonometry was 40 %
+    of a pair's calibration)."""
+    d = np.frombuffer(d_bytes)
+    s = np.frombuffer(s_bytes)
+    x = np.frombuffer(x_bytes)
+    psi = 2 * np.pi * (d[None] - s[:, None]) / period_s + x[None]  # (K, S_c)
+    b = _basis(psi, harmonics, odd)
+    g = np.einsum("ksi,ksj->kij", b, b)
+    b.flags.writeable = False
+    g.flags.writeable = False
+    return b, g
+
+
 def fit_centre(deltas, error_rad, period_s: float, near_s: float, harmonics: int = 2,
                search_s: float | None = None, extra_phase_rad=None, search_phase=None,
                odd=None, return_fit: bool = False):
@@ -205,11 +225,10 @@ def fit_centre(deltas, error_rad, period_s: float, near_s: float, harmonics: int
         coefs = []
         for c in cols:
             m = ok[:, c]
-            psi = 2 * np.pi * (d[m][None] - s[:, None]) / period_s + x[m, c][None]  # (K, S_c)
-            b = _basis(psi, harmonics, odd[c])  # (K, S_c, 1 + H)
             # least squares by the normal equations, batched over the candidates: the basis
             # is a handful of well-separated harmonics over a quarter period or more
-            g = np.einsum("ksi,ksj->kij", b, b)
+            b, g = _basis_gram(d[m].tobytes(), s.tobytes(), x[m, c].tobytes(), float(period_s),
+                               int(harmonics), bool(odd[c]))  # (K, S_c, 1 + H), its Gram
             r = np.einsum("ksi,s->ki", b, e[m, c])
             coef = np.linalg.solve(g, r[..., None])[..., 0]  # (K, 1 + H)
             total += np.sum(e[m, c] ** 2) - np.einsum("ki,ki->k", coef, r)

@@ -21,6 +21,7 @@ import numpy as np
 from scipy.constants import c
 
 from .._lib.util import one_blas_thread, warn_caller
+from ..errors import RtsgeomWarning
 from ..geometry import Setup
 from ..geometry.farfield import two_way_lengths
 from ..paths import Paths, nominal_model
@@ -33,7 +34,8 @@ from ..synthesis.model import ChannelModel
 
 __all__ = ["FrontEndProbe", "clipping_note", "probe_front_ends", "probe_ranges", "probe_angles",
            "probe_total_delay", "probe_program", "simulate_detect", "if_phase_slope_hz",
-           "air_phase_slope_hz", "mean_air_delay", "place_in_bins", "PLACEMENT_OFFSETS_BINS"]
+           "air_phase_slope_hz", "mean_air_delay", "place_in_bins", "PLACEMENT_OFFSETS_BINS",
+           "probes_per_frame", "probe_layout", "ProbeWarning"]
 
 
 @dataclass(frozen=True)
@@ -108,11 +110,18 @@ def probe_angles(theta_i: float, theta_j: float) -> tuple[float, float]:
 def probe_ranges(setup: Setup, n: int) -> np.ndarray:
     """Ranges for n simultaneous probe targets: distinct, away from the setup, and clear of
     each other's cable ghosts (at multiples of L / VF behind each probe), which would otherwise
-    leak into a neighbour's bin and bias its angle."""
+    leak into a neighbour's bin and bias its angle. More than :func:`probes_per_frame` of them
+    run past the usable range axis: :func:`probe_layout` measures those in turns."""
     scene = setup.scene
     radar = scene.radar
     r0 = max(0.2 * radar.max_range_m, scene.rts.arc_radius_m + 2.0)
-    ghosts = [k * fe.cable_length_m / fe.cable_velocity_factor for fe in scene.rts.front_ends
+    return r0 + _probe_step(setup, n) * np.arange(n)
+
+
+def _probe_step(setup: Setup, n: int) -> float:
+    """The spacing (m) of n simultaneous probes (:func:`probe_ranges`)."""
+    radar = setup.scene.radar
+    ghosts = [k * fe.cable_length_m / fe.cable_velocity_factor for fe in setup.scene.rts.front_ends
               if fe.return_loss_fe_db is not None and fe.return_loss_be_db is not None
               for k in range(1, 6)]
     clear = 4 * radar.range_resolution_m
@@ -123,7 +132,36 @@ def probe_ranges(setup: Setup, n: int) -> np.ndarray:
     step = max(max(8, cfar_cells) * radar.range_resolution_m, 3.0)
     while any(abs(m * step - g) < clear for g in ghosts for m in range(1, n)):
         step += radar.range_resolution_m
-    return r0 + step * np.arange(n)
+    return step
+
+
+PROBE_RANGE_LIMIT = 0.85  # probes stay below this fraction of the range axis (its IF roll-off)
+
+
+def probes_per_frame(setup: Setup, n: int) -> int:
+    """How many of n front ends' probes one frame holds (at least 1): the probes at
+    :func:`probe_ranges` up to ``PROBE_RANGE_LIMIT`` of the RuT's range axis, beyond which
+    the IF filter's roll-off and the axis' end lose them (33 front ends 3 m apart ran to 111
+    m on a 77 m axis)."""
+    limit = PROBE_RANGE_LIMIT * setup.scene.radar.max_range_m
+    r0 = float(probe_ranges(setup, 1)[0])
+    # no more than the unconstrained spacing allows (a ghost only widens it), then fewer
+    # until the spacing they need fits
+    k = max(1, min(n, int((limit - r0) // _probe_step(setup, 1)) + 1))
+    while k > 1 and r0 + _probe_step(setup, k) * (k - 1) > limit:
+        k = max(1, min(k - 1, int((limit - r0) // _probe_step(setup, k)) + 1))
+    return k
+
+
+def probe_layout(setup: Setup, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Each of n front ends' probe range (n,) and the turn (frame) it is measured in (n,):
+    :func:`probes_per_frame` front ends a frame at :func:`probe_ranges`, the next ones in the
+    next frame at the same ranges (one frame where they all fit: the same ranges as one
+    frame). The frames grow linearly with n, and so does the cost."""
+    k = probes_per_frame(setup, n)
+    ranges = probe_ranges(setup, k)
+    q = np.arange(n)
+    return ranges[q % k], q // k
 
 
 def simulate_detect(setup, paths, program, seed, frames: int = 1, clipped: bool = False):
@@ -141,14 +179,20 @@ def simulate_detect(setup, paths, program, seed, frames: int = 1, clipped: bool 
     return (rd, det, int(cube.clipped)) if clipped else (rd, det)
 
 
+class ProbeWarning(RtsgeomWarning, RuntimeWarning):
+    """A front end the RuT does not detect alone at its probe range (its angle is NaN)."""
+
+
 @one_blas_thread
 def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe:
-    """Each front end alone at its own probe range (one simulated frame): measured angle and
-    power; the gain correction equalises measured against modelled power. BLAS on one
-    thread, as :func:`calibrate_pair`."""
+    """Each front end alone at its own probe range: measured angle and power; the gain
+    correction equalises measured against modelled power. One simulated frame holds
+    :func:`probes_per_frame` of them; more are measured in turns, a frame each, at the same
+    ranges (:func:`probe_layout`; turn t > 0 draws its noise from ``SeedSequence([seed, t])``).
+    BLAS on one thread, as :func:`calibrate_pair`."""
     scene = setup.scene
     n = setup.fe.count
-    ranges = probe_ranges(setup, n)
+    ranges, turn = probe_layout(setup, n)
     design, design_paths = nominal_model(setup, paths)
     model_p = np.empty(n)
     amps = np.empty(n)
@@ -157,21 +201,26 @@ def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe
         m = ChannelModel.build(design, design_paths, (q, j), TargetConfig(float(ranges[q])))
         model_p[q] = np.max(np.sum(np.abs(m.responses[:, 0]) ** 2, axis=-1))
         amps[q] = m.unit_gain
-    prog = RtsProgram.build(np.arange(n), np.arange(n), requested_delay(scene, ranges),
-                            np.zeros(n), amps)
-    rd, det, n_clip = simulate_detect(setup, paths, prog, seed, clipped=True)
     ang = np.full(n, np.nan)
     pw = np.full(n, np.nan)
-    for q in range(n):
-        k = nearest_detection(det, rd, ranges[q])
-        if k is not None:
-            ang[q], pw[q] = det.angle_rad[k], det.power_db[k]
+    n_clip = 0
+    for t in range(int(turn.max()) + 1 if n else 0):
+        fes = np.flatnonzero(turn == t)
+        prog = RtsProgram.build(np.arange(fes.size), fes, requested_delay(scene, ranges[fes]),
+                                np.zeros(fes.size), amps[fes])
+        frame_seed = seed if t == 0 else np.random.SeedSequence([int(seed) % 2 ** 32, t])
+        rd, det, clipped = simulate_detect(setup, paths, prog, frame_seed, clipped=True)
+        n_clip += clipped
+        for q in fes:
+            k = nearest_detection(det, rd, ranges[q])
+            if k is not None:
+                ang[q], pw[q] = det.angle_rad[k], det.power_db[k]
     missed = [q for q in range(n) if not np.isfinite(ang[q])]
     if missed:  # not silently: its angle is NaN and its gain correction falls back to 1
         warn_caller(f"front end(s) {missed} not detected alone at the probe range(s) "
                       f"{np.round(ranges[missed], 3).tolist()} m (below the CFAR threshold or "
                       "beyond the range axis): their measured angle is NaN and their gain "
-                    "correction 1" + clipping_note(n_clip), RuntimeWarning)
+                    "correction 1" + clipping_note(n_clip), ProbeWarning)
     meas = 10 ** (pw / 10) / amps ** 2
     corr = np.sqrt(model_p / meas)
     return FrontEndProbe(ang, pw, np.where(np.isfinite(corr), corr, 1.0), n_clip)

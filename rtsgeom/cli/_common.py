@@ -17,7 +17,6 @@ import os
 import re
 import sys
 import time
-import warnings
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -124,12 +123,15 @@ class steps:
     """Progress of a multi-step command on stderr (a spinner per step; silent when quiet).
 
     ``with steps(quiet) as step: step("calibrating"); ...`` prints each finished step with its
-    duration, so a user sees what takes time.
+    duration, so a user sees what takes time. ``step.count(label, done, total)`` counts within
+    a step (frames, pairs): on a terminal a bar with the time left, elsewhere plain lines
+    ``rtsgeom: frame 240/1000 (24 %), 12.1 s, about 38.3 s left`` (:class:`LineProgress`).
     """
 
     def __init__(self, quiet: bool = False):
         self.quiet = quiet
         self._status = None
+        self._bar = None
         self._label = None
         self._t0 = 0.0
 
@@ -137,6 +139,7 @@ class steps:
         if not self.quiet:
             from rich.console import Console
             self._console = Console(stderr=True)
+            self._lines = None if sys.stderr.isatty() else LineProgress(sys.stderr)
         return self
 
     def __call__(self, label: str) -> None:
@@ -147,15 +150,35 @@ class steps:
         self._status = self._console.status(label + " ...")
         self._status.start()
 
-    def _finish(self, failed: bool = False) -> None:
-        if self._status is not None:
-            self._status.stop()
-            if failed:  # the error message follows; no duration for a step that did not finish
+    def count(self, label: str, done: int, total: int) -> None:
+        """``done`` of ``total`` within the current step (a bar or lines, see the class)."""
+        if self.quiet:
+            return
+        if self._lines is not None:
+            self._lines(label, done, total)
+            return
+        if self._bar is None:  # the step's spinner becomes a bar (one live display at once)
+            from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn,
+                                       TimeElapsedColumn, TimeRemainingColumn)
+            if self._status is not None:
+                self._status.stop()
                 self._status = None
-                return
+            self._bar = Progress(TextColumn("{task.description}"), BarColumn(),
+                                 MofNCompleteColumn(), TimeElapsedColumn(),
+                                 TimeRemainingColumn(), console=self._console, transient=True)
+            self._bar.start()
+            self._task = self._bar.add_task(label, total=total)
+        self._bar.update(self._task, description=label, completed=done, total=total)
+
+    def _finish(self, failed: bool = False) -> None:
+        live = self._status is not None or self._bar is not None
+        for display in (self._status, self._bar):
+            if display is not None:
+                display.stop()
+        self._status = self._bar = None
+        if live and not failed:  # the error message follows; no duration for a failed step
             self._console.print(f"  {self._label}: {time.perf_counter() - self._t0:.1f} s",
                                 style="dim", highlight=False, soft_wrap=True)
-            self._status = None
 
     def __exit__(self, exc_type, exc, tb):
         self._finish(failed=exc_type is not None)
@@ -171,11 +194,13 @@ def warn_scene_errors(scene, command: str, what: str | None = None) -> None:
 
 def show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     """``warnings.showwarning`` of the commands: rtsgeom's own warnings as
-    ``rtsgeom: warning: <message>`` on stderr, any other as Python prints it."""
+    ``rtsgeom: warning: <message>`` on stderr, any other (numpy's, a library's) as the same
+    one line with its category: a user of the CLI never sees a source line."""
+    from ..errors import RtsgeomWarning
     if issubclass(category, RtsgeomWarning):
         print(f"rtsgeom: warning: {message}", file=sys.stderr)
     else:
-        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+        print(f"rtsgeom: warning: {category.__name__}: {message}", file=sys.stderr)
 
 
 # -- the front-end pair: --pair I J | all, --cell Q.. | all ----------------------------------
@@ -237,7 +262,7 @@ def print_outputs(args, name: str, out: dict, text) -> int:
 def progress(quiet: bool):
     """A ``progress(label, done, total)`` callback on stderr (None when quiet): on a terminal
     one rich bar, relabelled at each stage, that appears with the first count; elsewhere (a
-    log file, a pipe) plain lines ``rtsgeom: <label> 12/40 (30 %), 4.1 s, ETA 9.6 s``, one
+    log file, a pipe) plain lines ``rtsgeom: <label> 12/40 (30 %), 4.1 s, about 9.6 s left``, one
     every 10 % or 5 s and one at each stage's end."""
     if quiet:
         yield None
@@ -286,7 +311,7 @@ class LineProgress:
         if total:
             line += f" ({100 * frac:.0f} %), {elapsed:.1f} s"
             if 0 < done < total:
-                line += f", ETA {elapsed * (total - done) / done:.1f} s"
+                line += f", about {elapsed * (total - done) / done:.1f} s left"
         print(line, file=self.stream, flush=True)
         if end:
             self.label = None  # a stage counted again from zero prints afresh

@@ -36,7 +36,7 @@ def cmd_play(args) -> int:
             step(_estimate(scene, study))
         step(f"playing {scene.name} (calibration once, then every frame through the chain)")
         try:
-            result = study(scene)
+            result = study(scene, progress=step)
         except ParameterError as exc:
             raise UsageError(str(exc)) from None
         summary = result.summary_json()

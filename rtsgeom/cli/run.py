@@ -30,7 +30,8 @@ def cmd_run(args) -> int:
     out = args.out
     with output_folder(out, [args.scene]) as stage, steps(args.quiet) as step:
         step(f"simulating {scene.name} ({args.paths} paths, calibration, ADC cube, detection)")
-        result = run_scene(scene, args.paths, args.amplitudes, **calibration_kw(args))
+        result = run_scene(scene, args.paths, args.amplitudes, progress=step,
+                           **calibration_kw(args))
         step("writing detections, summary, maps" + ("" if args.no_report else
                                                       " and report.html (3D view, figures)"))
         write_run(result, stage, args.paths, args.maps, not args.no_report,

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.constants import c
 
+from .._lib.util import tell
 from ..calibration.channels import calibrate_channels, channel_offsets, pair_edges, tree_phases
 from ..calibration.file import calibration_mismatch, load_calibration
 from ..calibration.pair import calibrate_pair
@@ -237,7 +238,8 @@ def calibrate_pairs(setup: Setup, paths: Paths, pairs, probe, loaded: dict | Non
     the pairs before it chained (``channel_offsets``); taken from ``loaded`` (a calibration
     file's pairs) where it is given."""
     cals: dict[tuple[int, int], Calibration] = {}
-    for pair in pairs:
+    pairs = list(pairs)
+    for n_done, pair in enumerate(pairs, 1):
         base = channel_offsets(setup.fe.count, cals)
         if loaded is not None:
             if pair not in loaded:
@@ -248,8 +250,8 @@ def calibrate_pairs(setup: Setup, paths: Paths, pairs, probe, loaded: dict | Non
             continue
         cals[pair] = calibrate_pair(setup, paths, pair, probe, (base[pair[0]], base[pair[0]]),
                                     seed=setup.scene.seed)
-        if progress:
-            progress(f"calibrated pair {pair}: delta_tau {cals[pair].delta_tau_s * 1e12:.1f} ps")
+        tell(progress, f"calibrated pair {pair}: delta_tau {cals[pair].delta_tau_s * 1e12:.1f} ps",
+             "calibrating pairs", n_done, len(pairs))
     return cals
 
 

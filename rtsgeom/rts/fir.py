@@ -81,8 +81,9 @@ def fir_error_response(mu, taps: int, f_s_hz: float, f_hz, shift_hz=0.0) -> np.n
     return resp
 
 
-#: per (taps, f_s, frequency grid): the settings met so far (sorted), their taps and the
-#: window's ``exp(j w mu)`` rows, and ``exp(-j w k)`` (see :func:`_fir_rows`)
+#: per (taps, f_s, frequency grid): the settings met so far (sorted) and their slots in
+#: buffers of ``_FIR_ROWS_MAX`` rows of taps and of the window's ``exp(j w mu)``, and
+#: ``exp(-j w k)`` (see :func:`_fir_rows`)
 _FIR_ROWS: dict = {}
 _FIR_ROWS_MAX = 2048  # settings kept per key (~17 MiB at N = 512); beyond: start afresh
 _FIR_KEYS_MAX = 2  # frequency grids kept (a process meets one per scene)
@@ -94,32 +95,43 @@ def _fir_rows(uniq: np.ndarray, taps: int, f_s_hz: float, grid: np.ndarray):
     (taps, N), w = 2 pi grid / f_s. A delay table meets the same few hundred settings (one
     per delay step in a sample period) in every block of echoes and in every design of a
     grid; their taps and phase rows (U N complex exponentials per call: over half of the
-    response's time) are computed once per process and looked up. Each row is computed by
-    the same elementwise arithmetic as before, so the bits do not depend on the memo."""
+    response's time) are computed once per process and looked up. New rows are written into
+    preallocated buffers (a drive meets new settings every frame: copying the whole memo per
+    call to insert them was 3.5 ms a call, most of a frame's planning). Each row is computed
+    by the same elementwise arithmetic as before, so the bits do not depend on the memo."""
     key = (taps, f_s_hz, grid.tobytes())
     w = 2 * np.pi * grid / f_s_hz  # (N,)
     entry = _FIR_ROWS.get(key)
     if entry is None:
         k = np.arange(taps) - (taps - 1) / 2
-        entry = (np.zeros(0), np.zeros((0, taps)), np.zeros((0, grid.size), complex),
-                 np.exp(-1j * np.outer(k, w)))
-    mus, h, phase, kern = entry
+        entry = {"mus": np.zeros(0), "slots": np.zeros(0, int),
+                 "h": np.empty((_FIR_ROWS_MAX, taps)),
+                 "phase": np.empty((_FIR_ROWS_MAX, grid.size), complex),
+                 "kern": np.exp(-1j * np.outer(k, w))}
+        if len(_FIR_ROWS) >= _FIR_KEYS_MAX:
+            _FIR_ROWS.clear()
+        _FIR_ROWS[key] = entry
+    mus, slots = entry["mus"], entry["slots"]
+    cap = min(_FIR_ROWS_MAX, entry["h"].shape[0])  # (the buffers' rows)
     pos = np.minimum(np.searchsorted(mus, uniq), max(mus.size - 1, 0))
     hit = (mus[pos] == uniq) if mus.size else np.zeros(uniq.size, bool)
     if not hit.all():
         new = uniq[~hit]
-        if mus.size + new.size > _FIR_ROWS_MAX:
-            mus, h, phase = np.zeros(0), np.zeros((0, taps)), np.zeros((0, grid.size), complex)
-            new = uniq  # the settings found in the old memo went with it
+        if mus.size + new.size > cap:  # start afresh with these settings
+            if uniq.size > cap:  # more than the memo holds: computed, not kept
+                return (fractional_delay_fir(uniq, taps), np.exp(1j * np.outer(uniq, w)),
+                        entry["kern"])
+            mus, slots, new = np.zeros(0), np.zeros(0, int), uniq
+        free = np.arange(mus.size, mus.size + new.size)  # slots are filled in order
+        entry["h"][free] = fractional_delay_fir(new, taps)
+        entry["phase"][free] = np.exp(1j * np.outer(new, w))
         order = np.argsort(np.concatenate([mus, new]), kind="stable")
         mus = np.concatenate([mus, new])[order]
-        h = np.concatenate([h, fractional_delay_fir(new, taps)])[order]
-        phase = np.concatenate([phase, np.exp(1j * np.outer(new, w))])[order]
-        if key not in _FIR_ROWS and len(_FIR_ROWS) >= _FIR_KEYS_MAX:
-            _FIR_ROWS.clear()
-        _FIR_ROWS[key] = (mus, h, phase, kern)
+        slots = np.concatenate([slots, free])[order]
+        entry["mus"], entry["slots"] = mus, slots
         pos = np.searchsorted(mus, uniq)
-    return h[pos], phase[pos], kern
+    rows = slots[pos]
+    return entry["h"][rows], entry["phase"][rows], entry["kern"]
 
 
 def fir_if_gain(scene: Scene, delay_s, tau_total_s) -> np.ndarray | None:

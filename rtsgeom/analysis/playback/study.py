@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..._lib.util import tell
 from ..._lib.parallel import fork_map
 from ...errors import ParameterError
 from ...geometry import build_setup
@@ -105,8 +106,14 @@ def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1, t
     scale = cell_scale(setup)  # the clouds' comparison cell (pipeline.merge)
     work = functools.partial(_frames, (scene, setup, paths, planner, frames, bins, truth))
     chunks = np.array_split(np.arange(n_f), max(1, min(n_f, 4 * int(workers))))
-    outs = (fork_map(work, chunks, int(workers)) if workers > 1 and n_f > 1
-            else [work(c) for c in chunks])
+    tell(progress, f"{mode}: playing {n_f} frames")
+    if workers > 1 and n_f > 1:
+        outs = fork_map(work, chunks, int(workers))
+    else:  # frame by frame, counted (the same frames: each a pure function of its index)
+        outs = []
+        for f in range(n_f):
+            outs.append(work(np.array([f])))
+            tell(progress, None, f"{mode}: frame", f + 1, n_f)
     clouds = []
     for f, (rows, found, extra, notes, seen, stat, cloud) in enumerate(o for out in outs
                                                                         for o in out):

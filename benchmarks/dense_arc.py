@@ -1,0 +1,111 @@
+"""``python -m benchmarks.dense_arc [--front-ends 64] [--step-deg 1] [--targets 32] [--repeat 3]``:
+how long the CLI takes on an arc of many front ends.
+
+The template's bench (``scenes/template.toml``: AWR1843BOOST, 1.5 m arc, noise at 10 dB) with
+``--front-ends`` front ends ``--step-deg`` apart (12 mm Rx/Tx modules in 24 mm cutouts so that
+neighbours fit) and ``--targets`` targets spread over the arc at 10 to 63 m and -3.3 to 3.3
+m/s. Times ``info``, ``run`` (with and without its report) and ``calibrate --pair all`` as
+whole processes (wall and user CPU, the median of ``--repeat``), with the machine's load
+average before each, checks that every target is detected, and writes
+``benchmarks/dense_arc.json``. Not part of the test suite.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from benchmarks._io import write_json
+
+ROOT = Path(__file__).resolve().parents[1]
+TEMPLATE = ROOT / "scenes" / "template.toml"
+
+
+def arc_scene(n: int, step_deg: float, n_targets: int) -> str:
+    """The template's bench with ``n`` front ends ``step_deg`` apart and ``n_targets``
+    targets, as TOML text (the template's [radar] and [rts] kept, its front ends, sheet and
+    targets replaced)."""
+    head = TEMPLATE.read_text().split("\n[[rts.front_ends]]\n")[0]
+    head = head.replace("five RTS front ends", f"{n} RTS front ends {step_deg:g} deg apart")
+    a0 = -step_deg * (n - 1) / 2
+    span = (n - 1) * step_deg
+    out = [head, ""]
+    for k in range(n):
+        out += ["[[rts.front_ends]]", f"angle_deg = {a0 + k * step_deg:.6f}",
+                "rx_tx_separation_m = 0.012", "cable_length_m = 1.0", ""]
+    out += ["[sheet]", "height_m = 0.3", f"angle_min_deg = {a0 - 4:.6f}",
+            f"angle_max_deg = {-a0 + 4:.6f}", "cutout_diameter_m = 0.024",
+            "thickness_m = 0.002", ""]
+    for k in range(n_targets):
+        ang = a0 + step_deg / 2 + span * (k + 0.37) / (n_targets + 0.2)
+        ang = min(max(ang, a0 + 0.2 * step_deg), -a0 - 0.2 * step_deg)
+        out += ["[[targets]]", f"range_m = {10 + 1.7 * k:.3f}",
+                f"velocity_mps = {((k % 7) - 3) * 1.1:.3f}", f"angle_deg = {ang:.4f}", ""]
+    return "\n".join(out)
+
+
+def timed(argv: list[str]) -> dict:
+    """One whole process ``python -m rtsgeom argv``: wall and user CPU (s), exit code."""
+    load = os.getloadavg()[0]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-m", "rtsgeom", *argv], capture_output=True,
+                          text=True, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if proc.returncode:
+        raise SystemExit(f"rtsgeom {' '.join(argv)}: exit {proc.returncode}: {proc.stderr[-2000:]}")
+    return {"wall_s": wall, "user_s": after.ru_utime - before.ru_utime, "load_before": load,
+            "stderr_lines": len(proc.stderr.splitlines())}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--front-ends", type=int, default=64)
+    ap.add_argument("--step-deg", type=float, default=1.0)
+    ap.add_argument("--targets", type=int, default=32)
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--out", default=str(ROOT / "benchmarks" / "dense_arc.json"))
+    args = ap.parse_args(argv)
+    rows = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        scene = Path(tmp) / f"arc{args.front_ends}.toml"
+        scene.write_text(arc_scene(args.front_ends, args.step_deg, args.targets))
+        cases = {"info": ["info", str(scene)],
+                 "run --no-report": ["run", str(scene), "--out", f"{tmp}/a", "--no-report"],
+                 "run": ["run", str(scene), "--out", f"{tmp}/b"],
+                 "calibrate --pair all": ["calibrate", str(scene), "--pair", "all"]}
+        for name, cmd in cases.items():
+            runs = []
+            for r in range(args.repeat):
+                if "--out" in cmd:  # a new folder each time (the last run's stays)
+                    shutil.rmtree(cmd[cmd.index("--out") + 1], ignore_errors=True)
+                runs.append(timed(cmd))
+                print(f"{name}: {runs[-1]['wall_s']:.1f} s wall, {runs[-1]['user_s']:.1f} s "
+                      f"user (load {runs[-1]['load_before']:.1f})", flush=True)
+            rows[name] = {"median_wall_s": statistics.median(x["wall_s"] for x in runs),
+                          "median_user_s": statistics.median(x["user_s"] for x in runs),
+                          "runs": runs}
+        summary = json.loads((Path(tmp) / "b" / "summary.json").read_text())
+    errs = [t["error"] for t in summary["targets"] if t["detection"] is not None]
+    accuracy = {"targets": len(summary["targets"]), "detected": len(errs),
+                **{f"max_abs_{k}": max(abs(e[k]) for e in errs)
+                   for k in ("range_m", "velocity_mps", "angle_deg")}}
+    print(accuracy)
+    write_json(args.out, {"front_ends": args.front_ends, "step_deg": args.step_deg,
+                          "targets": args.targets, "repeat": args.repeat, "cpus": os.cpu_count(),
+                          "commands": rows, "accuracy": accuracy}, newline=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
