@@ -204,7 +204,7 @@ def test_a_broken_capture_is_a_capture_error_and_exit_2(capture_files, tmp_path,
     _corrupt(kind, path)
     with pytest.raises(CaptureError, match=re.escape(str(tmp_path))) as exc:
         read_capture(path)
-    assert ("no such capture file" in str(exc.value)) == (kind == "missing")
+    assert ("no such file" in str(exc.value)) == (kind == "missing")
     assert main(["identify", str(DEFAULT_SCENE), str(path)]) == 2
     err = capsys.readouterr().err
     assert err.startswith("rtsgeom: error: CAPTURE: ") and "Traceback" not in err

@@ -112,9 +112,7 @@ def test_front_end_layout_fields_read_per_front_end():
     layer; some may leave them unset, i.e. default): placed by those, not the shorthand."""
     from rtsgeom.geometry.frontends import front_ends
     base = make_scene().rts.front_ends
-    fes = [SimpleNamespace(**{k: getattr(f, k) for k in (
-        "angle_rad", "rx_tx_separation_m", "radial_offset_m", "tangential_offset_m",
-        "height_offset_m")}) for f in base]
+    fes = [SimpleNamespace(**{k: getattr(f, k) for k in f.__dataclass_fields__}) for f in base]
     fes[0].rx_offset_m, fes[0].tx_offset_m = (0.004, 0.001), (-0.006, 0.0)
     fes[1].rx_offset_m, fes[1].tx_offset_m = None, None  # default: both at the module centre
     scene = SimpleNamespace(rts=SimpleNamespace(front_ends=fes, arc_radius_m=1.0))

@@ -116,7 +116,8 @@ class CalibrationStudy:
         fir = None if arc else fir_effect(setup, cals[0].delta_tau_s,
                                           ranges=cals[0].probe_ranges_m)
         return CalibrationReport(tuple(pairs), tuple(cals), probe, self.procedure,
-                                 setup_fingerprint(scene), arc, uses_cells(scene), fir)
+                                 setup_fingerprint(scene), arc, uses_cells(scene), fir,
+                                 scene.name)
 
 
 @dataclass(frozen=True, repr=False)
@@ -148,6 +149,7 @@ class CalibrationReport(Result):
     arc: bool = False  # the study of every pair (its file lists them)
     cells: bool = False  # the scene's front ends form 2-D cells
     fir: dict | None = None  # one pair's fractional-delay filter effect
+    scene_name: str = ""  # the figures' titles
 
     @property
     def calibration(self):
@@ -207,20 +209,14 @@ class CalibrationReport(Result):
     def write(self, folder: str | Path) -> list[str]:
         """calibration.json and the sweep figure(s) into ``folder``: calibration_sweep.png of
         one pair, calibration_sweep_I_J.png per pair of the arc; returns the names."""
-        from ..viz.figures import calibration_sweep_figure, save_figure  # matplotlib
+        from ..viz.figures import save_figure  # matplotlib
         folder, names = Path(folder), []
         for pair, cal in zip(self.pairs, self.calibrations):
-            if self.arc:
-                name = f"calibration_sweep_{pair[0]}_{pair[1]}.png"
-                fig = calibration_sweep_figure(cal.sweep_delta_tau_s, cal.sweep_error_deg,
-                                               cal.delta_tau_s, cal.period_s)
-            else:
-                name = "calibration_sweep.png"
-                fig = calibration_sweep_figure(cal.sweep_delta_tau_s, cal.sweep_error_deg,
-                                               cal.delta_tau_s, cal.period_s,
-                                               residual_error_deg=cal.residual_error_deg,
-                                               refine_delta_tau_s=cal.refine_delta_tau_s,
-                                               refine_error_deg=cal.refine_error_deg)
+            name = (f"calibration_sweep_{pair[0]}_{pair[1]}.png" if self.arc
+                    else "calibration_sweep.png")
+            # titled with the scene and the pair; the residual marked as stdout gives it
+            fig = cal.plot(f"{self.scene_name}: phase coherency calibration, front ends "
+                           f"{pair[0]}-{pair[1]}" if self.scene_name else "")
             save_figure(fig, folder / name)
             names.append(name)
         self.to_json(folder / "calibration.json")

@@ -8,7 +8,7 @@ import argparse
 
 from ..errors import ParameterError, UsageError
 from ._common import (load_scene_checked, number, output_folder, output_path, print_outputs,
-                      scene_arg, steps, write_outputs)
+                      scene_arg, steps, write_json)
 
 
 def _ranges(text: str) -> tuple[float, ...]:
@@ -54,7 +54,10 @@ def cmd_objects(args) -> int:
         except ParameterError as exc:
             raise UsageError(str(exc)) from None
         out = res.to_dict()
-        write_outputs(stage, "objects", out, res.plot)
+        if stage is not None:
+            from ..viz.figures import save_figure
+            write_json(stage / "objects.json", out)
+            save_figure(res.plot(), stage / "objects.png")
     return print_outputs(args, "objects", out, lambda o: repr(res))
 
 

@@ -5,6 +5,7 @@ summary.json, the maps (PNG and arrays) and report.html."""
 from __future__ import annotations
 
 import argparse
+import json
 
 from ..geometry.warnings import scene_warnings
 from ..pipeline.output import MAP_FORMATS, write_run

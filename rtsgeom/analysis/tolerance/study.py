@@ -18,7 +18,6 @@ from pathlib import Path
 import numpy as np
 
 from ..._lib.results import Result
-from ..._lib.util import user_stacklevel
 from ...errors import AngleUnreachable, ParameterError
 from ...geometry import build_setup
 from ...geometry.setup import warn_setup_errors
@@ -190,7 +189,7 @@ class ToleranceStudy:
 
     def __call__(self, scene: Scene) -> "ToleranceReport":
         check_scene_arg(scene, "tolerance")
-        warn_setup_errors(scene, "tolerance", stacklevel=user_stacklevel())  # NominalSetupWarning
+        warn_setup_errors(scene, "tolerance")  # NominalSetupWarning
         model = self.model(scene)
         mc = self.mc.seeded(scene.seed)
         if model.kind != "arc":
