@@ -3,10 +3,22 @@
 from __future__ import annotations
 
 import copy
+import os
 import tomllib
 from pathlib import Path
 
 import pytest
+
+# One BLAS thread per test process (unless the environment asks for more): the suite's
+# products are small, and with one xdist worker per core a threaded BLAS only hands work
+# between threads (the 2-D cells grid of tests/test_nchannel.py: 10.6 -> 2.4 s of CPU on a
+# loaded two-core machine). The results are the same bits (tests/test_calibration_threads.py
+# sets its own limits); subprocesses (the CLI, the docs build) inherit the variables.
+if not any(k in os.environ for k in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
+                                     "OMP_NUM_THREADS")):
+    os.environ.update(OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1")
+    from threadpoolctl import threadpool_limits
+    _BLAS_LIMIT = threadpool_limits(limits=1, user_api="blas")  # numpy may be loaded already
 
 from rtsgeom.scene import parse_scene
 

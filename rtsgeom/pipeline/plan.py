@@ -15,10 +15,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.constants import c
 
-from .._lib.util import tell
+from ..calibration.chains import calibrate_chained
 from ..calibration.channels import calibrate_channels, channel_offsets, pair_edges, tree_phases
 from ..calibration.file import calibration_mismatch, load_calibration
-from ..calibration.pair import calibrate_pair
 from ..calibration.sweep import Calibration
 from ..calibration.probes import probe_angles, probe_front_ends
 from ..errors import (AngleUnreachable, CalibrationFailed, CellUnreachable, ParameterError,
@@ -237,22 +236,14 @@ def calibrate_pairs(setup: Setup, paths: Paths, pairs, probe, loaded: dict | Non
     """The pairs' calibrations, in the given order, each with channel I at the delay offset
     the pairs before it chained (``channel_offsets``); taken from ``loaded`` (a calibration
     file's pairs) where it is given."""
-    cals: dict[tuple[int, int], Calibration] = {}
-    pairs = list(pairs)
-    for n_done, pair in enumerate(pairs, 1):
-        base = channel_offsets(setup.fe.count, cals)
-        if loaded is not None:
-            if pair not in loaded:
-                raise SceneError(f"calibration file: has no pair {pair} (it has "
-                                 f"{sorted(loaded)}): run `rtsgeom calibrate SCENE --pair "
-                                 f"{pair[0]} {pair[1]} --out DIR`")
-            cals[pair] = loaded[pair]
-            continue
-        cals[pair] = calibrate_pair(setup, paths, pair, probe, (base[pair[0]], base[pair[0]]),
-                                    seed=setup.scene.seed)
-        tell(progress, f"calibrated pair {pair}: delta_tau {cals[pair].delta_tau_s * 1e12:.1f} ps",
-             "calibrating pairs", n_done, len(pairs))
-    return cals
+    if loaded is None:  # measured: independent chains side by side, the same calibrations
+        return calibrate_chained(setup, paths, pairs, probe, progress)
+    missing = [pair for pair in pairs if pair not in loaded]
+    if missing:
+        raise SceneError(f"calibration file: has no pair {missing[0]} (it has "
+                         f"{sorted(loaded)}): run `rtsgeom calibrate SCENE --pair "
+                         f"{missing[0][0]} {missing[0][1]} --out DIR`")
+    return {pair: loaded[pair] for pair in pairs}
 
 
 def program_pairs(setup: Setup, paths: Paths, mode: str, targets, pairs, probe, cals: dict,

@@ -12,6 +12,7 @@ import numpy as np
 
 from .. import __version__
 from .._lib.results import Result
+from .._lib.util import one_blas_thread
 from ..geometry import Setup, build_setup
 from ..paths import Paths, compute_paths
 from ..geometry.arrays import rut_array
@@ -268,6 +269,7 @@ def label_detections(result: "RunResult", bins: float = 2.0) -> list[str]:
     return labels
 
 
+@one_blas_thread  # small products (the planner's models): BLAS threads cost more than they give
 def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = None,
               progress=None, calibration: dict | None = None, truth: bool = True) -> RunResult:
     """Run the whole pipeline on ``scene``.
