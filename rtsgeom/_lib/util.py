@@ -97,18 +97,6 @@ def warn_caller(message: str, category: type[Warning]) -> None:
     warnings.warn(message, category, stacklevel=level)
 
 
-def user_stacklevel() -> int:
-    """The ``stacklevel`` that makes a warning raised one call below the caller (e.g. in
-    ``warn_setup_errors``) point at the first line outside rtsgeom: the user's call of a study,
-    however many of the package's functions lie between."""
-    import os
-    frame, level = sys._getframe(1), 2
-    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(
-            _PACKAGE_DIR + os.sep):
-        frame, level = frame.f_back, level + 1
-    return level
-
-
 def tell(progress, message: str | None, stage: str | None = None, done: int = 0,
          total: int = 0) -> None:
     """Report to a ``progress`` callback (None: nothing): a count ``progress.count(stage,

@@ -37,6 +37,7 @@ from ..radar.truth import simulate_truth, truth_echoes
 from ..rts.channels import EchoKind, RtsProgram, build_echoes
 from ..scene import Scene, TargetConfig
 from ..scene.registry import AOA_MODES
+from ..scene.schema import check_arg
 from .playback.frames import FramePlanner
 
 __all__ = ["ResolutionStudy", "Resolution", "resolution", "SOURCES"]
@@ -77,29 +78,30 @@ class ResolutionStudy:
     amplitudes: str | None = None
 
     def __post_init__(self):
-        for name in ("velocity_mps", "rcs_dbsm"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float, np.number)) and np.isfinite(v)):
-                raise ParameterError(f"resolution: {name} = {v!r}: must be a finite number")
-        if self.range_m is not None and not (isinstance(self.range_m, (int, float, np.number))
-                                             and 0.1 <= self.range_m <= 1e4):
-            raise ParameterError(f"resolution: range_m = {self.range_m!r}: must be in "
-                                 "[0.1, 10000] m")
+        src, err = "resolution", ParameterError
+        check_arg(self.velocity_mps, "velocity_mps", "float", src, err, lo=-1e3, hi=1e3,
+                  unit="m/s")
+        check_arg(self.rcs_dbsm, "rcs_dbsm", "float", src, err, lo=-100.0, hi=100.0,
+                  unit="dBsm")
+        if self.range_m is not None:
+            check_arg(self.range_m, "range_m", "float", src, err, lo=0.1, hi=1e4, unit="m")
+        if self.centre_deg is not None:
+            check_arg(self.centre_deg, "centre_deg", "float", src, err, lo=-90.0, hi=90.0,
+                      unit="deg")
+        if self.amplitudes is not None:
+            check_arg(self.amplitudes, "amplitudes", "str", src, err, choices=tuple(AOA_MODES))
         seps, phases = np.asarray(self.separations_deg, float), np.asarray(self.phases_deg,
                                                                            float)
         if seps.ndim != 1 or not np.all(np.isfinite(seps)) or np.any(seps <= 0) or np.any(
                 seps > 120):
-            raise ParameterError(f"resolution: separations_deg = {self.separations_deg!r}: "
-                                 "must be separations in (0, 120] deg")
+            raise err(f"resolution: separations_deg = {self.separations_deg!r}: must be "
+                      "separations in (0, 120] deg")
         if phases.ndim != 1 or phases.size == 0 or not np.all(np.abs(phases) <= 360):
-            raise ParameterError(f"resolution: phases_deg = {self.phases_deg!r}: must be one "
-                                 "or more phases in [-360, 360] deg")
+            raise err(f"resolution: phases_deg = {self.phases_deg!r}: must be one or more "
+                      "phases in [-360, 360] deg")
         if seps.size * phases.size > _MAX_CASES:
-            raise ParameterError(f"resolution: {seps.size} separations x {phases.size} phases: "
-                                 f"at most {_MAX_CASES} cases")
-        if self.amplitudes is not None and self.amplitudes not in AOA_MODES:
-            raise ParameterError(f"resolution: amplitudes = {self.amplitudes!r}: must be one "
-                                 f"of {', '.join(AOA_MODES)}")
+            raise err(f"resolution: {seps.size} separations x {phases.size} phases: at most "
+                      f"{_MAX_CASES} cases")
 
     def __call__(self, scene: Scene, progress=None) -> "Resolution":
         """Run the test on ``scene``'s bench (its targets and drive are not used)."""
@@ -114,20 +116,27 @@ class ResolutionStudy:
         centre = self.centre_deg if self.centre_deg is not None else float(
             np.degrees(np.mean(setup.fe_azimuth_rad()[[0, -1]])))
         seps = np.asarray(self.separations_deg or _default_separations(setup, centre), float)
+        if seps.size == 0:
+            raise ParameterError(f"resolution: the arc reaches no separation of 2 deg or more "
+                                 f"about centre_deg {centre:g}: give separations_deg")
         frames = [_pair(rng, self.velocity_mps, self.rcs_dbsm, centre, s) for s in seps]
         try:
             planner = FramePlanner(setup, paths, mode, frames, progress)
         except (SceneError, AngleUnreachable) as exc:
             raise ParameterError(f"resolution: separations_deg up to {seps.max():g} about "
                                  f"centre_deg {centre:g}: {exc}") from None
+        case = _Case(setup, paths, planner, Steering.auto(setup.rut, scene.radar))
+        # the figure's spectra: a few separations spread over the grid, at the first phase
+        pick = set(np.linspace(0, seps.size - 1, min(4, seps.size)).round().astype(int).tolist())
+        spectra = {"angle_deg": _SPECTRUM_GRID_DEG, "separation_deg": seps[sorted(pick)],
+                   "phase_deg": float(self.phases_deg[0]), "truth": [], "rts": []}
         rows = []
         for f, s in enumerate(seps):
             if progress:
                 progress(f"separation {s:g} deg ({f + 1}/{seps.size})")
-            rows += _cases(setup, paths, planner, f, frames[f], self.phases_deg)
+            rows += case.rows(f, frames[f], self.phases_deg, spectra if f in pick else None)
         return Resolution(scene_name=scene.name, study=self, range_m=rng, centre_deg=centre,
-                          table=_table(rows, seps, self.phases_deg),
-                          spectra=_spectra(setup, paths, planner, frames, seps))
+                          table=_table(rows, seps, self.phases_deg), spectra=spectra)
 
 
 def resolution(scene: Scene, **kwargs) -> "Resolution":
@@ -165,41 +174,66 @@ def _beam_phase(setup: Setup, echoes, targets, steering) -> np.ndarray:
     return np.asarray(out)
 
 
-def _cubes(setup: Setup, paths, planner, f: int, targets, phase_deg: float) -> list:
-    """One case through the radar twice: [("truth", cube), ("rts", cube)], the second target's
-    echo turned so that its phase at the RuT's phase centre leads the first's by
-    ``phase_deg`` in both; the same seed and noise power in both."""
-    scene = setup.scene
-    program, _ = planner.program(f, dataclasses.replace(scene, targets=targets))
-    steering = Steering.auto(setup.rut, scene.radar)
-    d_truth = np.diff(_beam_phase(setup, truth_echoes(setup, targets), targets, steering))[0]
-    d_rts = np.diff(_beam_phase(setup, build_echoes(setup, paths, program), targets,
-                                steering))[0]
-    want = -np.radians(phase_deg)  # the beat carries the conjugate of the received phase
-    turn = np.where(program.target == 1, np.exp(-1j * (want - d_rts)), 1.0)
-    program = RtsProgram.build(program.target, program.front_end, program.delay_s,
-                               program.doppler_hz, program.amplitude * turn)
-    echoes, cube = simulate(setup, paths, program, scene.seed, scene.radar.snr_db)
-    noise = None if scene.radar.snr_db is None else noise_power(echoes, scene.radar.snr_db)
-    _, t_cube = simulate_truth(setup, targets, scene.seed, noise, [0.0, -(want - d_truth)])
-    return [("truth", t_cube), ("rts", cube)]
+#: the figure's angle axis (deg)
+_SPECTRUM_GRID_DEG = np.linspace(-60.0, 60.0, 1201)
 
 
-def _cases(setup: Setup, paths, planner, f: int, targets, phases_deg) -> list[dict]:
-    """Rows of the table for one separation: per phase and source, resolved and the two
-    targets' detected angles (NaN where a target has no detection of its own)."""
-    scene = dataclasses.replace(setup.scene, targets=targets)
-    rows = []
-    for ph in phases_deg:
-        for source, cube in _cubes(setup, paths, planner, f, targets, ph):
-            rd, det = process(cube)
-            m = match_targets(scene, det, rd, steering=cube.steering, real=source == "truth")
-            ang = [x["detection"]["angle_deg"] if x["status"] == "detected" else np.nan
-                   for x in m]
-            rows.append({"phase_deg": float(ph), "source": source,
-                         "resolved": all(x["status"] == "detected" for x in m),
-                         "angle_1_deg": float(ang[0]), "angle_2_deg": float(ang[1])})
-    return rows
+@dataclass(frozen=True)
+class _Case:
+    """The bench, its calibrated planner and the RuT's beamformer, for the cases of a study."""
+
+    setup: Setup
+    paths: object
+    planner: FramePlanner
+    steering: Steering
+
+    def cubes(self, f: int, targets, phase_deg: float) -> list:
+        """One case through the radar twice: [("truth", cube), ("rts", cube)], the second
+        target's echo turned so that its phase at the RuT's phase centre leads the first's by
+        ``phase_deg`` in both; the same seed and noise power in both."""
+        setup, scene = self.setup, self.setup.scene
+        program, _ = self.planner.program(f, dataclasses.replace(scene, targets=targets))
+        d_truth = np.diff(_beam_phase(setup, truth_echoes(setup, targets), targets,
+                                      self.steering))[0]
+        d_rts = np.diff(_beam_phase(setup, build_echoes(setup, self.paths, program), targets,
+                                    self.steering))[0]
+        want = -np.radians(phase_deg)  # the beat carries the conjugate of the received phase
+        turn = np.where(program.target == 1, np.exp(-1j * (want - d_rts)), 1.0)
+        program = RtsProgram.build(program.target, program.front_end, program.delay_s,
+                                   program.doppler_hz, program.amplitude * turn)
+        echoes, cube = simulate(setup, self.paths, program, scene.seed, scene.radar.snr_db)
+        noise = None if scene.radar.snr_db is None else noise_power(echoes, scene.radar.snr_db)
+        _, t_cube = simulate_truth(setup, targets, scene.seed, noise, [0.0, -(want - d_truth)])
+        return [("truth", t_cube), ("rts", cube)]
+
+    def rows(self, f: int, targets, phases_deg, spectra: dict | None = None) -> list[dict]:
+        """Rows of the table for one separation: per phase and source, resolved and the two
+        targets' detected angles (NaN where a target has no detection of its own); with
+        ``spectra``, the first phase's angle spectra appended to it (the figure's)."""
+        scene = dataclasses.replace(self.setup.scene, targets=targets)
+        rows = []
+        for k, ph in enumerate(phases_deg):
+            for source, cube in self.cubes(f, targets, ph):
+                rd, det = process(cube)
+                m = match_targets(scene, det, rd, steering=cube.steering,
+                                  real=source == "truth")
+                ang = [x["detection"]["angle_deg"] if x["status"] == "detected" else np.nan
+                       for x in m]
+                rows.append({"phase_deg": float(ph), "source": source,
+                             "resolved": all(x["status"] == "detected" for x in m),
+                             "angle_1_deg": float(ang[0]), "angle_2_deg": float(ang[1])})
+                if spectra is not None and k == 0:
+                    spectra[source].append(_cell_spectrum_db(rd, cube))
+        return rows
+
+
+def _cell_spectrum_db(rd, cube) -> np.ndarray:
+    """The RuT's angle spectrum (dB, normalised) of the map's strongest cell over
+    :data:`_SPECTRUM_GRID_DEG`."""
+    r, d = np.unravel_index(np.argmax(rd.power), rd.power.shape)
+    snap = tdm_compensate(rd.spectrum[r, d], rd.doppler_hz[d], cube.rut, cube.radar)
+    p = angle_spectrum(snap, cube.steering, None, np.radians(_SPECTRUM_GRID_DEG))
+    return 10 * np.log10(np.maximum(p / p.max(), 1e-12))
 
 
 def _table(rows: list[dict], seps, phases_deg) -> dict:
@@ -209,23 +243,6 @@ def _table(rows: list[dict], seps, phases_deg) -> dict:
     for key in ("phase_deg", "source", "resolved", "angle_1_deg", "angle_2_deg"):
         cols[key] = np.array([r[key] for r in rows])
     return cols
-
-
-def _spectra(setup: Setup, paths, planner, frames, seps, phase_deg: float = 0.0,
-             count: int = 4) -> dict:
-    """The RuT's angle spectrum (dB, normalised) of the targets' cell, truth and RTS, at
-    ``count`` separations spread over the grid (the figure's upper row)."""
-    pick = np.unique(np.linspace(0, len(seps) - 1, min(count, len(seps))).round().astype(int))
-    grid = np.linspace(-60.0, 60.0, 1201)
-    out = {"angle_deg": grid, "separation_deg": np.asarray(seps)[pick], "truth": [], "rts": []}
-    for f in pick:
-        for source, cube in _cubes(setup, paths, planner, int(f), frames[f], phase_deg):
-            rd, det = process(cube)
-            r, d = np.unravel_index(np.argmax(rd.power), rd.power.shape)
-            snap = tdm_compensate(rd.spectrum[r, d], rd.doppler_hz[d], cube.rut, cube.radar)
-            p = angle_spectrum(snap, cube.steering, None, np.radians(grid))
-            out[source].append(10 * np.log10(np.maximum(p / p.max(), 1e-12)))
-    return out
 
 
 def min_separation(separations, resolved) -> float | None:

@@ -29,7 +29,7 @@ __all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checke
            "warn_scene_errors", "show_warning",
            "pair_word", "pair_of", "pair_options", "print_outputs", "progress", "study_options",
            "declared_option",
-           "read_calibration", "calibration_kw", "flag_words"]
+           "read_calibration", "calibration_kw", "flag_words", "numbers"]
 
 
 def number(lo=None, hi=None, integer=False):
@@ -45,6 +45,36 @@ def number(lo=None, hi=None, integer=False):
         if (lo is not None and v < lo) or (hi is not None and v > hi):
             raise argparse.ArgumentTypeError(f"{text} is outside the allowed range [{lo}, {hi}]")
         return v if integer else v + 0.0  # -0 reads as 0 (numpy refuses a scale of -0.0)
+    return parse
+
+
+def numbers(lo: float, hi: float, most: int, unit: str, example: str):
+    """argparse type: ``START:STOP:STEP`` (STOP included, STEP > 0) or a comma-separated list
+    of finite numbers, each in [lo, hi] ``unit``, at most ``most`` of them (the grid is refused
+    from its count, before any array is made)."""
+    def parse(text: str) -> tuple[float, ...]:
+        def bad(why: str):
+            return argparse.ArgumentTypeError(
+                f"{text!r}: {why}; must be START:STOP:STEP (STEP > 0) or a comma-separated "
+                f"list such as {example}, each in [{lo:g}, {hi:g}] {unit}, at most {most}")
+        try:
+            if ":" in text:
+                a, b, step = (float(x) for x in text.split(":"))
+                if not (step > 0 and b >= a and math.isfinite(a + b + step)):
+                    raise bad("not a grid")
+                n = math.floor((b - a) / step + 1e-9) + 1
+                if n > most:
+                    raise bad(f"{n} values")
+                vals = tuple(round(a + k * step, 9) for k in range(n))
+            else:
+                vals = tuple(float(x) + 0.0 for x in text.split(",") if x.strip())
+        except ValueError:
+            raise bad("not numbers") from None
+        if not vals or len(vals) > most:
+            raise bad(f"{len(vals)} values")
+        if not all(math.isfinite(v) and lo <= v <= hi for v in vals):
+            raise bad("a value outside the range")
+        return vals
     return parse
 
 

@@ -7,23 +7,9 @@ from __future__ import annotations
 import argparse
 
 from ..errors import ParameterError, UsageError
-from ._common import (load_scene_checked, number, output_folder, output_path, print_outputs,
+from ._common import (load_scene_checked, number, numbers, output_folder, output_path,
+                      print_outputs,
                       scene_arg, steps, write_json)
-
-
-def _ranges(text: str) -> tuple[float, ...]:
-    """``--ranges START:STOP:STEP`` (STOP included) or a comma-separated list (m)."""
-    try:
-        if ":" in text:
-            a, b, s = (float(x) for x in text.split(":"))
-            if not (s > 0 and b >= a and (b - a) / s <= 64):
-                raise ValueError
-            n = int(round((b - a) / s)) + 1
-            return tuple(round(a + k * s, 9) for k in range(n) if a + k * s <= b + 1e-9)
-        return tuple(float(x) for x in text.split(",") if x.strip())
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: must be START:STOP:STEP in m (STEP > 0, "
-                                         "at most 64 ranges) or a list such as 5,10,20") from None
 
 
 def _budgets(text: str) -> tuple:
@@ -65,7 +51,8 @@ def register(sub) -> None:
     p = sub.add_parser("objects", help="extended object: the smallest front-end arc and "
                                        "per-channel budget that reproduce it over its ranges")
     scene_arg(p)
-    p.add_argument("--ranges", type=_ranges, default=(5.0, 10.0, 15.0, 20.0, 25.0, 30.0),
+    p.add_argument("--ranges", type=numbers(0.1, 1e4, 64, "m", "5,10,20"),
+                   default=(5.0, 10.0, 15.0, 20.0, 25.0, 30.0),
                    metavar="START:STOP:STEP", help="the object's ranges in m (default 5:30:5)")
     p.add_argument("--spacings", type=number(0.5, 60.0), nargs="+", default=(8.0, 16.0),
                    metavar="DEG", help="front-end spacings (default 8 16)")

@@ -5,44 +5,9 @@ resolution.png."""
 
 from __future__ import annotations
 
-import argparse
-
-import numpy as np
-
 from ..analysis.resolution import ResolutionStudy
-from ._common import (load_scene_checked, number, output_folder, print_json, scene_arg, steps,
-                      write_json)
-
-_MAX_SEPARATIONS = 1000
-
-
-def _grid(text: str) -> tuple[float, ...]:
-    """``--separations-deg START:STOP:STEP`` (STOP included) in (0, 120] deg."""
-    try:
-        start, stop, step = (float(x) for x in text.split(":"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: must be START:STOP:STEP in deg, e.g. "
-                                         "2:30:1") from None
-    if not (0 < start <= stop <= 120 and step > 0 and np.isfinite([start, stop, step]).all()):
-        raise argparse.ArgumentTypeError(f"{text!r}: must satisfy 0 < START <= STOP <= 120 "
-                                         "and STEP > 0 (deg)")
-    n = int(np.floor((stop - start) / step + 1e-9)) + 1
-    if n > _MAX_SEPARATIONS:
-        raise argparse.ArgumentTypeError(f"{text!r}: {n} separations; at most "
-                                         f"{_MAX_SEPARATIONS}")
-    return tuple(float(x) for x in start + step * np.arange(n))
-
-
-def _phases(text: str) -> tuple[float, ...]:
-    """``--phases-deg`` a comma-separated list in [-360, 360] deg."""
-    try:
-        got = tuple(float(x) for x in text.split(",") if x.strip())
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: must be comma-separated phases in deg, "
-                                         "e.g. 0,90,180") from None
-    if not got or len(got) > 36 or not all(np.isfinite(g) and abs(g) <= 360 for g in got):
-        raise argparse.ArgumentTypeError(f"{text!r}: must be 1 to 36 phases in [-360, 360] deg")
-    return got
+from ._common import (load_scene_checked, number, numbers, output_folder, print_json,
+                      scene_arg, steps, write_json)
 
 
 def cmd_resolution(args) -> int:
@@ -81,9 +46,11 @@ def register(sub) -> None:
                    help="their velocity, m/s (default 0)")
     p.add_argument("--centre-deg", type=number(-90.0, 90.0), default=None,
                    help="C, the targets' midpoint, deg (default: the middle of the arc)")
-    p.add_argument("--separations-deg", type=_grid, default=None,
+    p.add_argument("--separations-deg", type=numbers(1e-3, 120.0, 1000, "deg", "10,20,30"),
+                   default=None,
                    help="START:STOP:STEP separations s, deg (default 2:30:1, cut to the arc)")
-    p.add_argument("--phases-deg", type=_phases, default=(0.0, 90.0, 180.0),
+    p.add_argument("--phases-deg", type=numbers(-360.0, 360.0, 36, "deg", "0,90,180"),
+                   default=(0.0, 90.0, 180.0),
                    help="relative phases of the targets' echoes at the RuT's phase centre, deg "
                         "(default 0,90,180; two real targets at one range are in phase)")
     p.add_argument("--amplitudes", choices=["exact", "array-factor", "paper"], default=None,

@@ -127,9 +127,8 @@ def detection_points(det: Detections, dims: int) -> np.ndarray:
     return np.c_[det.range_m, det.velocity_mps, u].reshape(len(det), -1)
 
 
-def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, expected_angle_rad=None,
-                  bins: int = 2, steering=None, targets=None, real: bool = False
-                  ) -> list[dict]:
+def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, bins: int = 2,
+                  steering=None, targets=None, real: bool = False) -> list[dict]:
     """Each target's detection by the one association (:func:`rtsgeom.radar.association.associate`):
     an optimal assignment in resolution cells, never a detection that lies nearer another
     target; ``status`` ``detected``, ``merged`` (one detection serves several targets the

@@ -16,6 +16,8 @@ the global check in 2-D (which would pull every start onto the strongest peak).
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from scipy import ndimage
 
@@ -148,9 +150,7 @@ def _spectrum_rows(steering: Steering, snaps: np.ndarray, angles: np.ndarray) ->
 def _candidates_2d(steering: Steering, snaps: np.ndarray):
     """The 2-D grid's local maxima (on the meshgrid of :meth:`Steering.grid`, the invisible
     region excluded): candidate u (n, G, 2) (NaN elsewhere) and their power (n, G)."""
-    axes = [np.linspace(-1.0, 1.0, int(np.ceil(16 * a / steering.wavelength_m)) + 1)
-            for a in steering.aperture_m]
-    mesh = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1)  # (A0, A1, 2)
+    mesh = steering.grid_mesh()  # (A0, A1, 2)
     visible = np.sum(mesh ** 2, axis=-1) <= 1.0
     grid = mesh[visible]
     y = steering.weighted(snaps) @ steering.steer(grid).T
@@ -176,9 +176,6 @@ def _refine_2d(steering: Steering, snaps: np.ndarray, cand: np.ndarray):
     return u, val
 
 
-_RESOLUTION_CACHE: dict = {}
-
-
 def two_target_resolution(steering: Steering) -> np.ndarray:
     """The beamformer's two-target resolution per direction-cosine axis (D,): the smallest
     separation ``s`` in u from which two equal, in-phase sources at ``-s/2`` and ``+s/2``
@@ -190,17 +187,23 @@ def two_target_resolution(steering: Steering) -> np.ndarray:
     array's own positions and taper (u steps of 1e-3), so sparse and custom arrays are right
     too. The association of detections with targets uses it as the angular resolution cell.
     """
-    key = (steering.positions_m.tobytes(), np.asarray(steering.taper).tobytes(),
-           steering.wavelength_m)
-    if key not in _RESOLUTION_CACHE:
-        _RESOLUTION_CACHE[key] = np.array([_resolution_axis(steering, a)
-                                           for a in range(steering.dims)])
-    return _RESOLUTION_CACHE[key].copy()
+    pos = np.ascontiguousarray(steering.positions_m, float)
+    taper = np.ascontiguousarray(steering.taper, float)
+    return np.array(_resolution(pos.tobytes(), pos.shape, taper.tobytes(),
+                                float(steering.wavelength_m)))
 
 
-def _resolution_axis(steering: Steering, axis: int) -> float:
-    k = 2 * np.pi / steering.wavelength_m * steering.positions_m[:, axis]  # (V_s,)
-    w = np.asarray(steering.taper)
+@functools.lru_cache(maxsize=32)  # one array per scene: a frame's association reuses it
+def _resolution(pos: bytes, shape: tuple, taper: bytes, wavelength_m: float) -> tuple:
+    p = np.frombuffer(pos).reshape(shape)
+    w = np.frombuffer(taper)
+    return tuple(_resolution_axis(2 * np.pi / wavelength_m * p[:, a], w)
+                 for a in range(shape[1]))
+
+
+def _resolution_axis(k: np.ndarray, w: np.ndarray) -> float:
+    """:func:`two_target_resolution` along one axis: wavenumbers times positions ``k`` (V_s,)
+    and the taper ``w`` (V_s,)."""
     seps = np.arange(0.002, 1.0 + 1e-9, 0.001)  # (S,)
     u = np.linspace(-1.0, 1.0, 2001)  # (U,) 1e-3 steps, u = 0 on the grid
     # snapshot of two in-phase sources at +-s/2: x_v = 2 cos(k_v s / 2); beam at u:

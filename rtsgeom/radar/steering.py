@@ -352,12 +352,17 @@ class Steering:
         u, _ = self.peak(flat, start, iterations=8)
         return self.angles(u).reshape(shape + (2,))
 
+    def grid_mesh(self) -> np.ndarray:
+        """The mesh (A_0, ..., A_{D-1}, D) of :meth:`grid` before the invisible region is cut:
+        steps of lambda / (8 d_A) in u per axis over [-1, 1]."""
+        axes = [np.linspace(-1.0, 1.0, int(np.ceil(16 * a / self.wavelength_m)) + 1)
+                for a in self.aperture_m]
+        return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1)
+
     def grid(self) -> np.ndarray:
         """Directions (G, D) of the global check: steps of lambda / (8 d_A) in u per axis
         (at most ~1 % below the top of a lobe), inside the visible region."""
-        axes = [np.linspace(-1.0, 1.0, int(np.ceil(16 * a / self.wavelength_m)) + 1)
-                for a in self.aperture_m]
-        g = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, self.dims)
+        g = self.grid_mesh().reshape(-1, self.dims)
         return g[np.sum(g ** 2, axis=-1) <= 1.0]
 
     def peak(self, snapshots, u0, iterations: int = 4):

@@ -14,7 +14,7 @@ _COLOURS = {"truth": "tab:blue", "rts": "tab:orange"}
 
 def resolution_figure(result):
     """Upper row: per chosen separation, the RuT's angle spectrum of the targets' cell (truth
-    and RTS, phase 0) with the set angles marked; lower row: resolved (filled) or not over
+    and RTS, at the study's first phase) with the set angles marked; lower row: resolved (filled) or not over
     separation x phase, truth and RTS, the minimum resolvable separation marked."""
     sp = result.spectra
     n = max(len(sp.get("separation_deg", [])), 2)
@@ -30,7 +30,7 @@ def resolution_figure(result):
             ax.axvline(a, color="0.4", lw=0.8, ls=":")
         ax.set_xlim(result.centre_deg - max(1.5 * s, 20), result.centre_deg + max(1.5 * s, 20))
         ax.set_ylim(-30, 1)
-        ax.set_title(f"s = {s:g} deg", fontsize=9)
+        ax.set_title(f"s = {s:g} deg, phase {sp.get('phase_deg', 0.0):g} deg", fontsize=9)
         ax.set_xlabel("angle (deg)")
         if i == 0:
             ax.set_ylabel("beamformer power (dB)")
