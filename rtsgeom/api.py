@@ -23,8 +23,8 @@ from .analysis.linearity import linearity as _linearity
 from .analysis.linearity_study import LinearityStudy
 from .analysis.nearfield import nearfield as _nearfield
 from .analysis.playback import play as _play
-from .analysis.tolerance import MAX_SIGMA_MM, Bounds, MonteCarlo, ToleranceStudy
-from .analysis.tolerance.config import check_study_args
+from .analysis.tolerance import Bounds, MonteCarlo, ToleranceStudy
+from .analysis.tolerance.config import check_sigma_mm, check_study_args
 from .analysis.transfer import TransferStudy
 from .calibration.probes import probe_front_ends
 from .errors import ParameterError, SceneError
@@ -142,13 +142,6 @@ def _check_pair(setup, pair) -> tuple[int, int]:
     return check_pair(setup, i, j, f"pair {(i, j)}")
 
 
-def _study_args(fn: str, draws, seed, distribution, spec_deg, points) -> None:
-    """The Monte-Carlo studies' arguments against their one declaration
-    (``analysis.tolerance.config.STUDY_ARGS``, which the CLI's options are made from)."""
-    check_study_args(fn, draws=draws, seed=seed, distribution=distribution, spec_deg=spec_deg,
-                     points=points)
-
-
 def calibrate(scene: Scene, pair=(0, 1)):
     """Calibrate a front-end pair by the paper's delay sweep on the simulated radar.
 
@@ -252,11 +245,11 @@ def tolerance(scene: Scene, pair=(0, 1), sigma_mm=(0.1, 0.1, 0.1), draws: int = 
         from the nominal setup, not from them.
     """
     check_scene_arg(scene, "tolerance")
-    _study_args("tolerance", draws, seed, distribution, spec_deg, points)
-    sigma = np.asarray(check_arg(sigma_mm, "sigma_mm", "vec", "tolerance", ParameterError,
-                                 n=3, lo=0.0, hi=MAX_SIGMA_MM, unit="mm"), float) * 1e-3
+    check_study_args("tolerance", draws=draws, seed=seed, distribution=distribution,
+                     spec_deg=spec_deg, points=points)
+    sigma = check_sigma_mm("tolerance", sigma_mm)
     _check_pair(build_setup(scene), pair)
-    study = ToleranceStudy(Bounds(tuple(float(s) for s in sigma)), tuple(pair),
+    study = ToleranceStudy(Bounds(sigma), tuple(pair),
                            mc=MonteCarlo(draws, seed, distribution), spec_deg=spec_deg,
                            points=points)
     return study(scene).run
@@ -288,7 +281,7 @@ def design(scene: Scene, radius_m, spacing_deg, pair=(0, 1), spec_deg: float = 0
         :data:`rtsgeom.analysis.design.METRICS`, ``exceeds_resolution`` and ``to_dict()``.
     """
     check_scene_arg(scene, "design")
-    _study_args("design", draws, seed, "normal", spec_deg, points)
+    check_study_args("design", draws=draws, seed=seed, spec_deg=spec_deg, points=points)
     check_arg(target_yield, "target_yield", "float", "design", ParameterError, lo=0.0, hi=1.0,
               lo_open=True, hi_open=True)
     return DesignStudy(tuple(np.atleast_1d(radius_m)), tuple(np.atleast_1d(spacing_deg)), pair,

@@ -26,7 +26,7 @@ from ._signals import raise_received
 
 __all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checked", "steps",
            "output_path", "output_file_path", "output_folder", "output_file",
-           "warn_scene_errors", "show_warning",
+           "show_warning",
            "pair_word", "pair_of", "pair_options", "print_outputs", "progress", "study_options",
            "declared_option",
            "read_calibration", "calibration_kw", "flag_words", "numbers"]
@@ -213,13 +213,6 @@ class steps:
     def __exit__(self, exc_type, exc, tb):
         self._finish(failed=exc_type is not None)
         return False
-
-
-def warn_scene_errors(scene, command: str, what: str | None = None) -> None:
-    """The library's :func:`~rtsgeom.geometry.setup.warn_setup_errors` for a command that
-    calls no study that warns itself (``main`` prints the warning on stderr)."""
-    from ..geometry.setup import DRAWS_REPLACE, warn_setup_errors
-    warn_setup_errors(scene, command, DRAWS_REPLACE if what is None else what)
 
 
 def show_warning(message, category, filename, lineno, file=None, line=None) -> None:

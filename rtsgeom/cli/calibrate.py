@@ -108,12 +108,6 @@ def _print_arc(report) -> None:
           f"{report.residuals_deg()[worst]:.4f} deg (pair {tuple(report.pairs[worst])})")
 
 
-def sweep_title(scene, pair) -> str:
-    """The calibration figure's title: the scene and the pair (every pair's figure of
-    ``--pair all`` says which it is)."""
-    return f"{scene.name}: phase coherency calibration, front ends {pair[0]}-{pair[1]}"
-
-
 def register(sub) -> None:
     p = sub.add_parser("calibrate", help="phase calibration sweep of a front-end pair")
     pair_options(p)

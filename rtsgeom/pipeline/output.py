@@ -19,7 +19,7 @@ from .info import scene_info
 from .run import RunResult, label_detections, summary
 
 __all__ = ["detections_csv", "figure_png", "map_dataset", "maps_arrays", "MAP_FORMATS",
-           "render_maps", "write_maps", "targets_table", "run_report_html", "write_run_report",
+           "render_maps", "write_maps", "targets_table", "run_report_html",
            "write_run"]
 
 
@@ -239,16 +239,6 @@ def run_report_html(result: RunResult, maps: dict[str, bytes], paths_method: str
     if warnings:
         sections.append({"heading": "Warnings", "warnings": warnings})
     return render_report(f"rtsgeom run: {result.scene.name}", scene_info(result.setup), sections)
-
-
-def write_run_report(result: RunResult, out: Path, maps, paths_method: str,
-                     warnings: list[str]) -> Path:
-    """Write :func:`run_report_html` to ``out/report.html`` (``maps``: PNG bytes by name, or
-    the paths :func:`write_maps` returned)."""
-    if not isinstance(maps, dict):
-        maps = {Path(p).name: Path(p).read_bytes() for p in maps}
-    write_text(out / "report.html", run_report_html(result, maps, paths_method, warnings))
-    return out / "report.html"
 
 
 def write_run(result: RunResult, folder: str | Path, paths_method: str = "exact",

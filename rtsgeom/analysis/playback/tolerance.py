@@ -26,7 +26,7 @@ from ...paths import exact_paths
 from ...pipeline.plan import target_pairs, uses_cells
 from ...scene import Scene, check_scene_arg
 from ..tolerance import ChannelPhasors, ToleranceModel, ToleranceResult, monte_carlo
-from ..tolerance.draws import check_study_args
+from ..tolerance.config import STUDY_ARGS, check_sigma_mm, check_study_args
 from .frames import frame_target_names, frame_targets
 
 __all__ = ["drive_tolerance"]
@@ -46,7 +46,7 @@ def drive_tolerance(scene: Scene, sigma_mm=(0.1, 0.1, 0.1), draws: int = 2000,
         deviation (``normal``) or the bound (``uniform``).
     draws, seed, distribution, spec_deg
         As for :func:`rtsgeom.tolerance` (``seed`` default: the scene's), with its ranges
-        (``analysis.tolerance.draws.check_study_args``: draws in [1, 1e7], sigma 0 to 10 mm).
+        (``analysis.tolerance.config.check_study_args``: draws in [1, 1e7], sigma 0 to 10 mm).
 
     Returns
     -------
@@ -57,8 +57,11 @@ def drive_tolerance(scene: Scene, sigma_mm=(0.1, 0.1, 0.1), draws: int = 2000,
         ``model.sets[p].front_ends``.
     """
     check_scene_arg(scene, "drive_tolerance")
-    draws, seed, distribution, spec_deg, _, sigma = check_study_args(
-        "drive_tolerance", draws, seed, distribution, spec_deg, sigma_mm=sigma_mm)
+    STUDY_ARGS["draws"].check(draws, "draws", "drive_tolerance")  # None is no default here
+    draws, seed, distribution, spec_deg = check_study_args(
+        "drive_tolerance", draws=draws, seed=seed, distribution=distribution,
+        spec_deg=spec_deg)
+    sigma = check_sigma_mm("drive_tolerance", sigma_mm)
     if scene.scenario is None:
         raise ParameterError(f"{scene.source}: has no [scenario] (docs/scenario.md)")
     if uses_cells(scene):

@@ -17,10 +17,10 @@ from typing import Callable, Iterable
 
 from ...errors import ParameterError
 from ...scene.schema import check_arg
-from .draws import DEFAULT_CHUNK, DISTRIBUTIONS
+from .draws import DEFAULT_CHUNK, DISTRIBUTIONS, MAX_SIGMA_MM
 
 __all__ = ["MonteCarlo", "Progress", "Mapper", "MC_FIELDS", "Arg", "STUDY_ARGS",
-           "check_study_args"]
+           "check_study_args", "check_sigma_mm"]
 
 Progress = Callable[[str, int, int], None]  # (label, draws done, draws total)
 Mapper = Callable[[Callable, list], Iterable]  # ordered map of a pure function over chunks
@@ -61,12 +61,19 @@ STUDY_ARGS: dict[str, Arg] = {
 }
 
 
-def check_study_args(source: str, **values) -> None:
+def check_study_args(source: str, **values) -> tuple:
     """Each of ``values`` (names of :data:`STUDY_ARGS`; None: not given) against its
-    declaration."""
-    for name, value in values.items():
-        if value is not None:
-            STUDY_ARGS[name].check(value, name, source)
+    declaration; returns them checked and normalised, in order (None stays None)."""
+    return tuple(None if v is None else STUDY_ARGS[n].check(v, n, source)
+                 for n, v in values.items())
+
+
+def check_sigma_mm(source: str, sigma_mm) -> tuple[float, float, float]:
+    """A study's mounting sigma (radial, tangential, height) in mm, in [0, MAX_SIGMA_MM]:
+    returned in metres; :class:`~rtsgeom.errors.ParameterError` naming ``sigma_mm``."""
+    mm = check_arg(sigma_mm, "sigma_mm", "vec", source, ParameterError, n=3, lo=0.0,
+                   hi=MAX_SIGMA_MM, unit="mm")
+    return tuple(float(x) * 1e-3 for x in mm)
 
 
 @dataclass(frozen=True)

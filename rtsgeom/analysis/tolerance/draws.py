@@ -36,24 +36,23 @@ from scipy.constants import c
 
 from ...errors import ParameterError
 
-__all__ = ["AXES", "DISTRIBUTIONS", "DEFAULT_CHUNK", "MAX_SIGMA_MM", "MAX_DRAWS", "Bounds",
-           "check_distribution", "check_study_args",
+__all__ = ["AXES", "DISTRIBUTIONS", "DEFAULT_CHUNK", "MAX_SIGMA_MM", "Bounds",
+           "check_distribution",
            "unit_block", "subbin_positions", "centre_index", "DrawChunk", "draw_chunks",
            "standard_draws", "subbin_draws", "draw_offsets", "draw_subbins"]
 
 #: the largest mounting sigma (mm) a study takes, in the CLI and in Python: the phasor model
 #: is first order in the errors (checked to 0.3 mm)
 MAX_SIGMA_MM = 10.0
-#: the most Monte-Carlo draws a study takes, in the CLI and in Python (the per-draw results,
-#: a few float64 per draw and pair, stay under a GB; the draws themselves are chunked)
-MAX_DRAWS = 10_000_000
 
 AXES = ("radial", "tangential", "height")
 DISTRIBUTIONS = ("normal", "uniform")
 DEFAULT_CHUNK = 10_000
 
-#: the streams beside the offsets' ``default_rng(seed)``: ``default_rng([seed, stream])``
+#: the streams beside the offsets' ``default_rng(seed)``: ``default_rng([seed, stream])``;
+#: every quantity drawn beside the offsets has its own, so none is correlated with them
 SUBBIN_STREAM, RUT_STREAM, ROTATION_STREAM = 1, 2, 3
+PHASE_STREAM, NOISE_STREAM = 4, 7  # the RuT's antenna phases, receiver noise (kpi)
 
 
 @dataclass(frozen=True)
@@ -267,28 +266,3 @@ def draw_subbins(seed: int, draws: int, positions: int) -> np.ndarray:
     """All sub-bin positions (draws,) of a study at once."""
     z = list(subbin_draws(seed, draws, positions, max(draws, 1)))
     return z[0] if z else np.zeros(0, int)
-
-
-def check_study_args(fn: str, draws, seed, distribution, spec_deg, points=None,
-                     sigma_mm=None) -> tuple:
-    """The Monte-Carlo studies' arguments against the CLI's ranges (``cli._common.
-    study_options``), through the one argument checker (``scene.schema.check_arg``): returns
-    ``(draws, seed, distribution, spec_deg, points, sigma_m)`` normalised (``sigma_m`` (3,) m
-    or None), else :class:`ParameterError` as ``<fn>: <name> = <value>: must be <allowed>``.
-    ``points`` and ``sigma_mm`` are checked where given (None: the study has none)."""
-    from ...scene.schema import check_arg
-    draws = check_arg(draws, "draws", "int", fn, ParameterError, lo=1, hi=MAX_DRAWS)
-    if seed is not None:
-        seed = check_arg(seed, "seed", "int", fn, ParameterError, lo=0, hi=2 ** 63 - 1)
-    distribution = check_arg(distribution, "distribution", "str", fn, ParameterError,
-                             choices=DISTRIBUTIONS)
-    spec_deg = check_arg(spec_deg, "spec_deg", "float", fn, ParameterError, lo=1e-6, hi=90.0,
-                         unit="deg")
-    if points is not None:
-        points = check_arg(points, "points", "int", fn, ParameterError, lo=3, hi=201)
-    sigma = None
-    if sigma_mm is not None:
-        sigma = tuple(x * 1e-3 for x in check_arg(sigma_mm, "sigma_mm", "vec", fn,
-                                                   ParameterError, n=3, lo=0.0,
-                                                   hi=MAX_SIGMA_MM, unit="mm"))
-    return draws, seed, distribution, spec_deg, points, sigma
