@@ -28,7 +28,7 @@ import numpy as np
 
 from ..geometry import Setup
 from ..radar import process
-from ..radar.peaks import two_target_resolution
+from ..radar.association import resolution_cell
 from ..radar.steering import Steering
 from ..radar.truth import simulate_truth
 from ..scene import TargetConfig
@@ -82,9 +82,7 @@ def cell_scale(setup: Setup) -> np.ndarray:
     """The RuT's resolution cell: range resolution (m), velocity resolution (m/s) and its
     two-target resolution in azimuth direction cosine (the range-Doppler map's bins)."""
     radar = setup.scene.radar
-    st = Steering.auto(setup.rut, radar)
-    return np.array([radar.range_resolution_m, radar.velocity_resolution_mps,
-                     float(two_target_resolution(st)[0])])
+    return resolution_cell(radar, Steering.auto(setup.rut, radar))[:3]  # azimuth only
 
 
 def _power(targets) -> np.ndarray:

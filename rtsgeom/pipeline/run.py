@@ -17,8 +17,7 @@ from ..geometry import Setup, build_setup
 from ..paths import Paths, compute_paths
 from ..geometry.arrays import rut_array
 from ..radar import AdcCube, Detections, RangeDoppler, process
-from ..radar.association import associate
-from ..radar.peaks import two_target_resolution
+from ..radar.association import associate, resolution_cell
 from ..radar.steering import Steering
 from ..radar.truth import simulate_truth
 from ..radar.frame import noise_power, simulate
@@ -104,8 +103,7 @@ def association_scale(scene: Scene, rd: RangeDoppler, steering=None) -> np.ndarr
     resolution per direction-cosine axis (:func:`rtsgeom.radar.peaks.two_target_resolution`)."""
     st = steering if steering is not None else Steering.auto(rut_array(scene.radar),
                                                              scene.radar)
-    return np.r_[rd.range_m[1] - rd.range_m[0], rd.velocity_mps[1] - rd.velocity_mps[0],
-                 two_target_resolution(st)]
+    return resolution_cell(scene.radar, st, rd)
 
 
 def target_points(targets, dims: int, range_m=None) -> np.ndarray:

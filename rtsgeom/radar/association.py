@@ -25,12 +25,26 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Association", "associate", "STATUSES"]
+from .peaks import two_target_resolution
+
+__all__ = ["Association", "associate", "resolution_cell", "STATUSES"]
 
 #: the statuses of a target
 STATUSES = ("detected", "merged", "not_detected")
 
 _FORBIDDEN = 1e12  # the cost of a pair the rules exclude (never kept)
+
+
+def resolution_cell(radar, steering, rd=None) -> np.ndarray:
+    """The radar's resolution cell as the association measures in it (K,): the range bin and
+    the velocity bin (of the range-Doppler map ``rd``, or the radar's range and velocity
+    resolutions, which they equal), then the beamformer's two-target resolution per
+    direction-cosine axis (:func:`rtsgeom.radar.peaks.two_target_resolution`)."""
+    if rd is None:
+        bins = [radar.range_resolution_m, radar.velocity_resolution_mps]
+    else:
+        bins = [rd.range_m[1] - rd.range_m[0], rd.velocity_mps[1] - rd.velocity_mps[0]]
+    return np.r_[bins, two_target_resolution(steering)]
 
 
 @dataclass(frozen=True)

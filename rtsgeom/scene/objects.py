@@ -48,7 +48,7 @@ MESH_DYNAMIC_DB = 40.0  # a mesh's scatterers within this of its strongest
 _RAY_CHUNK = 256  # facets per block of the visibility test (memory: chunk x facets)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # numpy fields: identity, not an ambiguous array ==
 class ObjectModel:
     """One extended object of a scene.
 
@@ -193,6 +193,8 @@ def mesh_scatterers(vertices: np.ndarray, faces: np.ndarray, radar_obj: np.ndarr
         return np.zeros((0, 3)), np.zeros(0)
     idx = np.flatnonzero(facing)
     idx = idx[_visible(cen[idx], tri, radar_obj)]
+    if not idx.size:  # every facing facet hidden (e.g. normals pointing inwards)
+        return np.zeros((0, 3)), np.zeros(0)
     k = 2.0 * math.pi / wavelength_m
     sin_t = np.sqrt(np.clip(1.0 - cos_t[idx] ** 2, 0.0, 1.0))
     sigma = (4.0 * math.pi * area[idx] ** 2 * cos_t[idx] ** 2 / wavelength_m ** 2
