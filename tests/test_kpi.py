@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import rtsgeom
-from conftest import DEFAULT_SCENE
+from conftest import DEFAULT_SCENE, ROOT
 from rtsgeom.analysis.kpi import KpiSpec, KpiStudy, check_spec, loads_spec
 from rtsgeom.analysis.kpi.budget import (K_COVERAGE, BudgetRow, combined, coverage_interval,
                                          validate)
@@ -316,3 +316,16 @@ def test_every_spec_key_is_documented():
     assert keys == list(SPEC_SENSE)
     for key in keys:
         assert re.search(rf"^{key} = ", page, re.M), key
+
+
+def test_the_monte_carlos_inputs_are_drawn_independently():
+    """The mounting offsets and the RuT's antenna phases come from separate streams: drawn
+    with one seed they are uncorrelated (the phases once repeated the offsets' normals)."""
+    from rtsgeom.analysis.tolerance.draws import PHASE_STREAM, draw_offsets
+    from rtsgeom.analysis.transfer import draw_channel_gains
+    from rtsgeom.geometry import build_setup
+    rut = build_setup(rtsgeom.load_scene(ROOT / "scenes" / "template.toml")).rut
+    off = draw_offsets(5, 4000, np.ones(3), "normal", 2).reshape(4000, -1)
+    ph = draw_channel_gains(rut, 4000, 1.0, 0.0, [5, PHASE_STREAM])[1]
+    r = np.corrcoef(off[:, 0], ph[:, 0])[0, 1]
+    assert abs(r) < 4 / np.sqrt(4000)

@@ -53,7 +53,7 @@ from ...radar.steering import Steering
 from ...scene import TargetConfig
 from ...synthesis.model import ChannelModel
 from ..tolerance import AXES, ChannelPhasors
-from ..tolerance.draws import draw_offsets
+from ..tolerance.draws import NOISE_STREAM, PHASE_STREAM, draw_offsets
 from ..transfer import draw_channel_gains
 from .budget import (K_COVERAGE, RECTANGULAR, TRIANGULAR, BudgetRow, combined,
                      coverage_interval, validate)
@@ -240,9 +240,10 @@ def pair_accuracy(setup, ideal, paths, pair, probe, angles_rad, inputs: Accuracy
                      "each channel's delay realised to the step [assumed independent]"))
     u_delay = math.sqrt(sum(u ** 2 for _, u, _, _ in delay_inputs))
     n_ant = rut.tx_local.shape[0] + rut.rx_local.shape[0]
-    rng = np.random.default_rng([inputs.seed, 7])
+    rng = np.random.default_rng([inputs.seed, NOISE_STREAM])
+    # its own stream: the offsets' draw_offsets(seed) would repeat the same normals
     ph_draw = draw_channel_gains(rut, inputs.draws, inputs.sigma_phase_rad, 0.0,
-                                 inputs.seed)[0]
+                                 [inputs.seed, PHASE_STREAM])[0]
     z_noise = (rng.standard_normal((inputs.draws, rut.num_virtual))
                + 1j * rng.standard_normal((inputs.draws, rut.num_virtual)))
     d_draw = (rng.normal(0.0, 1.0, inputs.draws) * u_res
