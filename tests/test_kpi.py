@@ -202,7 +202,8 @@ def test_sensitivity_coefficients_match_finite_differences_of_the_full_model():
     chain: J's delay and an Rx antenna's phase through the ADC-cube chain (the programme
     fixed), a front end's tangential offset through the whole lab procedure (``run``:
     calibrated on the setup as built, planned, synthesized, detected)."""
-    from rtsgeom.analysis.kpi.accuracy import AccuracyInputs, pair_accuracy, set_angles
+    from rtsgeom.analysis.kpi.accuracy import AccuracyInputs, pair_accuracy
+    from rtsgeom.analysis.transfer import set_angles
     from rtsgeom.calibration.probes import probe_front_ends, probe_angles
     from rtsgeom.calibration.pair import calibrate_pair
     from rtsgeom.geometry import build_setup

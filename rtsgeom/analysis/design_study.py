@@ -95,7 +95,8 @@ class DesignStudy:
                 raise ParameterError(f"{fn}: coverage_deg = ({a:g}, {b:g}): need -80 <= A < B "
                                      "<= 80 deg")
             object.__setattr__(self, "coverage_deg", (a, b))
-        check_study_args(fn, spec_deg=self.spec_deg, points=self.points)
+        check_study_args(fn, draws=None if self.mc is None else self.mc.draws,
+                         spec_deg=self.spec_deg, points=self.points)
         check_arg(self.target_yield, "target_yield", "float", fn, ParameterError, lo=0.0,
                   hi=1.0, lo_open=True)
         if self.workers is not None:

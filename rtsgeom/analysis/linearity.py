@@ -27,7 +27,8 @@ from ..scene import TargetConfig
 from ..synthesis.closed_form import array_factor_args, ratio_array_factor, ratio_paper
 from ..synthesis.model import ChannelModel
 
-__all__ = ["Linearity", "linearity", "cell_grid", "error_map_figure", "END_ANGLES"]
+__all__ = ["Linearity", "linearity", "cell_grid", "error_map_figure", "END_ANGLES",
+           "finite_or_none"]
 
 END_ANGLES = ("geometric", "measured")
 
@@ -108,19 +109,18 @@ class Linearity(Result):
         if self.dims == 1:
             return {
                 "mode": self.mode, "calibrated": self.calibrated, "end_angles": self.end_angles,
-                "points": [{"set_deg": float(s), "detected_deg": float(d),
-                            "error_deg": float(d - s)}
+                "points": [{"set_deg": float(s), "detected_deg": finite_or_none(d),
+                            "error_deg": finite_or_none(d - s)}
                            for s, d in zip(self.set_deg, self.detected_deg)],
-                "max_abs_error_deg": self.max_abs_error_deg}
+                "max_abs_error_deg": finite_or_none(self.max_abs_error_deg)}
         mx = self.max_abs_error_deg
         return {"mode": self.mode, "calibrated": self.calibrated, "cell": list(self.channels),
                 "points": [{"set_deg": [float(x) for x in s],
-                            "detected_deg": [None if not np.isfinite(x) else float(x)
-                                             for x in d],
-                            "error_deg": [None if not np.isfinite(x) else float(x)
-                                          for x in d - s]}
+                            "detected_deg": [finite_or_none(x) for x in d],
+                            "error_deg": [finite_or_none(x) for x in d - s]}
                            for s, d in zip(self.set_deg, self.detected_deg)],
-                "max_abs_error_deg": {"azimuth": mx[0], "elevation": mx[1]}}
+                "max_abs_error_deg": {"azimuth": finite_or_none(mx[0]),
+                                      "elevation": finite_or_none(mx[1])}}
 
     def plot(self):
         """The figure: a pair's detected against set angle and the amplitudes; a cell's
@@ -290,3 +290,10 @@ def error_map_figure(em: Linearity):
                      f"{'calibrated' if em.calibrated else 'uncalibrated'})")
         fig.colorbar(sc, ax=ax, label=f"{name} error (deg)")
     return fig
+
+
+def finite_or_none(x) -> float | None:
+    """A JSON value: the number, or None where it is not finite (a set-point the RuT did not
+    detect), since the outputs are written with ``allow_nan=False``."""
+    x = float(x)
+    return x if np.isfinite(x) else None

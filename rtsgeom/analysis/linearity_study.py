@@ -28,7 +28,7 @@ from ..scene import Scene, check_scene_arg
 from ..scene.registry import SYNTHESIS_MODES
 from ..scene.schema import check_arg
 from .calibration_study import with_fir
-from .linearity import END_ANGLES, Linearity, linearity
+from .linearity import END_ANGLES, Linearity, finite_or_none, linearity
 from .pairs import is_all, study_pairs
 
 __all__ = ["LinearityStudy", "ArcLinearity"]
@@ -201,7 +201,9 @@ class ArcLinearity(Result):
     def to_dict(self) -> dict:
         return {"pairs": [lin.to_dict() for lin in self.linearities],
                 "arc": {"pairs": [list(p) for p in self.pairs],
-                        "max_abs_error_deg": max(self.worst_deg),
+                        # a pair with an undetected point is the worst (NaN as inf): null
+                        "max_abs_error_deg": finite_or_none(np.max(np.where(
+                            np.isfinite(self.worst_deg), self.worst_deg, np.inf))),
                         "worst_pair": list(self.worst_pair),
                         "calibrated": self.calibrated, "amplitudes": self.amplitudes}}
 

@@ -23,6 +23,7 @@ error on its own calibration, and the shift of the calibrated delay offset).
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,7 +47,8 @@ from ..scene.schema import check_arg, fmt
 from ..synthesis.model import ChannelModel
 
 __all__ = ["TransferStudy", "Transfer", "draw_channel_gains", "percentiles", "snapshot_angles",
-           "own_angle_errors", "MAX_RADARS", "MAX_POINTS", "MAX_RADAR_POINTS"]
+           "own_angle_errors", "set_angles", "ideal_radar", "MAX_RADARS", "MAX_POINTS",
+           "MAX_RADAR_POINTS"]
 
 #: radars one study draws (``rtsgeom transfer --radars``, ``rtsgeom.transfer(radars=...)``)
 MAX_RADARS = 100_000
@@ -322,7 +324,7 @@ class TransferStudy:
             raise ParameterError("transfer: the arc needs at least two front ends")
         pairs = self.pairs or tuple((i, i + 1) for i in range(n - 1))
         self.set_points(len(pairs))
-        ideal = _ideal_radar(setup)
+        ideal = ideal_radar(setup)
         probe = _probe(setup, paths, self.seed)
         probe0 = _probe(ideal, paths, self.seed) if ideal is not setup else probe
         rng_m = float(probe_ranges(setup, 1)[0])
@@ -347,7 +349,7 @@ class TransferStudy:
             cal0 = cal if ideal is setup else calibrate_pair(ideal, paths, pair, probe0,
                                                               seed=self.seed)
             shifts.append((cal.delta_tau_s - cal0.delta_tau_s) * 1e12)
-            alphas = _set_angles(setup, probe, pair, self.points)
+            alphas = set_angles(setup, probe, pair, self.points)
             for a in alphas:
                 t = TargetConfig(rng_m, 0.0, 10.0, float(a))
                 e, prog = _measure(ideal, paths, pair, t, probe, cal, gains, st, self.mode,
@@ -392,16 +394,16 @@ def _probe(setup: Setup, paths: Paths, seed) -> FrontEndProbe:
     return probe
 
 
-def _ideal_radar(setup: Setup) -> Setup:
+def ideal_radar(setup: Setup) -> Setup:
     """The setup as built with an ideal radar (the same paths: channels move none)."""
     if setup.scene.radar.channels is None:
         return setup
-    from dataclasses import replace
     scene = setup.scene
-    return build_setup(replace(scene, radar=replace(scene.radar, channels=None)))
+    return build_setup(dataclasses.replace(scene, radar=dataclasses.replace(scene.radar,
+                                                                            channels=None)))
 
 
-def _set_angles(setup: Setup, probe: FrontEndProbe, pair, points: int) -> np.ndarray:
+def set_angles(setup: Setup, probe: FrontEndProbe, pair, points: int) -> np.ndarray:
     """Set angles (rad) across the pair's span, ends excluded: the intersection of the measured
     and the geometric span, as ``analysis.linearity``."""
     i, j = pair

@@ -58,7 +58,7 @@ from ..transfer import draw_channel_gains
 from .budget import (K_COVERAGE, RECTANGULAR, TRIANGULAR, BudgetRow, combined,
                      coverage_interval, validate)
 
-__all__ = ["AccuracyInputs", "AnglePoint", "pair_accuracy", "effective_snr", "set_angles"]
+__all__ = ["AccuracyInputs", "AnglePoint", "pair_accuracy", "effective_snr"]
 
 DELAY_NODES = 9  # phasor models across J's delay spread (the Monte Carlo interpolates)
 FALLBACK_MM = 0.1  # the mounting coefficient's step where no tolerance is given (mm)
@@ -136,16 +136,6 @@ def effective_snr(radar) -> float | None:
     gain = (n_s * window_snr_loss(radar.range_window, n_s)
             * n_c * window_snr_loss(radar.doppler_window, n_c))
     return 10 ** (radar.snr_db / 10) * gain
-
-
-def set_angles(setup, probe, pair, points: int) -> np.ndarray:
-    """Set angles (rad) across the pair's span, ends excluded: the intersection of the measured
-    and the geometric span (as ``analysis.linearity`` and ``analysis.transfer``)."""
-    i, j = pair
-    meas = np.sort(probe.angle_rad[[i, j]])
-    geo = np.sort(setup.fe_azimuth_rad()[[i, j]])
-    lo, hi = max(meas[0], geo[0]), min(meas[1], geo[1])
-    return lo + np.arange(1, points + 1) / (points + 1) * (hi - lo)
 
 
 def _angles(model: ChannelModel, w, gains, start_rad: float, coupling=None, noise=None

@@ -23,7 +23,8 @@ from ...geometry import build_setup
 from ...paths import exact_paths
 from ...scene import Scene, check_scene_arg
 from ..tolerance import MAX_SIGMA_MM
-from .accuracy import AccuracyInputs, AnglePoint, effective_snr, pair_accuracy, set_angles
+from ..transfer import ideal_radar, set_angles
+from .accuracy import AccuracyInputs, AnglePoint, effective_snr, pair_accuracy
 from .sections import (field_of_view, ghosts_section, nearfield_section, range_velocity,
                        resolution_section, targets_section, uncovered_deg)
 from .spec import KpiSpec, SpecCheck, check_spec
@@ -155,7 +156,7 @@ class KpiStudy:
             return [], f"no synthesizable pair in the {fov['mode']} mode"
         from ...calibration.probes import probe_front_ends
         probe = probe_front_ends(setup, paths, setup.scene.seed)
-        ideal = _ideal_radar(setup)
+        ideal = ideal_radar(setup)
         points = []
         for pair in pairs:
             pair = tuple(sorted(pair))
@@ -179,17 +180,6 @@ class _Steps:
         self.label = label
         if self.progress and label:
             self.progress(label, 0, 1)
-
-
-def _ideal_radar(setup):
-    """The setup as built with an ideal radar (the same geometry and paths: the channel gains
-    multiply the phasor model's snapshots)."""
-    if setup.scene.radar.channels is None:
-        return setup
-    import dataclasses
-    scene = setup.scene
-    return build_setup(dataclasses.replace(scene, radar=dataclasses.replace(scene.radar,
-                                                                            channels=None)))
 
 
 @dataclass(frozen=True, repr=False)

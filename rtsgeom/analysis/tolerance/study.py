@@ -127,7 +127,8 @@ class ToleranceStudy:
         self.bounds.check()
         if not isinstance(self.mc, MonteCarlo):
             raise ParameterError(f"{fn}: mc must be a MonteCarlo")
-        check_study_args(fn, spec_deg=self.spec_deg, points=self.points)
+        # a study draws at least one setup (the engine alone takes 0: a yield of no draws)
+        check_study_args(fn, draws=self.mc.draws, spec_deg=self.spec_deg, points=self.points)
         check_arg(self.verify, "verify", "int", fn, ParameterError, lo=0, hi=10_000)
         if self.invert_yield is not None:
             check_arg(self.invert_yield, "invert_yield", "float", fn, ParameterError, lo=0.0,
