@@ -606,3 +606,19 @@ def test_fuzzed_entry_points_keep_the_contract(capsys):
     from benchmarks.fuzz_inputs import main as fuzz
     assert fuzz(["--inputs", "12", "--seed", "3", "--kind", "entry"]) == 0, \
         capsys.readouterr().out
+
+
+@pytest.mark.parametrize("make, field", [
+    (lambda: rtsgeom.CalibrationStudy(procedure="paper", full_chain=True), "full_chain"),
+    (lambda: rtsgeom.LinearityStudy(pair="all", grid=3), "grid")])
+def test_study_options_that_would_be_ignored_are_refused(make, field):
+    """A combination a study would silently ignore is refused, naming the field."""
+    with pytest.raises(ParameterError, match=field):
+        make()
+
+
+def test_an_arcs_inversion_refuses_one_axis(scene):
+    study = rtsgeom.ToleranceStudy(rtsgeom.Bounds((1e-4,) * 3), pair="all", invert_yield=0.9,
+                                   invert_axis="tangential", mc=rtsgeom.MonteCarlo(50, 1))
+    with pytest.raises(ParameterError, match="invert_axis"):
+        study(scene)

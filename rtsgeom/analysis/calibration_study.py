@@ -87,6 +87,9 @@ class CalibrationStudy:
         if self.procedure not in PROCEDURES:
             raise ParameterError(f"CalibrationStudy: procedure = {self.procedure!r}: must be "
                                  f"one of {', '.join(PROCEDURES)}")
+        if self.full_chain and self.procedure == "paper":
+            raise ParameterError("CalibrationStudy: full_chain: must be false with procedure "
+                                 "'paper' (the paper's sweep runs the full chain already)")
 
     def _step(self, label: str) -> None:
         if self.steps is not None:

@@ -88,6 +88,9 @@ class LinearityStudy:
         check_arg(self.end_angles, "end_angles", "str", fn, ParameterError, choices=END_ANGLES)
         if self.grid is not None:
             check_arg(self.grid, "grid", "int", fn, ParameterError, lo=2, hi=50)
+            if is_all(self.pair):
+                raise ParameterError(f"{fn}: grid: must be unset with pair 'all' (a grid "
+                                     "measures one cell; 'all' the arc's pairs)")
 
     def _step(self, label: str) -> None:
         if self.steps is not None:

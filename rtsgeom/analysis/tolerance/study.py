@@ -192,6 +192,9 @@ class ToleranceStudy:
         check_scene_arg(scene, "tolerance")
         warn_setup_errors(scene, "tolerance")  # NominalSetupWarning
         model = self.model(scene)
+        if model.kind == "arc" and self.invert_yield is not None and self.invert_axis != "all":
+            raise ParameterError(f"ToleranceStudy: invert_axis = {self.invert_axis!r}: must be "
+                                 "'all' for an arc (its inversion scales every error together)")
         mc = self.mc.seeded(scene.seed)
         if model.kind != "arc":
             m = model.sets[0]
