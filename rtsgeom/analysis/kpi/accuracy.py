@@ -54,7 +54,7 @@ from ...scene import TargetConfig
 from ...synthesis.model import ChannelModel
 from ..tolerance import AXES, ChannelPhasors
 from ..tolerance.draws import NOISE_STREAM, PHASE_STREAM, draw_offsets
-from ..transfer import draw_channel_gains
+from ..transfer import CHUNK_SNAPSHOTS, draw_channel_gains
 from .budget import (K_COVERAGE, RECTANGULAR, TRIANGULAR, BudgetRow, combined,
                      coverage_interval, validate)
 
@@ -146,13 +146,21 @@ def _angles(model: ChannelModel, w, gains, start_rad: float, coupling=None, nois
     x = np.tensordot(w, model.responses, axes=([0], [1]))  # (K, V)
     if coupling is not None:
         x = x @ coupling.T
-    xb = x[None] * np.asarray(gains)[:, None, :]
-    k = np.argmax(np.sum(np.abs(xb) ** 2, axis=-1), axis=-1)
-    sel = np.take_along_axis(xb, k[:, None, None], axis=1)[:, 0]
-    sel = tdm_compensate(sel, model.doppler_hz, model.setup.rut, model.setup.scene.radar)
-    if noise is not None:
-        sel = sel + noise
-    return refine_angles(sel, model.steering, None, start_rad)
+    gains = np.asarray(gains)
+    n = max(gains.shape[0], 1 if noise is None else np.shape(noise)[0])
+    gains = np.broadcast_to(gains, (n, gains.shape[-1]))
+    out = np.empty(n)
+    # in blocks of transfer's snapshot budget: (B, K, V) at a million draws is gigabytes
+    step = max(1, CHUNK_SNAPSHOTS // x.shape[0])
+    for a in range(0, n, step):
+        xb = x[None] * gains[a:a + step, None, :]
+        k = np.argmax(np.sum(np.abs(xb) ** 2, axis=-1), axis=-1)
+        sel = np.take_along_axis(xb, k[:, None, None], axis=1)[:, 0]
+        sel = tdm_compensate(sel, model.doppler_hz, model.setup.rut, model.setup.scene.radar)
+        if noise is not None:
+            sel = sel + noise[a:a + step]
+        out[a:a + step] = refine_angles(sel, model.steering, None, start_rad)
+    return out
 
 
 class _Point:
