@@ -300,3 +300,19 @@ def test_the_resolution_command_writes_its_three_files(tmp_path):
     rows = list(csv.DictReader((out / "resolution.csv").open()))
     assert len(rows) == 4 and {r["source"] for r in rows} == {"truth", "rts"}
     assert (out / "resolution.png").stat().st_size > 0
+
+
+def test_a_scene_without_static_targets_runs_and_an_empty_frame_associates():
+    """crossing.toml has only a drive: `run` simulates its bench with no target (the
+    association's points once failed to reshape an empty set); a frame without detections
+    leaves every target not detected."""
+    from rtsgeom.pipeline.run import detection_points, target_points
+    scene = load_scene(ROOT / "scenes" / "crossing.toml")
+    assert run_scene(scene).matches == []
+    assert target_points([], 1).shape == (0, 3) and target_points([], 2).shape == (0, 4)
+    empty = associate(target_points(_two_target_bench(4.0).targets, 1), np.zeros((0, 3)),
+                      [1.0, 1.0, 0.3])
+    assert empty.status == ("not_detected", "not_detected")
+    from rtsgeom.radar.processing import Detections
+    none = Detections(*(np.zeros(0),) * 5, np.zeros(0, int), np.zeros(0, int))
+    assert detection_points(none, 2).shape == (0, 4)

@@ -115,14 +115,14 @@ def target_points(targets, dims: int, range_m=None) -> np.ndarray:
     el = np.array([x.elevation_rad for x in t], float)
     u = np.sin(az)[:, None] if dims == 1 else np.c_[np.sin(az) * np.cos(el), np.sin(el)]
     r = [x.range_m for x in t] if range_m is None else range_m
-    return np.c_[r, [x.velocity_mps for x in t], u].reshape(len(t), -1)
+    return np.c_[r, [x.velocity_mps for x in t], u].reshape(len(t), 2 + dims)
 
 
 def detection_points(det: Detections, dims: int) -> np.ndarray:
     """Detections (D, 2 + dims) in the columns of :func:`target_points`."""
     az, el = np.asarray(det.angle_rad, float), np.radians(det.elevation_deg)
     u = np.sin(az)[:, None] if dims == 1 else np.c_[np.sin(az) * np.cos(el), np.sin(el)]
-    return np.c_[det.range_m, det.velocity_mps, u].reshape(len(det), -1)
+    return np.c_[det.range_m, det.velocity_mps, u].reshape(len(det), 2 + dims)
 
 
 def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, bins: int = 2,
