@@ -33,7 +33,8 @@ def shared_cell_warnings(setup: Setup, targets, where: str = "targets") -> list[
     targets : sequence of TargetConfig
         The targets of one frame.
     where : str
-        How the lines name the targets (``targets``, ``frame 12: targets``).
+        How the lines name the targets (``targets``, ``frame 12: targets``). Pairs of
+        scatterers of one extended object are not named: they share cells by design.
 
     Returns
     -------
@@ -53,9 +54,13 @@ def shared_cell_warnings(setup: Setup, targets, where: str = "targets") -> list[
     fe = setup.fe_azimuth_rad()
     pair = [bracketing_pair(x.angle_rad, fe) for x in t]
     out = []
+    obj = np.array([getattr(x, "object_index", -1) for x in t])  # duck-typed targets too
+    # an extended object's scatterers share cells by design: its own summary (clouds.csv,
+    # objects.json) says what the radar sees of it
+    same &= ~((obj[:, None] == obj[None]) & (obj[:, None] >= 0))
     for i, j in zip(*np.nonzero(np.triu(same, 1))):
         sep = abs(u[i] - u[j])
-        name = f"{where}[{i}] and {where}[{j}]"
+        name = f"{_name(where, i, obj[i])} and {_name(where, j, obj[j])}"
         if sep < res_u:
             out.append(f"{name} share a range-Doppler cell and lie {sep:.3f} apart in sin(az), "
                        f"within the radar's two-target resolution {res_u:.3f}: it will see "
@@ -66,3 +71,8 @@ def shared_cell_warnings(setup: Setup, targets, where: str = "targets") -> list[
                        "pattern, so the radar may see one broad peak where real targets give "
                        "two (the truth twin shows what it would see; rtsgeom resolution)")
     return out
+
+
+def _name(where: str, k: int, obj: int) -> str:
+    """Target ``k`` as the lines name it; a scatterer with its object's index."""
+    return f"{where}[{k}]" + (f" (a scatterer of object {obj})" if obj >= 0 else "")
