@@ -10,7 +10,7 @@ with the source name; anything else (another exception, a NaN, an input slower t
     python -m benchmarks.fuzz_scene --engine atheris --inputs 100000   # coverage-guided
 
 Input ``i`` of seed ``s`` is reproducible on its own (its generator is seeded with ``(s, i)``),
-so a failure report names what ``--replay`` needs. ``tests/test_fuzz.py`` drives the same
+so a failure report names what ``--replay`` needs. ``tests/cli/test_fuzz.py`` drives the same
 mutators from hypothesis (through ``random.Random`` instances it controls).
 """
 

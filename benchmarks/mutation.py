@@ -42,8 +42,8 @@ are listed in ``EQUIVALENT`` with the reason; they are reported apart and left o
 
 A module's tests are found from their imports, so a new module or test needs no entry; a new
 physics subpackage needs one line in ``SOURCES`` (and ``[tool.mutmut]`` ``only_mutate`` in
-pyproject.toml, which ``tests/test_mutation_driver.py`` keeps equal to it). New tests for a sample's survivors go to ``tests/test_physics_core.py`` / ``_aoa.py``
-(seed 3), ``tests/test_physics_core_seed4.py`` (seed 4); ``KILLED_BY`` names the test per
+pyproject.toml, which ``tests/test_mutation_driver.py`` keeps equal to it). New tests for a sample's survivors go to the test file of the module they check
+(``tests/<subpackage>/test_<module>.py``); ``KILLED_BY`` names the test per
 mutant, ``RENAMED`` a mutant's name in today's code where its function moved or was
 renumbered (``benchmarks/mutation_tables.py``); judge the suite on a sample it was not
 written for (a new ``--seed``).
@@ -73,9 +73,7 @@ REPORT_JSON = ROOT / "benchmarks" / "mutation-report.json"
 
 #: the tests every physics module's sample runs besides its own importers: the closed forms
 #: and invariants of the core and the tests written for earlier samples' survivors
-CORE_TESTS = ("tests/test_physics_core.py", "tests/test_physics_core_aoa.py",
-              "tests/test_physics_core_seed4.py", "tests/test_mutants.py",
-              "tests/test_properties.py", "tests/test_signal_properties.py")
+CORE_TESTS = ("tests/geometry/test_properties.py", "tests/synthesis/test_signal_properties.py")
 
 #: module -> its source globs (relative to the repository; ``*`` spans subfolders): every
 #: physics subpackage as it stands. Each module's tests are the fast test files that import it
@@ -105,7 +103,7 @@ def tests_for(module: str) -> tuple[str, ...]:
         stem = glob.removesuffix("/*").removesuffix(".py").replace("/", ".")
         names.add(stem)
     found = set(CORE_TESTS)
-    for t in sorted((ROOT / "tests").glob("test_*.py")):
+    for t in sorted((ROOT / "tests").rglob("test_*.py")):
         text = t.read_text()
         if any(n in text for n in names):
             found.add(str(t.relative_to(ROOT)))
@@ -340,10 +338,8 @@ def write_report(s: dict) -> None:
             lines += [f"### `{k}`", "", *why, "```diff", d.strip(), "```", ""]
     if s["killed_later"]:
         lines += ["## First-pass survivors killed by later tests", "",
-                  "Each was killed by a test added after the first pass (named below; in "
-                  "`tests/test_physics_core.py` or, for `aoa/`, `tests/test_physics_core_aoa.py` "
-                  "for the seed-3 sample, `tests/test_physics_core_seed4.py` (and two in "
-                  "`_aoa.py`) for the seed-4 one, `tests/test_mutants.py` for the seed-2 one).",
+                  "Each was killed by a test added after the first pass (named below; in the "
+                  "test file of the module it checks, `tests/<subpackage>/test_<module>.py`).",
                   ""]
         for k, d in s["killed_later"].items():
             by = [f"Killed by `{KILLED_BY[k]}`.", ""] if k in KILLED_BY else []

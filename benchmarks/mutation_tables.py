@@ -109,8 +109,8 @@ EQUIVALENT: dict[str, str] = {
 }
 
 
-# first-pass survivor -> the test that kills it (tests/test_physics_core.py for analysis/,
-# geometry/, radar/; tests/test_physics_core_aoa.py for aoa/); the fresh sample (seed 3).
+# first-pass survivor -> the test that kills it (in the test file of the module it checks);
+# the fresh sample (seed 3).
 # Printed in the report's "killed by later tests" section.
 KILLED_BY: dict[str, str] = {
     "rtsgeom.analysis.tolerance.arc.x_max_scale_for_yield__mutmut_56":
@@ -175,7 +175,7 @@ KILLED_BY: dict[str, str] = {
     "rtsgeom.identify.capture.x_read_capture__mutmut_96": "test_probe_capture_round_trip",
     "rtsgeom.radar.frame.x__simulate_linked__mutmut_64":
         "test_linked_frame_noise_is_the_receivers_thermal_noise_through_the_if_chain",
-    # second fresh sample (seed 4): tests/test_physics_core_seed4.py (fir_effect: _aoa.py)
+    # second fresh sample (seed 4)
     "rtsgeom.analysis.coverage.x_plan_arc__mutmut_17":
         "test_planned_arc_is_bound_by_resolution_when_the_fewest_front_ends_suffice",
     "rtsgeom.analysis.coverage.x_coverage_designs__mutmut_6":

@@ -1,4 +1,5 @@
-"""Shared fixtures: the bundled default scene and scene variants built from it."""
+"""Shared fixtures: the bundled default scene, scene variants built from it, and the small
+quiet scenes and setups the unit tests of several subpackages share."""
 
 from __future__ import annotations
 
@@ -11,8 +12,8 @@ import pytest
 
 # One BLAS thread per test process (unless the environment asks for more): the suite's
 # products are small, and with one xdist worker per core a threaded BLAS only hands work
-# between threads (the 2-D cells grid of tests/test_nchannel.py: 10.6 -> 2.4 s of CPU on a
-# loaded two-core machine). The results are the same bits (tests/test_calibration_threads.py
+# between threads (the 2-D cells grid of tests/synthesis/test_nchannel.py: 10.6 -> 2.4 s of CPU on a
+# loaded two-core machine). The results are the same bits (tests/calibration/test_calibration_threads.py
 # sets its own limits); subprocesses (the CLI, the docs build) inherit the variables.
 if not any(k in os.environ for k in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
                                      "OMP_NUM_THREADS")):
@@ -20,6 +21,8 @@ if not any(k in os.environ for k in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
     from threadpoolctl import threadpool_limits
     _BLAS_LIMIT = threadpool_limits(limits=1, user_api="blas")  # numpy may be loaded already
 
+from rtsgeom.geometry import build_setup
+from rtsgeom.paths import exact_paths
 from rtsgeom.scene import parse_scene
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -165,3 +168,63 @@ def scenes_with_and_without_error(path: Path, section: str, key: str, value):
     moved = copy.deepcopy(doc)
     (moved["rts"]["front_ends"][1] if section == "fe" else moved["radar"])[key] = value
     return (parse_scene(doc, str(path), path.parent), parse_scene(moved, str(path), path.parent))
+
+
+# Small quiet scenes and module-scoped setups shared by the unit tests of several subpackages
+
+
+def small_noiseless(mutate=None):
+    """A small noise-free scene: 32 chirps per Tx, 128 samples at 12.5 MHz."""
+    def m(doc):
+        doc["radar"].pop("snr_db", None)
+        doc["radar"].update(chirps_per_tx=32, samples_per_chirp=128, adc_rate_hz=12.5e6)
+        if mutate:
+            mutate(doc)
+    return make_scene(m)
+
+
+def small_quiet(targets=None, **radar):
+    def mutate(doc):
+        quiet(doc, small=True, **radar)
+        doc["targets"] = targets if targets is not None else [
+            {"range_m": 30.0, "angle_deg": 7.0}, {"range_m": 45.0, "velocity_mps": 2.0,
+                                                  "angle_deg": 10.0}]
+    return make_scene(mutate)
+
+
+@pytest.fixture(scope="module")
+def small_setup():
+    # 512 samples: the probes' 3 m spacing (probe_ranges) must clear the CA-CFAR ring of
+    # 2 + 8 range bins; with 128 samples (0.6 m bins) it does not and one probe is masked
+    scene = small_quiet(samples_per_chirp=512)
+    setup = build_setup(scene)
+    return setup, exact_paths(setup)
+
+
+@pytest.fixture(scope="module")
+def cal_setup():
+    """Small quiet scene with a 3 dB gain error on front end 0 and a 0.3 mm radial error on
+    front end 1, a coarse FIR (50 ps) and a short sweep (0 .. 1.2 ns in 200 ps steps)."""
+    def mutate(doc):
+        doc["radar"].pop("snr_db", None)
+        doc["radar"]["chirps_per_tx"] = 32
+        doc["rts"].update(calibration_span_ns=[0.0, 1.2], calibration_step_ps=200.0,
+                          fractional_delay_step_s=50e-12)
+        for fe in doc["rts"]["front_ends"]:
+            fe.pop("return_loss_fe_db", None)
+            fe.pop("return_loss_be_db", None)
+        doc["rts"]["front_ends"][0]["gain_offset_db"] = 3.0
+        doc["rts"]["front_ends"][1]["radial_offset_mm"] = 0.3
+        doc["targets"] = []
+    setup = build_setup(make_scene(mutate))
+    return setup, exact_paths(setup)
+
+
+@pytest.fixture(scope="module")
+def calibrated(cal_setup):
+    from rtsgeom.calibration.pair import calibrate_pair
+    from rtsgeom.calibration.probes import probe_front_ends
+    setup, paths = cal_setup
+    probe = probe_front_ends(setup, paths)
+    return probe, calibrate_pair(setup, paths, (0, 1), probe)
+

@@ -197,3 +197,24 @@ def test_running_the_examples_from_a_checkout_leaves_git_status_clean():
                   "examples/example_output/calibration_sweep.png"):
         r = subprocess.run(["git", "check-ignore", "-q", where], cwd=ROOT)
         assert r.returncode == 0, f"{where} is not ignored"
+
+
+#: test files at the top of ``tests/``: the package's face (``api.py``, the public names, the
+#: contracts of every command) and the project around it (docs, examples, benchmarks, layout)
+PROJECT_TESTS = {"test_api.py", "test_api_names.py", "test_contracts.py", "test_structure.py",
+                 "test_docs.py", "test_examples.py", "test_add_a_study.py",
+                 "test_benchmark_io.py", "test_mutation_driver.py"}
+
+
+def test_the_tests_mirror_the_package():
+    """``tests/<subpackage>/`` for every subpackage of ``rtsgeom`` and nothing else; the top of
+    ``tests/`` holds only the tests of the package's face and of the project around it."""
+    subpackages = {p.parent.name for p in PKG.glob("*/__init__.py")}
+    folders = {p.name for p in (ROOT / "tests").iterdir()
+               if p.is_dir() and not p.name.startswith((".", "__"))}
+    assert folders == subpackages, (sorted(folders - subpackages), sorted(subpackages - folders))
+    for folder in folders:
+        assert (ROOT / "tests" / folder / "__init__.py").exists(), folder
+        assert list((ROOT / "tests" / folder).glob("test_*.py")), folder
+    top = {p.name for p in (ROOT / "tests").glob("test_*.py")}
+    assert top <= PROJECT_TESTS, sorted(top - PROJECT_TESTS)

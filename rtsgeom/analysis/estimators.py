@@ -9,7 +9,7 @@ is one synthesized target. A smoothed Capon or MUSIC decorrelates the two channe
 instead resolve the two front ends: its peak then jumps from near u_i to near u_j at some rho,
 and the directions in the jump cannot be synthesized at all. :func:`pair_sweep` measures
 that, for a grid of front-end spacings against the array's resolution
-(``benchmarks/estimators.py``, ``tests/test_estimators.py``).
+(``benchmarks/estimators.py``, ``tests/radar/test_estimators.py``).
 """
 
 from __future__ import annotations

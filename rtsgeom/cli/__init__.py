@@ -24,7 +24,7 @@ __all__ = ["main", "build_parser"]
 #: Every subcommand: (the module of this package that registers it, its one-line help). ``main``
 #: imports only the module of the command it runs (the modules import numpy, scipy, the signal
 #: chain), so ``rtsgeom --help`` and ``rtsgeom info`` start without the heavy libraries; the
-#: other commands are listed from this table. ``tests/test_lazy_cli.py`` checks it against what
+#: other commands are listed from this table. ``tests/cli/test_lazy_cli.py`` checks it against what
 #: the modules register. A study whose command is made from its config is one line here:
 #: ``"name": ("study", "help", "rtsgeom.analysis.module:NameStudy")`` (``cli/study.py``).
 COMMANDS: dict[str, tuple[str, ...]] = {

@@ -16,7 +16,7 @@ the Tx-switching phase 2 pi f_D s T_rep) and ``S = B / T``.
 :class:`rtsgeom.rts.channels.RtsProgram`), so the slow-time frequency at the target's range bin is f_D
 exactly. A delay that moves at 2 v / c0 instead (a real target, :func:`synthesize_exact` with
 ``delay_rate``) gives 2 v f_mid / c0 with f_mid = f_c + S (t_mid - tau), t_mid the middle of
-the ADC window (README "Velocity and the carrier frequency"; tests/test_velocity_frequency.py).
+the ADC window (README "Velocity and the carrier frequency"; tests/radar/test_velocity_frequency.py).
 
 Every echo is separable into a slow-time factor and a fast-time factor, so for each virtual
 channel the cube is a complex matrix product ``X_v = A_v @ F_v`` with ``A_v`` (loops x echoes)

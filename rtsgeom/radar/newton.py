@@ -86,7 +86,7 @@ def parabolic(y0, y1, y2) -> np.ndarray:
 # sums accumulated element by element from 0.0 (explicit loops over the V_s elements, not
 # numpy's reductions, whose order depends on the array's layout), complex products written
 # out as (ac - bd, ad + bc) (the kernel's, CPython's), cosines and sines from numpy (equal to
-# the C library's that the kernel calls, checked bit for bit by tests/test_kernels_peak.py).
+# the C library's that the kernel calls, checked bit for bit by tests/radar/test_kernels_peak.py).
 # Steering.peak runs this while numba's set-up would cost more (``rtsgeom._lib.util.use_kernels``:
 # no numba import for a few thousand snapshots, the calibration), the kernel after; both give
 # the same bits.

@@ -5,7 +5,7 @@
 
 Every key, unit, default and range comes from the one declaration of each field in
 ``rtsgeom/scene/sections.py``; the named choices from ``rtsgeom/scene/registry.py``; the rules from the
-docstrings in ``rtsgeom/scene/rules.py``. ``tests/test_scene.py`` fails if the committed file
+docstrings in ``rtsgeom/scene/rules.py``. ``tests/scene/test_scene.py`` fails if the committed file
 and this generator drift apart.
 """
 

@@ -399,7 +399,7 @@ def resolvable_limits(radar: "RadarConfig") -> tuple[float, float, str, str]:
     beyond, the peak wraps to the opposite velocity and the TDM phase compensation takes the
     wrong sign (an angle error of degrees). The Doppler CFAR ring may wrap: the far edge of
     the cyclic Doppler axis holds only noise (a target at 94 % of the maximum is found in its
-    bin, tests/test_signal.py)."""
+    bin, tests/radar/test_signal.py)."""
     cfar = radar.cfar
     k_r = (WINDOWS[radar.range_window].mainlobe_half_bins + cfar.guard_cells[0]
            + cfar.training_cells[0])

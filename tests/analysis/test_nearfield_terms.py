@@ -1,0 +1,23 @@
+"""Tests of ``rtsgeom.analysis.nearfield_terms``: closed forms and invariants on grids of inputs."""
+
+from __future__ import annotations
+
+import numpy as np
+from conftest import make_scene
+
+from rtsgeom.geometry import build_setup
+
+
+def test_phase_residual_of_a_plane_wave_is_zero():
+    """The residual after the best linear fit over the element positions vanishes for path
+    lengths linear in the position (a plane wave), and is the curvature otherwise."""
+    from rtsgeom.analysis.nearfield_terms import _residual_deg
+    from rtsgeom.radar.steering import Steering
+    s = make_scene()
+    st = Steering.build(build_setup(s).rut, s.radar)
+    x = st.positions_m[:, 0]
+    lengths = np.stack([2.0 + 0.3 * x, 1.0 - 0.1 * x])
+    assert np.max(np.abs(_residual_deg(st, lengths))) < 1e-9
+    bent = lengths + 1e-3 * (x - x.mean()) ** 2 / np.ptp(x) ** 2
+    r = _residual_deg(st, bent)
+    assert np.max(np.abs(r)) > 1e-3 and np.allclose(r.sum(axis=1), 0, atol=1e-9)

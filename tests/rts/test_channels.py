@@ -1,0 +1,97 @@
+"""Tests of ``rtsgeom.rts.channels``: closed forms and invariants on grids of inputs."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import make_scene, small_noiseless, small_quiet
+
+from rtsgeom.geometry import build_setup
+from rtsgeom.paths import exact_paths
+from rtsgeom.paths.table import RUT_TO_RUT, Paths
+from rtsgeom.rts.channels import KIND_SETUP, setup_echoes
+
+
+@pytest.mark.parametrize("extra_tx, extra_rx", [(1, 0), (0, 2), (2, 1)])
+def test_channel_echoes_pair_every_path_of_one_leg_with_every_path_of_the_other(extra_tx,
+                                                                              extra_rx):
+    """A leg with Pa paths (Tx -> front end) and one with Pb (front end -> Rx) give Pa x Pb
+    direct echoes per channel and virtual element, with delays tau_a + tau_b (+ the RTS's)
+    and amplitudes conj(g_a g_b G): here the line-of-sight legs plus copies 0.1 ns later each
+    and half as strong, so the echoes' delays are the LoS one plus 0.1 ns x (m + n)."""
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    from rtsgeom.paths.table import FE_TO_RX, TX_TO_FE, Paths
+    from rtsgeom.rts.channels import KIND_DIRECT, RtsProgram, channel_echoes
+    setup = build_setup(small_noiseless())
+    los = exact_paths(setup)
+    extra = []
+    for direction, count in ((TX_TO_FE, extra_tx), (FE_TO_RX, extra_rx)):
+        leg = los.select(los.direction == direction)
+        for m in range(1, count + 1):
+            extra.append(Paths.build(leg.front_end, leg.direction, leg.rut_tx, leg.rut_rx,
+                                     leg.delay_s + m * 0.1e-9, leg.gain * 0.5 ** m,
+                                     np.ones(len(leg), int)))
+    paths = Paths.concat([los, *extra])
+    prog = RtsProgram.build([0, 1], [0, 1], [1e-7, 1.2e-7], [0.0, 0.0], [1.0, 0.5])
+    ref = channel_echoes(setup, los, prog)
+    ref = ref.select(ref.kind == KIND_DIRECT)
+    got = channel_echoes(setup, paths, prog)
+    got = got.select(got.kind == KIND_DIRECT)
+    pa, pb = 1 + extra_tx, 1 + extra_rx
+    assert len(got) == len(ref) * pa * pb
+    for k in range(len(prog)):
+        r = np.flatnonzero(ref.target == k)[0]
+        rows = np.flatnonzero(got.target == k)
+        assert rows.size == pa * pb
+        lag = got.tau_air_s[rows] - ref.tau_air_s[r]  # (Pa Pb, V): 0.1 ns x (m + n)
+        steps = np.round(lag / 0.1e-9)
+        np.testing.assert_allclose(lag, steps * 0.1e-9, atol=1e-15)
+        expect = sorted(m + n for m in range(pa) for n in range(pb))
+        assert sorted(steps[:, 0].astype(int).tolist()) == expect
+        np.testing.assert_allclose(got.amplitude[rows], ref.amplitude[r] * 0.5 ** steps,
+                                   rtol=1e-12)
+
+
+def test_setup_echoes_are_the_rut_to_rut_rows_conjugated():
+    """Static reflections of the RuT's own chirp: per virtual element each RUT_TO_RUT row of
+    its (Tx, Rx) pair becomes an echo with that delay and the conjugate gain; other rows and
+    other pairs add nothing."""
+    scene = small_quiet([])
+    setup = build_setup(scene)
+    rut = setup.rut
+    rows = []
+    rng = np.random.default_rng(4)
+    for m in range(rut.tx_world.shape[0]):
+        for k in range(rut.rx_world.shape[0]):
+            for _ in range(1 + (m + k) % 2):
+                rows.append((m, k, rng.uniform(5e-9, 9e-9), rng.normal() + 1j * rng.normal()))
+    m_, k_, d_, g_ = map(np.array, zip(*rows))
+    paths = Paths.build(np.full(len(rows), -1), np.full(len(rows), RUT_TO_RUT), m_, k_, d_, g_,
+                        bounces=np.ones(len(rows), int))
+    ech = setup_echoes(setup, paths)
+    assert np.all(ech.kind == KIND_SETUP) and np.all(ech.tau_if_s == 0)
+    assert ech.amplitude.dtype.kind == "c"
+    for v in range(rut.num_virtual):
+        sel = (m_ == rut.virtual_tx[v]) & (k_ == rut.virtual_rx[v])
+        got = sorted(zip(ech.tau_air_s[:, v][ech.amplitude[:, v] != 0],
+                         ech.amplitude[:, v][ech.amplitude[:, v] != 0]), key=lambda x: x[0])
+        want = sorted(zip(d_[sel], np.conj(g_[sel])), key=lambda x: x[0])
+        assert len(got) == len(want)
+        for (a, b), (x, y) in zip(got, want):
+            assert a == x and b == y
+    # no RUT_TO_RUT rows: no echoes
+    assert len(setup_echoes(setup, exact_paths(setup))) == 0
+
+
+def test_ghosts_of_a_later_front_end_when_an_earlier_one_is_idle():
+    """Cable ghosts are added per front end with echoes; a front end without any programmed
+    channel does not end the loop, and the ghost order is an integer."""
+    from rtsgeom.rts.channels import RtsProgram, channel_echoes
+    s = make_scene(lambda d: d["radar"].pop("snr_db", None))
+    setup = build_setup(s)
+    prog = RtsProgram.build([0], [1], [1e-7], [0.0], [1.0])  # only front end 1
+    ech = channel_echoes(setup, exact_paths(setup), prog)
+    ghosts = ech.kind == 1
+    assert ghosts.any() and np.all(ech.front_end[ghosts] == 1)
+    assert ech.order.dtype.kind == "i"
