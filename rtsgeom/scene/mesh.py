@@ -33,7 +33,8 @@ Near field (:func:`mesh_scatterers`)
     far-field integral taken about its own centre with its own direction and distance to the
     RuT, and the tiles summed coherently per resolution cell of the RuT (its range resolution
     and the virtual aperture's Rayleigh cell ``2 / N_virtual`` in direction cosine, the grid
-    centred where the whole return comes from, so a plate smaller than a cell is one). Each cell
+    centred where the whole return comes from, so a plate smaller than a cell is one; a cell
+    never narrower than the Fresnel zone ``sqrt(lambda / R)``, whose return is one). Each cell
     is one scatterer with ``sigma = |sum|^2``, placed at the centroid of its tiles weighted by
     their share in phase with the cell's sum (the part of the surface that makes the return:
     a flank's specular spot, not its middle); a face larger than a cell is thereby split into
@@ -62,7 +63,7 @@ MAX_MESH_FACETS = 4096  # triangles of one mesh (a car's outline needs a few hun
 MAX_MESH_BYTES = 4 << 20  # a mesh file's size (read before it is parsed: memory bounded)
 MAX_MESH_SCATTERERS = 32  # scatterers kept from a mesh per pose
 MESH_DYNAMIC_DB = 40.0  # a mesh's scatterers within this of its strongest
-TILE_PER_FRESNEL = 6.0  # a tile's longest edge: the Fresnel length sqrt(lambda R) over this
+TILE_PER_FRESNEL = 4.0  # a tile's longest edge: the Fresnel length sqrt(lambda R) over this
 MAX_MESH_TILES = 1 << 17  # tiles of one pose (memory); beyond it the tiles grow
 _RAY_CHUNK = 256  # facets per block of the visibility test (memory: chunk x facets)
 _TAYLOR = 0.05  # |p_t| times the triangle's size below which its integral is a Taylor series
@@ -213,28 +214,86 @@ def _visible(centres: np.ndarray, tri: np.ndarray, radar: np.ndarray) -> np.ndar
     return out
 
 
-def _tiles(tri: np.ndarray, max_edge_m: float) -> tuple[np.ndarray, float]:
-    """Triangles (T, 3, 3) cut by longest-edge bisection until no edge exceeds ``max_edge_m``;
-    where that makes more than :data:`MAX_MESH_TILES` tiles the edge limit grows by sqrt(2)
-    until it does not. Returns the tiles and the edge limit used."""
-    while True:
-        out, ok = tri, True
-        while True:
-            edge = np.linalg.norm(out - np.roll(out, -1, axis=1), axis=2)  # edge v -> v+1
-            big = edge.max(axis=1) > max_edge_m
-            if not big.any():
-                break
-            if len(out) + int(big.sum()) > MAX_MESH_TILES:
-                ok = False
-                break
-            t, e = out[big], edge[big].argmax(axis=1)
-            i = np.arange(len(t))
-            a, b, c = t[i, e], t[i, (e + 1) % 3], t[i, (e + 2) % 3]
-            m = 0.5 * (a + b)
-            out = np.concatenate([out[~big], np.stack([a, m, c], 1), np.stack([m, b, c], 1)])
-        if ok:
-            return out, max_edge_m
-        max_edge_m *= math.sqrt(2.0)
+def _grid(n: int) -> np.ndarray:
+    """Integer barycentric coordinates (n^2, 3, 3) of the n x n uniform subdivision of a
+    triangle (each row sums to n): tile t's vertex v is ``g[t, v] @ (r0, r1, r2) / n``;
+    neighbouring tiles share their vertices."""
+    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    keep = i + j < n
+    i, j = i[keep], j[keep]
+    up = np.stack([np.c_[i, j], np.c_[i + 1, j], np.c_[i, j + 1]], 1)  # (n(n+1)/2, 3, 2)
+    keep = i + j < n - 1
+    down = np.stack([np.c_[i + 1, j], np.c_[i + 1, j + 1], np.c_[i, j + 1]], 1)[keep]
+    ij = np.concatenate([up, down])
+    return np.concatenate([n - ij.sum(axis=2, keepdims=True), ij], axis=2)
+
+
+def _tiles(tri: np.ndarray, edge_n: np.ndarray, phase_of, max_edge_m: float
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each triangle (T, 3, 3) cut into n^2 equal tiles, n the smallest power of two that makes
+    every edge at most ``max_edge_m`` (fewer where that makes more than
+    :data:`MAX_MESH_TILES` tiles). ``edge_n(n)`` (T, 3): the fewest cuts of each triangle's
+    edge v -> v+1 among the triangles that share it. A tile vertex on an edge its neighbour
+    cuts more coarsely takes the phase interpolated along the neighbour's cuts (a hanging
+    node), so the phase is continuous across every shared edge. Returns the tiles (N, 3, 3),
+    each one's triangle (N,) and its vertices' phase (N, 3) from ``phase_of`` (points -> rad)."""
+    longest = np.linalg.norm(tri - np.roll(tri, -1, axis=1), axis=2).max(axis=1)
+    n = 2 ** np.ceil(np.log2(np.maximum(longest / max_edge_m, 1.0))).astype(np.int64)
+    while (n ** 2).sum() > MAX_MESH_TILES:
+        n = np.maximum(n // 2, 1)
+    nb = edge_n(n)
+    tiles, owner, phase = [], [], []
+    for m in np.unique(n):
+        sel = np.flatnonzero(n == m)
+        g = _grid(int(m))  # (G, 3, 3) integer
+        t = tri[sel]
+        pts = np.einsum("gvw,twk->tgvk", g / m, t)
+        ph = phase_of(pts)
+        for e in range(3):  # edge e -> e+1: the vertices with no weight on e+2
+            on = g[:, :, (e + 2) % 3] == 0  # (G, 3)
+            coarse = nb[sel, e] < m
+            if not (on.any() and coarse.any()):
+                continue
+            nc = nb[sel, e][:, None, None]  # (T', 1, 1)
+            tc = g[None, :, :, (e + 1) % 3] / m * nc  # position along the edge in its cuts
+            i0 = np.minimum(np.floor(tc), nc - 1)
+            frac = tc - i0
+            a, b = t[:, e][:, None, None, :], t[:, (e + 1) % 3][:, None, None, :]
+            p0 = a + (i0 / nc)[..., None] * (b - a)
+            p1 = a + ((i0 + 1) / nc)[..., None] * (b - a)
+            hang = (1 - frac) * phase_of(p0) + frac * phase_of(p1)
+            ph = np.where(on[None] & coarse[:, None, None], hang, ph)
+        tiles.append(pts.reshape(-1, 3, 3))
+        owner.append(np.repeat(sel, len(g)))
+        phase.append(ph.reshape(-1, 3))
+    return np.concatenate(tiles), np.concatenate(owner), np.concatenate(phase)
+
+
+def _lin_integrals(tiles: np.ndarray, phase: np.ndarray) -> np.ndarray:
+    """``int_T exp(j phi) dS`` over each tile (N, 3, 3), ``phi`` the linear interpolation of its
+    vertices' ``phase`` (N, 3): continuous across shared edges, so tiles add without the
+    spurious edge terms a per-tile linearisation leaves."""
+    e = np.roll(tiles, -1, axis=1) - tiles  # edge v -> v + 1
+    n2 = np.cross(e[:, 0], -e[:, 2])  # 2 A n
+    two_a2 = np.einsum("tk,tk->t", n2, n2)
+    # grad of barycentric lambda_v: n x (r_{v+2} - r_{v+1}) / (2A) = (2A n) x e_{v+1} / (2A)^2
+    grad = np.cross(n2[:, None, :], np.roll(e, -1, axis=1)) / two_a2[:, None, None]
+    g = np.einsum("tv,tvk->tk", phase, grad)
+    return np.exp(1j * phase.mean(axis=1)) * triangle_integrals(tiles, g)
+
+
+def _edge_cuts(faces: np.ndarray):
+    """For triangles ``faces`` (T, 3) (vertex indices): a function of their cuts n (T,) giving,
+    per triangle and edge v -> v+1 (T, 3), the fewest cuts among the triangles sharing it."""
+    e = np.stack([faces, np.roll(faces, -1, axis=1)], axis=2)  # (T, 3, 2)
+    _, key = np.unique(np.sort(e, axis=2).reshape(-1, 2), axis=0, return_inverse=True)
+    key = key.ravel()
+
+    def edge_n(n: np.ndarray) -> np.ndarray:
+        fewest = np.full(key.max() + 1, np.iinfo(np.int64).max)
+        np.minimum.at(fewest, key, np.repeat(n, 3))
+        return fewest[key].reshape(-1, 3)
+    return edge_n
 
 
 def mesh_scatterers(vertices: np.ndarray, faces: np.ndarray, radar_obj: np.ndarray,
@@ -257,16 +316,20 @@ def mesh_scatterers(vertices: np.ndarray, faces: np.ndarray, radar_obj: np.ndarr
     if not idx.size:  # nothing faces the RuT, or every facing facet hidden
         return np.zeros((0, 3)), np.zeros(0)
     r_min = np.linalg.norm(tri[idx] - radar_obj, axis=2).min()
-    tiles, _ = _tiles(tri[idx], math.sqrt(wavelength_m * r_min) / TILE_PER_FRESNEL)
     k = 2.0 * math.pi / wavelength_m
+    tiles, owner, phase = _tiles(
+        tri[idx], _edge_cuts(np.asarray(faces, np.int64)[idx]),
+        lambda pts: -2.0 * k * np.linalg.norm(pts - radar_obj, axis=-1),  # exp(-j 2 k R)
+        math.sqrt(wavelength_m * r_min) / TILE_PER_FRESNEL)
     c = tiles.mean(axis=1)
     rel = radar_obj[None] - c
     r = np.linalg.norm(rel, axis=1)
-    d = rel / r[:, None]
-    n = np.cross(tiles[:, 1] - tiles[:, 0], tiles[:, 2] - tiles[:, 0])
-    n = n / np.linalg.norm(n, axis=1)[:, None]
-    amp = (math.sqrt(4.0 * math.pi) / wavelength_m * np.einsum("tk,tk->t", n, d)
-           * np.exp(-2j * k * r) * triangle_integrals(tiles, 2.0 * k * d))
+    n = nrm[idx][owner] / (2.0 * area[idx][owner])[:, None]
+    mid = 0.5 * (tiles + np.roll(tiles, -1, axis=1))  # the phase's mean departure from its
+    bend = (-2.0 * k * np.linalg.norm(mid - radar_obj, axis=-1)  # linear interpolation over a
+            - 0.5 * (phase + np.roll(phase, -1, axis=1))).sum(axis=1) / 3.0  # tile (its bend)
+    amp = (math.sqrt(4.0 * math.pi) / wavelength_m * np.einsum("tk,tk->t", n, rel) / r
+           * _lin_integrals(tiles, phase) * np.exp(1j * bend))
     # cells of range and direction cosine seen from the RuT (its lateral axis: the object
     # frame's x turned with the RuT's line of sight to the object's origin)
     axis = np.cross(-radar_obj, [0.0, 0.0, 1.0])
@@ -276,9 +339,11 @@ def mesh_scatterers(vertices: np.ndarray, faces: np.ndarray, radar_obj: np.ndarr
     if not w.sum() > 0:  # whole return comes from (an object of one face: in one cell)
         w = np.abs(amp)
     r0, u0 = np.average(r, weights=w), np.average(u, weights=w)
-    _, cell = np.unique(np.c_[np.round((r - r0) / cell_m), np.round((u - u0) / cell_u)],
-                        axis=0, return_inverse=True)
-    cell = cell.ravel()
+    cell_u = max(cell_u, math.sqrt(wavelength_m / r_min))  # never below the Fresnel zone
+    ir = np.round((r - r0) / cell_m).astype(np.int64)
+    iu = np.round((u - u0) / cell_u).astype(np.int64)
+    iu -= iu.min()
+    _, cell = np.unique((ir - ir.min()) * (iu.max() + 1) + iu, return_inverse=True)
     total = np.bincount(cell, amp.real) + 1j * np.bincount(cell, amp.imag)
     w = np.clip((amp * np.conj(total[cell])).real, 0.0, None)  # in phase with the cell's sum
     wsum = np.bincount(cell, w, len(total))
