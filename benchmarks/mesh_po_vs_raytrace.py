@@ -10,6 +10,8 @@ Sionna RT's monostatic geometrical optics (rtsgeom.paths.raytrace_monostatic), t
   z = 0 (as the scene places it) and at 0.5 m (a bumper-height radar): each PO scatterer (one
   per resolution cell of the car-crossing radar) and each Sionna path (one and two bounces),
   every Sionna path matched to the PO scatterer of its cell.
+* ``sweep``: the car's total return over headings 0-90 deg, both models; docs/mesh_po.png
+  draws it with the plates.
 
 Times are wall seconds on this (shared) machine, with the process's CPU seconds beside them;
 Sionna's first solve includes its kernel compilation and is reported apart.
@@ -144,10 +146,72 @@ def car(mono, po) -> list[dict]:
     return rows
 
 
+def sweep(mono, po) -> list[dict]:
+    """The car's total return over headings 0-90 deg (nose to flank) 15 m ahead: PO (coherent
+    cells, summed in power) and Sionna RT (one bounce), the RuT at z = 0 and 0.5 m."""
+    from rtsgeom.scene.mesh import load_mesh
+    v, f = load_mesh(str(ROOT / "scenes" / "car.ply"), "car", "benchmark")
+    rows, r = [], 15.0
+    for height in (0.0, 0.5):
+        for h_deg in range(0, 91, 5):
+            h = math.radians(h_deg)
+            radar = np.array([r * math.sin(h), -r * math.cos(h), height])
+            _, rcs = po(v, f, radar, LAM, CELL_M, CELL_U)
+            go = mono(v, f, radar, LAM)
+            rows.append({"heading_deg": h_deg, "rut_height_m": height,
+                         "po_dbsm": _total_db(rcs), "sionna_dbsm": _total_db(go.rcs_dbsm)})
+    return rows
+
+
+def figure(out: dict, path: str) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    p = out["plate"]
+    side = np.array([row["side_m"] for row in p])
+    fine = np.geomspace(side.min(), side.max(), 200)
+    a1.plot(fine, 10 * np.log10(4 * math.pi * fine ** 4 / LAM ** 2), "k:",
+            label="far field $4\\pi A^2/\\lambda^2$")
+    a1.plot(fine, [_fresnel_db(a, a, 15.0) for a in fine], "k-", lw=1,
+            label="Fresnel closed form")
+    a1.axhline(10 * math.log10(math.pi * 15.0 ** 2), color="0.5", ls="--",
+               label="mirror $\\pi R^2$")
+    a1.plot(side, [row["po_dbsm"] for row in p], "o", ms=7, mfc="none", label="PO (rtsgeom)")
+    got = [(row["side_m"], row["sionna_dbsm"]) for row in p if row["sionna_dbsm"] is not None]
+    a1.plot(*zip(*got), "x", ms=8, mew=2, label="Sionna RT (GO)")
+    a1.set(xscale="log", xlabel="square plate's side (m)", ylabel="RCS (dBsm)",
+           title="Plate 15 m ahead, normal incidence, 77 GHz", ylim=(0, 60))
+    a1.legend(fontsize=8, loc="upper left")
+    for height, style in ((0.5, "-"), (0.0, "--")):
+        rows = [row for row in out["sweep"] if row["rut_height_m"] == height]
+        h = [row["heading_deg"] for row in rows]
+        a2.plot(h, [np.nan if row["po_dbsm"] is None else row["po_dbsm"] for row in rows],
+                "C0" + style, label=f"PO, RuT at z = {height} m")
+        sio = [(row["heading_deg"], row["sionna_dbsm"]) for row in rows
+               if row["sionna_dbsm"] is not None]
+        if sio:
+            a2.plot(*zip(*sio), "C1x", ms=8, mew=2,
+                    label=f"Sionna RT, RuT at z = {height} m" if height else None)
+    a2.set(xlabel="heading (deg): 0 nose on, 90 flank", ylabel="total RCS (dBsm)",
+           title="scenes/car.ply 15 m ahead (Sionna: no path at z = 0)", ylim=(-30, 35))
+    a2.legend(fontsize=8)
+    for ax in (a1, a2):
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--json", default=str(Path(__file__).with_suffix(".json")))
+    ap.add_argument("--figure", default=str(ROOT / "docs" / "mesh_po.png"))
+    ap.add_argument("--from-json", action="store_true", help="only redraw the figure")
     args = ap.parse_args(argv)
+    if args.from_json:
+        import json
+        figure(json.loads(Path(args.json).read_text()), args.figure)
+        return 0
     os.environ.setdefault("RTSGEOM_RAYTRACE_BACKEND", "llvm")
     from rtsgeom.paths.raytrace_monostatic import monostatic
     from rtsgeom.paths.raytrace_backend import backend_info
@@ -159,8 +223,9 @@ def main(argv=None) -> int:
            "sionna_import_s": round(first.timings_s["import_s"], 2),
            "sionna_first_call_s": t_first, "cell_m": CELL_M, "cell_u": CELL_U,
            "plate": plates(monostatic, mesh_scatterers), "tilt": tilts(monostatic, mesh_scatterers),
-           "car": car(monostatic, mesh_scatterers)}
+           "car": car(monostatic, mesh_scatterers), "sweep": sweep(monostatic, mesh_scatterers)}
     write_json(args.json, out, newline=True)
+    figure(out, args.figure)
     for key in ("plate", "tilt"):
         for row in out[key]:
             print(key, row)
