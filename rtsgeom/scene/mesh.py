@@ -27,11 +27,16 @@ Far field (:func:`face_rcs`)
 Near field (:func:`mesh_scatterers`)
     A face larger than its Fresnel zone ``sqrt(lambda R)`` is not in its own far field: a car's
     flank 15 m away (4.5 m long, far field beyond 2 D^2 / lambda ~ 10 km) returns what a mirror
-    does, ``pi R^2`` (28.5 dBsm), not ``4 pi A^2 / lambda^2`` (68 dBsm). The lit triangles are
-    therefore cut (longest-edge bisection) into tiles of at most ``sqrt(lambda R_min) /``
-    :data:`TILE_PER_FRESNEL` (the quadratic phase across a tile below 0.06 rad), each tile's
-    far-field integral taken about its own centre with its own direction and distance to the
-    RuT, and the tiles summed coherently per resolution cell of the RuT (its range resolution
+    does, ``pi R^2`` (28.5 dBsm), not ``4 pi A^2 / lambda^2`` (68 dBsm). Each lit triangle is
+    therefore cut into n x n equal tiles (n a power of two) no longer than
+    ``sqrt(lambda R_min) /`` :data:`TILE_PER_FRESNEL`, the two-way phase ``-2 k R`` taken
+    exactly at the tiles' vertices and interpolated linearly over each tile (its integral the
+    far-field one above, with the phase's gradient in the tile's plane; the mean departure of
+    the exact phase from the interpolation, its bend, as a phase factor). The interpolated
+    phase is continuous across every shared edge (where the triangle beside cuts an edge more
+    coarsely, the tiles' vertices on it take the phase interpolated along the coarser cuts), so
+    the tiles add without spurious edge terms, and are summed coherently per resolution cell
+    of the RuT (its range resolution
     and the virtual aperture's Rayleigh cell ``2 / N_virtual`` in direction cosine, the grid
     centred where the whole return comes from, so a plate smaller than a cell is one; a cell
     never narrower than the Fresnel zone ``sqrt(lambda / R)``, whose return is one). Each cell
