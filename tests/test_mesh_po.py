@@ -210,3 +210,30 @@ def test_tiles_are_bounded_in_memory():
     area = 0.5 * np.linalg.norm(np.cross(tiles[:, 1] - tiles[:, 0], tiles[:, 2] - tiles[:, 0]),
                                 axis=1)
     assert area.sum() == pytest.approx(100.0)
+
+
+@pytest.mark.parametrize("heading_deg, side", [(0.0, 0.2), (0.0, 0.05), (3.0, 0.05),
+                                               (-10.0, 0.05)])
+def test_a_plate_mesh_in_a_scene_is_the_closed_form(tmp_path, heading_deg, side):
+    """Through the scene file: a square plate mesh 15 m ahead (its normal towards the RuT at
+    heading 0) is one target at 15 m with the closed form's RCS at the radar's wavelength,
+    the Fresnel one at normal incidence, the far-field sinc^2 lobe turned (a 5 cm plate is
+    in its far field beyond 1.3 m)."""
+    from test_objects import bench_doc, with_object
+    from rtsgeom.scene import parse_scene
+    plate(side, side).export(tmp_path / "plate.stl")
+    s = parse_scene(with_object(bench_doc(), mesh="plate.stl", heading_deg=heading_deg),
+                    "p.toml", base_dir=tmp_path)
+    lam = s.radar.wavelength_m
+    k = 2 * math.pi / lam
+    if heading_deg == 0.0:
+        def f(w):
+            sn, cs = fresnel(w / 2 * math.sqrt(2 * k / (math.pi * 15.0)))
+            return math.sqrt(math.pi * 15.0 / (2 * k)) * 2 * (cs - 1j * sn)
+        want = 4 * math.pi / lam ** 2 * abs(f(side)) ** 4
+    else:
+        th = math.radians(heading_deg)
+        want = (4 * math.pi * side ** 4 / lam ** 2 * math.cos(th) ** 2
+                * sinc(k * side * math.sin(th)) ** 2)
+    assert len(s.targets) == 1 and s.targets[0].range_m == pytest.approx(15.0, abs=1e-3)
+    assert s.targets[0].rcs_dbsm == pytest.approx(10 * math.log10(want), abs=0.1)
