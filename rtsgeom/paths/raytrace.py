@@ -1,6 +1,7 @@
 """Ray-traced paths with Sionna RT (``--paths raytrace``): the setup's reflections per element pair.
 
-This module and :mod:`~rtsgeom.paths.raytrace_backend` (the pre-flight check of Dr.Jit's
+This module, :mod:`~rtsgeom.paths.raytrace_monostatic` (a mesh object's returns to a
+monostatic radar) and :mod:`~rtsgeom.paths.raytrace_backend` (the pre-flight check of Dr.Jit's
 backend, re-exported here) are the one adapter of rtsgeom that imports ``sionna``, ``mitsuba``
 or ``drjit``, lazily, on the first :func:`raytrace_paths` call, after the pre-flight.
 
@@ -405,3 +406,4 @@ def raytrace_paths(setup: Setup, config: RaytraceConfig | None = None) -> Paths:
                              "must be isotropic with --paths raytrace (antenna patterns enter "
                              "the exact paths only so far)")
     return trace(setup, config).paths
+

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from . import file, registry, rules, scene, sections
 from .schema import REQUIRED, Derived, Spec, rows_text, specs
-from .objects import MAX_MESH_BYTES, MAX_MESH_FACETS, MAX_MESH_SCATTERERS
+from .mesh import MAX_MESH_BYTES, MAX_MESH_FACETS, MAX_MESH_SCATTERERS
 
 __all__ = ["render", "DOC_PATH"]
 

@@ -11,14 +11,8 @@ one per scatterer, ``object_index`` naming the object): the planner, the truth t
 association then work per scatterer, as for any point target. A static object is expanded on
 load (``Scene.targets``); a moving one per frame (:func:`place`, by the playback).
 
-A mesh's scatterers come from its geometry as the RuT sees it: the facets facing the RuT whose
-centre it sees (no other facet in between), each facet's physical-optics return as a flat plate
-of its area ``A`` at the angle ``theta`` off its normal,
-``sigma = 4 pi A^2 cos^2(theta) / lambda^2 / (1 + 2 (k sqrt(A) sin theta)^2)`` (the plate's
-``sinc^2`` lobe, averaged over its side lobes beyond the main lobe), summed in power over cells
-of the radar's range resolution and its virtual aperture's Rayleigh cell in direction cosine
-``2 / N_virtual``, each cell one scatterer at the power centroid of its facets; the strongest
-:data:`MAX_MESH_SCATTERERS` within :data:`MESH_DYNAMIC_DB` of the strongest are kept.
+A mesh's scatterers come from its geometry as the RuT sees it, by physical optics
+(:mod:`rtsgeom.scene.mesh`).
 
 An RuT that beamforms in azimuth only sees no elevation: a scatterer off the horizontal plane
 keeps its 3-D range and azimuth and is placed at elevation 0.
@@ -29,23 +23,15 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from ..errors import SceneError
+from .mesh import load_mesh, mesh_scatterers
 from .schema import fmt
 from .sections import MAX_TARGETS, TargetConfig
 
-__all__ = ["ObjectModel", "load_mesh", "mesh_scatterers", "place", "expand_objects",
-           "frame_objects", "object_paths",
-           "MAX_MESH_FACETS", "MAX_MESH_BYTES", "MAX_MESH_SCATTERERS"]
-
-MAX_MESH_FACETS = 4096  # facets of one mesh (a car's outline needs a few hundred)
-MAX_MESH_BYTES = 4 << 20  # a mesh file's size (read before it is parsed: memory bounded)
-MAX_MESH_SCATTERERS = 32  # scatterers kept from a mesh per pose
-MESH_DYNAMIC_DB = 40.0  # a mesh's scatterers within this of its strongest
-_RAY_CHUNK = 256  # facets per block of the visibility test (memory: chunk x facets)
+__all__ = ["ObjectModel", "place", "expand_objects", "frame_objects", "object_paths"]
 
 
 @dataclass(frozen=True, eq=False)  # numpy fields: identity, not an ambiguous array ==
@@ -114,108 +100,6 @@ def _hull(xy: np.ndarray) -> np.ndarray:
         return pts[ConvexHull(pts).vertices]
     except QhullError:  # collinear
         return pts[[np.argmin(pts[:, 0] + pts[:, 1]), np.argmax(pts[:, 0] + pts[:, 1])]]
-
-
-def load_mesh(path: str, where: str, source: str) -> tuple[np.ndarray, np.ndarray]:
-    """A mesh file's vertices (V, 3) and triangular faces (F, 3), at most
-    :data:`MAX_MESH_FACETS` facets in a file of at most :data:`MAX_MESH_BYTES`; every failure
-    one ``SceneError`` naming ``where``."""
-    p = Path(path)
-    shown = fmt(p.name)
-    size = p.stat().st_size
-    if size > MAX_MESH_BYTES:
-        raise SceneError(f"{source}: {where} = {shown}: must be a mesh file of at most "
-                         f"{MAX_MESH_BYTES >> 20} MiB and {MAX_MESH_FACETS} facets (it has "
-                         f"{size} bytes): decimate it (a car's outline needs a few hundred "
-                         "facets)")
-    import trimesh  # only for a scene with a mesh
-    try:
-        m = trimesh.load(str(p), force="mesh", process=True)
-        v = np.asarray(m.vertices, float)
-        f = np.asarray(m.faces, np.int64)
-    except Exception as exc:  # trimesh raises many kinds for a file it cannot read
-        raise SceneError(f"{source}: {where} = {shown}: must be a mesh file trimesh reads "
-                         f"(PLY, STL, OBJ, GLB ...): {type(exc).__name__}: "
-                         f"{str(exc)[:120]}") from None
-    if f.ndim != 2 or f.shape[1] != 3 or not len(f):
-        raise SceneError(f"{source}: {where} = {shown}: must be a mesh of triangles (it has "
-                         "no facets)")
-    if len(f) > MAX_MESH_FACETS:
-        raise SceneError(f"{source}: {where} = {shown}: must be a mesh of at most "
-                         f"{MAX_MESH_FACETS} facets (it has {len(f)}): decimate it")
-    if not np.all(np.isfinite(v)) or np.abs(v).max() > 50.0:
-        raise SceneError(f"{source}: {where} = {shown}: must have finite vertices within "
-                         "50 m of the object's origin (metres)")
-    return v, f
-
-
-def _visible(centres: np.ndarray, tri: np.ndarray, radar: np.ndarray) -> np.ndarray:
-    """Whether the RuT sees each facet's centre: no other facet crosses the segment from the
-    centre to the RuT (Moeller-Trumbore, vectorised in blocks of facets)."""
-    a, b, cc = tri[:, 0], tri[:, 1], tri[:, 2]
-    e1, e2 = b - a, cc - a
-    out = np.ones(len(centres), bool)
-    for s in range(0, len(centres), _RAY_CHUNK):
-        o = centres[s:s + _RAY_CHUNK]  # (R, 3)
-        d = radar[None] - o  # segment to the RuT, t in (0, 1)
-        pv = np.cross(d[:, None, :], e2[None])  # (R, F, 3)
-        det = np.einsum("fk,rfk->rf", e1, pv)
-        ok = np.abs(det) > 1e-12
-        inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
-        tv = o[:, None, :] - a[None]
-        u = np.einsum("rfk,rfk->rf", tv, pv) * inv
-        qv = np.cross(tv, e1[None])
-        v = np.einsum("rk,rfk->rf", d, qv) * inv
-        t = np.einsum("fk,rfk->rf", e2, qv) * inv
-        hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 1e-6) & (t < 1.0)
-        own = np.arange(s, s + len(o))
-        hit[np.arange(len(o)), own] = False
-        out[s:s + len(o)] = ~hit.any(axis=1)
-    return out
-
-
-def mesh_scatterers(vertices: np.ndarray, faces: np.ndarray, radar_obj: np.ndarray,
-                    wavelength_m: float, cell_m: float, cell_u: float
-                    ) -> tuple[np.ndarray, np.ndarray]:
-    """A mesh's scatterers seen from ``radar_obj`` (the RuT in the object's frame): points
-    (N, 3) in the object's frame and their RCS (N,) in dBsm (module docstring). An empty
-    result: no facet faces the RuT."""
-    tri = vertices[faces]  # (F, 3, 3)
-    cen = tri.mean(axis=1)
-    nrm = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    area = 0.5 * np.linalg.norm(nrm, axis=1)
-    nrm = nrm / np.maximum(2.0 * area, 1e-300)[:, None]
-    los = radar_obj[None] - cen
-    dist = np.linalg.norm(los, axis=1)
-    cos_t = np.einsum("fk,fk->f", nrm, los) / dist
-    facing = (cos_t > 1e-6) & (area > 0)
-    if not facing.any():
-        return np.zeros((0, 3)), np.zeros(0)
-    idx = np.flatnonzero(facing)
-    idx = idx[_visible(cen[idx], tri, radar_obj)]
-    if not idx.size:  # every facing facet hidden (e.g. normals pointing inwards)
-        return np.zeros((0, 3)), np.zeros(0)
-    k = 2.0 * math.pi / wavelength_m
-    sin_t = np.sqrt(np.clip(1.0 - cos_t[idx] ** 2, 0.0, 1.0))
-    sigma = (4.0 * math.pi * area[idx] ** 2 * cos_t[idx] ** 2 / wavelength_m ** 2
-             / (1.0 + 2.0 * (k * np.sqrt(area[idx]) * sin_t) ** 2))
-    # cells of range and direction cosine seen from the RuT (its lateral axis: the object
-    # frame's x turned with the RuT's line of sight to the object's origin)
-    rel = cen[idx] - radar_obj[None]
-    r = np.linalg.norm(rel, axis=1)
-    axis = np.cross(-radar_obj, [0.0, 0.0, 1.0])
-    axis = axis / max(np.linalg.norm(axis), 1e-12)
-    u = rel @ axis / r
-    key = np.c_[np.floor(r / cell_m), np.floor(u / cell_u)]
-    _, cell = np.unique(key, axis=0, return_inverse=True)
-    cell = cell.ravel()
-    power = np.bincount(cell, sigma)
-    pos = np.stack([np.bincount(cell, sigma * cen[idx, j]) for j in range(3)], axis=1)
-    keep = power > 0
-    pos, power = pos[keep] / power[keep, None], power[keep]
-    order = np.argsort(power)[::-1][:MAX_MESH_SCATTERERS]
-    order = order[power[order] >= power[order[0]] * 10 ** (-MESH_DYNAMIC_DB / 10)]
-    return pos[order], 10.0 * np.log10(power[order])
 
 
 def place(model: ObjectModel, origin: np.ndarray, velocity_vec, radar, index: int,

@@ -28,7 +28,7 @@ from rtsgeom.pipeline.merge import budget_targets
 from rtsgeom.pipeline.plan import bracketing_pair
 from rtsgeom.pipeline.run import run_scene
 from rtsgeom.scene import parse_scene
-from rtsgeom.scene.objects import MAX_MESH_FACETS
+from rtsgeom.scene.mesh import MAX_MESH_FACETS
 
 SCENES = Path(__file__).resolve().parents[2] / "scenes"
 CAR = SCENES / "car-crossing.toml"
