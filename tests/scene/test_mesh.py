@@ -219,7 +219,7 @@ def test_a_plate_mesh_in_a_scene_is_the_closed_form(tmp_path, heading_deg, side)
     heading 0) is one target at 15 m with the closed form's RCS at the radar's wavelength,
     the Fresnel one at normal incidence, the far-field sinc^2 lobe turned (a 5 cm plate is
     in its far field beyond 1.3 m)."""
-    from test_objects import bench_doc, with_object
+    from .test_objects import bench_doc, with_object
     from rtsgeom.scene import parse_scene
     plate(side, side).export(tmp_path / "plate.stl")
     s = parse_scene(with_object(bench_doc(), mesh="plate.stl", heading_deg=heading_deg),
