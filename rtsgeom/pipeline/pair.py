@@ -19,7 +19,9 @@ from ..paths import Paths, nominal_model
 from ..rts.fir import fir_modelled, realised_delay
 from ..rts.channels import requested_delay
 from ..scene import TargetConfig
+from ..radar.processing import tdm_compensate
 from ..synthesis.model import ChannelModel
+from ..synthesis.pair import design_at_detected_bin
 
 __all__ = ["pair_amplitudes", "MIN_BIN_MARGIN", "PairPlan", "nearest_setting", "plan_pair",
            "pair_design", "plan_pairs", "residual_warning"]
@@ -266,15 +268,64 @@ def plan_pairs(setup: Setup, paths: Paths, mode: str, rows) -> list[PairPlan | N
     real = ChannelModel.build_many(models[0], models[1], pairs, targets,
                                    [(c.o_i, req - c.tau) for c, (req, _) in zip(ctxs, sets)],
                                    HALF_BINS)
+    return _batch_plans(ctxs, sets, ideal, real, [row[4] for row in rows])
+
+
+def _batch_plans(ctxs, sets, ideal, real, gains) -> list[PairPlan | None]:
+    """:func:`plan_pairs`' designs, batched over its rows: the phase the calibration
+    establishes (``ChannelModel.pair_phase`` of the continuous models), the design for the
+    bin the RuT detects (``design_at_detected_bin``) and the amplitudes
+    (``ChannelModel.amplitudes``), each as those methods compute it, row by row."""
+    st = real[0].steering
+    scene = real[0].setup.scene
+    rut, radar = real[0].setup.rut, scene.radar
+    dop = np.array([m.doppler_hz for m in real])
+    mid = HALF_BINS
+    # pair_phase: channel J's coherent phase at the row's probes
+    x = tdm_compensate(np.stack([m.responses[mid] for m in ideal]), dop[:, None], rut, radar)
+    u = st.directions(np.array([np.atleast_1d(np.asarray(c.probes_rad, float)) for c in ctxs]))
+    b = np.sum(st.weighted(x)[..., :, None] * np.swapaxes(st.steer(u), -1, -2)[:, None],
+               axis=-2)  # (N, Q, P)
+    z = b[..., :1, :] * np.conj(b)
+    mag = np.abs(z)
+    phase = np.angle(np.sum(z / np.where(mag > 0, mag, 1.0), axis=-1))[:, 1]
+    # solve_checked: the design for the detected bin
+    resp = np.stack([m.responses for m in real])  # (N, K, 2, V)
+    h = tdm_compensate(resp, dop[:, None, None], rut, radar)
+    alpha = np.array([c.target.angle_rad for c in ctxs])
+    rho, _, ok, margin = design_at_detected_bin(st, h, alpha, phase - 0.0)
+    good = ok & (margin > MIN_BIN_MARGIN) & np.isfinite(rho)
+    # amplitudes: the combined target's power at the set direction over channel I's own
+    w = np.stack([np.ones_like(rho), np.where(good, rho, 0.0)], -1) * np.exp(
+        1j * np.stack([np.zeros_like(phase), phase], -1))  # (N, 2)
+    p_sum = _power_at(st, _snapshots(resp, w, dop, rut, radar), np.sin(alpha))
+    one = _snapshots(resp, np.eye(2)[0] * np.ones((len(ctxs), 1)), dop, rut, radar)
+    p_one = _power_at(st, one, np.sin(st.search(one)))
+    gain = np.array([m.unit_gain for m in real])
+    amps = (gain * np.sqrt(p_one / np.maximum(p_sum, 1e-300)))[:, None] * np.abs(w)
     out = []
-    for c, (req, eps), mi, mr, row in zip(ctxs, sets, ideal, real, rows):
-        phase = float(mi.pair_phase(c.probes_rad))
-        rho, ok, margin = mr.solve_checked(c.target.angle_rad, (0.0, phase))
-        if rho is None or not ok or margin <= MIN_BIN_MARGIN:
+    for n, c in enumerate(ctxs):
+        if not good[n]:
             out.append(None)
             continue
-        out.append(_finish(c, (mr, rho, phase, req - c.tau, c.want0, eps, 0), row[4]))
+        req, eps = sets[n]
+        out.append(PairPlan(float(amps[n, 0] * gains[n][0]), float(amps[n, 1] * gains[n][1]),
+                            float(rho[n]), float(req - c.tau), float(c.want0 + eps),
+                            float(c.want0), float(eps), 0, c.f_if))
     return out
+
+
+def _snapshots(resp, w, dop, rut, radar) -> np.ndarray:
+    """``ChannelModel.snapshot`` per row: responses (N, K, 2, V), weights (N, 2) -> (N, V)."""
+    x = resp[:, :, 0] * w[:, 0, None, None] + w[:, 1, None, None] * resp[:, :, 1]
+    k = np.argmax(np.sum(np.abs(x) ** 2, axis=-1), axis=-1)
+    x = np.take_along_axis(x, k[:, None, None], axis=-2)[:, 0, :]
+    return tdm_compensate(x, dop, rut, radar)
+
+
+def _power_at(st, snaps, u) -> np.ndarray:
+    """Bartlett power of each snapshot (N, V) at its own direction cosine u (N,) (D = 1)."""
+    return np.abs(np.einsum("nv,nv->n", st.weighted(snaps), st.steer(u[:, None]))) ** 2
 
 
 def pair_design(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str, probes_rad,
