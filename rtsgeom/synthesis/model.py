@@ -159,10 +159,10 @@ class ChannelModel:
         (a drive's planning builds two per target and frame)."""
         scene, radar = setup.scene, setup.scene.radar
         require_air_path_compensation(scene)
+        if len(targets) == 0:
+            return []
         ch = np.asarray(channels, int).reshape(len(targets), -1)
         n_m, n_q = ch.shape
-        if n_m == 0:
-            return []
         dtau = np.asarray(delta_tau_s, float).reshape(n_m, n_q)
         lam = setup.rut.wavelength_m
         f_d = np.array([2 * radar.f_c_hz * t.velocity_mps / c for t in targets])
