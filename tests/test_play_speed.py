@@ -1,7 +1,8 @@
-"""The batched planning of a drive and the pruned angle-peak refinement give what the one-by-one
-computations give: the channel models of ``ChannelModel.build_many`` are ``build``'s bit for
-bit, ``plan_pairs``' plans are ``plan_pair``'s, and ``angle_peaks`` reports the same peaks with
-and without skipping the grid candidates its bound rules out."""
+"""The batched planning of a drive and the pruned angle-peak refinement give what the
+one-by-one computations give: the channel models of ``synthesis.batch.build_models`` are
+``ChannelModel.build``'s bit for bit, ``plan_pairs``' plans are ``plan_pair``'s, and
+``angle_peaks`` reports the same peaks with and without skipping the grid candidates its
+bound rules out."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ from rtsgeom.pipeline.pair import plan_pair, plan_pairs
 from rtsgeom.radar import peaks
 from rtsgeom.radar.steering import Steering
 from rtsgeom.scene import TargetConfig
+from rtsgeom.synthesis.batch import build_models
 from rtsgeom.synthesis.model import ChannelModel
 
 
@@ -59,20 +61,19 @@ def test_batched_channel_models_are_the_single_builds(window, fir, separation_m,
     targets = _targets(setup, 12, 3)
     pairs = [_pair_of(setup, t) for t in targets]
     dtau = np.random.default_rng(4).normal(0.0, 2e-10, (len(targets), 2))
-    many = ChannelModel.build_many(nom, nom_paths, pairs, targets, dtau, half_bins)
+    many = build_models(nom, nom_paths, pairs, targets, dtau, half_bins)
     for m, p, t, d in zip(many, pairs, targets, dtau):
         one = ChannelModel.build(nom, nom_paths, p, t, d, half_bins)
         np.testing.assert_array_equal(m.responses, one.responses)
         assert (m.channels, m.doppler_hz, m.unit_gain, m.range_m) == (
             one.channels, one.doppler_hz, one.unit_gain, one.range_m)
-    assert ChannelModel.build_many(nom, nom_paths, [], [], np.zeros((0, 2))) == []
+    assert build_models(nom, nom_paths, [], [], np.zeros((0, 2))) == []
 
 
 @pytest.mark.parametrize("window,fir", [("hann", "windowed-sinc"), ("none", "ideal")])
 def test_batched_plans_are_plan_pairs(window, fir):
     """Every row ``plan_pairs`` settles is ``plan_pair``'s plan (to the last bits of the
-    amplitudes); the rows it leaves open (None) are the ones ``plan_pair`` does not settle at
-    the calibrated offset."""
+    amplitudes); ``plan_pair`` plans the rows it leaves open (None) itself."""
     setup, paths = _setup(window, fir)
     th = setup.fe_azimuth_rad()
     rng = np.random.default_rng(8)
@@ -136,3 +137,21 @@ def test_pruned_angle_candidates_change_no_peak(threshold, window, monkeypatch):
         rows = np.isfinite(refined[:, j])
         ok = real(st, snaps[rows], val[rows], refined[rows, j])[:, j]
         assert ok.all()
+
+
+def test_plays_estimate_runs_no_frame(monkeypatch):
+    """``play``'s line before the drive names the frames, modes and targets without running
+    a frame through the chain (which measured the process's one-time costs, not a frame's)."""
+    from rtsgeom.analysis.playback import Playback, frames
+    from rtsgeom.cli import play
+    from rtsgeom.scene import load_scene
+    from conftest import ROOT
+
+    def refuse(*a, **k):
+        raise AssertionError("the estimate ran a frame")
+    monkeypatch.setattr(frames, "detect_frame", refuse)
+    scene = load_scene(ROOT / "scenes" / "crossing.toml")
+    n = scene.scenario.frame_times().size
+    line = play._estimate(scene, Playback())
+    assert line.startswith(f"{n} frames x 2 mode(s) of 1 targets, 1 worker(s)")
+    assert play._estimate(scene, Playback(baseline=False)).startswith(f"{n} frames x 1 mode(s)")

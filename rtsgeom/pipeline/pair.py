@@ -20,6 +20,7 @@ from ..rts.fir import fir_modelled, realised_delay
 from ..rts.channels import requested_delay
 from ..scene import TargetConfig
 from ..radar.processing import tdm_compensate
+from ..synthesis.batch import build_models
 from ..synthesis.model import ChannelModel
 from ..synthesis.pair import design_at_detected_bin
 
@@ -249,7 +250,7 @@ def _closed_form_plan(setup, paths, ctx: _PairContext, mode, gain_correction) ->
 def plan_pairs(setup: Setup, paths: Paths, mode: str, rows) -> list[PairPlan | None]:
     """:func:`plan_pair` for many targets at once: ``rows`` of ``(pair, target, probes_rad,
     offsets, gain_correction, residual_s)``. The calibrated offset's design (``m = 0``) of
-    every row from two batched model builds (``ChannelModel.build_many``: the continuous
+    every row from two batched model builds (``synthesis.batch.build_models``: the continuous
     model at the planned difference and the realised one); a row whose design the RuT
     detects at its bin with a margin over :data:`MIN_BIN_MARGIN` gets its plan (what
     :func:`plan_pair` returns: it stops there too), any other row None (the caller plans it
@@ -263,9 +264,9 @@ def plan_pairs(setup: Setup, paths: Paths, mode: str, rows) -> list[PairPlan | N
     sets = [c.setting(c.want0, 0.0) for c in ctxs]
     pairs = [c.pair for c in ctxs]
     targets = [c.target for c in ctxs]
-    ideal = ChannelModel.build_many(ctxs[0].cont, models[1], pairs, targets,
+    ideal = build_models(ctxs[0].cont, models[1], pairs, targets,
                                     [(c.base_i, c.base_i + c.want0) for c in ctxs], HALF_BINS)
-    real = ChannelModel.build_many(models[0], models[1], pairs, targets,
+    real = build_models(models[0], models[1], pairs, targets,
                                    [(c.o_i, req - c.tau) for c, (req, _) in zip(ctxs, sets)],
                                    HALF_BINS)
     return _batch_plans(ctxs, sets, ideal, real, [row[4] for row in rows])

@@ -155,7 +155,7 @@ def bin_response_rows(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_b
     """:func:`bin_response` with each echo at its own bins: ``range_bins``, ``doppler_bins``
     (E, K) indices (Doppler fftshifted) -> (K, E, V) complex128.
 
-    The many channel models of a batch of designs (``ChannelModel.build_many``: every target
+    The many channel models of a batch of designs (``synthesis.batch.build_models``: every target
     of a drive's frames at its own range and Doppler bins) in one pass, in blocks of
     :data:`ROWS_BLOCK` echoes: per echo the arithmetic of :func:`bin_response`'s per-echo
     branch (its fast-time tones times the windowed DFT kernel of its bins, the same for the
