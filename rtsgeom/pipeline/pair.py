@@ -174,7 +174,8 @@ class _PairContext:
     f_if: float
 
     @classmethod
-    def of(cls, setup, paths, pair, target, probes_rad, offsets, residual_s, models=None):
+    def of(cls, setup, paths, pair, target, probes_rad, offsets, residual_s, models=None,
+           cont=None):
         scene = setup.scene
         rts = scene.rts
         nom, nom_paths = models or nominal_model(setup, paths)
@@ -183,7 +184,8 @@ class _PairContext:
         # I's delay as realised, as an offset from the request: the continuous model's base
         base_i = float(realised_delay(tau + o_i, rts.f_s_hz, rts.fractional_delay,
                                       rts.fractional_delay_step_s)) - tau
-        return cls(setup, nom, nom_paths, continuous_delay_setup(nom), tuple(pair), target,
+        cont = continuous_delay_setup(nom) if cont is None else cont
+        return cls(setup, nom, nom_paths, cont, tuple(pair), target,
                    probes_rad, (float(offsets[0]), float(offsets[1])), tau, o_i, base_i,
                    float(offsets[1] - offsets[0]) + residual_s,
                    float(if_phase_slope_hz(scene, 2 * target.range_m / c)))
@@ -259,12 +261,13 @@ def plan_pairs(setup: Setup, paths: Paths, mode: str, rows) -> list[PairPlan | N
     if mode != "exact" or not rows:
         return [None] * len(rows)
     models = nominal_model(setup, paths)
-    ctxs = [_PairContext.of(setup, paths, pair, t, pr, off, res, models)
+    cont = continuous_delay_setup(models[0])
+    ctxs = [_PairContext.of(setup, paths, pair, t, pr, off, res, models, cont)
             for pair, t, pr, off, _, res in rows]
     sets = [c.setting(c.want0, 0.0) for c in ctxs]
     pairs = [c.pair for c in ctxs]
     targets = [c.target for c in ctxs]
-    ideal = build_models(ctxs[0].cont, models[1], pairs, targets,
+    ideal = build_models(cont, models[1], pairs, targets,
                                     [(c.base_i, c.base_i + c.want0) for c in ctxs], HALF_BINS)
     real = build_models(models[0], models[1], pairs, targets,
                                    [(c.o_i, req - c.tau) for c, (req, _) in zip(ctxs, sets)],
