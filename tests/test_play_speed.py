@@ -160,3 +160,23 @@ def test_plays_estimate_runs_no_frame(monkeypatch):
     line = play._estimate(scene, Playback())
     assert line.startswith(f"{n} frames x 2 mode(s) of 1 targets, 1 worker(s)")
     assert play._estimate(scene, Playback(baseline=False)).startswith(f"{n} frames x 1 mode(s)")
+
+
+def test_steering_is_built_once_per_rut_and_radar():
+    """``Steering.build`` returns the beamformer it built for the same (immutable) RuT and
+    radar objects, and a new one for another radar (another taper) or the 2-D case; a
+    beamformer it refuses is refused every time."""
+    from rtsgeom.errors import SceneError
+    scene = make_scene()
+    setup = build_setup(scene)
+    a = Steering.build(setup.rut, scene.radar)
+    assert Steering.build(setup.rut, scene.radar) is a
+    other = dataclasses.replace(scene.radar, angle_window="hann")
+    b = Steering.build(setup.rut, other)
+    assert b is not a and not np.array_equal(a.taper, b.taper)
+    np.testing.assert_array_equal(b.taper, Steering._build(setup.rut, other, False).taper)
+    assert Steering.build(setup.rut, scene.radar, elevation=True).dims == 2
+    bad = dataclasses.replace(scene.radar, angle_estimator="capon", angle_subarray=999)
+    for _ in range(2):
+        with pytest.raises(SceneError, match="angle_subarray"):
+            Steering.build(setup.rut, bad)
