@@ -268,10 +268,9 @@ def plan_pairs(setup: Setup, paths: Paths, mode: str, rows) -> list[PairPlan | N
     pairs = [c.pair for c in ctxs]
     targets = [c.target for c in ctxs]
     ideal = build_models(cont, models[1], pairs, targets,
-                                    [(c.base_i, c.base_i + c.want0) for c in ctxs], HALF_BINS)
+                         [(c.base_i, c.base_i + c.want0) for c in ctxs], HALF_BINS)
     real = build_models(models[0], models[1], pairs, targets,
-                                   [(c.o_i, req - c.tau) for c, (req, _) in zip(ctxs, sets)],
-                                   HALF_BINS)
+                        [(c.o_i, req - c.tau) for c, (req, _) in zip(ctxs, sets)], HALF_BINS)
     return _batch_plans(ctxs, sets, ideal, real, [row[4] for row in rows])
 
 
@@ -297,6 +296,7 @@ def _batch_plans(ctxs, sets, ideal, real, gains) -> list[PairPlan | None]:
     resp = np.stack([m.responses for m in real])  # (N, K, 2, V)
     h = tdm_compensate(resp, dop[:, None, None], rut, radar)
     alpha = np.array([c.target.angle_rad for c in ctxs])
+    # J's phase minus I's (0), as solve_checked passes it
     rho, _, ok, margin = design_at_detected_bin(st, h, alpha, phase - 0.0)
     good = ok & (margin > MIN_BIN_MARGIN) & np.isfinite(rho)
     # amplitudes: the combined target's power at the set direction over channel I's own
