@@ -5,12 +5,16 @@ The bundled crossing bench (``scenes/crossing.toml``: five front ends 8 deg apar
 ``--targets`` targets crossing the arc from -8.5 to +8.5 deg at 16.2 to 16.2 + 1.9 (N - 1) m,
 played over its 2 s drive in ``--frames`` frames (the exact synthesis, no baseline), as a
 whole process (wall and user CPU, the median of ``--repeat``, the load average before each);
-writes ``benchmarks/play_speed.json``. Not part of the test suite.
+writes ``benchmarks/play_speed.json``, the earlier records of that file kept under
+``history`` (each with its ``label``; ``--label`` names this one). ``--root`` plays another
+checkout's code (e.g. an export of an earlier commit: the before of a change). Not part of
+the test suite.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import resource
 import statistics
@@ -45,6 +49,8 @@ def main(argv=None) -> int:
     ap.add_argument("--targets", type=int, default=8)
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--out", default=str(ROOT / "benchmarks" / "play_speed.json"))
+    ap.add_argument("--label", default="current", help="what this record measures")
+    ap.add_argument("--root", default=str(ROOT), help="the checkout whose rtsgeom plays")
     args = ap.parse_args(argv)
     runs = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -56,8 +62,8 @@ def main(argv=None) -> int:
             t0 = time.perf_counter()
             proc = subprocess.run([sys.executable, "-m", "rtsgeom", "play", str(scene), "--out",
                                    f"{tmp}/out{r}", "--no-baseline", "--quiet"],
-                                  capture_output=True, text=True,
-                                  env={**os.environ, "PYTHONPATH": str(ROOT)})
+                                  capture_output=True, text=True, cwd=args.root,
+                                  env={**os.environ, "PYTHONPATH": args.root})
             wall = time.perf_counter() - t0
             user = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime - before.ru_utime
             if proc.returncode:
@@ -65,11 +71,16 @@ def main(argv=None) -> int:
             runs.append({"wall_s": wall, "user_s": user, "load_before": load})
             print(f"play {args.frames} frames x {args.targets} targets: {wall:.1f} s wall, "
                   f"{user:.1f} s user (load {load:.1f})", flush=True)
-    write_json(args.out, {"frames": args.frames, "targets": args.targets,
-                          "median_wall_s": statistics.median(x["wall_s"] for x in runs),
-                          "median_user_s": statistics.median(x["user_s"] for x in runs),
-                          "user_s_per_frame": statistics.median(x["user_s"] for x in runs)
-                          / args.frames, "cpus": os.cpu_count(), "runs": runs}, newline=True)
+    record = {"label": args.label, "frames": args.frames, "targets": args.targets,
+              "median_wall_s": statistics.median(x["wall_s"] for x in runs),
+              "median_user_s": statistics.median(x["user_s"] for x in runs),
+              "user_s_per_frame": statistics.median(x["user_s"] for x in runs) / args.frames,
+              "cpus": os.cpu_count(), "runs": runs}
+    history = []
+    if Path(args.out).exists():
+        old = json.loads(Path(args.out).read_text())
+        history = old.pop("history", []) + [{"label": old.pop("label", "earlier"), **old}]
+    write_json(args.out, {**record, "history": history}, newline=True)
     return 0
 
 

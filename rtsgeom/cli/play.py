@@ -82,33 +82,16 @@ def cmd_play(args) -> int:
 
 
 def _estimate(scene, study) -> str:
-    """The drive's expected time, before it starts: frame 0 through the chain on its nearest
-    front ends (what every frame costs, the calibration aside), times the frames and modes,
-    over the workers."""
-    import dataclasses
-    import time
-    from ..analysis.playback.frames import detect_frame, frame_targets
-    from ..geometry import build_setup
-    from ..paths import exact_paths
-    from ..rts.channels import program_nearest
-    setup = build_setup(dataclasses.replace(scene, scenario=None))
-    paths = exact_paths(setup)
-    times, frames = frame_targets(scene)
-    scene_0 = dataclasses.replace(setup.scene, targets=frames[0])
-    t0 = time.perf_counter()
-    detect_frame(setup, paths, program_nearest(scene_0, setup), scene_0, scene.seed)
-    per = time.perf_counter() - t0
+    """What the drive will play, before it starts, without running any of it: the frames,
+    modes and targets (``frame_targets``: the set-points alone). The time left shows in the
+    per-frame count as the frames play (the first frames' rate: a frame measured alone before
+    the drive carried the process's one-time costs, and cost as much as the first frames)."""
+    from ..analysis.playback.frames import frame_targets
+    _, frames = frame_targets(scene)
     modes = 1 if (not study.baseline or (study.amplitudes or scene.rts.aoa_mode) == "nearest") \
         else 2
-    total = per * len(frames) * modes / study.workers
-    return (f"{len(frames)} frames x {modes} mode(s) of {len(frames[0])} targets: about "
-            f"{_duration(total)} ({per:.2g} s a frame measured on frame 0, {study.workers} "
-            "worker(s); the calibration comes on top)")
-
-
-def _duration(s: float) -> str:
-    return (f"{s:.0f} s" if s < 120 else f"{s / 60:.0f} min" if s < 7200
-            else f"{s / 3600:.1f} h")
+    return (f"{len(frames)} frames x {modes} mode(s) of {len(frames[0])} targets, "
+            f"{study.workers} worker(s): the calibration first, then the time left per frame")
 
 
 def _tolerance(scene, args) -> dict:

@@ -19,10 +19,13 @@ from ..paths import Paths, nominal_model
 from ..rts.fir import fir_modelled, realised_delay
 from ..rts.channels import requested_delay
 from ..scene import TargetConfig
+from ..radar.processing import tdm_compensate
+from ..synthesis.batch import build_models
 from ..synthesis.model import ChannelModel
+from ..synthesis.pair import design_at_detected_bin
 
 __all__ = ["pair_amplitudes", "MIN_BIN_MARGIN", "PairPlan", "nearest_setting", "plan_pair",
-           "pair_design", "residual_warning"]
+           "pair_design", "plan_pairs", "residual_warning"]
 
 
 def pair_amplitudes(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str,
@@ -130,64 +133,203 @@ def plan_pair(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str,
     (34 deg of IF phase; -0.173 deg of angle).
 
     ``paper`` / ``array-factor``: :func:`pair_amplitudes` at the calibrated offsets."""
-    scene = setup.scene
-    f_if = float(if_phase_slope_hz(scene, 2 * target.range_m / c))
-    period = 1.0 / f_if
+    ctx = _PairContext.of(setup, paths, pair, target, probes_rad, offsets, residual_s)
     if mode != "exact":
-        a_i, a_j, rho = pair_amplitudes(setup, paths, pair, target, mode, probes_rad, offsets,
-                                        gain_correction)
-        return PairPlan(a_i, a_j, rho, float(offsets[1]), float(offsets[1] - offsets[0]),
-                        float(offsets[1] - offsets[0]), 0.0, 0, f_if)
-    nom, nom_paths = nominal_model(setup, paths)
-    cont = continuous_delay_setup(nom)
-    rts = scene.rts
-    tau = float(requested_delay(scene, target.range_m))
-    o_i = float(offsets[0])
-    # I's delay as realised, as an offset from the request: the continuous model's base
-    base_i = float(realised_delay(tau + o_i, rts.f_s_hz, rts.fractional_delay,
-                                  rts.fractional_delay_step_s)) - tau
-    fir = fir_modelled(scene)
-
-    def ideal(want):  # the continuous model with J exactly at the planned difference
-        return ChannelModel.build(cont, nom_paths, pair, target, (base_i, base_i + want),
-                                  HALF_BINS)
-
-    best = None
+        return _closed_form_plan(setup, paths, ctx, mode, gain_correction)
+    best, phase0 = None, None
     for m in (0, -1, 1):
-        shift = m * period
-        want = float(offsets[1] - offsets[0]) + residual_s + shift
-        model = ideal(want)
-        phase = float(model.pair_phase(probes_rad))
+        cand, phase = _candidate(ctx, m, phase0)
         if m == 0:
             phase0 = phase
-        for _ in range(2 if m and fir else 0):
-            # the FIR's response a period later: Newton back to the calibrated phase
-            miss = np.angle(np.exp(1j * (phase - phase0)))
-            shift += miss / (2 * np.pi) * period
-            want += miss / (2 * np.pi) * period
-            model = ideal(want)
-            phase = float(model.pair_phase(probes_rad))
-        req, eps = nearest_setting(scene, tau + o_i, want, tau + float(offsets[1]) + shift)
-        real = ChannelModel.build(nom, nom_paths, pair, target, (o_i, req - tau), HALF_BINS)
-        rho, ok, margin = real.solve_checked(target.angle_rad, (0.0, phase))
-        if rho is None:
+        if cand is None:
             continue
-        score = (ok, margin if ok else 0.0, -abs(m))
-        if best is None or score > best[0]:
-            best = (score, real, rho, phase, req - tau, want, eps, m)
+        if best is None or cand[0] > best[0]:
+            best = cand
+        ok, margin = cand[0][0], cand[0][1]
         if ok and margin > MIN_BIN_MARGIN:  # the calibrated offset unless it is ambiguous
             break
     if best is None:
-        a_i, a_j, rho = pair_amplitudes(setup, paths, pair, target, mode, probes_rad, offsets,
-                                        gain_correction)
-        return PairPlan(a_i, a_j, rho, float(offsets[1]), float(offsets[1] - offsets[0]),
-                        float(offsets[1] - offsets[0]), 0.0, 0, f_if)
-    _, model, rho, phase, off_j, want, eps, m = best
+        return _closed_form_plan(setup, paths, ctx, mode, gain_correction)
+    return _finish(ctx, best[1:], gain_correction)
+
+
+@dataclass(frozen=True)
+class _PairContext:
+    """What :func:`plan_pair` plans one target's pair on: the nominal and continuous models,
+    the target's request ``tau``, I's offset ``o_i`` and its realised part ``base_i`` (as an
+    offset from the request), the calibrated difference ``want0`` and the IF phase slope."""
+
+    setup: Setup
+    nom: Setup
+    nom_paths: Paths
+    cont: Setup
+    pair: tuple
+    target: TargetConfig
+    probes_rad: np.ndarray
+    offsets: tuple
+    tau: float
+    o_i: float
+    base_i: float
+    want0: float
+    f_if: float
+
+    @classmethod
+    def of(cls, setup, paths, pair, target, probes_rad, offsets, residual_s, models=None,
+           cont=None):
+        scene = setup.scene
+        rts = scene.rts
+        nom, nom_paths = models or nominal_model(setup, paths)
+        tau = float(requested_delay(scene, target.range_m))
+        o_i = float(offsets[0])
+        # I's delay as realised, as an offset from the request: the continuous model's base
+        base_i = float(realised_delay(tau + o_i, rts.f_s_hz, rts.fractional_delay,
+                                      rts.fractional_delay_step_s)) - tau
+        cont = continuous_delay_setup(nom) if cont is None else cont
+        return cls(setup, nom, nom_paths, cont, tuple(pair), target,
+                   probes_rad, (float(offsets[0]), float(offsets[1])), tau, o_i, base_i,
+                   float(offsets[1] - offsets[0]) + residual_s,
+                   float(if_phase_slope_hz(scene, 2 * target.range_m / c)))
+
+    def ideal(self, want):  # the continuous model with J exactly at the planned difference
+        return ChannelModel.build(self.cont, self.nom_paths, self.pair, self.target,
+                                  (self.base_i, self.base_i + want), HALF_BINS)
+
+    def setting(self, want, shift):
+        """J's request near its calibrated one moved by ``shift``: (request, residual)."""
+        return nearest_setting(self.setup.scene, self.tau + self.o_i, want,
+                               self.tau + self.offsets[1] + shift)
+
+    def real(self, req):
+        """The model of what the RTS realises with J at request ``req``."""
+        return ChannelModel.build(self.nom, self.nom_paths, self.pair, self.target,
+                                  (self.o_i, req - self.tau), HALF_BINS)
+
+
+def _candidate(ctx: _PairContext, m: int, phase0):
+    """The design with J moved by ``m`` periods of the IF phase: ``((ok, margin, -|m|), model,
+    rho, phase, J's offset, planned difference, residual, m)`` or None where no bin has a
+    design, and the phase the calibration establishes there."""
+    period = 1.0 / ctx.f_if
+    shift = m * period
+    want = ctx.want0 + shift
+    model = ctx.ideal(want)
+    phase = float(model.pair_phase(ctx.probes_rad))
+    for _ in range(2 if m and fir_modelled(ctx.setup.scene) else 0):
+        # the FIR's response a period later: Newton back to the calibrated phase
+        miss = np.angle(np.exp(1j * (phase - phase0)))
+        shift += miss / (2 * np.pi) * period
+        want += miss / (2 * np.pi) * period
+        model = ctx.ideal(want)
+        phase = float(model.pair_phase(ctx.probes_rad))
+    req, eps = ctx.setting(want, shift)
+    real = ctx.real(req)
+    rho, ok, margin = real.solve_checked(ctx.target.angle_rad, (0.0, phase))
+    if rho is None:
+        return None, phase
+    return ((ok, margin if ok else 0.0, -abs(m)), real, rho, phase, req - ctx.tau, want, eps,
+            m), phase
+
+
+def _finish(ctx: _PairContext, chosen, gain_correction) -> PairPlan:
+    """The plan of the chosen design: its amplitudes at the set angle."""
+    model, rho, phase, off_j, want, eps, m = chosen
     a_i, a_j = model.amplitudes(model.pair_weights(rho, (0.0, phase)),
-                                np.sin([target.angle_rad]))
+                                np.sin([ctx.target.angle_rad]))
     return PairPlan(float(a_i * gain_correction[0]), float(a_j * gain_correction[1]),
                     float(rho), float(off_j), float(want + eps), float(want), float(eps), int(m),
-                    f_if)
+                    ctx.f_if)
+
+
+def _closed_form_plan(setup, paths, ctx: _PairContext, mode, gain_correction) -> PairPlan:
+    """:func:`pair_amplitudes` at the calibrated offsets (``paper``, ``array-factor``, or no
+    exact design)."""
+    a_i, a_j, rho = pair_amplitudes(setup, paths, ctx.pair, ctx.target, mode, ctx.probes_rad,
+                                    ctx.offsets, gain_correction)
+    d = ctx.offsets[1] - ctx.offsets[0]
+    return PairPlan(a_i, a_j, rho, ctx.offsets[1], d, d, 0.0, 0, ctx.f_if)
+
+
+def plan_pairs(setup: Setup, paths: Paths, mode: str, rows) -> list[PairPlan | None]:
+    """:func:`plan_pair` for many targets at once: ``rows`` of ``(pair, target, probes_rad,
+    offsets, gain_correction, residual_s)``. The calibrated offset's design (``m = 0``) of
+    every row from two batched model builds (``synthesis.batch.build_models``: the continuous
+    model at the planned difference and the realised one); a row whose design the RuT
+    detects at its bin with a margin over :data:`MIN_BIN_MARGIN` gets its plan (what
+    :func:`plan_pair` returns: it stops there too), any other row None (the caller plans it
+    with :func:`plan_pair`, which tries the periods either side and names an unreachable
+    angle)."""
+    if mode != "exact" or not rows:
+        return [None] * len(rows)
+    models = nominal_model(setup, paths)
+    cont = continuous_delay_setup(models[0])
+    ctxs = [_PairContext.of(setup, paths, pair, t, pr, off, res, models, cont)
+            for pair, t, pr, off, _, res in rows]
+    sets = [c.setting(c.want0, 0.0) for c in ctxs]
+    pairs = [c.pair for c in ctxs]
+    targets = [c.target for c in ctxs]
+    ideal = build_models(cont, models[1], pairs, targets,
+                         [(c.base_i, c.base_i + c.want0) for c in ctxs], HALF_BINS)
+    real = build_models(models[0], models[1], pairs, targets,
+                        [(c.o_i, req - c.tau) for c, (req, _) in zip(ctxs, sets)], HALF_BINS)
+    return _batch_plans(ctxs, sets, ideal, real, [row[4] for row in rows])
+
+
+def _batch_plans(ctxs, sets, ideal, real, gains) -> list[PairPlan | None]:
+    """:func:`plan_pairs`' designs, batched over its rows: the phase the calibration
+    establishes (``ChannelModel.pair_phase`` of the continuous models), the design for the
+    bin the RuT detects (``design_at_detected_bin``) and the amplitudes
+    (``ChannelModel.amplitudes``), each as those methods compute it, row by row."""
+    st = real[0].steering
+    scene = real[0].setup.scene
+    rut, radar = real[0].setup.rut, scene.radar
+    dop = np.array([m.doppler_hz for m in real])
+    mid = HALF_BINS
+    # pair_phase: channel J's coherent phase at the row's probes
+    x = tdm_compensate(np.stack([m.responses[mid] for m in ideal]), dop[:, None], rut, radar)
+    u = st.directions(np.array([np.atleast_1d(np.asarray(c.probes_rad, float)) for c in ctxs]))
+    b = np.sum(st.weighted(x)[..., :, None] * np.swapaxes(st.steer(u), -1, -2)[:, None],
+               axis=-2)  # (N, Q, P)
+    z = b[..., :1, :] * np.conj(b)
+    mag = np.abs(z)
+    phase = np.angle(np.sum(z / np.where(mag > 0, mag, 1.0), axis=-1))[:, 1]
+    # solve_checked: the design for the detected bin
+    resp = np.stack([m.responses for m in real])  # (N, K, 2, V)
+    h = tdm_compensate(resp, dop[:, None, None], rut, radar)
+    alpha = np.array([c.target.angle_rad for c in ctxs])
+    # J's phase minus I's (0), as solve_checked passes it
+    rho, _, ok, margin = design_at_detected_bin(st, h, alpha, phase - 0.0)
+    good = ok & (margin > MIN_BIN_MARGIN) & np.isfinite(rho)
+    # amplitudes: the combined target's power at the set direction over channel I's own
+    w = np.stack([np.ones_like(rho), np.where(good, rho, 0.0)], -1) * np.exp(
+        1j * np.stack([np.zeros_like(phase), phase], -1))  # (N, 2)
+    p_sum = _power_at(st, _snapshots(resp, w, dop, rut, radar), np.sin(alpha))
+    one = _snapshots(resp, np.eye(2)[0] * np.ones((len(ctxs), 1)), dop, rut, radar)
+    p_one = _power_at(st, one, np.sin(st.search(one)))
+    gain = np.array([m.unit_gain for m in real])
+    amps = (gain * np.sqrt(p_one / np.maximum(p_sum, 1e-300)))[:, None] * np.abs(w)
+    out = []
+    for n, c in enumerate(ctxs):
+        if not good[n]:
+            out.append(None)
+            continue
+        req, eps = sets[n]
+        out.append(PairPlan(float(amps[n, 0] * gains[n][0]), float(amps[n, 1] * gains[n][1]),
+                            float(rho[n]), float(req - c.tau), float(c.want0 + eps),
+                            float(c.want0), float(eps), 0, c.f_if))
+    return out
+
+
+def _snapshots(resp, w, dop, rut, radar) -> np.ndarray:
+    """``ChannelModel.snapshot`` per row: responses (N, K, 2, V), weights (N, 2) -> (N, V)."""
+    x = resp[:, :, 0] * w[:, 0, None, None] + w[:, 1, None, None] * resp[:, :, 1]
+    k = np.argmax(np.sum(np.abs(x) ** 2, axis=-1), axis=-1)
+    x = np.take_along_axis(x, k[:, None, None], axis=-2)[:, 0, :]
+    return tdm_compensate(x, dop, rut, radar)
+
+
+def _power_at(st, snaps, u) -> np.ndarray:
+    """Bartlett power of each snapshot (N, V) at its own direction cosine u (N,) (D = 1)."""
+    return np.abs(np.einsum("nv,nv->n", st.weighted(snaps), st.steer(u[:, None]))) ** 2
 
 
 def pair_design(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str, probes_rad,

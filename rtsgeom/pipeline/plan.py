@@ -30,10 +30,11 @@ from ..rts.channels import RtsProgram, requested_delay
 from ..synthesis.cells import enclosing_cell
 from ..synthesis.model import ChannelModel, target_direction
 from .merge import budget_targets
-from .pair import plan_pair, residual_warning
+from .pair import plan_pair, plan_pairs, residual_warning
 
 __all__ = ["bracketing_pair", "check_pair", "measured_pairs", "uses_cells", "target_cells",
-           "plan_targets", "target_pairs", "calibrate_pairs", "program_pairs"]
+           "plan_targets", "target_pairs", "calibrate_pairs", "program_pairs",
+           "program_frames"]
 
 
 def bracketing_pair(angle_rad: float, fe_angles_rad: np.ndarray) -> tuple[int, int] | None:
@@ -253,28 +254,53 @@ def program_pairs(setup: Setup, paths: Paths, mode: str, targets, pairs, probe, 
     target's delay plus its offset, channel J at the delay :func:`~.pair.plan_pair` chose, both
     amplitudes from it. Returns the programme, each target's realised plan (for summary.json)
     and warnings; ``SceneError`` for an angle the pair cannot reach."""
+    return program_frames(setup, paths, mode, [targets], [pairs], probe, cals, offsets,
+                          [where])[0]
+
+
+def program_frames(setup: Setup, paths: Paths, mode: str, frames, pairs, probe, cals: dict,
+                   offsets, wheres) -> list[tuple[RtsProgram, list[dict], list[str]]]:
+    """:func:`program_pairs` of several frames (``frames``: each frame's targets, ``pairs``
+    and ``wheres`` per frame) at once: every target's design at the calibrated offset in one
+    batch (:func:`~.pair.plan_pairs`), the few it leaves open by :func:`~.pair.plan_pair`;
+    the same programmes as frame by frame."""
+    rows = [[_pair_row(probe, cals, offsets, pr, t) for t, pr in zip(tg, ps)]
+            for tg, ps in zip(frames, pairs)]
+    plans = iter(plan_pairs(setup, paths, mode, [r for fr in rows for r in fr]))
+    return [_frame_programme(setup, paths, mode, tg, fr, [next(plans) for _ in fr], where)
+            for tg, fr, where in zip(frames, rows, wheres)]
+
+
+def _pair_row(probe, cals, offsets, pair, target) -> tuple:
+    """:func:`~.pair.plan_pairs`' row of a target on ``pair`` with the calibration fixed."""
+    i, j = pair
+    cal = cals.get((i, j))
+    return ((i, j), target, probe_angles(probe.angle_rad[i], probe.angle_rad[j]),
+            (offsets[i], offsets[j]), probe.gain_correction[[i, j]],
+            cal.quantisation_residual_s if cal is not None else 0.0)
+
+
+def _frame_programme(setup, paths, mode, targets, rows, plans, where):
+    """One frame's programme from its rows and the batch's plans (None: planned here)."""
     scene = setup.scene
-    rows, realised, warnings = [], [], []
-    for k, t in enumerate(targets):
-        i, j = pairs[k]
-        probes = probe_angles(probe.angle_rad[i], probe.angle_rad[j])
-        cal = cals.get((i, j))
-        try:
-            plan = plan_pair(setup, paths, (i, j), t, mode, probes, (offsets[i], offsets[j]),
-                             probe.gain_correction[[i, j]],
-                             cal.quantisation_residual_s if cal is not None else 0.0)
-        except AngleUnreachable as exc:
-            raise SceneError(f"{scene.source}: {target_name(where, k)}.angle_deg = "
-                             f"{np.degrees(t.angle_rad):g}: {exc}") from None
+    out, realised, warnings = [], [], []
+    for k, (t, row, plan) in enumerate(zip(targets, rows, plans)):
+        (i, j), offs = row[0], row[3]
+        if plan is None:
+            try:
+                plan = plan_pair(setup, paths, *row[:1], t, mode, *row[2:])
+            except AngleUnreachable as exc:
+                raise SceneError(f"{scene.source}: {target_name(where, k)}.angle_deg = "
+                                 f"{np.degrees(t.angle_rad):g}: {exc}") from None
         tau = float(requested_delay(scene, t.range_m))
         f_d = 2 * scene.radar.f_c_hz * t.velocity_mps / c
-        rows += [(k, i, tau + offsets[i], f_d, plan.a_i), (k, j, tau + plan.offset_j_s, f_d,
-                                                           plan.a_j)]
+        out += [(k, i, tau + offs[0], f_d, plan.a_i), (k, j, tau + plan.offset_j_s, f_d,
+                                                       plan.a_j)]
         realised.append({"target": k, "pair": [i, j], **plan.to_dict()})
         note = residual_warning(scene, k, plan)
         if note:
             warnings.append(note)
-    program = RtsProgram.build(*zip(*rows)) if rows else RtsProgram.build([], [], [], [], [])
+    program = RtsProgram.build(*zip(*out)) if out else RtsProgram.build([], [], [], [], [])
     return program, realised, warnings
 
 

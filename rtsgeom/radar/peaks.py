@@ -66,13 +66,16 @@ def angle_peaks(steering: Steering, snapshots: np.ndarray, max_peaks: int,
         return angles, level
     if steering.dims == 1:
         u1 = np.sin(first)[:, None]
+        p1 = _value(steering, snaps, u1)
         cand, val = _candidates_1d(steering, snaps)
+        if not steering.smoothing:
+            cand = np.where(_may_pass(steering, snaps, val, threshold ** 2 * p1), cand, np.nan)
         u_sec, p_sec = _refine_1d(steering, snaps, cand)
     else:
         u1 = steering.directions(first)
         cand, val = _candidates_2d(steering, snaps)
         u_sec, p_sec = _refine_2d(steering, snaps, cand)
-    p1 = _value(steering, snaps, u1)
+        p1 = _value(steering, snaps, u1)
     keep = (np.isfinite(p_sec) & (p_sec >= threshold ** 2 * p1[:, None])
             & (np.linalg.norm(u_sec - u1[:, None, :], axis=-1) > _SAME_PEAK_U))
     for i in range(n):  # a few candidates per detection: distinct peaks, strongest first
@@ -87,6 +90,24 @@ def angle_peaks(steering: Steering, snapshots: np.ndarray, max_peaks: int,
                             else steering.angles(u_sec[i, j]))
             level[i, r] = 10 * np.log10(p_sec[i, j] / p1[i])
     return angles, level
+
+
+#: how far (rad) :func:`_refine_1d`'s zooms may move from a grid candidate: 0.3 + 0.005 deg,
+#: then 0.006 + 1e-4 deg (with margin)
+_REFINE_REACH_RAD = np.radians(0.32)
+
+
+def _may_pass(steering: Steering, snaps: np.ndarray, val: np.ndarray, floor: np.ndarray
+              ) -> np.ndarray:
+    """Which grid candidates (n, G) of Bartlett's spectrum ``val`` may refine to a peak of at
+    least ``floor`` (n,): a bound, so the others are skipped without changing a result. The
+    beam b(u) = sum_v w_v x_v e^{j k p_v u} moves at most sum_v |k p_v| |w_v x_v| per unit
+    of u, and the zooms move at most :data:`_REFINE_REACH_RAD` in angle (less in u), so
+    |b| there is at most sqrt(val) plus that times the reach."""
+    w = np.abs(steering.weighted(snaps))  # (n, V_s)
+    slope = w @ np.abs(steering.wavevector[:, 0])  # (n,)
+    bound = np.sqrt(np.where(np.isfinite(val), val, 0.0)) + (slope * _REFINE_REACH_RAD)[:, None]
+    return bound ** 2 * (1 + 1e-6) >= floor[:, None]
 
 
 def _value(steering: Steering, snaps: np.ndarray, u: np.ndarray) -> np.ndarray:

@@ -25,7 +25,7 @@ from .channels import received_amplitude
 from .fmcw import beat_phase0, chirp_start_s
 from .windows import window
 
-__all__ = ["bin_response"]
+__all__ = ["bin_response", "bin_response_rows"]
 
 
 def _tap_sums(taps: FirTaps, kern: np.ndarray, slope: float, f_d: float, t0: float,
@@ -144,3 +144,51 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
     slow = np.exp(2j * np.pi * f_u[:, None, None] * t_c.T[None, :, :])  # (U, V, L)
     dd = np.moveaxis((slow @ kern_d.T)[np.ravel(f_inv)], -1, 0)
     return amp[None] * rr * dd
+
+
+#: echoes per block of :func:`bin_response_rows` (each block holds (E, V, N) fast-time tones)
+ROWS_BLOCK = 256
+
+
+def bin_response_rows(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bins,
+                      doppler_bins) -> np.ndarray:
+    """:func:`bin_response` with each echo at its own bins: ``range_bins``, ``doppler_bins``
+    (E, K) indices (Doppler fftshifted) -> (K, E, V) complex128.
+
+    The many channel models of a batch of designs (``synthesis.batch.build_models``: every target
+    of a drive's frames at its own range and Doppler bins) in one pass, in blocks of
+    :data:`ROWS_BLOCK` echoes: per echo the arithmetic of :func:`bin_response`'s per-echo
+    branch (its fast-time tones times the windowed DFT kernel of its bins, the same for the
+    slow time), so an echo's response does not depend on the batch it is computed in."""
+    r = np.asarray(range_bins)
+    d = np.asarray(doppler_bins)
+    n_v = echoes.tau_air_s.shape[1]
+    out = np.empty((r.shape[1], len(echoes), n_v), complex)
+    n_l, n_s = radar.chirps_per_tx, radar.samples_per_chirp
+    w_r = window(radar.range_window, n_s)
+    w_d = window(radar.doppler_window, n_l)
+    n, l = np.arange(n_s), np.arange(n_l)
+    t_c = chirp_start_s(radar, rut)  # (L, V)
+    t0, dt = radar.adc_start_s, 1.0 / radar.adc_rate_hz
+    block = np.arange(len(echoes)) // ROWS_BLOCK
+    # the windowed DFT kernel of each distinct bin once (elementwise: the same bits)
+    r_u, r_inv = np.unique(r, return_inverse=True)
+    kern_rs = w_r * np.exp(-2j * np.pi * np.outer(r_u, n) / n_s)  # (U, N)
+    d_u, d_inv = np.unique(d, return_inverse=True)
+    kern_ds = w_d * np.exp(-2j * np.pi * np.outer((d_u - n_l // 2) % n_l, l) / n_l)
+    r_inv, d_inv = r_inv.reshape(r.shape), d_inv.reshape(d.shape)
+    for a in range(0, len(echoes), ROWS_BLOCK):
+        sel = slice(a, a + ROWS_BLOCK)
+        ech = echoes.select(block == a // ROWS_BLOCK)
+        phi0 = beat_phase0(ech, radar)
+        amp = received_amplitude(ech.amplitude, radar, rut, phi0) * np.exp(1j * phi0)
+        kern_r = kern_rs[r_inv[sel]]  # (E, K, N)
+        fast = tones(radar.slope_hz_per_s * ech.tau_s + ech.doppler_hz[:, None], t0, dt, n_s)
+        if ech.fast_gain is not None:  # fractional-delay FIR ripple along the chirp
+            fast = fast * ech.fast_gain[:, None, :]
+        rr = np.moveaxis(fast @ np.swapaxes(kern_r, -1, -2), -1, 0)  # (K, E, V)
+        kern_d = kern_ds[d_inv[sel]]  # (E, K, L)
+        slow = np.exp(2j * np.pi * ech.doppler_hz[:, None, None] * t_c.T[None, :, :])
+        dd = np.moveaxis(slow @ np.swapaxes(kern_d, -1, -2), -1, 0)
+        out[:, sel] = amp[None] * rr * dd
+    return out

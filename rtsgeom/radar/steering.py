@@ -44,6 +44,12 @@ def smoothed_estimator(estimator: str, subarray: int) -> bool:
     return estimator != "bartlett" and subarray > 0
 
 
+#: :meth:`Steering.build`'s last beamformers: (id(rut), id(radar), elevation) -> (rut, radar,
+#: steering)
+_BUILT: dict = {}
+_BUILT_MAX = 8
+
+
 @dataclass(frozen=True)
 class Steering:
     """Virtual positions, taper and element selection of the RuT's beamformer (eq. 14).
@@ -76,7 +82,23 @@ class Steering:
     @classmethod
     def build(cls, rut: RutArray, radar: RadarConfig, elevation: bool = False) -> "Steering":
         """The azimuth beamformer (D = 1, the azimuth row), or with ``elevation`` the 2-D one
-        over all virtual elements (D = 2: x and z), with the scene's direction estimator."""
+        over all virtual elements (D = 2: x and z), with the scene's direction estimator.
+
+        The last few built are kept per (``rut``, ``radar``) object (both immutable): a
+        drive's frames build one per cube, and each new one computed its search grid's
+        steering vectors again (about 2 ms a frame of a drive's two chains)."""
+        key = (id(rut), id(radar), bool(elevation))
+        hit = _BUILT.get(key)
+        if hit is not None and hit[0] is rut and hit[1] is radar:
+            return hit[2]
+        out = cls._build(rut, radar, elevation)
+        if len(_BUILT) >= _BUILT_MAX:
+            _BUILT.pop(next(iter(_BUILT)))
+        _BUILT[key] = (rut, radar, out)  # the objects kept: their ids stay theirs
+        return out
+
+    @classmethod
+    def _build(cls, rut: RutArray, radar: RadarConfig, elevation: bool) -> "Steering":
         kind = str(getattr(radar, "angle_estimator", "bartlett"))
         sub = int(getattr(radar, "angle_subarray", 0))
         if elevation:

@@ -18,7 +18,7 @@ from ...errors import ParameterError
 from ...geometry import Setup
 from ...paths import Paths
 from ...pipeline.merge import budget_targets
-from ...pipeline.plan import (bracketing_pair, calibrate_pairs, lead_program, program_pairs,
+from ...pipeline.plan import (bracketing_pair, calibrate_pairs, lead_program, program_frames,
                               target_pairs, uses_cells)
 from ...pipeline.run import association_scale, match_targets, truth_twin
 from ...radar import process
@@ -30,7 +30,10 @@ from ...scene import Scene, TargetConfig
 from ...scene.objects import frame_objects
 from ...scene.scenario import trajectory
 
-__all__ = ["frame_targets", "frame_target_names", "FramePlanner", "detect_frame"]
+__all__ = ["frame_targets", "frame_target_names", "FramePlanner", "detect_frame", "PLAN_BLOCK"]
+
+#: frames planned in one batch (:meth:`FramePlanner.program`)
+PLAN_BLOCK = 16
 
 
 def frame_targets(scene: Scene) -> tuple[np.ndarray, list[tuple[TargetConfig, ...]]]:
@@ -76,6 +79,8 @@ class FramePlanner:
         self.record: dict = {"mode": mode}
         self.warnings: list[str] = []
         self.budgets: list = []  # per frame the Budgeted targets (pipeline.merge), if any
+        self.frames = frames
+        self._block: tuple = (None, None)  # the block of frames planned last, its programmes
         if mode == "nearest":
             return
         if uses_cells(scene) or any(t.elevation_rad for tg in frames for t in tg):
@@ -109,16 +114,26 @@ class FramePlanner:
 
     def program(self, f: int, scene_f: Scene) -> tuple[RtsProgram, list[str]]:
         """Frame ``f``'s programme for ``scene_f`` (the scene with the frame's targets) and
-        the planner's warnings about it."""
+        the planner's warnings about it. Planned with the frames of its block of
+        :data:`PLAN_BLOCK` (aligned: the same blocks in any worker) in one batch
+        (:func:`~rtsgeom.pipeline.plan.program_frames`)."""
         if self.mode == "nearest":
             return program_nearest(scene_f, self.setup), []
+        b = f // PLAN_BLOCK
+        if self._block[0] != b:
+            self._block = (b, self._plan_block(b))
+        program, _, notes = self._block[1][f - b * PLAN_BLOCK]
         budget = self.budgets[f] if self.budgets else None
-        program, _, notes = program_pairs(self.setup, self.paths, self.mode,
-                                          budget.targets if budget else scene_f.targets,
-                                          self.pairs[f], self.probe, self.cals, self.offsets,
-                                          where=frame_target_names(scene_f, f,
-                                                                   len(self.setup.scene.targets)))
         return (lead_program(program, budget) if budget else program), notes
+
+    def _plan_block(self, b: int) -> list:
+        fs = range(b * PLAN_BLOCK, min((b + 1) * PLAN_BLOCK, len(self.frames)))
+        scene, static = self.setup.scene, len(self.setup.scene.targets)
+        return program_frames(
+            self.setup, self.paths, self.mode,
+            [self.budgets[f].targets if self.budgets else self.frames[f] for f in fs],
+            [self.pairs[f] for f in fs], self.probe, self.cals, self.offsets,
+            [frame_target_names(scene, f, static) for f in fs])
 
 
 def detect_frame(setup: Setup, paths: Paths, program: RtsProgram, scene_f: Scene, seed: int,
