@@ -20,7 +20,7 @@ from ...paths import Paths
 from ...pipeline.merge import budget_targets
 from ...pipeline.plan import (bracketing_pair, calibrate_pairs, lead_program, program_pairs,
                               target_pairs, uses_cells)
-from ...pipeline.run import association_scale, match_targets, truth_twin
+from ...pipeline.run import match_targets, truth_twin
 from ...radar import process
 from ...radar.frame import simulate
 from ...calibration.channels import channel_offsets
@@ -122,27 +122,32 @@ class FramePlanner:
 
 
 def detect_frame(setup: Setup, paths: Paths, program: RtsProgram, scene_f: Scene, seed: int,
-                 bins: int = 2, truth: bool = True, detections: bool = False) -> tuple:
+                 bins: int = 2, truth: bool = True, synthesized=None) -> tuple:
     """One frame through the full chain: the matches of ``match_targets`` (with the truth
     twin's detections where ``truth``: :func:`rtsgeom.pipeline.run.truth_twin`, same seed) and,
     per target, the number of other detections within ``bins`` range and Doppler bins of its
-    set-point that no target claimed (a split: the RuT sees the target twice). With
-    ``detections`` also ``(detections, truth twin's detections or None, association scale)``
-    (the frame's clouds, :mod:`rtsgeom.analysis.objects`)."""
+    set-point that no target claimed (a split: the RuT sees the target twice), and
+    ``(detections, truth twin's detections or None, range-Doppler map, steering)`` (the
+    frame's clouds, :mod:`rtsgeom.analysis.objects`).
+
+    ``synthesized``: the targets the RTS synthesizes where they are not ``scene_f``'s (a
+    budget's, :mod:`rtsgeom.pipeline.merge`): the matches are theirs, each against the truth
+    twin's detection of its cell (the truth twin still looks at ``scene_f``'s real targets)."""
     echoes, cube = simulate(setup, paths, program, seed, scene_f.radar.snr_db)
     rd, det = process(cube)
-    matches = match_targets(scene_f, det, rd, bins=bins, steering=cube.steering)
+    compare = tuple(scene_f.targets if synthesized is None else synthesized)
+    matches = match_targets(scene_f, det, rd, bins=bins, steering=cube.steering,
+                            targets=compare)
     t_det = None
     if truth and scene_f.targets:
-        t_det, matches = truth_twin(setup, scene_f.targets, echoes, matches, bins, seed)
+        t_det, matches = truth_twin(setup, scene_f.targets, echoes, matches, bins, seed,
+                                    compare=None if synthesized is None else compare)
     claimed = {m.get("detection_index") for m in matches}
     dr = rd.range_m[1] - rd.range_m[0]
     dv = rd.velocity_mps[1] - rd.velocity_mps[0]
     extra = np.zeros(len(matches), int)
-    for k, t in enumerate(scene_f.targets):
+    for k, t in enumerate(compare):
         near = np.flatnonzero((np.abs(det.range_m - t.range_m) <= bins * dr)
                               & (np.abs(det.velocity_mps - t.velocity_mps) <= bins * dv))
         extra[k] = sum(1 for j in near if j not in claimed)
-    if detections:
-        return matches, extra, (det, t_det, association_scale(scene_f, rd, cube.steering))
-    return matches, extra
+    return matches, extra, (det, t_det, rd, cube.steering)
