@@ -227,8 +227,8 @@ def objects_lines(section: dict) -> list[str]:
               if r["paired_azimuth_diff_max_deg"] is not None]
         rb = [r["paired_range_diff_max_bins"] for r in t
               if r["paired_range_diff_max_bins"] is not None]
-        line = (f"object {where}: {len(t)} frame(s), truth {span([r['truth_detections'] for r in t])}"
-                f" / RTS {span([r['rts_detections'] for r in t])} detections a frame, "
+        n_t, n_r = span([r["truth_detections"] for r in t]), span([r["rts_detections"] for r in t])
+        line = (f"object {where}: {len(t)} frame(s), truth {n_t} / RTS {n_r} detections a frame, "
                 f"{100 * min(share):.0f} % (worst frame) of the truth's reproduced within a cell"
                 if share else f"object {where}: no truth twin detection")
         if az:

@@ -19,7 +19,7 @@ from ...geometry import Setup
 from ...paths import Paths
 from ...pipeline.merge import budget_targets
 from ...pipeline.plan import (bracketing_pair, calibrate_pairs, lead_program, program_pairs,
-                              target_pairs, uses_cells)
+                              target_namer, target_pairs, uses_cells)
 from ...pipeline.run import match_targets, truth_twin
 from ...radar import process
 from ...radar.frame import simulate
@@ -54,13 +54,20 @@ def frame_targets(scene: Scene) -> tuple[np.ndarray, list[tuple[TargetConfig, ..
     return times, frames
 
 
-def frame_target_names(scene: Scene, f: int, static: int | None = None):
+def frame_target_names(scene: Scene, f: int, static: int | None = None, targets=None,
+                       budget=None):
     """Frame ``f``'s target ``k`` as the scene file names it (``frame_targets`` puts the
-    ``[[targets]]`` first): ``frame f: targets[k]`` or ``frame f: scenario.targets[k - S]``
-    (``static``: S, default the scene's own count)."""
+    ``[[targets]]`` first): ``frame f: targets[k]`` or ``frame f: scenario.targets[i]``, an
+    object's scatterer ``frame f: scenario.targets[0].scatterers[3]`` (``static``: S, default
+    the scene's own count; ``targets``: the frame's, for the objects' scatterers;
+    ``budget``: ``k`` a synthesized target, named by its strongest member,
+    :func:`rtsgeom.pipeline.plan.target_namer`)."""
     s = len(scene.targets) if static is None else static
-    return lambda k: (f"frame {f}: targets[{k}]" if k < s
-                      else f"frame {f}: scenario.targets[{k - s}]")
+    if targets is None and budget is None:
+        return lambda k: (f"frame {f}: targets[{k}]" if k < s
+                          else f"frame {f}: scenario.targets[{k - s}]")
+    name = target_namer(scene, targets, budget, moving_from=s)
+    return lambda k: f"frame {f}: {name(k)}"
 
 
 class FramePlanner:
@@ -87,15 +94,17 @@ class FramePlanner:
         if scene.rts.max_targets_per_channel is not None:  # each frame's merged targets
             self.budgets = [budget_targets(setup, tg, self.probe, bracketing_pair)
                             for tg in frames]
-            frames = [b.targets for b in self.budgets]
         self.pairs, seen = [], set()
-        for f, targets in enumerate(frames):
-            pairs, notes = target_pairs(setup, self.probe, targets,
-                                        where=frame_target_names(scene, f))
+        for f, scatterers in enumerate(frames):
+            budget = self.budgets[f] if self.budgets else None
+            targets = budget.targets if budget else scatterers
+            pairs, notes = target_pairs(setup, self.probe, targets, where=frame_target_names(
+                scene, f, targets=scatterers, budget=budget))
             self.pairs.append(pairs)
             for n in notes:  # a pair too wide: once, at the first frame it is used
-                if n.split("]: ", 1)[-1] not in seen:
-                    seen.add(n.split("]: ", 1)[-1])
+                key = n[n.find(": front ends"):]
+                if key not in seen:
+                    seen.add(key)
                     self.warnings.append(n)
         used = sorted({p for pairs in self.pairs for p in pairs})
         self.cals = calibrate_pairs(setup, paths, used, self.probe, progress=progress)
@@ -116,8 +125,9 @@ class FramePlanner:
         program, _, notes = program_pairs(self.setup, self.paths, self.mode,
                                           budget.targets if budget else scene_f.targets,
                                           self.pairs[f], self.probe, self.cals, self.offsets,
-                                          where=frame_target_names(scene_f, f,
-                                                                   len(self.setup.scene.targets)))
+                                          where=frame_target_names(
+                                              scene_f, f, len(self.setup.scene.targets),
+                                              scene_f.targets, budget))
         return (lead_program(program, budget) if budget else program), notes
 
 
