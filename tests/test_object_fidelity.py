@@ -87,3 +87,40 @@ def test_budgeted_drive_is_compared_cell_by_cell():
     tracks = res.tracks_csv().splitlines()
     assert tracks[0].endswith(",status,budget")
     assert any(t.endswith(",merged_by_rts,merged") for t in tracks[1:])
+
+
+def test_reference_power_of_every_merged_group_at_once(monkeypatch):
+    """The merged targets' reference powers (a 0 dBsm point alone through the truth twin) in
+    one batch: equal to the serial simulation and detection of each point over a grid of
+    ranges, velocities and azimuths, and the budget runs the truth twin once per frame (one
+    more run per merged group before)."""
+    import rtsgeom.pipeline.merge as merge
+    from rtsgeom.calibration.probes import probe_front_ends
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import compute_paths
+    from rtsgeom.pipeline.plan import bracketing_pair
+    from rtsgeom.radar import process
+    from rtsgeom.radar.truth import simulate_truth
+    from rtsgeom.scene import TargetConfig
+    s = parse_scene(bench_doc(), "b.toml")
+    setup = build_setup(s)
+    refs = [TargetConfig(range_m=r, velocity_mps=v, rcs_dbsm=0.0, angle_rad=np.radians(a))
+            for r in (3.0, 12.34, 30.0) for v in (-4.0, 0.0, 1.7) for a in (-40.0, 0.0, 21.0)]
+    got = merge.reference_power_db(setup, refs)
+    assert len(refs) > merge.REFERENCE_CHUNK  # more than one block
+    serial = [float(process(simulate_truth(setup, [t], s.seed, 0.0)[1])[1].power_db.max())
+              for t in refs]
+    np.testing.assert_allclose(got, serial, atol=1e-6)
+
+    calls = []
+    monkeypatch.setattr(merge, "simulate_truth",
+                        lambda *a, **k: calls.append(1) or simulate_truth(*a, **k))
+    doc = bench_doc(max_targets_per_channel=1)
+    doc["targets"] = [{"range_m": 15.0, "scatterers": [
+        [0.8, 0.0, 0.0, 10.0], [0.0, 0.02, 0.0, 7.0], [-0.8, 0.0, 0.0, 10.0],
+        [0.5, 3.0, 0.0, 5.0], [-0.5, 3.02, 0.0, 5.0]]}]
+    s1 = parse_scene(doc, "m.toml")
+    setup1 = build_setup(s1)
+    probe = probe_front_ends(setup1, compute_paths(setup1, "exact"), s1.seed)
+    b = merge.budget_targets(setup1, s1.targets, probe, bracketing_pair)
+    assert any(b.truth_found) and len(calls) == 1  # the cells' view, nothing per group
