@@ -124,3 +124,25 @@ def test_reference_power_of_every_merged_group_at_once(monkeypatch):
     probe = probe_front_ends(setup1, compute_paths(setup1, "exact"), s1.seed)
     b = merge.budget_targets(setup1, s1.targets, probe, bracketing_pair)
     assert any(b.truth_found) and len(calls) == 1  # the cells' view, nothing per group
+
+
+def test_run_prints_scatterers_as_written_and_the_budget(tmp_path, capsys):
+    """`rtsgeom run` of a budget of one: each scatterer by its name in the file, merged and
+    dropped ones said so (no error against a scatterer the RTS merged), and the object's line
+    comparing each RTS detection with the truth twin's of its cell."""
+    from rtsgeom.cli import main
+    text = CAR.read_text()
+    text = text[:text.index("[scenario]")].replace("max_targets_per_channel = 3",
+                                                   "max_targets_per_channel = 1")
+    path = tmp_path / "m.toml"
+    path.write_text(text + "[[targets]]\nrange_m = 15.0\nscatterers = [[0.8, 0.0, 0.0, 10.0], "
+                    "[0.0, 0.02, 0.0, 7.0], [-0.8, 0.0, 0.0, 10.0], [0.5, 3.0, 0.0, 5.0], "
+                    "[-0.5, 3.02, 0.0, 5.0]]\n")
+    assert main(["run", str(path), "--out", str(tmp_path / "o"), "--no-report"]) == 0
+    out = capsys.readouterr().out
+    assert "targets[0].scatterers[0]: carries the RTS's merged target of" in out
+    assert "targets[0].scatterers[1]: merged into targets[0].scatterers[0]'s target" in out
+    assert "errors" not in out.split("object targets[0]")[0]  # nothing against scatterers
+    line = next(x for x in out.splitlines() if x.startswith("object targets[0]"))
+    az = float(line.split("max |azimuth| ")[1].split(" deg")[0])
+    assert az <= 0.2 and "budget: kept" in line

@@ -265,5 +265,16 @@ def objects_figure(scene, rows, section: dict, frame: int | None = None):
         origin, vel = m.pose(scene, frame)
         pts = place(m, origin, vel, scene.radar, 0)
         scat += [[t.range_m * np.sin(t.angle_rad), t.range_m * np.cos(t.angle_rad)] for t in pts]
+    ranges = None
+    if models and models[0].moving and len({t["frame"] for t in table}) > 1:
+        from ..scene.scenario import trajectory
+        i = int(models[0].where.split("[")[1].rstrip("]"))
+        ranges = trajectory(scene.scenario.targets[i].waypoints,
+                            scene.scenario.frame_times()).range_m
+    title = scene.name
+    row = next((t for t in table if t["frame"] == frame and "kept" in t), None)
+    if row is not None:  # the budget's counts at the frame shown
+        title += (f" (budget {scene.rts.max_targets_per_channel} a channel: kept "
+                  f"{row['kept']}, merged {row['merged']}, dropped {row['dropped']})")
     return object_figure(outlines, np.array(scat, float).reshape(-1, 2), rows, frame, table,
-                         title=scene.name)
+                         title=title, ranges_m=ranges)
