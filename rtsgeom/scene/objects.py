@@ -391,7 +391,9 @@ def object_set_points(model: ObjectModel, sp, radar) -> tuple[np.ndarray, np.nda
     if model.points is None:  # the mesh as the RuT sees it at the first frame
         model = _mesh_frozen(model, sp, radar)
     vel = sp.velocity_vec_mps
-    h = np.array([model.heading(v) for v in vel])  # (F,)
+    moves = np.hypot(vel[:, 0], vel[:, 1]) > 0  # as ObjectModel.heading, every frame at once
+    h = np.where(model.along_velocity & moves, np.arctan2(vel[:, 0], vel[:, 1]),
+                 model.heading_rad)  # (F,)
     ch, sh = np.cos(h), np.sin(h)
     x, y, z = model.points[:, 0], model.points[:, 1], model.points[:, 2]
     pos = np.stack([ch[:, None] * x + sh[:, None] * y, -sh[:, None] * x + ch[:, None] * y,
