@@ -228,9 +228,10 @@ class ObjectDesignResult(Result):
                           for k, v in r.items()} for r in df.to_dict("records")]}
 
     def plot(self):
-        """Share reproduced and targets kept over range, one line per design."""
+        """Share reproduced, centroid azimuth difference and targets kept over range, one line
+        per design (both criteria of :attr:`reproduces` with their tolerance)."""
         from ..viz.figures import new_figure
-        fig, (ax, bx) = new_figure(figsize=(10.0, 4.2), ncols=2)
+        fig, (ax, cx, bx) = new_figure(figsize=(14.0, 4.2), ncols=3)
         r = np.asarray(self.study.ranges_m, float)
         for i, s in enumerate(self.study.spacings_deg):
             for j, b in enumerate(self.study.budgets):
@@ -238,7 +239,15 @@ class ObjectDesignResult(Result):
                 style = dict(ls=("-", "--", "-.", ":")[i % 4], marker="osd^v"[j % 5],
                              ms=5 - i % 3, color=f"C{j}", lw=2.2 - 0.6 * (i % 3))
                 ax.plot(r, self.share[i, j], label=lab, **style)
+                cx.plot(r, np.abs(self.centroid_deg[i, j]), label=lab, **style)
                 bx.plot(r, self.kept[i, j], label=lab, **style)
+        cx.axhline(self.study.max_centroid_deg, color="0.4", ls="--", lw=1, label="tolerance")
+        cx.set_xlabel("object range (m)")
+        cx.set_ylabel("|centroid azimuth, RTS - truth| (deg)")
+        top = np.nanmax(np.r_[np.abs(self.centroid_deg).ravel(), self.study.max_centroid_deg])
+        cx.set_ylim(0, 1.6 * top)  # room above the lines for the legend
+        cx.legend(fontsize=7)
+        cx.set_title("where the RTS puts the object")
         ax.axhline(self.study.min_share, color="0.4", ls="--", lw=1, label="tolerance")
         ax.set_xlabel("object range (m)")
         ax.set_ylabel("truth detections reproduced (share)")

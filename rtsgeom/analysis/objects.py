@@ -2,15 +2,24 @@
 summary per object and frame.
 
 A cloud is the detections the RuT makes of one object in one frame: the truth twin's
-(``source`` ``truth``: the same radar on the real scatterers) and the RTS's (``rts``). A
-detection belongs to the object of the nearest of the frame's point targets within the
-association's gate (two range and Doppler bins, one angular resolution cell:
-:func:`rtsgeom.pipeline.run.association_scale`); detections near no target (noise, cable
+(``source`` ``truth``: the same radar on the real scatterers) and the RTS's (``rts``). Which
+detection is whose is the project's one association
+(:func:`rtsgeom.pipeline.run.associate_targets`, as for every target of ``run`` and ``play``):
+in the radar's resolution cells (range bin, velocity bin, two-target resolution per
+direction-cosine axis, elevation included for a 2-D RuT), the RTS's targets where the radar sees
+them (R_c further without ``rts.compensate_air_path``), the truth twin's at their set range. A
+detection belongs to the object of the target it was assigned to, else of the target it lies
+nearest within the gate and one angular cell; detections near no target (noise, cable
 ghosts, the sheet) belong to none and are left out. Per object and frame the summary compares
 the clouds: their sizes, the difference of their centroids (mean azimuth and range, RTS minus
-truth) and of their extents (azimuth span and range depth), and the share of the truth's
-detections the RTS reproduces within one resolution cell (range bin, velocity bin and
-two-target resolution in direction cosine).
+truth, the RTS's ranges referred to the real scene) and of their extents (azimuth span and
+range depth), and the share of the truth's detections the RTS reproduces within one
+resolution cell: the same association of the truth's detections (as targets) with the RTS's,
+one range and Doppler bin for the gate, each pair within one cell on every axis; and over
+each RTS detection paired with the truth twin's detection of its cell (the same
+association, the other way round) the largest azimuth and range differences: the fidelity of
+what the RTS synthesizes, merged targets included (a scatterer the budget dropped lowers the
+share, not the pairs).
 """
 
 from __future__ import annotations
@@ -21,36 +30,36 @@ import io
 import numpy as np
 
 __all__ = ["CLOUD_COLUMNS", "SUMMARY_KEYS", "cloud_rows", "clouds_csv", "object_summary",
-           "summary_table", "run_objects", "play_objects", "objects_figure"]
+           "summary_table", "run_objects", "play_objects", "objects_figure", "objects_lines",
+           "pairs", "air_offset_m"]
 
 CLOUD_COLUMNS = ("frame", "source", "object", "range_m", "velocity_mps", "azimuth_deg",
                  "elevation_deg", "power_db")
 SUMMARY_KEYS = ("object", "frame", "truth_detections", "rts_detections",
                 "centroid_azimuth_diff_deg", "centroid_range_diff_m", "azimuth_span_diff_deg",
-                "range_depth_diff_m", "reproduced_share")
+                "range_depth_diff_m", "reproduced_share", "paired_detections",
+                "paired_azimuth_diff_max_deg", "paired_range_diff_max_bins")
 
 
-def cloud_rows(frame: int, source: str, det, targets, scale, gate: float = 2.0) -> list[tuple]:
+def cloud_rows(frame: int, source: str, scene, det, rd, targets, steering=None,
+               gate: float = 2.0) -> list[tuple]:
     """The detections ``det`` of frame ``frame`` that belong to an object, as rows of
-    :data:`CLOUD_COLUMNS` (module docstring): each to the object of its nearest target
-    (``targets``, with ``object_index``) within ``gate`` range and Doppler cells and one
-    angular cell of ``scale`` (range bin, velocity bin, resolution in u)."""
-    t = list(targets)
+    :data:`CLOUD_COLUMNS` (module docstring): the association of ``targets`` (with
+    ``object_index``; the RTS's where the radar sees them, ``source`` ``truth``: at their set
+    range) with ``det`` on the map ``rd`` and the beamformer ``steering``, ``gate`` range and
+    Doppler bins."""
+    from ..pipeline.run import associate_targets
+    t = tuple(targets)
     if not len(det) or not t:
         return []
+    assoc, _, _ = associate_targets(scene, det, rd, gate, steering, t,
+                                    real=source == "truth")
     obj = np.array([x.object_index for x in t])
-    tp = np.c_[[x.range_m for x in t], [x.velocity_mps for x in t], np.sin([x.angle_rad
-                                                                          for x in t])]
-    dp = np.c_[det.range_m, det.velocity_mps, np.sin(det.angle_rad)]
-    sc = np.asarray(scale, float)[:3]
-    diff = (dp[:, None, :] - tp[None]) / sc  # (D, T, 3)
-    ok = np.all(np.abs(diff[..., :2]) <= gate, axis=-1) & (np.abs(diff[..., 2]) <= 1.0)
-    dist = np.where(ok, np.sqrt((diff ** 2).sum(-1)), np.inf)
-    near = np.argmin(dist, axis=1)
+    whose = np.where(assoc.owner >= 0, assoc.owner, assoc.nearest)
     el = det.elevation_deg if det.elevation_rad is not None else np.full(len(det), np.nan)
     rows = []
-    for j in np.flatnonzero(np.isfinite(dist[np.arange(len(det)), near])):
-        o = int(obj[near[j]])
+    for j in np.flatnonzero((whose >= 0)):
+        o = int(obj[whose[j]])
         if o < 0:
             continue
         rows.append((int(frame), source, o, float(det.range_m[j]), float(det.velocity_mps[j]),
@@ -70,14 +79,54 @@ def clouds_csv(rows) -> str:
 
 
 def _cloud(rows) -> np.ndarray:
-    return np.array([[r[3], r[4], r[5]] for r in rows], float).reshape(-1, 3)
+    """(N, 4): range, velocity, azimuth (deg), elevation (deg, 0 where not measured)."""
+    c = np.array([[r[3], r[4], r[5], r[6]] for r in rows], float).reshape(-1, 4)
+    c[:, 3] = np.nan_to_num(c[:, 3])
+    return c
 
 
-def object_summary(rows, scale, obj: int, frame: int) -> dict:
+def _points(c: np.ndarray, dims: int) -> np.ndarray:
+    from ..pipeline.run import direction_columns
+    return np.c_[c[:, :2], direction_columns(np.radians(c[:, 2]), np.radians(c[:, 3]), dims)]
+
+
+def pairs(truth: np.ndarray, rts: np.ndarray, scale) -> tuple[np.ndarray, np.ndarray]:
+    """Each detection of one cloud (``truth``; rows of :func:`_cloud`) with the other's
+    (``rts``) of the same cell: the one association
+    (:func:`rtsgeom.radar.association.associate`) of the first cloud, as targets, with the
+    second, one range and Doppler bin for the gate. Returns the index (T,) of the paired
+    detection (-1: none) and whether the pair lies within one cell of ``scale`` on every
+    axis (T,) (with the truth first: the truth detection is reproduced)."""
+    from ..radar.association import associate
+    sc = np.asarray(scale, float)
+    dims = sc.size - 2
+    tp, rp = _points(truth, dims), _points(rts, dims)
+    a = associate(tp, rp, sc, gate=1.0)
+    ok = a.detection >= 0
+    close = np.zeros(len(tp), bool)
+    close[ok] = np.all(np.abs(rp[a.detection[ok]] - tp[ok]) <= sc * (1 + 1e-9), axis=1)
+    return np.asarray(a.detection), close
+
+
+def clouds_by_frame(rows, offset_m: float = 0.0):
+    """``(frame, object, truth cloud, RTS cloud)`` (clouds: rows of :func:`_cloud`, the RTS's
+    ranges referred to the real scene by ``offset_m``) for every frame and object in
+    ``rows``."""
+    for f, o in sorted({(r[0], r[2]) for r in rows}):
+        tr = _cloud([r for r in rows if r[1] == "truth" and r[2] == o and r[0] == f])
+        rt = _cloud([r for r in rows if r[1] == "rts" and r[2] == o and r[0] == f])
+        rt[:, 0] -= offset_m
+        yield f, o, tr, rt
+
+
+def object_summary(rows, scale, obj: int, frame: int, offset_m: float = 0.0) -> dict:
     """One object's clouds in one frame compared (module docstring): a dict of
-    :data:`SUMMARY_KEYS` (differences None where a cloud is empty)."""
+    :data:`SUMMARY_KEYS` (differences None where a cloud is empty). ``scale``: the
+    association's resolution cell; ``offset_m``: how much further the radar sees the RTS's
+    targets than their set range (R_c without ``rts.compensate_air_path``, else 0)."""
     tr = _cloud([r for r in rows if r[1] == "truth" and r[2] == obj and r[0] == frame])
     rt = _cloud([r for r in rows if r[1] == "rts" and r[2] == obj and r[0] == frame])
+    rt[:, 0] -= offset_m  # referred to the real scene
     out = {"object": obj, "frame": frame, "truth_detections": len(tr),
            "rts_detections": len(rt)}
     both = len(tr) and len(rt)
@@ -88,26 +137,27 @@ def object_summary(rows, scale, obj: int, frame: int) -> dict:
     out["centroid_range_diff_m"] = d(lambda c: c[:, 0].mean())
     out["azimuth_span_diff_deg"] = d(lambda c: np.ptp(c[:, 2]))
     out["range_depth_diff_m"] = d(lambda c: np.ptp(c[:, 0]))
-    if len(tr):
-        sc = np.asarray(scale, float)[:3]
-        ut, ur = np.sin(np.radians(tr[:, 2])), np.sin(np.radians(rt[:, 2]))
-        close = ((np.abs(tr[:, None, 0] - rt[None, :, 0]) <= sc[0])
-                 & (np.abs(tr[:, None, 1] - rt[None, :, 1]) <= sc[1])
-                 & (np.abs(ut[:, None] - ur[None]) <= sc[2]))
-        out["reproduced_share"] = float(close.any(axis=1).mean())
-    else:
-        out["reproduced_share"] = None
+    _, close = pairs(tr, rt, scale)
+    out["reproduced_share"] = float(close.mean()) if len(tr) else None
+    j, _ = pairs(rt, tr, scale)  # each RTS detection's truth twin detection of its cell
+    ok = j >= 0
+    out["paired_detections"] = int(ok.sum())
+    out["paired_azimuth_diff_max_deg"] = (float(np.abs(rt[ok, 2] - tr[j[ok], 2]).max())
+                                          if ok.any() else None)
+    out["paired_range_diff_max_bins"] = (float(np.abs(rt[ok, 0] - tr[j[ok], 0]).max()
+                                               / float(scale[0])) if ok.any() else None)
     return out
 
 
-def summary_table(rows, scale, num_objects: int, frames, budget=None) -> list[dict]:
+def summary_table(rows, scale, num_objects: int, frames, budget=None, offset_m: float = 0.0
+                  ) -> list[dict]:
     """Per object and frame :func:`object_summary`, with the frame's budget counts
     (``kept``, ``merged``, ``dropped``: :attr:`rtsgeom.pipeline.merge.Budgeted.counts`) where
     ``budget`` (per frame a counts dict, or None) is given."""
     out = []
     for f in frames:
         for o in range(num_objects):
-            s = object_summary(rows, scale, o, int(f))
+            s = object_summary(rows, scale, o, int(f), offset_m)
             if budget is not None and budget[int(f)] is not None:
                 s.update({k: budget[int(f)][k] for k in ("kept", "merged", "dropped")})
             out.append(s)
@@ -118,20 +168,21 @@ def run_objects(result) -> tuple[list, dict]:
     """A run's clouds (frame 0) and its ``summary.json`` ``objects`` section (per object the
     comparison, with the planner's budget counts where ``[rts] max_targets_per_channel`` is
     set)."""
-    from ..pipeline.merge import cell_scale
-    scene = result.scene
-    scale = cell_scale(result.setup)
+    from ..pipeline.run import association_scale
+    scene, rd, st = result.scene, result.rd, result.cube.steering
+    scale = association_scale(scene, rd, st)
     rows = []
-    if result.truth_detections is not None:
-        rows += cloud_rows(0, "truth", result.truth_detections, scene.targets, scale)
-    rows += cloud_rows(0, "rts", result.detections, scene.targets, scale)
+    if result.truth_detections is not None:  # the same radar and map bins as the RTS frame
+        rows += cloud_rows(0, "truth", scene, result.truth_detections, rd, scene.targets, st)
+    rows += cloud_rows(0, "rts", scene, result.detections, rd, scene.targets, st)
     budget = result.calibration.get("budget")
     counts = None if budget is None else [{k: budget[k] for k in ("kept", "merged",
                                                                     "dropped")}]
     n_obj = sum(1 for m in scene.objects if not m.moving)
     return rows, {"objects": [m.where for m in scene.objects if not m.moving],
                   "resolution_cell": _cell(scale), "budget": budget,
-                  "frames": summary_table(rows, scale, n_obj, [0], counts)}
+                  "frames": summary_table(rows, scale, n_obj, [0], counts,
+                                          air_offset_m(scene))}
 
 
 def play_objects(result) -> tuple[list, dict]:
@@ -147,12 +198,55 @@ def play_objects(result) -> tuple[list, dict]:
                                 result.scene.rts.max_targets_per_channel,
                             "kept": [c["kept"] for c in counts]},
                         "frames": summary_table(rows, scale, len(result.scene.objects),
-                                                frames, counts)}
+                                                frames, counts, air_offset_m(result.scene))}
+
+
+def air_offset_m(scene) -> float:
+    """How much further the radar sees the RTS's targets than their set range
+    (:func:`rtsgeom.rts.channels.apparent_range`: R_c without ``rts.compensate_air_path``)."""
+    from ..rts.channels import apparent_range
+    return float(apparent_range(scene, 0.0))
+
+
+def objects_lines(section: dict) -> list[str]:
+    """One printed line per object of an ``objects`` section (:func:`run_objects`,
+    :func:`play_objects`): detections of truth and RTS, the share of the truth's the RTS
+    reproduces within a cell, and the largest differences of paired detections (each RTS
+    detection and the truth twin's of its cell)."""
+    def span(v):
+        v = [x for x in v if x is not None]
+        if not v:
+            return "n/a"
+        lo, hi = min(v), max(v)
+        return f"{lo:g}" if lo == hi else f"{lo:g}-{hi:g}"
+    out = []
+    for o, where in enumerate(section["objects"]):
+        t = [r for r in section["frames"] if r["object"] == o]
+        share = [r["reproduced_share"] for r in t if r["reproduced_share"] is not None]
+        az = [r["paired_azimuth_diff_max_deg"] for r in t
+              if r["paired_azimuth_diff_max_deg"] is not None]
+        rb = [r["paired_range_diff_max_bins"] for r in t
+              if r["paired_range_diff_max_bins"] is not None]
+        n_t, n_r = span([r["truth_detections"] for r in t]), span([r["rts_detections"] for r in t])
+        line = (f"object {where}: {len(t)} frame(s), truth {n_t} / RTS {n_r} detections a frame, "
+                f"{100 * min(share):.0f} % (worst frame) of the truth's reproduced within a cell"
+                if share else f"object {where}: no truth twin detection")
+        if az:
+            line += (f"; each RTS detection against the truth twin's of its cell: max |azimuth| "
+                     f"{max(az):.3f} deg, max |range| {max(rb):.2f} bins")
+        if "kept" in t[0] if t else False:
+            line += (f"; budget: kept {span([r['kept'] for r in t])}, merged "
+                     f"{span([r['merged'] for r in t])}, dropped {span([r['dropped'] for r in t])}")
+        out.append(line)
+    return out
 
 
 def _cell(scale) -> dict:
-    return {"range_m": float(scale[0]), "velocity_mps": float(scale[1]),
-            "direction_cosine": float(scale[2])}
+    out = {"range_m": float(scale[0]), "velocity_mps": float(scale[1]),
+           "direction_cosine": float(scale[2])}
+    if len(scale) > 3:
+        out["direction_cosine_elevation"] = float(scale[3])
+    return out
 
 
 def objects_figure(scene, rows, section: dict, frame: int | None = None):
@@ -171,5 +265,16 @@ def objects_figure(scene, rows, section: dict, frame: int | None = None):
         origin, vel = m.pose(scene, frame)
         pts = place(m, origin, vel, scene.radar, 0)
         scat += [[t.range_m * np.sin(t.angle_rad), t.range_m * np.cos(t.angle_rad)] for t in pts]
+    ranges = None
+    if models and models[0].moving and len({t["frame"] for t in table}) > 1:
+        from ..scene.scenario import trajectory
+        i = int(models[0].where.split("[")[1].rstrip("]"))
+        ranges = trajectory(scene.scenario.targets[i].waypoints,
+                            scene.scenario.frame_times()).range_m
+    title = scene.name
+    row = next((t for t in table if t["frame"] == frame and "kept" in t), None)
+    if row is not None:  # the budget's counts at the frame shown
+        title += (f" (budget {scene.rts.max_targets_per_channel} a channel: kept "
+                  f"{row['kept']}, merged {row['merged']}, dropped {row['dropped']})")
     return object_figure(outlines, np.array(scat, float).reshape(-1, 2), rows, frame, table,
-                         title=scene.name)
+                         title=title, ranges_m=ranges)

@@ -16,6 +16,7 @@ from ._common import (load_scene_checked, number, output_folder, output_path, sc
 
 def cmd_play(args) -> int:
     from ..analysis.playback import Playback
+    from ..analysis.playback.result import budget_line
     from ..viz.figures import save_figure
     if not args.tolerance_draws:
         for flag, value in (("--sigma-mm", args.sigma_mm), ("--spec-deg", args.spec_deg)):
@@ -49,10 +50,16 @@ def cmd_play(args) -> int:
         (stage / "summary.json").write_text(
             json.dumps(summary, indent=2, allow_nan=False) + "\n", encoding="utf-8")
         save_figure(result.plot(), stage / "playback.png")
+        objects_lines = []
         if result.clouds is not None:  # extended objects: clouds.csv, objects.json/png
-            from ..analysis.objects import play_objects
+            from ..analysis.objects import objects_lines as lines_of, play_objects
             from .run import write_objects
-            write_objects(stage, scene, *play_objects(result))
+            rows, section = play_objects(result)
+            write_objects(stage, scene, rows, section)
+            objects_lines = [f"{result.mode}: {x}" for x in lines_of(section)]
+            if result.baseline is not None and result.baseline.clouds is not None:
+                objects_lines += [f"baseline {result.baseline.mode}: {x}" for x in
+                                  lines_of(play_objects(result.baseline)[1])]
         if args.gif:
             step("writing playback.gif")
             result.animate(stage / "playback.gif")
@@ -65,9 +72,15 @@ def cmd_play(args) -> int:
             worst = "n/a" if e["max"] is None else f"{e['max']:.4f} deg (p95 {e['p95']:.4f})"
             jump = ("n/a" if v["handover_jump_deg"] is None
                     else f"{v['handover_jump_deg']:.4f} deg")
-            print(f"{r}{v['mode']}: {v['frames']} frames, max |angle error| {worst}, "
-                  f"{v['lost_frames']} lost, {v['split_frames']} split, {v['handovers']} "
-                  f"hand-overs (largest jump {jump})")
+            if v["point_targets"]:
+                print(f"{r}{v['mode']}: {v['frames']} frames, {v['point_targets']} point "
+                      f"target(s): max |angle error| {worst}, {v['lost_frames']} lost, "
+                      f"{v['split_frames']} split, {v['handovers']} hand-overs (largest jump "
+                      f"{jump})")
+            if "budget" in v:
+                print(f"{r}{v['mode']}: budget {budget_line(v['budget'])}")
+        for line in objects_lines:
+            print(line)
         if "tolerance" in summary:
             t = summary["tolerance"]
             print(f"tolerance over the drive ({t['draws']} setups, sigma {t['sigma_mm']} mm, "

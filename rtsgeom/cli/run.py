@@ -10,6 +10,7 @@ import json
 from ..geometry.warnings import scene_warnings
 from ..pipeline.output import MAP_FORMATS, write_run
 from ..pipeline.run import run_scene
+from ..scene.objects import target_labels
 from ..scene.registry import ANGLE_ESTIMATORS, AOA_MODES, PATH_METHODS
 from ._common import (calibration_kw, load_scene_checked, number, output_folder, output_path,
                       scene_arg, steps)
@@ -37,12 +38,21 @@ def cmd_run(args) -> int:
                                                       " and report.html (3D view, figures)"))
         write_run(result, stage, args.paths, args.maps, not args.no_report,
                   scene_warnings(scene))
+        objects_lines = []
         if scene.objects:  # extended objects: what the radar sees of them, truth and RTS
-            from ..analysis.objects import run_objects
-            write_objects(stage, scene, *run_objects(result))
+            from ..analysis.objects import objects_lines as lines_of, run_objects
+            rows, section = run_objects(result)
+            write_objects(stage, scene, rows, section)
+            objects_lines = lines_of(section)
     if not args.quiet:
+        names = target_labels(scene) if scene.objects else None
+        roles = budget_roles(result.calibration.get("budget"), names)
         for m in result.matches:
-            print(target_line(m))
+            k = m["index"]
+            print(roles[k] if k in roles else
+                  target_line(m, None if names is None else names[k]))
+        for line in objects_lines:
+            print(line)
         for w in result.warnings:
             print(f"warning: {w}")
         print(f"{len(result.detections)} detections; wrote {out}/detections.csv, summary.json, "
@@ -61,18 +71,43 @@ def write_objects(stage, scene, rows, section: dict) -> None:
     save_figure(objects_figure(scene, rows, section), stage / "objects.png")
 
 
-def target_line(m: dict) -> str:
-    """One printed line per target: the RTS's detection and its errors against the set-point,
-    then the truth twin's detection and the RTS's difference from it."""
+def budget_roles(budget: dict | None, names) -> dict:
+    """Under ``[rts] max_targets_per_channel``: the printed line of each scatterer the RTS
+    does not synthesize as itself (merged into another's target, carrying a merged target,
+    dropped), by its index; the others print :func:`target_line`. Their comparison with the
+    truth is the object's (``objects.json``: each RTS detection against the truth twin's
+    detection of its cell)."""
+    if budget is None:
+        return {}
+    name = (lambda k: f"target {k}") if names is None else names.__getitem__
+    out = {}
+    for t in budget["targets"]:
+        m = t["members"]
+        if len(m) > 1:
+            out[m[0]] = (f"{name(m[0])}: carries the RTS's merged target of "
+                         f"{', '.join(name(j) for j in m)} at {t['range_m']:.3f} m "
+                         f"{t['azimuth_deg']:.3f} deg (the truth twin's detection of their cell"
+                         + (")" if t["from_truth_twin"] else ": none, its strongest member)"))
+            out.update({j: f"{name(j)}: merged into {name(m[0])}'s target (budget)"
+                        for j in m[1:]})
+    out.update({j: f"{name(j)}: dropped (budget)" for j in budget["dropped_targets"]})
+    return out
+
+
+def target_line(m: dict, name: str | None = None) -> str:
+    """One printed line per target (``name``: as the file names it, default ``target k``):
+    the RTS's detection and its errors against the set-point, then the truth twin's
+    detection and the RTS's difference from it."""
     d, e = m["detection"], m["error"]
+    name = name or f"target {m['index']}"
     if d is None:
-        line = f"target {m['index']}: NOT DETECTED: {m['undetected']['reason']}"
+        line = f"{name}: NOT DETECTED: {m['undetected']['reason']}"
     else:
         el = (f" el {d['elevation_deg']:7.3f} deg" if "elevation_deg" in d else "")
         el_e = (f", el {e['elevation_deg']:+.3f} deg" if "elevation_deg" in e else "")
         merged = (f" MERGED with target {', '.join(map(str, m['merged_with']))}:"
                   if m.get("status") == "merged" else "")
-        line = (f"target {m['index']}:{merged} {d['range_m']:7.3f} m {d['velocity_mps']:+7.3f} "
+        line = (f"{name}:{merged} {d['range_m']:7.3f} m {d['velocity_mps']:+7.3f} "
                 f"m/s {d['angle_deg']:8.3f} deg{el}  (errors {e['range_m']:+.3f} m, "
                 f"{e['velocity_mps']:+.3f} m/s, {e['angle_deg']:+.3f} deg{el_e})")
     if "truth_status" not in m:

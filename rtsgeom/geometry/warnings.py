@@ -81,9 +81,11 @@ def _arc_warnings(setup, warn) -> None:
 
     # Targets are synthesised between front ends; outside their span means extrapolation.
     lo, hi = float(az.min()), float(az.max())
+    from ..scene.objects import target_field, target_labels
+    names = target_labels(scene)  # an object's scatterers as the file writes them
     for i, tg in enumerate(scene.targets):
         if not lo - 1e-9 <= tg.angle_rad <= hi + 1e-9:
-            warn(f"targets[{i}].angle_deg", math.degrees(tg.angle_rad),
+            warn(target_field(names[i], "angle_deg"), math.degrees(tg.angle_rad),
                  f"outside the span of the front ends seen from the RuT "
                  f"[{math.degrees(lo):.4g}, {math.degrees(hi):.4g}] deg: the RTS can only "
                  "interpolate between front ends")

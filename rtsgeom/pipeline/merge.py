@@ -22,6 +22,7 @@ in, with the scatterers' coherent sum at the carrier,
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,10 +31,14 @@ from ..geometry import Setup
 from ..radar import process
 from ..radar.association import resolution_cell
 from ..radar.steering import Steering
-from ..radar.truth import simulate_truth
+from ..radar.fmcw import synthesize_each
+from ..radar.link import apply_radar_link
+from ..radar.processing import range_doppler_power
+from ..radar.truth import simulate_truth, truth_echoes
 from ..scene import TargetConfig
 
-__all__ = ["Budgeted", "budget_targets", "resolution_clusters", "cell_scale"]
+__all__ = ["Budgeted", "budget_targets", "resolution_clusters", "cell_scale",
+           "reference_power_db", "REFERENCE_CHUNK"]
 
 
 @dataclass(frozen=True)
@@ -109,18 +114,38 @@ def resolution_clusters(targets, scale) -> list[list[int]]:
     return sorted(groups, key=lambda g: g[0])
 
 
-def _reference_power_db(setup: Setup, ref: TargetConfig, scale) -> float | None:
-    """The truth twin's detected power (dB) of one point target ``ref`` alone (noiseless)."""
-    _, cube = simulate_truth(setup, [ref], setup.scene.seed, 0.0)
-    det = process(cube)[1]
-    near = ((np.abs(det.range_m - ref.range_m) <= scale[0])
-            & (np.abs(det.velocity_mps - ref.velocity_mps) <= scale[1]))
-    return float(det.power_db[near].max()) if near.any() else None
+#: reference points per batch of :func:`reference_power_db` (memory: this many ADC cubes)
+REFERENCE_CHUNK = 16
 
 
-def _merged(setup, targets, group, det, scale) -> tuple[TargetConfig, float, bool]:
+def reference_power_db(setup: Setup, refs) -> np.ndarray:
+    """The truth twin's detected power (dB, noiseless) of each point target of ``refs`` alone
+    (K,): the peak of its own range-Doppler map (what :func:`rtsgeom.radar.process` reports as
+    a lone point's ``power_db``), all K at once -- one cube per point
+    (:func:`rtsgeom.radar.fmcw.synthesize_each`, in blocks of :data:`REFERENCE_CHUNK`) through
+    :func:`rtsgeom.radar.processing.range_doppler_power`. With ``[radar.link]`` the link's
+    gains apply; its ADC quantisation does not (a lone point far above it)."""
+    refs = list(refs)
+    if not refs:
+        return np.zeros(0)
+    scene = setup.scene
+    echoes = truth_echoes(setup, refs)
+    if scene.radar.link is not None:
+        echoes = apply_radar_link(echoes, scene)
+    out = np.empty(len(refs))
+    for s in range(0, len(refs), REFERENCE_CHUNK):  # blocks of points, each block one batch
+        part = echoes.select((np.arange(len(refs)) >= s) & (np.arange(len(refs))
+                                                            < s + REFERENCE_CHUNK))
+        power = range_doppler_power(synthesize_each(part, scene.radar, setup.rut), scene.radar)
+        out[s:s + len(part)] = 10 * np.log10(np.maximum(power.max(axis=(-2, -1)), 1e-300))
+    return out
+
+
+def _merged(setup, targets, group, det, scale) -> tuple[TargetConfig, float, bool, float]:
     """One synthesized target for ``group`` (module docstring): (target, power-centroid
-    azimuth in deg, whether the truth twin's detection set it)."""
+    azimuth in deg, whether the truth twin's detection set it, that detection's power in dB
+    or NaN). Where it did, the target's RCS is set by :func:`budget_targets` from the
+    detection's power and a reference point's (:func:`reference_power_db`)."""
     wavelength_m = setup.scene.radar.wavelength_m
     ts = [targets[j] for j in group]
     p = _power(ts)
@@ -130,9 +155,9 @@ def _merged(setup, targets, group, det, scale) -> tuple[TargetConfig, float, boo
     centroid = float(np.degrees(np.arcsin(np.clip(np.sum(p * u) / p.sum(), -1, 1))))
     lead = ts[0]
     if len(ts) == 1:
-        return lead, centroid, False
+        return lead, centroid, False, float("nan")
     r_c = float(np.sum(p * r) / p.sum())
-    found = False
+    found, power_db = False, float("nan")
     rng, az = lead.range_m, lead.angle_rad
     if len(det):
         d_u = np.sin(det.angle_rad)
@@ -142,17 +167,28 @@ def _merged(setup, targets, group, det, scale) -> tuple[TargetConfig, float, boo
         if near.any():
             j = np.flatnonzero(near)[np.argmax(det.power_db[near])]
             rng, az, found = float(det.range_m[j]), float(det.angle_rad[j]), True
+            power_db = float(det.power_db[j])
     amp = np.sqrt([x.rcs_m2 for x in ts]) * (rng / r) ** 2 * np.exp(
         -4j * np.pi * r / wavelength_m)
     rcs_db = float(10 * np.log10(max(abs(amp.sum()) ** 2, 1e-10)))
-    if found:  # the single point the truth twin would detect with the cell's power
-        ref = _reference_power_db(setup, TargetConfig(range_m=rng, velocity_mps=v,
-                                                      rcs_dbsm=0.0, angle_rad=az), scale)
-        rcs_db = rcs_db if ref is None else float(det.power_db[j]) - ref
     objs = {x.object_index for x in ts}
     return (TargetConfig(range_m=rng, velocity_mps=v, rcs_dbsm=float(np.clip(rcs_db, -100, 100)),
                          angle_rad=az, object_index=objs.pop() if len(objs) == 1 else -1),
-            centroid, found)
+            centroid, found, power_db)
+
+
+def _with_detected_power(setup, made: list) -> list:
+    """The merged targets the truth twin detected with the RCS a single point there needs
+    for the cell's detected power: that power minus a 0 dBsm reference point's at the same
+    range, velocity and direction (:func:`reference_power_db`, all at once)."""
+    idx = [k for k, m in enumerate(made) if m[2]]
+    refs = [dataclasses.replace(made[k][0], rcs_dbsm=0.0) for k in idx]
+    out = list(made)
+    for k, ref_db in zip(idx, reference_power_db(setup, refs)):
+        t, cd, found, power_db = made[k]
+        rcs = float(np.clip(power_db - ref_db, -100, 100))
+        out[k] = (dataclasses.replace(t, rcs_dbsm=rcs), cd, found, power_db)
+    return out
 
 
 def budget_targets(setup: Setup, targets, probe, pair_of, limit: int | None = None
@@ -171,7 +207,8 @@ def budget_targets(setup: Setup, targets, probe, pair_of, limit: int | None = No
     if any(len(g) > 1 for g in groups):  # the truth twin's view of every cell, noiseless
         _, cube = simulate_truth(setup, targets, scene.seed, 0.0)
         det = process(cube)[1]
-    made = [_merged(setup, targets, g, det, scale) for g in groups]
+    made = _with_detected_power(setup, [_merged(setup, targets, g, det, scale)
+                                        for g in groups])
     keep = np.ones(len(groups), bool)
     power = _power([m[0] for m in made])
     pairs = [pair_of(m[0].angle_rad, probe.angle_rad) for m in made]

@@ -341,17 +341,18 @@ def pair_design(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: st
     return p.a_i, p.a_j, p.rho, p.offset_j_s
 
 
-def residual_warning(scene, k: int, plan: PairPlan) -> str | None:
+def residual_warning(scene, k: int, plan: PairPlan, name: str | None = None) -> str | None:
     """A run warning for target ``k`` where J's realised delay difference misses the planned
     one by more than half the RTS's delay step (what the calibration's own rounding leaves):
     no setting within reach realises it. The amplitudes are designed for the phase it
     leaves, so the angle holds on the nominal model, but the pair is that much less coherent
-    than calibrated (power, sensitivity to the model). None where it does not."""
+    than calibrated (power, sensitivity to the model). None where it does not. ``name``:
+    the target as the file names it (default ``targets[k]``)."""
     res = scene.rts.delay_resolution_s
     eps = plan.quantisation_residual_s
     if abs(eps) <= 0.5 * res * (1 + 1e-6) + 1e-15:
         return None
-    return (f"targets[{k}]: channel J's realised delay difference misses the calibrated one by "
+    return (f"{name or f'targets[{k}]'}: channel J's realised delay difference misses the calibrated one by "
             f"{eps * 1e12:.1f} ps ({plan.residual_phase_deg:.1f} deg of IF phase), more than "
             f"half the RTS delay step {res * 1e12:g} ps (rts.fractional_delay_step_s / "
             "rts.f_s_hz): no realisable setting is nearer; the amplitudes are designed for it")

@@ -27,6 +27,7 @@ from ..geometry.farfield import angular_resolution_rad
 from ..paths import Paths, nominal_model
 from ..radar.steering import Steering
 from ..rts.channels import RtsProgram, requested_delay
+from ..scene.objects import target_field, target_labels
 from ..synthesis.cells import enclosing_cell
 from ..synthesis.model import ChannelModel, target_direction
 from .merge import budget_targets
@@ -100,9 +101,11 @@ def target_cells(setup: Setup) -> tuple[Steering, np.ndarray, list]:
     st = Steering.auto(setup.rut, scene.radar)  # the beamformer the RuT runs
     u_fe = setup.fe_direction_cosines(st.dims)
     out: list = []
+    names = target_labels(scene)
     for k, t in enumerate(scene.targets):
         if st.dims == 1 and getattr(t, "elevation_rad", 0.0):
-            out.append((None, f"targets[{k}].elevation_deg = {np.degrees(t.elevation_rad):g}: "
+            out.append((None, f"{target_field(names[k], 'elevation_deg')} = "
+                              f"{np.degrees(t.elevation_rad):g}: "
                               f"must be 0: the RuT's array ({scene.radar.antenna_preset}, "
                               "use_elevation_tx = "
                               f"{str(scene.radar.use_elevation_tx).lower()}) has no elevation "
@@ -111,7 +114,7 @@ def target_cells(setup: Setup) -> tuple[Steering, np.ndarray, list]:
         try:
             out.append((enclosing_cell(target_direction(st, t), u_fe), None))
         except CellUnreachable as exc:
-            out.append((None, f"targets[{k}] (angle_deg = {np.degrees(t.angle_rad):g}, "
+            out.append((None, f"{names[k]} (angle_deg = {np.degrees(t.angle_rad):g}, "
                               f"elevation_deg = {np.degrees(getattr(t, 'elevation_rad', 0.0)):g})"
                               f": unreachable: {exc}"))
     return st, u_fe, out
@@ -162,14 +165,15 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
     if scene.rts.max_targets_per_channel is not None:  # dynamic resolution (.merge)
         budget = budget_targets(setup, scene.targets, probe, bracketing_pair)
         targets = budget.targets
-    pairs, notes = target_pairs(setup, probe, targets)
+    where = target_namer(scene, budget=budget)  # as the file names them
+    pairs, notes = target_pairs(setup, probe, targets, where)
     warnings += notes
     cals = (calibrate_pairs(setup, paths, sorted(set(pairs)), probe,
                             loaded if calibration is not None else None, progress)
             if calibrate else {})
     offsets = channel_offsets(setup.fe.count, cals)
     program, realised, notes = program_pairs(setup, paths, mode, targets, pairs, probe,
-                                             cals, offsets)
+                                             cals, offsets, where)
     warnings += notes
     if budget is not None:
         program = lead_program(program, budget)
@@ -196,8 +200,21 @@ def lead_program(program: RtsProgram, budget) -> RtsProgram:
 
 def target_name(where, k: int) -> str:
     """Target ``k`` as messages name it: ``where[k]`` for a prefix (``targets``), or
-    ``where(k)`` (a drive's frames name static and moving targets apart)."""
+    ``where(k)`` (a drive's frames name static and moving targets apart; an object's
+    scatterers as the file writes them, :func:`target_namer`)."""
     return where(k) if callable(where) else f"{where}[{k}]"
+
+
+def target_namer(scene, targets=None, budget=None, moving_from: int | None = None):
+    """``k -> name`` of ``targets`` (default the scene's) as the file writes them
+    (:func:`rtsgeom.scene.objects.target_labels`); under a ``budget`` (``targets`` the
+    scatterers, ``k`` a synthesized target) its strongest member, and how many it merges."""
+    names = target_labels(scene, targets, moving_from)
+    if budget is None:
+        return names.__getitem__
+    lead = budget.lead()
+    return lambda k: names[lead[k]] + (f" (merged target of {len(budget.members[k])} "
+                                       "scatterers)" if len(budget.members[k]) > 1 else "")
 
 
 def target_pairs(setup: Setup, probe, targets, where: str = "targets"
@@ -220,7 +237,8 @@ def target_pairs(setup: Setup, probe, targets, where: str = "targets"
         pair = bracketing_pair(t.angle_rad, probe.angle_rad)
         if pair is None:
             lo, hi = np.degrees(np.nanmin(probe.angle_rad)), np.degrees(np.nanmax(probe.angle_rad))
-            raise SceneError(f"{scene.source}: {target_name(where, k)}.angle_deg = "
+            raise SceneError(f"{scene.source}: "
+                             f"{target_field(target_name(where, k), 'angle_deg')} = "
                              f"{np.degrees(t.angle_rad):g}: must be within the measured span of "
                              f"the front ends [{lo:.4f}, {hi:.4f}] deg (no pair can reach it)")
         pairs.append(pair)
@@ -290,14 +308,15 @@ def _frame_programme(setup, paths, mode, targets, rows, plans, where):
             try:
                 plan = plan_pair(setup, paths, *row[:1], t, mode, *row[2:])
             except AngleUnreachable as exc:
-                raise SceneError(f"{scene.source}: {target_name(where, k)}.angle_deg = "
+                raise SceneError(f"{scene.source}: "
+                                 f"{target_field(target_name(where, k), 'angle_deg')} = "
                                  f"{np.degrees(t.angle_rad):g}: {exc}") from None
         tau = float(requested_delay(scene, t.range_m))
         f_d = 2 * scene.radar.f_c_hz * t.velocity_mps / c
         out += [(k, i, tau + offs[0], f_d, plan.a_i), (k, j, tau + plan.offset_j_s, f_d,
                                                        plan.a_j)]
         realised.append({"target": k, "pair": [i, j], **plan.to_dict()})
-        note = residual_warning(scene, k, plan)
+        note = residual_warning(scene, k, plan, target_name(where, k))
         if note:
             warnings.append(note)
     program = RtsProgram.build(*zip(*out)) if out else RtsProgram.build([], [], [], [], [])
@@ -344,12 +363,14 @@ def _plan_cells(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, p
             w = cs.solve(u, phases, mode=mode)
         except AngleUnreachable as exc:
             if tree is not None and cal.failed:  # inside the cell: the calibration is why
-                raise SceneError(f"{scene.source}: targets[{k}]: the channel calibration "
+                raise SceneError(f"{scene.source}: {target_labels(scene)[k]}: the channel "
+                                 "calibration "
                                  f"failed ({'; '.join(cal.warnings)}), and with its offsets "
                                  f"{exc}") from None
             cal_note = ("" if tree is None else " (with the channel calibration's delay "
                         f"offsets {np.round(offsets[list(cell)] * 1e12, 1).tolist()} ps)")
-            raise SceneError(f"{scene.source}: targets[{k}]: {exc}{cal_note}") from None
+            raise SceneError(f"{scene.source}: {target_labels(scene)[k]}: {exc}{cal_note}"
+                             ) from None
         amps = cs.amplitudes(w, u) * probe.gain_correction[list(cell)]
         tau = float(requested_delay(scene, t.range_m))
         f_d = 2 * scene.radar.f_c_hz * t.velocity_mps / c

@@ -35,8 +35,8 @@ from .plan import plan_targets
 
 MAX_SUMMARY_TARGETS = 12  # targets listed in a summary
 
-__all__ = ["RunResult", "simulate", "run_scene", "match_targets", "label_detections",
-           "noise_power"]
+__all__ = ["RunResult", "simulate", "run_scene", "match_targets", "associate_targets",
+           "label_detections", "noise_power"]
 
 
 @dataclass(frozen=True, repr=False)
@@ -106,23 +106,49 @@ def association_scale(scene: Scene, rd: RangeDoppler, steering=None) -> np.ndarr
     return resolution_cell(scene.radar, st, rd)
 
 
+def direction_columns(az_rad, el_rad, dims: int) -> np.ndarray:
+    """The association's direction columns (N, dims): sin az (``dims`` 1) or sin az cos el
+    and sin el (``dims`` 2)."""
+    az, el = np.asarray(az_rad, float).ravel(), np.asarray(el_rad, float).ravel()
+    u = np.sin(az)[:, None] if dims == 1 else np.c_[np.sin(az) * np.cos(el), np.sin(el)]
+    return u.reshape(len(az), dims)
+
+
 def target_points(targets, dims: int, range_m=None) -> np.ndarray:
     """Set-points (T, 2 + dims) as the association compares them: range (``range_m`` (T,),
     where the radar sees them, default the set ranges), velocity and the direction cosines
-    (sin az; with ``dims`` 2 also sin el, az scaled by cos el)."""
+    (:func:`direction_columns`)."""
     t = list(targets)
     az = np.array([x.angle_rad for x in t], float)
     el = np.array([x.elevation_rad for x in t], float)
-    u = np.sin(az)[:, None] if dims == 1 else np.c_[np.sin(az) * np.cos(el), np.sin(el)]
     r = [x.range_m for x in t] if range_m is None else range_m
-    return np.c_[r, [x.velocity_mps for x in t], u].reshape(len(t), 2 + dims)
+    return np.c_[np.reshape(r, (-1, 1)), np.reshape([x.velocity_mps for x in t], (-1, 1)),
+                 direction_columns(az, el, dims)].reshape(len(t), 2 + dims)
 
 
 def detection_points(det: Detections, dims: int) -> np.ndarray:
     """Detections (D, 2 + dims) in the columns of :func:`target_points`."""
     az, el = np.asarray(det.angle_rad, float), np.radians(det.elevation_deg)
-    u = np.sin(az)[:, None] if dims == 1 else np.c_[np.sin(az) * np.cos(el), np.sin(el)]
-    return np.c_[det.range_m, det.velocity_mps, u].reshape(len(det), 2 + dims)
+    return np.c_[det.range_m, det.velocity_mps, direction_columns(az, el, dims)].reshape(
+        len(det), 2 + dims)
+
+
+def associate_targets(scene: Scene, det: Detections, rd: RangeDoppler, bins: float = 2,
+                      steering=None, targets=None, real: bool = False):
+    """The one association of ``targets`` (default the scene's) with ``det``
+    (:func:`rtsgeom.radar.association.associate`) in the radar's resolution cells
+    (:func:`association_scale`): the RTS's targets where the radar sees them
+    (:func:`rtsgeom.rts.channels.apparent_range`), ``real`` ones (the truth twin's) at their
+    set range. Returns ``(association, scale, seen_at)`` (``seen_at`` (T,) the ranges
+    compared)."""
+    targets = tuple(scene.targets if targets is None else targets)
+    seen_at = [t.range_m if real else float(apparent_range(scene, t.range_m))
+               for t in targets]
+    scale = association_scale(scene, rd, steering)
+    dims = scale.size - 2
+    assoc = associate(target_points(targets, dims, seen_at), detection_points(det, dims),
+                      scale, bins)
+    return assoc, scale, seen_at
 
 
 def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, bins: int = 2,
@@ -138,12 +164,7 @@ def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, bins: int = 2
     ``rts.compensate_air_path``); ``real`` targets (the truth twin's) at their set range.
     """
     targets = tuple(scene.targets if targets is None else targets)
-    seen_at = [t.range_m if real else float(apparent_range(scene, t.range_m))
-               for t in targets]
-    scale = association_scale(scene, rd, steering)
-    dims = scale.size - 2
-    assoc = associate(target_points(targets, dims, seen_at), detection_points(det, dims),
-                      scale, bins)
+    assoc, scale, seen_at = associate_targets(scene, det, rd, bins, steering, targets, real)
     dr, dv = scale[0], scale[1]
     out = []
     for i, t in enumerate(targets):
@@ -319,12 +340,16 @@ def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = 
 
 
 def truth_twin(setup: Setup, targets, echoes: Echoes, matches: list[dict], bins: int = 2,
-               seed: int | None = None) -> tuple[Detections, list[dict]]:
+               seed: int | None = None, compare=None) -> tuple[Detections, list[dict]]:
     """The same radar on the real scene (:mod:`rtsgeom.radar.truth`), with the RTS frame's
     noise seed and power, and each target's match completed with ``truth`` (the truth twin's
     own detection of it: range, velocity, angle, elevation where 2-D; None where the real
     scene gives it none of its own either), ``truth_status`` and ``vs_truth`` (the RTS's
     detection minus the truth's, same keys; None unless both exist).
+
+    ``compare``: the targets ``matches`` are of, where they are not ``targets`` (a budget's
+    synthesized targets, :mod:`rtsgeom.pipeline.merge`): the truth twin looks at the real
+    ``targets`` and each of ``compare`` gets the truth twin's detection of its cell.
 
     Returns the truth twin's detections and the completed matches (new dicts)."""
     scene = setup.scene
@@ -334,7 +359,7 @@ def truth_twin(setup: Setup, targets, echoes: Echoes, matches: list[dict], bins:
     _, t_cube = simulate_truth(setup, targets, seed, noise_w)
     t_rd, t_det = process(t_cube)
     t_matches = match_targets(scene, t_det, t_rd, bins=bins, steering=t_cube.steering,
-                              targets=targets, real=True)
+                              targets=targets if compare is None else compare, real=True)
     keys = ("range_m", "velocity_mps", "angle_deg", "elevation_deg")
     out = []
     for m, t in zip(matches, t_matches):

@@ -16,6 +16,12 @@ bin, velocity over the velocity bin, direction (direction cosine u = sin az, and
   (``merged_with`` lists the others), as when the radar cannot resolve two targets;
 * every other target is ``not_detected``.
 
+Each detection also has its ``nearest`` target: the one it lies nearest to, where that is
+within the gate and one angular resolution cell (-1: none). A detection the assignment left
+without an owner (a second detection of a target, or one of several scatterers the radar
+sees as one) still belongs to that target's neighbourhood: the clouds of an extended object
+(:mod:`rtsgeom.analysis.objects`) are built from ``owner``, then ``nearest``.
+
 The same function serves ``run``, ``play``, the truth twin, the resolution study and the API.
 """
 
@@ -53,13 +59,16 @@ class Association:
 
     ``detection`` (T,) the index of the serving detection, -1 for none; ``status`` (T,) one of
     :data:`STATUSES`; ``merged_with`` the other targets a merged detection serves (empty
-    otherwise); ``owner`` (D,) the target each detection was assigned to, -1 for none.
+    otherwise); ``owner`` (D,) the target each detection was assigned to, -1 for none;
+    ``nearest`` (D,) the target each detection lies nearest to within the gate and one angular
+    resolution cell, -1 for none.
     """
 
     detection: np.ndarray
     status: tuple[str, ...]
     merged_with: tuple[tuple[int, ...], ...]
     owner: np.ndarray
+    nearest: np.ndarray
 
 
 def associate(targets: np.ndarray, detections: np.ndarray, scale, gate: float = 2.0
@@ -90,18 +99,22 @@ def associate(targets: np.ndarray, detections: np.ndarray, scale, gate: float = 
     n_t, n_d = len(t), len(d)
     det_of = np.full(n_t, -1)
     owner = np.full(n_d, -1)
+    near_t = np.full(n_d, -1)
     if n_t and n_d:
         diff = (d[None, :, :] - t[:, None, :]) / scale  # (T, D, K) in resolution cells
         dist = np.sqrt(np.sum(diff ** 2, axis=-1))
         in_gate = np.all(np.abs(diff[..., :2]) <= gate, axis=-1)
         nearest = dist <= dist.min(axis=0, keepdims=True)  # no other target is nearer
+        in_cell = in_gate & (np.abs(diff[..., 2:]) <= 1.0).all(axis=-1)
+        first = np.argmax(nearest, axis=0)  # (D,) the nearest target (ties: the lower index)
+        near_t = np.where(in_cell[first, np.arange(n_d)], first, -1)
         allowed = in_gate & nearest
         cost = np.where(allowed, dist, _FORBIDDEN)
         rows, cols = linear_sum_assignment(cost)
         ok = allowed[rows, cols]
         det_of[rows[ok]], owner[cols[ok]] = cols[ok], rows[ok]
         status = ["detected" if j >= 0 else "not_detected" for j in det_of]
-        shared = in_gate & (np.abs(diff[..., 2:]) <= 1.0).all(axis=-1) & (owner >= 0)[None]
+        shared = in_cell & (owner >= 0)[None]
         merged: dict[int, set[int]] = {}
         for i in np.flatnonzero(det_of < 0):
             cand = np.flatnonzero(shared[i])
@@ -116,4 +129,4 @@ def associate(targets: np.ndarray, detections: np.ndarray, scale, gate: float = 
                 with_[i] = tuple(sorted(group - {i}))
     else:
         status, with_ = ["not_detected"] * n_t, [()] * n_t
-    return Association(det_of, tuple(status), tuple(with_), owner)
+    return Association(det_of, tuple(status), tuple(with_), owner, near_t)

@@ -44,6 +44,7 @@ from ..scene import RadarConfig
 from .steering import Steering
 
 __all__ = ["AdcCube", "fast_time_s", "chirp_start_s", "beat_phase0", "synthesize",
+           "synthesize_each",
            "synthesize_exact", "add_noise"]
 
 
@@ -119,6 +120,22 @@ def _single_threaded_blas():
 
 def synthesize(echoes: Echoes, radar: RadarConfig, rut: RutArray) -> AdcCube:
     """Noise-free ADC cube of all echoes (batched GEMM over virtual channels)."""
+    a, f = _slow_fast(echoes, radar, rut)
+    with _single_threaded_blas():  # fixed reduction order: bytes independent of thread count
+        data = np.matmul(a, f)  # (V, L, N)
+    return AdcCube(np.ascontiguousarray(data.transpose(1, 0, 2)), radar, rut)
+
+
+def synthesize_each(echoes: Echoes, radar: RadarConfig, rut: RutArray) -> np.ndarray:
+    """Each echo's own noise-free ADC cube (E, L, V, N), complex64: the terms
+    :func:`synthesize` sums (for E small: E times a cube's memory)."""
+    a, f = _slow_fast(echoes, radar, rut)
+    return np.einsum("vle,ven->elvn", a, f)
+
+
+def _slow_fast(echoes: Echoes, radar: RadarConfig, rut: RutArray):
+    """The separable factors of the echoes' beat (eq. 8): slow time A (V, L, E) and fast
+    time F (V, E, N), complex64; the cube is their product summed over the echoes."""
     s = radar.slope_hz_per_s
     t_n = fast_time_s(radar)  # (N,)
     t_c = chirp_start_s(radar, rut)  # (L, V)
@@ -134,10 +151,7 @@ def synthesize(echoes: Echoes, radar: RadarConfig, rut: RutArray) -> AdcCube:
     f = np.exp(2j * np.pi * beat[:, :, None] * t_n[None, None, :])
     if echoes.fast_gain is not None:  # the fractional-delay FIR's ripple along the chirp
         f = f * echoes.fast_gain[None]
-    f = f.astype(np.complex64)
-    with _single_threaded_blas():  # fixed reduction order: bytes independent of thread count
-        data = np.matmul(a, f)  # (V, L, N)
-    return AdcCube(np.ascontiguousarray(data.transpose(1, 0, 2)), radar, rut)
+    return a, f.astype(np.complex64)
 
 
 def synthesize_exact(echoes: Echoes, radar: RadarConfig, rut: RutArray,

@@ -311,7 +311,10 @@ def check_channels(scene, program: RtsProgram, link: RadarLink | None = None,
         rcs = tg.rcs_dbsm if tg is not None else float("nan")
         lo, hi = rcs - (mx[row] - att[row]), rcs + att[row]  # amplitude ~ sqrt(sigma): dB for dB
         rng = tg.range_m if tg is not None else float("nan")
-        raise LinkError(f"{src}: targets[{i}].rcs_dbsm = {rcs:g}: must be in [{lo:.1f}, "
+        from ..scene.objects import target_field, target_labels
+        name = (target_field(target_labels(scene)[i], "rcs_dbsm") if tg is not None
+                else f"targets[{i}].rcs_dbsm")
+        raise LinkError(f"{src}: {name} = {rcs:g}: must be in [{lo:.1f}, "
                         f"{hi:.1f}] dBsm at range_m = {rng:g} on RTS channel "
                         f"{int(program.front_end[row])} (attenuation {att[row]:.1f} dB needed; "
                         f"the back end offers [0, {mx[row]:.1f}] dB with rts.link gains, full scales "

@@ -29,7 +29,8 @@ from .peaks import angle_peaks
 from .steering import Steering
 from .windows import window
 
-__all__ = ["RangeDoppler", "Detections", "range_doppler", "cfar_mask", "detect",
+__all__ = ["RangeDoppler", "Detections", "range_doppler", "range_doppler_power", "cfar_mask",
+           "detect",
            "nearest_detection",
            "angle_spectrum", "estimate_angles", "range_angle_map", "process"]
 
@@ -159,6 +160,22 @@ def range_doppler(cube: AdcCube) -> RangeDoppler:
     nu = np.fft.fftshift(np.fft.fftfreq(n_l, d=radar.tdm_cycle_s))
     vel = nu * c / (2 * radar.f_c_hz)
     return RangeDoppler(spec, power, frozen(rng), frozen(vel), frozen(nu))
+
+
+def range_doppler_power(data: np.ndarray, radar: RadarConfig) -> np.ndarray:
+    """The power maps (..., R, D) of a batch of ADC cubes (..., L, V, N): the windows, FFTs
+    (double precision), complex64 spectrum and channel sum of :func:`range_doppler`, over
+    any leading axes (e.g. one cube per echo, :func:`rtsgeom.radar.fmcw.synthesize_each`)."""
+    import scipy.fft as sfft
+    n_l, n_s = data.shape[-3], data.shape[-1]
+    w_r = window(radar.range_window, n_s)
+    w_d = window(radar.doppler_window, n_l)
+    x = sfft.fft(data * w_r, axis=-1)  # (..., L, V, R)
+    x *= w_d[:, None, None]
+    x = sfft.fft(x, axis=-3, overwrite_x=True)  # (..., D, V, R)
+    spec = np.fft.fftshift(x, axes=-3).astype(np.complex64)  # stored as range_doppler's
+    power = (spec.real.astype(np.float64) ** 2 + spec.imag.astype(np.float64) ** 2).sum(-2)
+    return np.swapaxes(power, -1, -2)  # (..., R, D)
 
 
 #: OS-CFAR ranks at most this many training cells per cell under test (an evenly thinned ring

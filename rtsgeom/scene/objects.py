@@ -27,11 +27,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import SceneError
-from .mesh import load_mesh, mesh_scatterers
+from .mesh import MAX_MESH_SCATTERERS, load_mesh, mesh_scatterers
 from .schema import fmt
 from .sections import MAX_TARGETS, TargetConfig
 
-__all__ = ["ObjectModel", "place", "expand_objects", "frame_objects", "object_paths"]
+__all__ = ["ObjectModel", "place", "expand_objects", "frame_objects", "object_paths",
+           "target_labels", "target_field", "check_moving_objects", "check_static_objects",
+           "targets_per_frame"]
 
 
 @dataclass(frozen=True, eq=False)  # numpy fields: identity, not an ambiguous array ==
@@ -204,23 +206,172 @@ def frame_objects(scene, sp_by_target: dict, num_frames: int) -> list[list[Targe
     """Each frame's scatterers of the scenario's objects: ``sp_by_target`` maps a scenario
     target's index to its :class:`~rtsgeom.scene.scenario.SetPoints`. A mesh's scatterers
     are derived once, at the drive's first frame, and move with the object (so a frame's
-    targets are the same scatterers throughout the drive)."""
+    targets are the same scatterers throughout the drive); the positions are
+    :func:`object_set_points`' (checked on load by :func:`check_moving_objects`)."""
     out: list[list[TargetConfig]] = [[] for _ in range(num_frames)]
+    radar = scene.radar
     for k, m in enumerate(scene.objects):
         if not m.moving:
             continue
         sp = sp_by_target[int(m.where.split("[")[1].rstrip("]"))]
         try:
-            if m.points is None:  # the mesh as the RuT sees it at the first frame
-                first = place(m, sp.position_m[0], sp.velocity_vec_mps[0], scene.radar, k)
-                turn = _turn(m.heading(sp.velocity_vec_mps[0]))
-                local = np.array([[math.sin(t.angle_rad), math.cos(t.angle_rad), 0.0]
-                                  for t in first]) * np.array([t.range_m for t in first])[:, None]
-                pts = (local - sp.position_m[0][None]) @ turn
-                m = dataclasses.replace(m, points=pts,
-                                        rcs_dbsm=np.array([t.rcs_dbsm for t in first]))
-            for f in range(num_frames):
-                out[f] += place(m, sp.position_m[f], sp.velocity_vec_mps[f], scene.radar, k)
+            if m.points is None:
+                m = _mesh_frozen(m, sp, radar)
+            pos, vel = object_set_points(m, sp, radar)
         except SceneError as exc:
             raise SceneError(f"{scene.source}: {exc}") from None
+        rng = np.linalg.norm(pos, axis=-1)  # (F, N)
+        az = np.arctan2(pos[..., 0], pos[..., 1])
+        el = (np.arcsin(np.clip(pos[..., 2] / rng, -1, 1)) if radar.elevation_processing
+              else np.zeros_like(rng))
+        v_r = np.einsum("fnk,fk->fn", pos, vel) / rng
+        for f in range(num_frames):
+            out[f] += [TargetConfig(range_m=float(r), velocity_mps=float(v), rcs_dbsm=float(s),
+                                    angle_rad=float(a), elevation_rad=float(e), object_index=k)
+                       for r, v, s, a, e in zip(rng[f], v_r[f], m.rcs_dbsm, az[f], el[f])]
     return out
+
+
+def target_labels(scene, targets=None, moving_from: int | None = None) -> list[str]:
+    """Each of ``targets`` (default the scene's, objects expanded) named as the scene file
+    writes it: a point target ``targets[i]`` (its entry's index in the file, the objects'
+    entries counted as one each), an object's scatterer ``targets[1].scatterers[2]`` (a
+    mesh's: ``targets[1].mesh (scatterer 2)``). A drive's frame (``moving_from``: the index of
+    its first moving target, :func:`rtsgeom.analysis.playback.frames.frame_targets`) names
+    its moving point targets ``scenario.targets[i]``."""
+    tg = tuple(scene.targets if targets is None else targets)
+    moving = [] if scene.scenario is None else [
+        i for i, t in enumerate(scene.scenario.targets) if t.scatterers is None and t.mesh is None]
+    out, seen, per_obj, n_point = [], set(), {}, 0
+    for k, t in enumerate(tg):
+        o = t.object_index
+        if 0 <= o < len(scene.objects):
+            m = scene.objects[o]
+            j = per_obj.get(o, 0)
+            per_obj[o] = j + 1
+            seen.add(o)
+            out.append(f"{m.where}.scatterers[{j}]" if m.points is not None
+                       else f"{m.where}.mesh (scatterer {j})")
+        elif moving_from is not None and k >= moving_from and k - moving_from < len(moving):
+            out.append(f"scenario.targets[{moving[k - moving_from]}]")
+        else:
+            static = sum(1 for x in seen if not scene.objects[x].moving)
+            out.append(f"targets[{n_point + static}]")
+            n_point += 1
+    return out
+
+
+def target_field(label: str, field: str) -> str:
+    """A field of a target named by :func:`target_labels`: ``targets[2].range_m``; an object's
+    scatterer has no such field in the file: ``targets[1].scatterers[2] (its range_m)``."""
+    return f"{label} (its {field})" if ".scatterers[" in label or ".mesh" in label \
+        else f"{label}.{field}"
+
+
+def object_set_points(model: ObjectModel, sp, radar) -> tuple[np.ndarray, np.ndarray]:
+    """A moving object's scatterers over its drive, vectorised over frames: their positions
+    (F, N, 3) in the radar frame and velocities (F, 3) (``sp``: the object's
+    :class:`~rtsgeom.scene.scenario.SetPoints`). A mesh's scatterers are derived at the first
+    frame (:func:`place`) and move with the object, as :func:`frame_objects` plays them."""
+    if model.points is None:  # the mesh as the RuT sees it at the first frame
+        model = _mesh_frozen(model, sp, radar)
+    vel = sp.velocity_vec_mps
+    moves = np.hypot(vel[:, 0], vel[:, 1]) > 0  # as ObjectModel.heading, every frame at once
+    h = np.where(model.along_velocity & moves, np.arctan2(vel[:, 0], vel[:, 1]),
+                 model.heading_rad)  # (F,)
+    ch, sh = np.cos(h), np.sin(h)
+    x, y, z = model.points[:, 0], model.points[:, 1], model.points[:, 2]
+    pos = np.stack([ch[:, None] * x + sh[:, None] * y, -sh[:, None] * x + ch[:, None] * y,
+                    np.broadcast_to(z, (len(h), len(z)))], axis=-1)
+    return sp.position_m[:, None, :] + pos, vel
+
+
+def _mesh_frozen(model: ObjectModel, sp, radar) -> ObjectModel:
+    """The mesh object with the scatterers the RuT sees at the drive's first frame, in its
+    own frame."""
+    first = place(model, sp.position_m[0], sp.velocity_vec_mps[0], radar, 0)
+    turn = _turn(model.heading(sp.velocity_vec_mps[0]))
+    local = np.array([[math.sin(t.angle_rad), math.cos(t.angle_rad), 0.0]
+                      for t in first]) * np.array([t.range_m for t in first])[:, None]
+    pts = (local - sp.position_m[0][None]) @ turn
+    return dataclasses.replace(model, points=pts, rcs_dbsm=np.array([t.rcs_dbsm for t in first]))
+
+
+def check_moving_objects(scene, fail, limits, air_extra_m: float, sps: dict) -> None:
+    """Every moving object's scatterers in every frame within what the processing resolves,
+    as a ``[[targets]]`` point target or a static object's scatterer is checked (range below
+    the radar's range axis less the air path the RTS does not subtract, above the arc's radius
+    where it subtracts it; radial velocity within the unambiguous one; azimuth within +-90 deg
+    and elevation within +-60 deg): one message each, naming the scatterer as written
+    (``scenario.targets[0].scatterers[3]``) with the time of its first frame outside.
+    ``sps``: each moving object's scenario index -> its SetPoints."""
+    r_lim, v_lim, why_r, why_v = limits
+    r_max = r_lim - air_extra_m
+    rts = scene.rts
+    times = scene.scenario.frame_times()
+    for m in scene.objects:
+        if not m.moving:
+            continue
+        i = int(m.where.split("[")[1].rstrip("]"))
+        if i not in sps:  # its waypoints are refused already
+            continue
+        try:
+            pos, vel = object_set_points(m, sps[i], scene.radar)
+        except SceneError as exc:  # a mesh with no facet facing the RuT at the first frame
+            fail(f"{m.where}.mesh", scene.scenario.targets[i].mesh, str(exc).split(": ", 1)[-1])
+            continue
+        rng = np.linalg.norm(pos, axis=-1)  # (F, N)
+        v_r = np.einsum("fnk,fk->fn", pos, vel) / np.maximum(rng, 1e-12)
+        az = np.degrees(np.arctan2(pos[..., 0], pos[..., 1]))
+        el = np.degrees(np.arcsin(np.clip(pos[..., 2] / np.maximum(rng, 1e-12), -1, 1)))
+        if not scene.radar.elevation_processing:
+            el = np.zeros_like(el)  # placed at elevation 0 (module docstring)
+        low = rts.arc_radius_m if rts.compensate_air_path else 1e-3
+        checks = ((rng >= r_max, rng, "range", "m",
+                   f"< {r_max:.4g} m, {why_r}" + (f" minus the air path {air_extra_m:.4g} m "
+                                                  "the RTS does not subtract"
+                                                  if air_extra_m > 1e-9 else "")),
+                  (rng <= low, rng, "range", "m",
+                   f"> rts.arc_radius_m ({rts.arc_radius_m:g} m): the RTS cannot emit before "
+                   "the radar signal reached it" if rts.compensate_air_path else "> 0 m"),
+                  (np.abs(v_r) >= v_lim, v_r, "radial velocity", "m/s",
+                   f"in (-{v_lim:.4g}, {v_lim:.4g}) m/s, {why_v}"),
+                  (np.abs(az) > 90.0, az, "azimuth", "deg", "in [-90, 90] deg (in front of "
+                   "the RuT)"),
+                  (np.abs(el) > 60.0, el, "elevation", "deg", "in [-60, 60] deg"))
+        for bad, val, what, unit, allowed in checks:
+            if bad.any():
+                f = int(np.flatnonzero(bad.any(axis=1))[0])
+                n = int(np.flatnonzero(bad[f])[0])
+                row = ([round(float(x), 6) for x in m.points[n]] + [float(m.rcs_dbsm[n])]
+                       if m.points is not None else None)
+                name = (f"{m.where}.scatterers[{n}]" if m.points is not None
+                        else f"{m.where}.mesh")
+                fail(name, row if row is not None else scene.scenario.targets[i].mesh,
+                     f"a scatterer whose {what} stays {allowed} (at t = {times[f]:g} s it is "
+                     f"{val[f, n]:.4g} {unit})")
+
+
+def targets_per_frame(scene) -> int:
+    """A drive's point targets in one frame: the ``[[targets]]`` (objects expanded) and each
+    ``[[scenario.targets]]`` entry's scatterers (a mesh: at most :data:`MAX_MESH_SCATTERERS`;
+    a point target: one)."""
+    return len(scene.targets) + sum(
+        len(t.scatterers) if t.scatterers is not None else
+        MAX_MESH_SCATTERERS if t.mesh is not None else 1 for t in scene.scenario.targets)
+
+
+def check_static_objects(scene, fail, names) -> None:
+    """A static object's scatterers in front of the RuT as a point target's ``angle_deg`` and
+    ``elevation_deg`` are (+-90 deg, +-60 deg); ``names``: :func:`target_labels`."""
+    for i, tg in enumerate(scene.targets):
+        if tg.object_index < 0:
+            continue
+        if abs(tg.angle_rad) > math.pi / 2 + 1e-12:
+            fail(target_field(names[i], "azimuth_deg"), round(math.degrees(tg.angle_rad), 6),
+                 "in [-90, 90] deg, in front of the RuT (as a point target's angle_deg): move "
+                 "the object or its scatterer")
+        if abs(tg.elevation_rad) > math.radians(60.0) + 1e-12:
+            fail(target_field(names[i], "elevation_deg"),
+                 round(math.degrees(tg.elevation_rad), 6),
+                 "in [-60, 60] deg (as a point target's elevation_deg)")

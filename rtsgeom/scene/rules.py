@@ -26,6 +26,8 @@ from .presets import ArraySpec
 from .registry import RADAR_PRESETS, WINDOWS, AOA_MODES
 from ..errors import SceneError
 from .scenario import check_scenario
+from .objects import (check_moving_objects, check_static_objects, target_field, target_labels,
+                      targets_per_frame)
 from .schema import fmt, specs
 from .sections import FrontEndConfig, RadarConfig, RtsConfig
 
@@ -425,19 +427,20 @@ def _target_rules(scene, fail) -> None:
     extra = _air_extra_m(scene)
     r_lim, v_lim, why_r, why_v = resolvable_limits(radar)
     r_max = r_lim - extra
+    names = target_labels(scene)  # an object's scatterer as the file writes it
     for i, tg in enumerate(scene.targets):
         if tg.range_m >= r_max:
-            air = (f" minus the air path {extra:.4g} m the RTS does not subtract "
-                   f"(rts.compensate_air_path = {str(rts.compensate_air_path).lower()})"
-                   if extra > 0 else "")
-            fail(f"targets[{i}].range_m", tg.range_m, f"< {r_max:.4g} m, {why_r}{air}")
+            air = (f" minus the air path {extra:.4g} m the RTS does not subtract (rts."
+                   f"compensate_air_path = {str(rts.compensate_air_path).lower()})" * (extra > 1e-9))
+            fail(target_field(names[i], "range_m"), tg.range_m, f"< {r_max:.4g} m, {why_r}{air}")
         if abs(tg.velocity_mps) >= v_lim:
-            fail(f"targets[{i}].velocity_mps", tg.velocity_mps,
+            fail(target_field(names[i], "velocity_mps"), tg.velocity_mps,
                  f"in (-{v_lim:.4g}, {v_lim:.4g}) m/s, {why_v}")
         if rts.compensate_air_path and tg.range_m <= rts.arc_radius_m:
-            fail(f"targets[{i}].range_m", tg.range_m,
+            fail(target_field(names[i], "range_m"), tg.range_m,
                  f"> rts.arc_radius_m ({rts.arc_radius_m:g} m): the RTS cannot emit before the "
                  "radar signal reached it")
+    check_static_objects(scene, fail, names)
 
 
 def _air_extra_m(scene) -> float:
@@ -452,7 +455,9 @@ def _scenario_rules(scene, fail) -> None:
     duration_s; at most MAX_FRAMES frames; in every frame each moving target's range, radial
     velocity (and elevation) within what the processing resolves, as for ``[[targets]]``."""
     if scene.scenario is not None:
-        check_scenario(scene, fail, resolvable_limits(scene.radar), _air_extra_m(scene))
+        lim, extra = resolvable_limits(scene.radar), _air_extra_m(scene)
+        check_moving_objects(scene, fail, lim, extra, check_scenario(  # objects' scatterers
+            scene, fail, lim, extra, targets_per_frame(scene)))
 
 
 def angular_resolution_rad(radar: "RadarConfig") -> float:
@@ -485,11 +490,11 @@ def _spacing_rules(scene, fail) -> None:
             continue
         between = [k for k, tg in enumerate(scene.targets) if lo < tg.angle_rad < hi]
         if between:
-            k = between[0]
+            k, name = between[0], target_field(target_labels(scene)[between[0]], "angle_deg")
             fail(f"rts.front_ends[{i}].angle_deg", math.degrees(rts.front_ends[i].angle_rad),
                  f"within the RuT's angular resolution 1.22 lambda/d_A = "
                  f"{math.degrees(res):.4g} deg of front end {i - 1} (paper eq. 24): seen from "
                  f"the RuT they are {math.degrees(hi - lo):.4g} deg apart and "
-                 f"targets[{k}].angle_deg = {math.degrees(scene.targets[k].angle_rad):g} is "
+                 f"{name} = {math.degrees(scene.targets[k].angle_rad):g} is "
                  f"synthesised between them (rts.aoa_mode = \"{rts.aoa_mode}\"); set "
                  "rts.allow_wide_spacing = true to force it, or rts.aoa_mode = \"nearest\"")

@@ -151,27 +151,38 @@ def trajectory(waypoints, time_s) -> SetPoints:
                      np.einsum("fi,fi->f", pos, vel) / rng, pos, vel)
 
 
-def check_scenario(scene, fail, limits, air_extra_m: float) -> None:
+def check_scenario(scene, fail, limits, air_extra_m: float, per_frame: int | None = None
+                   ) -> dict:
     """The scenario's own rules (called by :func:`rtsgeom.scene.rules.problems`): waypoint
     times, the number of frames, and every frame's set-points within what the processing
     resolves (``limits``: :func:`~rtsgeom.scene.rules.resolvable_limits`; ``air_extra_m``: the
-    air path the RTS does not subtract)."""
+    air path the RTS does not subtract; ``per_frame``: the point targets of a frame, the
+    objects' scatterers counted, :func:`rtsgeom.scene.objects.targets_per_frame`). Returns
+    each moving object's set-points by its index, where its waypoints pass (its scatterers
+    are checked by :func:`rtsgeom.scene.objects.check_moving_objects`)."""
     sc = scene.scenario
+    sps: dict = {}
     if sc is None:
-        return
+        return sps
     if sc.num_frames > MAX_FRAMES:
         fail("scenario.frame_period_s", sc.frame_period_s,
              f">= {sc.duration_s / (MAX_FRAMES - 1):g} s: scenario.duration_s = "
              f"{sc.duration_s:g} s would take {sc.num_frames} frames (at most {MAX_FRAMES})")
-        return
-    n_t = len(sc.targets) + len(scene.targets)
+        return sps
+    from .sections import MAX_TARGETS
+    n_t = len(scene.targets) + len(sc.targets) if per_frame is None else per_frame
+    if n_t > MAX_TARGETS:
+        fail("scenario.targets", f"{len(sc.targets)} entries",
+             f"at most {MAX_TARGETS} point targets a frame with [[targets]] and the objects' "
+             f"scatterers (they make {n_t})")
+        return sps
     if sc.num_frames * n_t > MAX_TARGET_FRAMES:
         fail("scenario.frame_period_s", sc.frame_period_s,
              f">= {sc.duration_s * n_t / (MAX_TARGET_FRAMES - n_t):g} s: {sc.num_frames} frames "
              f"x {n_t} targets would be {sc.num_frames * n_t} target-frames (at most "
              f"{MAX_TARGET_FRAMES}: the played drive's memory; a shorter scenario.duration_s "
              "or fewer targets)")
-        return
+        return sps
     r_lim, v_lim, why_r, why_v = limits
     r_max = r_lim - air_extra_m
     times = sc.frame_times()
@@ -193,6 +204,8 @@ def check_scenario(scene, fail, limits, air_extra_m: float) -> None:
                  f"({sc.duration_s:g} s): the last waypoint ends the drive, or later")
             continue
         sp = trajectory(wp, times)
+        if tg.scatterers is not None or tg.mesh is not None:
+            sps[i] = sp
 
         def blame(k: int, what: str, allowed: str) -> None:
             """The waypoint that starts the segment holding frame k (as written in the file)."""
@@ -220,3 +233,4 @@ def check_scenario(scene, fail, limits, air_extra_m: float) -> None:
         if np.any(wp[:, 3] != 0) and not scene.radar.elevation_processing:
             fail("radar.elevation_processing", False, f"true: {where} has elevations; a "
                  "target off the horizontal plane needs the RuT's 2-D beamforming")
+    return sps

@@ -2,8 +2,9 @@
 
 Left: a bird's-eye view (the RuT at the origin, x to the right, y ahead) of each object's
 outline at one frame with its scatterers, the truth twin's detections and the RTS's. Right
-(over a drive): per frame the detections of truth and RTS, the targets the RTS kept under its
-budget, and the difference of the clouds' centroid azimuths.
+(over a drive): per frame the detections of truth and RTS, the truth's the RTS reproduces
+within a resolution cell, the targets the RTS kept under its budget, and the difference of
+the clouds' centroid azimuths; the object's range above the frames.
 """
 
 from __future__ import annotations
@@ -22,7 +23,8 @@ def _xy(rows) -> np.ndarray:
 
 
 @_styled
-def object_figure(outlines, scatterers, rows, frame: int, table=None, title: str = ""):
+def object_figure(outlines, scatterers, rows, frame: int, table=None, title: str = "",
+                  ranges_m=None):
     """The object figure (module docstring).
 
     Parameters
@@ -38,6 +40,8 @@ def object_figure(outlines, scatterers, rows, frame: int, table=None, title: str
     table : list of dict, optional
         The per object and frame summary (:func:`rtsgeom.analysis.objects.summary_table`);
         over more than one frame, the right panel.
+    ranges_m : array_like, optional
+        Per frame the range of the (first) object's origin (m), shown above the frames.
     """
     frames = sorted({t["frame"] for t in table}) if table else [frame]
     drive = len(frames) > 1
@@ -70,6 +74,9 @@ def object_figure(outlines, scatterers, rows, frame: int, table=None, title: str
                     label="truth detections" + suffix)
             bx.plot(f, [t["rts_detections"] for t in rows_o], "x-", color="C3", ms=4,
                     label="RTS detections" + suffix)
+            bx.plot(f, [round(t["truth_detections"] * (t["reproduced_share"] or 0.0))
+                        for t in rows_o], "^:", color="C4", ms=3,
+                    label="truth detections the RTS reproduces (within a cell)" + suffix)
             if "kept" in rows_o[0]:
                 bx.plot(f, [t["kept"] for t in rows_o], "s--", color="C2", ms=3,
                         label="targets the RTS kept (budget)")
@@ -77,6 +84,12 @@ def object_figure(outlines, scatterers, rows, frame: int, table=None, title: str
         bx.xaxis.set_major_locator(MaxNLocator(integer=True))
         bx.yaxis.set_major_locator(MaxNLocator(integer=True))
         bx.set_xlabel("frame")
+        bx.set_ylim(bottom=0)  # counts from zero: a drop to 3 of 5 reads as it is
+        if ranges_m is not None:  # the object's range on top: dynamic resolution reads by it
+            top = bx.secondary_xaxis("top")
+            ticks = [k for k in bx.get_xticks() if 0 <= k < len(ranges_m) and k == int(k)]
+            top.set_xticks(ticks, [f"{ranges_m[int(k)]:.3g}" for k in ticks])
+            top.set_xlabel("range of the object's origin (m)", fontsize=8)
         bx.set_ylabel("count")
         tx = bx.twinx()
         for o in objs[:3]:

@@ -20,7 +20,8 @@ LEGEND_TARGETS = 8
 
 @_styled
 def playback_figure(time_s, set_deg, detected_deg: Mapping[str, np.ndarray],
-                    handovers_s: Mapping[str, list], title: str = "") -> Figure:
+                    handovers_s: Mapping[str, list], title: str = "",
+                    objects: Mapping | None = None) -> Figure:
     """One column per AoA mode: top, the set azimuth (lines) and the detected one (dots) of
     every target over time; bottom, the detected minus set azimuth. Dotted vertical lines:
     the frames where a target changed the front ends that carry it (hand-overs).
@@ -31,6 +32,10 @@ def playback_figure(time_s, set_deg, detected_deg: Mapping[str, np.ndarray],
     set_deg : (F, T) set azimuths
     detected_deg : mode -> (F, T) detected azimuths (NaN where lost)
     handovers_s : mode -> times of the hand-overs
+    objects : optional, mode -> the extended objects of the drive in that mode's column:
+        ``set_deg`` (F, S) their scatterers' azimuths (thin grey lines), ``truth`` and ``rts``
+        (N, 2) their detections (time, azimuth), ``pairs`` (P, 2) each truth detection's
+        RTS detection of its cell (time, RTS minus truth azimuth)
     """
     t = np.asarray(time_s, float)
     s = np.asarray(set_deg, float).reshape(t.size, -1)
@@ -43,6 +48,8 @@ def playback_figure(time_s, set_deg, detected_deg: Mapping[str, np.ndarray],
         top, bottom = axes[0, col], axes[1, col]
         named = s.shape[1] <= LEGEND_TARGETS
         for k in range(s.shape[1]):
+            if not np.isfinite(s[:, k]).any():  # not a tracked point target (an object's)
+                continue
             line, = top.plot(t, s[:, k], lw=1.0,
                              label=f"target {k} set" if named else
                              ("set (one colour per target)" if k == 0 else None))
@@ -54,13 +61,16 @@ def playback_figure(time_s, set_deg, detected_deg: Mapping[str, np.ndarray],
             if np.any(lost):
                 top.plot(t[lost], s[lost, k], "x", color="red", ms=6,
                          label=f"target {k} lost" if named else "lost")
+        if objects is not None and mode in objects:
+            _objects(top, bottom, t, objects[mode])
         for i, th in enumerate(handovers_s.get(mode, [])):
             for ax in (top, bottom):
                 ax.axvline(th, color="0.4", ls=":", lw=0.9,
                            label="hand-over" if (i == 0 and ax is top) else None)
         top.set_title(f"{title + ': ' if title else ''}{mode}")
         top.set_ylabel("azimuth (deg)")
-        bottom.set_ylabel("detected - set azimuth (deg)")
+        bottom.set_ylabel("detected - set azimuth (deg)" if objects is None or mode not in
+                          objects else "detected - set (targets) or\nRTS - truth (object) (deg)")
         bottom.set_xlabel("time (s)")
     # one legend for the figure, below the plots (inside, with a few targets, it covered the
     # tracks); constrained layout makes room for it
@@ -73,6 +83,24 @@ def playback_figure(time_s, set_deg, detected_deg: Mapping[str, np.ndarray],
     fig.legend(handles, labels, loc="outside lower center", ncol=min(4, len(labels)),
                fontsize=8, frameon=False)
     return fig
+
+
+def _objects(top, bottom, t, objects) -> None:
+    """An extended object's clouds over the drive: its scatterers' set azimuths, the truth
+    twin's and the RTS's detections; below, RTS minus truth per truth detection."""
+    sd = np.asarray(objects["set_deg"], float).reshape(t.size, -1)
+    for k in range(sd.shape[1]):
+        top.plot(t, sd[:, k], color="0.75", lw=0.8, zorder=1,
+                 label="object scatterers, set" if k == 0 else None)
+    tr = np.asarray(objects["truth"], float).reshape(-1, 2)
+    rt = np.asarray(objects["rts"], float).reshape(-1, 2)
+    top.scatter(tr[:, 0], tr[:, 1], s=40, facecolors="none", edgecolors="C0", lw=1.2,
+                zorder=3, label="object: truth twin detections")
+    top.scatter(rt[:, 0], rt[:, 1], s=22, marker="x", color="C3", lw=1.2, zorder=4,
+                label="object: RTS detections")
+    pr = np.asarray(objects["pairs"], float).reshape(-1, 2)
+    bottom.plot(pr[:, 0], pr[:, 1], "x", color="C3", ms=5,
+                label="object: RTS - truth twin detection of the cell")
 
 
 def playback_animation(path, time_s, fe_azimuth_deg, amplitude, target_xy_m, set_deg,

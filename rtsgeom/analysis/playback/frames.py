@@ -19,8 +19,8 @@ from ...geometry import Setup
 from ...paths import Paths
 from ...pipeline.merge import budget_targets
 from ...pipeline.plan import (bracketing_pair, calibrate_pairs, lead_program, program_frames,
-                              target_pairs, uses_cells)
-from ...pipeline.run import association_scale, match_targets, truth_twin
+                              target_namer, target_pairs, uses_cells)
+from ...pipeline.run import match_targets, truth_twin
 from ...radar import process
 from ...radar.frame import simulate
 from ...calibration.channels import channel_offsets
@@ -57,13 +57,20 @@ def frame_targets(scene: Scene) -> tuple[np.ndarray, list[tuple[TargetConfig, ..
     return times, frames
 
 
-def frame_target_names(scene: Scene, f: int, static: int | None = None):
+def frame_target_names(scene: Scene, f: int, static: int | None = None, targets=None,
+                       budget=None):
     """Frame ``f``'s target ``k`` as the scene file names it (``frame_targets`` puts the
-    ``[[targets]]`` first): ``frame f: targets[k]`` or ``frame f: scenario.targets[k - S]``
-    (``static``: S, default the scene's own count)."""
+    ``[[targets]]`` first): ``frame f: targets[k]`` or ``frame f: scenario.targets[i]``, an
+    object's scatterer ``frame f: scenario.targets[0].scatterers[3]`` (``static``: S, default
+    the scene's own count; ``targets``: the frame's, for the objects' scatterers;
+    ``budget``: ``k`` a synthesized target, named by its strongest member,
+    :func:`rtsgeom.pipeline.plan.target_namer`)."""
     s = len(scene.targets) if static is None else static
-    return lambda k: (f"frame {f}: targets[{k}]" if k < s
-                      else f"frame {f}: scenario.targets[{k - s}]")
+    if targets is None and budget is None:
+        return lambda k: (f"frame {f}: targets[{k}]" if k < s
+                          else f"frame {f}: scenario.targets[{k - s}]")
+    name = target_namer(scene, targets, budget, moving_from=s)
+    return lambda k: f"frame {f}: {name(k)}"
 
 
 class FramePlanner:
@@ -92,15 +99,17 @@ class FramePlanner:
         if scene.rts.max_targets_per_channel is not None:  # each frame's merged targets
             self.budgets = [budget_targets(setup, tg, self.probe, bracketing_pair)
                             for tg in frames]
-            frames = [b.targets for b in self.budgets]
         self.pairs, seen = [], set()
-        for f, targets in enumerate(frames):
-            pairs, notes = target_pairs(setup, self.probe, targets,
-                                        where=frame_target_names(scene, f))
+        for f, scatterers in enumerate(frames):
+            budget = self.budgets[f] if self.budgets else None
+            targets = budget.targets if budget else scatterers
+            pairs, notes = target_pairs(setup, self.probe, targets, where=frame_target_names(
+                scene, f, targets=scatterers, budget=budget))
             self.pairs.append(pairs)
             for n in notes:  # a pair too wide: once, at the first frame it is used
-                if n.split("]: ", 1)[-1] not in seen:
-                    seen.add(n.split("]: ", 1)[-1])
+                key = n[n.find(": front ends"):]
+                if key not in seen:
+                    seen.add(key)
                     self.warnings.append(n)
         used = sorted({p for pairs in self.pairs for p in pairs})
         self.cals = calibrate_pairs(setup, paths, used, self.probe, progress=progress)
@@ -133,31 +142,37 @@ class FramePlanner:
             self.setup, self.paths, self.mode,
             [self.budgets[f].targets if self.budgets else self.frames[f] for f in fs],
             [self.pairs[f] for f in fs], self.probe, self.cals, self.offsets,
-            [frame_target_names(scene, f, static) for f in fs])
+            [frame_target_names(scene, f, static, self.frames[f],
+                                self.budgets[f] if self.budgets else None) for f in fs])
 
 
 def detect_frame(setup: Setup, paths: Paths, program: RtsProgram, scene_f: Scene, seed: int,
-                 bins: int = 2, truth: bool = True, detections: bool = False) -> tuple:
+                 bins: int = 2, truth: bool = True, synthesized=None) -> tuple:
     """One frame through the full chain: the matches of ``match_targets`` (with the truth
     twin's detections where ``truth``: :func:`rtsgeom.pipeline.run.truth_twin`, same seed) and,
     per target, the number of other detections within ``bins`` range and Doppler bins of its
-    set-point that no target claimed (a split: the RuT sees the target twice). With
-    ``detections`` also ``(detections, truth twin's detections or None, association scale)``
-    (the frame's clouds, :mod:`rtsgeom.analysis.objects`)."""
+    set-point that no target claimed (a split: the RuT sees the target twice), and
+    ``(detections, truth twin's detections or None, range-Doppler map, steering)`` (the
+    frame's clouds, :mod:`rtsgeom.analysis.objects`).
+
+    ``synthesized``: the targets the RTS synthesizes where they are not ``scene_f``'s (a
+    budget's, :mod:`rtsgeom.pipeline.merge`): the matches are theirs, each against the truth
+    twin's detection of its cell (the truth twin still looks at ``scene_f``'s real targets)."""
     echoes, cube = simulate(setup, paths, program, seed, scene_f.radar.snr_db)
     rd, det = process(cube)
-    matches = match_targets(scene_f, det, rd, bins=bins, steering=cube.steering)
+    compare = tuple(scene_f.targets if synthesized is None else synthesized)
+    matches = match_targets(scene_f, det, rd, bins=bins, steering=cube.steering,
+                            targets=compare)
     t_det = None
     if truth and scene_f.targets:
-        t_det, matches = truth_twin(setup, scene_f.targets, echoes, matches, bins, seed)
+        t_det, matches = truth_twin(setup, scene_f.targets, echoes, matches, bins, seed,
+                                    compare=None if synthesized is None else compare)
     claimed = {m.get("detection_index") for m in matches}
     dr = rd.range_m[1] - rd.range_m[0]
     dv = rd.velocity_mps[1] - rd.velocity_mps[0]
     extra = np.zeros(len(matches), int)
-    for k, t in enumerate(scene_f.targets):
+    for k, t in enumerate(compare):
         near = np.flatnonzero((np.abs(det.range_m - t.range_m) <= bins * dr)
                               & (np.abs(det.velocity_mps - t.velocity_mps) <= bins * dv))
         extra[k] = sum(1 for j in near if j not in claimed)
-    if detections:
-        return matches, extra, (det, t_det, association_scale(scene_f, rd, cube.steering))
-    return matches, extra
+    return matches, extra, (det, t_det, rd, cube.steering)

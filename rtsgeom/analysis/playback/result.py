@@ -13,13 +13,18 @@ from ... import __version__
 from ..._lib.results import Result
 from ...scene import Scene
 
-__all__ = ["PlaybackResult", "PROGRAMME_COLUMNS", "TRACK_COLUMNS"]
+__all__ = ["PlaybackResult", "PROGRAMME_COLUMNS", "TRACK_COLUMNS", "BUDGET_ROLES", "budget_line"]
 
 PROGRAMME_COLUMNS = ("frame", "time_s", "target", "channel", "delay_s", "doppler_hz",
                      "amplitude_db", "phase_rad")
 TRACK_COLUMNS = ("frame", "time_s", "target", "set_range_m", "set_azimuth_deg",
                  "set_velocity_mps", "range_m", "azimuth_deg", "velocity_mps",
-                 "truth_range_m", "truth_azimuth_deg", "truth_velocity_mps", "status")
+                 "truth_range_m", "truth_azimuth_deg", "truth_velocity_mps", "status",
+                 "budget")
+#: a target's role under ``[rts] max_targets_per_channel`` (:mod:`rtsgeom.pipeline.merge`):
+#: synthesized alone, carrying a merged target (its strongest member), folded into another's
+#: merged target, or dropped
+BUDGET_ROLES = ("kept", "lead", "merged", "dropped")
 
 
 @dataclass(frozen=True, repr=False)
@@ -36,7 +41,15 @@ class PlaybackResult(Result):
     ``status`` (frames, targets) ``detected``, ``merged`` or ``not_detected``; ``clouds``
     (a scene with extended objects) the truth twin's and the RTS's detections of each object
     (:mod:`rtsgeom.analysis.objects`) and the resolution cell they are compared in;
-    ``budget`` per frame the planner's counts under ``[rts] max_targets_per_channel``.
+    ``budget`` per frame the planner's counts under ``[rts] max_targets_per_channel``;
+    ``role`` (frames, targets) each target's role under that budget (:data:`BUDGET_ROLES`;
+    None without one): a ``lead``'s detection and truth are the merged target's and the truth
+    twin's detection of its cell, a ``merged`` or ``dropped`` target has neither;
+    ``object_of`` (targets,) the extended object each target belongs to (-1: a point target).
+    The angle, range and velocity errors, losses and hand-overs are over the point targets
+    synthesized as themselves (:attr:`tracked`); an object's scatterers are compared as its
+    cloud, each RTS detection against the truth twin's detection of its cell
+    (:mod:`rtsgeom.analysis.objects`, ``objects.json``).
     """
 
     scene: Scene
@@ -54,6 +67,8 @@ class PlaybackResult(Result):
     status: np.ndarray | None = None
     clouds: tuple | None = None  # (clouds.csv rows, resolution cell) of a scene with objects
     budget: tuple | None = None  # per frame the planner's kept/merged/dropped counts
+    role: np.ndarray | None = None  # (frames, targets) BUDGET_ROLES under a budget
+    object_of: np.ndarray | None = None  # (targets,) each target's object, -1: a point target
 
     def _summary(self):
         s = self.summary()
@@ -68,6 +83,8 @@ class PlaybackResult(Result):
         rows = [("max |angle error|", deg(err["max"])), ("p95 |angle error|", deg(err["p95"])),
                 ("hand-overs", s["handovers"]),
                 ("largest jump at a hand-over", deg(s["handover_jump_deg"]))]
+        if "budget" in s:
+            rows.append(("budget", budget_line(s["budget"])))
         if self.baseline is not None:
             b = self.baseline.summary()
             rows.append((f"baseline ({self.baseline.mode}) max |angle error|",
@@ -82,9 +99,24 @@ class PlaybackResult(Result):
         return int(self.split.shape[1])
 
     @property
+    def tracked(self) -> np.ndarray:
+        """(frames, targets) where a target's track is compared to its set-point: a point
+        target (an extended object's scatterers are compared as the object's cloud,
+        :mod:`rtsgeom.analysis.objects`) that the RTS synthesizes as itself (under a budget,
+        role ``kept``)."""
+        out = np.ones(self.split.shape, bool)
+        if self.object_of is not None:
+            out &= (np.asarray(self.object_of) < 0)[None, :]
+        if self.role is not None:
+            out &= np.asarray(self.role) == "kept"
+        return out
+
+    @property
     def angle_error_deg(self) -> np.ndarray:
-        """Detected minus set azimuth (frames, targets), NaN where lost."""
-        return self.detected["azimuth_deg"] - self.set["azimuth_deg"]
+        """Detected minus set azimuth (frames, targets), NaN where lost or where the target is
+        not synthesized as itself (:attr:`tracked`)."""
+        return np.where(self.tracked, self.detected["azimuth_deg"] - self.set["azimuth_deg"],
+                        np.nan)
 
     @property
     def vs_truth_deg(self) -> np.ndarray:
@@ -95,9 +127,13 @@ class PlaybackResult(Result):
         return self.detected["azimuth_deg"] - self.truth["azimuth_deg"]
 
     def handovers(self) -> list[tuple[int, int]]:
-        """(frame, target) where the channels carrying the target differ from the frame before."""
+        """(frame, target) where the channels carrying the target differ from the frame before,
+        the target synthesized as itself in both (:attr:`tracked`: a budget's merge or drop
+        is no hand-over)."""
+        a = self.tracked
         return [(f, k) for k in range(self.num_targets) for f in range(1, len(self.time_s))
-                if self.channels[f, k] != self.channels[f - 1, k]]
+                if a[f, k] and a[f - 1, k] and self.channels[f, k]
+                and self.channels[f - 1, k] and self.channels[f, k] != self.channels[f - 1, k]]
 
     def handover_jumps_deg(self) -> np.ndarray:
         """At each hand-over, how far the angle error moved from the frame before (deg; NaN
@@ -114,9 +150,11 @@ class PlaybackResult(Result):
         per target the same, and the baseline's where it was played."""
         err = np.abs(self.angle_error_deg)
         # the track's range and radial velocity against the set-points
-        r_err = np.abs(self.detected["range_m"] - self.set["range_m"])
-        v_err = np.abs(self.detected["velocity_mps"] - self.set["velocity_mps"])
-        lost = ~np.isfinite(self.detected["azimuth_deg"])
+        alone = self.tracked
+        r_err = np.where(alone, np.abs(self.detected["range_m"] - self.set["range_m"]), np.nan)
+        v_err = np.where(alone, np.abs(self.detected["velocity_mps"] - self.set["velocity_mps"]),
+                         np.nan)
+        lost = ~np.isfinite(self.detected["azimuth_deg"]) & alone
         jumps = self.handover_jumps_deg()
 
         def stats(e):
@@ -132,6 +170,7 @@ class PlaybackResult(Result):
         out = {
             "mode": self.mode,
             "frames": int(len(self.time_s)),
+            "point_targets": int(self.tracked.any(axis=0).sum()),
             "angle_error_deg": stats(err),
             "range_error_m": stats(r_err), "velocity_error_mps": stats(v_err),
             "lost_frames": int(np.any(lost, axis=1).sum()),
@@ -149,9 +188,22 @@ class PlaybackResult(Result):
                          "handover_jump_deg": jump(jumps[hk == k])}
                         for k in range(self.num_targets)],
         }
+        if self.role is not None:
+            out["budget"] = self._budget_summary()
         if self.baseline is not None:
             out["baseline"] = {k: v for k, v in self.baseline.summary().items()
                                if k != "targets"}
+        return out
+
+    def _budget_summary(self) -> dict:
+        """Under ``[rts] max_targets_per_channel``: the per-frame counts (min, max over the
+        frames); how the merged targets compare to the truth twin is the objects' summary
+        (:mod:`rtsgeom.analysis.objects`: each RTS detection against the truth twin's
+        detection of its cell)."""
+        out = {"max_targets_per_channel": self.scene.rts.max_targets_per_channel}
+        for k in ("kept", "merged", "dropped"):
+            v = [c[k] for c in self.budget] if self.budget else [0]
+            out[k] = {"min": int(min(v)), "max": int(max(v))}
         return out
 
     @property
@@ -195,7 +247,9 @@ class PlaybackResult(Result):
                 **{f"truth_{k}": (self.truth[k] if self.truth is not None
                                   else np.full((n_f, n_t), np.nan)).ravel()
                    for k in ("range_m", "azimuth_deg", "velocity_mps")},
-                "status": self._status.ravel()}
+                "status": self._status.ravel(),
+                "budget": (np.asarray(self.role).ravel() if self.role is not None
+                           else np.full(n_f * n_t, "", dtype=object))}
 
     def _programme_columns(self) -> dict:
         p = self.programme
@@ -219,11 +273,34 @@ class PlaybackResult(Result):
         the switched baseline beside it where it was played."""
         from ...viz.playback import playback_figure  # matplotlib: only for the figure
         runs = [self] + ([self.baseline] if self.baseline is not None else [])
+        # under a budget: the targets synthesized as themselves (the merged ones are compared
+        # to the truth twin in the summary and objects.png)
+        alone = self.tracked
         return playback_figure(
-            self.time_s, self.set["azimuth_deg"],
-            {r.mode: r.detected["azimuth_deg"] for r in runs},
+            self.time_s, np.where(alone, self.set["azimuth_deg"], np.nan),
+            {r.mode: np.where(r.tracked, r.detected["azimuth_deg"], np.nan) for r in runs},
             {r.mode: [self.time_s[f] for f, _ in r.handovers()] for r in runs},
-            title=self.scene.name)
+            title=self.scene.name,
+            objects={r.mode: o for r in runs if (o := r._object_tracks()) is not None})
+
+    def _object_tracks(self) -> dict | None:
+        """The extended objects' clouds over the drive for :meth:`plot` (None: no object or
+        no truth twin)."""
+        if self.clouds is None or self.object_of is None:
+            return None
+        from ..objects import air_offset_m, clouds_by_frame, pairs
+        rows, scale = self.clouds
+        t = self.time_s
+        obj = np.asarray(self.object_of) >= 0
+        pr = []
+        for f, o, tr, rt in clouds_by_frame(rows, air_offset_m(self.scene)):
+            j, _ = pairs(rt, tr, scale)  # each RTS detection's truth of its cell
+            ok = j >= 0
+            pr += [(t[f], d) for d in rt[ok, 2] - tr[j[ok], 2]]
+        return {"set_deg": self.set["azimuth_deg"][:, obj],
+                "truth": [(t[r[0]], r[5]) for r in rows if r[1] == "truth"],
+                "rts": [(t[r[0]], r[5]) for r in rows if r[1] == "rts"],
+                "pairs": pr}
 
     def animate(self, path, fps: int = 5):
         """Write the drive as an animated GIF (matplotlib's PillowWriter): the arc from above
@@ -242,6 +319,16 @@ class PlaybackResult(Result):
                                   xy, self.set["azimuth_deg"], self.detected["azimuth_deg"],
                                   self.scene.rts.arc_radius_m, f"{self.scene.name}: {self.mode}",
                                   fps)
+
+
+def budget_line(b: dict) -> str:
+    """One line on a played budget (:meth:`PlaybackResult.summary`'s ``budget``)."""
+    def span(k):
+        lo, hi = b[k]["min"], b[k]["max"]
+        return f"{lo}" if lo == hi else f"{lo}-{hi}"
+    line = (f"{b['max_targets_per_channel']} a channel: {span('kept')} targets kept, "
+            f"{span('merged')} scatterers merged, {span('dropped')} dropped a frame")
+    return line
 
 
 def _csv(cols: dict, names) -> str:

@@ -23,7 +23,7 @@ from ...scene import Scene, check_scene_arg
 from ...scene.schema import check_arg
 from ...scene.registry import AOA_MODES, PATH_METHODS
 from ...pipeline.cells import shared_cell_warnings
-from ...pipeline.merge import cell_scale
+from ...pipeline.run import association_scale
 from ..objects import cloud_rows
 from .frames import FramePlanner, detect_frame, frame_targets
 from .result import PlaybackResult
@@ -84,7 +84,10 @@ class Playback:
         if self.baseline and mode != "nearest":  # the same drive: the same truth twin
             base = _play(scene, setup, paths, "nearest", times, frames, self.bins, progress,
                          self.workers, truth=False)
-            base = dataclasses.replace(base, truth=result.truth)
+            base = dataclasses.replace(base, truth=result.truth, clouds=None if base.clouds
+                                       is None else (tuple(r for r in result.clouds[0] if
+                                                           r[1] == "truth") + base.clouds[0],
+                                                     base.clouds[1]))
             result = dataclasses.replace(result, baseline=base)
         return result
 
@@ -105,7 +108,7 @@ def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1, t
     split = np.zeros(shape, int)
     channels = np.empty(shape, object)
     programme, warnings = [], list(planner.warnings) + shared
-    scale = cell_scale(setup)  # the clouds' comparison cell (pipeline.merge)
+    scale = association_scale(setup.scene, None)  # the clouds' cells (the association's)
     work = functools.partial(_frames, (scene, setup, paths, planner, frames, bins, truth))
     chunks = np.array_split(np.arange(n_f), max(1, min(n_f, 4 * int(workers))))
     tell(progress, f"{mode}: playing {n_f} frames")
@@ -117,11 +120,13 @@ def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1, t
             outs.append(work(np.array([f])))
             tell(progress, None, f"{mode}: frame", f + 1, n_f)
     clouds = []
-    for f, (rows, found, extra, notes, seen, stat, cloud) in enumerate(o for out in outs
-                                                                        for o in out):
+    role = np.full(shape, "", dtype=object)
+    for f, (rows, found, extra, notes, seen, stat, cloud, rl) in enumerate(
+            o for out in outs for o in out):
         clouds += cloud
         split[f] = extra
         status[f] = stat
+        role[f] = rl
         for into, got in ((det, found), (tru, seen)):
             for k, d in enumerate(got):
                 if d is not None:
@@ -138,8 +143,10 @@ def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1, t
                           split=split, channels=channels, programme=np.concatenate(programme),
                           calibration=planner.record, warnings=tuple(warnings),
                           truth=tru if truth else None, status=status,
-                          clouds=(tuple(clouds), scale) if scene.objects and truth else None,
-                          budget=tuple(b.counts for b in planner.budgets) or None)
+                          clouds=(tuple(clouds), scale) if scene.objects else None,
+                          budget=tuple(b.counts for b in planner.budgets) or None,
+                          role=role if planner.budgets else None,
+                          object_of=np.array([t.object_index for t in frames[0]], int))
 
 
 def _shared_cells(setup, frames) -> list[str]:
@@ -157,7 +164,8 @@ def _frames(ctx, chunk) -> list:
     """Frames ``chunk`` (indices) played: per frame the programme rows (frame, target,
     channel, delay_s, doppler_hz, |amplitude|, phase_rad), each target's detection (range,
     azimuth, velocity) or None, its unclaimed detections nearby, the planner's notes, the
-    truth twin's detection of each target (or None) and each target's status.
+    truth twin's detection of each target (or None), each target's status, the frame's
+    clouds and each target's role under the budget (:func:`_per_scatterer`).
     A pure function of the frame (its noise seeded by it): the same in a forked worker."""
     scene, setup, paths, planner, frames, bins, truth = ctx
     out = []
@@ -165,19 +173,41 @@ def _frames(ctx, chunk) -> list:
         scene_f = dataclasses.replace(setup.scene, targets=frames[f])  # checked on load
         program, notes = planner.program(int(f), scene_f)
         seed = (scene.seed + int(f)) % (2 ** 63)  # frame 0: the scene's own noise, as `run`
-        matches, extra, (det, t_det, scale) = detect_frame(
-            setup, paths, program, scene_f, seed, bins, truth, detections=True)
-        cloud = [] if not scene.objects or t_det is None else (
-            cloud_rows(f, "truth", t_det, frames[f], scale)
-            + cloud_rows(f, "rts", det, frames[f], scale))
-        found, seen = ([None if m.get(key) is None else
+        budget = planner.budgets[f] if planner.budgets else None
+        matches, extra, (det, t_det, rd, st) = detect_frame(
+            setup, paths, program, scene_f, seed, bins, truth,
+            synthesized=None if budget is None else budget.targets)
+        cloud = [] if not scene.objects else (
+            ([] if t_det is None else cloud_rows(f, "truth", scene_f, t_det, rd, frames[f], st))
+            + cloud_rows(f, "rts", scene_f, det, rd, frames[f], st))
+        matches, extra, role = _per_scatterer(matches, extra, budget, len(frames[f]))
+        found, seen = ([None if m is None or m.get(key) is None else
                         (m[key]["range_m"], m[key]["angle_deg"], m[key]["velocity_mps"])
                         for m in matches] for key in ("detection", "truth"))
+        stat = [m["status"] if m is not None else f"{r}_by_rts"
+                for m, r in zip(matches, role)]
         rows = np.column_stack([
             np.full(len(program), f), program.target, program.front_end, program.delay_s,
             program.doppler_hz, np.abs(program.amplitude), np.angle(program.amplitude)])
-        out.append((rows, found, extra, notes, seen, [m["status"] for m in matches], cloud))
+        out.append((rows, found, extra, notes, seen, stat, cloud, role))
     return out
+
+
+def _per_scatterer(matches, extra, budget, n: int):
+    """A budgeted frame's matches (one per synthesized target) per scene target: the
+    synthesized target's match on its strongest member (role ``kept`` where it stands for
+    itself alone, ``lead`` for a merged one: its detection against the truth twin's detection
+    of the cell), None on the others (role ``merged``) and on the dropped ones (``dropped``).
+    Without a budget: unchanged, every role empty."""
+    if budget is None:
+        return list(matches), extra, [""] * n
+    per, ext, role = [None] * n, np.zeros(n, int), ["dropped"] * n
+    for g, m, e in zip(budget.members, matches, extra):
+        per[g[0]], ext[g[0]] = m, e
+        role[g[0]] = "kept" if len(g) == 1 else "lead"
+        for j in g[1:]:
+            role[j] = "merged"
+    return per, ext, role
 
 
 def play(scene: Scene, amplitudes: str | None = None, paths: str = "exact",

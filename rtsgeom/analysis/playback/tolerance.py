@@ -75,7 +75,8 @@ def drive_tolerance(scene: Scene, sigma_mm=(0.1, 0.1, 0.1), draws: int = 2000,
     probe = probe_front_ends(setup, exact_paths(setup), scene.seed)
     visits: dict = defaultdict(list)
     for f, targets in enumerate(frames):
-        pairs, _ = target_pairs(setup, probe, targets, where=frame_target_names(scene, f))
+        pairs, _ = target_pairs(setup, probe, targets,
+                                where=frame_target_names(scene, f, targets=targets))
         for pair, t in zip(pairs, targets):
             visits[pair].append((t.angle_rad, t.range_m))
     models = []
