@@ -159,10 +159,11 @@ def measure(setup: Setup, cap: Capture, check_direction: bool = True
     scale = float(np.max(np.abs(cap.data)))
     rd = range_doppler(AdcCube((cap.data / scale).astype(np.complex64), radar, setup.rut))
     model = ProbeModel.of(setup, cap)
-    _check_peak(rd.power, model, radar, cap)
-    _check_subbin(rd.power, model, radar, cap)
+    power, gain = _positive_half(rd.power, model, radar, cap)
+    _check_peak(power, model, radar, cap)
+    _check_subbin(power, model, radar, cap)
     rbs = (model.range_bin + np.arange(-1, 2)) % radar.samples_per_chirp
-    best = int(rbs[np.argmax(rd.power[rbs, model.doppler_bin])])
+    best = int(rbs[np.argmax(power[rbs, model.doppler_bin])])
     model = ProbeModel.of(setup, cap, best)
     x = rd.spectrum
     sigma2 = float(np.median(x.real.astype(float) ** 2 + x.imag.astype(float) ** 2) / np.log(2))
@@ -170,10 +171,35 @@ def measure(setup: Setup, cap: Capture, check_direction: bool = True
         raise CaptureError(f"{cap.source}: no receiver noise in the capture (the median "
                            "range-Doppler power is 0): must be a recorded or simulated "
                            "capture with noise")
-    y = rd.spectrum[best, model.doppler_bin].astype(complex)
+    y = rd.spectrum[best, model.doppler_bin].astype(complex) * gain
     if check_direction:
         _check_front_end(setup, model, y, cap)
-    return y * scale, sigma2 * scale ** 2, model
+    return y * scale, sigma2 * (gain * scale) ** 2, model
+
+
+def _positive_half(power: np.ndarray, model: ProbeModel, radar, cap: Capture
+                   ) -> tuple[np.ndarray, float]:
+    """The power map the probe is searched in and the factor from a spectrum value to the
+    complex-baseband model's. A complex capture: the whole map, 1. A real-only capture
+    (``cap.adc == "real"``, the AWR2944's receiver): ``x = Re(z)`` has the conjugate-symmetric
+    spectrum ``X[k, d] = (Z[k, d] + conj(Z[-k, -d])) / 2``, so the echo appears twice; the
+    estimator reads the positive-frequency half (range bins 1 .. N/2 - 1, the mirror zeroed)
+    at twice its value (``2 X[k] = Z[k]`` up to the mirror's leakage through the range
+    window), and its noise variance is four times the map's. Its unambiguous range is half
+    the complex ADC's: ``c f_adc / (4 S)``."""
+    if cap.adc != "real":
+        return power, 1.0
+    n_s = radar.samples_per_chirp
+    if not 2 <= model.range_bin <= n_s // 2 - 2:
+        r_max = radar.max_range_m / 2
+        raise CaptureError(f"{cap.source}: probe_range_m = {cap.range_m:g}: must be within a "
+                           f"real-only capture's unambiguous range, below {r_max:.4g} m "
+                           "(beat frequencies up to half the ADC rate; above it the echo "
+                           "folds onto its mirror)")
+    half = power.copy()
+    half[0] = 0.0
+    half[n_s // 2:] = 0.0
+    return half, 2.0
 
 
 def _check_front_end(setup: Setup, model: ProbeModel, y: np.ndarray, cap: Capture) -> None:
