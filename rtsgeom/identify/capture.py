@@ -53,6 +53,9 @@ SIDECAR = {
                                unit="m/s", lo=-1e3, hi=1e3),
     "probe_amplitude": Spec("probe_amplitude", "float", "programmed amplitude of the probe's "
                             "channel", lo=0.0, hi=1e12, lo_open=True),
+    "rts_delay_s": Spec("rts_delay_s", "float", "the delay programmed into the probe's RTS "
+                        "channel (requested, before the RTS's delay quantisation); absent: the "
+                        "scene's for probe_range_m", unit="s", lo=-1e-3, hi=1e-3, default=None),
     "kind": Spec("kind", "str", "what the file is", choices=("rtsgeom-probe-capture",),
                  default=None),
     "shape": Spec("shape", "ints", "the cube's [loop, virtual, sample]", lo=1, hi=1 << 20,
@@ -97,6 +100,7 @@ class Capture:
     source: str = "capture"  # what messages call it (its file)
     tx_order: tuple[int, ...] | None = None  # the TDM order it was recorded in (None: the scene's)
     adc: str = "complex"  # "real": a real-only receiver's samples (imaginary part 0)
+    rts_delay_s: float | None = None  # the RTS channel's programmed delay (None: the scene's)
 
     def __repr__(self) -> str:
         shape = "x".join(str(n) for n in np.shape(self.data))
@@ -107,6 +111,8 @@ class Capture:
     def to_meta(self) -> dict:
         meta = {"active_front_end": self.active, "probe_range_m": self.range_m,
                 "probe_velocity_mps": self.velocity_mps, "probe_amplitude": self.amplitude}
+        if self.rts_delay_s is not None:
+            meta["rts_delay_s"] = self.rts_delay_s
         if self.radar is not None:
             meta["radar"] = dict(self.radar)
         return meta
@@ -165,10 +171,11 @@ def simulate_capture(setup: Setup, active: int, range_m: float | None = None,
         raise CaptureError(f"probe range {r:g} m: must be in (0, {scene.radar.max_range_m:g}) m")
     paths = exact_paths(setup) if paths is None else paths
     f_d = 2 * scene.radar.f_c_hz * velocity_mps / c
-    prog = RtsProgram.build([0], [active], [float(requested_delay(scene, r))], [f_d], [amp])
+    tau = float(requested_delay(scene, r))
+    prog = RtsProgram.build([0], [active], [tau], [f_d], [amp])
     _, cube = simulate(setup, paths, prog, seed, scene.radar.snr_db)
     return Capture(cube.data, int(active), r, float(velocity_mps), amp,
-                   radar_record(scene.radar))
+                   radar_record(scene.radar), rts_delay_s=tau)
 
 
 def write_capture(cap: Capture, rut, out: Path, fmt: str,
@@ -340,4 +347,5 @@ def read_capture(path, shape=None, max_bytes: int = MAX_CAPTURE_BYTES) -> Captur
     if not np.any(data):
         raise CaptureError(f"{path}: every sample is 0: must hold the probe's echo")
     return Capture(np.asarray(data), *probe, radar=radar, source=str(path),
-                   tx_order=None if v["tx_order"] is None else tuple(v["tx_order"]), adc=adc)
+                   tx_order=None if v["tx_order"] is None else tuple(v["tx_order"]), adc=adc,
+                   rts_delay_s=v["rts_delay_s"])
