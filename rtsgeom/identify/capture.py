@@ -267,6 +267,34 @@ def _npy_header(path: Path, shape, max_bytes: int) -> None:
                            f"most {max_bytes / 2**30:.3g} GiB")
 
 
+def _read_dca1000(path: Path, side: Path, v: dict, shape, max_bytes: int
+                  ) -> tuple[np.ndarray, str]:
+    """A ``.bin`` capture in the layout its checked sidecar ``v`` states: (cube in capture
+    units, ``"complex"`` or ``"real"``); its size checked against the sidecar and the scene's
+    ``shape`` before it is read."""
+    n_rx, n_s, chirps = v["num_rx"], v["samples_per_chirp"], v["chirps"]
+    n_tx = len(v["tx_order"])
+    if chirps % n_tx:
+        raise CaptureError(f"{side}: chirps = {chirps}: must be a multiple of the "
+                           f"{n_tx} TDM slots of tx_order")
+    got = (chirps // n_tx, n_tx * n_rx, n_s)
+    if shape is not None and got != tuple(shape):
+        raise CaptureError(f"{side}: chirps, tx_order, num_rx, samples_per_chirp "
+                           f"describe {list(got)}: must be the scene's radar "
+                           f"{list(shape)} [loop, virtual, sample]")
+    layout = sidecar_layout(v, side)
+    want = dca1000_bytes(chirps, n_rx, n_s, layout)
+    cube = chirps * n_rx * n_s * 8  # decoded as complex64
+    if cube > max_bytes:
+        raise CaptureError(f"{side}: {list(got)} ({cube / 2**30:.3g} GiB): must be "
+                           f"at most {max_bytes / 2**30:.3g} GiB")
+    if path.stat().st_size != want:
+        raise CaptureError(f"{path}: {path.stat().st_size} bytes: must be the "
+                           f"{want} bytes its sidecar describes ({layout.name})")
+    raw = from_dca1000(path.read_bytes(), chirps, n_rx, n_s, layout)
+    return raw.reshape(got) / np.float32(v["scale"]), layout.adc
+
+
 def read_capture(path, shape=None, max_bytes: int = MAX_CAPTURE_BYTES) -> Capture:
     """Read a probe capture written by ``rtsgeom adc --active`` (``.bin`` or ``.npy`` with its
     sidecar ``PATH.json``). Errors name the file and the field (:data:`SIDECAR`).
@@ -309,27 +337,7 @@ def read_capture(path, shape=None, max_bytes: int = MAX_CAPTURE_BYTES) -> Captur
             _npy_header(path, shape, max_bytes)
             data = np.load(path, allow_pickle=False)
         else:
-            n_rx, n_s, chirps = v["num_rx"], v["samples_per_chirp"], v["chirps"]
-            n_tx = len(v["tx_order"])
-            if chirps % n_tx:
-                raise CaptureError(f"{side}: chirps = {chirps}: must be a multiple of the "
-                                   f"{n_tx} TDM slots of tx_order")
-            got = (chirps // n_tx, n_tx * n_rx, n_s)
-            if shape is not None and got != tuple(shape):
-                raise CaptureError(f"{side}: chirps, tx_order, num_rx, samples_per_chirp "
-                                   f"describe {list(got)}: must be the scene's radar "
-                                   f"{list(shape)} [loop, virtual, sample]")
-            layout = sidecar_layout(v, side)
-            want = dca1000_bytes(chirps, n_rx, n_s, layout)
-            if want * 2 > max_bytes:
-                raise CaptureError(f"{side}: {list(got)} ({want * 2 / 2**30:.3g} GiB): must be "
-                                   f"at most {max_bytes / 2**30:.3g} GiB")
-            if path.stat().st_size != want:
-                raise CaptureError(f"{path}: {path.stat().st_size} bytes: must be the "
-                                   f"{want} bytes its sidecar describes")
-            raw = from_dca1000(path.read_bytes(), chirps, n_rx, n_s, layout)
-            adc = layout.adc
-            data = raw.reshape(got) / np.float32(v["scale"])
+            data, adc = _read_dca1000(path, side, v, shape, max_bytes)
     except (ValueError, TypeError, EOFError) as exc:
         if isinstance(exc, CaptureError):
             raise
