@@ -33,9 +33,20 @@ SCENE = "scenes/diewald2022.toml"
 CHILD = """
 import json, resource, sys, time
 import numpy as np
-if {stub}:
+if {stub}:  # the study's searches (not the calibration's, nor the probes') return zeros
+    import rtsgeom.analysis.transfer as T
     from rtsgeom.radar.steering import Steering
-    Steering.search = lambda self, s: np.zeros(np.shape(s)[:-1])
+    real, on = Steering.search, [True]
+    Steering.search = lambda self, s: np.zeros(np.shape(s)[:-1]) if on[0] else real(self, s)
+    def off(f):
+        def g(*a, **k):
+            on[0] = False
+            try:
+                return f(*a, **k)
+            finally:
+                on[0] = True
+        return g
+    T.calibrate_pair, T._probe = off(T.calibrate_pair), off(T._probe)
 t0 = time.perf_counter()
 if "{entry}" == "cli":
     from rtsgeom.cli import main
