@@ -11,7 +11,8 @@ The entry points get one argument replaced by a hostile value (:data:`HOSTILE`: 
 NaN, infinities, -0, huge and negative numbers, arrays, strings), the others small and valid;
 each call must return a result whose numbers are finite or raise an ``RtsgeomError`` (any other
 exception is a failure). ``identify-joint`` fits both front ends' captures with the radar's
-channels after mutating one sidecar.
+channels after mutating one sidecar, or (one in four) captures of a 1.2 m arc against the 1 m
+scene, which must be refused.
 
     python -m benchmarks.fuzz_inputs --inputs 2000 --seed 0 [--kind sidecar|calibration|
         transfer|drive_tolerance|play|identify-joint|both|entry|all]
@@ -135,6 +136,13 @@ def _entry_scenes(inp: Inputs):
             name = f"joint{q}.npy"
             inp.joint[name] = write_capture(simulate_capture(sim, q, seed=10 + q), sim.rut,
                                             inp.folder / name, "npy")
+        # captures of another arc (1.2 m, the scene's is 1 m): must be refused, not fitted
+        wide = build_setup(inp.scene.evolve(rts=inp.scene.rts.evolve(arc_radius_m=1.2)))
+        inp.arc = []
+        for q in range(wide.fe.count):
+            f = inp.folder / f"arc{q}.npy"
+            write_capture(simulate_capture(wide, q, seed=20 + q), wide.rut, f, "npy")
+            inp.arc.append(f)
     return inp
 
 
@@ -144,6 +152,13 @@ def run_entry(inp: Inputs, kind: str, rng: random.Random) -> str:
     import rtsgeom
     from rtsgeom.identify import identify
     inp = _entry_scenes(inp)
+    if kind == "identify-joint" and rng.random() < 0.25:
+        try:
+            res = identify(inp.scene, [read_capture(f) for f in inp.arc], radar_channels=True)
+        except RtsgeomError:
+            return "rejected"
+        raise FuzzFailure("accepted captures of a 1.2 m arc against the 1 m scene "
+                          f"(residual {res.to_dict()['residual_rms']:.3g})")
     if kind == "identify-joint":
         name = rng.choice(sorted(inp.joint))
         doc = mutate_doc(copy.deepcopy(inp.joint[name]), rng)

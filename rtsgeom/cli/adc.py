@@ -11,7 +11,7 @@ import numpy as np
 from .._lib.io import atomic_path, write_bytes, write_json
 from ..errors import CaptureError, ParameterError, UsageError
 from ..pipeline.run import run_scene
-from ..radar.dca1000 import to_dca1000
+from ..radar.dca1000 import capture_layout, dca1000_meta, to_dca1000
 from ..scene.registry import AOA_MODES
 from ._common import (calibration_kw, load_scene_checked, number, output_file, output_file_path,
                       scene_arg, steps)
@@ -36,18 +36,17 @@ def cmd_adc(args) -> int:
         print(f"wrote {args.out}: complex64 {list(cube.shape)} "
               "[chirp_loop, virtual_channel, sample]")
     else:
+        layout = capture_layout(scene.radar)
         try:
-            raw, scale = to_dca1000(cube)
+            raw, scale = to_dca1000(cube, layout)
         except ParameterError as exc:
             raise UsageError(f"--format dca1000: {exc}") from None
         write_bytes(args.out, raw)
         n_l, n_v, n_s = cube.shape
-        meta = {"format": "dca1000-xwr18xx-complex-2lane", "scale": scale,
-                "chirps": n_l * len(cube.rut.tx_order), "tx_order": list(cube.rut.tx_order),
-                "num_rx": cube.rut.num_rx, "samples_per_chirp": n_s, "dtype": "int16 (<i2)",
-                "order": "chirp (transmit order) > rx > sample pairs I0 I1 Q0 Q1"}
+        meta = dca1000_meta(layout, scale, n_l * len(cube.rut.tx_order), cube.rut, n_s)
         write_json(Path(str(args.out) + ".json"), meta)
-        print(f"wrote {args.out} ({len(raw)} bytes, scale {scale:.6g}) and {args.out}.json")
+        print(f"wrote {args.out} ({len(raw)} bytes, {layout.name}, scale {scale:.6g}) and "
+              f"{args.out}.json")
     return 0
 
 
@@ -66,7 +65,8 @@ def _probe_capture(scene, args) -> int:
             step(f"simulating front end {args.active} alone with a probe target")
             cap = simulate_capture(setup, args.active, args.probe_range_m,
                                    args.probe_velocity_mps, seed)
-            meta = write_capture(cap, setup.rut, args.out, args.format)
+            meta = write_capture(cap, setup.rut, args.out, args.format,
+                                 capture_layout(scene.radar))
     except CaptureError as exc:
         raise UsageError(f"--active/--probe-range-m: {exc}") from None
     except ParameterError as exc:

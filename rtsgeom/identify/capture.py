@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,12 +23,13 @@ from ..rts.channels import RtsProgram, nominal_link_gain, requested_delay, targe
 from ..radar.frame import simulate
 from .._lib.io import atomic_path, write_bytes, write_json
 from ..calibration.probes import probe_ranges
-from ..radar.dca1000 import from_dca1000, to_dca1000
+from ..radar.dca1000 import dca1000_bytes, dca1000_meta, from_dca1000, to_dca1000
+from ..scene.presets import LAYOUT_DEFAULT, PRESETS, CaptureLayout
 from ..radar.fmcw import AdcCube
 
 __all__ = ["Capture", "capture_probe", "simulate_capture", "write_capture", "read_capture",
            "SIDECAR", "SIDECAR_DCA1000", "RADAR_KEYS", "MAX_CAPTURE_BYTES", "radar_record",
-           "check_capture_radar"]
+           "check_capture_radar", "sidecar_layout"]
 
 
 #: the radar fields a capture records and ``identify`` compares with the scene's (a capture made
@@ -51,6 +53,9 @@ SIDECAR = {
                                unit="m/s", lo=-1e3, hi=1e3),
     "probe_amplitude": Spec("probe_amplitude", "float", "programmed amplitude of the probe's "
                             "channel", lo=0.0, hi=1e12, lo_open=True),
+    "rts_delay_s": Spec("rts_delay_s", "float", "the delay programmed into the probe's RTS "
+                        "channel (requested, before the RTS's delay quantisation); absent: the "
+                        "scene's for probe_range_m", unit="s", lo=-1e-3, hi=1e-3, default=None),
     "kind": Spec("kind", "str", "what the file is", choices=("rtsgeom-probe-capture",),
                  default=None),
     "shape": Spec("shape", "ints", "the cube's [loop, virtual, sample]", lo=1, hi=1 << 20,
@@ -66,6 +71,12 @@ SIDECAR_DCA1000 = {
     "tx_order": Spec("tx_order", "ints", "Tx per TDM slot", lo=0, hi=63, min_items=1,
                      max_items=64),
     "scale": Spec("scale", "float", "int16 counts per capture unit", lo=1e-30, hi=1e30),
+    "adc": Spec("adc", "str", "the ADC's samples (the board's layout)",
+                choices=("complex", "real"), default=None),
+    "lvds_lanes": Spec("lvds_lanes", "int", "the LVDS data lanes of the layout", lo=2, hi=4,
+                       default=None),
+    "format": Spec("format", "str", "the layout's name, dca1000-FAMILY-ADC-NLANElane",
+                   default=None),
 }
 
 
@@ -88,6 +99,8 @@ class Capture:
     radar: dict | None = None  # RADAR_KEYS of the radar that recorded it (None: not recorded)
     source: str = "capture"  # what messages call it (its file)
     tx_order: tuple[int, ...] | None = None  # the TDM order it was recorded in (None: the scene's)
+    adc: str = "complex"  # "real": a real-only receiver's samples (imaginary part 0)
+    rts_delay_s: float | None = None  # the RTS channel's programmed delay (None: the scene's)
 
     def __repr__(self) -> str:
         shape = "x".join(str(n) for n in np.shape(self.data))
@@ -98,6 +111,8 @@ class Capture:
     def to_meta(self) -> dict:
         meta = {"active_front_end": self.active, "probe_range_m": self.range_m,
                 "probe_velocity_mps": self.velocity_mps, "probe_amplitude": self.amplitude}
+        if self.rts_delay_s is not None:
+            meta["rts_delay_s"] = self.rts_delay_s
         if self.radar is not None:
             meta["radar"] = dict(self.radar)
         return meta
@@ -156,15 +171,25 @@ def simulate_capture(setup: Setup, active: int, range_m: float | None = None,
         raise CaptureError(f"probe range {r:g} m: must be in (0, {scene.radar.max_range_m:g}) m")
     paths = exact_paths(setup) if paths is None else paths
     f_d = 2 * scene.radar.f_c_hz * velocity_mps / c
-    prog = RtsProgram.build([0], [active], [float(requested_delay(scene, r))], [f_d], [amp])
+    tau = float(requested_delay(scene, r))
+    prog = RtsProgram.build([0], [active], [tau], [f_d], [amp])
     _, cube = simulate(setup, paths, prog, seed, scene.radar.snr_db)
     return Capture(cube.data, int(active), r, float(velocity_mps), amp,
-                   radar_record(scene.radar))
+                   radar_record(scene.radar), rts_delay_s=tau)
 
 
-def write_capture(cap: Capture, rut, out: Path, fmt: str) -> dict:
+def write_capture(cap: Capture, rut, out: Path, fmt: str,
+                  layout: CaptureLayout | None = None) -> dict:
     """Write ``cap`` as ``.npy`` or DCA1000 ``.bin``; the sidecar ``out.json`` (both formats)
-    records the probe and the active front end. Returns the sidecar's content."""
+    records the probe and the active front end. Returns the sidecar's content.
+
+    ``layout``: the DCA1000 layout of the board (default: the preset's that ``rut`` was built
+    from, :attr:`~rtsgeom.scene.presets.ArrayPreset.capture`); the sidecar states it
+    (``format``, ``adc``, ``lvds_lanes``). A real-only layout writes the real part, the real
+    IF signal such a receiver samples."""
+    if layout is None:
+        p = PRESETS.get(getattr(rut, "name", None))
+        layout = LAYOUT_DEFAULT if p is None else p.capture
     n_l, n_v, n_s = cap.data.shape
     meta = {"kind": "rtsgeom-probe-capture", **cap.to_meta(), "shape": [n_l, n_v, n_s]}
     if fmt == "npy":
@@ -172,14 +197,36 @@ def write_capture(cap: Capture, rut, out: Path, fmt: str) -> dict:
             np.save(fh, cap.data)
         meta["format"] = "npy"
     else:
-        raw, scale = to_dca1000(AdcCube(cap.data, None, rut))
+        raw, scale = to_dca1000(AdcCube(cap.data, None, rut), layout)
         write_bytes(out, raw)
-        meta.update({"format": "dca1000-xwr18xx-complex-2lane", "scale": scale,
-                     "chirps": n_l * len(rut.tx_order), "tx_order": list(rut.tx_order),
-                     "num_rx": rut.num_rx, "samples_per_chirp": n_s, "dtype": "int16 (<i2)",
-                     "order": "chirp (transmit order) > rx > sample pairs I0 I1 Q0 Q1"})
+        meta.update(dca1000_meta(layout, scale, n_l * len(rut.tx_order), rut, n_s))
     write_json(Path(str(out) + ".json"), meta)
     return meta
+
+
+_FORMAT = re.compile(r"^dca1000-([a-z0-9]+)-(complex|real)-([24])lane$")
+
+
+def sidecar_layout(v: dict, side) -> CaptureLayout:
+    """The DCA1000 layout a checked sidecar states: ``adc`` and ``lvds_lanes``, else what
+    its ``format`` name says; a sidecar with neither is the xWR18xx complex 2-lane layout
+    (captures written before the layout was recorded). ``format`` and the fields must agree."""
+    name = v.get("format")
+    parsed = _FORMAT.match(name) if name is not None else None
+    if name is not None and parsed is None:
+        raise CaptureError(f"{side}: format = {name!r}: must be a DCA1000 layout "
+                           "dca1000-FAMILY-complex|real-2lane|4lane (e.g. "
+                           f"{LAYOUT_DEFAULT.name}) for a .bin capture")
+    adc = v.get("adc") or (parsed.group(2) if parsed else LAYOUT_DEFAULT.adc)
+    lanes = v.get("lvds_lanes") or (int(parsed.group(3)) if parsed else LAYOUT_DEFAULT.lanes)
+    if lanes not in (2, 4):
+        raise CaptureError(f"{side}: lvds_lanes = {lanes}: must be 2 or 4 (the DCA1000's "
+                           "layouts)")
+    if parsed and (parsed.group(2), int(parsed.group(3))) != (adc, lanes):
+        raise CaptureError(f"{side}: format = {name!r}: must agree with adc = {adc!r} and "
+                           f"lvds_lanes = {lanes}")
+    family = parsed.group(1) if parsed else LAYOUT_DEFAULT.family
+    return CaptureLayout(family, adc == "complex", lanes, f"the sidecar {side}")
 
 
 def _read_sidecar(side: Path) -> dict:
@@ -220,6 +267,34 @@ def _npy_header(path: Path, shape, max_bytes: int) -> None:
                            f"most {max_bytes / 2**30:.3g} GiB")
 
 
+def _read_dca1000(path: Path, side: Path, v: dict, shape, max_bytes: int
+                  ) -> tuple[np.ndarray, str]:
+    """A ``.bin`` capture in the layout its checked sidecar ``v`` states: (cube in capture
+    units, ``"complex"`` or ``"real"``); its size checked against the sidecar and the scene's
+    ``shape`` before it is read."""
+    n_rx, n_s, chirps = v["num_rx"], v["samples_per_chirp"], v["chirps"]
+    n_tx = len(v["tx_order"])
+    if chirps % n_tx:
+        raise CaptureError(f"{side}: chirps = {chirps}: must be a multiple of the "
+                           f"{n_tx} TDM slots of tx_order")
+    got = (chirps // n_tx, n_tx * n_rx, n_s)
+    if shape is not None and got != tuple(shape):
+        raise CaptureError(f"{side}: chirps, tx_order, num_rx, samples_per_chirp "
+                           f"describe {list(got)}: must be the scene's radar "
+                           f"{list(shape)} [loop, virtual, sample]")
+    layout = sidecar_layout(v, side)
+    want = dca1000_bytes(chirps, n_rx, n_s, layout)
+    cube = chirps * n_rx * n_s * 8  # decoded as complex64
+    if cube > max_bytes:
+        raise CaptureError(f"{side}: {list(got)} ({cube / 2**30:.3g} GiB): must be "
+                           f"at most {max_bytes / 2**30:.3g} GiB")
+    if path.stat().st_size != want:
+        raise CaptureError(f"{path}: {path.stat().st_size} bytes: must be the "
+                           f"{want} bytes its sidecar describes ({layout.name})")
+    raw = from_dca1000(path.read_bytes(), chirps, n_rx, n_s, layout)
+    return raw.reshape(got) / np.float32(v["scale"]), layout.adc
+
+
 def read_capture(path, shape=None, max_bytes: int = MAX_CAPTURE_BYTES) -> Capture:
     """Read a probe capture written by ``rtsgeom adc --active`` (``.bin`` or ``.npy`` with its
     sidecar ``PATH.json``). Errors name the file and the field (:data:`SIDECAR`).
@@ -241,8 +316,8 @@ def read_capture(path, shape=None, max_bytes: int = MAX_CAPTURE_BYTES) -> Captur
     if not isinstance(meta, dict):
         raise CaptureError(f"{side}: not a probe capture's sidecar (a JSON object)")
     npy = meta.get("format") == "npy" or path.suffix == ".npy"
-    for key in [k for k, d in SIDECAR.items() if d.default is REQUIRED] + (
-            [] if npy else list(SIDECAR_DCA1000)):
+    for key in [k for k, d in {**SIDECAR, **({} if npy else SIDECAR_DCA1000)}.items()
+                if d.default is REQUIRED]:
         if key not in meta:
             raise CaptureError(f"{side}: no {key!r}: not a probe capture (rtsgeom adc "
                                "--active I)")
@@ -254,6 +329,7 @@ def read_capture(path, shape=None, max_bytes: int = MAX_CAPTURE_BYTES) -> Captur
                              where="radar")
     probe = (v["active_front_end"], v["probe_range_m"], v["probe_velocity_mps"],
              v["probe_amplitude"])
+    adc = "complex"
     # numpy's own errors for a file that is no .npy / a .bin of the wrong size (ValueError,
     # EOFError) become the capture's error
     try:
@@ -261,25 +337,7 @@ def read_capture(path, shape=None, max_bytes: int = MAX_CAPTURE_BYTES) -> Captur
             _npy_header(path, shape, max_bytes)
             data = np.load(path, allow_pickle=False)
         else:
-            n_rx, n_s, chirps = v["num_rx"], v["samples_per_chirp"], v["chirps"]
-            n_tx = len(v["tx_order"])
-            if chirps % n_tx:
-                raise CaptureError(f"{side}: chirps = {chirps}: must be a multiple of the "
-                                   f"{n_tx} TDM slots of tx_order")
-            got = (chirps // n_tx, n_tx * n_rx, n_s)
-            if shape is not None and got != tuple(shape):
-                raise CaptureError(f"{side}: chirps, tx_order, num_rx, samples_per_chirp "
-                                   f"describe {list(got)}: must be the scene's radar "
-                                   f"{list(shape)} [loop, virtual, sample]")
-            want = chirps * n_rx * n_s * 4
-            if want * 2 > max_bytes:
-                raise CaptureError(f"{side}: {list(got)} ({want * 2 / 2**30:.3g} GiB): must be "
-                                   f"at most {max_bytes / 2**30:.3g} GiB")
-            if path.stat().st_size != want:
-                raise CaptureError(f"{path}: {path.stat().st_size} bytes: must be the "
-                                   f"{want} bytes its sidecar describes")
-            raw = from_dca1000(path.read_bytes(), chirps, n_rx, n_s)
-            data = raw.reshape(got) / np.float32(v["scale"])
+            data, adc = _read_dca1000(path, side, v, shape, max_bytes)
     except (ValueError, TypeError, EOFError) as exc:
         if isinstance(exc, CaptureError):
             raise
@@ -297,4 +355,5 @@ def read_capture(path, shape=None, max_bytes: int = MAX_CAPTURE_BYTES) -> Captur
     if not np.any(data):
         raise CaptureError(f"{path}: every sample is 0: must hold the probe's echo")
     return Capture(np.asarray(data), *probe, radar=radar, source=str(path),
-                   tx_order=None if v["tx_order"] is None else tuple(v["tx_order"]))
+                   tx_order=None if v["tx_order"] is None else tuple(v["tx_order"]), adc=adc,
+                   rts_delay_s=v["rts_delay_s"])

@@ -45,6 +45,7 @@ class ProbeModel:
     amplitude: float
     range_bin: int
     doppler_bin: int
+    rts_delay_s: float | None = None  # the RTS channel's programmed delay (None: the scene's)
 
     @classmethod
     def of(cls, setup: Setup, cap: Capture, range_bin: int | None = None) -> "ProbeModel":
@@ -54,7 +55,15 @@ class ProbeModel:
                            / radar.adc_rate_hz)) if range_bin is None else int(range_bin))
         n_l = radar.chirps_per_tx
         db = (int(np.round(f_d * radar.tdm_cycle_s * n_l)) + n_l // 2) % n_l
-        return cls(setup, cap.active, cap.range_m, cap.velocity_mps, cap.amplitude, rb, db)
+        return cls(setup, cap.active, cap.range_m, cap.velocity_mps, cap.amplitude, rb, db,
+                   cap.rts_delay_s)
+
+    def programmed_delay(self) -> float:
+        """The probe channel's requested delay: the capture's recorded ``rts_delay_s``, else
+        what the scene programs for the probe's range (``requested_delay``)."""
+        if self.rts_delay_s is not None:
+            return float(self.rts_delay_s)
+        return float(requested_delay(self.setup.scene, self.range_m))
 
     def nominal(self) -> np.ndarray:
         """The scene's own values of the parameters (its offsets, gain and phase errors)."""
@@ -80,7 +89,7 @@ class ProbeModel:
         g = (lam / (4 * np.pi * c * t_a)) * (lam / (4 * np.pi * c * t_b))
         gain = np.exp(th[:, 5] + 1j * th[:, 6]) * self.amplitude
         rts = scene.rts
-        tau0 = realised_delay(requested_delay(scene, self.range_m), rts.f_s_hz,
+        tau0 = realised_delay(self.programmed_delay(), rts.f_s_hz,
                               rts.fractional_delay, rts.fractional_delay_step_s)
         tau_if = tau0 + th[:, 4]
         tau_air = t_a + t_b
@@ -159,10 +168,11 @@ def measure(setup: Setup, cap: Capture, check_direction: bool = True
     scale = float(np.max(np.abs(cap.data)))
     rd = range_doppler(AdcCube((cap.data / scale).astype(np.complex64), radar, setup.rut))
     model = ProbeModel.of(setup, cap)
-    _check_peak(rd.power, model, radar, cap)
-    _check_subbin(rd.power, model, radar, cap)
+    power, gain = _positive_half(rd.power, model, radar, cap)
+    _check_peak(power, model, radar, cap)
+    _check_subbin(power, model, radar, cap)
     rbs = (model.range_bin + np.arange(-1, 2)) % radar.samples_per_chirp
-    best = int(rbs[np.argmax(rd.power[rbs, model.doppler_bin])])
+    best = int(rbs[np.argmax(power[rbs, model.doppler_bin])])
     model = ProbeModel.of(setup, cap, best)
     x = rd.spectrum
     sigma2 = float(np.median(x.real.astype(float) ** 2 + x.imag.astype(float) ** 2) / np.log(2))
@@ -170,10 +180,35 @@ def measure(setup: Setup, cap: Capture, check_direction: bool = True
         raise CaptureError(f"{cap.source}: no receiver noise in the capture (the median "
                            "range-Doppler power is 0): must be a recorded or simulated "
                            "capture with noise")
-    y = rd.spectrum[best, model.doppler_bin].astype(complex)
+    y = rd.spectrum[best, model.doppler_bin].astype(complex) * gain
     if check_direction:
         _check_front_end(setup, model, y, cap)
-    return y * scale, sigma2 * scale ** 2, model
+    return y * scale, sigma2 * (gain * scale) ** 2, model
+
+
+def _positive_half(power: np.ndarray, model: ProbeModel, radar, cap: Capture
+                   ) -> tuple[np.ndarray, float]:
+    """The power map the probe is searched in and the factor from a spectrum value to the
+    complex-baseband model's. A complex capture: the whole map, 1. A real-only capture
+    (``cap.adc == "real"``, the AWR2944's receiver): ``x = Re(z)`` has the conjugate-symmetric
+    spectrum ``X[k, d] = (Z[k, d] + conj(Z[-k, -d])) / 2``, so the echo appears twice; the
+    estimator reads the positive-frequency half (range bins 1 .. N/2 - 1, the mirror zeroed)
+    at twice its value (``2 X[k] = Z[k]`` up to the mirror's leakage through the range
+    window), and its noise variance is four times the map's. Its unambiguous range is half
+    the complex ADC's: ``c f_adc / (4 S)``."""
+    if cap.adc != "real":
+        return power, 1.0
+    n_s = radar.samples_per_chirp
+    if not 2 <= model.range_bin <= n_s // 2 - 2:
+        r_max = radar.max_range_m / 2
+        raise CaptureError(f"{cap.source}: probe_range_m = {cap.range_m:g}: must be within a "
+                           f"real-only capture's unambiguous range, below {r_max:.4g} m "
+                           "(beat frequencies up to half the ADC rate; above it the echo "
+                           "folds onto its mirror)")
+    half = power.copy()
+    half[0] = 0.0
+    half[n_s // 2:] = 0.0
+    return half, 2.0
 
 
 def _check_front_end(setup: Setup, model: ProbeModel, y: np.ndarray, cap: Capture) -> None:
@@ -213,11 +248,14 @@ def _interpolated(p_lo: np.ndarray, p_0: np.ndarray, p_hi: np.ndarray) -> np.nda
     return np.where(den < 0, 0.5 * (a - c_) / np.where(den < 0, den, -1.0), 0.0)
 
 
-def probe_offset_bins(power: np.ndarray, model: ProbeModel) -> tuple[float, float]:
+def probe_offset_bins(power: np.ndarray, model: ProbeModel, span: int = 3
+                      ) -> tuple[float, float]:
     """(range, Doppler) offset in bins of the probe's echo in the capture's power map
-    ``power`` (R, D) from where the nominal setup puts the sidecar's probe (``model``, at the
-    bins the sidecar names): each interpolated over the three bins around its own strongest
-    cell (the measurement's within one bin of the model's)."""
+    ``power`` (R, D) from where the nominal setup puts the sidecar's probe (``model``): each
+    interpolated over the three bins around its own strongest cell, the measurement's within
+    one bin of the sidecar's probe, the model's within ``span`` range bins and 2 Doppler bins
+    of it (the model's echo sits away from the sidecar's range when the recorded RTS delay
+    and the scene's air path disagree)."""
     n_r, n_d = power.shape
     rb, db = model.range_bin, model.doppler_bin
     radar, rut = model.setup.scene.radar, model.setup.rut
@@ -225,18 +263,24 @@ def probe_offset_bins(power: np.ndarray, model: ProbeModel) -> tuple[float, floa
     block = power[np.ix_(near_r, near_d)]
     i, j = np.unravel_index(int(np.argmax(block)), block.shape)
     mr, md = int(near_r[i]), int(near_d[j])
+    # the model on a (2 span + 1) x 5 grid of (range, Doppler) bins around the sidecar's
+    ro, do = np.arange(-span, span + 1), np.arange(-2, 3)
+    gr, gd = np.meshgrid((rb + ro) % n_r, (db + do) % n_d, indexing="ij")
+    resp = bin_response(model.echoes(model.nominal()[None]), radar, rut, gr.ravel(),
+                        gd.ravel()).sum(axis=1)
+    p_model = np.sum(np.abs(resp) ** 2, axis=-1).reshape(gr.shape)
+    a, b = np.unravel_index(int(np.argmax(p_model)), p_model.shape)
+    a, b = int(np.clip(a, 1, len(ro) - 2)), int(np.clip(b, 1, len(do) - 2))
 
     def three(centre, n):
         return (centre + np.arange(-1, 2)) % n
-    resp = bin_response(model.echoes(model.nominal()[None]), radar, rut,
-                        np.r_[three(rb, n_r), np.full(3, rb)],
-                        np.r_[np.full(3, db), three(db, n_d)]).sum(axis=1)
-    p_model = np.sum(np.abs(resp) ** 2, axis=-1)  # (6,)
     p_meas = np.r_[power[three(mr, n_r), md], power[mr, three(md, n_d)]]
+    p_mod = np.r_[p_model[a - 1:a + 2, b], p_model[a, b - 1:b + 2]]
     got = _interpolated(p_meas[[0, 3]], p_meas[[1, 4]], p_meas[[2, 5]])
-    want = _interpolated(p_model[[0, 3]], p_model[[1, 4]], p_model[[2, 5]])
+    want = _interpolated(p_mod[[0, 3]], p_mod[[1, 4]], p_mod[[2, 5]])
     dd = (md - db + n_d // 2) % n_d - n_d // 2  # circular
-    return float(mr - rb + got[0] - want[0]), float(dd + got[1] - want[1])
+    return (float(mr - rb + got[0] - (ro[a] + want[0])),
+            float(dd + got[1] - (do[b] + want[1])))
 
 
 def _check_subbin(power: np.ndarray, model: ProbeModel, radar, cap: Capture) -> None:
@@ -244,10 +288,23 @@ def _check_subbin(power: np.ndarray, model: ProbeModel, radar, cap: Capture) -> 
     :data:`SUBBIN_LIMIT` of a bin (:func:`probe_offset_bins`): a probe range wrong by less than a
     bin passes the strongest-cell check but fits a wrong channel phase and gain (the range
     shift of the model's bin response), a wrong velocity a wrong Doppler phase ramp across
-    the TDM slots (a tangential offset)."""
-    dr, dd = probe_offset_bins(power, model)
+    the TDM slots (a tangential offset).
+
+    First, where the sidecar records the RTS delay it programmed (``rts_delay_s``), the echo
+    against that delay plus the scene's two-way air path of the front end: the echo's range
+    measures the path, so captures of another arc are refused here, whose curvature and
+    spreading loss the radar's antenna phases and the channel gains absorb in the joint fit
+    (a 1.2 m arc on the 1 m scene read 1.33 bins away and was accepted at residual 0.86
+    without this check). Its limit, 0.25 bin, is a radius error of 3.8 cm at the bundled
+    scene's 0.151 m bins."""
     r_bin = c * radar.adc_rate_hz / (2 * radar.slope_hz_per_s * radar.samples_per_chirp)
     v_bin = c / (2 * radar.f_c_hz * radar.tdm_cycle_s * radar.chirps_per_tx)
+    if model.rts_delay_s is not None:  # the echo against the recorded delay + the scene's air
+        dr, _ = probe_offset_bins(power, model)
+        if not abs(dr) <= SUBBIN_LIMIT["range"]:
+            raise CaptureError(_air_path_message(model, cap, dr, r_bin))
+    # the sidecar's probe range (and velocity) against the echo, the scene's delay for it
+    dr, dd = probe_offset_bins(power, dataclasses.replace(model, rts_delay_s=None))
     for name, have, off, step, unit, axis, also in (
             ("probe_range_m", cap.range_m, dr, r_bin, "m", "range",
              "or a radial or channel delay offset larger than that moves the echo"),
@@ -259,6 +316,27 @@ def _check_subbin(power: np.ndarray, model: ProbeModel, radar, cap: Capture) -> 
                 f"{have + off * step:.5g} {unit} ({off:+.2f} bins of {step:.4g} {unit} away, "
                 f"at most {limit:g} bin on the nominal setup): the sidecar does not describe "
                 f"this capture{', ' + also if also else ''}")
+
+
+def _air_path_message(model: ProbeModel, cap: Capture, dr: float, r_bin: float) -> str:
+    """The range check's line when the sidecar records the RTS's programmed delay: the echo's
+    range then measures the two-way air path, which is the scene's arc that disagrees."""
+    scene = model.setup.scene
+    rts = scene.rts
+    air = float(model.echoes(model.nominal()[None]).tau_air_s.mean()) * c  # two-way, m
+    tau0 = realised_delay(model.programmed_delay(), rts.f_s_hz, rts.fractional_delay,
+                          rts.fractional_delay_step_s)
+    want = c / 2 * (float(tau0) + air / c)
+    own = float(requested_delay(scene, model.range_m)) * 1e9
+    return (f"{cap.source}: the capture's echo is at {want + dr * r_bin:.4g} m, where the scene "
+            f"puts it {want:.4g} m ({dr:+.2f} bins of {r_bin:.3g} m, at most "
+            f"{SUBBIN_LIMIT['range']:g}): front end {cap.active}'s two-way air path on the "
+            f"scene's arc (rts.arc_radius_m = {rts.arc_radius_m:g} m, {air:.4g} m) misses the "
+            f"capture's by about {2 * dr * r_bin:+.2g} m, with the RTS delay its sidecar "
+            f"records (rts_delay_s = {model.programmed_delay() * 1e9:.4f} ns; the scene "
+            f"programs {own:.4f} ns for probe_range_m = {model.range_m:g}): the capture was "
+            "made on another arc or front-end position; identify it against the bench's "
+            "scene")
 
 
 def _check_peak(power: np.ndarray, model: ProbeModel, radar, cap: Capture) -> None:

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..errors import SceneError
 
-__all__ = ["ArrayPreset", "ArraySpec", "PRESETS", "preset"]
+__all__ = ["ArrayPreset", "ArraySpec", "CaptureLayout", "PRESETS", "preset", "LAYOUT_DEFAULT"]
 
 
 def _frozen(a) -> np.ndarray:
@@ -116,6 +116,49 @@ class ArraySpec:
 
 
 @dataclass(frozen=True)
+class CaptureLayout:
+    """How the board's raw ADC samples reach a DCA1000 capture file (TI SWRA581, "Mmwave Radar
+    Device ADC Raw Data Capture", sections 5, 6 and 9): real-only or complex (I/Q) samples and
+    the number of LVDS data lanes, which sets the interleaving (:mod:`rtsgeom.radar.dca1000`).
+
+    ``name`` is what the capture's sidecar records as its ``format``.
+    """
+
+    family: str  # the device family as the format name says it (xwr18xx, awr2944, ...)
+    complex: bool  # I/Q (complex baseband) samples, else real-only
+    lanes: int  # LVDS data lanes: 2 (xWR16xx/18xx/68xx/2944) or 4 (xWR12xx/14xx/22xx)
+    source: str  # the documents that say so
+
+    def __post_init__(self):
+        if self.lanes not in (2, 4):
+            raise SceneError(f"capture layout lanes = {self.lanes}: must be 2 or 4 (the "
+                             "DCA1000's LVDS layouts)")
+
+    @property
+    def adc(self) -> str:
+        """``"complex"`` or ``"real"``."""
+        return "complex" if self.complex else "real"
+
+    @property
+    def name(self) -> str:
+        """The sidecar's ``format``, e.g. ``dca1000-awr2944-real-2lane``."""
+        return f"dca1000-{self.family}-{self.adc}-{self.lanes}lane"
+
+
+_SWRA581_2LANE = ("TI SWRA581B (Mmwave Radar Device ADC Raw Data Capture), sec. 6 'xWR16xx and "
+                  "IWR6843 with DCA1000 data format' and sec. 9 (readDCA1000): 2 LVDS lanes; "
+                  "per chirp Rx 0..3 one after the other; complex samples stored I0 I1 Q0 Q1, "
+                  "real samples in order")
+_SWRA581_4LANE = ("TI SWRA581B, sec. 5 'xWR12xx and xWR14xx with DCA1000 data format' and sec. "
+                  "9: 4 LVDS lanes, one Rx per lane, per sample the lanes' I then their Q "
+                  "(reshape(adcData, numLanes*2, [])); real: the lanes' samples in turn")
+
+#: the layout of a capture whose sidecar names no layout (captures written before layouts were
+#: per preset): the xWR18xx's complex 2-lane format
+LAYOUT_DEFAULT = CaptureLayout("xwr18xx", True, 2, _SWRA581_2LANE)
+
+
+@dataclass(frozen=True)
 class ArrayPreset:
     """A documented radar board layout, positions in units of ``d`` (lambda/2 at the design
     frequency).
@@ -142,6 +185,7 @@ class ArrayPreset:
     num_azimuth_unique: int = 0  # documented number of distinct azimuth virtual positions
     labels: tuple[str, ...] = field(default=())  # Tx names in index order
     link: dict = field(default_factory=dict)  # [radar.link] values and their sources
+    capture: CaptureLayout = LAYOUT_DEFAULT  # the board's raw-capture layout (DCA1000)
 
     def __post_init__(self):
         object.__setattr__(self, "tx_units", _frozen(self.tx_units))
@@ -177,7 +221,8 @@ class ArrayPreset:
         if n_all > n_az:
             virtual += (f", {n_all * n_rx} with the {n_all - n_az} elevated Tx "
                         "(radar.use_elevation_tx = true)")
-        return f"{n_tx} Tx x {n_rx} Rx board: {virtual} ({self.source.split(';')[0]})"
+        return (f"{n_tx} Tx x {n_rx} Rx board: {virtual}; captures {self.capture.name} "
+                f"({self.source.split(';')[0]})")
 
     @property
     def num_rx(self) -> int:
@@ -316,6 +361,8 @@ _RX4 = [[0, 0], [1, 0], [2, 0], [3, 0]]
 PRESETS: dict[str, ArrayPreset] = {p.name: p for p in (
     ArrayPreset(
         name="awr1843boost", link=_AWR1843BOOST_LINK,
+        capture=CaptureLayout("xwr18xx", True, 2, _SWRA581_2LANE + "; TI AWR1843 datasheet "
+                              "(SWRS222): complex baseband receiver"),
         tx_units=[[0, 0], [2, 1], [4, 0]], rx_units=_RX4,
         tx_order=(0, 2), tx_order_elevation=(0, 1, 2), board_gap_units=6.0,
         design_frequency_hz=77e9, num_azimuth_unique=8, labels=("TX1", "TX2", "TX3"),
@@ -327,6 +374,8 @@ PRESETS: dict[str, ArrayPreset] = {p.name: p for p in (
              "TX3 to RX1) is an ASSUMPTION of this project, not a documented value."),
     ArrayPreset(
         name="iwr6843isk", link=_IWR6843ISK_LINK,
+        capture=CaptureLayout("iwr6843", True, 2, _SWRA581_2LANE + "; TI AWR6843 datasheet "
+                              "(SWRS248D), LVDS: two data lanes"),
         tx_units=[[0, 0], [2, 1], [4, 0]], rx_units=_RX4,
         tx_order=(0, 2), tx_order_elevation=(0, 1, 2), board_gap_units=6.0,
         design_frequency_hz=62e9, num_azimuth_unique=8, labels=("TX1", "TX2", "TX3"),
@@ -337,6 +386,10 @@ PRESETS: dict[str, ArrayPreset] = {p.name: p for p in (
              "elevated), lambda at 62 GHz. The board gap is ASSUMED (3 lambda), not documented."),
     ArrayPreset(
         name="awr2944", link=_AWR2944_LINK,
+        capture=CaptureLayout("awr2944", False, 2, _SWRA581_2LANE + "; TI AWR2944 datasheet "
+                              "(SWRS273A), LVDS: '2-data lane'; (JAJSNB2A), Receive "
+                              "Subsystem: 'The device supports a real-only receiver'; TI "
+                              "AWR2944EVM user's guide (SPRUJ22A): streams to the DCA1000"),
         tx_units=[[0, 0], [4, 0], [8, 0], [2, 1]], rx_units=_RX4,
         tx_order=(0, 1, 2), tx_order_elevation=(0, 1, 2, 3), board_gap_units=6.0,
         design_frequency_hz=77e9, num_azimuth_unique=12, labels=("TX1", "TX2", "TX3", "TX4"),
@@ -350,6 +403,12 @@ PRESETS: dict[str, ArrayPreset] = {p.name: p for p in (
              "a 3 lambda board gap (assumed). Use a custom [radar.array] for the real board."),
     ArrayPreset(
         name="awr2243-cascade", link=_AWR2243_CASCADE_LINK,
+        capture=CaptureLayout("awr2243", True, 4, _SWRA581_4LANE + "; TI AWR2243 datasheet "
+                              "(SWRS223D), Receive Subsystem: complex baseband (I and Q "
+                              "outputs). [assumed] the four devices' streams one after the "
+                              "other per chirp (Rx 0-3, 4-7, 8-11, 12-15), each in the 4-lane "
+                              "layout: the cascade board records through the MMWCAS-DSP-EVM, "
+                              "one file per device, not a DCA1000"),
         tx_units=[[11, 6], [10, 4], [9, 1], [32, 0], [28, 0], [24, 0], [20, 0], [16, 0],
                   [12, 0], [8, 0], [4, 0], [0, 0]],
         rx_units=[[x, 0] for x in (*range(11, 15), *range(50, 54), *range(46, 50),

@@ -286,6 +286,10 @@ def test_absurd_estimates_and_misfits_are_refused_or_flagged(captures, tmp_path,
     wide = scene.evolve(rts=scene.rts.evolve(arc_radius_m=1.2))
     setup = build_setup(wide)
     write_capture(simulate_capture(setup, 0, seed=5), setup.rut, tmp_path / "arc.npy", "npy")
+    # a sidecar without the RTS delay (the scene's is taken): the arc shows only in the fit
+    side = tmp_path / "arc.npy.json"
+    side.write_text(json.dumps({k: v for k, v in json.loads(side.read_text()).items()
+                                if k != "rts_delay_s"}))
     assert main(["identify", str(DEFAULT_SCENE), str(tmp_path / "arc.npy"), "--quiet"]) == 2
     _clean_error(capsys.readouterr().err, "residual_rms", "must be at most 3")
     assert main(["identify", str(DEFAULT_SCENE), str(tmp_path / "arc.npy"), "--json",
@@ -622,3 +626,20 @@ def test_an_arcs_inversion_refuses_one_axis(scene):
                                    invert_axis="tangential", mc=rtsgeom.MonteCarlo(50, 1))
     with pytest.raises(ParameterError, match="invert_axis"):
         study(scene)
+
+
+def test_radar_channels_refuse_captures_of_a_wider_arc_on_the_cli(tmp_path, capsys):
+    """`rtsgeom adc` on a copy of the bundled scene with arc_radius_m = 1.2, identified
+    against the 1 m scene with --radar-channels: accepted at residual 0.86 before (the antenna
+    phases took the curvature); now exit 2 with one line naming the arc and the air path."""
+    text = DEFAULT_SCENE.read_text()
+    assert "arc_radius_m = 1.0 " in text
+    wide = tmp_path / "wide.toml"
+    wide.write_text(text.replace("arc_radius_m = 1.0 ", "arc_radius_m = 1.2 "))
+    caps = []
+    for q in (0, 1):
+        caps.append(str(tmp_path / f"cap{q}.bin"))
+        assert main(["adc", str(wide), "--active", str(q), "--out", caps[-1], "--quiet"]) == 0
+    assert main(["identify", str(DEFAULT_SCENE), *caps, "--radar-channels", "--quiet"]) == 2
+    _clean_error(capsys.readouterr().err, "rts.arc_radius_m = 1 m", "another arc",
+                 "rts_delay_s")

@@ -13,6 +13,7 @@ from rtsgeom import identify as ident_mod
 from rtsgeom.calibration.pair import pair_coherence
 from rtsgeom.calibration.probes import probe_angles, probe_front_ends
 from rtsgeom.cli import main
+from rtsgeom.errors import CaptureError
 from rtsgeom.paths import exact_paths
 from rtsgeom.scene import load_scene
 
@@ -282,3 +283,61 @@ def test_the_page_simulates_the_captures_from_the_bench_as_built():
     adc = {m.group(1) for m in re.finditer(r"rtsgeom adc (\S+) --active", block)}
     ident = {m.group(1) for m in re.finditer(r"rtsgeom identify (\S+) ", block)}
     assert adc and ident and not adc & ident, block
+
+
+def _arc_captures(radius_m, offsets_mm=((0.0, 0.0), (0.0, 0.0)), seed=0):
+    """Captures of both front ends of the bundled scene built on an arc of ``radius_m`` with
+    (radial, tangential) mounting offsets per front end and channel errors, as `rtsgeom adc
+    --active` simulates them (its sidecar records the RTS delay it programmed)."""
+    scene = BASE.evolve(rts=BASE.rts.evolve(arc_radius_m=radius_m))
+    fes = tuple(f.evolve(radial_offset_m=r * 1e-3, tangential_offset_m=t * 1e-3,
+                         gain_offset_db=0.5 * (-1) ** q, phase_offset_rad=0.3 * q)
+                for q, (f, (r, t)) in enumerate(zip(scene.rts.front_ends, offsets_mm)))
+    setup = ident_mod.setup_of(scene.evolve(rts=scene.rts.evolve(front_ends=fes)))
+    return [ident_mod.simulate_capture(setup, q, seed=seed + q) for q in range(2)]
+
+
+@pytest.mark.parametrize("radius_m", [1.2, 0.8])
+def test_radar_channels_refuse_captures_of_another_arc(radius_m):
+    """Captures of a 1.2 m (or 0.8 m) arc identified against the 1 m scene with the radar's
+    channels free: the antenna phases absorbed the wavefront's curvature and the channel gains
+    the spreading loss (accepted at residual 0.86 x noise). The echo's range measured in the
+    capture against the scene's two-way path with the RTS delay the sidecar records refuses
+    it, naming the arc."""
+    caps = _arc_captures(radius_m)
+    for channels in (True, False):
+        with pytest.raises(CaptureError) as exc:
+            ident_mod.identify(BASE, caps, radar_channels=channels)
+        msg = str(exc.value)
+        assert "\n" not in msg and "rts.arc_radius_m = 1 m" in msg and "rts_delay_s" in msg
+        assert "another arc" in msg
+        # the path it names: 2 (R - 1 m) two-way, to the range interpolation's 25 %
+        got = float(msg.split("misses the capture's by about ")[1].split(" m")[0])
+        assert got == pytest.approx(2 * (radius_m - 1.0), rel=0.25)
+
+
+@pytest.mark.parametrize("offsets_mm", [((-5.0, 0.5), (3.0, -1.0)), ((0.0, 0.0), (0.0, 0.0)),
+                                        ((5.0, -0.5), (-3.0, 1.0))])
+def test_radar_channels_accept_captures_of_the_right_arc_with_mounting_offsets(offsets_mm):
+    """The right arc with radial offsets up to 5 mm (0.03 bin of range) and tangential ones:
+    accepted, the fit explains them (residual within the limit) and reads the second front
+    end's tangential offset relative to the reference's within 3 sigma."""
+    caps = _arc_captures(1.0, offsets_mm, seed=20)
+    r = ident_mod.identify(BASE, caps, radar_channels=True)
+    d = r.to_dict()
+    assert d["model_fits"]
+    for fe in d["front_ends"]:
+        assert fe["residual_rms"] < 1.5
+
+
+def test_a_sidecar_without_the_rts_delay_takes_the_scenes():
+    """Sidecars written before the RTS delay was recorded: the scene's requested delay for the
+    probe's range, as before (the capture of a correct bench reads the same)."""
+    import dataclasses
+    caps = _arc_captures(1.0, ((0.0, 0.3), (0.0, -0.4)), seed=30)
+    a = ident_mod.identify(BASE, caps).to_dict()
+    b = ident_mod.identify(BASE, [dataclasses.replace(c, rts_delay_s=None)
+                                  for c in caps]).to_dict()
+    for fa, fb in zip(a["front_ends"], b["front_ends"]):
+        assert fa["tangential_offset_mm"]["value"] == pytest.approx(
+            fb["tangential_offset_mm"]["value"], abs=1e-9)
