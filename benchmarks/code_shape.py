@@ -1,0 +1,128 @@
+"""The code's shape in two figures, read from the source as text (nothing imported): the length
+of every function and the parameter count of every public one.
+
+``python -m benchmarks.code_shape`` prints the functions over the limits; tests/test_structure.py
+holds the package to them (:data:`MAX_FUNCTION_LINES`, :data:`MAX_PARAMETERS`,
+:data:`MAX_WIDE_PUBLIC`).
+
+- A function's length is its lines from ``def`` to its last line, decorators aside, docstring
+  included (a nested function counts in its parent's lines and on its own).
+- Its parameters are every name it takes (positional, keyword-only, ``*args``, ``**kwargs``)
+  but ``self`` and ``cls``.
+- Public: the function's name and every enclosing class's name start without ``_``, and it is
+  not nested in another function. A module's or package's leading ``_`` (``_lib``) does not
+  make its functions private: the package's own layers call them as an API.
+- The compiled kernels (decorated ``njit``/``jit``: numba) are left out of both figures; their
+  arguments are the flat arrays numba compiles for.
+"""
+
+from __future__ import annotations
+
+import ast
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PKG = ROOT / "rtsgeom"
+
+#: the longest a function may be (lines)
+MAX_FUNCTION_LINES = 80
+#: a public function with more parameters than this is "wide"
+MAX_PARAMETERS = 8
+#: how many wide public functions the package may have
+MAX_WIDE_PUBLIC = 5
+
+KERNEL_DECORATORS = ("njit", "jit")
+
+
+@dataclass(frozen=True)
+class Function:
+    """One function (or method) of the package, as the source reads."""
+
+    module: str  #: dotted module name, ``rtsgeom.paths.raytrace``
+    qualname: str  #: ``Class.method`` or ``outer.<locals>.inner``
+    lineno: int
+    lines: int
+    parameters: int
+    public: bool
+    kernel: bool
+
+    @property
+    def where(self) -> str:
+        return f"{self.module}.{self.qualname}"
+
+
+def _decorator_name(node: ast.expr) -> str:
+    if isinstance(node, ast.Call):
+        node = node.func
+    if isinstance(node, ast.Attribute):
+        return node.attr
+    return node.id if isinstance(node, ast.Name) else ""
+
+
+def _parameters(node: ast.FunctionDef | ast.AsyncFunctionDef) -> int:
+    a = node.args
+    names = [x.arg for x in (*a.posonlyargs, *a.args, *a.kwonlyargs)]
+    names += [x.arg for x in (a.vararg, a.kwarg) if x is not None]
+    return sum(n not in ("self", "cls") for n in names)
+
+
+def _walk(tree: ast.AST, module: str):
+    def visit(node, prefix: str, public: bool, in_function: bool):
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.ClassDef):
+                yield from visit(child, f"{prefix}{child.name}.",
+                                 public and not child.name.startswith("_"), in_function)
+            elif isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                kernel = any(_decorator_name(d) in KERNEL_DECORATORS
+                             for d in child.decorator_list)
+                yield Function(module, prefix + child.name, child.lineno,
+                               child.end_lineno - child.lineno + 1, _parameters(child),
+                               public and not in_function and not child.name.startswith("_"),
+                               kernel)
+                yield from visit(child, f"{prefix}{child.name}.<locals>.", False, True)
+            else:
+                yield from visit(child, prefix, public, in_function)
+
+    yield from visit(tree, "", True, False)
+
+
+def functions(pkg: Path = PKG) -> list[Function]:
+    """Every function and method under ``pkg``, in file order."""
+    out = []
+    for p in sorted(pkg.rglob("*.py")):
+        parts = p.relative_to(pkg.parent).with_suffix("").parts
+        module = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+        out += _walk(ast.parse(p.read_text()), module)
+    return out
+
+
+def long_functions(fns=None, limit: int = MAX_FUNCTION_LINES) -> list[Function]:
+    """The functions (kernels aside) longer than ``limit`` lines, longest first."""
+    fns = functions() if fns is None else fns
+    return sorted((f for f in fns if f.lines > limit and not f.kernel), key=lambda f: -f.lines)
+
+
+def wide_public(fns=None, limit: int = MAX_PARAMETERS) -> list[Function]:
+    """The public functions (kernels aside) with more than ``limit`` parameters, widest
+    first."""
+    fns = functions() if fns is None else fns
+    return sorted((f for f in fns if f.public and not f.kernel and f.parameters > limit),
+                  key=lambda f: -f.parameters)
+
+
+def main() -> None:
+    fns = functions()
+    long, wide = long_functions(fns), wide_public(fns)
+    print(f"{len(fns)} functions; longest {max(f.lines for f in fns if not f.kernel)} lines")
+    print(f"over {MAX_FUNCTION_LINES} lines: {len(long)}")
+    for f in long:
+        print(f"  {f.lines:4d}  {f.where}  (line {f.lineno})")
+    print(f"public with over {MAX_PARAMETERS} parameters: {len(wide)} "
+          f"(allowed {MAX_WIDE_PUBLIC})")
+    for f in wide:
+        print(f"  {f.parameters:4d}  {f.where}  (line {f.lineno})")
+
+
+if __name__ == "__main__":
+    main()
