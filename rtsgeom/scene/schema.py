@@ -28,7 +28,7 @@ from typing import Any, Callable
 import numpy as np
 from ..errors import SceneError
 
-__all__ = ["SceneError", "REQUIRED", "Derived", "Spec", "spec", "specs", "read", "check_fields",
+__all__ = ["SceneError", "REQUIRED", "Derived", "Spec", "spec", "specs", "read", "check_value",
            "check_record", "check_arg", "fmt", "range_text", "rows_text"]
 
 

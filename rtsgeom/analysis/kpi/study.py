@@ -22,7 +22,9 @@ from ...errors import ParameterError
 from ...geometry import build_setup
 from ...paths import exact_paths
 from ...scene import Scene, check_scene_arg
+from ...scene.schema import check_arg
 from ..tolerance import MAX_SIGMA_MM
+from ..tolerance.args import STUDY_ARGS
 from ..transfer import ideal_radar, set_angles
 from .accuracy import AccuracyInputs, AnglePoint, effective_snr, pair_accuracy
 from .sections import (field_of_view, ghosts_section, nearfield_section, range_velocity,
@@ -60,17 +62,16 @@ class KpiStudy:
                 isinstance(v, (int, float)) and 0 <= v <= MAX_SIGMA_MM for v in vals)):
             raise ParameterError(f"sigma_mm = {s}: must be one number or three (radial, "
                                  f"tangential, height) in [0, {MAX_SIGMA_MM:g}] mm")
-        checks = (("sigma_phase_deg", self.sigma_phase_deg, 0.0, 90.0),
-                  ("points", self.points, 1, 201), ("draws", self.draws, 100, 1_000_000))
-        for name, v, lo, hi in checks:
-            if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v)
-                                      and lo <= v <= hi):
-                raise ParameterError(f"{name} = {v}: must be in [{lo:g}, {hi:g}]")
-        for name in ("points", "draws"):
-            if not isinstance(getattr(self, name), int):
-                raise ParameterError(f"{name} = {getattr(self, name)}: must be an integer")
-        if self.seed is not None and not (isinstance(self.seed, int) and self.seed >= 0):
-            raise ParameterError(f"seed = {self.seed}: must be an integer >= 0")
+        src = "KpiStudy"
+        if self.sigma_phase_deg is not None:
+            check_arg(self.sigma_phase_deg, "sigma_phase_deg", "float", src, ParameterError,
+                      lo=0.0, hi=90.0, unit="deg")
+        check_arg(self.points, "points", "int", src, ParameterError, lo=1, hi=201)
+        # the Monte-Carlo arguments as every study declares them, the datasheet's draws
+        # within its own bounds [100, 1e6]
+        STUDY_ARGS["draws"].check(self.draws, "draws", src, lo=100, hi=1_000_000)
+        if self.seed is not None:
+            STUDY_ARGS["seed"].check(self.seed, "seed", src)
         if self.spec is not None and not isinstance(self.spec, KpiSpec):
             raise ParameterError("spec: must be a KpiSpec (rtsgeom.analysis.kpi.load_spec)")
 
