@@ -7,8 +7,10 @@ holds the package to them (:data:`MAX_FUNCTION_LINES`, :data:`MAX_PARAMETERS`,
 
 - A function's length is its lines from ``def`` to its last line, decorators aside, docstring
   included (a nested function counts in its parent's lines and on its own).
-- Its parameters are every name it takes (positional, keyword-only, ``*args``, ``**kwargs``)
-  but ``self`` and ``cls``.
+- Its parameters are the names a caller may pass by position (``self`` and ``cls`` aside):
+  keyword-only ones are named at every call, so a long group of them cannot be passed in the
+  wrong order, which is what the limit guards against. ``Function.all_parameters`` counts
+  every name (keyword-only, ``*args``, ``**kwargs`` too).
 - Public: the function's name and every enclosing class's name start without ``_``, and it is
   not nested in another function. A module's or package's leading ``_`` (``_lib``) does not
   make its functions private: the package's own layers call them as an API.
@@ -43,7 +45,8 @@ class Function:
     qualname: str  #: ``Class.method`` or ``outer.<locals>.inner``
     lineno: int
     lines: int
-    parameters: int
+    parameters: int  #: positional (self/cls aside)
+    all_parameters: int  #: every name, keyword-only and ``*args``/``**kwargs`` included
     public: bool
     kernel: bool
 
@@ -60,11 +63,14 @@ def _decorator_name(node: ast.expr) -> str:
     return node.id if isinstance(node, ast.Name) else ""
 
 
-def _parameters(node: ast.FunctionDef | ast.AsyncFunctionDef) -> int:
+def _parameters(node: ast.FunctionDef | ast.AsyncFunctionDef) -> tuple[int, int]:
+    """(positional, all) parameter counts, ``self``/``cls`` aside."""
     a = node.args
-    names = [x.arg for x in (*a.posonlyargs, *a.args, *a.kwonlyargs)]
+    positional = [x.arg for x in (*a.posonlyargs, *a.args)]
+    names = positional + [x.arg for x in a.kwonlyargs]
     names += [x.arg for x in (a.vararg, a.kwarg) if x is not None]
-    return sum(n not in ("self", "cls") for n in names)
+    return (sum(n not in ("self", "cls") for n in positional),
+            sum(n not in ("self", "cls") for n in names))
 
 
 def _walk(tree: ast.AST, module: str):
@@ -77,7 +83,7 @@ def _walk(tree: ast.AST, module: str):
                 kernel = any(_decorator_name(d) in KERNEL_DECORATORS
                              for d in child.decorator_list)
                 yield Function(module, prefix + child.name, child.lineno,
-                               child.end_lineno - child.lineno + 1, _parameters(child),
+                               child.end_lineno - child.lineno + 1, *_parameters(child),
                                public and not in_function and not child.name.startswith("_"),
                                kernel)
                 yield from visit(child, f"{prefix}{child.name}.<locals>.", False, True)
@@ -104,8 +110,8 @@ def long_functions(fns=None, limit: int = MAX_FUNCTION_LINES) -> list[Function]:
 
 
 def wide_public(fns=None, limit: int = MAX_PARAMETERS) -> list[Function]:
-    """The public functions (kernels aside) with more than ``limit`` parameters, widest
-    first."""
+    """The public functions (kernels aside) with more than ``limit`` positional parameters,
+    widest first."""
     fns = functions() if fns is None else fns
     return sorted((f for f in fns if f.public and not f.kernel and f.parameters > limit),
                   key=lambda f: -f.parameters)
@@ -118,10 +124,15 @@ def main() -> None:
     print(f"over {MAX_FUNCTION_LINES} lines: {len(long)}")
     for f in long:
         print(f"  {f.lines:4d}  {f.where}  (line {f.lineno})")
-    print(f"public with over {MAX_PARAMETERS} parameters: {len(wide)} "
+    print(f"public with over {MAX_PARAMETERS} positional parameters: {len(wide)} "
           f"(allowed {MAX_WIDE_PUBLIC})")
     for f in wide:
         print(f"  {f.parameters:4d}  {f.where}  (line {f.lineno})")
+    every = sorted((f for f in fns if f.public and not f.kernel
+                    and f.all_parameters > MAX_PARAMETERS), key=lambda f: -f.all_parameters)
+    print(f"public with over {MAX_PARAMETERS} parameters of any kind: {len(every)}")
+    for f in every:
+        print(f"  {f.all_parameters:4d}  {f.where}  ({f.parameters} positional)")
 
 
 if __name__ == "__main__":

@@ -255,7 +255,7 @@ def tolerance(scene: Scene, pair=(0, 1), sigma_mm=(0.1, 0.1, 0.1), draws: int = 
     return study(scene).run
 
 
-def design(scene: Scene, radius_m, spacing_deg, pair=(0, 1), spec_deg: float = 0.1,
+def design(scene: Scene, radius_m, spacing_deg, pair=(0, 1), *, spec_deg: float = 0.1,
            target_yield: float = 0.95, draws: int = 2000, seed: int | None = None,
            points: int = 21):
     """Arc design map: every (front-end spacing, arc radius) as a two-front-end variant.

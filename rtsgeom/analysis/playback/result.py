@@ -240,8 +240,8 @@ class PlaybackResult(Result):
         xy = self.set["range_m"][..., None] * np.stack([np.sin(az), np.cos(az)], axis=-1)
         return playback_animation(path, self.time_s, np.degrees(setup.fe_azimuth_rad()), amp,
                                   xy, self.set["azimuth_deg"], self.detected["azimuth_deg"],
-                                  self.scene.rts.arc_radius_m, f"{self.scene.name}: {self.mode}",
-                                  fps)
+                                  self.scene.rts.arc_radius_m,
+                                  title=f"{self.scene.name}: {self.mode}", fps=fps)
 
 
 def _csv(cols: dict, names) -> str:

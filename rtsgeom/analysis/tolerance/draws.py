@@ -197,7 +197,7 @@ class DrawChunk:
 
 
 def draw_chunks(seed: int, draws: int, count: int, distribution: str = "normal",
-                chunk: int = DEFAULT_CHUNK, positions: int | None = None, centre: int = 0,
+                chunk: int = DEFAULT_CHUNK, *, positions: int | None = None, centre: int = 0,
                 rotations: bool = False, rut: bool = False) -> Iterator[DrawChunk]:
     """A study's draws chunk by chunk as :class:`DrawChunk` (the streams advanced here by
     drawing each chunk once: normal draws take a varying number of raw numbers each).
