@@ -107,8 +107,9 @@ def replace(obj, **changes):
 
 
 def _tuples(value):
-    """A list (or a 1-D/2-D array) of numbers as the tuple a scene field holds (the file's
-    lists are read as tuples; a list set in code was a TypeError in the re-check)."""
+    """A list (or a 1-D/2-D array) of numbers as the tuple a scene field holds: the reader
+    turns the file's lists into tuples, and the re-check of a value set in code takes the
+    same."""
     if isinstance(value, np.ndarray) and value.ndim in (1, 2) and value.dtype.kind in "iuf":
         value = value.tolist()
     if isinstance(value, list) and all(_is_number(v) or isinstance(v, (list, tuple))

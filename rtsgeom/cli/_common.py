@@ -312,7 +312,7 @@ def progress(quiet: bool):
 
         def update(label: str, done: int, total: int) -> None:
             nonlocal task
-            if task is None:  # no bar before the first count (was an unlabelled "0/?")
+            if task is None:  # the bar appears with the first count, labelled and sized
                 task = bar.add_task(label, total=total)
             bar.update(task, description=label, completed=done, total=total)
         yield update

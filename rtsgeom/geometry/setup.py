@@ -148,8 +148,7 @@ def nominal_scene(scene: Scene, validate: bool = True) -> Scene:
     False: not validated again (a study's internal variant, checked by its own rules: zeroing
     a radial offset lengthens the air path, which can put a valid scene's target, one the
     study drops anyway, beyond the range the rules allow)."""
-    # a front end without errors as it is (re-validating each one, per target and frame of
-    # a drive, was an eighth of its planning)
+    # a front end without errors is kept as it is: no copy per target and frame of a drive
     fes = tuple(f if not any(np.any(np.asarray(getattr(f, k)) != 0.0) for k in FRONT_END_ERRORS)
                 else f.derive(**dict.fromkeys(FRONT_END_ERRORS, 0.0)) for f in scene.rts.front_ends)
     radar = scene.radar
