@@ -135,5 +135,63 @@ def main() -> None:
         print(f"  {f.all_parameters:4d}  {f.where}  ({f.parameters} positional)")
 
 
+
+
+# --------------------------------------------------------------------------------------------
+# numpydoc sections on the package's face
+# --------------------------------------------------------------------------------------------
+
+#: the share of ``rtsgeom.__all__`` (callables) whose docstrings carry their numpydoc sections
+MIN_NUMPYDOC_SHARE = 0.9
+
+
+def numpydoc_sections(doc: str | None) -> set[str]:
+    """The numpydoc section titles in ``doc``: a title line followed by a line of dashes as
+    long."""
+    import inspect
+    lines = inspect.cleandoc(doc or "").splitlines()
+    return {a.strip() for a, b in zip(lines, lines[1:])
+            if a.strip() and set(b.strip()) == {"-"} and len(b.strip()) == len(a.strip())}
+
+
+def numpydoc_missing(obj) -> list[str]:
+    """The sections ``obj``'s docstring lacks: a function ``Parameters`` (when it takes any)
+    and ``Returns``; a class ``Parameters`` or ``Attributes`` (an exception or warning class:
+    only a docstring)."""
+    import inspect
+    doc = inspect.getdoc(obj)
+    if not doc:
+        return ["docstring"]
+    have = numpydoc_sections(doc)
+    if inspect.isclass(obj):
+        if issubclass(obj, BaseException):
+            return []
+        return [] if have & {"Parameters", "Attributes"} else ["Parameters/Attributes"]
+    try:
+        takes = any(n not in ("self", "cls") for n in inspect.signature(obj).parameters)
+    except (TypeError, ValueError):
+        takes = True
+    missing = ["Parameters"] if takes and "Parameters" not in have else []
+    return missing + ([] if have & {"Returns", "Yields"} else ["Returns"])
+
+
+def numpydoc_report() -> tuple[list[str], dict[str, list[str]]]:
+    """(the callables of ``rtsgeom.__all__``, those lacking sections -> what they lack)."""
+    import rtsgeom
+    names = [n for n in rtsgeom.__all__ if callable(getattr(rtsgeom, n))]
+    missing = {n: m for n in names if (m := numpydoc_missing(getattr(rtsgeom, n)))}
+    return names, missing
+
+
+def _print_numpydoc() -> None:
+    names, missing = numpydoc_report()
+    print(f"numpydoc sections on {len(names) - len(missing)} of {len(names)} callables of "
+          f"rtsgeom.__all__ ({1 - len(missing) / len(names):.0%}; at least "
+          f"{MIN_NUMPYDOC_SHARE:.0%})")
+    for n, m in missing.items():
+        print(f"  {n}: no {', '.join(m)}")
+
+
 if __name__ == "__main__":
     main()
+    _print_numpydoc()

@@ -54,6 +54,11 @@ def replace(obj, **changes):
     **changes
         Fields to change: SI attribute names or the scene file's keys.
 
+    Returns
+    -------
+    object
+        A new object of ``obj``'s type (``obj`` itself is frozen and unchanged).
+
     Raises
     ------
     ParameterError

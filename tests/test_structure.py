@@ -151,6 +151,38 @@ def test_few_public_functions_take_over_8_parameters():
     assert len(wide) <= MAX_WIDE_PUBLIC, wide
 
 
+def test_the_packages_face_has_its_numpydoc_sections():
+    """At least 90 % of the callables in ``rtsgeom.__all__`` carry their numpydoc sections
+    (Parameters/Attributes, Returns: benchmarks/code_shape.py says which each needs)."""
+    from benchmarks.code_shape import MIN_NUMPYDOC_SHARE, numpydoc_report
+    names, missing = numpydoc_report()
+    assert 1 - len(missing) / len(names) >= MIN_NUMPYDOC_SHARE, missing
+
+
+def test_the_numpydoc_measure_reads_sections():
+    from benchmarks.code_shape import numpydoc_missing, numpydoc_sections
+
+    def f(a):
+        """One line.
+
+        Parameters
+        ----------
+        a : int
+            A.
+
+        Returns
+        -------
+        int
+        """
+
+    def g(a):
+        """One line; ``a``: a number. Returns it.
+        ----
+        """
+    assert numpydoc_sections(f.__doc__) == {"Parameters", "Returns"}
+    assert numpydoc_missing(f) == [] and numpydoc_missing(g) == ["Parameters", "Returns"]
+
+
 def test_the_shape_measure_counts_what_it_says():
     """The measure itself, on a made-up module: lines from ``def`` to the last line, parameters
     without self/cls, nested and underscored functions not public, numba kernels flagged."""

@@ -39,14 +39,30 @@ SCHEMA_VERSION = 1
 
 @dataclass(frozen=True)
 class KpiStudy:
-    """The datasheet of a scene (module doc).
+    """The datasheet of a scene (module doc): ``KpiStudy(...)(scene)`` is a :class:`Datasheet`.
 
-    ``sigma_mm``: the mounting offsets' standard deviation per axis (radial, tangential,
-    height; one number for all three), default 0.1 mm; ``sigma_phase_deg``: each RuT antenna's
-    phase spread over radars of the type (default: the RMS of the scene's
-    ``[radar.channels]`` phases, 0 without them); ``points``: set angles across each pair's
-    span; ``draws``: the Monte Carlo's; ``seed``: its (default the scene's); ``spec``: the
-    :class:`~.spec.KpiSpec` to check."""
+    Parameters
+    ----------
+    sigma_mm : float or (float, float, float), optional
+        The mounting offsets' standard deviation per axis (radial, tangential, height; one
+        number for all three), in [0, 10] mm; default 0.1 mm.
+    sigma_phase_deg : float, optional
+        Each RuT antenna's phase spread over radars of the type, in [0, 90] deg; default the
+        RMS of the scene's ``[radar.channels]`` phases, 0 without them.
+    points : int
+        Set angles across each pair's span, in [1, 201].
+    draws : int
+        The Monte Carlo's draws, in [100, 1 000 000].
+    seed : int, optional
+        Its seed; default the scene's.
+    spec : KpiSpec, optional
+        The requirements to check (:func:`~.spec.load_spec`).
+
+    Raises
+    ------
+    ParameterError
+        A value outside its range, naming it.
+    """
 
     sigma_mm: float | tuple[float, float, float] | None = None
     sigma_phase_deg: float | None = None
@@ -185,9 +201,28 @@ class _Steps:
 
 @dataclass(frozen=True, repr=False)
 class Datasheet(Result):
-    """The setup's datasheet (module doc): ``accuracy`` per set angle (:class:`AnglePoint`),
-    the sections as plain dicts, ``checks`` against the spec; ``to_dict()`` the JSON,
-    ``plot()`` the angle accuracy, ``figures()`` every figure of the report."""
+    """The setup's datasheet (module doc): ``to_dict()`` the JSON, ``plot()`` the angle
+    accuracy, ``figures()`` every figure of the report.
+
+    Attributes
+    ----------
+    scene_name : str
+        The scene's name.
+    study : KpiStudy
+        The study that made it.
+    fov : dict
+        The field of view the arc covers.
+    accuracy : tuple of AnglePoint
+        The angle accuracy per set angle; ``accuracy_note`` how it was evaluated.
+    inputs : dict
+        The uncertainty budget's inputs (sigmas, SNR, draws, seed).
+    range_velocity, targets, ghosts, nearfield : dict
+        The other sections, as plain dicts.
+    spec : KpiSpec or None
+        The requirements checked; ``checks`` the verdict per requirement.
+    elapsed_s : float
+        The study's wall time.
+    """
 
     scene_name: str
     study: KpiStudy

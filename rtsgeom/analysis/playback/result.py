@@ -26,17 +26,39 @@ TRACK_COLUMNS = ("frame", "time_s", "target", "set_range_m", "set_azimuth_deg",
 class PlaybackResult(Result):
     """A drive played frame by frame (``Playback``).
 
-    ``set`` and ``detected``: ``range_m``, ``azimuth_deg``, ``velocity_mps`` arrays (frames,
-    targets), detected NaN where the target was lost; ``split`` (frames, targets) the other
-    detections near a target's set-point that no target claimed; ``channels`` (frames,
-    targets) the front ends that carry each target; ``programme`` (rows, 7): frame, target,
-    channel, delay_s, doppler_hz, |amplitude|, phase_rad; ``baseline`` the switched baseline
-    (``nearest``) on the same drive, or None; ``truth`` the truth twin's detections (the same
-    keys, NaN where the real scene gives the target no detection of its own; None: not run);
-    ``status`` (frames, targets) ``detected``, ``merged`` or ``not_detected``; ``clouds``
-    (a scene with extended objects) the truth twin's and the RTS's detections of each object
-    (:mod:`rtsgeom.analysis.objects`) and the resolution cell they are compared in;
-    ``budget`` per frame the planner's counts under ``[rts] max_targets_per_channel``.
+    Attributes
+    ----------
+    scene : Scene
+        The scene played.
+    mode : str
+        The amplitude mode.
+    time_s : ndarray, (frames,)
+        Each frame's time.
+    set, detected : dict
+        ``range_m``, ``azimuth_deg``, ``velocity_mps`` arrays (frames, targets); detected NaN
+        where the target was lost.
+    split : ndarray, (frames, targets)
+        The other detections near a target's set-point that no target claimed.
+    channels : ndarray, (frames, targets)
+        The front ends that carry each target.
+    programme : ndarray, (rows, 7)
+        Frame, target, channel, delay_s, doppler_hz, |amplitude|, phase_rad.
+    calibration : dict
+        The pairs' calibration used.
+    warnings : tuple of str
+        The run's warnings.
+    baseline : PlaybackResult or None
+        The switched baseline (``nearest``) on the same drive.
+    truth : dict or None
+        The truth twin's detections (the same keys, NaN where the real scene gives the target
+        no detection of its own; None: not run).
+    status : ndarray or None, (frames, targets)
+        ``detected``, ``merged`` or ``not_detected``.
+    clouds : tuple or None
+        For a scene with extended objects, the truth twin's and the RTS's detections of each
+        object (:mod:`rtsgeom.analysis.objects`) and the resolution cell they are compared in.
+    budget : tuple or None
+        Per frame the planner's counts under ``[rts] max_targets_per_channel``.
     """
 
     scene: Scene
