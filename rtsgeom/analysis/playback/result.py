@@ -37,10 +37,10 @@ class PlaybackResult(Result):
     set, detected : dict
         ``range_m``, ``azimuth_deg``, ``velocity_mps`` arrays (frames, targets); detected NaN
         where the target was lost.
-    split : ndarray, (frames, targets)
-        The other detections near a target's set-point that no target claimed.
-    channels : ndarray, (frames, targets)
-        The front ends that carry each target.
+    split : ndarray
+        (frames, targets): the other detections near a target's set-point that no target claimed.
+    channels : ndarray
+        (frames, targets): the front ends that carry each target.
     programme : ndarray, (rows, 7)
         Frame, target, channel, delay_s, doppler_hz, |amplitude|, phase_rad.
     calibration : dict
@@ -52,8 +52,8 @@ class PlaybackResult(Result):
     truth : dict or None
         The truth twin's detections (the same keys, NaN where the real scene gives the target
         no detection of its own; None: not run).
-    status : ndarray or None, (frames, targets)
-        ``detected``, ``merged`` or ``not_detected``.
+    status : ndarray or None
+        (frames, targets): ``detected``, ``merged`` or ``not_detected``.
     clouds : tuple or None
         For a scene with extended objects, the truth twin's and the RTS's detections of each
         object (:mod:`rtsgeom.analysis.objects`) and the resolution cell they are compared in.
