@@ -54,6 +54,11 @@ def replace(obj, **changes):
     **changes
         Fields to change: SI attribute names or the scene file's keys.
 
+    Returns
+    -------
+    object
+        A new object of ``obj``'s type (``obj`` itself is frozen and unchanged).
+
     Raises
     ------
     ParameterError
@@ -107,8 +112,9 @@ def replace(obj, **changes):
 
 
 def _tuples(value):
-    """A list (or a 1-D/2-D array) of numbers as the tuple a scene field holds (the file's
-    lists are read as tuples; a list set in code was a TypeError in the re-check)."""
+    """A list (or a 1-D/2-D array) of numbers as the tuple a scene field holds: the reader
+    turns the file's lists into tuples, and the re-check of a value set in code takes the
+    same."""
     if isinstance(value, np.ndarray) and value.ndim in (1, 2) and value.dtype.kind in "iuf":
         value = value.tolist()
     if isinstance(value, list) and all(_is_number(v) or isinstance(v, (list, tuple))
@@ -255,7 +261,7 @@ def tolerance(scene: Scene, pair=(0, 1), sigma_mm=(0.1, 0.1, 0.1), draws: int = 
     return study(scene).run
 
 
-def design(scene: Scene, radius_m, spacing_deg, pair=(0, 1), spec_deg: float = 0.1,
+def design(scene: Scene, radius_m, spacing_deg, pair=(0, 1), *, spec_deg: float = 0.1,
            target_yield: float = 0.95, draws: int = 2000, seed: int | None = None,
            points: int = 21):
     """Arc design map: every (front-end spacing, arc radius) as a two-front-end variant.

@@ -86,8 +86,9 @@ _PACKAGE_DIR = str(__import__("pathlib").Path(__file__).resolve().parents[1])
 def warn_caller(message: str, category: type[Warning]) -> None:
     """``warnings.warn`` attributed to the first frame outside the rtsgeom package: the
     user's line that called the API, however deep inside the package the warning is raised
-    (a fixed ``stacklevel`` pointed ``rtsgeom.design()``'s warning at ``rtsgeom/api.py``).
-    Python 3.12's ``skip_file_prefixes`` does this; 3.11 needs the walk."""
+    (a fixed ``stacklevel`` names a line of the package whenever the call chain inside it is
+    longer or shorter than counted). Python 3.12's ``skip_file_prefixes`` does this; 3.11 needs
+    the walk."""
     import os
     import warnings
     level, f = 2, sys._getframe(1)  # stacklevel 2: warn_caller's caller

@@ -141,7 +141,7 @@ def build_problem(scene: Scene) -> str | None:
 
 
 def evaluate_design(scene: Scene, pair: tuple[int, int], radius_m: float, spacing_rad: float,
-                    spec_deg: float = 0.1, target_yield: float = 0.95, draws: int = 2000,
+                    *, spec_deg: float = 0.1, target_yield: float = 0.95, draws: int = 2000,
                     seed: int = 0, points: int = 21, rel_tol: float = 0.02) -> dict:
     """All metrics of one design (NaN where it cannot be built; ``problem`` says why)."""
     variant, sheet_state, problem = two_front_end_scene(scene, pair, radius_m, spacing_rad)
@@ -242,8 +242,8 @@ def pilot_estimate(model: ChannelPhasors, case: str, seed: int, target_yield: fl
 
 def _evaluate_cell(scene, pair, spec_deg, target_yield, draws, seed, points, cell) -> dict:
     """:func:`evaluate_design` of one (radius, spacing) cell (a picklable task for a pool)."""
-    return evaluate_design(scene, pair, cell[0], cell[1], spec_deg, target_yield, draws, seed,
-                           points)
+    return evaluate_design(scene, pair, cell[0], cell[1], spec_deg=spec_deg,
+                           target_yield=target_yield, draws=draws, seed=seed, points=points)
 
 
 @dataclass(frozen=True, repr=False)

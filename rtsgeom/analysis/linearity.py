@@ -144,7 +144,7 @@ class Linearity(Result):
 
 def linearity(setup: Setup, paths: Paths, channels=None, mode: str = "exact",
               probe: FrontEndProbe | None = None, calibration: Calibration | None = None,
-              points: int = 21, seed: int = 0, end_angles: str = "geometric",
+              points: int = 21, seed: int = 0, *, end_angles: str = "geometric",
               calibrate: bool = True, progress=None) -> Linearity:
     """Synthesize targets at set directions across ``channels`` and detect each on the
     simulated RuT: for a RuT that beamforms in azimuth a pair of front ends (default (0, 1);

@@ -114,7 +114,7 @@ class LinearityStudy:
             cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
         self._step(f"sweeping {self.points} set-points ({self.amplitudes} amplitudes)")
         return linearity(setup, paths, pair, self.amplitudes, probe, cal, self.points,
-                         scene.seed, self.end_angles)
+                         scene.seed, end_angles=self.end_angles)
 
     def _grid(self, scene: Scene) -> Linearity:
         self._step("measuring each front end alone")
@@ -147,7 +147,7 @@ class LinearityStudy:
             self._step(f"pair {pair}: sweeping {self.points} set-points ({self.amplitudes} "
                        "amplitudes)")
             lins.append(linearity(setup, paths, pair, self.amplitudes, probe, cal, self.points,
-                                  scene.seed, self.end_angles))
+                                  scene.seed, end_angles=self.end_angles))
         return ArcLinearity(tuple(pairs), tuple(lins), self.calibrated, self.amplitudes)
 
 

@@ -309,8 +309,8 @@ def nearfield(scene: Scene, radii=None, points: int = 11) -> NearField:
     # is the arc's near field, on the nominal setup (``nominal_scene``): a scene's own
     # mounting, channel or RuT pose errors had entered the detected angles but not the
     # synthesis's set-points (0.5 deg of RuT yaw read as 0.5 deg of "exact" synthesis error).
-    probe_scene = nominal_scene(scene, validate=False).evolve(
-        targets=(), sheet=scene.sheet.evolve(enabled=False))
+    probe_scene = nominal_scene(scene, validate=False).derive(
+        targets=(), sheet=scene.sheet.derive(enabled=False))
     for r in radii:
         setup = build_setup(with_arc_radius(probe_scene, r))
         paths = exact_paths(setup)

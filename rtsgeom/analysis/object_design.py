@@ -121,7 +121,24 @@ class ObjectDesign:
 
 def object_design(scene: Scene, **kwargs) -> "ObjectDesignResult":
     """Run :class:`ObjectDesign` (``kwargs`` its parameters) on ``scene``, the function of
-    ``rtsgeom objects``."""
+    ``rtsgeom objects``.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene with an extended object.
+    **kwargs
+        :class:`ObjectDesign`'s fields.
+
+    Returns
+    -------
+    ObjectDesignResult
+
+    Raises
+    ------
+    ParameterError
+        A field outside its range, naming it.
+    """
     return ObjectDesign(**kwargs)(scene)
 
 
@@ -156,11 +173,27 @@ def _variant(arc: Scene, targets, budget, model, range_m: float) -> Scene:
 
 @dataclass(frozen=True, repr=False)
 class ObjectDesignResult(Result):
-    """The object design study's result: per spacing (S), budget (B) and range (R) the share
-    of the truth twin's detections the RTS reproduces, the centroid azimuth difference (deg),
-    the targets the RTS kept and the detections of truth and RTS; ``front_ends`` (S,) the
-    arc's front ends per spacing; :meth:`best` the smallest design that reproduces the
-    object."""
+    """The object design study's result; :meth:`best` the smallest design that reproduces
+    the object.
+
+    Attributes
+    ----------
+    study : ObjectDesign
+        The study that made it.
+    scene_name, object_where : str
+        The scene's name and the object's place in it.
+    front_ends : ndarray, (S,)
+        The arc's front ends per spacing.
+    share : ndarray, (S, B, R)
+        Per spacing, budget and range the share of the truth twin's detections the RTS
+        reproduces.
+    centroid_deg : ndarray, (S, B, R)
+        The centroid azimuth difference, RTS against truth.
+    kept : ndarray, (S, B, R)
+        The targets the RTS kept.
+    truth, rts : ndarray, (S, B, R)
+        The detections of the truth twin and of the RTS.
+    """
 
     study: ObjectDesign
     scene_name: str

@@ -140,7 +140,24 @@ class ResolutionStudy:
 
 
 def resolution(scene: Scene, **kwargs) -> "Resolution":
-    """Run :class:`ResolutionStudy` (``kwargs`` its parameters) on ``scene``."""
+    """Run :class:`ResolutionStudy` (``kwargs`` its parameters) on ``scene``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The setup to test.
+    **kwargs
+        :class:`ResolutionStudy`'s fields.
+
+    Returns
+    -------
+    Resolution
+
+    Raises
+    ------
+    ParameterError
+        A field outside its range, naming it.
+    """
     return ResolutionStudy(**kwargs)(scene)
 
 
@@ -260,11 +277,22 @@ def min_separation(separations, resolved) -> float | None:
 
 @dataclass(frozen=True, repr=False)
 class Resolution(Result):
-    """A resolution test's result (:class:`ResolutionStudy`).
+    """A resolution test's result (:class:`ResolutionStudy`); :attr:`min_separation_deg` the
+    headline.
 
-    ``table``: columns ``separation_deg``, ``phase_deg``, ``source`` (``truth``, ``rts``),
-    ``resolved``, ``angle_1_deg``, ``angle_2_deg``; ``spectra``: the angle spectra of the
-    figure. :attr:`min_separation_deg` the headline.
+    Attributes
+    ----------
+    scene_name : str
+        The scene's name.
+    study : ResolutionStudy
+        The study that made it.
+    range_m, centre_deg : float
+        The two targets' range and the azimuth they are placed about.
+    table : dict
+        Columns ``separation_deg``, ``phase_deg``, ``source`` (``truth``, ``rts``),
+        ``resolved``, ``angle_1_deg``, ``angle_2_deg``.
+    spectra : dict
+        The angle spectra of the figure.
     """
 
     scene_name: str

@@ -44,6 +44,7 @@ from ..pipeline.pair import pair_design
 from ..scene import TargetConfig
 from ..scene.registry import SYNTHESIS_MODES
 from ..scene.schema import check_arg, fmt
+from .tolerance.args import STUDY_ARGS
 from ..synthesis.model import ChannelModel
 
 __all__ = ["TransferStudy", "Transfer", "draw_channel_gains", "percentiles", "snapshot_angles",
@@ -290,11 +291,9 @@ class TransferStudy:
                                       hi=MAX_POINTS),
                   "mode": check_arg(self.mode, "mode", "str", src, ParameterError,
                                     choices=SYNTHESIS_MODES),
-                  "seed": check_arg(self.seed, "seed", "int", src, ParameterError, lo=0,
-                                    hi=2 ** 63 - 1)}
+                  "seed": STUDY_ARGS["seed"].check(self.seed, "seed", src)}
         if self.spec_deg is not None:
-            values["spec_deg"] = check_arg(self.spec_deg, "spec_deg", "float", src,
-                                           ParameterError, lo=1e-6, hi=90.0, unit="deg")
+            values["spec_deg"] = STUDY_ARGS["spec_deg"].check(self.spec_deg, "spec_deg", src)
         if self.pairs is not None:
             pairs = self.pairs
             if (not isinstance(pairs, (tuple, list)) or not pairs

@@ -237,29 +237,45 @@ def fit_centre(deltas, error_rad, period_s: float, near_s: float, harmonics: int
 
     half = 1.5 * step if search_s is None else search_s
     grid = near_s + np.arange(-half, half + 1e-15, SEARCH_GRID_S)
-    resid = fits(grid)[0]
-    k = int(np.argmin(resid))
-    centre = float(grid[k])
-    if 0 < k < grid.size - 1:  # the residual is a parabola about its minimum: its vertex
-        y0, y1, y2 = resid[k - 1:k + 2]
-        curv = y0 - 2 * y1 + y2
-        if curv > 0:
-            centre += 0.5 * (y0 - y2) / curv * SEARCH_GRID_S
+    centre = _least(grid, fits(grid)[0])
     _, coefs = fits(centre)
     for c, coef in zip(cols, coefs):
         m = ok[:, c]
         psi = 2 * np.pi * (d[m] - centre) / period_s + x[m, c]
         fitted[m, c] = _basis(psi, harmonics, odd[c]) @ coef[0]
-    best = centre
-    if extra_phase_rad is not None:  # the delay whose phase mismatch is zero (fixed point)
-        order = np.argsort(d)
-        for _ in range(4):
-            if search_phase is not None:
-                x_b = np.asarray(search_phase(np.array([best])), float).reshape(-1)[cols]
-            else:
-                x_b = np.array([np.interp(best, d[order], x[order, c]) for c in cols])
-            best = centre - period_s * float(np.mean(x_b)) / (2 * np.pi)
+    best = centre if extra_phase_rad is None else _zero_mismatch(centre, d, x[:, cols],
+                                                                 period_s, search_phase, cols)
     return (float(best), fitted) if return_fit else float(best)
+
+
+def _least(grid: np.ndarray, resid: np.ndarray) -> float:
+    """The delay of least residual on ``grid``, refined to the vertex of the parabola through
+    the lowest point and its two neighbours (the residual is a parabola about its minimum)."""
+    k = int(np.argmin(resid))
+    centre = float(grid[k])
+    if 0 < k < grid.size - 1:
+        y0, y1, y2 = resid[k - 1:k + 2]
+        curv = y0 - 2 * y1 + y2
+        if curv > 0:
+            centre += 0.5 * (y0 - y2) / curv * SEARCH_GRID_S
+    return centre
+
+
+def _zero_mismatch(centre: float, d, x_cols, period_s: float, search_phase, cols) -> float:
+    """The delay whose phase mismatch is zero, ``2 pi (delta - s) / period = -mean_c
+    x_c(delta)``, by four fixed-point steps from the fitted ``centre``: x_c (the fitted columns'
+    extra phases ``x_cols`` (S, C_fit)) from ``search_phase`` on the continuous delay, or
+    interpolated between the steps ``d``."""
+    order = np.argsort(d)
+    best = centre
+    for _ in range(4):
+        if search_phase is not None:
+            x_b = np.asarray(search_phase(np.array([best])), float).reshape(-1)[cols]
+        else:
+            x_b = np.array([np.interp(best, d[order], x_cols[order, i])
+                            for i in range(len(cols))])
+        best = centre - period_s * float(np.mean(x_b)) / (2 * np.pi)
+    return best
 
 
 def fit_scatter(fit, fitted, e, harmonics: int, seed, pair, repeat=None,

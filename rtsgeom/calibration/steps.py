@@ -60,10 +60,10 @@ def continuous_delay_setup(setup: Setup) -> Setup:
 
 
 def _variant(setup: Setup, **changes) -> Setup:
-    """``setup`` with its scene's sections replaced, not validated again: the variants the
-    sweep makes (a continuous RTS, noise off, a channel's phase) are valid by construction,
-    and ``Scene.evolve`` checks every front end and rule again, per pair an O(F) cost that
-    made a calibration of all pairs of an arc grow as F^2 (64 front ends: 12 s of 30)."""
+    """``setup`` with its scene's sections replaced, not validated again (a derived variant,
+    :meth:`~rtsgeom.scene.evolve.Evolvable.derive`): the variants the sweep makes (a
+    continuous RTS, noise off, a channel's phase) are valid by construction, and checking
+    every front end and rule again costs O(F) per pair, O(F^2) for all pairs of an arc."""
     return dataclasses.replace(setup, scene=dataclasses.replace(setup.scene, **changes))
 
 

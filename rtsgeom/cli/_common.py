@@ -29,7 +29,7 @@ __all__ = ["UsageError", "number", "scene_arg", "print_json", "load_scene_checke
            "show_warning",
            "pair_word", "pair_of", "pair_options", "print_outputs", "progress", "study_options",
            "declared_option",
-           "read_calibration", "calibration_kw", "flag_words", "numbers"]
+           "read_calibration", "calibration_kw", "flag_words", "flagged", "numbers"]
 
 
 def number(lo=None, hi=None, integer=False):
@@ -90,6 +90,17 @@ def flag_words(message: str, args: dict) -> str:
     def flag(m):
         return "--" + m.group(0).replace("_", "-") if m.group(0) in names else m.group(0)
     return re.sub(r"(?<![-\w./])[a-z][a-z_]*\b(?![-/.])", flag, head) + sep + tail
+
+
+@contextmanager
+def flagged(args):
+    """Run a study in the words of the command line: a :class:`ParameterError` raised inside
+    becomes the command's :class:`UsageError` (one line, exit 2) with the argument names that
+    are the command's options written as its flags (:func:`flag_words`)."""
+    try:
+        yield
+    except ParameterError as exc:
+        raise UsageError(flag_words(str(exc), vars(args))) from None
 
 
 def output_path(text: str) -> Path:
@@ -301,7 +312,7 @@ def progress(quiet: bool):
 
         def update(label: str, done: int, total: int) -> None:
             nonlocal task
-            if task is None:  # no bar before the first count (was an unlabelled "0/?")
+            if task is None:  # the bar appears with the first count, labelled and sized
                 task = bar.add_task(label, total=total)
             bar.update(task, description=label, completed=done, total=total)
         yield update

@@ -9,9 +9,9 @@ import numpy as np
 from .._lib.io import write_json
 from ..analysis.calibration_study import PROCEDURES, CalibrationStudy
 from ..calibration.file import setup_fingerprint
-from ..errors import ParameterError, UsageError
+from ..errors import UsageError
 from ..geometry import build_setup
-from ._common import (flag_words, load_scene_checked, output_folder, output_path, pair_of,
+from ._common import (flagged, load_scene_checked, output_folder, output_path, pair_of,
                       pair_options, print_json, steps)
 
 
@@ -74,10 +74,8 @@ def study_of(args, step=None) -> CalibrationStudy:
 
 def _calibrate(args, stage) -> int:
     with steps(args.quiet or args.json) as step:
-        try:
+        with flagged(args):
             report = study_of(args, step)(load_scene_checked(args.scene))
-        except ParameterError as exc:
-            raise UsageError(flag_words(str(exc), vars(args))) from None
     if stage is not None:
         report.write(stage)
     out = report.to_dict()

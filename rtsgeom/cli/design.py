@@ -14,8 +14,7 @@ from ..analysis.coverage import best_per_radius
 from ..analysis.design_study import DesignStudy
 from ..analysis.tolerance import MonteCarlo
 from ..analysis.tolerance.config import STUDY_ARGS
-from ..errors import ParameterError, UsageError
-from ._common import (flag_words, load_scene_checked, number, output_folder, print_json,
+from ._common import (flagged, load_scene_checked, number, output_folder, print_json,
                       progress, study_options)
 
 
@@ -75,10 +74,8 @@ def cmd_design(args) -> int:
                   f"adjacent pair ({others}), --coverage-deg A:B for the whole arc",
                   file=sys.stderr)
         with progress(args.quiet) as report:
-            try:
+            with flagged(args):
                 grid = study_of(args, report)(scene)
-            except ParameterError as exc:
-                raise UsageError(flag_words(str(exc), vars(args))) from None
         if stage is not None:
             grid.write(stage)
     if args.coverage_deg is not None:

@@ -30,8 +30,8 @@ def _kind(why: str) -> str:
 def _text(d: dict) -> str:
     """The human summary: per front end its estimates, "not identifiable" where fixed; the
     reasons once for all front ends (the first front end's wording), and under a front end
-    only a reason of another kind than that one (the four paragraphs were repeated under
-    every front end: about 60 lines for six captures)."""
+    only a reason of another kind than that one, so that the summary grows by a few lines per
+    front end, not by the reasons' paragraphs."""
     lines = []
 
     def val(x, unit, digits=4):

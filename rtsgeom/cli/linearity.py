@@ -6,9 +6,8 @@ from __future__ import annotations
 
 from ..analysis.linearity import END_ANGLES
 from ..analysis.linearity_study import LinearityStudy
-from ..errors import ParameterError, UsageError
 from ..scene.registry import SYNTHESIS_MODES
-from ._common import (flag_words, load_scene_checked, number, output_folder, pair_options,
+from ._common import (flagged, load_scene_checked, number, output_folder, pair_options,
                       print_json, steps)
 
 
@@ -23,10 +22,8 @@ def cmd_linearity(args) -> int:
     with output_folder(args.out, [args.scene]) as stage:
         with steps(args.quiet or args.json) as step:
             scene = load_scene_checked(args.scene)
-            try:
+            with flagged(args):
                 result = study_of(args, step)(scene)
-            except ParameterError as exc:
-                raise UsageError(flag_words(str(exc), vars(args))) from None
         if stage is not None:
             result.write(stage)
         _print(args, result)

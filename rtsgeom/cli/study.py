@@ -18,9 +18,8 @@ import importlib
 import re
 
 from ..analysis.tolerance.config import STUDY_ARGS, MonteCarlo
-from ..errors import ParameterError, UsageError
 from . import COMMANDS
-from ._common import (declared_option, flag_words, load_scene_checked, output_folder, output_path,
+from ._common import (declared_option, flagged, load_scene_checked, output_folder, output_path,
                       print_json, scene_arg)
 
 __all__ = ["register", "study_class", "cmd_study"]
@@ -101,12 +100,10 @@ def cmd_study(args) -> int:
     kw = {k: v for k, v in vars(args).items() if k in names and k not in ("mc",)}
     scene = load_scene_checked(args.scene)
     with output_folder(args.out, [args.scene]) as stage:
-        try:
+        with flagged(args):
             if args.uses_mc:
                 kw["mc"] = MonteCarlo(args.draws, args.seed, args.distribution)
             result = cls(**kw)(scene)
-        except ParameterError as exc:
-            raise UsageError(flag_words(str(exc), vars(args))) from None
         if stage is not None:
             result.write(stage)
     if args.json:

@@ -14,8 +14,8 @@ from ..analysis.tolerance import (AXES, NOMINAL_AMPLITUDES, Bounds, MonteCarlo,
 from ..analysis.tolerance.config import STUDY_ARGS
 from ..analysis.tolerance.draws import MAX_SIGMA_MM
 from ..analysis.tolerance.study import CHUNK_MEMORY_BYTES, capped_chunk, chunk_bytes_per_draw
-from ..errors import ClusterError, ParameterError, UsageError
-from ._common import (declared_option, flag_words, load_scene_checked, number, output_folder,
+from ..errors import ClusterError, UsageError
+from ._common import (declared_option, flagged, load_scene_checked, number, output_folder,
                       pair_word, print_json, progress, study_options)
 
 __all__ = ["cmd_tolerance", "register", "scales", "study_of", "CHUNK_MEMORY_BYTES",
@@ -82,10 +82,8 @@ def cmd_tolerance(args) -> int:
     scene = load_scene_checked(args.scene)
     with output_folder(args.out, [args.scene]) as stage:
         with progress(args.quiet) as report, chunk_mapper(args.dask, args.workers) as mapper:
-            try:
+            with flagged(args):
                 report_ = study_of(args, mapper, report)(scene)
-            except ParameterError as exc:
-                raise UsageError(flag_words(str(exc), vars(args))) from None
         if stage is not None:
             report_.write(stage)
     _print(args, report_)

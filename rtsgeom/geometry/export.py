@@ -71,7 +71,25 @@ def setup_scene(setup: Setup) -> trimesh.Scene:
 
 
 def export_setup(setup: Setup, path: str | Path) -> Path:
-    """Write the setup to ``path``; the format follows the suffix (.glb, .ply, .obj, .stl)."""
+    """Write the setup to ``path``; the format follows the suffix (.glb, .ply, .obj, .stl).
+
+    Parameters
+    ----------
+    setup : Setup
+        The setup as built (sheet, front ends, RuT).
+    path : str or Path
+        The file to write; its suffix picks the mesh format (``.gltf`` too).
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Raises
+    ------
+    OutputError
+        A suffix that is no supported mesh format.
+    """
     path = Path(path)
     fmt = path.suffix.lower().lstrip(".")
     if fmt not in ("glb", "gltf", "ply", "obj", "stl"):

@@ -2,21 +2,21 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..scene import Scene
-from ..scene.rules import arc_centre_m
+from ..scene.rules import arc_centre_m, problems
 from .frontends import FrontEnds, front_ends
 from .arrays import RutArray, rut_array
 from .sheet import sheet_mesh
 from ..scene import FrontEndConfig, RadarConfig
 from ..scene.schema import specs
 from .._lib.util import warn_caller
-from ..errors import NominalSetupWarning
+from ..errors import NominalSetupWarning, SceneError
 
 if TYPE_CHECKING:  # trimesh loads where the mesh is built (geometry.sheet)
     import trimesh
@@ -148,21 +148,24 @@ def nominal_scene(scene: Scene, validate: bool = True) -> Scene:
     False: not validated again (a study's internal variant, checked by its own rules: zeroing
     a radial offset lengthens the air path, which can put a valid scene's target, one the
     study drops anyway, beyond the range the rules allow)."""
-    # a front end without errors as it is (re-validating each one, per target and frame of
-    # a drive, was an eighth of its planning)
+    # a front end without errors is kept as it is: no copy per target and frame of a drive
     fes = tuple(f if not any(np.any(np.asarray(getattr(f, k)) != 0.0) for k in FRONT_END_ERRORS)
-                else f.evolve(**dict.fromkeys(FRONT_END_ERRORS, 0.0)) for f in scene.rts.front_ends)
+                else f.derive(**dict.fromkeys(FRONT_END_ERRORS, 0.0)) for f in scene.rts.front_ends)
     radar = scene.radar
     if _rut_pose_errors(radar):  # (zeroing every field of RUT_POSE_ERRORS)
-        radar = radar.evolve(position_offset_m=(0.0, 0.0, 0.0), yaw_offset_rad=0.0)
+        radar = radar.derive(position_offset_m=(0.0, 0.0, 0.0), yaw_offset_rad=0.0)
     if _channel_errors(radar):
-        radar = replace(radar, channels=None)
+        radar = radar.derive(channels=None)
     if fes == scene.rts.front_ends and radar is scene.radar:
         return scene
-    rts = scene.rts.evolve(front_ends=fes)
-    if not validate:
-        return replace(scene, rts=rts, radar=radar)
-    return scene.evolve(rts=rts, radar=radar)  # validated again
+    # zeros within every field's range: the fields are not read through the file's schema
+    # again (its errors would name a value nobody wrote); the rules between them are
+    new = scene.derive(rts=scene.rts.derive(front_ends=fes), radar=radar)
+    if validate:
+        found = problems(new)
+        if found:
+            raise SceneError(found[0], found)
+    return new
 
 
 def nominal_setup(setup: Setup) -> Setup:

@@ -25,6 +25,8 @@ Three references, all float64:
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from scipy.constants import c
 from scipy.optimize import brentq
@@ -253,91 +255,141 @@ def _check_los(setup: Setup, paths: Paths, freq: float) -> dict:
             "missing": missing}
 
 
+@dataclass(frozen=True)
+class _SheetCheck:
+    """What every element pair's sheet check reads: the ray-traced rows, the smooth cylinder
+    (radius ``r0`` about ``centre``), the mesh's inner triangles and the single-bounce rows."""
+
+    setup: Setup
+    paths: Paths
+    details: object
+    freq: float
+    po: bool
+    r0: float
+    centre: np.ndarray
+    inner: np.ndarray
+    single: np.ndarray
+
+
+def _facet_delays(ck: _SheetCheck, a, b, rows) -> tuple[np.ndarray, list, int]:
+    """Exact geometric optics on the mesh for the pair (a, b): the distinct glint lengths (every
+    inner triangle with its own specular point; the two triangles of a planar quad merged), each
+    row's delay against its own facet's (ps) and how many rows hit outside their triangle."""
+    tris, paths, details = ck.setup.sheet.triangles, ck.paths, ck.details
+    glints = {}
+    for f in ck.inner:
+        length, inside = facet_image_length(a, b, tris[f])
+        if inside:
+            glints[int(f)] = length
+    g_len = np.unique(np.round(np.array(sorted(glints.values())), 12))
+    facet_ps, outside = [], 0
+    for j in rows:
+        if details is not None:
+            length, inside = facet_image_length(a, b, tris[int(details.primitives[j, 0])])
+            outside += not inside
+        else:
+            if g_len.size == 0:
+                continue
+            length = g_len[np.argmin(np.abs(g_len - paths.delay_s[j] * c))]
+        facet_ps.append((paths.delay_s[j] - length / c) * 1e12)
+    return g_len, facet_ps, outside
+
+
+def _smooth_points(ck: _SheetCheck, a, b) -> tuple[list, dict]:
+    """The smooth cylinder's stationary points for the pair (a, b), each with its azimuth,
+    height, delay and whether it lies on the sheet."""
+    sp = stationary_points(a, b, ck.centre, ck.r0)
+    spts = []
+    for az, length in zip(sp["azimuth_rad"], sp["length_m"]):
+        z = _smooth_z(a, b, ck.centre, ck.r0, az)
+        spts.append({"azimuth_deg": float(np.degrees(az)), "z_m": float(z),
+                     "delay_ns": float(length / c * 1e9),
+                     "on_sheet": _on_sheet(ck.setup, az, z)})
+    return spts, sp
+
+
+def _rows_vs_smooth(ck: _SheetCheck, a, b, rows, spts, entry) -> list:
+    """The rows' delay span, their delay against the smooth cylinder at their hit point (ps,
+    returned), and the row nearest the smooth specular delay, added to ``entry``."""
+    paths, details = ck.paths, ck.details
+    entry["rt_delay_span_ns"] = [float(paths.delay_s[rows].min() * 1e9),
+                                 float(paths.delay_s[rows].max() * 1e9)]
+    sm = []
+    if details is not None:
+        hit = details.vertices[rows, 0] - ck.centre
+        az_hit = np.arctan2(hit[:, 0], hit[:, 1])
+        sm = (paths.delay_s[rows] - smooth_path_length(a, b, ck.centre, ck.r0, az_hit) / c) * 1e12
+        entry["delay_vs_smooth_at_hit_ps"] = _stats(sm)
+    on = [s for s in spts if s["on_sheet"]]
+    if on:
+        best = min(on, key=lambda s: abs(s["delay_ns"] * 1e-9 - paths.delay_s[rows]).min())
+        entry["nearest_row_to_specular_ps"] = float(
+            np.min(np.abs(paths.delay_s[rows] - best["delay_ns"] * 1e-9)) * 1e12)
+    return list(sm)
+
+
+def _levels(ck: _SheetCheck, a, b, rows, entry) -> None:
+    """The rows' coherent sum, one smooth glint's level and (``po``) physical optics on the
+    mesh, in dB, added to ``entry``."""
+    paths, freq = ck.paths, ck.freq
+    h_rt = np.sum(paths.gain[rows] * np.exp(-2j * np.pi * freq * paths.delay_s[rows]))
+    entry["rt_coherent_db"] = float(20 * np.log10(max(abs(h_rt), 1e-300)))
+    entry["single_glint_db"] = float(20 * np.log10(c / freq / (4 * np.pi * 2 * ck.r0)))
+    if ck.po:
+        h_po = po_sheet_response(ck.setup, a, b, freq)
+        entry["po_db"] = float(20 * np.log10(abs(h_po)))
+        entry["rt_minus_po_db"] = entry["rt_coherent_db"] - entry["po_db"]
+        entry["rt_minus_po_phase_deg"] = float(np.degrees(np.angle(h_rt / h_po))) \
+            if abs(h_rt) > 0 else None
+
+
+def _sheet_pair(ck: _SheetCheck, m: int, k: int) -> tuple[dict, list, list, int]:
+    """One (RuT Tx m, RuT Rx k) pair's sheet echo against the faceted and the smooth model:
+    its entry, its delays against the own facet and the smooth cylinder (ps), rows outside."""
+    rut, cfg = ck.setup.rut, ck.setup.scene.sheet
+    a, b = rut.tx_world[m], rut.rx_world[k]
+    rows = np.flatnonzero(ck.single & (ck.paths.rut_tx == m) & (ck.paths.rut_rx == k))
+    g_len, facet_ps, outside = _facet_delays(ck, a, b, rows)
+    spts, sp = _smooth_points(ck, a, b)
+    grid = np.linspace(cfg.angle_min_rad, cfg.angle_max_rad, 2001)
+    lengths = smooth_path_length(a, b, ck.centre, ck.r0, grid)
+    entry = {"tx": m, "rx": k, "rows": int(rows.size),
+             "faceted_go_glints": int(g_len.size),
+             "rows_outside_their_triangle": outside,
+             "delay_vs_own_facet_ps": _stats(facet_ps),
+             "stationary_points": spts,
+             "degenerate": sp["degenerate"],
+             "smooth_delay_span_on_sheet_ns": [float(lengths.min() / c * 1e9),
+                                               float(lengths.max() / c * 1e9)]}
+    smooth = _rows_vs_smooth(ck, a, b, rows, spts, entry) if rows.size else []
+    _levels(ck, a, b, rows, entry)
+    return entry, facet_ps, smooth, outside
+
+
 def _check_sheet(setup: Setup, paths: Paths, details, freq: float, po: bool) -> dict:
-    rut, fe, cfg = setup.rut, setup.fe, setup.scene.sheet
-    mesh = setup.sheet
-    r0 = fe.arc_radius_m + cfg.radius_offset_m
+    rut, fe = setup.rut, setup.fe
+    r0 = fe.arc_radius_m + setup.scene.sheet.radius_offset_m
     centre = np.asarray(fe.arc_centre, float)
     inner = _inner_faces(setup)
-    tris = mesh.triangles
     sagitta_ps = None
     if inner.size:  # facet width -> bias of a flat facet's centre against the smooth cylinder
-        v = tris[inner] - centre
+        v = setup.sheet.triangles[inner] - centre
         az_v = np.arctan2(v[..., 0], v[..., 1])
         daz = float(np.max(np.ptp(az_v, axis=1)))  # a planar triangle spans one facet at most
         sagitta_ps = -2 * r0 * (1 - np.cos(daz / 2)) / c * 1e12
     single = (paths.direction == RUT_TO_RUT) & (paths.bounces == 1)
     if details is not None:
         single &= details.objects[:, 0] == "sheet"
+    ck = _SheetCheck(setup, paths, details, freq, po, r0, centre, inner, single)
     pairs, all_facet, all_smooth = [], [], []
     outside_total = 0
     for m in range(rut.tx_world.shape[0]):
         for k in range(rut.rx_world.shape[0]):
-            a, b = rut.tx_world[m], rut.rx_world[k]
-            rows = np.flatnonzero(single & (paths.rut_tx == m) & (paths.rut_rx == k))
-            # exact geometric optics on this mesh: every inner triangle with its own specular point
-            glints = {}
-            for f in inner:
-                length, inside = facet_image_length(a, b, tris[f])
-                if inside:
-                    glints[int(f)] = length
-            # merge the two triangles of one planar quad (same plane -> same length)
-            g_len = np.unique(np.round(np.array(sorted(glints.values())), 12))
-            facet_ps, outside = [], 0
-            for j in rows:
-                if details is not None:
-                    f = int(details.primitives[j, 0])
-                    length, inside = facet_image_length(a, b, tris[f])
-                    outside += not inside
-                else:
-                    if g_len.size == 0:
-                        continue
-                    length = g_len[np.argmin(np.abs(g_len - paths.delay_s[j] * c))]
-                facet_ps.append((paths.delay_s[j] - length / c) * 1e12)
-            outside_total += outside
-            sp = stationary_points(a, b, centre, r0)
-            spts = []
-            for az, length in zip(sp["azimuth_rad"], sp["length_m"]):
-                z = _smooth_z(a, b, centre, r0, az)
-                spts.append({"azimuth_deg": float(np.degrees(az)), "z_m": float(z),
-                             "delay_ns": float(length / c * 1e9), "on_sheet": _on_sheet(setup, az, z)})
-            on = [s for s in spts if s["on_sheet"]]
-            grid = np.linspace(cfg.angle_min_rad, cfg.angle_max_rad, 2001)
-            lengths = smooth_path_length(a, b, centre, r0, grid)
-            entry = {"tx": m, "rx": k, "rows": int(rows.size),
-                     "faceted_go_glints": int(g_len.size),
-                     "rows_outside_their_triangle": outside,
-                     "delay_vs_own_facet_ps": _stats(facet_ps),
-                     "stationary_points": spts,
-                     "degenerate": sp["degenerate"],
-                     "smooth_delay_span_on_sheet_ns": [float(lengths.min() / c * 1e9),
-                                                       float(lengths.max() / c * 1e9)]}
-            all_facet += facet_ps
-            if rows.size:
-                entry["rt_delay_span_ns"] = [float(paths.delay_s[rows].min() * 1e9),
-                                             float(paths.delay_s[rows].max() * 1e9)]
-                if details is not None:
-                    hit = details.vertices[rows, 0] - centre
-                    az_hit = np.arctan2(hit[:, 0], hit[:, 1])
-                    sm = (paths.delay_s[rows]
-                          - smooth_path_length(a, b, centre, r0, az_hit) / c) * 1e12
-                    entry["delay_vs_smooth_at_hit_ps"] = _stats(sm)
-                    all_smooth += list(sm)
-                if on:
-                    best = min(on, key=lambda s: abs(s["delay_ns"] * 1e-9 - paths.delay_s[rows]).min())
-                    entry["nearest_row_to_specular_ps"] = float(
-                        np.min(np.abs(paths.delay_s[rows] - best["delay_ns"] * 1e-9)) * 1e12)
-            h_rt = np.sum(paths.gain[rows] * np.exp(-2j * np.pi * freq * paths.delay_s[rows]))
-            entry["rt_coherent_db"] = float(20 * np.log10(max(abs(h_rt), 1e-300)))
-            entry["single_glint_db"] = float(20 * np.log10(c / freq / (4 * np.pi * 2 * r0)))
-            if po:
-                h_po = po_sheet_response(setup, a, b, freq)
-                entry["po_db"] = float(20 * np.log10(abs(h_po)))
-                entry["rt_minus_po_db"] = entry["rt_coherent_db"] - entry["po_db"]
-                entry["rt_minus_po_phase_deg"] = float(np.degrees(np.angle(h_rt / h_po))) \
-                    if abs(h_rt) > 0 else None
+            entry, facet_ps, smooth, outside = _sheet_pair(ck, m, k)
             pairs.append(entry)
-    on_axis = stationary_points(centre, centre, centre, r0)["degenerate"]
+            all_facet += facet_ps
+            all_smooth += smooth
+            outside_total += outside
     virtual = {(int(t), int(r)) for t, r in zip(rut.virtual_tx, rut.virtual_rx)}
     used = [p for p in pairs if (p["tx"], p["rx"]) in virtual]
     res = {
@@ -350,7 +402,7 @@ def _check_sheet(setup: Setup, paths: Paths, details, freq: float, po: bool) -> 
         "delay_vs_smooth_at_hit_ps": _stats(all_smooth),
         "pairs_with_specular_point_on_sheet": sum(bool(any(s["on_sheet"] for s in p["stationary_points"]))
                                                   for p in pairs),
-        "axis_is_degenerate": on_axis,
+        "axis_is_degenerate": stationary_points(centre, centre, centre, r0)["degenerate"],
         "pairs": pairs,
     }
     if po and used:

@@ -259,8 +259,143 @@ def _dedupe(tau: np.ndarray, inter: np.ndarray, objs: np.ndarray, verts: np.ndar
     return keep
 
 
+@dataclass(frozen=True)
+class _Solved:
+    """Sionna's paths for every (receiver, transmitter) pair, one antenna each, as float64
+    numpy: ``valid``/``tau``/``a`` (rx, tx, P), ``inter``/``objs``/``prims`` (D, rx, tx, P),
+    ``verts`` (D, rx, tx, P, 3); at ``max_depth = 0`` one row of no interaction."""
+
+    valid: np.ndarray
+    tau: np.ndarray
+    a: np.ndarray
+    inter: np.ndarray
+    objs: np.ndarray
+    prims: np.ndarray
+    verts: np.ndarray
+
+
+def _solve(built: _Built, rt, cfg: RaytraceConfig, seed: int) -> _Solved:
+    """Run Sionna's path solver on ``built`` (deterministic, no diffraction, every antenna its
+    own source: ``synthetic_array=False``) and take its tensors to numpy."""
+    solver = rt.PathSolver(deterministic=True)
+    res = solver(built.scene, max_depth=int(cfg.max_depth),
+                 max_num_paths_per_src=int(cfg.samples_per_src) * max(1, int(cfg.max_depth)),
+                 samples_per_src=int(cfg.samples_per_src), synthetic_array=False,
+                 los=bool(cfg.los), specular_reflection=bool(cfg.specular_reflection),
+                 diffuse_reflection=bool(cfg.diffuse_reflection),
+                 refraction=bool(cfg.refraction), diffraction=False,
+                 seed=int(seed % (2**31 - 1)))
+    valid = np.asarray(res.valid.numpy(), bool)[:, 0, :, 0, :]  # (rx, tx, P)
+    tau = res.tau.numpy().astype(np.float64)[:, 0, :, 0, :]
+    a_re, a_im = res.a
+    a = (a_re.numpy().astype(np.float64) + 1j * a_im.numpy().astype(np.float64))[:, 0, :, 0, :]
+    if int(cfg.max_depth) > 0:
+        inter = res.interactions.numpy()[:, :, 0, :, 0, :]  # (D, rx, tx, P)
+        objs = res.objects.numpy()[:, :, 0, :, 0, :]
+        prims = res.primitives.numpy()[:, :, 0, :, 0, :]
+        verts = res.vertices.numpy().astype(np.float64)[:, :, 0, :, 0, :, :]
+    else:
+        shape = (1,) + tau.shape
+        inter = np.zeros(shape, np.uint32)
+        objs = prims = np.full(shape, 0xFFFFFFFF, np.uint32)
+        verts = np.zeros(shape + (3,))
+    return _Solved(valid, tau, a, inter, objs, prims, verts)
+
+
+class _Rows:
+    """The paths kept so far, column by column, and the counts of those dropped (raw,
+    duplicates, weaker than ``min_gain_db``)."""
+
+    COLUMNS = ("front_end", "direction", "rut_tx", "rut_rx", "delay_s", "gain", "bounces",
+               "interactions", "surfaces")
+
+    def __init__(self, solved: _Solved, built: _Built, min_gain_db: float, origin: np.ndarray):
+        self.s, self.built, self.min_gain_db, self.origin = solved, built, min_gain_db, origin
+        self.board_id = next(i for i, name in built.object_names.items() if name == "rut_board")
+        self.cols = {k: [] for k in self.COLUMNS}
+        self.det_v, self.det_p, self.det_o = [], [], []
+        self.raw = self.dupes = self.weak = 0
+
+    def take(self, ti: int, ri: int, direction: str, fe_i: int, m: int, k: int,
+             need_bounce: bool) -> None:
+        """Keep the valid, distinct, strong enough paths from transmitter ``ti`` to receiver
+        ``ri`` as rows (``need_bounce``: rut_to_rut, a setup echo must leave the radar's
+        board)."""
+        s = self.s
+        sel = np.flatnonzero(s.valid[ri, ti])
+        if sel.size == 0:
+            return
+        it = s.inter[:, ri, ti, sel].T  # (p, D)
+        if need_bounce:
+            off_board = np.any((it != 0) & (s.objs[:, ri, ti, sel].T != self.board_id), axis=1)
+            sel, it = sel[off_board], it[off_board]
+            if sel.size == 0:
+                return
+        self.raw += sel.size
+        ob = s.objs[:, ri, ti, sel].T
+        vt = s.verts[:, ri, ti, sel].transpose(1, 0, 2)
+        vt = np.where((it != 0)[..., None], vt, np.nan)
+        keep = _dedupe(s.tau[ri, ti, sel], it, np.where(it != 0, ob, 0), vt)
+        self.dupes += int((~keep).sum())
+        g = s.a[ri, ti, sel]
+        for oid, f in self.built.absorber.items():  # an absorber's loss once per bounce off it
+            g = g * f ** np.sum((it != 0) & (ob == oid), axis=1)
+        with np.errstate(divide="ignore"):
+            strong = 20 * np.log10(np.abs(g)) >= self.min_gain_db
+        self.weak += int((keep & ~strong).sum())
+        keep &= strong
+        pr = s.prims[:, ri, ti, sel].T
+        for j in np.flatnonzero(keep):
+            self._row(j, (direction, fe_i, m, k), s.tau[ri, ti, sel[j]], g[j], it[j], ob[j],
+                      pr[j], vt[j])
+
+    def _row(self, j, where, delay, gain, it, ob, pr, vt) -> None:
+        direction, fe_i, m, k = where
+        for key, v in zip(("direction", "front_end", "rut_tx", "rut_rx", "delay_s", "gain",
+                           "bounces"), (direction, fe_i, m, k, delay, gain, int((it != 0).sum()))):
+            self.cols[key].append(v)
+        names = [_INTERACTION_NAMES.get(int(x), f"type{int(x)}") for x in it if x != 0]
+        self.cols["interactions"].append("+".join(names) if names else "los")
+        self.det_v.append(vt + self.origin)
+        self.det_p.append(np.where(it != 0, pr.astype(np.int64), -1))
+        self.det_o.append([self.built.object_names.get(int(o), "?") if x != 0 else ""
+                           for o, x in zip(ob, it)])
+        self.cols["surfaces"].append("+".join(o for o in self.det_o[-1] if o))
+
+    def table(self):
+        """The rows sorted by (direction, front end, RuT Tx, RuT Rx, delay): the paths table and
+        the hit points, primitives and object names per interaction."""
+        cols, n, d = self.cols, len(self.cols["delay_s"]), self.s.verts.shape[0]
+        order = np.lexsort((cols["delay_s"], cols["rut_rx"], cols["rut_tx"], cols["front_end"],
+                            cols["direction"])) if n else np.zeros(0, int)
+        paths = Paths.build(**{k: np.asarray(v)[order] if n else np.zeros(0)
+                               for k, v in cols.items()}, method="raytrace")
+        vertices = np.asarray(self.det_v, float).reshape(n, d, 3)[order]
+        primitives = np.asarray(self.det_p, np.int64).reshape(n, d)[order]
+        objects = np.asarray(self.det_o, dtype=object).reshape(n, d)[order].astype(str)
+        return paths, vertices, primitives, objects
+
+
 def trace(setup: Setup, config: RaytraceConfig | None = None) -> RaytraceResult:
-    """Ray-trace ``setup`` with Sionna RT; the :class:`RaytraceResult` with the paths table."""
+    """Ray-trace ``setup`` with Sionna RT; the :class:`RaytraceResult` with the paths table.
+
+    Parameters
+    ----------
+    setup : Setup
+        The RTS setup (sheet, front ends, RuT, structures).
+    config : RaytraceConfig, optional
+        Solver settings; the scene's ``[raytrace]`` section by default.
+
+    Returns
+    -------
+    RaytraceResult
+        The paths table with hit points, the Mitsuba variant, timings and counts.
+
+    Raises
+    ------
+    RaytraceUnavailable
+        Sionna RT or its Dr.Jit backend cannot run here.
+    """
     cfg = config or setup.scene.raytrace
     timings = {}
     t0 = time.perf_counter()
@@ -271,106 +406,25 @@ def trace(setup: Setup, config: RaytraceConfig | None = None) -> RaytraceResult:
         built = _build_scene(setup, mi, rt)
         timings["build_s"] = time.perf_counter() - t0
         t0 = time.perf_counter()
-        solver = rt.PathSolver(deterministic=True)
-        res = solver(built.scene, max_depth=int(cfg.max_depth),
-                     max_num_paths_per_src=int(cfg.samples_per_src) * max(1, int(cfg.max_depth)),
-                     samples_per_src=int(cfg.samples_per_src), synthetic_array=False,
-                     los=bool(cfg.los), specular_reflection=bool(cfg.specular_reflection),
-                     diffuse_reflection=bool(cfg.diffuse_reflection),
-                     refraction=bool(cfg.refraction), diffraction=False,
-                     seed=int(setup.scene.seed % (2**31 - 1)))
-        valid = np.asarray(res.valid.numpy(), bool)[:, 0, :, 0, :]  # (rx, tx, P)
+        solved = _solve(built, rt, cfg, setup.scene.seed)
         timings["solve_s"] = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        tau = res.tau.numpy().astype(np.float64)[:, 0, :, 0, :]
-        a_re, a_im = res.a
-        a = (a_re.numpy().astype(np.float64)
-             + 1j * a_im.numpy().astype(np.float64))[:, 0, :, 0, :]
-        depth = int(cfg.max_depth)
-        if depth > 0:
-            inter = res.interactions.numpy()[:, :, 0, :, 0, :]  # (D, rx, tx, P)
-            objs = res.objects.numpy()[:, :, 0, :, 0, :]
-            prims = res.primitives.numpy()[:, :, 0, :, 0, :]
-            verts = res.vertices.numpy().astype(np.float64)[:, :, 0, :, 0, :, :]
-        else:
-            shape = (1,) + tau.shape
-            inter = np.zeros(shape, np.uint32)
-            objs = prims = np.full(shape, 0xFFFFFFFF, np.uint32)
-            verts = np.zeros(shape + (3,))
         variant = mi.variant()
-    origin = np.asarray(setup.rut.position, float)
+    t0 = time.perf_counter()
+    rows = _Rows(solved, built, cfg.min_gain_db, np.asarray(setup.rut.position, float))
     n_tx, n_rxel = setup.rut.tx_world.shape[0], setup.rut.rx_world.shape[0]
-    n_fe = setup.fe.count
-    board_id = next(i for i, name in built.object_names.items() if name == "rut_board")
-    cols = {k: [] for k in ("front_end", "direction", "rut_tx", "rut_rx", "delay_s", "gain",
-                            "bounces", "interactions", "surfaces")}
-    det_v, det_p, det_o = [], [], []
-    raw = dupes = weak = 0
-
-    def take(ti, ri, direction, fe_i, m, k, need_bounce):
-        nonlocal raw, dupes, weak
-        sel = np.flatnonzero(valid[ri, ti])
-        if sel.size == 0:
-            return
-        it = inter[:, ri, ti, sel].T  # (p, D)
-        nb = (it != 0).sum(axis=1)
-        if need_bounce:  # rut_to_rut: a setup echo must leave the radar
-            ob_all = objs[:, ri, ti, sel].T
-            off_board = np.any((it != 0) & (ob_all != board_id), axis=1)
-            sel, it, nb = sel[off_board], it[off_board], nb[off_board]
-            if sel.size == 0:
-                return
-        raw += sel.size
-        ob = objs[:, ri, ti, sel].T
-        pr = prims[:, ri, ti, sel].T
-        vt = verts[:, ri, ti, sel].transpose(1, 0, 2)
-        vt = np.where((it != 0)[..., None], vt, np.nan)
-        keep = _dedupe(tau[ri, ti, sel], it, np.where(it != 0, ob, 0), vt)
-        dupes += int((~keep).sum())
-        g = a[ri, ti, sel]
-        for oid, f in built.absorber.items():  # an absorber's loss once per bounce off it
-            g = g * f ** np.sum((it != 0) & (ob == oid), axis=1)
-        with np.errstate(divide="ignore"):
-            strong = 20 * np.log10(np.abs(g)) >= cfg.min_gain_db
-        weak += int((keep & ~strong).sum())
-        keep &= strong
-        for j in np.flatnonzero(keep):
-            cols["front_end"].append(fe_i)
-            cols["direction"].append(direction)
-            cols["rut_tx"].append(m)
-            cols["rut_rx"].append(k)
-            cols["delay_s"].append(tau[ri, ti, sel[j]])
-            cols["gain"].append(g[j])
-            cols["bounces"].append(int(nb[j]))
-            names = [_INTERACTION_NAMES.get(int(x), f"type{int(x)}") for x in it[j] if x != 0]
-            cols["interactions"].append("+".join(names) if names else "los")
-            det_v.append(vt[j] + origin)
-            det_p.append(np.where(it[j] != 0, pr[j].astype(np.int64), -1))
-            det_o.append([built.object_names.get(int(o), "?") if x != 0 else ""
-                          for o, x in zip(ob[j], it[j])])
-            cols["surfaces"].append("+".join(o for o in det_o[-1] if o))
-
-    for q in range(n_fe):
+    for q in range(setup.fe.count):
         for m in range(n_tx):  # RuT Tx m -> FE q Rx
-            take(m, n_rxel + q, TX_TO_FE, q, m, -1, False)
+            rows.take(m, n_rxel + q, TX_TO_FE, q, m, -1, False)
         for k in range(n_rxel):  # FE q Tx -> RuT Rx k
-            take(n_tx + q, k, FE_TO_RX, q, -1, k, False)
+            rows.take(n_tx + q, k, FE_TO_RX, q, -1, k, False)
     for m in range(n_tx):
         for k in range(n_rxel):  # RuT Tx m -> setup -> RuT Rx k
-            take(m, k, RUT_TO_RUT, -1, m, k, True)
-
-    n = len(cols["delay_s"])
-    d = verts.shape[0]
-    order = np.lexsort((cols["delay_s"], cols["rut_rx"], cols["rut_tx"], cols["front_end"],
-                        cols["direction"])) if n else np.zeros(0, int)
-    paths = Paths.build(**{k: np.asarray(v)[order] if n else np.zeros(0) for k, v in cols.items()},
-                        method="raytrace")
-    vertices = np.asarray(det_v, float).reshape(n, d, 3)[order]
-    primitives = np.asarray(det_p, np.int64).reshape(n, d)[order]
-    objects = np.asarray(det_o, dtype=object).reshape(n, d)[order].astype(str)
+            rows.take(m, k, RUT_TO_RUT, -1, m, k, True)
+    paths, vertices, primitives, objects = rows.table()
     timings["extract_s"] = time.perf_counter() - t0
-    stats = {"raw_paths": raw, "duplicates_dropped": dupes, "weak_dropped": weak,
-             "rows": n, "samples_per_src": int(cfg.samples_per_src), "max_depth": depth,
+    stats = {"raw_paths": rows.raw, "duplicates_dropped": rows.dupes, "weak_dropped": rows.weak,
+             "rows": vertices.shape[0],
+             "samples_per_src": int(cfg.samples_per_src), "max_depth": int(cfg.max_depth),
              "frequency_hz": c / setup.rut.wavelength_m,
              "faces": {k: int(len(v.faces)) for k, v in built.meshes.items()}}
     return RaytraceResult(paths, vertices, primitives, objects, variant, timings, stats)

@@ -68,7 +68,7 @@ class Paths:
                 raise ValueError(f"Paths.{name} must have shape ({n},)")
 
     @classmethod
-    def build(cls, front_end, direction, rut_tx, rut_rx, delay_s, gain, bounces=None,
+    def build(cls, front_end, direction, rut_tx, rut_rx, delay_s, gain, bounces=None, *,
               interactions=None, method="exact", surfaces=None) -> "Paths":
         """The table from columns (each (P,)). ``bounces`` default 0 (line of sight);
         ``interactions`` default ``los`` / ``reflection``; ``surfaces`` (what each bounce hit,
@@ -104,8 +104,9 @@ class Paths:
     def select(self, mask: np.ndarray) -> "Paths":
         m = np.asarray(mask, bool)
         return Paths.build(self.front_end[m], self.direction[m], self.rut_tx[m], self.rut_rx[m],
-                           self.delay_s[m], self.gain[m], self.bounces[m], self.interactions[m],
-                           self.method, self.surfaces[m])
+                           self.delay_s[m], self.gain[m], self.bounces[m],
+                           interactions=self.interactions[m], method=self.method,
+                           surfaces=self.surfaces[m])
 
     def leg(self, front_end: int, direction: int, element: int) -> "Paths":
         """All rows of one leg: (front end, direction, RuT element)."""

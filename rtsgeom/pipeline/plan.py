@@ -266,7 +266,7 @@ def calibrate_pairs(setup: Setup, paths: Paths, pairs, probe, loaded: dict | Non
 
 
 def program_pairs(setup: Setup, paths: Paths, mode: str, targets, pairs, probe, cals: dict,
-                  offsets, where: str = "targets") -> tuple[RtsProgram, list[dict], list[str]]:
+                  offsets, *, where: str = "targets") -> tuple[RtsProgram, list[dict], list[str]]:
     """The RTS programme of ``targets`` on their ``pairs`` with the calibration fixed
     (``cals`` and the channels' delay offsets ``offsets``): per target channel I at the
     target's delay plus its offset, channel J at the delay :func:`~.pair.plan_pair` chose, both

@@ -79,6 +79,98 @@ def _entry(p_in_w, h2, noise_w, nq, fs_w, gain_db) -> dict:
             "snr_after_fft_db": float(snr), "clip_margin_db": float(dbm(fs_w) - dbm(p_adc))}
 
 
+def _noise(scene, program, link, setup, noise_override_w, modelled: bool,
+           predict: bool) -> tuple[float, str, float, float]:
+    """The noise per sample the budget uses and where it comes from: ``snr_db``'s override, or
+    thermal ``k T0 F f_adc`` plus the RTS channels' noise; also both parts on their own."""
+    radar = scene.radar
+    n_th = thermal_noise_w(radar, link)
+    n_ch = channel_noise_w(scene, program, link, setup) if len(program) else 0.0
+    if noise_override_w is not None:
+        return noise_override_w, ("snr_db override: fixed per-sample SNR of the strongest "
+                                  "target echo (not the physical noise)"), n_th, n_ch
+    src = "thermal k T0 F f_adc + RTS channel noise"
+    if not modelled:
+        src += (" (prediction: the scene has no [radar.link])" if predict else
+                "; not in the signal (no [radar.link], no snr_db)")
+    if predict and radar.snr_db is not None:  # info: what run will simulate instead
+        src += (f"; the simulation's noise is radar.snr_db = {radar.snr_db:g} dB per sample "
+                "for the strongest echo, not this")
+    return n_th + n_ch, src, n_th, n_ch
+
+
+def _target_rows(scene, raw: Echoes, e: Echoes, h2, f_b, levels) -> list[dict]:
+    """One row per target: its direct echoes summed coherently over its channels per virtual
+    channel, power averaged over the virtual channels (None where it has no direct echo)."""
+    targets = []
+    for i, t in enumerate(scene.targets):
+        sel = (raw.target == i) & (raw.kind == KIND_DIRECT)
+        if not np.any(sel):
+            targets.append({"index": i, "adc_power_dbm": None, "snr_after_fft_db": None,
+                            "clip_margin_db": None})
+            continue
+        amp = e.amplitude[sel].sum(axis=0)
+        hh = float(np.mean(h2[sel]))
+        ent = _entry(float(np.mean(np.abs(amp) ** 2)) / hh, hh, *levels)
+        targets.append({"index": i, "range_m": t.range_m, "rcs_dbsm": t.rcs_dbsm,
+                        "beat_hz": float(np.mean(f_b[sel])), **ent})
+    return targets
+
+
+def _setup_rows(scene, raw: Echoes, p_in, h2, f_b, link, levels,
+                estimated_setup: Echoes | None) -> list[dict]:
+    """One row per setup echo in the signal, then one per estimated echo not in it."""
+    rows = []
+    for j in np.flatnonzero(raw.kind == KIND_SETUP):
+        ent = _entry(float(p_in[j]), float(h2[j]), *levels)
+        rows.append({"index": len(rows), "range_m": float(np.mean(raw.tau_s[j]) * c / 2),
+                     "beat_hz": float(np.mean(f_b[j])), "in_signal": True, **ent})
+    if estimated_setup is not None and len(estimated_setup):
+        est = apply_radar_link(estimated_setup, scene, link)
+        fe_b = beat_hz(estimated_setup, scene.radar)
+        hh = np.mean(np.abs(if_response(link, fe_b)) ** 2, axis=1)
+        for j in range(len(est)):
+            p = float(np.mean(np.abs(est.amplitude[j]) ** 2)) / hh[j]
+            ent = _entry(p, float(hh[j]), *levels)
+            rows.append({"index": len(rows), "range_m": float(np.mean(
+                estimated_setup.tau_s[j]) * c / 2), "beat_hz": float(np.mean(fe_b[j])),
+                "in_signal": False, "source": "sheet, physical-optics estimate", **ent})
+    return rows
+
+
+def _front_end_rows(scene, program: RtsProgram, link, setup) -> list[dict]:
+    """One row per front end: the RuT's chirp at its ADC, its attenuations and each antenna's
+    gain toward the other (scalar x pattern, dBi)."""
+    if not len(scene.rts.front_ends):
+        return []
+    tab = channel_table(scene, program, link, setup)
+    pg, (fe_rx_db, fe_tx_db) = tab["pattern_gains"], tab["fe_antenna_gain_dbi"]
+    fes = []
+    for q in range(len(scene.rts.front_ends)):
+        rows = program.front_end == q
+        fes.append({"index": q, "rut_chirp_at_adc_dbm": float(tab["input_dbm"][q]),
+                    "adc_level_dbfs": float(tab["level_dbfs"][q]),
+                    "max_attenuation_db": float(tab["max_attenuation_fe_db"][q]),
+                    "attenuation_db": [float(a) for a in tab["attenuation_db"][rows]],
+                    "rut_tx_gain_dbi": float(10 * np.log10(link.tx_gain * pg["rut_tx"][q])),
+                    "rut_rx_gain_dbi": float(10 * np.log10(link.rx_gain * pg["rut_rx"][q])),
+                    "fe_rx_gain_dbi": float(fe_rx_db + 10 * np.log10(pg["fe_rx"][q])),
+                    "fe_tx_gain_dbi": float(fe_tx_db + 10 * np.log10(pg["fe_tx"][q]))})
+    return fes
+
+
+def _radar_row(link, n_th: float, n_ch: float) -> dict:
+    """The radar's link values, in dBm, dBi and dB."""
+    return {"tx_power_dbm": float(dbm(link.tx_power_w)),
+            "tx_antenna_gain_dbi": float(10 * np.log10(link.tx_gain)),
+            "rx_antenna_gain_dbi": float(10 * np.log10(link.rx_gain)),
+            "noise_figure_db": float(10 * np.log10(link.noise_figure)),
+            "if_highpass_hz": link.if_highpass_hz, "if_lowpass_hz": link.if_lowpass_hz,
+            "adc_bits": link.adc_bits, "adc_full_scale_dbm": float(dbm(link.adc_full_scale_w)),
+            "thermal_noise_dbm_per_sample": float(dbm(n_th)),
+            "rts_noise_dbm_per_sample": float(dbm(n_ch)), "sources": link.sources}
+
+
 def link_budget(scene, echoes: Echoes, program: RtsProgram, linked: bool,
                 noise_override_w: float | None = None,
                 estimated_setup: Echoes | None = None, predict: bool = False,
@@ -103,76 +195,18 @@ def link_budget(scene, echoes: Echoes, program: RtsProgram, linked: bool,
     h2 = np.mean(np.abs(if_response(link, f_b)) ** 2, axis=1) if len(raw) else np.zeros(0)
     with np.errstate(invalid="ignore", divide="ignore"):
         p_in = np.mean(np.abs(e.amplitude) ** 2, axis=1) / np.where(h2 > 0, h2, 1.0)
-    n_th = thermal_noise_w(radar, link)
-    n_ch = channel_noise_w(scene, program, link, setup) if len(program) else 0.0
-    if noise_override_w is not None:
-        noise, src = noise_override_w, ("snr_db override: fixed per-sample SNR of the strongest "
-                                        "target echo (not the physical noise)")
-    else:
-        noise = n_th + n_ch
-        src = "thermal k T0 F f_adc + RTS channel noise"
-        if not modelled:
-            src += (" (prediction: the scene has no [radar.link])" if predict else
-                    "; not in the signal (no [radar.link], no snr_db)")
-        if predict and radar.snr_db is not None:  # info: what run will simulate instead
-            src += (f"; the simulation's noise is radar.snr_db = {radar.snr_db:g} dB per sample "
-                    "for the strongest echo, not this")
+    noise, src, n_th, n_ch = _noise(scene, program, link, setup, noise_override_w, modelled,
+                                    predict)
     nq = link.quantisation_noise_w if linked or predict else 0.0  # no ADC in the relative model
     gain_db = float(10 * np.log10(radar.samples_per_chirp * radar.chirps_per_tx
                                   * window_snr_loss(radar.range_window, radar.samples_per_chirp)
                                   * window_snr_loss(radar.doppler_window, radar.chirps_per_tx)))
-    targets = []
-    for i, t in enumerate(scene.targets):
-        sel = (raw.target == i) & (raw.kind == KIND_DIRECT)
-        if not np.any(sel):
-            targets.append({"index": i, "adc_power_dbm": None, "snr_after_fft_db": None,
-                            "clip_margin_db": None})
-            continue
-        amp = e.amplitude[sel].sum(axis=0)
-        hh = float(np.mean(h2[sel]))
-        ent = _entry(float(np.mean(np.abs(amp) ** 2)) / hh, hh, noise, nq,
-                     link.adc_full_scale_w, gain_db)
-        targets.append({"index": i, "range_m": t.range_m, "rcs_dbsm": t.rcs_dbsm,
-                        "beat_hz": float(np.mean(f_b[sel])), **ent})
-    rows_setup = []
-    for j in np.flatnonzero(raw.kind == KIND_SETUP):
-        ent = _entry(float(p_in[j]), float(h2[j]), noise, nq, link.adc_full_scale_w, gain_db)
-        rows_setup.append({"index": len(rows_setup), "range_m": float(np.mean(raw.tau_s[j]) * c / 2),
-                      "beat_hz": float(np.mean(f_b[j])), "in_signal": True, **ent})
-    if estimated_setup is not None and len(estimated_setup):
-        est = apply_radar_link(estimated_setup, scene, link)
-        fe_b = beat_hz(estimated_setup, radar)
-        hh = np.mean(np.abs(if_response(link, fe_b)) ** 2, axis=1)
-        for j in range(len(est)):
-            p = float(np.mean(np.abs(est.amplitude[j]) ** 2)) / hh[j]
-            ent = _entry(p, float(hh[j]), noise, nq, link.adc_full_scale_w, gain_db)
-            rows_setup.append({"index": len(rows_setup), "range_m": float(np.mean(
-                estimated_setup.tau_s[j]) * c / 2), "beat_hz": float(np.mean(fe_b[j])),
-                "in_signal": False, "source": "sheet, physical-optics estimate", **ent})
-    fes = []
-    if len(scene.rts.front_ends):
-        tab = channel_table(scene, program, link, setup)
-        pg, (fe_rx_db, fe_tx_db) = tab["pattern_gains"], tab["fe_antenna_gain_dbi"]
-        for q in range(len(scene.rts.front_ends)):
-            rows = program.front_end == q
-            fes.append({"index": q, "rut_chirp_at_adc_dbm": float(tab["input_dbm"][q]),
-                        "adc_level_dbfs": float(tab["level_dbfs"][q]),
-                        "max_attenuation_db": float(tab["max_attenuation_fe_db"][q]),
-                        "attenuation_db": [float(a) for a in tab["attenuation_db"][rows]],
-                        # each antenna's gain toward the other (scalar x pattern), dBi
-                        "rut_tx_gain_dbi": float(10 * np.log10(link.tx_gain * pg["rut_tx"][q])),
-                        "rut_rx_gain_dbi": float(10 * np.log10(link.rx_gain * pg["rut_rx"][q])),
-                        "fe_rx_gain_dbi": float(fe_rx_db + 10 * np.log10(pg["fe_rx"][q])),
-                        "fe_tx_gain_dbi": float(fe_tx_db + 10 * np.log10(pg["fe_tx"][q]))})
-    rad = {"tx_power_dbm": float(dbm(link.tx_power_w)),
-           "tx_antenna_gain_dbi": float(10 * np.log10(link.tx_gain)),
-           "rx_antenna_gain_dbi": float(10 * np.log10(link.rx_gain)),
-           "noise_figure_db": float(10 * np.log10(link.noise_figure)),
-           "if_highpass_hz": link.if_highpass_hz, "if_lowpass_hz": link.if_lowpass_hz,
-           "adc_bits": link.adc_bits, "adc_full_scale_dbm": float(dbm(link.adc_full_scale_w)),
-           "thermal_noise_dbm_per_sample": float(dbm(n_th)),
-           "rts_noise_dbm_per_sample": float(dbm(n_ch)), "sources": link.sources}
-    return LinkBudget(modelled, src, float(noise), nq, gain_db, rad, fes, targets, rows_setup)
+    levels = (noise, nq, link.adc_full_scale_w, gain_db)  # _entry's noise, ADC and FFT gain
+    targets = _target_rows(scene, raw, e, h2, f_b, levels)
+    rows_setup = _setup_rows(scene, raw, p_in, h2, f_b, link, levels, estimated_setup)
+    fes = _front_end_rows(scene, program, link, setup)
+    return LinkBudget(modelled, src, float(noise), nq, gain_db, _radar_row(link, n_th, n_ch),
+                      fes, targets, rows_setup)
 
 
 def link_warnings(budget: LinkBudget, threshold_db: float) -> list[str]:

@@ -37,7 +37,21 @@ __all__ = ["RangeDoppler", "Detections", "range_doppler", "range_doppler_power",
 
 @dataclass(frozen=True)
 class RangeDoppler:
-    """Range-Doppler spectrum per virtual channel and its integrated power map."""
+    """Range-Doppler spectrum per virtual channel and its integrated power map.
+
+    Attributes
+    ----------
+    spectrum : ndarray, (R, D, V) complex64
+        The 2-D FFT per virtual channel, the Doppler axis fftshifted.
+    power : ndarray, (R, D)
+        ``sum_v |spectrum|^2``, the map CFAR runs on; :attr:`power_db` in dB.
+    range_m : ndarray, (R,)
+        Each range bin's range.
+    velocity_mps : ndarray, (D,)
+        Each Doppler bin's radial velocity.
+    doppler_hz : ndarray, (D,)
+        Each Doppler bin's slow-time frequency per TDM cycle.
+    """
 
     spectrum: np.ndarray  # (R, D, V) complex64, Doppler axis fftshifted
     power: np.ndarray  # (R, D) sum over virtual channels of |X|^2
@@ -80,7 +94,24 @@ class RangeDoppler:
 
 @dataclass(frozen=True)
 class Detections:
-    """Detection list (SI units; ``angle_rad`` in the radar frame, from boresight to +x)."""
+    """Detection list (SI units; ``angle_rad`` in the radar frame, from boresight to +x).
+
+    Attributes
+    ----------
+    range_m, velocity_mps, angle_rad : ndarray, (N,)
+        Each detection's range, radial velocity and azimuth.
+    power_db : ndarray, (N,)
+        The integrated range-Doppler power at the peak.
+    snr_db : ndarray, (N,)
+        The peak over the CFAR noise estimate.
+    range_bin, doppler_bin : ndarray, (N,)
+        The peak's cell in the range-Doppler map.
+    elevation_rad : ndarray or None
+        The 2-D beamformer's elevation (arrays with elevation extent); None: azimuth only.
+    angle_peak, angle_level_db : ndarray or None
+        The direction's rank among its cell's angle peaks (0: the strongest; ``radar.peaks``)
+        and its spectrum's level relative to the strongest; None: one direction per cell.
+    """
 
     range_m: np.ndarray
     velocity_mps: np.ndarray
@@ -369,7 +400,23 @@ def nearest_detection(det: Detections, rd: RangeDoppler, range_m: float,
 
 
 def range_angle_map(rd: RangeDoppler, cube: AdcCube, angles_rad: np.ndarray) -> np.ndarray:
-    """Beamformer power over (range, angle), each range bin at its strongest Doppler bin."""
+    """Beamformer power over (range, angle), each range bin at its strongest Doppler bin.
+
+    Parameters
+    ----------
+    rd : RangeDoppler
+        The frame's range-Doppler spectrum.
+    cube : AdcCube
+        The ADC cube it came from (its RuT, radar and steering: the beamformer).
+    angles_rad : ndarray, (A,)
+        The azimuths to evaluate, radar frame.
+
+    Returns
+    -------
+    ndarray, (R, A)
+        The angle spectrum's power per range bin and azimuth, TDM motion compensated at
+        the bin's strongest Doppler bin.
+    """
     d_best = np.argmax(rd.power, axis=1)
     r = np.arange(rd.power.shape[0])
     snaps = tdm_compensate(rd.spectrum[r, d_best, :], rd.doppler_hz[d_best], cube.rut, cube.radar)

@@ -15,7 +15,8 @@ import math
 from dataclasses import dataclass
 
 from .registry import COMPENSATIONS, RADAR_PRESETS
-from .schema import Evolvable, spec
+from .evolve import Evolvable
+from .schema import spec
 
 __all__ = ["RadarChannelsConfig", "MAX_GAIN_ERROR_DB", "MAX_CHANNELS", "antenna_counts",
            "channel_rules"]

@@ -15,7 +15,8 @@ import numpy as np
 
 from ..errors import SceneError
 from .registry import PATTERN_KINDS
-from .schema import Evolvable, spec
+from .evolve import Evolvable
+from .schema import spec
 from .schema import fmt as _fmt
 
 __all__ = ["PatternConfig", "ArrayConfig", "check_layout_keys", "resolve_pattern_tables",

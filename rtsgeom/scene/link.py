@@ -14,7 +14,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .presets import PRESETS
-from .schema import Derived, Evolvable, spec
+from .evolve import Evolvable
+from .schema import Derived, spec
 
 __all__ = ["RadarLinkConfig", "RtsLinkConfig", "RADAR_LINK_PRESETS", "FE_ANTENNA_GAIN_DBI"]
 

@@ -15,7 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .schema import Evolvable, spec
+from .evolve import Evolvable
+from .schema import spec
 from .sections import HEADING_DOC, MAX_SCATTERERS, SCATTERER_COLUMNS
 
 __all__ = ["ScenarioTargetConfig", "ScenarioConfig", "SetPoints", "trajectory", "frame_times",

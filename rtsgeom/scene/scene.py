@@ -19,7 +19,8 @@ from .file import decode_toml, read_scene_bytes, resolve_meshes
 from .hardware import check_layout_keys, resolve_pattern_tables
 from .rules import problems
 from .scenario import ScenarioConfig
-from .schema import Derived, Evolvable, check_fields, fmt, read, spec
+from .evolve import Evolvable, check_fields
+from .schema import Derived, fmt, read, spec
 from ..errors import ParameterError, SceneError
 from .sections import (MAX_NAME_CHARS, MAX_TARGETS, RadarConfig, RaytraceConfig, RtsConfig,
                        SheetConfig, StructureConfig, TargetConfig)

@@ -3,7 +3,7 @@
 Each field of a scene configuration dataclass carries its declaration in the dataclass field's
 metadata (:func:`spec`): the key in the file, the kind, the unit, the allowed range, the default
 (in the file's units) and a one-line doc. From that one declaration come the reader
-(:func:`read`), the re-check of :meth:`Evolvable.evolve`, and the generated reference
+(:func:`read`), the re-check of a value set in code (:mod:`.evolve`), and the generated reference
 ``docs/scene-format.md`` (:mod:`rtsgeom.scene.docs`).
 
 Why dataclass metadata and not pydantic or msgspec: the rest of the package works with the
@@ -28,8 +28,8 @@ from typing import Any, Callable
 import numpy as np
 from ..errors import SceneError
 
-__all__ = ["SceneError", "REQUIRED", "Derived", "Spec", "spec", "specs", "read", "check_fields",
-           "check_record", "check_arg", "Evolvable", "fmt", "range_text", "rows_text"]
+__all__ = ["SceneError", "REQUIRED", "Derived", "Spec", "spec", "specs", "read", "check_value",
+           "check_record", "check_arg", "fmt", "range_text", "rows_text"]
 
 
 REQUIRED = object()
@@ -233,87 +233,115 @@ def _read_field(s: Spec, data: dict, ctx: _Ctx, values: dict, context: dict) -> 
     return s.to_si(check_value(s, v, ctx, path, context))
 
 
+def _check_float(s: Spec, v: Any, ctx: _Ctx, path: str, context) -> float:
+    if not _is_num(v):
+        ctx.fail(path, v, f"a number{' in ' + s.unit if s.unit else ''}")
+    rng = s.range_text()
+    f = _as_float(v)
+    if f is None or not math.isfinite(f):
+        ctx.fail(path, v, f"a finite number {rng}".rstrip())
+    if ((s.lo is not None and (f < s.lo or (s.lo_open and f == s.lo)))
+            or (s.hi is not None and (f > s.hi or (s.hi_open and f == s.hi)))):
+        ctx.fail(path, f, rng)
+    return f + 0.0  # -0.0 reads as 0 (numpy refuses a scale of -0.0: "scale < 0")
+
+
+def _check_int(s: Spec, v: Any, ctx: _Ctx, path: str, context) -> int:
+    rng = s.range_text()
+    if isinstance(v, bool) or not isinstance(v, int):
+        ctx.fail(path, _written(v), f"an integer {rng}".rstrip())
+    if (s.lo is not None and v < s.lo) or (s.hi is not None and v > s.hi):
+        ctx.fail(path, v, rng)
+    return int(v)
+
+
+def _check_bool(s: Spec, v: Any, ctx: _Ctx, path: str, context) -> bool:
+    if not isinstance(v, bool):
+        ctx.fail(path, v, "true or false")
+    return v
+
+
+def _check_str(s: Spec, v: Any, ctx: _Ctx, path: str, context) -> str:
+    """A string (``str``) or a radio material's name (``material``)."""
+    ch = s.choices
+    if not isinstance(v, str):
+        ctx.fail(path, v, "a string" + (f": one of {', '.join(ch)}" if ch else ""))
+    if ch is not None and v not in ch:
+        ctx.fail(path, v, f"one of {', '.join(ch)}")
+    if len(v) > s.max_chars:
+        ctx.fail(path, v, f"a string of at most {s.max_chars} characters (it has {len(v)})")
+    if s.printable and not v.isprintable():
+        ctx.fail(path, v, "a string of printable characters (no newlines, tabs or control "
+                          "characters)")
+    if s.printable and not v.strip():
+        ctx.fail(path, v, "a non-empty string")
+    if s.kind == "material" and not v.replace("_", "").isalnum():
+        ctx.fail(path, v, "a radio material name such as itu_metal")
+    return v
+
+
+def _check_vec(s: Spec, v: Any, ctx: _Ctx, path: str, context) -> tuple | None:
+    """A fixed-length vector (``s.n`` numbers in [lo, hi], whole numbers with ``s.whole``)."""
+    if v is None and s.default is None:
+        return None
+    unit = s.unit or "m"
+    if (not isinstance(v, (list, tuple)) or len(v) != s.n
+            or any(not _is_num(x) for x in v)):
+        ctx.fail(path, v, f"a list of {s.n} numbers in {unit}")
+    out = tuple(_as_float(x) for x in v)
+    if not all(x is not None and math.isfinite(x) and s.lo <= x <= s.hi for x in out):
+        ctx.fail(path, v, f"{s.n} finite numbers in [{s.lo:g}, {s.hi:g}] {unit}")
+    if s.whole:
+        if any(x != int(x) for x in out):
+            ctx.fail(path, list(out), f"{s.n} whole numbers of {unit}")
+        return tuple(int(x) for x in out)
+    return out
+
+
+def _check_table(s: Spec, v: Any, ctx: _Ctx, path: str, context):
+    """One sub-table, read into its class (a value already of that class passes as is)."""
+    if isinstance(v, s.cls):
+        return v
+    return read(s.cls, v, ctx.source, path, context)
+
+
+def _check_tables(s: Spec, v: Any, ctx: _Ctx, path: str, context) -> tuple:
+    """An array of tables ``[[...]]`` with ``s.min_items`` to ``s.max_items`` entries, each
+    read into ``s.cls`` (a tuple already of that class passes as is)."""
+    if isinstance(v, tuple) and all(isinstance(t, s.cls) for t in v):
+        items = v
+    else:
+        if not isinstance(v, list) or not all(isinstance(t, dict) for t in v):
+            ctx.fail(path, v, "an array of tables ([[...]])")
+        items = None
+    n = len(v)
+    if s.max_items and n > s.max_items:
+        ctx.fail(path, _Written(f"<{n} {s.item}s>"), f"a list of at most {s.max_items} {s.item}s")
+    if n < s.min_items:
+        ctx.fail(path, [], f"a list of at least {s.min_items} {s.item}")
+    if items is None:
+        items = tuple(read(s.cls, t, ctx.source, f"{path}[{i}]", context)
+                      for i, t in enumerate(v))
+    return tuple(items)
+
+
 def check_value(s: Spec, v: Any, ctx: _Ctx, path: str, context: dict | None = None) -> Any:
     """One value in file units against its declaration; returns it normalised (file units)."""
     k = s.kind
-    if k == "float":
-        if not _is_num(v):
-            ctx.fail(path, v, f"a number{' in ' + s.unit if s.unit else ''}")
-        rng = s.range_text()
-        f = _as_float(v)
-        if f is None or not math.isfinite(f):
-            ctx.fail(path, v, f"a finite number {rng}".rstrip())
-        if ((s.lo is not None and (f < s.lo or (s.lo_open and f == s.lo)))
-                or (s.hi is not None and (f > s.hi or (s.hi_open and f == s.hi)))):
-            ctx.fail(path, f, rng)
-        return f + 0.0  # -0.0 reads as 0 (numpy refuses a scale of -0.0: "scale < 0")
-    if k == "int":
-        rng = s.range_text()
-        if isinstance(v, bool) or not isinstance(v, int):
-            ctx.fail(path, _written(v), f"an integer {rng}".rstrip())
-        if (s.lo is not None and v < s.lo) or (s.hi is not None and v > s.hi):
-            ctx.fail(path, v, rng)
-        return int(v)
-    if k == "bool":
-        if not isinstance(v, bool):
-            ctx.fail(path, v, "true or false")
-        return v
-    if k in ("str", "material"):
-        ch = s.choices
-        if not isinstance(v, str):
-            ctx.fail(path, v, "a string" + (f": one of {', '.join(ch)}" if ch else ""))
-        if ch is not None and v not in ch:
-            ctx.fail(path, v, f"one of {', '.join(ch)}")
-        if len(v) > s.max_chars:
-            ctx.fail(path, v, f"a string of at most {s.max_chars} characters (it has {len(v)})")
-        if s.printable and not v.isprintable():
-            ctx.fail(path, v, "a string of printable characters (no newlines, tabs or control "
-                              "characters)")
-        if s.printable and not v.strip():
-            ctx.fail(path, v, "a non-empty string")
-        if k == "material" and not v.replace("_", "").isalnum():
-            ctx.fail(path, v, "a radio material name such as itu_metal")
-        return v
-    if k == "vec":
-        if v is None and s.default is None:
-            return None
-        unit = s.unit or "m"
-        if (not isinstance(v, (list, tuple)) or len(v) != s.n
-                or any(not _is_num(x) for x in v)):
-            ctx.fail(path, v, f"a list of {s.n} numbers in {unit}")
-        out = tuple(_as_float(x) for x in v)
-        if not all(x is not None and math.isfinite(x) and s.lo <= x <= s.hi for x in out):
-            ctx.fail(path, v, f"{s.n} finite numbers in [{s.lo:g}, {s.hi:g}] {unit}")
-        if s.whole:
-            if any(x != int(x) for x in out):
-                ctx.fail(path, list(out), f"{s.n} whole numbers of {unit}")
-            return tuple(int(x) for x in out)
-        return out
     if k in ("points", "ints", "floats"):
         return _check_list(s, v, ctx, path)
     if k == "rows":
         return _check_rows(s, v, ctx, path)
-    if k == "table":
-        if isinstance(v, s.cls):
-            return v
-        return read(s.cls, v, ctx.source, path, context)
-    if k == "tables":
-        if isinstance(v, tuple) and all(isinstance(t, s.cls) for t in v):
-            items = v
-        else:
-            if not isinstance(v, list) or not all(isinstance(t, dict) for t in v):
-                ctx.fail(path, v, "an array of tables ([[...]])")
-            items = None
-        n = len(v)
-        if s.max_items and n > s.max_items:
-            ctx.fail(path, _Written(f"<{n} {s.item}s>"), f"a list of at most {s.max_items} {s.item}s")
-        if n < s.min_items:
-            ctx.fail(path, [], f"a list of at least {s.min_items} {s.item}")
-        if items is None:
-            items = tuple(read(s.cls, t, ctx.source, f"{path}[{i}]", context)
-                          for i, t in enumerate(v))
-        return tuple(items)
-    raise AssertionError(f"unknown kind {k}")  # a declaration error, not input
+    check = _CHECKS.get(k)
+    if check is None:
+        raise AssertionError(f"unknown kind {k}")  # a declaration error, not input
+    return check(s, v, ctx, path, context)
+
+
+#: the checker of each kind of declared value
+_CHECKS = {"float": _check_float, "int": _check_int, "bool": _check_bool, "str": _check_str,
+           "material": _check_str, "vec": _check_vec, "table": _check_table,
+           "tables": _check_tables}
 
 
 def _check_list(s: Spec, v: Any, ctx: _Ctx, path: str) -> tuple:
@@ -428,57 +456,3 @@ def check_arg(value: Any, name: str, kind: str, source: str, error: type = Scene
     if kind == "float" and isinstance(value, np.floating):
         value = float(value)
     return check_value(Spec(name, kind, "", **declaration), value, _Ctx(source, "", error), name)
-
-
-# --------------------------------------------------------------------------------------------
-# Re-checking values set in code (evolve)
-# --------------------------------------------------------------------------------------------
-
-
-def check_fields(obj: Any, source: str, where: str = "") -> None:
-    """Check every declared field of a config object (SI values) against its declaration."""
-    ctx = _Ctx(source, where)
-    for name, s in specs(type(obj)):
-        v = getattr(obj, name)
-        path = ctx.path(s.key)
-        if v is None and (s.default is None or isinstance(s.default, Derived)):
-            continue
-        if s.kind == "table":
-            if v is not None:
-                if not isinstance(v, s.cls):
-                    ctx.fail(path, v, f"a {s.cls.__name__} (a table set in code is the "
-                                      f"section's object, not a {type(v).__name__})")
-                check_fields(v, source, path)
-            continue
-        if s.kind == "tables":
-            if not isinstance(v, (tuple, list)) or not all(isinstance(t, s.cls) for t in v):
-                ctx.fail(path, v, f"a tuple of {s.cls.__name__} (entries set in code are "
-                                  f"the section's objects, e.g. replace(scene.{path}[0], ...), "
-                                  "not dicts)")
-            check_value(s, tuple(v), ctx, path)
-            for i, item in enumerate(v):
-                check_fields(item, source, f"{path}[{i}]")
-            continue
-        if s.kind == "rows":  # back to file units, column by column (as rounded: see below)
-            fv = tuple(tuple(x / col[4] for x, col in zip(row, s.columns)) for row in v)
-            cols = tuple((n, u, lo - 1e-9 * max(1.0, abs(lo)), hi + 1e-9 * max(1.0, abs(hi)), f)
-                         for n, u, lo, hi, f in s.columns)
-            check_value(dataclasses.replace(s, columns=cols), fv, ctx, path)
-            continue
-        if s.scale != 1.0 and v is not None:
-            # back to file units; allow the rounding of the unit conversion at the bounds
-            fv = tuple(x / s.scale for x in v) if isinstance(v, tuple) else v / s.scale
-            lo = None if s.lo is None else s.lo - 1e-9 * max(1.0, abs(s.lo))
-            hi = None if s.hi is None else s.hi + 1e-9 * max(1.0, abs(s.hi))
-            check_value(dataclasses.replace(s, lo=lo, hi=hi), fv, ctx, path)
-        else:
-            check_value(s, v, ctx, path)
-
-
-class Evolvable:
-    """Mixin: ``obj.evolve(**changes)`` is ``dataclasses.replace`` that validates again."""
-
-    def evolve(self, **changes):
-        new = dataclasses.replace(self, **changes)
-        check_fields(new, getattr(self, "source", None) or "<evolve>")
-        return new

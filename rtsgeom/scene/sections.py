@@ -24,7 +24,8 @@ from .registry import ANGLE_ESTIMATORS, AOA_MODES, CFAR_KINDS, RADAR_PRESETS, WI
 from .hardware import ArrayConfig, PatternConfig
 from .channels import RadarChannelsConfig
 from .link import RadarLinkConfig, RtsLinkConfig
-from .schema import Derived, Evolvable, spec
+from .evolve import Evolvable
+from .schema import Derived, spec
 
 __all__ = ["RadarChannelsConfig", "RadarConfig", "CfarConfig", "FrontEndConfig", "RtsConfig", "SheetConfig",
            "TargetConfig", "RaytraceConfig", "PatternConfig", "ArrayConfig", "StructureConfig"]

@@ -362,7 +362,7 @@ ANNOTATE_CELLS = 150  # a heat map of at most this many cells writes each value 
 
 
 @_styled
-def design_heatmap_figure(x, y, z, xlabel: str, ylabel: str, zlabel: str, title: str,
+def design_heatmap_figure(x, y, z, xlabel: str, ylabel: str, zlabel: str, title: str, *,
                           mask=None, contour_floor: float | None = None,
                           integer_y: bool = False, integer_z: bool = False) -> Figure:
     """Heat map of a figure of merit ``z`` (shape (len(y), len(x))) over two design parameters,

@@ -104,7 +104,7 @@ def _objects(top, bottom, t, objects) -> None:
 
 
 def playback_animation(path, time_s, fe_azimuth_deg, amplitude, target_xy_m, set_deg,
-                       detected_deg, arc_radius_m: float, title: str = "", fps: int = 5):
+                       detected_deg, arc_radius_m: float, *, title: str = "", fps: int = 5):
     """An animated GIF of a drive (matplotlib's ``PillowWriter``): left, the arc
     seen from above with the RuT at its centre, every front end (filled and sized by its
     programmed amplitude when it carries a target) and each target's set (line) and detected

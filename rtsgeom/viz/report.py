@@ -121,7 +121,7 @@ def _format_value(value: Any, unit: str | None = None, digits: int | None = None
         return "\u2013"
     if isinstance(value, bool):
         return "yes" if value else "no"
-    if isinstance(value, (list, tuple)):  # an empty list says so (was an empty cell)
+    if isinstance(value, (list, tuple)):  # an empty list says "none", not an empty cell
         return ", ".join(_format_value(v, unit, digits) for v in value) if value else "none"
     if _is_number(value):
         if isinstance(value, int) and unit is None:

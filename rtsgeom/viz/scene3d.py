@@ -390,7 +390,7 @@ def export_setup_html(setup: Setup, path: str | Path, paths=None) -> Path:
 
 
 def _html_page(page: str, scene_name: str, legend) -> str:
-    """The exported page titled ``rtsgeom — <scene>`` (was the viewer's example title) with
+    """The exported page titled ``rtsgeom — <scene>`` (not the viewer's default title) with
     the view's legend as an HTML box (screen-space text does not survive the export)."""
     from matplotlib.colors import to_hex  # matplotlib: only for the HTML page
     name = html.escape(scene_name)

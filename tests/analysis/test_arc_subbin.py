@@ -70,7 +70,7 @@ def test_arc_pairs_share_one_target_position(radius_m, angles):
                       keep_errors=True, chunk=40)
     idx = next(subbin_draws(seed, draws, steps.size, draws))
     assert np.array_equal(res.subbin_steps, steps[idx])
-    again = next(draw_chunks(seed, draws, n_fe, "uniform", draws, steps.size)).subbin()
+    again = next(draw_chunks(seed, draws, n_fe, "uniform", draws, positions=steps.size)).subbin()
     assert np.array_equal(again, idx)
     off = res.errors["offsets_m"]
     centre = monte_carlo(ToleranceModel.arc(models, n_fe), b, draws, seed, "uniform", 0.05,

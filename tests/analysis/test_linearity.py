@@ -45,8 +45,8 @@ def test_measured_end_angles_equal_geometric_ones_in_the_ideal_far_field(mode):
     setup = build_setup(small_noiseless(far))
     paths = exact_paths(setup)
     probe = probe_front_ends(setup, paths, 1)
-    geo = linearity(setup, paths, (0, 1), mode, probe, None, 5, 1, "geometric")
-    meas = linearity(setup, paths, (0, 1), mode, probe, None, 5, 1, "measured")
+    geo = linearity(setup, paths, (0, 1), mode, probe, None, 5, 1, end_angles="geometric")
+    meas = linearity(setup, paths, (0, 1), mode, probe, None, 5, 1, end_angles="measured")
     assert np.all(np.isfinite(meas.error_deg))
     np.testing.assert_allclose(meas.error_deg, geo.error_deg, atol=0.02)
 

@@ -292,7 +292,7 @@ def test_draw_chunks_regenerate_the_streams_bit_for_bit(distribution, chunk):
     subbin = np.concatenate([p.subbin() for p in parts])
     assert np.array_equal(offsets, np.concatenate(list(standard_draws(5, 300, distribution))) * sigma)
     assert np.array_equal(subbin, np.concatenate(list(subbin_draws(5, 300, 9))))
-    centre = draw_chunks(5, 300, 2, distribution, chunk, None, 4)
+    centre = draw_chunks(5, 300, 2, distribution, chunk, positions=None, centre=4)
     assert np.array_equal(np.concatenate([p.subbin() for p in centre]), np.full(300, 4))
 
 

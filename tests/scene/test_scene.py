@@ -147,6 +147,28 @@ def test_evolve_validates_again(default_scene):
         s.evolve(radar=s.radar.evolve(chirps_per_tx=4))
 
 
+def test_derive_is_not_checked_again_and_the_nominal_scene_names_no_derived_value(default_scene):
+    """A variant the package derives (``derive``) is not read through the file's schema again:
+    the nominal scene of a scene carrying a derived value outside the file's range (a reference
+    step's 447.8 deg phase, a noise level) raised '<evolve>: ... = 447.803', a field nobody
+    wrote. ``evolve``, for values a user sets in code, still checks."""
+    import math
+    from rtsgeom.geometry.setup import nominal_scene
+    s = default_scene
+    fe = s.rts.front_ends[1].derive(phase_offset_rad=math.radians(447.803))
+    assert fe.phase_offset_rad == math.radians(447.803)
+    with pytest.raises(SceneError, match="phase_offset_deg = 447.803"):
+        s.rts.front_ends[1].evolve(phase_offset_rad=math.radians(447.803))
+    fes = list(s.rts.front_ends)
+    fes[0] = fes[0].derive(radial_offset_m=0.002)
+    fes[1] = fes[1].derive(gain_offset_db=200.0)  # out of the file's range, derived
+    radar = s.radar.derive(yaw_offset_rad=math.radians(1.0), snr_db=-500.0)
+    derived = s.derive(rts=s.rts.derive(front_ends=tuple(fes)), radar=radar)
+    nominal = nominal_scene(derived)
+    assert nominal.rts.front_ends[0].radial_offset_m == 0.0
+    assert nominal.radar.yaw_offset_rad == 0.0 and nominal.radar.snr_db == -500.0
+
+
 def test_problems_lists_every_violated_rule(default_scene):
     from rtsgeom.scene.rules import problems
     assert problems(default_scene) == []

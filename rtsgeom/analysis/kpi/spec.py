@@ -26,7 +26,26 @@ MAX_SPEC_BYTES = 64 * 1024
 @dataclass(frozen=True)
 class KpiSpec:
     """The test device's requirements (every field optional; None: not checked). Units in the
-    keys, file units kept (degrees, metres, dB)."""
+    keys, file units kept (degrees, metres, dB).
+
+    Attributes
+    ----------
+    angle_accuracy_deg : float, optional
+        |error| + U (k = 2) of the synthesized angle after calibration, worst over
+        ``azimuth_deg``.
+    azimuth_deg : (float, float), optional
+        The azimuth span the setup must reach without a gap.
+    min_range_m, max_range_m : float, optional
+        The nearest and farthest range it must emulate.
+    max_velocity_mps : float, optional
+        The largest |radial velocity| it must emulate.
+    range_accuracy_m, velocity_accuracy_mps : float, optional
+        The largest range and velocity errors the RuT may see on the scene's targets.
+    targets : int, optional
+        Simultaneous targets it must emulate.
+    resolution_deg : float, optional
+        The minimum resolvable separation of two targets as the RuT sees them.
+    """
 
     angle_accuracy_deg: float | None = spec(
         "angle_accuracy_deg", "float", "|error| + U (k = 2) of the synthesized angle after "
@@ -97,15 +116,47 @@ class SpecCheck:
 
 
 def loads_spec(text: str | bytes, source: str = "<spec>") -> KpiSpec:
-    """A spec from TOML text (:class:`KpiSpec`); every failure a
-    :class:`~rtsgeom.errors.SceneError` naming the key."""
+    """A spec from TOML text (:class:`KpiSpec`).
+
+    Parameters
+    ----------
+    text : str or bytes
+        The spec's TOML.
+    source : str
+        Its name in errors.
+
+    Returns
+    -------
+    KpiSpec
+
+    Raises
+    ------
+    SceneError
+        Bad TOML, an unknown key or a value outside its range, naming the key.
+    """
     from ...scene.file import decode_toml
     data, _ = decode_toml(text, source)
     return read(KpiSpec, data, source)
 
 
 def load_spec(path: str | Path) -> KpiSpec:
-    """A spec file (:func:`loads_spec`)."""
+    """A spec file (:func:`loads_spec`).
+
+    Parameters
+    ----------
+    path : str or Path
+        The spec's TOML file.
+
+    Returns
+    -------
+    KpiSpec
+
+    Raises
+    ------
+    SceneError
+        A file over the size limit, a value :func:`loads_spec` refuses, or an
+        ``azimuth_deg`` whose low end is not below its high end.
+    """
     path = Path(path)
     with open(path, "rb") as fh:
         raw = fh.read(MAX_SPEC_BYTES + 1)

@@ -22,7 +22,9 @@ from ...errors import ParameterError
 from ...geometry import build_setup
 from ...paths import exact_paths
 from ...scene import Scene, check_scene_arg
+from ...scene.schema import check_arg
 from ..tolerance import MAX_SIGMA_MM
+from ..tolerance.args import STUDY_ARGS
 from ..transfer import ideal_radar, set_angles
 from .accuracy import AccuracyInputs, AnglePoint, effective_snr, pair_accuracy
 from .sections import (field_of_view, ghosts_section, nearfield_section, range_velocity,
@@ -37,14 +39,30 @@ SCHEMA_VERSION = 1
 
 @dataclass(frozen=True)
 class KpiStudy:
-    """The datasheet of a scene (module doc).
+    """The datasheet of a scene (module doc): ``KpiStudy(...)(scene)`` is a :class:`Datasheet`.
 
-    ``sigma_mm``: the mounting offsets' standard deviation per axis (radial, tangential,
-    height; one number for all three), default 0.1 mm; ``sigma_phase_deg``: each RuT antenna's
-    phase spread over radars of the type (default: the RMS of the scene's
-    ``[radar.channels]`` phases, 0 without them); ``points``: set angles across each pair's
-    span; ``draws``: the Monte Carlo's; ``seed``: its (default the scene's); ``spec``: the
-    :class:`~.spec.KpiSpec` to check."""
+    Parameters
+    ----------
+    sigma_mm : float or (float, float, float), optional
+        The mounting offsets' standard deviation per axis (radial, tangential, height; one
+        number for all three), in [0, 10] mm; default 0.1 mm.
+    sigma_phase_deg : float, optional
+        Each RuT antenna's phase spread over radars of the type, in [0, 90] deg; default the
+        RMS of the scene's ``[radar.channels]`` phases, 0 without them.
+    points : int
+        Set angles across each pair's span, in [1, 201].
+    draws : int
+        The Monte Carlo's draws, in [100, 1 000 000].
+    seed : int, optional
+        Its seed; default the scene's.
+    spec : KpiSpec, optional
+        The requirements to check (:func:`~.spec.load_spec`).
+
+    Raises
+    ------
+    ParameterError
+        A value outside its range, naming it.
+    """
 
     sigma_mm: float | tuple[float, float, float] | None = None
     sigma_phase_deg: float | None = None
@@ -60,17 +78,16 @@ class KpiStudy:
                 isinstance(v, (int, float)) and 0 <= v <= MAX_SIGMA_MM for v in vals)):
             raise ParameterError(f"sigma_mm = {s}: must be one number or three (radial, "
                                  f"tangential, height) in [0, {MAX_SIGMA_MM:g}] mm")
-        checks = (("sigma_phase_deg", self.sigma_phase_deg, 0.0, 90.0),
-                  ("points", self.points, 1, 201), ("draws", self.draws, 100, 1_000_000))
-        for name, v, lo, hi in checks:
-            if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v)
-                                      and lo <= v <= hi):
-                raise ParameterError(f"{name} = {v}: must be in [{lo:g}, {hi:g}]")
-        for name in ("points", "draws"):
-            if not isinstance(getattr(self, name), int):
-                raise ParameterError(f"{name} = {getattr(self, name)}: must be an integer")
-        if self.seed is not None and not (isinstance(self.seed, int) and self.seed >= 0):
-            raise ParameterError(f"seed = {self.seed}: must be an integer >= 0")
+        src = "KpiStudy"
+        if self.sigma_phase_deg is not None:
+            check_arg(self.sigma_phase_deg, "sigma_phase_deg", "float", src, ParameterError,
+                      lo=0.0, hi=90.0, unit="deg")
+        check_arg(self.points, "points", "int", src, ParameterError, lo=1, hi=201)
+        # the Monte-Carlo arguments as every study declares them, the datasheet's draws
+        # within its own bounds [100, 1e6]
+        STUDY_ARGS["draws"].check(self.draws, "draws", src, lo=100, hi=1_000_000)
+        if self.seed is not None:
+            STUDY_ARGS["seed"].check(self.seed, "seed", src)
         if self.spec is not None and not isinstance(self.spec, KpiSpec):
             raise ParameterError("spec: must be a KpiSpec (rtsgeom.analysis.kpi.load_spec)")
 
@@ -184,9 +201,28 @@ class _Steps:
 
 @dataclass(frozen=True, repr=False)
 class Datasheet(Result):
-    """The setup's datasheet (module doc): ``accuracy`` per set angle (:class:`AnglePoint`),
-    the sections as plain dicts, ``checks`` against the spec; ``to_dict()`` the JSON,
-    ``plot()`` the angle accuracy, ``figures()`` every figure of the report."""
+    """The setup's datasheet (module doc): ``to_dict()`` the JSON, ``plot()`` the angle
+    accuracy, ``figures()`` every figure of the report.
+
+    Attributes
+    ----------
+    scene_name : str
+        The scene's name.
+    study : KpiStudy
+        The study that made it.
+    fov : dict
+        The field of view the arc covers.
+    accuracy : tuple of AnglePoint
+        The angle accuracy per set angle; ``accuracy_note`` how it was evaluated.
+    inputs : dict
+        The uncertainty budget's inputs (sigmas, SNR, draws, seed).
+    range_velocity, targets, ghosts, nearfield : dict
+        The other sections, as plain dicts.
+    spec : KpiSpec or None
+        The requirements checked; ``checks`` the verdict per requirement.
+    elapsed_s : float
+        The study's wall time.
+    """
 
     scene_name: str
     study: KpiStudy

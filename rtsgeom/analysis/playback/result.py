@@ -31,25 +31,50 @@ BUDGET_ROLES = ("kept", "lead", "merged", "dropped")
 class PlaybackResult(Result):
     """A drive played frame by frame (``Playback``).
 
-    ``set`` and ``detected``: ``range_m``, ``azimuth_deg``, ``velocity_mps`` arrays (frames,
-    targets), detected NaN where the target was lost; ``split`` (frames, targets) the other
-    detections near a target's set-point that no target claimed; ``channels`` (frames,
-    targets) the front ends that carry each target; ``programme`` (rows, 7): frame, target,
-    channel, delay_s, doppler_hz, |amplitude|, phase_rad; ``baseline`` the switched baseline
-    (``nearest``) on the same drive, or None; ``truth`` the truth twin's detections (the same
-    keys, NaN where the real scene gives the target no detection of its own; None: not run);
-    ``status`` (frames, targets) ``detected``, ``merged`` or ``not_detected``; ``clouds``
-    (a scene with extended objects) the truth twin's and the RTS's detections of each object
-    (:mod:`rtsgeom.analysis.objects`) and the resolution cell they are compared in;
-    ``budget`` per frame the planner's counts under ``[rts] max_targets_per_channel``;
-    ``role`` (frames, targets) each target's role under that budget (:data:`BUDGET_ROLES`;
-    None without one): a ``lead``'s detection and truth are the merged target's and the truth
-    twin's detection of its cell, a ``merged`` or ``dropped`` target has neither;
-    ``object_of`` (targets,) the extended object each target belongs to (-1: a point target).
     The angle, range and velocity errors, losses and hand-overs are over the point targets
     synthesized as themselves (:attr:`tracked`); an object's scatterers are compared as its
     cloud, each RTS detection against the truth twin's detection of its cell
     (:mod:`rtsgeom.analysis.objects`, ``objects.json``).
+
+    Attributes
+    ----------
+    scene : Scene
+        The scene played.
+    mode : str
+        The amplitude mode.
+    time_s : ndarray, (frames,)
+        Each frame's time.
+    set, detected : dict
+        ``range_m``, ``azimuth_deg``, ``velocity_mps`` arrays (frames, targets); detected NaN
+        where the target was lost.
+    split : ndarray
+        (frames, targets): the other detections near a target's set-point that no target claimed.
+    channels : ndarray
+        (frames, targets): the front ends that carry each target.
+    programme : ndarray, (rows, 7)
+        Frame, target, channel, delay_s, doppler_hz, |amplitude|, phase_rad.
+    calibration : dict
+        The pairs' calibration used.
+    warnings : tuple of str
+        The run's warnings.
+    baseline : PlaybackResult or None
+        The switched baseline (``nearest``) on the same drive.
+    truth : dict or None
+        The truth twin's detections (the same keys, NaN where the real scene gives the target
+        no detection of its own; None: not run).
+    status : ndarray or None
+        (frames, targets): ``detected``, ``merged`` or ``not_detected``.
+    clouds : tuple or None
+        For a scene with extended objects, the truth twin's and the RTS's detections of each
+        object (:mod:`rtsgeom.analysis.objects`) and the resolution cell they are compared in.
+    budget : tuple or None
+        Per frame the planner's counts under ``[rts] max_targets_per_channel``.
+    role : ndarray or None
+        (frames, targets): each target's role under that budget (:data:`BUDGET_ROLES`; None
+        without one): a ``lead``'s detection and truth are the merged target's and the truth
+        twin's detection of its cell, a ``merged`` or ``dropped`` target has neither.
+    object_of : ndarray, (targets,)
+        The extended object each target belongs to (-1: a point target).
     """
 
     scene: Scene
@@ -317,8 +342,8 @@ class PlaybackResult(Result):
         xy = self.set["range_m"][..., None] * np.stack([np.sin(az), np.cos(az)], axis=-1)
         return playback_animation(path, self.time_s, np.degrees(setup.fe_azimuth_rad()), amp,
                                   xy, self.set["azimuth_deg"], self.detected["azimuth_deg"],
-                                  self.scene.rts.arc_radius_m, f"{self.scene.name}: {self.mode}",
-                                  fps)
+                                  self.scene.rts.arc_radius_m,
+                                  title=f"{self.scene.name}: {self.mode}", fps=fps)
 
 
 def budget_line(b: dict) -> str:

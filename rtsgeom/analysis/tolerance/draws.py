@@ -35,18 +35,13 @@ import numpy as np
 from scipy.constants import c
 
 from ...errors import ParameterError
+from .args import DISTRIBUTIONS, MAX_SIGMA_MM, STUDY_ARGS
 
 __all__ = ["AXES", "DISTRIBUTIONS", "DEFAULT_CHUNK", "MAX_SIGMA_MM", "Bounds",
-           "check_distribution",
            "unit_block", "subbin_positions", "centre_index", "DrawChunk", "draw_chunks",
            "standard_draws", "subbin_draws", "draw_offsets", "draw_subbins"]
 
-#: the largest mounting sigma (mm) a study takes, in the CLI and in Python: the phasor model
-#: is first order in the errors (checked to 0.3 mm)
-MAX_SIGMA_MM = 10.0
-
 AXES = ("radial", "tangential", "height")
-DISTRIBUTIONS = ("normal", "uniform")
 DEFAULT_CHUNK = 10_000
 
 #: the streams beside the offsets' ``default_rng(seed)``: ``default_rng([seed, stream])``;
@@ -121,13 +116,6 @@ class Bounds:
                 "pitch_deg": math.degrees(self.pitch_rad),
                 "rut_position_mm": [v * 1e3 for v in self.rut_position_m],
                 "rut_yaw_deg": math.degrees(self.rut_yaw_rad)}
-
-
-def check_distribution(distribution: str) -> None:
-    """A clear error naming the allowed draw distributions."""
-    if distribution not in DISTRIBUTIONS:
-        raise ParameterError(f"distribution {distribution!r}: must be one of "
-                             f"{', '.join(DISTRIBUTIONS)}")
 
 
 def unit_block(rng: np.random.Generator, shape, distribution: str) -> np.ndarray:
@@ -209,13 +197,13 @@ class DrawChunk:
 
 
 def draw_chunks(seed: int, draws: int, count: int, distribution: str = "normal",
-                chunk: int = DEFAULT_CHUNK, positions: int | None = None, centre: int = 0,
+                chunk: int = DEFAULT_CHUNK, *, positions: int | None = None, centre: int = 0,
                 rotations: bool = False, rut: bool = False) -> Iterator[DrawChunk]:
     """A study's draws chunk by chunk as :class:`DrawChunk` (the streams advanced here by
     drawing each chunk once: normal draws take a varying number of raw numbers each).
     ``positions``: the count of sub-bin positions (None: every draw at the bin centre
     ``centre``); ``rotations``, ``rut``: whether those streams are drawn."""
-    check_distribution(distribution)
+    STUDY_ARGS["distribution"].check(distribution, "distribution", "draw_chunks")
     rng = np.random.default_rng(seed)
     g_sub = None if positions is None else np.random.default_rng([int(seed), SUBBIN_STREAM])
     g_rut = np.random.default_rng([seed, RUT_STREAM]) if rut else None

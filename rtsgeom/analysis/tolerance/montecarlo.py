@@ -418,8 +418,9 @@ def simulate(model, bounds, mc: MonteCarlo, spec_deg: float = 0.1, cases=CASES,
     bounds.check()
     positions = model.subbin_steps
     chunks = draw_chunks(seed, draws, model.count, distribution, chunk,
-                         positions.size if subbin else None, int(np.flatnonzero(positions == 0)[0])
-                         if positions.size else 0, bounds.rotations, bounds.rut_pose)
+                         positions=positions.size if subbin else None,
+                         centre=int(np.flatnonzero(positions == 0)[0]) if positions.size else 0,
+                         rotations=bounds.rotations, rut=bounds.rut_pose)
     func = functools.partial(_evaluate, shared, bounds=bounds, cases=tuple(cases),
                              keep=keep_errors)
     parts, done = [], 0

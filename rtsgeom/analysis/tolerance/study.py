@@ -208,7 +208,7 @@ class ToleranceStudy:
         if self.verify:
             verify = verify_draws(model.sets[0], self.bounds.offsets_m,
                                   min(self.verify, mc.draws), mc.seed, mc.distribution,
-                                  self.cases, progress=mc.progress,
+                                  cases=self.cases, progress=mc.progress,
                                   all_points=self.verify_all_points)
         inversion = None
         if self.invert_yield is not None:

@@ -117,7 +117,7 @@ class VerifyResult(Result):
 
 
 def verify_draws(model: ChannelPhasors, sigma_m, n: int, seed: int, distribution: str = "normal",
-                 cases=CASES, subbin: bool = True, progress=None, all_points: bool = False,
+                 *, cases=CASES, subbin: bool = True, progress=None, all_points: bool = False,
                  positions=None) -> VerifyResult:
     """The first ``n`` draws of ``monte_carlo(model, sigma_m, n, seed, distribution)`` through
     the full chain (see the module). ``subbin``: the sub-bin positions the study draws
