@@ -256,8 +256,6 @@ class Calibration(Result):
 
 
 RECENTRE_S = 10e-12  # a fit this far from the fine sweep's centre is measured again around it
-RECENTRE_PLACED_STEPS = 2  # the probes are placed for the fine window this many coarse steps
-# wider either side, so that a recentred sweep within them keeps the placement
 
 
 class _FineSweep:
@@ -311,13 +309,9 @@ def run_sweep(probes: Probes, config: SweepConfig = SweepConfig()) -> Calibratio
         return _calibration(probes, grid, errs, grid, errs, near, near, k_coarse, k_coarse,
                             frame_noise, 0.0, (np.zeros(0, int), np.zeros(0, bool)))
     half = period / 4
-    # the window's delays as the RTS realises them (a coarse RTS would round them), two
-    # coarse steps wider either side: a fine sweep recentred within two steps of the
-    # coarse minimum (a noisy coarse sweep's minimum is a step off the point in most
-    # pairs) stays inside the window the probes were placed for and is not placed again
-    placed_at, wider = near, RECENTRE_PLACED_STEPS * step
-    probes = probes.placed(np.unique(realisable(
-        near + np.arange(-half - wider, half + wider + 1e-15, step), res)))
+    # the window's delays as the RTS realises them (a coarse RTS would round them)
+    probes = probes.placed(np.unique(realisable(near + np.arange(-half, half + 1e-15, step),
+                                                res)))
     # fine steps the RTS can set (an RTS whose delay moves in 25 ps cannot take 5 ps ones)
     steps = fine_window(half, res * max(1, round(probes.fine_step_s / res)))
     fine = _FineSweep(probes, near, steps, period)
@@ -355,9 +349,8 @@ def run_sweep(probes: Probes, config: SweepConfig = SweepConfig()) -> Calibratio
         # window lopsided about it the fit drifts (5 ps at 46 ps off, sphere4's elevation pair,
         # where a noisy coarse minimum was 50 ps from the point); the same columns
         centre = float(realisable(best_fit, res))
-        if abs(centre - placed_at) > wider + res / 2:
-            probes = probes.placed(np.unique(realisable(
-                centre + np.arange(-half, half + 1e-15, step), res)))
+        probes = probes.placed(np.unique(realisable(
+            centre + np.arange(-half, half + 1e-15, step), res)))
         fine = _FineSweep(probes, centre, steps, period)
         e_fine = probes.measure(fine.t, n_frames)
         best_fit, _ = fine.fit(e_fine, columns)
