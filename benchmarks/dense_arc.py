@@ -1,5 +1,7 @@
 """``python -m benchmarks.dense_arc [--front-ends 64] [--step-deg 1] [--targets 32] [--repeat 3]``:
-how long the CLI takes on an arc of many front ends.
+how long the CLI takes on an arc of many front ends; ``--scaling 16 32 64``: the same commands
+on arcs of those many front ends (the same targets), each command's CPU per front end, written
+to ``benchmarks/dense_arc_scaling.json``.
 
 The template's bench (``scenes/template.toml``: AWR1843BOOST, 1.5 m arc, noise at 10 dB) with
 ``--front-ends`` front ends ``--step-deg`` apart (12 mm Rx/Tx modules in 24 mm cutouts so that
@@ -74,12 +76,44 @@ def main(argv=None) -> int:
     ap.add_argument("--step-deg", type=float, default=1.0)
     ap.add_argument("--targets", type=int, default=32)
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--out", default=str(ROOT / "benchmarks" / "dense_arc.json"))
+    ap.add_argument("--out", default=None)
+    ap.add_argument("--scaling", type=int, nargs="+", default=None, metavar="N")
     args = ap.parse_args(argv)
+    if args.scaling:
+        return scaling(args)
+    out = args.out or str(ROOT / "benchmarks" / "dense_arc.json")
+    record = measure(args.front_ends, args)
+    old = json.loads(Path(out).read_text()) if Path(out).exists() else {}
+    if "before" in old or "commands" in old:  # the record this run replaces, kept beside it
+        record["before"] = old.get("before", {k: old[k] for k in ("commands", "accuracy")
+                                              if k in old})
+    write_json(out, record, newline=True)
+    return 0
+
+
+def scaling(args) -> int:
+    """Each command on arcs of ``args.scaling`` front ends: medians, and CPU per front end."""
+    rows = {}
+    for n in args.scaling:
+        rec = measure(n, args)
+        rows[str(n)] = {"commands": {k: {"median_wall_s": v["median_wall_s"],
+                                         "median_user_s": v["median_user_s"],
+                                         "user_s_per_front_end": v["median_user_s"] / n}
+                                     for k, v in rec["commands"].items()},
+                        "accuracy": rec["accuracy"]}
+    write_json(args.out or str(ROOT / "benchmarks" / "dense_arc_scaling.json"),
+               {"front_ends": args.scaling, "step_deg": args.step_deg,
+                "targets": args.targets, "repeat": args.repeat, "cpus": os.cpu_count(),
+                "scaling": rows}, newline=True)
+    return 0
+
+
+def measure(n_fe: int, args) -> dict:
+    """The four commands on an arc of ``n_fe`` front ends (module doc)."""
     rows = {}
     with tempfile.TemporaryDirectory() as tmp:
-        scene = Path(tmp) / f"arc{args.front_ends}.toml"
-        scene.write_text(arc_scene(args.front_ends, args.step_deg, args.targets))
+        scene = Path(tmp) / f"arc{n_fe}.toml"
+        scene.write_text(arc_scene(n_fe, args.step_deg, args.targets))
         cases = {"info": ["info", str(scene)],
                  "run --no-report": ["run", str(scene), "--out", f"{tmp}/a", "--no-report"],
                  "run": ["run", str(scene), "--out", f"{tmp}/b"],
@@ -90,7 +124,8 @@ def main(argv=None) -> int:
                 if "--out" in cmd:  # a new folder each time (the last run's stays)
                     shutil.rmtree(cmd[cmd.index("--out") + 1], ignore_errors=True)
                 runs.append(timed(cmd))
-                print(f"{name}: {runs[-1]['wall_s']:.1f} s wall, {runs[-1]['user_s']:.1f} s "
+                print(f"{n_fe} front ends, {name}: {runs[-1]['wall_s']:.1f} s wall, "
+                      f"{runs[-1]['user_s']:.1f} s "
                       f"user (load {runs[-1]['load_before']:.1f})", flush=True)
             rows[name] = {"median_wall_s": statistics.median(x["wall_s"] for x in runs),
                           "median_user_s": statistics.median(x["user_s"] for x in runs),
@@ -101,10 +136,9 @@ def main(argv=None) -> int:
                 **{f"max_abs_{k}": max(abs(e[k]) for e in errs)
                    for k in ("range_m", "velocity_mps", "angle_deg")}}
     print(accuracy)
-    write_json(args.out, {"front_ends": args.front_ends, "step_deg": args.step_deg,
-                          "targets": args.targets, "repeat": args.repeat, "cpus": os.cpu_count(),
-                          "commands": rows, "accuracy": accuracy}, newline=True)
-    return 0
+    return {"front_ends": n_fe, "step_deg": args.step_deg, "targets": args.targets,
+            "repeat": args.repeat, "cpus": os.cpu_count(), "commands": rows,
+            "accuracy": accuracy}
 
 
 if __name__ == "__main__":

@@ -27,8 +27,8 @@ from contextlib import contextmanager
 from typing import Callable, Sequence
 from ..errors import ClusterError
 
-__all__ = ["chunk_mapper", "available_cores", "ForkPool", "fork_map", "map_chunks", "dask_client", "ClusterError",
-           "check_address", "retain_freed_memory"]
+__all__ = ["chunk_mapper", "available_cores", "ForkPool", "fork_map", "fork_call", "Forked",
+           "map_chunks", "dask_client", "ClusterError", "check_address", "retain_freed_memory"]
 
 _ADDRESS = re.compile(r"(?:(tcp|tls|ws|wss|ucx|inproc)://)?(\[[0-9a-fA-F:]+\]|[A-Za-z0-9_.-]+)"
                       r"(?::(\d{1,5}))?")
@@ -240,6 +240,69 @@ def fork_map(func: Callable, chunks: Sequence, workers: int = 2,
     chunks = list(chunks)
     with ForkPool(min(int(workers), max(len(chunks), 1))) as pool:
         return pool.map(func, chunks, progress)
+
+
+class Forked:
+    """``func(*args)`` computed beside this process (:func:`fork_call`): :meth:`result`
+    waits for it and returns its value or raises its exception."""
+
+    def __init__(self, func: Callable, args: tuple, forked: bool):
+        self._func, self._args, self._proc, self._conn = func, args, None, None
+        if forked:
+            import signal
+            ctx = multiprocessing.get_context("fork")
+            self._conn, child = ctx.Pipe(duplex=False)
+            # SIGINT and SIGTERM held while forking (delivered right after): a handler that
+            # raises (the CLI's) inside the fork's own handlers printed a traceback
+            held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+            try:  # fork: the function and its arguments are inherited, not pickled
+                self._proc = ctx.Process(target=_forked_call, args=(func, args, child, held),
+                                         daemon=True)
+                self._proc.start()
+            finally:
+                signal.pthread_sigmask(signal.SIG_SETMASK, held)
+            child.close()
+
+    def result(self):
+        """The value of ``func(*args)`` (computed here where no process was forked)."""
+        if self._proc is None:
+            return self._func(*self._args)
+        try:
+            ok, value = self._conn.recv()
+        except EOFError:  # the process died without an answer (killed, out of memory)
+            ok, value = False, RuntimeError(
+                f"the process computing {getattr(self._func, '__name__', 'it')} ended with "
+                f"exit code {self._proc.exitcode}")
+        finally:
+            self._conn.close()
+            self._proc.join()
+        if not ok:
+            raise value
+        return value
+
+
+def fork_call(func: Callable, *args) -> Forked:
+    """Start ``func(*args)`` in a process forked now, where this one may run on more than one
+    core and can fork; :meth:`Forked.result` collects it (else it is computed there, in this
+    process). For work independent of what this process does meanwhile: the run's 3D view,
+    rendered while the run simulates (its imports and the render: ~1.5 s of a main job's
+    4 s on a 2-core machine). The value and any exception are pickled back."""
+    return Forked(func, args, available_cores() > 1 and _can_fork())
+
+
+def _forked_call(func: Callable, args: tuple, conn, mask) -> None:
+    import signal
+    _fork_worker_init()  # (SIGTERM to its default, SIGINT ignored) before they are let in
+    signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+    try:
+        out = (True, func(*args))
+    except Exception as exc:  # handed to the parent, which raises it
+        out = (False, exc)
+    try:
+        conn.send(out)
+    except Exception as exc:  # an unpicklable value or exception: said in one
+        conn.send((False, RuntimeError(f"{type(exc).__name__}: {exc}")))
+    conn.close()
 
 
 def _fork_worker_init() -> None:

@@ -13,13 +13,16 @@ the report.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
+from .._lib.parallel import available_cores, local_map
 from .._lib.results import Result
+from .._lib.util import tell
 from ..calibration.file import setup_fingerprint
 from ..calibration.fir import fir_effect
 from ..calibration.pair import calibrate_pair
@@ -30,6 +33,7 @@ from ..geometry import build_setup
 from ..paths import exact_paths
 from ..pipeline.plan import uses_cells
 from ..scene import Scene, check_scene_arg
+from ..scene.schema import check_arg
 from .pairs import is_all, study_pairs
 
 __all__ = ["CalibrationStudy", "CalibrationReport", "PROCEDURES", "with_fir"]
@@ -63,7 +67,12 @@ class CalibrationStudy:
         The fractional-delay filter model (default: the scene's ``rts.fractional_delay_filter``,
         checked there).
     steps : callable, optional
-        ``steps(label)`` at the start of each step (measuring, each sweep).
+        ``steps(label)`` at the start of each step (measuring, each sweep); a ``steps``
+        with a ``count(stage, done, total)`` (the CLI's) is told the pairs calibrated.
+    workers : int, optional
+        Pairs calibrated in this many processes, in [1, 1024] (None: the cores this
+        process may use). Each pair is a pure function of the scene (its noise from the
+        scene's seed), so the report is the same for any number.
 
     Raises
     ------
@@ -82,8 +91,12 @@ class CalibrationStudy:
     full_chain: bool = False
     fir: str | None = None
     steps: Callable[[str], None] | None = field(default=None, compare=False, repr=False)
+    workers: int | None = None
 
     def __post_init__(self):
+        if self.workers is not None:
+            check_arg(self.workers, "workers", "int", "CalibrationStudy", ParameterError,
+                      lo=1, hi=1024)
         if self.procedure not in PROCEDURES:
             raise ParameterError(f"CalibrationStudy: procedure = {self.procedure!r}: must be "
                                  f"one of {', '.join(PROCEDURES)}")
@@ -107,20 +120,34 @@ class CalibrationStudy:
         if self.procedure == "paper" and uses_cells(scene):
             raise ParameterError("procedure paper: the paper's sweep is a pair on an arc (one "
                                  "set angle in azimuth); this scene's front ends form 2-D cells")
-        cals = []
-        for pair in pairs:
-            self._step(f"sweeping the delay of front end {pair[1]} (pair {pair})" if arc else
-                       f"sweeping the delay of front end {pair[1]} on the simulated radar "
-                       f"({self.procedure} procedure)")
-            cals.append(calibrate_pair_paper(setup, paths, pair, probe, seed=scene.seed)
-                        if self.procedure == "paper" else
-                        calibrate_pair(setup, paths, pair, probe, seed=scene.seed,
-                                       full_chain=self.full_chain))
+        one = functools.partial(_calibrate_one, setup, paths, probe, scene.seed,
+                                self.procedure, self.full_chain)
+        workers = available_cores() if self.workers is None else self.workers
+        if len(pairs) > 1 and workers > 1:  # side by side: the same calibrations
+            self._step(f"sweeping the delay of front end J of each of {len(pairs)} pairs "
+                       f"({min(workers, len(pairs))} processes)")
+            cals = local_map(one, pairs, workers, progress=lambda done, total: tell(
+                self.steps, None, "pairs calibrated", done, total))
+        else:
+            cals = []
+            for pair in pairs:
+                self._step(f"sweeping the delay of front end {pair[1]} (pair {pair})" if arc
+                           else f"sweeping the delay of front end {pair[1]} on the simulated "
+                                f"radar ({self.procedure} procedure)")
+                cals.append(one(pair))
         fir = None if arc else fir_effect(setup, cals[0].delta_tau_s,
                                           ranges=cals[0].probe_ranges_m)
         return CalibrationReport(tuple(pairs), tuple(cals), probe, self.procedure,
                                  setup_fingerprint(scene), arc, uses_cells(scene), fir,
                                  scene.name)
+
+
+def _calibrate_one(setup, paths, probe, seed, procedure, full_chain, pair):
+    """One pair's calibration: a pure function of its arguments (its noise from ``seed``),
+    so that pairs may be calibrated in any process and order with the same result."""
+    if procedure == "paper":
+        return calibrate_pair_paper(setup, paths, pair, probe, seed=seed)
+    return calibrate_pair(setup, paths, pair, probe, seed=seed, full_chain=full_chain)
 
 
 @dataclass(frozen=True, repr=False)

@@ -22,6 +22,7 @@ spectra with the variance the windowed range and Doppler DFTs give it.
 from __future__ import annotations
 
 import copy
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -90,12 +91,29 @@ class SweepResult:
         return np.where(np.isfinite(self.amplitudes).all(-1), err, np.nan)
 
 
+#: the last few probes' models (:func:`_models`): the sweep's reference measures the delays
+#: the sweep measured, on the same nominal models (``phasor_sweep``'s ``j_phase_rad``)
+_MODELS: list = []
+_MODELS_KEPT = 8
+
+
 def _models(setup, paths, pair, targets, base_offsets, deltas):
-    """One model per probe: channel I, then J at every step's delay."""
+    """One model per probe: channel I, then J at every step's delay (the same ones again
+    where the last few calls asked for them: same setup and paths objects, pair, probes,
+    offsets and delays)."""
     i, j = pair
+    deltas = np.asarray(deltas, float)
+    key = (tuple(int(q) for q in pair), tuple(targets),
+           tuple(float(b) for b in base_offsets), deltas.tobytes())
+    for s, p, k, models in _MODELS:
+        if s is setup and p is paths and k == key:
+            return models
     ch = [i] + [j] * len(deltas)
-    dt = np.concatenate([[base_offsets[0]], base_offsets[1] + np.asarray(deltas, float)])
-    return [ChannelModel.build(setup, paths, ch, t, dt, HALF_BINS) for t in targets]
+    dt = np.concatenate([[base_offsets[0]], base_offsets[1] + deltas])
+    models = [ChannelModel.build(setup, paths, ch, t, dt, HALF_BINS) for t in targets]
+    _MODELS.insert(0, (setup, paths, key, models))
+    del _MODELS[_MODELS_KEPT:]
+    return models
 
 
 def _range_bin(scene, range_m: float) -> int:
@@ -138,18 +156,32 @@ def _linked_noise_sigma(setup, targets, amps) -> np.ndarray:
 
 def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair, targets,
                  alphas, deltas, base_offsets=(0.0, 0.0), gain_correction=(1.0, 1.0),
-                 bins=None) -> SweepResult:
+                 bins=None, j_phase_rad: float | None = None, noise: bool = True
+                 ) -> SweepResult:
     """The calibration sweep's spectra at every delay ``deltas`` (S,) of channel J, on the
     setup as built (``setup``, ``paths``), with amplitudes designed on the ``nominal`` setup
     for the bin the RuT detects (fixed point, see the module); ``bins`` (S, P) forces the
     design bins (the full chain passes the bins its detection reported). Noise and angles:
-    :meth:`SweepResult.errors`."""
+    :meth:`SweepResult.errors`.
+
+    ``j_phase_rad``: ``setup`` is the nominal setup with channel J's hardware phase set to
+    this (the sweep's reference, ``steps.reference_setup``): its models are the nominal
+    ones with J's responses turned by ``e^{-j phase}`` (the beat carries the conjugate of
+    the channel's gain, ``rts.channels.channel_echoes``; the chain is linear in it), not
+    built a second time. ``noise=False``: no noise level (``noise_sigma`` zeros; the probe
+    placement reads only the designs' bins and margins)."""
     deltas = np.atleast_1d(np.asarray(deltas, float))
     n_s, n_p = deltas.size, len(targets)
     nom_models = _models(*nominal, pair, targets, base_offsets, deltas)
     # no mounting errors (nominal_model returns the same objects): the same models, built once
-    real_models = (nom_models if nominal[0] is setup and nominal[1] is paths
-                   else _models(setup, paths, pair, targets, base_offsets, deltas))
+    if j_phase_rad is not None:
+        turn = np.r_[1.0, np.full(n_s, np.exp(-1j * float(j_phase_rad)))][None, :, None]
+        real_models = [dataclasses.replace(m, responses=m.responses * turn)
+                       for m in nom_models]
+    elif nominal[0] is setup and nominal[1] is paths:
+        real_models = nom_models
+    else:
+        real_models = _models(setup, paths, pair, targets, base_offsets, deltas)
     st = nom_models[0].steering
     radar = setup.scene.radar
     kbin = np.empty((n_s, n_p), int)
@@ -191,7 +223,9 @@ def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair,
         amps[:, p] = np.stack([a_i[k, steps], a_j[k, steps]], -1)
         snaps.append(x[k, steps])  # (S, K_bins, V)
     x = np.stack(snaps, 1)  # (S, P, K_bins, V)
-    if radar.snr_db is not None:
+    if not noise:
+        sigma = np.zeros(n_s)
+    elif radar.snr_db is not None:
         sigma = _noise_sigma(setup, paths, pair, targets, amps, radar.snr_db)
     elif radar.link is not None:  # the link budget's thermal noise (kTBF, RTS, ADC)
         sigma = _linked_noise_sigma(setup, targets, amps)
@@ -212,7 +246,7 @@ def place_probes(setup, paths, nominal, pair, ranges, alphas, window_s, base_off
     coherence point."""
     def margin(r):
         res = phasor_sweep(setup, paths, nominal, pair, [TargetConfig(float(x)) for x in r],
-                           alphas, window_s, base_offsets, gain_correction)
+                           alphas, window_s, base_offsets, gain_correction, noise=False)
         return np.min(np.where(res.consistent, res.margin, 0.0), axis=0)
     return place_in_bins(setup.scene, ranges, margin, offsets_bins)
 
@@ -275,6 +309,7 @@ class PhasorProbes:
         self.method = "full-chain" if full_chain else "phasor"
         self._rng = np.random.default_rng(np.random.SeedSequence([self.seed % 2 ** 32, 1713]))
         self._last = None  # (deltas, SweepResult) of the last sweep: measured once
+        self._j_phase = None  # the reference's channel J phase over the nominal's (reference)
 
     @property
     def targets(self) -> list[TargetConfig]:
@@ -290,7 +325,7 @@ class PhasorProbes:
         if self._last is None or not np.array_equal(self._last[0], d):
             self._last = (d, phasor_sweep(self.setup, self.paths, self.nominal, self.pair,
                                           self.targets, self.alphas, d, self.base_offsets,
-                                          self.gain_correction))
+                                          self.gain_correction, j_phase_rad=self._j_phase))
         return self._last[1]
 
     def measure(self, deltas, frames: int = 1, repeat: int = 0) -> np.ndarray:
@@ -333,6 +368,10 @@ class PhasorProbes:
         inside its far field)."""
         out = reference_probes(self, phase_rad)
         out.full_chain, out.method = False, "phasor"
+        # the nominal setup but for channel J's phase: its models are the nominal's, turned
+        nominal_phase = self.nominal[0].scene.rts.front_ends[self.pair[1]].phase_offset_rad
+        out._j_phase = (out.setup.scene.rts.front_ends[self.pair[1]].phase_offset_rad
+                        - nominal_phase)
         out._rng = np.random.default_rng(np.random.SeedSequence([self.seed % 2 ** 32, 1713]))
         out._last = None
         return out

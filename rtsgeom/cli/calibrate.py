@@ -11,8 +11,8 @@ from ..analysis.calibration_study import PROCEDURES, CalibrationStudy
 from ..calibration.file import setup_fingerprint
 from ..errors import UsageError
 from ..geometry import build_setup
-from ._common import (flagged, load_scene_checked, output_folder, output_path, pair_of,
-                      pair_options, print_json, steps)
+from ._common import (flagged, load_scene_checked, number, output_folder, output_path,
+                      pair_of, pair_options, print_json, steps)
 
 
 def cmd_calibrate(args) -> int:
@@ -69,7 +69,7 @@ def _from_identified(args) -> dict:
 def study_of(args, step=None) -> CalibrationStudy:
     """The :class:`~rtsgeom.analysis.calibration_study.CalibrationStudy` the flags ask for."""
     pair = "all" if list(args.pair) == ["all"] else tuple(args.pair)
-    return CalibrationStudy(pair, args.procedure, args.full_chain, args.fir, step)
+    return CalibrationStudy(pair, args.procedure, args.full_chain, args.fir, step, args.workers)
 
 
 def _calibrate(args, stage) -> int:
@@ -120,4 +120,7 @@ def register(sub) -> None:
     p.add_argument("--full-chain", action="store_true",
                    help="evaluate every sweep step through the full ADC-cube chain "
                         "instead of the phasor model (validation; about a minute)")
+    p.add_argument("--workers", type=number(1, 1024, integer=True), default=None,
+                   metavar="N", help="--pair all: calibrate the pairs in N processes (the same "
+                                     "result; default: the cores this process may run on)")
     p.set_defaults(func=cmd_calibrate)

@@ -8,7 +8,7 @@ import argparse
 import json
 
 from ..geometry.warnings import scene_warnings
-from ..pipeline.output import MAP_FORMATS, write_run
+from ..pipeline.output import MAP_FORMATS, start_setup_view, write_run
 from ..pipeline.run import run_scene
 from ..scene.objects import target_labels
 from ..scene.registry import ANGLE_ESTIMATORS, AOA_MODES, PATH_METHODS
@@ -31,13 +31,16 @@ def cmd_run(args) -> int:
     scene = _with_estimator(load_scene_checked(args.scene), args)
     out = args.out
     with output_folder(out, [args.scene]) as stage, steps(args.quiet) as step:
+        # the report's 3D view depends on the geometry alone: rendered beside the run
+        view = (start_setup_view(scene) if not args.no_report and args.paths == "exact"
+                else None)
         step(f"simulating {scene.name} ({args.paths} paths, calibration, ADC cube, detection)")
         result = run_scene(scene, args.paths, args.amplitudes, progress=step,
                            **calibration_kw(args))
         step("writing detections, summary, maps" + ("" if args.no_report else
                                                       " and report.html (3D view, figures)"))
         write_run(result, stage, args.paths, args.maps, not args.no_report,
-                  scene_warnings(scene))
+                  scene_warnings(scene), view)
         objects_lines = []
         if scene.objects:  # extended objects: what the radar sees of them, truth and RTS
             from ..analysis.objects import objects_lines as lines_of, run_objects

@@ -6,6 +6,7 @@ range-angle maps (PNG, and as arrays in ``maps.npz|mat|nc``) and the self-contai
 from __future__ import annotations
 
 import csv
+import functools
 import io
 import json
 import tempfile
@@ -14,13 +15,17 @@ from pathlib import Path
 import numpy as np
 
 from .._lib.io import write_bytes, write_json, write_text
-from ..paths import compute_paths
+from .._lib.parallel import Forked, fork_call, local_map
+from ..geometry import build_setup
+from ..paths import compute_paths, exact_paths
+from ..radar.processing import range_angle_map
 from .info import scene_info
 from .run import RunResult, label_detections, summary
 
-__all__ = ["detections_csv", "figure_png", "map_dataset", "maps_arrays", "MAP_FORMATS",
+__all__ = ["detections_csv", "figure_png", "map_arrays", "map_dataset", "maps_arrays",
+           "MAP_FORMATS", "MAP_UNITS",
            "render_maps", "write_maps", "targets_table", "run_report_html",
-           "write_run"]
+           "start_setup_view", "write_run"]
 
 
 def detections_csv(result: RunResult) -> str:
@@ -56,40 +61,72 @@ def figure_png(fig) -> bytes:
     return buf.getvalue()
 
 
-def map_dataset(result: RunResult):
+#: the maps' arrays (:func:`map_arrays`) in their order, with units
+MAP_UNITS = {"range_m": "m", "velocity_mps": "m/s", "doppler_hz": "Hz", "angle_deg": "deg",
+             "range_doppler_db": "dB", "range_angle_db": "dB"}
+
+
+def map_arrays(result: RunResult) -> dict[str, np.ndarray]:
+    """The two maps of a run as plain arrays in dB, in the order of :data:`MAP_UNITS`: the
+    axes ``range_m``, ``velocity_mps``, ``doppler_hz`` (of the Doppler axis), ``angle_deg``
+    (-60..60 deg in 0.25 deg steps), ``range_doppler_db`` (range, velocity) and
+    ``range_angle_db`` (range, angle; each range bin at its strongest Doppler bin). What the
+    PNGs and ``maps.npz|mat`` are drawn from, without xarray (its import with pandas was a
+    tenth of the main job); :func:`map_dataset` is the same as an ``xarray.Dataset``."""
+    rd = result.rd
+    angle = np.arange(-60.0, 60.0 + 1e-9, 0.25)  # as RangeDoppler.range_angle_to_xarray
+    return {"range_m": rd.range_m, "velocity_mps": rd.velocity_mps,
+            "doppler_hz": rd.doppler_hz, "angle_deg": angle,
+            "range_doppler_db": _to_db(rd.power),
+            "range_angle_db": _to_db(range_angle_map(rd, result.cube, np.radians(angle)))}
+
+
+def _to_db(power):  # as RangeDoppler.power_db
+    return 10 * np.log10(np.maximum(power, 1e-30))
+
+
+def map_dataset(result: RunResult, arrays: dict | None = None):
     """The two maps of a run as one ``xarray.Dataset``, in dB: ``range_doppler_db`` (dims
     ``range_m``, ``velocity_mps``; ``doppler_hz`` a second coordinate on the Doppler axis) and
-    ``range_angle_db`` (dims ``range_m``, ``angle_deg``, -60..60 deg in 0.25 deg steps), from
-    :meth:`RangeDoppler.to_xarray <rtsgeom.radar.processing.RangeDoppler.to_xarray>` and
-    :meth:`~rtsgeom.radar.processing.RangeDoppler.range_angle_to_xarray`. Every variable and
-    coordinate carries ``units``. The PNGs and ``maps.npz|mat|nc`` are drawn from this."""
+    ``range_angle_db`` (dims ``range_m``, ``angle_deg``, -60..60 deg in 0.25 deg steps), the
+    arrays of :func:`map_arrays` (``arrays``: those, computed when not given). Every variable
+    and coordinate carries ``units``; ``maps.nc`` is written from this."""
     import xarray as xr
-    rd = result.rd
-
-    def to_db(da):  # as RangeDoppler.power_db
-        return 10 * np.log10(np.maximum(da, 1e-30))
-    rdm = to_db(rd.to_xarray()).assign_attrs(
-        units="dB", long_name="range-Doppler power, sum over virtual channels of |X|^2")
-    ram = to_db(rd.range_angle_to_xarray(result.cube)).assign_attrs(
-        units="dB", long_name="beamformer power, each range bin at its strongest Doppler bin")
+    a = map_arrays(result) if arrays is None else arrays
+    rdm = xr.DataArray(a["range_doppler_db"], dims=("range_m", "velocity_mps"),
+                       coords={"range_m": a["range_m"], "velocity_mps": a["velocity_mps"],
+                               "doppler_hz": ("velocity_mps", a["doppler_hz"])},
+                       attrs={"units": "dB", "long_name": "range-Doppler power, sum over "
+                                                         "virtual channels of |X|^2"})
+    ram = xr.DataArray(a["range_angle_db"], dims=("range_m", "angle_deg"),
+                       coords={"range_m": a["range_m"], "angle_deg": a["angle_deg"]},
+                       attrs={"units": "dB", "long_name": "beamformer power, each range bin "
+                                                         "at its strongest Doppler bin"})
     ds = xr.Dataset({"range_doppler_db": rdm, "range_angle_db": ram},
                     attrs={"scene": result.scene.name, "source": "rtsgeom run"})
-    for name, unit in (("range_m", "m"), ("velocity_mps", "m/s"), ("doppler_hz", "Hz"),
-                       ("angle_deg", "deg")):
-        ds[name].attrs["units"] = unit
+    for name in ("range_m", "velocity_mps", "doppler_hz", "angle_deg"):
+        ds[name].attrs["units"] = MAP_UNITS[name]
     return ds
+
+
+def _plain(maps) -> dict[str, np.ndarray]:
+    """:func:`map_arrays`' dict of a :func:`map_dataset` (or that dict itself)."""
+    if isinstance(maps, dict):
+        return maps
+    return {k: np.asarray(maps[k].values) for k in MAP_UNITS}
 
 
 MAP_FORMATS = ("npz", "mat", "nc")  # what ``run --maps`` may write; npz by default
 
 
 def maps_arrays(ds, formats=MAP_FORMATS) -> dict[str, bytes]:
-    """:func:`map_dataset` as ``maps.npz`` (numpy), ``maps.mat`` (MATLAB: the same variable
-    names, axes as column vectors, a ``units`` struct) and ``maps.nc`` (NetCDF-3 via xarray's
-    scipy engine), as bytes by file name: those of ``formats`` only (each costs its writing
-    time; all three were 2.1 s of a 4.8 s run)."""
-    arrays = {k: np.asarray(v.values) for k, v in {**ds.coords, **ds.data_vars}.items()}
-    units = {k: (ds[k].attrs["units"]) for k in arrays}
+    """:func:`map_dataset` (or :func:`map_arrays`) as ``maps.npz`` (numpy), ``maps.mat``
+    (MATLAB: the same variable names, axes as column vectors, a ``units`` struct) and
+    ``maps.nc`` (NetCDF-3 via xarray's scipy engine: ``ds`` a dataset), as bytes by file
+    name: those of ``formats`` only (each costs its writing time; all three were 2.1 s of a
+    4.8 s run)."""
+    arrays = _plain(ds)
+    units = {k: MAP_UNITS[k] for k in arrays}
     out = {}
     if "npz" in formats:
         npz = io.BytesIO()
@@ -101,6 +138,8 @@ def maps_arrays(ds, formats=MAP_FORMATS) -> dict[str, bytes]:
         scipy.io.savemat(mat, {**arrays, "units": units}, oned_as="column")
         out["maps.mat"] = _without_timestamp(mat.getvalue())
     if "nc" in formats:
+        if isinstance(ds, dict):
+            raise ValueError("maps_arrays: maps.nc is written from map_dataset's dataset")
         out["maps.nc"] = ds.to_netcdf(engine="scipy")
     return out
 
@@ -117,18 +156,18 @@ def _without_timestamp(mat: bytes) -> bytes:
 
 def render_maps(result: RunResult, ds=None) -> dict[str, bytes]:
     """Range-Doppler and range-angle maps as PNG bytes (paper Figs. "Range-Doppler map ..." and
-    "Range angle detections ..."), by file name; ``ds``: :func:`map_dataset` (computed when
-    not given)."""
+    "Range angle detections ..."), by file name; ``ds``: :func:`map_arrays` or
+    :func:`map_dataset` (computed when not given)."""
     from ..viz.figures import range_angle_figure, range_doppler_figure
-    ds = map_dataset(result) if ds is None else ds
+    a = map_arrays(result) if ds is None else _plain(ds)
     rd, det, scene = result.rd, result.detections, result.scene
-    f1 = range_doppler_figure(ds.range_doppler_db.values, rd.range_m, rd.velocity_mps,
+    f1 = range_doppler_figure(a["range_doppler_db"], rd.range_m, rd.velocity_mps,
                               detections=np.c_[det.range_m, det.velocity_mps],
                               title=f"{scene.name}: range-Doppler map"
                               + (f" (ADC CLIPPED: {result.cube.clipped} samples)"
                                  if result.cube.clipped else ""))
     sets = np.array([[t.range_m, np.degrees(t.angle_rad)] for t in scene.targets]).reshape(-1, 2)
-    f2 = range_angle_figure(ds.range_angle_db.values, rd.range_m, ds.angle_deg.values,
+    f2 = range_angle_figure(a["range_angle_db"], rd.range_m, a["angle_deg"],
                             detections=np.c_[det.range_m, det.angle_deg], set_points=sets,
                             title=f"{scene.name}: range-angle map")
     return {"range_doppler.png": figure_png(f1), "range_angle.png": figure_png(f2)}
@@ -144,34 +183,54 @@ def write_maps(result: RunResult, out: Path) -> list[Path]:
 
 
 def _calibration_figures(result: RunResult) -> list[bytes]:
+    """The calibration sweep of each pair as PNG bytes, in the pairs' order; the pairs'
+    figures side by side in forked processes where there are several (each ~0.15 s: 32
+    pairs of a 64-front-end arc took 5 s of its report), the same bytes."""
+    pairs = result.calibration.get("pairs", [])
+    one = functools.partial(_calibration_png, result.scene.name)
+    return local_map(one, pairs, None if len(pairs) > 1 else 1, before_fork=_import_figures)
+
+
+def _import_figures() -> None:
+    """matplotlib and the figures module imported before forking (the workers inherit them)."""
+    from ..viz import figures  # noqa: F401
+
+
+def _calibration_png(scene_name: str, cal: dict) -> bytes:
+    """One pair's calibration sweep (a calibration record's ``to_dict``) as PNG bytes."""
     from ..viz.figures import calibration_sweep_figure
-    out = []
-    for cal in result.calibration.get("pairs", []):
-        t = np.array([p["delta_tau_s"] for p in cal["sweep"]])
-        e = np.array([np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
-                      for p in cal["sweep"]])
-        rf = cal.get("refinement", [])
-        fig = calibration_sweep_figure(
-            t, e, cal["delta_tau_s"], cal["period_s"],
-            residual_error_deg=cal.get("residual_error_deg"),
-            refine_delta_tau_s=[p["delta_tau_s"] for p in rf],
-            refine_error_deg=[np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
-                              for p in rf],
-            title=f"{result.scene.name}: phase coherency calibration, front ends "
-                  f"{cal['pair'][0]}-{cal['pair'][1]}")
-        out.append(figure_png(fig))
-    return out
+    t = np.array([p["delta_tau_s"] for p in cal["sweep"]])
+    e = np.array([np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
+                  for p in cal["sweep"]])
+    rf = cal.get("refinement", [])
+    fig = calibration_sweep_figure(
+        t, e, cal["delta_tau_s"], cal["period_s"],
+        residual_error_deg=cal.get("residual_error_deg"),
+        refine_delta_tau_s=[p["delta_tau_s"] for p in rf],
+        refine_error_deg=[np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
+                          for p in rf],
+        title=f"{scene_name}: phase coherency calibration, front ends "
+              f"{cal['pair'][0]}-{cal['pair'][1]}")
+    return figure_png(fig)
 
 
-def _setup_png(result: RunResult, paths_method: str) -> bytes:
+def _setup_png(setup, paths, paths_method: str) -> bytes:
+    """The report's 3D view of ``setup`` with its ``paths`` as PNG bytes."""
     from ..viz.scene3d import render_setup_png
-    paths = result.paths
     if paths_method != "exact":  # the view draws reflections through their hit points,
         # which the table alone does not carry
-        paths = compute_paths(result.setup, paths_method, for_drawing=True)
+        paths = compute_paths(setup, paths_method, for_drawing=True)
     with tempfile.TemporaryDirectory(prefix="rtsgeom-3d-") as tmp:  # private to this run
-        return render_setup_png(result.setup, Path(tmp) / "setup.png",
-                                paths=paths).read_bytes()
+        return render_setup_png(setup, Path(tmp) / "setup.png", paths=paths).read_bytes()
+
+
+def start_setup_view(scene) -> Forked:
+    """The report's 3D view of ``scene``'s setup with its exact paths, rendered in a process
+    forked now (``_lib.parallel.fork_call``) while the run simulates: it depends on the
+    geometry alone, and its imports (pyvista, VTK) and render took ~1.5 s of the main job's
+    4 s on a 2-core machine. Pass it to :func:`write_run` (``setup_view``)."""
+    setup = build_setup(scene)
+    return fork_call(_setup_png, setup, exact_paths(setup), "exact")
 
 
 def targets_table(matches: list[dict]) -> dict:
@@ -196,15 +255,18 @@ def targets_table(matches: list[dict]) -> dict:
 
 
 def run_report_html(result: RunResult, maps: dict[str, bytes], paths_method: str,
-                    warnings: list[str]) -> str:
+                    warnings: list[str], setup_view: Forked | None = None) -> str:
     """``report.html`` of a run: scene summary, 3D view, figures, detections vs set-points,
     calibration, warnings; self-contained. Every image is bytes this run produced (``maps``
-    from :func:`render_maps`), never a file read back from the output folder."""
+    from :func:`render_maps`; the 3D view from ``setup_view``, :func:`start_setup_view`, where
+    given for exact paths, else rendered here), never a file read back from the output
+    folder."""
     from ..viz.report import render_report
     sections = []
     images = []
     try:
-        images.append(_setup_png(result, paths_method))
+        images.append(setup_view.result() if setup_view is not None and paths_method == "exact"
+                      else _setup_png(result.setup, result.paths, paths_method))
     except (ImportError, RuntimeError) as exc:  # no pyvista, no off-screen OpenGL (VizError),
         # no ray tracing for the drawn paths (RaytraceUnavailable): the report has the rest
         warnings = warnings + [f"3D view not rendered: {exc}"]
@@ -242,7 +304,8 @@ def run_report_html(result: RunResult, maps: dict[str, bytes], paths_method: str
 
 
 def write_run(result: RunResult, folder: str | Path, paths_method: str = "exact",
-              maps=("npz",), report: bool = True, warnings=()) -> list[str]:
+              maps=("npz",), report: bool = True, warnings=(),
+              setup_view: Forked | None = None) -> list[str]:
     """The output folder of ``rtsgeom run`` for ``result``.
 
     Parameters
@@ -258,6 +321,8 @@ def write_run(result: RunResult, folder: str | Path, paths_method: str = "exact"
         Also write report.html (3D view, figures).
     warnings : sequence of str
         The scene's warnings for the report (the run's own are added).
+    setup_view : Forked, optional
+        The report's 3D view started before the run (:func:`start_setup_view`).
 
     Returns
     -------
@@ -268,15 +333,16 @@ def write_run(result: RunResult, folder: str | Path, paths_method: str = "exact"
     folder = Path(folder)
     write_text(folder / "detections.csv", detections_csv(result))
     write_json(folder / "summary.json", summary(result, paths_method))
-    ds = map_dataset(result)
-    pngs = render_maps(result, ds)
-    files = {**pngs, **maps_arrays(ds, tuple(maps))}
+    arrays = map_arrays(result)
+    pngs = render_maps(result, arrays)
+    files = {**pngs, **maps_arrays(map_dataset(result, arrays) if "nc" in maps else arrays,
+                                   tuple(maps))}
     for name, data in files.items():
         write_bytes(folder / name, data)
     names = ["detections.csv", "summary.json", *files]
     if report:
         write_text(folder / "report.html",
                    run_report_html(result, pngs, paths_method,
-                                   list(warnings) + list(result.warnings)))
+                                   list(warnings) + list(result.warnings), setup_view))
         names.append("report.html")
     return names

@@ -292,6 +292,24 @@ def nominal_link_gain(scene: Scene, wavelength_m: float) -> float:
 # ------------------------------------------------------------------------------------------
 
 
+#: the last few path tables' legs (:func:`_leg_tables`): (paths, n_fe, n_tx, n_rx, tables)
+_LEGS: list = []
+_LEGS_KEPT = 4
+
+
+def _leg_tables(paths: Paths, n_fe: int, n_tx: int, n_rx: int):
+    """Both legs' padded tables (:func:`_leg_table`) of ``paths``, made once per table object
+    (the last few kept): each channel-model build of a calibration read them again, a pass
+    over every front end's paths per call (its cost grew with the arc's front ends)."""
+    for p, *key, tables in _LEGS:
+        if p is paths and key == [n_fe, n_tx, n_rx]:
+            return tables
+    tables = (_leg_table(paths, TX_TO_FE, n_fe, n_tx), _leg_table(paths, FE_TO_RX, n_fe, n_rx))
+    _LEGS.insert(0, (paths, n_fe, n_tx, n_rx, tables))
+    del _LEGS[_LEGS_KEPT:]
+    return tables
+
+
 def _leg_table(paths: Paths, direction: int, n_fe: int, n_el: int):
     """Rows of one direction as padded arrays (F, n_el, P): delay and gain (0 where absent)."""
     sel = paths.direction == direction
@@ -326,8 +344,8 @@ def channel_echoes(setup: Setup, paths: Paths, program: RtsProgram) -> Echoes:
     v = rut.num_virtual
     if k == 0:
         return _empty(v)
-    d_a, g_a = _leg_table(paths, TX_TO_FE, n_fe, rut.tx_world.shape[0])
-    d_b, g_b = _leg_table(paths, FE_TO_RX, n_fe, rut.rx_world.shape[0])
+    (d_a, g_a), (d_b, g_b) = _leg_tables(paths, n_fe, rut.tx_world.shape[0],
+                                         rut.rx_world.shape[0])
     q = program.front_end
     # (K, V, Pa) and (K, V, Pb) -> (K, Pa, Pb, V)
     da, ga = d_a[q][:, rut.virtual_tx], g_a[q][:, rut.virtual_tx]
@@ -339,7 +357,10 @@ def channel_echoes(setup: Setup, paths: Paths, program: RtsProgram) -> Echoes:
     gain = gain.transpose(0, 2, 3, 1).reshape(k * pa * pb, v)
 
     fes = scene.rts.front_ends
-    hw = np.array([10 ** (f.gain_offset_db / 20) * np.exp(1j * f.phase_offset_rad) for f in fes])
+    used = np.unique(q)  # the programmed front ends' hardware gains (not every one's)
+    hw = np.zeros(n_fe, complex)
+    hw[used] = [10 ** (fes[u].gain_offset_db / 20) * np.exp(1j * fes[u].phase_offset_rad)
+                for u in used]
     tau_rts = realised_delay(program.delay_s, scene.rts.f_s_hz, scene.rts.fractional_delay,
                              scene.rts.fractional_delay_step_s)
     rep = pa * pb
@@ -372,7 +393,8 @@ def cable_ghosts(scene: Scene, direct: Echoes, min_level_db: float = -80.0) -> E
     their level drops below ``min_level_db`` relative to the direct echo.
     """
     parts = []
-    for q, fe in enumerate(scene.rts.front_ends):
+    for q in np.unique(direct.front_end[direct.front_end >= 0]):  # those with echoes, in order
+        fe = scene.rts.front_ends[q]
         if fe.return_loss_fe_db is None or fe.return_loss_be_db is None:
             continue
         sel = (direct.front_end == q) & (direct.kind == KIND_DIRECT)
