@@ -229,10 +229,16 @@ def test_bad_meshes_one_clear_line(tmp_path):
 
 
 def test_mesh_object_scatterers_face_the_radar(tmp_path):
-    """The bundled car mesh 15 m ahead: its scatterers lie on the side facing the RuT (nearer
-    than the origin but for the far corners) and within the object's extent."""
+    """The bundled car mesh 15 m ahead: nose on, its flat front is one mirror-like scatterer
+    (its 1.1 m lie within one resolution cell) 2.25 m before the origin; turned 30 deg, its
+    scatterers lie on the side facing the RuT (nearer than the origin but for the far corners)
+    and within the object's extent."""
     shutil.copy(SCENES / "car.ply", tmp_path / "car.ply")
     s = parse_scene(with_object(bench_doc(), mesh="car.ply"), "m.toml", base_dir=tmp_path)
+    r = np.array([t.range_m for t in s.targets])
+    assert len(r) == 1 and abs(r[0] - (15.0 - 4.5 / 2)) < 0.02
+    s = parse_scene(with_object(bench_doc(), mesh="car.ply", heading_deg=30.0), "m.toml",
+                    base_dir=tmp_path)
     r = np.array([t.range_m for t in s.targets])
     assert 3 <= len(r) <= 32 and np.all(np.abs(r - 15.0) <= 2.5)
     assert np.median(r) < 15.0  # the near half of the car returns most

@@ -42,8 +42,8 @@ class PlaybackResult(Result):
         The scene played.
     mode : str
         The amplitude mode.
-    time_s : ndarray, (frames,)
-        Each frame's time.
+    time_s : ndarray
+        (frames,): each frame's time.
     set, detected : dict
         ``range_m``, ``azimuth_deg``, ``velocity_mps`` arrays (frames, targets); detected NaN
         where the target was lost.
@@ -73,8 +73,8 @@ class PlaybackResult(Result):
         (frames, targets): each target's role under that budget (:data:`BUDGET_ROLES`; None
         without one): a ``lead``'s detection and truth are the merged target's and the truth
         twin's detection of its cell, a ``merged`` or ``dropped`` target has neither.
-    object_of : ndarray, (targets,)
-        The extended object each target belongs to (-1: a point target).
+    object_of : ndarray or None
+        (targets,): the extended object each target belongs to (-1: a point target).
     """
 
     scene: Scene
