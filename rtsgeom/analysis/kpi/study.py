@@ -27,6 +27,7 @@ from ..tolerance import MAX_SIGMA_MM
 from ..tolerance.args import STUDY_ARGS
 from ..transfer import ideal_radar, set_angles
 from .accuracy import AccuracyInputs, AnglePoint, effective_snr, pair_accuracy
+from .headline import headline
 from .sections import (field_of_view, ghosts_section, nearfield_section, range_velocity,
                        resolution_section, targets_section, uncovered_deg)
 from .spec import KpiSpec, SpecCheck, check_spec
@@ -329,14 +330,7 @@ class Datasheet(Result):
         }
 
     def _summary(self):
-        rv = self.range_velocity
-        rows = [("azimuth_deg", "{:.2f} .. {:.2f}".format(*self.fov["azimuth_deg"])),
-                ("gaps_deg", str(self.fov["gaps_deg"]) if self.fov["gaps_deg"] else "none"),
-                ("worst |error| + U (deg)", self.worst_accuracy_deg()),
-                ("range_m", f"{rv['min_range_m']:.3g} .. {rv['max_range_m']:.4g}"),
-                ("max |velocity| (m/s)", rv["max_velocity_mps"]),
-                ("targets (total)", self.targets["total"]),
-                ("ghost suppression (dB)", self.ghosts["ghost_suppression_db"])]
+        rows = headline(self.to_dict())
         rows += [(f"spec {c.kpi}", "no value" if c.passed is None else
                   f"{'pass' if c.passed else 'FAIL'} (margin {c.margin:.4g})")
                  for c in self.checks]
