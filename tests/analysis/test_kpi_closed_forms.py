@@ -11,6 +11,8 @@ import math
 import numpy as np
 import pytest
 from conftest import ROOT, make_scene
+from radar.test_budget_synthesized import linked_scene as _linked
+from radar.test_budget_synthesized import scalloping_db as _scalloping_db
 from scipy.constants import c
 
 import rtsgeom
@@ -100,29 +102,6 @@ def test_the_snr_of_snr_db_is_the_ffts_coherent_gain_with_the_window_losses(snr_
 
 # -- the SNR under [radar.link] ----------------------------------------------------------------
 
-def _linked(nf_db=12.0, fs_dbm=-25.0, target_m=None, **radar):
-    """The paper's bench with a physical link and no snr_db; ``target_m``: one target of 10
-    dBsm at that range in front end 0's direction (what ``rtsgeom info`` budgets)."""
-    def mut(d):
-        d["radar"].pop("snr_db", None)
-        d["radar"].update(radar)
-        d["radar"]["link"] = {"noise_figure_db": nf_db, "adc_full_scale_dbm": fs_dbm}
-        if target_m is not None:
-            d["targets"] = [{"range_m": target_m, "velocity_mps": 0.0, "angle_deg": 3.4,
-                             "rcs_dbsm": 10.0}]
-    return make_scene(mut)
-
-
-def _scalloping_db(radar, range_m: float) -> float:
-    """The range window's gain (dB) at the target's fractional bin against the bin centre."""
-    n = radar.samples_per_chirp
-    frac = range_m * 2 * radar.slope_hz_per_s / c * n / radar.adc_rate_hz
-    d = frac - round(frac)
-    w = window(radar.range_window, n)
-    return 20 * math.log10(abs(np.sum(w * np.exp(2j * np.pi * d * np.arange(n) / n)))
-                           / np.sum(w))
-
-
 @pytest.mark.parametrize("nf_db, fs_dbm, radar", [
     (12.0, -25.0, {}), (40.0, -25.0, {}), (15.0, -60.0, {}),  # thermal, thermal, quantisation
     (20.0, -25.0, {"range_window": "none"}), (20.0, -25.0, {"samples_per_chirp": 256})])
@@ -187,7 +166,7 @@ def test_a_linked_scene_without_snr_db_has_the_link_budgets_receiver_noise(linke
     (``radar.frame``), so the budget's noise row is not zero: its SNR at each set angle is the
     link budget's for that set angle's programme (within 0.05 dB), its u = 1 / sqrt(2 SNR),
     and the Monte Carlo widens with it (its interval still U's). Before, the datasheet saw
-    such a scene as noiseless: the row 0, U 0.027 deg at NF 40 dB where it is 0.6 deg."""
+    such a scene as noiseless: the row 0, U 0.010 deg at NF 40 dB where it is 0.56-0.61 deg."""
     for nf, (scene, points, seen) in linked_points.items():
         assert len(seen) == len(points)
         for p, pt in zip(points, seen):
