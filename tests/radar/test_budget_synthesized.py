@@ -54,8 +54,8 @@ def test_a_synthesized_targets_budget_snr_is_its_cells(ratio, off_j_ps):
     link's noise through the same windows, within 0.05 dB once the range window's scalloping
     is counted (the budget counts the bin centre; J's delay offsets of tens of ps, which move
     its tone by a tenth of a bin and turn its windowed DFT's phase, leave 0.1-0.2 dB). Before,
-    the budget summed the channels' echo amplitudes without their beat phases: 0.9 to 1.4 dB
-    high."""
+    the budget summed the channels' echo amplitudes without their beat phases: 0.85 to 1.25
+    dB high."""
     rng_m = float(probe_ranges(build_setup(linked_scene()), 1)[0])
     scene = linked_scene(target_m=rng_m)
     radar = scene.radar
