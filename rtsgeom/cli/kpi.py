@@ -51,32 +51,11 @@ def cmd_kpi(args) -> int:
 
 
 def summary(out: dict) -> str:
-    """The datasheet's headline numbers and the spec's verdicts, with margins."""
-    fov, rv, tg, gh = (out["field_of_view"], out["range_velocity"], out["targets"],
-                       out["ghosts_leakage"])
-    acc = out["angle_accuracy_summary"]
-    gaps = ", ".join(f"{a:.2f}..{b:.2f}" for a, b in fov["gaps_deg"]) or "none"
-    worst = acc["worst_accuracy_deg"]
-    lines = [f"{out['scene']}: datasheet",
-             f"  field of view      {fov['azimuth_deg'][0]:.2f} .. {fov['azimuth_deg'][1]:.2f} "
-             f"deg ({fov['mode']}), gaps: {gaps}"
-             + (", elevation {:.2f} .. {:.2f} deg".format(*fov["elevation_deg"])
-                if fov["cells"] else ""),
-             "  angle accuracy     " + (acc["note"] if worst is None else
-                                        f"|error| + U (k = 2) worst {worst:.4f} deg; "
-                                        f"{acc['gum_validation']}"),
-             f"  range              {rv['min_range_m']:.3f} .. {rv['max_range_m']:.2f} m, "
-             f"resolution {rv['range_resolution_m']:.4f} m, accuracy "
-             + ("- (no targets)" if rv["range_accuracy_m"] is None else
-                f"{rv['range_accuracy_m']:.4g} m on the scene's targets"),
-             f"  velocity           +-{rv['max_velocity_mps']:.3f} m/s, resolution "
-             f"{rv['velocity_resolution_mps']:.4f} m/s, accuracy "
-             + ("-" if rv["velocity_accuracy_mps"] is None else
-                f"{rv['velocity_accuracy_mps']:.4g} m/s"),
-             f"  targets            {tg['per_channel']} per channel, {tg['total']} in total; "
-             + _resolution(tg["resolution"]),
-             f"  ghosts             strongest {gh['ghost_suppression_db']:.1f} dB below its "
-             "target"]
+    """The datasheet's headline (:func:`~rtsgeom.analysis.kpi.headline.headline`) and the
+    spec's verdicts, with margins."""
+    from ..analysis.kpi.headline import headline
+    lines = [f"{out['scene']}: datasheet"]
+    lines += [f"  {name:<18} {value}" for name, value in headline(out)]
     if out["spec"]:
         lines.append("spec: " + ("PASS" if out["passed"] else "FAIL"))
         for c in out["spec"]:
@@ -87,14 +66,6 @@ def summary(out: dict) -> str:
                          f"{_num(c['value'])}, limit {_num(c['limit'])}, margin "
                          f"{_num(c['margin'])}")
     return "\n".join(lines)
-
-
-def _resolution(res: dict) -> str:
-    if res.get("rts_deg") is None:
-        return "minimum separation: - (" + res["note"] + ")"
-    truth = res.get("truth_deg")
-    return (f"minimum separation {res['rts_deg']:g} deg on the RTS, "
-            f"{'-' if truth is None else f'{truth:g}'} deg on real targets")
 
 
 def _num(v) -> str:

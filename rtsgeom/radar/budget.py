@@ -17,6 +17,7 @@ from ..rts.channels import KIND_DIRECT, KIND_SETUP, Echoes, RtsProgram
 from ..paths import exact_paths
 from ..paths.table import Paths, RUT_TO_RUT
 from ..rts.channels import build_echoes, program_nearest, setup_echoes
+from .fmcw import beat_phase0
 from .windows import window
 
 __all__ = ["LinkBudget", "window_snr_loss", "link_budget", "link_warnings", "sheet_paths",
@@ -101,15 +102,19 @@ def _noise(scene, program, link, setup, noise_override_w, modelled: bool,
 
 def _target_rows(scene, raw: Echoes, e: Echoes, h2, f_b, levels) -> list[dict]:
     """One row per target: its direct echoes summed coherently over its channels per virtual
-    channel, power averaged over the virtual channels (None where it has no direct echo)."""
+    channel (each with its beat's constant phase, :func:`rtsgeom.radar.fmcw.beat_phase0`, as
+    the range-Doppler cell adds them: a synthesized target's channels reach the RuT over
+    different air paths), power averaged over the virtual channels (None where it has no
+    direct echo)."""
     targets = []
+    phase = np.exp(1j * beat_phase0(e, scene.radar)) if len(e) else None
     for i, t in enumerate(scene.targets):
         sel = (raw.target == i) & (raw.kind == KIND_DIRECT)
         if not np.any(sel):
             targets.append({"index": i, "adc_power_dbm": None, "snr_after_fft_db": None,
                             "clip_margin_db": None})
             continue
-        amp = e.amplitude[sel].sum(axis=0)
+        amp = (e.amplitude[sel] * phase[sel]).sum(axis=0)
         hh = float(np.mean(h2[sel]))
         ent = _entry(float(np.mean(np.abs(amp) ** 2)) / hh, hh, *levels)
         targets.append({"index": i, "range_m": t.range_m, "rcs_dbsm": t.rcs_dbsm,

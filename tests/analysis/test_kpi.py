@@ -174,6 +174,31 @@ def test_the_json_contract(sheet):
     assert all(f["distance_m"] > f["fraunhofer_distance_m"] for f in fes)
 
 
+def test_every_view_shows_the_one_headline(sheet):
+    """The command's summary, the HTML's and the PDF's key figures and the repr show the rows
+    one function makes (each view once formatted its own, with different names and digits),
+    and the headline names the receiver noise's SNR and where it comes from."""
+    import html
+    from rtsgeom.analysis.kpi.headline import headline
+    from rtsgeom.analysis.kpi.report import _text_page, to_html
+    from rtsgeom.cli.kpi import summary
+    d = sheet.to_dict()
+    rows = headline(d)
+    assert [n for n, _ in rows] == ["field of view", "angle accuracy", "receiver noise", "range",
+                                    "velocity", "targets", "ghosts", "near field"]
+    # the paper's 10 dB per sample after the FFTs: symmetric Hann windows lose 2 (N - 1) / 3 N
+    snr = d["inputs"]["snr_effective_db"]
+    assert snr == pytest.approx(10 + 10 * math.log10(511 * 119 * (2 / 3) ** 2), abs=1e-6)
+    assert f"SNR {snr:.1f} dB at the detection cell (radar.snr_db" in dict(rows)["receiver noise"]
+    cli, page, rep = summary(d), to_html(sheet, figs={}), repr(sheet)
+    pdf = "".join("".join(t.get_text() for t in _text_page(sheet).texts).split())
+    for name, value in rows:
+        assert f"  {name:<18} {value}" in cli, name
+        assert f"<td>{html.escape(name)}</td><td>{html.escape(value)}</td>" in page, name
+        assert "".join(value.split()) in pdf, name
+        assert f"{name} " in rep and value[:30] in rep, name
+
+
 # -- the sensitivity coefficients against the full model -------------------------------------
 
 def _chain_error_deg(scene, pair, alpha, off_j, amps) -> float:

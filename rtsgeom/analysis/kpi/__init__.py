@@ -4,8 +4,9 @@
 :class:`KpiStudy` (:mod:`.study`) called on a scene returns a :class:`Datasheet`: the field of
 view, the angle accuracy over it with its GUM budget validated by a Monte Carlo
 (:mod:`.accuracy`, :mod:`.budget`), range and velocity, targets, ghosts and leakage, the near
-field (:mod:`.sections`), checked against a :class:`KpiSpec` (:mod:`.spec`); :mod:`.report`
-writes its HTML page and PDF.
+field (:mod:`.sections`), checked against a :class:`KpiSpec` (:mod:`.spec`);
+:func:`.headline.headline` makes its key KPIs for every view; :mod:`.report` writes its HTML
+page and PDF.
 """
 
 from .budget import BudgetRow

@@ -25,10 +25,14 @@ The inputs of the budget, per set angle of pair (I, J):
 * each RuT antenna's phase error (``sigma_phase_rad``: radars of the type about the scene's
   own, ``[radar.channels]``): the coefficients from the phasor model with that antenna's phase
   moved, the Monte Carlo's draws ``analysis.transfer.draw_channel_gains``;
-* receiver noise at the scene's SNR (``radar.snr_db``, per sample, after the range and Doppler
-  FFTs' coherent gain and their windows' losses), complex Gaussian on each virtual channel of
-  the detected cell: one row, the root sum of squares of the coefficients of every channel's
-  in-phase and quadrature part.
+* receiver noise at the scene's SNR, complex Gaussian on each virtual channel of the detected
+  cell: one row, the root sum of squares of the coefficients of every channel's in-phase and
+  quadrature part. The SNR is ``radar.snr_db`` (per sample) after the range and Doppler FFTs'
+  coherent gain and their windows' losses (:func:`effective_snr`); without it and with
+  ``[radar.link]`` the link budget's (:func:`link_snr`: thermal, RTS channel and quantisation
+  noise of ``radar.link.relative_noise_power`` for the set angle's programme, against the
+  detected cell's amplitude, as ``rtsgeom info`` and ``run``'s ``link_budget`` compute a
+  target's SNR after the FFTs); neither: noiseless.
 
 The Monte Carlo draws every input at once; the mounting draws go through the tolerance model
 and the others through the phasor model at J's drawn delay (interpolated between nine models
@@ -42,11 +46,14 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.constants import c
 
 from ...calibration.pair import calibrate_pair
 from ...calibration.probes import probe_angles, probe_ranges
 from ...pipeline.pair import pair_design
 from ...radar.budget import window_snr_loss
+from ...radar.link import relative_noise_power
+from ...radar.windows import window
 from ...radar.channels import antenna_gains, channel_coupling, channel_gain, virtual_gain
 from ...radar.processing import refine_angles, tdm_compensate
 from ...radar.steering import Steering
@@ -58,7 +65,7 @@ from ..transfer import CHUNK_SNAPSHOTS, draw_channel_gains
 from .budget import (K_COVERAGE, RECTANGULAR, TRIANGULAR, BudgetRow, combined,
                      coverage_interval, validate)
 
-__all__ = ["AccuracyInputs", "AnglePoint", "pair_accuracy", "effective_snr"]
+__all__ = ["AccuracyInputs", "AnglePoint", "pair_accuracy", "effective_snr", "link_snr"]
 
 DELAY_NODES = 9  # phasor models across J's delay spread (the Monte Carlo interpolates)
 FALLBACK_MM = 0.1  # the mounting coefficient's step where no tolerance is given (mm)
@@ -94,6 +101,7 @@ class AnglePoint:
     mc_std_deg: float
     validated: bool
     end_difference: float  # the GUM interval's larger end difference, relative to U
+    snr_effective_db: float | None = None  # at the detection cell (None: noiseless)
 
     @property
     def mc_half_width_deg(self) -> float:
@@ -123,19 +131,39 @@ class AnglePoint:
                 "gum_end_difference_of_u": self.end_difference,
                 "accuracy_deg": self.accuracy_deg,
                 "accuracy_from": "gum" if self.validated else "monte_carlo",
+                "snr_effective_db": self.snr_effective_db,
                 "budget": [r.to_dict() for r in self.budget]}
 
 
 def effective_snr(radar) -> float | None:
     """The SNR per virtual channel at the detection cell (linear): the scene's per-sample
     ``snr_db`` times the range and Doppler FFTs' coherent gain with their windows' losses
-    (``radar.budget.window_snr_loss``); None for a noiseless scene."""
+    (``radar.budget.window_snr_loss``); None without ``snr_db`` (noiseless, or the link's
+    noise: :func:`link_snr`, per set angle)."""
     if radar.snr_db is None:
         return None
     n_s, n_c = radar.samples_per_chirp, radar.chirps_per_tx
     gain = (n_s * window_snr_loss(radar.range_window, n_s)
             * n_c * window_snr_loss(radar.doppler_window, n_c))
     return 10 ** (radar.snr_db / 10) * gain
+
+
+def link_snr(scene, model: ChannelModel, w) -> float:
+    """The SNR per virtual channel at the detection cell (linear) of programme weights ``w``
+    (Q,) on ``model`` under ``[radar.link]``'s noise: the cell's power (the strongest candidate
+    bin's mean over the virtual channels) over the windowed FFTs' noise ``N_rel sum w_r^2 sum
+    w_d^2``, ``N_rel`` the link's noise per sample referred to the model's relative amplitudes
+    (``radar.link.relative_noise_power``: thermal k T0 F f_adc, the programmed RTS channels'
+    re-radiated noise and the ADC's quantisation at the echo's IF response). For a target on a
+    bin centre it is the link budget's ``snr_after_fft_db`` (``radar.budget.link_budget``)."""
+    radar = scene.radar
+    x = np.tensordot(np.asarray(w), model.responses, axes=([0], [1]))  # (K, V)
+    p_cell = float(np.max(np.mean(np.abs(x) ** 2, axis=-1)))
+    beat_hz = radar.slope_hz_per_s * 2.0 * model.range_m / c + model.doppler_hz
+    n_rel = float(relative_noise_power(scene, float(np.sum(np.abs(w) ** 2)), beat_hz))
+    g = (np.sum(window(radar.range_window, radar.samples_per_chirp) ** 2)
+         * np.sum(window(radar.doppler_window, radar.chirps_per_tx) ** 2))
+    return p_cell / (n_rel * float(g))
 
 
 def _angles(model: ChannelModel, w, gains, start_rad: float, coupling=None, noise=None
@@ -248,7 +276,6 @@ def pair_accuracy(setup, ideal, paths, pair, probe, angles_rad, inputs: Accuracy
               + rng.uniform(-0.5, 0.5, inputs.draws) * res
               + (rng.uniform(-0.5, 0.5, inputs.draws) - rng.uniform(-0.5, 0.5, inputs.draws))
               * res)
-    u_noise = 0.0 if inputs.snr_effective is None else 1 / math.sqrt(2 * inputs.snr_effective)
     out = []
     for m, alpha in enumerate(angles_rad):
         t = TargetConfig(rng_m, 0.0, 10.0, float(alpha))
@@ -266,7 +293,9 @@ def pair_accuracy(setup, ideal, paths, pair, probe, angles_rad, inputs: Accuracy
         rows += [BudgetRow(q, u * 1e12, "ps", dist, c_tau, note)
                  for q, u, dist, note in delay_inputs]
         rows += _antenna_rows(pt, rut, n_ant, inputs.sigma_phase_rad)
-        rows.append(_noise_row(pt, rut, u_noise, inputs.snr_effective))
+        snr, snr_from = _point_snr(scene, inputs, pt)
+        u_noise = 0.0 if snr is None else 1 / math.sqrt(2 * snr)
+        rows.append(_noise_row(pt, rut, u_noise, snr, snr_from))
         u_c = combined(rows)
         # Monte Carlo: every input drawn
         nodes = np.linspace(-1, 1, DELAY_NODES) * max(4 * u_delay, res)
@@ -280,10 +309,22 @@ def pair_accuracy(setup, ideal, paths, pair, probe, angles_rad, inputs: Accuracy
         fin = total[np.isfinite(total)]
         out.append(AnglePoint(tuple(pair), float(np.degrees(alpha)), e0,
                               tuple(rows), u_c, K_COVERAGE * u_c, interval,
-                              float(np.mean(fin)), float(np.std(fin)), ok, diff))
+                              float(np.mean(fin)), float(np.std(fin)), ok, diff,
+                              None if snr is None else 10 * math.log10(snr)))
         if progress:
             progress(f"angle accuracy: pair {tuple(pair)}", m + 1, angles_rad.size)
     return out
+
+
+def _point_snr(scene, inputs: AccuracyInputs, pt: "_Point") -> tuple[float | None, str]:
+    """The SNR at the set angle's detection cell and where it comes from: ``snr_db`` (which
+    overrides the link's noise in the chain, ``radar.frame.simulate``), else the link budget
+    where the scene has ``[radar.link]``, else None (noiseless)."""
+    if inputs.snr_effective is not None:
+        return inputs.snr_effective, "radar.snr_db"
+    if scene.radar.link is not None:
+        return link_snr(scene, pt.model, pt.w), "the link budget ([radar.link])"
+    return None, "noiseless (no radar.snr_db, no [radar.link])"
 
 
 def _mount_rows(pair, sigma_m, coef) -> list[BudgetRow]:
@@ -311,7 +352,7 @@ def _antenna_rows(pt: _Point, rut, n_ant: int, sigma_rad: float) -> list[BudgetR
             for name, c in zip(names, coef)]
 
 
-def _noise_row(pt: _Point, rut, u_noise: float, snr) -> BudgetRow:
+def _noise_row(pt: _Point, rut, u_noise: float, snr, snr_from: str) -> BudgetRow:
     """Receiver noise: the coefficients of each virtual channel's in-phase and quadrature
     noise (relative to the echo's rms amplitude), combined by their root sum of squares."""
     v = rut.num_virtual
@@ -323,8 +364,8 @@ def _noise_row(pt: _Point, rut, u_noise: float, snr) -> BudgetRow:
     c_re = (e[:v] - e[v:2 * v]) / (2 * h)
     c_im = (e[2 * v:3 * v] - e[3 * v:]) / (2 * h)
     c = float(np.sqrt(np.sum(c_re ** 2 + c_im ** 2)))
-    note = ("noiseless scene (radar.snr_db unset)" if snr is None else
+    note = (snr_from if snr is None else
             f"each of {v} virtual channels' I and Q, SNR {10 * math.log10(snr):.1f} dB at the "
-            "detection")
+            f"detection, from {snr_from}")
     return BudgetRow("receiver noise (per I/Q, relative to the echo)", u_noise, "1", "normal",
                      c, note)

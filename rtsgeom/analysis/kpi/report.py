@@ -15,6 +15,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ...viz.figures import STYLE, new_figure
+from .headline import headline
 
 __all__ = ["figures", "accuracy_figure", "to_html", "write_pdf"]
 
@@ -220,32 +221,6 @@ def _table(head, rows, classes=None) -> str:
     return f"<table><tr>{h}</tr>{''.join(body)}</table>"
 
 
-def key_rows(sheet) -> list[tuple[str, str]]:
-    """The headline KPIs as (name, value with unit) rows."""
-    fov, rv, tg, gh = sheet.fov, sheet.range_velocity, sheet.targets, sheet.ghosts
-    worst = sheet.worst_accuracy_deg()
-    gaps = ", ".join(f"{a:.2f} .. {b:.2f}" for a, b in fov["gaps_deg"]) or "none"
-    res = tg["resolution"]
-    return [
-        ("field of view (azimuth)", f"{fov['azimuth_deg'][0]:.2f} .. {fov['azimuth_deg'][1]:.2f} "
-                                    f"deg ({fov['mode']}); gaps: {gaps}"),
-        ("angle accuracy |error| + U (k = 2), worst", "-" if worst is None else f"{worst:.4f} deg"),
-        ("range span", f"{rv['min_range_m']:.3f} .. {rv['max_range_m']:.2f} m"),
-        ("range resolution / RTS range step", f"{rv['range_resolution_m']:.4f} m / "
-                                              f"{rv['range_step_m'] * 1e3:.3f} mm"),
-        ("range accuracy (scene's targets)", _fmt(rv["range_accuracy_m"]) + " m"),
-        ("velocity span", f"+-{rv['max_velocity_mps']:.3f} m/s"),
-        ("velocity resolution", f"{rv['velocity_resolution_mps']:.4f} m/s"),
-        ("velocity accuracy (scene's targets)", _fmt(rv["velocity_accuracy_mps"]) + " m/s"),
-        ("simultaneous targets per channel / total", f"{tg['per_channel']} / {tg['total']}"),
-        ("minimum resolvable separation", res["note"] if res.get("rts_deg") is None
-         else f"RTS {res['rts_deg']:.2f} deg, truth {_fmt(res.get('truth_deg'))} deg"),
-        ("strongest cable ghost below its target", f"{gh['ghost_suppression_db']:.1f} dB"),
-        ("clip margin (RuT ADC)", _fmt(tg["clip_margin_db"]) + " dB"),
-        ("Fraunhofer distance", f"{sheet.nearfield['fraunhofer_distance_m']:.3f} m"),
-    ]
-
-
 def _spec_rows(sheet):
     rows, classes = [], []
     for c in sheet.checks:
@@ -274,7 +249,7 @@ def to_html(sheet, figs: dict | None = None) -> str:
         rows, classes = _spec_rows(sheet)
         parts += [f"<h2>Spec: {esc(verdict)}</h2>",
                   _table(("KPI", "value", "limit", "margin", "verdict", "note"), rows, classes)]
-    parts += ["<h2>Key figures</h2>", _table(("KPI", "value"), key_rows(sheet))]
+    parts += ["<h2>Key figures</h2>", _table(("KPI", "value"), headline(d))]
     titles = {"field_of_view": "Field of view", "angle_accuracy": "Angle accuracy",
               "uncertainty_budget": "Uncertainty budget (JCGM 100, validated by JCGM 101)",
               "near_field_and_ghosts": "Near field, ghosts and leakage"}
@@ -357,7 +332,7 @@ def _text_page(sheet) -> Figure:
         y -= 0.02
     page.text(0.06, y, "Key figures", fontsize=12, weight="bold")
     y -= 0.03
-    for name, value in key_rows(sheet):
+    for name, value in headline(sheet.to_dict()):
         page.text(0.08, y, f"{name}:", fontsize=8.5)
         for line in textwrap.wrap(value, 62) or [""]:
             page.text(0.45, y, line, fontsize=8.5)

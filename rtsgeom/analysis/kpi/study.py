@@ -27,6 +27,7 @@ from ..tolerance import MAX_SIGMA_MM
 from ..tolerance.args import STUDY_ARGS
 from ..transfer import ideal_radar, set_angles
 from .accuracy import AccuracyInputs, AnglePoint, effective_snr, pair_accuracy
+from .headline import headline
 from .sections import (field_of_view, ghosts_section, nearfield_section, range_velocity,
                        resolution_section, targets_section, uncovered_deg)
 from .spec import KpiSpec, SpecCheck, check_spec
@@ -155,9 +156,7 @@ class KpiStudy:
                                       f"the default {DEFAULT_SIGMA_MM:g} mm (the scene declares "
                                       "no tolerance)"),
                     "sigma_phase_deg": phase_deg, "sigma_phase_from": phase_from,
-                    "snr_db": scene.radar.snr_db,
-                    "snr_effective_db": (None if inputs.snr_effective is None else
-                                         10 * math.log10(inputs.snr_effective)),
+                    "snr_db": scene.radar.snr_db, **_snr_inputs(scene, inputs, points),
                     "draws": self.draws, "seed": seed, "points_per_pair": self.points,
                     "delay_resolution_ps": scene.rts.delay_resolution_s * 1e12},
             range_velocity=rv, targets=tg, ghosts=gh, nearfield=nf, nearfield_result=nf_result,
@@ -182,6 +181,19 @@ class KpiStudy:
         return points, ("the synthesized angle after the pair's calibration on the setup as "
                         "built, planned as rtsgeom run plans it; U (k = 2) from the GUM budget, "
                         "validated by a Monte Carlo of every input (JCGM 101)")
+
+
+def _snr_inputs(scene, inputs: AccuracyInputs, points) -> dict:
+    """The budget's SNR at the detection (the lowest over the set angles where it varies
+    with them: the link budget's) and where it comes from."""
+    if inputs.snr_effective is not None:
+        return {"snr_effective_db": 10 * math.log10(inputs.snr_effective),
+                "snr_from": "radar.snr_db per sample, after the FFTs' coherent gain"}
+    if scene.radar.link is not None:
+        snr = [p.snr_effective_db for p in points if p.snr_effective_db is not None]
+        return {"snr_effective_db": min(snr, default=None),
+                "snr_from": "the link budget ([radar.link]) per set angle, the lowest"}
+    return {"snr_effective_db": None, "snr_from": "noiseless (no radar.snr_db, no [radar.link])"}
 
 
 class _Steps:
@@ -318,14 +330,7 @@ class Datasheet(Result):
         }
 
     def _summary(self):
-        rv = self.range_velocity
-        rows = [("azimuth_deg", "{:.2f} .. {:.2f}".format(*self.fov["azimuth_deg"])),
-                ("gaps_deg", str(self.fov["gaps_deg"]) if self.fov["gaps_deg"] else "none"),
-                ("worst |error| + U (deg)", self.worst_accuracy_deg()),
-                ("range_m", f"{rv['min_range_m']:.3g} .. {rv['max_range_m']:.4g}"),
-                ("max |velocity| (m/s)", rv["max_velocity_mps"]),
-                ("targets (total)", self.targets["total"]),
-                ("ghost suppression (dB)", self.ghosts["ghost_suppression_db"])]
+        rows = headline(self.to_dict())
         rows += [(f"spec {c.kpi}", "no value" if c.passed is None else
                   f"{'pass' if c.passed else 'FAIL'} (margin {c.margin:.4g})")
                  for c in self.checks]
