@@ -5,12 +5,9 @@ calibrated side by side (``CalibrationStudy(workers=N)``) give the report of one
 
 from __future__ import annotations
 
-import copy
-import tomllib
-from pathlib import Path
-
 import numpy as np
 import pytest
+from calibration.test_dense_arc import TEMPLATE, dense_arc
 
 import rtsgeom
 from rtsgeom.calibration import phasor
@@ -19,21 +16,7 @@ from rtsgeom.calibration.steps import reference_setup
 from rtsgeom.errors import ParameterError
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
-from rtsgeom.scene import load_scene, parse_scene
-
-TEMPLATE = Path(__file__).resolve().parents[2] / "scenes" / "template.toml"
-
-
-def dense_arc(n: int, step_deg: float):
-    """The template's bench with ``n`` front ends ``step_deg`` apart, noiseless."""
-    doc = copy.deepcopy(tomllib.loads(TEMPLATE.read_text()))
-    doc["radar"].pop("snr_db", None)
-    a0 = -step_deg * (n - 1) / 2
-    doc["rts"]["front_ends"] = [{"angle_deg": a0 + k * step_deg, "rx_tx_separation_m": 0.012,
-                                 "cable_length_m": 1.0} for k in range(n)]
-    doc["sheet"].update(angle_min_deg=a0 - 4, angle_max_deg=-a0 + 4, cutout_diameter_m=0.024)
-    doc["targets"] = [{"range_m": 20.0, "angle_deg": step_deg / 2}]
-    return parse_scene(doc, "dense.toml")
+from rtsgeom.scene import load_scene
 
 
 @pytest.mark.parametrize("phase_deg", [0.0, 37.0, -150.0, 180.0])

@@ -6,28 +6,16 @@ association: the clouds where the RuT sees the RTS's targets (R_c further withou
 from __future__ import annotations
 
 import tomllib
-from pathlib import Path
 
 import numpy as np
 import pytest
+from scene.test_objects import BOX, CAR, bench_doc
 
 from rtsgeom.analysis.objects import objects_lines, play_objects, run_objects
 from rtsgeom.analysis.playback import Playback
 from rtsgeom.analysis.playback.result import BUDGET_ROLES
 from rtsgeom.pipeline.run import associate_targets, run_scene
 from rtsgeom.scene import parse_scene
-
-CAR = Path(__file__).resolve().parents[2] / "scenes" / "car-crossing.toml"
-BOX = [[0.9, 2.25, 0.0, 10.0], [-0.9, 2.25, 0.0, 10.0], [0.9, -2.25, 0.0, 10.0],
-       [-0.9, -2.25, 0.0, 10.0]]
-
-
-def bench_doc(**rts) -> dict:
-    doc = tomllib.loads(CAR.read_text())
-    del doc["scenario"]
-    doc["rts"].pop("max_targets_per_channel")
-    doc["rts"].update(rts)
-    return doc
 
 
 @pytest.mark.parametrize("compensate", [True, False])
