@@ -131,16 +131,10 @@ def test_no_module_is_two_concepts(module):
     assert lines <= MAX_LINES, f"{module}: {lines} lines"
 
 
-#: functions their owners are splitting on other branches; the limits hold for all the rest
-#: (remove an entry once its function is split)
-LONG_ALLOWED = {"rtsgeom.pipeline.pair.plan_pair", "rtsgeom.radar.phasors.bin_response"}
-
-
 def test_no_function_is_over_80_lines():
     """A function past 80 lines is two steps (kernels in numba aside: benchmarks/code_shape.py
     says how lines are counted)."""
-    long = [f"{f.where}: {f.lines} lines" for f in long_functions(limit=MAX_FUNCTION_LINES)
-            if f.where not in LONG_ALLOWED]
+    long = [f"{f.where}: {f.lines} lines" for f in long_functions(limit=MAX_FUNCTION_LINES)]
     assert not long, long
 
 

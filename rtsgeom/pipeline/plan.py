@@ -173,7 +173,7 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
             if calibrate else {})
     offsets = channel_offsets(setup.fe.count, cals)
     program, realised, notes = program_pairs(setup, paths, mode, targets, pairs, probe,
-                                             cals, offsets, where)
+                                             cals, offsets, where=where)
     warnings += notes
     if budget is not None:
         program = lead_program(program, budget)
