@@ -47,8 +47,8 @@ from .probes import (PLACEMENT_OFFSETS_BINS, FrontEndProbe, if_phase_slope_hz,
 from .steps import (FINE_STEP_S, adds_noise, predicted_angle_noise, reference_probes,
                     sweep_phase)
 
-__all__ = ["SweepResult", "phasor_sweep", "HALF_BINS", "place_probes", "chain_errors",
-           "PhasorProbes"]
+__all__ = ["SweepResult", "PairChannels", "phasor_sweep", "HALF_BINS", "place_probes",
+           "chain_errors", "PhasorProbes"]
 
 HALF_BINS = 3  # candidate bins either side of the set range's bin (J moves <= ~2 bins)
 
@@ -136,14 +136,29 @@ def _linked_noise_sigma(setup, targets, amps) -> np.ndarray:
     return np.sqrt(n0 * g)
 
 
-def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair, targets,
-                 alphas, deltas, base_offsets=(0.0, 0.0), gain_correction=(1.0, 1.0),
-                 bins=None) -> SweepResult:
+@dataclass(frozen=True)
+class PairChannels:
+    """A front-end pair's two channels as the RTS sets them while the pair is swept or
+    programmed: the front ends ``pair`` (I, J), the channels' delay offsets ``offsets`` (s;
+    added to every request on I and J) and their ``gain_correction`` (the factors the
+    amplitudes are multiplied by: :attr:`FrontEndProbe.gain_correction
+    <rtsgeom.calibration.probes.FrontEndProbe.gain_correction>`)."""
+
+    pair: tuple
+    offsets: tuple = (0.0, 0.0)
+    gain_correction: tuple = (1.0, 1.0)
+
+
+def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths],
+                 channels: PairChannels, targets, alphas, deltas, bins=None) -> SweepResult:
     """The calibration sweep's spectra at every delay ``deltas`` (S,) of channel J, on the
     setup as built (``setup``, ``paths``), with amplitudes designed on the ``nominal`` setup
-    for the bin the RuT detects (fixed point, see the module); ``bins`` (S, P) forces the
-    design bins (the full chain passes the bins its detection reported). Noise and angles:
+    for the bin the RuT detects (fixed point, see the module); ``channels``: the pair with
+    its channels' offsets and gain corrections; ``bins`` (S, P) forces the design bins (the
+    full chain passes the bins its detection reported). Noise and angles:
     :meth:`SweepResult.errors`."""
+    pair, base_offsets, gain_correction = (channels.pair, channels.offsets,
+                                           channels.gain_correction)
     deltas = np.atleast_1d(np.asarray(deltas, float))
     n_s, n_p = deltas.size, len(targets)
     nom_models = _models(*nominal, pair, targets, base_offsets, deltas)
@@ -204,15 +219,15 @@ def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair,
 
 
 
-def place_probes(setup, paths, nominal, pair, ranges, alphas, window_s, base_offsets,
-                 gain_correction, offsets_bins=PLACEMENT_OFFSETS_BINS) -> np.ndarray:
+def place_probes(setup, paths, nominal, channels: PairChannels, ranges, alphas, window_s,
+                 offsets_bins=PLACEMENT_OFFSETS_BINS) -> np.ndarray:
     """Probe ranges (P,) moved within a range bin so that over the delays ``window_s`` the
     design and the detection agree on each probe's bin with the largest power margin
     (``probes.place_in_bins``): the sweep curve stays on one bin, continuous, around the
-    coherence point."""
+    coherence point (``channels``: as :func:`phasor_sweep`'s)."""
     def margin(r):
-        res = phasor_sweep(setup, paths, nominal, pair, [TargetConfig(float(x)) for x in r],
-                           alphas, window_s, base_offsets, gain_correction)
+        res = phasor_sweep(setup, paths, nominal, channels,
+                           [TargetConfig(float(x)) for x in r], alphas, window_s)
         return np.min(np.where(res.consistent, res.margin, 0.0), axis=0)
     return place_in_bins(setup.scene, ranges, margin, offsets_bins)
 
@@ -281,6 +296,11 @@ class PhasorProbes:
         return [TargetConfig(float(r)) for r in self.ranges]
 
     @property
+    def channels(self) -> PairChannels:
+        """The pair's channels as the sweep sets them (:class:`PairChannels`)."""
+        return PairChannels(self.pair, self.base_offsets, self.gain_correction)
+
+    @property
     def probe_angles_deg(self) -> tuple:
         return tuple(float(np.degrees(a)) for a in self.alphas)
 
@@ -288,9 +308,8 @@ class PhasorProbes:
         """The phasor model's spectra at the delays ``deltas`` (:func:`phasor_sweep`)."""
         d = np.atleast_1d(np.asarray(deltas, float))
         if self._last is None or not np.array_equal(self._last[0], d):
-            self._last = (d, phasor_sweep(self.setup, self.paths, self.nominal, self.pair,
-                                          self.targets, self.alphas, d, self.base_offsets,
-                                          self.gain_correction))
+            self._last = (d, phasor_sweep(self.setup, self.paths, self.nominal,
+                                          self.channels, self.targets, self.alphas, d))
         return self._last[1]
 
     def measure(self, deltas, frames: int = 1, repeat: int = 0) -> np.ndarray:
@@ -319,9 +338,8 @@ class PhasorProbes:
         one bin over the delays ``window_s`` (:func:`place_probes`); the same random
         stream."""
         out = copy.copy(self)
-        out.ranges = place_probes(self.setup, self.paths, self.nominal, self.pair, self.ranges,
-                                  self.alphas, window_s, self.base_offsets,
-                                  self.gain_correction)
+        out.ranges = place_probes(self.setup, self.paths, self.nominal, self.channels,
+                                  self.ranges, self.alphas, window_s)
         out._last = None
         return out
 

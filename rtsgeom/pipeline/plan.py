@@ -20,6 +20,7 @@ from scipy.constants import c
 from ..calibration.chains import calibrate_chained
 from ..calibration.channels import calibrate_channels, channel_offsets, pair_edges, tree_phases
 from ..calibration.file import calibration_mismatch, load_calibration
+from ..calibration.phasor import PairChannels
 from ..calibration.sweep import Calibration
 from ..calibration.probes import FrontEndProbe, probe_angles, probe_front_ends
 from ..errors import (AngleUnreachable, CalibrationFailed, CellUnreachable, ParameterError,
@@ -322,7 +323,8 @@ def _frame_programme(setup, paths, mode, targets, rows, plans, where):
         (i, j), offs = row[0], row[3]
         if plan is None:
             try:
-                plan = plan_pair(setup, paths, *row[:1], t, mode, *row[2:])
+                plan = plan_pair(setup, paths, PairChannels(row[0], row[3], row[4]), t, mode,
+                                 row[2], row[5])
             except AngleUnreachable as exc:
                 raise SceneError(f"{scene.source}: "
                                  f"{target_field(target_name(where, k), 'angle_deg')} = "
