@@ -73,8 +73,8 @@ class PlaybackResult(Result):
         (frames, targets): each target's role under that budget (:data:`BUDGET_ROLES`; None
         without one): a ``lead``'s detection and truth are the merged target's and the truth
         twin's detection of its cell, a ``merged`` or ``dropped`` target has neither.
-    object_of : ndarray, (targets,)
-        The extended object each target belongs to (-1: a point target).
+    object_of : ndarray of int
+        (targets,): the extended object each target belongs to (-1: a point target).
     """
 
     scene: Scene
