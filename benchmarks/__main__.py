@@ -246,6 +246,7 @@ def bench_design_parts(scene, quick: bool) -> dict:
     import math
     from rtsgeom.analysis.design import two_front_end_scene
     from rtsgeom.analysis.tolerance.phasors import CASES, ChannelPhasors
+    from rtsgeom.analysis.tolerance.config import MonteCarlo
     from rtsgeom.analysis.tolerance.search import max_sigma_for_yield
     from rtsgeom.geometry import build_setup
     radii = np.linspace(0.5, 2.0, 2 if quick else 4)
@@ -268,8 +269,9 @@ def bench_design_parts(scene, quick: bool) -> dict:
             designs += 1
             for case in CASES:
                 c0 = time.process_time()
-                res = max_sigma_for_yield(model, [1e-4] * 3, 2000, scene.seed, 0.95, 0.1, case,
-                                          rel_tol=0.02)
+                res = max_sigma_for_yield(model, [1e-4] * 3,
+                                          MonteCarlo(draws=2000, seed=scene.seed), 0.95, 0.1,
+                                          case, rel_tol=0.02)
                 cpu[f"tolerance_{case}_s"] += time.process_time() - c0
                 evaluations += len(res["evaluations"])
     total = time.process_time() - c_all

@@ -7,10 +7,10 @@ holds the package to them (:data:`MAX_FUNCTION_LINES`, :data:`MAX_PARAMETERS`,
 
 - A function's length is its lines from ``def`` to its last line, decorators aside, docstring
   included (a nested function counts in its parent's lines and on its own).
-- Its parameters are the names a caller may pass by position (``self`` and ``cls`` aside):
-  keyword-only ones are named at every call, so a long group of them cannot be passed in the
-  wrong order, which is what the limit guards against. ``Function.all_parameters`` counts
-  every name (keyword-only, ``*args``, ``**kwargs`` too).
+- Its parameters are every name it takes, of any kind (``self`` and ``cls`` aside):
+  positional, keyword-only, ``*args`` and ``**kwargs`` (``Function.all_parameters``); a
+  wide signature is many things to know at a call, in whatever order they are named.
+  ``Function.parameters`` counts the positional ones alone.
 - Public: the function's name and every enclosing class's name start without ``_``, and it is
   not nested in another function. A module's or package's leading ``_`` (``_lib``) does not
   make its functions private: the package's own layers call them as an API.
@@ -110,11 +110,11 @@ def long_functions(fns=None, limit: int = MAX_FUNCTION_LINES) -> list[Function]:
 
 
 def wide_public(fns=None, limit: int = MAX_PARAMETERS) -> list[Function]:
-    """The public functions (kernels aside) with more than ``limit`` positional parameters,
+    """The public functions (kernels aside) with more than ``limit`` parameters of any kind,
     widest first."""
     fns = functions() if fns is None else fns
-    return sorted((f for f in fns if f.public and not f.kernel and f.parameters > limit),
-                  key=lambda f: -f.parameters)
+    return sorted((f for f in fns if f.public and not f.kernel and f.all_parameters > limit),
+                  key=lambda f: -f.all_parameters)
 
 
 def main() -> None:
@@ -124,15 +124,11 @@ def main() -> None:
     print(f"over {MAX_FUNCTION_LINES} lines: {len(long)}")
     for f in long:
         print(f"  {f.lines:4d}  {f.where}  (line {f.lineno})")
-    print(f"public with over {MAX_PARAMETERS} positional parameters: {len(wide)} "
+    print(f"public with over {MAX_PARAMETERS} parameters of any kind: {len(wide)} "
           f"(allowed {MAX_WIDE_PUBLIC})")
     for f in wide:
-        print(f"  {f.parameters:4d}  {f.where}  (line {f.lineno})")
-    every = sorted((f for f in fns if f.public and not f.kernel
-                    and f.all_parameters > MAX_PARAMETERS), key=lambda f: -f.all_parameters)
-    print(f"public with over {MAX_PARAMETERS} parameters of any kind: {len(every)}")
-    for f in every:
-        print(f"  {f.all_parameters:4d}  {f.where}  ({f.parameters} positional)")
+        print(f"  {f.all_parameters:4d}  {f.where}  ({f.parameters} positional, "
+              f"line {f.lineno})")
 
 
 

@@ -41,6 +41,7 @@ def run(draws: int, verify: int, inversion_draws: int) -> list[dict]:
     from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
     from rtsgeom.analysis.tolerance.search import max_sigma_for_yield
     from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
+    from rtsgeom.analysis.tolerance.config import MonteCarlo
     from rtsgeom.analysis.tolerance.verify import verify_draws
     from rtsgeom.geometry import build_setup
     rows = []
@@ -75,7 +76,7 @@ def run(draws: int, verify: int, inversion_draws: int) -> list[dict]:
                     row[f"calibrated_p99_offset_{b / 10:.1f}_{(b + 1) / 10:.1f}_bin_deg"] = (
                         float(np.percentile(e[sel], 99)) if sel.any() else None)
                 if verify:
-                    v = verify_draws(model, [SIGMA_M] * 3, verify, SEED)
+                    v = verify_draws(model, [SIGMA_M] * 3, MonteCarlo(draws=verify, seed=SEED))
                     row["verify_draws"] = verify
                     row["verify_max_abs_difference_deg"] = v.max_difference_deg
             rows.append(row)
@@ -84,8 +85,9 @@ def run(draws: int, verify: int, inversion_draws: int) -> list[dict]:
 
 
 def _inversion(max_sigma_for_yield, model, base, draws, axis, subbin):
-    return max_sigma_for_yield(model, base, draws, SEED, 0.95, SPEC_DEG, "calibrated", axis,
-                               subbin=subbin)
+    from rtsgeom.analysis.tolerance.config import MonteCarlo
+    return max_sigma_for_yield(model, base, MonteCarlo(draws=draws, seed=SEED, subbin=subbin),
+                               0.95, SPEC_DEG, "calibrated", axis)
 
 
 def main(argv=None) -> int:

@@ -87,6 +87,7 @@ _LAZY = {
     "design": (".api", "design"),
     "DesignStudy": (".analysis.design_study", "DesignStudy"),
     "design_grid": (".analysis.design", "design_grid"),
+    "DesignSpec": (".analysis.design", "DesignSpec"),
     "DesignGrid": (".analysis.design", "DesignGrid"),
     "nearfield": (".api", "nearfield"),
     "NearField": (".analysis.nearfield", "NearField"),

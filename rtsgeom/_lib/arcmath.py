@@ -15,10 +15,12 @@ cannot import ``geometry``) and ``geometry.arc`` use it.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 __all__ = ["radial_tangent", "sphere_frame", "layout_offsets", "module_axes",
-           "antenna_positions"]
+           "ModuleLayout", "antenna_positions"]
 
 
 def radial_tangent(angle_rad: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -84,13 +86,24 @@ def module_axes(angle_rad, yaw_rad=None, pitch_rad=None, elevation_rad=None
     return t, up, b
 
 
+@dataclass(frozen=True)
+class ModuleLayout:
+    """Where the antennas sit on each front-end module and how it is turned on its mount:
+    ``rx_offset_m``, ``tx_offset_m`` (..., F, 2) signed antenna offsets ``(t, h)`` in the
+    module frame (tangential, positive towards larger azimuth; height), ``yaw_rad``,
+    ``pitch_rad`` (..., F) mounting rotations about the module's centre. None: the
+    symmetric layout of the separation, no rotation."""
+
+    rx_offset_m: np.ndarray | None = None
+    tx_offset_m: np.ndarray | None = None
+    yaw_rad: np.ndarray | None = None
+    pitch_rad: np.ndarray | None = None
+
+
 def antenna_positions(centre: np.ndarray, radius_m: float, angle_rad: np.ndarray,
                       separation_m: np.ndarray | None = None,
                       offsets_m: np.ndarray | None = None, *,
-                      rx_offset_m: np.ndarray | None = None,
-                      tx_offset_m: np.ndarray | None = None,
-                      yaw_rad: np.ndarray | None = None,
-                      pitch_rad: np.ndarray | None = None,
+                      layout: ModuleLayout = ModuleLayout(),
                       elevation_rad: np.ndarray | None = None,
                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Rx, Tx and module-centre positions of front ends on an arc (or a sphere).
@@ -103,9 +116,8 @@ def antenna_positions(centre: np.ndarray, radius_m: float, angle_rad: np.ndarray
     separation_m : (F,) shorthand for ``rx_offset_m = (s/2, 0)``, ``tx_offset_m = (-s/2, 0)``;
         ignored where the offsets are given.
     offsets_m : (..., F, 3) mounting errors (radial, tangential, height); broadcast over draws.
-    rx_offset_m, tx_offset_m : (..., F, 2) signed antenna offsets ``(t, h)`` in the module frame
-        (tangential, positive towards larger azimuth; height).
-    yaw_rad, pitch_rad : (..., F) mounting rotations of the module about its centre.
+    layout : ModuleLayout
+        The antennas' offsets on the module and its mounting rotations.
     elevation_rad : (F,) nominal elevations epsilon_q on the sphere (None or all 0: the arc,
         the arc's arithmetic). The height offset and the antennas' ``h`` then run along the
         sphere's elevation direction, the radial offset along the sphere's radius.
@@ -114,6 +126,8 @@ def antenna_positions(centre: np.ndarray, radius_m: float, angle_rad: np.ndarray
     -------
     rx, tx, module_centre : (..., F, 3)
     """
+    rx_offset_m, tx_offset_m = layout.rx_offset_m, layout.tx_offset_m
+    yaw_rad, pitch_rad = layout.yaw_rad, layout.pitch_rad
     if elevation_rad is not None and not np.any(np.asarray(elevation_rad, float)):
         elevation_rad = None  # all on the arc: the arc's arithmetic, no elevation terms
     if elevation_rad is None:

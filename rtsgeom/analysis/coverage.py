@@ -46,7 +46,8 @@ from ..geometry.setup import nominal_scene, warn_setup_errors
 from ..geometry.farfield import angular_resolution_rad
 from ..paths import exact_paths
 from ..scene import Scene
-from .tolerance import Bounds, ChannelPhasors, ToleranceModel, max_scale_for_yield, monte_carlo
+from .tolerance import (Bounds, ChannelPhasors, MonteCarlo, ToleranceModel, max_scale_for_yield,
+                        monte_carlo)
 from .design import build_problem, fit_sheet, import_for_workers
 from ..calibration.probes import probe_ranges
 from .nearfield_terms import single_front_end_angles_rad
@@ -276,7 +277,8 @@ def evaluate_arc(plan: ArcPlan, spec_deg: float = 0.1, target_yield: float = 0.9
     ref = monte_carlo(arc, Bounds((BASE_SIGMA_M,) * 3), draws, seed, "normal", spec_deg)
     p95 = {case: float(np.percentile(np.abs(ref.arc_worst(case)), 95))
            for case in ("calibrated", "uncalibrated")}
-    inv = max_scale_for_yield(arc, Bounds((BASE_SIGMA_M,) * 3), draws, seed,
+    inv = max_scale_for_yield(arc, Bounds((BASE_SIGMA_M,) * 3),
+                              MonteCarlo(draws=int(draws), seed=int(seed)),
                               target_yield, spec_deg, "calibrated", rel_tol=0.05)
     return ArcDesign(plan, worst["calibrated"], worst["uncalibrated"],
                      inv["factor"] * BASE_SIGMA_M * 1e3, inv["capped"], None,

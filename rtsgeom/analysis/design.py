@@ -43,13 +43,13 @@ from ..geometry.farfield import angular_resolution_rad
 from .._lib.parallel import local_map
 from ..scene import Scene, SheetConfig
 from ..scene.rules import arc_centre_m, problems
-from .tolerance import CASES, ChannelPhasors, max_sigma_for_yield, monte_carlo
+from .tolerance import CASES, ChannelPhasors, MonteCarlo, max_sigma_for_yield, monte_carlo
 from .tolerance.search import critical_ratio, largest_passing_scale
 from ..errors import ParameterError
 from ..pipeline.plan import uses_cells
 
-__all__ = ["METRICS", "DesignGrid", "two_front_end_scene", "evaluate_design", "design_grid",
-           "check_azimuth_arc"]
+__all__ = ["METRICS", "DesignGrid", "two_front_end_scene", "DesignSpec", "evaluate_design",
+           "design_grid", "check_azimuth_arc"]
 
 # name -> (heat-map colour label, title)
 METRICS = {
@@ -140,10 +140,38 @@ def build_problem(scene: Scene) -> str | None:
     return found[0] if found else None
 
 
+@dataclass(frozen=True)
+class DesignSpec:
+    """How each design of :func:`design_grid` is judged.
+
+    Parameters
+    ----------
+    spec_deg : float
+        The angle error a setup may have (deg).
+    target_yield : float
+        The share of the setups within ``spec_deg`` the design's tolerance keeps.
+    draws, seed : int
+        Monte-Carlo draws per tolerance search and their seed.
+    points : int
+        Set-points across the pair's span per design.
+    rel_tol : float
+        The tolerance search's relative tolerance.
+    """
+
+    spec_deg: float = 0.1
+    target_yield: float = 0.95
+    draws: int = 2000
+    seed: int = 0
+    points: int = 21
+    rel_tol: float = 0.02
+
+
 def evaluate_design(scene: Scene, pair: tuple[int, int], radius_m: float, spacing_rad: float,
-                    *, spec_deg: float = 0.1, target_yield: float = 0.95, draws: int = 2000,
-                    seed: int = 0, points: int = 21, rel_tol: float = 0.02) -> dict:
-    """All metrics of one design (NaN where it cannot be built; ``problem`` says why)."""
+                    spec: DesignSpec = DesignSpec()) -> dict:
+    """All metrics of one design (NaN where it cannot be built; ``problem`` says why), judged
+    by ``spec``."""
+    spec_deg, target_yield, draws = spec.spec_deg, spec.target_yield, spec.draws
+    seed, points, rel_tol = spec.seed, spec.points, spec.rel_tol
     variant, sheet_state, problem = two_front_end_scene(scene, pair, radius_m, spacing_rad)
     out = {"radius_m": float(radius_m), "spacing_deg": round(math.degrees(spacing_rad), 9),
            "sheet": sheet_state, "problem": problem, "exceeds_resolution": None}
@@ -205,8 +233,8 @@ def tolerance_search(model: ChannelPhasors, case: str, draws: int, seed: int,
     start, slope = 1e-4, 1.0
     if draws >= 4 * PILOT_DRAWS:
         start, slope = pilot_estimate(model, case, seed, target_yield, spec_deg)
-    return max_sigma_for_yield(model, [start] * 3, draws, seed, target_yield, spec_deg, case,
-                               rel_tol=rel_tol, slope=slope)
+    return max_sigma_for_yield(model, [start] * 3, MonteCarlo(draws=int(draws), seed=int(seed)),
+                               target_yield, spec_deg, case, rel_tol=rel_tol, slope=slope)
 
 
 def pilot_estimate(model: ChannelPhasors, case: str, seed: int, target_yield: float,
@@ -240,10 +268,9 @@ def pilot_estimate(model: ChannelPhasors, case: str, seed: int, target_yield: fl
     return min(t1 * math.exp(-v1 / slope), cap_m), slope
 
 
-def _evaluate_cell(scene, pair, spec_deg, target_yield, draws, seed, points, cell) -> dict:
+def _evaluate_cell(scene, pair, spec: DesignSpec, cell) -> dict:
     """:func:`evaluate_design` of one (radius, spacing) cell (a picklable task for a pool)."""
-    return evaluate_design(scene, pair, cell[0], cell[1], spec_deg=spec_deg,
-                           target_yield=target_yield, draws=draws, seed=seed, points=points)
+    return evaluate_design(scene, pair, cell[0], cell[1], spec)
 
 
 @dataclass(frozen=True, repr=False)
@@ -373,8 +400,7 @@ def import_for_workers() -> None:
 
 
 def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
-                spec_deg: float = 0.1, target_yield: float = 0.95, draws: int = 2000,
-                seed: int = 0, **options) -> DesignGrid:
+                spec: DesignSpec = DesignSpec(), **options) -> DesignGrid:
     """Evaluate every (spacing, radius) design (:class:`~.design_study.DesignStudy` calls it).
 
     Parameters
@@ -384,13 +410,12 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     pair : tuple of 2 int
     radius_m, spacing_deg : array_like
         Arc radii (m) and front-end spacings (deg).
-    spec_deg, target_yield : float
-        The tolerance per design keeps ``target_yield`` of the setups within ``spec_deg``.
-    draws, seed : int
-        Monte-Carlo draws per tolerance search and their seed.
+    spec : DesignSpec
+        How each design is judged: the tolerance keeps ``target_yield`` of the setups within
+        ``spec_deg``, searched on ``draws`` Monte-Carlo draws of ``seed`` over ``points``
+        set-points per design.
     **options
-        ``points`` (set-points per design, default 21), ``progress(done, total)`` after each
-        design, ``workers`` (default 1).
+        ``progress(done, total)`` after each design, ``workers`` (default 1).
 
     Returns
     -------
@@ -414,12 +439,13 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     whose composite splits costs one build. The forked workers each load the compiled
     kernels once (~0.3 s CPU each) and keep the memory they free
     (``parallel.retain_freed_memory``)."""
-    points = options.pop("points", 21)
+    spec_deg, target_yield, draws, seed = (spec.spec_deg, spec.target_yield, spec.draws,
+                                           spec.seed)
     progress = options.pop("progress", None)
     workers = options.pop("workers", 1)
     if options:
-        raise ParameterError(f"design_grid: no option {', '.join(options)} (points, progress, "
-                             "workers)")
+        raise ParameterError(f"design_grid: no option {', '.join(options)} (progress, "
+                             "workers; the rest is the DesignSpec)")
     check_azimuth_arc(scene)
     warn_setup_errors(scene, "design")
     radii = np.asarray(radius_m, float).ravel()
@@ -427,8 +453,7 @@ def design_grid(scene: Scene, pair: tuple[int, int], radius_m, spacing_deg,
     fes = scene.rts.front_ends
     centre = 0.5 * (fes[pair[0]].angle_rad + fes[pair[1]].angle_rad)
     cells = [(float(r), math.radians(s)) for s in spacings for r in radii]
-    one = functools.partial(_evaluate_cell, scene, pair, spec_deg, target_yield, draws, seed,
-                            points)
+    one = functools.partial(_evaluate_cell, scene, pair, spec)
     # the studies' own pool (parallel.chunk_mapper: forked workers inheriting the scene, one
     # BLAS thread each; results in order, so the same bits however they are spread)
     designs = local_map(one, cells, workers, progress, before_fork=import_for_workers)

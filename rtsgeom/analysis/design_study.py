@@ -21,7 +21,7 @@ from ..geometry import build_setup
 from ..scene import Scene, check_scene_arg
 from ..scene.schema import check_arg
 from .coverage import CoverageDesign, coverage_designs
-from .design import DesignGrid, check_azimuth_arc, design_grid
+from .design import DesignGrid, DesignSpec, check_azimuth_arc, design_grid
 from .pairs import study_pairs
 from .tolerance.config import MonteCarlo, check_study_args
 
@@ -121,15 +121,16 @@ class DesignStudy:
         report = mc.progress
         if report is not None:  # the bar from the start, labelled with the count to come
             report("designs", 0, n)
-        kw = dict(points=points, workers=self.workers,
+        kw = dict(workers=self.workers,
                   progress=None if report is None else
                   (lambda done, total: report("designs", done, total)))
         if self.coverage_deg is not None:
             return coverage_designs(scene, self.coverage_deg, self.radius_m, self.spec_deg,
-                                    self.target_yield, mc.draws, mc.seed, **kw)
+                                    self.target_yield, mc.draws, mc.seed, points=points, **kw)
         pair = study_pairs(build_setup(scene), self.pair)[0]
-        return design_grid(scene, pair, self.radius_m, self.spacing_deg, self.spec_deg,
-                           self.target_yield, mc.draws, mc.seed, **kw)
+        return design_grid(scene, pair, self.radius_m, self.spacing_deg,
+                           DesignSpec(self.spec_deg, self.target_yield, mc.draws, mc.seed,
+                                      points), **kw)
 
     def evolve(self, **changes) -> "DesignStudy":
         """A copy with ``changes`` (checked again)."""

@@ -19,6 +19,7 @@ from ..calibration.probes import (FrontEndProbe, probe_angles, probe_front_ends,
 from ..errors import ParameterError
 from ..geometry import Setup
 from ..paths import Paths, nominal_model
+from ..calibration.phasor import PairChannels
 from ..pipeline.pair import pair_design
 from ..radar.processing import nearest_detection
 from ..radar.steering import Steering
@@ -185,8 +186,8 @@ def linearity(setup: Setup, paths: Paths, channels=None, mode: str = "exact",
         if end_angles == "measured" and mode != "exact":
             a_i, a_j, _ = _closed_form_measured(setup, paths, pair, t, mode, probe, off, corr)
         else:
-            a_i, a_j, _, off_j = pair_design(setup, paths, pair, t, mode,
-                                             probe_angles(*probe.angle_rad[[i, j]]), off, corr,
+            a_i, a_j, _, off_j = pair_design(setup, paths, PairChannels(pair, off, corr), t,
+                                             mode, probe_angles(*probe.angle_rad[[i, j]]),
                                              calibration.quantisation_residual_s
                                              if calibration else 0.0)
         amp[:, k] = a_i, a_j

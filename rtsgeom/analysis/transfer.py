@@ -40,6 +40,7 @@ from ..radar.channels import (antenna_gains, channel_coupling, channel_gain, com
                               plane_wave_errors, virtual_gain)
 from ..radar.processing import tdm_compensate
 from ..radar.steering import Steering
+from ..calibration.phasor import PairChannels
 from ..pipeline.pair import pair_design
 from ..scene import TargetConfig
 from ..scene.registry import SYNTHESIS_MODES
@@ -427,8 +428,8 @@ def _measure(ideal: Setup, paths: Paths, pair, target: TargetConfig, probe, cal,
     i, j = pair
     off = (0.0, cal.delta_tau_s)
     corr = probe.gain_correction[[i, j]]
-    a_i, a_j, _, off_j = pair_design(ideal, paths, pair, target, mode,
-                                     probe_angles(*probe.angle_rad[[i, j]]), off, corr,
+    a_i, a_j, _, off_j = pair_design(ideal, paths, PairChannels(pair, off, corr), target, mode,
+                                     probe_angles(*probe.angle_rad[[i, j]]),
                                      cal.quantisation_residual_s)
     model = ChannelModel.build(ideal, paths, pair, target, (0.0, off_j), steering=st)
     return (snapshot_angles(model, np.array([a_i, a_j]), gains, coupling) - target.angle_rad,

@@ -44,12 +44,13 @@ periodic shape that is zero at s).
 from __future__ import annotations
 
 import warnings
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 
 __all__ = ["rms_error_deg", "coarse_minimum", "crossing_columns", "continuous_steps",
-           "fit_centre", "fit_scatter",
+           "CentreFit", "fit_centre", "fit_scatter",
            "MC_DRAWS", "SCATTER_DRAW_FRAMES"]
 
 MC_DRAWS = 32  # noise realisations that size the frames per step
@@ -176,11 +177,25 @@ def _basis_gram(d_bytes: bytes, s_bytes: bytes, x_bytes: bytes, period_s: float,
     return b, g
 
 
-def fit_centre(deltas, error_rad, period_s: float, near_s: float, harmonics: int = 2,
-               search_s: float | None = None, extra_phase_rad=None, search_phase=None,
-               odd=None, return_fit: bool = False):
+@dataclass(frozen=True)
+class CentreFit:
+    """How :func:`fit_centre` models the sweep's columns and searches their centre: the
+    ``harmonics`` of each column's series, which columns are ``odd`` (C,) bool (None: none),
+    the search's half-width ``search_s`` (None: 1.5 steps), and the phase channel J adds
+    beyond its delay's, known in advance: ``extra_phase_rad`` (S, C) at the steps and
+    ``search_phase`` (delays (F,) -> (F, C)) on the continuous delays."""
+
+    harmonics: int = 2
+    search_s: float | None = None
+    odd: object = None
+    extra_phase_rad: object = None
+    search_phase: object = None
+
+
+def fit_centre(deltas, error_rad, period_s: float, near_s: float, fit: CentreFit = CentreFit(),
+               return_fit: bool = False):
     """The coherence point: the common centre of symmetry of the columns of ``error_rad``
-    (S, C) measured at ``deltas`` (S,) (module doc).
+    (S, C) measured at ``deltas`` (S,) (module doc), modelled and searched as ``fit`` says.
 
     Each even column c is modelled as ``a_0 + sum_h a_h cos(h psi_c)`` (symmetric about s,
     its vertex at any value), each crossing one (``odd`` (C,) bool) as ``sum_h b_h sin(h
@@ -203,6 +218,8 @@ def fit_centre(deltas, error_rad, period_s: float, near_s: float, harmonics: int
     ``return_fit``: also the fitted curves at the data's steps (S, C) (NaN where not
     fitted), whose residual is the steps' noise (:func:`fit_scatter`); the point and the
     curves are NaN where too few steps were detected for the fit."""
+    harmonics, search_s, odd = fit.harmonics, fit.search_s, fit.odd
+    extra_phase_rad, search_phase = fit.extra_phase_rad, fit.search_phase
     d = np.asarray(deltas, float)
     e = np.asarray(error_rad, float).reshape(d.size, -1)
     n_col = e.shape[1]

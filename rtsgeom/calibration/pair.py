@@ -66,6 +66,18 @@ def calibrate_pair(setup: Setup, paths: Paths, pair: tuple[int, int],
     config : :class:`SweepConfig`; ``settings`` (its field names: ``seed``, ``span_s``,
         ``step_s``, ``frames``, ``full_chain``) change single settings.
 
+    Returns
+    -------
+    Calibration
+        J's delay offset (``delta_tau_s``), the sweep it was fitted on and its scatter.
+
+    Raises
+    ------
+    CalibrationFailed
+        No probe detected at any step of the sweep, or at too few steps for the fit.
+    ParameterError
+        A setting outside its range (:class:`SweepConfig`), naming it.
+
     BLAS runs on one thread throughout: the phasor model's products are small, and handing
     them to threads cost more than their arithmetic (the whole calibration 1.4-1.7 s CPU ->
     0.3 s on a busy 2-core machine); one thread also makes the bits independent of the

@@ -48,8 +48,8 @@ from .probes import (PLACEMENT_OFFSETS_BINS, FrontEndProbe, if_phase_slope_hz,
 from .steps import (FINE_STEP_S, adds_noise, predicted_angle_noise, reference_probes,
                     sweep_phase)
 
-__all__ = ["SweepResult", "phasor_sweep", "HALF_BINS", "place_probes", "chain_errors",
-           "PhasorProbes"]
+__all__ = ["SweepResult", "PairChannels", "phasor_sweep", "HALF_BINS", "place_probes",
+           "chain_errors", "PhasorProbes"]
 
 HALF_BINS = 3  # candidate bins either side of the set range's bin (J moves <= ~2 bins)
 
@@ -154,22 +154,53 @@ def _linked_noise_sigma(setup, targets, amps) -> np.ndarray:
     return np.sqrt(n0 * g)
 
 
-def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair, targets,
-                 alphas, deltas, base_offsets=(0.0, 0.0), gain_correction=(1.0, 1.0),
-                 bins=None, j_phase_rad: float | None = None, noise: bool = True
-                 ) -> SweepResult:
+@dataclass(frozen=True)
+class PairChannels:
+    """A front-end pair's two channels as the RTS sets them while the pair is swept or
+    programmed: the front ends ``pair`` (I, J), the channels' delay offsets ``offsets`` (s;
+    added to every request on I and J) and their ``gain_correction`` (the factors the
+    amplitudes are multiplied by: :attr:`FrontEndProbe.gain_correction
+    <rtsgeom.calibration.probes.FrontEndProbe.gain_correction>`). ``j_phase_rad``: the setup
+    swept is the nominal one with channel J's hardware phase set to this (the sweep's
+    reference, ``steps.reference_setup``); None: any setup."""
+
+    pair: tuple
+    offsets: tuple = (0.0, 0.0)
+    gain_correction: tuple = (1.0, 1.0)
+    j_phase_rad: float | None = None
+
+
+def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths],
+                 channels: PairChannels, targets, alphas, deltas, bins=None) -> SweepResult:
     """The calibration sweep's spectra at every delay ``deltas`` (S,) of channel J, on the
     setup as built (``setup``, ``paths``), with amplitudes designed on the ``nominal`` setup
-    for the bin the RuT detects (fixed point, see the module); ``bins`` (S, P) forces the
-    design bins (the full chain passes the bins its detection reported). Noise and angles:
-    :meth:`SweepResult.errors`.
+    for the bin the RuT detects (fixed point, see the module); ``channels``: the pair with
+    its channels' offsets and gain corrections; ``bins`` (S, P) forces the design bins (the
+    full chain passes the bins its detection reported). Noise and angles:
+    :meth:`SweepResult.errors`; the designs alone (no noise level): :func:`_sweep_designs`."""
+    res = _sweep_designs(setup, paths, nominal, channels, targets, alphas, deltas, bins)
+    radar, pair = setup.scene.radar, channels.pair
+    if radar.snr_db is not None:
+        sigma = _noise_sigma(setup, paths, pair, targets, res.amplitudes, radar.snr_db)
+    elif radar.link is not None:  # the link budget's thermal noise (kTBF, RTS, ADC)
+        sigma = _linked_noise_sigma(setup, targets, res.amplitudes)
+    else:
+        return res
+    return dataclasses.replace(res, noise_sigma=sigma)
 
-    ``j_phase_rad``: ``setup`` is the nominal setup with channel J's hardware phase set to
-    this (the sweep's reference, ``steps.reference_setup``): its models are the nominal
-    ones with J's responses turned by ``e^{-j phase}`` (the beat carries the conjugate of
-    the channel's gain, ``rts.channels.channel_echoes``; the chain is linear in it), not
-    built a second time. ``noise=False``: no noise level (``noise_sigma`` zeros; the probe
-    placement reads only the designs' bins and margins)."""
+
+def _sweep_designs(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths],
+                   channels: PairChannels, targets, alphas, deltas, bins=None) -> SweepResult:
+    """:func:`phasor_sweep` without the noise level (``noise_sigma`` zeros): the designs'
+    bins and margins, all the probe placement reads.
+
+    With ``channels.j_phase_rad`` the swept setup's models are the nominal ones with J's
+    responses turned by ``e^{-j phase}`` (the beat carries the conjugate of the channel's
+    gain, ``rts.channels.channel_echoes``; the chain is linear in it), not built a second
+    time."""
+    pair, base_offsets, gain_correction = (channels.pair, channels.offsets,
+                                           channels.gain_correction)
+    j_phase_rad = channels.j_phase_rad
     deltas = np.atleast_1d(np.asarray(deltas, float))
     n_s, n_p = deltas.size, len(targets)
     nom_models = _models(*nominal, pair, targets, base_offsets, deltas)
@@ -223,14 +254,7 @@ def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair,
         amps[:, p] = np.stack([a_i[k, steps], a_j[k, steps]], -1)
         snaps.append(x[k, steps])  # (S, K_bins, V)
     x = np.stack(snaps, 1)  # (S, P, K_bins, V)
-    if not noise:
-        sigma = np.zeros(n_s)
-    elif radar.snr_db is not None:
-        sigma = _noise_sigma(setup, paths, pair, targets, amps, radar.snr_db)
-    elif radar.link is not None:  # the link budget's thermal noise (kTBF, RTS, ADC)
-        sigma = _linked_noise_sigma(setup, targets, amps)
-    else:
-        sigma = np.zeros(n_s)
+    sigma = np.zeros(n_s)
     r0 = np.array([_range_bin(setup.scene, t.range_m) for t in targets])
     return SweepResult(deltas, x, kbin, amps, r0, consistent, margin, sigma,
                        np.asarray(alphas, float), st)
@@ -238,15 +262,15 @@ def phasor_sweep(setup: Setup, paths: Paths, nominal: tuple[Setup, Paths], pair,
 
 
 
-def place_probes(setup, paths, nominal, pair, ranges, alphas, window_s, base_offsets,
-                 gain_correction, offsets_bins=PLACEMENT_OFFSETS_BINS) -> np.ndarray:
+def place_probes(setup, paths, nominal, channels: PairChannels, ranges, alphas, window_s,
+                 offsets_bins=PLACEMENT_OFFSETS_BINS) -> np.ndarray:
     """Probe ranges (P,) moved within a range bin so that over the delays ``window_s`` the
     design and the detection agree on each probe's bin with the largest power margin
     (``probes.place_in_bins``): the sweep curve stays on one bin, continuous, around the
-    coherence point."""
+    coherence point (``channels``: as :func:`phasor_sweep`'s)."""
     def margin(r):
-        res = phasor_sweep(setup, paths, nominal, pair, [TargetConfig(float(x)) for x in r],
-                           alphas, window_s, base_offsets, gain_correction, noise=False)
+        res = _sweep_designs(setup, paths, nominal, channels,
+                             [TargetConfig(float(x)) for x in r], alphas, window_s)
         return np.min(np.where(res.consistent, res.margin, 0.0), axis=0)
     return place_in_bins(setup.scene, ranges, margin, offsets_bins)
 
@@ -316,6 +340,11 @@ class PhasorProbes:
         return [TargetConfig(float(r)) for r in self.ranges]
 
     @property
+    def channels(self) -> PairChannels:
+        """The pair's channels as the sweep sets them (:class:`PairChannels`)."""
+        return PairChannels(self.pair, self.base_offsets, self.gain_correction, self._j_phase)
+
+    @property
     def probe_angles_deg(self) -> tuple:
         return tuple(float(np.degrees(a)) for a in self.alphas)
 
@@ -323,9 +352,8 @@ class PhasorProbes:
         """The phasor model's spectra at the delays ``deltas`` (:func:`phasor_sweep`)."""
         d = np.atleast_1d(np.asarray(deltas, float))
         if self._last is None or not np.array_equal(self._last[0], d):
-            self._last = (d, phasor_sweep(self.setup, self.paths, self.nominal, self.pair,
-                                          self.targets, self.alphas, d, self.base_offsets,
-                                          self.gain_correction, j_phase_rad=self._j_phase))
+            self._last = (d, phasor_sweep(self.setup, self.paths, self.nominal,
+                                          self.channels, self.targets, self.alphas, d))
         return self._last[1]
 
     def measure(self, deltas, frames: int = 1, repeat: int = 0) -> np.ndarray:
@@ -354,9 +382,8 @@ class PhasorProbes:
         one bin over the delays ``window_s`` (:func:`place_probes`); the same random
         stream."""
         out = copy.copy(self)
-        out.ranges = place_probes(self.setup, self.paths, self.nominal, self.pair, self.ranges,
-                                  self.alphas, window_s, self.base_offsets,
-                                  self.gain_correction)
+        out.ranges = place_probes(self.setup, self.paths, self.nominal, self.channels,
+                                  self.ranges, self.alphas, window_s)
         out._last = None
         return out
 

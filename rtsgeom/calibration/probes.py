@@ -189,7 +189,28 @@ def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe
     correction equalises measured against modelled power. One simulated frame holds
     :func:`probes_per_frame` of them; more are measured in turns, a frame each, at the same
     ranges (:func:`probe_layout`; turn t > 0 draws its noise from ``SeedSequence([seed, t])``).
-    BLAS on one thread, as :func:`calibrate_pair`."""
+    BLAS on one thread, as :func:`calibrate_pair`.
+
+    Parameters
+    ----------
+    setup : Setup
+        The setup as built (:func:`rtsgeom.build_setup`).
+    paths : Paths
+        Its propagation paths.
+    seed : int
+        The first frame's noise seed.
+
+    Returns
+    -------
+    FrontEndProbe
+        Per front end the measured angle (rad; NaN where not detected), power (dB) and gain
+        correction (1 where not detected), and the ADC samples the probe frames clipped.
+
+    Warns
+    -----
+    ProbeWarning
+        A front end the RuT does not detect alone at its probe range.
+    """
     scene = setup.scene
     n = setup.fe.count
     ranges, turn = probe_layout(setup, n)

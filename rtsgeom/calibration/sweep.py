@@ -38,7 +38,8 @@ from scipy.constants import c
 from .._lib.results import Result
 from .._lib.util import frozen
 from ..errors import CalibrationFailed, ParameterError
-from .fit import coarse_minimum, continuous_steps, fit_centre, fit_scatter, rms_error_deg
+from .fit import (CentreFit, coarse_minimum, continuous_steps, fit_centre, fit_scatter,
+                  rms_error_deg)
 from .probes import mean_air_delay
 from .steps import coarse_frames, continuous_delay_setup, fine_frames, fine_window, realisable
 
@@ -278,8 +279,8 @@ class _FineSweep:
         search = None if self.search_phase is None else (
             lambda f: np.asarray(self.search_phase(f), float)[:, cols])
         return fit_centre(self.t, e, self.period, self.centre,
-                          w.harmonics, max(self.period / 8, w.step_s), extra, search, odd,
-                          return_fit=True)
+                          CentreFit(w.harmonics, max(self.period / 8, w.step_s), odd, extra,
+                                    search), return_fit=True)
 
 
 def run_sweep(probes: Probes, config: SweepConfig = SweepConfig()) -> Calibration:

@@ -18,11 +18,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._lib.util import frozen
-from .._lib.arcmath import antenna_positions, layout_offsets, module_axes, radial_tangent
+from .._lib.arcmath import (ModuleLayout, antenna_positions, layout_offsets, module_axes,
+                           radial_tangent)
 from ..scene import Scene
 
-__all__ = ["FrontEnds", "antenna_positions", "front_ends", "layout_offsets", "module_axes",
-           "radial_tangent"]
+__all__ = ["FrontEnds", "ModuleLayout", "antenna_positions", "front_ends", "layout_offsets",
+           "module_axes", "radial_tangent"]
 
 
 @dataclass(frozen=True)
@@ -110,8 +111,7 @@ def front_ends(scene: Scene, arc_centre: np.ndarray, *, rx_offset_m=None, tx_off
         to = ts if to is None else to
         sep = ro[:, 0] - to[:, 0]
     rx, tx, mod = antenna_positions(arc_centre, scene.rts.arc_radius_m, ang, sep, off,
-                                    rx_offset_m=ro, tx_offset_m=to, yaw_rad=yaw, pitch_rad=pitch,
-                                    elevation_rad=elev)
+                                    layout=ModuleLayout(ro, to, yaw, pitch), elevation_rad=elev)
     opt = [None if a is None else frozen(a) for a in (ro, to, yaw, pitch, elev)]
     return FrontEnds(frozen(ang), frozen(rx), frozen(tx), frozen(mod), frozen(sep), frozen(off),
                      frozen(arc_centre), scene.rts.arc_radius_m, *opt)

@@ -34,6 +34,26 @@ own antenna gains and phases fitted with every front end), :mod:`.identification
 entry point and its result), :mod:`.built` (the setup as
 built: corrected scene, calibration without a sweep), :mod:`.crb` (the bound versus SNR and
 arc radius). Everything is importable from ``rtsgeom.identify``.
+
+Calling the package, ``rtsgeom.identify(scene, captures, ...)``, is
+:func:`~rtsgeom.identify.identification.identify`.
+
+Parameters
+----------
+scene, captures, accept_misfit, radar_channels, reference
+    As :func:`~rtsgeom.identify.identification.identify`: the nominal scene, its probe
+    captures, whether a misfit is kept (flagged), whether the radar's channels are fitted,
+    the reference front end.
+
+Returns
+-------
+Identification
+    Each front end's fit and, with ``radar_channels``, the radar's channels.
+
+Raises
+------
+ParameterError, CaptureError
+    As :func:`~rtsgeom.identify.identification.identify`.
 """
 
 from __future__ import annotations

@@ -254,7 +254,38 @@ def identify(scene: Scene, captures, accept_misfit: bool = False, radar_channels
     probe's bin when it arrives, so memory holds one cube at a time. Each capture is checked
     against the scene (:func:`~rtsgeom.identify.model.measure`) and each fit by
     :func:`check_fit`: a misfit raises ``CaptureError`` unless ``accept_misfit``, which keeps
-    it flagged (``misfit`` in the JSON)."""
+    it flagged (``misfit`` in the JSON).
+
+    Parameters
+    ----------
+    scene : Scene
+        The nominal scene whose setup the captures were recorded on.
+    captures : iterable of Capture
+        The probe captures (a list, or a generator of ``read_capture``), at most
+        :data:`MAX_CAPTURES`.
+    accept_misfit : bool
+        Keep a fit that fails :func:`check_fit`, flagged, instead of raising.
+    radar_channels : bool
+        Also fit the radar's antenna gains and phases, jointly with every front end.
+    reference : int, optional
+        With ``radar_channels``: the front end whose tangential offset fixes the array's
+        phase ramp.
+
+    Returns
+    -------
+    Identification
+        Each front end's fit (mounting offsets, channel gain, phase and delay, their
+        covariance) and, with ``radar_channels``, the radar's channels.
+
+    Raises
+    ------
+    ParameterError
+        No captures, more than :data:`MAX_CAPTURES`, an item that is not a capture, or an
+        argument outside its allowed values.
+    CaptureError
+        A capture that does not fit the scene, the same recording twice, or a misfit
+        (without ``accept_misfit``).
+    """
     _check_captures(scene, captures, reference)
     accept_misfit = check_arg(accept_misfit, "accept_misfit", "bool", "identify",
                               ParameterError)

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.constants import c
 
-from .._lib.arcmath import antenna_positions, layout_offsets
+from .._lib.arcmath import ModuleLayout, antenna_positions, layout_offsets
 from ..errors import CaptureError
 from ..geometry import Setup
 from ..paths.exact import leg_delays
@@ -81,8 +81,8 @@ class ProbeModel:
         to = fe.tx_offset_m[q] if fe.tx_offset_m is not None else layout_offsets(fe.separation_m[q])[1]
         pitch = None if fe.pitch_rad is None else fe.pitch_rad[q]
         rx, tx, _ = antenna_positions(fe.arc_centre, fe.arc_radius_m, fe.angle_rad[q],
-                                      fe.separation_m[q], th[:, None, 0:3], rx_offset_m=ro,
-                                      tx_offset_m=to, yaw_rad=th[:, 3:4], pitch_rad=pitch)
+                                      fe.separation_m[q], th[:, None, 0:3],
+                                      layout=ModuleLayout(ro, to, th[:, 3:4], pitch))
         t_a, t_b = leg_delays(rut.tx_world, rut.rx_world, rx, tx)  # (B, 1, Ntx), (B, 1, Nrx)
         t_a, t_b = t_a[:, 0, rut.virtual_tx], t_b[:, 0, rut.virtual_rx]  # (B, V)
         lam = rut.wavelength_m

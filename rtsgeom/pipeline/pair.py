@@ -13,7 +13,7 @@ from scipy.constants import c
 
 from ..calibration.probes import if_phase_slope_hz
 from ..calibration.steps import continuous_delay_setup
-from ..calibration.phasor import HALF_BINS
+from ..calibration.phasor import HALF_BINS, PairChannels
 from ..geometry import Setup
 from ..paths import Paths, nominal_model
 from ..rts.fir import fir_modelled, realised_delay
@@ -109,10 +109,10 @@ def nearest_setting(scene, tau_i_s: float, want_s: float, start_s: float
     return float(cand[order[0]]), float(eps[order[0]])
 
 
-def plan_pair(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str, probes_rad,
-              offsets=(0.0, 0.0), gain_correction=(1.0, 1.0), residual_s: float = 0.0
-              ) -> PairPlan:
-    """Channel J's delay and both amplitudes for a target synthesized by ``pair``, planned on
+def plan_pair(setup: Setup, paths: Paths, channels: PairChannels, target: TargetConfig,
+              mode: str, probes_rad, residual_s: float = 0.0) -> PairPlan:
+    """Channel J's delay and both amplitudes for a target synthesized by ``channels.pair``
+    (with its channels' delay ``offsets`` and ``gain_correction``), planned on
     realised delays: J's delay offset chosen among the calibrated one and one period of the
     target's IF phase either side (``m = 0, -1, 1``: the same phase, J's echo a period's
     range further), the first whose exact design the RuT detects at the bin it was designed
@@ -133,6 +133,8 @@ def plan_pair(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str,
     (34 deg of IF phase; -0.173 deg of angle).
 
     ``paper`` / ``array-factor``: :func:`pair_amplitudes` at the calibrated offsets."""
+    pair, offsets, gain_correction = (channels.pair, channels.offsets,
+                                      channels.gain_correction)
     ctx = _PairContext.of(setup, paths, pair, target, probes_rad, offsets, residual_s)
     if mode != "exact":
         return _closed_form_plan(setup, paths, ctx, mode, gain_correction)
@@ -332,12 +334,11 @@ def _power_at(st, snaps, u) -> np.ndarray:
     return np.abs(np.einsum("nv,nv->n", st.weighted(snaps), st.steer(u[:, None]))) ** 2
 
 
-def pair_design(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str, probes_rad,
-                offsets=(0.0, 0.0), gain_correction=(1.0, 1.0), residual_s: float = 0.0
+def pair_design(setup: Setup, paths: Paths, channels: PairChannels, target: TargetConfig,
+                mode: str, probes_rad, residual_s: float = 0.0
                 ) -> tuple[float, float, float, float]:
     """:func:`plan_pair` as (A_I, A_J, rho, J's requested delay offset)."""
-    p = plan_pair(setup, paths, pair, target, mode, probes_rad, offsets, gain_correction,
-                  residual_s)
+    p = plan_pair(setup, paths, channels, target, mode, probes_rad, residual_s)
     return p.a_i, p.a_j, p.rho, p.offset_j_s
 
 

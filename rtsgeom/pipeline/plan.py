@@ -12,14 +12,17 @@ one weight per channel (:meth:`ChannelModel.solve <rtsgeom.synthesis.model.Chann
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from scipy.constants import c
 
 from ..calibration.chains import calibrate_chained
 from ..calibration.channels import calibrate_channels, channel_offsets, pair_edges, tree_phases
 from ..calibration.file import calibration_mismatch, load_calibration
+from ..calibration.phasor import PairChannels
 from ..calibration.sweep import Calibration
-from ..calibration.probes import probe_angles, probe_front_ends
+from ..calibration.probes import FrontEndProbe, probe_angles, probe_front_ends
 from ..errors import (AngleUnreachable, CalibrationFailed, CellUnreachable, ParameterError,
                       SceneError)
 from ..geometry import Setup
@@ -34,8 +37,8 @@ from .merge import budget_targets
 from .pair import plan_pair, plan_pairs, residual_warning
 
 __all__ = ["bracketing_pair", "check_pair", "measured_pairs", "uses_cells", "target_cells",
-           "plan_targets", "target_pairs", "calibrate_pairs", "program_pairs",
-           "program_frames"]
+           "plan_targets", "target_pairs", "calibrate_pairs", "FixedCalibration",
+           "program_pairs", "program_frames"]
 
 
 def bracketing_pair(angle_rad: float, fe_angles_rad: np.ndarray) -> tuple[int, int] | None:
@@ -172,8 +175,9 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
                             loaded if calibration is not None else None, progress)
             if calibrate else {})
     offsets = channel_offsets(setup.fe.count, cals)
-    program, realised, notes = program_pairs(setup, paths, mode, targets, pairs, probe,
-                                             cals, offsets, where=where)
+    program, realised, notes = program_pairs(setup, paths, mode, targets, pairs,
+                                             FixedCalibration(probe, cals, offsets),
+                                             where=where)
     warnings += notes
     if budget is not None:
         program = lead_program(program, budget)
@@ -265,25 +269,38 @@ def calibrate_pairs(setup: Setup, paths: Paths, pairs, probe, loaded: dict | Non
     return {pair: loaded[pair] for pair in pairs}
 
 
-def program_pairs(setup: Setup, paths: Paths, mode: str, targets, pairs, probe, cals: dict,
-                  offsets, *, where: str = "targets") -> tuple[RtsProgram, list[dict], list[str]]:
-    """The RTS programme of ``targets`` on their ``pairs`` with the calibration fixed
-    (``cals`` and the channels' delay offsets ``offsets``): per target channel I at the
-    target's delay plus its offset, channel J at the delay :func:`~.pair.plan_pair` chose, both
-    amplitudes from it. Returns the programme, each target's realised plan (for summary.json)
-    and warnings; ``SceneError`` for an angle the pair cannot reach."""
-    return program_frames(setup, paths, mode, [targets], [pairs], probe, cals, offsets,
-                          [where])[0]
+@dataclass(frozen=True)
+class FixedCalibration:
+    """The calibration a programme is planned with, fixed: the front ends' ``probe``
+    (measured angles, gain corrections), the pairs' calibrations ``cals`` ((i, j) ->
+    :class:`~rtsgeom.calibration.sweep.Calibration`) and the channels' delay offsets
+    ``offsets`` (F,) s (:func:`~rtsgeom.calibration.channels.channel_offsets`)."""
+
+    probe: FrontEndProbe
+    cals: dict
+    offsets: np.ndarray
 
 
-def program_frames(setup: Setup, paths: Paths, mode: str, frames, pairs, probe, cals: dict,
-                   offsets, wheres) -> list[tuple[RtsProgram, list[dict], list[str]]]:
+def program_pairs(setup: Setup, paths: Paths, mode: str, targets, pairs,
+                  fixed: FixedCalibration, *, where: str = "targets"
+                  ) -> tuple[RtsProgram, list[dict], list[str]]:
+    """The RTS programme of ``targets`` on their ``pairs`` with the calibration ``fixed``:
+    per target channel I at the target's delay plus its offset, channel J at the delay
+    :func:`~.pair.plan_pair` chose, both amplitudes from it. Returns the programme, each
+    target's realised plan (for summary.json) and warnings; ``SceneError`` for an angle the
+    pair cannot reach."""
+    return program_frames(setup, paths, mode, [targets], [pairs], fixed, [where])[0]
+
+
+def program_frames(setup: Setup, paths: Paths, mode: str, frames, pairs,
+                   fixed: FixedCalibration, wheres
+                   ) -> list[tuple[RtsProgram, list[dict], list[str]]]:
     """:func:`program_pairs` of several frames (``frames``: each frame's targets, ``pairs``
     and ``wheres`` per frame) at once: every target's design at the calibrated offset in one
     batch (:func:`~.pair.plan_pairs`), the few it leaves open by :func:`~.pair.plan_pair`;
     the same programmes as frame by frame."""
-    rows = [[_pair_row(probe, cals, offsets, pr, t) for t, pr in zip(tg, ps)]
-            for tg, ps in zip(frames, pairs)]
+    rows = [[_pair_row(fixed.probe, fixed.cals, fixed.offsets, pr, t)
+             for t, pr in zip(tg, ps)] for tg, ps in zip(frames, pairs)]
     plans = iter(plan_pairs(setup, paths, mode, [r for fr in rows for r in fr]))
     return [_frame_programme(setup, paths, mode, tg, fr, [next(plans) for _ in fr], where)
             for tg, fr, where in zip(frames, rows, wheres)]
@@ -306,7 +323,8 @@ def _frame_programme(setup, paths, mode, targets, rows, plans, where):
         (i, j), offs = row[0], row[3]
         if plan is None:
             try:
-                plan = plan_pair(setup, paths, *row[:1], t, mode, *row[2:])
+                plan = plan_pair(setup, paths, PairChannels(row[0], row[3], row[4]), t, mode,
+                                 row[2], row[5])
             except AngleUnreachable as exc:
                 raise SceneError(f"{scene.source}: "
                                  f"{target_field(target_name(where, k), 'angle_deg')} = "

@@ -41,9 +41,41 @@ __all__ = ["RunResult", "simulate", "run_scene", "match_targets", "associate_tar
 
 @dataclass(frozen=True, repr=False)
 class RunResult(Result):
-    """One simulated frame of a scene and what the RuT detected. ``print(result)`` is a
-    summary; ``to_dataframe()`` one row per target (set, detected, error);
-    ``detections.to_dataframe()`` every detection; ``plot()`` the range-Doppler map."""
+    """One simulated frame of a scene and what the RuT detected (:func:`run_scene`).
+    ``print(result)`` is a summary; ``to_dataframe()`` one row per target (set, detected,
+    error); ``detections.to_dataframe()`` every detection; ``plot()`` the range-Doppler map.
+
+    Attributes
+    ----------
+    scene : Scene
+        The scene as run (with the ``aoa_mode`` override applied).
+    setup : Setup
+        Its built geometry.
+    paths : Paths
+        The propagation paths.
+    program : RtsProgram
+        The RTS programme: per channel the delay, Doppler shift and amplitude.
+    echoes : Echoes
+        The echoes the RuT receives.
+    cube : AdcCube
+        The frame's ADC samples.
+    rd : RangeDoppler
+        The range-Doppler maps.
+    detections : Detections
+        What the RuT detected.
+    matches : list of dict
+        Per target its set values, the matched detection and the error.
+    calibration : dict
+        The calibration record (front-end angles, gain corrections, pair calibrations).
+    warnings : tuple of str
+        The run's warnings.
+    aoa_mode : str
+        The amplitude mode used.
+    link_budget : LinkBudget or None
+        The frame's link budget (:mod:`rtsgeom.radar.budget`).
+    truth_detections : Detections or None
+        The truth twin's detections (None: not run).
+    """
 
     scene: Scene
     setup: Setup
@@ -290,15 +322,46 @@ def label_detections(result: "RunResult", bins: float = 2.0) -> list[str]:
 @one_blas_thread  # small products (the planner's models): BLAS threads cost more than they give
 def run_scene(scene: Scene, paths_method: str = "exact", aoa_mode: str | None = None,
               progress=None, calibration: dict | None = None, truth: bool = True) -> RunResult:
-    """Run the whole pipeline on ``scene``.
+    """Run the whole pipeline on ``scene``: geometry, paths, the RTS programme (calibrated
+    where the mode synthesizes), one simulated frame, the RuT's processing and detections.
 
-    ``aoa_mode`` overrides the scene's ``rts.aoa_mode``: ``nearest`` puts each target on its
-    nearest front end; the synthesis modes calibrate the front-end pairs first, or take
-    them from ``calibration`` (a calibration file's content, ``calibration.file.load_calibration``).
-    ``truth``: also run the truth twin (:func:`truth_twin`: the same radar on the real
-    targets) and add ``truth``, ``truth_status`` and ``vs_truth`` to every match.
-    The override is validated like the scene's own mode (``Scene.evolve``: e.g. paper eq. 24's
-    spacing rule for the synthesis modes), so it cannot bypass a rule the scene file must meet.
+    Parameters
+    ----------
+    scene : Scene
+        The scene (:func:`rtsgeom.load_scene`).
+    paths_method : str
+        The path solver (``rtsgeom.paths.PATH_METHODS``: ``exact`` by default).
+    aoa_mode : str, optional
+        Overrides the scene's ``rts.aoa_mode``: ``nearest`` puts each target on its nearest
+        front end; the synthesis modes calibrate the front-end pairs first, or take them
+        from ``calibration``. The override is validated like the scene's own mode
+        (``Scene.evolve``: e.g. paper eq. 24's spacing rule for the synthesis modes), so it
+        cannot bypass a rule the scene file must meet.
+    progress : callable, optional
+        Told each calibrated pair: ``progress(message)`` (a list's ``append`` keeps the
+        messages), or ``progress.count(stage, done, total)`` where it has one
+        (``rtsgeom._lib.util.tell``).
+    calibration : dict, optional
+        A calibration file's content (``json.load`` of ``calibration.json``,
+        :func:`rtsgeom.calibration.file.load_calibration`) used instead of calibrating.
+    truth : bool
+        Also run the truth twin (:func:`truth_twin`: the same radar on the real targets)
+        and add ``truth``, ``truth_status`` and ``vs_truth`` to every match.
+
+    Returns
+    -------
+    RunResult
+        The frame, its detections and each target's match.
+
+    Raises
+    ------
+    ParameterError
+        An argument outside its allowed values, naming it.
+    SceneError
+        A scene the mode cannot program (a set angle no pair reaches, a calibration file
+        that does not fit the scene's front ends).
+    CalibrationFailed
+        A pair whose probes the calibration sweep never detects.
     """
     check_scene_arg(scene, "run_scene")
     check_arg(paths_method, "paths_method", "str", "run_scene", ParameterError,

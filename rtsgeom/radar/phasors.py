@@ -62,31 +62,14 @@ def _tap_sums(taps: FirTaps, kern: np.ndarray, slope: float, f_d: float, t0: flo
     return out
 
 
-def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, doppler_bin,
-                 taps: FirTaps | None = None) -> np.ndarray:
-    """Spectrum contributions of each echo at the given bins.
-
-    ``range_bin``, ``doppler_bin``: (K,) indices into ``RangeDoppler`` (Doppler fftshifted).
-    ``taps``: the echoes' fractional-delay FIR as whole-sample copies (:func:`rtsgeom.rts.channels.fir_taps`
-    of these echoes, in place of ``echoes.fast_gain``, which must then be None; direct echoes
-    of one Doppler shift): the fast-time sums of the tones at the few whole-sample delays the
-    taps reach, formed once per geometry (M x N x V K products, M ~ the delays' span in
-    samples plus T) and combined per echo, T x V K products (2 T x V K where the setting's
-    rounding leaves a residual) instead of N x (V K + T) (a delay table of thousands of
-    settings; the same sums to rounding).
-    Returns (K, E, V) complex128; sum over axis 1 for the total.
-    """
-    r = np.atleast_1d(np.asarray(range_bin))
-    d = np.atleast_1d(np.asarray(doppler_bin))
-    n_l, n_s = radar.chirps_per_tx, radar.samples_per_chirp
-    if len(echoes) == 0:  # (every path blocked)
-        return np.zeros((r.size, 0, echoes.tau_air_s.shape[1]), complex)
+def _fast_time_sums(echoes: Echoes, radar: RadarConfig, r: np.ndarray,
+                    taps: FirTaps | None) -> np.ndarray:
+    """The range windows' DFT sums of each echo's beat tones along the chirp at range bins
+    ``r`` (:func:`bin_response`'s fast time): (K, E, V) complex."""
+    n_s = radar.samples_per_chirp
     s = radar.slope_hz_per_s
     tau = echoes.tau_s  # (E, V)
     f_d = echoes.doppler_hz
-    # (E, V), through the RuT's own channels (radar.channels)
-    phi0 = beat_phase0(echoes, radar)
-    amp = received_amplitude(echoes.amplitude, radar, rut, phi0) * np.exp(1j * phi0)
     # fast time: sum_n w_n exp(j 2 pi (S tau + f_D) t_n) exp(-j 2 pi r n / N)
     w_r = window(radar.range_window, n_s)
     n = np.arange(n_s)
@@ -133,6 +116,14 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
         # here, which were a third of the tolerance model's tables); rounding-level
         # differences only
         rr = np.moveaxis(fast @ kern_r.T, -1, 0)
+    return rr
+
+
+def _slow_time_sums(f_d: np.ndarray, radar: RadarConfig, rut: RutArray, d: np.ndarray
+                    ) -> np.ndarray:
+    """The Doppler windows' DFT sums over the chirps of each echo's Doppler shift ``f_d``
+    (E,) at Doppler bins ``d`` (:func:`bin_response`'s slow time): (K, E, V) complex."""
+    n_l = radar.chirps_per_tx
     # slow time (Doppler bin d of the fftshifted spectrum is DFT index d - L/2)
     t_c = chirp_start_s(radar, rut)  # (L, V)
     w_d = window(radar.doppler_window, n_l)
@@ -142,7 +133,32 @@ def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, d
     # per distinct Doppler shift (a delay table has one): the same arithmetic, fewer rows
     f_u, f_inv = np.unique(f_d, return_inverse=True)
     slow = np.exp(2j * np.pi * f_u[:, None, None] * t_c.T[None, :, :])  # (U, V, L)
-    dd = np.moveaxis((slow @ kern_d.T)[np.ravel(f_inv)], -1, 0)
+    return np.moveaxis((slow @ kern_d.T)[np.ravel(f_inv)], -1, 0)
+
+
+def bin_response(echoes: Echoes, radar: RadarConfig, rut: RutArray, range_bin, doppler_bin,
+                 taps: FirTaps | None = None) -> np.ndarray:
+    """Spectrum contributions of each echo at the given bins.
+
+    ``range_bin``, ``doppler_bin``: (K,) indices into ``RangeDoppler`` (Doppler fftshifted).
+    ``taps``: the echoes' fractional-delay FIR as whole-sample copies (:func:`rtsgeom.rts.channels.fir_taps`
+    of these echoes, in place of ``echoes.fast_gain``, which must then be None; direct echoes
+    of one Doppler shift): the fast-time sums of the tones at the few whole-sample delays the
+    taps reach, formed once per geometry (M x N x V K products, M ~ the delays' span in
+    samples plus T) and combined per echo, T x V K products (2 T x V K where the setting's
+    rounding leaves a residual) instead of N x (V K + T) (a delay table of thousands of
+    settings; the same sums to rounding).
+    Returns (K, E, V) complex128; sum over axis 1 for the total.
+    """
+    r = np.atleast_1d(np.asarray(range_bin))
+    d = np.atleast_1d(np.asarray(doppler_bin))
+    if len(echoes) == 0:  # (every path blocked)
+        return np.zeros((r.size, 0, echoes.tau_air_s.shape[1]), complex)
+    # (E, V), through the RuT's own channels (radar.channels)
+    phi0 = beat_phase0(echoes, radar)
+    amp = received_amplitude(echoes.amplitude, radar, rut, phi0) * np.exp(1j * phi0)
+    rr = _fast_time_sums(echoes, radar, r, taps)
+    dd = _slow_time_sums(echoes.doppler_hz, radar, rut, d)
     return amp[None] * rr * dd
 
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from .evolve import Evolvable
 from .schema import spec
-from .sections import HEADING_DOC, MAX_SCATTERERS, SCATTERER_COLUMNS
+from .sections import HEADING_DOC, MAX_SCATTERERS, MAX_TARGETS, SCATTERER_COLUMNS
 
 __all__ = ["ScenarioTargetConfig", "ScenarioConfig", "SetPoints", "trajectory", "frame_times",
            "check_scenario", "MAX_FRAMES", "MAX_WAYPOINTS", "MAX_TARGET_FRAMES"]
@@ -152,6 +152,32 @@ def trajectory(waypoints, time_s) -> SetPoints:
                      np.einsum("fi,fi->f", pos, vel) / rng, pos, vel)
 
 
+def _frames_fit(scene, fail, per_frame: int | None) -> bool:
+    """Whether the scenario's frames, targets a frame and target-frames stay within what the
+    played drive holds (:data:`MAX_FRAMES`, ``MAX_TARGETS``, :data:`MAX_TARGET_FRAMES`); the
+    first one over is reported through ``fail``."""
+    sc = scene.scenario
+    if sc.num_frames > MAX_FRAMES:
+        fail("scenario.frame_period_s", sc.frame_period_s,
+             f">= {sc.duration_s / (MAX_FRAMES - 1):g} s: scenario.duration_s = "
+             f"{sc.duration_s:g} s would take {sc.num_frames} frames (at most {MAX_FRAMES})")
+        return False
+    n_t = len(scene.targets) + len(sc.targets) if per_frame is None else per_frame
+    if n_t > MAX_TARGETS:
+        fail("scenario.targets", f"{len(sc.targets)} entries",
+             f"at most {MAX_TARGETS} point targets a frame with [[targets]] and the objects' "
+             f"scatterers (they make {n_t})")
+        return False
+    if sc.num_frames * n_t > MAX_TARGET_FRAMES:
+        fail("scenario.frame_period_s", sc.frame_period_s,
+             f">= {sc.duration_s * n_t / (MAX_TARGET_FRAMES - n_t):g} s: {sc.num_frames} frames "
+             f"x {n_t} targets would be {sc.num_frames * n_t} target-frames (at most "
+             f"{MAX_TARGET_FRAMES}: the played drive's memory; a shorter scenario.duration_s "
+             "or fewer targets)")
+        return False
+    return True
+
+
 def check_scenario(scene, fail, limits, air_extra_m: float, per_frame: int | None = None
                    ) -> dict:
     """The scenario's own rules (called by :func:`rtsgeom.scene.rules.problems`): waypoint
@@ -163,26 +189,7 @@ def check_scenario(scene, fail, limits, air_extra_m: float, per_frame: int | Non
     are checked by :func:`rtsgeom.scene.objects.check_moving_objects`)."""
     sc = scene.scenario
     sps: dict = {}
-    if sc is None:
-        return sps
-    if sc.num_frames > MAX_FRAMES:
-        fail("scenario.frame_period_s", sc.frame_period_s,
-             f">= {sc.duration_s / (MAX_FRAMES - 1):g} s: scenario.duration_s = "
-             f"{sc.duration_s:g} s would take {sc.num_frames} frames (at most {MAX_FRAMES})")
-        return sps
-    from .sections import MAX_TARGETS
-    n_t = len(scene.targets) + len(sc.targets) if per_frame is None else per_frame
-    if n_t > MAX_TARGETS:
-        fail("scenario.targets", f"{len(sc.targets)} entries",
-             f"at most {MAX_TARGETS} point targets a frame with [[targets]] and the objects' "
-             f"scatterers (they make {n_t})")
-        return sps
-    if sc.num_frames * n_t > MAX_TARGET_FRAMES:
-        fail("scenario.frame_period_s", sc.frame_period_s,
-             f">= {sc.duration_s * n_t / (MAX_TARGET_FRAMES - n_t):g} s: {sc.num_frames} frames "
-             f"x {n_t} targets would be {sc.num_frames * n_t} target-frames (at most "
-             f"{MAX_TARGET_FRAMES}: the played drive's memory; a shorter scenario.duration_s "
-             "or fewer targets)")
+    if sc is None or not _frames_fit(scene, fail, per_frame):
         return sps
     r_lim, v_lim, why_r, why_v = limits
     r_max = r_lim - air_extra_m

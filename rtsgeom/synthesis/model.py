@@ -45,7 +45,7 @@ from scipy.constants import c
 from ..errors import AngleUnreachable, ParameterError, SceneError
 from ..geometry import Setup
 from ..geometry.arrays import posed_positions
-from ..geometry.frontends import antenna_positions
+from ..geometry.frontends import ModuleLayout, antenna_positions
 from ..paths import Paths
 from ..paths.exact import leg_delays
 from ..radar.phasors import bin_response
@@ -457,9 +457,9 @@ class ChannelModel:
         to = None if fe.tx_offset_m is None else fe.tx_offset_m[q]
         el = None if fe.elevation_rad is None else fe.elevation_rad[q]
         rx, tx, _ = antenna_positions(fe.arc_centre, fe.arc_radius_m, fe.angle_rad[q],
-                                      fe.separation_m[q], offsets_m, rx_offset_m=ro,
-                                      tx_offset_m=to, yaw_rad=pick(fe.yaw_rad, yaw_rad),
-                                      pitch_rad=pick(fe.pitch_rad, pitch_rad), elevation_rad=el)
+                                      fe.separation_m[q], offsets_m, elevation_rad=el,
+                                      layout=ModuleLayout(ro, to, pick(fe.yaw_rad, yaw_rad),
+                                                          pick(fe.pitch_rad, pitch_rad)))
         if rut_offset_m is None and rut_yaw_rad is None:
             rut_tx, rut_rx = rut.tx_world, rut.rx_world
         else:

@@ -3,6 +3,7 @@ the hand-overs marked, and the angle error, per AoA mode side by side."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Mapping
 
 import numpy as np
@@ -103,8 +104,22 @@ def _objects(top, bottom, t, objects) -> None:
                 label="object: RTS - truth twin detection of the cell")
 
 
-def playback_animation(path, time_s, fe_azimuth_deg, amplitude, target_xy_m, set_deg,
-                       detected_deg, arc_radius_m: float, *, title: str = "", fps: int = 5):
+@dataclass(frozen=True)
+class DriveFrames:
+    """What :func:`playback_animation` shows of each of F frames of a drive: the frame times
+    ``time_s`` (F,), the programmed ``amplitude`` (F, Q) per channel (0: off), the targets'
+    set positions ``target_xy_m`` (F, T, 2) (x right, y along the boresight) and their set
+    and detected azimuths ``set_deg``, ``detected_deg`` (F, T) (detected NaN where lost)."""
+
+    time_s: np.ndarray
+    amplitude: np.ndarray
+    target_xy_m: np.ndarray
+    set_deg: np.ndarray
+    detected_deg: np.ndarray
+
+
+def playback_animation(path, frames: DriveFrames, fe_azimuth_deg, arc_radius_m: float, *,
+                       title: str = "", fps: int = 5):
     """An animated GIF of a drive (matplotlib's ``PillowWriter``): left, the arc
     seen from above with the RuT at its centre, every front end (filled and sized by its
     programmed amplitude when it carries a target) and each target's set (line) and detected
@@ -113,11 +128,9 @@ def playback_animation(path, time_s, fe_azimuth_deg, amplitude, target_xy_m, set
     Parameters
     ----------
     path : where the GIF goes (written atomically)
-    time_s : (F,) frame times
+    frames : DriveFrames
+        The frames' times, programmed amplitudes, targets' positions and azimuths.
     fe_azimuth_deg : (Q,) front-end azimuths
-    amplitude : (F, Q) the programmed amplitude per frame and channel (0: off)
-    target_xy_m : (F, T, 2) the targets' set positions (x right, y along the boresight)
-    set_deg, detected_deg : (F, T) azimuths (detected NaN where lost)
     arc_radius_m : the arc's radius
     """
     from matplotlib.animation import FuncAnimation, PillowWriter
@@ -126,11 +139,11 @@ def playback_animation(path, time_s, fe_azimuth_deg, amplitude, target_xy_m, set
     from .figures import STYLE
     import matplotlib as mpl
 
-    t = np.asarray(time_s, float)
+    t = np.asarray(frames.time_s, float)
     az = np.radians(np.asarray(fe_azimuth_deg, float))
-    amp = np.asarray(amplitude, float)
-    xy = np.asarray(target_xy_m, float)
-    s_rad, d_rad = np.radians(set_deg), np.radians(detected_deg)
+    amp = np.asarray(frames.amplitude, float)
+    xy = np.asarray(frames.target_xy_m, float)
+    s_rad, d_rad = np.radians(frames.set_deg), np.radians(frames.detected_deg)
     with mpl.rc_context(STYLE):
         fig, (ax, ax2) = new_figure(figsize=(9.0, 4.4), ncols=2)
         r = arc_radius_m

@@ -14,7 +14,7 @@ from rtsgeom.analysis.tolerance.montecarlo import ToleranceModel
 from rtsgeom.analysis.design import two_front_end_scene
 from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
 from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
-from rtsgeom.analysis.tolerance.draws import draw_chunks, subbin_draws
+from rtsgeom.analysis.tolerance.draws import DrawStreams, draw_chunks, subbin_draws
 from rtsgeom.errors import ParameterError
 from rtsgeom.geometry import build_setup
 from rtsgeom.scene import load_scene
@@ -70,7 +70,8 @@ def test_arc_pairs_share_one_target_position(radius_m, angles):
                       keep_errors=True, chunk=40)
     idx = next(subbin_draws(seed, draws, steps.size, draws))
     assert np.array_equal(res.subbin_steps, steps[idx])
-    again = next(draw_chunks(seed, draws, n_fe, "uniform", draws, positions=steps.size)).subbin()
+    again = next(draw_chunks(seed, draws, n_fe, "uniform", draws,
+                             DrawStreams(positions=steps.size))).subbin()
     assert np.array_equal(again, idx)
     off = res.errors["offsets_m"]
     centre = monte_carlo(ToleranceModel.arc(models, n_fe), b, draws, seed, "uniform", 0.05,

@@ -35,9 +35,10 @@ def test_reference_models_turned_equal_models_built(phase_deg, pair):
     phasor._MODELS.clear()
     built = phasor.phasor_sweep(reference_setup(probes.nominal[0], pair[1],
                                                 np.radians(phase_deg)),
-                                probes.nominal[1], probes.nominal, pair, probes.targets,
-                                probes.alphas, deltas, probes.base_offsets,
-                                probes.gain_correction)
+                                probes.nominal[1], probes.nominal,
+                                phasor.PairChannels(pair, probes.base_offsets,
+                                                    probes.gain_correction),
+                                probes.targets, probes.alphas, deltas)
     scale = np.max(np.abs(built.spectra))
     assert np.max(np.abs(fast.spectra - built.spectra)) < 1e-12 * scale
     assert np.array_equal(fast.bin_index, built.bin_index)

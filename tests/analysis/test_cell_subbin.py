@@ -16,6 +16,7 @@ from scipy.constants import c
 from rtsgeom.analysis.tolerance.draws import subbin_draws, subbin_positions
 from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
 from rtsgeom.analysis.tolerance.phasors import CASES, ChannelPhasors
+from rtsgeom.analysis.tolerance.config import MonteCarlo
 from rtsgeom.analysis.tolerance.verify import verify_draws
 from rtsgeom.geometry import build_setup
 from rtsgeom.scene import load_scene
@@ -109,7 +110,7 @@ def test_model_matches_the_chain_across_the_bin(model):
     through the full ADC-cube chain at every set-point: the fast model within 1e-4 deg."""
     n_u = model.subbin_steps.size
     pos = [0, n_u // 4, model.subbin_zero, 3 * n_u // 4, n_u - 1]
-    v = verify_draws(model, [1e-4] * 3, len(pos), seed=2, all_points=True,
+    v = verify_draws(model, [1e-4] * 3, MonteCarlo(draws=len(pos), seed=2), all_points=True,
                           positions=pos)
     assert v.max_difference_deg < 1e-4
     assert all(c["missed"] == 0 for c in v.to_dict()["cases"].values())
@@ -124,7 +125,7 @@ def test_bin_edge_draws_match_the_chain():
     res = monte_carlo(m, [3e-4] * 3, 60, seed=4, cases=("calibrated",))
     worst = np.argsort(-res.worst_error_deg["calibrated"][:, 2])[:4]
     n = int(worst.max()) + 1
-    v = verify_draws(m, [3e-4] * 3, n, seed=4, cases=("calibrated",))
+    v = verify_draws(m, [3e-4] * 3, MonteCarlo(draws=n, seed=4), cases=("calibrated",))
     diff = np.abs(v.chain_deg["calibrated"] - v.model_deg["calibrated"])
     assert np.max(diff[worst]) < 1e-4
     assert math.isfinite(v.max_difference_deg)

@@ -18,6 +18,7 @@ from conftest import (
 
 from rtsgeom.analysis.design import (
     METRICS,
+    DesignSpec,
     design_grid,
     evaluate_design,
     two_front_end_scene,
@@ -35,8 +36,8 @@ def scene():
 
 @pytest.fixture(scope="module")
 def grid(scene):
-    return design_grid(scene, (0, 1), [0.5, 1.0, 2.0], [8.8, 19.0], draws=200, seed=1,
-                       points=11)
+    return design_grid(scene, (0, 1), [0.5, 1.0, 2.0], [8.8, 19.0],
+                       DesignSpec(draws=200, seed=1, points=11))
 
 
 def test_output_shapes(grid):
@@ -162,9 +163,9 @@ def test_design_grid_in_processes_is_the_same_grid(scene, grid):
     """``workers=2`` spreads the designs over two processes: the same designs, in the same
     order, bit for bit, and the progress still counts every design once, in order."""
     seen = []
-    par = design_grid(scene, (0, 1), [0.5, 1.0, 2.0], [8.8, 19.0], draws=200, seed=1,
-                      points=11, progress=lambda done, total: seen.append((done, total)),
-                      workers=2)
+    par = design_grid(scene, (0, 1), [0.5, 1.0, 2.0], [8.8, 19.0],
+                      DesignSpec(draws=200, seed=1, points=11),
+                      progress=lambda done, total: seen.append((done, total)), workers=2)
     assert json.dumps(par.to_dict()) == json.dumps(grid.to_dict())
     assert seen == [(k, 6) for k in range(1, 7)]
 
@@ -201,7 +202,7 @@ def test_design_grid_refuses_elevation(scene, where, elevation_deg):
     else:
         cell = dataclasses.replace(scene, targets=(TargetConfig(5.0, elevation_rad=el),))
     with pytest.raises(ParameterError, match="tolerance SCENE --cell all"):
-        design_grid(cell, (0, 1), [1.0], [8.0], draws=10, points=5)
+        design_grid(cell, (0, 1), [1.0], [8.0], DesignSpec(draws=10, points=5))
 
 
 @pytest.mark.parametrize("scene_file", ["diewald2022.toml", "custom-array.toml"])
@@ -214,7 +215,7 @@ def test_the_scenes_own_errors_do_not_enter_the_design(scene_file, section, key,
     from rtsgeom.analysis.design import evaluate_design
     clean, moved = scenes_with_and_without_error(ROOT / "scenes" / scene_file, section, key,
                                                  value)
-    a, b = (evaluate_design(s, (0, 1), 1.0, math.radians(8), draws=40, points=3)
+    a, b = (evaluate_design(s, (0, 1), 1.0, math.radians(8), DesignSpec(draws=40, points=3))
             for s in (clean, moved))
     assert a == b
 
@@ -254,7 +255,7 @@ def test_a_valid_scene_whose_nominal_would_break_a_target_rule_is_still_designed
     scene = moved(limit - 0.004)  # valid as built ...
     with pytest.raises(SceneError, match="targets"):
         nominal_scene(scene)  # ... not as designed
-    d = evaluate_design(scene, (0, 1), 1.0, math.radians(8), draws=40, points=3)
+    d = evaluate_design(scene, (0, 1), 1.0, math.radians(8), DesignSpec(draws=40, points=3))
     assert d["problem"] is None and math.isfinite(d["sigma_calibrated_mm"])
     arc_scene(scene, 1.0, np.radians([-8.0, 0.0, 8.0]))
     from rtsgeom.errors import NominalSetupWarning
@@ -270,7 +271,7 @@ def test_design_grid_flags_spacings_beyond_the_resolution_and_reports_progress()
     from rtsgeom.geometry.farfield import angular_resolution_rad
     s = small_quiet([], samples_per_chirp=512)
     seen = []
-    grid = design_grid(s, (0, 1), [1.0], [8.0, 20.0], draws=20, points=5,
+    grid = design_grid(s, (0, 1), [1.0], [8.0, 20.0], DesignSpec(draws=20, points=5),
                        progress=lambda done, total: seen.append((done, total)))
     res = np.degrees(angular_resolution_rad(build_setup(s).rut))
     flags = {round(d["spacing_deg"]): d["exceeds_resolution"] for d in grid.designs}

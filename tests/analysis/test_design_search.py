@@ -7,6 +7,7 @@ import pytest
 
 from rtsgeom.analysis.design import pilot_estimate, tolerance_search
 from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
+from rtsgeom.analysis.tolerance.config import MonteCarlo
 from rtsgeom.analysis.tolerance.search import largest_passing_scale, max_sigma_for_yield
 from rtsgeom.geometry import build_setup
 
@@ -45,8 +46,8 @@ def test_pilot_started_search_agrees_with_the_plain_search(model, case):
     evaluated within rel_tol of a failing one: each lies within rel_tol below the exact
     answer), with fewer full Monte Carlos."""
     draws, seed, rel_tol = 1000, 3, 0.02
-    plain = max_sigma_for_yield(model, [1e-4] * 3, draws, seed, 0.95, 0.1, case,
-                                rel_tol=rel_tol)
+    plain = max_sigma_for_yield(model, [1e-4] * 3, MonteCarlo(draws=draws, seed=seed), 0.95,
+                                0.1, case, rel_tol=rel_tol)
     fast = tolerance_search(model, case, draws, seed, 0.95, 0.1, rel_tol)
     a, b = plain["sigma_mm"]["radial"], fast["sigma_mm"]["radial"]
     assert a > 0 and b > 0 and not fast["capped"]

@@ -233,6 +233,7 @@ def test_sensitivity_coefficients_match_finite_differences_of_the_full_model():
     from rtsgeom.calibration.pair import calibrate_pair
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
+    from rtsgeom.calibration.phasor import PairChannels
     from rtsgeom.pipeline.pair import pair_design
     from rtsgeom.scene import TargetConfig
     from rtsgeom.calibration.probes import probe_ranges
@@ -249,9 +250,9 @@ def test_sensitivity_coefficients_match_finite_differences_of_the_full_model():
     # the programme the budget's operating point uses
     cal = calibrate_pair(setup, paths, pair, probe, seed=scene.seed)
     t = TargetConfig(float(probe_ranges(setup, 1)[0]), 0.0, 10.0, alpha)
-    a_i, a_j, _, off_j = pair_design(setup, paths, pair, t, scene.rts.aoa_mode,
+    channels = PairChannels(pair, (0.0, cal.delta_tau_s), probe.gain_correction[list(pair)])
+    a_i, a_j, _, off_j = pair_design(setup, paths, channels, t, scene.rts.aoa_mode,
                                      probe_angles(*probe.angle_rad[list(pair)]),
-                                     (0.0, cal.delta_tau_s), probe.gain_correction[list(pair)],
                                      cal.quantisation_residual_s)
     # J's delay, deg/ps
     h = 0.5e-12

@@ -68,12 +68,13 @@ def test_linearity_sweeps_the_inner_span_and_reports_relative_amplitudes(cal_set
     assert amp_db.max() == 0.0 and np.all(amp_db <= 0.0)
     # 20 log10 of the programmed amplitudes relative to the largest
     from rtsgeom.calibration.probes import probe_angles, probe_ranges
+    from rtsgeom.calibration.phasor import PairChannels
     from rtsgeom.pipeline.pair import pair_design
     from rtsgeom.scene import TargetConfig
     rng = float(probe_ranges(setup, 1)[0])
-    amps = np.array([pair_design(setup, paths, (0, 1), TargetConfig(rng, 0.0, 10.0, float(a)),
+    channels = PairChannels((0, 1), (0.0, cal.delta_tau_s), probe.gain_correction[[0, 1]])
+    amps = np.array([pair_design(setup, paths, channels, TargetConfig(rng, 0.0, 10.0, float(a)),
                                  "exact", probe_angles(*probe.angle_rad[[0, 1]]),
-                                 (0.0, cal.delta_tau_s), probe.gain_correction[[0, 1]],
                                  cal.quantisation_residual_s)[:2]
                      for a in np.radians(lin.set_deg)]).T
     np.testing.assert_allclose(amp_db, 20 * np.log10(amps / amps.max()), atol=1e-9)

@@ -19,6 +19,7 @@ from conftest import (
 )
 from scipy.constants import c
 
+from rtsgeom.analysis.tolerance.config import MonteCarlo
 from rtsgeom.analysis.tolerance.draws import draw_offsets
 from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
 from rtsgeom.analysis.tolerance.phasors import CASES, NOMINAL_AMPLITUDES, ChannelPhasors
@@ -281,18 +282,19 @@ def test_draw_chunks_regenerate_the_streams_bit_for_bit(distribution, chunk):
     """The chunks a cluster is sent (stream states, not draws) rebuild exactly the draws of
     standard_draws / subbin_draws, whatever the chunk size."""
     from rtsgeom.analysis.tolerance.draws import (
+        DrawStreams,
         draw_chunks,
         standard_draws,
         subbin_draws,
     )
     sigma = np.array([1.0, 2.0, 3.0]) * 1e-4
-    parts = list(draw_chunks(5, 300, 2, distribution, chunk, positions=9, centre=4))
+    parts = list(draw_chunks(5, 300, 2, distribution, chunk, DrawStreams(positions=9, centre=4)))
     assert [p.k for p in parts] == [min(chunk, 300 - s) for s in range(0, 300, chunk)]
     offsets = np.concatenate([p.offsets() for p in parts]) * sigma
     subbin = np.concatenate([p.subbin() for p in parts])
     assert np.array_equal(offsets, np.concatenate(list(standard_draws(5, 300, distribution))) * sigma)
     assert np.array_equal(subbin, np.concatenate(list(subbin_draws(5, 300, 9))))
-    centre = draw_chunks(5, 300, 2, distribution, chunk, positions=None, centre=4)
+    centre = draw_chunks(5, 300, 2, distribution, chunk, DrawStreams(positions=None, centre=4))
     assert np.array_equal(np.concatenate([p.subbin() for p in centre]), np.full(300, 4))
 
 
@@ -366,8 +368,8 @@ def test_uniform_draws_stay_within_their_bounds():
 
 
 def test_inversion_finds_the_sigma_at_the_yield(model):
-    inv = max_sigma_for_yield(model, [1e-4] * 3, 400, seed=4, target_yield=0.9, spec_deg=0.1,
-                              case="uncalibrated", rel_tol=0.02)
+    inv = max_sigma_for_yield(model, [1e-4] * 3, MonteCarlo(draws=400, seed=4), target_yield=0.9,
+                              spec_deg=0.1, case="uncalibrated", rel_tol=0.02)
     sig = inv["sigma_mm"]["radial"]
     assert inv["sigma_mm"]["tangential"] == sig == inv["sigma_mm"]["height"]
     assert inv["yield"] >= 0.9 and not inv["capped"]
@@ -376,8 +378,8 @@ def test_inversion_finds_the_sigma_at_the_yield(model):
     above = [y for s, y in ev if s > sig]
     assert above and max(above) < 0.9
     # one axis: height errors are second order (both legs grow by dz^2 / 2R): never the limit
-    h = max_sigma_for_yield(model, [1e-5] * 3, 200, seed=4, target_yield=0.9, spec_deg=0.1,
-                            case="calibrated", axis="height", cap_m=2e-3)
+    h = max_sigma_for_yield(model, [1e-5] * 3, MonteCarlo(draws=200, seed=4), target_yield=0.9,
+                            spec_deg=0.1, case="calibrated", axis="height", cap_m=2e-3)
     assert h["capped"] and h["sigma_mm"]["radial"] == pytest.approx(0.01)
 
 
@@ -534,12 +536,13 @@ def test_arc_draws_do_not_depend_on_the_chunk(distribution):
     """The unit draws are the same whatever the chunk size (each stream from its own
     generator), with the documented shapes; uniform ones fill [-1, 1], normal ones have unit
     variance."""
-    from rtsgeom.analysis.tolerance.draws import Bounds, draw_chunks
+    from rtsgeom.analysis.tolerance.draws import Bounds, DrawStreams, draw_chunks
     draws, count = 400, 3
     ref = None
     unit = Bounds((1.0,) * 3, 1.0, 1.0, (1.0,) * 3, 1.0)
     for chunk in (1, 37, 400, 10_000):
-        parts = list(draw_chunks(5, draws, count, distribution, chunk, rotations=True, rut=True))
+        parts = list(draw_chunks(5, draws, count, distribution, chunk,
+                                 DrawStreams(rotations=True, rut=True)))
         assert len(parts) == -(-draws // chunk)
         errs = [p.errors(unit) for p in parts]
         got = {"offsets": np.concatenate([e["offsets_m"] for e in errs]),
@@ -572,10 +575,11 @@ def test_arc_yield_search_stops_at_zero_when_the_nominal_arc_fails():
     models = ToleranceModel.arc([ChannelPhasors.build(setup, (0, 1), 3)], 2)
     b = Bounds((1e-4, 1e-4, 1e-4))
     # the nominal calibrated synthesis is exact to ~1e-5 deg: a spec below that fails at 0
-    res = max_scale_for_yield(models, b, 20, 1, 0.9, spec_deg=1e-12, case="uncalibrated")
+    res = max_scale_for_yield(models, b, MonteCarlo(draws=20, seed=1), 0.9, spec_deg=1e-12,
+                              case="uncalibrated")
     assert res["factor"] == 0.0 and res["yield"] == 0.0 and not res["capped"]
-    ok = max_scale_for_yield(models, b, 20, 1, 0.9, spec_deg=0.1, case="calibrated",
-                             rel_tol=0.1)
+    ok = max_scale_for_yield(models, b, MonteCarlo(draws=20, seed=1), 0.9, spec_deg=0.1,
+                             case="calibrated", rel_tol=0.1)
     assert ok["factor"] > 0 and ok["yield"] >= 0.9
 
 
@@ -639,8 +643,8 @@ def test_yield_inversion_says_when_the_nominal_setup_misses_the_spec():
     from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
     from rtsgeom.analysis.tolerance.search import max_sigma_for_yield
     model = ChannelPhasors.build(build_setup(small_quiet([])), (0, 1), points=3)
-    res = max_sigma_for_yield(model, [1e-4] * 3, 20, 0, 0.95, spec_deg=1e-9,
-                              case="uncalibrated")
+    res = max_sigma_for_yield(model, [1e-4] * 3, MonteCarlo(draws=20, seed=0), 0.95,
+                              spec_deg=1e-9, case="uncalibrated")
     assert "misses the spec" in str(res.get("note"))
 
 

@@ -18,6 +18,7 @@ from conftest import ROOT
 from rtsgeom.analysis.tolerance.phasors import CASES
 from rtsgeom.analysis.tolerance.draws import draw_offsets, standard_draws
 from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
+from rtsgeom.analysis.tolerance.config import MonteCarlo
 from rtsgeom.analysis.tolerance.search import max_sigma_for_yield
 from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
 from rtsgeom.analysis.tolerance.verify import verify_draws
@@ -166,8 +167,8 @@ def test_statistics_keys_and_yield(model):
 
 def test_yield_search_brackets_the_target():
     model = ChannelPhasors.build(build_setup(cell_scene(*CELLS[0])), points=4)
-    inv = max_sigma_for_yield(model, [1e-4, 0.0, 0.0], 100, 4, 0.9, spec_deg=0.05,
-                                   case="calibrated", axis="radial", rel_tol=0.05)
+    inv = max_sigma_for_yield(model, [1e-4, 0.0, 0.0], MonteCarlo(draws=100, seed=4), 0.9,
+                              spec_deg=0.05, case="calibrated", axis="radial", rel_tol=0.05)
     sig = inv["sigma_mm"]["radial"] * 1e-3
     assert not inv["capped"] and inv["yield"] >= 0.9
     above = monte_carlo(model, [sig * 1.12, 0.0, 0.0], 100, 4, spec_deg=0.05,
@@ -179,7 +180,7 @@ def test_fast_model_matches_the_full_chain():
     """Two draws (0.1 mm per axis) through the ADC-cube chain (range-Doppler, CFAR, the 2-D
     beamformer) at every set-point, both cases: the phasor model within 1e-4 deg."""
     model = ChannelPhasors.build(build_setup(cell_scene(*CELLS[1])), points=4)
-    v = verify_draws(model, [1e-4] * 3, 2, seed=7, all_points=True)
+    v = verify_draws(model, [1e-4] * 3, MonteCarlo(draws=2, seed=7), all_points=True)
     assert v.max_difference_deg < 1e-4
     assert all(c["missed"] == 0 for c in v.to_dict()["cases"].values())
 

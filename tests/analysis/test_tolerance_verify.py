@@ -9,6 +9,7 @@ from scipy.constants import c
 
 from rtsgeom.analysis.tolerance.phasors import CASES, NOMINAL_AMPLITUDES, ChannelPhasors
 from rtsgeom.analysis.tolerance.draws import draw_subbins
+from rtsgeom.analysis.tolerance.config import MonteCarlo
 from rtsgeom.analysis.tolerance.verify import verify_draws
 from rtsgeom.geometry import build_setup
 
@@ -23,7 +24,8 @@ def test_fast_model_agrees_with_the_adc_cube_chain(radius_m, sigma_mm):
     + beamformer search: the detected angle at each draw's worst set-point as modelled."""
     scene = make_scene(lambda d: d["rts"].__setitem__("arc_radius_m", radius_m))
     model = ChannelPhasors.build(build_setup(scene), (0, 1), 7)
-    res = verify_draws(model, [sigma_mm * 1e-3] * 3, 4, 17, cases=CASES + (NOMINAL_AMPLITUDES,))
+    res = verify_draws(model, [sigma_mm * 1e-3] * 3, MonteCarlo(draws=4, seed=17),
+                       cases=CASES + (NOMINAL_AMPLITUDES,))
     assert res.max_difference_deg < REQUIRED_DEG, res.to_dict()
     # not a test that cannot fail: the draws reach errors far beyond the agreement
     assert max(np.max(np.abs(v)) for v in res.model_deg.values()) > 20 * res.max_difference_deg
@@ -33,7 +35,7 @@ def test_every_set_point_and_the_worst_agree_with_the_chain():
     """``all_points``: every set-point of a draw through the chain, and the study's per-draw
     statistic (the worst error over the set-points) from both."""
     model = ChannelPhasors.build(build_setup(make_scene()), (0, 1), 5)
-    res = verify_draws(model, [2e-4] * 3, 2, 7, all_points=True)
+    res = verify_draws(model, [2e-4] * 3, MonteCarlo(draws=2, seed=7), all_points=True)
     for case in CASES:
         assert res.model_deg[case].shape == (2, 5)
         assert np.max(res.difference_deg(case)) < REQUIRED_DEG
@@ -62,7 +64,7 @@ def test_verify_200_on_the_default_study():
     from rtsgeom.scene import load_scene
     scene = load_scene("scenes/diewald2022.toml")
     model = ChannelPhasors.build(build_setup(scene), (0, 1))
-    res = verify_draws(model, [1e-4] * 3, 200, scene.seed)
+    res = verify_draws(model, [1e-4] * 3, MonteCarlo(draws=200, seed=scene.seed))
     assert res.max_difference_deg < REQUIRED_DEG, res.to_dict()
 
 
@@ -107,5 +109,6 @@ def test_bin_centre_model_agrees_with_the_chain_on_a_planned_arc(radius_m):
     plan = coverage.plan_arc(load_scene("scenes/diewald2022.toml"),
                              (math.radians(-10), math.radians(10)), radius_m)
     model = ChannelPhasors.build(build_setup(plan.scene), (0, 1), 11)
-    v = verify_draws(model, (0.5e-3,) * 3, 12, 0, cases=("calibrated",), subbin=False)
+    v = verify_draws(model, (0.5e-3,) * 3, MonteCarlo(draws=12, seed=0, subbin=False),
+                     cases=("calibrated",))
     assert np.max(v.difference_deg("calibrated")) < 0.005

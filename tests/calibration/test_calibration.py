@@ -521,6 +521,7 @@ def test_fir_changes_linearity_by_no_more_than_its_phase_ripple_explains(taps):
     from rtsgeom.calibration.probes import mean_air_delay
     from rtsgeom.calibration.fir import fir_bin_gain
     from rtsgeom.analysis.linearity import linearity
+    from rtsgeom.calibration.phasor import PairChannels
     from rtsgeom.pipeline.pair import pair_design
     from rtsgeom.synthesis.model import ChannelModel
     from rtsgeom.rts.channels import requested_delay
@@ -544,8 +545,10 @@ def test_fir_changes_linearity_by_no_more_than_its_phase_ripple_explains(taps):
     alphas = probe_angles(*probe.angle_rad[[0, 1]])
     for k, a in enumerate(np.radians(l_i.set_deg)):
         t = TargetConfig(rng, 0.0, 10.0, float(a))
-        _, _, rho, off_j = pair_design(ideal, paths, (0, 1), t, "exact", alphas,
-                                       (0.0, c_i.delta_tau_s), probe.gain_correction[[0, 1]])
+        _, _, rho, off_j = pair_design(ideal, paths,
+                                       PairChannels((0, 1), (0.0, c_i.delta_tau_s),
+                                                    probe.gain_correction[[0, 1]]),
+                                       t, "exact", alphas)
         m = ChannelModel.build(ideal, paths, (0, 1), t, (0.0, off_j))
         ph = float(m.pair_phase(alphas))
         worst = max(abs(float(m.direction(m.pair_weights(rho, (0.0, ph + s))))
@@ -673,7 +676,7 @@ def test_fine_sweep_is_fitted_up_to_its_first_jump_either_side():
     """``continuous_steps``: a column that jumps (a probe's bin changing part-way) keeps the
     steps between the jumps around the centre, a smooth column (any curvature) all of them;
     the fitted centre of the kept curve is its centre of symmetry again."""
-    from rtsgeom.calibration.fit import continuous_steps, fit_centre
+    from rtsgeom.calibration.fit import CentreFit, continuous_steps, fit_centre
     period = 1e-9
     d = np.arange(-25, 26) * 10e-12  # +-period/4 in 10 ps steps, centre at index 25
     s0 = 7e-12
@@ -686,9 +689,10 @@ def test_fine_sweep_is_fitted_up_to_its_first_jump_either_side():
     np.testing.assert_array_equal(kept[:, 0], smooth)
     assert np.isnan(kept[:8, 1]).all() and np.isnan(kept[42:, 1]).all()
     np.testing.assert_array_equal(kept[8:42, 1], jumped[8:42])
-    assert fit_centre(d, kept, period, 0.0, search_s=30e-12) == pytest.approx(s0, abs=0.3e-12)
+    assert fit_centre(d, kept, period, 0.0, CentreFit(search_s=30e-12)) == pytest.approx(
+        s0, abs=0.3e-12)
     # without the cut the jumps pull the fitted centre off
-    assert abs(fit_centre(d, e, period, 0.0, search_s=30e-12) - s0) > 1e-12
+    assert abs(fit_centre(d, e, period, 0.0, CentreFit(search_s=30e-12)) - s0) > 1e-12
     assert continuous_steps(e[:5], 2).shape == (5, 2)  # too few steps: as they are
 
 

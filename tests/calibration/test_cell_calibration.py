@@ -28,7 +28,7 @@ def test_fit_on_the_crossing_columns_finds_the_coherence_point_despite_biased_ve
     (1 - cos), its vertex past zero by the estimator's bias, across it odd (sin) with an even
     part: only the across columns cross zero between the window's ends, and their fit as
     crossing columns (zero at the point, any shape) lands on the point within 0.01 ps."""
-    from rtsgeom.calibration.fit import crossing_columns, fit_centre
+    from rtsgeom.calibration.fit import CentreFit, crossing_columns, fit_centre
     near = true_ps * 1e-12 + 40e-12  # the coarse minimum, a step and a half off
     d = near + np.arange(-25, 26) * 10e-12
     th = 2 * np.pi * (d - true_ps * 1e-12) / PERIOD
@@ -37,10 +37,11 @@ def test_fit_on_the_crossing_columns_finds_the_coherence_point_despite_biased_ve
     e = np.stack([odd, -even, 0.8 * odd, 0.9 * even], axis=1)
     cross = crossing_columns(e)
     assert cross.tolist() == [True, False, True, False]
-    got = fit_centre(d, e[:, cross], PERIOD, near, 2, 125e-12, odd=[True, True])
+    got = fit_centre(d, e[:, cross], PERIOD, near, CentreFit(2, 125e-12, odd=[True, True]))
     assert abs(got - true_ps * 1e-12) < 0.01e-12
     # fitted as symmetric (no zero at the point), the odd columns' even part moves it
-    assert abs(fit_centre(d, e[:, cross], PERIOD, near, 2, 125e-12) - true_ps * 1e-12) > 5e-12
+    assert abs(fit_centre(d, e[:, cross], PERIOD, near, CentreFit(2, 125e-12))
+               - true_ps * 1e-12) > 5e-12
 
 
 def test_crossing_columns_none_where_every_error_is_even():

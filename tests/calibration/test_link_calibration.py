@@ -105,7 +105,7 @@ def test_predicted_angle_noise_follows_the_noise_figure(quiet_reference):
     amplitude (x 10^(5/20) per 5 dB, in the linear regime) and the coarse frames as its
     square; NF 12 dB keeps one frame per coarse step (the path before), NF 50 dB averages
     ~100 (one frame there: 1 deg of noise per step, a wrong minimum on 3 of 3 seeds)."""
-    from rtsgeom.calibration.phasor import phasor_sweep
+    from rtsgeom.calibration.phasor import PairChannels, phasor_sweep
     from rtsgeom.calibration.probes import probe_angles, probe_ranges
     from rtsgeom.calibration.steps import (
         COARSE_NOISE_DEG,
@@ -119,11 +119,11 @@ def test_predicted_angle_noise_follows_the_noise_figure(quiet_reference):
     for nf in (12.0, 40.0, 45.0, 50.0):
         s = build_setup(_linked(nf))
         p = exact_paths(s)
-        sweep = phasor_sweep(s, p, nominal_model(s, p), (0, 1),
+        sweep = phasor_sweep(s, p, nominal_model(s, p),
+                             PairChannels((0, 1), (0.0, 0.0), probe.gain_correction),
                              [TargetConfig(float(r)) for r in probe_ranges(s, 2)],
                              np.asarray(probe_angles(*probe.angle_rad[[0, 1]])),
-                             np.arange(-0.5e-9, 1.0e-9 + 1e-12, 25e-12), (0.0, 0.0),
-                             probe.gain_correction)
+                             np.arange(-0.5e-9, 1.0e-9 + 1e-12, 25e-12))
         noise[nf] = predicted_angle_noise(sweep, 0)
     assert coarse_frames(noise[12.0]) == 1
     assert noise[12.0] < COARSE_NOISE_DEG

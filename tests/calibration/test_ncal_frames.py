@@ -29,14 +29,14 @@ def test_fit_scatter_from_one_sweep_is_the_refits_scatter(sigma_rad, amp_rad, tr
     estimate is within 35 % of the std of the minima of 200 independent noisy sweeps
     (32 draws: ~13 % statistical), and the frames it asks for grow as sigma^2."""
     from rtsgeom.calibration.steps import TARGET_BIAS_PS, fine_frames
-    from rtsgeom.calibration.fit import fit_centre, fit_scatter
+    from rtsgeom.calibration.fit import CentreFit, fit_centre, fit_scatter
     near = true_ps * 1e-12 + 30e-12
     d = near + np.arange(-25, 26) * 10e-12
     clean = _curves(d, true_ps * 1e-12, amp_rad)
     rng = np.random.default_rng(7)
 
     def fit(e):
-        return fit_centre(d, e, PERIOD, near, 2, 125e-12, odd=ODD, return_fit=True)
+        return fit_centre(d, e, PERIOD, near, CentreFit(2, 125e-12, odd=ODD), return_fit=True)
     truth = np.std([fit(clean + sigma_rad * rng.standard_normal(clean.shape))[0]
                     for _ in range(200)])
     one = clean + sigma_rad * rng.standard_normal(clean.shape)
@@ -52,12 +52,12 @@ def test_fit_scatter_from_one_sweep_is_the_refits_scatter(sigma_rad, amp_rad, tr
 def test_fit_scatter_is_zero_without_noise_and_unknown_without_enough_steps():
     """No noise: no scatter. Too few steps for a residual (the curves pass through them): not
     "no noise" but unknown (NaN), which the sweep answers with a second, independent one."""
-    from rtsgeom.calibration.fit import fit_centre, fit_scatter
+    from rtsgeom.calibration.fit import CentreFit, fit_centre, fit_scatter
     d = np.arange(-25, 26) * 10e-12
     clean = _curves(d, 0.0, np.radians(0.05))
 
     def fit(e):
-        return fit_centre(d, e, PERIOD, 0.0, 2, 125e-12, odd=ODD, return_fit=True)
+        return fit_centre(d, e, PERIOD, 0.0, CentreFit(2, 125e-12, odd=ODD), return_fit=True)
     _, fitted = fit(clean)
     assert fit_scatter(fit, fitted, clean, 2, 0, (0, 1), odd=ODD)[0] < 1e-15
     few = np.full_like(clean, np.nan)
@@ -73,7 +73,7 @@ def test_coarse_rts_steps_measure_the_noise_from_a_repeated_sweep(sigma_rad):
     it is no measure of the noise (the frames were sized to 1, the scatter reported 0).
     With a second, independent sweep the noise is that of their difference: within 40 % of
     sigma on 5 steps x 2 columns, and the scatter grows with it."""
-    from rtsgeom.calibration.fit import fit_centre, fit_scatter
+    from rtsgeom.calibration.fit import CentreFit, fit_centre, fit_scatter
     d = np.arange(-2, 3) * 100e-12
     clean = _curves(d, 20e-12, np.radians(0.05))
     rng = np.random.default_rng(11)
@@ -81,7 +81,7 @@ def test_coarse_rts_steps_measure_the_noise_from_a_repeated_sweep(sigma_rad):
     two = clean + sigma_rad * rng.standard_normal(clean.shape)
 
     def fit(e):
-        return fit_centre(d, e, PERIOD, 0.0, 2, 250e-12, odd=ODD, return_fit=True)
+        return fit_centre(d, e, PERIOD, 0.0, CentreFit(2, 250e-12, odd=ODD), return_fit=True)
     _, fitted = fit(one)
     # 4 coefficients a column and the shared point on 5 steps: less than one degree of
     # freedom a column, no residual to measure the noise by

@@ -85,7 +85,7 @@ def test_pair_calibration_places_its_probes_over_the_fine_window_and_reports_its
     them for the window +-period/4 around the coarse minimum (the fine sweep's centre), not
     for one delay of it; a noiseless sweep averages one frame per step, ``frames`` sets it."""
     from rtsgeom.calibration.pair import calibrate_pair
-    from rtsgeom.calibration.phasor import place_probes
+    from rtsgeom.calibration.phasor import PairChannels, place_probes
     from rtsgeom.calibration.probes import probe_angles, probe_front_ends, probe_ranges
     from rtsgeom.paths import nominal_model
     setup = build_setup(small_noiseless(
@@ -98,9 +98,9 @@ def test_pair_calibration_places_its_probes_over_the_fine_window_and_reports_its
     near = cal.refine_delta_tau_s[cal.refine_delta_tau_s.size // 2]
     half, step = cal.period_s / 4, setup.scene.rts.calibration_step_s
     alphas = np.asarray(probe_angles(probe.angle_rad[0], probe.angle_rad[1]))
-    expect = place_probes(setup, paths, nominal_model(setup, paths), (0, 1),
-                          probe_ranges(setup, 2), alphas, near + np.arange(-half, half + 1e-15, step),
-                          (0.0, 0.0), tuple(probe.gain_correction[[0, 1]]))
+    expect = place_probes(setup, paths, nominal_model(setup, paths),
+                          PairChannels((0, 1), (0.0, 0.0), tuple(probe.gain_correction[[0, 1]])),
+                          probe_ranges(setup, 2), alphas, near + np.arange(-half, half + 1e-15, step))
     np.testing.assert_allclose(cal.probe_ranges_m, expect, rtol=1e-12)
     assert calibrate_pair(setup, paths, (0, 1), probe, span_s=span, frames=3).frames_per_step == 3
 

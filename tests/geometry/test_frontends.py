@@ -17,6 +17,7 @@ from rtsgeom.analysis.nearfield_terms import (
 from rtsgeom.calibration.probes import probe_ranges
 from rtsgeom.geometry import Setup, build_setup
 from rtsgeom.geometry.arrays import rut_array
+from rtsgeom._lib.arcmath import ModuleLayout
 from rtsgeom.geometry.frontends import (
     antenna_positions,
     front_ends,
@@ -42,16 +43,14 @@ def test_separation_is_the_symmetric_signed_layout(radius, sep):
     s = np.full(ANGLES.size, sep)
     rx0, tx0, m0 = antenna_positions(CENTRE, radius, ANGLES, s, off)
     ro = np.tile([sep / 2, 0.0], (ANGLES.size, 1))
-    rx, tx, m = antenna_positions(CENTRE, radius, ANGLES, None, off, rx_offset_m=ro,
-                                  tx_offset_m=-ro)
+    rx, tx, m = antenna_positions(CENTRE, radius, ANGLES, None, off, layout=ModuleLayout(ro, -ro))
     assert np.allclose(rx, rx0, atol=1e-15) and np.allclose(tx, tx0, atol=1e-15)
     assert np.array_equal(m, m0)
     # Rx towards larger azimuth, as seen from the arc centre; a mirrored module flips it
     az = lambda p: np.arctan2(p[..., 0] - CENTRE[0], p[..., 1] - CENTRE[1])  # noqa: E731
     if sep > 0:
         assert np.all(az(rx) > az(m)) and np.all(az(tx) < az(m))
-        rxm, txm, _ = antenna_positions(CENTRE, radius, ANGLES, None, off, rx_offset_m=-ro,
-                                        tx_offset_m=ro)
+        rxm, txm, _ = antenna_positions(CENTRE, radius, ANGLES, None, off, layout=ModuleLayout(-ro, ro))
         assert np.all(az(rxm) < az(m)) and np.all(az(txm) > az(m))
 
 
@@ -62,8 +61,7 @@ def test_mounting_rotations_are_rigid_about_the_module_centre(yaw_deg, pitch_deg
     pitch = np.full(ANGLES.size, np.radians(pitch_deg))
     ro = np.tile([0.011, 0.004], (ANGLES.size, 1))
     to = np.tile([-0.009, -0.002], (ANGLES.size, 1))
-    rx, tx, mod = antenna_positions(CENTRE, 1.0, ANGLES, None, None, rx_offset_m=ro,
-                                    tx_offset_m=to, yaw_rad=yaw, pitch_rad=pitch)
+    rx, tx, mod = antenna_positions(CENTRE, 1.0, ANGLES, None, None, layout=ModuleLayout(ro, to, yaw, pitch))
     assert np.allclose(np.linalg.norm(rx - mod, axis=-1), np.hypot(0.011, 0.004))
     assert np.allclose(np.linalg.norm(tx - mod, axis=-1), np.hypot(0.009, 0.002))
     assert np.allclose(np.linalg.norm(rx - tx, axis=-1), np.hypot(0.020, 0.006))
@@ -90,12 +88,10 @@ def test_rotations_and_layouts_broadcast_over_draws():
     yaw = rng.normal(0, 0.02, (6, ANGLES.size))
     pitch = rng.normal(0, 0.02, (6, ANGLES.size))
     ro = np.tile([0.01, 0.0], (ANGLES.size, 1))
-    rx, tx, mod = antenna_positions(CENTRE, 0.8, ANGLES, None, off, rx_offset_m=ro,
-                                    tx_offset_m=-ro, yaw_rad=yaw, pitch_rad=pitch)
+    rx, tx, mod = antenna_positions(CENTRE, 0.8, ANGLES, None, off, layout=ModuleLayout(ro, -ro, yaw, pitch))
     assert rx.shape == tx.shape == mod.shape == (6, ANGLES.size, 3)
     for k in range(6):
-        r1, t1, m1 = antenna_positions(CENTRE, 0.8, ANGLES, None, off[k], rx_offset_m=ro,
-                                       tx_offset_m=-ro, yaw_rad=yaw[k], pitch_rad=pitch[k])
+        r1, t1, m1 = antenna_positions(CENTRE, 0.8, ANGLES, None, off[k], layout=ModuleLayout(ro, -ro, yaw[k], pitch[k]))
         assert np.allclose(rx[k], r1) and np.allclose(tx[k], t1) and np.allclose(mod[k], m1)
 
 

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from rtsgeom._lib.arcmath import antenna_positions, module_axes, sphere_frame
+from rtsgeom._lib.arcmath import ModuleLayout, antenna_positions, module_axes, sphere_frame
 from rtsgeom.geometry import build_setup
 from rtsgeom.geometry.sheet import segments_blocked
 from rtsgeom.errors import SceneError
@@ -34,9 +34,10 @@ def test_elevation_zero_is_bit_identical(layout):
     off = rng.normal(0, 1e-3, (5, 7, 3))
     kw = {} if layout is None else dict(yaw_rad=rng.normal(0, .01, 7),
                                         pitch_rad=rng.normal(0, .01, 7))
-    ref = antenna_positions(np.array([0.1, -0.2, 0.3]), 1.3, ang, sep, off, **kw)
+    ref = antenna_positions(np.array([0.1, -0.2, 0.3]), 1.3, ang, sep, off,
+                            layout=ModuleLayout(**kw))
     got = antenna_positions(np.array([0.1, -0.2, 0.3]), 1.3, ang, sep, off,
-                            elevation_rad=np.zeros(7), **kw)
+                            elevation_rad=np.zeros(7), layout=ModuleLayout(**kw))
     for a, b in zip(ref, got):
         assert np.array_equal(a, b)
 

@@ -15,6 +15,7 @@ from conftest import make_scene
 from rtsgeom.calibration.probes import probe_angles
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths, nominal_model
+from rtsgeom.calibration.phasor import PairChannels
 from rtsgeom.pipeline.pair import plan_pair, plan_pairs
 from rtsgeom.radar import peaks
 from rtsgeom.radar.steering import Steering
@@ -91,7 +92,8 @@ def test_batched_plans_are_plan_pairs(window, fir, estimator):
     got = plan_pairs(setup, paths, "exact", rows)
     assert sum(p is not None for p in got) >= 12
     for plan, row in zip(got, rows):
-        want = plan_pair(setup, paths, row[0], row[1], "exact", *row[2:])
+        want = plan_pair(setup, paths, PairChannels(row[0], row[3], row[4]), row[1], "exact",
+                         row[2], row[5])
         if plan is None:  # plan_pair tries the periods either side
             continue
         assert plan.period_offset == want.period_offset == 0

@@ -50,6 +50,7 @@ from scipy.constants import c
 
 from ...calibration.pair import calibrate_pair
 from ...calibration.probes import probe_angles, probe_ranges
+from ...calibration.phasor import PairChannels
 from ...pipeline.pair import pair_design
 from ...radar.budget import window_snr_loss
 from ...radar.link import relative_noise_power
@@ -279,9 +280,10 @@ def pair_accuracy(setup, ideal, paths, pair, probe, angles_rad, inputs: Accuracy
     out = []
     for m, alpha in enumerate(angles_rad):
         t = TargetConfig(rng_m, 0.0, 10.0, float(alpha))
-        a_i, a_j, _, off_j = pair_design(ideal, paths, pair, t, scene.rts.aoa_mode,
+        channels = PairChannels(pair, (0.0, cal.delta_tau_s),
+                                probe.gain_correction[list(pair)])
+        a_i, a_j, _, off_j = pair_design(ideal, paths, channels, t, scene.rts.aoa_mode,
                                          probe_angles(*probe.angle_rad[list(pair)]),
-                                         (0.0, cal.delta_tau_s), probe.gain_correction[list(pair)],
                                          cal.quantisation_residual_s)
         pt = _Point(ideal, paths, pair, t, off_j, np.array([a_i, a_j]), st, coupling, g_gold)
         e0 = float(pt.error_deg()[0])

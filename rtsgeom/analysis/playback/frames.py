@@ -18,8 +18,8 @@ from ...errors import ParameterError
 from ...geometry import Setup
 from ...paths import Paths
 from ...pipeline.merge import budget_targets
-from ...pipeline.plan import (bracketing_pair, calibrate_pairs, lead_program, program_frames,
-                              target_namer, target_pairs, uses_cells)
+from ...pipeline.plan import (FixedCalibration, bracketing_pair, calibrate_pairs, lead_program,
+                              program_frames, target_namer, target_pairs, uses_cells)
 from ...pipeline.run import match_targets, truth_twin
 from ...radar import process
 from ...radar.frame import simulate
@@ -141,7 +141,8 @@ class FramePlanner:
         return program_frames(
             self.setup, self.paths, self.mode,
             [self.budgets[f].targets if self.budgets else self.frames[f] for f in fs],
-            [self.pairs[f] for f in fs], self.probe, self.cals, self.offsets,
+            [self.pairs[f] for f in fs],
+            FixedCalibration(self.probe, self.cals, self.offsets),
             [frame_target_names(scene, f, static, self.frames[f],
                                 self.budgets[f] if self.budgets else None) for f in fs])
 

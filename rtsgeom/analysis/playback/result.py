@@ -332,7 +332,7 @@ class PlaybackResult(Result):
         with the front ends that carry a target, the set and detected directions, and the
         targets' paths (:func:`rtsgeom.viz.playback.playback_animation`)."""
         from ...geometry import build_setup
-        from ...viz.playback import playback_animation  # matplotlib: only for the figure
+        from ...viz.playback import DriveFrames, playback_animation  # matplotlib: the figure
         setup = build_setup(self.scene)
         n_f, n_q = len(self.time_s), setup.fe.count
         amp = np.zeros((n_f, n_q))
@@ -340,8 +340,9 @@ class PlaybackResult(Result):
         np.add.at(amp, (p[:, 0].astype(int), p[:, 2].astype(int)), p[:, 5])
         az = np.radians(self.set["azimuth_deg"])
         xy = self.set["range_m"][..., None] * np.stack([np.sin(az), np.cos(az)], axis=-1)
-        return playback_animation(path, self.time_s, np.degrees(setup.fe_azimuth_rad()), amp,
-                                  xy, self.set["azimuth_deg"], self.detected["azimuth_deg"],
+        frames = DriveFrames(self.time_s, amp, xy, self.set["azimuth_deg"],
+                             self.detected["azimuth_deg"])
+        return playback_animation(path, frames, np.degrees(setup.fe_azimuth_rad()),
                                   self.scene.rts.arc_radius_m,
                                   title=f"{self.scene.name}: {self.mode}", fps=fps)
 

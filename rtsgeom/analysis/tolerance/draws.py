@@ -38,7 +38,7 @@ from ...errors import ParameterError
 from .args import DISTRIBUTIONS, MAX_SIGMA_MM, STUDY_ARGS
 
 __all__ = ["AXES", "DISTRIBUTIONS", "DEFAULT_CHUNK", "MAX_SIGMA_MM", "Bounds",
-           "unit_block", "subbin_positions", "centre_index", "DrawChunk", "draw_chunks",
+           "unit_block", "subbin_positions", "centre_index", "DrawChunk", "DrawStreams", "draw_chunks",
            "standard_draws", "subbin_draws", "draw_offsets", "draw_subbins"]
 
 AXES = ("radial", "tangential", "height")
@@ -196,13 +196,27 @@ class DrawChunk:
         return out
 
 
+@dataclass(frozen=True)
+class DrawStreams:
+    """Which of a study's random streams :func:`draw_chunks` draws beside the offsets':
+    ``positions``, the count of sub-bin positions (None: no sub-bin stream, every draw at
+    the bin centre ``centre``, an index into them); ``rotations`` (the front ends' yaw and
+    pitch) and ``rut`` (the RuT's pose): whether those streams are drawn."""
+
+    positions: int | None = None
+    centre: int = 0
+    rotations: bool = False
+    rut: bool = False
+
+
 def draw_chunks(seed: int, draws: int, count: int, distribution: str = "normal",
-                chunk: int = DEFAULT_CHUNK, *, positions: int | None = None, centre: int = 0,
-                rotations: bool = False, rut: bool = False) -> Iterator[DrawChunk]:
+                chunk: int = DEFAULT_CHUNK, streams: DrawStreams = DrawStreams()
+                ) -> Iterator[DrawChunk]:
     """A study's draws chunk by chunk as :class:`DrawChunk` (the streams advanced here by
-    drawing each chunk once: normal draws take a varying number of raw numbers each).
-    ``positions``: the count of sub-bin positions (None: every draw at the bin centre
-    ``centre``); ``rotations``, ``rut``: whether those streams are drawn."""
+    drawing each chunk once: normal draws take a varying number of raw numbers each):
+    ``draws`` of ``count`` front ends' offsets, and the ``streams`` beside them."""
+    positions, centre = streams.positions, streams.centre
+    rotations, rut = streams.rotations, streams.rut
     STUDY_ARGS["distribution"].check(distribution, "distribution", "draw_chunks")
     rng = np.random.default_rng(seed)
     g_sub = None if positions is None else np.random.default_rng([int(seed), SUBBIN_STREAM])

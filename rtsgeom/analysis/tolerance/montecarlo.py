@@ -27,7 +27,7 @@ from ..._lib.results import Result
 from ..._lib.util import frozen
 from ...errors import ParameterError
 from .config import Mapper, MonteCarlo, Progress
-from .draws import AXES, Bounds, DrawChunk, draw_chunks
+from .draws import AXES, Bounds, DrawChunk, DrawStreams, draw_chunks
 from .present import columns as _columns, figure as _figure, summary as _summary
 from .phasors import CASES, ChannelPhasors
 
@@ -417,10 +417,11 @@ def simulate(model, bounds, mc: MonteCarlo, spec_deg: float = 0.1, cases=CASES,
     bounds = as_bounds(bounds)
     bounds.check()
     positions = model.subbin_steps
-    chunks = draw_chunks(seed, draws, model.count, distribution, chunk,
-                         positions=positions.size if subbin else None,
-                         centre=int(np.flatnonzero(positions == 0)[0]) if positions.size else 0,
-                         rotations=bounds.rotations, rut=bounds.rut_pose)
+    streams = DrawStreams(
+        positions=positions.size if subbin else None,
+        centre=int(np.flatnonzero(positions == 0)[0]) if positions.size else 0,
+        rotations=bounds.rotations, rut=bounds.rut_pose)
+    chunks = draw_chunks(seed, draws, model.count, distribution, chunk, streams)
     func = functools.partial(_evaluate, shared, bounds=bounds, cases=tuple(cases),
                              keep=keep_errors)
     parts, done = [], 0

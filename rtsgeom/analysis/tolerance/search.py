@@ -198,7 +198,7 @@ def _search(model, line, start: float, mc: MonteCarlo, search: YieldSearch, labe
     return history, (t, y, capped, None)
 
 
-def max_sigma_for_yield(model, sigma_m, draws: int, seed: int, target_yield: float,
+def max_sigma_for_yield(model, sigma_m, mc: MonteCarlo, target_yield: float,
                         spec_deg: float = 0.1, case: str = "calibrated", axis: str = "all",
                         **options) -> dict:
     """The largest mounting tolerance (the offsets' sigmas) that keeps ``target_yield`` of the
@@ -209,29 +209,28 @@ def max_sigma_for_yield(model, sigma_m, draws: int, seed: int, target_yield: flo
     model : ToleranceModel or ChannelPhasors
     sigma_m : array_like of 3 float
         The sigmas' ratios (``axis="all"``), or the held sigmas (an axis name), m.
-    draws, seed
-        As :class:`~.config.MonteCarlo`.
+    mc : MonteCarlo
+        The draws of every evaluation (its seed set).
     target_yield, spec_deg, case
         As :class:`YieldSearch`.
     axis : {'all', 'radial', 'tangential', 'height'}
     **options
-        :class:`~.config.MonteCarlo`'s ``distribution``, ``chunk``, ``mapper``, ``progress``,
-        ``subbin``; :class:`YieldSearch`'s ``rel_tol``, ``slope``; ``cap_m`` (the cap, m);
-        ``bounds`` (rotations and RuT pose, held).
+        :class:`YieldSearch`'s ``rel_tol``, ``slope``; ``cap_m`` (the cap, m); ``bounds``
+        (rotations and RuT pose, held).
 
     Returns
     -------
     dict
         ``sigma_mm`` per axis, ``yield``, ``capped``, ``note``, ``evaluations``.
     """
-    mc, rest = MonteCarlo.split(dict(options, draws=int(draws), seed=int(seed)))
+    rest = dict(options)
     bounds = rest.pop("bounds", None)
     search = YieldSearch(target_yield, spec_deg, case, rest.pop("rel_tol", 0.01),
                          rest.pop("cap_m", 0.01), **rest)
     return search.sigma(model, sigma_m, mc, axis, bounds)
 
 
-def max_scale_for_yield(model, bounds, draws: int, seed: int, target_yield: float,
+def max_scale_for_yield(model, bounds, mc: MonteCarlo, target_yield: float,
                         spec_deg: float = 0.1, case: str = "calibrated", **options) -> dict:
     """The largest factor s on ``bounds`` that keeps ``target_yield`` of the setups within
     ``spec_deg``: :meth:`YieldSearch.scale`.
@@ -241,21 +240,19 @@ def max_scale_for_yield(model, bounds, draws: int, seed: int, target_yield: floa
     model : ToleranceModel or ChannelPhasors
     bounds : Bounds or array_like of 3 float
         Every bound of the study (SI), scaled together.
-    draws, seed
-        As :class:`~.config.MonteCarlo`.
+    mc : MonteCarlo
+        The draws of every evaluation (its seed set).
     target_yield, spec_deg, case
         As :class:`YieldSearch`.
     **options
-        :class:`~.config.MonteCarlo`'s ``distribution``, ``chunk``, ``mapper``, ``progress``,
-        ``subbin``; :class:`YieldSearch`'s ``rel_tol`` (default 0.02), ``cap`` (default 100).
+        :class:`YieldSearch`'s ``rel_tol`` (default 0.02), ``cap`` (default 100).
 
     Returns
     -------
     dict
         ``factor``, ``scales``, ``yield``, ``capped``, ``evaluations``.
     """
-    mc, rest = MonteCarlo.split(dict(options, draws=int(draws), seed=int(seed)))
-    return YieldSearch(target_yield, spec_deg, case, **rest).scale(model, bounds, mc)
+    return YieldSearch(target_yield, spec_deg, case, **options).scale(model, bounds, mc)
 
 
 def largest_passing_scale(evaluate, y0: float, target_yield: float, start: float, cap: float,

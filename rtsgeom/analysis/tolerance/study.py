@@ -206,10 +206,10 @@ class ToleranceStudy:
                        keep_errors=self.keep_draws and model.kind == "arc")
         verify = None
         if self.verify:
+            # the verification draws the sub-bin positions whatever the study's mc.subbin
             verify = verify_draws(model.sets[0], self.bounds.offsets_m,
-                                  min(self.verify, mc.draws), mc.seed, mc.distribution,
-                                  cases=self.cases, progress=mc.progress,
-                                  all_points=self.verify_all_points)
+                                  mc.evolve(draws=min(self.verify, mc.draws), subbin=True),
+                                  cases=self.cases, all_points=self.verify_all_points)
         inversion = None
         if self.invert_yield is not None:
             inversion = {}

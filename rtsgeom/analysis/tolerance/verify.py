@@ -27,6 +27,7 @@ from ...radar import process
 from ...radar.frame import simulate
 from ...radar.processing import nearest_detection
 from ...rts.channels import RtsProgram, requested_delay
+from .config import MonteCarlo
 from .draws import draw_offsets, draw_subbins
 from .phasors import CASES, ChannelPhasors
 
@@ -116,13 +117,16 @@ class VerifyResult(Result):
                 "elapsed_s": self.elapsed_s}
 
 
-def verify_draws(model: ChannelPhasors, sigma_m, n: int, seed: int, distribution: str = "normal",
-                 *, cases=CASES, subbin: bool = True, progress=None, all_points: bool = False,
-                 positions=None) -> VerifyResult:
-    """The first ``n`` draws of ``monte_carlo(model, sigma_m, n, seed, distribution)`` through
-    the full chain (see the module). ``subbin``: the sub-bin positions the study draws
-    (False: the bin centre); ``positions`` (n,): indices into ``model.subbin_steps`` to use
-    instead (e.g. a grid across the bin). ``progress(label, done, total)`` per draw."""
+def verify_draws(model: ChannelPhasors, sigma_m, mc: MonteCarlo, *, cases=CASES,
+                 all_points: bool = False, positions=None) -> VerifyResult:
+    """The first ``mc.draws`` draws of :func:`~.montecarlo.simulate` (``model``, ``sigma_m``,
+    ``mc``) through the full chain
+    (see the module): ``mc.seed`` (set), ``mc.distribution``; ``mc.subbin``: the sub-bin
+    positions the study draws (False: the bin centre); ``positions`` (n,): indices into
+    ``model.subbin_steps`` to use instead (e.g. a grid across the bin);
+    ``mc.progress(label, done, total)`` per draw."""
+    n, seed, distribution = mc.draws, mc.seed, mc.distribution
+    subbin, progress = mc.subbin, mc.progress
     t0 = time.perf_counter()
     channels = list(model.front_ends)
     n_q = len(channels)
