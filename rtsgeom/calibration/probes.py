@@ -46,6 +46,9 @@ class FrontEndProbe:
     power_db: np.ndarray  # (F,) detected range-Doppler power
     gain_correction: np.ndarray  # (F,) multiply the programmed amplitude by this
     adc_clipped: int = 0  # samples the ADC clipped in the probe frame (with [radar.link])
+    #: (F,) each front end alone as the planner's model (the nominal setup, noiseless) reads
+    #: it: the span the exact design reaches; None where not modelled (a calibration file)
+    model_angle_rad: np.ndarray | None = None
 
     def clipping_note(self) -> str:
         """Why a front end may be missing: the probe frame's ADC clipping, if any."""
@@ -186,7 +189,8 @@ class ProbeWarning(RtsgeomWarning, RuntimeWarning):
 @one_blas_thread
 def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe:
     """Each front end alone at its own probe range: measured angle and power; the gain
-    correction equalises measured against modelled power. One simulated frame holds
+    correction equalises measured against modelled power; the angle each reads on the
+    nominal model (``model_angle_rad``, what the planner's exact design reaches). One simulated frame holds
     :func:`probes_per_frame` of them; more are measured in turns, a frame each, at the same
     ranges (:func:`probe_layout`; turn t > 0 draws its noise from ``SeedSequence([seed, t])``).
     BLAS on one thread, as :func:`calibrate_pair`."""
@@ -196,11 +200,13 @@ def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe
     design, design_paths = nominal_model(setup, paths)
     model_p = np.empty(n)
     amps = np.empty(n)
+    model_ang = np.empty(n)
     for q in range(n):
         j = (q + 1) % n if n > 1 else q
         m = ChannelModel.build(design, design_paths, (q, j), TargetConfig(float(ranges[q])))
         model_p[q] = np.max(np.sum(np.abs(m.responses[:, 0]) ** 2, axis=-1))
         amps[q] = m.unit_gain
+        model_ang[q] = float(m.direction(np.array([1.0, 0.0])))
     ang = np.full(n, np.nan)
     pw = np.full(n, np.nan)
     n_clip = 0
@@ -223,7 +229,7 @@ def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe
                     "correction 1" + clipping_note(n_clip), ProbeWarning)
     meas = 10 ** (pw / 10) / amps ** 2
     corr = np.sqrt(model_p / meas)
-    return FrontEndProbe(ang, pw, np.where(np.isfinite(corr), corr, 1.0), n_clip)
+    return FrontEndProbe(ang, pw, np.where(np.isfinite(corr), corr, 1.0), n_clip, model_ang)
 
 
 def probe_program(design, pair, base, delta):

@@ -117,7 +117,11 @@ def plan_pair(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str,
     target's IF phase either side (``m = 0, -1, 1``: the same phase, J's echo a period's
     range further), the first whose exact design the RuT detects at the bin it was designed
     for, with the largest power margin (where J's echo straddles a range-bin boundary no
-    design is consistent).
+    design is consistent). A shifted design counts only where it is consistent: one the RuT
+    detects at another bin reaches neither the angle nor the range (J's echo a bin from I's,
+    the combined peak half a bin to a bin off); where the calibrated offset has no design at
+    all (the angle outside the pair's span as the nominal model reads it) and no shifted one
+    is consistent, the angle is unreachable (``AngleUnreachable``), not planned a bin off.
 
     For each ``m`` the difference the calibration makes coherent, ``offsets[1] - offsets[0]
     + residual_s + m period`` (``residual_s``: the calibration's ``quantisation_residual_s``;
@@ -141,8 +145,8 @@ def plan_pair(setup: Setup, paths: Paths, pair, target: TargetConfig, mode: str,
         cand, phase = _candidate(ctx, m, phase0)
         if m == 0:
             phase0 = phase
-        if cand is None:
-            continue
+        if cand is None or (m and not cand[0][0]):
+            continue  # a shifted design only where the RuT detects it at its own bin
         if best is None or cand[0] > best[0]:
             best = cand
         ok, margin = cand[0][0], cand[0][1]

@@ -33,7 +33,7 @@ from ..synthesis.model import ChannelModel, target_direction
 from .merge import budget_targets
 from .pair import plan_pair, plan_pairs, residual_warning
 
-__all__ = ["bracketing_pair", "check_pair", "measured_pairs", "uses_cells", "target_cells",
+__all__ = ["bracketing_pair", "modelled_pair", "check_pair", "measured_pairs", "uses_cells", "target_cells",
            "plan_targets", "target_pairs", "calibrate_pairs", "program_pairs",
            "program_frames"]
 
@@ -46,6 +46,27 @@ def bracketing_pair(angle_rad: float, fe_angles_rad: np.ndarray) -> tuple[int, i
         if a[k] <= angle_rad <= a[k + 1]:
             return int(order[k]), int(order[k + 1])
     return None
+
+
+def modelled_pair(angle_rad: float, probe) -> tuple[int, int] | None:
+    """The pair of :func:`bracketing_pair` on the front ends' *measured* angles, or, where the
+    planner's model puts the target in the pair beside it, that one.
+
+    The exact design (:func:`~.pair.plan_pair`) works on the nominal model and reaches the
+    angles between its two front ends as that model reads them
+    (``FrontEndProbe.model_angle_rad``). The measured angles differ from those by the probe
+    frame's noise (at the template's 10 dB SNR up to 0.18 deg on an arc of 1 deg steps) and
+    by the bench's unknown mounting errors; a target between the measured and the modelled
+    angle of the front end two pairs share lies outside the measured pair's modelled span,
+    where no design of that pair reaches it (J alone reads the modelled angle), and inside
+    the neighbour's, whose design reaches it exactly. No tolerance: the neighbour is taken
+    wherever the model brackets the target with it."""
+    pair = bracketing_pair(angle_rad, probe.angle_rad)
+    model = getattr(probe, "model_angle_rad", None)
+    if pair is None or model is None or not np.all(np.isfinite(model)):
+        return pair
+    alt = bracketing_pair(angle_rad, np.asarray(model, float))
+    return alt if alt is not None and len(set(alt) & set(pair)) == 1 else pair
 
 
 def check_pair(setup: Setup, i: int, j: int, name: str, cells: bool = False
@@ -220,7 +241,8 @@ def target_namer(scene, targets=None, budget=None, moving_from: int | None = Non
 def target_pairs(setup: Setup, probe, targets, where: str = "targets"
                  ) -> tuple[list[tuple[int, int]], list[str]]:
     """Each target's pair of front ends: the adjacent pair whose *measured* span (``probe``,
-    each front end alone as the RuT detects it) holds its angle, and a warning per pair wider
+    each front end alone as the RuT detects it) holds its angle, or the one beside it where
+    the planner's model brackets it there (:func:`modelled_pair`), and a warning per pair wider
     than the RuT's angular resolution (eq. 24). ``where`` names the targets in messages.
     Raises ``SceneError`` for a front end the RuT does not detect or a target outside the
     measured span."""
@@ -234,7 +256,7 @@ def target_pairs(setup: Setup, probe, targets, where: str = "targets"
     res = angular_resolution_rad(setup.rut)
     pairs, warnings = [], []
     for k, t in enumerate(targets):
-        pair = bracketing_pair(t.angle_rad, probe.angle_rad)
+        pair = modelled_pair(t.angle_rad, probe)
         if pair is None:
             lo, hi = np.degrees(np.nanmin(probe.angle_rad)), np.degrees(np.nanmax(probe.angle_rad))
             raise SceneError(f"{scene.source}: "
