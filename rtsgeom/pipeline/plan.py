@@ -12,6 +12,8 @@ one weight per channel (:meth:`ChannelModel.solve <rtsgeom.synthesis.model.Chann
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 from scipy.constants import c
 
@@ -19,7 +21,7 @@ from ..calibration.chains import calibrate_chained
 from ..calibration.channels import calibrate_channels, channel_offsets, pair_edges, tree_phases
 from ..calibration.file import calibration_mismatch, load_calibration
 from ..calibration.sweep import Calibration
-from ..calibration.probes import probe_angles, probe_front_ends
+from ..calibration.probes import front_end_models, probe_angles, probe_front_ends
 from ..errors import (AngleUnreachable, CalibrationFailed, CellUnreachable, ParameterError,
                       SceneError)
 from ..geometry import Setup
@@ -33,9 +35,9 @@ from ..synthesis.model import ChannelModel, target_direction
 from .merge import budget_targets
 from .pair import plan_pair, plan_pairs, residual_warning
 
-__all__ = ["bracketing_pair", "modelled_pair", "check_pair", "measured_pairs", "uses_cells", "target_cells",
-           "plan_targets", "target_pairs", "calibrate_pairs", "program_pairs",
-           "program_frames"]
+__all__ = ["bracketing_pair", "modelled_pair", "probe_pair", "check_pair", "measured_pairs",
+           "uses_cells", "target_cells", "plan_targets", "target_pairs", "calibrate_pairs",
+           "program_pairs", "program_frames"]
 
 
 def bracketing_pair(angle_rad: float, fe_angles_rad: np.ndarray) -> tuple[int, int] | None:
@@ -67,6 +69,12 @@ def modelled_pair(angle_rad: float, probe) -> tuple[int, int] | None:
         return pair
     alt = bracketing_pair(angle_rad, np.asarray(model, float))
     return alt if alt is not None and len(set(alt) & set(pair)) == 1 else pair
+
+
+def probe_pair(probe):
+    """:func:`modelled_pair` of ``probe`` as a budget's ``pair_of(angle_rad, angles_rad)``
+    (``merge.budget_targets``: the channels a target loads are the pair it is planned on)."""
+    return lambda angle_rad, _angles=None: modelled_pair(angle_rad, probe)
 
 
 def check_pair(setup: Setup, i: int, j: int, name: str, cells: bool = False
@@ -175,8 +183,9 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
                          "elements side by side at one height, or set "
                          "radar.elevation_processing = true)")
     loaded: dict = {}
-    if calibration is not None:
+    if calibration is not None:  # the file's measured angles, the model's beside them
         probe, loaded = load_calibration(calibration, setup)
+        probe = dataclasses.replace(probe, model_angle_rad=front_end_models(setup, paths)[2])
     else:
         probe = probe_front_ends(setup, paths, scene.seed)
     warnings = []
@@ -184,7 +193,7 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
         warnings.append(mismatch)
     targets, budget = scene.targets, None
     if scene.rts.max_targets_per_channel is not None:  # dynamic resolution (.merge)
-        budget = budget_targets(setup, scene.targets, probe, bracketing_pair)
+        budget = budget_targets(setup, scene.targets, probe, probe_pair(probe))
         targets = budget.targets
     where = target_namer(scene, budget=budget)  # as the file names them
     pairs, notes = target_pairs(setup, probe, targets, where)
