@@ -121,7 +121,7 @@ def test_the_pair_is_the_one_the_model_brackets_the_target_with(measured_deg):
                                                                       measured)
 
 
-def test_a_shifted_design_counts_only_where_the_ruT_detects_it_at_its_bin():
+def test_a_shifted_design_counts_only_where_the_rut_detects_it_at_its_bin():
     """Pair (4, 5) of the noiseless dense arc and a target 0.027 deg past front end 5 as the
     model reads it: no design of the calibrated offset reaches it, and J an IF period either
     side is detected at another bin (it was planned so: period_offset -1, 150 mm short).
@@ -147,12 +147,13 @@ def test_a_shifted_design_counts_only_where_the_ruT_detects_it_at_its_bin():
 def test_dense_arc_targets_at_bin_edges_over_snr_and_seeds():
     """The dense arc (16 front ends 1 deg apart), six targets 0.40 to 0.65 of a bin past a bin
     centre, each 0.025 deg from a front end (where the probe's noise moves the measured span
-    across it), at 10, 20 and 30 dB SNR (seeds 1 to 3) and noiseless: every target within 15
-    mm of its set range and no programme with J an IF period away (each unshifted design
-    reaches its angle). Before the pair followed the model: 149 and 148 mm short at 10 dB,
-    seeds 1 and 3, J an IF period early."""
+    across it), at 10 dB SNR (seeds 1 to 3), 20 and 30 dB (seeds 1, 2) and noiseless: every
+    target within 15 mm of its set range and no programme with J an IF period away (each
+    unshifted design reaches its angle, detected at its own bin with a margin over 1.2).
+    Before the pair followed the model: 149 and 148 mm short at 10 dB, seeds 1 and 3, J an
+    IF period early."""
     fractions = (0.40, 0.45, 0.50, 0.55, 0.60, 0.65)
-    for snr_db, seeds in ((10, (1, 2, 3)), (20, (1, 2, 3)), (30, (1, 2, 3)), (None, (1,))):
+    for snr_db, seeds in ((10, (1, 2, 3)), (20, (1, 2)), (30, (1, 2)), (None, (1,))):
         for seed in seeds:
             result = run_scene(parse_scene(_dense16(snr_db, seed, fractions), "grid.toml"),
                                truth=False)
