@@ -47,7 +47,7 @@ class FrontEndProbe:
     gain_correction: np.ndarray  # (F,) multiply the programmed amplitude by this
     adc_clipped: int = 0  # samples the ADC clipped in the probe frame (with [radar.link])
     #: (F,) each front end alone as the planner's model (the nominal setup, noiseless) reads
-    #: it: the span the exact design reaches; None where not modelled (a calibration file)
+    #: it: the span the exact design reaches; None where not modelled
     model_angle_rad: np.ndarray | None = None
 
     def clipping_note(self) -> str:

@@ -62,13 +62,17 @@ def modelled_pair(angle_rad: float, probe) -> tuple[int, int] | None:
     angle of the front end two pairs share lies outside the measured pair's modelled span,
     where no design of that pair reaches it (J alone reads the modelled angle), and inside
     the neighbour's, whose design reaches it exactly. No tolerance: the neighbour is taken
-    wherever the model brackets the target with it."""
+    wherever the model brackets the target with it (and the two are neighbours in measured
+    angle as well)."""
     pair = bracketing_pair(angle_rad, probe.angle_rad)
     model = getattr(probe, "model_angle_rad", None)
     if pair is None or model is None or not np.all(np.isfinite(model)):
         return pair
     alt = bracketing_pair(angle_rad, np.asarray(model, float))
-    return alt if alt is not None and len(set(alt) & set(pair)) == 1 else pair
+    if alt is None or len(set(alt) & set(pair)) != 1:
+        return pair
+    rank = np.argsort(np.argsort(probe.angle_rad))  # alt adjacent in measured angle too
+    return alt if abs(int(rank[alt[0]]) - int(rank[alt[1]])) == 1 else pair
 
 
 def probe_pair(probe):
