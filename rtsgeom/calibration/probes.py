@@ -35,7 +35,7 @@ from ..synthesis.model import ChannelModel
 __all__ = ["FrontEndProbe", "clipping_note", "probe_front_ends", "probe_ranges", "probe_angles",
            "probe_total_delay", "probe_program", "simulate_detect", "if_phase_slope_hz",
            "air_phase_slope_hz", "mean_air_delay", "place_in_bins", "PLACEMENT_OFFSETS_BINS",
-           "probes_per_frame", "probe_layout", "ProbeWarning"]
+           "probes_per_frame", "probe_layout", "ProbeWarning", "front_end_models"]
 
 
 @dataclass(frozen=True)
@@ -46,6 +46,9 @@ class FrontEndProbe:
     power_db: np.ndarray  # (F,) detected range-Doppler power
     gain_correction: np.ndarray  # (F,) multiply the programmed amplitude by this
     adc_clipped: int = 0  # samples the ADC clipped in the probe frame (with [radar.link])
+    #: (F,) each front end alone as the planner's model (the nominal setup, noiseless) reads
+    #: it: the span the exact design reaches; None where not modelled
+    model_angle_rad: np.ndarray | None = None
 
     def clipping_note(self) -> str:
         """Why a front end may be missing: the probe frame's ADC clipping, if any."""
@@ -186,10 +189,11 @@ class ProbeWarning(RtsgeomWarning, RuntimeWarning):
 @one_blas_thread
 def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe:
     """Each front end alone at its own probe range: measured angle and power; the gain
-    correction equalises measured against modelled power. One simulated frame holds
-    :func:`probes_per_frame` of them; more are measured in turns, a frame each, at the same
-    ranges (:func:`probe_layout`; turn t > 0 draws its noise from ``SeedSequence([seed, t])``).
-    BLAS on one thread, as :func:`calibrate_pair`.
+    correction equalises measured against modelled power; the angle each reads on the
+    nominal model (``model_angle_rad``, noiseless: the span the planner's exact design
+    reaches). One simulated frame holds :func:`probes_per_frame` of them; more are measured
+    in turns, a frame each, at the same ranges (:func:`probe_layout`; turn t > 0 draws its
+    noise from ``SeedSequence([seed, t])``). BLAS on one thread, as :func:`calibrate_pair`.
 
     Parameters
     ----------
@@ -203,8 +207,9 @@ def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe
     Returns
     -------
     FrontEndProbe
-        Per front end the measured angle (rad; NaN where not detected), power (dB) and gain
-        correction (1 where not detected), and the ADC samples the probe frames clipped.
+        Per front end the measured angle (rad; NaN where not detected), the angle on the
+        nominal model, power (dB) and gain correction (1 where not detected), and the ADC
+        samples the probe frames clipped.
 
     Warns
     -----
@@ -214,14 +219,7 @@ def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe
     scene = setup.scene
     n = setup.fe.count
     ranges, turn = probe_layout(setup, n)
-    design, design_paths = nominal_model(setup, paths)
-    model_p = np.empty(n)
-    amps = np.empty(n)
-    for q in range(n):
-        j = (q + 1) % n if n > 1 else q
-        m = ChannelModel.build(design, design_paths, (q, j), TargetConfig(float(ranges[q])))
-        model_p[q] = np.max(np.sum(np.abs(m.responses[:, 0]) ** 2, axis=-1))
-        amps[q] = m.unit_gain
+    model_p, amps, model_ang = front_end_models(setup, paths, ranges)
     ang = np.full(n, np.nan)
     pw = np.full(n, np.nan)
     n_clip = 0
@@ -244,7 +242,25 @@ def probe_front_ends(setup: Setup, paths: Paths, seed: int = 0) -> FrontEndProbe
                     "correction 1" + clipping_note(n_clip), ProbeWarning)
     meas = 10 ** (pw / 10) / amps ** 2
     corr = np.sqrt(model_p / meas)
-    return FrontEndProbe(ang, pw, np.where(np.isfinite(corr), corr, 1.0), n_clip)
+    return FrontEndProbe(ang, pw, np.where(np.isfinite(corr), corr, 1.0), n_clip, model_ang)
+
+
+def front_end_models(setup: Setup, paths: Paths, ranges=None
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each front end alone on the nominal model at its probe range (``ranges`` (F,), default
+    :func:`probe_layout`'s): its power summed over the virtual elements at its strongest bin,
+    its unit gain and the azimuth the RuT reads it at (rad, noiseless), each (F,)."""
+    n = setup.fe.count
+    ranges = probe_layout(setup, n)[0] if ranges is None else ranges
+    design, design_paths = nominal_model(setup, paths)
+    model_p, amps, ang = np.empty(n), np.empty(n), np.empty(n)
+    for q in range(n):
+        j = (q + 1) % n if n > 1 else q
+        m = ChannelModel.build(design, design_paths, (q, j), TargetConfig(float(ranges[q])))
+        model_p[q] = np.max(np.sum(np.abs(m.responses[:, 0]) ** 2, axis=-1))
+        amps[q] = m.unit_gain
+        ang[q] = float(m.direction(np.array([1.0, 0.0])))
+    return model_p, amps, ang
 
 
 def probe_program(design, pair, base, delta):

@@ -20,7 +20,7 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
-from .._lib.io import check_output_file, staged_dir, write_json
+from .._lib.io import check_output_file, staged_dir
 from ..errors import ParameterError, RtsgeomWarning, UsageError
 from ._signals import raise_received
 
@@ -230,7 +230,6 @@ def show_warning(message, category, filename, lineno, file=None, line=None) -> N
     """``warnings.showwarning`` of the commands: rtsgeom's own warnings as
     ``rtsgeom: warning: <message>`` on stderr, any other (numpy's, a library's) as the same
     one line with its category: a user of the CLI never sees a source line."""
-    from ..errors import RtsgeomWarning
     if issubclass(category, RtsgeomWarning):
         print(f"rtsgeom: warning: {message}", file=sys.stderr)
     else:

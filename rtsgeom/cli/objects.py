@@ -7,9 +7,10 @@ from __future__ import annotations
 import argparse
 
 from ..errors import ParameterError, UsageError
+from .._lib.io import write_json
 from ._common import (load_scene_checked, number, numbers, output_folder, output_path,
                       print_outputs,
-                      scene_arg, steps, write_json)
+                      scene_arg, steps)
 
 
 def _budgets(text: str) -> tuple:

@@ -6,8 +6,9 @@ resolution.png."""
 from __future__ import annotations
 
 from ..analysis.resolution import ResolutionStudy
+from .._lib.io import write_json
 from ._common import (load_scene_checked, number, numbers, output_folder, print_json,
-                      scene_arg, steps, write_json)
+                      scene_arg, steps)
 
 
 def cmd_resolution(args) -> int:

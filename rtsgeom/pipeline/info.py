@@ -18,7 +18,7 @@ from ..paths import exact_paths
 from ..radar.budget import format_budget
 from ..radar.channels import channel_coupling, channel_gain, plane_wave_errors
 from ..radar.steering import Steering
-from .plan import bracketing_pair, target_cells, uses_cells
+from .plan import modelled_pair, target_cells, uses_cells
 
 __all__ = ["scene_info", "format_info", "reachable_spans"]
 
@@ -31,7 +31,8 @@ def reachable_spans(setup: Setup, mode: str | None = None, paths=None) -> dict:
     The span is *measured* as ``run`` measures it (:func:`rtsgeom.calibration.pair.
     probe_front_ends`: each front end alone, detected by the simulated RuT with the scene's
     seed and noise; the Rx/Tx separation and the near field move it off the geometric
-    angles), pairs adjacent in measured angle (:func:`rtsgeom.pipeline.plan.bracketing_pair`). The
+    angles), pairs adjacent in measured angle, each target's the pair ``run`` plans it on
+    (:func:`rtsgeom.pipeline.plan.modelled_pair`). The
     closed-form amplitude modes (``paper``, ``array-factor``) address only the front ends'
     geometric angles, so for them the span is the intersection. ``nearest`` puts each target
     on its nearest front end: every angle is accepted.
@@ -77,7 +78,7 @@ def reachable_spans(setup: Setup, mode: str | None = None, paths=None) -> dict:
                       "hi_deg": float(np.degrees(hi))})
     targets = []
     for k, t in enumerate(scene.targets):
-        pair = None if not np.all(np.isfinite(meas)) else bracketing_pair(t.angle_rad, meas)
+        pair = None if not np.all(np.isfinite(meas)) else modelled_pair(t.angle_rad, probe)
         ok = pair is not None
         if ok and mode in CLOSED_FORM_MODES:
             span = next(p for p in pairs if sorted(p["pair"]) == sorted(pair))

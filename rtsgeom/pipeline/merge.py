@@ -197,7 +197,7 @@ def budget_targets(setup: Setup, targets, probe, pair_of, limit: int | None = No
     scene's ``rts.max_targets_per_channel``): merged where the RuT cannot resolve them, then
     the weakest dropped on every channel over the limit (module docstring). ``probe``: the
     front ends as the RuT measures them; ``pair_of(angle_rad, probe_angles_rad)`` a target's
-    channels (the planner's ``bracketing_pair``: the pair whose measured span holds it)."""
+    channels (the planner's ``plan.probe_pair``: the pair it plans the target on)."""
     scene = setup.scene
     limit = scene.rts.max_targets_per_channel if limit is None else limit
     targets = tuple(targets)

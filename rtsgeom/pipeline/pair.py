@@ -117,7 +117,11 @@ def plan_pair(setup: Setup, paths: Paths, channels: PairChannels, target: Target
     target's IF phase either side (``m = 0, -1, 1``: the same phase, J's echo a period's
     range further), the first whose exact design the RuT detects at the bin it was designed
     for, with the largest power margin (where J's echo straddles a range-bin boundary no
-    design is consistent).
+    design is consistent). A shifted design counts only where it is consistent: one the RuT
+    detects at another bin reaches neither the angle nor the range (J's echo a bin from I's,
+    the combined peak half a bin to a bin off); where the calibrated offset has no design at
+    all (the angle outside the pair's span as the nominal model reads it) and no shifted one
+    is consistent, the angle is unreachable (``AngleUnreachable``), not planned a bin off.
 
     For each ``m`` the difference the calibration makes coherent, ``offsets[1] - offsets[0]
     + residual_s + m period`` (``residual_s``: the calibration's ``quantisation_residual_s``;
@@ -143,8 +147,8 @@ def plan_pair(setup: Setup, paths: Paths, channels: PairChannels, target: Target
         cand, phase = _candidate(ctx, m, phase0)
         if m == 0:
             phase0 = phase
-        if cand is None:
-            continue
+        if cand is None or (m and not cand[0][0]):
+            continue  # a shifted design only where the RuT detects it at its own bin
         if best is None or cand[0] > best[0]:
             best = cand
         ok, margin = cand[0][0], cand[0][1]
@@ -297,7 +301,7 @@ def _batch_plans(ctxs, sets, ideal, real, gains) -> list[PairPlan | None]:
     # solve_checked: the design for the detected bin
     resp = np.stack([m.responses for m in real])  # (N, K, 2, V)
     h = tdm_compensate(resp, dop[:, None, None], rut, radar)
-    alpha = np.array([c.target.angle_rad for c in ctxs])
+    alpha = np.array([ctx.target.angle_rad for ctx in ctxs])
     # J's phase minus I's (0), as solve_checked passes it
     rho, _, ok, margin = design_at_detected_bin(st, h, alpha, phase - 0.0)
     good = ok & (margin > MIN_BIN_MARGIN) & np.isfinite(rho)
@@ -310,14 +314,14 @@ def _batch_plans(ctxs, sets, ideal, real, gains) -> list[PairPlan | None]:
     gain = np.array([m.unit_gain for m in real])
     amps = (gain * np.sqrt(p_one / np.maximum(p_sum, 1e-300)))[:, None] * np.abs(w)
     out = []
-    for n, c in enumerate(ctxs):
+    for n, ctx in enumerate(ctxs):
         if not good[n]:
             out.append(None)
             continue
         req, eps = sets[n]
         out.append(PairPlan(float(amps[n, 0] * gains[n][0]), float(amps[n, 1] * gains[n][1]),
-                            float(rho[n]), float(req - c.tau), float(c.want0 + eps),
-                            float(c.want0), float(eps), 0, c.f_if))
+                            float(rho[n]), float(req - ctx.tau), float(ctx.want0 + eps),
+                            float(ctx.want0), float(eps), 0, ctx.f_if))
     return out
 
 

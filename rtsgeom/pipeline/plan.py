@@ -12,6 +12,7 @@ one weight per channel (:meth:`ChannelModel.solve <rtsgeom.synthesis.model.Chann
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,7 +23,7 @@ from ..calibration.channels import calibrate_channels, channel_offsets, pair_edg
 from ..calibration.file import calibration_mismatch, load_calibration
 from ..calibration.phasor import PairChannels
 from ..calibration.sweep import Calibration
-from ..calibration.probes import FrontEndProbe, probe_angles, probe_front_ends
+from ..calibration.probes import FrontEndProbe, front_end_models, probe_angles, probe_front_ends
 from ..errors import (AngleUnreachable, CalibrationFailed, CellUnreachable, ParameterError,
                       SceneError)
 from ..geometry import Setup
@@ -36,8 +37,9 @@ from ..synthesis.model import ChannelModel, target_direction
 from .merge import budget_targets
 from .pair import plan_pair, plan_pairs, residual_warning
 
-__all__ = ["bracketing_pair", "check_pair", "measured_pairs", "uses_cells", "target_cells",
-           "plan_targets", "target_pairs", "calibrate_pairs", "FixedCalibration",
+__all__ = ["bracketing_pair", "modelled_pair", "probe_pair", "check_pair", "measured_pairs",
+           "uses_cells", "target_cells", "plan_targets", "target_pairs", "calibrate_pairs",
+           "FixedCalibration",
            "program_pairs", "program_frames"]
 
 
@@ -49,6 +51,37 @@ def bracketing_pair(angle_rad: float, fe_angles_rad: np.ndarray) -> tuple[int, i
         if a[k] <= angle_rad <= a[k + 1]:
             return int(order[k]), int(order[k + 1])
     return None
+
+
+def modelled_pair(angle_rad: float, probe) -> tuple[int, int] | None:
+    """The pair of :func:`bracketing_pair` on the front ends' *measured* angles, or, where the
+    planner's model puts the target in the pair beside it, that one.
+
+    The exact design (:func:`~.pair.plan_pair`) works on the nominal model and reaches the
+    angles between its two front ends as that model reads them
+    (``FrontEndProbe.model_angle_rad``). The measured angles differ from those by the probe
+    frame's noise (at the template's 10 dB SNR up to 0.18 deg on an arc of 1 deg steps) and
+    by the bench's unknown mounting errors; a target between the measured and the modelled
+    angle of the front end two pairs share lies outside the measured pair's modelled span,
+    where no design of that pair reaches it (J alone reads the modelled angle), and inside
+    the neighbour's, whose design reaches it exactly. No tolerance: the neighbour is taken
+    wherever the model brackets the target with it (and the two are neighbours in measured
+    angle as well)."""
+    pair = bracketing_pair(angle_rad, probe.angle_rad)
+    model = getattr(probe, "model_angle_rad", None)
+    if pair is None or model is None or not np.all(np.isfinite(model)):
+        return pair
+    alt = bracketing_pair(angle_rad, np.asarray(model, float))
+    if alt is None or len(set(alt) & set(pair)) != 1:
+        return pair
+    rank = np.argsort(np.argsort(probe.angle_rad))  # alt adjacent in measured angle too
+    return alt if abs(int(rank[alt[0]]) - int(rank[alt[1]])) == 1 else pair
+
+
+def probe_pair(probe):
+    """:func:`modelled_pair` of ``probe`` as a budget's ``pair_of(angle_rad, angles_rad)``
+    (``merge.budget_targets``: the channels a target loads are the pair it is planned on)."""
+    return lambda angle_rad, _angles=None: modelled_pair(angle_rad, probe)
 
 
 def check_pair(setup: Setup, i: int, j: int, name: str, cells: bool = False
@@ -157,8 +190,9 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
                          "elements side by side at one height, or set "
                          "radar.elevation_processing = true)")
     loaded: dict = {}
-    if calibration is not None:
+    if calibration is not None:  # the file's measured angles, the model's beside them
         probe, loaded = load_calibration(calibration, setup)
+        probe = dataclasses.replace(probe, model_angle_rad=front_end_models(setup, paths)[2])
     else:
         probe = probe_front_ends(setup, paths, scene.seed)
     warnings = []
@@ -166,7 +200,7 @@ def plan_targets(setup: Setup, paths: Paths, mode: str, calibrate: bool = True, 
         warnings.append(mismatch)
     targets, budget = scene.targets, None
     if scene.rts.max_targets_per_channel is not None:  # dynamic resolution (.merge)
-        budget = budget_targets(setup, scene.targets, probe, bracketing_pair)
+        budget = budget_targets(setup, scene.targets, probe, probe_pair(probe))
         targets = budget.targets
     where = target_namer(scene, budget=budget)  # as the file names them
     pairs, notes = target_pairs(setup, probe, targets, where)
@@ -224,7 +258,8 @@ def target_namer(scene, targets=None, budget=None, moving_from: int | None = Non
 def target_pairs(setup: Setup, probe, targets, where: str = "targets"
                  ) -> tuple[list[tuple[int, int]], list[str]]:
     """Each target's pair of front ends: the adjacent pair whose *measured* span (``probe``,
-    each front end alone as the RuT detects it) holds its angle, and a warning per pair wider
+    each front end alone as the RuT detects it) holds its angle, or the one beside it where
+    the planner's model brackets it there (:func:`modelled_pair`), and a warning per pair wider
     than the RuT's angular resolution (eq. 24). ``where`` names the targets in messages.
     Raises ``SceneError`` for a front end the RuT does not detect or a target outside the
     measured span."""
@@ -238,7 +273,7 @@ def target_pairs(setup: Setup, probe, targets, where: str = "targets"
     res = angular_resolution_rad(setup.rut)
     pairs, warnings = [], []
     for k, t in enumerate(targets):
-        pair = bracketing_pair(t.angle_rad, probe.angle_rad)
+        pair = modelled_pair(t.angle_rad, probe)
         if pair is None:
             lo, hi = np.degrees(np.nanmin(probe.angle_rad)), np.degrees(np.nanmax(probe.angle_rad))
             raise SceneError(f"{scene.source}: "

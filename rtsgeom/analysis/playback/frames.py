@@ -18,8 +18,9 @@ from ...errors import ParameterError
 from ...geometry import Setup
 from ...paths import Paths
 from ...pipeline.merge import budget_targets
-from ...pipeline.plan import (FixedCalibration, bracketing_pair, calibrate_pairs, lead_program,
-                              program_frames, target_namer, target_pairs, uses_cells)
+from ...pipeline.plan import (FixedCalibration, calibrate_pairs, lead_program,
+                              probe_pair, program_frames, target_namer, target_pairs,
+                              uses_cells)
 from ...pipeline.run import match_targets, truth_twin
 from ...radar import process
 from ...radar.frame import simulate
@@ -97,7 +98,7 @@ class FramePlanner:
                 "--amplitudes nearest, or targets at elevation 0 on an arc)")
         self.probe = probe_front_ends(setup, paths, scene.seed)
         if scene.rts.max_targets_per_channel is not None:  # each frame's merged targets
-            self.budgets = [budget_targets(setup, tg, self.probe, bracketing_pair)
+            self.budgets = [budget_targets(setup, tg, self.probe, probe_pair(self.probe))
                             for tg in frames]
         self.pairs, seen = [], set()
         for f, scatterers in enumerate(frames):
