@@ -8,11 +8,17 @@ which function, and then runs, per mutant, only the tests that reach its functio
 
 What this driver adds to ``mutmut run``:
 
-* **every physics subpackage** (``SOURCES``): geometry/, paths/ (exact, table), rts/, radar/,
-  synthesis/, calibration/, pipeline/ (plan, pair, run), identify/, the scenario code
-  (scene/scenario.py, analysis/playback/), the calibration transfer, analysis/; ``--modules``
+* **every physics subpackage** (``SOURCES``): geometry/ (with the arc formula in
+  _lib/arcmath.py), paths/ (exact, table), rts/, radar/ (the truth twin and the association
+  included), synthesis/, calibration/, pipeline/ (plan, pair, run), identify/, the scenario code
+  (scene/scenario.py, analysis/playback/), the calibration transfer, the extended objects
+  (scene/objects.py's scatterers, the budget's merge, the shared-cell check, the object study),
+  analysis/; ``--modules``
   picks some of them (names as in ``SOURCES``); a file in two modules' globs belongs to the
-  more specific one;
+  more specific one. Left out: the ray tracer and its cross-check (paths/raytrace*,
+  paths/crosscheck.py: Sionna, their tests are marked ``raytrace``), the scene's schema and
+  rules (input validation: the hostile-input tests, not physics), pipeline/info.py and
+  pipeline/output.py (the ``info`` text and the run's writers), cli/, viz/, api.py;
 * **targeted fast tests**: each module's tests are the test files that import it and the
   core's (``tests_for``, ``CORE_TESTS``, found at every run: ``MODULES``); the selection is
   their union for the chosen modules, without the ``slow``
@@ -82,7 +88,7 @@ CORE_TESTS = ("tests/test_physics_core.py", "tests/test_physics_core_aoa.py",
 #: (:func:`tests_for`) and :data:`CORE_TESTS`, found anew at every run, so a new module or test
 #: needs no entry here.
 SOURCES: dict[str, tuple[str, ...]] = {
-    "geometry": ("rtsgeom/geometry/*",),
+    "geometry": ("rtsgeom/geometry/*", "rtsgeom/_lib/arcmath.py"),
     "paths": ("rtsgeom/paths/exact.py", "rtsgeom/paths/table.py"),
     "rts": ("rtsgeom/rts/*",),
     "radar": ("rtsgeom/radar/*",),
@@ -93,6 +99,9 @@ SOURCES: dict[str, tuple[str, ...]] = {
     "identify": ("rtsgeom/identify/*",),
     "scenario": ("rtsgeom/scene/scenario.py", "rtsgeom/analysis/playback/*"),
     "transfer": ("rtsgeom/analysis/transfer.py", "rtsgeom/radar/channels.py"),
+    "objects": ("rtsgeom/scene/objects.py", "rtsgeom/pipeline/merge.py",
+                "rtsgeom/pipeline/cells.py", "rtsgeom/analysis/objects.py",
+                "rtsgeom/analysis/object_design.py"),
     "analysis": ("rtsgeom/analysis/*",),
 }
 
