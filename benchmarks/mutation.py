@@ -43,6 +43,7 @@ are listed in ``EQUIVALENT`` with the reason; they are reported apart and left o
     python -m benchmarks.mutation --sample 150 --seed 1
     python -m benchmarks.mutation --modules rts radar --sample 40 --seed 2
     python -m benchmarks.mutation --report-only          # rewrite the report from the last run
+    python -m benchmarks.mutation --keep-mutants ...     # reuse the workdir's mutants
     python -m benchmarks.mutation --rerun-survivors      # after new tests: the survivors again
     python -m benchmarks.mutation --rerun-survivors --names NAME ...   # only these survivors
 
@@ -145,17 +146,23 @@ def selection(modules: list[str]) -> tuple[list[str], list[str]]:
     return globs, tests
 
 
-def prepare(workdir: Path, modules: list[str]) -> None:
-    """A scratch copy of the project whose [tool.mutmut] names the chosen modules and tests."""
-    if workdir.exists():
+def prepare(workdir: Path, modules: list[str], keep: bool = False) -> None:
+    """A scratch copy of the project whose [tool.mutmut] names the chosen modules and tests.
+
+    ``keep``: a workdir's ``mutants/`` from an earlier run stays (the copies are refreshed in
+    place, keeping the sources' times): mutmut then mutates again only the files that changed
+    and runs the stats again only for new tests (generating all mutants takes about 20 minutes
+    of a loaded 2-core machine)."""
+    if workdir.exists() and not (keep and (workdir / "mutants").is_dir()):
         shutil.rmtree(workdir)
-    workdir.mkdir(parents=True)
+    workdir.mkdir(parents=True, exist_ok=True)
     ignore = shutil.ignore_patterns("__pycache__", "*.pyc", ".hypothesis", ".pytest_cache")
     for d in ("rtsgeom", "tests", "scenes", "docs"):
-        shutil.copytree(ROOT / d, workdir / d, ignore=ignore)
-    # result tables some tests read (e.g. test_calibration's sample of the linearity grid)
-    shutil.copytree(ROOT / "benchmarks", workdir / "benchmarks",
-                    ignore=shutil.ignore_patterns("__pycache__", "*.py", "*.md"))
+        shutil.copytree(ROOT / d, workdir / d, ignore=ignore, dirs_exist_ok=True)
+    # the result tables and helpers some tests read or import (test_calibration's sample of
+    # the linearity grid, test_cell_calibration's benchmarks.cell_calibration)
+    shutil.copytree(ROOT / "benchmarks", workdir / "benchmarks", dirs_exist_ok=True,
+                    ignore=shutil.ignore_patterns("__pycache__", "*.md"))
     base = tomllib.loads((ROOT / "pyproject.toml").read_text()).get("tool", {})
     cfg = dict(base.get("mutmut", {}))
     globs, tests = selection(modules)
@@ -388,6 +395,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="run the last run's survivors again (after new tests) and merge")
     ap.add_argument("--report", default="mutation-report",
                     help="report name in benchmarks/ (NAME.md and NAME.json)")
+    ap.add_argument("--keep-mutants", action="store_true",
+                    help="reuse the mutants (and mutmut's stats) left in --workdir by an earlier "
+                         "run; --rerun-survivors always does")
     ap.add_argument("--note", action="append", default=[],
                     help="a line for the report's header (kept with the run's state)")
     a = ap.parse_args(argv)
@@ -407,7 +417,7 @@ def main(argv: list[str] | None = None) -> int:
         rerun = sorted(k for k, r in previous.items()
                        if r["status"] in ("survived", "no tests", "suspicious")
                        and (not a.names or k in a.names))  # --names: only those of them
-        prepare(a.workdir, meta["modules"])
+        prepare(a.workdir, meta["modules"], keep=True)
         present = {k for v in all_mutants(a.workdir).values() for k in v}
         # a mutant of code that moved since the sample runs under its new name (RENAMED);
         # one of code removed since is no longer generated: it keeps its first status
@@ -436,7 +446,7 @@ def main(argv: list[str] | None = None) -> int:
         names = meta["names"]
         previous = json.loads((a.workdir / "results.json").read_text())
     else:
-        prepare(a.workdir, a.modules)
+        prepare(a.workdir, a.modules, keep=a.keep_mutants)
         population = all_mutants(a.workdir)
         names = a.names or sample(population, a.sample, a.seed)
         meta.update(population=sum(len(v) for v in population.values()), sampled=len(names),
