@@ -208,6 +208,13 @@ create_mutants(2)
 _MUTMUT = [sys.executable, "-c", "import sys; from mutmut.__main__ import cli; "
            "sys.argv[0] = 'mutmut'; cli()"]
 
+# ``--skip-clean``: mutmut's clean run (the sampled mutants' tests once on the unmutated code)
+# repeats what its stats run has just done (every selected test on the unmutated code, which
+# must pass); on a loaded machine it costs as much as the stats run
+_SKIP_CLEAN = ("import mutmut.workers.isolation as iso\n"
+               "for c in (iso.ForkServerRunner, iso.ForkRunner):\n"
+               "    c.run_clean_tests = lambda self, tests: 0\n")
+
 
 def all_mutants(workdir: Path) -> dict[str, list[str]]:
     """Generate the mutants (no tests run) and list their names per module of ``MODULES``."""
@@ -251,10 +258,14 @@ def sample(names: dict[str, list[str]], n: int | None, seed: int) -> list[str]:
     return sorted(picked)
 
 
-def run(workdir: Path, names: list[str], children: int, timeout_s: float) -> float:
+def run(workdir: Path, names: list[str], children: int, timeout_s: float,
+        skip_clean: bool = False) -> float:
     t0 = time.perf_counter()
+    cmd = list(_MUTMUT)
+    if skip_clean:
+        cmd[2] = _SKIP_CLEAN + cmd[2]
     # pass the names through a file-free argv: mutmut matches each name exactly
-    proc = subprocess.run(_MUTMUT + ["run", "--max-children", str(children), *names],
+    proc = subprocess.run(cmd + ["run", "--max-children", str(children), *names],
                           cwd=workdir, env=_env(), timeout=timeout_s,
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     (workdir / "mutmut-run.log").write_text(proc.stdout)
@@ -398,6 +409,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--keep-mutants", action="store_true",
                     help="reuse the mutants (and mutmut's stats) left in --workdir by an earlier "
                          "run; --rerun-survivors always does")
+    ap.add_argument("--skip-clean", action="store_true",
+                    help="skip mutmut's clean run of the sampled mutants' tests (its stats run "
+                         "has run them all on the unmutated code already)")
     ap.add_argument("--note", action="append", default=[],
                     help="a line for the report's header (kept with the run's state)")
     a = ap.parse_args(argv)
@@ -427,7 +441,8 @@ def main(argv: list[str] | None = None) -> int:
         if gone:
             print(f"no longer generated (code removed since): {', '.join(gone)}", flush=True)
         print(f"re-running {len(rerun)} survivors", flush=True)
-        wall = run(a.workdir, [run_as[k] for k in rerun], a.children, a.timeout_s)
+        wall = run(a.workdir, [run_as[k] for k in rerun], a.children, a.timeout_s,
+                   a.skip_clean)
         meta.setdefault("reruns", []).append({"mutants": len(rerun), "wall_s": round(wall, 1)})
         names = meta["names"]
         state.write_text(json.dumps(meta))
@@ -453,7 +468,7 @@ def main(argv: list[str] | None = None) -> int:
                     population_per_module={m: len(v) for m, v in population.items()})
         print(f"{meta['population']} mutants in {', '.join(a.modules)}; running {len(names)}",
               flush=True)
-        meta["wall_s"] = run(a.workdir, names, a.children, a.timeout_s)
+        meta["wall_s"] = run(a.workdir, names, a.children, a.timeout_s, a.skip_clean)
         meta["names"] = names
         state.write_text(json.dumps(meta))
     if a.note:
