@@ -104,3 +104,37 @@ def test_a_bad_invert_yield_is_named(value):
 def test_a_bad_separation_says_the_allowed_range(seps):
     with pytest.raises(ParameterError, match=r"separations in \(0, 120\] deg"):
         ResolutionStudy(separations_deg=seps)
+
+
+@pytest.mark.parametrize("radius_m, seed", [(None, 3), (1.6, 4)])
+def test_identifying_a_nominal_radar_finds_no_antenna_errors(radius_m, seed):
+    """The joint fit (``identify(..., radar_channels=True)``) of captures simulated on the
+    nominal scene itself at 30 dB SNR: an identification of that scene, one fit per front
+    end, every antenna's estimated gain and phase zero to within noise (1e-2)."""
+    from conftest import DEFAULT_SCENE
+    from rtsgeom import identify as ident_mod
+    from rtsgeom.paths import exact_paths
+    from rtsgeom.scene import load_scene
+    scene = load_scene(DEFAULT_SCENE)
+    rts = scene.rts if radius_m is None else scene.rts.evolve(arc_radius_m=radius_m)
+    scene = scene.evolve(radar=scene.radar.evolve(snr_db=30.0), rts=rts)
+    setup = ident_mod.setup_of(scene)
+    paths = exact_paths(setup)
+    caps = [ident_mod.simulate_capture(setup, q, seed=[seed, q], paths=paths)
+            for q in range(setup.fe.count)]
+    ident = ident_mod.identify(scene, caps, radar_channels=True)
+    assert ident.scene is scene
+    assert len(ident.fits) == setup.fe.count
+    np.testing.assert_allclose(ident.radar.phase, 0.0, atol=1e-2)
+    np.testing.assert_allclose(ident.radar.log_gain, 0.0, atol=1e-2)
+
+
+@pytest.mark.parametrize("n_bad", [1, 4, 5, 9])
+def test_bad_arc_radii_are_listed_four_at_most(default_scene, n_bad):
+    """The error names the first bad radii, four at most (a long list stays one line)."""
+    from rtsgeom.analysis.nearfield import nearfield
+    bad = [-1.0 - k for k in range(n_bad)]
+    with pytest.raises(ParameterError, match="arc radii") as err:
+        nearfield(default_scene, [1.0] + bad, points=3)
+    listed = str(err.value).split("got ")[1].removesuffix(" m").split(", ")
+    assert [float(x) for x in listed] == bad[:4]
