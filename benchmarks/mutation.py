@@ -50,7 +50,8 @@ are listed in ``EQUIVALENT`` with the reason; they are reported apart and left o
 A module's tests are found from their imports, so a new module or test needs no entry; a new
 physics subpackage needs one line in ``SOURCES`` (and ``[tool.mutmut]`` ``only_mutate`` in
 pyproject.toml, which ``tests/test_mutation_driver.py`` keeps equal to it). New tests for a sample's survivors go to ``tests/test_physics_core.py`` / ``_aoa.py``
-(seed 3), ``tests/test_physics_core_seed4.py`` (seed 4); ``KILLED_BY`` names the test per
+(seed 3), ``tests/test_physics_core_seed4.py`` (seed 4), ``tests/test_mutants_seed11.py``
+(seed 11); ``KILLED_BY`` names the test per
 mutant, ``RENAMED`` a mutant's name in today's code where its function moved or was
 renumbered (``benchmarks/mutation_tables.py``); judge the suite on a sample it was not
 written for (a new ``--seed``).
@@ -82,7 +83,8 @@ REPORT_JSON = ROOT / "benchmarks" / "mutation-report.json"
 #: and invariants of the core and the tests written for earlier samples' survivors
 CORE_TESTS = ("tests/test_physics_core.py", "tests/test_physics_core_aoa.py",
               "tests/test_physics_core_seed4.py", "tests/test_mutants.py",
-              "tests/test_properties.py", "tests/test_signal_properties.py")
+              "tests/test_mutants_seed11.py", "tests/test_properties.py",
+              "tests/test_signal_properties.py")
 
 #: module -> its source globs (relative to the repository; ``*`` spans subfolders): every
 #: physics subpackage as it stands. Each module's tests are the fast test files that import it
@@ -370,7 +372,8 @@ def write_report(s: dict) -> None:
                   "Each was killed by a test added after the first pass (named below; in "
                   "`tests/test_physics_core.py` or, for `aoa/`, `tests/test_physics_core_aoa.py` "
                   "for the seed-3 sample, `tests/test_physics_core_seed4.py` (and two in "
-                  "`_aoa.py`) for the seed-4 one, `tests/test_mutants.py` for the seed-2 one).",
+                  "`_aoa.py`) for the seed-4 one, `tests/test_mutants.py` for the seed-2 one, "
+                  "`tests/test_mutants_seed11.py` for the seed-11 one).",
                   ""]
         for k, d in s["killed_later"].items():
             by = [f"Killed by `{KILLED_BY[k]}`.", ""] if k in KILLED_BY else []
