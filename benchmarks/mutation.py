@@ -8,11 +8,17 @@ which function, and then runs, per mutant, only the tests that reach its functio
 
 What this driver adds to ``mutmut run``:
 
-* **every physics subpackage** (``SOURCES``): geometry/, paths/ (exact, table), rts/, radar/,
-  synthesis/, calibration/, pipeline/ (plan, pair, run), identify/, the scenario code
-  (scene/scenario.py, analysis/playback/), the calibration transfer, analysis/; ``--modules``
+* **every physics subpackage** (``SOURCES``): geometry/ (with the arc formula in
+  _lib/arcmath.py), paths/ (exact, table), rts/, radar/ (the truth twin and the association
+  included), synthesis/, calibration/, pipeline/ (plan, pair, run), identify/, the scenario code
+  (scene/scenario.py, analysis/playback/), the calibration transfer, the extended objects
+  (scene/objects.py's scatterers, the budget's merge, the shared-cell check, the object study),
+  analysis/; ``--modules``
   picks some of them (names as in ``SOURCES``); a file in two modules' globs belongs to the
-  more specific one;
+  more specific one. Left out: the ray tracer and its cross-check (paths/raytrace*,
+  paths/crosscheck.py: Sionna, their tests are marked ``raytrace``), the scene's schema and
+  rules (input validation: the hostile-input tests, not physics), pipeline/info.py and
+  pipeline/output.py (the ``info`` text and the run's writers), cli/, viz/, api.py;
 * **targeted fast tests**: each module's tests are the test files that import it and the
   core's (``tests_for``, ``CORE_TESTS``, found at every run: ``MODULES``); the selection is
   their union for the chosen modules, without the ``slow``
@@ -37,6 +43,7 @@ are listed in ``EQUIVALENT`` with the reason; they are reported apart and left o
     python -m benchmarks.mutation --sample 150 --seed 1
     python -m benchmarks.mutation --modules rts radar --sample 40 --seed 2
     python -m benchmarks.mutation --report-only          # rewrite the report from the last run
+    python -m benchmarks.mutation --keep-mutants ...     # reuse the workdir's mutants
     python -m benchmarks.mutation --rerun-survivors      # after new tests: the survivors again
     python -m benchmarks.mutation --rerun-survivors --names NAME ...   # only these survivors
 
@@ -80,7 +87,7 @@ CORE_TESTS = ("tests/geometry/test_properties.py", "tests/synthesis/test_signal_
 #: (:func:`tests_for`) and :data:`CORE_TESTS`, found anew at every run, so a new module or test
 #: needs no entry here.
 SOURCES: dict[str, tuple[str, ...]] = {
-    "geometry": ("rtsgeom/geometry/*",),
+    "geometry": ("rtsgeom/geometry/*", "rtsgeom/_lib/arcmath.py"),
     "paths": ("rtsgeom/paths/exact.py", "rtsgeom/paths/table.py"),
     "rts": ("rtsgeom/rts/*",),
     "radar": ("rtsgeom/radar/*",),
@@ -91,6 +98,9 @@ SOURCES: dict[str, tuple[str, ...]] = {
     "identify": ("rtsgeom/identify/*",),
     "scenario": ("rtsgeom/scene/scenario.py", "rtsgeom/analysis/playback/*"),
     "transfer": ("rtsgeom/analysis/transfer.py", "rtsgeom/radar/channels.py"),
+    "objects": ("rtsgeom/scene/objects.py", "rtsgeom/pipeline/merge.py",
+                "rtsgeom/pipeline/cells.py", "rtsgeom/analysis/objects.py",
+                "rtsgeom/analysis/object_design.py"),
     "analysis": ("rtsgeom/analysis/*",),
 }
 
@@ -134,17 +144,23 @@ def selection(modules: list[str]) -> tuple[list[str], list[str]]:
     return globs, tests
 
 
-def prepare(workdir: Path, modules: list[str]) -> None:
-    """A scratch copy of the project whose [tool.mutmut] names the chosen modules and tests."""
-    if workdir.exists():
+def prepare(workdir: Path, modules: list[str], keep: bool = False) -> None:
+    """A scratch copy of the project whose [tool.mutmut] names the chosen modules and tests.
+
+    ``keep``: a workdir's ``mutants/`` from an earlier run stays (the copies are refreshed in
+    place, keeping the sources' times): mutmut then mutates again only the files that changed
+    and runs the stats again only for new tests (generating all mutants takes about 20 minutes
+    of a loaded 2-core machine)."""
+    if workdir.exists() and not (keep and (workdir / "mutants").is_dir()):
         shutil.rmtree(workdir)
-    workdir.mkdir(parents=True)
+    workdir.mkdir(parents=True, exist_ok=True)
     ignore = shutil.ignore_patterns("__pycache__", "*.pyc", ".hypothesis", ".pytest_cache")
     for d in ("rtsgeom", "tests", "scenes", "docs"):
-        shutil.copytree(ROOT / d, workdir / d, ignore=ignore)
-    # result tables some tests read (e.g. test_calibration's sample of the linearity grid)
-    shutil.copytree(ROOT / "benchmarks", workdir / "benchmarks",
-                    ignore=shutil.ignore_patterns("__pycache__", "*.py", "*.md"))
+        shutil.copytree(ROOT / d, workdir / d, ignore=ignore, dirs_exist_ok=True)
+    # the result tables and helpers some tests read or import (test_calibration's sample of
+    # the linearity grid, test_cell_calibration's benchmarks.cell_calibration)
+    shutil.copytree(ROOT / "benchmarks", workdir / "benchmarks", dirs_exist_ok=True,
+                    ignore=shutil.ignore_patterns("__pycache__", "*.md"))
     base = tomllib.loads((ROOT / "pyproject.toml").read_text()).get("tool", {})
     cfg = dict(base.get("mutmut", {}))
     globs, tests = selection(modules)
@@ -190,6 +206,13 @@ create_mutants(2)
 _MUTMUT = [sys.executable, "-c", "import sys; from mutmut.__main__ import cli; "
            "sys.argv[0] = 'mutmut'; cli()"]
 
+# ``--skip-clean``: mutmut's clean run (the sampled mutants' tests once on the unmutated code)
+# repeats what its stats run has just done (every selected test on the unmutated code, which
+# must pass); on a loaded machine it costs as much as the stats run
+_SKIP_CLEAN = ("import mutmut.workers.isolation as iso\n"
+               "for c in (iso.ForkServerRunner, iso.ForkRunner):\n"
+               "    c.run_clean_tests = lambda self, tests: 0\n")
+
 
 def all_mutants(workdir: Path) -> dict[str, list[str]]:
     """Generate the mutants (no tests run) and list their names per module of ``MODULES``."""
@@ -233,10 +256,14 @@ def sample(names: dict[str, list[str]], n: int | None, seed: int) -> list[str]:
     return sorted(picked)
 
 
-def run(workdir: Path, names: list[str], children: int, timeout_s: float) -> float:
+def run(workdir: Path, names: list[str], children: int, timeout_s: float,
+        skip_clean: bool = False) -> float:
     t0 = time.perf_counter()
+    cmd = list(_MUTMUT)
+    if skip_clean:
+        cmd[2] = _SKIP_CLEAN + cmd[2]
     # pass the names through a file-free argv: mutmut matches each name exactly
-    proc = subprocess.run(_MUTMUT + ["run", "--max-children", str(children), *names],
+    proc = subprocess.run(cmd + ["run", "--max-children", str(children), *names],
                           cwd=workdir, env=_env(), timeout=timeout_s,
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     (workdir / "mutmut-run.log").write_text(proc.stdout)
@@ -375,6 +402,12 @@ def main(argv: list[str] | None = None) -> int:
                     help="run the last run's survivors again (after new tests) and merge")
     ap.add_argument("--report", default="mutation-report",
                     help="report name in benchmarks/ (NAME.md and NAME.json)")
+    ap.add_argument("--keep-mutants", action="store_true",
+                    help="reuse the mutants (and mutmut's stats) left in --workdir by an earlier "
+                         "run; --rerun-survivors always does")
+    ap.add_argument("--skip-clean", action="store_true",
+                    help="skip mutmut's clean run of the sampled mutants' tests (its stats run "
+                         "has run them all on the unmutated code already)")
     ap.add_argument("--note", action="append", default=[],
                     help="a line for the report's header (kept with the run's state)")
     a = ap.parse_args(argv)
@@ -394,7 +427,7 @@ def main(argv: list[str] | None = None) -> int:
         rerun = sorted(k for k, r in previous.items()
                        if r["status"] in ("survived", "no tests", "suspicious")
                        and (not a.names or k in a.names))  # --names: only those of them
-        prepare(a.workdir, meta["modules"])
+        prepare(a.workdir, meta["modules"], keep=True)
         present = {k for v in all_mutants(a.workdir).values() for k in v}
         # a mutant of code that moved since the sample runs under its new name (RENAMED);
         # one of code removed since is no longer generated: it keeps its first status
@@ -404,7 +437,8 @@ def main(argv: list[str] | None = None) -> int:
         if gone:
             print(f"no longer generated (code removed since): {', '.join(gone)}", flush=True)
         print(f"re-running {len(rerun)} survivors", flush=True)
-        wall = run(a.workdir, [run_as[k] for k in rerun], a.children, a.timeout_s)
+        wall = run(a.workdir, [run_as[k] for k in rerun], a.children, a.timeout_s,
+                   a.skip_clean)
         meta.setdefault("reruns", []).append({"mutants": len(rerun), "wall_s": round(wall, 1)})
         names = meta["names"]
         state.write_text(json.dumps(meta))
@@ -423,14 +457,14 @@ def main(argv: list[str] | None = None) -> int:
         names = meta["names"]
         previous = json.loads((a.workdir / "results.json").read_text())
     else:
-        prepare(a.workdir, a.modules)
+        prepare(a.workdir, a.modules, keep=a.keep_mutants)
         population = all_mutants(a.workdir)
         names = a.names or sample(population, a.sample, a.seed)
         meta.update(population=sum(len(v) for v in population.values()), sampled=len(names),
                     population_per_module={m: len(v) for m, v in population.items()})
         print(f"{meta['population']} mutants in {', '.join(a.modules)}; running {len(names)}",
               flush=True)
-        meta["wall_s"] = run(a.workdir, names, a.children, a.timeout_s)
+        meta["wall_s"] = run(a.workdir, names, a.children, a.timeout_s, a.skip_clean)
         meta["names"] = names
         state.write_text(json.dumps(meta))
     if a.note:

@@ -32,6 +32,15 @@ def test_every_physics_subpackage_is_sampled():
     assert module_of("rtsgeom/analysis/transfer.py") == "transfer"
     assert module_of("rtsgeom/analysis/tolerance/montecarlo.py") == "analysis"
     assert module_of("rtsgeom/paths/raytrace.py") is None  # Sionna: not in the fast tests
+    # the drive's pieces: the truth twin and the association (radar), the extended objects'
+    # scatterers and the budget's merge, and the arc formula every front end is placed by
+    assert module_of("rtsgeom/radar/truth.py") == "radar"
+    assert module_of("rtsgeom/radar/association.py") == "radar"
+    for f in ("rtsgeom/scene/objects.py", "rtsgeom/pipeline/merge.py",
+              "rtsgeom/pipeline/cells.py", "rtsgeom/analysis/objects.py"):
+        assert module_of(f) == "objects", f
+    assert module_of("rtsgeom/_lib/arcmath.py") == "geometry"
+    assert "tests/scene/test_objects.py" in MODULES["objects"][1]
 
 
 def test_pyproject_holds_the_drivers_selection():

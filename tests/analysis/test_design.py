@@ -23,8 +23,11 @@ from rtsgeom.analysis.design import (
     evaluate_design,
     two_front_end_scene,
 )
+from rtsgeom.analysis.design_study import DesignStudy
+from rtsgeom.analysis.tolerance.config import MonteCarlo
 from rtsgeom.analysis.tolerance.phasors import ChannelPhasors
 from rtsgeom.cli import main
+from rtsgeom.errors import ParameterError
 from rtsgeom.geometry import build_setup
 from rtsgeom.geometry.farfield import angular_resolution_rad
 
@@ -192,7 +195,6 @@ def test_design_grid_refuses_elevation(scene, where, elevation_deg):
     elevation; the API raises ParameterError before any design is built."""
     import dataclasses
 
-    from rtsgeom.errors import ParameterError
     from rtsgeom.scene import TargetConfig
     el = math.radians(elevation_deg)
     if where == "front end":
@@ -277,3 +279,22 @@ def test_design_grid_flags_spacings_beyond_the_resolution_and_reports_progress()
     flags = {round(d["spacing_deg"]): d["exceeds_resolution"] for d in grid.designs}
     assert flags == {8: 8.0 > res, 20: 20.0 > res} == {8: False, 20: True}
     assert seen == [(1, 2), (2, 2)]
+
+
+
+def test_the_design_study_draws_with_its_seed_and_announces_its_count(default_scene):
+    """``DesignStudy(mc=MonteCarlo(seed=s))`` is ``design_grid(..., seed=s)`` (not the
+    default seed's), and its progress opens with the number of designs to come."""
+    calls = []
+    radii, spacings = (1.0,), (8.0, 12.0)
+    study = DesignStudy(radius_m=radii, spacing_deg=spacings, points=3,
+                        mc=MonteCarlo(draws=30, seed=7,
+                                      progress=lambda *a: calls.append(a)))
+    got = study(default_scene).to_dataframe()
+    want = design_grid(default_scene, (0, 1), list(radii), list(spacings), 0.1, 0.95, 30, 7,
+                       points=3).to_dataframe()
+    other = design_grid(default_scene, (0, 1), list(radii), list(spacings), 0.1, 0.95, 30, 0,
+                        points=3).to_dataframe()
+    assert got.equals(want)
+    assert not got.equals(other)  # the seed matters at 30 draws
+    assert calls[0] == ("designs", 0, len(radii) * len(spacings))

@@ -11,15 +11,19 @@ import re
 
 import numpy as np
 import pytest
+from conftest import DEFAULT_SCENE, ROOT
 
 import rtsgeom
-from conftest import DEFAULT_SCENE, ROOT
 from rtsgeom.analysis.kpi import KpiSpec, KpiStudy, check_spec, loads_spec
-from rtsgeom.analysis.kpi.budget import (K_COVERAGE, BudgetRow, combined, coverage_interval,
-                                         validate)
+from rtsgeom.analysis.kpi.budget import (
+    K_COVERAGE,
+    BudgetRow,
+    combined,
+    coverage_interval,
+    validate,
+)
 from rtsgeom.cli import main
-from rtsgeom.errors import SceneError
-
+from rtsgeom.errors import ParameterError, SceneError
 
 # -- the GUM arithmetic -----------------------------------------------------------------------
 
@@ -179,6 +183,7 @@ def test_every_view_shows_the_one_headline(sheet):
     one function makes (each view once formatted its own, with different names and digits),
     and the headline names the receiver noise's SNR and where it comes from."""
     import html
+
     from rtsgeom.analysis.kpi.headline import headline
     from rtsgeom.analysis.kpi.report import _text_page, to_html
     from rtsgeom.cli.kpi import summary
@@ -229,14 +234,13 @@ def test_sensitivity_coefficients_match_finite_differences_of_the_full_model():
     calibrated on the setup as built, planned, synthesized, detected)."""
     from rtsgeom.analysis.kpi.accuracy import AccuracyInputs, pair_accuracy
     from rtsgeom.analysis.transfer import set_angles
-    from rtsgeom.calibration.probes import probe_front_ends, probe_angles
     from rtsgeom.calibration.pair import calibrate_pair
+    from rtsgeom.calibration.phasor import PairChannels
+    from rtsgeom.calibration.probes import probe_angles, probe_front_ends, probe_ranges
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
-    from rtsgeom.calibration.phasor import PairChannels
     from rtsgeom.pipeline.pair import pair_design
     from rtsgeom.scene import TargetConfig
-    from rtsgeom.calibration.probes import probe_ranges
     scene = rtsgeom.replace(rtsgeom.load_scene(DEFAULT_SCENE), radar=rtsgeom.replace(
         rtsgeom.load_scene(DEFAULT_SCENE).radar, snr_db=None))
     setup, pair = build_setup(scene), (0, 1)
@@ -356,3 +360,12 @@ def test_the_monte_carlos_inputs_are_drawn_independently():
     ph = draw_channel_gains(rut, 4000, 1.0, 0.0, [5, PHASE_STREAM])[1]
     r = np.corrcoef(off[:, 0], ph[:, 0])[0, 1]
     assert abs(r) < 4 / np.sqrt(4000)
+
+
+
+@pytest.mark.parametrize("sigma", [(0.1, 0.2, 0.3), [0.0, 0.05, 1.0]])
+def test_kpi_study_takes_three_sigmas(sigma):
+    """``sigma_mm`` is one number or three (radial, tangential, height)."""
+    assert tuple(KpiStudy(sigma_mm=sigma).sigma_mm) == tuple(sigma)
+    with pytest.raises(ParameterError, match="sigma_mm"):
+        KpiStudy(sigma_mm=tuple(sigma)[:2])

@@ -19,7 +19,7 @@ from conftest import (
 from rtsgeom.analysis.nearfield import default_radii, nearfield, with_arc_radius
 from rtsgeom.analysis.nearfield_terms import phase_error_deg
 from rtsgeom.cli import main
-from rtsgeom.errors import NominalSetupWarning
+from rtsgeom.errors import NominalSetupWarning, ParameterError
 from rtsgeom.geometry import build_setup
 from rtsgeom.geometry.farfield import curvature_phase_error_rad, fraunhofer_distance_m
 
@@ -277,3 +277,15 @@ def test_nearfield_rows_carry_the_curvature_part_of_the_phase_error():
     rows = nf["radii"]
     curv = [[fe["curvature_phase_error_pp_deg"] for fe in r["front_ends"]] for r in rows]
     np.testing.assert_allclose(np.array(curv[0]) / np.array(curv[1]), 4.0, rtol=0.05)
+
+
+
+@pytest.mark.parametrize("n_bad", [1, 4, 5, 9])
+def test_bad_arc_radii_are_listed_four_at_most(default_scene, n_bad):
+    """The error names the first bad radii, four at most (a long list stays one line)."""
+    from rtsgeom.analysis.nearfield import nearfield
+    bad = [-1.0 - k for k in range(n_bad)]
+    with pytest.raises(ParameterError, match="arc radii") as err:
+        nearfield(default_scene, [1.0] + bad, points=3)
+    listed = str(err.value).split("got ")[1].removesuffix(" m").split(", ")
+    assert [float(x) for x in listed] == bad[:4]

@@ -5,13 +5,21 @@ association: the clouds where the RuT sees the RTS's targets (R_c further withou
 
 from __future__ import annotations
 
+import csv
+import io
 import tomllib
 
 import numpy as np
 import pytest
 from scene.test_objects import BOX, CAR, bench_doc
 
-from rtsgeom.analysis.objects import objects_lines, play_objects, run_objects
+from rtsgeom.analysis.objects import (
+    CLOUD_COLUMNS,
+    clouds_csv,
+    objects_lines,
+    play_objects,
+    run_objects,
+)
 from rtsgeom.analysis.playback import Playback
 from rtsgeom.analysis.playback.result import BUDGET_ROLES
 from rtsgeom.pipeline.run import associate_targets, run_scene
@@ -134,3 +142,23 @@ def test_run_prints_scatterers_as_written_and_the_budget(tmp_path, capsys):
     line = next(x for x in out.splitlines() if x.startswith("object targets[0]"))
     az = float(line.split("max |azimuth| ")[1].split(" deg")[0])
     assert az <= 0.2 and "budget: kept" in line
+
+
+
+def test_clouds_csv_writes_every_column_of_every_row():
+    """One CSV row per detection with all of :data:`CLOUD_COLUMNS`: the numbers to six
+    significant digits, a missing elevation (azimuth-only RuT) empty."""
+    rng = np.random.default_rng(11)
+    rows = [(f, src, k, *rng.uniform(-50, 50, 3), (np.nan if f % 2 else rng.uniform(-5, 5)),
+             rng.uniform(-90, 0)) for f in range(4) for src in ("truth", "rts") for k in range(2)]
+    got = list(csv.reader(io.StringIO(clouds_csv(rows))))
+    assert tuple(got[0]) == CLOUD_COLUMNS
+    assert len(got) == len(rows) + 1
+    for r, line in zip(rows, got[1:]):
+        assert len(line) == len(CLOUD_COLUMNS)
+        assert line[:3] == [str(r[0]), r[1], str(r[2])]
+        for x, text in zip(r[3:], line[3:]):
+            if np.isfinite(x):
+                assert float(text) == pytest.approx(x, rel=1e-5)
+            else:
+                assert text == ""

@@ -24,7 +24,9 @@ from rtsgeom.analysis.tolerance.draws import draw_offsets
 from rtsgeom.analysis.tolerance.montecarlo import monte_carlo
 from rtsgeom.analysis.tolerance.phasors import CASES, NOMINAL_AMPLITUDES, ChannelPhasors
 from rtsgeom.analysis.tolerance.search import max_sigma_for_yield
+from rtsgeom.analysis.tolerance.study import ToleranceStudy
 from rtsgeom.cli import main
+from rtsgeom.errors import ParameterError
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
 from rtsgeom.radar import process
@@ -659,3 +661,10 @@ def test_range_offset_is_half_c_times_the_mean_delay_mismatch():
     got = model.range_offsets_m(off[None], [[0, 7]])[0, 1]
     assert got - base == pytest.approx(0.5 * c * (2 * 2e-3 / c + 7 * model.delay_resolution_s),
                                        rel=1e-3)
+
+
+
+@pytest.mark.parametrize("value", [0.0, -0.5, 1.5, math.nan])
+def test_a_bad_invert_yield_is_named(value):
+    with pytest.raises(ParameterError, match=r"invert_yield"):
+        ToleranceStudy(invert_yield=value)

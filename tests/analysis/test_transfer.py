@@ -5,8 +5,10 @@ peak at the documented maximum)."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
-from rtsgeom.analysis.transfer import percentiles
+from rtsgeom.analysis.transfer import TransferStudy, percentiles
+from rtsgeom.errors import ParameterError
 
 
 def test_percentiles_are_numpys_and_leave_the_input_alone():
@@ -21,3 +23,10 @@ def test_percentiles_are_numpys_and_leave_the_input_alone():
                        "max": float(a.max())}
         assert np.array_equal(x, keep, equal_nan=True)
     assert percentiles(np.full(4, np.nan)) == {"p50": None, "p95": None, "max": None}
+
+
+
+@pytest.mark.parametrize("pairs", [((0,),), ((0, 1), (2,)), ((0, 1, 2),)])
+def test_a_transfer_pair_is_two_front_ends(pairs):
+    with pytest.raises(ParameterError, match=r"pairs\[\d\]"):
+        TransferStudy(pairs=pairs)

@@ -7,10 +7,10 @@ import json
 
 import numpy as np
 import pytest
+from conftest import DEFAULT_SCENE, ROOT
 from scipy.optimize import least_squares
 from scipy.stats import chi2
 
-from conftest import DEFAULT_SCENE, ROOT
 from rtsgeom import identify as ident_mod
 from rtsgeom.cli import main
 from rtsgeom.geometry import build_setup
@@ -278,3 +278,28 @@ def test_an_antenna_gain_beyond_the_schema_is_refused_naming_it():
     with pytest.raises(CaptureError, match=r"rx_gain_db\[2\] = 25"):
         check_radar_fit(RadarChannelsFit(lg, np.zeros(n), np.ones(n), np.ones(n), ok, 3, 0,
                                          0, 0))
+
+
+
+@pytest.mark.parametrize("radius_m, seed", [(None, 3), (1.6, 4)])
+def test_identifying_a_nominal_radar_finds_no_antenna_errors(radius_m, seed):
+    """The joint fit (``identify(..., radar_channels=True)``) of captures simulated on the
+    nominal scene itself at 30 dB SNR: an identification of that scene, one fit per front
+    end, every antenna's estimated gain and phase zero to within noise (1e-2)."""
+    from conftest import DEFAULT_SCENE
+
+    from rtsgeom import identify as ident_mod
+    from rtsgeom.paths import exact_paths
+    from rtsgeom.scene import load_scene
+    scene = load_scene(DEFAULT_SCENE)
+    rts = scene.rts if radius_m is None else scene.rts.evolve(arc_radius_m=radius_m)
+    scene = scene.evolve(radar=scene.radar.evolve(snr_db=30.0), rts=rts)
+    setup = ident_mod.setup_of(scene)
+    paths = exact_paths(setup)
+    caps = [ident_mod.simulate_capture(setup, q, seed=[seed, q], paths=paths)
+            for q in range(setup.fe.count)]
+    ident = ident_mod.identify(scene, caps, radar_channels=True)
+    assert ident.scene is scene
+    assert len(ident.fits) == setup.fe.count
+    np.testing.assert_allclose(ident.radar.phase, 0.0, atol=1e-2)
+    np.testing.assert_allclose(ident.radar.log_gain, 0.0, atol=1e-2)
