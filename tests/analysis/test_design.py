@@ -283,7 +283,7 @@ def test_design_grid_flags_spacings_beyond_the_resolution_and_reports_progress()
 
 
 def test_the_design_study_draws_with_its_seed_and_announces_its_count(default_scene):
-    """``DesignStudy(mc=MonteCarlo(seed=s))`` is ``design_grid(..., seed=s)`` (not the
+    """``DesignStudy(mc=MonteCarlo(seed=s))`` is ``design_grid(..., DesignSpec(seed=s))`` (not the
     default seed's), and its progress opens with the number of designs to come."""
     calls = []
     radii, spacings = (1.0,), (8.0, 12.0)
@@ -291,10 +291,10 @@ def test_the_design_study_draws_with_its_seed_and_announces_its_count(default_sc
                         mc=MonteCarlo(draws=30, seed=7,
                                       progress=lambda *a: calls.append(a)))
     got = study(default_scene).to_dataframe()
-    want = design_grid(default_scene, (0, 1), list(radii), list(spacings), 0.1, 0.95, 30, 7,
-                       points=3).to_dataframe()
-    other = design_grid(default_scene, (0, 1), list(radii), list(spacings), 0.1, 0.95, 30, 0,
-                        points=3).to_dataframe()
+    want = design_grid(default_scene, (0, 1), list(radii), list(spacings),
+                       DesignSpec(0.1, 0.95, 30, 7, points=3)).to_dataframe()
+    other = design_grid(default_scene, (0, 1), list(radii), list(spacings),
+                        DesignSpec(0.1, 0.95, 30, 0, points=3)).to_dataframe()
     assert got.equals(want)
     assert not got.equals(other)  # the seed matters at 30 draws
     assert calls[0] == ("designs", 0, len(radii) * len(spacings))

@@ -143,13 +143,16 @@ def _datasheet():
             BudgetRow("receiver noise", 0.002, "1", "normal", 3.0))
     pts = tuple(AnglePoint((0, 1), a, 0.001, rows, 0.006, 0.012, (-0.011, 0.013), 0.001,
                            0.006, True, 0.03) for a in (5.0, 8.0))
-    fov = {"mode": "exact", "azimuth_deg": [4.0, 12.0], "gaps_deg": [], "covered_deg":
-           [[4.0, 12.0]]}
+    fov = {"mode": "exact", "cells": False, "azimuth_deg": [4.0, 12.0], "gaps_deg": [],
+           "covered_deg": [[4.0, 12.0]]}
     rv = {"min_range_m": 1.6, "max_range_m": 75.0, "max_velocity_mps": 9.0,
+          "range_resolution_m": 0.15, "range_step_m": 0.0001, "velocity_resolution_mps": 0.1,
           "range_accuracy_m": 0.05, "velocity_accuracy_mps": 0.01, "accuracy_note": ""}
     return Datasheet("unit", KpiStudy(), fov, pts, "", {}, rv,
-                     {"total": 8, "resolution": {"rts_deg": None, "note": "none"}},
-                     {"ghost_suppression_db": 26.0}, {}, spec=KpiSpec(targets=4))
+                     {"total": 8, "per_channel": 4,
+                      "resolution": {"rts_deg": None, "note": "none"}},
+                     {"ghost_suppression_db": 26.0}, {"fraunhofer_distance_m": 0.12},
+                     spec=KpiSpec(targets=4))
 
 
 def _object_design():
