@@ -31,7 +31,9 @@ def setup_fingerprint(scene) -> str:
     """SHA-256 of what a calibration is a measurement of: the RTS's arc, front ends (their
     mounting and channel fields) and delay hardware, and the RuT (array, pose, chirp,
     processing). Not the scenario (targets, seed, name), not what only changes noise or
-    levels (the RuT's ``snr_db``, ``link`` and CFAR, ``rts.link``), not the calibration
+    levels (the RuT's ``snr_db``, ``link`` and CFAR, ``rts.link``), not how many targets a
+    cell or a channel reports or carries (``angle_peaks_max``, ``angle_peak_threshold``,
+    ``rts.max_targets_per_channel``: a calibration measures one target), not the calibration
     procedure's own settings (``rts.calibration_span_ns``/``calibration_step_ps``) or the
     AoA mode, and not the sheet or ray tracing (``calibrate`` measures on exact paths).
     Files the scene names (antenna pattern tables) count by their content, not their path,
@@ -53,13 +55,14 @@ def setup_fingerprint(scene) -> str:
             return float(v)  # 1, 1.0 and np.float64(1.0) alike
         return v
     radar = dataclasses.asdict(scene.radar)
-    for key in ("snr_db", "link", "cfar"):
+    for key in ("snr_db", "link", "cfar", "angle_peaks_max", "angle_peak_threshold"):
         radar.pop(key, None)
     ch = scene.radar.channels
     if ch is None or ch.ideal:  # an ideal radar: the fingerprint it always had
         radar.pop("channels", None)
     rts = dataclasses.asdict(scene.rts)
-    for key in ("link", "aoa_mode", "calibration_span_s", "calibration_step_s"):
+    for key in ("link", "aoa_mode", "calibration_span_s", "calibration_step_s",
+                "max_targets_per_channel"):
         rts.pop(key, None)
     return hashlib.sha256(repr(canonical((radar, rts))).encode()).hexdigest()
 

@@ -627,7 +627,11 @@ def test_calibration_file_names_the_setup_it_was_made_on():
         return lambda d: d["rts"]["front_ends"][1].update(kw)
     base = setup_fingerprint(make_scene())
     same = [make_scene(lambda d: d.update(seed=7)), make_scene(snr_db=5.0),
-            make_scene(lambda d: d["targets"].pop())]
+            make_scene(lambda d: d["targets"].pop()),
+            # how many targets a cell reports or a channel carries: not what is measured
+            # (these moved every bundled scene's fingerprint when they were added)
+            make_scene(angle_peaks_max=4), make_scene(angle_peak_threshold=0.2),
+            make_scene(lambda d: d["rts"].update(max_targets_per_channel=2))]
     assert all(setup_fingerprint(s) == base for s in same)
     moved = [make_scene(fe1(radial_offset_mm=0.2)), make_scene(fe1(phase_offset_deg=30.0)),
              make_scene(lambda d: d["rts"].update(arc_radius_m=1.2)),
