@@ -168,10 +168,11 @@ class Detections:
 def range_doppler(cube: AdcCube) -> RangeDoppler:
     """Windowed range and Doppler FFTs of the cube and the power map.
 
-    ``scipy.fft`` with ``workers`` on the cube viewed as (sample, loop, channel): the FFTs
-    write the (R, D, V) layout the detections read, so no transposing copy; each 1-D
-    transform is computed whole by one thread, so the bytes do not depend on the thread
-    count. The transforms run in double precision (the spectrum is stored as complex64):
+    ``scipy.fft`` on the cube viewed as (sample, loop, channel): the FFTs write the (R, D, V)
+    layout the detections read, so no transposing copy. One thread (``workers=1``): pocketfft's
+    thread pool joins its threads before every ``fork`` and could hang there, and the
+    commands fork (the design's and calibration's pools, the report's 3D view); a second
+    thread saved under 1 ms a frame. The transforms run in double precision (the spectrum is stored as complex64):
     single-precision FFTs leave rounding spurs about 150 dB below a noise-free target that
     CFAR detects against the even lower rounding floor around them. The power sums |X|^2
     of the stored spectrum over the channels in float64."""
@@ -180,9 +181,9 @@ def range_doppler(cube: AdcCube) -> RangeDoppler:
     n_l, _, n_s = cube.data.shape
     w_r = window(radar.range_window, n_s)
     w_d = window(radar.doppler_window, n_l)
-    x = sfft.fft((cube.data * w_r).transpose(2, 0, 1), axis=0, workers=-1)  # (R, L, V)
+    x = sfft.fft((cube.data * w_r).transpose(2, 0, 1), axis=0, workers=1)  # (R, L, V)
     x *= w_d[None, :, None]
-    x = sfft.fft(x, axis=1, workers=-1, overwrite_x=True)
+    x = sfft.fft(x, axis=1, workers=1, overwrite_x=True)
     spec = np.ascontiguousarray(np.fft.fftshift(x, axes=1), dtype=np.complex64)  # (R, D, V)
     re_im = spec.view(np.float32)
     power = np.einsum("rdk,rdk->rd", re_im, re_im, dtype=np.float64)

@@ -5,6 +5,9 @@ xarray are the dataset's."""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -48,3 +51,32 @@ def test_map_arrays_are_the_datasets(result):
     for k, v in arrays.items():
         assert np.array_equal(v, ds[k].values)
     assert maps_arrays(arrays, ("npz", "mat")) == maps_arrays(ds, ("npz", "mat"))
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="needs Linux's /proc")
+def test_the_range_doppler_ffts_start_no_thread_pool():
+    """The commands fork (design and calibration pools, the report's 3D view); a thread pool
+    of pocketfft's joins its threads in its pre-fork handler and hung a forked design in the
+    test suite once. The chain's FFTs run on the calling thread: a fresh process has as many
+    native threads after a frame's range-Doppler as before it."""
+    code = """
+import os, numpy as np
+from rtsgeom.geometry import build_setup
+from rtsgeom.paths import exact_paths
+from rtsgeom.radar import process
+from rtsgeom.radar.frame import simulate
+from rtsgeom.rts.channels import program_nearest
+from rtsgeom.scene import load_scene
+scene = load_scene(%r)
+setup = build_setup(scene)
+paths = exact_paths(setup)
+_, cube = simulate(setup, paths, program_nearest(scene, setup), 0)
+before = len(os.listdir("/proc/self/task"))
+process(cube)
+print(before, len(os.listdir("/proc/self/task")))
+""" % str(SCENE)
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1", OMP_NUM_THREADS="1",
+               NUMBA_NUM_THREADS="1")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, env=env, cwd=SCENE.parents[1]).stdout.split()
+    assert out[0] == out[1], out
