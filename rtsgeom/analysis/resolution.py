@@ -20,9 +20,11 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
+from .._lib.io import write_text
 from .._lib.results import Result
 from ..errors import AngleUnreachable, ParameterError, SceneError
 from ..geometry import Setup, build_setup
@@ -339,15 +341,28 @@ class Resolution(Result):
                 "phases_deg": [float(p) for p in st.phases_deg],
                 "min_separation_deg": self.min_separation_deg}
 
-    def to_csv(self) -> str:
-        """``resolution.csv``: one row per separation, phase and source."""
-        return self.to_dataframe().to_csv(index=False, float_format="%.6g", na_rep="")
+    def to_csv(self, path) -> Path:
+        """``resolution.csv``: one row per separation, phase and source (atomically); returns
+        the path (the base's :meth:`~rtsgeom._lib.results.Result.to_csv` with six digits)."""
+        write_text(Path(path), self.to_dataframe().to_csv(index=False, float_format="%.6g",
+                                                         na_rep=""))
+        return Path(path)
 
     def plot(self):
         """Upper row: the RuT's angle spectrum of the cell, truth and RTS, at a few
         separations (phase 0); lower row: resolved or not over separation x phase."""
         from ..viz.resolution import resolution_figure  # matplotlib: only for the figure
         return resolution_figure(self)
+
+    def write(self, folder) -> list[str]:
+        """``rtsgeom resolution --out``: resolution.csv, summary.json and resolution.png into
+        ``folder``; returns the names."""
+        from ..viz.figures import save_figure  # matplotlib: only where a figure is written
+        folder = Path(folder)
+        self.to_csv(folder / "resolution.csv")
+        self.to_json(folder / "summary.json")
+        save_figure(self.plot(), folder / "resolution.png")
+        return ["resolution.csv", "summary.json", "resolution.png"]
 
 
 def _phase_key(ph: float) -> str:

@@ -279,16 +279,17 @@ def pair_options(p: argparse.ArgumentParser) -> None:
 
 # -- writing and printing a result ------------------------------------------------------------
 
-def print_outputs(args, name: str, out: dict, text) -> int:
+def print_outputs(args, name: str, out: dict, text, files=None, code: int = 0) -> int:
     """Print the JSON (``--json``) or ``text(out)`` once the output folder is in place, and
-    the files the result's ``write(folder)`` wrote (NAME.json, NAME.png)."""
+    the files written (``files``, default NAME.json and NAME.png); returns ``code``, the
+    command's exit status."""
     if args.json:
         print_json(out)
     else:
         print(text(out))
         if args.out:
-            print(f"wrote {args.out}/{name}.json, {name}.png")
-    return 0
+            print(f"wrote {args.out}/" + ", ".join(files or (f"{name}.json", f"{name}.png")))
+    return code
 
 
 @contextmanager

@@ -5,7 +5,7 @@ of the spec is met (or no spec), 1 when one is missed, 2 on bad input."""
 from __future__ import annotations
 
 from ..errors import AngleUnreachable, ParameterError, UsageError
-from ._common import (load_scene_checked, number, output_folder, output_path, print_json,
+from ._common import (load_scene_checked, number, output_folder, output_path, print_outputs,
                       progress, scene_arg)
 
 
@@ -41,13 +41,8 @@ def cmd_kpi(args) -> int:
             buf = io.BytesIO()
             write_pdf(sheet, buf, figs)
             write_bytes(stage / "kpi.pdf", buf.getvalue())
-    if args.json:
-        print_json(out)
-    else:
-        print(summary(out))
-        if args.out:
-            print(f"wrote {args.out}/kpi.json, kpi.html, kpi.pdf")
-    return sheet.exit_code
+    return print_outputs(args, "kpi", out, summary, ("kpi.json", "kpi.html", "kpi.pdf"),
+                         sheet.exit_code)
 
 
 def summary(out: dict) -> str:

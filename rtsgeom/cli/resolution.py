@@ -6,7 +6,6 @@ resolution.png."""
 from __future__ import annotations
 
 from ..analysis.resolution import ResolutionStudy
-from .._lib.io import write_json
 from ._common import (load_scene_checked, number, numbers, output_folder, print_json,
                       scene_arg, steps)
 
@@ -21,10 +20,7 @@ def cmd_resolution(args) -> int:
         with steps(args.quiet or args.json) as step:
             res = study(scene, progress=step)
         if stage is not None:
-            from ..viz.figures import save_figure
-            (stage / "resolution.csv").write_text(res.to_csv(), encoding="utf-8")
-            write_json(stage / "summary.json", res.to_dict())
-            save_figure(res.plot(), stage / "resolution.png")
+            res.write(stage)
     if args.json:
         print_json(res.to_dict())
     elif not args.quiet:
