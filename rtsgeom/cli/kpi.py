@@ -4,14 +4,15 @@ of the spec is met (or no spec), 1 when one is missed, 2 on bad input."""
 
 from __future__ import annotations
 
+from ..analysis.kpi import KpiStudy, load_spec
+from ..analysis.kpi.study import DEFAULT_SIGMA_MM
 from ..errors import AngleUnreachable, ParameterError, UsageError
-from ._common import (load_scene_checked, number, output_folder, output_path, print_outputs,
-                      progress, scene_arg)
+from ._common import (declared_option, load_scene_checked, output_folder, output_path,
+                      print_outputs, progress, scene_arg)
 
 
 def cmd_kpi(args) -> int:
     from .._lib.io import write_bytes, write_json, write_text
-    from ..analysis.kpi import KpiStudy, load_spec
     scene = load_scene_checked(args.scene)
     spec = None if args.spec is None else load_spec(args.spec)
     sigma = args.sigma_mm
@@ -75,18 +76,16 @@ def register(sub) -> None:
     scene_arg(p)
     p.add_argument("--spec", default=None, help="spec file (TOML, every key optional: "
                                                 "docs/kpi.md); exit 1 when a KPI misses it")
-    p.add_argument("--sigma-mm", type=number(0.0, 10.0), nargs="+", default=None,
-                   help="mounting offsets' sigma in mm: one number, or radial tangential "
-                        "height, each in [0, 10] (default 0.1)")
-    p.add_argument("--sigma-phase-deg", type=number(0.0, 90.0), default=None,
-                   help="each RuT antenna's phase spread over radars of the type, deg, in "
-                        "[0, 90] (default: the RMS of [radar.channels]' phases, else 0)")
-    p.add_argument("--points", type=number(1, 201, integer=True), default=11,
-                   help="set angles across each pair's span, ends excluded (default 11)")
-    p.add_argument("--draws", type=number(100, 1_000_000, integer=True), default=2000,
-                   help="Monte Carlo draws per set angle, in [100, 1000000] (default 2000)")
-    p.add_argument("--seed", type=number(0, 2 ** 63 - 1, integer=True), default=None,
-                   help="the Monte Carlo's seed (default: the scene's seed)")
+    # the study's options made from its declared arguments (KpiStudy.ARGS): ranges and
+    # defaults written once, in the study
+    declared = KpiStudy.ARGS
+    declared_option(p, "sigma_mm", declared["sigma_mm"], None, f"{DEFAULT_SIGMA_MM:g}",
+                    nargs="+")
+    declared_option(p, "sigma_phase_deg", declared["sigma_phase_deg"], None,
+                    "the RMS of [radar.channels]' phases, else 0")
+    declared_option(p, "points", declared["points"], KpiStudy.points)
+    declared_option(p, "draws", declared["draws"], KpiStudy.draws)
+    declared_option(p, "seed", declared["seed"], None, "the scene's seed")
     p.add_argument("--json", action="store_true", help="print the datasheet as JSON")
     p.add_argument("--out", type=output_path, default=None,
                    help="folder for kpi.json, kpi.html and kpi.pdf")

@@ -11,9 +11,11 @@ whether that meets the spec of the tests it was built for (:mod:`.spec`).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
@@ -22,9 +24,8 @@ from ...errors import ParameterError
 from ...geometry import build_setup
 from ...paths import exact_paths
 from ...scene import Scene, check_scene_arg
-from ...scene.schema import check_arg
 from ..tolerance import MAX_SIGMA_MM
-from ..tolerance.args import STUDY_ARGS
+from ..tolerance.args import STUDY_ARGS, Arg
 from ..transfer import ideal_radar, set_angles
 from .accuracy import AccuracyInputs, AnglePoint, effective_snr, pair_accuracy
 from .headline import headline
@@ -65,6 +66,20 @@ class KpiStudy:
         A value outside its range, naming it.
     """
 
+    #: the arguments declared once: each field's kind, range and help, checked here and the
+    #: options of ``rtsgeom kpi`` made from them (``cli._common.declared_option``); the
+    #: Monte-Carlo's as every study declares them, the draws within the datasheet's bounds
+    ARGS: ClassVar[dict[str, Arg]] = {
+        "sigma_mm": Arg("float", "mounting offsets' sigma in mm: one number, or radial "
+                                 "tangential height", 0.0, MAX_SIGMA_MM, unit="mm"),
+        "sigma_phase_deg": Arg("float", "each RuT antenna's phase spread over radars of the "
+                                        "type, deg", 0.0, 90.0, unit="deg"),
+        "points": Arg("int", "set angles across each pair's span, ends excluded", 1, 201),
+        "draws": dataclasses.replace(STUDY_ARGS["draws"], help="Monte Carlo draws per set "
+                                                               "angle", lo=100, hi=1_000_000),
+        "seed": dataclasses.replace(STUDY_ARGS["seed"], help="the Monte Carlo's seed"),
+    }
+
     sigma_mm: float | tuple[float, float, float] | None = None
     sigma_phase_deg: float | None = None
     points: int = 11
@@ -73,22 +88,16 @@ class KpiStudy:
     spec: KpiSpec | None = None
 
     def __post_init__(self):
-        s = self.sigma_mm
+        s, lo, hi = self.sigma_mm, self.ARGS["sigma_mm"].lo, self.ARGS["sigma_mm"].hi
         vals = () if s is None else (s,) * 3 if np.isscalar(s) else tuple(s)
         if s is not None and (len(vals) != 3 or not all(
-                isinstance(v, (int, float)) and 0 <= v <= MAX_SIGMA_MM for v in vals)):
+                isinstance(v, (int, float)) and lo <= v <= hi for v in vals)):
             raise ParameterError(f"sigma_mm = {s}: must be one number or three (radial, "
-                                 f"tangential, height) in [0, {MAX_SIGMA_MM:g}] mm")
-        src = "KpiStudy"
-        if self.sigma_phase_deg is not None:
-            check_arg(self.sigma_phase_deg, "sigma_phase_deg", "float", src, ParameterError,
-                      lo=0.0, hi=90.0, unit="deg")
-        check_arg(self.points, "points", "int", src, ParameterError, lo=1, hi=201)
-        # the Monte-Carlo arguments as every study declares them, the datasheet's draws
-        # within its own bounds [100, 1e6]
-        STUDY_ARGS["draws"].check(self.draws, "draws", src, lo=100, hi=1_000_000)
-        if self.seed is not None:
-            STUDY_ARGS["seed"].check(self.seed, "seed", src)
+                                 f"tangential, height) in [{lo:g}, {hi:g}] mm")
+        for name in ("sigma_phase_deg", "points", "draws", "seed"):
+            value = getattr(self, name)
+            if value is not None or name in ("points", "draws"):  # the others: None, default
+                self.ARGS[name].check(value, name, "KpiStudy")
         if self.spec is not None and not isinstance(self.spec, KpiSpec):
             raise ParameterError("spec: must be a KpiSpec (rtsgeom.analysis.kpi.load_spec)")
 
