@@ -112,3 +112,28 @@ def test_bin_centre_model_agrees_with_the_chain_on_a_planned_arc(radius_m):
     v = verify_draws(model, (0.5e-3,) * 3, MonteCarlo(draws=12, seed=0, subbin=False),
                      cases=("calibrated",))
     assert np.max(v.difference_deg("calibrated")) < 0.005
+
+
+@pytest.mark.parametrize("subbin", [True, False])
+def test_the_studys_verification_is_of_its_first_draws(subbin):
+    """``ToleranceStudy(verify=N)`` pushes the study's own first N draws through the chain:
+    the same mounting errors and the same target positions, drawn across the bin with
+    ``mc.subbin`` and at the bin centre without it (the verification once drew sub-bin
+    positions whatever ``mc.subbin``: it checked draws the study never made). The model's
+    worst error of each verified draw is then the study's."""
+    from rtsgeom.analysis.tolerance import Bounds, ToleranceStudy
+    n = 3
+    study = ToleranceStudy(Bounds((2e-4,) * 3), pair=(0, 1), points=5, verify=n,
+                           mc=MonteCarlo(draws=40, seed=5, subbin=subbin))
+    rep = study(make_scene())
+    run, ver = rep.run, rep.verify
+    drawn = (np.asarray(run.subbin_steps)[:n] if subbin
+             else np.zeros(n, int))  # the bin centre: step 0
+    assert (run.subbin_steps is not None) == subbin
+    np.testing.assert_array_equal(ver.subbin_steps, drawn)
+    if subbin:  # not a test that cannot fail: the draws leave the bin centre
+        assert np.any(drawn != 0)
+    for case in CASES:
+        np.testing.assert_allclose(ver.model_deg[case], run.worst_error_deg[case][:n],
+                                   rtol=1e-9, atol=1e-12)
+    assert ver.max_difference_deg < REQUIRED_DEG

@@ -206,9 +206,10 @@ class ToleranceStudy:
                        keep_errors=self.keep_draws and model.kind == "arc")
         verify = None
         if self.verify:
-            # the verification draws the sub-bin positions whatever the study's mc.subbin
+            # the study's first draws: its mounting errors and target positions (sub-bin,
+            # or the bin centre without mc.subbin)
             verify = verify_draws(model.sets[0], self.bounds.offsets_m,
-                                  mc.evolve(draws=min(self.verify, mc.draws), subbin=True),
+                                  mc.evolve(draws=min(self.verify, mc.draws)),
                                   cases=self.cases, all_points=self.verify_all_points)
         inversion = None
         if self.invert_yield is not None:
