@@ -196,3 +196,34 @@ def test_steering_search_in_two_dimensions_returns_azimuth_and_elevation():
     got = st.search(x)
     assert got.shape == (1, 2)
     np.testing.assert_allclose(np.degrees(got), [[5.0, 3.0]], atol=1e-6)
+
+
+#: evolutions of the scene's radar that change its beamformer: the wavelength, the array
+#: (the elevation Tx's virtual elements, the element spacing) and the taper
+RADAR_CHANGES = [{"f_c_hz": 78e9}, {"use_elevation_tx": True}, {"element_spacing_m": 2.1e-3},
+                 {"angle_window": "blackman"}]
+
+
+@pytest.mark.parametrize("change", RADAR_CHANGES)
+def test_the_kept_beamformer_follows_an_evolved_radar(change):
+    """``Steering.build`` keeps its last beamformers per RuT and radar object; after
+    ``Scene.evolve`` of the radar or its array the beamformer is the evolved one's (as built
+    afresh), never the one kept for the scene before, which stays what it was."""
+    scene = make_scene()
+    rut = build_setup(scene).rut
+    before = Steering.build(rut, scene.radar)
+    assert Steering.build(rut, scene.radar) is before  # kept: the cache is in use
+    evolved = scene.evolve(radar=scene.radar.evolve(**change))
+    rut2 = build_setup(evolved).rut
+    after = Steering.build(rut2, evolved.radar)
+    fresh = Steering._build(rut2, evolved.radar, False)
+    fields = ("mask", "positions_m", "taper", "aperture_m", "wavelength_m", "pitch_m")
+    for name in fields:
+        np.testing.assert_array_equal(getattr(after, name), getattr(fresh, name), name)
+    assert not all(np.array_equal(getattr(after, n), getattr(before, n)) for n in fields)
+    assert Steering.build(rut, scene.radar) is before
+    # one object new, the other kept: still the pair's own beamformer
+    for r, radar in ((rut, evolved.radar), (rut2, scene.radar)):
+        got, own = Steering.build(r, radar), Steering._build(r, radar, False)
+        for name in fields:
+            np.testing.assert_array_equal(getattr(got, name), getattr(own, name), name)
