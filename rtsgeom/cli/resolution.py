@@ -6,8 +6,8 @@ resolution.png."""
 from __future__ import annotations
 
 from ..analysis.resolution import ResolutionStudy
-from ._common import (load_scene_checked, number, numbers, output_folder, print_json,
-                      scene_arg, steps)
+from ._common import (load_scene_checked, number, numbers, output_folder, output_path,
+                      print_outputs, scene_arg, steps)
 
 
 def cmd_resolution(args) -> int:
@@ -21,13 +21,8 @@ def cmd_resolution(args) -> int:
             res = study(scene, progress=step)
         if stage is not None:
             res.write(stage)
-    if args.json:
-        print_json(res.to_dict())
-    elif not args.quiet:
-        print(res)
-        if args.out is not None:
-            print(f"wrote {args.out}/resolution.csv, summary.json, resolution.png")
-    return 0
+    return print_outputs(args, "resolution", res.to_dict(), lambda _: str(res),
+                         ("resolution.csv", "summary.json", "resolution.png"))
 
 
 def register(sub) -> None:
@@ -35,8 +30,8 @@ def register(sub) -> None:
                                           "the truth twin beside the RTS over separation x "
                                           "phase")
     scene_arg(p)
-    p.add_argument("--out", type=str, default=None, help="output folder (resolution.csv, "
-                   "summary.json, resolution.png)")
+    p.add_argument("--out", type=output_path, default=None,
+                   help="output folder (resolution.csv, summary.json, resolution.png)")
     p.add_argument("--range-m", type=number(0.1, 1e4), default=None,
                    help="the targets' range, m (default 20, or half the range axis)")
     p.add_argument("--velocity-mps", type=number(-1e3, 1e3), default=0.0,
@@ -53,5 +48,5 @@ def register(sub) -> None:
     p.add_argument("--amplitudes", choices=["exact", "array-factor", "paper"], default=None,
                    help="the RTS's AoA mode (default: the scene's rts.aoa_mode)")
     p.add_argument("--json", action="store_true", help="print summary.json to stdout")
-    p.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress output")
     p.set_defaults(func=cmd_resolution)
