@@ -66,7 +66,7 @@ def main(argv=None) -> int:
         scene_f = dataclasses.replace(setup.scene, targets=targets)
         program, _ = planner.program(f, scene_f)
         b = time.perf_counter()
-        matches, _, _ = detect_frame(setup, paths, program, scene_f, scene.seed + f)
+        matches, _, _, _ = detect_frame(setup, paths, program, scene_f, scene.seed + f)
         chain_s += time.perf_counter() - b
         plan_s += b - a
         for m in matches:

@@ -397,7 +397,7 @@ def show(scene_or_setup, paths=None, png: str | Path | None = None,
 
 
 def play(scene: Scene, amplitudes: str | None = None, paths: str = "exact",
-         baseline: bool = True, workers: int = 1):
+         baseline: bool = True, workers: int = 1, chain: str = "fast"):
     """Play the scene's ``[scenario]`` frame by frame (``rtsgeom play``).
 
     Parameters
@@ -411,6 +411,10 @@ def play(scene: Scene, amplitudes: str | None = None, paths: str = "exact",
         Also play the switched baseline on the same drive (``result.baseline``).
     workers : int
         Forked processes for the frames (the same result for any number).
+    chain : {'fast', 'full'}
+        ``fast``: each frame's detections near its targets from the echoes' closed-form
+        spectrum, the full chain for the frames outside it (``summary()['chain']`` counts
+        them); ``full``: every frame through the ADC cube, FFTs and CFAR.
 
     Returns
     -------
@@ -418,7 +422,7 @@ def play(scene: Scene, amplitudes: str | None = None, paths: str = "exact",
         ``summary()``, ``to_dataframe()`` (tracks), ``programme_dataframe()``, ``plot()``.
     """
     check_scene_arg(scene, "play")
-    return _play(scene, amplitudes, paths, baseline, workers)
+    return _play(scene, amplitudes, paths, baseline, workers, chain=chain)
 
 
 def kpi(scene: Scene, spec=None, sigma_mm=None, sigma_phase_deg: float | None = None,

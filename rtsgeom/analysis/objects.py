@@ -4,7 +4,7 @@ summary per object and frame.
 A cloud is the detections the RuT makes of one object in one frame: the truth twin's
 (``source`` ``truth``: the same radar on the real scatterers) and the RTS's (``rts``). Which
 detection is whose is the project's one association
-(:func:`rtsgeom.pipeline.run.associate_targets`, as for every target of ``run`` and ``play``):
+(:func:`rtsgeom.pipeline.matching.associate_targets`, as for every target of ``run`` and ``play``):
 in the radar's resolution cells (range bin, velocity bin, two-target resolution per
 direction-cosine axis, elevation included for a 2-D RuT), the RTS's targets where the radar sees
 them (R_c further without ``rts.compensate_air_path``), the truth twin's at their set range. A
@@ -48,7 +48,7 @@ def cloud_rows(frame: int, source: str, scene, det, rd, targets, steering=None,
     ``object_index``; the RTS's where the radar sees them, ``source`` ``truth``: at their set
     range) with ``det`` on the map ``rd`` and the beamformer ``steering``, ``gate`` range and
     Doppler bins."""
-    from ..pipeline.run import associate_targets
+    from ..pipeline.matching import associate_targets
     t = tuple(targets)
     if not len(det) or not t:
         return []
@@ -86,7 +86,7 @@ def _cloud(rows) -> np.ndarray:
 
 
 def _points(c: np.ndarray, dims: int) -> np.ndarray:
-    from ..pipeline.run import direction_columns
+    from ..pipeline.matching import direction_columns
     return np.c_[c[:, :2], direction_columns(np.radians(c[:, 2]), np.radians(c[:, 3]), dims)]
 
 
@@ -168,7 +168,7 @@ def run_objects(result) -> tuple[list, dict]:
     """A run's clouds (frame 0) and its ``summary.json`` ``objects`` section (per object the
     comparison, with the planner's budget counts where ``[rts] max_targets_per_channel`` is
     set)."""
-    from ..pipeline.run import association_scale
+    from ..pipeline.matching import association_scale
     scene, rd, st = result.scene, result.rd, result.cube.steering
     scale = association_scale(scene, rd, st)
     rows = []

@@ -29,7 +29,7 @@ from .._lib.results import Result
 from ..errors import AngleUnreachable, ParameterError, SceneError
 from ..geometry import Setup, build_setup
 from ..paths import compute_paths
-from ..pipeline.run import match_targets
+from ..pipeline.matching import match_targets
 from ..radar import process
 from ..radar.fmcw import beat_phase0
 from ..radar.frame import noise_power, simulate

@@ -9,6 +9,7 @@ import json
 
 from ..analysis.tolerance.draws import MAX_SIGMA_MM
 from ..errors import ParameterError, UsageError
+from ..radar.frame import CHAINS
 from ..scene.registry import AOA_MODES, PATH_METHODS
 from ._common import (load_scene_checked, number, output_folder, output_path, scene_arg,
                       steps)
@@ -16,7 +17,6 @@ from ._common import (load_scene_checked, number, output_folder, output_path, sc
 
 def cmd_play(args) -> int:
     from ..analysis.playback import Playback
-    from ..analysis.playback.result import budget_line
     from ..viz.figures import save_figure
     if not args.tolerance_draws:
         for flag, value in (("--sigma-mm", args.sigma_mm), ("--spec-deg", args.spec_deg)):
@@ -31,7 +31,7 @@ def cmd_play(args) -> int:
         raise UsageError(f"{args.scene}: has no [scenario] to play (add [scenario] with "
                          "[[scenario.targets]], docs/scenario.md)")
     study = Playback(args.amplitudes, args.paths, baseline=not args.no_baseline,
-                     workers=args.workers)
+                     workers=args.workers, chain=args.chain)
     with output_folder(args.out, [args.scene]) as stage, steps(args.quiet) as step:
         if not args.quiet:
             step(_estimate(scene, study))
@@ -64,34 +64,46 @@ def cmd_play(args) -> int:
             step("writing playback.gif")
             result.animate(stage / "playback.gif")
     if not args.quiet:
-        s = result.summary()
-        for r, v in (("", s), ("baseline ", s.get("baseline"))):
-            if v is None:
-                continue
-            e = v["angle_error_deg"]
-            worst = "n/a" if e["max"] is None else f"{e['max']:.4f} deg (p95 {e['p95']:.4f})"
-            jump = ("n/a" if v["handover_jump_deg"] is None
-                    else f"{v['handover_jump_deg']:.4f} deg")
-            if v["point_targets"]:
-                print(f"{r}{v['mode']}: {v['frames']} frames, {v['point_targets']} point "
-                      f"target(s): max |angle error| {worst}, {v['lost_frames']} lost, "
-                      f"{v['split_frames']} split, {v['handovers']} hand-overs (largest jump "
-                      f"{jump})")
-            if "budget" in v:
-                print(f"{r}{v['mode']}: budget {budget_line(v['budget'])}")
-        for line in objects_lines:
-            print(line)
-        if "tolerance" in summary:
-            t = summary["tolerance"]
-            print(f"tolerance over the drive ({t['draws']} setups, sigma {t['sigma_mm']} mm, "
-                  f"spec {t['spec_deg']:g} deg): yield calibrated "
-                  f"{t['yield']['calibrated']:.3f}, uncalibrated "
-                  f"{t['yield']['uncalibrated']:.3f}")
-        for w in result.warnings:
-            print(f"warning: {w}")
-        print(f"wrote {args.out}/programme.csv, tracks.csv, summary.json, playback.png"
-              + (", playback.gif" if args.gif else ""))
+        _print_result(result, summary, objects_lines, args)
     return 0
+
+
+def _print_result(result, summary: dict, objects_lines, args) -> None:
+    """The drive's lines on stdout: per mode the errors, losses, splits and hand-overs, the
+    budget, the frames left to the full chain, the objects, the tolerance and warnings."""
+    from ..analysis.playback.result import budget_line
+    s = result.summary()
+    for r, v in (("", s), ("baseline ", s.get("baseline"))):
+        if v is None:
+            continue
+        e = v["angle_error_deg"]
+        worst = "n/a" if e["max"] is None else f"{e['max']:.4f} deg (p95 {e['p95']:.4f})"
+        jump = ("n/a" if v["handover_jump_deg"] is None
+                else f"{v['handover_jump_deg']:.4f} deg")
+        if v["point_targets"]:
+            print(f"{r}{v['mode']}: {v['frames']} frames, {v['point_targets']} point "
+                  f"target(s): max |angle error| {worst}, {v['lost_frames']} lost, "
+                  f"{v['split_frames']} split, {v['handovers']} hand-overs (largest jump "
+                  f"{jump})")
+        if "budget" in v:
+            print(f"{r}{v['mode']}: budget {budget_line(v['budget'])}")
+        ch = v["chain"]
+        if ch["full_chain_frames"]:
+            why = "; ".join(f"{k}: {n}" for k, n in ch["reasons"].items())
+            print(f"{r}{v['mode']}: {ch['full_chain_frames']} of {v['frames']} frames on "
+                  f"the full chain ({why})")
+    for line in objects_lines:
+        print(line)
+    if "tolerance" in summary:
+        t = summary["tolerance"]
+        print(f"tolerance over the drive ({t['draws']} setups, sigma {t['sigma_mm']} mm, "
+              f"spec {t['spec_deg']:g} deg): yield calibrated "
+              f"{t['yield']['calibrated']:.3f}, uncalibrated "
+              f"{t['yield']['uncalibrated']:.3f}")
+    for w in result.warnings:
+        print(f"warning: {w}")
+    print(f"wrote {args.out}/programme.csv, tracks.csv, summary.json, playback.png"
+          + (", playback.gif" if args.gif else ""))
 
 
 def _estimate(scene, study) -> str:
@@ -151,5 +163,10 @@ def register(sub) -> None:
                         "(default 0.1 deg)")
     p.add_argument("--workers", type=number(1, 256, integer=True), default=1, metavar="N",
                    help="play the frames in N forked processes (the same result)")
+    p.add_argument("--chain", choices=CHAINS, default="fast",
+                   help="fast (default): each frame's detections near its targets from the "
+                        "echoes' closed-form spectrum, the full chain for frames outside it "
+                        "(counted in summary.json's chain); full: every frame through the ADC "
+                        "cube, FFTs and CFAR over the whole map")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(func=cmd_play)

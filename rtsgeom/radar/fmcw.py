@@ -45,7 +45,7 @@ from .steering import Steering
 
 __all__ = ["AdcCube", "fast_time_s", "chirp_start_s", "beat_phase0", "synthesize",
            "synthesize_each",
-           "synthesize_exact", "add_noise"]
+           "synthesize_exact", "add_noise", "noise_cube"]
 
 
 @dataclass(frozen=True)
@@ -188,6 +188,13 @@ def add_noise(cube: AdcCube, noise_power: float, rng: np.random.Generator) -> Ad
     """Add circular complex white Gaussian receiver noise of the given power per sample."""
     if noise_power <= 0:
         return cube
-    n = rng.standard_normal(cube.data.shape + (2,), dtype=np.float32)
+    return AdcCube(cube.data + noise_cube(cube.data.shape, noise_power, rng), cube.radar,
+                   cube.rut)
+
+
+def noise_cube(shape, noise_power: float, rng: np.random.Generator) -> np.ndarray:
+    """Circular complex white Gaussian noise (complex64) of the given power per sample: the
+    draws :func:`add_noise` adds (the same generator calls, the same values)."""
+    n = rng.standard_normal(tuple(shape) + (2,), dtype=np.float32)
     n *= np.float32(np.sqrt(noise_power / 2))
-    return AdcCube(cube.data + n.view(np.complex64)[..., 0], cube.radar, cube.rut)
+    return n.view(np.complex64)[..., 0]

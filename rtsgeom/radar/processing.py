@@ -22,7 +22,8 @@ from scipy.constants import c
 
 from .._lib.util import frozen
 from ..geometry import RutArray
-from ..scene import CfarConfig, RadarConfig
+from ..scene import RadarConfig
+from .cfar import cfar_mask
 from .fmcw import AdcCube
 from .newton import parabolic as _parabolic
 from .peaks import angle_peaks
@@ -30,7 +31,7 @@ from .steering import Steering
 from .windows import window
 
 __all__ = ["RangeDoppler", "Detections", "range_doppler", "range_doppler_power", "cfar_mask",
-           "detect",
+           "detect", "detections_at", "PeakCells", "spectrum_axes",
            "nearest_detection",
            "angle_spectrum", "estimate_angles", "range_angle_map", "process"]
 
@@ -187,11 +188,18 @@ def range_doppler(cube: AdcCube) -> RangeDoppler:
     spec = np.ascontiguousarray(np.fft.fftshift(x, axes=1), dtype=np.complex64)  # (R, D, V)
     re_im = spec.view(np.float32)
     power = np.einsum("rdk,rdk->rd", re_im, re_im, dtype=np.float64)
+    return RangeDoppler(spec, power, *spectrum_axes(radar))
+
+
+def spectrum_axes(radar: RadarConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The range-Doppler map's axes: range (R,) m, radial velocity (D,) m/s and slow-time
+    frequency per TDM cycle (D,) Hz, the Doppler axis fftshifted (read-only arrays)."""
+    n_s, n_l = radar.samples_per_chirp, radar.chirps_per_tx
     f_beat = np.arange(n_s) * radar.adc_rate_hz / n_s
     rng = f_beat * c / (2 * radar.slope_hz_per_s)
     nu = np.fft.fftshift(np.fft.fftfreq(n_l, d=radar.tdm_cycle_s))
     vel = nu * c / (2 * radar.f_c_hz)
-    return RangeDoppler(spec, power, frozen(rng), frozen(vel), frozen(nu))
+    return frozen(rng), frozen(vel), frozen(nu)
 
 
 def range_doppler_power(data: np.ndarray, radar: RadarConfig) -> np.ndarray:
@@ -208,113 +216,6 @@ def range_doppler_power(data: np.ndarray, radar: RadarConfig) -> np.ndarray:
     spec = np.fft.fftshift(x, axes=-3).astype(np.complex64)  # stored as range_doppler's
     power = (spec.real.astype(np.float64) ** 2 + spec.imag.astype(np.float64) ** 2).sum(-2)
     return np.swapaxes(power, -1, -2)  # (..., R, D)
-
-
-#: OS-CFAR ranks at most this many training cells per cell under test (an evenly thinned ring
-#: beyond it), so that its cost stays O(map x OS_MAX_CELLS) whatever the ring the scene asks for.
-OS_MAX_CELLS = 512
-
-
-def _window_sums(a: np.ndarray, lo: int, hi: int, axis: int) -> np.ndarray:
-    """``out[i] = sum(a[(i + k) mod n] for k in lo..hi)`` along ``axis`` (cyclic), in O(size)
-    time and memory whatever the window, with additions only: blocks of the window's length,
-    each window the suffix of one block plus the prefix of the next (van Herk / Gil-Werman), so
-    the rounding error is relative to the window's own content (no difference of long running
-    sums, which would leave eps x the strongest peak in every quiet cell). A window longer than
-    the axis counts each wrap in full, as a wrapped convolution does."""
-    return np.roll(_leading_window_sums(a, hi - lo + 1, axis), -lo, axis=axis)
-
-
-def _leading_window_sums(a: np.ndarray, length: int, axis: int) -> np.ndarray:
-    """:func:`_window_sums` of the window ``0..length - 1``: every window of the same length is
-    a cyclic shift of it (``np.roll``, a permutation: the same bits), so windows of equal
-    length share one pass."""
-    lo, hi = 0, length - 1
-    a = np.moveaxis(a, axis, 0)
-    n = a.shape[0]
-    full, w = divmod(hi - lo + 1, n)
-    out = full * a.sum(axis=0, keepdims=True) if full else None
-    if w:
-        nb = -(-(n + w - 1) // w)  # blocks covering every window start 0..n-1
-        ext = np.take(a, np.arange(nb * w + w) % n, axis=0)  # cyclic extension
-        blocks = ext.reshape((nb + 1, w) + a.shape[1:])
-        pre = np.cumsum(blocks, axis=1).reshape(ext.shape)
-        suf = np.flip(np.cumsum(np.flip(blocks, 1), axis=1), 1).reshape(ext.shape)
-        s = np.arange(n)
-        part = np.where(((s % w) == 0).reshape((n,) + (1,) * (a.ndim - 1)),
-                        suf[s], suf[s] + pre[s + w - 1])
-        out = part if out is None else out + part
-    out = np.broadcast_to(out, a.shape)
-    return np.moveaxis(out, 0, axis)
-
-
-def _ring_sum(power: np.ndarray, gr: int, gd: int, tr: int, td: int) -> np.ndarray:
-    """Sum over the CA-CFAR ring: four cyclic rectangles (the bands above and below the guard
-    window, over the full Doppler width; left and right of it), each summed over range first,
-    then Doppler, and added in that order. Sums only, no outer-minus-inner cancellation.
-
-    The two bands have the same range length and the same Doppler window, the two sides the
-    same range window and the same Doppler length: each pair shares its window sums and
-    differs by a cyclic shift (bit-identical to summing each rectangle on its own, 4 passes
-    instead of 8)."""
-    hr, hd = gr + tr, gd + td
-    bands = _window_sums(_leading_window_sums(power, tr, 0), -hd, hd, 1)
-    above = np.roll(bands, hr, axis=0)  # range offsets -hr..-gr-1
-    below = np.roll(bands, -(gr + 1), axis=0)  # gr+1..hr
-    sides = _leading_window_sums(_window_sums(power, -gr, gr, 0), td, 1)
-    left = np.roll(sides, hd, axis=1)  # Doppler offsets -hd..-gd-1
-    right = np.roll(sides, -(gd + 1), axis=1)  # gd+1..hd
-    return above + below + left + right
-
-
-def _os_footprint(shape, gr: int, gd: int, tr: int, td: int) -> np.ndarray:
-    """The OS-CFAR training ring, clipped to the map (no cell twice) and thinned evenly to at
-    most :data:`OS_MAX_CELLS` cells."""
-    hr = min(gr + tr, (shape[0] - 1) // 2)
-    hd = min(gd + td, (shape[1] - 1) // 2)
-    ring = np.ones((2 * hr + 1, 2 * hd + 1), bool)
-    ring[max(hr - gr, 0):hr + gr + 1, max(hd - gd, 0):hd + gd + 1] = False
-    if not ring.any():  # the guard cells cover the whole map: train on every other cell
-        ring[:] = True
-        ring[hr, hd] = False
-    idx = np.flatnonzero(ring)
-    if idx.size > OS_MAX_CELLS:
-        keep = idx[np.linspace(0, idx.size - 1, OS_MAX_CELLS).round().astype(int)]
-        ring = np.zeros_like(ring)
-        ring.flat[keep] = True
-    return ring
-
-
-def cfar_mask(power: np.ndarray, cfg: CfarConfig) -> tuple[np.ndarray, np.ndarray]:
-    """2D CFAR on a (range, Doppler) power map: returns (detected mask, noise estimate).
-
-    Training cells form a ring around each cell under test (guard cells excluded); the range
-    axis is cyclic too: with a complex ADC the beat frequencies wrap at f_adc, so the top
-    range bins neighbour the bottom ones.
-
-    CA averages the ring, summed as four rectangles with cyclic block prefix/suffix sums
-    (:func:`_window_sums`): time and memory O(map) whatever the ring size, rounding relative to
-    the ring's own content (a ring larger than the map counts wrapped cells once per wrap, as a
-    wrapped convolution does).
-    OS takes the ring's ``os_rank`` quantile; its ring is clipped to the map and thinned evenly
-    to at most :data:`OS_MAX_CELLS` cells, bounding the cost at O(map x OS_MAX_CELLS).
-    """
-    from scipy import ndimage  # here: 0.2 s of imports that `rtsgeom info` does not need
-    gr, gd = cfg.guard_cells
-    tr, td = cfg.training_cells
-    power = np.asarray(power, dtype=np.float64)
-    if cfg.kind == "ca":
-        hr, hd = gr + tr, gd + td
-        total = _ring_sum(power, gr, gd, tr, td)
-        count = (2 * hr + 1) * (2 * hd + 1) - (2 * gr + 1) * (2 * gd + 1)
-        noise = total / count
-    else:
-        ring = _os_footprint(power.shape, gr, gd, tr, td)
-        noise = ndimage.percentile_filter(power, 100 * cfg.os_rank, footprint=ring,
-                                          mode="wrap")
-    thr = noise * 10 ** (cfg.threshold_db / 10)
-    peak = power == ndimage.maximum_filter(power, size=3, mode="wrap")
-    return (power > thr) & peak, noise
 
 
 def _steering_of(rut: RutArray | Steering, radar: RadarConfig | None) -> Steering:
@@ -353,21 +254,64 @@ def tdm_compensate(snapshots: np.ndarray, doppler_hz, rut: RutArray,
 
 def detect(rd: RangeDoppler, cube: AdcCube) -> Detections:
     """CFAR detections with sub-bin range/velocity and a refined angle per detection."""
-    radar, rut = cube.radar, cube.rut
-    mask, noise = cfar_mask(rd.power, radar.cfar)
+    mask, noise = cfar_mask(rd.power, cube.radar.cfar)
     r_i, d_i = np.nonzero(mask)
     n_r, n_d = rd.power.shape
     logp = np.log(np.maximum(rd.power, 1e-300))
-    dr = _parabolic(logp[(r_i - 1) % n_r, d_i], logp[r_i, d_i], logp[(r_i + 1) % n_r, d_i])
-    dd = _parabolic(logp[r_i, (d_i - 1) % n_d], logp[r_i, d_i], logp[r_i, (d_i + 1) % n_d])
-    range_step = rd.range_m[1] - rd.range_m[0]
-    nu_step = rd.doppler_hz[1] - rd.doppler_hz[0]
-    nu = rd.doppler_hz[d_i] + dd * nu_step
-    snaps = tdm_compensate(rd.spectrum[r_i, d_i, :], nu, rut, radar)
-    st = cube.steering
-    k_max = int(getattr(radar, "angle_peaks_max", 1))
-    ang, level = angle_peaks(st, snaps, k_max, float(getattr(radar, "angle_peak_threshold",
-                                                                  0.5)))
+    cells = PeakCells(
+        (logp[(r_i - 1) % n_r, d_i], logp[r_i, d_i], logp[(r_i + 1) % n_r, d_i]),
+        (logp[r_i, (d_i - 1) % n_d], logp[r_i, d_i], logp[r_i, (d_i + 1) % n_d]),
+        rd.spectrum[r_i, d_i, :], rd.power[r_i, d_i], noise[r_i, d_i], r_i, d_i)
+    return detections_at(cells, (rd.range_m, rd.velocity_mps, rd.doppler_hz), cube.radar,
+                         cube.rut, cube.steering)
+
+
+@dataclass(frozen=True)
+class PeakCells:
+    """The cells CFAR passed, as :func:`detections_at` reads them.
+
+    Attributes
+    ----------
+    range_logp, doppler_logp : tuple of three ndarray, (n,)
+        The log power of each cell's lower neighbour, itself and its upper neighbour along
+        the range and the Doppler axis.
+    snapshots : ndarray, (n, V)
+        The cells' spectrum over the virtual channels.
+    power, noise : ndarray, (n,)
+        The cells' power and CFAR noise estimate.
+    range_bin, doppler_bin : ndarray, (n,) int
+        The cells' indices in the map (Doppler fftshifted).
+    """
+
+    range_logp: tuple
+    doppler_logp: tuple
+    snapshots: np.ndarray
+    power: np.ndarray
+    noise: np.ndarray
+    range_bin: np.ndarray
+    doppler_bin: np.ndarray
+
+
+def detections_at(cells: PeakCells, axes, radar: RadarConfig, rut: RutArray,
+                  steering: Steering) -> Detections:
+    """The detections of the cells CFAR passed (:class:`PeakCells`): sub-bin range and velocity
+    by a parabola through the log power of each cell and its two neighbours along the axis,
+    the TDM-compensated snapshots beamformed (:func:`~rtsgeom.radar.peaks.angle_peaks`: one
+    row per direction, each cell's rows together, strongest first); ``axes`` the map's
+    (:func:`spectrum_axes`). The arithmetic of :func:`detect`, whatever holds the cells (a
+    whole map, or the windows of :func:`rtsgeom.radar.windowed.detect_near`)."""
+    r_i, d_i, power, noise = cells.range_bin, cells.doppler_bin, cells.power, cells.noise
+    range_logp, doppler_logp, snapshots = cells.range_logp, cells.doppler_logp, cells.snapshots
+    range_m, _, doppler_hz = axes
+    dr = _parabolic(*range_logp)
+    dd = _parabolic(*doppler_logp)
+    range_step = range_m[1] - range_m[0]
+    nu_step = doppler_hz[1] - doppler_hz[0]
+    nu = doppler_hz[d_i] + dd * nu_step
+    snaps = tdm_compensate(snapshots, nu, rut, radar)
+    st = steering
+    k_max = int(radar.angle_peaks_max)
+    ang, level = angle_peaks(st, snaps, k_max, float(radar.angle_peak_threshold))
     # one row per direction, each cell's rows together, strongest first
     cell, rank = np.nonzero(np.isfinite(level))
     ang = ang[cell, rank]
@@ -376,11 +320,11 @@ def detect(rd: RangeDoppler, cube: AdcCube) -> Detections:
         ang, elev = ang[..., 0], frozen(ang[..., 1])
     r_i, d_i = r_i[cell], d_i[cell]
     return Detections(
-        range_m=frozen(rd.range_m[r_i] + dr[cell] * range_step),
+        range_m=frozen(range_m[r_i] + dr[cell] * range_step),
         velocity_mps=frozen(nu[cell] * c / (2 * radar.f_c_hz)),
         angle_rad=frozen(ang),
-        power_db=frozen(10 * np.log10(rd.power[r_i, d_i])),
-        snr_db=frozen(10 * np.log10(rd.power[r_i, d_i] / noise[r_i, d_i])),
+        power_db=frozen(10 * np.log10(power[cell])),
+        snr_db=frozen(10 * np.log10(power[cell] / noise[cell])),
         range_bin=frozen(r_i), doppler_bin=frozen(d_i), elevation_rad=elev,
         angle_peak=frozen(rank) if k_max > 1 else None,
         angle_level_db=frozen(level[cell, rank]) if k_max > 1 else None,

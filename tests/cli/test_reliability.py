@@ -339,7 +339,7 @@ def test_tolerance_chunk_is_bounded_by_memory():
 # --- 4. no silent wrong answer --------------------------------------------------------------
 
 def test_one_detection_matches_at_most_one_target(nearest_result):
-    from rtsgeom.pipeline.run import match_targets
+    from rtsgeom.pipeline.matching import match_targets
     det, rd = nearest_result.detections, nearest_result.rd
     j = 0
     t = SimpleNamespace(range_m=float(det.range_m[j]), velocity_mps=float(det.velocity_mps[j]),

@@ -93,6 +93,6 @@ def test_plan_programs_two_channels_per_target_at_the_set_range_and_doppler(smal
     if mode == "exact":
         _, cube = simulate(setup, paths, prog)
         rd, det = process(cube)
-        from rtsgeom.pipeline.run import match_targets
+        from rtsgeom.pipeline.matching import match_targets
         for e in match_targets(scene, det, rd):
             assert abs(e["error"]["angle_deg"]) < 0.05

@@ -244,20 +244,24 @@ def test_the_switched_baseline_keeps_a_target_midway_between_two_front_ends():
 
 def test_a_static_scenario_reproduces_run():
     """A target at rest in [scenario] plays frame 0 exactly as `run` runs it in [[targets]]
-    (the same calibration, programme, noise and detection); later frames the same programme."""
+    (the same calibration, programme, noise and detection); later frames the same programme.
+    On the full chain to an ulp; on the fast path within its tolerance of the full chain."""
     doc = crossing_doc(duration_s=0.1, frame_period_s=0.1)
     doc["radar"]["snr_db"] = 20.0
     doc["scenario"]["targets"][0]["waypoints"] = [[0.0, 20.0, 3.0]]
     scene = scene_of(doc)
-    res = rtsgeom.play(scene, baseline=False)
+    res = rtsgeom.play(scene, baseline=False, chain="full")
+    fast = rtsgeom.play(scene, baseline=False)
     static = scene.evolve(targets=(TargetConfig(range_m=20.0, angle_rad=3 * DEG),),
                           scenario=None)
     run = rtsgeom.run_scene(static)
     m = run.matches[0]["detection"]
     # the set azimuth comes through atan2 of the position: equal to an ulp, not bit for bit
-    assert res.detected["range_m"][0, 0] == pytest.approx(m["range_m"], abs=1e-9)
-    assert res.detected["azimuth_deg"][0, 0] == pytest.approx(m["angle_deg"], abs=1e-9)
-    assert res.detected["velocity_mps"][0, 0] == pytest.approx(m["velocity_mps"], abs=1e-9)
+    for r, tol in ((res, 1e-9), (fast, 1e-6)):
+        assert r.detected["range_m"][0, 0] == pytest.approx(m["range_m"], abs=tol)
+        assert r.detected["azimuth_deg"][0, 0] == pytest.approx(m["angle_deg"], abs=tol)
+        assert r.detected["velocity_mps"][0, 0] == pytest.approx(m["velocity_mps"], abs=tol)
+    assert fast.summary()["chain"] == {"asked": "fast", "full_chain_frames": 0, "reasons": {}}
     assert abs(m["angle_deg"] - 3.0) > 1e-6  # noise: a number worth reproducing
     prog = res.programme[res.programme[:, 0] == 0]
     np.testing.assert_array_equal(prog[:, 2], run.program.front_end)
@@ -360,3 +364,28 @@ def test_play_animates_and_adds_the_drive_tolerance(tmp_path):
     t = json.loads((out / "summary.json").read_text())["tolerance"]
     assert t["draws"] == 50 and t["sigma_mm"] == [0.2, 0.2, 0.0]
     assert t["pairs"] and 0.0 <= t["yield"]["calibrated"] <= 1.0
+
+
+@pytest.mark.parametrize("snr_db", [None, 12.0])
+def test_the_fast_path_plays_the_full_chains_drive(snr_db):
+    """Three targets crossing the arc (one passing another's cell), five frames: the tracks
+    and the truth twin's on the fast path within 1 mm, 1e-3 m/s and 1e-3 deg of the full
+    chain's, the same statuses and splits; the summary says which chain ran."""
+    doc = crossing_doc(duration_s=0.4, frame_period_s=0.1)
+    t0 = doc["scenario"]["targets"][0]
+    doc["scenario"]["targets"] = [
+        t0, dict(t0, waypoints=[[0.0, 20.2, 6.0], [0.4, 20.2, -2.0]]),
+        dict(t0, waypoints=[[0.0, 26.0, -4.0], [0.4, 26.0, 4.0]])]
+    if snr_db is not None:
+        doc["radar"]["snr_db"] = snr_db
+    scene = scene_of(doc)
+    fast, full = (rtsgeom.play(scene, baseline=False, chain=c) for c in ("fast", "full"))
+    for key, tol in (("range_m", 1e-3), ("velocity_mps", 1e-3), ("azimuth_deg", 1e-3)):
+        for a, b in ((fast.detected, full.detected), (fast.truth, full.truth)):
+            np.testing.assert_array_equal(np.isnan(a[key]), np.isnan(b[key]))
+            np.testing.assert_allclose(a[key], b[key], rtol=0, atol=tol)
+    assert np.isfinite(fast.detected["azimuth_deg"]).sum() >= 12
+    np.testing.assert_array_equal(fast.status, full.status)
+    np.testing.assert_array_equal(fast.split, full.split)
+    assert fast.summary()["chain"]["full_chain_frames"] == 0
+    assert full.summary()["chain"] == {"asked": "full", "full_chain_frames": 0, "reasons": {}}

@@ -6,7 +6,7 @@ import pytest
 
 from conftest import make_scene
 from rtsgeom.radar.processing import Detections, RangeDoppler
-from rtsgeom.pipeline.run import undetected_reason
+from rtsgeom.pipeline.matching import undetected_reason
 from rtsgeom.scene import TargetConfig
 
 

@@ -13,7 +13,7 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from rtsgeom.radar.processing import OS_MAX_CELLS, cfar_mask
+from rtsgeom.radar.cfar import OS_MAX_CELLS, cfar_mask
 from rtsgeom.scene import CfarConfig
 
 WINDOWS = [((0, 0), (1, 1)), ((2, 2), (8, 4)), ((1, 3), (2, 5)), ((4, 0), (3, 2))]

@@ -306,7 +306,7 @@ def test_a_scene_without_static_targets_runs_and_an_empty_frame_associates():
     """crossing.toml has only a drive: `run` simulates its bench with no target (the
     association's points once failed to reshape an empty set); a frame without detections
     leaves every target not detected."""
-    from rtsgeom.pipeline.run import detection_points, target_points
+    from rtsgeom.pipeline.matching import detection_points, target_points
     scene = load_scene(ROOT / "scenes" / "crossing.toml")
     assert run_scene(scene).matches == []
     assert target_points([], 1).shape == (0, 3) and target_points([], 2).shape == (0, 4)

@@ -16,7 +16,7 @@ from rtsgeom.radar.processing import estimate_angles, tdm_compensate
 from rtsgeom.rts.channels import Echoes, RtsProgram, build_echoes, program_nearest
 from rtsgeom.rts.fir import realised_delay
 from rtsgeom.radar.frame import simulate
-from rtsgeom.pipeline.run import match_targets
+from rtsgeom.pipeline.matching import match_targets
 
 from conftest import make_scene
 

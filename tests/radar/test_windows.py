@@ -24,7 +24,7 @@ from rtsgeom.radar.processing import estimate_angles, range_doppler, refine_angl
 from rtsgeom.radar.windows import window
 from rtsgeom.scene.registry import WINDOWS as WINDOW_REGISTRY
 from rtsgeom.rts.channels import Echoes, build_echoes, program_nearest
-from rtsgeom.pipeline.run import match_targets
+from rtsgeom.pipeline.matching import match_targets
 from rtsgeom.scene import TargetConfig
 
 WINDOWS = tuple(WINDOW_REGISTRY)

@@ -12,6 +12,8 @@ what the frame period resolves.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ...errors import ParameterError
@@ -21,12 +23,12 @@ from ...pipeline.merge import budget_targets
 from ...pipeline.plan import (FixedCalibration, calibrate_pairs, lead_program,
                               probe_pair, program_frames, target_namer, target_pairs,
                               uses_cells)
-from ...pipeline.run import match_targets, truth_twin
-from ...radar import process
-from ...radar.frame import simulate
+from ...pipeline.matching import match_targets, truth_twin
+from ...radar.frame import observe
+from ...radar.windowed import cell_centres
 from ...calibration.channels import channel_offsets
 from ...calibration.probes import probe_front_ends
-from ...rts.channels import RtsProgram, program_nearest
+from ...rts.channels import RtsProgram, apparent_range, program_nearest
 from ...scene import Scene, TargetConfig
 from ...scene.objects import frame_objects
 from ...scene.scenario import trajectory
@@ -148,27 +150,47 @@ class FramePlanner:
                                 self.budgets[f] if self.budgets else None) for f in fs])
 
 
+@dataclass(frozen=True)
+class FrameOptions:
+    """How :func:`detect_frame` looks at a frame: the association's gate ``bins`` (range and
+    Doppler bins), whether the truth twin looks too, and the ``chain`` (``fast``, ``full``:
+    :data:`rtsgeom.radar.frame.CHAINS`)."""
+
+    bins: int = 2
+    truth: bool = True
+    chain: str = "full"
+
+
 def detect_frame(setup: Setup, paths: Paths, program: RtsProgram, scene_f: Scene, seed: int,
-                 bins: int = 2, truth: bool = True, synthesized=None) -> tuple:
-    """One frame through the full chain: the matches of ``match_targets`` (with the truth
-    twin's detections where ``truth``: :func:`rtsgeom.pipeline.run.truth_twin`, same seed) and,
-    per target, the number of other detections within ``bins`` range and Doppler bins of its
-    set-point that no target claimed (a split: the RuT sees the target twice), and
-    ``(detections, truth twin's detections or None, range-Doppler map, steering)`` (the
-    frame's clouds, :mod:`rtsgeom.analysis.objects`).
+                 options: FrameOptions = FrameOptions(), synthesized=None) -> tuple:
+    """One frame through the chain: the matches of ``match_targets`` (with the truth
+    twin's detections where ``truth``: :func:`rtsgeom.pipeline.matching.truth_twin`, same seed)
+    and, per target, the number of other detections within ``bins`` range and Doppler bins of
+    its set-point that no target claimed (a split: the RuT sees the target twice),
+    ``(detections, truth twin's detections or None, map or its axes, steering)`` (the frame's
+    clouds, :mod:`rtsgeom.analysis.objects`) and why the full chain ran where ``chain`` asked
+    for the fast path (:mod:`rtsgeom.radar.windowed`; one reason per look: the RTS's, the truth
+    twin's; empty where none did).
 
     ``synthesized``: the targets the RTS synthesizes where they are not ``scene_f``'s (a
     budget's, :mod:`rtsgeom.pipeline.merge`): the matches are theirs, each against the truth
     twin's detection of its cell (the truth twin still looks at ``scene_f``'s real targets)."""
-    echoes, cube = simulate(setup, paths, program, seed, scene_f.radar.snr_db)
-    rd, det = process(cube)
+    bins, truth, chain = options.bins, options.truth, options.chain
     compare = tuple(scene_f.targets if synthesized is None else synthesized)
-    matches = match_targets(scene_f, det, rd, bins=bins, steering=cube.steering,
+    look = tuple(scene_f.targets) + (() if synthesized is None else compare)
+    centres = cell_centres(scene_f.radar, apparent_range(scene_f, [t.range_m for t in look]),
+                           [t.velocity_mps for t in look])
+    view = observe(setup, paths, program, seed, scene_f.radar.snr_db, centres, bins, chain)
+    det, rd = view.detections, view.rd
+    fallbacks = [] if view.fallback is None else [view.fallback]
+    matches = match_targets(scene_f, det, rd, bins=bins, steering=view.steering,
                             targets=compare)
     t_det = None
     if truth and scene_f.targets:
-        t_det, matches = truth_twin(setup, scene_f.targets, echoes, matches, bins, seed,
-                                    compare=None if synthesized is None else compare)
+        t_det, matches, why = truth_twin(
+            setup, scene_f.targets, view.echoes, matches, bins, seed,
+            compare=None if synthesized is None else compare, look=view)
+        fallbacks += [] if why is None else [why]
     claimed = {m.get("detection_index") for m in matches}
     dr = rd.range_m[1] - rd.range_m[0]
     dv = rd.velocity_mps[1] - rd.velocity_mps[0]
@@ -177,4 +199,4 @@ def detect_frame(setup: Setup, paths: Paths, program: RtsProgram, scene_f: Scene
         near = np.flatnonzero((np.abs(det.range_m - t.range_m) <= bins * dr)
                               & (np.abs(det.velocity_mps - t.velocity_mps) <= bins * dv))
         extra[k] = sum(1 for j in near if j not in claimed)
-    return matches, extra, (det, t_det, rd, cube.steering)
+    return matches, extra, (det, t_det, rd, view.steering), tuple(fallbacks)

@@ -75,6 +75,11 @@ class PlaybackResult(Result):
         twin's detection of its cell, a ``merged`` or ``dropped`` target has neither.
     object_of : ndarray or None
         (targets,): the extended object each target belongs to (-1: a point target).
+    chain : str
+        The chain asked for (``fast`` or ``full``, :data:`rtsgeom.radar.frame.CHAINS`).
+    fallbacks : tuple
+        Per frame why the full chain ran where the fast path was asked for (a tuple of
+        reasons, one per look: the RTS's, the truth twin's; empty: the fast path held).
     """
 
     scene: Scene
@@ -94,6 +99,8 @@ class PlaybackResult(Result):
     budget: tuple | None = None  # per frame the planner's kept/merged/dropped counts
     role: np.ndarray | None = None  # (frames, targets) BUDGET_ROLES under a budget
     object_of: np.ndarray | None = None  # (targets,) each target's object, -1: a point target
+    chain: str = "full"
+    fallbacks: tuple = ()  # per frame: why the full chain ran on the fast path's request
 
     def _summary(self):
         s = self.summary()
@@ -172,7 +179,8 @@ class PlaybackResult(Result):
         and target, ``lost_frames`` and
         ``split_frames`` (frames where any target was lost, or seen twice),
         ``handover_jump_deg`` (the largest change of a target's angle error at a hand-over),
-        per target the same, and the baseline's where it was played."""
+        per target the same, ``chain`` (the chain asked for and the frames that ran the full
+        chain instead, with their reasons), and the baseline's where it was played."""
         err = np.abs(self.angle_error_deg)
         # the track's range and radial velocity against the set-points
         alone = self.tracked
@@ -213,12 +221,24 @@ class PlaybackResult(Result):
                          "handover_jump_deg": jump(jumps[hk == k])}
                         for k in range(self.num_targets)],
         }
+        out["chain"] = self._chain_summary()
         if self.role is not None:
             out["budget"] = self._budget_summary()
         if self.baseline is not None:
             out["baseline"] = {k: v for k, v in self.baseline.summary().items()
                                if k != "targets"}
         return out
+
+    def _chain_summary(self) -> dict:
+        """The chain asked for, the frames that ran the full chain on the fast path's request
+        and how often each reason sent them there."""
+        reasons: dict[str, int] = {}
+        for f in self.fallbacks:
+            for r in set(f):
+                reasons[r] = reasons.get(r, 0) + 1
+        return {"asked": self.chain, "full_chain_frames": int(sum(1 for f in self.fallbacks
+                                                                  if f)),
+                "reasons": dict(sorted(reasons.items()))}
 
     def _budget_summary(self) -> dict:
         """Under ``[rts] max_targets_per_channel``: the per-frame counts (min, max over the

@@ -23,9 +23,10 @@ from ...scene import Scene, check_scene_arg
 from ...scene.schema import check_arg
 from ...scene.registry import AOA_MODES, PATH_METHODS
 from ...pipeline.cells import shared_cell_warnings
-from ...pipeline.run import association_scale
+from ...radar.frame import CHAINS
+from ...pipeline.matching import association_scale
 from ..objects import cloud_rows
-from .frames import FramePlanner, detect_frame, frame_targets
+from .frames import FrameOptions, FramePlanner, detect_frame, frame_targets
 from .result import PlaybackResult
 
 __all__ = ["Playback", "play"]
@@ -49,6 +50,11 @@ class Playback:
     workers : int
         Forked processes that play the frames after the calibration (``_lib.parallel``;
         every frame is a pure function of its index: the same result for any number).
+    chain : {'fast', 'full'}
+        ``fast``: each frame's detections near its targets from the echoes' closed-form
+        spectrum (:mod:`rtsgeom.radar.windowed`; the same detections as the full chain to
+        rounding, tested), the full chain for the frames outside it (counted in the summary);
+        ``full``: every frame through the ADC cube, FFTs and CFAR over the whole map.
     """
 
     amplitudes: str | None = None
@@ -56,6 +62,7 @@ class Playback:
     baseline: bool = True
     bins: int = 2
     workers: int = 1
+    chain: str = "fast"
 
     def __post_init__(self):
         if self.amplitudes is not None:
@@ -65,6 +72,7 @@ class Playback:
         check_arg(self.baseline, "baseline", "bool", "Playback", ParameterError)
         check_arg(self.bins, "bins", "int", "Playback", ParameterError, lo=0, hi=64)
         check_arg(self.workers, "workers", "int", "Playback", ParameterError, lo=1, hi=256)
+        check_arg(self.chain, "chain", "str", "Playback", ParameterError, choices=CHAINS)
 
     def __call__(self, scene: Scene, progress=None) -> PlaybackResult:
         check_scene_arg(scene, "Playback")
@@ -80,10 +88,10 @@ class Playback:
         paths = compute_paths(setup, self.paths)
         times, frames = frame_targets(scene)
         result = _play(scene, setup, paths, mode, times, frames, self.bins, progress,
-                       self.workers)
+                       self.workers, chain=self.chain)
         if self.baseline and mode != "nearest":  # the same drive: the same truth twin
             base = _play(scene, setup, paths, "nearest", times, frames, self.bins, progress,
-                         self.workers, truth=False)
+                         self.workers, truth=False, chain=self.chain)
             base = dataclasses.replace(base, truth=result.truth, clouds=None if base.clouds
                                        is None else (tuple(r for r in result.clouds[0] if
                                                            r[1] == "truth") + base.clouds[0],
@@ -94,8 +102,8 @@ class Playback:
 
 @one_blas_thread  # a frame's products are small: threads cost more than they give (play of
 # 200 frames x 8 targets: 18.2 -> 9.0 s of CPU on a loaded machine)
-def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1, truth=True
-          ) -> PlaybackResult:
+def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1, truth=True,
+          chain="full") -> PlaybackResult:
     if progress:
         progress(f"{mode}: calibrating and planning {len(frames)} frames")
     planner = FramePlanner(setup, paths, mode, frames, progress)
@@ -109,7 +117,8 @@ def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1, t
     channels = np.empty(shape, object)
     programme, warnings = [], list(planner.warnings) + shared
     scale = association_scale(setup.scene, None)  # the clouds' cells (the association's)
-    work = functools.partial(_frames, (scene, setup, paths, planner, frames, bins, truth))
+    work = functools.partial(_frames, (scene, setup, paths, planner, frames, bins, truth,
+                                       chain))
     chunks = np.array_split(np.arange(n_f), max(1, min(n_f, 4 * int(workers))))
     tell(progress, f"{mode}: playing {n_f} frames")
     if workers > 1 and n_f > 1:
@@ -121,9 +130,11 @@ def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1, t
             tell(progress, None, f"{mode}: frame", f + 1, n_f)
     clouds = []
     role = np.full(shape, "", dtype=object)
-    for f, (rows, found, extra, notes, seen, stat, cloud, rl) in enumerate(
+    fallbacks = []
+    for f, (rows, found, extra, notes, seen, stat, cloud, rl, why) in enumerate(
             o for out in outs for o in out):
         clouds += cloud
+        fallbacks.append(why)
         split[f] = extra
         status[f] = stat
         role[f] = rl
@@ -146,7 +157,8 @@ def _play(scene, setup, paths, mode, times, frames, bins, progress, workers=1, t
                           clouds=(tuple(clouds), scale) if scene.objects else None,
                           budget=tuple(b.counts for b in planner.budgets) or None,
                           role=role if planner.budgets else None,
-                          object_of=np.array([t.object_index for t in frames[0]], int))
+                          object_of=np.array([t.object_index for t in frames[0]], int),
+                          chain=chain, fallbacks=tuple(fallbacks))
 
 
 def _shared_cells(setup, frames) -> list[str]:
@@ -165,17 +177,18 @@ def _frames(ctx, chunk) -> list:
     channel, delay_s, doppler_hz, |amplitude|, phase_rad), each target's detection (range,
     azimuth, velocity) or None, its unclaimed detections nearby, the planner's notes, the
     truth twin's detection of each target (or None), each target's status, the frame's
-    clouds and each target's role under the budget (:func:`_per_scatterer`).
+    clouds, each target's role under the budget (:func:`_per_scatterer`) and why the full
+    chain ran where the fast path was asked for.
     A pure function of the frame (its noise seeded by it): the same in a forked worker."""
-    scene, setup, paths, planner, frames, bins, truth = ctx
+    scene, setup, paths, planner, frames, bins, truth, chain = ctx
     out = []
     for f in chunk:
         scene_f = dataclasses.replace(setup.scene, targets=frames[f])  # checked on load
         program, notes = planner.program(int(f), scene_f)
         seed = (scene.seed + int(f)) % (2 ** 63)  # frame 0: the scene's own noise, as `run`
         budget = planner.budgets[f] if planner.budgets else None
-        matches, extra, (det, t_det, rd, st) = detect_frame(
-            setup, paths, program, scene_f, seed, bins, truth,
+        matches, extra, (det, t_det, rd, st), why = detect_frame(
+            setup, paths, program, scene_f, seed, FrameOptions(bins, truth, chain),
             synthesized=None if budget is None else budget.targets)
         cloud = [] if not scene.objects else (
             ([] if t_det is None else cloud_rows(f, "truth", scene_f, t_det, rd, frames[f], st))
@@ -189,7 +202,7 @@ def _frames(ctx, chunk) -> list:
         rows = np.column_stack([
             np.full(len(program), f), program.target, program.front_end, program.delay_s,
             program.doppler_hz, np.abs(program.amplitude), np.angle(program.amplitude)])
-        out.append((rows, found, extra, notes, seen, stat, cloud, role))
+        out.append((rows, found, extra, notes, seen, stat, cloud, role, why))
     return out
 
 
@@ -211,7 +224,8 @@ def _per_scatterer(matches, extra, budget, n: int):
 
 
 def play(scene: Scene, amplitudes: str | None = None, paths: str = "exact",
-         baseline: bool = True, workers: int = 1, progress=None) -> PlaybackResult:
+         baseline: bool = True, workers: int = 1, progress=None, chain: str = "fast"
+         ) -> PlaybackResult:
     """Play the scene's ``[scenario]``: :class:`Playback` configured and called once."""
-    return Playback(amplitudes, paths, baseline, workers=workers)(scene, progress)
+    return Playback(amplitudes, paths, baseline, workers=workers, chain=chain)(scene, progress)
 
