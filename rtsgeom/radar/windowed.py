@@ -130,12 +130,18 @@ def detect_near(echoes: Echoes, radar: RadarConfig, rut: RutArray, steering: Ste
     spec = np.ascontiguousarray(spec, dtype=np.complex64)
     re_im = spec.view(np.float32)
     power = np.einsum("trdk,trdk->trd", re_im, re_im, dtype=np.float64)
-    stacked = np.moveaxis(power, 0, -1)  # (Rw, Dw, T): the map's axes first
-    mask, noise = cfar_mask(stacked, radar.cfar, map_shape=(n_s, n_l))
-    mask, noise = np.moveaxis(mask, -1, 0), np.moveaxis(noise, -1, 0)
     cut = ((_distance(rows, c[:, 0], n_s) <= k)[:, :, None]
            & (_distance(cols, c[:, 1], n_l) <= k)[:, None, :])
-    reason = _marginal(power, noise, cut, radar.cfar.threshold_db)
+    nb = _neighbour_max(power)
+    if radar.cfar.kind == "ca" and rows.shape[1] < n_s and cols.shape[1] < n_l:
+        noise = _ca_noise(power, k, radar.cfar)
+        thr = noise * 10 ** (radar.cfar.threshold_db / 10)
+        mask = cut & (power > thr) & (power >= nb)
+    else:  # the map's own CFAR on the windows side by side
+        stacked = np.moveaxis(power, 0, -1)  # (Rw, Dw, T): the map's axes first
+        mask, noise = cfar_mask(stacked, radar.cfar, map_shape=(n_s, n_l))
+        mask, noise = np.moveaxis(mask, -1, 0), np.moveaxis(noise, -1, 0)
+    reason = _marginal(power, noise, nb, cut, radar.cfar.threshold_db)
     if reason is not None:
         return None, reason
     t_i, r_w, d_w = np.nonzero(mask & cut)
@@ -193,16 +199,51 @@ def _window_spectrum(echoes: Echoes, radar: RadarConfig, rut: RutArray, rows: np
     return np.moveaxis(x, 1, -1)
 
 
-def _marginal(power, noise, cut, threshold_db: float) -> str | None:
-    """Why a window's verdicts are left to the full chain: a cell under test within
-    :data:`MARGIN_DB` of the CFAR threshold, or a local maximum decided by a tie."""
-    p = power[cut]
-    margin = 10 * np.log10(np.maximum(p, 1e-300) / np.maximum(noise[cut], 1e-300)) - threshold_db
+def _neighbour_max(power: np.ndarray) -> np.ndarray:
+    """The largest of each window cell's eight neighbours (T, Rw, Dw) (cyclic in the window:
+    the cells under test have theirs inside it)."""
     nb = np.full(power.shape, -np.inf)
     for dr in (-1, 0, 1):
         for dd in (-1, 0, 1):
             if dr or dd:
-                nb = np.maximum(nb, np.roll(power, (dr, dd), axis=(1, 2)))
+                np.maximum(nb, np.roll(power, (dr, dd), axis=(1, 2)), out=nb)
+    return nb
+
+
+def _ca_noise(power: np.ndarray, k: int, cfar) -> np.ndarray:
+    """CA-CFAR's noise estimate at the central (2k + 1)^2 cells of each window (T, Rw, Dw),
+    +inf elsewhere: the training ring's mean, its sum as the outer rectangle's less the guard
+    rectangle's from a summed-area table of the window. The window holds the target's main lobe
+    and its ring's sidelobes, so the table's differences lose at most ~1e-16 of the window's
+    power, below 1e-6 of any ring sum (the map's CFAR sums without differences, over a whole
+    map whose quiet cells a difference would drown); a cell that close to its threshold is left
+    to the full chain (:data:`MARGIN_DB`)."""
+    gr, gd = cfar.guard_cells
+    tr, td = cfar.training_cells
+    hr, hd = gr + tr, gd + td
+    n_t, n_r, n_d = power.shape
+    sat = np.zeros((n_t, n_r + 1, n_d + 1))
+    np.cumsum(np.cumsum(power, axis=1), axis=2, out=sat[:, 1:, 1:])
+    i = (n_r - 1) // 2 + np.arange(-k, k + 1)  # the windows' centres +- k
+    j = (n_d - 1) // 2 + np.arange(-k, k + 1)
+
+    def box(a: int, b: int) -> np.ndarray:  # sums over rows i +- a, columns j +- b
+        r0, r1, c0, c1 = i - a, i + a + 1, j - b, j + b + 1
+        return ((sat[:, r1[:, None], c1] - sat[:, r0[:, None], c1])
+                - (sat[:, r1[:, None], c0] - sat[:, r0[:, None], c0]))
+
+    count = (2 * hr + 1) * (2 * hd + 1) - (2 * gr + 1) * (2 * gd + 1)
+    noise = np.full(power.shape, np.inf)
+    noise[:, i[:, None], j] = (box(hr, hd) - box(gr, gd)) / count
+    return noise
+
+
+def _marginal(power, noise, nb, cut, threshold_db: float) -> str | None:
+    """Why a window's verdicts are left to the full chain: a cell under test within
+    :data:`MARGIN_DB` of the CFAR threshold, or a local maximum decided by a tie (``nb`` each
+    cell's largest neighbour)."""
+    p = power[cut]
+    margin = 10 * np.log10(np.maximum(p, 1e-300) / np.maximum(noise[cut], 1e-300)) - threshold_db
     nb = nb[cut]
     tie = np.abs(p - nb) <= TIE * np.maximum(p, nb)
     peak = p >= nb * (1 - TIE)
