@@ -389,3 +389,43 @@ def test_the_fast_path_plays_the_full_chains_drive(snr_db):
     np.testing.assert_array_equal(fast.split, full.split)
     assert fast.summary()["chain"]["full_chain_frames"] == 0
     assert full.summary()["chain"] == {"asked": "full", "full_chain_frames": 0, "reasons": {}}
+
+
+def _noisy_crossing(duration_s: float, snr_db: float) -> dict:
+    """The crossing with many noise detections around its target: a low per-sample SNR and
+    a CFAR threshold of 1 dB."""
+    doc = crossing_doc(duration_s=duration_s, frame_period_s=0.1)
+    doc["radar"].update(snr_db=snr_db, cfar={"kind": "ca", "threshold_db": 1.0})
+    return doc
+
+
+def test_splits_are_counted_where_the_radar_sees_the_target():
+    """Without rts.compensate_air_path the RuT sees a target R_c (here 5 range bins) further
+    than its set range: a split is an unclaimed detection within the gate of that cell (where
+    the association looks and the fast path forms the map), the same on both chains, and
+    never a noise detection at the set range, 5 bins away from the target's echo."""
+    doc = _noisy_crossing(0.3, -38.0)
+    doc["rts"]["compensate_air_path"] = False
+    scene = scene_of(doc)
+    fast, full = (rtsgeom.play(scene, amplitudes="nearest", chain=c) for c in ("fast", "full"))
+    np.testing.assert_array_equal(fast.split, full.split)
+    assert full.split.sum() >= 3  # the noise splits the target in some frames
+    assert fast.summary()["chain"]["full_chain_frames"] == 0
+
+
+def test_clouds_use_the_playbacks_gate():
+    """An object's cloud is the detections within the play's gate (``Playback(bins=...)``)
+    of its scatterers, as the matches: at gates 0 and 1 too, where the fast path's windows
+    are narrower than the default gate of two bins; the same clouds on both chains."""
+    from rtsgeom.analysis.playback import Playback
+    doc = _noisy_crossing(0.2, -30.0)
+    doc["scenario"]["targets"][0]["scatterers"] = [[0.0, 0.0, 0.0, 10.0], [1.5, 0.0, 0.0, 10.0]]
+    scene = scene_of(doc)
+    for bins, least in ((0, 0), (1, 6)):  # gate 1: both sources, both scatterers, 3 frames
+        fast, full = (Playback(amplitudes="nearest", bins=bins, chain=c)(scene)
+                      for c in ("fast", "full"))
+        rows = [sorted(r.clouds[0]) for r in (fast, full)]
+        assert len(rows[0]) == len(rows[1]) >= least
+        for a, b in zip(*rows):
+            assert a[:3] == b[:3]
+            np.testing.assert_allclose(a[3:6], b[3:6], rtol=0, atol=1e-3)

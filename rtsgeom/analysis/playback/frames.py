@@ -166,7 +166,8 @@ def detect_frame(setup: Setup, paths: Paths, program: RtsProgram, scene_f: Scene
     """One frame through the chain: the matches of ``match_targets`` (with the truth
     twin's detections where ``truth``: :func:`rtsgeom.pipeline.matching.truth_twin`, same seed)
     and, per target, the number of other detections within ``bins`` range and Doppler bins of
-    its set-point that no target claimed (a split: the RuT sees the target twice),
+    its set-point where the radar sees it (:func:`~rtsgeom.rts.channels.apparent_range`, as
+    the association) that no target claimed (a split: the RuT sees the target twice),
     ``(detections, truth twin's detections or None, map or its axes, steering)`` (the frame's
     clouds, :mod:`rtsgeom.analysis.objects`) and why the full chain ran where ``chain`` asked
     for the fast path (:mod:`rtsgeom.radar.windowed`; one reason per look: the RTS's, the truth
@@ -194,9 +195,10 @@ def detect_frame(setup: Setup, paths: Paths, program: RtsProgram, scene_f: Scene
     claimed = {m.get("detection_index") for m in matches}
     dr = rd.range_m[1] - rd.range_m[0]
     dv = rd.velocity_mps[1] - rd.velocity_mps[0]
+    seen_at = apparent_range(scene_f, [t.range_m for t in compare])  # as the association
     extra = np.zeros(len(matches), int)
     for k, t in enumerate(compare):
-        near = np.flatnonzero((np.abs(det.range_m - t.range_m) <= bins * dr)
+        near = np.flatnonzero((np.abs(det.range_m - seen_at[k]) <= bins * dr)
                               & (np.abs(det.velocity_mps - t.velocity_mps) <= bins * dv))
         extra[k] = sum(1 for j in near if j not in claimed)
     return matches, extra, (det, t_det, rd, view.steering), tuple(fallbacks)

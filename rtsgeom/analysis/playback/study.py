@@ -190,9 +190,10 @@ def _frames(ctx, chunk) -> list:
         matches, extra, (det, t_det, rd, st), why = detect_frame(
             setup, paths, program, scene_f, seed, FrameOptions(bins, truth, chain),
             synthesized=None if budget is None else budget.targets)
-        cloud = [] if not scene.objects else (
-            ([] if t_det is None else cloud_rows(f, "truth", scene_f, t_det, rd, frames[f], st))
-            + cloud_rows(f, "rts", scene_f, det, rd, frames[f], st))
+        cloud = [] if not scene.objects else (  # in the association's gate, as the matches
+            ([] if t_det is None else cloud_rows(f, "truth", scene_f, t_det, rd, frames[f], st,
+                                                 bins))
+            + cloud_rows(f, "rts", scene_f, det, rd, frames[f], st, bins))
         matches, extra, role = _per_scatterer(matches, extra, budget, len(frames[f]))
         found, seen = ([None if m is None or m.get(key) is None else
                         (m[key]["range_m"], m[key]["angle_deg"], m[key]["velocity_mps"])
