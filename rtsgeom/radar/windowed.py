@@ -16,7 +16,9 @@ echoes is never formed.
 
 A frame is outside the fast path (``reason`` is returned and the caller runs the full chain)
 where a cell under test lies within :data:`MARGIN_DB` of its CFAR threshold or within
-:data:`TIE` of a neighbour's power (rounding decides those in either chain).
+:data:`TIE` of a neighbour's power (rounding decides those in either chain), and where its
+targets' windows together hold more cells than the map (many targets: the full chain is then
+cheaper, and the windows' memory stays below the map's).
 """
 
 from __future__ import annotations
@@ -43,6 +45,9 @@ __all__ = ["MARGIN_DB", "TIE", "MapAxes", "cell_centres", "detect_near", "noise_
 MARGIN_DB = 0.01
 #: a local-maximum test this close (relative power) is left to the full chain
 TIE = 1e-6
+#: complex elements of the windows' range and Doppler factors formed at once (a block of
+#: targets; 2**22: 64 MiB)
+BLOCK_ELEMENTS = 2 ** 22
 
 
 @dataclass(frozen=True)
@@ -124,6 +129,9 @@ def detect_near(echoes: Echoes, radar: RadarConfig, rut: RutArray, steering: Ste
     k = int(gate) + 1  # cells under test: every cell a detection within the gate can sit in
     rows = _axis_window(c[:, 0], k + max(gr + tr, 1), n_s)  # (T, Rw)
     cols = _axis_window(c[:, 1], k + max(gd + td, 1), n_l)  # (T, Dw)
+    if rows.size * cols.shape[1] > n_s * n_l:  # many targets: windows past the map's size
+        return None, ("the targets' windows hold more cells than the map (the full chain is "
+                      "cheaper)")
     spec = _window_spectrum(echoes, radar, rut, rows, cols)  # (T, Rw, Dw, V)
     if noise_spec is not None:
         spec = spec + noise_spec[rows[:, :, None], cols[:, None, :]]
@@ -193,10 +201,16 @@ def _window_spectrum(echoes: Echoes, radar: RadarConfig, rut: RutArray, rows: np
     w_d = window(radar.doppler_window, radar.chirps_per_tx)
     fr = sfft.fft(f, axis=2, workers=1, overwrite_x=True)  # (V, E, R)
     ad = np.fft.fftshift(sfft.fft(a * w_d[None, :, None], axis=1, workers=1), axes=1)
-    fr_w = np.moveaxis(fr[:, :, rows], 2, 0)  # (T, V, E, Rw)
-    ad_w = np.moveaxis(ad[:, cols, :], 1, 0)  # (T, V, Dw, E)
-    x = np.swapaxes(fr_w, -1, -2) @ np.swapaxes(ad_w, -1, -2)  # (T, V, Rw, Dw)
-    return np.moveaxis(x, 1, -1)
+    n_t, n_rw, n_dw = rows.shape[0], rows.shape[1], cols.shape[1]
+    x = np.empty((n_t, n_v, n_rw, n_dw), complex)
+    # the windows' factors in blocks of targets: at most ~BLOCK_ELEMENTS each (memory)
+    step = max(1, BLOCK_ELEMENTS // (n_v * len(echoes) * (n_rw + n_dw)))
+    for t0 in range(0, n_t, step):
+        t = slice(t0, t0 + step)
+        fr_w = np.moveaxis(fr[:, :, rows[t]], 2, 0)  # (t, V, E, Rw)
+        ad_w = np.moveaxis(ad[:, cols[t], :], 1, 0)  # (t, V, Dw, E)
+        np.matmul(np.swapaxes(fr_w, -1, -2), np.swapaxes(ad_w, -1, -2), out=x[t])
+    return np.moveaxis(x, 1, -1)  # (T, Rw, Dw, V)
 
 
 def _neighbour_max(power: np.ndarray) -> np.ndarray:
