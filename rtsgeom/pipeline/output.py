@@ -6,7 +6,6 @@ range-angle maps (PNG, and as arrays in ``maps.npz|mat|nc``) and the self-contai
 from __future__ import annotations
 
 import csv
-import functools
 import io
 import json
 import tempfile
@@ -15,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from .._lib.io import write_bytes, write_json, write_text
-from .._lib.parallel import Forked, fork_call, local_map
+from .._lib.parallel import Forked, fork_call
 from ..geometry import build_setup
 from ..paths import compute_paths, exact_paths
 from ..radar.processing import range_angle_map
@@ -183,34 +182,45 @@ def write_maps(result: RunResult, out: Path) -> list[Path]:
 
 
 def _calibration_figures(result: RunResult) -> list[bytes]:
-    """The calibration sweep of each pair as PNG bytes, in the pairs' order; the pairs'
-    figures side by side in forked processes where there are several (each ~0.15 s: 32
-    pairs of a 64-front-end arc took 5 s of its report), the same bytes."""
+    """The calibration sweeps as PNG bytes: one pair's figure, or one figure of every pair's
+    sweep as small multiples on shared axes (32 figures of a 64-front-end arc's 32 pairs took
+    5 s of CPU, 0.15 s each, and made the report 32 figures long; the one figure takes ~1 s)."""
     pairs = result.calibration.get("pairs", [])
-    one = functools.partial(_calibration_png, result.scene.name)
-    return local_map(one, pairs, None if len(pairs) > 1 else 1, before_fork=_import_figures)
+    if not pairs:
+        return []
+    name = result.scene.name
+    if len(pairs) == 1:
+        return [_calibration_png(name, pairs[0])]
+    from ..viz.sweeps import calibration_sweeps_figure
+    return [figure_png(calibration_sweeps_figure(
+        [_sweep_arrays(cal) for cal in pairs],
+        title=f"{name}: phase coherency calibration of the {len(pairs)} front-end pairs"))]
 
 
-def _import_figures() -> None:
-    """matplotlib and the figures module imported before forking (the workers inherit them)."""
-    from ..viz import figures  # noqa: F401
+def _sweep_arrays(cal: dict) -> dict:
+    """A calibration record's (``to_dict``) sweep as arrays, by the names the figures take."""
+    rf = cal.get("refinement", [])
+
+    def err(points):
+        return np.array([np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
+                         for p in points], float)
+    return {"label": f"{cal['pair'][0]}-{cal['pair'][1]}",
+            "delta_tau_s": np.array([p["delta_tau_s"] for p in cal["sweep"]], float),
+            "angle_error_deg": err(cal["sweep"]),
+            "chosen_delta_tau_s": cal["delta_tau_s"], "period_s": cal["period_s"],
+            "residual_error_deg": cal.get("residual_error_deg"),
+            "refine_delta_tau_s": [p["delta_tau_s"] for p in rf], "refine_error_deg": err(rf)}
 
 
 def _calibration_png(scene_name: str, cal: dict) -> bytes:
     """One pair's calibration sweep (a calibration record's ``to_dict``) as PNG bytes."""
     from ..viz.figures import calibration_sweep_figure
-    t = np.array([p["delta_tau_s"] for p in cal["sweep"]])
-    e = np.array([np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
-                  for p in cal["sweep"]])
-    rf = cal.get("refinement", [])
+    a = _sweep_arrays(cal)
     fig = calibration_sweep_figure(
-        t, e, cal["delta_tau_s"], cal["period_s"],
-        residual_error_deg=cal.get("residual_error_deg"),
-        refine_delta_tau_s=[p["delta_tau_s"] for p in rf],
-        refine_error_deg=[np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
-                          for p in rf],
-        title=f"{scene_name}: phase coherency calibration, front ends "
-              f"{cal['pair'][0]}-{cal['pair'][1]}")
+        a["delta_tau_s"], a["angle_error_deg"], a["chosen_delta_tau_s"], a["period_s"],
+        residual_error_deg=a["residual_error_deg"],
+        refine_delta_tau_s=a["refine_delta_tau_s"], refine_error_deg=a["refine_error_deg"],
+        title=f"{scene_name}: phase coherency calibration, front ends {a['label']}")
     return figure_png(fig)
 
 
@@ -228,7 +238,10 @@ def start_setup_view(scene) -> Forked:
     """The report's 3D view of ``scene``'s setup with its exact paths, rendered in a process
     forked now (``_lib.parallel.fork_call``) while the run simulates: it depends on the
     geometry alone, and its imports (pyvista, VTK) and render took ~1.5 s of the main job's
-    4 s on a 2-core machine. Pass it to :func:`write_run` (``setup_view``)."""
+    4 s on a 2-core machine. Pass it to :func:`write_run` (``setup_view``). matplotlib, which
+    the run's own figures need and pyvista imports, is imported here before the fork (the
+    view's process inherits it instead of importing it again: ~0.3 s of CPU)."""
+    from ..viz import figures  # noqa: F401
     setup = build_setup(scene)
     return fork_call(_setup_png, setup, exact_paths(setup), "exact")
 

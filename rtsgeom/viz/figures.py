@@ -59,10 +59,12 @@ def _styled(func):
     return wrapper
 
 
-def new_figure(figsize=(6.4, 4.4), nrows=1, ncols=1, **subplot_kw) -> tuple[Figure, object]:
-    """A figure of the house style (``DPI``, constrained layout) on the Agg canvas, without
-    pyplot's global state, and its axes (``nrows`` x ``ncols``, squeezed)."""
-    fig = Figure(figsize=figsize, dpi=DPI, layout="constrained")
+def new_figure(figsize=(6.4, 4.4), nrows=1, ncols=1, layout="constrained",
+               **subplot_kw) -> tuple[Figure, object]:
+    """A figure of the house style (``DPI``, constrained layout unless ``layout`` says
+    otherwise) on the Agg canvas, without pyplot's global state, and its axes (``nrows`` x
+    ``ncols``, squeezed; ``subplot_kw`` to ``Figure.subplots``, e.g. ``gridspec_kw``)."""
+    fig = Figure(figsize=figsize, dpi=DPI, layout=layout)
     FigureCanvasAgg(fig)
     axes = fig.subplots(nrows, ncols, squeeze=True, **subplot_kw)
     return fig, axes
