@@ -51,12 +51,9 @@ def detections_csv(result: RunResult) -> str:
 def figure_png(fig) -> bytes:
     """A figure as PNG bytes, in the style and resolution of
     :func:`rtsgeom.viz.figures.save_figure` (kept in memory: the report embeds exactly these)."""
-    import matplotlib as mpl
-
-    from ..viz.figures import DPI, STYLE
+    from ..viz.figures import print_png
     buf = io.BytesIO()
-    with mpl.rc_context(STYLE):
-        fig.savefig(buf, format="png", dpi=DPI)
+    print_png(fig, buf)
     return buf.getvalue()
 
 
