@@ -59,13 +59,14 @@ def arc_scene(n: int, step_deg: float, n_targets: int) -> str:
 
 
 def timed(argv: list[str], root: Path = ROOT) -> dict:
-    """One whole process ``python -m rtsgeom argv`` importing rtsgeom from ``root``: wall,
+    """One whole process ``python -m rtsgeom argv`` importing rtsgeom from ``root``
+    (run in ``root``: ``python -m`` puts the working directory first on the path): wall,
     user and user + system CPU (s), load average before, lines on stderr."""
     load = os.getloadavg()[0]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.run([sys.executable, "-m", "rtsgeom", *argv], capture_output=True,
-                          text=True, env={**os.environ, "PYTHONPATH": str(root)})
+                          text=True, cwd=root, env={**os.environ, "PYTHONPATH": str(root)})
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if proc.returncode:

@@ -30,7 +30,8 @@ COMPARED = ("summary.json", "detections.csv", "maps.npz")
 
 
 def timed(argv: list[str], root: Path) -> dict:
-    """One whole process ``python -m rtsgeom argv`` importing rtsgeom from ``root``: wall,
+    """One whole process ``python -m rtsgeom argv`` importing rtsgeom from ``root``
+    (run in ``root``: ``python -m`` puts the working directory first on the path): wall,
     user and system CPU (s, its forked children included), load average before."""
     load = os.getloadavg()[0]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from rtsgeom._lib.parallel import fork_call
-from rtsgeom.pipeline.output import (map_arrays, map_dataset, maps_arrays, run_report_html,
-                                     start_setup_view)
+from rtsgeom.pipeline.output import (_calibration_figures, map_arrays, map_dataset,
+                                     maps_arrays, run_report_html, start_setup_view)
 from rtsgeom.pipeline.run import run_scene
 from rtsgeom.scene import load_scene
 
@@ -42,6 +42,15 @@ def test_forked_view_gives_the_same_report(result):
     view = start_setup_view(result.scene)
     assert (run_report_html(result, {}, "exact", [], view)
             == run_report_html(result, {}, "exact", []))
+
+
+def test_forked_calibration_figures_give_the_same_report():
+    """The calibration's figures drawn in a process forked before the maps (write_run)."""
+    result = run_scene(load_scene(SCENE), truth=False)  # exact amplitudes: calibrated
+    here = run_report_html(result, {}, "exact", [])
+    assert here.count('alt="Calibration"') == 1  # the one pair's sweep
+    assert run_report_html(result, {}, "exact", [], None,
+                           fork_call(_calibration_figures, result)) == here
 
 
 def test_map_arrays_are_the_datasets(result):
