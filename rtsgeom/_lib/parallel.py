@@ -253,8 +253,10 @@ class Forked:
             ctx = multiprocessing.get_context("fork")
             self._conn, child = ctx.Pipe(duplex=False)
             # SIGINT and SIGTERM held while forking (delivered right after): a handler that
-            # raises (the CLI's) inside the fork's own handlers printed a traceback
-            held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+            # raises (the CLI's) inside the fork's own handlers printed a traceback; SIGALRM
+            # too, the CLI's timer that raises a signal deferred out of an import
+            held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM,
+                                                             signal.SIGALRM})
             try:  # fork: the function and its arguments are inherited, not pickled
                 self._proc = ctx.Process(target=_forked_call, args=(func, args, child, held),
                                          daemon=True)
