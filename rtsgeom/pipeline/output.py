@@ -8,18 +8,17 @@ from __future__ import annotations
 import csv
 import io
 import json
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
 from .._lib.io import write_bytes, write_json, write_text
 from .._lib.parallel import Forked, fork_call
-from ..geometry import build_setup
-from ..paths import compute_paths, exact_paths
 from ..radar.processing import range_angle_map
+from ..scene.registry import MAP_FORMATS
 from .info import scene_info
 from .run import RunResult, label_detections, summary
+from .view import setup_png, start_setup_view
 
 __all__ = ["detections_csv", "figure_png", "map_arrays", "map_dataset", "maps_arrays",
            "MAP_FORMATS", "MAP_UNITS",
@@ -110,9 +109,6 @@ def _plain(maps) -> dict[str, np.ndarray]:
     if isinstance(maps, dict):
         return maps
     return {k: np.asarray(maps[k].values) for k in MAP_UNITS}
-
-
-MAP_FORMATS = ("npz", "mat", "nc")  # what ``run --maps`` may write; npz by default
 
 
 def maps_arrays(ds, formats=MAP_FORMATS) -> dict[str, bytes]:
@@ -221,28 +217,6 @@ def _calibration_png(scene_name: str, cal: dict) -> bytes:
     return figure_png(fig)
 
 
-def _setup_png(setup, paths, paths_method: str) -> bytes:
-    """The report's 3D view of ``setup`` with its ``paths`` as PNG bytes."""
-    from ..viz.scene3d import render_setup_png
-    if paths_method != "exact":  # the view draws reflections through their hit points,
-        # which the table alone does not carry
-        paths = compute_paths(setup, paths_method, for_drawing=True)
-    with tempfile.TemporaryDirectory(prefix="rtsgeom-3d-") as tmp:  # private to this run
-        return render_setup_png(setup, Path(tmp) / "setup.png", paths=paths).read_bytes()
-
-
-def start_setup_view(scene) -> Forked:
-    """The report's 3D view of ``scene``'s setup with its exact paths, rendered in a process
-    forked now (``_lib.parallel.fork_call``) while the run simulates: it depends on the
-    geometry alone, and its imports (pyvista, VTK) and render took ~1.5 s of the main job's
-    4 s on a 2-core machine. Pass it to :func:`write_run` (``setup_view``). matplotlib, which
-    the run's own figures need and pyvista imports, is imported here before the fork (the
-    view's process inherits it instead of importing it again: ~0.3 s of CPU)."""
-    from ..viz import figures  # noqa: F401
-    setup = build_setup(scene)
-    return fork_call(_setup_png, setup, exact_paths(setup), "exact")
-
-
 def targets_table(matches: list[dict]) -> dict:
     """The report's set-point vs detection table; with elevation columns when a target has
     an elevation (a 2-D cell scene: ``set`` carries ``elevation_deg``)."""
@@ -278,7 +252,7 @@ def run_report_html(result: RunResult, maps: dict[str, bytes], paths_method: str
     images = []
     try:
         images.append(setup_view.result() if setup_view is not None and paths_method == "exact"
-                      else _setup_png(result.setup, result.paths, paths_method))
+                      else setup_png(result.setup, result.paths, paths_method))
     except (ImportError, RuntimeError) as exc:  # no pyvista, no off-screen OpenGL (VizError),
         # no ray tracing for the drawn paths (RaytraceUnavailable): the report has the rest
         warnings = warnings + [f"3D view not rendered: {exc}"]
