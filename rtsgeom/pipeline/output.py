@@ -176,8 +176,8 @@ def write_maps(result: RunResult, out: Path) -> list[Path]:
 
 def _calibration_figures(result: RunResult) -> list[bytes]:
     """The calibration sweeps as PNG bytes: one pair's figure, or one figure of every pair's
-    sweep as small multiples on shared axes (32 figures of a 64-front-end arc's 32 pairs took
-    5 s of CPU, 0.15 s each, and made the report 32 figures long; the one figure takes ~1 s)."""
+    sweep as small multiples on common axes (``viz.sweeps``: 32 figures of a 64-front-end
+    arc's pairs took 5 s of CPU and made the report 32 figures long; the one, 0.9 s)."""
     pairs = result.calibration.get("pairs", [])
     if not pairs:
         return []
