@@ -8,6 +8,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +32,26 @@ def test_fork_call_returns_and_raises_as_the_call():
     assert np.array_equal(fork_call(np.arange, 5).result(), np.arange(5))
     with pytest.raises(KeyError, match="nothing here"):
         fork_call(_fail, "nothing here").result()
+
+
+def _late_bytes():
+    time.sleep(0.3)
+    return b"x" * (1 << 20)  # more than a pipe holds: sending waits for a reader
+
+
+def test_a_forked_call_whose_parent_is_gone_ends():
+    """A parent killed before collecting (SIGKILL of a run): the forked process's answer
+    finds no reader and it ends, instead of waiting forever with its memory (it held the
+    pipe's other end itself)."""
+    forked = fork_call(_late_bytes)
+    forked._conn.close()  # what the parent's death does to its end
+    forked._proc.join(timeout=20)
+    try:
+        assert forked._proc.exitcode == 0
+    finally:
+        if forked._proc.exitcode is None:
+            forked._proc.kill()
+            forked._proc.join()
 
 
 @pytest.fixture(scope="module")
