@@ -7,9 +7,12 @@ The template's bench (``scenes/template.toml``: AWR1843BOOST, 1.5 m arc, noise a
 ``--front-ends`` front ends ``--step-deg`` apart (12 mm Rx/Tx modules in 24 mm cutouts so that
 neighbours fit) and ``--targets`` targets spread over the arc at 10 to 63 m and -3.3 to 3.3
 m/s. Times ``info``, ``run`` (with and without its report) and ``calibrate --pair all`` as
-whole processes (wall and user CPU, the median of ``--repeat``), with the machine's load
-average before each, checks that every target is detected, and writes
-``benchmarks/dense_arc.json``. Not part of the test suite.
+whole processes (wall, user CPU and user + system CPU of the process and its forked
+children, the median of ``--repeat``), with the machine's load average before each, checks
+that every target is detected, and writes ``benchmarks/dense_arc.json`` (the record it
+replaces kept under ``before``). ``--against DIR``: also time another checkout of rtsgeom
+(e.g. ``git worktree add DIR COMMIT``), its runs interleaved with this tree's so that both see
+the same load on a shared machine (``against`` in the record). Not part of the test suite.
 """
 
 from __future__ import annotations
@@ -55,19 +58,22 @@ def arc_scene(n: int, step_deg: float, n_targets: int) -> str:
     return "\n".join(out)
 
 
-def timed(argv: list[str]) -> dict:
-    """One whole process ``python -m rtsgeom argv``: wall and user CPU (s), exit code."""
+def timed(argv: list[str], root: Path = ROOT) -> dict:
+    """One whole process ``python -m rtsgeom argv`` importing rtsgeom from ``root``
+    (run in ``root``: ``python -m`` puts the working directory first on the path): wall,
+    user and user + system CPU (s), load average before, lines on stderr."""
     load = os.getloadavg()[0]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.run([sys.executable, "-m", "rtsgeom", *argv], capture_output=True,
-                          text=True, env={**os.environ, "PYTHONPATH": str(ROOT)})
+                          text=True, cwd=root, env={**os.environ, "PYTHONPATH": str(root)})
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if proc.returncode:
         raise SystemExit(f"rtsgeom {' '.join(argv)}: exit {proc.returncode}: {proc.stderr[-2000:]}")
-    return {"wall_s": wall, "user_s": after.ru_utime - before.ru_utime, "load_before": load,
-            "stderr_lines": len(proc.stderr.splitlines())}
+    user = after.ru_utime - before.ru_utime
+    return {"wall_s": wall, "user_s": user, "cpu_s": user + after.ru_stime - before.ru_stime,
+            "load_before": load, "stderr_lines": len(proc.stderr.splitlines())}
 
 
 def main(argv=None) -> int:
@@ -78,15 +84,15 @@ def main(argv=None) -> int:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--out", default=None)
     ap.add_argument("--scaling", type=int, nargs="+", default=None, metavar="N")
+    ap.add_argument("--against", default=None, metavar="DIR")
     args = ap.parse_args(argv)
     if args.scaling:
         return scaling(args)
     out = args.out or str(ROOT / "benchmarks" / "dense_arc.json")
     record = measure(args.front_ends, args)
     old = json.loads(Path(out).read_text()) if Path(out).exists() else {}
-    if "before" in old or "commands" in old:  # the record this run replaces, kept beside it
-        record["before"] = old.get("before", {k: old[k] for k in ("commands", "accuracy")
-                                              if k in old})
+    if "commands" in old:  # the record this run replaces, kept beside it
+        record["before"] = {k: old[k] for k in ("commands", "accuracy") if k in old}
     write_json(out, record, newline=True)
     return 0
 
@@ -108,9 +114,17 @@ def scaling(args) -> int:
     return 0
 
 
+def _median(runs: list[dict]) -> dict:
+    return {"median_wall_s": statistics.median(x["wall_s"] for x in runs),
+            "median_user_s": statistics.median(x["user_s"] for x in runs),
+            "median_cpu_s": statistics.median(x["cpu_s"] for x in runs), "runs": runs}
+
+
 def measure(n_fe: int, args) -> dict:
     """The four commands on an arc of ``n_fe`` front ends (module doc)."""
-    rows = {}
+    trees = ({"against ": Path(args.against).resolve()}  # first: this tree's files stay
+             if getattr(args, "against", None) else {}) | {"": ROOT}
+    rows, other = {}, {}
     with tempfile.TemporaryDirectory() as tmp:
         scene = Path(tmp) / f"arc{n_fe}.toml"
         scene.write_text(arc_scene(n_fe, args.step_deg, args.targets))
@@ -119,26 +133,31 @@ def measure(n_fe: int, args) -> dict:
                  "run": ["run", str(scene), "--out", f"{tmp}/b"],
                  "calibrate --pair all": ["calibrate", str(scene), "--pair", "all"]}
         for name, cmd in cases.items():
-            runs = []
+            runs = {tree: [] for tree in trees}
             for r in range(args.repeat):
-                if "--out" in cmd:  # a new folder each time (the last run's stays)
-                    shutil.rmtree(cmd[cmd.index("--out") + 1], ignore_errors=True)
-                runs.append(timed(cmd))
-                print(f"{n_fe} front ends, {name}: {runs[-1]['wall_s']:.1f} s wall, "
-                      f"{runs[-1]['user_s']:.1f} s "
-                      f"user (load {runs[-1]['load_before']:.1f})", flush=True)
-            rows[name] = {"median_wall_s": statistics.median(x["wall_s"] for x in runs),
-                          "median_user_s": statistics.median(x["user_s"] for x in runs),
-                          "runs": runs}
+                for tree, root in trees.items():  # interleaved: the same load for both
+                    if "--out" in cmd:  # a new folder each time (this tree's last run stays)
+                        shutil.rmtree(cmd[cmd.index("--out") + 1], ignore_errors=True)
+                    runs[tree].append(timed(cmd, root))
+                    x = runs[tree][-1]
+                    print(f"{tree}{n_fe} front ends, {name}: {x['wall_s']:.1f} s wall, "
+                          f"{x['user_s']:.1f} s user, {x['cpu_s']:.1f} s CPU "
+                          f"(load {x['load_before']:.1f})", flush=True)
+            rows[name] = _median(runs[""])
+            if len(trees) > 1:
+                other[name] = _median(runs["against "])
         summary = json.loads((Path(tmp) / "b" / "summary.json").read_text())
     errs = [t["error"] for t in summary["targets"] if t["detection"] is not None]
     accuracy = {"targets": len(summary["targets"]), "detected": len(errs),
                 **{f"max_abs_{k}": max(abs(e[k]) for e in errs)
                    for k in ("range_m", "velocity_mps", "angle_deg")}}
     print(accuracy)
-    return {"front_ends": n_fe, "step_deg": args.step_deg, "targets": args.targets,
-            "repeat": args.repeat, "cpus": os.cpu_count(), "commands": rows,
-            "accuracy": accuracy}
+    out = {"front_ends": n_fe, "step_deg": args.step_deg, "targets": args.targets,
+           "repeat": args.repeat, "cpus": os.cpu_count(), "commands": rows,
+           "accuracy": accuracy}
+    if other:
+        out["against"] = {"tree": str(trees["against "]), "commands": other}
+    return out
 
 
 if __name__ == "__main__":

@@ -253,10 +253,13 @@ class Forked:
             ctx = multiprocessing.get_context("fork")
             self._conn, child = ctx.Pipe(duplex=False)
             # SIGINT and SIGTERM held while forking (delivered right after): a handler that
-            # raises (the CLI's) inside the fork's own handlers printed a traceback
-            held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+            # raises (the CLI's) inside the fork's own handlers printed a traceback; SIGALRM
+            # too, the CLI's timer that raises a signal deferred out of an import
+            held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM,
+                                                             signal.SIGALRM})
             try:  # fork: the function and its arguments are inherited, not pickled
-                self._proc = ctx.Process(target=_forked_call, args=(func, args, child, held),
+                self._proc = ctx.Process(target=_forked_call,
+                                         args=(func, args, child, held, self._conn),
                                          daemon=True)
                 self._proc.start()
             finally:
@@ -290,8 +293,11 @@ def fork_call(func: Callable, *args) -> Forked:
     return Forked(func, args, available_cores() > 1 and _can_fork())
 
 
-def _forked_call(func: Callable, args: tuple, conn, mask) -> None:
+def _forked_call(func: Callable, args: tuple, conn, mask, parent_end) -> None:
     import signal
+    # the parent's end of the pipe, inherited: closed, so that where the parent has died
+    # (killed) sending fails instead of waiting forever for a reader that is this process
+    parent_end.close()
     _fork_worker_init()  # (SIGTERM to its default, SIGINT ignored) before they are let in
     signal.pthread_sigmask(signal.SIG_SETMASK, mask)
     try:
@@ -300,6 +306,8 @@ def _forked_call(func: Callable, args: tuple, conn, mask) -> None:
         out = (False, exc)
     try:
         conn.send(out)
+    except (BrokenPipeError, ConnectionResetError):  # the parent is gone: no one to tell
+        pass
     except Exception as exc:  # an unpicklable value or exception: said in one
         conn.send((False, RuntimeError(f"{type(exc).__name__}: {exc}")))
     conn.close()

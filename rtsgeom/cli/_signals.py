@@ -42,6 +42,10 @@ def raise_received() -> None:
 #: on calling ctypes callback function": llvmlite's object cache while numba compiles; VTK's
 #: observers)
 _CALLBACK_PACKAGES = ("/llvmlite/", "/vtkmodules/")
+#: Python code of numpy's, which C code in numpy calls and whose exceptions it may replace: a
+#: SIGTERM raised in ``np.unique`` of structured rows (building a setup) came out as
+#: "TypeError: Cannot compare structured arrays", a traceback instead of exit 143
+_CONVERTING_PACKAGES = ("/numpy/",)
 
 
 def _unsafe(frame) -> bool:
@@ -50,7 +54,7 @@ def _unsafe(frame) -> bool:
         code = frame.f_code
         name = code.co_filename
         if (name.startswith("<frozen importlib") or code.co_name == "__del__"
-                or any(part in name for part in _CALLBACK_PACKAGES)):
+                or any(part in name for part in _CALLBACK_PACKAGES + _CONVERTING_PACKAGES)):
             return True
         frame = frame.f_back
     return False

@@ -8,10 +8,9 @@ import argparse
 import json
 
 from ..geometry.warnings import scene_warnings
-from ..pipeline.output import MAP_FORMATS, start_setup_view, write_run
-from ..pipeline.run import run_scene
+from ..pipeline.view import start_setup_view
 from ..scene.objects import target_labels
-from ..scene.registry import ANGLE_ESTIMATORS, AOA_MODES, PATH_METHODS
+from ..scene.registry import ANGLE_ESTIMATORS, AOA_MODES, MAP_FORMATS, PATH_METHODS
 from ._common import (calibration_kw, load_scene_checked, number, output_folder, output_path,
                       scene_arg, steps)
 
@@ -27,6 +26,14 @@ def _with_estimator(scene, args):
     return scene.evolve(radar=radar)
 
 
+def run_scene(*args, **kwargs):
+    """:func:`rtsgeom.pipeline.run.run_scene`, its module imported on the first call: ``run``
+    forks the report's 3D view before it imports the simulation's modules, which the view's
+    process does not need (0.3 s of imports beside the view instead of before it)."""
+    from ..pipeline.run import run_scene as run
+    return run(*args, **kwargs)
+
+
 def cmd_run(args) -> int:
     scene = _with_estimator(load_scene_checked(args.scene), args)
     out = args.out
@@ -34,6 +41,7 @@ def cmd_run(args) -> int:
         # the report's 3D view depends on the geometry alone: rendered beside the run
         view = (start_setup_view(scene) if not args.no_report and args.paths == "exact"
                 else None)
+        from ..pipeline.output import write_run  # after the fork (see run_scene)
         step(f"simulating {scene.name} ({args.paths} paths, calibration, ADC cube, detection)")
         result = run_scene(scene, args.paths, args.amplitudes, progress=step,
                            **calibration_kw(args))

@@ -6,21 +6,19 @@ range-angle maps (PNG, and as arrays in ``maps.npz|mat|nc``) and the self-contai
 from __future__ import annotations
 
 import csv
-import functools
 import io
 import json
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
 from .._lib.io import write_bytes, write_json, write_text
-from .._lib.parallel import Forked, fork_call, local_map
-from ..geometry import build_setup
-from ..paths import compute_paths, exact_paths
+from .._lib.parallel import Forked, fork_call
 from ..radar.processing import range_angle_map
+from ..scene.registry import MAP_FORMATS
 from .info import scene_info
 from .run import RunResult, label_detections, summary
+from .view import setup_png, start_setup_view
 
 __all__ = ["detections_csv", "figure_png", "map_arrays", "map_dataset", "maps_arrays",
            "MAP_FORMATS", "MAP_UNITS",
@@ -52,12 +50,9 @@ def detections_csv(result: RunResult) -> str:
 def figure_png(fig) -> bytes:
     """A figure as PNG bytes, in the style and resolution of
     :func:`rtsgeom.viz.figures.save_figure` (kept in memory: the report embeds exactly these)."""
-    import matplotlib as mpl
-
-    from ..viz.figures import DPI, STYLE
+    from ..viz.figures import print_png
     buf = io.BytesIO()
-    with mpl.rc_context(STYLE):
-        fig.savefig(buf, format="png", dpi=DPI)
+    print_png(fig, buf)
     return buf.getvalue()
 
 
@@ -114,9 +109,6 @@ def _plain(maps) -> dict[str, np.ndarray]:
     if isinstance(maps, dict):
         return maps
     return {k: np.asarray(maps[k].values) for k in MAP_UNITS}
-
-
-MAP_FORMATS = ("npz", "mat", "nc")  # what ``run --maps`` may write; npz by default
 
 
 def maps_arrays(ds, formats=MAP_FORMATS) -> dict[str, bytes]:
@@ -183,54 +175,46 @@ def write_maps(result: RunResult, out: Path) -> list[Path]:
 
 
 def _calibration_figures(result: RunResult) -> list[bytes]:
-    """The calibration sweep of each pair as PNG bytes, in the pairs' order; the pairs'
-    figures side by side in forked processes where there are several (each ~0.15 s: 32
-    pairs of a 64-front-end arc took 5 s of its report), the same bytes."""
+    """The calibration sweeps as PNG bytes: one pair's figure, or one figure of every pair's
+    sweep as small multiples on common axes (``viz.sweeps``: 32 figures of a 64-front-end
+    arc's pairs took 5 s of CPU and made the report 32 figures long; the one, 0.9 s)."""
     pairs = result.calibration.get("pairs", [])
-    one = functools.partial(_calibration_png, result.scene.name)
-    return local_map(one, pairs, None if len(pairs) > 1 else 1, before_fork=_import_figures)
+    if not pairs:
+        return []
+    name = result.scene.name
+    if len(pairs) == 1:
+        return [_calibration_png(name, pairs[0])]
+    from ..viz.sweeps import calibration_sweeps_figure
+    return [figure_png(calibration_sweeps_figure(
+        [_sweep_arrays(cal) for cal in pairs],
+        title=f"{name}: phase coherency calibration of the {len(pairs)} front-end pairs"))]
 
 
-def _import_figures() -> None:
-    """matplotlib and the figures module imported before forking (the workers inherit them)."""
-    from ..viz import figures  # noqa: F401
+def _sweep_arrays(cal: dict) -> dict:
+    """A calibration record's (``to_dict``) sweep as arrays, by the names the figures take."""
+    rf = cal.get("refinement", [])
+
+    def err(points):
+        return np.array([np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
+                         for p in points], float)
+    return {"label": f"{cal['pair'][0]}-{cal['pair'][1]}",
+            "delta_tau_s": np.array([p["delta_tau_s"] for p in cal["sweep"]], float),
+            "angle_error_deg": err(cal["sweep"]),
+            "chosen_delta_tau_s": cal["delta_tau_s"], "period_s": cal["period_s"],
+            "residual_error_deg": cal.get("residual_error_deg"),
+            "refine_delta_tau_s": [p["delta_tau_s"] for p in rf], "refine_error_deg": err(rf)}
 
 
 def _calibration_png(scene_name: str, cal: dict) -> bytes:
     """One pair's calibration sweep (a calibration record's ``to_dict``) as PNG bytes."""
     from ..viz.figures import calibration_sweep_figure
-    t = np.array([p["delta_tau_s"] for p in cal["sweep"]])
-    e = np.array([np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
-                  for p in cal["sweep"]])
-    rf = cal.get("refinement", [])
+    a = _sweep_arrays(cal)
     fig = calibration_sweep_figure(
-        t, e, cal["delta_tau_s"], cal["period_s"],
-        residual_error_deg=cal.get("residual_error_deg"),
-        refine_delta_tau_s=[p["delta_tau_s"] for p in rf],
-        refine_error_deg=[np.nan if p["angle_error_deg"] is None else p["angle_error_deg"]
-                          for p in rf],
-        title=f"{scene_name}: phase coherency calibration, front ends "
-              f"{cal['pair'][0]}-{cal['pair'][1]}")
+        a["delta_tau_s"], a["angle_error_deg"], a["chosen_delta_tau_s"], a["period_s"],
+        residual_error_deg=a["residual_error_deg"],
+        refine_delta_tau_s=a["refine_delta_tau_s"], refine_error_deg=a["refine_error_deg"],
+        title=f"{scene_name}: phase coherency calibration, front ends {a['label']}")
     return figure_png(fig)
-
-
-def _setup_png(setup, paths, paths_method: str) -> bytes:
-    """The report's 3D view of ``setup`` with its ``paths`` as PNG bytes."""
-    from ..viz.scene3d import render_setup_png
-    if paths_method != "exact":  # the view draws reflections through their hit points,
-        # which the table alone does not carry
-        paths = compute_paths(setup, paths_method, for_drawing=True)
-    with tempfile.TemporaryDirectory(prefix="rtsgeom-3d-") as tmp:  # private to this run
-        return render_setup_png(setup, Path(tmp) / "setup.png", paths=paths).read_bytes()
-
-
-def start_setup_view(scene) -> Forked:
-    """The report's 3D view of ``scene``'s setup with its exact paths, rendered in a process
-    forked now (``_lib.parallel.fork_call``) while the run simulates: it depends on the
-    geometry alone, and its imports (pyvista, VTK) and render took ~1.5 s of the main job's
-    4 s on a 2-core machine. Pass it to :func:`write_run` (``setup_view``)."""
-    setup = build_setup(scene)
-    return fork_call(_setup_png, setup, exact_paths(setup), "exact")
 
 
 def targets_table(matches: list[dict]) -> dict:
@@ -255,18 +239,20 @@ def targets_table(matches: list[dict]) -> dict:
 
 
 def run_report_html(result: RunResult, maps: dict[str, bytes], paths_method: str,
-                    warnings: list[str], setup_view: Forked | None = None) -> str:
+                    warnings: list[str], setup_view: Forked | None = None,
+                    calibration_figures: Forked | None = None) -> str:
     """``report.html`` of a run: scene summary, 3D view, figures, detections vs set-points,
     calibration, warnings; self-contained. Every image is bytes this run produced (``maps``
     from :func:`render_maps`; the 3D view from ``setup_view``, :func:`start_setup_view`, where
-    given for exact paths, else rendered here), never a file read back from the output
-    folder."""
+    given for exact paths, else rendered here; the calibration's from
+    ``calibration_figures``, a ``fork_call`` of ``_calibration_figures``, where given, else
+    drawn here), never a file read back from the output folder."""
     from ..viz.report import render_report
     sections = []
     images = []
     try:
         images.append(setup_view.result() if setup_view is not None and paths_method == "exact"
-                      else _setup_png(result.setup, result.paths, paths_method))
+                      else setup_png(result.setup, result.paths, paths_method))
     except (ImportError, RuntimeError) as exc:  # no pyvista, no off-screen OpenGL (VizError),
         # no ray tracing for the drawn paths (RaytraceUnavailable): the report has the rest
         warnings = warnings + [f"3D view not rendered: {exc}"]
@@ -288,7 +274,8 @@ def run_report_html(result: RunResult, maps: dict[str, bytes], paths_method: str
             "table": {"columns": ["front-end pair", "delay offset (ps)",
                                   "residual angle error (deg)", "range offset (mm)"],
                       "rows": rows, "digits": [None, 1, 4, 2]},
-            "images": _calibration_figures(result)})
+            "images": (calibration_figures.result() if calibration_figures is not None
+                       else _calibration_figures(result))})
     det = result.detections
     labels = label_detections(result)
     sections.append({"heading": "All detections",
@@ -331,6 +318,10 @@ def write_run(result: RunResult, folder: str | Path, paths_method: str = "exact"
         report.html.
     """
     folder = Path(folder)
+    # the report's calibration figures depend on the calibration alone: drawn in a process
+    # forked now, beside the maps (a 64-front-end arc's 32 pairs: 0.9 s of CPU)
+    cal_figures = (fork_call(_calibration_figures, result)
+                   if report and (result.calibration or {}).get("pairs") else None)
     write_text(folder / "detections.csv", detections_csv(result))
     write_json(folder / "summary.json", summary(result, paths_method))
     arrays = map_arrays(result)
@@ -343,6 +334,7 @@ def write_run(result: RunResult, folder: str | Path, paths_method: str = "exact"
     if report:
         write_text(folder / "report.html",
                    run_report_html(result, pngs, paths_method,
-                                   list(warnings) + list(result.warnings), setup_view))
+                                   list(warnings) + list(result.warnings), setup_view,
+                                   cal_figures))
         names.append("report.html")
     return names

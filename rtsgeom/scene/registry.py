@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 __all__ = ["AoaMode", "AOA_MODES", "SYNTHESIS_MODES", "PathMethod", "PATH_METHODS",
            "RADAR_PRESETS", "Window", "WINDOWS", "CFAR_KINDS", "PATTERN_KINDS",
-           "ANGLE_ESTIMATORS"]
+           "ANGLE_ESTIMATORS", "MAP_FORMATS"]
 
 
 @dataclass(frozen=True)
@@ -97,3 +97,7 @@ COMPENSATIONS: dict[str, str] = {
     "boresight": "each virtual channel divided by what the radar measured on a reflector at "
                  "boresight (the SDK's Rx-channel phase and gain compensation)",
 }
+
+#: the maps' array formats ``run --maps`` may write (``pipeline.output.maps_arrays``): npz
+#: (numpy), mat (MATLAB), nc (NetCDF); npz by default
+MAP_FORMATS: tuple[str, ...] = ("npz", "mat", "nc")

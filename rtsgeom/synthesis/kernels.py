@@ -14,14 +14,10 @@ import numpy as np
 from numba import njit
 
 from .._lib.jit import JIT
+from .choice import SAME_DESIGN_LN
 
 __all__ = ["ratio_one", "ratios", "choice_row", "bin_choice_rows", "argmax_row",
            "SAME_DESIGN_LN"]
-
-#: design ratios of two bins this close (|ln(rho_b / rho_k)|, 1 %) are one design: the RuT
-#: detecting either reports the set angle to about 0.03 deg on an 8 deg pair (d alpha / d ln
-#: rho is about a quarter of the span)
-SAME_DESIGN_LN = 0.01
 
 
 # -- the pair's design for the bin the RuT detects (synthesis.pair, the tolerance model's) ------

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._lib.util import use_kernels
+from .choice import bin_choice_rows_numpy
 from ..radar.steering import Steering
 
 __all__ = ["JUMP_RAD", "beam_derivatives", "design_ratio", "ratio_from_beams",
@@ -192,7 +193,6 @@ def detected_bin_choice(rho, phase, p_ii, p_jj, c_ij, margin: bool = True):
     their own bin the one nearest the middle (ties to the lower bin), else the fixed point of
     "design at the reported bin" from the middle bin; the margin is the detected bin's power
     over the next strongest (1 where not consistent)."""
-    from .kernels import bin_choice_rows
     rho = np.asarray(rho, float)
     c_ij = np.asarray(c_ij)
     n_k = rho.shape[-1]
@@ -203,8 +203,12 @@ def detected_bin_choice(rho, phase, p_ii, p_jj, c_ij, margin: bool = True):
                                    for f in (np.cos, np.sin)), p_ii, p_jj, c_ij.real,
                       np.imag(c_ij))]
     n = rows[0].shape[0]
-    out, k = np.empty(n), np.empty(n, np.int64)
-    ok, mg = np.empty(n, bool), np.empty(n)
-    bin_choice_rows(*rows, out, k, ok, mg)
+    if use_kernels(n, 1e-7 * n_k * n_k):  # numpy 0.03-0.1 us per row and bin pair (measured)
+        from .kernels import bin_choice_rows
+        out, k = np.empty(n), np.empty(n, np.int64)
+        ok, mg = np.empty(n, bool), np.empty(n)
+        bin_choice_rows(*rows, out, k, ok, mg)
+    else:
+        out, k, ok, mg = bin_choice_rows_numpy(*rows)
     out, k, ok, mg = (a.reshape(lead) for a in (out, k, ok, mg))
     return out, k, ok, (mg if margin else None)

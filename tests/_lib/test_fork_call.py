@@ -8,14 +8,15 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from rtsgeom._lib.parallel import fork_call
-from rtsgeom.pipeline.output import (map_arrays, map_dataset, maps_arrays, run_report_html,
-                                     start_setup_view)
+from rtsgeom.pipeline.output import (_calibration_figures, map_arrays, map_dataset,
+                                     maps_arrays, run_report_html, start_setup_view)
 from rtsgeom.pipeline.run import run_scene
 from rtsgeom.scene import load_scene
 
@@ -33,6 +34,26 @@ def test_fork_call_returns_and_raises_as_the_call():
         fork_call(_fail, "nothing here").result()
 
 
+def _late_bytes():
+    time.sleep(0.3)
+    return b"x" * (1 << 20)  # more than a pipe holds: sending waits for a reader
+
+
+def test_a_forked_call_whose_parent_is_gone_ends():
+    """A parent killed before collecting (SIGKILL of a run): the forked process's answer
+    finds no reader and it ends, instead of waiting forever with its memory (it held the
+    pipe's other end itself)."""
+    forked = fork_call(_late_bytes)
+    forked._conn.close()  # what the parent's death does to its end
+    forked._proc.join(timeout=20)
+    try:
+        assert forked._proc.exitcode == 0
+    finally:
+        if forked._proc.exitcode is None:
+            forked._proc.kill()
+            forked._proc.join()
+
+
 @pytest.fixture(scope="module")
 def result():
     return run_scene(load_scene(SCENE), aoa_mode="nearest", truth=False)
@@ -42,6 +63,15 @@ def test_forked_view_gives_the_same_report(result):
     view = start_setup_view(result.scene)
     assert (run_report_html(result, {}, "exact", [], view)
             == run_report_html(result, {}, "exact", []))
+
+
+def test_forked_calibration_figures_give_the_same_report():
+    """The calibration's figures drawn in a process forked before the maps (write_run)."""
+    result = run_scene(load_scene(SCENE), truth=False)  # exact amplitudes: calibrated
+    here = run_report_html(result, {}, "exact", [])
+    assert here.count('alt="Calibration"') == 1  # the one pair's sweep
+    assert run_report_html(result, {}, "exact", [], None,
+                           fork_call(_calibration_figures, result)) == here
 
 
 def test_map_arrays_are_the_datasets(result):

@@ -473,6 +473,45 @@ def test_a_signal_in_a_finalizer_is_not_swallowed():
             _wait_for_the_signal()
 
 
+def test_a_signal_in_numpys_own_python_code_is_raised_after_it():
+    """numpy's C code calls its Python code and may replace an exception raised there (a
+    SIGTERM in np.unique of structured rows came out as a TypeError): the signal is raised
+    once back outside numpy."""
+    import numpy as np
+
+    from rtsgeom.cli._signals import _unsafe, honoured_signals
+    seen = []
+
+    def row(r):  # called by numpy's apply_along_axis (numpy's Python code below this frame)
+        seen.append(_unsafe(sys._getframe()))
+        if len(seen) == 1:
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.06)  # the handler and its 20 ms retries run here: deferred
+        return r.sum()
+
+    with pytest.raises(Terminated):
+        with honoured_signals():
+            np.apply_along_axis(row, 1, np.ones((3, 2)))
+            _wait_for_the_signal()
+    assert seen == [True, True, True]  # deferred: every row ran
+    assert not _unsafe(sys._getframe())
+
+
+def test_a_signal_deferred_out_of_an_import_is_raised_after_a_fork(capsys):
+    """A signal deferred out of an import (the CLI's timer raises it ~20 ms later) while a
+    process forks: raised after the fork, not inside its handlers ('Exception ignored in
+    _releaseLock' and a traceback)."""
+    from rtsgeom._lib.parallel import fork_call
+    from rtsgeom.cli._signals import honoured_signals
+    with pytest.raises(Terminated):
+        with honoured_signals():
+            _SignalInFinalizer(signal.SIGTERM)  # deferred: the timer fires 20 ms later
+            t = time.monotonic()
+            while time.monotonic() - t < 0.1:  # forks while the timer is due
+                fork_call(pow, 2, 3).result()
+    assert "Exception ignored" not in capsys.readouterr().err
+
+
 def test_a_swallowed_signal_still_ends_the_command_with_its_code(monkeypatch, capsys):
     """Whatever swallowed the exception, a command that received SIGTERM exits 143, not 0."""
     import rtsgeom.cli as cli

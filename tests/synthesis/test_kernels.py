@@ -174,6 +174,45 @@ def test_bin_choice_equals_the_rule(n_k):
         np.testing.assert_allclose([got[0][i], got[3][i]], [ref[0], ref[3]], rtol=1e-12)
 
 
+def _choice_rows(n_k: int, n: int = 3000):
+    """Rows for the bin choice: ratios with NaN and non-positive bins, a third of the rows
+    one design at every bin (within +-1.5 %: most bins equivalent), and rows whose power is
+    NaN or inf at some bin (inf and NaN channel sums)."""
+    rng = np.random.default_rng(n_k)
+    rho = rng.uniform(-0.2, 2, (n, n_k))
+    same = rng.random(n) < 0.3
+    rho[same] = rho[same, n_k // 2, None] * (1 + rng.uniform(-0.015, 0.015, (same.sum(), n_k)))
+    rho[rng.random((n, n_k)) < 0.15] = np.nan
+    ph = rng.uniform(-np.pi, np.pi, (n, 1))
+    p_ii, p_jj = rng.uniform(0, 1, (2, n, n_k)) ** 3
+    c_ij = np.sqrt(p_ii * p_jj) * rng.uniform(0, 1, (n, n_k)) * np.exp(
+        1j * rng.uniform(-np.pi, np.pi, (n, n_k)))
+    bad = rng.random((n, n_k)) < 0.01
+    p_jj[bad] = np.where(rng.random(bad.sum()) < 0.5, np.nan, np.inf)
+    return rho, ph, p_ii, p_jj, c_ij
+
+
+@pytest.mark.parametrize("n_k", [1, 3, 5, 7])
+def test_bin_choice_kernel_gives_the_definitions_bits(n_k, monkeypatch):
+    """``kernels.bin_choice_rows`` (large batches) against ``choice.bin_choice_rows_numpy``
+    (small batches: a run of a few targets loads no numba), bit for bit, through
+    detected_bin_choice with either path forced: both branches, equivalent bins, NaN and inf
+    powers."""
+    args = _choice_rows(n_k)
+    out = []
+    for compiled in (True, False):
+        monkeypatch.setattr(pair_design, "use_kernels", lambda n, s: compiled)
+        out.append(detected_bin_choice(*args))
+    for a, b in zip(*out):
+        assert a.dtype == b.dtype
+        np.testing.assert_array_equal(a, b)
+        np.testing.assert_array_equal(np.signbit(a), np.signbit(b))
+    ok, margin = out[1][2], out[1][3]
+    if n_k > 1:
+        assert 0.05 < ok.mean() < 0.999  # both branches taken
+        assert 0 < np.isinf(margin).sum() < ok.sum() and np.isnan(margin).any()
+
+
 def test_numpy_definitions_are_as_silent_as_the_kernels():
     """inf, NaN and 1e300 beams: the numpy definition of the design ratio warns no more than
     the compiled kernel (a RuntimeWarning must not depend on which path a process took)."""

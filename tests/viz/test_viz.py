@@ -229,6 +229,20 @@ def test_each_figure_saves_a_nonempty_png_without_pyplot(tmp_path):
     assert not list(tmp_path.glob("*.part*"))
 
 
+def test_a_figure_drawn_once_has_savefigs_bytes():
+    """print_png draws a constrained-layout figure once, savefig twice: the same PNG bytes."""
+    import io
+
+    import matplotlib as mpl
+    once, twice = _figures(), _figures()
+    for name in once:
+        a, b = io.BytesIO(), io.BytesIO()
+        F.print_png(once[name], a)
+        with mpl.rc_context(F.STYLE):
+            twice[name].savefig(b, format="png", dpi=F.DPI)
+        assert a.getvalue() == b.getvalue(), name
+
+
 def test_figure_inputs_are_checked():
     r, v = np.arange(4.0), np.arange(3.0)
     with pytest.raises(ValueError, match=r"power_db must have shape \(4, 3\)"):
