@@ -155,9 +155,9 @@ def _panel(ax, s: Mapping, worst: bool) -> bool:
     y = s.get("residual_error_deg")
     if y is not None and np.isfinite(y):
         ax.plot([chosen], [float(y)], marker="o", markersize=4, color="C3", linestyle="none")
-        text = f"{s['label']}: {chosen * 1e3:.1f} ps, {float(y):.4f} deg"
+        text = f"{s['label']}: {round(chosen * 1e3, 1) + 0.0:.1f} ps, {float(y):.4f} deg"
     else:
-        text = f"{s['label']}: {chosen * 1e3:.1f} ps, residual not measured"
+        text = f"{s['label']}: {round(chosen * 1e3, 1) + 0.0:.1f} ps, residual not measured"
     _title(ax, text)
     ax.title.set_fontsize(8)
     if worst:
