@@ -6,8 +6,8 @@ The bundled crossing bench (``scenes/crossing.toml``: five front ends 8 deg apar
 played over its 2 s drive in ``--frames`` frames (the exact synthesis, no baseline), as a
 whole process (wall and user CPU, the median of ``--repeat``, the load average before each);
 writes ``benchmarks/play_speed.json``, the earlier records of that file kept under
-``history`` (each with its ``label``; ``--label`` names this one). ``--root`` plays another
-checkout's code (e.g. an export of an earlier commit: the before of a change). Not part of
+``history`` (each with its ``label``; ``--label`` names this one). ``--chain`` passes play's
+``--chain``. ``--root`` plays another checkout's code (e.g. an export of an earlier commit: the before of a change). Not part of
 the test suite.
 """
 
@@ -51,6 +51,8 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default=str(ROOT / "benchmarks" / "play_speed.json"))
     ap.add_argument("--label", default="current", help="what this record measures")
     ap.add_argument("--root", default=str(ROOT), help="the checkout whose rtsgeom plays")
+    ap.add_argument("--chain", choices=("fast", "full"), default=None,
+                    help="play's --chain (default: play's own default)")
     args = ap.parse_args(argv)
     runs = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -61,7 +63,8 @@ def main(argv=None) -> int:
             before = resource.getrusage(resource.RUSAGE_CHILDREN)
             t0 = time.perf_counter()
             proc = subprocess.run([sys.executable, "-m", "rtsgeom", "play", str(scene), "--out",
-                                   f"{tmp}/out{r}", "--no-baseline", "--quiet"],
+                                   f"{tmp}/out{r}", "--no-baseline", "--quiet"]
+                                  + ([] if args.chain is None else ["--chain", args.chain]),
                                   capture_output=True, text=True, cwd=args.root,
                                   env={**os.environ, "PYTHONPATH": args.root})
             wall = time.perf_counter() - t0
@@ -72,6 +75,7 @@ def main(argv=None) -> int:
             print(f"play {args.frames} frames x {args.targets} targets: {wall:.1f} s wall, "
                   f"{user:.1f} s user (load {load:.1f})", flush=True)
     record = {"label": args.label, "frames": args.frames, "targets": args.targets,
+              "chain": args.chain or "default",
               "median_wall_s": statistics.median(x["wall_s"] for x in runs),
               "median_user_s": statistics.median(x["user_s"] for x in runs),
               "user_s_per_frame": statistics.median(x["user_s"] for x in runs) / args.frames,
