@@ -22,9 +22,10 @@ What this driver adds to ``mutmut run``:
 * **targeted fast tests**: each module's tests are the test files that import it and the
   core's (``tests_for``, ``CORE_TESTS``, found at every run: ``MODULES``); the selection is
   their union for the chosen modules, without the ``slow``
-  marker, the ray tracer, and the tests that run a subprocess or a dask cluster (a mutant is
-  switched by an environment variable inside the forked test process, so a subprocess or a
-  dask worker would run the unmutated code anyway, and they are slow);
+  marker, the ray tracer, and the tests that run a child process (marker ``subprocess``) or a
+  dask cluster (a mutant is switched by an environment variable inside the forked test
+  process, so a subprocess or a dask worker would run the unmutated code anyway, and they are
+  slow); the commands' in-process tests (``main([...])``) are in;
 * **a reproducible sample**: ``--sample N --seed K`` runs N mutants drawn with
   ``numpy.random.default_rng(K)``, stratified per module (each module's share of the sample is
   its share of all mutants, at least one); without ``--sample`` every mutant runs;

@@ -190,6 +190,7 @@ def _cli(*args):
                           capture_output=True, text=True, cwd=ROOT)
 
 
+@pytest.mark.subprocess
 def test_cli_sphere4_defaults_to_the_cell(tmp_path):
     p = _cli(str(SPHERE), "--draws", "50", "--points", "9", "--json", "--out",
              str(tmp_path / "o"))
@@ -204,6 +205,7 @@ def test_cli_sphere4_defaults_to_the_cell(tmp_path):
     assert npz["offsets_m"].shape == (50, 4, 3) and npz["calibrated_deg"].shape == (50, 3)
 
 
+@pytest.mark.subprocess
 @pytest.mark.parametrize("args, word", [
     (["--cell", "0", "1"], "3 or 4"),
     (["--cell", "0", "1", "7"], "3 or 4"),
@@ -216,6 +218,7 @@ def test_cli_bad_cell_exits_2(args, word):
     assert p.returncode == 2 and word in p.stderr and "Traceback" not in p.stderr
 
 
+@pytest.mark.subprocess
 def test_cli_cell_on_an_azimuth_only_radar_exits_2():
     p = _cli(str(ROOT / "scenes" / "diewald2022.toml"), "--cell", "all", "--draws", "5")
     assert p.returncode == 2 and "elevation" in p.stderr and "Traceback" not in p.stderr
