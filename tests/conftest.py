@@ -228,3 +228,17 @@ def calibrated(cal_setup):
     probe = probe_front_ends(setup, paths)
     return probe, calibrate_pair(setup, paths, (0, 1), probe)
 
+
+
+def assert_bounds(make, ok, bad, error=None):
+    """A config's declared range, enforced exactly at its edges: ``make(value)`` accepts every
+    value of ``ok`` (the bounds themselves) and refuses each ``(value, message)`` of ``bad``
+    (just outside them) with ``error`` (default ``ParameterError``) whose text is ``message``,
+    the whole of it (the field, the value and the allowed range)."""
+    from rtsgeom.errors import ParameterError
+    for v in ok:
+        make(v)
+    for v, message in bad:
+        with pytest.raises(error or ParameterError) as exc:
+            make(v)
+        assert str(exc.value) == message, (v, str(exc.value))
