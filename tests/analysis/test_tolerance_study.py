@@ -1,0 +1,61 @@
+"""ToleranceStudy's config: each declared range enforced exactly at its edges, the error naming
+the field, the value and the allowed range in full; the combinations it refuses."""
+
+from __future__ import annotations
+
+import pytest
+
+from conftest import assert_bounds
+from rtsgeom.analysis.tolerance.config import MonteCarlo
+from rtsgeom.analysis.tolerance.draws import Bounds
+from rtsgeom.analysis.tolerance.study import ToleranceStudy
+from rtsgeom.errors import ParameterError
+
+BOUNDS = [
+    ("spec_deg", [1e-6, 90.0],
+     [(0.0, "ToleranceStudy: spec_deg = 0: must be in [1e-06, 90] deg"),
+      (90.5, "ToleranceStudy: spec_deg = 90.5: must be in [1e-06, 90] deg")]),
+    ("points", [3, 201], [(2, "ToleranceStudy: points = 2: must be in [3, 201]"),
+                          (202, "ToleranceStudy: points = 202: must be in [3, 201]")]),
+    ("verify", [0, 10_000], [(-1, "ToleranceStudy: verify = -1: must be in [0, 10000]"),
+                             (10_001, "ToleranceStudy: verify = 10001: must be in [0, 10000]")]),
+    ("invert_yield", [None, 1.0, 1e-9],
+     [(0.0, "ToleranceStudy: invert_yield = 0: must be in (0, 1]"),
+      (1.5, "ToleranceStudy: invert_yield = 1.5: must be in (0, 1]")]),
+    ("invert_axis", ["all", "radial", "tangential", "height"],
+     [("yaw", "ToleranceStudy: invert_axis = 'yaw': must be one of all, radial, tangential, "
+              "height")]),
+    ("mc", [MonteCarlo(1), MonteCarlo(10_000_000)],
+     [(MonteCarlo(0), "ToleranceStudy: draws = 0: must be in [1, 1e+07]"),
+      (None, "ToleranceStudy: mc must be a MonteCarlo")]),
+    ("bounds", [Bounds(), Bounds((1e-3, 0.0, 0.0), 0.01)],
+     [((1e-4,) * 3, "ToleranceStudy: bounds must be a Bounds (the error scales, SI)"),
+      (Bounds((-1e-4, 0.0, 0.0)), "tolerance bounds [-0.0001, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, "
+                                  "0.0]: must be finite and >= 0"),
+      (Bounds(rut_yaw_rad=float("nan")), "tolerance bounds [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, "
+                                         "0.0, nan]: must be finite and >= 0")]),
+]
+
+
+@pytest.mark.parametrize("name, ok, bad", BOUNDS, ids=[b[0] for b in BOUNDS])
+def test_tolerance_study_enforces_each_range_at_its_edges(name, ok, bad):
+    assert_bounds(lambda v: ToleranceStudy(**{name: v}), ok, bad)
+
+
+def test_tolerance_study_takes_a_cell_or_a_pair_not_both():
+    ToleranceStudy(cell="all")
+    ToleranceStudy(pair=(0, 1))
+    with pytest.raises(ParameterError) as exc:
+        ToleranceStudy(cell="all", pair=(0, 1))
+    assert str(exc.value) == ("ToleranceStudy: cell and pair: give one of them (the cell study "
+                              "is of the cell's front ends)")
+
+
+def test_tolerance_study_cases_and_defaults():
+    from rtsgeom.analysis.tolerance.phasors import CASES, NOMINAL_AMPLITUDES
+    assert ToleranceStudy().cases == CASES == ("uncalibrated", "calibrated")
+    assert ToleranceStudy(nominal_amplitudes=True).cases == CASES + (NOMINAL_AMPLITUDES,)
+    d = ToleranceStudy()
+    assert (d.bounds, d.pair, d.cell, d.mc, d.spec_deg, d.points, d.verify, d.invert_yield,
+            d.invert_axis, d.sigma_level, d.keep_draws) == (
+        Bounds((1e-4,) * 3), None, None, MonteCarlo(), 0.1, 21, 0, None, "all", None, False)
