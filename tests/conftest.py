@@ -242,3 +242,29 @@ def assert_bounds(make, ok, bad, error=None):
         with pytest.raises(error or ParameterError) as exc:
             make(v)
         assert str(exc.value) == message, (v, str(exc.value))
+
+
+#: the whole warning a Monte-Carlo study gives on a scene with front end 1 moved radially
+#: (:func:`moved_front_end`): ``<study> `` and this
+DRAWS_REPLACE_TEXT = (
+    "draws mounting errors about the nominal setup; the scene's own errors "
+    "(rts.front_ends[1].radial_offset_mm) are not its starting point: each draw replaces them. "
+    "Their effect on the synthesized angle: `rtsgeom linearity SCENE --uncalibrated` (and "
+    "without the flag, calibrated), in Python rtsgeom.linearity(scene, calibration=False)")
+
+
+def moved_front_end(scene):
+    """``scene`` with front end 1 moved 0.3 mm radially (an error of the scene's own)."""
+    import rtsgeom
+    fes = list(scene.rts.front_ends)
+    fes[1] = rtsgeom.replace(fes[1], radial_offset_mm=0.3)
+    return rtsgeom.replace(scene, rts=rtsgeom.replace(scene.rts, front_ends=tuple(fes)))
+
+
+def the_warnings(call, category) -> list[str]:
+    """The texts of the ``category`` warnings ``call()`` gives (each once)."""
+    import warnings
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        call()
+    return [str(w.message) for w in caught if issubclass(w.category, category)]

@@ -298,3 +298,11 @@ def test_the_design_study_draws_with_its_seed_and_announces_its_count(default_sc
     assert got.equals(want)
     assert not got.equals(other)  # the seed matters at 30 draws
     assert calls[0] == ("designs", 0, len(radii) * len(spacings))
+
+
+def test_a_scene_with_its_own_errors_gets_the_whole_warning(default_scene):
+    from conftest import DRAWS_REPLACE_TEXT, moved_front_end, the_warnings
+    from rtsgeom.errors import NominalSetupWarning
+    study = DesignStudy(radius_m=(1.0,), spacing_deg=(8.0,), mc=MonteCarlo(20), points=5)
+    assert the_warnings(lambda: study(moved_front_end(default_scene)), NominalSetupWarning) == [
+        "design " + DRAWS_REPLACE_TEXT]

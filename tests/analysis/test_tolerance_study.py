@@ -59,3 +59,12 @@ def test_tolerance_study_cases_and_defaults():
     assert (d.bounds, d.pair, d.cell, d.mc, d.spec_deg, d.points, d.verify, d.invert_yield,
             d.invert_axis, d.sigma_level, d.keep_draws) == (
         Bounds((1e-4,) * 3), None, None, MonteCarlo(), 0.1, 21, 0, None, "all", None, False)
+
+
+def test_a_scene_with_its_own_errors_gets_the_whole_warning(default_scene):
+    from conftest import DRAWS_REPLACE_TEXT, moved_front_end, the_warnings
+    from rtsgeom.errors import NominalSetupWarning
+    study = ToleranceStudy(pair=(0, 1), mc=MonteCarlo(20), points=5)
+    assert the_warnings(lambda: study(moved_front_end(default_scene)), NominalSetupWarning) == [
+        "tolerance " + DRAWS_REPLACE_TEXT]
+    assert the_warnings(lambda: study(default_scene), NominalSetupWarning) == []
