@@ -268,3 +268,27 @@ def the_warnings(call, category) -> list[str]:
         warnings.simplefilter("always")
         call()
     return [str(w.message) for w in caught if issubclass(w.category, category)]
+
+
+def assert_refused(call, message, error=None):
+    """``call()`` raises ``error`` (default ``ParameterError``) whose whole text is
+    ``message``."""
+    from rtsgeom.errors import ParameterError
+    with pytest.raises(error or ParameterError) as exc:
+        call()
+    assert str(exc.value) == message
+
+
+@pytest.fixture(scope="session")
+def sphere_scene():
+    """scenes/sphere4.toml: four front ends on a sphere (a 2-D cell), an RuT with elevation."""
+    from rtsgeom.scene import load_scene
+    return load_scene(ROOT / "scenes" / "sphere4.toml")
+
+
+@pytest.fixture(scope="session")
+def crossing_bench():
+    """scenes/crossing.toml's bench without its drive: five front ends on an arc."""
+    import dataclasses
+    from rtsgeom.scene import load_scene
+    return dataclasses.replace(load_scene(ROOT / "scenes" / "crossing.toml"), scenario=None)

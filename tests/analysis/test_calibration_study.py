@@ -106,3 +106,11 @@ def test_calibration_study_enforces_its_ranges_and_choices():
     d = CalibrationStudy()
     assert (d.pair, d.procedure, d.full_chain, d.fir, d.steps, d.workers) == (
         (0, 1), "exact", False, None, None, None)
+
+
+def test_the_papers_procedure_is_refused_on_cells(sphere_scene):
+    from conftest import assert_refused
+    from rtsgeom.analysis.calibration_study import CalibrationStudy
+    assert_refused(lambda: CalibrationStudy(procedure="paper")(sphere_scene),
+                   "procedure paper: the paper's sweep is a pair on an arc (one set angle in "
+                   "azimuth); this scene's front ends form 2-D cells")

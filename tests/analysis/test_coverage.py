@@ -95,3 +95,10 @@ def test_a_scene_with_its_own_errors_gets_the_whole_warning(default_scene):
     assert the_warnings(lambda: coverage_designs(moved_front_end(default_scene), (-10.0, 10.0),
                                                  [1.0], draws=20, points=5),
                         NominalSetupWarning) == ["design " + DRAWS_REPLACE_TEXT]
+
+
+def test_coverage_refuses_unknown_options_in_full_words(default_scene):
+    from conftest import assert_refused
+    from rtsgeom.analysis.coverage import coverage_designs
+    assert_refused(lambda: coverage_designs(default_scene, (-10.0, 10.0), [1.0], foo=1, bar=2),
+                   "coverage_designs: no option foo, bar (points, extras, progress, workers)")

@@ -47,3 +47,10 @@ def test_steps_are_told_each_stage_in_order():
     study._step("sweeping")
     LinearityStudy()._step("nobody listens")
     assert told == ["measuring", "sweeping"]
+
+
+def test_a_grid_needs_a_rut_with_elevation(default_scene):
+    from conftest import assert_refused
+    assert_refused(lambda: LinearityStudy(grid=3)(default_scene),
+                   "grid: needs a RuT with elevation (an array with elevation extent, e.g. "
+                   "radar.use_elevation_tx = true)")

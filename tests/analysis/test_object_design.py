@@ -60,3 +60,10 @@ def test_object_design_runs_are_capped(ranges, spacings, budgets):
 def test_object_design_repr_is_short_and_says_the_grid():
     s = ObjectDesign(ranges_m=(7.0, 3.0, 12.5), spacings_deg=(8.0,), budgets=(None, 2))
     assert repr(s) == "ObjectDesign(3 ranges 3..12.5 m, spacings [8.0] deg, budgets [None, 2])"
+
+
+def test_a_scene_without_an_extended_object_is_refused(default_scene):
+    from conftest import assert_refused
+    assert_refused(lambda: ObjectDesign()(default_scene),
+                   f"{default_scene.source}: has no extended object (a [[targets]] or "
+                   "[[scenario.targets]] entry with scatterers or mesh)")

@@ -31,3 +31,10 @@ def test_playback_enforces_each_range_at_its_edges(name, ok, bad):
 def test_playback_defaults_are_the_documented_ones():
     d = Playback()
     assert (d.amplitudes, d.paths, d.baseline, d.bins, d.workers) == (None, "exact", True, 2, 1)
+
+
+def test_a_scene_without_a_drive_is_refused(default_scene):
+    from conftest import assert_refused
+    assert_refused(lambda: Playback()(default_scene),
+                   f"{default_scene.source}: has no [scenario] to play (add [scenario] with "
+                   "[[scenario.targets]], docs/scenario.md)")

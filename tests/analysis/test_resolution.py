@@ -72,3 +72,16 @@ def test_resolution_cases_are_capped_at_twenty_thousand(seps, phases):
         ResolutionStudy(separations_deg=s + (1.0,), phases_deg=(0.0,) * phases)
     assert str(exc.value) == (f"resolution: {seps + 1} separations x {phases} phases: at most "
                               "20000 cases")
+
+
+def test_separations_the_arc_cannot_reach_are_refused(default_scene):
+    from conftest import assert_refused
+    assert_refused(lambda: ResolutionStudy(centre_deg=60.0)(default_scene),
+                   "resolution: the arc reaches no separation of 2 deg or more about centre_deg "
+                   "60: give separations_deg")
+    with pytest.raises(ParameterError) as exc:
+        ResolutionStudy(separations_deg=(100.0,))(default_scene)
+    assert str(exc.value).startswith("resolution: separations_deg up to 100 about centre_deg "
+                                     "7.8: ")
+    assert str(exc.value).endswith(": must be within the measured span of the front ends "
+                                   "[3.9728, 12.7565] deg (no pair can reach it)")

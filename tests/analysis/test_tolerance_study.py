@@ -68,3 +68,31 @@ def test_a_scene_with_its_own_errors_gets_the_whole_warning(default_scene):
     assert the_warnings(lambda: study(moved_front_end(default_scene)), NominalSetupWarning) == [
         "tolerance " + DRAWS_REPLACE_TEXT]
     assert the_warnings(lambda: study(default_scene), NominalSetupWarning) == []
+
+
+def test_the_combinations_the_study_does_not_model_are_refused(default_scene, sphere_scene,
+                                                              crossing_bench):
+    from conftest import assert_refused
+    mc = MonteCarlo(10)
+    rot = Bounds((1e-4,) * 3, 1e-3)
+    verify = ("verify: only for one pair with offsets (not pair='all', rotations or RuT-pose "
+              "errors)")
+    assert_refused(lambda: ToleranceStudy(pair="all", verify=2, mc=mc, points=3)(crossing_bench),
+                   verify)
+    assert_refused(lambda: ToleranceStudy(rot, pair=(0, 1), verify=2, mc=mc, points=3)(
+        default_scene), verify)
+    assert_refused(lambda: ToleranceStudy(Bounds((1e-4,) * 3, rut_yaw_rad=1e-3), pair=(0, 1),
+                                          verify=1, mc=mc, points=3)(default_scene), verify)
+    assert_refused(lambda: ToleranceStudy(cell="all", nominal_amplitudes=True, mc=mc, points=3)(
+        sphere_scene), "nominal_amplitudes: only for the pair study (the cell study designs its "
+                       "amplitudes once, at the bin centre)")
+    for kw in ({"invert_yield": 0.9}, {"verify": 1}):
+        assert_refused(lambda: ToleranceStudy(rot, cell="all", mc=mc, points=3, **kw)(
+            sphere_scene), "verify, invert_yield: only without rotation or RuT-pose errors so far")
+    assert_refused(lambda: ToleranceStudy(cell="all", mc=mc, points=3)(default_scene),
+                   "cell: tolerance --cell needs a RuT that beamforms in azimuth and elevation "
+                   "(an array with elevation extent, e.g. radar.use_elevation_tx = true)")
+    for cell, shown in (((0, 1), "[0, 1]"), ((0, 1, 9), "[0, 1, 9]"), ((0, 1, 1), "[0, 1, 1]"),
+                        ((0, 1, 2, 3, 0), "[0, 0, 1, 2, 3]")):  # shown sorted
+        assert_refused(lambda: ToleranceStudy(cell=cell, mc=mc, points=3)(sphere_scene),
+                       f"cell: cell {shown}: must be 3 or 4 distinct front-end indices in [0, 3]")
