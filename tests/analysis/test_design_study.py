@@ -4,6 +4,7 @@ config and set-points it draws with."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from conftest import assert_bounds
@@ -63,3 +64,29 @@ def test_design_draws_and_points_are_the_documented_defaults(coverage, mc, point
     got, n = s.draws_config(SimpleNamespace(seed=17))
     assert (got.draws, n) == want
     assert got.seed == (17 if mc is None or mc.seed is None else mc.seed)
+
+
+@pytest.mark.parametrize("coverage, radii, spacings, n", [
+    (None, (1.0,), (8.0, 10.0), 2), (None, (1.0, 1.5), (8.0, 10.0, 12.0), 6),
+    ((-5.0, 5.0), (1.0,), (8.0,), 2), ((-5.0, 5.0), (1.0, 1.5), (8.0, 10.0), 4)])
+def test_design_progress_counts_every_design_from_the_start(default_scene, coverage, radii,
+                                                           spacings, n):
+    """('designs', done, total) from 0 to the count to come: radii x spacings on the grid,
+    two candidate arcs per radius for a coverage."""
+    told = []
+    DesignStudy(radius_m=radii, spacing_deg=spacings, coverage_deg=coverage, points=3,
+                mc=MonteCarlo(20, progress=lambda *a: told.append(a)))(default_scene)
+    assert told == [("designs", k, n) for k in range(n + 1)]
+
+
+def test_the_design_draws_with_the_mc_seed_else_the_scenes(default_scene):
+    def grid(mc):
+        g = DesignStudy(radius_m=(1.0,), spacing_deg=(8.0,), mc=mc, points=3)(default_scene)
+        return g.seed, g.metrics
+    seed0, m0 = grid(MonteCarlo(200))
+    assert seed0 == default_scene.seed
+    s, m = grid(MonteCarlo(200, seed=default_scene.seed))
+    assert s == seed0 and all(np.array_equal(m[k], m0[k], equal_nan=True) for k in m0)
+    s, m = grid(MonteCarlo(200, seed=default_scene.seed + 1))
+    assert s == default_scene.seed + 1
+    assert any(not np.array_equal(m[k], m0[k], equal_nan=True) for k in m0)

@@ -232,3 +232,43 @@ def test_ideal_radar_drops_the_channels_and_keeps_an_ideal_setup(small_setup):
     assert real.scene.radar.channels is not None and ideal.scene.radar.channels is None
     assert np.array_equal(ideal.fe_azimuth_rad(), real.fe_azimuth_rad())
     assert ideal.scene.rts == real.scene.rts
+
+
+def test_radars_without_spread_are_the_ideal_golden_radar(default_scene):
+    """sigma 0: every drawn radar is ideal, as the scene's (no [radar.channels]): each sees
+    what the golden radar sees, its compensation changes nothing, a real target reads its own
+    angle (to 1e-9 deg), the calibration absorbs nothing; the set-points split the pair's span
+    in equal steps."""
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    setup = build_setup(default_scene)
+    r = TransferStudy(radars=3, points=4, sigma_phase_deg=0.0, seed=1)(setup,
+                                                                      exact_paths(setup))
+    assert r.error_deg.shape == (3, 4) and r.pairs == ((0, 1),)
+    for b in range(3):
+        assert np.array_equal(r.error_deg[b], r.golden_error_deg)
+        assert np.array_equal(r.compensated_error_deg[b], r.golden_error_deg)
+    assert np.max(np.abs(r.own_error_deg)) < 1e-9
+    assert r.offset_shift_ps == (0.0,) and np.array_equal(r.absorbed_deg, np.zeros(4))
+    assert np.allclose(np.diff(r.set_deg), np.diff(r.set_deg)[0], rtol=1e-9)
+    assert np.max(np.abs(r.golden_error_deg)) < 0.01
+    assert list(r.pair_index) == [0, 0, 0, 0] and r.range_m > 0
+    assert r.draw_phase_rad.shape == (3, setup.rut.tx_local.shape[0] + setup.rut.rx_local.shape[0])
+    assert not np.any(r.draw_phase_rad) and not np.any(r.draw_gain_db)
+    assert (r.sigma_phase_deg, r.sigma_gain_db, r.spec_deg, r.scene_name) == (
+        0.0, 0.0, None, default_scene.name)
+
+
+def test_the_study_tells_each_pair_it_calibrates_and_indexes_its_set_points(crossing_bench):
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+    setup = build_setup(crossing_bench)
+    told = []
+    r = TransferStudy(radars=2, points=2, pairs=((1, 2), (3, 4)))(setup, exact_paths(setup),
+                                                                  progress=told.append)
+    assert told == ["calibrating pair (1, 2) with the golden radar",
+                    "calibrating pair (3, 4) with the golden radar"]
+    assert r.pairs == ((1, 2), (3, 4)) and list(r.pair_index) == [0, 0, 1, 1]
+    fe = np.degrees(setup.fe_azimuth_rad())
+    assert fe[1] < r.set_deg[0] < r.set_deg[1] < fe[2] < fe[3] < r.set_deg[2] < r.set_deg[3] < fe[4]
+    assert r.error_deg.shape == (2, 4) and r.programs.shape == (4, 4)
