@@ -21,3 +21,13 @@ def test_phase_residual_of_a_plane_wave_is_zero():
     bent = lengths + 1e-3 * (x - x.mean()) ** 2 / np.ptp(x) ** 2
     r = _residual_deg(st, bent)
     assert np.max(np.abs(r)) > 1e-3 and np.allclose(r.sum(axis=1), 0, atol=1e-9)
+
+
+def test_the_cells_of_two_d_front_ends():
+    """3 or 4 front ends are one cell; more are the Delaunay triangles of their direction
+    cosines (each a sorted tuple): a square with its centre is four triangles through it."""
+    from rtsgeom.analysis.nearfield_terms import cells_of
+    sq = np.array([[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1], [-0.1, 0.1]])
+    assert cells_of(sq[:3]) == [(0, 1, 2)] and cells_of(sq) == [(0, 1, 2, 3)]
+    five = np.r_[sq, [[0.0, 0.0]]]
+    assert sorted(cells_of(five)) == [(0, 1, 4), (0, 3, 4), (1, 2, 4), (2, 3, 4)]
