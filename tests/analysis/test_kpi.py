@@ -446,3 +446,22 @@ def test_the_html_budget_section_is_the_worst_set_angles(sheet):
             "deg.</p><table><tr><th>quantity</th><th>u(x_i)</th><th>unit</th><th>distribution"
             "</th><th>c_i (deg/unit)</th><th>u_i(y) (deg)</th></tr>") in page
     assert page.count("<tr><td>") >= len(worst.budget)
+
+
+def test_a_spec_file_too_large_or_with_a_reversed_span_is_refused(tmp_path):
+    from conftest import assert_refused
+    from rtsgeom.analysis.kpi.spec import MAX_SPEC_BYTES, load_spec
+    big = tmp_path / "big.toml"
+    big.write_text("#" * MAX_SPEC_BYTES)
+    assert load_spec(big) == KpiSpec()  # at the limit: read
+    big.write_text("#" * (MAX_SPEC_BYTES + 1))
+    assert_refused(lambda: load_spec(big),
+                   f"{big}: spec file too large (at most {MAX_SPEC_BYTES} bytes)", SceneError)
+    for span in ("[5.0, 5.0]", "[6.0, -6.0]"):
+        p = tmp_path / "span.toml"
+        p.write_text(f"azimuth_deg = {span}\n")
+        lo, hi = (float(x) for x in span.strip("[]").split(","))
+        assert_refused(lambda: load_spec(p), f"{p}: azimuth_deg = {[lo, hi]}: must be [lo, hi] "
+                                             "with lo < hi", SceneError)
+    p.write_text("azimuth_deg = [-6.0, 6.0]\n")
+    assert load_spec(p).azimuth_deg == (-6.0, 6.0)
