@@ -114,6 +114,26 @@ EQUIVALENT: dict[str, str] = {
         "the (0, taps) table of an empty delay set as float instead of complex: the package's "
         "only caller (analysis/tolerance/tables.py) passes at least one echo, so the branch is "
         "dead for it, and an empty table contributes no row to any response.",
+    # fresh sample (seed 23)
+    "rtsgeom.analysis.coverage.x_coverage_designs__mutmut_79":
+        "local_map(before_fork=None) instead of import_for_workers: the hook only imports the "
+        "compiled kernels before a pool forks, so the workers inherit them instead of "
+        "importing them each (~0.15 s CPU per worker); every design is computed the same "
+        "either way (and with workers=1 no pool starts).",
+    "rtsgeom.analysis.tolerance.cell.x_build_cell__mutmut_123":
+        "the cell's response table one delay row longer at each end (z + 2 instead of z + 1): "
+        "every row read is table_zero + sub-bin step + calibration step, at most "
+        "max|sub| + max_steps = z - 1 from the centre, and np.gradient's slope at those rows "
+        "is the central difference either way; the extra end rows are never read.",
+    "rtsgeom.analysis.tolerance.cell.xǁCellProcedureǁcalibration_steps__mutmut_64":
+        "np.take_along_axis without axis= uses axis=-1 in numpy 2 (2.4 here), the axis given "
+        "(numpy 1.26, which pyproject still allows, would raise instead).",
+    "rtsgeom.calibration.phasor.xǁSweepResultǁerrors__mutmut_1":
+        "SweepResult.errors' default frames 1 -> 2: its three callers (phasor.py twice, "
+        "steps.py) pass frames, so the default is never used.",
+    "rtsgeom.radar.channels.x_rx_coupling_matrix__mutmut_44":
+        "np.eye(n) as float instead of complex: adding complex(coefficient) * adj makes the "
+        "sum complex128 with the same values (the coefficient is always a complex).",
 }
 
 
@@ -307,4 +327,28 @@ NOT_KILLED: dict[str, str] = {
     "rtsgeom.synthesis.model.xǁChannelModelǁangles__mutmut_10":
         "no fast test calls ChannelModel.angles on a 1-D model; the clip's lower bound matters "
         "only for u < -1 (a rounding past -1).",
+    # seed 23: the first pass's survivors (reasons; tests written after the report)
+    "rtsgeom.analysis.object_design.xǁObjectDesignResultǁplot__mutmut_157":
+        "the object design figure's truth-twin line without its data (a figure's content): no "
+        "test read the lines a figure draws.",
+    "rtsgeom.analysis.playback.result.xǁPlaybackResultǁplot__mutmut_28":
+        "the playback figure's detected azimuths replaced by None (a figure's content): no "
+        "test read the lines a figure draws.",
+    "rtsgeom.analysis.tolerance.cell.x_build_cell__mutmut_78":
+        "the cell study's 'no set direction of a G x G grid lies inside it' check tests the "
+        "set directions' second axis (always 2) instead of their count: a real gap, no test "
+        "has a cell that holds no grid point.",
+    "rtsgeom.analysis.tolerance.montecarlo.xǁToleranceResultǁyield___mutmut_4":
+        "the yield of a study of zero draws (MonteCarlo's draws = 0, the engine's) is NaN "
+        "either way, but through np.mean of an empty array, which warns (RuntimeWarning); no "
+        "test ran a zero-draw study.",
+    "rtsgeom.analysis.tolerance.verify.xǁVerifyResultǁworst_difference_deg__mutmut_5":
+        "a verified draw the chain did not detect (NaN) would raise a TypeError (abs of None) "
+        "instead of counting as an infinite difference: no test has an undetected draw in "
+        "the verification.",
+    "rtsgeom.calibration.beam.xǁBeamProbesǁ__init____mutmut_90":
+        "an axis pair's boundary '<=' -> '<' at exactly sin(10 deg): differs only for a pair "
+        "whose line is at 10 deg from an axis to the last bit, which a scene's geometry "
+        "(front ends given in degrees, direction cosines computed) does not produce; "
+        "practically equivalent, not proven, counted as a survivor.",
 }
