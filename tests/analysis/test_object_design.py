@@ -67,3 +67,85 @@ def test_a_scene_without_an_extended_object_is_refused(default_scene):
     assert_refused(lambda: ObjectDesign()(default_scene),
                    f"{default_scene.source}: has no extended object (a [[targets]] or "
                    "[[scenario.targets]] entry with scatterers or mesh)")
+
+
+def _result():
+    """Two spacings x two budgets x three ranges, hand-made."""
+    import numpy as np
+    from rtsgeom.analysis.object_design import ObjectDesignResult
+    study = ObjectDesign(ranges_m=(5.0, 10.0, 20.0), spacings_deg=(8.0, 16.0), budgets=(None, 2),
+                         min_share=0.8, max_centroid_deg=0.5)
+    share = np.array([[[0.9, 0.8, 1.0], [0.9, 0.7, 1.0]], [[1.0, 0.95, 0.85], [0.8, 0.9, 0.8]]])
+    cent = np.array([[[0.1, -0.5, 0.2], [0.1, 0.1, 0.1]], [[0.6, 0.0, 0.0], [-0.2, 0.3, 0.5]]])
+    kept = np.arange(12.0).reshape(2, 2, 3)
+    truth = 10.0 + np.arange(12.0).reshape(2, 2, 3)
+    return ObjectDesignResult(study, "bench", "targets[0]", np.array([5, 3]), share, cent, kept,
+                              truth, truth - 1.0)
+
+
+def test_the_smallest_design_that_reproduces_the_object():
+    res = _result()
+    # share >= 0.8 and |centroid| <= 0.5 at every range (both edges included)
+    assert res.reproduces.tolist() == [[True, False], [False, True]]
+    assert res.best() == {"front_ends": 3, "spacing_deg": 16.0, "max_targets_per_channel": 2}
+    title, rows = res._summary()
+    assert title == "bench: object design (targets[0])"
+    assert rows == [
+        ("ranges", "5 .. 20 m"),
+        ("tolerance", "share >= 0.8, |centroid| <= 0.5 deg at every range"),
+        ("smallest design", "3 front ends 16 deg apart, budget 2"),
+        ("5 x 8 deg, budget none", "min share 0.80, max |centroid| 0.50 deg (reproduces)"),
+        ("5 x 8 deg, budget 2", "min share 0.70, max |centroid| 0.10 deg"),
+        ("3 x 16 deg, budget none", "min share 0.85, max |centroid| 0.60 deg"),
+        ("3 x 16 deg, budget 2", "min share 0.80, max |centroid| 0.50 deg (reproduces)")]
+    cols = res._columns()
+    assert list(cols["spacing_deg"]) == [8.0] * 6 + [16.0] * 6
+    assert list(cols["max_targets_per_channel"]) == [0, 0, 0, 2, 2, 2] * 2
+    assert list(cols["range_m"]) == [5.0, 10.0, 20.0] * 4
+    assert list(cols["front_ends"]) == [5] * 6 + [3] * 6
+    assert list(cols["truth_detections"]) == list(res.truth.ravel())
+
+
+def test_nothing_reproduces_the_object_when_no_design_meets_both():
+    import dataclasses
+    import numpy as np
+    res = _result()
+    worse = dataclasses.replace(res, share=res.share - 0.3)
+    assert not worse.reproduces.any() and worse.best() is None
+    assert worse._summary()[1][2] == ("smallest design", "none reproduces the object")
+    assert np.array_equal(dataclasses.replace(res, centroid_deg=res.centroid_deg + 1.0)
+                          .reproduces, np.zeros((2, 2), bool))
+
+
+def test_the_figure_draws_each_designs_share_centroid_and_targets_kept():
+    import matplotlib
+    matplotlib.use("Agg")
+    import numpy as np
+    res = _result()
+    fig = res.plot()
+    ax, cx, bx = fig.axes[:3]
+    r = [5.0, 10.0, 20.0]
+    designs = [(i, j) for i in range(2) for j in range(2)]
+    share = [ln for ln in ax.get_lines() if ln.get_label() != "tolerance"]
+    assert [list(ln.get_ydata()) for ln in share] == [list(res.share[i, j]) for i, j in designs]
+    assert all(list(ln.get_xdata()) == r for ln in share)
+    cen = [ln for ln in cx.get_lines() if ln.get_label() != "tolerance"]
+    assert [list(ln.get_ydata()) for ln in cen] == [list(np.abs(res.centroid_deg[i, j]))
+                                                    for i, j in designs]
+    kept = bx.get_lines()
+    assert [list(ln.get_ydata()) for ln in kept[:4]] == [list(res.kept[i, j]) for i, j in designs]
+    truth = kept[4]
+    assert truth.get_label() == "truth twin's detections"
+    assert list(truth.get_xdata()) == r and list(truth.get_ydata()) == list(res.truth[0, 0])
+    assert [ln.get_label() for ln in share] == ["5 FE x 8 deg, budget none",
+                                                "5 FE x 8 deg, budget 2",
+                                                "3 FE x 16 deg, budget none",
+                                                "3 FE x 16 deg, budget 2"]
+    tol = [ln for ln in ax.get_lines() if ln.get_label() == "tolerance"]
+    assert list(tol[0].get_ydata()) == [0.8, 0.8]
+    tol = [ln for ln in cx.get_lines() if ln.get_label() == "tolerance"]
+    assert list(tol[0].get_ydata()) == [0.5, 0.5]
+    assert ax.get_title() == "bench: what the RTS reproduces"
+    assert cx.get_ylim() == (0.0, 1.6 * 0.6)
+    import matplotlib.pyplot as plt
+    plt.close(fig)

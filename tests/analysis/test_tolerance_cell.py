@@ -258,3 +258,16 @@ def test_gain_calibration_inverts_a_channel_gain(model):
     x = model.x_nominal * g[:, None]
     assert np.allclose(model.gain_correction(x), 1 / np.abs(g), rtol=1e-12)
     assert np.allclose(model.gain_correction(model.x_nominal), 1.0, rtol=1e-12)
+
+
+def test_a_cell_holding_no_set_direction_is_refused(monkeypatch, sphere_scene):
+    """A cell whose grid keeps no set direction inside its hull (a sliver of a cell): named,
+    with the grid's size, instead of a study of nothing."""
+    import rtsgeom.analysis.tolerance.cell as cell_mod
+    from conftest import assert_refused
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.scene import TargetConfig
+    nom = build_setup(sphere_scene)
+    monkeypatch.setattr(cell_mod, "cell_grid", lambda st, u, n: np.zeros((0, 2)))
+    assert_refused(lambda: cell_mod.build_cell(nom, (0, 1, 2), 5, TargetConfig(15.0)),
+                   "cell [0, 1, 2]: no set direction of a 5 x 5 grid lies inside it")
