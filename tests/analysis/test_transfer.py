@@ -272,3 +272,54 @@ def test_the_study_tells_each_pair_it_calibrates_and_indexes_its_set_points(cros
     fe = np.degrees(setup.fe_azimuth_rad())
     assert fe[1] < r.set_deg[0] < r.set_deg[1] < fe[2] < fe[3] < r.set_deg[2] < r.set_deg[3] < fe[4]
     assert r.error_deg.shape == (2, 4) and r.programs.shape == (4, 4)
+
+
+@pytest.mark.parametrize("radars, spec", [(3, 0.2), (45, None)])
+def test_the_transfer_figure_draws_the_radars_their_band_and_the_histograms(radars, spec):
+    """Left: up to 40 radars' errors over the set angles (grey), the 5-95 % band of the radars
+    and of the compensated ones, the golden radar, the compensated median, +-spec; right: the
+    |error| histograms over 30 bins from 0 to the largest, the spec."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import PolyCollection
+    rng = np.random.default_rng(radars)
+    e, c = rng.normal(0, 0.1, (radars, 5)), rng.normal(0, 0.03, (radars, 5))
+    g = rng.normal(0, 0.05, 5)
+    res = _transfer(e, c, rng.normal(0, 0.01, (radars, 5)), spec, golden=g)
+    fig = res.plot()
+    ax, bx = fig.axes[:2]
+    lines = ax.get_lines()
+    grey = [ln for ln in lines if ln.get_color() == "0.75"]
+    assert len(grey) == min(radars, 40)
+    for k, ln in enumerate(grey):
+        assert np.array_equal(ln.get_xdata(), res.set_deg)
+        assert np.array_equal(ln.get_ydata(), e[k])
+    golden = next(ln for ln in lines if ln.get_label() == "golden radar A (calibrated with)")
+    assert np.array_equal(golden.get_ydata(), g) and golden.get_linewidth() == 2
+    med = next(ln for ln in lines
+               if ln.get_label() == "radars B with boresight compensation, 5-95 %")
+    assert np.allclose(med.get_ydata(), np.median(c, axis=0), rtol=0, atol=1e-15)
+    bands = [p for p in ax.collections if isinstance(p, PolyCollection)]
+    assert len(bands) == 2 and bands[0].get_label() == "radars B, 5-95 %"
+    for band, x in zip(bands, (e, c)):
+        verts = band.get_paths()[0].vertices
+        lo, hi = np.percentile(x, [5, 95], axis=0)
+        for k, s in enumerate(res.set_deg):  # the band's edges at each set angle
+            at = np.isclose(verts[:, 0], s, rtol=0, atol=1e-12)
+            assert np.isclose(verts[at, 1].min(), lo[k]) and np.isclose(verts[at, 1].max(), hi[k])
+    specs = [ln for ln in lines if ln.get_color() == "C3"]
+    assert sorted(float(ln.get_ydata()[0]) for ln in specs) == ([-spec, spec] if spec else [])
+    assert ax.get_title() == ("bench: calibrated with radar A, testing radar B (sigma 5 deg, "
+                              "0.5 dB)")
+    bars = bx.patches
+    assert len(bars) == 2 * 29
+    top = np.max(np.abs(e))
+    counts_b = [p.get_height() for p in bars[:29]]
+    want, _ = np.histogram(np.abs(e).ravel(), np.linspace(0, top, 30))
+    assert counts_b == list(want)
+    want_c, _ = np.histogram(np.abs(c).ravel(), np.linspace(0, top, 30))
+    assert [p.get_height() for p in bars[29:]] == list(want_c)
+    vlines = [ln for ln in bx.get_lines() if ln.get_label() == "spec"]
+    assert [float(ln.get_xdata()[0]) for ln in vlines] == ([spec] if spec else [])
+    plt.close(fig)

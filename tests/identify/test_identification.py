@@ -228,3 +228,60 @@ def test_the_json_has_values_stds_reasons_and_the_strong_correlations(ident, sce
     fits = Identification(scene, (ident.fits[0],)).to_dict()
     assert fits["model_fits"] is True and fits["residual_rms"] == pytest.approx(0.8)
     assert Identification(scene, ()).to_dict()["residual_rms"] is None
+
+
+def test_the_figure_draws_each_front_ends_offsets_with_their_sigmas(ident, scene):
+    """One errorbar series per mounting axis (radial, tangential, height) at the front ends'
+    indices (shifted by -0.12, 0, +0.12), the values and 1-sigma bars in mm, NaN where not
+    identifiable; with the radar's channels a second panel of each antenna's phase in deg,
+    the references (fixed) as open markers without a bar."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig = ident.plot()
+    assert len(fig.axes) == 1
+    ax = fig.axes[0]
+    cols = ident._columns()
+    bars = ax.containers
+    assert [b.get_label() for b in bars] == ["radial", "tangential", "height"]
+    for k, (b, name) in enumerate(zip(bars, ("radial", "tangential", "height"))):
+        line = b.lines[0]
+        assert np.allclose(np.asarray(line.get_xdata(), float),
+                           np.array([0, 3]) + (k - 1) * 0.12, atol=1e-12)
+        assert np.allclose(np.asarray(line.get_ydata(), float),
+                           np.asarray(cols[f"{name}_offset_mm"], float), atol=1e-12,
+                           equal_nan=True)
+        seg = b.lines[2][0].get_segments()[0]  # front end 0's bar: value -+ its sigma
+        assert np.allclose(sorted(seg[:, 1]), [cols[f"{name}_offset_mm"][0]
+                                               + d * cols[f"{name}_offset_std_mm"][0]
+                                               for d in (-1, 1)], rtol=1e-12)
+    assert ax.get_title() == f"{scene.name}: identified mounting offsets"
+    plt.close(fig)
+    assert ident.plot("my title").axes[0].get_title() == "my title"
+    plt.close("all")
+
+
+def test_the_figure_of_a_joint_fit_shows_each_antennas_phase(ident, scene):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from rtsgeom.identify.joint import RadarChannelsFit
+    ph = np.radians([0.0, 10.0, -5.0, 0.0, 3.0])
+    why = (("ref", "ref"), (None, None), (None, None), ("ref", "ref"), (None, None))
+    radar = RadarChannelsFit(np.zeros(5), ph, np.full(5, 0.01), np.radians(np.full(5, 0.5)),
+                             why, 2, 0, 0, 3)
+    fig = Identification(scene, ident.fits, radar).plot()
+    assert len(fig.axes) == 2
+    assert fig._suptitle.get_text() == f"{scene.name}: identified mounting and radar channels"
+    ax_r = fig.axes[1]
+    pts = ax_r.containers
+    assert len(pts) == 5
+    assert [float(b.lines[0].get_xdata()[0]) for b in pts] == [0, 1, 2, 3, 4]
+    assert np.allclose([float(b.lines[0].get_ydata()[0]) for b in pts],
+                       [0.0, 10.0, -5.0, 0.0, 3.0], atol=1e-12)
+    fixed = [b.lines[2] == () or len(b.lines[2]) == 0 for b in pts]
+    assert fixed == [True, False, False, True, False]
+    assert [t.get_text() for t in ax_r.get_xticklabels()] == ["TX0*", "TX1", "RX0", "RX1*",
+                                                               "RX2"]
+    assert ax_r.get_xlabel() == "antenna (* fixed: reference or unseen)"
+    plt.close(fig)
