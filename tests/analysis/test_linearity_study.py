@@ -128,3 +128,14 @@ def test_the_steps_of_a_calibrated_arc_and_of_a_grid(crossing_bench, sphere_scen
     LinearityStudy(points=3, steps=told.append, amplitudes="paper")(crossing_bench)
     assert told == ["measuring each front end alone", "calibrating the pair",
                     "sweeping 3 set-points (paper amplitudes)"]
+
+
+def test_an_arc_writes_a_figure_per_pair_and_its_json(arc, tmp_path):
+    import json
+    res, _ = arc
+    names = res.write(tmp_path)
+    assert names == [f"linearity_{i}_{j}.png" for i, j in res.pairs] + ["linearity.json"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(names)
+    assert all((tmp_path / n).stat().st_size > 1000 for n in names[:-1])
+    assert json.loads((tmp_path / "linearity.json").read_text()) == json.loads(
+        json.dumps(res.to_dict()))

@@ -320,6 +320,8 @@ def test_the_transfer_figure_draws_the_radars_their_band_and_the_histograms(rada
     assert counts_b == list(want)
     want_c, _ = np.histogram(np.abs(c).ravel(), np.linspace(0, top, 30))
     assert [p.get_height() for p in bars[29:]] == list(want_c)
+    for a in (ax, bx):  # the legends' small print
+        assert {t.get_fontsize() for t in a.get_legend().get_texts()} == {8.0}
     vlines = [ln for ln in bx.get_lines() if ln.get_label() == "spec"]
     assert [float(ln.get_xdata()[0]) for ln in vlines] == ([spec] if spec else [])
     plt.close(fig)

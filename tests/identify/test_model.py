@@ -72,3 +72,26 @@ def test_a_capture_showing_another_front_end_is_refused(bench):
     assert 0.0 <= float(got[len(head):-1]) < 0.98
     # without the direction check (the joint fit's), it is measured
     assert measure(setup, dataclasses.replace(cap1, active=0), False)[2].active == 0
+
+
+def test_a_sidecar_putting_the_probe_elsewhere_names_where_the_echo_is(bench):
+    """The strongest echo of the map, in metres and m/s (its bins times the range bin and
+    the velocity bin), against the sidecar's bins."""
+    import re
+    setup, cap, _ = bench
+    radar = setup.scene.radar
+    wrong = dataclasses.replace(cap, range_m=2 * cap.range_m)
+    with pytest.raises(CaptureError) as exc:
+        measure(setup, wrong)
+    msg = str(exc.value)
+    m = re.fullmatch(
+        rf"capture: probe_range_m = {2 * cap.range_m:g}, probe_velocity_mps = 0: must be where "
+        r"the capture's strongest echo is, (\S+) m and (\S+) m/s \(range bin (\d+), Doppler bin "
+        r"(\d+); the sidecar's probe is at bins (\d+), (\d+)\): the sidecar does not describe "
+        r"this capture", msg)
+    assert m, msg
+    r, v, ri, di, rs, ds = float(m[1]), float(m[2]), int(m[3]), int(m[4]), int(m[5]), int(m[6])
+    assert abs(r - cap.range_m) <= 1.5 * radar.range_resolution_m  # where the echo is
+    assert r == pytest.approx(ri * radar.range_resolution_m, rel=1e-3)
+    assert v == pytest.approx(0.0, abs=1e-9) and di == ds  # at rest: the probe's Doppler bin
+    assert abs(rs * radar.range_resolution_m - 2 * cap.range_m) <= 1.5 * radar.range_resolution_m
