@@ -138,6 +138,18 @@ EQUIVALENT: dict[str, str] = {
     "rtsgeom.analysis.transfer.xǁTransferǁ_draw__mutmut_214":
         "the histogram's legend(fontsize=None) instead of 8: Transfer.plot draws inside "
         "rc_context(viz.figures.STYLE), whose legend.fontsize is 8, so the legend is the same.",
+    # fresh sample (seed 37)
+    "rtsgeom.analysis.objects.x_pairs__mutmut_33":
+        "pairs' 'close' as float zeros instead of bool: the assigned comparisons store 1.0 / "
+        "0.0, and its only reader (object_summary's reproduced_share) takes its mean, the same "
+        "number; playback's reader uses the other return value.",
+    "rtsgeom.rts.fir.x_fir_taps__mutmut_27":
+        "the empty delay set's index array as float instead of int64: the branch is dead for "
+        "the package, whose only caller passes at least one echo (as seed 11's "
+        "fir_taps__mutmut_31).",
+    "rtsgeom.synthesis.closed_form.x_closed_form_amplitudes__mutmut_59":
+        "np.linalg.lstsq without rcond=None: numpy 2 (2.4 here) defaults rcond to None, the "
+        "value given (numpy 1.26 warned and used -1 instead).",
 }
 
 
@@ -397,4 +409,23 @@ NOT_KILLED: dict[str, str] = {
         "no fast test writes an arc's linearity folder (linearity.json's name). Killed since by "
         "test_an_arc_writes_a_figure_per_pair_and_its_json (run with MUTANT_UNDER_TEST in the "
         "mutated copy: fails there, passes unmutated)",
+    # seed 37 (a third fresh sample; no test written for it)
+    "rtsgeom.analysis.coverage.xǁCoverageDesignǁ_columns__mutmut_15":
+        "the coverage table's worst_uncalibrated_deg column renamed: no test reads that column "
+        "of CoverageDesign.to_dataframe().",
+    "rtsgeom.analysis.transfer.xǁTransferStudyǁ__call____mutmut_13":
+        "the transfer study's refusal of a RuT that beamforms in 2-D, its plain words' case: "
+        "no test has a 2-D RuT in the transfer study (the message was tried, not kept as a "
+        "test).",
+    "rtsgeom.calibration.fit.x_continuous_steps__mutmut_110":
+        "the jump detector's threshold 2 -> 3 x JUMP_FACTOR: no test has a jump between the two "
+        "(a heuristic's constant, not checked at its edge).",
+    "rtsgeom.pipeline.run.x_summary__mutmut_48":
+        "summary.json's radar.snr_db key renamed: no test reads that key.",
+    "rtsgeom.radar.processing.xǁRangeDopplerǁrange_angle_to_xarray__mutmut_10":
+        "the range-angle map's default angle grid from +60 instead of -60 deg: no test calls "
+        "it without angles.",
+    "rtsgeom.radar.steering.xǁSteeringǁ_search_smoothed_blocks__mutmut_190":
+        "the smoothed search's parabolic refinement index clipped one short at the upper end: "
+        "differs only for a peak at the zoom grid's last interior point; no test has one.",
 }
