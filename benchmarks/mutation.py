@@ -22,9 +22,10 @@ What this driver adds to ``mutmut run``:
 * **targeted fast tests**: each module's tests are the test files that import it and the
   core's (``tests_for``, ``CORE_TESTS``, found at every run: ``MODULES``); the selection is
   their union for the chosen modules, without the ``slow``
-  marker, the ray tracer, and the tests that run a subprocess or a dask cluster (a mutant is
-  switched by an environment variable inside the forked test process, so a subprocess or a
-  dask worker would run the unmutated code anyway, and they are slow);
+  marker, the ray tracer, and the tests that run a child process (marker ``subprocess``) or a
+  dask cluster (a mutant is switched by an environment variable inside the forked test
+  process, so a subprocess or a dask worker would run the unmutated code anyway, and they are
+  slow); the commands' in-process tests (``main([...])``) are in;
 * **a reproducible sample**: ``--sample N --seed K`` runs N mutants drawn with
   ``numpy.random.default_rng(K)``, stratified per module (each module's share of the sample is
   its share of all mutants, at least one); without ``--sample`` every mutant runs;
@@ -65,6 +66,7 @@ import fnmatch
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -258,20 +260,42 @@ def sample(names: dict[str, list[str]], n: int | None, seed: int) -> list[str]:
 
 def run(workdir: Path, names: list[str], children: int, timeout_s: float,
         skip_clean: bool = False) -> float:
+    """``mutmut run`` of ``names`` in ``workdir``, its output in ``mutmut-run.log``.
+
+    mutmut runs in a process group of its own, ended when it exits: a mutant's test that forks
+    a pool can leave workers behind (orphaned, blocked on mutmut's result pipe), and a run
+    that waited for them, or for the end of an output pipe they hold, never returned."""
     t0 = time.perf_counter()
     cmd = list(_MUTMUT)
     if skip_clean:
         cmd[2] = _SKIP_CLEAN + cmd[2]
-    # pass the names through a file-free argv: mutmut matches each name exactly
-    proc = subprocess.run(cmd + ["run", "--max-children", str(children), *names],
-                          cwd=workdir, env=_env(), timeout=timeout_s,
-                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    (workdir / "mutmut-run.log").write_text(proc.stdout)
-    if proc.returncode != 0:
-        print(proc.stdout[-3000:], file=sys.stderr)
-        raise SystemExit(f"mutmut run failed (exit {proc.returncode}); log: "
-                         f"{workdir / 'mutmut-run.log'}")
+    log = workdir / "mutmut-run.log"
+    with open(log, "w") as out:
+        # pass the names through a file-free argv: mutmut matches each name exactly
+        proc = subprocess.Popen(cmd + ["run", "--max-children", str(children), *names],
+                                cwd=workdir, env=_env(), stdout=out, stderr=subprocess.STDOUT,
+                                start_new_session=True)
+        try:
+            code = proc.wait(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            code = None
+        finally:
+            _end_group(proc.pid)
+    if code is None:
+        raise SystemExit(f"mutmut run took more than --timeout-s {timeout_s:g} s; log: {log} "
+                         "(run again with --keep-mutants to reuse the mutants and stats)")
+    if code != 0:
+        print(log.read_text()[-3000:], file=sys.stderr)
+        raise SystemExit(f"mutmut run failed (exit {code}); log: {log}")
     return time.perf_counter() - t0
+
+
+def _end_group(pgid: int) -> None:
+    """SIGKILL to what is left of the process group ``pgid`` (the mutmut run's)."""
+    try:
+        os.killpg(pgid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
 
 
 _COLLECT = """

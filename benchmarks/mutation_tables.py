@@ -114,6 +114,42 @@ EQUIVALENT: dict[str, str] = {
         "the (0, taps) table of an empty delay set as float instead of complex: the package's "
         "only caller (analysis/tolerance/tables.py) passes at least one echo, so the branch is "
         "dead for it, and an empty table contributes no row to any response.",
+    # fresh sample (seed 23)
+    "rtsgeom.analysis.coverage.x_coverage_designs__mutmut_79":
+        "local_map(before_fork=None) instead of import_for_workers: the hook only imports the "
+        "compiled kernels before a pool forks, so the workers inherit them instead of "
+        "importing them each (~0.15 s CPU per worker); every design is computed the same "
+        "either way (and with workers=1 no pool starts).",
+    "rtsgeom.analysis.tolerance.cell.x_build_cell__mutmut_123":
+        "the cell's response table one delay row longer at each end (z + 2 instead of z + 1): "
+        "every row read is table_zero + sub-bin step + calibration step, at most "
+        "max|sub| + max_steps = z - 1 from the centre, and np.gradient's slope at those rows "
+        "is the central difference either way; the extra end rows are never read.",
+    "rtsgeom.analysis.tolerance.cell.xǁCellProcedureǁcalibration_steps__mutmut_64":
+        "np.take_along_axis without axis= uses axis=-1 in numpy 2 (2.4 here), the axis given "
+        "(numpy 1.26, which pyproject still allows, would raise instead).",
+    "rtsgeom.calibration.phasor.xǁSweepResultǁerrors__mutmut_1":
+        "SweepResult.errors' default frames 1 -> 2: its three callers (phasor.py twice, "
+        "steps.py) pass frames, so the default is never used.",
+    "rtsgeom.radar.channels.x_rx_coupling_matrix__mutmut_44":
+        "np.eye(n) as float instead of complex: adding complex(coefficient) * adj makes the "
+        "sum complex128 with the same values (the coefficient is always a complex).",
+    # seed 31 (found equivalent while writing its test, after the report)
+    "rtsgeom.analysis.transfer.xǁTransferǁ_draw__mutmut_214":
+        "the histogram's legend(fontsize=None) instead of 8: Transfer.plot draws inside "
+        "rc_context(viz.figures.STYLE), whose legend.fontsize is 8, so the legend is the same.",
+    # fresh sample (seed 37)
+    "rtsgeom.analysis.objects.x_pairs__mutmut_33":
+        "pairs' 'close' as float zeros instead of bool: the assigned comparisons store 1.0 / "
+        "0.0, and its only reader (object_summary's reproduced_share) takes its mean, the same "
+        "number; playback's reader uses the other return value.",
+    "rtsgeom.rts.fir.x_fir_taps__mutmut_27":
+        "the empty delay set's index array as float instead of int64: the branch is dead for "
+        "the package, whose only caller passes at least one echo (as seed 11's "
+        "fir_taps__mutmut_31).",
+    "rtsgeom.synthesis.closed_form.x_closed_form_amplitudes__mutmut_59":
+        "np.linalg.lstsq without rcond=None: numpy 2 (2.4 here) defaults rcond to None, the "
+        "value given (numpy 1.26 warned and used -1 instead).",
 }
 
 
@@ -251,6 +287,28 @@ KILLED_BY: dict[str, str] = {
         "test_identifying_a_nominal_radar_finds_no_antenna_errors",
     "rtsgeom.analysis.nearfield.x__check_radii__mutmut_31":
         "test_bad_arc_radii_are_listed_four_at_most",
+    # seed 23 (after its report; each confirmed with MUTANT_UNDER_TEST in the mutated copy)
+    "rtsgeom.analysis.object_design.xǁObjectDesignResultǁplot__mutmut_157":
+        "test_the_figure_draws_each_designs_share_centroid_and_targets_kept",
+    "rtsgeom.analysis.playback.result.xǁPlaybackResultǁplot__mutmut_28":
+        "test_the_figure_draws_the_set_and_detected_azimuths_of_each_mode",
+    "rtsgeom.analysis.tolerance.cell.x_build_cell__mutmut_78":
+        "test_a_cell_holding_no_set_direction_is_refused",
+    "rtsgeom.analysis.tolerance.montecarlo.xǁToleranceResultǁyield___mutmut_4":
+        "test_a_study_of_no_draws_has_no_yield_and_warns_of_nothing",
+    "rtsgeom.analysis.tolerance.verify.xǁVerifyResultǁworst_difference_deg__mutmut_5":
+        "test_verified_differences_per_draw_an_undetected_draw_infinite",
+    # seed 31 (after its report; confirmed with MUTANT_UNDER_TEST, not re-run by the driver)
+    "rtsgeom.analysis.tolerance.pair.x__set_beams__mutmut_15":
+        "test_the_beams_derivatives_are_the_beams_slopes_in_u",
+    "rtsgeom.pipeline.run.xǁRunResultǁ_summary__mutmut_35":
+        "test_a_run_summary_lists_twelve_targets_and_counts_the_rest",
+    "rtsgeom.analysis.linearity_study.xǁArcLinearityǁwrite__mutmut_27":
+        "test_an_arc_writes_a_figure_per_pair_and_its_json",
+    "rtsgeom.analysis.nearfield_terms.x_synthesis_worst_errors_deg__mutmut_63":
+        "test_spans_that_do_not_overlap_have_no_synthesis_errors",
+    "rtsgeom.identify.model.x__check_peak__mutmut_28":
+        "test_a_sidecar_putting_the_probe_elsewhere_names_where_the_echo_is",
 }
 
 # a sample's mutant -> the same change under its name in today's code (the function moved to
@@ -307,4 +365,67 @@ NOT_KILLED: dict[str, str] = {
     "rtsgeom.synthesis.model.xǁChannelModelǁangles__mutmut_10":
         "no fast test calls ChannelModel.angles on a 1-D model; the clip's lower bound matters "
         "only for u < -1 (a rounding past -1).",
+    # seed 23: left without a test (reason)
+    "rtsgeom.calibration.beam.xǁBeamProbesǁ__init____mutmut_90":
+        "an axis pair's boundary '<=' -> '<' at exactly sin(10 deg): differs only for a pair "
+        "whose line is at 10 deg from an axis to the last bit, which a scene's geometry "
+        "(front ends given in degrees, direction cosines computed) does not produce; "
+        "practically equivalent, not proven, counted as a survivor.",
+    # seed 31 (a second fresh sample): the first pass's survivors (none shown equivalent)
+    "rtsgeom.analysis.kpi.sections.x_resolution_section__mutmut_49":
+        "the datasheet's resolution step told its progress without its total: a TypeError for "
+        "a caller that passes progress; no test ran the datasheet with progress.",
+    "rtsgeom.analysis.nearfield_terms.x_synthesis_worst_errors_deg__mutmut_63":
+        "a key's name in the branch of a pair whose measured and geometric spans do not "
+        "overlap; no test has such a pair. Killed since by "
+        "test_spans_that_do_not_overlap_have_no_synthesis_errors (run with MUTANT_UNDER_TEST in "
+        "the mutated copy: fails there, passes unmutated)",
+    "rtsgeom.analysis.tolerance.pair.x__set_beams__mutmut_15":
+        "the beams' first derivative doubled: the Newton refinement of the set-points' peaks "
+        "takes other steps; the tests' tolerances (the grid search, the chain) do not see the "
+        "difference. Not shown equivalent. Killed since by "
+        "test_the_beams_derivatives_are_the_beams_slopes_in_u (run with MUTANT_UNDER_TEST in the "
+        "mutated copy: fails there, passes unmutated)",
+    "rtsgeom.identify.model.x__check_peak__mutmut_28":
+        "the range bin in the 'not where the capture's strongest echo is' message computed "
+        "c / f_adc instead of c f_adc: the message's range is wrong; no test reads it. Killed "
+        "since by test_a_sidecar_putting_the_probe_elsewhere_names_where_the_echo_is (run with "
+        "MUTANT_UNDER_TEST in the mutated copy: fails there, passes unmutated)",
+    "rtsgeom.pipeline.plan.x_target_namer__mutmut_12":
+        "a budget-merged target's name loses '(merged target of N scatterers)'; no test reads "
+        "that name.",
+    "rtsgeom.pipeline.run.xǁRunResultǁ_summary__mutmut_35":
+        "the run summary's '... N more targets' row at exactly MAX_SUMMARY_TARGETS targets "
+        "(a boundary no test has). Killed since by "
+        "test_a_run_summary_lists_twelve_targets_and_counts_the_rest (run with MUTANT_UNDER_TEST "
+        "in the mutated copy: fails there, passes unmutated)",
+    "rtsgeom.rts.fir.x__fir_rows__mutmut_99":
+        "the FIR memo's branch for more settings than it holds (computed, not kept) with a "
+        "wrong kernel phase; no test asks for that many settings at once.",
+    "rtsgeom.synthesis.model.xǁChannelModelǁair_legs__mutmut_58":
+        "a drawn front-end pitch ignored in the air legs (the scene's pitch kept): no test "
+        "draws a pitch through ChannelModel.air_legs.",
+    "rtsgeom.analysis.linearity_study.xǁArcLinearityǁwrite__mutmut_27":
+        "no fast test writes an arc's linearity folder (linearity.json's name). Killed since by "
+        "test_an_arc_writes_a_figure_per_pair_and_its_json (run with MUTANT_UNDER_TEST in the "
+        "mutated copy: fails there, passes unmutated)",
+    # seed 37 (a third fresh sample; no test written for it)
+    "rtsgeom.analysis.coverage.xǁCoverageDesignǁ_columns__mutmut_15":
+        "the coverage table's worst_uncalibrated_deg column renamed: no test reads that column "
+        "of CoverageDesign.to_dataframe().",
+    "rtsgeom.analysis.transfer.xǁTransferStudyǁ__call____mutmut_13":
+        "the transfer study's refusal of a RuT that beamforms in 2-D, its plain words' case: "
+        "no test has a 2-D RuT in the transfer study (the message was tried, not kept as a "
+        "test).",
+    "rtsgeom.calibration.fit.x_continuous_steps__mutmut_110":
+        "the jump detector's threshold 2 -> 3 x JUMP_FACTOR: no test has a jump between the two "
+        "(a heuristic's constant, not checked at its edge).",
+    "rtsgeom.pipeline.run.x_summary__mutmut_48":
+        "summary.json's radar.snr_db key renamed: no test reads that key.",
+    "rtsgeom.radar.processing.xǁRangeDopplerǁrange_angle_to_xarray__mutmut_10":
+        "the range-angle map's default angle grid from +60 instead of -60 deg: no test calls "
+        "it without angles.",
+    "rtsgeom.radar.steering.xǁSteeringǁ_search_smoothed_blocks__mutmut_190":
+        "the smoothed search's parabolic refinement index clipped one short at the upper end: "
+        "differs only for a peak at the zoom grid's last interior point; no test has one.",
 }

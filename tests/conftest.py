@@ -228,3 +228,67 @@ def calibrated(cal_setup):
     probe = probe_front_ends(setup, paths)
     return probe, calibrate_pair(setup, paths, (0, 1), probe)
 
+
+
+def assert_bounds(make, ok, bad, error=None):
+    """A config's declared range, enforced exactly at its edges: ``make(value)`` accepts every
+    value of ``ok`` (the bounds themselves) and refuses each ``(value, message)`` of ``bad``
+    (just outside them) with ``error`` (default ``ParameterError``) whose text is ``message``,
+    the whole of it (the field, the value and the allowed range)."""
+    from rtsgeom.errors import ParameterError
+    for v in ok:
+        make(v)
+    for v, message in bad:
+        with pytest.raises(error or ParameterError) as exc:
+            make(v)
+        assert str(exc.value) == message, (v, str(exc.value))
+
+
+#: the whole warning a Monte-Carlo study gives on a scene with front end 1 moved radially
+#: (:func:`moved_front_end`): ``<study> `` and this
+DRAWS_REPLACE_TEXT = (
+    "draws mounting errors about the nominal setup; the scene's own errors "
+    "(rts.front_ends[1].radial_offset_mm) are not its starting point: each draw replaces them. "
+    "Their effect on the synthesized angle: `rtsgeom linearity SCENE --uncalibrated` (and "
+    "without the flag, calibrated), in Python rtsgeom.linearity(scene, calibration=False)")
+
+
+def moved_front_end(scene):
+    """``scene`` with front end 1 moved 0.3 mm radially (an error of the scene's own)."""
+    import rtsgeom
+    fes = list(scene.rts.front_ends)
+    fes[1] = rtsgeom.replace(fes[1], radial_offset_mm=0.3)
+    return rtsgeom.replace(scene, rts=rtsgeom.replace(scene.rts, front_ends=tuple(fes)))
+
+
+def the_warnings(call, category) -> list[str]:
+    """The texts of the ``category`` warnings ``call()`` gives (each once)."""
+    import warnings
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        call()
+    return [str(w.message) for w in caught if issubclass(w.category, category)]
+
+
+def assert_refused(call, message, error=None):
+    """``call()`` raises ``error`` (default ``ParameterError``) whose whole text is
+    ``message``."""
+    from rtsgeom.errors import ParameterError
+    with pytest.raises(error or ParameterError) as exc:
+        call()
+    assert str(exc.value) == message
+
+
+@pytest.fixture(scope="session")
+def sphere_scene():
+    """scenes/sphere4.toml: four front ends on a sphere (a 2-D cell), an RuT with elevation."""
+    from rtsgeom.scene import load_scene
+    return load_scene(ROOT / "scenes" / "sphere4.toml")
+
+
+@pytest.fixture(scope="session")
+def crossing_bench():
+    """scenes/crossing.toml's bench without its drive: five front ends on an arc."""
+    import dataclasses
+    from rtsgeom.scene import load_scene
+    return dataclasses.replace(load_scene(ROOT / "scenes" / "crossing.toml"), scenario=None)

@@ -20,6 +20,7 @@ def test_all_names_resolve():
         rtsgeom.no_such_name  # noqa: B018
 
 
+@pytest.mark.subprocess
 def test_import_is_lazy():
     """``import rtsgeom`` loads neither Sionna, pyvista, matplotlib nor the pipeline."""
     code = ("import sys, rtsgeom; heavy = [m for m in ('sionna', 'pyvista', 'matplotlib', "

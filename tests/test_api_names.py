@@ -91,6 +91,7 @@ COMMAND_FUNCTIONS = {
 }
 
 
+@pytest.mark.subprocess
 def test_every_command_has_its_function_at_the_top_level():
     """What each command does is importable from ``rtsgeom`` in a fresh interpreter, and
     callable (``rtsgeom.identify`` raised AttributeError until the subpackage happened to be

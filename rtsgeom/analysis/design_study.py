@@ -95,14 +95,14 @@ class DesignStudy:
                 raise ParameterError(f"{fn}: coverage_deg = ({a:g}, {b:g}): need -80 <= A < B "
                                      "<= 80 deg")
             object.__setattr__(self, "coverage_deg", (a, b))
+        if self.mc is not None and not isinstance(self.mc, MonteCarlo):
+            raise ParameterError(f"{fn}: mc must be a MonteCarlo")
         check_study_args(fn, draws=None if self.mc is None else self.mc.draws,
                          spec_deg=self.spec_deg, points=self.points)
         check_arg(self.target_yield, "target_yield", "float", fn, ParameterError, lo=0.0,
                   hi=1.0, lo_open=True)
         if self.workers is not None:
             check_arg(self.workers, "workers", "int", fn, ParameterError, lo=1, hi=1024)
-        if self.mc is not None and not isinstance(self.mc, MonteCarlo):
-            raise ParameterError(f"{fn}: mc must be a MonteCarlo")
 
     def draws_config(self, scene: Scene) -> tuple[MonteCarlo, int]:
         """The Monte-Carlo config (seeded with the scene's seed) and the set-points per pair

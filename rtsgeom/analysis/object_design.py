@@ -65,8 +65,8 @@ class ObjectDesign:
             v = getattr(self, name)
             check_arg(list(v), name, "floats", src, ParameterError, lo=lo, hi=hi, min_items=1,
                       max_items=64)
-        if not self.budgets or any(b is not None and not (isinstance(b, int) and b >= 1)
-                                   for b in self.budgets):
+        if not self.budgets or any(b is not None and not (isinstance(b, int) and not isinstance(
+                b, bool) and b >= 1) for b in self.budgets):
             raise ParameterError(f"{src}: budgets = {self.budgets!r}: must be a non-empty "
                                  "tuple of integers >= 1 or None (no limit)")
         check_arg(self.min_share, "min_share", "float", src, ParameterError, lo=0.0, hi=1.0)

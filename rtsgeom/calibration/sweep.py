@@ -29,6 +29,8 @@ phase mismatch the coherence point zeroes (:func:`coherence_point`).
 from __future__ import annotations
 
 import dataclasses
+import math
+import numbers
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -73,15 +75,22 @@ class SweepConfig:
 
     def __post_init__(self):
         if self.span_s is not None:
-            lo, hi = (float(x) for x in self.span_s)
-            if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+            span = (tuple(self.span_s) if isinstance(self.span_s, (tuple, list, np.ndarray))
+                    else ())
+            if not (len(span) == 2 and all(_real(x) for x in span)
+                    and math.isfinite(span[0]) and math.isfinite(span[1])
+                    and span[0] < span[1]):
                 raise ParameterError(f"span_s: must be two finite delays, low < high; got "
                                      f"{self.span_s}")
-            object.__setattr__(self, "span_s", (lo, hi))
-        if self.step_s is not None and not (np.isfinite(self.step_s) and self.step_s > 0):
+            object.__setattr__(self, "span_s", (float(span[0]), float(span[1])))
+        if self.step_s is not None and not (_real(self.step_s) and math.isfinite(self.step_s)
+                                            and self.step_s > 0):
             raise ParameterError(f"step_s: must be a positive delay (s); got {self.step_s}")
-        if self.frames is not None and (int(self.frames) != self.frames or self.frames < 1):
-            raise ParameterError(f"frames: must be a whole number >= 1; got {self.frames}")
+        f = self.frames
+        if f is not None:
+            if not (_real(f) and math.isfinite(f) and f == int(f) and f >= 1):
+                raise ParameterError(f"frames: must be a whole number >= 1; got {f}")
+            object.__setattr__(self, "frames", int(f))
 
     def evolve(self, **changes) -> "SweepConfig":
         """A copy with ``changes`` (unknown names: :class:`ParameterError`)."""
@@ -90,6 +99,11 @@ class SweepConfig:
             raise ParameterError(f"{sorted(unknown)}: not a sweep setting; allowed: "
                                  f"{[f.name for f in dataclasses.fields(self)]}")
         return dataclasses.replace(self, **changes)
+
+
+def _real(x) -> bool:
+    """A real number (numpy's included), not a bool."""
+    return isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_))
 
 
 class Probes(Protocol):

@@ -451,6 +451,9 @@ def check_arg(value: Any, name: str, kind: str, source: str, error: type = Scene
     normalised, or raises ``error`` as ``<source>: <name> = <value>: must be <allowed>``."""
     if kind == "vec" and isinstance(value, np.ndarray):
         value = value.tolist()
+    if kind in ("vec", "points", "ints", "floats") and isinstance(value, (list, tuple)):
+        # numpy scalars as Python numbers (np.bool_ stays a bool, refused as a number)
+        value = type(value)(x.item() if isinstance(x, np.generic) else x for x in value)
     if kind == "int" and isinstance(value, np.integer):
         value = int(value)
     if kind == "float" and isinstance(value, np.floating):

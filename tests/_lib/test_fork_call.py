@@ -83,6 +83,7 @@ def test_map_arrays_are_the_datasets(result):
     assert maps_arrays(arrays, ("npz", "mat")) == maps_arrays(ds, ("npz", "mat"))
 
 
+@pytest.mark.subprocess
 @pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="needs Linux's /proc")
 def test_the_range_doppler_ffts_start_no_thread_pool():
     """The commands fork (design and calibration pools, the report's 3D view); a thread pool

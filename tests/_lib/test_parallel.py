@@ -31,6 +31,7 @@ print(*out)
 """
 
 
+@pytest.mark.subprocess
 def test_retained_memory_is_reused_not_mapped_afresh():
     """``parallel.retain_freed_memory`` (glibc): a 28 MiB block that glibc maps afresh and
     unmaps on every allocation (a design's tables and temporaries: ~7 000 page faults a

@@ -85,3 +85,32 @@ def test_pairs_side_by_side_give_the_report_of_one_process():
 def test_workers_out_of_range_refused(bad):
     with pytest.raises(ParameterError, match="workers"):
         rtsgeom.CalibrationStudy(pair="all", workers=bad)
+
+
+# -- the config: each declared range and choice enforced exactly, in full words --
+
+def test_calibration_study_enforces_its_ranges_and_choices():
+    from conftest import assert_bounds
+    from rtsgeom.analysis.calibration_study import CalibrationStudy
+    assert_bounds(lambda v: CalibrationStudy(workers=v), [None, 1, 1024],
+                  [(0, "CalibrationStudy: workers = 0: must be in [1, 1024]"),
+                   (1025, "CalibrationStudy: workers = 1025: must be in [1, 1024]"),
+                   (2.0, "CalibrationStudy: workers = 2.0: must be an integer in [1, 1024]")])
+    assert_bounds(lambda v: CalibrationStudy(procedure=v), ["exact", "paper"],
+                  [("Exact", "CalibrationStudy: procedure = 'Exact': must be one of exact, "
+                             "paper")])
+    assert_bounds(lambda v: CalibrationStudy(procedure="paper", full_chain=v), [False],
+                  [(True, "CalibrationStudy: full_chain: must be false with procedure 'paper' "
+                          "(the paper's sweep runs the full chain already)")])
+    CalibrationStudy(procedure="exact", full_chain=True)
+    d = CalibrationStudy()
+    assert (d.pair, d.procedure, d.full_chain, d.fir, d.steps, d.workers) == (
+        (0, 1), "exact", False, None, None, None)
+
+
+def test_the_papers_procedure_is_refused_on_cells(sphere_scene):
+    from conftest import assert_refused
+    from rtsgeom.analysis.calibration_study import CalibrationStudy
+    assert_refused(lambda: CalibrationStudy(procedure="paper")(sphere_scene),
+                   "procedure paper: the paper's sweep is a pair on an arc (one set angle in "
+                   "azimuth); this scene's front ends form 2-D cells")

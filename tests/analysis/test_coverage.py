@@ -86,3 +86,19 @@ def test_coverage_designs_plan_every_radius_for_the_coverage_in_degrees():
         ref = plan_arc(scene, (0.0, math.radians(12.0)), r)
         assert d.plan.radius_m == r
         assert d.plan.angles_deg == pytest.approx(ref.angles_deg, abs=1e-12)
+
+
+def test_a_scene_with_its_own_errors_gets_the_whole_warning(default_scene):
+    from conftest import DRAWS_REPLACE_TEXT, moved_front_end, the_warnings
+    from rtsgeom.analysis.coverage import coverage_designs
+    from rtsgeom.errors import NominalSetupWarning
+    assert the_warnings(lambda: coverage_designs(moved_front_end(default_scene), (-10.0, 10.0),
+                                                 [1.0], draws=20, points=5),
+                        NominalSetupWarning) == ["design " + DRAWS_REPLACE_TEXT]
+
+
+def test_coverage_refuses_unknown_options_in_full_words(default_scene):
+    from conftest import assert_refused
+    from rtsgeom.analysis.coverage import coverage_designs
+    assert_refused(lambda: coverage_designs(default_scene, (-10.0, 10.0), [1.0], foo=1, bar=2),
+                   "coverage_designs: no option foo, bar (points, extras, progress, workers)")

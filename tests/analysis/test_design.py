@@ -298,3 +298,27 @@ def test_the_design_study_draws_with_its_seed_and_announces_its_count(default_sc
     assert got.equals(want)
     assert not got.equals(other)  # the seed matters at 30 draws
     assert calls[0] == ("designs", 0, len(radii) * len(spacings))
+
+
+def test_a_scene_with_its_own_errors_gets_the_whole_warning(default_scene):
+    from conftest import DRAWS_REPLACE_TEXT, moved_front_end, the_warnings
+    from rtsgeom.errors import NominalSetupWarning
+    study = DesignStudy(radius_m=(1.0,), spacing_deg=(8.0,), mc=MonteCarlo(20), points=5)
+    assert the_warnings(lambda: study(moved_front_end(default_scene)), NominalSetupWarning) == [
+        "design " + DRAWS_REPLACE_TEXT]
+
+
+def test_design_refuses_unknown_options_and_cells_in_full_words(default_scene, sphere_scene):
+    from conftest import assert_refused
+    from rtsgeom.analysis.design import check_azimuth_arc, design_grid
+    assert_refused(lambda: design_grid(default_scene, (0, 1), [1.0], [8.0], foo=1, bar=2),
+                   "design_grid: no option foo, bar (progress, workers; the rest is the "
+                   "DesignSpec)")
+    for name in ("design", "design scenes/sphere4.toml"):
+        assert_refused(lambda: check_azimuth_arc(sphere_scene, name), (
+            f"{name}: this scene's front ends form 2-D cells (azimuth and elevation); the arc "
+            "design varies the azimuth spacing of front ends on an arc and synthesizes in "
+            "azimuth only, it has no design for a cell: use `tolerance SCENE --cell all` (the "
+            "cell's mounting tolerance), `linearity SCENE --grid N` and `nearfield SCENE` for "
+            "the cell"))
+    check_azimuth_arc(default_scene)

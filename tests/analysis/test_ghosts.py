@@ -51,3 +51,49 @@ def test_ghost_reports_name_their_fields_and_cfar_misses_the_first_ghost():
     rep = ghost_analysis(s, simulate=True)
     first = rep.simulated[0]["ghosts"][0]
     assert first["within_cfar_window_of_target"] and first["cfar_detected"] is False
+
+
+def _ghost_report(n_targets, simulated=None):
+    from types import SimpleNamespace
+    from rtsgeom.analysis.ghosts import GhostReport
+    targets = []
+    for k in range(n_targets):
+        ghosts = [{"order": o, "range_m": 10.0 + k + 1.5 * o, "level_db": -20.0 * o}
+                  for o in range(1, (k % 5) + 1)]
+        targets.append({"index": k, "range_m": 10.0 + k, "front_end": k % 2, "ghosts": ghosts})
+    fes = [{"index": 0, "mismatched": True}, {"index": 1, "mismatched": False},
+           {"index": 2, "mismatched": True}]
+    return GhostReport(SimpleNamespace(name="bench"), -60.0, fes, targets, simulated)
+
+
+def test_the_ghost_summary_lists_targets_up_to_twelve():
+    title, rows = _ghost_report(14)._summary()
+    assert title == "bench: cable ghosts above -60 dB"
+    assert rows[0] == ("mismatched front ends", "[0, 2]")
+    assert rows[1] == ("target 0 (10 m, FE 0)", "none above the floor")
+    assert rows[2] == ("target 1 (11 m, FE 1)", "order 1 at 12.5 m -20.0 dB")
+    assert rows[4] == ("target 3 (13 m, FE 1)", "order 1 at 14.5 m -20.0 dB, order 2 at 16 m "
+                                                "-40.0 dB, order 3 at 17.5 m -60.0 dB")
+    assert rows[5] == ("target 4 (14 m, FE 0)", "order 1 at 15.5 m -20.0 dB, order 2 at 17 m "
+                                                "-40.0 dB, order 3 at 18.5 m -60.0 dB and 1 more")
+    assert len(rows) == 1 + 12 + 1 and rows[-1] == ("...", "2 more targets")
+    assert len(_ghost_report(12)._summary()[1]) == 13
+    assert _ghost_report(1, simulated=[])._summary()[0] == (
+        "bench: cable ghosts above -60 dB, simulated")
+
+
+def test_the_ghost_table_has_a_row_per_target_and_order_with_the_simulated_level():
+    rep = _ghost_report(3)
+    cols = rep._columns()
+    assert cols == {"target": [1, 2, 2], "front_end": [1, 0, 0],
+                    "target_range_m": [11.0, 12.0, 12.0], "order": [1, 1, 2],
+                    "range_m": [12.5, 13.5, 15.0], "level_db": [-20.0, -20.0, -40.0]}
+    sim = [{"index": 2, "ghosts": [{"order": 1, "level_db": -21.0}]},
+           {"ghosts": [{"order": 1, "level_db": -19.0}]},  # no index: its position, 1
+           {"index": 2, "ghosts": [{"order": 2, "level_db": -41.0}]}]
+    cols = _ghost_report(3, simulated=sim)._columns()
+    # the simulated level of each (target, order): an entry's own index, else its position
+    assert cols["simulated_level_db"] == [-19.0, -21.0, -41.0]
+    sim[2] = {"ghosts": []}
+    assert _ghost_report(3, simulated=sim)._columns()["simulated_level_db"] == [-19.0, -21.0,
+                                                                                 None]

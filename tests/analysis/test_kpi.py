@@ -369,3 +369,99 @@ def test_kpi_study_takes_three_sigmas(sigma):
     assert tuple(KpiStudy(sigma_mm=sigma).sigma_mm) == tuple(sigma)
     with pytest.raises(ParameterError, match="sigma_mm"):
         KpiStudy(sigma_mm=tuple(sigma)[:2])
+
+
+# -- the HTML datasheet's pieces, word for word --
+
+@pytest.mark.parametrize("v, text", [(None, "-"), (True, "yes"), (False, "no"), (3, "3"),
+                                     (np.int64(7), "7"), (0.123456, "0.1235"), (12345.0, "1.234e+04"),
+                                     ([1.5, None, True], "[1.5, -, yes]"), ((2, 0.5), "[2, 0.5]"),
+                                     ("a<b", "a<b")])
+def test_report_values_are_formatted_by_their_type(v, text):
+    from rtsgeom.analysis.kpi.report import _fmt
+    assert _fmt(v) == text
+    assert _fmt(0.123456, 2) == "0.12"
+
+
+def test_report_tables_escape_and_mark_failed_rows():
+    from rtsgeom.analysis.kpi.report import _table
+    assert _table(("a<", "b"), [(1, "x&y"), (0.5, None)], ["", "fail"]) == (
+        "<table><tr><th>a&lt;</th><th>b</th></tr><tr><td>1</td><td>x&amp;y</td></tr>"
+        "<tr class='fail'><td>0.5</td><td>-</td></tr></table>")
+    assert _table(("k",), [(True,)]) == "<table><tr><th>k</th></tr><tr><td>yes</td></tr></table>"
+
+
+@pytest.mark.parametrize("quantity, unit, group", [
+    ("radial offset", "mm", "mounting"), ("delay quantisation", "ps", "calibration and delay"),
+    ("RuT Tx phase", "deg", "RuT channels"), ("receiver noise", "deg", "noise"),
+    ("RuT offset", "mm", "mounting")])
+def test_budget_rows_are_grouped_by_what_they_are(quantity, unit, group):
+    from types import SimpleNamespace
+    from rtsgeom.analysis.kpi.report import _group
+    assert _group(SimpleNamespace(quantity=quantity, unit=unit)) == group
+
+
+def test_the_html_says_the_spec_verdict_and_marks_each_failed_kpi(sheet):
+    from rtsgeom.analysis.kpi.report import _spec_rows, to_html
+    tight = dataclasses.replace(sheet, spec=dataclasses.replace(
+        _met(sheet), angle_accuracy_deg=sheet.spec_values()["angle_accuracy_deg"] / 2))
+    rows, classes = _spec_rows(tight)
+    verdicts = {r[0]: (r[4], cls) for r, cls in zip(rows, classes)}
+    assert verdicts["angle_accuracy_deg"] == ("FAIL", "fail")
+    assert all(v == ("pass", "") for k, v in verdicts.items() if k != "angle_accuracy_deg")
+    page = to_html(tight, figs={})
+    assert page.startswith(f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>"
+                           f"{sheet.scene_name} datasheet</title><style>")
+    assert f"<h1>{sheet.scene_name}: RTS setup datasheet</h1>" in page
+    assert "<h2>Spec: FAIL: see below</h2><table><tr><th>KPI</th><th>value</th><th>limit</th>" \
+           "<th>margin</th><th>verdict</th><th>note</th></tr>" in page
+    assert "<tr class='fail'><td>angle_accuracy_deg</td>" in page
+    assert page.endswith(f"Computed in {sheet.elapsed_s:.1f} s by rtsgeom kpi.</p></body></html>")
+    met = to_html(dataclasses.replace(sheet, spec=_met(sheet)), figs={})
+    assert "<h2>Spec: PASS: every KPI meets the spec</h2>" in met and "class='fail'" not in met
+    assert "<h2>Spec" not in to_html(sheet, figs={})
+    none = dataclasses.replace(sheet, spec=KpiSpec(resolution_deg=12.0))
+    assert _spec_rows(none)[0][0][4] == "no value" and _spec_rows(none)[1] == ["fail"]
+
+
+def test_the_html_budget_section_is_the_worst_set_angles(sheet):
+    import matplotlib
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+    from rtsgeom.analysis.kpi.report import to_html
+    tiny = Figure(figsize=(1, 1))
+    page = to_html(sheet, figs={"angle_accuracy": tiny, "uncertainty_budget": tiny,
+                                "mystery": tiny})
+    d = sheet.to_dict()
+    assert ("<h2>Angle accuracy</h2><img alt='angle_accuracy' src='data:image/png;base64,"
+            in page)
+    import html
+    assert f"<p>{html.escape(d['angle_accuracy_summary']['gum_validation'])}.</p>" in page
+    assert "<h2>Uncertainty budget (JCGM 100, validated by JCGM 101)</h2>" in page
+    assert "<h2>mystery</h2><img alt='mystery'" in page
+    worst = max(sheet.accuracy, key=lambda p: p.accuracy_deg)
+    assert (f"<p>The budget at the worst set angle, {worst.set_deg:.3f} deg (pair {worst.pair}): "
+            f"u_c = {worst.combined_deg:.4g} deg, U = {worst.expanded_deg:.4g} deg; Monte Carlo "
+            f"95 % interval [{worst.mc_interval_deg[0]:.4g}, {worst.mc_interval_deg[1]:.4g}] "
+            "deg.</p><table><tr><th>quantity</th><th>u(x_i)</th><th>unit</th><th>distribution"
+            "</th><th>c_i (deg/unit)</th><th>u_i(y) (deg)</th></tr>") in page
+    assert page.count("<tr><td>") >= len(worst.budget)
+
+
+def test_a_spec_file_too_large_or_with_a_reversed_span_is_refused(tmp_path):
+    from conftest import assert_refused
+    from rtsgeom.analysis.kpi.spec import MAX_SPEC_BYTES, load_spec
+    big = tmp_path / "big.toml"
+    big.write_text("#" * MAX_SPEC_BYTES)
+    assert load_spec(big) == KpiSpec()  # at the limit: read
+    big.write_text("#" * (MAX_SPEC_BYTES + 1))
+    assert_refused(lambda: load_spec(big),
+                   f"{big}: spec file too large (at most {MAX_SPEC_BYTES} bytes)", SceneError)
+    for span in ("[5.0, 5.0]", "[6.0, -6.0]"):
+        p = tmp_path / "span.toml"
+        p.write_text(f"azimuth_deg = {span}\n")
+        lo, hi = (float(x) for x in span.strip("[]").split(","))
+        assert_refused(lambda: load_spec(p), f"{p}: azimuth_deg = {[lo, hi]}: must be [lo, hi] "
+                                             "with lo < hi", SceneError)
+    p.write_text("azimuth_deg = [-6.0, 6.0]\n")
+    assert load_spec(p).azimuth_deg == (-6.0, 6.0)

@@ -289,3 +289,24 @@ def test_bad_arc_radii_are_listed_four_at_most(default_scene, n_bad):
         nearfield(default_scene, [1.0] + bad, points=3)
     listed = str(err.value).split("got ")[1].removesuffix(" m").split(", ")
     assert [float(x) for x in listed] == bad[:4]
+
+
+def test_a_scene_with_its_own_errors_gets_the_whole_warning(default_scene):
+    from conftest import moved_front_end, the_warnings
+    assert the_warnings(lambda: nearfield(moved_front_end(default_scene), [1.0], points=3),
+                        NominalSetupWarning) == [
+        "nearfield analyses the arc's near field on the nominal setup: the scene's own errors "
+        "(rts.front_ends[1].radial_offset_mm) play no part"]
+
+
+@pytest.mark.parametrize("radii, got", [
+    ([0.01, 0.02, 0.03, 0.04, 0.05], "0.01, 0.02, 0.03, 0.04"), ([1.0, -2.0], "-2"),
+    ([float("nan"), 1.0], "nan"), ([1e6], "1e+06"), ([], "none")])
+def test_bad_radii_are_named_the_first_four(default_scene, radii, got):
+    from rtsgeom.analysis.nearfield import MIN_RADIUS_M, max_radius_m
+    assert MIN_RADIUS_M == 0.05
+    with pytest.raises(ParameterError) as exc:
+        nearfield(default_scene, radii, points=3)
+    assert str(exc.value) == (f"arc radii must lie in [0.05, {max_radius_m(default_scene):.4g}] "
+                              f"m (the probe target must stay within the radar's range), got "
+                              f"{got} m")

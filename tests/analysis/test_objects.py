@@ -15,7 +15,9 @@ from scene.test_objects import BOX, CAR, bench_doc
 
 from rtsgeom.analysis.objects import (
     CLOUD_COLUMNS,
+    SUMMARY_KEYS,
     clouds_csv,
+    object_summary,
     objects_lines,
     play_objects,
     run_objects,
@@ -186,3 +188,95 @@ def test_the_fast_path_gives_the_full_chains_clouds(snr_db):
                                rtol=0, atol=1e-3)
     np.testing.assert_array_equal(fast.status, full.status)
     np.testing.assert_array_equal(fast.role, full.role)
+
+
+# -- the clouds compared, in closed form on hand-made rows --
+
+SCALE = (0.5, 0.2, 0.02)  # one range bin, one Doppler bin, one direction-cosine cell
+
+
+def _rows(frame, source, obj, pts):
+    return [(frame, source, obj, r, v, az, np.nan, -30.0) for r, v, az in pts]
+
+
+TRUTH = [(10.0, 0.0, -2.0), (10.5, 0.0, 0.0), (11.0, 0.0, 3.0)]
+
+
+@pytest.mark.parametrize("dr, daz, offset", [(0.0, 0.0, 0.0), (0.1, 0.2, 0.0), (-0.2, -0.3, 0.0),
+                                             (1.5, 0.0, 1.5), (0.0, 5.0, 0.0)])
+def test_object_summary_of_a_shifted_cloud_is_the_shift(dr, daz, offset):
+    """The RTS's cloud is the truth's moved by (dr, daz) beyond ``offset`` (the air path the
+    radar sees in addition): centroid and extent differences are the shift and zero, every
+    truth detection reproduced where the shift is within a cell, and the paired differences
+    the shift."""
+    rts = [(r + dr + offset, v, az + daz) for r, v, az in TRUTH]
+    rows = (_rows(4, "truth", 1, TRUTH) + _rows(4, "rts", 1, rts) + _rows(4, "rts", 0, rts[:1])
+            + _rows(5, "truth", 1, TRUTH[:1]))
+    s = object_summary(rows, SCALE, 1, 4, offset)
+    assert list(s) == list(SUMMARY_KEYS)
+    assert (s["object"], s["frame"], s["truth_detections"], s["rts_detections"]) == (1, 4, 3, 3)
+    assert s["centroid_azimuth_diff_deg"] == pytest.approx(daz, abs=1e-12)
+    assert s["centroid_range_diff_m"] == pytest.approx(dr, abs=1e-12)
+    assert s["azimuth_span_diff_deg"] == pytest.approx(0.0, abs=1e-12)
+    assert s["range_depth_diff_m"] == pytest.approx(0.0, abs=1e-12)
+    u = np.abs(np.sin(np.radians(np.array(TRUTH)[:, 2] + daz)) - np.sin(np.radians(
+        np.array(TRUTH)[:, 2])))
+    inside = abs(dr) <= SCALE[0] and np.all(u <= SCALE[2])
+    assert s["reproduced_share"] == (1.0 if inside else 0.0)  # every one moved alike
+    if inside:
+        assert s["paired_detections"] == 3
+        assert s["paired_azimuth_diff_max_deg"] == pytest.approx(abs(daz), abs=1e-12)
+        assert s["paired_range_diff_max_bins"] == pytest.approx(abs(dr) / SCALE[0], abs=1e-12)
+
+
+def test_object_summary_of_an_empty_cloud_has_no_differences():
+    s = object_summary(_rows(0, "truth", 0, TRUTH), SCALE, 0, 0)
+    assert (s["truth_detections"], s["rts_detections"]) == (3, 0)
+    for k in ("centroid_azimuth_diff_deg", "centroid_range_diff_m", "azimuth_span_diff_deg",
+              "range_depth_diff_m", "paired_azimuth_diff_max_deg",
+              "paired_range_diff_max_bins"):
+        assert s[k] is None, k
+    assert s["reproduced_share"] == 0.0 and s["paired_detections"] == 0
+    none = object_summary(_rows(0, "rts", 0, TRUTH), SCALE, 0, 0)
+    assert none["reproduced_share"] is None and none["paired_detections"] == 0
+
+
+def test_summary_table_adds_each_frames_budget_counts():
+    from rtsgeom.analysis.objects import summary_table
+    rows = _rows(0, "truth", 0, TRUTH) + _rows(0, "rts", 0, TRUTH) + _rows(1, "truth", 1, TRUTH)
+    budget = [{"kept": 3, "merged": 1, "dropped": 0, "other": 9}, None]
+    t = summary_table(rows, SCALE, 2, [0, 1], budget)
+    assert [(r["object"], r["frame"]) for r in t] == [(0, 0), (1, 0), (0, 1), (1, 1)]
+    assert [r.get("kept") for r in t] == [3, 3, None, None]
+    assert "other" not in t[0] and t[0]["merged"] == 1 and t[1]["dropped"] == 0
+    assert t[0]["reproduced_share"] == 1.0 and t[3]["truth_detections"] == 3
+    assert all("kept" not in r for r in summary_table(rows, SCALE, 2, [0, 1]))
+
+
+def test_objects_lines_say_each_objects_counts_share_and_budget():
+    from rtsgeom.analysis.objects import objects_lines
+
+    def row(o, t, r, share, az, rb, **budget):
+        return {"object": o, "truth_detections": t, "rts_detections": r,
+                "reproduced_share": share, "paired_azimuth_diff_max_deg": az,
+                "paired_range_diff_max_bins": rb, **budget}
+    section = {"objects": ["targets[0]", "targets[1]", "targets[2]"], "frames": [
+        row(0, 5, 4, 0.8, 0.1234, 0.5, kept=2, merged=1, dropped=0),
+        row(0, 7, 4, 0.6, 0.25, 0.25, kept=3, merged=1, dropped=2),
+        row(1, 3, 3, None, None, None)]}
+    assert objects_lines(section) == [
+        "object targets[0]: 2 frame(s), truth 5-7 / RTS 4 detections a frame, 60 % (worst "
+        "frame) of the truth's reproduced within a cell; each RTS detection against the truth "
+        "twin's of its cell: max |azimuth| 0.250 deg, max |range| 0.50 bins; budget: kept 2-3, "
+        "merged 1, dropped 0-2",
+        "object targets[1]: no truth twin detection",
+        "object targets[2]: no truth twin detection"]
+
+
+def test_the_resolution_cell_is_named_per_axis():
+    from rtsgeom.analysis.objects import _cell
+    assert _cell((0.5, 0.2, 0.02)) == {"range_m": 0.5, "velocity_mps": 0.2,
+                                       "direction_cosine": 0.02}
+    assert _cell(np.array([0.5, 0.2, 0.02, 0.04])) == {
+        "range_m": 0.5, "velocity_mps": 0.2, "direction_cosine": 0.02,
+        "direction_cosine_elevation": 0.04}

@@ -190,6 +190,7 @@ def _cli(*args):
                           capture_output=True, text=True, cwd=ROOT)
 
 
+@pytest.mark.subprocess
 def test_cli_sphere4_defaults_to_the_cell(tmp_path):
     p = _cli(str(SPHERE), "--draws", "50", "--points", "9", "--json", "--out",
              str(tmp_path / "o"))
@@ -204,6 +205,7 @@ def test_cli_sphere4_defaults_to_the_cell(tmp_path):
     assert npz["offsets_m"].shape == (50, 4, 3) and npz["calibrated_deg"].shape == (50, 3)
 
 
+@pytest.mark.subprocess
 @pytest.mark.parametrize("args, word", [
     (["--cell", "0", "1"], "3 or 4"),
     (["--cell", "0", "1", "7"], "3 or 4"),
@@ -216,6 +218,7 @@ def test_cli_bad_cell_exits_2(args, word):
     assert p.returncode == 2 and word in p.stderr and "Traceback" not in p.stderr
 
 
+@pytest.mark.subprocess
 def test_cli_cell_on_an_azimuth_only_radar_exits_2():
     p = _cli(str(ROOT / "scenes" / "diewald2022.toml"), "--cell", "all", "--draws", "5")
     assert p.returncode == 2 and "elevation" in p.stderr and "Traceback" not in p.stderr
@@ -255,3 +258,16 @@ def test_gain_calibration_inverts_a_channel_gain(model):
     x = model.x_nominal * g[:, None]
     assert np.allclose(model.gain_correction(x), 1 / np.abs(g), rtol=1e-12)
     assert np.allclose(model.gain_correction(model.x_nominal), 1.0, rtol=1e-12)
+
+
+def test_a_cell_holding_no_set_direction_is_refused(monkeypatch, sphere_scene):
+    """A cell whose grid keeps no set direction inside its hull (a sliver of a cell): named,
+    with the grid's size, instead of a study of nothing."""
+    import rtsgeom.analysis.tolerance.cell as cell_mod
+    from conftest import assert_refused
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.scene import TargetConfig
+    nom = build_setup(sphere_scene)
+    monkeypatch.setattr(cell_mod, "cell_grid", lambda st, u, n: np.zeros((0, 2)))
+    assert_refused(lambda: cell_mod.build_cell(nom, (0, 1, 2), 5, TargetConfig(15.0)),
+                   "cell [0, 1, 2]: no set direction of a 5 x 5 grid lies inside it")

@@ -137,3 +137,30 @@ def test_the_studys_verification_is_of_its_first_draws(subbin):
         np.testing.assert_allclose(ver.model_deg[case], run.worst_error_deg[case][:n],
                                    rtol=1e-9, atol=1e-12)
     assert ver.max_difference_deg < REQUIRED_DEG
+
+
+def _verified(model, chain, all_points=False, dims=1):
+    from rtsgeom.analysis.tolerance.verify import VerifyResult
+    model, chain = np.asarray(model, float), np.asarray(chain, float)
+    return VerifyResult({"calibrated": np.zeros(model.shape[0], int)}, {"calibrated": model},
+                        {"calibrated": chain}, 0.5, np.zeros(model.shape[0]), dims, all_points)
+
+
+def test_verified_differences_per_draw_an_undetected_draw_infinite():
+    """|chain - model| per draw (the largest over its points), |chain's worst - model's
+    worst|, inf where the chain detected nothing; the largest over the draws; the summary."""
+    r = _verified([0.01, -0.02, 0.03], [0.015, -0.01, np.nan])
+    assert np.allclose(r.difference_deg("calibrated")[:2], [0.005, 0.01], rtol=0, atol=1e-15)
+    assert r.difference_deg("calibrated")[2] == np.inf
+    w = r.worst_difference_deg("calibrated")
+    assert w.dtype == float and np.allclose(w[:2], [0.005, 0.01], atol=1e-15)
+    assert w[2] == np.inf and r.max_difference_deg == np.inf
+    assert r._summary() == ("3 draws through the full ADC-cube chain against the phasor model",
+                            [("calibrated", "|chain - model| max 0.01 deg, 1 missed"),
+                             ("elapsed_s", 0.5)])
+    every = _verified([[0.01, -0.05], [0.02, 0.0]], [[0.02, 0.04], [np.nan, 0.01]],
+                      all_points=True)
+    assert np.allclose(every.difference_deg("calibrated"), [0.09, np.inf], atol=1e-15)
+    # each draw's worst |error| over its points: chain 0.04 vs model 0.05; inf vs 0.02
+    assert np.allclose(every.worst_difference_deg("calibrated"), [0.01, np.inf], atol=1e-15)
+    assert _verified(np.zeros((0,)), np.zeros((0,))).max_difference_deg == 0.0

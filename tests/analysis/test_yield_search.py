@@ -99,3 +99,55 @@ def test_yield_without_errors_per_subbin_position_is_the_monte_carlos(subbin):
             mc = monte_carlo(model, [0.0] * 3, 700, 5, dist, cases=(case,), subbin=subbin)
             got = _zero_errors(ToleranceModel.of(model), 700, 5, case, subbin)[:, 0, 0]
             assert np.array_equal(mc.worst_error_deg[case], got)
+
+
+@pytest.mark.parametrize("n, target", [(1, 0.5), (4, 0.5), (4, 0.75), (10, 0.95), (20, 0.95),
+                                       (7, 1.0), (5, 0.0), (3, 1e-9)])
+def test_the_critical_ratio_is_the_order_statistic_that_decides_the_yield(n, target):
+    """With |e| sorted, the k-th smallest over the spec, k the fewest passing draws whose share
+    reaches the target (0 for a target of 0); the yield meets the target exactly where the
+    ratio is <= 1."""
+    import math
+    from rtsgeom.analysis.tolerance.search import critical_ratio
+    e = np.arange(1, n + 1, dtype=float) * 0.01 * np.where(np.arange(n) % 2, 1, -1)
+    k = math.ceil(target * n - 1e-12)
+    want = 0.0 if k == 0 else abs(e[k - 1]) / 0.02
+    got = critical_ratio(np.random.default_rng(n).permutation(e), 0.02, target)
+    assert got == pytest.approx(want, rel=1e-15)
+    for scale in (0.5, 1.0, 2.0):  # the yield at this spec scale against the ratio
+        spec = 0.02 * got * scale if got else 0.02
+        share = float(np.mean(np.abs(e) <= spec * (1 + 1e-12)))
+        if got:
+            assert (share >= target) == (scale >= 1.0), (scale, share)
+
+
+def test_the_critical_ratio_of_pairs_nans_and_nothing():
+    import math
+    from rtsgeom.analysis.tolerance.search import critical_ratio
+    worst = np.array([[0.01, -0.03], [0.02, 0.0], [-0.05, 0.04]])  # a draw's worst: 3, 2, 5
+    assert critical_ratio(worst, 0.01, 2 / 3) == pytest.approx(3.0)
+    assert critical_ratio([0.01, np.nan, 0.02], 0.01, 1.0) == math.inf  # NaN fails
+    assert critical_ratio([0.01, np.nan, 0.02], 0.01, 2 / 3) == pytest.approx(2.0)
+    assert math.isnan(critical_ratio([], 0.1, 0.9))
+    assert math.isnan(critical_ratio([0.1], 0.0, 0.9))
+    assert math.isnan(critical_ratio([0.1], -1.0, 0.9))
+
+
+@pytest.mark.parametrize("sigma, axis, direction, fixed", [
+    ((1e-4, 2e-4, 4e-4), "all", (0.25, 0.5, 1.0), (0.0, 0.0, 0.0)),
+    ((0.0, 0.0, 0.0), "all", (1.0, 1.0, 1.0), (0.0, 0.0, 0.0)),
+    ((1e-4, 2e-4, 4e-4), "radial", (1.0, 0.0, 0.0), (0.0, 2e-4, 4e-4)),
+    ((1e-4, 2e-4, 4e-4), "tangential", (0.0, 1.0, 0.0), (1e-4, 0.0, 4e-4)),
+    ((1e-4, 2e-4, 4e-4), "height", (0.0, 0.0, 1.0), (1e-4, 2e-4, 0.0))])
+def test_the_search_line_in_sigma_space(sigma, axis, direction, fixed):
+    from rtsgeom.analysis.tolerance.search import search_direction
+    d, f = search_direction(sigma, axis)
+    assert np.allclose(d, direction, rtol=0, atol=1e-15)
+    assert np.allclose(f, fixed, rtol=0, atol=1e-18)
+
+
+def test_a_search_line_of_another_axis_is_refused():
+    from conftest import assert_refused
+    from rtsgeom.analysis.tolerance.search import search_direction
+    assert_refused(lambda: search_direction((1e-4,) * 3, "yaw"),
+                   "axis 'yaw': must be 'all' or one of radial, tangential, height", ValueError)

@@ -114,6 +114,7 @@ def test_keyboard_interrupt_leaves_the_old_folder(tmp_path, monkeypatch, fast_ru
     _no_leftovers(tmp_path)
 
 
+@pytest.mark.subprocess
 def test_sigterm_cleans_up_like_sigint(tmp_path):
     out = tmp_path / "out"
     _old_folder(out)
@@ -165,6 +166,7 @@ def test_stale_lock_and_staging_of_a_killed_run_are_taken_over(tmp_path):
     _no_leftovers(tmp_path)
 
 
+@pytest.mark.subprocess
 def test_sigkill_mid_run_leaves_the_old_folder_and_the_next_run_cleans_up(tmp_path):
     out = tmp_path / "out"
     _old_folder(out)
@@ -360,6 +362,7 @@ def test_one_detection_matches_at_most_one_target(nearest_result):
     assert "nearer target 1" in m[0]["undetected"]["reason"]  # run says why
 
 
+@pytest.mark.subprocess
 def test_synthesis_bytes_do_not_depend_on_the_thread_count():
     code = textwrap.dedent("""
         import hashlib, numpy as np

@@ -226,3 +226,20 @@ def test_cos_pattern_from_config_without_an_elevation_beamwidth():
     assert isinstance(p, CosinePattern) and p.hpbw_el_rad is None
     q = pattern_from_config("cos", hpbw_deg=60.0, hpbw_el_deg=30.0)
     assert q.hpbw_el_rad == pytest.approx(np.radians(30.0))
+
+
+def test_bad_pattern_input_is_refused_word_for_word():
+    from conftest import assert_refused
+    for bad, shown in ((0.0, "0"), (np.pi, "180"), (-0.1, "-5.72958")):
+        assert_refused(lambda: cos_power_exponent(bad),
+                       f"pattern.hpbw_deg: must lie in (0, 180) deg, got {shown}", ValueError)
+    # the open interval's edges: just inside is a pattern, q = ln(1/2) / ln(cos(HPBW / 2))
+    for h in (np.pi - 1e-9, 1e-6):
+        assert cos_power_exponent(h) == pytest.approx(np.log(0.5) / np.log(np.cos(h / 2)),
+                                                      rel=1e-12)
+    assert_refused(lambda: pattern_from_config("dipole"),
+                   "pattern.kind: one of isotropic, cos, table; got 'dipole'", ValueError)
+    assert_refused(lambda: pattern_from_config("cos"),
+                   "pattern.hpbw_deg: required for a 'cos' pattern, in (0, 180) deg", ValueError)
+    assert_refused(lambda: pattern_from_config("table"),
+                   "pattern.table: a CSV path is required for a 'table' pattern", ValueError)

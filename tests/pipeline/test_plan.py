@@ -96,3 +96,31 @@ def test_plan_programs_two_channels_per_target_at_the_set_range_and_doppler(smal
         from rtsgeom.pipeline.matching import match_targets
         for e in match_targets(scene, det, rd):
             assert abs(e["error"]["angle_deg"]) < 0.05
+
+
+def test_a_pair_is_checked_against_the_arc_or_the_cells(crossing_bench, sphere_scene):
+    """On an arc: two adjacent indices in range (either order); in a scene of 2-D cells: a
+    measured edge where cells are asked for, refused with what to use otherwise."""
+    from conftest import assert_refused
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.pipeline.plan import check_pair, measured_pairs
+    arc, sph = build_setup(crossing_bench), build_setup(sphere_scene)
+    assert check_pair(arc, 3, 2, "p") == (2, 3) and check_pair(arc, 0, 1, "p", True) == (0, 1)
+    for i, j in ((0, 2), (0, 5), (-1, 0), (4, 4)):
+        assert_refused(lambda: check_pair(arc, i, j, "pair X"),
+                       "pair X: must be two adjacent front-end indices in [0, 4]")
+    assert_refused(lambda: check_pair(arc, 0, 5, "pair X", True),
+                   "pair X: must be two neighbouring front-end indices in [0, 4]")
+    edges = measured_pairs(sph)
+    assert edges == [(0, 1), (0, 2), (0, 3), (1, 3), (2, 3)]
+    assert [check_pair(sph, j, i, "p", True) for i, j in edges] == edges
+    assert_refused(lambda: check_pair(sph, 0, 1, "pair X"),
+                   "pair X: this scene's front ends form 2-D cells (azimuth and elevation), not "
+                   "pairs on an arc: use `run`, `linearity --grid N`, `nearfield` and `tolerance "
+                   "--cell` for the cell")
+    assert_refused(lambda: check_pair(sph, 1, 2, "pair X", True),
+                   "pair X: not neighbours in this scene's cells; its pairs are 0 1, 0 2, 0 3, "
+                   "1 3, 2 3")
+    assert_refused(lambda: check_pair(sph, 0, 4, "pair X", True),
+                   "pair X: must be two neighbouring front-end indices in [0, 3]")
+    assert measured_pairs(arc) == [(0, 1), (1, 2), (2, 3), (3, 4)]

@@ -366,3 +366,59 @@ def test_the_tolerance_model_refuses_a_smoothed_estimator(estimator, capsys):
         ChannelPhasors.build(build_setup(smoothed), (0, 1), points=3)
     plain = make_scene(angle_estimator=estimator, angle_subarray=0)
     assert np.isfinite(ChannelPhasors.build(build_setup(plain), (0, 1), points=3).amplitudes).all()
+
+
+@pytest.mark.parametrize("pitch", [1.95e-3, 0.5, 7.0])
+def test_uniform_cells_hold_a_filled_grid_to_a_millionth_of_its_pitch(pitch):
+    """Cells of a filled uniform row (any order, repeated positions), its N; a position off
+    the grid by more than 1e-6 pitch is not on it, within that it is; a missing cell is a
+    gap, counted."""
+    x = np.array([3, 0, 1, 2, 1, 3], float) * pitch + 0.25
+    cell, n = est.uniform_cells(x, pitch)
+    assert n == 4 and list(cell) == [3, 0, 1, 2, 1, 3]
+    near = x.copy()
+    near[2] += 0.5e-6 * pitch
+    assert est.uniform_cells(near, pitch)[1] == 4
+    off = x.copy()
+    off[2] += 2e-6 * pitch
+    with pytest.raises(ValueError) as exc:
+        est.uniform_cells(off, pitch)
+    assert str(exc.value) == "the azimuth row's elements are not on a uniform grid"
+    with pytest.raises(ValueError) as exc:
+        est.uniform_cells(np.array([0, 1, 4, 5, 9], float) * pitch, pitch)
+    assert str(exc.value) == "the azimuth row has gaps (5 of 10 grid positions filled)"
+
+
+def test_bad_smoothing_settings_are_refused_word_for_word():
+    from conftest import assert_refused
+    assert_refused(lambda: make_scene(_no_targets, angle_subarray=4),
+                   'test.toml: radar.angle_subarray = 4: must be 0 with radar.angle_estimator = '
+                   '"bartlett" (eq. 14 beamforms the whole array; spatial smoothing is for capon '
+                   'and music)', SceneError)
+    assert_refused(lambda: make_scene(_no_targets, angle_estimator="music", angle_subarray=4,
+                                      elevation_processing=True, use_elevation_tx=True),
+                   "test.toml: radar.angle_subarray = 4: must be 0 with "
+                   "radar.elevation_processing = true: spatial smoothing is implemented for the "
+                   "1-D azimuth row only (2-D arrays need 2-D subarrays, not implemented); "
+                   "without smoothing capon and music peak where bartlett does", SceneError)
+    for sub in (9, 1):
+        scene = make_scene(_no_targets, angle_estimator="music", angle_subarray=8)
+        st = dataclasses.replace(Steering.build(build_setup(scene).rut, scene.radar),
+                                 subarray=sub)
+        assert_refused(st._check_smoothing,
+                       f"radar.angle_subarray = {sub}: must be in [2, 8] (the azimuth row has 8 "
+                       "distinct positions), or 0 for no smoothing", SceneError)
+    st, _ = steering(estimator="music", subarray=3)
+    for k in (2, 8):
+        dataclasses.replace(st, subarray=k)._check_smoothing()  # the edges are taken
+    shifted = st.positions_m.copy()
+    shifted[:, 0] += 1e-5 * (shifted[:, 0] > shifted[:, 0].min())
+    assert_refused(dataclasses.replace(st, positions_m=shifted)._check_smoothing,
+                   "radar.angle_subarray = 3: must be 0 for this array: the azimuth row's "
+                   "elements are not on a uniform grid (spatial smoothing needs a filled uniform "
+                   "row; a sparse row has no shifted subarrays)", SceneError)
+    flat = dataclasses.replace(st, positions_m=np.c_[st.positions_m, np.zeros(st.size)])
+    assert_refused(flat._check_smoothing,
+                   "radar.angle_subarray = 3: must be 0 with 2-D (azimuth x elevation) "
+                   "processing: spatial smoothing is implemented for the 1-D azimuth row only",
+                   SceneError)

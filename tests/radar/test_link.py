@@ -313,3 +313,29 @@ def test_info_budget_names_front_ends_without_a_target():
         assert bool(fe["attenuation_db"]) is (fe["index"] in carrying)
         assert ("no target on it" in line) is (fe["index"] not in carrying), line
         assert " - dB" not in line
+
+
+@pytest.mark.parametrize("gain_db", [45.0, 60.0])
+def test_a_back_end_the_ruts_chirp_clips_is_refused_with_its_limit(gain_db):
+    """The chirp's level at the back-end ADC grows dB for dB with rts.link.rx_gain_db: the
+    message names the gain, its largest value and the input power; just below that limit the
+    channels pass."""
+    from rtsgeom.rts.channels import program_nearest
+
+    def mut(d, g=gain_db):
+        linked_doc(d)
+        d["rts"]["link"] = {"rx_gain_db": g}
+    scene = make_scene(mut)
+    setup = build_setup(scene)
+    t = lk.channel_table(scene, program_nearest(scene, setup))
+    assert t["level_dbfs"][0] > 0
+    limit = gain_db - t["level_dbfs"][0]
+    with pytest.raises(lk.LinkError) as exc:
+        lk.check_channels(scene, program_nearest(scene, setup))
+    assert str(exc.value) == (
+        f"test.toml: rts.link.rx_gain_db = {gain_db:g}: must be <= {limit:.1f} dB: the RuT's "
+        f"chirp reaches front end 0's back-end ADC at {t['input_dbm'][0]:.1f} dBm, above its "
+        "full scale rts.link.adc_full_scale_dbm")
+    below = make_scene(lambda d: mut(d, limit - 0.1))
+    t2 = lk.check_channels(below, program_nearest(below, setup))
+    assert t2["level_dbfs"][0] == pytest.approx(-0.1, abs=1e-9)

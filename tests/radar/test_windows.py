@@ -291,3 +291,30 @@ def test_coherence_point_moves_by_the_closed_form_for_every_taper(angle_window, 
         d = pair_coherence(s, exact_paths(s), (0, 1), alphas=shift.alphas,
                            near_s=shift.d0).continuous_s
         assert abs(shift.wrapped(d, fe, dr_mm)) < 1e-12
+
+
+@pytest.mark.parametrize("name", ["hann", "hamming", "blackman", "none", "bartlett"])
+@pytest.mark.parametrize("n", [0, 1, 2, 5, 16])
+def test_windows_are_scipys_symmetric_windows_bit_for_bit(name, n):
+    from scipy.signal import get_window
+    from rtsgeom.radar.windows import window
+    got = window(name, n)
+    want = np.ones(n) if name == "none" or n <= 1 else get_window(name, n, fftbins=False)
+    assert got.shape == (n,) and np.array_equal(got, want)
+
+
+def test_a_taper_follows_the_elements_positions():
+    """1-D: the window over the elements sorted by position, whatever their order; 2-D: the
+    product of one window per distinct row and per distinct column, an axis whose window has
+    zero ends (a Hann over two rows is (0, 0)) taking the middle of one two points longer."""
+    from rtsgeom.radar.windows import taper, window
+    x = np.array([[0.3], [0.0], [0.2], [0.1]])
+    assert np.array_equal(taper("hamming", x), window("hamming", 4)[[3, 0, 2, 1]])
+    xs, zs = np.meshgrid([0.0, 0.1, 0.2, 0.3, 0.4], [0.0, 0.05], indexing="ij")
+    pos = np.c_[xs.ravel(), zs.ravel()]
+    w = taper("hann", pos)
+    want = np.outer(window("hann", 7)[1:-1], window("hann", 4)[1:-1]).ravel()
+    assert np.allclose(w, want, rtol=0, atol=1e-15) and np.all(w > 0)
+    assert np.array_equal(taper("none", pos), np.ones(10))
+    ham = np.outer(window("hamming", 5), window("hamming", 2)).ravel()  # no zero ends: as is
+    assert np.allclose(taper("hamming", pos), ham, rtol=0, atol=1e-15)

@@ -95,3 +95,53 @@ def test_ghosts_of_a_later_front_end_when_an_earlier_one_is_idle():
     ghosts = ech.kind == 1
     assert ghosts.any() and np.all(ech.front_end[ghosts] == 1)
     assert ech.order.dtype.kind == "i"
+
+
+def _echo_fields(e=3, v=4, n=None):
+    f = dict(tau_air_s=np.zeros((e, v)), tau_if_s=np.zeros(e), f_if_hz=np.zeros(e),
+             doppler_hz=np.zeros(e), amplitude=np.ones((e, v), complex),
+             target=np.zeros(e, int), front_end=np.zeros(e, int), kind=np.zeros(e, int),
+             order=np.zeros(e, int))
+    if n is not None:
+        f["fast_gain"] = np.ones((e, n), complex)
+    return f
+
+
+@pytest.mark.parametrize("name, bad, message", [
+    ("tau_air_s", np.zeros(3), "Echoes.tau_air_s: shape (3,) must be (E, V) (echoes, virtual "
+                               "channels)"),
+    ("amplitude", np.ones((3, 5)), "Echoes.amplitude: got shape (3, 5) of float64, must be "
+                                   "(E, V) = (3, 4) numbers (E echoes and V virtual channels as "
+                                   "in tau_air_s, N fast-time samples)"),
+    ("tau_if_s", np.zeros(2), "Echoes.tau_if_s: got shape (2,) of float64, must be (E,) = (3,) "
+                              "numbers (E echoes and V virtual channels as in tau_air_s, N "
+                              "fast-time samples)"),
+    ("target", np.zeros(3), "Echoes.target: got shape (3,) of float64, must be (E,) = (3,) "
+                            "integers (E echoes and V virtual channels as in tau_air_s, N "
+                            "fast-time samples)"),
+    ("kind", np.array(["a", "b", "c"]), "Echoes.kind: got shape (3,) of <U1, must be (E,) = "
+                                        "(3,) integers (E echoes and V virtual channels as in "
+                                        "tau_air_s, N fast-time samples)"),
+    ("doppler_hz", np.array(["a", "b", "c"]), "Echoes.doppler_hz: got shape (3,) of <U1, must "
+                                              "be (E,) = (3,) numbers (E echoes and V virtual "
+                                              "channels as in tau_air_s, N fast-time samples)")])
+def test_echoes_name_the_field_and_the_shape_it_must_have(name, bad, message):
+    from conftest import assert_refused
+    from rtsgeom.rts.channels import Echoes
+    fields = _echo_fields()
+    fields[name] = bad
+    assert_refused(lambda: Echoes(**fields), message, ValueError)
+
+
+def test_echoes_are_stored_read_only_with_an_optional_fast_gain():
+    from conftest import assert_refused
+    from rtsgeom.rts.channels import Echoes
+    e = Echoes(**_echo_fields(n=6))
+    assert e.fast_gain.shape == (3, 6) and not e.fast_gain.flags.writeable
+    assert not e.amplitude.flags.writeable and not e.target.flags.writeable
+    assert Echoes(**_echo_fields()).fast_gain is None
+    bad = _echo_fields(n=6)
+    bad["fast_gain"] = np.ones((2, 6))
+    assert_refused(lambda: Echoes(**bad), (
+        "Echoes.fast_gain: got shape (2, 6) of float64, must be (E, N) = (3, 6) numbers (E "
+        "echoes and V virtual channels as in tau_air_s, N fast-time samples)"), ValueError)

@@ -285,3 +285,68 @@ def test_an_objects_own_scatterers_raise_no_shared_cell_warning():
     _, frames = frame_targets(scene)
     assert all(t.object_index >= 0 for t in frames[7])
     assert shared_cell_warnings(setup, frames[7]) == []
+
+
+# -- an object's pose in closed form --
+
+def _obj(**kw):
+    from rtsgeom.scene.objects import ObjectModel
+    pts = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.5], [-0.5, -2.0, 0.0]])
+    base = dict(where="scenario.targets[0]", points=pts, rcs_dbsm=np.zeros(3), vertices=None,
+                faces=None, outline=np.array([[-1.0, -2.0], [1.0, -2.0], [1.0, 2.0],
+                                              [-1.0, 2.0]]))
+    base.update(kw)
+    return ObjectModel(**base)
+
+
+@pytest.mark.parametrize("along, v, heading, want", [
+    (True, (3.0, 4.0, 0.0), 0.2, math.atan2(3.0, 4.0)), (True, (0.0, 0.0, 5.0), 0.2, 0.2),
+    (False, (3.0, 4.0, 0.0), 0.2, 0.2), (True, None, -0.4, -0.4),
+    (True, (-1.0, 0.0, 0.0), 0.0, -math.pi / 2)])
+def test_an_objects_heading_follows_its_motion_where_asked(along, v, heading, want):
+    m = _obj(along_velocity=along, heading_rad=heading)
+    assert m.heading(None if v is None else np.array(v)) == pytest.approx(want, abs=1e-15)
+
+
+@pytest.mark.parametrize("h", [0.0, 0.3, -1.2, math.pi])
+def test_an_objects_outline_turns_its_plus_y_to_its_heading(h):
+    m = _obj(heading_rad=h)
+    got = m.outline_at((5.0, 10.0, 1.0))
+    c, s = math.cos(h), math.sin(h)
+    o = m.outline
+    want = np.c_[c * o[:, 0] + s * o[:, 1], -s * o[:, 0] + c * o[:, 1]] + [5.0, 10.0]
+    assert np.allclose(got, want, rtol=0, atol=1e-12)
+    # the footprint's centre stays at the origin; its +y end points along (sin h, cos h)
+    assert np.allclose(got.mean(axis=0), [5.0, 10.0], atol=1e-12)
+
+
+def test_a_moving_objects_scatterers_are_its_points_turned_and_carried():
+    """pos[f, n] = p_f + R(h_f) x_n with h_f along the frame's velocity (the fixed heading in a
+    frame at rest); the velocities are the drive's."""
+    from types import SimpleNamespace
+    from rtsgeom.scene.objects import object_set_points
+    m = _obj(along_velocity=True, heading_rad=0.7, moving=True)
+    vel = np.array([[3.0, 4.0, 0.0], [0.0, 0.0, 0.0], [-2.0, 0.0, 1.0]])
+    p = np.array([[0.0, 20.0, 0.0], [1.0, 21.0, 0.2], [2.0, 22.0, -0.3]])
+    pos, v = object_set_points(m, SimpleNamespace(position_m=p, velocity_vec_mps=vel), None)
+    assert pos.shape == (3, 3, 3) and np.array_equal(v, vel)
+    for f, h in enumerate((math.atan2(3.0, 4.0), 0.7, math.atan2(-2.0, 0.0))):
+        c, s = math.cos(h), math.sin(h)
+        x = m.points
+        want = p[f] + np.c_[c * x[:, 0] + s * x[:, 1], -s * x[:, 0] + c * x[:, 1], x[:, 2]]
+        assert np.allclose(pos[f], want, rtol=0, atol=1e-12), f
+    fixed = _obj(heading_rad=0.7, moving=True)
+    pos2, _ = object_set_points(fixed, SimpleNamespace(position_m=p, velocity_vec_mps=vel), None)
+    assert np.allclose(pos2[0], pos[1] - p[1] + p[0], atol=1e-12)  # 0.7 in every frame
+
+
+def test_hulls_of_points_segments_and_polygons():
+    from rtsgeom.scene.objects import _hull
+    assert np.array_equal(_hull(np.array([[1.0, 2.0], [1.0, 2.0]])), [[1.0, 2.0]])
+    seg = _hull(np.array([[0.0, 0.0], [2.0, 2.0], [1.0, 1.0]]))  # collinear: its two ends
+    assert sorted(map(tuple, seg)) == [(0.0, 0.0), (2.0, 2.0)]
+    sq = _hull(np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 0.5]], float))
+    assert sorted(map(tuple, sq)) == [(0.0, 0.0), (0.0, 1.0), (1.0, 0.0), (1.0, 1.0)]
+    assert repr(_obj()) == "ObjectModel(scenario.targets[0]: 3 scatterers)"
+    assert repr(_obj(points=None, faces=np.zeros((12, 3)), moving=True)) == (
+        "ObjectModel(scenario.targets[0]: mesh of 12 facets, moving)")

@@ -376,6 +376,7 @@ def _run_cli(*args, cwd=None):
                           text=True, cwd=cwd, env=env, timeout=120)
 
 
+@pytest.mark.subprocess
 def test_cli_subprocess_exit_codes(tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text(dump_toml(_mutated(_set("rts.fractional_delay", False))))
@@ -481,6 +482,7 @@ def test_default_scene_has_no_warnings(default_scene):
     assert scene_warnings(default_scene) == []
 
 
+@pytest.mark.subprocess
 def test_cli_output_into_a_closed_pipe_stops_quietly():
     # `rtsgeom ... | head`: the reader closes the pipe before the CLI writes
     import subprocess

@@ -163,6 +163,7 @@ _HTML_NEEDS = _html_requirements()
 _HTML_DEPS = all(importlib.util.find_spec(m) for m in _HTML_NEEDS)
 
 
+@pytest.mark.subprocess
 @pytest.mark.skipif(not _HTML_DEPS, reason="HTML export needs " + ", ".join(_HTML_NEEDS.values()))
 def test_show_writes_interactive_html(tmp_path):
     out = tmp_path / "setup.html"
@@ -446,6 +447,7 @@ _CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 
 @pytest.mark.skipif(_CHROMIUM is None, reason="Chromium (chromium or chromium-browser) is not on "
                                                "PATH: the report is not loaded in a browser")
+@pytest.mark.subprocess
 def test_report_loads_in_headless_chromium(report, tmp_path):
     path, _ = report
     shot = tmp_path / "shot.png"

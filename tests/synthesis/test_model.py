@@ -1,0 +1,74 @@
+"""The channel model's refusals word for word: modes, a ratio of more than a pair, the paper's
+closed form on a cell, set angles outside the span a pair or a closed form reaches (the
+span's numbers the setup's), an RTS that does not subtract the air path."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from conftest import assert_refused
+from rtsgeom.errors import AngleUnreachable, ParameterError, SceneError
+from rtsgeom.geometry import build_setup
+from rtsgeom.paths import exact_paths
+from rtsgeom.scene import TargetConfig
+from rtsgeom.synthesis.model import ChannelModel, require_air_path_compensation
+
+
+@pytest.fixture(scope="module")
+def pair(default_scene):
+    setup = build_setup(default_scene)
+    return setup, ChannelModel.build(setup, exact_paths(setup), (0, 1), TargetConfig(20.0))
+
+
+@pytest.mark.parametrize("mode", ["paper", "array-factor"])
+def test_a_closed_form_addresses_the_geometric_span_ends_included(pair, mode):
+    setup, cm = pair
+    lo, hi = np.sort(setup.fe_azimuth_rad()[[0, 1]])
+    for a in (lo, hi, 0.5 * (lo + hi)):
+        assert np.isfinite(cm.pair_ratio(a, mode=mode))
+    for a in (hi + 1e-3, lo - 1e-3):
+        assert_refused(lambda: cm.pair_ratio(a, mode=mode), (
+            f"angle {np.degrees(a):.4f} deg is outside the span the {mode} closed form can "
+            f"address: the front ends' geometric angles [{np.degrees(lo):.4f}, "
+            f"{np.degrees(hi):.4f}] deg (use the exact mode for the measured span)"),
+            AngleUnreachable)
+
+
+def test_the_exact_mode_names_the_span_the_pair_reaches(pair):
+    setup, cm = pair
+    a = setup.fe_azimuth_rad()[1] + 0.05
+    with pytest.raises(AngleUnreachable) as exc:
+        cm.pair_ratio(a, mode="exact")
+    got = str(exc.value)
+    head = (f"angle {np.degrees(a):.4f} deg is outside the span this front-end pair can "
+            "synthesize [")
+    assert got.startswith(head) and got.endswith("] deg")
+    lo, hi = (float(x) for x in got[len(head):-len("] deg")].split(", "))
+    # the measured span: the detected angles of each front end alone, near the geometric ones
+    geo = np.degrees(np.sort(setup.fe_azimuth_rad()[[0, 1]]))
+    assert abs(lo - geo[0]) < 1.0 and abs(hi - geo[1]) < 1.0 and lo < hi < np.degrees(a)
+
+
+def test_modes_and_channel_counts_are_refused_by_name(pair, crossing_bench):
+    _, cm = pair
+    for call in (lambda: cm.pair_ratio(0.1, mode="x"), lambda: cm.solve(0.1, mode="x")):
+        assert_refused(call, "mode 'x': must be one of exact, array-factor, paper")
+    setup = build_setup(crossing_bench)
+    three = ChannelModel.build(setup, exact_paths(setup), (0, 1, 2), TargetConfig(20.0))
+    assert_refused(lambda: three.pair_ratio(0.0), "pair_ratio: 3 channels; a ratio needs a pair")
+    assert_refused(lambda: three.solve(np.array([0.0]), mode="paper"),
+                   "mode 'paper': eq. 23 is defined for a pair of front ends in azimuth only; "
+                   "use exact or array-factor")
+
+
+def test_an_rts_that_does_not_subtract_the_air_path_is_refused(default_scene):
+    require_air_path_compensation(default_scene)
+    bare = default_scene.evolve(rts=default_scene.rts.evolve(compensate_air_path=False))
+    assert_refused(lambda: require_air_path_compensation(bare), (
+        "rts.compensate_air_path = false: the AoA synthesis, its calibration and the studies "
+        "built on them (calibrate, run and adc with synthesized amplitudes, tolerance, design, "
+        "nearfield, linearity) assume the RTS subtracts the air path, so that each echo lies at "
+        "its set range's bin; without it the echoes lie about R_c = 1 m further, which they do "
+        "not model yet: set it to true, or run the plain program (run --amplitudes nearest)"),
+        SceneError)
