@@ -10,9 +10,34 @@ from __future__ import annotations
 
 import csv
 import json
+import os
+import resource
+import subprocess
+import sys
+import time
 from pathlib import Path
 
-__all__ = ["write_json", "write_csv", "csv_writer", "write_json_csv"]
+__all__ = ["write_json", "write_csv", "csv_writer", "write_json_csv", "timed_rtsgeom"]
+
+
+def timed_rtsgeom(argv: list[str], root: Path) -> dict:
+    """One whole process ``python -m rtsgeom argv`` importing rtsgeom from ``root``
+    (run in ``root``: ``python -m`` puts the working directory first on the path): wall,
+    user and user + system CPU (s, its forked children included), the load average before,
+    its lines on stderr. A non-zero exit ends the benchmark with its stderr's tail."""
+    load = os.getloadavg()[0]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-m", "rtsgeom", *argv], capture_output=True,
+                          text=True, cwd=root, env={**os.environ, "PYTHONPATH": str(root)})
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if proc.returncode:
+        raise SystemExit(f"{root}: rtsgeom {' '.join(argv)}: exit {proc.returncode}: "
+                         f"{proc.stderr[-2000:]}")
+    user = after.ru_utime - before.ru_utime
+    return {"wall_s": wall, "user_s": user, "cpu_s": user + after.ru_stime - before.ru_stime,
+            "load_before": load, "stderr_lines": len(proc.stderr.splitlines())}
 
 
 def write_json(path, obj, *, indent: int = 1, newline: bool = False, default=None) -> Path:

@@ -20,16 +20,12 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import resource
 import shutil
 import statistics
-import subprocess
-import sys
 import tempfile
-import time
 from pathlib import Path
 
-from benchmarks._io import write_json
+from benchmarks._io import timed_rtsgeom, write_json
 
 ROOT = Path(__file__).resolve().parents[1]
 TEMPLATE = ROOT / "scenes" / "template.toml"
@@ -59,21 +55,8 @@ def arc_scene(n: int, step_deg: float, n_targets: int) -> str:
 
 
 def timed(argv: list[str], root: Path = ROOT) -> dict:
-    """One whole process ``python -m rtsgeom argv`` importing rtsgeom from ``root``
-    (run in ``root``: ``python -m`` puts the working directory first on the path): wall,
-    user and user + system CPU (s), load average before, lines on stderr."""
-    load = os.getloadavg()[0]
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-m", "rtsgeom", *argv], capture_output=True,
-                          text=True, cwd=root, env={**os.environ, "PYTHONPATH": str(root)})
-    wall = time.perf_counter() - t0
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    if proc.returncode:
-        raise SystemExit(f"rtsgeom {' '.join(argv)}: exit {proc.returncode}: {proc.stderr[-2000:]}")
-    user = after.ru_utime - before.ru_utime
-    return {"wall_s": wall, "user_s": user, "cpu_s": user + after.ru_stime - before.ru_stime,
-            "load_before": load, "stderr_lines": len(proc.stderr.splitlines())}
+    """:func:`benchmarks._io.timed_rtsgeom` (this checkout by default)."""
+    return timed_rtsgeom(argv, root)
 
 
 def main(argv=None) -> int:

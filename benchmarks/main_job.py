@@ -14,37 +14,18 @@ from __future__ import annotations
 
 import argparse
 import os
-import resource
 import statistics
-import subprocess
-import sys
 import tempfile
-import time
 from pathlib import Path
 
-from benchmarks._io import write_json
+from benchmarks._io import timed_rtsgeom, write_json
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "scenes" / "diewald2022.toml"
 COMPARED = ("summary.json", "detections.csv", "maps.npz")
 
 
-def timed(argv: list[str], root: Path) -> dict:
-    """One whole process ``python -m rtsgeom argv`` importing rtsgeom from ``root``
-    (run in ``root``: ``python -m`` puts the working directory first on the path): wall,
-    user and system CPU (s, its forked children included), load average before."""
-    load = os.getloadavg()[0]
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-m", "rtsgeom", *argv], capture_output=True,
-                          text=True, cwd=root, env={**os.environ, "PYTHONPATH": str(root)})
-    wall = time.perf_counter() - t0
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    if proc.returncode:
-        raise SystemExit(f"{root}: rtsgeom {' '.join(argv)}: exit {proc.returncode}: "
-                         f"{proc.stderr[-2000:]}")
-    user, system = after.ru_utime - before.ru_utime, after.ru_stime - before.ru_stime
-    return {"wall_s": wall, "user_s": user, "cpu_s": user + system, "load_before": load}
+timed = timed_rtsgeom  # one whole process of rtsgeom, timed (benchmarks._io)
 
 
 def summary(runs: list[dict]) -> dict:
