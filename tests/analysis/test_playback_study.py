@@ -20,6 +20,8 @@ BOUNDS = [
                        (65, "Playback: bins = 65: must be in [0, 64]")]),
     ("workers", [1, 256], [(0, "Playback: workers = 0: must be in [1, 256]"),
                            (257, "Playback: workers = 257: must be in [1, 256]")]),
+    ("chain", ["fast", "full"], [("quick", "Playback: chain = 'quick': must be one of fast, "
+                                           "full")]),
 ]
 
 
@@ -30,7 +32,8 @@ def test_playback_enforces_each_range_at_its_edges(name, ok, bad):
 
 def test_playback_defaults_are_the_documented_ones():
     d = Playback()
-    assert (d.amplitudes, d.paths, d.baseline, d.bins, d.workers) == (None, "exact", True, 2, 1)
+    assert (d.amplitudes, d.paths, d.baseline, d.bins, d.workers, d.chain) == (
+        None, "exact", True, 2, 1, "fast")
 
 
 def test_a_scene_without_a_drive_is_refused(default_scene):

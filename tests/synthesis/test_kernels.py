@@ -154,17 +154,8 @@ def _choice_loop(rho, ph, p_ii, p_jj, c_ij):
 
 @pytest.mark.parametrize("n_k", [3, 5, 7])
 def test_bin_choice_equals_the_rule(n_k):
-    rng = np.random.default_rng(n_k)
-    n = 3000
-    rho = rng.uniform(-0.2, 2, (n, n_k))
-    # a third of the rows one design at every bin (within +-1.5 %: most bins equivalent)
-    same = rng.random(n) < 0.3
-    rho[same] = rho[same, n_k // 2, None] * (1 + rng.uniform(-0.015, 0.015, (same.sum(), n_k)))
-    rho[rng.random((n, n_k)) < 0.15] = np.nan
-    ph = rng.uniform(-np.pi, np.pi, (n, 1))
-    p_ii, p_jj = rng.uniform(0, 1, (2, n, n_k)) ** 3
-    c_ij = np.sqrt(p_ii * p_jj) * rng.uniform(0, 1, (n, n_k)) * np.exp(
-        1j * rng.uniform(-np.pi, np.pi, (n, n_k)))
+    rho, ph, p_ii, p_jj, c_ij = _choice_rows(n_k, non_finite=False)
+    n = rho.shape[0]
     got = detected_bin_choice(rho, ph, p_ii, p_jj, c_ij)
     assert 0.05 < got[2].mean() < 0.999  # both branches taken
     assert 0 < np.isinf(got[3]).sum() < got[2].sum()  # every other bin equivalent, or not
@@ -174,10 +165,10 @@ def test_bin_choice_equals_the_rule(n_k):
         np.testing.assert_allclose([got[0][i], got[3][i]], [ref[0], ref[3]], rtol=1e-12)
 
 
-def _choice_rows(n_k: int, n: int = 3000):
+def _choice_rows(n_k: int, n: int = 3000, non_finite: bool = True):
     """Rows for the bin choice: ratios with NaN and non-positive bins, a third of the rows
-    one design at every bin (within +-1.5 %: most bins equivalent), and rows whose power is
-    NaN or inf at some bin (inf and NaN channel sums)."""
+    one design at every bin (within +-1.5 %: most bins equivalent), and (``non_finite``)
+    rows whose power is NaN or inf at some bin (inf and NaN channel sums)."""
     rng = np.random.default_rng(n_k)
     rho = rng.uniform(-0.2, 2, (n, n_k))
     same = rng.random(n) < 0.3
@@ -187,8 +178,9 @@ def _choice_rows(n_k: int, n: int = 3000):
     p_ii, p_jj = rng.uniform(0, 1, (2, n, n_k)) ** 3
     c_ij = np.sqrt(p_ii * p_jj) * rng.uniform(0, 1, (n, n_k)) * np.exp(
         1j * rng.uniform(-np.pi, np.pi, (n, n_k)))
-    bad = rng.random((n, n_k)) < 0.01
-    p_jj[bad] = np.where(rng.random(bad.sum()) < 0.5, np.nan, np.inf)
+    if non_finite:
+        bad = rng.random((n, n_k)) < 0.01
+        p_jj[bad] = np.where(rng.random(bad.sum()) < 0.5, np.nan, np.inf)
     return rho, ph, p_ii, p_jj, c_ij
 
 
