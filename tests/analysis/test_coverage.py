@@ -80,8 +80,11 @@ def test_coverage_designs_plan_every_radius_for_the_coverage_in_degrees():
     ``plan_arc`` of the same coverage in radians at its radius."""
     from rtsgeom.analysis.coverage import coverage_designs, plan_arc
     scene = make_scene()
-    out = coverage_designs(scene, (0.0, 12.0), [2.0], draws=2, points=3, extras=(0,))
+    seen = []
+    out = coverage_designs(scene, (0.0, 12.0), [2.0], draws=2, points=3, extras=(0,),
+                           progress=lambda done, total: seen.append((done, total)))
     assert out.coverage_deg == (0.0, 12.0) and len(out.designs) == 1
+    assert seen == [(1, 1)]  # progress(done, total) after each design
     for r, d in zip((2.0,), out.designs):
         ref = plan_arc(scene, (0.0, math.radians(12.0)), r)
         assert d.plan.radius_m == r

@@ -99,6 +99,9 @@ def sheet():
         assert told.finished(step), (step, told.calls)
     acc = [c for c in told.calls if c[0].startswith("angle accuracy")]
     assert [c[1:] for c in acc] == [(m, 3) for m in (1, 2, 3)], acc
+    seps = [c[0] for c in told.calls if c[0].startswith("separation")]
+    n = len(seps)
+    assert n >= 2 and all(lab.endswith(f"({k}/{n})") for k, lab in enumerate(seps, 1)), seps
     return sheet
 
 
