@@ -150,6 +150,20 @@ EQUIVALENT: dict[str, str] = {
     "rtsgeom.synthesis.closed_form.x_closed_form_amplitudes__mutmut_59":
         "np.linalg.lstsq without rcond=None: numpy 2 (2.4 here) defaults rcond to None, the "
         "value given (numpy 1.26 warned and used -1 instead).",
+    # seed 41 (a fourth fresh sample; no test written for it)
+    "rtsgeom.geometry.setup.x_nominal_scene__mutmut_4":
+        "every front end derived with its errors set to zero, also one without errors: the "
+        "copy equals the front end (f.derive(errors = 0) == f for every error-free front end "
+        "of the bundled scenes, field by field), so the nominal scene is the same; only the "
+        "copy's cost differs (the comment's reason for keeping it).",
+    "rtsgeom.radar.steering.x_smoothed_estimator__mutmut_3":
+        "'bartlett' compared as 'XXbartlettXX': differs only for bartlett with "
+        "angle_subarray > 0, which the scene's rules refuse (scene/rules.py: angle_subarray "
+        "must be 0 with bartlett), and every caller passes a validated scene's radar values.",
+    "rtsgeom.synthesis.batch.x_build_models__mutmut_166":
+        "the steering argument ignored (always Steering.build(setup.rut, radar)): the "
+        "package's only callers (pipeline/pair.py, twice) pass no steering, so the built one "
+        "is what they get either way.",
 }
 
 
@@ -428,4 +442,42 @@ NOT_KILLED: dict[str, str] = {
     "rtsgeom.radar.steering.xǁSteeringǁ_search_smoothed_blocks__mutmut_190":
         "the smoothed search's parabolic refinement index clipped one short at the upper end: "
         "differs only for a peak at the zoom grid's last interior point; no test has one.",
+    # seed 41 (a fourth fresh sample; no test written for it)
+    "rtsgeom.analysis.design.xǁDesignGridǁplot__mutmut_47":
+        "a word's case in the design map's title note ('hatched'); no test reads that note.",
+    "rtsgeom.analysis.kpi.sections.x_ghosts_section__mutmut_70":
+        "the datasheet's setup_echoes_note text; no test reads it.",
+    "rtsgeom.analysis.kpi.sections.x_nearfield_section__mutmut_72":
+        "the datasheet's near-field section loses its pairs (the key read under another name "
+        "gives []); no test reads the section's pairs. A real gap.",
+    "rtsgeom.analysis.playback.frames.xǁFramePlannerǁprogram__mutmut_19":
+        "a drive's per-frame budget ignored (every frame's full programme instead of its "
+        "budget's lead programme); no fast test plays a drive under a target budget through "
+        "FramePlanner.program. A real gap.",
+    "rtsgeom.calibration.fir.x_fir_sweep_phase__mutmut_46":
+        "the continuous-delay branch of the FIR sweep's phase with channel J's base offset "
+        "subtracted instead of added; no test's result tells them apart. Not analysed further "
+        "(the session's time), not shown equivalent.",
+    "rtsgeom.calibration.probes.x_probes_per_frame__mutmut_42":
+        "'>' -> '>=' at the probes' last range exactly at the limit (a float boundary no "
+        "test has).",
+    "rtsgeom.identify.model.x_measure__mutmut_91":
+        "the best range bin searched over 4 bins (-1..+2) instead of 3: differs only where the "
+        "bin two above the model's has the most power, which no test's capture has.",
+    "rtsgeom.pipeline.pair.x__closed_form_plan__mutmut_8":
+        "the closed-form plan's model built without the calibrated offsets (None): the paper "
+        "and array-factor ratios are closed forms of the geometry; the offsets (ps of delay) "
+        "enter only the model's phase and gains used beside them, by less than the tests' "
+        "tolerances, it seems. Not shown equivalent.",
+    "rtsgeom.pipeline.plan.x_calibrate_pairs__mutmut_19":
+        "the 'calibration file has no pair' message indexes the second missing pair: an "
+        "IndexError instead of the SceneError where one pair is missing; no test loads a "
+        "calibration file that lacks a pair the run needs. A real gap.",
+    "rtsgeom.radar.processing.xǁRangeDopplerǁto_xarray__mutmut_27":
+        "the range-Doppler array's long_name attribute text; no test reads it.",
+    "rtsgeom.scene.objects.x_check_static_objects__mutmut_30":
+        "one word's case in an object's 'azimuth in front of the RuT' refusal; no test has an "
+        "object scatterer behind the RuT.",
+    "rtsgeom.scene.scenario.x_check_scenario__mutmut_36":
+        "the 'a drive starts at t_s = 0' refusal's text; no test has a drive starting later.",
 }

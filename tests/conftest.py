@@ -292,3 +292,25 @@ def crossing_bench():
     import dataclasses
     from rtsgeom.scene import load_scene
     return dataclasses.replace(load_scene(ROOT / "scenes" / "crossing.toml"), scenario=None)
+
+
+class CountedProgress:
+    """A ``progress(label, done, total)`` callback that holds the study to its contract on
+    every call: exactly three arguments (a missing total is a TypeError where it is told), a
+    non-empty text label, integer counts with 0 <= done <= total and total >= 1, and, per
+    label, counts that never go back. ``calls`` keeps what it was told."""
+
+    def __init__(self):
+        self.calls: list[tuple[str, int, int]] = []
+
+    def __call__(self, label, done, total):
+        assert isinstance(label, str) and label, label
+        assert int(done) == done and int(total) == total, (label, done, total)
+        assert 0 <= done <= total and total >= 1, (label, done, total)
+        last = [c for c in self.calls if c[0] == label]
+        assert not last or (done >= last[-1][1] or done == 0), (label, done, last[-1])
+        self.calls.append((label, int(done), int(total)))
+
+    def finished(self, label) -> bool:
+        """Whether ``label`` was told its end (done == total)."""
+        return any(c[0] == label and c[1] == c[2] for c in self.calls)

@@ -80,8 +80,18 @@ def test_coverage_designs_plan_every_radius_for_the_coverage_in_degrees():
     ``plan_arc`` of the same coverage in radians at its radius."""
     from rtsgeom.analysis.coverage import coverage_designs, plan_arc
     scene = make_scene()
-    out = coverage_designs(scene, (0.0, 12.0), [2.0], draws=2, points=3, extras=(0,))
+    seen = []
+    out = coverage_designs(scene, (0.0, 12.0), [2.0], draws=2, points=3, extras=(0,),
+                           progress=lambda done, total: seen.append((done, total)))
     assert out.coverage_deg == (0.0, 12.0) and len(out.designs) == 1
+    assert seen == [(1, 1)]  # progress(done, total) after each design
+    # the table: one row per design, each column the design's value under its own name
+    df = out.to_dataframe()
+    row = out.designs[0].to_dict()
+    assert len(df) == 1 and set(df.columns) <= set(row), set(df.columns) - set(row)
+    for k in df.columns:
+        assert df[k].iloc[0] == row[k] or (row[k] is None and df[k].isna().iloc[0]), k
+    assert {"worst_calibrated_deg", "worst_uncalibrated_deg", "sigma_mm"} <= set(df.columns)
     for r, d in zip((2.0,), out.designs):
         ref = plan_arc(scene, (0.0, math.radians(12.0)), r)
         assert d.plan.radius_m == r

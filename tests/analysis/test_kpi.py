@@ -11,7 +11,7 @@ import re
 
 import numpy as np
 import pytest
-from conftest import DEFAULT_SCENE, ROOT
+from conftest import DEFAULT_SCENE, ROOT, CountedProgress
 
 import rtsgeom
 from rtsgeom.analysis.kpi import KpiSpec, KpiStudy, check_spec, loads_spec
@@ -87,8 +87,22 @@ def test_every_spec_key_is_optional():
 
 @pytest.fixture(scope="module")
 def sheet():
+    # every progress call is checked as it is told (CountedProgress): a step told without its
+    # total fails every test of this sheet, whichever test built it
+    told = CountedProgress()
     scene = rtsgeom.load_scene(DEFAULT_SCENE)
-    return KpiStudy(points=3, draws=2000, sigma_phase_deg=1.0)(scene)
+    sheet = KpiStudy(points=3, draws=2000, sigma_phase_deg=1.0)(scene, told)
+    for step in ("field of view", "angle accuracy: pair (0, 1)",
+                 "the signal chain on the scene's targets (rtsgeom run)",
+                 "range, velocity, targets, ghosts, near field",
+                 "resolution (two targets, truth beside RTS)"):
+        assert told.finished(step), (step, told.calls)
+    acc = [c for c in told.calls if c[0].startswith("angle accuracy")]
+    assert [c[1:] for c in acc] == [(m, 3) for m in (1, 2, 3)], acc
+    seps = [c[0] for c in told.calls if c[0].startswith("separation")]
+    n = len(seps)
+    assert n >= 2 and all(lab.endswith(f"({k}/{n})") for k, lab in enumerate(seps, 1)), seps
+    return sheet
 
 
 def test_the_gum_budget_holds_against_its_monte_carlo_on_the_paper_scene(sheet):

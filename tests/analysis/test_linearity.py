@@ -22,8 +22,11 @@ def test_2d_error_map_exact_mode_puts_every_grid_point_on_its_direction():
                                          adc_rate_hz=12.5e6))
     setup = build_setup(sc)
     paths = exact_paths(setup)
-    em = linearity(setup, paths, None, "exact", points=2, calibrate=False, seed=1)
+    told = []
+    em = linearity(setup, paths, None, "exact", points=2, calibrate=False, seed=1,
+                   progress=told.append)
     assert em.set_deg.shape == (4, 2)
+    assert told == [f"set-point {k}/4" for k in range(1, 5)]  # one line per grid point
     assert max(em.max_abs_error_deg) < 1e-4
     af = linearity(setup, paths, None, "array-factor", points=2, calibrate=False, seed=1)
     assert 0.05 < max(af.max_abs_error_deg) < 1.0

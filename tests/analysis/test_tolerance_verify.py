@@ -13,7 +13,7 @@ from rtsgeom.analysis.tolerance.config import MonteCarlo
 from rtsgeom.analysis.tolerance.verify import verify_draws
 from rtsgeom.geometry import build_setup
 
-from conftest import make_scene
+from conftest import CountedProgress, make_scene
 
 REQUIRED_DEG = 0.005  # largest |fast model - ADC-cube chain| allowed per draw, deg
 
@@ -35,7 +35,10 @@ def test_every_set_point_and_the_worst_agree_with_the_chain():
     """``all_points``: every set-point of a draw through the chain, and the study's per-draw
     statistic (the worst error over the set-points) from both."""
     model = ChannelPhasors.build(build_setup(make_scene()), (0, 1), 5)
-    res = verify_draws(model, [2e-4] * 3, MonteCarlo(draws=2, seed=7), all_points=True)
+    told = CountedProgress()
+    res = verify_draws(model, [2e-4] * 3, MonteCarlo(draws=2, seed=7, progress=told),
+                       all_points=True)
+    assert told.calls == [("verify (ADC-cube chain)", 1, 2), ("verify (ADC-cube chain)", 2, 2)]
     for case in CASES:
         assert res.model_deg[case].shape == (2, 5)
         assert np.max(res.difference_deg(case)) < REQUIRED_DEG

@@ -325,3 +325,23 @@ def test_the_transfer_figure_draws_the_radars_their_band_and_the_histograms(rada
     vlines = [ln for ln in bx.get_lines() if ln.get_label() == "spec"]
     assert [float(ln.get_xdata()[0]) for ln in vlines] == ([spec] if spec else [])
     plt.close(fig)
+
+
+def test_a_2d_rut_and_a_single_front_end_are_refused_in_full_sentences():
+    """The study covers an arc of pairs seen by a RuT that beamforms in azimuth: a RuT that
+    beamforms in 2-D, and an arc of one front end, are each refused with the whole sentence
+    (a ParameterError; the CLI prints it as one line)."""
+    from conftest import ROOT
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.scene import load_scene
+    scene = load_scene(ROOT / "scenes" / "diewald2022.toml")
+    two_d = scene.evolve(radar=scene.radar.evolve(use_elevation_tx=True,
+                                                  elevation_processing=True), targets=())
+    with pytest.raises(ParameterError) as exc:
+        TransferStudy()(build_setup(two_d), None)
+    assert str(exc.value) == ("transfer: the RuT beamforms in azimuth and elevation; the study "
+                              "covers a RuT that beamforms in azimuth (an arc of pairs)")
+    one = scene.evolve(rts=scene.rts.evolve(front_ends=scene.rts.front_ends[:1]), targets=())
+    with pytest.raises(ParameterError) as exc:
+        TransferStudy()(build_setup(one), None)
+    assert str(exc.value) == "transfer: the arc needs at least two front ends"

@@ -124,3 +124,25 @@ def test_a_pair_is_checked_against_the_arc_or_the_cells(crossing_bench, sphere_s
     assert_refused(lambda: check_pair(sph, 0, 4, "pair X", True),
                    "pair X: must be two neighbouring front-end indices in [0, 3]")
     assert measured_pairs(arc) == [(0, 1), (1, 2), (2, 3), (3, 4)]
+
+
+def test_a_budget_merged_target_is_named_by_its_strongest_member_and_its_count():
+    """``target_namer``: without a budget each target its own label; under a budget a
+    synthesized target is its strongest member's label, with "(merged target of N
+    scatterers)" where it merges N > 1 of them, for merges of 1, 2 and 3."""
+    from types import SimpleNamespace
+
+    from conftest import small_quiet
+    from rtsgeom.pipeline.plan import target_namer
+    from rtsgeom.scene.objects import target_labels
+    scene = small_quiet(targets=[{"range_m": 30.0 + 5 * k, "angle_deg": 2.0 * k}
+                                 for k in range(4)])
+    names = target_labels(scene, None, None)
+    assert len(set(names)) == 4
+    plain = target_namer(scene)
+    assert [plain(k) for k in range(4)] == list(names)
+    budget = SimpleNamespace(lead=lambda: [2, 3, 0], members=[(1, 2), (3,), (0, 1, 2)])
+    named = target_namer(scene, budget=budget)
+    assert [named(k) for k in range(3)] == [
+        f"{names[2]} (merged target of 2 scatterers)", names[3],
+        f"{names[0]} (merged target of 3 scatterers)"]

@@ -37,3 +37,34 @@ def test_a_run_summary_lists_twelve_targets_and_counts_the_rest(n):
         data=np.zeros((4, 8, 16)), clipped=7), "warnings": []})
     t2, r2 = RunResult._summary(clipped)
     assert r2[0] == ("cube", "4x8x16 ADC samples, 7 CLIPPED") and r2[-1] == ("warnings", "none")
+
+
+@pytest.mark.parametrize("snr_db", [None, 20.0])
+def test_summary_json_says_the_run_and_the_radar_it_ran(snr_db):
+    """``summary`` (summary.json): every radar key is the scene's value under its own name
+    (the SNR's absence as null), the counts are the result's, and the whole is JSON."""
+    import json
+
+    from conftest import small_quiet
+    from rtsgeom.pipeline.run import run_scene, summary
+    scene = small_quiet(**({} if snr_db is None else {"snr_db": snr_db}))
+    assert scene.radar.snr_db == snr_db
+    res = run_scene(scene)
+    s = json.loads(json.dumps(summary(res, "exact")))
+    r = scene.radar
+    same = ("f_c_hz", "bandwidth_hz", "slope_hz_per_s", "adc_rate_hz", "adc_start_s",
+            "samples_per_chirp", "chirps_per_tx", "chirp_repetition_s", "range_resolution_m",
+            "velocity_resolution_mps", "snr_db")
+    assert set(s["radar"]) == set(same) | {"tx_order", "num_rx", "cube_layout"}
+    for k in same:
+        assert s["radar"][k] == getattr(r, k), k
+    assert s["radar"]["tx_order"] == list(res.setup.rut.tx_order)
+    assert s["radar"]["num_rx"] == res.setup.rut.num_rx
+    assert (s["scene"], s["seed"], s["paths"], s["aoa_mode"]) == (scene.name, scene.seed,
+                                                                  "exact", res.aoa_mode)
+    assert s["num_detections"] == len(res.detections) >= 2
+    assert s["num_echoes"] == len(res.echoes)
+    assert s["adc_clipped_samples"] == res.cube.clipped
+    assert len(s["targets"]) == len(scene.targets) == 2
+    assert all("detection_index" not in t for t in s["targets"])
+    assert s["warnings"] == list(res.warnings)

@@ -87,3 +87,21 @@ def test_range_angle_map_peaks_at_each_detection_angle():
         peak = grid[np.argmax(ram[det.range_bin[k]])]
         # grid step 0.1 deg; the map compensates TDM at the bin's Doppler, not the refined one
         assert np.degrees(abs(peak - det.angle_rad[k])) < 0.12
+
+
+def test_the_range_angle_array_defaults_to_minus_60_to_60_deg_in_quarter_degrees():
+    """``range_angle_to_xarray`` without angles: the grid -60..60 deg in 0.25 deg steps (481
+    angles), its values ``range_angle_map`` there; with angles given, those angles."""
+    scene = small_quiet()
+    setup = build_setup(scene)
+    _, cube = simulate(setup, exact_paths(setup), program_nearest(scene, setup))
+    rd, _ = process(cube)
+    da = rd.range_angle_to_xarray(cube)
+    ang = da.coords["angle_deg"].values
+    assert ang.size == 481 and ang[0] == -60.0 and ang[-1] == 60.0
+    np.testing.assert_array_equal(np.diff(ang), 0.25)
+    np.testing.assert_array_equal(da.values, range_angle_map(rd, cube, np.radians(ang)))
+    assert da.dims == ("range_m", "angle_deg")
+    np.testing.assert_array_equal(da.coords["range_m"].values, rd.range_m)
+    given = rd.range_angle_to_xarray(cube, [-5.0, 0.0, 7.5])
+    np.testing.assert_array_equal(given.coords["angle_deg"].values, [-5.0, 0.0, 7.5])

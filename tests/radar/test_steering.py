@@ -227,3 +227,31 @@ def test_the_kept_beamformer_follows_an_evolved_radar(change):
         got, own = Steering.build(r, radar), Steering._build(r, radar, False)
         for name in fields:
             np.testing.assert_array_equal(getattr(got, name), getattr(own, name), name)
+
+
+def test_the_beamformers_memo_past_its_size_keeps_the_last_and_builds_the_same(monkeypatch):
+    """More (rut, radar) objects than the memo holds: it keeps at most ``_BUILT_MAX`` entries
+    (the oldest dropped first), the last one built is found again (the same object), and every
+    beamformer equals one built afresh."""
+    import dataclasses
+
+    from rtsgeom.radar import steering as st
+    monkeypatch.setattr(st, "_BUILT", {})
+    monkeypatch.setattr(st, "_BUILT_MAX", 3)
+    scene = make_scene()
+    rut = build_setup(scene).rut
+    radars = [dataclasses.replace(scene.radar) for _ in range(5)]  # equal, not the same
+    built = []
+    for radar in radars:
+        for elevation in (False, True):
+            built.append(Steering.build(rut, radar, elevation))
+            assert len(st._BUILT) <= 3
+            assert Steering.build(rut, radar, elevation) is built[-1]
+    assert list(st._BUILT) == [(id(rut), id(radars[-2]), True), (id(rut), id(radars[-1]), False),
+                               (id(rut), id(radars[-1]), True)]
+    for k, s in enumerate(built):
+        fresh = Steering._build(rut, radars[k // 2], bool(k % 2))
+        for f in dataclasses.fields(Steering):
+            a, b = getattr(s, f.name), getattr(fresh, f.name)
+            assert np.array_equal(a, b) if isinstance(a, np.ndarray) else a == b, f.name
+    assert Steering.build(rut, radars[0], False) is not built[0]  # dropped, built again

@@ -72,3 +72,37 @@ def test_an_rts_that_does_not_subtract_the_air_path_is_refused(default_scene):
         "its set range's bin; without it the echoes lie about R_c = 1 m further, which they do "
         "not model yet: set it to true, or run the plain program (run --amplitudes nearest)"),
         SceneError)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_drawn_mounting_rotations_move_both_air_legs_as_the_setup_built_with_them(seed):
+    """``air_legs`` with drawn offsets, yaws and pitches of the front ends (added to the
+    scene's own) = the exact paths of ``build_setup`` with those offsets and rotations, on
+    both legs (RuT Tx -> FE Rx, FE Tx -> RuT Rx), and each drawn rotation alone moves them."""
+    from conftest import ROOT
+    from rtsgeom.paths.table import FE_TO_RX, TX_TO_FE
+    from rtsgeom.scene import loads_scene
+    # the Rx off the module's centre in azimuth and in height: a yaw and a pitch both move it
+    text = (ROOT / "scenes" / "custom-array.toml").read_text()
+    scene = loads_scene(text.replace("rx_offset_mm = [-15.0, 0.0]", "rx_offset_mm = [-15.0, 6.0]"),
+                        "x.toml")
+    setup = build_setup(scene)
+    n = setup.fe.count
+    model = ChannelModel.build(setup, exact_paths(setup), tuple(range(n)), TargetConfig(12.0))
+    rng = np.random.default_rng(seed)
+    off = rng.normal(0, 3e-4, (n, 3))
+    yaw, pitch = rng.normal(0, 0.02, n), rng.normal(0, 0.02, n)
+    t_a, t_b = model.air_legs(off, yaw_rad=yaw, pitch_rad=pitch)
+    own = [np.zeros(n) if a is None else a for a in (setup.fe.yaw_rad, setup.fe.pitch_rad)]
+    assert np.any(own[0] != 0)  # the scene's own yaw (2 deg), which the draw adds to
+    moved = build_setup(scene, offsets_m=off, yaw_rad=own[0] + yaw, pitch_rad=own[1] + pitch)
+    p = exact_paths(moved)
+    rut = setup.rut
+    want_a = p.delay_s[p.direction == TX_TO_FE].reshape(n, -1)[:, rut.virtual_tx]
+    want_b = p.delay_s[p.direction == FE_TO_RX].reshape(n, -1)[:, rut.virtual_rx]
+    np.testing.assert_allclose(t_a, want_a, rtol=0, atol=1e-18)
+    np.testing.assert_allclose(t_b, want_b, rtol=0, atol=1e-18)
+    for drawn in ({"yaw_rad": yaw}, {"pitch_rad": pitch}):  # each rotation alone counts
+        a, b = model.air_legs(off, **drawn)
+        plain_a, plain_b = model.air_legs(off)
+        assert np.max(np.abs(a - plain_a)) + np.max(np.abs(b - plain_b)) > 1e-15
