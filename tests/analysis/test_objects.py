@@ -188,6 +188,14 @@ def test_the_fast_path_gives_the_full_chains_clouds(snr_db):
                                rtol=0, atol=1e-3)
     np.testing.assert_array_equal(fast.status, full.status)
     np.testing.assert_array_equal(fast.role, full.role)
+    # the programme is the budget's: one target per channel and frame, the merged ones' lead
+    rows = fast.programme
+    per = {(int(f), int(ch)): {int(t) for t in rows[(rows[:, 0] == f) & (rows[:, 2] == ch), 1]}
+           for f, ch in {(r[0], r[2]) for r in rows}}
+    assert per and max(len(t) for t in per.values()) == 1
+    lead = {int(t) for t in rows[:, 1]}
+    assert lead <= {k for k in range(fast.role.shape[1]) if set(fast.role[:, k]) & {"kept",
+                                                                                    "lead"}}
 
 
 # -- the clouds compared, in closed form on hand-made rows --
