@@ -7,8 +7,10 @@ range DFT of its beat tone (the fractional-delay FIR's ripple included), with th
 :func:`~rtsgeom.radar.fmcw.synthesize` multiplies into the cube. Only the cells a frame's
 verdicts depend on are formed: around each target, the cells a detection within the gate can
 sit in, their CFAR training rings and the neighbours of the local-maximum test and of the
-parabolic interpolation. On those windows the CFAR, the local-maximum test and the per-detection
-arithmetic are :func:`~rtsgeom.radar.processing.detect`'s own.
+parabolic interpolation. On those windows: the CFAR (CA's ring mean at the cells under test
+from a summed-area table of each window, :func:`_ca_noise`; OS by the map's own filter on the
+windows side by side), the local-maximum test, and the per-detection arithmetic of
+:func:`~rtsgeom.radar.processing.detect` (:func:`~rtsgeom.radar.processing.detections_at`).
 
 Noise, where the frame has it, is the full chain's realisation (the same generator and
 draws), transformed by the same FFTs and added on the windows; the range-Doppler map of the
