@@ -190,6 +190,12 @@ def test_the_json_contract(sheet):
     assert "resolution" in d["targets"] and "note" in d["targets"]["resolution"]
     fes = d["near_field"]["front_ends"]
     assert all(f["distance_m"] > f["fraunhofer_distance_m"] for f in fes)
+    # each adjacent pair's far-field design error, as the near-field study gives it
+    from rtsgeom.analysis.nearfield import nearfield
+    scene = rtsgeom.load_scene(DEFAULT_SCENE)  # the sheet's scene
+    at = nearfield(scene, [scene.rts.arc_radius_m], 5).to_dict()["at_scene_radius"]
+    assert d["near_field"]["pairs"] and d["near_field"]["pairs"] == json.loads(
+        json.dumps(at["synthesis"], allow_nan=False))
 
 
 def test_every_view_shows_the_one_headline(sheet):
