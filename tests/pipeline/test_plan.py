@@ -146,3 +146,18 @@ def test_a_budget_merged_target_is_named_by_its_strongest_member_and_its_count()
     assert [named(k) for k in range(3)] == [
         f"{names[2]} (merged target of 2 scatterers)", names[3],
         f"{names[0]} (merged target of 3 scatterers)"]
+
+
+def test_a_calibration_file_without_a_pair_the_run_needs_is_refused_naming_it():
+    """Loaded pairs that lack one the run needs: one SceneError naming the first missing pair,
+    the pairs the file has and the command that calibrates it (one pair missing, or two)."""
+    from rtsgeom.errors import SceneError
+    from rtsgeom.pipeline.plan import calibrate_pairs
+    have = {(0, 1): object()}
+    for pairs in ([(0, 1), (1, 2)], [(1, 2), (2, 3)]):
+        with pytest.raises(SceneError) as e:
+            calibrate_pairs(None, None, pairs, None, loaded=have)
+        assert str(e.value) == (
+            f"calibration file: has no pair (1, 2) (it has [(0, 1)]): run `rtsgeom calibrate "
+            f"SCENE --pair 1 2 --out DIR`")
+    assert calibrate_pairs(None, None, [(0, 1)], None, loaded=have) == {(0, 1): have[(0, 1)]}
