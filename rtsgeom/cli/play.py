@@ -72,7 +72,7 @@ def _print_result(result, summary: dict, objects_lines, args) -> None:
     """The drive's lines on stdout: per mode the errors, losses, splits and hand-overs, the
     budget, the frames left to the full chain, the objects, the tolerance and warnings."""
     from ..analysis.playback.result import budget_line
-    s = result.summary()
+    s = summary  # summary.json's content: the result's summary() and its context
     for r, v in (("", s), ("baseline ", s.get("baseline"))):
         if v is None:
             continue

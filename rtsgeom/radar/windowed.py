@@ -264,7 +264,7 @@ def _marginal(power, noise, nb, cut, threshold_db: float) -> str | None:
     tie = np.abs(p - nb) <= TIE * np.maximum(p, nb)
     peak = p >= nb * (1 - TIE)
     if np.any(peak & (np.abs(margin) < MARGIN_DB)):
-        return "a cell within 0.01 dB of the CFAR threshold"
+        return f"a cell within {MARGIN_DB:g} dB of the CFAR threshold"
     if np.any(tie & (margin > -MARGIN_DB)):
         return "a local maximum decided by rounding (two equal cells)"
     return None
