@@ -4,9 +4,6 @@ before importing the rest of the pipeline (0.3 s of imports the view's process d
 
 from __future__ import annotations
 
-import tempfile
-from pathlib import Path
-
 from .._lib.parallel import Forked, fork_call
 from ..geometry import build_setup
 from ..paths import compute_paths, exact_paths
@@ -16,22 +13,21 @@ __all__ = ["setup_png", "start_setup_view"]
 
 def setup_png(setup, paths, paths_method: str) -> bytes:
     """The report's 3D view of ``setup`` with its ``paths`` as PNG bytes."""
-    from ..viz.scene3d import render_setup_png
+    from ..viz.scene3d import setup_png_bytes
     if paths_method != "exact":  # the view draws reflections through their hit points,
         # which the table alone does not carry
         paths = compute_paths(setup, paths_method, for_drawing=True)
-    with tempfile.TemporaryDirectory(prefix="rtsgeom-3d-") as tmp:  # private to this run
-        return render_setup_png(setup, Path(tmp) / "setup.png", paths=paths).read_bytes()
+    return setup_png_bytes(setup, paths)
 
 
 def start_setup_view(scene) -> Forked:
     """The report's 3D view of ``scene``'s setup with its exact paths, rendered in a process
     forked now (``_lib.parallel.fork_call``) while the run simulates: it depends on the
-    geometry alone, and its imports (pyvista, VTK) and render took ~1.5 s of the main job's
-    4 s on a 2-core machine. Pass it to :func:`rtsgeom.pipeline.output.write_run`
-    (``setup_view``). matplotlib, which the run's own figures need and pyvista imports, is
-    imported here before the fork (the view's process inherits it instead of importing it
-    again: ~0.3 s of CPU)."""
+    geometry alone, and its imports (pyvista, VTK, trimesh) and render take ~1.5 s of CPU beside
+    the run's. Pass it to :func:`rtsgeom.pipeline.output.write_run` (``setup_view``).
+    matplotlib, which the run's own figures need and pyvista's colours import, is imported
+    here before the fork (the view's process inherits it instead of importing it again:
+    ~0.3 s of CPU)."""
     from ..viz import figures  # noqa: F401
     setup = build_setup(scene)
     return fork_call(setup_png, setup, exact_paths(setup), "exact")

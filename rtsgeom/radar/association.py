@@ -33,12 +33,26 @@ import numpy as np
 
 from .peaks import two_target_resolution
 
-__all__ = ["Association", "associate", "resolution_cell", "STATUSES"]
+__all__ = ["Association", "assign", "associate", "resolution_cell", "STATUSES"]
 
 #: the statuses of a target
 STATUSES = ("detected", "merged", "not_detected")
 
 _FORBIDDEN = 1e12  # the cost of a pair the rules exclude (never kept)
+
+
+def assign(allowed: np.ndarray, dist: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs (rows, columns) of one optimal assignment of targets (rows) to detections
+    (columns) over the ``allowed`` pairs: the most pairs, then the least total ``dist``
+    (``scipy.optimize.linear_sum_assignment`` with the excluded pairs at a prohibitive cost;
+    pairs it returns that are not allowed are to be dropped by the caller). Where no two
+    allowed pairs share a row or a column, those pairs are the only optimal assignment and
+    are returned as they are: the usual frame, each target alone near its detection, needs
+    no solver (importing scipy.optimize is 0.15-0.3 s of a main job's 2.5 s)."""
+    if (allowed.sum(axis=0) <= 1).all() and (allowed.sum(axis=1) <= 1).all():
+        return np.nonzero(allowed)
+    from scipy.optimize import linear_sum_assignment  # here: see above
+    return linear_sum_assignment(np.where(allowed, dist, _FORBIDDEN))
 
 
 def resolution_cell(radar, steering, rd=None) -> np.ndarray:
@@ -91,8 +105,6 @@ def associate(targets: np.ndarray, detections: np.ndarray, scale, gate: float = 
     -------
     Association
     """
-    # here: scipy.optimize costs `rtsgeom run --help` 0.3 s of imports it does not need
-    from scipy.optimize import linear_sum_assignment
     t = np.asarray(targets, float).reshape(-1, np.size(scale))
     d = np.asarray(detections, float).reshape(-1, np.size(scale))
     scale = np.asarray(scale, float)
@@ -109,8 +121,7 @@ def associate(targets: np.ndarray, detections: np.ndarray, scale, gate: float = 
         first = np.argmax(nearest, axis=0)  # (D,) the nearest target (ties: the lower index)
         near_t = np.where(in_cell[first, np.arange(n_d)], first, -1)
         allowed = in_gate & nearest
-        cost = np.where(allowed, dist, _FORBIDDEN)
-        rows, cols = linear_sum_assignment(cost)
+        rows, cols = assign(allowed, dist)
         ok = allowed[rows, cols]
         det_of[rows[ok]], owner[cols[ok]] = cols[ok], rows[ok]
         status = ["detected" if j >= 0 else "not_detected" for j in det_of]

@@ -9,7 +9,7 @@ that together form a convex quadrilateral of four front ends make one quadrilate
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import ConvexHull, Delaunay
+
 from ..errors import CellUnreachable
 
 __all__ = ["enclosing_cell", "CellUnreachable"]
@@ -41,6 +41,8 @@ def enclosing_cell(u, points, quads: bool = True) -> tuple[int, ...]:
     if pts.shape[0] < 3:
         raise CellUnreachable(f"{pts.shape[0]} front ends cannot enclose a 2-D direction "
                               "(a cell needs at least 3 not on one line)")
+    # here, not at the top: scipy.spatial (70 ms of imports) serves the 2-D cells alone
+    from scipy.spatial import ConvexHull, Delaunay
     tri = Delaunay(pts)
     s = int(tri.find_simplex(u[None])[0])
     if s < 0:

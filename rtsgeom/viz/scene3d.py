@@ -19,6 +19,7 @@ started only as a last resort (see :func:`ensure_render_backend`).
 from __future__ import annotations
 
 import html
+import io
 import os
 import re
 from pathlib import Path
@@ -27,7 +28,7 @@ import numpy as np
 import pyvista as pv
 
 from ..geometry import Setup
-from .._lib.io import atomic_path, write_text
+from .._lib.io import write_bytes, write_text
 from .meshes import (ARC, BACKGROUND, LOS, MODULE, PANEL_BACKGROUND, REFLECTION_BY_BOUNCES,
                      RIM, SHEET, SHEET_LEGEND, TARGET, TARGET_RADIUS_FACTOR, angle_span, arc_points, board,
                      cutout_rims, merge, merge_lines, modules, path_polylines, polyline, rgb,
@@ -38,6 +39,7 @@ from ..errors import RtsgeomWarning, VizError
 from .render_backend import ensure_render_backend
 
 __all__ = ["VizError", "ensure_render_backend", "build_plotter", "render_setup_png",
+           "setup_png_bytes",
            "export_setup_html", "show_setup", "TARGET_RADIUS_FACTOR", "rut_scale_factor",
            "undrawable_reflections"]
 
@@ -299,12 +301,39 @@ def build_plotter(setup: Setup, paths=None, window_size=(1600, 1000), off_screen
     return pl
 
 
-def _render_image(setup: Setup, paths, window_size) -> np.ndarray:
+def _render_image(setup: Setup, paths, window_size, png: bool = False):
+    """The setup rendered off screen: the (H, W, 3) uint8 image, or with ``png`` its PNG bytes
+    (pyvista's screenshot encoder, Pillow: the view's process needs no matplotlib)."""
     pl = build_plotter(setup, paths, window_size=window_size, off_screen=True)
     try:
-        return pl.screenshot(None, return_img=True)
+        if not png:
+            return pl.screenshot(None, return_img=True)
+        buf = io.BytesIO()
+        pl.screenshot(buf, return_img=False)
+        return buf.getvalue()
     finally:
         pl.close()
+
+
+def setup_png_bytes(setup: Setup, paths=None, window_size=(1600, 1000)) -> bytes:
+    """The setup rendered off screen as PNG bytes (what :func:`render_setup_png` writes).
+
+    Parameters
+    ----------
+    setup : Setup
+    paths : Paths, optional
+    window_size : (int, int)
+
+    Returns
+    -------
+    bytes
+
+    Raises
+    ------
+    VizError
+        No off-screen rendering here.
+    """
+    return _render_image(setup, paths, window_size, png=True)
 
 
 def render_setup_png(setup: Setup, path: str | Path, paths=None,
@@ -327,11 +356,8 @@ def render_setup_png(setup: Setup, path: str | Path, paths=None,
     VizError
         No off-screen rendering here.
     """
-    from matplotlib.image import imsave
     path = Path(path)
-    img = _render_image(setup, paths, window_size)
-    with atomic_path(path) as tmp:
-        imsave(tmp, np.ascontiguousarray(img), format="png")
+    write_bytes(path, setup_png_bytes(setup, paths, window_size))
     return path
 
 

@@ -9,7 +9,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from rtsgeom.radar.association import associate, resolution_cell
+from rtsgeom.radar.association import assign, associate, resolution_cell
 
 SCALE = np.array([0.5, 0.25, 0.0625])  # range bin, velocity bin, two-target resolution in u
 
@@ -80,3 +80,29 @@ def test_the_resolution_cell_is_the_bins_then_the_two_target_resolution(default_
                                                             radar.velocity_resolution_mps, res])
     rd = SimpleNamespace(range_m=np.array([0.0, 0.3, 0.6]), velocity_mps=np.array([-1.0, -0.75]))
     assert resolution_cell(radar, st, rd) == pytest.approx(np.r_[0.3, 0.25, res], rel=1e-15)
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("shape", [(1, 1), (3, 3), (4, 7), (7, 4), (8, 8)])
+@pytest.mark.parametrize("density", [0.15, 0.5, 1.0])
+def test_assign_is_an_optimal_assignment_with_or_without_the_solver(seed, shape, density):
+    """The allowed pairs taken as they are (no row or column shared) or the solver's: the
+    same number of allowed pairs and the same total distance as scipy's assignment, each
+    target and detection at most once; a conflict-free pattern is returned unchanged."""
+    from scipy.optimize import linear_sum_assignment
+    rng = np.random.default_rng(seed)
+    dist = rng.uniform(0.0, 5.0, shape)
+    allowed = rng.random(shape) < density
+    rows, cols = assign(allowed, dist)
+    ok = allowed[rows, cols]
+    r_ref, c_ref = linear_sum_assignment(np.where(allowed, dist, 1e12))
+    ok_ref = allowed[r_ref, c_ref]
+    assert ok.sum() == ok_ref.sum()
+    assert dist[rows[ok], cols[ok]].sum() == pytest.approx(dist[r_ref[ok_ref], c_ref[ok_ref]].sum())
+    assert len(set(rows[ok])) == ok.sum() and len(set(cols[ok])) == ok.sum()
+    # a pattern without conflicts: one allowed pair per row and column at most
+    free = np.zeros(shape, bool)
+    k = min(shape)
+    free[rng.permutation(shape[0])[:k], rng.permutation(shape[1])[:k]] = rng.random(k) < 0.7
+    rows, cols = assign(free, dist)
+    assert sorted(zip(rows.tolist(), cols.tolist())) == sorted(zip(*map(list, np.nonzero(free))))
