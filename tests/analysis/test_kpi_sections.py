@@ -9,6 +9,8 @@ from __future__ import annotations
 import math
 from types import SimpleNamespace
 
+from scipy.constants import c
+
 import numpy as np
 import pytest
 from conftest import make_scene, quiet
@@ -23,6 +25,7 @@ from rtsgeom.geometry import build_setup
 from rtsgeom.geometry.farfield import angular_resolution_rad
 from rtsgeom.paths import exact_paths
 from rtsgeom.pipeline.info import reachable_spans
+from rtsgeom.scene.rules import resolvable_limits
 from rtsgeom.scene.sections import MAX_TARGETS
 
 
@@ -126,6 +129,38 @@ def test_merge_joins_overlapping_and_touching_intervals(intervals, merged):
 ])
 def test_uncovered_is_the_span_less_its_covered_parts(covered, span, missed):
     assert uncovered_deg({"covered_deg": covered}, span) == pytest.approx(missed, abs=1e-12)
+
+
+@pytest.mark.parametrize("compensate, fir", [(True, True), (False, False)])
+def test_the_range_and_velocity_section_without_targets_in_full(compensate, fir):
+    """Every key of the section of a scene without targets: the limits from the air path, the
+    FIR's bulk delay and the processing (``scene.rules.resolvable_limits``)."""
+    def mutate(doc):
+        quiet(doc)
+        doc["rts"].update(compensate_air_path=compensate, fractional_delay=fir)
+        if not fir:
+            doc["rts"]["calibration_step_ps"] = 250.0
+    setup = build_setup(make_scene(mutate))
+    radar, rts = setup.scene.radar, setup.scene.rts
+    r_lim, v_lim, why_r, why_v = resolvable_limits(radar)
+    air = rts.arc_radius_m  # the RuT at the arc's centre
+    fir_m = 0.5 * c * (rts.fractional_delay_taps - 1) / 2 / rts.f_s_hz if fir else 0.0
+    unsub = 0.0 if compensate else air
+    assert range_velocity(setup, None) == {
+        "min_range_m": pytest.approx(air + fir_m), "max_range_m": pytest.approx(r_lim - unsub),
+        "limits": {"air_path_m": pytest.approx(air), "fir_latency_m": pytest.approx(fir_m),
+                   "fir_latency_note": "[assumed] the fractional-delay FIR's bulk (taps - 1)/2 "
+                                       "samples are part of the delay buffer (rts.fir), the "
+                                       "least delay the back end realises",
+                   "buffer_note": "the scene declares no buffer depth: no limit from it",
+                   "processing_max_range_m": r_lim, "processing_note": why_r,
+                   "unsubtracted_air_path_m": pytest.approx(unsub, abs=1e-12)},
+        "max_velocity_mps": v_lim, "velocity_note": why_v,
+        "range_resolution_m": radar.range_resolution_m,
+        "velocity_resolution_mps": radar.velocity_resolution_mps,
+        "range_step_m": 0.5 * c * rts.delay_resolution_s,
+        "range_accuracy_m": None, "velocity_accuracy_mps": None, "targets": [],
+        "accuracy_note": "the scene has no [[targets]] to measure"}
 
 
 def _match(k, r, v, err):
