@@ -249,7 +249,7 @@ def test_the_coverage_folder_is_a_map_per_name_and_the_json(monkeypatch, tmp_pat
 @pytest.mark.parametrize("sheet, enabled, spacing_deg, text", [
     ("kept", True, 5.0, "sheet kept"),
     ("widened", True, 5.0, "sheet widened to [-20.50, 31.25] deg"),
-    ("disabled", True, 2.5, "sheet REMOVED: cutouts of 50 mm need 2.86 deg spacing, the design "
+    ("disabled", True, 2.5, "sheet REMOVED: cutouts of 50 mm need 2.87 deg spacing, the design "
                             "has 2.50 deg"),
     ("disabled", True, 3.0, "sheet REMOVED (its cutouts cannot hold the antennas or it would not "
                             "enclose the RuT)"),
