@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -112,3 +113,157 @@ def test_coverage_refuses_unknown_options_in_full_words(default_scene):
     from rtsgeom.analysis.coverage import coverage_designs
     assert_refused(lambda: coverage_designs(default_scene, (-10.0, 10.0), [1.0], foo=1, bar=2),
                    "coverage_designs: no option foo, bar (points, extras, progress, workers)")
+
+
+# -- the grid of candidate arcs as a result: summary, table, best pick, maps, folder ----------
+
+def _arc(r, n, extra, cal, unc=0.3, sigma=0.2, problem=None):
+    from rtsgeom.analysis.coverage import ArcDesign, ArcPlan
+    plan = ArcPlan(None, r, n, tuple(np.linspace(-10, 10, n)), 20 / (n - 1), 17.5, 3.0,
+                   (0.1, -0.1), "kept", "sheet kept", ("resolution",), extra)
+    return ArcDesign(plan, cal, unc, sigma, False, problem, 0.02, 0.97, 0.5, 0.3, 0.95)
+
+
+def _grid(designs, radii=(0.5, 1.0), spec=0.1):
+    from rtsgeom.analysis.coverage import CoverageDesign
+    return CoverageDesign((-10.0, 12.5), np.array(radii), spec, 0.95, 100, tuple(designs),
+                          "bench")
+
+
+@pytest.mark.parametrize("designs, best", [
+    # both meet the spec (the bound itself meets it): the fewest front ends
+    ([_arc(0.5, 3, 0, 0.1), _arc(0.5, 4, 1, 0.01)], [(0.5, 3)]),
+    # the fewer misses by a hair: the other
+    ([_arc(0.5, 3, 0, 0.1000001), _arc(0.5, 4, 1, 0.01)], [(0.5, 4)]),
+    # equal counts: the larger tolerance
+    ([_arc(0.5, 3, 0, 0.05, sigma=0.2), _arc(0.5, 3, 1, 0.05, sigma=0.4)], [(0.5, 3, 0.4)]),
+    # none meets it: the smallest worst error
+    ([_arc(0.5, 3, 0, 0.3), _arc(0.5, 4, 1, 0.2)], [(0.5, 4)]),
+    # a problem or a NaN error is no candidate; a radius without one is left out
+    ([_arc(0.5, 3, 0, 0.01, problem="x"), _arc(0.5, 4, 1, math.nan), _arc(1.0, 5, 0, 0.2)],
+     [(1.0, 5)]),
+])
+def test_the_best_arc_per_radius_is_the_fewest_front_ends_meeting_the_spec(designs, best):
+    from rtsgeom.analysis.coverage import best_per_radius
+    got = best_per_radius(_grid(designs))
+    assert [(d.plan.radius_m, d.plan.front_ends, d.sigma_mm)[:len(b)] for d, b in
+            zip(got, best)] == best and len(got) == len(best)
+
+
+def test_the_coverage_grids_summary_and_table_in_full():
+    grid = _grid([_arc(0.5, 3, 0, 0.01234, 0.5678, 0.25), _arc(0.5, 4, 1, math.nan,
+                                                              problem="missed"),
+                  _arc(1.0, 3, 0, 0.2, 0.3, 0.125), _arc(1.0, 4, 1, 0.05, 0.25, 0.5)])
+    title, rows = grid._summary()
+    assert title == "arcs covering -10..12.5 deg: 2 radii x 2 candidates"
+    assert rows == [
+        ("spec", "0.1 deg, 95 % of whole arcs, 100 draws"),
+        ("R_c 0.5 m", "3 front ends 10 deg apart, worst 0.0123 deg calibrated (0.568 "
+                      "uncalibrated), sigma 0.25 mm"),
+        ("R_c 1 m", "4 front ends 6.67 deg apart, worst 0.05 deg calibrated (0.25 "
+                    "uncalibrated), sigma 0.5 mm")]
+    df = grid.to_dataframe()
+    assert list(df.columns) == ["radius_m", "front_ends", "extra", "spacing_deg", "sheet",
+                                "worst_calibrated_deg", "worst_uncalibrated_deg", "sigma_mm",
+                                "problem"]
+    assert df["radius_m"].tolist() == [0.5, 0.5, 1.0, 1.0]
+    assert df["front_ends"].tolist() == [3, 4, 3, 4]
+    assert df["extra"].tolist() == [0, 1, 0, 1]
+    assert df["spacing_deg"].tolist() == pytest.approx([10.0, 20 / 3, 10.0, 20 / 3])
+    assert df["sheet"].tolist() == ["kept"] * 4
+    assert df["worst_calibrated_deg"].tolist()[::2] == [0.01234, 0.2]
+    assert math.isnan(df["worst_calibrated_deg"][1])
+    assert df["worst_uncalibrated_deg"].tolist() == [0.5678, 0.3, 0.3, 0.25]
+    assert df["sigma_mm"].tolist() == [0.25, 0.2, 0.125, 0.5]
+    assert [p if isinstance(p, str) else None for p in df["problem"]] == [None, "missed", None,
+                                                                            None]
+    assert df["problem"].isna().tolist() == [True, False, True, True]
+
+
+@pytest.mark.parametrize("name, label, what, floor", [
+    ("worst_calibrated_deg", "worst |angle error| (deg)", "Calibrated, over the coverage",
+     0.001),
+    ("worst_uncalibrated_deg", "worst |angle error| (deg)", "Uncalibrated, over the coverage",
+     0.001),
+    ("sigma_mm", "mounting sigma (mm)", "Tolerance for the yield (whole arc)", None),
+    ("front_ends", "front ends", "Number of front ends", None),
+])
+def test_each_coverage_map_draws_its_values_with_its_labels(monkeypatch, name, label, what,
+                                                            floor):
+    import rtsgeom.viz.figures as figures
+    seen = {}
+    monkeypatch.setattr(figures, "design_heatmap_figure",
+                        lambda *a, **kw: seen.update(args=a, kw=kw) or "fig")
+    designs = [_arc(0.5, 3, 0, 0.01, 0.5, 0.25), _arc(0.5, 4, 1, math.nan, problem="p"),
+               _arc(1.0, 3, 0, 0.2, 0.3, 0.125), _arc(1.0, 5, 2, 0.05, 0.25, 0.5)]
+    grid = _grid(designs)
+    assert grid.plot(name) == "fig"
+    x, y, z, xl, yl, zl, title = seen["args"]
+    assert x.tolist() == [0.5, 1.0] and y.tolist() == [0.0, 1.0, 2.0]
+    want = np.full((3, 2), np.nan)
+    for d in designs:
+        v = getattr(d, name) if name != "front_ends" else d.plan.front_ends
+        want[d.plan.extra, int(d.plan.radius_m == 1.0)] = v
+    np.testing.assert_array_equal(z, want)
+    assert (xl, yl, zl) == ("arc radius R_c (m)", "front ends beyond the fewest", label)
+    assert title == (f"bench: {what}\ncoverage -10..12.5 deg, spec 0.1 deg, 95 % yield, "
+                     "100 draws")
+    assert seen["kw"] == {"contour_floor": floor, "integer_y": True,
+                          "integer_z": name == "front_ends"}
+    unnamed = dataclasses.replace(grid, scene_name="")
+    unnamed.plot(name)
+    assert seen["args"][-1].startswith(f"{what}\ncoverage")
+
+
+def test_an_unknown_coverage_map_is_refused_naming_the_maps():
+    from rtsgeom.errors import ParameterError
+    with pytest.raises(ParameterError) as e:
+        _grid([_arc(0.5, 3, 0, 0.01)]).plot("yield")
+    assert str(e.value) == ("map 'yield': one of worst_calibrated_deg, worst_uncalibrated_deg, "
+                            "sigma_mm, front_ends")
+
+
+def test_the_coverage_folder_is_a_map_per_name_and_the_json(monkeypatch, tmp_path):
+    import json
+
+    import rtsgeom.viz.figures as figures
+    saved = []
+    monkeypatch.setattr(figures, "design_heatmap_figure", lambda *a, **kw: a[-1])
+    monkeypatch.setattr(figures, "save_figure", lambda fig, path: saved.append((fig, path)))
+    grid = _grid([_arc(0.5, 3, 0, 0.01), _arc(1.0, 4, 1, math.nan, problem="p")])
+    names = grid.write(tmp_path)
+    maps = ["worst_calibrated_deg", "worst_uncalibrated_deg", "sigma_mm", "front_ends"]
+    assert names == [f"coverage_{m}.png" for m in maps] + ["coverage.json"]
+    assert [p for _, p in saved] == [tmp_path / f"coverage_{m}.png" for m in maps]
+    assert [f.split("\n")[0] for f, _ in saved] == [
+        "bench: Calibrated, over the coverage", "bench: Uncalibrated, over the coverage",
+        "bench: Tolerance for the yield (whole arc)", "bench: Number of front ends"]
+    d = json.loads((tmp_path / "coverage.json").read_text())
+    assert d == json.loads(json.dumps(grid.to_dict()))
+    assert d["designs"][1]["worst_calibrated_deg"] is None  # NaN written as null
+    assert [b["radius_m"] for b in d["best"]] == [0.5]
+    assert (d["coverage_deg"], d["radius_m"], d["spec_deg"], d["yield"], d["draws"]) == (
+        [-10.0, 12.5], [0.5, 1.0], 0.1, 0.95, 100)
+
+
+@pytest.mark.parametrize("sheet, enabled, spacing_deg, text", [
+    ("kept", True, 5.0, "sheet kept"),
+    ("widened", True, 5.0, "sheet widened to [-20.50, 31.25] deg"),
+    ("disabled", True, 2.5, "sheet REMOVED: cutouts of 50 mm need 2.87 deg spacing, the design "
+                            "has 2.50 deg"),
+    ("disabled", True, 3.0, "sheet REMOVED (its cutouts cannot hold the antennas or it would not "
+                            "enclose the RuT)"),
+    ("disabled", False, 2.5, "no sheet in the scene"),
+])
+def test_what_an_arc_did_to_the_sheet_in_words(sheet, enabled, spacing_deg, text):
+    from types import SimpleNamespace
+
+    from rtsgeom.analysis.coverage import _sheet_text
+    scene = SimpleNamespace(sheet=SimpleNamespace(enabled=enabled, cutout_diameter_m=0.05))
+    variant = SimpleNamespace(sheet=SimpleNamespace(angle_min_rad=math.radians(-20.5),
+                                                    angle_max_rad=math.radians(31.25)))
+    cut = 2 * math.asin(0.025)  # 50 mm at 1 m
+    assert _sheet_text(scene, variant, sheet, math.radians(spacing_deg), cut) == text
+    # the spacing exactly at the cutouts' need is not "too close"
+    if sheet == "disabled" and enabled:
+        assert _sheet_text(scene, variant, sheet, cut, cut).startswith("sheet REMOVED (its")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 
@@ -322,3 +323,120 @@ def test_design_refuses_unknown_options_and_cells_in_full_words(default_scene, s
             "cell's mounting tolerance), `linearity SCENE --grid N` and `nearfield SCENE` for "
             "the cell"))
     check_azimuth_arc(default_scene)
+
+
+# -- DesignGrid as a result: summary, table, each map's title notes and data, the folder -------
+
+def _grid(radii, spacings, metric_scale=1.0, mask=None, scene_name="bench"):
+    from rtsgeom.analysis.design import METRICS, DesignGrid
+    r, s = np.asarray(radii, float), np.asarray(spacings, float)
+    z = np.outer(s, 1 / r) * metric_scale
+    mask = np.zeros((s.size, r.size), bool) if mask is None else np.asarray(mask)
+    return DesignGrid((0, 1), 7.8, r, s, 17.5, 0.1, 0.95, 200, 3,
+                      {name: z * (k + 1) for k, name in enumerate(METRICS)}, mask, (),
+                      scene_name)
+
+
+def test_the_design_grids_summary_and_table_in_full():
+    from rtsgeom.analysis.design import METRICS
+    grid = _grid([0.5, 2.0], [4.0, 10.0, 20.0], mask=[[0, 0], [0, 0], [1, 1]])
+    title, rows = grid._summary()
+    assert title == "arc design of pair (0, 1) (centre 7.80 deg): 3 spacings x 2 radii"
+    assert [k for k, _ in rows] == ["radius_m", "spacing_deg", "tolerance", "exceeds_resolution",
+                                    *METRICS, "widest tolerance"]
+    d = dict(rows)
+    assert d["tolerance"] == "95 % within 0.1 deg, 200 draws, seed 3"
+    assert d["exceeds_resolution"] == "2 of 6 designs (spacing > 17.50 deg, eq. 24)"
+    # sigma_calibrated_mm is the 4th metric: 4 s / r, widest at s = 20, r = 0.5
+    assert d["widest tolerance"] == "160 mm calibrated at R_c 0.5 m, spacing 20 deg"
+    none = dataclasses.replace(grid, metrics={**grid.metrics, "sigma_calibrated_mm":
+                                              np.full((3, 2), np.nan)})
+    assert [k for k, _ in none._summary()[1]][-1] == "sigma_uncalibrated_mm"
+    df = grid.to_dataframe()
+    assert list(df.columns) == ["radius_m", "spacing_deg", *METRICS, "exceeds_resolution"]
+    assert df["radius_m"].tolist() == [0.5, 2.0] * 3
+    assert df["spacing_deg"].tolist() == [4.0, 4.0, 10.0, 10.0, 20.0, 20.0]
+    assert df["worst_error_deg"].tolist() == [8.0, 2.0, 20.0, 5.0, 40.0, 10.0]
+    assert df["exceeds_resolution"].tolist() == [False] * 4 + [True] * 2
+
+
+@pytest.mark.parametrize("radii, spacings, scale, mask, lines, notes", [
+    ([0.5, 2.0], [4.0, 10.0], 1.0, [[0, 0], [0, 0]], False, ""),
+    ([0.5, 2.0], [4.0, 20.0], 1.0, [[0, 0], [1, 1]], False,
+     "\nhatched: spacing > 17.5 deg (eq. 24)"),
+    ([1.0], [4.0, 20.0], 1.0, [[0], [1]], True, "\nhollow: spacing > 17.5 deg (eq. 24)"),
+    ([0.5, 2.0], [4.0], 1.0, [[0, 0]], True, ""),
+    # every value below the floor (0.01 x spec for the worst error): said, with the mask's note
+    ([0.5, 2.0], [4.0, 20.0], 1e-5, [[0, 0], [1, 1]], False,
+     "\nevery value below 0.001 (colours 0..0.001); hatched: spacing > 17.5 deg (eq. 24)"),
+])
+def test_the_design_maps_title_notes_and_data(monkeypatch, radii, spacings, scale, mask, lines,
+                                              notes):
+    import rtsgeom.viz.figures as figures
+    seen = {}
+    for name in ("design_heatmap_figure", "design_lines_figure"):
+        monkeypatch.setattr(figures, name, lambda *a, _n=name, **kw: seen.update(
+            kind=_n, args=a, kw=kw) or "fig")
+    grid = _grid(radii, spacings, scale, mask)
+    assert grid.plot("worst_error_deg") == "fig"
+    assert seen["kind"] == ("design_lines_figure" if lines else "design_heatmap_figure")
+    r, s, z, xl, yl, zl, title = seen["args"]
+    assert r is grid.radius_m and s is grid.spacing_deg
+    assert z is grid.metrics["worst_error_deg"]
+    assert (xl, yl, zl) == ("arc radius R_c (m)", "front-end spacing (deg)",
+                            "worst |angle error| (deg)")
+    assert title == ("bench: Synthesized angle after calibration\npair (0, 1), spec 0.1 deg, "
+                     "95 % yield, 200 draws" + notes)
+    assert seen["kw"].keys() == ({"mask"} if lines else {"mask", "contour_floor"})
+    np.testing.assert_array_equal(seen["kw"]["mask"], np.asarray(mask, bool))
+    if not lines:
+        assert seen["kw"]["contour_floor"] == pytest.approx(0.001)
+
+
+@pytest.mark.parametrize("metric, label, what, floor", [
+    ("near_field_bias_deg", "detected - geometric (deg)", "Near-field bias of one front end",
+     0.001),
+    ("range_offset_mm", "range offset (mm)", "Calibration range offset", 0.01),
+    ("sigma_calibrated_mm", "mounting sigma (mm)", "Tolerance for the spec, calibrated", 0.001),
+    ("sigma_uncalibrated_mm", "mounting sigma (mm)", "Tolerance for the spec, uncalibrated",
+     0.001),
+])
+def test_each_design_map_has_its_label_title_and_floor(monkeypatch, metric, label, what, floor):
+    import rtsgeom.viz.figures as figures
+    seen = {}
+    monkeypatch.setattr(figures, "design_heatmap_figure",
+                        lambda *a, **kw: seen.update(args=a, kw=kw) or "fig")
+    grid = _grid([0.5, 2.0], [4.0, 10.0], scene_name="")
+    grid.plot(metric)
+    assert seen["args"][5:] == (label, f"{what}\npair (0, 1), spec 0.1 deg, 95 % yield, "
+                                       "200 draws")
+    assert seen["kw"]["contour_floor"] == pytest.approx(floor)
+
+
+def test_an_unknown_design_map_is_refused_naming_the_metrics():
+    from rtsgeom.errors import ParameterError
+    with pytest.raises(ParameterError) as e:
+        _grid([1.0], [4.0]).plot("yield")
+    assert str(e.value) == ("metric 'yield': one of worst_error_deg, near_field_bias_deg, "
+                            "range_offset_mm, sigma_calibrated_mm, sigma_uncalibrated_mm")
+
+
+def test_the_design_folder_is_a_map_per_metric_and_the_json(monkeypatch, tmp_path):
+    import json
+
+    import rtsgeom.viz.figures as figures
+    from rtsgeom.analysis.design import METRICS
+    saved = []
+    monkeypatch.setattr(figures, "design_heatmap_figure", lambda *a, **kw: a[-1])
+    monkeypatch.setattr(figures, "save_figure", lambda fig, path: saved.append((fig, path)))
+    grid = dataclasses.replace(_grid([0.5, 2.0], [4.0, 10.0]),
+                               designs=({"radius_m": 0.5, "worst_error_deg": float("nan")},))
+    names = grid.write(tmp_path)
+    assert names == [f"design_{m}.png" for m in METRICS] + ["design.json"]
+    assert [p for _, p in saved] == [tmp_path / f"design_{m}.png" for m in METRICS]
+    assert [f.split("\n")[0] for f, _ in saved] == [f"bench: {w}" for _, w in METRICS.values()]
+    d = json.loads((tmp_path / "design.json").read_text())
+    assert d == {"pair": [0, 1], "centre_deg": 7.8, "radius_m": [0.5, 2.0],
+                 "spacing_deg": [4.0, 10.0], "angular_resolution_deg": 17.5, "spec_deg": 0.1,
+                 "yield": 0.95, "draws": 200, "seed": 3,
+                 "designs": [{"radius_m": 0.5, "worst_error_deg": None}]}

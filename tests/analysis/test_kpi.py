@@ -485,3 +485,44 @@ def test_a_spec_file_too_large_or_with_a_reversed_span_is_refused(tmp_path):
                                              "with lo < hi", SceneError)
     p.write_text("azimuth_deg = [-6.0, 6.0]\n")
     assert load_spec(p).azimuth_deg == (-6.0, 6.0)
+
+
+def test_every_budget_row_names_its_input_unit_distribution_and_source(sheet):
+    """The rows of each set angle's budget (rtsgeom.analysis.kpi.accuracy.pair_accuracy) in
+    full but the sensitivities: six mounting offsets at the default 0.1 mm, the three delay
+    inputs (the calibration's scatter, half the RTS step as a rectangular, the step as a
+    triangular), each RuT antenna's phase at sigma_phase_deg, the receiver noise at the SNR of
+    the detection cell; one sensitivity for the three delay inputs."""
+    from rtsgeom.analysis.kpi.accuracy import effective_snr
+    from rtsgeom.geometry import build_setup
+    scene = rtsgeom.load_scene(DEFAULT_SCENE)
+    rut = build_setup(scene).rut
+    res_ps = scene.rts.delay_resolution_s * 1e12
+    snr = effective_snr(scene.radar)
+    n_tx, n_rx = rut.tx_local.shape[0], rut.rx_local.shape[0]
+    mount = "tolerance model, calibrated on the nominal setup"
+    rows = ([(f"front end {fe} {axis} offset", pytest.approx(0.1), "mm", "normal", mount)
+             for fe in (0, 1) for axis in ("radial", "tangential", "height")]
+            + [("calibration residual (J's fitted delay)", None, "ps", "normal",
+                "the sweep's fitted delay scatter over the frames averaged"),
+               ("calibration step (J's delay rounded)", pytest.approx(0.5 * res_ps / math.sqrt(3)),
+                "ps", "rectangular", f"half the RTS delay step {res_ps:g} ps"),
+               ("RTS delay quantisation (J against I)", pytest.approx(res_ps / math.sqrt(6)), "ps",
+                "triangular", "each channel's delay realised to the step [assumed independent]")]
+            + [(f"RuT {kind} {k} phase", pytest.approx(1.0), "deg", "normal",
+                "radars of the type about the scene's own")
+               for kind, n in (("Tx", n_tx), ("Rx", n_rx)) for k in range(n)]
+            + [("receiver noise (per I/Q, relative to the echo)",
+                pytest.approx(1 / math.sqrt(2 * snr)), "1", "normal",
+                f"each of {rut.num_virtual} virtual channels' I and Q, SNR "
+                f"{10 * math.log10(snr):.1f} dB at the detection, from radar.snr_db")])
+    for p in sheet.accuracy:
+        got = [(r.quantity, r.standard_uncertainty, r.unit, r.distribution, r.note)
+               for r in p.budget]
+        assert got[6][1] >= 0
+        assert got == [w if w[1] is not None else (*w[:1], got[6][1], *w[2:]) for w in rows]
+        assert len({r.sensitivity for r in p.budget[6:9]}) == 1
+        assert p.pair == (0, 1) and p.snr_effective_db == pytest.approx(10 * math.log10(snr))
+        assert p.expanded_deg == pytest.approx(2 * p.combined_deg)
+        assert p.combined_deg == pytest.approx(math.sqrt(sum(r.contribution_deg ** 2
+                                                             for r in p.budget)))

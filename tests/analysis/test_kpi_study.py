@@ -108,3 +108,167 @@ def test_the_snr_the_budget_uses_and_where_it_comes_from():
         "snr_effective_db"] is None
     assert math.isclose(_snr_inputs(linked, SimpleNamespace(snr_effective=10.0), pts)[
         "snr_effective_db"], 10.0)
+
+
+# -- the study on scenes without a synthesizable pair, and the Datasheet's views -----------
+
+def _no_resolution(monkeypatch):
+    import rtsgeom.analysis.kpi.study as study
+    called = []
+    monkeypatch.setattr(study, "resolution_section",
+                        lambda setup, progress: called.append(setup) or {"rts_deg": None,
+                                                                         "note": "stub"})
+    return called
+
+
+def test_a_nearest_mode_sheet_names_its_inputs_and_why_it_has_no_accuracy(monkeypatch):
+    """Every input of the budget named with where it comes from; no synthesizable pair in the
+    nearest mode: no accuracy, that note; the steps told in order."""
+    from conftest import CountedProgress, make_scene, quiet
+
+    from rtsgeom.analysis.kpi.study import Datasheet
+
+    def mutate(doc):
+        quiet(doc)
+        doc["radar"]["snr_db"] = 10.0
+        doc["rts"]["aoa_mode"] = "nearest"
+        doc["targets"] = []
+    scene = make_scene(mutate)
+    called = _no_resolution(monkeypatch)
+    told = CountedProgress()
+    sheet = KpiStudy(sigma_mm=(0.1, 0.2, 0.3), sigma_phase_deg=2.0, points=4, draws=300,
+                     seed=7)(scene, told)
+    assert isinstance(sheet, Datasheet) and len(called) == 1
+    r = scene.radar
+    from rtsgeom.analysis.kpi.accuracy import effective_snr
+    import math
+    assert sheet.inputs == {
+        "sigma_mm": {"radial": 0.1, "tangential": 0.2, "height": 0.3}, "sigma_mm_from": "sigma_mm",
+        "sigma_phase_deg": 2.0, "sigma_phase_from": "sigma_phase_deg", "snr_db": 10.0,
+        "snr_effective_db": pytest.approx(10 * math.log10(effective_snr(r))),
+        "snr_from": "radar.snr_db per sample, after the FFTs' coherent gain", "draws": 300,
+        "seed": 7, "points_per_pair": 4,
+        "delay_resolution_ps": pytest.approx(scene.rts.delay_resolution_s * 1e12)}
+    assert sheet.accuracy == () and sheet.accuracy_note == "no synthesizable pair in the " \
+                                                           "nearest mode"
+    assert sheet.targets["resolution"] == {"rts_deg": None, "note": "stub"}
+    assert sheet.scene_name == scene.name and sheet.study.points == 4 and sheet.spec is None
+    steps = [c[0] for c in told.calls if c[1:] == (0, 1)]
+    assert steps == ["field of view", "the signal chain on the scene's targets (rtsgeom run)",
+                     "range, velocity, targets, ghosts, near field",
+                     "resolution (two targets, truth beside RTS)"]
+    for s in steps:
+        assert told.finished(s), s
+    # the defaults: the scene's seed and the documented sigma
+    d = KpiStudy(draws=100)(scene)
+    assert d.inputs["seed"] == scene.seed
+    assert d.inputs["sigma_mm"] == {"radial": 0.1, "tangential": 0.1, "height": 0.1}
+    assert d.inputs["sigma_mm_from"] == ("the default 0.1 mm (the scene declares no "
+                                         "tolerance)")
+
+
+def test_a_sheet_of_cells_has_no_pair_budget_and_no_resolution(monkeypatch, sphere_scene):
+    import dataclasses
+    called = _no_resolution(monkeypatch)
+    sheet = KpiStudy(points=1, draws=100)(dataclasses.replace(sphere_scene, targets=()))
+    assert called == []
+    assert sheet.accuracy == () and sheet.accuracy_note == (
+        "a scene of 2-D cells: the budget covers pairs on an arc (azimuth); rtsgeom tolerance "
+        "--cell gives a cell's Monte Carlo")
+    assert sheet.targets["resolution"] == {
+        "min_separation_deg": None, "rts_deg": None, "truth_deg": None,
+        "note": "a scene of 2-D cells: the resolution test covers an arc"}
+
+
+def _point(pair, set_deg, err, u, validated=True, lo=-1.0, hi=1.0):
+    from rtsgeom.analysis.kpi.accuracy import AnglePoint
+    return AnglePoint(pair=pair, set_deg=set_deg, error_deg=err, budget=(), combined_deg=u / 2,
+                      expanded_deg=u, mc_interval_deg=(lo, hi), mc_mean_deg=0.0, mc_std_deg=0.1,
+                      validated=validated, end_difference=0.0)
+
+
+def _datasheet(points, spec=None, resolution=None, accuracy_m=0.01):
+    """A datasheet of ``points``, its other sections the headline test's."""
+    import copy
+
+    from analysis.test_kpi_headline import SHEET
+
+    from rtsgeom.analysis.kpi.study import Datasheet
+    d = copy.deepcopy(SHEET)
+    rv = {**d["range_velocity"], "min_range_m": 1.6, "max_range_m": 75.0,
+          "max_velocity_mps": 9.2, "range_accuracy_m": accuracy_m,
+          "velocity_accuracy_mps": None if accuracy_m is None else 0.05,
+          "accuracy_note": "no targets here"}
+    return Datasheet(scene_name="s", study=KpiStudy(),
+                     fov={**d["field_of_view"], "covered_deg": [[0.0, 10.0]]},
+                     accuracy=tuple(points), accuracy_note="acc note", inputs=d["inputs"],
+                     range_velocity=rv,
+                     targets={**d["targets"], "total": 12,
+                              "resolution": resolution or {"rts_deg": 4.0}},
+                     ghosts={"ghost_suppression_db": 26.0}, nearfield=d["near_field"],
+                     spec=spec)
+
+
+POINTS = [_point((0, 1), 2.0, 0.1, 0.2), _point((0, 1), 5.0, -0.3, 0.1),
+          _point((1, 2), 9.0, 0.0, 0.2, validated=False, lo=-0.7, hi=0.25)]
+
+
+@pytest.mark.parametrize("span, worst", [
+    (None, 0.7), ((2.0, 5.0), 0.4), ((2.0, 4.99), 0.3), ((2.01, 5.0), 0.4), ((5.0, 9.0), 0.7),
+    ((5.01, 8.99), None)])
+def test_the_worst_accuracy_over_a_span_includes_its_ends(span, worst):
+    got = _datasheet(POINTS).worst_accuracy_deg(span)
+    assert got == (None if worst is None else pytest.approx(worst))
+
+
+def test_the_sheets_values_for_the_spec_and_their_notes():
+    from rtsgeom.analysis.kpi.spec import KpiSpec
+    base = {"min_range_m": 1.6, "max_range_m": 75.0, "max_velocity_mps": 9.2, "targets": 12,
+            "ghost_suppression_db": 26.0}
+    assert _datasheet(POINTS).spec_values() == {
+        **base, "angle_accuracy_deg": pytest.approx(0.7), "azimuth_deg": None,
+        "range_accuracy_m": 0.01, "velocity_accuracy_mps": 0.05, "resolution_deg": 4.0}
+    got = _datasheet(POINTS, spec=KpiSpec(azimuth_deg=(-4.0, 1.5)),
+                     resolution={"rts_deg": None, "note": "res note"},
+                     accuracy_m=None).spec_values()
+    assert got == {**base, "angle_accuracy_deg": None, "azimuth_deg": pytest.approx(4.0),
+                   "range_accuracy_m": None, "velocity_accuracy_mps": None,
+                   "resolution_deg": None,
+                   "angle_accuracy_deg_note": "no set angle within azimuth_deg",
+                   "resolution_deg_note": "res note", "range_accuracy_m_note": "no targets here",
+                   "velocity_accuracy_mps_note": "no targets here"}
+    assert _datasheet([]).spec_values()["angle_accuracy_deg_note"] == "acc note"
+
+
+def test_the_sheets_table_summary_and_verdict():
+    from rtsgeom.analysis.kpi.spec import KpiSpec
+    sheet = _datasheet(POINTS)
+    assert (sheet.passed, sheet.exit_code, sheet.checks) == (None, 0, ())
+    df = sheet.to_dataframe()
+    assert list(df.columns) == ["pair", "set_angle_deg", "error_deg", "expanded_uncertainty_deg",
+                                "monte_carlo_half_width_deg", "gum_validated", "accuracy_deg"]
+    assert df["pair"].tolist() == ["0-1", "0-1", "1-2"]
+    assert df["set_angle_deg"].tolist() == [2.0, 5.0, 9.0]
+    assert df["error_deg"].tolist() == [0.1, -0.3, 0.0]
+    assert df["expanded_uncertainty_deg"].tolist() == [0.2, 0.1, 0.2]
+    assert df["monte_carlo_half_width_deg"].tolist() == pytest.approx([1.0, 1.0, 0.475])
+    assert df["gum_validated"].tolist() == [True, True, False]
+    assert df["accuracy_deg"].tolist() == pytest.approx([0.3, 0.4, 0.7])
+    met = _datasheet(POINTS, spec=KpiSpec(targets=12, max_range_m=70.0))
+    assert (met.passed, met.exit_code) == (True, 0)
+    title, rows = met._summary()
+    assert title == "s: datasheet"
+    from rtsgeom.analysis.kpi.headline import headline
+    assert rows[:-2] == headline(met.to_dict())
+    missed = _datasheet(POINTS, spec=KpiSpec(targets=13, resolution_deg=3.0))
+    assert (missed.passed, missed.exit_code) == (False, 1)
+    _, rows = missed._summary()
+    assert rows[-2:] == [("spec targets", "FAIL (margin -1)"),
+                         ("spec resolution_deg", "FAIL (margin -1)")]
+    _, rows = met._summary()
+    assert rows[-2:] == [("spec max_range_m", "pass (margin 5)"), ("spec targets",
+                                                                    "pass (margin 0)")]
+    none = _datasheet(POINTS, spec=KpiSpec(resolution_deg=3.0),
+                      resolution={"rts_deg": None, "note": "n"})
+    assert none._summary()[1][-1] == ("spec resolution_deg", "no value")
+    assert (none.passed, none.exit_code) == (False, 1)
