@@ -11,13 +11,15 @@ from rtsgeom.analysis.kpi.study import DEFAULT_SIGMA_MM, KpiStudy
 _SIGMA = "must be one number or three (radial, tangential, height) in [0, 10] mm"
 BOUNDS = [
     ("sigma_mm", [None, 0.0, 10.0, 0, (0.0, 10.0, 5.0), [1, 2, 3]],
-     [(-0.5, f"sigma_mm = -0.5: {_SIGMA}"), (10.5, f"sigma_mm = 10.5: {_SIGMA}"),
-      ((1.0, 1.0), f"sigma_mm = (1.0, 1.0): {_SIGMA}"),
-      ((1.0, 1.0, 1.0, 1.0), f"sigma_mm = (1.0, 1.0, 1.0, 1.0): {_SIGMA}"),
-      ((1.0, 1.0, 10.5), f"sigma_mm = (1.0, 1.0, 10.5): {_SIGMA}"),
-      ((-1.0, 1.0, 1.0), f"sigma_mm = (-1.0, 1.0, 1.0): {_SIGMA}"),
-      ((1.0, "2", 1.0), f"sigma_mm = (1.0, '2', 1.0): {_SIGMA}"),
-      ("1", f"sigma_mm = 1: {_SIGMA}")]),
+     [(-0.5, f"KpiStudy: sigma_mm = -0.5: {_SIGMA}"), (10.5, f"KpiStudy: sigma_mm = 10.5: {_SIGMA}"),
+      ((1.0, 1.0), f"KpiStudy: sigma_mm = (1.0, 1.0): {_SIGMA}"),
+      ((1.0, 1.0, 1.0, 1.0), f"KpiStudy: sigma_mm = (1.0, 1.0, 1.0, 1.0): {_SIGMA}"),
+      ((1.0, 1.0, 10.5), f"KpiStudy: sigma_mm = (1.0, 1.0, 10.5): {_SIGMA}"),
+      ((-1.0, 1.0, 1.0), f"KpiStudy: sigma_mm = (-1.0, 1.0, 1.0): {_SIGMA}"),
+      ((1.0, "2", 1.0), f"KpiStudy: sigma_mm = (1.0, '2', 1.0): {_SIGMA}"),
+      ("1", f"KpiStudy: sigma_mm = 1: {_SIGMA}"),
+      (True, f"KpiStudy: sigma_mm = True: {_SIGMA}"),
+      ((1.0, False, 1.0), f"KpiStudy: sigma_mm = (1.0, False, 1.0): {_SIGMA}")]),
     ("sigma_phase_deg", [None, 0.0, 90.0],
      [(-0.5, "KpiStudy: sigma_phase_deg = -0.5: must be in [0, 90] deg"),
       (90.5, "KpiStudy: sigma_phase_deg = 90.5: must be in [0, 90] deg")]),
@@ -29,7 +31,8 @@ BOUNDS = [
      [(-1, "KpiStudy: seed = -1: must be in [0, 9.22337e+18]"),
       (2 ** 63, "KpiStudy: seed = 9223372036854775808: must be in [0, 9.22337e+18]")]),
     ("spec", [None], [({"angle_accuracy_deg": 0.1},
-                       "spec: must be a KpiSpec (rtsgeom.analysis.kpi.load_spec)")]),
+                       "KpiStudy: spec = {'angle_accuracy_deg': 0.1}: must be a KpiSpec "
+                       "(rtsgeom.analysis.kpi.load_spec)")]),
 ]
 
 

@@ -91,15 +91,17 @@ class KpiStudy:
         s, lo, hi = self.sigma_mm, self.ARGS["sigma_mm"].lo, self.ARGS["sigma_mm"].hi
         vals = () if s is None else (s,) * 3 if np.isscalar(s) else tuple(s)
         if s is not None and (len(vals) != 3 or not all(
-                isinstance(v, (int, float)) and lo <= v <= hi for v in vals)):
-            raise ParameterError(f"sigma_mm = {s}: must be one number or three (radial, "
-                                 f"tangential, height) in [{lo:g}, {hi:g}] mm")
+                isinstance(v, (int, float)) and not isinstance(v, bool) and lo <= v <= hi
+                for v in vals)):  # a bool is an int to Python, never a sigma
+            raise ParameterError(f"KpiStudy: sigma_mm = {s}: must be one number or three "
+                                 f"(radial, tangential, height) in [{lo:g}, {hi:g}] mm")
         for name in ("sigma_phase_deg", "points", "draws", "seed"):
             value = getattr(self, name)
             if value is not None or name in ("points", "draws"):  # the others: None, default
                 self.ARGS[name].check(value, name, "KpiStudy")
         if self.spec is not None and not isinstance(self.spec, KpiSpec):
-            raise ParameterError("spec: must be a KpiSpec (rtsgeom.analysis.kpi.load_spec)")
+            raise ParameterError(f"KpiStudy: spec = {self.spec!r}: must be a KpiSpec "
+                                 "(rtsgeom.analysis.kpi.load_spec)")
 
     def __repr__(self) -> str:
         return (f"KpiStudy(sigma_mm={self.sigma_mm}, sigma_phase_deg={self.sigma_phase_deg}, "
