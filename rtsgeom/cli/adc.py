@@ -86,7 +86,7 @@ def register(sub) -> None:
                         "JSON); default: dca1000 for a .bin file, else npy")
     p.add_argument("--amplitudes", choices=tuple(AOA_MODES), default=None,
                    help="AoA amplitude mode (default: the scene's rts.aoa_mode)")
-    p.add_argument("--quiet", action="store_true", help="no progress output on stderr")
+    p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.add_argument("--active", type=number(0, 10_000, integer=True), default=None, metavar="I",
                    help="capture front end I alone with a probe target (for rtsgeom identify; "
                         "the sidecar OUT.json records the probe)")

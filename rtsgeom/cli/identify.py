@@ -124,7 +124,7 @@ def register(sub) -> None:
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     p.add_argument("--out", type=output_path, default=None,
                    help="folder for identified.toml (the corrected scene) and identified.json")
-    p.add_argument("--quiet", action="store_true", help="no progress output")
+    p.add_argument("--quiet", action="store_true", help="print nothing but errors (--json still prints the estimates)")
     p.add_argument("--accept-misfit", action="store_true",
                    help="write the estimates of a fit whose residual exceeds "
                         f"{RESIDUAL_LIMIT:g} x noise (flagged misfit) instead of refusing them")
