@@ -120,3 +120,21 @@ def test_command_table_matches_the_modules():
         assert prog_full.get_default("func").__module__ == f"rtsgeom.cli.{module}"
     top_lazy = build_parser(None, lazy=True).format_help()
     assert top_lazy == build_parser().format_help()
+
+
+@pytest.mark.parametrize("code", [0, 2, 130])
+def test_the_console_entry_exits_with_mains_code_its_objects_frozen_first(monkeypatch, code):
+    """``rtsgeom`` (console script, ``python -m rtsgeom``) is main's exit code; what the
+    command left is frozen out of the garbage collector before the interpreter's teardown."""
+    import gc
+
+    import rtsgeom.cli as cli
+    monkeypatch.setattr(cli, "main", lambda: code)
+    gc.unfreeze()
+    try:
+        with pytest.raises(SystemExit) as exc:
+            cli.console()
+        assert exc.value.code == code
+        assert gc.get_freeze_count() > 0
+    finally:
+        gc.unfreeze()
