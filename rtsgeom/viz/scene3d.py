@@ -41,7 +41,7 @@ from .render_backend import ensure_render_backend
 __all__ = ["VizError", "ensure_render_backend", "build_plotter", "render_setup_png",
            "setup_png_bytes",
            "export_setup_html", "show_setup", "TARGET_RADIUS_FACTOR", "rut_scale_factor",
-           "undrawable_reflections"]
+           "undrawable_reflections", "labelled_targets", "MAX_TARGET_LABELS"]
 
 
 def _add_setup(pl, setup: Setup, paths, scale: float, labels: str) -> list:
@@ -118,6 +118,22 @@ def _add_setup(pl, setup: Setup, paths, scale: float, labels: str) -> list:
     return legend
 
 
+#: the most targets labelled in the 3D view; beyond, every k-th in azimuth (the staggered
+#: labels of 32 targets rose out of the picture and covered the title)
+MAX_TARGET_LABELS = 8
+
+
+def labelled_targets(setup: Setup) -> list[int]:
+    """The indices of the targets the view labels, in azimuth order: all of up to
+    :data:`MAX_TARGET_LABELS`, else every k-th (the first and the last included)."""
+    order = np.argsort([t.angle_rad for t in setup.scene.targets], kind="stable")
+    n = order.size
+    if n <= MAX_TARGET_LABELS:
+        return [int(j) for j in order]
+    keep = np.unique(np.round(np.linspace(0, n - 1, MAX_TARGET_LABELS)).astype(int))
+    return [int(order[k]) for k in keep]
+
+
 def _add_labels(pl, setup: Setup, scale: float, text3d: bool = False) -> None:
     """Text labels with leader lines: FE antennas above/below the cutout, targets staggered.
 
@@ -137,18 +153,17 @@ def _add_labels(pl, setup: Setup, scale: float, text3d: bool = False) -> None:
     board_top = board(setup, scale).bounds
     anchors.append(np.array([rut.position[0], rut.position[1], board_top[5] + 0.04]))
     texts.append(f"RuT (x{scale:g})")
-    if setup.scene.targets:
-        pos, _ = target_positions(setup)
-        order = np.argsort([t.angle_rad for t in setup.scene.targets])
-        for k, j in enumerate(order):
-            t = setup.scene.targets[j]
-            a = pos[j] + (0.06 + 0.045 * k) * z_hat
-            anchors.append(a)
-            leaders.append(np.array([pos[j], a]))
-            el = t.elevation_rad
-            texts.append(f"T{j}: {t.range_m:g} m, {np.degrees(t.angle_rad):g} deg"
-                         + (f" el {np.degrees(el):g} deg" if el else "")
-                         + f", {t.velocity_mps:+g} m/s")
+    pos = target_positions(setup)[0] if setup.scene.targets else None
+    for k, j in enumerate(labelled_targets(setup)):
+        t = setup.scene.targets[j]
+        p = pos[j]
+        a = p + (0.06 + 0.045 * k) * z_hat  # staggered upwards, one level per label
+        anchors.append(a)
+        leaders.append(np.array([p, a]))
+        el = t.elevation_rad
+        texts.append(f"T{j}: {t.range_m:.4g} m, {np.degrees(t.angle_rad):.1f} deg"
+                     + (f" el {np.degrees(el):.1f} deg" if el else "")
+                     + f", {t.velocity_mps:+.3g} m/s")
     pl.add_mesh(merge_lines(leaders), color="#444444", line_width=1)
     if text3d:
         normal = -_overview_direction(setup)  # towards the camera
@@ -273,8 +288,10 @@ def build_plotter(setup: Setup, paths=None, window_size=(1600, 1000), off_screen
     # literal dollar (vtkTextRenderer strips the escape before FreeType draws it)
     title = title.replace("$", "\\$")
     pl.add_text(title, position="upper_left", font_size=12, color="black")
+    n_t, n_lab = len(s.targets), len(labelled_targets(setup))
     note = (f"RuT drawn x{scale:g} about its phase centre; front-end markers enlarged; "
-            f"targets drawn at {TARGET_RADIUS_FACTOR:g} x arc radius")
+            f"targets drawn at {TARGET_RADIUS_FACTOR:g} x arc radius"
+            + (f" ({n_lab} of {n_t} labelled)" if n_lab < n_t else ""))
     if paths is not None:
         table = split_paths(paths)[0]
         n_refl = int((np.asarray(table.bounces) > 0).sum())

@@ -459,3 +459,26 @@ def test_report_loads_in_headless_chromium(report, tmp_path):
                          capture_output=True, text=True, timeout=60)
     assert run.returncode == 0, run.stderr
     assert shot.is_file() and shot.stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("n", [0, 1, 7, 8, 9, 16, 32, 100])
+def test_the_view_labels_all_targets_up_to_eight_else_every_kth_in_azimuth(n):
+    """Up to MAX_TARGET_LABELS targets all labelled in azimuth order; more: that many, spread
+    evenly over the azimuth order with the outermost two included, no target twice."""
+    from types import SimpleNamespace
+
+    from rtsgeom.viz.scene3d import MAX_TARGET_LABELS, labelled_targets
+    rng = np.random.default_rng(n)
+    angles = rng.permutation(np.linspace(-0.5, 0.5, n))
+    setup = SimpleNamespace(scene=SimpleNamespace(
+        targets=[SimpleNamespace(angle_rad=a) for a in angles]))
+    got = labelled_targets(setup)
+    order = list(np.argsort(angles))
+    assert MAX_TARGET_LABELS == 8
+    if n <= 8:
+        assert got == order
+        return
+    assert len(got) == 8 == len(set(got))
+    ranks = [order.index(j) for j in got]
+    assert ranks == sorted(ranks) and ranks[0] == 0 and ranks[-1] == n - 1
+    assert np.ptp(np.diff(ranks)) <= 1  # evenly spread: gaps differ by one at most
