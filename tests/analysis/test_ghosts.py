@@ -97,3 +97,63 @@ def test_the_ghost_table_has_a_row_per_target_and_order_with_the_simulated_level
     sim[2] = {"ghosts": []}
     assert _ghost_report(3, simulated=sim)._columns()["simulated_level_db"] == [-19.0, -21.0,
                                                                                  None]
+
+
+@pytest.mark.parametrize("floor_db", [-40.0, -25.0])
+def test_the_ghost_orders_and_predictions_in_full(floor_db):
+    """Each front end's whole entry from the cable's closed form: Gamma = 10^(-RL/20),
+    a = 10^(-loss/20), order n at n L / VF (delay n L / (VF c) ... as 2 x range / c) with
+    level (n + 1) (Gamma_fe Gamma_be a^2)^n, those above the floor, in order; a matched
+    front end (a return loss at one end only) has none. Each target's ghosts sit on its nearest front
+    end's, at its range plus the offset."""
+    from scipy.constants import c
+
+    from rtsgeom.analysis.ghosts import ghost_orders, predict_ghosts
+
+    def m(doc):
+        doc.update(targets=[{"range_m": 12.0, "angle_deg": 3.4, "velocity_mps": -2.0},
+                            {"range_m": 20.0, "angle_deg": 12.2}])
+        doc["rts"]["front_ends"][0].update(cable_length_m=2.5, return_loss_fe_db=6.0,
+                                           return_loss_be_db=10.0, cable_loss_db=1.0)
+        doc["rts"]["front_ends"][1]["return_loss_fe_db"] = 20.0  # one end alone: matched
+        doc["rts"]["front_ends"][1].pop("return_loss_be_db", None)
+    scene = make_scene(m)
+    fes = scene.rts.front_ends
+    want = []
+    for q, fe in enumerate(fes):
+        vf = fe.cable_velocity_factor
+        entry = {"index": q, "mismatched": q == 0, "cable_length_m": fe.cable_length_m,
+                 "cable_velocity_factor": vf, "cable_loss_db": fe.cable_loss_db,
+                 "return_loss_fe_db": 6.0 if q == 0 else 20.0,
+                 "return_loss_be_db": 10.0 if q == 0 else None,
+                 "gamma_fe": 10 ** (-6 / 20) if q == 0 else 0.1,
+                 "gamma_be": 10 ** (-10 / 20) if q == 0 else None,
+                 "range_offset_per_order_m": fe.cable_length_m / vf, "ghosts": []}
+        if q == 0:
+            r = 10 ** (-6 / 20) * 10 ** (-10 / 20) * 10 ** (-2 * 1.0 / 20)
+            for n in range(1, 40):
+                level = 20 * np.log10((n + 1) * r ** n)
+                if level < floor_db:
+                    break
+                entry["ghosts"].append({"order": n, "delay_s": 2 * n * 2.5 / vf / c,
+                                        "range_offset_m": n * 2.5 / vf, "level_db": level})
+        want.append(entry)
+    got = ghost_orders(scene, floor_db)
+    assert [len(g["ghosts"]) for g in got] == [len(w["ghosts"]) for w in want]
+    assert len(want[0]["ghosts"]) == {-40.0: 2, -25.0: 1}[floor_db]
+    for g, w in zip(got, want):
+        gh, wh = g.pop("ghosts"), w.pop("ghosts")
+        assert g == w
+        for a, b in zip(gh, wh):
+            assert a == pytest.approx(b, rel=1e-9, abs=1e-18)
+            assert a["order"] == b["order"]
+        g["ghosts"] = gh
+    pred = predict_ghosts(scene, floor_db)
+    assert [{k: v for k, v in p.items() if k != "ghosts"} for p in pred] == [
+        {"index": 0, "range_m": 12.0, "velocity_mps": -2.0, "angle_deg": pytest.approx(3.4),
+         "front_end": 0},
+        {"index": 1, "range_m": 20.0, "velocity_mps": 0.0, "angle_deg": pytest.approx(12.2),
+         "front_end": 1}]
+    assert pred[0]["ghosts"] == [{**x, "range_m": 12.0 + x["range_offset_m"]}
+                                 for x in got[0]["ghosts"]]
+    assert pred[1]["ghosts"] == []

@@ -310,3 +310,133 @@ def test_bad_radii_are_named_the_first_four(default_scene, radii, got):
     assert str(exc.value) == (f"arc radii must lie in [0.05, {max_radius_m(default_scene):.4g}] "
                               f"m (the probe target must stay within the radar's range), got "
                               f"{got} m")
+
+
+# -- the result as it shows itself: summary, table and the 1/R coefficient, in full --------
+
+
+def _near_field(scene, radii, **over):
+    """A NearField of made-up numbers (R radii x 2 front ends), each array distinct, so that
+    every row of the summary and every column of the table reads a field of its own."""
+    from rtsgeom.analysis.nearfield import NearField
+    r = np.asarray(radii, float)
+    n = r.size
+    base = np.arange(1.0, 2 * n + 1).reshape(n, 2)
+    fields = dict(scene=scene, radius_m=r, range_m=10.0 + r, geometric_deg=5.0 + base,
+                  detected_deg=5.0 + 1.25 * base, separation_deg=0.1 * base,
+                  parallax_deg=0.05 * base ** 2, beat_frequency_deg=-0.01 * base,
+                  phase_pp_deg=2.0 * base, phase_rms_deg=0.5 * base,
+                  curvature_pp_deg=0.02 * base, synthesis=[[] for _ in r],
+                  fraunhofer_m=0.1238, aperture_m=0.0175, wavelength_m=0.0039)
+    fields.update(over)
+    return NearField(**fields)
+
+
+@pytest.mark.parametrize("radii, k", [([0.5, 1.0, 3.0], 1), ([0.5, 2.0], None),
+                                      ([1.0 + 1e-12, 4.0], 0)])
+def test_the_near_fields_summary_in_full(radii, k):
+    """The title (radii, their range, front ends), each array's row, bias x R as the largest
+    |coefficient| over the front ends with the radius where it falls below 0.01 deg, and the
+    scene radius's worst |bias| only where the scene's radius is one of the sweep's (to 1e-9
+    relative)."""
+    from rtsgeom._lib.results import brief
+    scene = make_scene()
+    nf = _near_field(scene, radii)
+    r = np.asarray(radii)
+    bias = nf.detected_deg - nf.geometric_deg
+    coef = (nf.separation_deg[-1] + nf.parallax_deg[-1]) * r[-1]
+    assert nf.bias_times_radius_deg_m() == pytest.approx(coef, rel=1e-15)
+    worst = np.max(np.abs(coef))
+    title, rows = nf._summary()
+    assert title == (f"diewald2022: near field over {r.size} arc radii ({r.min():g} to "
+                     f"{r.max():g} m), 2 front ends")
+    curvature = bias - nf.separation_deg - nf.parallax_deg - nf.beat_frequency_deg
+    expected = [("radius_m", r), ("bias_deg", bias), ("separation_deg", nf.separation_deg),
+                ("parallax_deg", nf.parallax_deg), ("curvature_deg", curvature),
+                ("phase_pp_deg", nf.phase_pp_deg),
+                ("bias x R", f"{worst:.3g} deg m (largest |.| over the front ends): below "
+                             f"0.01 deg from R_c {worst / 0.01:.3g} m"),
+                ("fraunhofer_m", 0.1238), ("aperture_m", 0.0175)]
+    if k is not None:
+        expected.append((f"at R_c {r[k]:g} m",
+                         f"|bias| up to {np.max(np.abs(bias[k])):.4g} deg"))
+    assert [name for name, _ in rows] == [name for name, _ in expected]
+    for (_, got), (_, want) in zip(rows, expected):
+        assert (brief(got) if not isinstance(got, str) else got) == (
+            brief(want) if not isinstance(want, str) else want)
+        if isinstance(want, np.ndarray):
+            np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-15)
+    assert nf.scene_index() == k
+
+
+def test_the_near_fields_bias_coefficient_of_a_smoothed_estimator_is_the_median():
+    """A smoothed Capon's coefficient: the median over the radii of the detected bias x R,
+    per front end (not the closed forms' value at the largest radius)."""
+    scene = make_scene(angle_estimator="capon", angle_subarray=5)
+    nf = _near_field(scene, [0.5, 1.0, 3.0, 9.0])
+    bias_r = (nf.detected_deg - nf.geometric_deg) * nf.radius_m[:, None]
+    np.testing.assert_array_equal(nf.bias_times_radius_deg_m(), np.median(bias_r, axis=0))
+    plain = _near_field(make_scene(angle_estimator="capon", angle_subarray=0), [0.5, 1.0])
+    np.testing.assert_array_equal(plain.bias_times_radius_deg_m(),
+                                  (plain.separation_deg[-1] + plain.parallax_deg[-1]) * 1.0)
+
+
+@pytest.mark.parametrize("two_d", [False, True])
+def test_the_near_fields_table_in_full(two_d):
+    """One row per (radius, front end), radius-major; every column the ravelled field (the
+    derived ones from their definitions), the elevation bias only for a 2-D beamformer."""
+    r = [0.5, 1.0, 3.0]
+    el = (dict(geometric_el_deg=np.full((3, 2), 1.0), detected_el_deg=np.arange(6.0).reshape(3, 2))
+          if two_d else {})
+    nf = _near_field(make_scene(), r, **el)
+    cols = nf._columns()
+    names = ["radius_m", "front_end", "geometric_deg", "detected_deg", "bias_deg",
+             "separation_deg", "parallax_deg", "beat_frequency_deg", "curvature_deg",
+             "phase_pp_deg", "phase_rms_deg", "curvature_pp_deg"]
+    assert list(cols) == names + (["elevation_bias_deg"] if two_d else [])
+    assert cols["radius_m"].tolist() == [0.5, 0.5, 1.0, 1.0, 3.0, 3.0]
+    assert cols["front_end"].tolist() == [0, 1, 0, 1, 0, 1]
+    bias = nf.detected_deg - nf.geometric_deg
+    want = {"geometric_deg": nf.geometric_deg, "detected_deg": nf.detected_deg,
+            "bias_deg": bias, "separation_deg": nf.separation_deg,
+            "parallax_deg": nf.parallax_deg, "beat_frequency_deg": nf.beat_frequency_deg,
+            "curvature_deg": bias - nf.separation_deg - nf.parallax_deg - nf.beat_frequency_deg,
+            "phase_pp_deg": nf.phase_pp_deg, "phase_rms_deg": nf.phase_rms_deg,
+            "curvature_pp_deg": nf.curvature_pp_deg}
+    for name, a in want.items():
+        np.testing.assert_allclose(cols[name], a.ravel(), rtol=1e-12, atol=1e-15, err_msg=name)
+    assert nf.near_field_deg == pytest.approx(bias - nf.separation_deg)
+    if two_d:
+        np.testing.assert_array_equal(cols["elevation_bias_deg"], np.arange(6.0) - 1.0)
+    else:
+        assert nf.elevation_bias_deg is None
+
+
+def test_the_radius_check_takes_its_bounds_and_refuses_beyond_them():
+    """[MIN_RADIUS_M, max_radius_m] both ends accepted, a hair beyond refused; a 2-D array of
+    radii is refused, naming its values."""
+    from rtsgeom.analysis.nearfield import _check_radii, max_radius_m
+    scene = make_scene()
+    hi = max_radius_m(scene)
+    assert hi == 0.8 * scene.radar.max_range_m - 2.0
+    _check_radii(scene, np.array([0.05, 1.0, hi]))
+    msg = ("arc radii must lie in [0.05, {:.4g}] m (the probe target must stay within the "
+           "radar's range), got {} m").format(hi, "{}")
+    for bad, got in (([0.05 * (1 - 1e-12)], "0.05"), ([hi * (1 + 1e-12)], f"{hi:.4g}"),
+                     ([[1.0, 2.0]], "1, 2"), ([float("inf")], "inf")):
+        with pytest.raises(ParameterError) as exc:
+            _check_radii(scene, np.array(bad))
+        assert str(exc.value) == msg.format(got)
+
+
+def test_default_radii_clip_to_the_limits_and_keep_them():
+    """Below MIN_RADIUS_M the sweep starts at 0.05 m exactly; radii inside are the log sweep
+    of R_c x 10^(-0.5..1.5); a sweep exactly at its ends keeps them without adding."""
+    from rtsgeom.analysis.nearfield import DEFAULT_DECADES, DEFAULT_POINTS, default_radii
+    assert (DEFAULT_DECADES, DEFAULT_POINTS) == ((-0.5, 1.5), 13)
+    small = with_arc_radius(make_scene(), 0.1)  # unchecked: only the radius is read
+    got = default_radii(small, 5)
+    full = 0.1 * np.logspace(-0.5, 1.5, 5)
+    assert got[0] == 0.05 and np.array_equal(got[1:], full[full >= 0.05])
+    scene = make_scene()
+    np.testing.assert_array_equal(default_radii(scene, 3), np.logspace(-0.5, 1.5, 3))

@@ -55,3 +55,97 @@ def test_spans_that_do_not_overlap_have_no_synthesis_errors(default_scene, shift
     assert ok["span_deg"] == pytest.approx(list(np.degrees(geo)), abs=1e-9)
     assert ok["array_factor_max_abs_error_deg"] >= 0 and ok["exact_max_abs_error_deg"] >= 0
     assert "note" not in ok
+
+
+# -- the synthesized direction's worst errors: the whole dict against the model's primitives --
+
+
+def _designs(setup, paths, channels, target, steering=None):
+    """The design model (nominal setup) and the detection model (as built), built here."""
+    from rtsgeom.paths import nominal_model
+    from rtsgeom.synthesis.model import ChannelModel
+    nom, nom_paths = nominal_model(setup, paths)
+    kw = {} if steering is None else {"steering": steering}
+    return (ChannelModel.build(nom, nom_paths, channels, target, **kw),
+            ChannelModel.build(setup, paths, channels, target, **kw))
+
+
+@pytest.mark.parametrize("moved", [False, True])
+def test_a_pairs_worst_synthesis_errors_in_full(default_scene, moved):
+    """Set-points at k / (points + 1) of the overlap of the measured and geometric spans;
+    the ratio designed on the nominal setup (array-factor or exact) at the probes' phase,
+    detected on the setup as built at its own phase; the worst |error| per mode, every key."""
+    from conftest import moved_front_end
+
+    from rtsgeom.analysis.nearfield_terms import synthesis_errors, synthesis_worst_errors_deg
+    from rtsgeom.calibration.probes import probe_angles
+    from rtsgeom.paths import exact_paths
+    from rtsgeom.radar.steering import Steering
+    from rtsgeom.scene import TargetConfig
+    scene = moved_front_end(default_scene) if moved else default_scene
+    setup = build_setup(scene)
+    paths = exact_paths(setup)
+    geo = build_setup(default_scene).fe_azimuth_rad()
+    single = geo + np.radians([0.3, -0.2])  # measured inside the geometric span
+    design, actual = _designs(setup, paths, (0, 1), TargetConfig(15.0))
+    lo, hi = single
+    sets = lo + np.arange(1, 5) / 5 * (hi - lo)
+    probes = probe_angles(*single)
+    ph_d, ph_a = float(design.pair_phase(probes)), float(actual.pair_phase(probes))
+    worst = {}
+    for mode in ("array-factor", "exact"):
+        err = [np.degrees(float(actual.direction(actual.pair_weights(
+            design.pair_ratio(a, (0.0, ph_d), mode), (0.0, ph_a)))) - a) for a in sets]
+        worst[mode] = float(np.max(np.abs(err)))
+    got = synthesis_worst_errors_deg(setup, paths, (0, 1), 15.0, single, points=4)
+    assert got == {"pair": [0, 1], "span_deg": [float(np.degrees(lo)), float(np.degrees(hi))],
+                   "points": 4, "array_factor_max_abs_error_deg": worst["array-factor"],
+                   "exact_max_abs_error_deg": worst["exact"]}
+    assert (worst["exact"] > 1e-3) is moved  # the design's model is not the built setup's
+    st = Steering.auto(setup.rut, scene.radar)
+    assert synthesis_errors(setup, paths, st, 15.0, single, 4) == [got]
+
+
+@pytest.mark.parametrize("points, n", [(6, 2), (7, 3), (1, 2)])
+def test_a_cells_worst_synthesis_errors_in_full(sphere_scene, points, n):
+    """An n x n grid, n = round(sqrt(points)) >= 2, at (k + 1) / (n + 1) of the front ends'
+    extent in azimuth and elevation (all inside sphere4's rectangle of front ends); each set
+    direction designed on the nominal model (array-factor, exact) at the channels' coherent
+    phases, detected on the built one; the worst |error| per angle and their larger, every
+    key."""
+    from rtsgeom.analysis.nearfield_terms import cell_synthesis_errors_deg, synthesis_errors
+    from rtsgeom.paths import exact_paths
+    from rtsgeom.radar.steering import Steering
+    from rtsgeom.scene import TargetConfig
+    setup = build_setup(sphere_scene)
+    paths = exact_paths(setup)
+    st = Steering.auto(setup.rut, sphere_scene.radar)
+    cell = (0, 1, 2, 3)
+    design, actual = _designs(setup, paths, cell, TargetConfig(15.0), st)
+    ang = st.angles(setup.fe_direction_cosines())
+    lo, hi = ang.min(0), ang.max(0)
+    f = np.arange(1, n + 1) / (n + 1)
+    grid = [(lo[0] + a * (hi[0] - lo[0]), lo[1] + b * (hi[1] - lo[1])) for a in f for b in f]
+    want = {"cell": [0, 1, 2, 3],
+            "span_deg": {"azimuth": list(np.degrees([lo[0], hi[0]])),
+                         "elevation": list(np.degrees([lo[1], hi[1]]))},
+            "points": n * n}
+    for mode, key in (("array-factor", "array_factor"), ("exact", "exact")):
+        errs = []
+        for a in grid:
+            u = st.directions(np.array(a))
+            w = design.solve(u, design.coherent_phases(u[None]), mode=mode)
+            got = actual.direction(np.abs(w) * np.exp(1j * actual.coherent_phases(u[None])))
+            errs.append(np.abs(np.degrees(got - np.array(a))))
+        worst = np.max(errs, axis=0)
+        want[f"{key}_max_abs_error_azimuth_deg"] = float(worst[0])
+        want[f"{key}_max_abs_error_elevation_deg"] = float(worst[1])
+        want[f"{key}_max_abs_error_deg"] = float(max(worst))
+    got = cell_synthesis_errors_deg(setup, paths, cell, 15.0, points)
+    assert got == want
+    assert want["array_factor_max_abs_error_elevation_deg"] != want[
+        "array_factor_max_abs_error_azimuth_deg"]
+    if points == 6:
+        assert synthesis_errors(setup, paths, st, 15.0, None, points) == [got]
+        tri = cell_synthesis_errors_deg(setup, paths, (0, 1, 2), 15.0, points)
+        assert tri["cell"] == [0, 1, 2] and 0 < tri["points"] < 4  # outside the hull dropped

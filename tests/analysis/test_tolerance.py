@@ -668,3 +668,168 @@ def test_range_offset_is_half_c_times_the_mean_delay_mismatch():
 def test_a_bad_invert_yield_is_named(value):
     with pytest.raises(ParameterError, match=r"invert_yield"):
         ToleranceStudy(invert_yield=value)
+
+
+# -- the pair's procedure against its closed forms (on the module's model: no second build) --
+
+
+def test_the_pairs_tables_are_laid_out_as_their_closed_forms_say(model):
+    """The set-points at k / (points + 1) and the probes at 1/4, 3/4 of the span between the
+    front ends each detected alone; eq. (27)'s slope f_rts + B/2; the calibration's reach
+    ceil(1 / (2 slope dtau)) + 4 steps; J's IF period at the target in steps; the table's
+    rows (every sub-bin position, calibration delay and period, +2) and bins (the reach of
+    J's echo in bins, +1 either side), each row the channel's response at that delay."""
+    from rtsgeom.analysis.tolerance.pair import PROBE_FRACTIONS
+    from rtsgeom.analysis.tolerance.tables import response_table
+    from rtsgeom.calibration.probes import if_phase_slope_hz
+    pr, ch = model.procedure, model.channels
+    nom, radar, rts = model.setup, model.setup.scene.radar, model.setup.scene.rts
+    th = ch.direction(np.eye(2))
+    np.testing.assert_allclose(pr.fe_angle_rad, th, atol=1e-12)
+    np.testing.assert_allclose(model.set_rad, th[0] + np.arange(1, 22) / 22 * (th[1] - th[0]),
+                               atol=1e-12)
+    assert PROBE_FRACTIONS == (0.25, 0.75)
+    np.testing.assert_allclose(pr.probe_rad, [0.75 * th[0] + 0.25 * th[1],
+                                              0.25 * th[0] + 0.75 * th[1]], atol=1e-12)
+    res = model.delay_resolution_s
+    assert res == rts.delay_resolution_s
+    slope = rts.f_rts_hz + radar.bandwidth_hz / 2
+    assert model.cal_slope_hz == slope
+    ms = math.ceil(0.5 / (slope * res)) + 4
+    assert pr.max_steps == ms and pr.delay_factor.shape == (2 * ms + 1, 8)
+    period = 1 / float(if_phase_slope_hz(nom.scene, 2 * model.range_m / c))
+    assert pr.period_steps == round(period / res)
+    n_bin = model.subbin_steps.size
+    assert np.array_equal(model.subbin_steps, np.arange(n_bin) - n_bin // 2)
+    z = n_bin // 2 + ms + pr.period_steps + 2
+    reach = max(1, math.floor((n_bin // 2 + ms) / n_bin + 0.5))
+    reach_far = max(1, math.floor((n_bin // 2 + ms + pr.period_steps) / n_bin + 0.5))
+    assert (pr.design.reach, pr.reach_far) == (reach, reach_far)
+    nb = reach_far + 1
+    assert model.table_zero == z and model.table.shape == (2, 2 * z + 1, 2 * nb + 1, 8)
+    assert pr.design.i0 == z - n_bin // 2 - 1
+    target = TargetConfig(model.range_m)
+    paths = exact_paths(nom)
+    d = np.array([-z, -3, 0, 17, z])
+    np.testing.assert_allclose(model.table[1, z + d], response_table(
+        nom, paths, 1, target, res, d, nb), rtol=1e-12, atol=1e-12)
+    # channel I only sits at the sub-bin positions (+-1 row): the rows beyond are its edge's
+    near = np.clip(d, -(n_bin // 2) - 1, n_bin // 2 + 1)
+    np.testing.assert_allclose(model.table[0, z + d], response_table(
+        nom, paths, 0, target, res, near, nb), rtol=1e-12, atol=1e-12)
+
+
+def test_the_pairs_derived_tables_are_their_definitions(model):
+    """J's delay response at the bin centre relative to no delay (1 at 0), the log slopes as
+    central differences of ln|table| in the delay (one-sided at the ends), each channel's power
+    over the elements, the probes' beams, channel I alone at its peak (a dense search),
+    the beams at the set angles for I's rows from i0 on."""
+    from rtsgeom.analysis.tolerance.pair import _set_beams
+    pr, ds = model.procedure, model.procedure.design
+    t, z, ms = model.table, model.table_zero, model.procedure.max_steps
+    res = model.delay_resolution_s
+    nb = t.shape[2] // 2
+    np.testing.assert_allclose(pr.delay_factor, t[1, z - ms:z + ms + 1, nb] / t[1, z, nb],
+                               rtol=1e-13)
+    np.testing.assert_allclose(pr.delay_factor[ms], 1.0, rtol=0, atol=1e-15)
+    ln = np.log(np.abs(t[1, :, nb]))
+    slope = model.table_log_slope
+    for row in (z - ms, z, z + 5):
+        np.testing.assert_allclose(slope[1, row, nb], (ln[row + 1] - ln[row - 1]) / (2 * res),
+                                   rtol=1e-9)
+    np.testing.assert_allclose(slope[1, 0, nb], (ln[1] - ln[0]) / res, rtol=1e-9)
+    np.testing.assert_allclose(pr.delay_log_slope, slope[1, z - ms:z + ms + 1, nb], rtol=0)
+    np.testing.assert_allclose(ds.power, np.sum(np.abs(t) ** 2, -1), rtol=1e-12)
+    st = model.channels.steering
+    np.testing.assert_allclose(ds.probe_beams, st.beam(t[:, :, nb], st.directions(pr.probe_rad)),
+                               rtol=1e-12)
+    assert ds.unit_gain == model.channels.unit_gain
+    sub = model.subbin_steps
+    for u in (0, sub.size // 2, sub.size - 1):
+        rows = t[0, z + sub[u]]
+        one = rows[np.argmax(np.sum(np.abs(rows) ** 2, -1))]
+        grid = np.linspace(pr.fe_angle_rad[0] - 0.02, pr.fe_angle_rad[0] + 0.02, 4001)
+        dense = np.max(np.abs(st.beam(one, st.directions(grid))) ** 2)
+        assert ds.p_one[u] == pytest.approx(dense, rel=1e-6)
+        assert ds.p_one[u] >= dense * (1 - 1e-12)  # the refined peak, not below the grid's
+    rows = np.array([ds.i0, z, z + sub[-1] + 1])
+    np.testing.assert_allclose(ds.beams_i[rows - ds.i0], _set_beams(st, t[0, rows],
+                                                                    model.set_rad), rtol=1e-12)
+    assert ds.beams_i.shape[0] == 2 * (sub.size // 2) + 3
+    np.testing.assert_allclose(ds.beams_j[[0, z, -1]], _set_beams(st, t[1, [0, z, -1]],
+                                                                  model.set_rad), rtol=1e-12)
+    np.testing.assert_array_equal(model.amplitudes, pr.design_amplitudes[model.subbin_zero])
+
+
+def test_the_pairs_calibration_phase_and_steps_follow_eq_27(model):
+    """The design's phase is the circular mean over the probes of I's beam times J's
+    conjugate; the calibration's steps are eq. (27)'s delay for the coherence phase, refined
+    to the table's phase within +-3 steps: turning J's phasors by phi moves them by
+    phi / (2 pi slope dtau) steps (to one step)."""
+    pr, ds = model.procedure, model.procedure.design
+    z = model.table_zero
+    rows_i, rows_j = np.array([z, z - 7, z + 3]), np.array([z, z + 11, z - 40])
+    zz = ds.probe_beams[0][rows_i] * np.conj(ds.probe_beams[1][rows_j])
+    want = np.angle(np.sum(zz / np.abs(zz), -1))
+    np.testing.assert_allclose(ds.phase(rows_i, rows_j), want, atol=1e-12)
+    x = model.x_nominal
+    phi = np.radians([-150.0, -40.0, 0.0, 25.0, 170.0])
+    xq = np.stack([x] * phi.size)
+    xq[:, 1] *= np.exp(1j * phi)[:, None]
+    coh = pr.coherence_phase(model, xq)
+    np.testing.assert_allclose(coh, model.channels.pair_phase(pr.probe_rad, xq), atol=1e-12)
+    steps = pr.calibration_steps(model, xq)
+    per_step = 2 * np.pi * model.cal_slope_hz * model.delay_resolution_s
+    k0 = np.round(coh / per_step).astype(int)
+    table_phase = np.angle(pr.delay_factor[:, model.channels.steering.mask].mean(axis=1))
+    for k, c0, p in zip(steps, k0, coh):
+        cand = np.arange(c0 - 3, c0 + 4)
+        miss = np.abs(np.angle(np.exp(1j * (p - table_phase[cand + pr.max_steps]))))
+        assert k == cand[np.argmin(miss)]
+    moved = steps - steps[2]
+    # eq. (27) with f_rts + B/2; the table has the exact IF slope at the target (0.4 % off)
+    np.testing.assert_allclose(moved, np.angle(np.exp(1j * (coh - coh[2]))) / per_step,
+                               rtol=0.01, atol=1.5)
+    assert np.all(np.diff(moved) < 0)  # J turned ahead: the delay shrinks
+
+
+@pytest.mark.parametrize("redesign", [True, False])
+def test_the_pairs_bin_centre_snapshots_are_the_programmed_sum(model, redesign):
+    """Uncalibrated: A_I x_I + A_J x_J per set-point; calibrated: J delayed by its steps
+    (the delay's factor on its elements), both gain-corrected, J's amplitude divided by the
+    delay's loss when redesigned."""
+    pr = model.procedure
+    rng = np.random.default_rng(4)
+    x = model.x_nominal
+    xq = x * (1 + 0.05 * rng.normal(size=(3, 2, 1)))
+    a = model.amplitudes
+    got = pr.snapshots(model, xq)
+    want = a[None, :, 0, None] * xq[:, None, 0] + a[None, :, 1, None] * xq[:, None, 1]
+    np.testing.assert_allclose(got, want, rtol=1e-12)
+    steps = np.array([0, 5, -9])
+    g = model.gain_correction(xq)
+    f = pr.delay_factor[steps + pr.max_steps]
+    gj = g[:, 1] / (np.abs(f[:, model.channels.steering.mask].mean(-1)) if redesign else 1.0)
+    got = pr.snapshots(model, xq, steps, redesign=redesign)
+    want = ((a[None, :, 0] * g[:, 0, None])[..., None] * xq[:, None, 0]
+            + (a[None, :, 1] * gj[:, None])[..., None] * (xq[:, 1] * f)[:, None])
+    np.testing.assert_allclose(got, want, rtol=1e-12)
+
+
+@pytest.mark.parametrize("offset", [-4, -3, -1, 0, 2, 3, 4])
+def test_the_pairs_calibration_refines_at_most_three_steps(model, offset):
+    """A delay table whose phase is eq. (27)'s line moved by ``offset`` steps: the refinement
+    follows it up to 3 steps either side of eq. (27)'s own step, no further."""
+    import dataclasses
+    pr = model.procedure
+    per_step = 2 * np.pi * model.cal_slope_hz * model.delay_resolution_s
+    k = np.arange(-pr.max_steps, pr.max_steps + 1)
+    line = np.exp(1j * per_step * (k - offset))[:, None] * np.ones(pr.delay_factor.shape[1])
+    moved = dataclasses.replace(pr, delay_factor=line)
+    x = model.x_nominal
+    phi = np.radians([-120.0, -10.0, 0.0, 33.0, 100.0])
+    xq = np.stack([x] * phi.size)
+    xq[:, 1] *= np.exp(1j * phi)[:, None]
+    k0 = np.round(pr.coherence_phase(model, xq) / per_step).astype(int)
+    np.testing.assert_array_equal(moved.calibration_steps(model, xq),
+                                  k0 + int(np.clip(offset, -3, 3)))
