@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import small_noiseless
+from conftest import ROOT, small_noiseless
 
 from rtsgeom.geometry import build_setup
 from rtsgeom.paths import exact_paths
@@ -17,7 +17,7 @@ def test_2d_error_map_exact_mode_puts_every_grid_point_on_its_direction():
     finite amount. The n x n grid inside a rectangular cell keeps all n^2 points."""
     from rtsgeom.analysis.linearity import linearity
     from rtsgeom.scene import load_scene
-    sc = load_scene("scenes/sphere4.toml")
+    sc = load_scene(ROOT / "scenes" / "sphere4.toml")
     sc = sc.evolve(radar=sc.radar.evolve(snr_db=None, samples_per_chirp=128, chirps_per_tx=32,
                                          adc_rate_hz=12.5e6))
     setup = build_setup(sc)
