@@ -173,10 +173,22 @@ def test_a_pair_that_fails_is_named_and_a_cell_it_disconnects_stops_the_run(
     cal = calibrate_channels(setup, paths, [0, 1, 2, 3], probe)
     assert any("(0, 3)" in w for w in cal.warnings) and cal.failed
     _fake_pairs(monkeypatch, CONSISTENT, fail={(0, 1), (0, 2), (0, 3)})  # 0 cut off
-    with pytest.raises(CalibrationFailed, match=r"\(0, 1\)"):
+    why = ("channel calibration: pair (0, 1): no probe detected; channel calibration: pair "
+           "(0, 2): no probe detected; channel calibration: pair (0, 3): no probe detected; "
+           "channels [1, 2, 3] are not connected to the reference 0 by calibrated pairs")
+    with pytest.raises(CalibrationFailed) as exc:
         calibrate_channels(setup, paths, [0, 1, 2, 3], probe)
-    with pytest.raises(SceneError, match="channel calibration failed"):
+    assert str(exc.value) == why
+    with pytest.raises(SceneError) as exc:
         plan_targets(setup, paths, "exact")
+    assert str(exc.value) == f"{setup.scene.source}: the channel calibration failed: {why}"
+    _fake_pairs(monkeypatch, CONSISTENT, fail={(0, 3), (1, 3), (2, 3)})  # 3 alone cut off
+    with pytest.raises(CalibrationFailed) as exc:
+        calibrate_channels(setup, paths, [0, 1, 2, 3], probe)
+    assert str(exc.value) == (
+        "channel calibration: pair (0, 3): no probe detected; channel calibration: pair "
+        "(1, 3): no probe detected; channel calibration: pair (2, 3): no probe detected; "
+        "channels [3] are not connected to the reference 0 by calibrated pairs")
 
 
 def test_run_says_the_calibration_failed_when_it_is_why_a_target_is_unreachable(

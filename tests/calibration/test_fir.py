@@ -71,3 +71,35 @@ def test_fir_effect_reports_its_filter_and_a_small_passband_ripple(taps):
     none = fir_effect(build_setup(make_scene(off)), 0.37e-9)
     assert none == {"model": "none", "gain_ripple_db": 0.0, "phase_ripple_deg": 0.0,
                     "predicted_shift_ps": 0.0}
+
+
+@pytest.mark.parametrize("continuous", [False, True])
+def test_fir_sweep_phase_is_j_s_bin_gain_over_i_s_at_the_realised_settings(continuous):
+    """``fir_sweep_phase``: per step and probe the angle of J's FIR bin gain (its base offset
+    plus the step, realised as a whole or with the step unrounded) over I's (its own base
+    offset, realised), each from ``fir_bin_gain`` at the probe's total delay; None for an
+    ideal delay. Base offsets of both signs, neither zero, so that their roles show."""
+    from rtsgeom.calibration.fir import fir_bin_gain, fir_sweep_phase
+    from rtsgeom.calibration.probes import mean_air_delay, probe_ranges
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.rts.channels import requested_delay
+    from rtsgeom.rts.fir import realised_delay
+    setup = build_setup(_fir_scene(5, "windowed-sinc"))
+    scene, rts = setup.scene, setup.scene.rts
+    ranges = probe_ranges(setup, 2)
+    deltas = np.array([-0.13e-9, 0.0, 0.041e-9, 0.29e-9])
+    offs = (0.07e-9, -0.23e-9)
+
+    def realise(t):
+        return realised_delay(t, rts.f_s_hz, rts.fractional_delay, rts.fractional_delay_step_s)
+    base = requested_delay(scene, ranges)
+    total = base + float(np.mean(mean_air_delay(setup)))
+    got = fir_sweep_phase(setup, ranges, deltas, offs, continuous)
+    assert got.shape == (deltas.size, ranges.size)
+    g_i = fir_bin_gain(scene, realise(base + offs[0]), total)
+    for s, d in enumerate(deltas):
+        j = realise(base + offs[1]) + d if continuous else realise(base + offs[1] + d)
+        np.testing.assert_allclose(got[s], np.angle(fir_bin_gain(scene, j, total) / g_i),
+                                   rtol=0, atol=1e-12)
+    assert np.ptp(got) > 1e-4  # the FIR's phase moves with the setting
+    assert fir_sweep_phase(build_setup(_fir_scene(5, "ideal")), ranges, deltas, offs) is None

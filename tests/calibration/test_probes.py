@@ -40,3 +40,26 @@ def test_probe_ranges_keep_clear_of_every_cable_ghost(length):
     for a in range(3):
         for b in range(a + 1, 3):
             assert all(abs((r[b] - r[a]) - g) >= clear - 1e-12 for g in ghosts)
+
+
+@pytest.mark.parametrize("r0, step1, step, limit", [
+    (8.0, 3.0, 4.0, 32.0),  # the 7th probe ends exactly on the limit
+    (8.0, 3.0, 4.0, 31.75),  # just below: 6
+    (8.0, 4.0, 4.0, 32.0), (2.0, 1.5, 6.0, 32.0), (8.0, 3.0, 32.0, 32.0), (40.0, 3.0, 4.0, 32.0)])
+def test_probes_per_frame_is_the_most_probes_up_to_the_limit_the_limit_included(
+        monkeypatch, r0, step1, step, limit):
+    """``probes_per_frame``: the largest k <= n whose k probes (the first at r0, the others a
+    spacing step(k) apart) end at or below ``PROBE_RANGE_LIMIT`` of the range axis, at least
+    1; probes ending exactly on the limit fit (exact binary fractions)."""
+    from types import SimpleNamespace
+
+    import rtsgeom.calibration.probes as pr
+    assert pr.PROBE_RANGE_LIMIT == 0.85
+    monkeypatch.setattr(pr, "PROBE_RANGE_LIMIT", 0.5)
+    monkeypatch.setattr(pr, "probe_ranges", lambda setup, n: r0 + step1 * np.arange(n))
+    monkeypatch.setattr(pr, "_probe_step", lambda setup, k: step1 if k == 1 else step)
+    setup = SimpleNamespace(scene=SimpleNamespace(radar=SimpleNamespace(max_range_m=2 * limit)))
+    for n in (1, 2, 5, 7, 10, 40):
+        fits = [k for k in range(1, n + 1)
+                if r0 + (step1 if k == 1 else step) * (k - 1) <= limit]
+        assert pr.probes_per_frame(setup, n) == max(fits + [1]), n

@@ -56,3 +56,34 @@ def test_evolve_names_unknown_settings():
                    "['seeds', 'span']: not a sweep setting; allowed: ['span_s', 'step_s', "
                    "'frames', 'full_chain', 'seed']")
     assert_refused(lambda: SweepConfig().evolve(frames=0), FRAMES + "0")
+
+
+def test_a_sweep_that_detects_no_probe_at_any_step_is_refused_naming_the_pair(cal_setup):
+    """``run_sweep`` on probes never detected (every error NaN): one ``CalibrationFailed``
+    naming the pair, before any fine sweep."""
+    from rtsgeom.calibration.sweep import run_sweep
+    from rtsgeom.errors import CalibrationFailed
+    setup, _ = cal_setup
+    asked = []
+
+    class Blind:
+        pair, period_s = (2, 3), 1 / setup.scene.radar.f_c_hz
+
+        def __init__(self):
+            self.setup = setup
+
+        def measure(self, t, frames, repeat=None):
+            asked.append((len(t), frames))
+            return np.full((len(t), 4), np.nan)
+
+        def frame_noise_deg(self, grid):
+            return None
+
+    for frames in (None, 3):
+        assert_refused(lambda: run_sweep(Blind(), SweepConfig(frames=frames)),
+                       "pair (2, 3): no probe detected at any step of the sweep",
+                       CalibrationFailed)
+    rts = setup.scene.rts
+    n = len(np.arange(rts.calibration_span_s[0], rts.calibration_span_s[1]
+                      + rts.calibration_step_s / 2, rts.calibration_step_s))
+    assert [a[0] for a in asked] == [n, n] and asked[1][1] == 3

@@ -257,8 +257,20 @@ def test_a_compensated_radar_is_refused_with_the_field_named():
     caps = [ident_mod.simulate_capture(setup, 0, seed=0)]
     comp = scene.evolve(radar=scene.radar.evolve(channels=RadarChannelsConfig(
         compensation="boresight")))
-    with pytest.raises(SceneError, match="radar.channels.compensation"):
+    with pytest.raises(SceneError) as exc:
         ident_mod.identify(comp, caps, radar_channels=True)
+    assert str(exc.value) == (
+        "radar.channels.compensation = 'boresight': must be \"none\" to identify the radar's "
+        "channels (the radar's compensation divides its own channel errors out of every "
+        "capture)")
+    # a reference front end that was not captured
+    from conftest import assert_refused
+    from rtsgeom.identify.joint import identify_joint
+    from rtsgeom.identify.model import measure
+    ms = [measure(setup, caps[0], False)]
+    for ref in (1, -1):
+        assert_refused(lambda: identify_joint(scene, ms, reference=ref),
+                       f"reference front end {ref}: must be one of the captured front ends [0]")
 
 
 def test_an_antenna_gain_beyond_the_schema_is_refused_naming_it():

@@ -8,6 +8,7 @@ import dataclasses
 
 import pytest
 
+import numpy as np
 from conftest import assert_refused, make_scene
 from rtsgeom.errors import CaptureError
 from rtsgeom.geometry import build_setup
@@ -95,3 +96,102 @@ def test_a_sidecar_putting_the_probe_elsewhere_names_where_the_echo_is(bench):
     assert r == pytest.approx(ri * radar.range_resolution_m, rel=1e-3)
     assert v == pytest.approx(0.0, abs=1e-9) and di == ds  # at rest: the probe's Doppler bin
     assert abs(rs * radar.range_resolution_m - 2 * cap.range_m) <= 1.5 * radar.range_resolution_m
+
+
+def _bins(radar):
+    """The range bin (m) and velocity bin (m/s) of the scene's radar, from its chirp."""
+    from scipy.constants import c
+    r_bin = c * radar.adc_rate_hz / (2 * radar.slope_hz_per_s * radar.samples_per_chirp)
+    v_bin = c / (2 * radar.f_c_hz * radar.tdm_cycle_s * radar.chirps_per_tx)
+    return r_bin, v_bin
+
+
+def _offsets(setup, cap, recorded_delay=False):
+    """(range, Doppler) offset in bins of the capture's echo from the sidecar's probe, read
+    on the capture's own range-Doppler map as ``measure`` reads it (its primitives)."""
+    from rtsgeom.identify.model import ProbeModel, probe_offset_bins
+    from rtsgeom.radar.fmcw import AdcCube
+    from rtsgeom.radar.processing import range_doppler
+    scale = float(np.max(np.abs(cap.data)))
+    rd = range_doppler(AdcCube((cap.data / scale).astype(np.complex64), setup.scene.radar,
+                               setup.rut))
+    model = ProbeModel.of(setup, cap)
+    if not recorded_delay:
+        model = dataclasses.replace(model, rts_delay_s=None)
+    return probe_offset_bins(rd.power, model)
+
+
+@pytest.mark.parametrize("shift", [0.5, -0.4])
+def test_a_sidecar_probe_range_off_by_part_of_a_bin_is_refused_whole(bench, shift):
+    """The sidecar's range ``shift`` bins off the echo: refused with the echo's range (the
+    sidecar's plus the offset it read, which is about -shift) in the whole message; a shift
+    of 0.1 bin (inside ``SUBBIN_LIMIT``) is measured."""
+    from rtsgeom.identify.model import SUBBIN_LIMIT
+    assert SUBBIN_LIMIT == {"range": 0.25, "doppler": 0.05}
+    setup, cap, _ = bench
+    r_bin, _ = _bins(setup.scene.radar)
+    measure(setup, dataclasses.replace(cap, range_m=cap.range_m + 0.1 * r_bin))
+    have = cap.range_m + shift * r_bin
+    with pytest.raises(CaptureError) as exc:
+        measure(setup, dataclasses.replace(cap, range_m=have))
+    msg = str(exc.value)
+    off = _offsets(setup, dataclasses.replace(cap, range_m=have))[0]
+    assert off == pytest.approx(-shift, abs=0.06)
+    assert msg == (
+        f"capture: probe_range_m = {have:g}: must be where the capture's echo is, "
+        f"{have + off * r_bin:.5g} m ({off:+.2f} bins of {r_bin:.4g} m away, at most 0.25 bin "
+        "on the nominal setup): the sidecar does not describe this capture, or a radial or "
+        "channel delay offset larger than that moves the echo")
+
+
+@pytest.mark.parametrize("shift", [0.3, -0.3])
+def test_a_sidecar_probe_velocity_off_by_part_of_a_bin_is_refused_whole(bench, shift):
+    """The sidecar's velocity ``shift`` Doppler bins off the static echo: refused whole (no
+    'or ...' tail for the Doppler); 0.01 bin off is measured."""
+    setup, cap, _ = bench
+    _, v_bin = _bins(setup.scene.radar)
+    measure(setup, dataclasses.replace(cap, velocity_mps=0.01 * v_bin))
+    have = shift * v_bin
+    with pytest.raises(CaptureError) as exc:
+        measure(setup, dataclasses.replace(cap, velocity_mps=have))
+    msg = str(exc.value)
+    off = _offsets(setup, dataclasses.replace(cap, velocity_mps=have))[1]
+    assert off == pytest.approx(-shift, abs=0.06)
+    assert msg == (
+        f"capture: probe_velocity_mps = {have:g}: must be where the capture's echo is, "
+        f"{have + off * v_bin:.5g} m/s ({off:+.2f} bins of {v_bin:.4g} m/s away, at most "
+        "0.05 bin on the nominal setup): the sidecar does not describe this capture")
+
+
+def test_a_recorded_rts_delay_that_the_scene_s_air_path_misses_is_refused_whole(bench):
+    """The sidecar's programmed RTS delay half a range bin (two-way) longer than the
+    capture's: the echo against that delay plus the scene's air path is refused, the message
+    built from the model's air path and the RTS's realised delay."""
+    from scipy.constants import c
+    from rtsgeom.identify.model import ProbeModel
+    from rtsgeom.rts.channels import requested_delay
+    from rtsgeom.rts.fir import realised_delay
+    setup, cap, _ = bench
+    scene, rts = setup.scene, setup.scene.rts
+    r_bin, _ = _bins(scene.radar)
+    wrong = dataclasses.replace(cap, rts_delay_s=cap.rts_delay_s + 2 * 0.5 * r_bin / c)
+    with pytest.raises(CaptureError) as exc:
+        measure(setup, wrong)
+    msg = str(exc.value)
+    dr = _offsets(setup, wrong, recorded_delay=True)[0]
+    assert dr == pytest.approx(-0.5, abs=0.06)
+    model = ProbeModel.of(setup, wrong)
+    air = float(model.echoes(model.nominal()[None]).tau_air_s.mean()) * c
+    tau0 = float(realised_delay(wrong.rts_delay_s, rts.f_s_hz, rts.fractional_delay,
+                                rts.fractional_delay_step_s))
+    want = c / 2 * (tau0 + air / c)
+    own = float(requested_delay(scene, cap.range_m)) * 1e9
+    assert own == pytest.approx(cap.rts_delay_s * 1e9, rel=1e-12)
+    assert msg == (
+        f"capture: the capture's echo is at {want + dr * r_bin:.4g} m, where the scene puts it "
+        f"{want:.4g} m ({dr:+.2f} bins of {r_bin:.3g} m, at most 0.25): front end 0's two-way "
+        f"air path on the scene's arc (rts.arc_radius_m = {rts.arc_radius_m:g} m, {air:.4g} m)"
+        f" misses the capture's by about {2 * dr * r_bin:+.2g} m, with the RTS delay its "
+        f"sidecar records (rts_delay_s = {wrong.rts_delay_s * 1e9:.4f} ns; the scene programs "
+        f"{own:.4f} ns for probe_range_m = {cap.range_m:g}): the capture was made on another "
+        "arc or front-end position; identify it against the bench's scene")

@@ -161,3 +161,102 @@ def test_a_calibration_file_without_a_pair_the_run_needs_is_refused_naming_it():
             f"calibration file: has no pair (1, 2) (it has [(0, 1)]): run `rtsgeom calibrate "
             f"SCENE --pair 1 2 --out DIR`")
     assert calibrate_pairs(None, None, [(0, 1)], None, loaded=have) == {(0, 1): have[(0, 1)]}
+
+
+def _probe(angles_deg, clipped=0, model_deg=None):
+    from rtsgeom.calibration.probes import FrontEndProbe
+    n = len(angles_deg)
+    return FrontEndProbe(np.radians(angles_deg), np.zeros(n), np.ones(n), clipped,
+                         None if model_deg is None else np.radians(model_deg))
+
+
+@pytest.mark.parametrize("clipped", [0, 7])
+def test_target_pairs_refuses_a_lost_front_end_or_a_target_outside_the_span_whole(clipped):
+    """``target_pairs``: the first front end the RuT does not detect (with the probe frame's
+    clipping, if any), a target outside the measured span (either side), each one whole
+    SceneError; a target exactly on the span's end is in its pair."""
+    from conftest import assert_refused
+    from rtsgeom.calibration.probes import clipping_note
+    from rtsgeom.errors import SceneError
+    from rtsgeom.pipeline.plan import target_pairs
+    from rtsgeom.scene import TargetConfig
+    setup = build_setup(small_noiseless())
+    src = setup.scene.source
+    lost = _probe([-4.0, np.nan, np.nan], clipped)
+    t = TargetConfig(20.0, angle_rad=0.0)
+    assert_refused(lambda: target_pairs(setup, lost, [t]),
+                   f"{src}: rts.front_ends[1]: the RuT does not detect this front end alone "
+                   "(blocked line of sight, or an echo far weaker than the noise"
+                   f"{clipping_note(clipped)}): cannot synthesize angles with it", SceneError)
+    probe = _probe([-4.0, 4.0 + 1e-3 * clipped])
+    lo, hi = -4.0, 4.0 + 1e-3 * clipped
+    assert target_pairs(setup, probe, [TargetConfig(20.0, angle_rad=np.radians(lo))],
+                        "x")[0] == [(0, 1)]
+    for a in (lo - 0.01, hi + 0.01):
+        far = [t, TargetConfig(20.0, angle_rad=np.radians(a))]
+        assert_refused(lambda: target_pairs(setup, probe, far, "frames[3].targets"),
+                       f"{src}: frames[3].targets[1].angle_deg = {a:g}: must be within the "
+                       f"measured span of the front ends [{lo:.4f}, {hi:.4f}] deg (no pair can "
+                       "reach it)", SceneError)
+
+
+def test_target_pairs_warns_of_each_pair_wider_than_the_angular_resolution():
+    """A pair wider than the RuT's angular resolution (eq. 24) warns for each target on it,
+    naming the target, the pair and both angles; a pair narrower does not."""
+    from rtsgeom.geometry.farfield import angular_resolution_rad
+    from rtsgeom.pipeline.plan import target_pairs
+    from rtsgeom.scene import TargetConfig
+    setup = build_setup(small_noiseless())
+    res = np.degrees(angular_resolution_rad(setup.rut))
+    wide, narrow = 1.5 * res, 0.5 * res
+    probe = _probe([-narrow, 0.0, wide])
+    targets = [TargetConfig(20.0, angle_rad=np.radians(a))
+               for a in (0.5 * wide, -0.5 * narrow, 0.25 * wide)]
+    pairs, warns = target_pairs(setup, probe, targets, lambda k: f"T{k}")
+    assert pairs == [(1, 2), (0, 1), (1, 2)]
+    assert warns == [f"T{k}: front ends (1, 2) are {wide:.2f} deg apart, more than the RuT's "
+                     f"angular resolution {res:.2f} deg (eq. 24): expect two peaks"
+                     for k in (0, 2)]
+
+
+def test_plan_targets_refuses_a_budget_or_a_calibration_file_on_cells(sphere_scene):
+    """Front ends on a sphere: ``rts.max_targets_per_channel`` and a calibration file are
+    refused, each whole, before any measurement."""
+    from conftest import assert_refused
+    from rtsgeom.errors import SceneError
+    from rtsgeom.pipeline.plan import plan_targets
+    setup = build_setup(sphere_scene)
+    src = sphere_scene.source
+    assert_refused(lambda: plan_targets(setup, None, "exact", calibration={}),
+                   f"{src}: --calibration: a calibration file holds pair calibrations; front "
+                   "ends on a sphere are calibrated per channel by the run itself", SceneError)
+    budget = build_setup(sphere_scene.evolve(
+        rts=sphere_scene.rts.evolve(max_targets_per_channel=2)))
+    assert_refused(lambda: plan_targets(budget, None, "exact"),
+                   f"{src}: rts.max_targets_per_channel = 2: must be left out for front ends "
+                   "on a sphere or targets in elevation (the budget merges targets on an "
+                   "arc's pairs)", SceneError)
+
+
+def test_an_uncalibrated_arc_plan_s_record_is_its_parts_whole():
+    """``plan_targets`` without calibration: the record is mode, source, the probe's angles
+    (deg) and gain corrections, zero offsets, no pairs and each target's realised plan, as
+    ``probe_front_ends`` and ``program_pairs`` give them; the programme is theirs."""
+    from rtsgeom.calibration.probes import probe_front_ends
+    from rtsgeom.pipeline.plan import FixedCalibration, plan_targets, program_pairs, target_pairs
+    setup = build_setup(small_noiseless())
+    paths = exact_paths(setup)
+    program, record, warns = plan_targets(setup, paths, "array-factor", calibrate=False)
+    probe = probe_front_ends(setup, paths, setup.scene.seed)
+    pairs, notes = target_pairs(setup, probe, setup.scene.targets)
+    zero = np.zeros(setup.fe.count)
+    want, realised, notes2 = program_pairs(setup, paths, "array-factor", setup.scene.targets,
+                                           pairs, FixedCalibration(probe, {}, zero))
+    assert record == {
+        "mode": "array-factor", "source": "measured",
+        "front_end_angles_deg": [float(x) for x in np.degrees(probe.angle_rad)],
+        "gain_correction": [float(x) for x in probe.gain_correction],
+        "channel_delay_offsets_s": [0.0] * setup.fe.count, "pairs": [], "targets": realised}
+    assert warns == notes + notes2
+    for f in ("target", "front_end", "delay_s", "doppler_hz", "amplitude"):
+        assert np.array_equal(getattr(program, f), getattr(want, f)), f

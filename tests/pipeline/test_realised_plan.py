@@ -133,6 +133,19 @@ def test_residual_warning_names_target_and_residual():
     assert residual_warning(scene, 3, plan(-0.49 * res)) is None
     w = residual_warning(scene, 3, plan(-0.6 * res))
     assert w.startswith("targets[3]:") and "-60.0 ps" in w and "-21.6 deg" in w
+    # whole, named or not, either sign; the plan's own residual phase 360 f_if eps
+    for eps, name in ((-0.6 * res, None), (0.51 * res, "targets[0].scatterers[2]")):
+        p = plan(eps)
+        assert p.residual_phase_deg == pytest.approx(360 * 1e9 * eps, rel=1e-12)
+        assert p.to_dict() == {"offset_j_s": 0.0, "realised_difference_s": 1e-9 + eps,
+                               "planned_difference_s": 1e-9, "quantisation_residual_s": eps,
+                               "residual_phase_deg": p.residual_phase_deg, "period_offset": 0}
+        assert residual_warning(scene, 3, p, name) == (
+            f"{name or 'targets[3]'}: channel J's realised delay difference misses the "
+            f"calibrated one by {eps * 1e12:.1f} ps ({360 * 1e9 * eps:.1f} deg of IF phase), "
+            f"more than half the RTS delay step {res * 1e12:g} ps "
+            "(rts.fractional_delay_step_s / rts.f_s_hz): no realisable setting is nearer; the "
+            "amplitudes are designed for it")
 
 
 @pytest.mark.parametrize("f_s,res_ps,warns", [

@@ -68,3 +68,38 @@ def test_summary_json_says_the_run_and_the_radar_it_ran(snr_db):
     assert len(s["targets"]) == len(scene.targets) == 2
     assert all("detection_index" not in t for t in s["targets"])
     assert s["warnings"] == list(res.warnings)
+    # the whole dict, built from the result's parts
+    import rtsgeom
+    from rtsgeom.pipeline.info import scene_info
+    info = scene_info(res.setup)
+    want = {
+        "rtsgeom_version": rtsgeom.__version__, "scene": scene.name,
+        "scene_sha256": scene.sha256, "seed": scene.seed, "paths": "exact",
+        "aoa_mode": res.aoa_mode,
+        "radar": {**{k: getattr(r, k) for k in same},
+                  "tx_order": list(res.setup.rut.tx_order), "num_rx": res.setup.rut.num_rx,
+                  "cube_layout": "[chirp_loop, virtual_channel (tx_slot * num_rx + rx), "
+                                 "sample]"},
+        "far_field": info["far_field"], "front_ends": info["front_ends"],
+        "calibration": res.calibration,
+        "targets": [{k: v for k, v in m.items() if k != "detection_index"}
+                    for m in res.matches],
+        "link_budget": res.link_budget.to_dict(), "adc_clipped_samples": res.cube.clipped,
+        "num_detections": len(res.detections), "num_echoes": len(res.echoes),
+        "warnings": list(res.warnings)}
+    assert s == json.loads(json.dumps(want))
+    assert res.calibration["mode"] == res.aoa_mode and len(res.calibration["targets"]) == 2
+    # the cube's layout as the text says: virtual channel v = slot * num_rx + rx
+    n_rx = res.setup.rut.num_rx
+    assert res.cube.data.shape == (r.chirps_per_tx, len(res.setup.rut.tx_order) * n_rx,
+                                   r.samples_per_chirp)
+
+
+def test_run_scene_refuses_a_calibration_that_is_no_dict():
+    from conftest import assert_refused, small_quiet
+    from rtsgeom.pipeline.run import run_scene
+    scene = small_quiet()
+    for bad in ([], "calibration.json", 3):
+        assert_refused(lambda: run_scene(scene, calibration=bad),
+                       f"run_scene: calibration = {type(bad).__name__}: must be a calibration "
+                       "file's content (a dict, json.load of calibration.json)")

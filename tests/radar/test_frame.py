@@ -105,3 +105,40 @@ def test_the_range_angle_array_defaults_to_minus_60_to_60_deg_in_quarter_degrees
     np.testing.assert_array_equal(da.coords["range_m"].values, rd.range_m)
     given = rd.range_angle_to_xarray(cube, [-5.0, 0.0, 7.5])
     np.testing.assert_array_equal(given.coords["angle_deg"].values, [-5.0, 0.0, 7.5])
+    # both arrays whole: name, dims, every coordinate, attrs, values
+    assert (da.name, da.attrs) == ("power", {"long_name": "beamformer power"})
+    assert set(da.coords) == {"range_m", "angle_deg"} and given.attrs == da.attrs
+    np.testing.assert_array_equal(given.values,
+                                  range_angle_map(rd, cube, np.radians([-5.0, 0.0, 7.5])))
+    rdx = rd.to_xarray()
+    assert (rdx.name, rdx.dims, rdx.attrs) == (
+        "power", ("range_m", "velocity_mps"),
+        {"long_name": "range-Doppler power", "description": "sum over virtual channels of |X|^2"})
+    assert set(rdx.coords) == {"range_m", "velocity_mps", "doppler_hz"}
+    assert rdx.coords["doppler_hz"].dims == ("velocity_mps",)
+    for name, want in (("range_m", rd.range_m), ("velocity_mps", rd.velocity_mps),
+                       ("doppler_hz", rd.doppler_hz)):
+        np.testing.assert_array_equal(rdx.coords[name].values, want)
+    np.testing.assert_array_equal(rdx.values, rd.power)
+
+
+def test_the_detection_table_is_the_detections_whole():
+    """``Detections.to_dataframe``: its columns in order, each the detection list's own field
+    (degrees from radians, 0 elevation and rank 0 on an azimuth-only array)."""
+    scene = small_quiet()
+    setup = build_setup(scene)
+    _, cube = simulate(setup, exact_paths(setup), program_nearest(scene, setup))
+    _, det = process(cube)
+    df = det.to_dataframe()
+    assert list(df.columns) == ["range_m", "velocity_mps", "angle_deg", "elevation_deg",
+                                "power_db", "snr_db", "range_bin", "doppler_bin", "angle_peak"]
+    assert len(df) == len(det) >= 2 and det.elevation_rad is None
+    want = {"range_m": det.range_m, "velocity_mps": det.velocity_mps,
+            "angle_deg": np.degrees(det.angle_rad), "elevation_deg": np.zeros(len(det)),
+            "power_db": det.power_db, "snr_db": det.snr_db, "range_bin": det.range_bin,
+            "doppler_bin": det.doppler_bin,
+            "angle_peak": (np.zeros(len(det), int) if det.angle_peak is None
+                           else det.angle_peak)}
+    for k, v in want.items():
+        np.testing.assert_array_equal(df[k].to_numpy(), v, err_msg=k)
+    assert np.array_equal(det.primary, np.asarray(want["angle_peak"]) == 0)

@@ -339,3 +339,31 @@ def test_a_back_end_the_ruts_chirp_clips_is_refused_with_its_limit(gain_db):
     below = make_scene(lambda d: mut(d, limit - 0.1))
     t2 = lk.check_channels(below, program_nearest(below, setup))
     assert t2["level_dbfs"][0] == pytest.approx(-0.1, abs=1e-9)
+
+
+@pytest.mark.parametrize("rcs_dbsm", [60.0, -80.0])
+def test_an_rcs_beyond_the_channel_is_refused_whole_from_its_channel_table(rcs_dbsm):
+    """Too large (attenuation below 0) or too small (above the back end's range on the
+    target's strongest row): the message's limits, attenuation and range from
+    ``channel_table``, whole."""
+    from rtsgeom.rts.channels import program_nearest
+
+    def mut(d):
+        linked_doc(d, targets=[{"range_m": 5.0, "rcs_dbsm": rcs_dbsm}])
+    scene = make_scene(mut)
+    setup = build_setup(scene)
+    prog = program_nearest(scene, setup)
+    t = lk.channel_table(scene, prog)
+    att, mx = t["attenuation_db"], t["max_attenuation_db"]
+    bad = np.flatnonzero((att < 0) | (att > mx))
+    assert bad.size, (att, mx)
+    row = int(bad[0])
+    lo, hi = rcs_dbsm - (mx[row] - att[row]), rcs_dbsm + att[row]
+    assert (hi < rcs_dbsm) == (rcs_dbsm > 0) and (lo > rcs_dbsm) == (rcs_dbsm < 0)
+    with pytest.raises(lk.LinkError) as exc:
+        lk.check_channels(scene, prog)
+    assert str(exc.value) == (
+        f"test.toml: targets[0].rcs_dbsm = {rcs_dbsm:g}: must be in [{lo:.1f}, {hi:.1f}] dBsm "
+        f"at range_m = 5 on RTS channel {int(prog.front_end[row])} (attenuation "
+        f"{att[row]:.1f} dB needed; the back end offers [0, {mx[row]:.1f}] dB with rts.link "
+        "gains, full scales and dac_bits)")

@@ -316,3 +316,22 @@ def test_a_scene_without_static_targets_runs_and_an_empty_frame_associates():
     from rtsgeom.radar.processing import Detections
     none = Detections(*(np.zeros(0),) * 5, np.zeros(0, int), np.zeros(0, int))
     assert detection_points(none, 2).shape == (0, 4)
+
+
+@pytest.mark.parametrize("estimator, subarray", [("bartlett", 0), ("capon", 5), ("music", 5)])
+def test_a_batch_without_candidates_refines_to_nothing(estimator, subarray):
+    """``peaks._refine_1d`` of snapshots none of which has a grid candidate (every one NaN):
+    no spectrum row is evaluated and every refined direction and value is NaN, for the plain
+    and the smoothed estimators; with one candidate its row alone is refined."""
+    from rtsgeom.radar import peaks
+    st = dataclasses.replace(_line(8), estimator=estimator, subarray=subarray)
+    x = np.stack([_snap(st, [-0.3, 0.25], [1.0, 0.8 * np.exp(1j * 1.0)]), _snap(st, [0.1])])
+    u, val = peaks._refine_1d(st, x, np.full((2, 5), np.nan))
+    assert u.shape == (2, 5, 1) and val.shape == (2, 5)
+    assert np.isnan(u).all() and np.isnan(val).all()
+    assert peaks._spectrum_rows(st, x[:0], np.zeros((0, 3))).shape == (0, 3)
+    cand = np.full((2, 5), np.nan)
+    cand[1, 2] = np.arcsin(0.1) + np.radians(0.2)
+    u, val = peaks._refine_1d(st, x, cand)
+    assert np.isfinite(u[1, 2, 0]) and abs(u[1, 2, 0] - 0.1) < 1e-5
+    assert np.isnan(np.delete(val.ravel(), 7)).all()

@@ -145,3 +145,58 @@ def test_echoes_are_stored_read_only_with_an_optional_fast_gain():
     assert_refused(lambda: Echoes(**bad), (
         "Echoes.fast_gain: got shape (2, 6) of float64, must be (E, N) = (3, 6) numbers (E "
         "echoes and V virtual channels as in tau_air_s, N fast-time samples)"), ValueError)
+
+
+@pytest.mark.parametrize("compensate", [True, False])
+def test_the_nearest_programme_is_each_targets_radar_equation_on_its_nearest_front_end(
+        compensate):
+    """``program_nearest`` field by field from the closed forms: target k on the nearest
+    front end, delay 2 R / c0 (minus 2 R_c / c0 where the RTS compensates the air path),
+    Doppler 2 f_c v / c0, amplitude sqrt(sigma) lambda / ((4 pi)^1.5 R^2) over the nominal
+    link gain (lambda / (4 pi R_c))^2; the apparent range R (or R + R_c); no target, no row."""
+    from scipy.constants import c
+
+    from conftest import make_scene
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.rts.channels import apparent_range, program_nearest
+
+    def mutate(doc):
+        doc["rts"]["compensate_air_path"] = compensate
+        doc["targets"] = [{"range_m": 12.5, "angle_deg": -3.0, "velocity_mps": 1.5,
+                           "rcs_dbsm": 10.0},
+                          {"range_m": 40.0, "angle_deg": 4.1, "velocity_mps": -7.0,
+                           "rcs_dbsm": -5.0}]
+    scene = make_scene(mutate)
+    setup = build_setup(scene)
+    prog = program_nearest(scene, setup)
+    az = setup.fe_azimuth_rad()
+    r_c, lam, f_c = scene.rts.arc_radius_m, setup.rut.wavelength_m, scene.radar.f_c_hz
+    rng = np.array([12.5, 40.0])
+    rcs = 10 ** (np.array([10.0, -5.0]) / 10)
+    angle = np.radians([-3.0, 4.1])
+    np.testing.assert_array_equal(prog.target, [0, 1])
+    np.testing.assert_array_equal(prog.front_end,
+                                  [int(np.argmin(np.abs(az - a))) for a in angle])
+    np.testing.assert_allclose(prog.delay_s, 2 * rng / c - (2 * r_c / c if compensate else 0),
+                               rtol=1e-12, atol=0)
+    np.testing.assert_allclose(prog.doppler_hz, 2 * f_c * np.array([1.5, -7.0]) / c,
+                               rtol=1e-12)
+    link = (lam / (4 * np.pi * r_c)) ** 2
+    np.testing.assert_allclose(prog.amplitude,
+                               np.sqrt(rcs) * lam / ((4 * np.pi) ** 1.5 * rng ** 2) / link,
+                               rtol=1e-12)
+    np.testing.assert_array_equal(apparent_range(scene, rng), rng if compensate else rng + r_c)
+    assert len(program_nearest(scene.evolve(targets=()), setup)) == 0
+
+
+def test_a_target_midway_between_two_front_ends_stays_on_the_lower_index():
+    """``nearest_front_ends``: distances within ``NEAREST_TIE_RAD`` of the smallest tie and the
+    lowest index wins; beyond it the nearer one."""
+    from rtsgeom.rts.channels import NEAREST_TIE_RAD, nearest_front_ends
+    assert NEAREST_TIE_RAD == 1e-9
+    fe = np.array([0.25, -0.25, 0.0])
+    e = 2.0 ** -31  # below the tie (4.7e-10): exact binary offsets
+    far = 2.0 ** -28  # beyond it (3.7e-9)
+    got = nearest_front_ends(fe, [0.125, 0.125 - e, 0.125 + e, 0.125 - far, 0.125 + far,
+                                  -0.125, -0.125 + far, -0.2, 0.3])
+    np.testing.assert_array_equal(got, [0, 0, 0, 2, 0, 1, 2, 1, 0])

@@ -61,3 +61,30 @@ def test_more_frequency_grids_than_the_memo_keeps_start_it_afresh(monkeypatch):
         sizes.append(len(fir._FIR_ROWS))
         assert (taps, f_s, grid.tobytes()) in fir._FIR_ROWS
     assert sizes == [1, 2, 1, 2]
+
+
+def test_rows_of_shifted_grids_are_the_grid_with_a_shift_and_other_rows_are_refused():
+    """``fir_error_response`` with (M, N) frequency rows: rows that are the grid shifted give
+    the response at the grid with those shifts; rows of another spacing are refused whole;
+    each value is the direct sum ``sum_k h_k exp(-j w (k - D))``."""
+    import pytest
+    taps, f_s = 9, 4e9
+    grid = np.linspace(1e7, 1e8, 12)
+    mu = np.array([0.1, 0.45, 0.1])
+    shift = np.array([0.0, 3e6, -2e6])
+    rows = grid[None, :] + shift[:, None]
+    got = fir.fir_error_response(mu, taps, f_s, rows)
+    np.testing.assert_allclose(got, fir.fir_error_response(mu, taps, f_s, grid, shift),
+                               rtol=0, atol=1e-13)
+    h = fir.fractional_delay_fir(mu, taps)
+    k = np.arange(taps)
+    d = (taps - 1) / 2 + mu
+    w = 2 * np.pi * rows / f_s
+    direct = np.einsum("mk,mkn->mn", h,
+                       np.exp(-1j * w[:, None, :] * (k[None, :, None] - d[:, None, None])))
+    np.testing.assert_allclose(got, direct, rtol=0, atol=1e-12)
+    bad = rows.copy()
+    bad[1] *= 1.01
+    with pytest.raises(ValueError) as exc:
+        fir.fir_error_response(mu, taps, f_s, bad)
+    assert str(exc.value) == "f_hz: each row must be the same frequency grid, shifted"

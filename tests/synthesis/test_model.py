@@ -41,6 +41,11 @@ def test_the_exact_mode_names_the_span_the_pair_reaches(pair):
     with pytest.raises(AngleUnreachable) as exc:
         cm.pair_ratio(a, mode="exact")
     got = str(exc.value)
+    # the span: the detected angle of either channel nearly alone (ratio e^-12, e^12)
+    ends = [float(cm.direction(cm.pair_weights(np.exp(s * 12.0), None))) for s in (-1, 1)]
+    assert got == (f"angle {np.degrees(a):.4f} deg is outside the span this front-end pair "
+                   f"can synthesize [{np.degrees(min(ends)):.4f}, "
+                   f"{np.degrees(max(ends)):.4f}] deg")
     head = (f"angle {np.degrees(a):.4f} deg is outside the span this front-end pair can "
             "synthesize [")
     assert got.startswith(head) and got.endswith("] deg")
