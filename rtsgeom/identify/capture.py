@@ -154,6 +154,8 @@ def capture_probe(setup: Setup, range_m: float | None = None) -> tuple[float, fl
     amplitude that gives a 10 m^2 target (what :class:`~rtsgeom.synthesis.model.ChannelModel` programs)."""
     scene = setup.scene
     r = float(probe_ranges(setup, 1)[0]) if range_m is None else float(range_m)
+    if not 0 < r < scene.radar.max_range_m:  # before the amplitude: 1/r^2 at r = 0
+        raise CaptureError(f"probe range {r:g} m: must be in (0, {scene.radar.max_range_m:g}) m")
     lam = setup.rut.wavelength_m
     return r, float(target_amplitude(r, 10.0, lam) / nominal_link_gain(scene, lam))
 
@@ -167,8 +169,6 @@ def simulate_capture(setup: Setup, active: int, range_m: float | None = None,
         raise CaptureError(f"active front end {active}: must be in 0..{n - 1}")
     scene = setup.scene
     r, amp = capture_probe(setup, range_m)
-    if not 0 < r < scene.radar.max_range_m:
-        raise CaptureError(f"probe range {r:g} m: must be in (0, {scene.radar.max_range_m:g}) m")
     paths = exact_paths(setup) if paths is None else paths
     f_d = 2 * scene.radar.f_c_hz * velocity_mps / c
     tau = float(requested_delay(scene, r))

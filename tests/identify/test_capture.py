@@ -310,7 +310,7 @@ def test_a_capture_s_radar_record_against_the_scene_s_is_refused_whole():
                          "it against a scene with that radar)")
 
 
-@pytest.mark.filterwarnings("ignore:divide by zero:RuntimeWarning")
+@pytest.mark.filterwarnings("error::RuntimeWarning")  # refused before any arithmetic on r
 def test_simulate_capture_refuses_a_front_end_or_probe_range_out_of_range():
     from rtsgeom.geometry import build_setup
     from rtsgeom.identify.capture import simulate_capture
