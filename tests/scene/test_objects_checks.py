@@ -122,6 +122,7 @@ ARC = ("a scatterer whose range stays > rts.arc_radius_m ({} m): the RTS cannot 
        "radar signal reached it (at t = {} s it is {} m)")
 FRONT = "a scatterer whose azimuth stays in [-90, 90] deg (in front of the RuT) (at t = {} s it is {} deg)"
 UP = "a scatterer whose elevation stays in [-60, 60] deg (at t = {} s it is {} deg)"
+BEHIND = -10.0 + 5.0 / math.tan(90.5 * DEG)  # at 90.5 deg from the origin 10 m ahead
 S0, S1 = ("scenario.targets[1].scatterers[0]", [0.0, 0.0, 0.0, 1.0]), \
     ("scenario.targets[1].scatterers[1]", [0.0, 5.0, 0.0, 2.0])
 
@@ -170,6 +171,15 @@ MOVING_CASES = [
      {"elevation": True}, []),
     ("no elevation processing", [[0.0, 0.0, 10 * math.tan(60.5 * DEG)]], AWAY, (30.0, 9.0, 0.0),
      {}, []),
+    ("just behind", [[5.0, BEHIND, 0.0]], AWAY, (30.0, 9.0, 0.0), {},
+     [("scenario.targets[1].scatterers[0]", [5.0, round(BEHIND, 6), 0.0, 1.0],
+       FRONT.format(0, 90.5))]),
+    # within a metre of the RuT: its radial velocity and elevation as they are
+    ("near, fast and steep", [[0.0, -9.8, 0.4]], AWAY, (30.0, 2.0, 0.0),
+     {"compensate": False, "elevation": True},
+     [("scenario.targets[1].scatterers[0]", [0.0, -9.8, 0.4, 1.0], msg) for msg in (
+         SLOW.format(2, 0, f"{0.2 * 5.0 / math.hypot(0.2, 0.4):.4g}"),
+         UP.format(0, f"{math.degrees(math.asin(0.4 / math.hypot(0.2, 0.4))):.4g}"))]),
     # every rule a scatterer breaks, one message each, in the rules' order; its row rounded
     ("far, fast and behind", [[0.1234567891, -30.0, 0.0]], NEAR, (5.0, 1.0, 0.5), {},
      [("scenario.targets[1].scatterers[0]", [0.123457, -30.0, 0.0, 1.0], msg) for msg in (
@@ -217,12 +227,15 @@ def test_a_moving_mesh_is_named_by_its_file_with_no_facet_or_a_scatterer_outside
         rts=SimpleNamespace(arc_radius_m=0.8, compensate_air_path=True),
         scenario=SimpleNamespace(targets=[None, SimpleNamespace(mesh="away.ply")],
                                  frame_times=lambda: times))
-    sps = {1: trajectory(AWAY, times)}
+    sps = {1: trajectory(AWAY, times), 0: trajectory(AWAY, times)}
+    scene.objects += (_moving([[0.0, -12.0, 0.0]], where="scenario.targets[0]"),)
     got, fail = recorder()
     check_moving_objects(scene, fail, (30.0, 9.0, "WHY_R", "WHY_V"), 0.0, sps)
     assert got == [("scenario.targets[1].mesh", "away.ply",
                     "no facet faces the RuT from 10 m (are its normals pointing inwards, or is "
-                    "it open towards the RuT?)")]
+                    "it open towards the RuT?)"),
+                   ("scenario.targets[0].scatterers[0]", [0.0, -12.0, 0.0, 1.0],
+                    FRONT.format(0, 180))]
     scene.objects = (_mesh(FACING[1]),)
     scene.scenario.targets[1] = SimpleNamespace(mesh="facing.ply")
     got, fail = recorder()
@@ -405,16 +418,15 @@ def test_labels_name_points_scatterers_meshes_and_a_drives_moving_targets():
                                      SimpleNamespace(scatterers=None, mesh="m.ply"),
                                      SimpleNamespace(scatterers=None, mesh=None)])
     t = [TargetConfig(range_m=1.0, object_index=o) for o in (-1, 0, 0, -1, 1, 1, 1, -1, -1,
-                                                            -1, 2, 2, -1)]
+                                                            -1, -1, 2, 2)]
     scene = SimpleNamespace(targets=t[:8], objects=objects, scenario=drive)
     assert target_labels(scene) == [
         "targets[0]", "targets[1].scatterers[0]", "targets[1].scatterers[1]", "targets[2]",
         "targets[3].mesh (scatterer 0)", "targets[3].mesh (scatterer 1)",
         "targets[3].mesh (scatterer 2)", "targets[4]"]
     frame = target_labels(scene, t, moving_from=8)
-    assert frame[8:] == ["scenario.targets[0]", "scenario.targets[3]",
-                         "scenario.targets[1].scatterers[0]", "scenario.targets[1].scatterers[1]",
-                         "targets[5]"]
+    assert frame[8:] == ["scenario.targets[0]", "scenario.targets[3]", "targets[5]",
+                         "scenario.targets[1].scatterers[0]", "scenario.targets[1].scatterers[1]"]
     assert target_labels(scene, t)[8:10] == ["targets[5]", "targets[6]"]
     assert target_labels(SimpleNamespace(targets=t[:1], objects=(), scenario=None)) == [
         "targets[0]"]
@@ -468,6 +480,8 @@ def test_a_drives_frames_carry_each_moving_objects_scatterers_at_its_pose(elevat
             assert t.elevation_rad == pytest.approx(math.asin(p[2] / r) if elevation else 0.0,
                                                     abs=1e-12)
             assert t.velocity_mps == pytest.approx(p @ vel[f] / r, rel=1e-12, abs=1e-12)
+    two = frame_objects(SimpleNamespace(objects=(mov, mov), radar=scene.radar), {1: sp}, 3)
+    assert [[t.object_index for t in frame] for frame in two] == [[0, 0, 1, 1]] * 3
 
 
 def test_a_drives_mesh_with_no_facet_facing_is_refused_naming_the_file(radar):
@@ -496,3 +510,118 @@ def test_a_moving_objects_pose_is_its_drives_and_a_static_ones_its_origin():
                     origin=(1.0, 2.0, 3.0))
     o, v = s.pose(None, 4)
     assert np.array_equal(o, [1.0, 2.0, 3.0]) and np.array_equal(v, np.zeros(3))
+
+
+# ------------------------------------------------------------------------------------------
+# Meshes: loaded into their models, frozen at a drive's first frame
+# ------------------------------------------------------------------------------------------
+
+def test_mesh_objects_load_into_models_of_the_files_geometry():
+    """A static and a moving mesh entry: the file's vertices and facets, the footprint's hull
+    of its (x, y), the heading (fixed, or along the motion), moving or not; an entry of
+    scatterers: its rows, its footprint's hull."""
+    from rtsgeom.scene.mesh import load_mesh
+    from rtsgeom.scene.objects import _hull
+    doc = copy.deepcopy(CAR)
+    del doc["scenario"]["targets"][0]["scatterers"]
+    doc["scenario"]["targets"][0]["mesh"] = "car.ply"
+    doc["targets"] = [{"range_m": 15.0, "mesh": "car.ply", "heading_deg": 30.0},
+                      {"range_m": 12.0, "angle_deg": 20.0, "scatterers": [
+                          [0.5, 1.0, 0.2, 1.0], [-0.5, 1.0, 0.0, 2.0], [0.0, -1.0, 0.0, 3.0]]}]
+    s = parse_scene(doc, "m.toml", base_dir=SCENES)
+    v, f = load_mesh(str(SCENES / "car.ply"), "targets[0].mesh", "m.toml")
+    static, points, moving = s.objects
+    for m, where in ((static, "targets[0]"), (moving, "scenario.targets[0]")):
+        assert m.where == where and m.points is None and m.rcs_dbsm is None
+        assert np.array_equal(m.vertices, v) and np.array_equal(m.faces, f)
+        assert np.array_equal(m.outline, _hull(v[:, :2]))
+    assert (static.heading_rad, static.along_velocity, static.moving) == (
+        pytest.approx(30 * DEG), False, False)
+    assert (moving.heading_rad, moving.along_velocity, moving.moving) == (0.0, True, True)
+    rows = np.array([[0.5, 1.0, 0.2], [-0.5, 1.0, 0.0], [0.0, -1.0, 0.0]])
+    assert np.array_equal(points.points, rows) and np.array_equal(points.rcs_dbsm, [1, 2, 3])
+    assert np.array_equal(points.outline, _hull(rows[:, :2])) and len(points.outline) == 3
+
+
+def test_a_moving_mesh_is_frozen_as_the_ruT_sees_it_at_the_first_frame(radar):
+    """Its scatterers the placement's at the first frame (turned along that frame's motion),
+    back in the object's frame: carried to the first frame they lie where placed, at
+    elevation 0 for an RuT without it; their RCS the placed ones'."""
+    from rtsgeom.scene.mesh import load_mesh
+    from rtsgeom.scene.objects import _mesh_frozen
+    v, f = load_mesh(str(SCENES / "car.ply"), "m", "m")
+    m = ObjectModel("scenario.targets[0]", None, None, v, f, v[:, :2], heading_rad=0.5,
+                    along_velocity=True, moving=True)
+    wp = [[0.0, 14.0, -0.3, 0.0], [1.0, 12.0, 0.1, 0.0], [2.0, 13.0, 0.4, 0.0]]
+    sp = trajectory(wp, frame_times(1.0, 2.0))
+    first = place(m, sp.position_m[0], sp.velocity_vec_mps[0], radar, 0)
+    frozen = _mesh_frozen(m, sp, radar)
+    assert len(first) >= 3 and frozen.vertices is v and frozen.along_velocity
+    assert np.array_equal(frozen.rcs_dbsm, [t.rcs_dbsm for t in first])
+    pos, _ = object_set_points(frozen, sp, radar)
+    want = np.array([[t.range_m * math.sin(t.angle_rad), t.range_m * math.cos(t.angle_rad), 0.0]
+                     for t in first])
+    assert np.allclose(pos[0], want, rtol=0, atol=1e-9)
+    h = math.atan2(*sp.velocity_vec_mps[0][:2])
+    c, s = math.cos(h), math.sin(h)
+    local = (want - sp.position_m[0]) @ np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
+    assert np.allclose(frozen.points, local, rtol=0, atol=1e-9)
+
+
+def test_a_car_meshs_placed_scatterers_are_merged_to_the_ruTs_resolution(radar):
+    """The bundled car turned 30 deg 15 m ahead: its scatterers are mesh_scatterers' with the
+    direction cell 2 / (Tx active x Rx) of the RuT's virtual array, carried to the origin."""
+    from rtsgeom.scene.mesh import load_mesh, mesh_scatterers
+    v, f = load_mesh(str(SCENES / "car.ply"), "m", "m")
+    o = np.array([0.0, 15.0, 0.0])
+    turn = np.array([[math.cos(0.5), math.sin(0.5), 0.0], [-math.sin(0.5), math.cos(0.5), 0.0],
+                     [0.0, 0.0, 1.0]])
+    got = place(ObjectModel("targets[0]", None, None, v, f, v[:, :2], heading_rad=0.5), o,
+                None, radar, 0)
+    pts, rcs = mesh_scatterers(v, f, turn.T @ (-o), radar.wavelength_m,
+                               radar.range_resolution_m, 2.0 / (radar.num_tx_active * radar.num_rx))
+    p = o + pts @ turn.T
+    assert len(got) == len(pts) > 3
+    assert np.allclose([t.range_m for t in got], np.linalg.norm(p, axis=1), rtol=1e-12)
+    assert np.allclose([t.angle_rad for t in got], np.arctan2(p[:, 0], p[:, 1]), atol=1e-12)
+    assert np.allclose([t.rcs_dbsm for t in got], rcs, rtol=1e-12)
+
+
+def test_static_objects_expand_at_their_direction_and_velocity(radar):
+    """The origin r (cos e sin a, cos e cos a, sin e) and the entry's radial velocity along
+    it; a placement's error names the scene, or <scene> without a file."""
+    import dataclasses
+    from rtsgeom.scene.objects import expand_objects
+    base = parse_scene(bench_doc([]), "b.toml")
+    a, e = 0.2, 0.15
+    entry = TargetConfig(range_m=15.0, velocity_mps=-3.0, angle_rad=a, elevation_rad=e,
+                         scatterers=((0.0, 0.0, 0.0, 1.0), (1.0, 0.5, 0.3, 2.0)))
+    scene = dataclasses.replace(base, targets=(entry,), source=None,
+                                radar=dataclasses.replace(radar, elevation_processing=True))
+    s = expand_objects(scene, {})
+    u = np.array([math.cos(e) * math.sin(a), math.cos(e) * math.cos(a), math.sin(e)])
+    assert np.allclose(s.objects[0].origin, 15.0 * u, rtol=0, atol=1e-12)
+    for t, x in zip(s.targets, ([0.0, 0.0, 0.0], [1.0, 0.5, 0.3])):
+        p = 15.0 * u + np.array(x)
+        r = np.linalg.norm(p)
+        assert t.range_m == pytest.approx(r, rel=1e-12)
+        assert t.velocity_mps == pytest.approx(p @ (-3.0 * u) / r, rel=1e-12)
+        assert t.elevation_rad == pytest.approx(math.asin(p[2] / r), abs=1e-12)
+    at_ruT = dataclasses.replace(entry, scatterers=((0.0, -15.0, 0.0, 1.0),), angle_rad=0.0,
+                                 elevation_rad=0.0)
+    with pytest.raises(SceneError) as exc:
+        expand_objects(dataclasses.replace(scene, targets=(at_ruT,)), {})
+    assert str(exc.value) == ("<scene>: targets[0].scatterers[0]: lies at the RuT (range 0): "
+                              "move the object or its scatterer")
+
+
+def test_a_placement_along_the_motion_turns_with_the_velocity():
+    m = _static([[0.0, 2.0, 0.0]])
+    along = ObjectModel("targets[0]", m.points, m.rcs_dbsm, None, None, m.outline,
+                        heading_rad=1.0, along_velocity=True)
+    o, v = np.array([0.0, 10.0, 0.0]), np.array([3.0, -4.0, 0.0])
+    h = math.atan2(3.0, -4.0)
+    got = place(along, o, v, SimpleNamespace(elevation_processing=False), 0)[0]
+    p = o + 2.0 * np.array([math.sin(h), math.cos(h), 0.0])
+    assert got.angle_rad == pytest.approx(math.atan2(p[0], p[1]), abs=1e-12)
+    assert got.range_m == pytest.approx(np.linalg.norm(p), rel=1e-12)
