@@ -52,6 +52,8 @@ W0, W1 = [0.0, 10.0, 0.0, 0.0], [2.0, 20.0, 0.0, 0.0]
 
 CASES = [
     ("within every limit", (AWAY,), {}, {"r_lim": 20.5, "v_lim": 5.5}, []),
+    ("short steps", (((0.0, 10.0, 0.0, 0.0), (0.5, 11.0, 0.0, 0.0), (2.0, 12.0, 0.0, 0.0)),), {},
+     {}, []),
     ("a late start", (((0.5, 10.0, 0.0, 0.0), (2.0, 20.0, 0.0, 0.0)),), {}, {},
      [(W.format(0) + "[0][0]", 0.5, START)]),
     ("a repeated time", (((0.0, 10.0, 0.0, 0.0), (1.0, 11.0, 0.0, 0.0), (1.0, 12.0, 0.0, 0.0),
@@ -59,15 +61,20 @@ CASES = [
      [(W.format(0) + "[2][0]", 1.0, "> 1 s: waypoint times must increase strictly")]),
     ("a time going back", (((0.0, 10.0, 0.0, 0.0), (2.5, 11.0, 0.0, 0.0), (1.5, 12.0, 0.0, 0.0)),),
      {}, {}, [(W.format(0) + "[2][0]", 1.5, "> 2.5 s: waypoint times must increase strictly")]),
-    ("an early end", (((0.0, 10.0, 0.0, 0.0), (1.5, 12.0, 0.0, 0.0)),), {}, {},
-     [(W.format(0) + "[1][0]", 1.5, ">= scenario.duration_s (2 s): the last waypoint ends the "
+    ("an early end", (((0.0, 10.0, 0.0, 0.0), (1.0, 11.0, 0.0, 0.0), (1.5, 12.0, 0.0, 0.0)),),
+     {}, {}, [(W.format(0) + "[2][0]", 1.5, ">= scenario.duration_s (2 s): the last waypoint ends the "
                                     "drive, or later")]),
     ("an end at the duration", (AWAY,), {}, {}, []),
     ("one waypoint: at rest", (((0.0, 10.0, 0.0, 0.0),),), {}, {}, []),
     # each target on its own: a refused one does not stop the next
-    ("two refused", (((1.0, 10.0, 0.0, 0.0),), AWAY), {}, {"r_lim": 15.0},
+    ("four refused", (((1.0, 10.0, 0.0, 0.0),), ((0.0, 10.0, 0.0, 0.0), (0.0, 11.0, 0.0, 0.0)),
+                      ((0.0, 10.0, 0.0, 0.0), (1.0, 11.0, 0.0, 0.0)), AWAY), {},
+     {"r_lim": 15.0},
      [(W.format(0) + "[0][0]", 1.0, START),
-      (W.format(1) + "[0]", W0, BLAME.format(FAR.format(15), 1, "the range is 15 m"))]),
+      (W.format(1) + "[1][0]", 0.0, "> 0 s: waypoint times must increase strictly"),
+      (W.format(2) + "[1][0]", 1.0, ">= scenario.duration_s (2 s): the last waypoint ends the "
+                                    "drive, or later"),
+      (W.format(3) + "[0]", W0, BLAME.format(FAR.format(15), 1, "the range is 15 m"))]),
     # the range at its bound refused, blaming the waypoint that starts the frame's segment
     ("range at its bound", (AWAY,), {}, {"r_lim": 15.0},
      [(W.format(0) + "[0]", W0, BLAME.format(FAR.format(15), 1, "the range is 15 m"))]),
@@ -75,10 +82,10 @@ CASES = [
      [(W.format(0) + "[1]", W1, BLAME.format(FAR.format(15), 2, "the range is 20 m"))]),
     ("range less the air path", (AWAY,), {}, {"r_lim": 15.5, "air": 0.5},
      [(W.format(0) + "[0]", W0, BLAME.format(FAR.format(15), 1, "the range is 15 m"))]),
-    ("a row in degrees", (((0.0, 25.0, 0.1, 0.0), (4.0, 25.0, -0.1, 0.0)),), {"duration": 4.0},
-     {"r_lim": 20.0},
-     [(W.format(0) + "[0]", [0.0, 25.0, round(math.degrees(0.1), 6), 0.0],
-       BLAME.format(FAR.format(20), 0, "the range is 25 m"))]),
+    ("a row in degrees", (((0.0, 25.12345678, 0.1, 0.0), (4.0, 25.12345678, -0.1, 0.0)),),
+     {"duration": 4.0}, {"r_lim": 20.0},
+     [(W.format(0) + "[0]", [0.0, 25.123457, round(math.degrees(0.1), 6), 0.0],
+       BLAME.format(FAR.format(20), 0, "the range is 25.12 m"))]),
     # the arc: the range must exceed its radius where the RTS subtracts the air path
     ("at the arc", (AWAY,), {"arc": 10.0}, {},
      [(W.format(0) + "[0]", W0, BLAME.format(ARC.format(10), 0, "the range is 10 m"))]),
@@ -91,6 +98,9 @@ CASES = [
      [(W.format(0) + "[0]", [0.0, 20.0, 0.0, 0.0],
        BLAME.format(FAST.format(5), 0, "the radial velocity is -5 m/s"))]),
     ("just below the limit", (AWAY,), {}, {"v_lim": np.nextafter(5.0, INF)}, []),
+    ("speeding up", (((0.0, 10.0, 0.0, 0.0), (1.0, 15.0, 0.0, 0.0), (2.0, 25.0, 0.0, 0.0)),), {},
+     {"v_lim": 5.0}, [(W.format(0) + "[0]", W0, BLAME.format(FAST.format(5), 0,
+                                                            "the radial velocity is 5 m/s"))]),
     # elevations need the RuT's 2-D beamforming
     ("an elevation", (((0.0, 10.0, 0.0, 0.0), (2.0, 10.0, 0.0, 2 * DEG)),), {}, {},
      [("radar.elevation_processing", False, f"true: {W.format(0)} has elevations; a target off "
@@ -131,8 +141,9 @@ def test_a_drive_returns_the_set_points_of_its_objects_whose_waypoints_pass():
 
 @pytest.mark.parametrize("duration, refused", [(99.999, False), (100.0, True)])
 def test_a_drive_has_at_most_max_frames(duration, refused):
-    sc = drive(((0.0, 10.0, 0.0, 0.0),), duration=duration, period=1e-3)
-    got, _ = check(sc)
+    sc = drive(((0.0, 10.0, 0.0, 0.0),), duration=duration, period=1e-3, objects=(0,))
+    got, sps = check(sc)
+    assert sorted(sps) == ([] if refused else [0])
     assert MAX_FRAMES == 100_000
     if not refused:
         assert got == [] and sc.scenario.num_frames == MAX_FRAMES
@@ -157,8 +168,9 @@ def test_a_drives_frame_holds_at_most_max_targets(static, per_frame, n_t):
 def test_a_drive_holds_at_most_max_target_frames(targets, refused):
     """100 000 frames x 10 targets are the million target-frames allowed; 11 are refused with
     the frame period that would fit."""
-    got, _ = check(drive(((0.0, 10.0, 0.0, 0.0),), duration=99.999, period=1e-3),
-                   per_frame=targets)
+    got, sps = check(drive(((0.0, 10.0, 0.0, 0.0),), duration=99.999, period=1e-3,
+                           objects=(0,)), per_frame=targets)
+    assert sorted(sps) == ([] if refused else [0])
     assert MAX_TARGET_FRAMES == 1_000_000
     assert got == ([] if not refused else [
         ("scenario.frame_period_s", 1e-3,
@@ -183,13 +195,16 @@ def test_at_a_waypoint_the_target_moves_on_the_segment_that_starts_there():
     r = np.linalg.norm(want_p, axis=1)
     assert np.allclose(sp.range_m, r, rtol=1e-12)
     assert np.allclose(sp.elevation_rad, np.arcsin(np.array(want_p)[:, 2] / r), atol=1e-12)
+    assert np.allclose(sp.azimuth_rad, np.arctan2(np.array(want_p)[:, 0], np.array(want_p)[:, 1]),
+                       atol=1e-12)
     assert np.allclose(sp.velocity_mps, np.einsum("fi,fi->f", want_p, want_v) / r, atol=1e-12)
     assert np.array_equal(sp.time_s, [-1.0, 0.0, 1.0, 2.0, 3.0, 4.0])
 
 
 @pytest.mark.parametrize("period, duration, want", [
     (0.1, 0.3, [0.0, 0.1, 0.2, 0.3]), (0.3, 1.0, [0.0, 0.3, 0.6, 0.9]), (0.5, 0.0, [0.0]),
-    (0.7, 2.1, [0.0, 0.7, 1.4, 2.1]), (1.0, 1.999, [0.0, 1.0])])
+    (0.7, 2.1, [0.0, 0.7, 1.4, 2.1]), (1.0, 1.999, [0.0, 1.0]),
+    (1 / 3, 1.0, [0.0, 0.333333333333, 0.666666666667, 1.0])])
 def test_frame_times_are_whole_periods_up_to_the_duration_as_written(period, duration, want):
     """k * period rounded to 1e-12 s (0.3, not 0.30000000000000004), the duration's last
     period taken where the division rounds below it (0.3 / 0.1 = 2.9999999999999996)."""
