@@ -351,7 +351,7 @@ def test_a_2d_rut_and_a_single_front_end_are_refused_in_full_sentences():
 
 # -- the study against its primitives: a golden radar with channel errors, drawn radars --
 
-def _channels_setup(compensation):
+def _channels_setup(compensation, **more):
     from conftest import make_scene, quiet
     from rtsgeom.geometry import build_setup
     from rtsgeom.paths import exact_paths
@@ -360,14 +360,14 @@ def _channels_setup(compensation):
         quiet(doc, small=True, samples_per_chirp=512)
         doc["radar"]["channels"] = {"rx_phase_deg": [0.0, 10.0, 0.0, 5.0],
                                     "tx_gain_db": [0.0, -0.5, 0.3],
-                                    "compensation": compensation}
+                                    "compensation": compensation, **more}
     setup = build_setup(make_scene(mutate))
     return setup, exact_paths(setup)
 
 
 @pytest.fixture(scope="module")
 def golden_with_errors():
-    setup, paths = _channels_setup("none")
+    setup, paths = _channels_setup("none", rx_coupling_db=-20.0)
     study = TransferStudy(radars=4, points=2, pairs=((0, 1),), sigma_phase_deg=3.0,
                           sigma_gain_db=0.5, seed=2, spec_deg=0.05)
     return setup, paths, study, study(setup, paths)
@@ -420,15 +420,29 @@ def test_the_study_draws_measures_and_calibrates_as_its_primitives_say(golden_wi
     assert not np.allclose(r.ideal_cal_error_deg, r.golden_error_deg, rtol=0, atol=1e-9)
     assert (r.sigma_phase_deg, r.sigma_gain_db, r.spec_deg, r.range_m > 0) == (3.0, 0.5, 0.05,
                                                                                 True)
+    assert coupling is not None
+    assert r.pair_index.tolist() == [0, 0] and r.scene_name == setup.scene.name
 
 
 def test_radars_that_compensate_at_boresight_are_measured_compensated():
-    """A golden radar that runs the boresight compensation: every drawn radar of the type runs
-    it too, so its error is its compensated one."""
-    setup, paths = _channels_setup("boresight")
+    """A golden radar that runs the boresight compensation (at its reflector's range): every
+    drawn radar of the type runs it too, so its error is its compensated one, and on a real
+    target too."""
+    from rtsgeom.analysis.transfer import draw_channel_gains, own_angle_errors
+    from rtsgeom.radar.channels import channel_coupling, compensation_vector
+    from rtsgeom.radar.steering import Steering
+    setup, paths = _channels_setup("boresight", compensation_range_m=4.0)
     r = TransferStudy(radars=3, points=1, sigma_phase_deg=4.0, seed=5)(setup, paths)
     assert np.array_equal(r.error_deg, r.compensated_error_deg)
     assert r.pairs == ((0, 1),) and r.error_deg.shape == (3, 1)
+    rut, radar = setup.rut, setup.scene.radar
+    g = draw_channel_gains(rut, 3, np.radians(4.0), 0.0, 5)[0]
+    coupling = channel_coupling(radar, rut)
+    g = g * compensation_vector(g, rut, 4.0, coupling)
+    own = own_angle_errors(Steering.build(rut, radar), g, np.radians(r.set_deg), coupling)
+    assert np.allclose(r.own_error_deg, np.degrees(own), rtol=0, atol=1e-9)
+    assert not np.allclose(compensation_vector(g, rut, None, coupling),
+                           compensation_vector(g, rut, 4.0, coupling))
 
 
 @pytest.mark.parametrize("channels, why", [
