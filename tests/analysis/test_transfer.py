@@ -4,6 +4,8 @@ peak at the documented maximum)."""
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -345,3 +347,142 @@ def test_a_2d_rut_and_a_single_front_end_are_refused_in_full_sentences():
     with pytest.raises(ParameterError) as exc:
         TransferStudy()(build_setup(one), None)
     assert str(exc.value) == "transfer: the arc needs at least two front ends"
+
+
+# -- the study against its primitives: a golden radar with channel errors, drawn radars --
+
+def _channels_setup(compensation, **more):
+    from conftest import make_scene, quiet
+    from rtsgeom.geometry import build_setup
+    from rtsgeom.paths import exact_paths
+
+    def mutate(doc):
+        quiet(doc, small=True, samples_per_chirp=512)
+        doc["radar"]["channels"] = {"rx_phase_deg": [0.0, 10.0, 0.0, 5.0],
+                                    "tx_gain_db": [0.0, -0.5, 0.3],
+                                    "compensation": compensation, **more}
+    setup = build_setup(make_scene(mutate))
+    return setup, exact_paths(setup)
+
+
+@pytest.fixture(scope="module")
+def golden_with_errors():
+    setup, paths = _channels_setup("none", rx_coupling_db=-20.0)
+    study = TransferStudy(radars=4, points=2, pairs=((0, 1),), sigma_phase_deg=3.0,
+                          sigma_gain_db=0.5, seed=2, spec_deg=0.05)
+    return setup, paths, study, study(setup, paths)
+
+
+def test_the_study_draws_measures_and_calibrates_as_its_primitives_say(golden_with_errors):
+    """A golden radar with its own channel errors (no compensation): the draws are
+    draw_channel_gains' (sigma in radians, the study's seed), the set-points set_angles' on
+    the probe, the range the first probe's, the calibration's shift the golden minus the ideal
+    radar's delay (ps), each radar's error the snapshot of the planned programme seen through
+    its gains (with its boresight compensation: those gains compensated), its own error
+    plane_wave_errors' at the set angles."""
+    from rtsgeom.analysis.transfer import (draw_channel_gains, ideal_radar, own_angle_errors,
+                                           set_angles, snapshot_angles)
+    from rtsgeom.calibration.pair import calibrate_pair
+    from rtsgeom.calibration.probes import probe_front_ends, probe_ranges
+    from rtsgeom.radar.channels import channel_coupling, channel_gain, compensation_vector
+    from rtsgeom.radar.steering import Steering
+    from rtsgeom.scene import TargetConfig
+    from rtsgeom.synthesis.model import ChannelModel
+    setup, paths, study, r = golden_with_errors
+    radar, rut = setup.scene.radar, setup.rut
+    g, ph, gd = draw_channel_gains(rut, 4, np.radians(3.0), 0.5, 2)
+    assert np.array_equal(r.draw_phase_rad, ph) and np.array_equal(r.draw_gain_db, gd)
+    probe = probe_front_ends(setup, paths, 2)
+    assert np.array_equal(r.set_deg, np.degrees(set_angles(setup, probe, (0, 1), 2)))
+    assert r.range_m == float(probe_ranges(setup, 1)[0])
+    ideal = ideal_radar(setup)
+    assert ideal is not setup
+    cal = calibrate_pair(setup, paths, (0, 1), probe, seed=2)
+    cal0 = calibrate_pair(ideal, paths, (0, 1), probe_front_ends(ideal, paths, 2), seed=2)
+    assert r.offset_shift_ps == ((cal.delta_tau_s - cal0.delta_tau_s) * 1e12,)
+    assert r.offset_shift_ps[0] != 0.0
+    st = Steering.build(rut, radar)
+    coupling = channel_coupling(radar, rut)
+    comp = g * compensation_vector(g, rut, radar.channels.compensation_range_m, coupling)
+    gold = channel_gain(radar, rut)
+    for p, (a_i, a_j, off_i, off_j) in enumerate(r.programs):
+        assert off_i == 0.0 and (a_i, a_j) != (0.0, 0.0)
+        t = TargetConfig(r.range_m, 0.0, 10.0, float(np.radians(r.set_deg[p])))
+        model = ChannelModel.build(ideal, paths, (0, 1), t, (0.0, off_j), steering=st)
+        w = np.array([a_i, a_j])
+        for got, gains in ((r.error_deg[:, p], g), (r.compensated_error_deg[:, p], comp),
+                           (r.golden_error_deg[p:p + 1], gold[None])):
+            want = np.degrees(snapshot_angles(model, w, gains, coupling) - t.angle_rad)
+            assert np.allclose(got, want, rtol=0, atol=1e-12), p
+    own = np.degrees(own_angle_errors(st, g, np.radians(r.set_deg), coupling))
+    assert np.allclose(r.own_error_deg, own, rtol=0, atol=1e-9)
+    assert not np.allclose(r.error_deg, r.compensated_error_deg, rtol=0, atol=1e-6)
+    assert not np.allclose(r.ideal_cal_error_deg, r.golden_error_deg, rtol=0, atol=1e-9)
+    assert (r.sigma_phase_deg, r.sigma_gain_db, r.spec_deg, r.range_m > 0) == (3.0, 0.5, 0.05,
+                                                                                True)
+    assert coupling is not None
+    assert r.pair_index.tolist() == [0, 0] and r.scene_name == setup.scene.name
+
+
+def test_radars_that_compensate_at_boresight_are_measured_compensated():
+    """A golden radar that runs the boresight compensation (at its reflector's range): every
+    drawn radar of the type runs it too, so its error is its compensated one, and on a real
+    target too."""
+    from rtsgeom.analysis.transfer import draw_channel_gains, own_angle_errors
+    from rtsgeom.radar.channels import channel_coupling, compensation_vector
+    from rtsgeom.radar.steering import Steering
+    setup, paths = _channels_setup("boresight", compensation_range_m=4.0)
+    r = TransferStudy(radars=3, points=1, sigma_phase_deg=4.0, seed=5)(setup, paths)
+    assert np.array_equal(r.error_deg, r.compensated_error_deg)
+    assert r.pairs == ((0, 1),) and r.error_deg.shape == (3, 1)
+    rut, radar = setup.rut, setup.scene.radar
+    g = draw_channel_gains(rut, 3, np.radians(4.0), 0.0, 5)[0]
+    coupling = channel_coupling(radar, rut)
+    g = g * compensation_vector(g, rut, 4.0, coupling)
+    own = own_angle_errors(Steering.build(rut, radar), g, np.radians(r.set_deg), coupling)
+    assert np.allclose(r.own_error_deg, np.degrees(own), rtol=0, atol=1e-9)
+    assert not np.allclose(compensation_vector(g, rut, None, coupling),
+                           compensation_vector(g, rut, 4.0, coupling))
+
+
+@pytest.mark.parametrize("channels, why", [
+    (None, ""),
+    (SimpleNamespace(tx_gain_db=(0.0, 1.0), rx_gain_db=(0.5,)), ""),
+    (SimpleNamespace(tx_gain_db=(-3.0, 1.0), rx_gain_db=(0.0, -1.5)),
+     "; radar.channels.tx_gain_db / rx_gain_db lower the channels by up to 4.5 dB"),
+    (SimpleNamespace(tx_gain_db=(), rx_gain_db=(-2.0, 0.0)),
+     "; radar.channels.tx_gain_db / rx_gain_db lower the channels by up to 2 dB"),
+])
+def test_front_ends_the_radar_does_not_see_alone_are_refused_naming_them(monkeypatch,
+                                                                         channels, why):
+    from rtsgeom.analysis import transfer
+    seen = []
+    probe = SimpleNamespace(angle_rad=np.array([0.1, np.nan, 0.2, np.inf]),
+                            clipping_note=lambda: " (NOTE)")
+    monkeypatch.setattr(transfer, "probe_front_ends",
+                        lambda setup, paths, seed: seen.append(seed) or probe)
+    setup = SimpleNamespace(scene=SimpleNamespace(radar=SimpleNamespace(channels=channels)))
+    with pytest.raises(ParameterError) as exc:
+        transfer._probe(setup, None, 11)
+    assert str(exc.value) == (
+        "front end(s) [1, 3] not detected alone by the scene's radar at their probe ranges "
+        f"(below the CFAR threshold, or clipped) (NOTE){why}: transfer calibrates each pair on "
+        "its front ends' measured angles")
+    probe.angle_rad = np.array([0.1, 0.2])
+    assert transfer._probe(setup, None, 11) is probe and seen == [11, 11]
+
+
+def test_the_result_writes_its_json_and_figure(tmp_path, monkeypatch):
+    """transfer.json (to_dict's) and transfer.png (the figure plot() draws), their names."""
+    import json
+    from rtsgeom.analysis.transfer import Transfer
+    from rtsgeom.viz import figures
+    saved = []
+    monkeypatch.setattr(Transfer, "plot", lambda self: ("figure of", self))
+    monkeypatch.setattr(figures, "save_figure", lambda fig, path: saved.append((fig, path)))
+    res = _transfer(np.full((3, 2), 0.25), np.full((3, 2), 0.125), np.full((3, 2), 0.0625), 0.2)
+    assert res.write(tmp_path) == ["transfer.json", "transfer.png"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["transfer.json"]
+    assert json.loads((tmp_path / "transfer.json").read_text()) == json.loads(
+        json.dumps(res.to_dict()))
+    assert saved == [(("figure of", res), tmp_path / "transfer.png")]
