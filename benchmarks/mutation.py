@@ -169,9 +169,13 @@ def prepare(workdir: Path, modules: list[str], keep: bool = False) -> None:
     cfg["only_mutate"] = globs
     cfg["also_copy"] = sorted(set(cfg.get("also_copy", [])) | {"benchmarks/"})
     cfg["pytest_add_cli_args_test_selection"] = tests
+    ini = base.get("pytest", {}).get("ini_options", {})
+    # the suite's own settings: its markers, and its warnings-as-errors (a mutant that makes
+    # the package warn fails the tests there as it does in the suite)
     lines = ["[tool.pytest.ini_options]", 'testpaths = ["tests"]',
-             "markers = " + _toml_list(base.get("pytest", {}).get("ini_options", {})
-                                       .get("markers", [])), "", "[tool.mutmut]"]
+             "markers = " + _toml_list(ini.get("markers", [])),
+             "filterwarnings = " + _toml_list(ini.get("filterwarnings", [])), "",
+             "[tool.mutmut]"]
     for k, v in cfg.items():
         if isinstance(v, list):
             lines.append(f"{k} = {_toml_list(v)}")
