@@ -90,3 +90,68 @@ def test_the_design_draws_with_the_mc_seed_else_the_scenes(default_scene):
     s, m = grid(MonteCarlo(200, seed=default_scene.seed + 1))
     assert s == default_scene.seed + 1
     assert any(not np.array_equal(m[k], m0[k], equal_nan=True) for k in m0)
+
+
+@pytest.fixture
+def recorded(monkeypatch):
+    """design_grid and coverage_designs replaced by recorders of their arguments."""
+    import rtsgeom.analysis.design_study as ds
+    calls = []
+    monkeypatch.setattr(ds, "design_grid", lambda *a, **k: calls.append(("grid", a, k)) or "G")
+    monkeypatch.setattr(ds, "coverage_designs",
+                        lambda *a, **k: calls.append(("coverage", a, k)) or "C")
+    return calls
+
+
+@pytest.mark.parametrize("pair, want_pair", [((0, 1), (0, 1)), ((1, 0), (0, 1))])
+def test_the_grid_is_called_with_the_studys_fields(default_scene, recorded, pair, want_pair):
+    """The grid's call: the scene, the pair in canonical order, the radii and spacings, the
+    spec with the yield, the draws, the seed (the scene's) and the set-points, the workers,
+    no progress without a reporter."""
+    from rtsgeom.analysis.design import DesignSpec
+    got = DesignStudy(radius_m=(1.0, 2.0), spacing_deg=(8.0,), pair=pair, spec_deg=0.05,
+                      target_yield=0.9, mc=MonteCarlo(40), points=5, workers=3)(default_scene)
+    assert got == "G"
+    assert recorded == [("grid", (default_scene, want_pair, (1.0, 2.0), (8.0,),
+                                  DesignSpec(0.05, 0.9, 40, default_scene.seed, 5)),
+                         {"workers": 3, "progress": None})]
+
+
+def test_the_coverage_is_called_with_the_studys_fields(default_scene, recorded):
+    told = []
+    got = DesignStudy(radius_m=(1.0,), coverage_deg=(-10, 12), spec_deg=0.2, target_yield=0.8,
+                      mc=MonteCarlo(30, seed=9, progress=lambda *a: told.append(a)))(
+        default_scene)
+    assert got == "C"
+    [(kind, args, kw)] = recorded
+    assert (kind, args) == ("coverage", (default_scene, (-10.0, 12.0), (1.0,), 0.2, 0.8, 30, 9))
+    assert set(kw) == {"points", "workers", "progress"}
+    assert (kw["points"], kw["workers"]) == (11, 1)
+    kw["progress"](1, 2)
+    assert told == [("designs", 0, 2), ("designs", 1, 2)]
+
+
+def test_a_scene_of_cells_gets_no_arc_design(sphere_scene, recorded):
+    from conftest import assert_refused
+    for study in (DesignStudy(), DesignStudy(coverage_deg=(-5.0, 5.0))):
+        assert_refused(lambda: study(sphere_scene),
+                       f"design {sphere_scene.source}: this scene's front ends form 2-D cells "
+                       "(azimuth and elevation); the arc design varies the azimuth spacing of "
+                       "front ends on an arc and synthesizes in azimuth only, it has no design "
+                       "for a cell: use `tolerance SCENE --cell all` (the cell's mounting "
+                       "tolerance), `linearity SCENE --grid N` and `nearfield SCENE` for the "
+                       "cell")
+    assert recorded == []
+
+
+def test_evolve_checks_again():
+    from conftest import assert_refused
+    s = DesignStudy().evolve(radius_m=[3], points=5)
+    assert (s.radius_m, s.points) == ((3.0,), 5) and s.spacing_deg == DesignStudy().spacing_deg
+    assert_refused(lambda: DesignStudy().evolve(points=2),
+                   "DesignStudy: points = 2: must be in [3, 201]")
+    assert DesignStudy().radius_m == (0.5, 1.0, 1.5, 2.0)
+    assert DesignStudy().spacing_deg == (4.0, 8.0, 12.0, 16.0, 20.0)
+    assert (DesignStudy().pair, DesignStudy().coverage_deg, DesignStudy().spec_deg,
+            DesignStudy().target_yield, DesignStudy().mc, DesignStudy().points,
+            DesignStudy().workers) == ((0, 1), None, 0.1, 0.95, None, None, 1)

@@ -271,3 +271,175 @@ def test_a_cell_holding_no_set_direction_is_refused(monkeypatch, sphere_scene):
     monkeypatch.setattr(cell_mod, "cell_grid", lambda st, u, n: np.zeros((0, 2)))
     assert_refused(lambda: cell_mod.build_cell(nom, (0, 1, 2), 5, TargetConfig(15.0)),
                    "cell [0, 1, 2]: no set direction of a 5 x 5 grid lies inside it")
+
+
+# -- the cell's fields and draws read whole against their definitions ----------------------
+
+
+@pytest.fixture(scope="module")
+def cell0():
+    return ChannelPhasors.build(build_setup(cell_scene(*CELLS[0])), points=4)
+
+
+def test_the_cells_fields_from_their_definitions(cell0):
+    """build_cell: the set directions (the 2 x 2 grid of 4 points inside the cell), the
+    spanning tree from front end 0 and its phases, the exact design per set direction, the
+    delay step and eq. (27)'s slope f_RTS + B/2, the calibration's reach (half an IF period
+    plus 8 refining steps and one), the tables' rows (every sub-bin position and calibration
+    delay, one more) and bins (2 either side), their log slopes and each channel's delay
+    factor at the set range's bin (1 at no delay)."""
+    from scipy.constants import c
+
+    from rtsgeom.analysis.linearity import cell_grid
+    from rtsgeom.analysis.tolerance.cell import ANGLES, HALF_BINS, REFINE_STEPS
+    from rtsgeom.analysis.tolerance.tables import reference_target, response_table
+    from rtsgeom.calibration.channels import pair_edges, spanning_tree, tree_phases
+    from rtsgeom.paths import exact_paths
+    assert (ANGLES, HALF_BINS, REFINE_STEPS) == (("azimuth", "elevation",
+                                                  "angular_distance"), 2, 8)
+    nom, cs, pr = cell0.setup, cell0.channels, cell0.procedure
+    radar, rts = nom.scene.radar, nom.scene.rts
+    st = cs.steering
+    assert cell0.front_ends == (0, 1, 2, 3) and st.dims == 2
+    grid = cell_grid(st, cs.fe_directions(), 2)
+    assert grid.shape == (4, 2)
+    np.testing.assert_array_equal(cell0.set_rad, grid)
+    np.testing.assert_array_equal(pr.set_u, st.directions(grid))
+    all_u = nom.fe_direction_cosines()
+    tree = tuple(spanning_tree(all_u, pair_edges(all_u, (0, 1, 2, 3)), 0))
+    assert pr.tree == tree and len(tree) == 3
+    np.testing.assert_array_equal(pr.phases, tree_phases(cs, tree))
+    np.testing.assert_array_equal(cell0.amplitudes, np.stack(
+        [np.abs(cs.solve(u, pr.phases, "exact")) for u in pr.set_u]))
+    res, slope = rts.delay_resolution_s, rts.f_rts_hz + 0.5 * radar.bandwidth_hz
+    assert (cell0.delay_resolution_s, cell0.cal_slope_hz) == (res, slope)
+    s = math_ceil(0.5 / (slope * res)) + 8 + 1
+    assert pr.max_steps == s and pr.block_draws == 500
+    n_bin = max(1, round(2 * radar.range_resolution_m / c / res))
+    np.testing.assert_array_equal(cell0.subbin_steps, np.arange(n_bin) - n_bin // 2)
+    z = n_bin // 2 + s + 1
+    v = cell0.x_nominal.shape[-1]
+    assert cell0.table_zero == z and cell0.table.shape == (4, 2 * z + 1, 5, v)
+    rows = np.array([0, z - 3, z, 2 * z])
+    want = np.stack([response_table(nom, exact_paths(nom), q, reference_target(nom, None), res,
+                                    rows - z, 2) for q in range(4)])
+    np.testing.assert_allclose(cell0.table[:, rows], want, rtol=1e-12, atol=0)
+    with np.errstate(divide="ignore"):
+        log_slope = np.gradient(np.log(np.abs(cell0.table)), res, axis=1)
+    np.testing.assert_array_equal(cell0.table_log_slope, log_slope)
+    ks = slice(z - s, z + s + 1)
+    np.testing.assert_array_equal(pr.delay_factor, cell0.table[:, ks, 2]
+                                  / cell0.table[:, z:z + 1, 2])
+    assert pr.delay_factor.shape == (4, 2 * s + 1, v)
+    np.testing.assert_allclose(pr.delay_factor[:, s], 1.0, rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(pr.delay_log_slope, log_slope[:, ks, 2])
+
+
+def math_ceil(x):
+    import math
+    return math.ceil(x)
+
+
+@pytest.mark.parametrize("offsets_um, positions", [(0.0, None), (30.0, [0, -1]),
+                                                   (100.0, [1, 2])])
+def test_a_cells_draw_in_full(cell0, offsets_um, positions):
+    """CellProcedure.draw: the calibration steps (the procedure's), per case the errors, the
+    angular distance between the detected and the set direction (the great-circle angle of
+    the unit vectors), the detected bin from the set range's (0 without errors), converged
+    peaks and the amplitudes: the design's uncalibrated; calibrated the design times the gain
+    correction over each channel's loss at its calibration delay."""
+    from rtsgeom.analysis.tolerance.cell import HALF_BINS
+    n = 2
+    rng = np.random.default_rng(int(offsets_um))
+    off = rng.standard_normal((n, 4, 3)) * offsets_um * 1e-6
+    u = None if positions is None else np.asarray(positions) + int(
+        np.flatnonzero(cell0.subbin_steps == 0)[0])
+    d = cell0.draw(off, u, CASES)
+    st, pr = cell0.channels.steering, cell0.procedure
+    x = cell0.channels.perturbed(off)
+    assert set(d) == {"steps", *CASES}
+    np.testing.assert_array_equal(d["steps"], pr.calibration_steps(cell0, x))
+    m = cell0.set_rad.shape[0]
+    for case in CASES:
+        got = d[case]
+        assert set(got) == {"error_rad", "distance_rad", "converged", "bin", "amplitudes"}
+        assert got["error_rad"].shape == (n, m, 2) and got["amplitudes"].shape == (n, m, 4)
+        det = st.directions(cell0.set_rad + got["error_rad"])
+        w = np.sqrt(1 - np.sum(det ** 2, -1))
+        w0 = np.sqrt(1 - np.sum(pr.set_u ** 2, -1))
+        cosang = np.sum(det * pr.set_u, -1) + w * w0
+        np.testing.assert_allclose(got["distance_rad"], np.arccos(np.clip(cosang, -1, 1)),
+                                   rtol=1e-6, atol=1e-9)
+        assert got["converged"].dtype == bool and np.all(got["converged"])
+        assert np.all(np.abs(got["bin"]) <= HALF_BINS)
+        if offsets_um == 0.0:
+            assert np.all(got["bin"] == 0)
+    np.testing.assert_array_equal(d["uncalibrated"]["amplitudes"],
+                                  np.broadcast_to(cell0.amplitudes, (n, m, 4)))
+    # calibrated: each channel's loss at its calibration delay, at the bin the nominal model
+    # of the operator detects, divided out, the gains corrected
+    z, mask, t = cell0.table_zero, st.mask, cell0.table
+    d_u = cell0.subbin_steps[u] if u is not None else np.zeros(n, int)
+    gain = cell0.gain_correction(x)
+    want = np.empty((n, m, 4))
+    for i in range(n):
+        rows = z + d_u[i] + d["steps"][i]
+        for j in range(m):
+            y = sum(cell0.amplitudes[j, q] * t[q, rows[q]] for q in range(4))  # (K, V)
+            k = int(np.argmax(np.sum(np.abs(y) ** 2, -1)))
+            for q in range(4):
+                loss = (abs(t[q, rows[q], k][mask].mean())
+                        / abs(t[q, z + d_u[i], k][mask].mean()))
+                want[i, j, q] = cell0.amplitudes[j, q] * gain[i, q] / loss
+    np.testing.assert_allclose(d["calibrated"]["amplitudes"], want, rtol=1e-12)
+    assert np.any(d["steps"] != 0)
+
+
+def test_the_cells_helpers_on_grids():
+    """The phase wrapped into (-pi, pi], the strongest bin of the power over the elements,
+    unit vectors of direction cosines (the front hemisphere, clipped at the horizon)."""
+    from rtsgeom.analysis.tolerance.cell import _detected_bin, _unit_vectors, _wrap
+    phi = np.linspace(-20, 20, 401)
+    w = _wrap(phi)
+    assert np.all((w > -np.pi - 1e-12) & (w <= np.pi + 1e-12))
+    np.testing.assert_allclose(np.exp(1j * w), np.exp(1j * phi), atol=1e-12)
+    rng = np.random.default_rng(2)
+    y = rng.standard_normal((3, 4, 5, 6)) + 1j * rng.standard_normal((3, 4, 5, 6))
+    np.testing.assert_array_equal(_detected_bin(y), np.argmax(np.sum(np.abs(y) ** 2, -1), -1))
+    y[..., 1, :] = 10 * (1 + 1j)
+    y[..., 1, 0] = 0  # the sum over the elements decides, not one element
+    y[..., 3, 0] = 30
+    assert np.all(_detected_bin(y) == 1)
+    u = np.array([[0.0, 0.0], [0.6, 0.0], [0.0, -0.8], [0.3, 0.4], [0.8, 0.8]])
+    v = _unit_vectors(u)
+    np.testing.assert_allclose(v, [[0, 0, 1], [0.6, 0, 0.8], [0, -0.8, 0.6],
+                                   [0.3, 0.4, np.sqrt(0.75)], [0.8, 0.8, 0.0]], atol=1e-15)
+    assert _unit_vectors(u[None]).shape == (1, 5, 3)
+
+
+@pytest.mark.parametrize("cell, accepted", [
+    ((0, 1, 2), True), ((1, 2, 3), True), ((0, 1, 2, 3), True),
+    ((0, 1), False), ((0, 1, 2, 3, 1), False), ((0, 1, 4), False), ((-1, 1, 2), False),
+    ((0, 1, 1), False)])
+def test_a_cells_front_ends_at_each_edge(cell, accepted, monkeypatch, sphere_scene):
+    """3 or 4 distinct indices in [0, 3]: the ends accepted (the study goes on to its paths),
+    one beyond refused with the whole message."""
+    import rtsgeom.analysis.tolerance.cell as cell_mod
+    from conftest import assert_refused
+    from rtsgeom.scene import TargetConfig
+
+    class Reached(Exception):
+        pass
+
+    def stop(nom):
+        raise Reached
+
+    monkeypatch.setattr(cell_mod, "exact_paths", stop)
+    nom = build_setup(sphere_scene)
+    call = lambda: cell_mod.build_cell(nom, cell, 3, TargetConfig(15.0))  # noqa: E731
+    if accepted:
+        with pytest.raises(Reached):
+            call()
+    else:
+        assert_refused(call, f"cell {list(cell)}: must be 3 or 4 distinct front-end indices "
+                             "in [0, 3]")

@@ -151,3 +151,241 @@ def test_a_search_line_of_another_axis_is_refused():
     from rtsgeom.analysis.tolerance.search import search_direction
     assert_refused(lambda: search_direction((1e-4,) * 3, "yaw"),
                    "axis 'yaw': must be 'all' or one of radial, tangential, height", ValueError)
+
+
+# -- the search's answers read whole, on a made-up Monte Carlo -----------------------------
+
+SENS = np.abs(np.random.default_rng(11).standard_normal(300))  # per-draw sensitivity
+
+
+class _FakeRuns:
+    """A Monte Carlo in closed form: draw i's error (deg) offset + SENS_i * 1e3 * (the sum of
+    the offsets' scales (m) + the rotations' and pose's bounds); a cell's two angles (the
+    elevation 1.5 times the azimuth) and an angular distance far beyond any spec."""
+
+    def __init__(self, offset=0.0, cols=1, spec=0.1):
+        self.offset, self.cols, self.spec = offset, cols, spec
+        self.calls = []  # (bounds or None where zero, label, yield)
+
+    def errors(self, bounds):
+        mag = 0.0 if bounds is None else (sum(bounds.offsets_m) + bounds.yaw_rad
+                                          + bounds.rut_yaw_rad)
+        e = self.offset + SENS * 1e3 * mag
+        cols = [e, -1.5 * e, np.full_like(e, 1e3)][:self.cols]
+        return np.stack(cols, -1)[:, None, :]  # (draws, 1, C)
+
+    def _record(self, bounds, label, e):
+        a = np.abs(e if e.shape[-1] == 1 else e[..., :2]).reshape(e.shape[0], -1)
+        self.calls.append((bounds, label, float(np.mean(np.all(a <= self.spec, -1)))))
+
+    def simulate(self, model, bounds, mc, spec_deg, cases, label):
+        from types import SimpleNamespace
+        assert spec_deg == self.spec and mc.draws == 300
+        e = self.errors(bounds)
+        self._record(bounds, label, e)
+        return SimpleNamespace(errors_deg={cases[0]: e})
+
+    def zero(self, model, draws, seed, case, subbin):
+        assert (draws, seed, subbin) == (300, 5, True)
+        e = self.errors(None)
+        self._record(None, None, e)
+        return e
+
+
+@pytest.fixture
+def fake(monkeypatch):
+    import rtsgeom.analysis.tolerance.search as search_mod
+    runs = {}
+
+    def make(**kw):
+        runs["f"] = f = _FakeRuns(**kw)
+        monkeypatch.setattr(search_mod, "simulate", f.simulate)
+        monkeypatch.setattr(search_mod, "_zero_errors", f.zero)
+        return f
+    return make
+
+
+def _model(cols=1):
+    from types import SimpleNamespace
+    from rtsgeom.analysis.tolerance.montecarlo import ToleranceModel
+    return ToleranceModel((SimpleNamespace(front_ends=(0, 1)),), 2, ((0, 1),),
+                          "pair" if cols == 1 else "cell")
+
+
+def _mc():
+    from rtsgeom.analysis.tolerance.config import MonteCarlo
+    return MonteCarlo(300, seed=5)
+
+
+@pytest.mark.parametrize("axis, sigma, start, t_of", [
+    ("all", (1e-4, 2e-4, 4e-4), 4e-4, lambda b: b.offsets_m[2]),
+    ("all", (0.0, 0.0, 0.0), 1e-4, lambda b: b.offsets_m[0]),
+    ("radial", (1e-4, 2e-5, 1e-5), 1e-4, lambda b: b.offsets_m[0]),
+    ("height", (2e-5, 0.0, 0.0), 1e-4, lambda b: b.offsets_m[2]),
+])
+@pytest.mark.parametrize("cols", [1, 3])
+def test_the_sigma_search_in_full(fake, axis, sigma, start, t_of, cols):
+    """YieldSearch.sigma: the search's line (the held sigmas, the first scale the largest
+    varied sigma, or 0.1 mm), each evaluation's label, sigma and yield (a cell's angular
+    distance left out of the spec), the answer the largest passing sigma evaluated with a
+    failing one within 1 % above it; the defaults (1 %, a 10 mm cap, slope 1) those given."""
+    from rtsgeom.analysis.tolerance.search import AXES, YieldSearch, search_direction
+    f = fake(offset=0.002, cols=cols)
+    got = YieldSearch(0.9).sigma(_model(cols), sigma, _mc(), axis)
+    direction, fixed = search_direction(sigma, axis)
+    ts = [0.0 if b is None else t_of(b) for b, _, _ in f.calls]
+    ys = [y for _, _, y in f.calls]
+    assert ts[0] == 0.0 and ts[1] == start
+    for (b, label, _), t in zip(f.calls, ts):
+        if b is not None:
+            np.testing.assert_array_equal(b.offsets_m, fixed + t * direction)
+            assert label == f"calibrated: sigma {t * 1e3:.4g} mm"
+            assert (b.yaw_rad, b.rut_yaw_rad) == (0.0, 0.0)
+        else:
+            assert not any(fixed)
+    t = max(t for t, y in zip(ts, ys) if y >= 0.9)
+    fail = min(t2 for t2, y in zip(ts, ys) if y < 0.9)
+    assert t < fail <= t * 1.01 / 0.99 + 1e-18 and fail - t <= 0.01 * fail
+    sig = fixed + t * direction
+    assert got == {"case": "calibrated", "axis": axis, "target_yield": 0.9, "spec_deg": 0.1,
+                   "sigma_mm": {a: float(s * 1e3) for a, s in zip(AXES, sig)},
+                   "yield": ys[ts.index(t)], "capped": False, "note": None,
+                   "evaluations": [{"scale_mm": a * 1e3, "yield": y} for a, y in zip(ts, ys)]}
+    n = len(f.calls)
+    assert YieldSearch(0.9, 0.1, "calibrated", 0.01, 0.01, 1.0).sigma(
+        _model(cols), sigma, _mc(), axis) == got
+    assert YieldSearch(0.9, rel_tol=0.1).sigma(_model(cols), sigma, _mc(), axis) != got
+    assert len(f.calls) > 2 * n
+
+
+def test_a_search_that_passes_up_to_its_cap_or_fails_without_errors(fake):
+    """Passing everywhere: the cap (10 mm by default, or as given) with its yield; failing
+    at no error at all: 0 with the note and the one evaluation."""
+    from rtsgeom.analysis.tolerance.search import YieldSearch
+    f = fake(spec=1e9)
+    got = YieldSearch(0.9, 1e9).sigma(_model(), (1e-4, 0.0, 0.0), _mc(), "radial")
+    assert got["capped"] and got["sigma_mm"] == {"radial": 10.0, "tangential": 0.0,
+                                                 "height": 0.0}
+    assert got["yield"] == 1.0 and got["evaluations"][-1] == {"scale_mm": 10.0, "yield": 1.0}
+    got = YieldSearch(0.9, 1e9, cap=2e-3).sigma(_model(), (1e-4, 0.0, 0.0), _mc(), "radial")
+    assert got["capped"] and got["sigma_mm"]["radial"] == 2.0
+    got = YieldSearch(0.9, 1e9).scale(_model(), Bounds_((1e-4, 0.0, 0.0)), _mc())
+    assert got["capped"] and got["factor"] == 100.0
+    f = fake(offset=0.2)
+    got = YieldSearch(0.9).sigma(_model(), (1e-4, 2e-4, 0.0), _mc(), "all")
+    assert got == {"case": "calibrated", "axis": "all", "target_yield": 0.9, "spec_deg": 0.1,
+                   "sigma_mm": {"radial": 0.0, "tangential": 0.0, "height": 0.0},
+                   "yield": 0.0, "capped": False,
+                   "note": "the setup misses the spec even without the varied errors",
+                   "evaluations": [{"scale_mm": 0.0, "yield": 0.0}]}
+    assert len(f.calls) == 1
+    got = YieldSearch(0.9).scale(_model(), Bounds_((1e-4, 0.0, 0.0)), _mc())
+    assert (got["factor"], got["capped"], got["evaluations"]) == (0.0, False,
+                                                                  [{"scale": 0.0, "yield": 0.0}])
+
+
+def Bounds_(offsets, **rest):
+    from rtsgeom.analysis.tolerance.draws import Bounds
+    return Bounds(offsets, **rest)
+
+
+def test_the_factor_search_in_full(fake):
+    """YieldSearch.scale: every bound scaled together (rotations and RuT pose too), from 1;
+    each evaluation's label and factor; the answer's scaled bounds; the defaults (2 %, cap
+    100) those given."""
+    from rtsgeom.analysis.tolerance.search import YieldSearch
+    f = fake(offset=0.002)
+    bounds = Bounds_((1e-5, 2e-5, 0.0), yaw_rad=1e-5, rut_yaw_rad=2e-5)
+    got = YieldSearch(0.8, case="uncalibrated").scale(_model(), bounds, _mc())
+    ss = [0.0 if b is None else b.yaw_rad / 1e-5 for b, _, _ in f.calls]
+    ys = [y for _, _, y in f.calls]
+    assert ss[:2] == [0.0, 1.0]
+    for (b, label, _), s in zip(f.calls[1:], ss[1:]):
+        assert b == bounds.scaled(s) and label == f"uncalibrated: factor {s:.4g}"
+    s = max(s for s, y in zip(ss, ys) if y >= 0.8)
+    fail = min(s2 for s2, y in zip(ss, ys) if y < 0.8)
+    assert s < fail and fail - s <= 0.02 * fail
+    assert got == {"case": "uncalibrated", "factor": s, "scales": bounds.scaled(s).to_dict(),
+                   "yield": ys[ss.index(s)], "capped": False,
+                   "evaluations": [{"scale": a, "yield": y} for a, y in zip(ss, ys)]}
+    assert YieldSearch(0.8, 0.1, "uncalibrated", 0.02, 100.0).scale(_model(), bounds,
+                                                                    _mc()) == got
+    assert YieldSearch(0.8, case="uncalibrated", rel_tol=0.2).scale(_model(), bounds,
+                                                                    _mc()) != got
+
+
+def test_the_functions_are_the_searchs_calls(fake):
+    """max_sigma_for_yield and max_scale_for_yield: YieldSearch with their options (the
+    sigma's cap as cap_m, 1 % and 10 mm by default; held rotations drawn at every sigma)."""
+    from rtsgeom.analysis.tolerance.search import (YieldSearch, max_scale_for_yield,
+                                                   max_sigma_for_yield)
+    f = fake(offset=0.002)
+    sig = (1e-4, 2e-4, 4e-4)
+    assert max_sigma_for_yield(_model(), sig, _mc(), 0.9) == YieldSearch(0.9).sigma(
+        _model(), sig, _mc())
+    held = Bounds_((0.0,) * 3, yaw_rad=1e-5)
+    got = max_sigma_for_yield(_model(), sig, _mc(), 0.9, 0.1, "uncalibrated", "tangential",
+                              rel_tol=0.05, cap_m=3e-4, slope=2.0, bounds=held)
+    f.calls.clear()
+    assert got == YieldSearch(0.9, 0.1, "uncalibrated", 0.05, 3e-4, 2.0).sigma(
+        _model(), sig, _mc(), "tangential", held)
+    assert all(b is not None and b.yaw_rad == 1e-5 for b, _, _ in f.calls)
+    assert got["sigma_mm"]["tangential"] <= 0.3
+    b = Bounds_(sig)
+    assert max_scale_for_yield(_model(), b, _mc(), 0.9) == YieldSearch(0.9).scale(
+        _model(), b, _mc())
+    assert max_scale_for_yield(_model(), sig, _mc(), 0.9, 0.1, "calibrated", rel_tol=0.1,
+                               cap=3.0) == YieldSearch(0.9, rel_tol=0.1, cap=3.0).scale(
+        _model(), b, _mc())
+    fake(spec=1e9)
+    assert max_sigma_for_yield(_model(), sig, _mc(), 0.9, 1e9)["sigma_mm"]["height"] == 10.0
+
+
+L = math.log
+
+
+@pytest.mark.parametrize("lo, hi, logs, cap, widths, want", [
+    # nothing failed yet: double without an estimate, else just above it, at most x10 and cap
+    (1.0, math.inf, {}, 100.0, [], 2.0),
+    (3.0, math.inf, {}, 5.0, [], 5.0),
+    (1.0, math.inf, {1.0: L(0.5)}, 100.0, [], 2.0 * 1.01),
+    (1.0, math.inf, {1.0: L(1.5)}, 100.0, [], 1.0 * 1.01),  # the estimate below lo
+    (1.0, math.inf, {1.0: L(1e-3)}, 100.0, [], 10.0),
+    (1.0, math.inf, {1.0: L(1e-3)}, 7.0, [], 7.0),
+    # a bracket: beside the secant estimate est = 2^(2/3), on the side nearer the open end
+    (1.0, 4.0, {1.0: L(0.5), 4.0: L(4.0)}, 100.0, [], 2 ** (2 / 3) * 1.01),
+    (1.0, 4.0, {1.0: L(0.25), 4.0: L(2.0)}, 100.0, [], 4 ** (2 / 3) * 0.99),
+    # stalled (the last width over half the one two before): the geometric middle
+    (1.0, 4.0, {1.0: L(0.5), 4.0: L(4.0)}, 100.0, [1.0, 0.9, 0.55], 2.0),
+    (1.0, 4.0, {1.0: L(0.5), 4.0: L(4.0)}, 100.0, [1.0, 0.9, 0.5], 2 ** (2 / 3) * 1.01),
+    (1.0, 4.0, {}, 100.0, [], 2.0),  # no estimate
+    (0.0, 4.0, {}, 100.0, [], 2.0),  # from 0: the arithmetic middle
+    (0.0, 4.0, {4.0: L(2.0)}, 100.0, [], 2.0 * 0.99),  # from 0: below the estimate
+    # the estimate at an end: 5 % of the bracket inside it; beyond it: the middle
+    (1.0, 4.0, {1.0: L(0.9999), 4.0: L(4.0)}, 100.0, [], 1.0 + 0.05 * 3),
+    (1.0, 4.0, {1.0: L(0.25), 4.0: L(1.0001)}, 100.0, [], 4.0 - 0.05 * 3),
+    (1.0, 4.0, {1.0: L(0.1), 4.0: L(0.2)}, 100.0, [], 2.0),
+])
+def test_the_next_scale_of_each_branch(lo, hi, logs, cap, widths, want):
+    """_next_scale's rules in its docstring's words, each branch on a bracket whose estimate
+    is known in closed form (rel_tol 0.03: 1 % beside the estimate)."""
+    from rtsgeom.analysis.tolerance.search import _next_scale
+    assert _next_scale(lo, hi, logs, cap, 0.03, widths) == pytest.approx(want, rel=1e-12)
+
+
+@pytest.mark.parametrize("lo, hi, logs, slope, want", [
+    (1.0, math.inf, {}, 1.0, None),
+    (1.0, math.inf, {2.0: L(0.5)}, 1.0, 4.0),  # one point: r ~ t^slope
+    (1.0, math.inf, {2.0: L(0.25)}, 2.0, 4.0),
+    (1.0, math.inf, {2.0: -800.0}, 1.0, 2.0 * math.exp(700.0)),  # bounded
+    (1.0, 4.0, {1.0: L(0.5), 4.0: L(2.0)}, 1.0, 2.0),  # through the ends
+    # the ends equal: through the two points nearest r = 1
+    (1.0, 4.0, {1.0: L(0.5), 4.0: L(0.5), 2.0: L(0.8), 3.0: L(1.2)}, 1.0,
+     math.exp(L(2.0) - L(0.8) / ((L(1.2) - L(0.8)) / (L(3.0) - L(2.0))))),
+    (1.0, 4.0, {1.0: L(2.0), 4.0: L(0.5)}, 1.0, None),  # falling: no estimate
+    (1.0, 4.0, {1.0: L(0.5), 2.0: L(0.5)}, 1.0, None),  # flat
+])
+def test_the_secant_estimate_of_each_branch(lo, hi, logs, slope, want):
+    from rtsgeom.analysis.tolerance.search import _secant
+    got = _secant(lo, hi, logs, slope)
+    assert got == want if want is None else got == pytest.approx(want, rel=1e-12)

@@ -366,3 +366,69 @@ def test_smallest_spacing_of_a_single_position_is_infinite():
     assert smallest_spacing_m(one) == float("inf")
     two = array_from_spec(ArraySpec(((0.0, 0.0),), ((0.0, 0.0), (0.7 * lam, 0.0)), (0,)), lam)
     assert smallest_spacing_m(two) == pytest.approx(0.7 * lam, rel=1e-12)
+
+
+# -- the array's frame, rows and aperture in closed form -----------------------------------
+
+
+@pytest.mark.parametrize("yaw", [-1.0, -0.1, 0.0, 0.3, 2.5])
+def test_the_yaw_turns_like_an_azimuth_and_the_frames_round_trip(yaw):
+    """yaw_matrix: boresight +y to (sin yaw, cos yaw, 0), up kept, orthonormal; a point at
+    azimuth a in the world is at a - yaw seen by a RuT yawed by yaw, at the same distance."""
+    from rtsgeom.geometry.arrays import array_from_spec, yaw_matrix
+    from rtsgeom.scene.presets import ArraySpec
+    m = yaw_matrix(yaw)
+    np.testing.assert_allclose(m @ [0.0, 1.0, 0.0], [np.sin(yaw), np.cos(yaw), 0.0], atol=1e-15)
+    np.testing.assert_allclose(m @ [0.0, 0.0, 1.0], [0.0, 0.0, 1.0], atol=0)
+    np.testing.assert_allclose(m @ m.T, np.eye(3), atol=1e-15)
+    assert np.linalg.det(m) == pytest.approx(1.0)
+    lam = 3.9e-3
+    pos = np.array([0.2, -0.1, 0.05])
+    rut = array_from_spec(ArraySpec(((0.0, 0.0),), ((0.0, 0.0), (lam / 2, 0.0)), (0,)), lam,
+                          pos, yaw)
+    a = np.array([-0.5, 0.0, 0.2, 0.7])
+    pts = pos + 2.0 * np.stack([np.sin(a), np.cos(a), np.zeros(4)], -1)
+    np.testing.assert_allclose(rut.azimuth_of(pts), np.angle(np.exp(1j * (a - yaw))),
+                               atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(rut.to_local(pts), axis=-1), 2.0, rtol=1e-12)
+    np.testing.assert_allclose(rut.to_local(pts) @ rut.rotation.T + pos, pts, atol=1e-12)
+    # the antennas: local positions turned and moved
+    np.testing.assert_allclose(rut.rx_world, rut.rx_local @ m.T + pos, atol=1e-15)
+    np.testing.assert_allclose(rut.tx_world, rut.tx_local @ m.T + pos, atol=1e-15)
+    assert (rut.num_rx, rut.num_virtual, rut.name) == (2, 2, "custom")
+
+
+def test_the_azimuth_row_is_the_fullest_its_centre_the_phase_centre():
+    """Two rows of 4 and one of 2 virtual elements: the azimuth row the fuller one nearer
+    z = 0 (a tie), the origin the mean Tx-Rx midpoint of that row; aperture (N cells + 1) d
+    on the grid, span + d off it."""
+    from rtsgeom.geometry.arrays import array_from_spec
+    from rtsgeom.scene.presets import ArraySpec
+    lam, d = 3.9e-3, 1.95e-3
+    rx = tuple((k * d, 0.0) for k in range(4))
+    spec = ArraySpec(((0.0, 2 * d), (0.0, -d), (0.0, 5 * d)), rx, (0, 1), spacing_m=d)
+    rut = array_from_spec(spec, lam)
+    z = rut.virtual_local[:, 2]
+    # rows at tx z + rx z: 2d (slot 0) and -d (slot 1): a tie of 4; the lower |z| wins: -d
+    assert rut.azimuth_mask.tolist() == [False] * 4 + [True] * 4
+    mid = 0.5 * (np.array([[0.0, 0.0, -d]] * 4) + np.array([[k * d, 0, 0] for k in range(4)]))
+    centre = mid.mean(0)
+    np.testing.assert_allclose(rut.tx_local, np.array([[0, 0, 2 * d], [0, 0, -d], [0, 0, 5 * d]])
+                               - centre, atol=1e-15)
+    np.testing.assert_allclose(z[rut.azimuth_mask], 0.0, atol=1e-15)  # the phase centre's row
+    np.testing.assert_allclose(z[~rut.azimuth_mask], 3 * d, atol=1e-15)
+    assert rut.aperture_m == pytest.approx(4 * d, rel=1e-12)
+    np.testing.assert_allclose(rut.azimuth_positions_m, np.arange(4) * d - 1.5 * d, atol=1e-15)
+    off_grid = array_from_spec(ArraySpec(((0.0, 0.0),), ((0.0, 0.0), (0.75 * d, 0.0),
+                                                         (2.0 * d, 0.0)), (0,), spacing_m=d),
+                               lam)
+    assert off_grid.aperture_m == pytest.approx(2.0 * d + d, rel=1e-12)
+    odd = array_from_spec(ArraySpec(((0.0, 0.0),), ((0.0, 0.0), (1.3 * d, 0.0)), (0,),
+                                    spacing_m=d), lam)
+    assert odd.aperture_m == pytest.approx(1.3 * d + d, rel=1e-12)
+    # the grid unit from the positions where the spec has none: the smallest gap
+    free = array_from_spec(ArraySpec(((0.0, 0.0),), ((0.0, 0.0), (0.6 * d, 0.0),
+                                                     (2.0 * d, 0.0)), (0,)), lam)
+    assert free.spacing_m == pytest.approx(0.6 * d, rel=1e-9)
+    single = array_from_spec(ArraySpec(((0.0, 0.0),), ((0.0, 0.0),), (0,)), lam)
+    assert single.spacing_m == lam / 2 and single.aperture_m == pytest.approx(lam / 2)

@@ -216,3 +216,40 @@ def test_front_end_layout_fields_read_per_front_end():
     np.testing.assert_allclose(fe.rx[0] - fe.module[0], 0.004 * t0 + [0, 0, 0.001], atol=1e-12)
     np.testing.assert_allclose(fe.tx[0] - fe.module[0], -0.006 * t0, atol=1e-12)
     np.testing.assert_allclose(fe.rx[1], fe.module[1], atol=1e-12)
+
+
+@pytest.mark.parametrize("kw, name, shape, got", [
+    ({"rx_offset_m": np.zeros((3, 2))}, "rx_offset_m", (2, 2), (3, 2)),
+    ({"tx_offset_m": np.zeros(2)}, "tx_offset_m", (2, 2), (2,)),
+    ({"yaw_rad": np.zeros(3)}, "yaw_offset_rad", (2,), (3,)),
+    ({"pitch_rad": np.zeros((2, 1))}, "pitch_offset_rad", (2,), (2, 1)),
+])
+def test_a_layout_or_rotation_of_another_shape_is_refused(default_scene, kw, name, shape, got):
+    from conftest import assert_refused
+    from rtsgeom.geometry.frontends import front_ends
+    assert_refused(lambda: front_ends(default_scene, np.zeros(3), **kw),
+                   f"front ends: {name} must have shape {shape}, got {got}", ValueError)
+
+
+def test_rotations_given_as_zeros_are_kept_and_the_antenna_frame(default_scene):
+    """Zero rotations given explicitly are kept (a draw of rotations); the scene's own zero
+    rotations are none. The antenna frame: columns (boresight x up, boresight, up),
+    right-handed, x towards smaller azimuth, the boresight at the arc centre."""
+    from rtsgeom.geometry.frontends import front_ends
+    centre = np.array([0.1, -0.2, 0.3])
+    given = front_ends(default_scene, centre, yaw_rad=np.zeros(2), pitch_rad=np.zeros(2))
+    assert given.yaw_rad is not None and given.pitch_rad is not None
+    plain = front_ends(default_scene, centre)
+    assert plain.yaw_rad is None and plain.pitch_rad is None and plain.count == 2
+    np.testing.assert_array_equal(given.rx, plain.rx)
+    f = plain.antenna_frame()
+    assert f.shape == (2, 3, 3)
+    for q in range(2):
+        np.testing.assert_allclose(f[q].T @ f[q], np.eye(3), atol=1e-15)
+        assert np.linalg.det(f[q]) == pytest.approx(1.0)
+        a = plain.angle_rad[q]
+        np.testing.assert_allclose(f[q][:, 1], [-np.sin(a), -np.cos(a), 0.0], atol=1e-15)
+        np.testing.assert_allclose(f[q][:, 2], [0.0, 0.0, 1.0], atol=1e-15)
+        np.testing.assert_allclose(f[q][:, 0], [-np.cos(a), np.sin(a), 0.0], atol=1e-15)
+    np.testing.assert_array_equal(plain.arc_centre, centre)
+    assert plain.arc_radius_m == default_scene.rts.arc_radius_m

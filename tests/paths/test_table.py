@@ -92,3 +92,17 @@ def test_the_csv_rows_say_each_column_in_its_unit():
     assert len(rows) == 4
     zero = Paths.build([0], [0], [0], [-1], [1e-9], [0.0]).to_csv().splitlines()[1]
     assert zero.split(",")[5] == "-6000.0000"  # |g| floored at 1e-300
+
+
+def test_build_gives_each_column_its_type_whatever_it_was_given():
+    """Delays as float64 even from integers, indices as int, the direction int8, gains complex,
+    bounces int, interactions and surfaces text."""
+    p = Paths.build([0.0, 1.0], [0.0, 1.0], [1.0, -1.0], [-1.0, 2.0], [1, 2], [1, 2],
+                    [0.0, 1.0], interactions=[1, 2], surfaces=[3, 4])
+    assert p.delay_s.dtype == np.float64 and p.gain.dtype == np.complex128
+    assert p.front_end.dtype.kind == p.rut_tx.dtype.kind == p.rut_rx.dtype.kind == "i"
+    assert p.direction.dtype == np.int8 and p.bounces.dtype.kind == "i"
+    assert p.interactions.dtype.kind == p.surfaces.dtype.kind == "U"
+    assert list(p.interactions) == ["1", "2"] and list(p.surfaces) == ["3", "4"]
+    assert p.delay_s.tolist() == [1.0, 2.0] and p.rut_rx.tolist() == [-1, 2]
+    assert p.length_m.dtype == np.float64
