@@ -12,6 +12,7 @@ Figures follow the paper: the range-Doppler map, the phase-coherency calibration
 from __future__ import annotations
 
 import functools
+import textwrap
 from pathlib import Path
 from typing import Mapping
 
@@ -49,6 +50,9 @@ DPI = 120
 DYNAMIC_RANGE_DB = 60.0  # colour scale of power maps: this far below the maximum
 _DETECTION = dict(marker="o", s=70, facecolors="none", edgecolors="red", linewidths=1.3)
 _SET_POINT = dict(marker="x", s=50, color="white", linewidths=1.5)
+# the power maps' fixed margins (fractions of the figure) instead of the constrained layout,
+# whose text measuring was a third of the main job's two maps (0.5 -> 0.4 s of CPU)
+_MAP_MARGINS = dict(left=0.1, right=0.97, bottom=0.11, top=0.93)
 
 
 def _styled(func):
@@ -143,7 +147,12 @@ def _points(name: str, values) -> np.ndarray | None:
 
 
 def _power_map(ax, fig, x, y, power_db, xlabel: str, ylabel: str, title: str) -> None:
-    """Colour map of power in dB over ``DYNAMIC_RANGE_DB`` below its maximum."""
+    """Colour map of power in dB over ``DYNAMIC_RANGE_DB`` below its maximum; a long title
+    (a lab's scene name, a clipping note) wrapped, the top margin lowered for each extra line
+    (the margins are fixed: nothing else makes room for it)."""
+    lines = textwrap.wrap(title, 60) if title else []
+    fig.subplots_adjust(**{**_MAP_MARGINS,
+                           "top": _MAP_MARGINS["top"] - 0.04 * max(len(lines) - 1, 0)})
     finite = power_db[np.isfinite(power_db)]
     vmax = float(finite.max()) if finite.size else 0.0
     mesh = ax.pcolormesh(x, y, power_db, shading="nearest", vmin=vmax - DYNAMIC_RANGE_DB,
@@ -153,7 +162,7 @@ def _power_map(ax, fig, x, y, power_db, xlabel: str, ylabel: str, title: str) ->
     ax.set_ylabel(ylabel)
     ax.grid(False)
     if title:
-        _title(ax, title)
+        _title(ax, "\n".join(lines))
 
 
 @_styled
@@ -165,7 +174,7 @@ def range_doppler_figure(power_db, range_m, velocity_mps, detections=None,
     v = _vector("velocity_mps", velocity_mps)
     p = _grid("power_db", power_db, (r.size, v.size), "n_range, n_doppler")
     det = _points("detections", detections)
-    fig, ax = new_figure()
+    fig, ax = new_figure(layout=None)
     _power_map(ax, fig, v, r, p, "radial velocity (m/s)", "range (m)", title or "Range-Doppler map")
     if det is not None:
         ax.scatter(det[:, 1], det[:, 0], label=f"detections ({len(det)})", **_DETECTION)
@@ -183,7 +192,7 @@ def range_angle_figure(power_db, range_m, angle_deg, detections=None, set_points
     p = _grid("power_db", power_db, (r.size, a.size), "n_range, n_angle")
     det = _points("detections", detections)
     sp = _points("set_points", set_points)
-    fig, ax = new_figure()
+    fig, ax = new_figure(layout=None)
     _power_map(ax, fig, a, r, p, "azimuth (deg)", "range (m)", title or "Range-angle map")
     if sp is not None:
         ax.scatter(sp[:, 1], sp[:, 0], label="set points", **_SET_POINT)

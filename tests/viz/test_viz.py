@@ -482,3 +482,21 @@ def test_the_view_labels_all_targets_up_to_eight_else_every_kth_in_azimuth(n):
     ranks = [order.index(j) for j in got]
     assert ranks == sorted(ranks) and ranks[0] == 0 and ranks[-1] == n - 1
     assert np.ptp(np.diff(ranks)) <= 1  # evenly spread: gaps differ by one at most
+
+
+@pytest.mark.parametrize("title, lines", [("lab: range-Doppler map", 1),
+                                          ("x" * 30 + " " + "y" * 40 + " (ADC CLIPPED: 12 samples)", 3)])
+def test_a_power_maps_long_title_wraps_and_the_axes_make_room_for_it(title, lines):
+    """The maps' margins are fixed: a title over 60 characters is wrapped at spaces and the
+    axes' top comes down 0.04 of the figure per extra line, so no line is cut at an edge."""
+    r, v = np.linspace(0, 50, 8), np.linspace(-5, 5, 6)
+    fig = F.range_doppler_figure(np.zeros((8, 6)), r, v, title=title)
+    ax = fig.axes[0]
+    shown = ax.get_title()
+    assert shown.count("\n") == lines - 1 and shown.replace("\n", " ") == title
+    assert max(len(s) for s in shown.split("\n")) <= 60
+    assert ax.get_position().y1 == pytest.approx(0.93 - 0.04 * (lines - 1))
+    fig.canvas.draw()
+    title_box = ax.title.get_window_extent()
+    width, height = fig.canvas.get_width_height()
+    assert 0 <= title_box.x0 and title_box.x1 <= width and title_box.y1 <= height
