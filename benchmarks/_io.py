@@ -20,16 +20,26 @@ from pathlib import Path
 __all__ = ["write_json", "write_csv", "csv_writer", "write_json_csv", "timed_rtsgeom"]
 
 
-def timed_rtsgeom(argv: list[str], root: Path) -> dict:
+def timed_rtsgeom(argv: list[str], root: Path, bytecode: bool | None = None) -> dict:
     """One whole process ``python -m rtsgeom argv`` importing rtsgeom from ``root``
     (run in ``root``: ``python -m`` puts the working directory first on the path): wall,
     user and user + system CPU (s, its forked children included), the load average before,
-    its lines on stderr. A non-zero exit ends the benchmark with its stderr's tail."""
+    its lines on stderr. A non-zero exit ends the benchmark with its stderr's tail.
+
+    ``bytecode``: None, Python as this environment sets it; True, as a user's Python (it
+    reads and writes ``__pycache__``: rtsgeom's modules are compiled on the first run only);
+    False, never writing it (``PYTHONDONTWRITEBYTECODE=1``, as some sandboxes and CI images
+    set: rtsgeom's modules, installed editable, are compiled at every start)."""
+    env = {**os.environ, "PYTHONPATH": str(root)}
+    if bytecode is not None:
+        env.pop("PYTHONDONTWRITEBYTECODE", None)
+        if not bytecode:
+            env["PYTHONDONTWRITEBYTECODE"] = "1"
     load = os.getloadavg()[0]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.run([sys.executable, "-m", "rtsgeom", *argv], capture_output=True,
-                          text=True, cwd=root, env={**os.environ, "PYTHONPATH": str(root)})
+                          text=True, cwd=root, env=env)
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if proc.returncode:

@@ -3,8 +3,12 @@ command takes, ``rtsgeom run scenes/diewald2022.toml --out DIR``, with its repor
 ``--no-report``, as whole processes (wall, user + system CPU of the process and its forked
 children, the median of ``--repeat``), with the machine's load average before each run.
 
+The runs are timed as a user's Python makes them (its ``__pycache__`` written by a first,
+untimed run) and, once more, as a Python that never writes bytecode
+(``PYTHONDONTWRITEBYTECODE=1``, as this project's sandbox and some CI images set).
+
 ``--against DIR``: also time another checkout of rtsgeom (e.g. ``git worktree add DIR
-COMMIT``), its runs interleaved with this tree's (A, B, A, B, ...) so that both see the same
+COMMIT``), its runs interleaved with this tree's (A, B, A, B, ..., the cases in turn too) so that both see the same
 load on a shared machine, and check that both wrote the same ``summary.json``,
 ``detections.csv`` and ``maps.npz``. Writes ``benchmarks/main_job.json``. Not part of the test
 suite.
@@ -40,15 +44,25 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default=str(ROOT / "benchmarks" / "main_job.json"))
     args = ap.parse_args(argv)
     trees = {"this": ROOT} | ({"against": Path(args.against).resolve()} if args.against else {})
-    cases = {"run": [], "run --no-report": ["--no-report"]}
+    # (extra arguments, bytecode): as a user's Python runs it, rtsgeom's modules compiled once
+    # (a first run, untimed, writes their __pycache__), and as a Python that never writes
+    # bytecode (PYTHONDONTWRITEBYTECODE=1: this sandbox, some CI images) compiles them at
+    # every start (about 0.2 s of CPU in the run's process)
+    cases = {"run": ([], True), "run --no-report": (["--no-report"], True),
+             "run, no bytecode cache": ([], False)}
     rows = {t: {c: [] for c in cases} for t in trees}
     with tempfile.TemporaryDirectory() as tmp:
-        for case, extra in cases.items():
-            for r in range(args.repeat):
+        for tree, root in trees.items():  # the first run: bytecode, caches (not timed)
+            timed(["run", str(SCENE), "--out", str(Path(tmp) / f"{tree}-first"), "--quiet"],
+                  root, bytecode=True)
+        # every case and tree in turn within each repeat (not case after case): a shared
+        # machine's slow minute then falls on all of them alike
+        for r in range(args.repeat):
+            for case, (extra, bytecode) in cases.items():
                 for tree, root in trees.items():
-                    out = Path(tmp) / f"{tree}-{case.replace(' ', '')}-{r}"
+                    out = Path(tmp) / f"{tree}-{case.replace(' ', '').replace(',', '')}-{r}"
                     rows[tree][case].append(timed(["run", str(SCENE), "--out", str(out),
-                                                   "--quiet", *extra], root))
+                                                   "--quiet", *extra], root, bytecode))
                     x = rows[tree][case][-1]
                     print(f"{tree} {case}: {x['wall_s']:.2f} s wall, {x['cpu_s']:.2f} s CPU "
                           f"(load {x['load_before']:.1f})", flush=True)

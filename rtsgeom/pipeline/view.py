@@ -8,7 +8,12 @@ from .._lib.parallel import Forked, fork_call
 from ..geometry import build_setup
 from ..paths import compute_paths, exact_paths
 
-__all__ = ["setup_png", "start_setup_view"]
+__all__ = ["REPORT_VIEW_SIZE", "setup_png", "start_setup_view"]
+
+#: the report's 3D view in pixels: the report shows it at most 1100 CSS pixels wide, so a
+#: larger render is scaled down (its labels to 9-10 px) and costs more (1600 x 1000: +0.15 s
+#: of the main job's critical CPU); ``rtsgeom show --png`` has its own ``--size``
+REPORT_VIEW_SIZE = (1280, 800)
 
 
 def setup_png(setup, paths, paths_method: str) -> bytes:
@@ -17,7 +22,7 @@ def setup_png(setup, paths, paths_method: str) -> bytes:
     if paths_method != "exact":  # the view draws reflections through their hit points,
         # which the table alone does not carry
         paths = compute_paths(setup, paths_method, for_drawing=True)
-    return setup_png_bytes(setup, paths)
+    return setup_png_bytes(setup, paths, REPORT_VIEW_SIZE)
 
 
 def start_setup_view(scene) -> Forked:
