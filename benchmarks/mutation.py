@@ -215,6 +215,25 @@ _MUTMUT = [sys.executable, "-c", "import sys; from mutmut.__main__ import cli; "
 # ``--skip-clean``: mutmut's clean run (the sampled mutants' tests once on the unmutated code)
 # repeats what its stats run has just done (every selected test on the unmutated code, which
 # must pass); on a loaded machine it costs as much as the stats run
+# mutmut runs its stats and clean tests in its own process, then waits for its mutant workers
+# with os.wait(), which also returns a child a test forked there and left to end later (a
+# forked figure or pool): mutmut then stopped with a KeyError in wait_for_result (seeds 41
+# and 107, a geometry-only run). Such strays are reaped here and the wait goes on.
+_REAP_STRAYS = (
+    "import os as _os, datetime as _dt, mutmut.workers.isolation as _iso\n"
+    "def _wait(self, timeout=None):\n"
+    "    if self._no_tests_results:\n"
+    "        return self._no_tests_results.pop(0)\n"
+    "    while True:\n"
+    "        pid, status = _os.wait()\n"
+    "        if pid in self._running:\n"
+    "            break\n"
+    "    w = self._running.pop(pid)\n"
+    "    return _iso.MutantResult(mutant_name=w.mutant_name,\n"
+    "        exit_code=_os.waitstatus_to_exitcode(status),\n"
+    "        duration=(_dt.datetime.now() - w.start_time).total_seconds())\n"
+    "_iso.ForkRunner.wait_for_result = _wait\n")
+
 _SKIP_CLEAN = ("import mutmut.workers.isolation as iso\n"
                "for c in (iso.ForkServerRunner, iso.ForkRunner):\n"
                "    c.run_clean_tests = lambda self, tests: 0\n")
@@ -271,8 +290,7 @@ def run(workdir: Path, names: list[str], children: int, timeout_s: float,
     that waited for them, or for the end of an output pipe they hold, never returned."""
     t0 = time.perf_counter()
     cmd = list(_MUTMUT)
-    if skip_clean:
-        cmd[2] = _SKIP_CLEAN + cmd[2]
+    cmd[2] = _REAP_STRAYS + (_SKIP_CLEAN if skip_clean else "") + cmd[2]
     log = workdir / "mutmut-run.log"
     with open(log, "w") as out:
         # pass the names through a file-free argv: mutmut matches each name exactly
@@ -503,7 +521,7 @@ def main(argv: list[str] | None = None) -> int:
     write_report(s)
     rate = s["kill_rate"]
     print(f"kill rate {'n/a' if rate is None else f'{100 * rate:.1f} %'}; {s['counts']}; "
-          f"report: {REPORT_MD.relative_to(ROOT)}")
+          f"report: {os.path.relpath(REPORT_MD, ROOT)}")  # a --report outside the tree too
     return 0
 
 
