@@ -6,6 +6,14 @@ from __future__ import annotations
 
 # mutant name -> why it is equivalent (no observable change); filled in from the survivors
 EQUIVALENT: dict[str, str] = {
+    "rtsgeom.analysis.kpi.report.x__stack__mutmut_5":
+        "FigureCanvasAgg(None) instead of FigureCanvasAgg(page): the page keeps matplotlib's "
+        "default canvas, and saving it to PDF or PNG switches to that format's canvas either "
+        "way (the Agg canvas was set only to draw it in memory); the same bytes.",
+    "rtsgeom.rts.fir.x__fir_rows__mutmut_80":
+        "every setting treated as a memo miss: its rows are computed again, by the same "
+        "elementwise arithmetic, and looked up at the first of the equal settings; the memo "
+        "fills and restarts sooner (time only), the returned rows are the same bits.",
     "rtsgeom.geometry.arrays.x__grid_unit__mutmut_5":
         "np.asarray(x) instead of np.asarray(x, float): every caller passes float positions "
         "(metres), so the array is the same.",
