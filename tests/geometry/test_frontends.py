@@ -253,3 +253,32 @@ def test_rotations_given_as_zeros_are_kept_and_the_antenna_frame(default_scene):
         np.testing.assert_allclose(f[q][:, 0], [-np.cos(a), np.sin(a), 0.0], atol=1e-15)
     np.testing.assert_array_equal(plain.arc_centre, centre)
     assert plain.arc_radius_m == default_scene.rts.arc_radius_m
+
+
+@pytest.mark.parametrize("radial_m", [0.0, 3e-3])
+def test_front_ends_on_a_sphere_sit_at_their_elevation(sphere_scene, default_scene, radial_m):
+    """scenes/sphere4.toml (+-5 deg elevation): each module centre is the arc centre plus
+    (R + dr) (cos el sin az, cos el cos az, sin el); its Rx and Tx lie on the sphere's
+    tangent plane there, sep/2 either side of it, its boresight at the centre; the setup keeps
+    the elevations. A scene all on the arc keeps none (the arc's arithmetic)."""
+    from rtsgeom.geometry.frontends import front_ends as fe_of
+    n = len(sphere_scene.rts.front_ends)
+    az = np.array([f.angle_rad for f in sphere_scene.rts.front_ends])
+    el = np.array([f.elevation_rad for f in sphere_scene.rts.front_ends])
+    assert np.ptp(el) > 0.1
+    centre = np.array([0.1, -0.2, 0.05])
+    off = np.zeros((n, 3))
+    off[:, 0] = radial_m
+    fe = fe_of(sphere_scene, centre, offsets_m=off)
+    np.testing.assert_array_equal(fe.elevation_rad, el)
+    r_hat = np.stack([np.cos(el) * np.sin(az), np.cos(el) * np.cos(az), np.sin(el)], -1)
+    r = sphere_scene.rts.arc_radius_m + radial_m
+    np.testing.assert_allclose(fe.module, centre + r * r_hat, rtol=0, atol=1e-12)
+    for ant in (fe.rx, fe.tx):
+        d = ant - fe.module
+        np.testing.assert_allclose(np.einsum("fi,fi->f", d, r_hat), 0.0, atol=1e-12)
+        np.testing.assert_allclose(np.linalg.norm(d, axis=-1), fe.separation_m / 2,
+                                   rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(fe.axes()[2], -r_hat, atol=1e-12)
+    flat = build_setup(default_scene).fe
+    assert flat.elevation_rad is None and np.all(flat.module[:, 2] == flat.arc_centre[2])

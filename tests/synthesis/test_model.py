@@ -111,3 +111,39 @@ def test_drawn_mounting_rotations_move_both_air_legs_as_the_setup_built_with_the
         a, b = model.air_legs(off, **drawn)
         plain_a, plain_b = model.air_legs(off)
         assert np.max(np.abs(a - plain_a)) + np.max(np.abs(b - plain_b)) > 1e-15
+
+
+@pytest.fixture(scope="module")
+def sphere_model(sphere_scene):
+    setup = build_setup(sphere_scene)
+    assert setup.fe.elevation_rad is not None and np.ptp(setup.fe.elevation_rad) > 0.1
+    return setup, ChannelModel.build(setup, exact_paths(setup), tuple(range(setup.fe.count)),
+                                     TargetConfig(12.0))
+
+
+@pytest.mark.parametrize("scale_m", [0.0, 2e-3])
+def test_air_legs_on_a_sphere_are_the_distances_to_the_elevated_front_ends(sphere_model,
+                                                                             scale_m):
+    """Front ends on a sphere (scenes/sphere4.toml, +-5 deg elevation): ``air_legs`` with
+    mounting offsets = |FE Rx - RuT Tx| / c0 and |FE Tx - RuT Rx| / c0 per virtual element,
+    the FE positions ``build_setup``'s with those offsets (its elevated antennas), and the
+    channels taken in any order."""
+    from scipy.constants import c
+    setup, model = sphere_model
+    n, rut = setup.fe.count, setup.rut
+    off = np.random.default_rng(7).normal(0, scale_m, (n, 3)) if scale_m else np.zeros((n, 3))
+    moved = build_setup(setup.scene, offsets_m=off) if scale_m else setup
+    t_a, t_b = model.air_legs(off)
+    want_a = np.linalg.norm(moved.fe.rx[:, None] - rut.tx_world[None], axis=-1) / c
+    want_b = np.linalg.norm(moved.fe.tx[:, None] - rut.rx_world[None], axis=-1) / c
+    np.testing.assert_allclose(t_a, want_a[:, rut.virtual_tx], rtol=1e-13, atol=0)
+    np.testing.assert_allclose(t_b, want_b[:, rut.virtual_rx], rtol=1e-13, atol=0)
+    # the elevation lifts the antennas well off the arc's plane (what a flat arc would give)
+    flat_z = np.abs(moved.fe.rx[:, 2] - setup.fe.arc_centre[2])
+    assert np.all(flat_z > 0.05 * setup.fe.arc_radius_m)
+    # a reordered channel tuple gives the same legs, reordered
+    rev = ChannelModel.build(setup, exact_paths(setup), tuple(reversed(range(n))),
+                             TargetConfig(12.0))
+    r_a, r_b = rev.air_legs(off[::-1])
+    np.testing.assert_allclose(r_a, t_a[::-1], rtol=1e-13, atol=0)
+    np.testing.assert_allclose(r_b, t_b[::-1], rtol=1e-13, atol=0)
