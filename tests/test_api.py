@@ -100,3 +100,40 @@ def test_raytrace_kernel_cache_is_outside_the_checkout(monkeypatch, tmp_path):
     assert repo not in default.parents
     monkeypatch.setenv("RTSGEOM_CACHE_DIR", str(tmp_path / "mine"))
     assert raytrace._default_cache_dir() == tmp_path / "mine" / "drjit"
+
+
+# -- the functions that call into the physics packages forward every argument unchanged ------
+
+def test_the_api_forwards_its_arguments_to_the_studies(monkeypatch, default_scene):
+    """A spy in place of each study: what it is built and called with, argument by argument."""
+    import rtsgeom.api as api
+    from rtsgeom.analysis.tolerance import Bounds, MonteCarlo
+    seen = {}
+
+    class Spy:
+        def __init__(self, *args, **kw):
+            seen["init"] = (args, kw)
+
+        def __call__(self, *args):
+            seen["call"] = args
+            return type("R", (), {"run": "ran"})()
+
+    monkeypatch.setattr(api, "ToleranceStudy", Spy)
+    assert api.tolerance(default_scene, [1, 0], (0.2, 0.3, 0.4), 17, 9, "uniform", 0.25,
+                         5) == "ran"
+    assert seen["init"] == ((Bounds((0.2e-3, 0.3e-3, 0.4e-3)), (1, 0)), {
+        "mc": MonteCarlo(17, 9, "uniform"), "spec_deg": 0.25, "points": 5})
+    assert seen["call"] == (default_scene,)
+    monkeypatch.setattr(api, "TransferStudy", Spy)
+    api.transfer(default_scene, 3, 2.5, 0.5, 4, 0.3, 11)
+    assert seen["init"] == ((), {"radars": 3, "sigma_phase_deg": 2.5, "sigma_gain_db": 0.5,
+                                 "points": 4, "spec_deg": 0.3, "seed": 11})
+    api.transfer(default_scene)
+    assert seen["init"][1] == {"radars": 100, "sigma_phase_deg": 5.0, "sigma_gain_db": 0.0,
+                               "points": 11, "spec_deg": None, "seed": default_scene.seed}
+    monkeypatch.setattr(api, "_nearfield", lambda *a: seen.setdefault("nf", a))
+    api.nearfield(default_scene, (1.0, 2.0), 7)
+    assert seen["nf"] == (default_scene, (1.0, 2.0), 7)
+    monkeypatch.setattr(api, "ghost_analysis", lambda *a: seen.setdefault("gh", a))
+    api.ghosts(default_scene, -60.0, True)
+    assert seen["gh"] == (default_scene, -60.0, True)

@@ -149,3 +149,52 @@ def test_a_cells_worst_synthesis_errors_in_full(sphere_scene, points, n):
         assert synthesis_errors(setup, paths, st, 15.0, None, points) == [got]
         tri = cell_synthesis_errors_deg(setup, paths, (0, 1, 2), 15.0, points)
         assert tri["cell"] == [0, 1, 2] and 0 < tri["points"] < 4  # outside the hull dropped
+
+
+def test_an_unreachable_set_direction_is_left_out_and_all_unreachable_is_none(
+        sphere_scene, monkeypatch):
+    """A set direction the design cannot reach (AngleUnreachable) counts as no error of its
+    own: the worst is over the others; a mode that reaches none reports None (JSON null) for
+    every angle and for their larger."""
+    from rtsgeom.analysis.nearfield_terms import cell_synthesis_errors_deg
+    from rtsgeom.errors import AngleUnreachable
+    from rtsgeom.paths import exact_paths
+    from rtsgeom.radar.steering import Steering
+    from rtsgeom.scene import TargetConfig
+    from rtsgeom.synthesis.model import ChannelModel
+    setup = build_setup(sphere_scene)
+    paths = exact_paths(setup)
+    st = Steering.auto(setup.rut, sphere_scene.radar)
+    cell = (0, 1, 2, 3)
+    design, actual = _designs(setup, paths, cell, TargetConfig(15.0), st)
+    ang = st.angles(setup.fe_direction_cosines())
+    lo, hi = ang.min(0), ang.max(0)
+    f = np.arange(1, 3) / 3
+    grid = [(lo[0] + a * (hi[0] - lo[0]), lo[1] + b * (hi[1] - lo[1])) for a in f for b in f]
+    errs = []
+    for a in grid[1:]:  # the first is unreachable in array-factor mode
+        u = st.directions(np.array(a))
+        w = design.solve(u, design.coherent_phases(u[None]), mode="array-factor")
+        got = actual.direction(np.abs(w) * np.exp(1j * actual.coherent_phases(u[None])))
+        errs.append(np.abs(np.degrees(got - np.array(a))))
+    worst = np.max(errs, axis=0)
+    solve, seen = ChannelModel.solve, []
+
+    def refusing(self, u, phases=None, mode="exact", *args, **kw):
+        seen.append(mode)
+        if mode == "exact" or seen.count("array-factor") == 1:
+            raise AngleUnreachable("made up")
+        return solve(self, u, phases, mode, *args, **kw)
+    monkeypatch.setattr(ChannelModel, "solve", refusing)
+    got = cell_synthesis_errors_deg(setup, paths, cell, 15.0, 4)
+    assert got == {"cell": [0, 1, 2, 3],
+                   "span_deg": {"azimuth": list(np.degrees([lo[0], hi[0]])),
+                                "elevation": list(np.degrees([lo[1], hi[1]]))},
+                   "points": 4,
+                   "array_factor_max_abs_error_azimuth_deg": float(worst[0]),
+                   "array_factor_max_abs_error_elevation_deg": float(worst[1]),
+                   "array_factor_max_abs_error_deg": float(max(worst)),
+                   "exact_max_abs_error_azimuth_deg": None,
+                   "exact_max_abs_error_elevation_deg": None,
+                   "exact_max_abs_error_deg": None}
+    assert seen == ["array-factor", "exact"] * 4

@@ -195,3 +195,27 @@ def test_percentiles_and_the_draws_header():
         "draws": 10, "seed": 3, "distribution": "uniform", "scale": "bound",
         "sigma_mm": {"radial": 1.0, "tangential": 0.0, "height": 0.25}, "spec_deg": 0.1}
     assert draws_header(1, 0, "normal", (0, 0, 0), 1.0)["scale"] == "sigma"
+
+
+def test_monte_carlo_forwards_every_argument_to_the_one_driver(monkeypatch):
+    """The old-style call parts its options into a MonteCarlo and simulate's own, unchanged."""
+    import rtsgeom.analysis.tolerance.montecarlo as mcmod
+    from rtsgeom.analysis.tolerance.config import MonteCarlo
+    calls = []
+    monkeypatch.setattr(mcmod, "simulate", lambda *a, **k: calls.append((a, k)) or "spied")
+    model, bounds, mapper, progress = object(), (1e-4, 2e-4, 3e-4), map, (lambda *a: None)
+    got = mcmod.monte_carlo(model, bounds, 12, 5, "uniform", 0.3, ("uncalibrated",),
+                            chunk=4, mapper=mapper, progress=progress, subbin=False,
+                            label="spy", keep_errors=True)
+    assert got == "spied"
+    (args, kw), = calls
+    assert args[0] is model and args[1] is bounds
+    assert args[2] == MonteCarlo(draws=12, seed=5, distribution="uniform", chunk=4,
+                                 subbin=False)
+    assert args[2].mapper is mapper and args[2].progress is progress
+    assert args[3:] == (0.3, ("uncalibrated",)) and kw == {"label": "spy", "keep_errors": True}
+    calls.clear()
+    mcmod.monte_carlo(model, bounds, 12, 5)  # the defaults
+    (args, kw), = calls
+    assert args[2] == MonteCarlo(draws=12, seed=5) and args[3:] == (0.1, mcmod.CASES)
+    assert kw == {}

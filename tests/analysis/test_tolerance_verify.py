@@ -167,3 +167,67 @@ def test_verified_differences_per_draw_an_undetected_draw_infinite():
     # each draw's worst |error| over its points: chain 0.04 vs model 0.05; inf vs 0.02
     assert np.allclose(every.worst_difference_deg("calibrated"), [0.01, np.inf], atol=1e-15)
     assert _verified(np.zeros((0,)), np.zeros((0,))).max_difference_deg == 0.0
+
+
+# -- a made-up VerifyResult: its columns, summary and dict whole, per kind of study ----------
+
+def _made_up(kind):
+    from rtsgeom.analysis.tolerance.verify import VerifyResult
+    shape = {"pair": (3,), "all_points": (3, 2), "cell": (3, 2, 2)}[kind]
+    n = int(np.prod(shape))
+    model = {"calibrated": np.arange(n, dtype=float).reshape(shape) * 0.1,
+             "uncalibrated": -np.arange(n, dtype=float).reshape(shape) * 0.2}
+    chain = {k: v + 0.01 * (1 + np.arange(n)).reshape(shape) for k, v in model.items()}
+    chain["uncalibrated"].flat[1] = np.nan  # a missed detection
+    return VerifyResult({k: np.zeros(shape[:1], int) for k in model}, model, chain, 1.5,
+                        np.array([0, 2, -1]), dims=2 if kind == "cell" else 1,
+                        all_points=kind == "all_points"), model, chain
+
+
+@pytest.mark.parametrize("kind", ["pair", "all_points", "cell"])
+def test_a_verify_results_columns_summary_and_dict_whole(kind):
+    res, model, chain = _made_up(kind)
+    diff = {}
+    for case in model:
+        d = np.abs(chain[case] - model[case])
+        d = np.where(np.isfinite(d), d, np.inf)
+        diff[case] = d.reshape(3, -1).max(axis=1)
+    cols = res._columns()
+    want = ["draw"]
+    for case in model:
+        want.append(f"{case}_difference_deg")
+        if kind == "pair":
+            want += [f"{case}_model_deg", f"{case}_chain_deg"]
+    assert list(cols) == want
+    np.testing.assert_array_equal(cols["draw"], [0, 1, 2])
+    for case in model:
+        np.testing.assert_array_equal(cols[f"{case}_difference_deg"], diff[case])
+        if kind == "pair":
+            assert cols[f"{case}_model_deg"] is model[case]
+            assert cols[f"{case}_chain_deg"] is chain[case]
+    title, rows = res._summary()
+    assert title == "3 draws through the full ADC-cube chain against the phasor model"
+    assert rows == [(case, f"|chain - model| max "
+                           f"{np.max(diff[case][np.isfinite(diff[case])]):.3g} deg, "
+                           f"{int(np.sum(~np.isfinite(diff[case])))} missed")
+                    for case in model] + [("elapsed_s", 1.5)]
+    assert [r[1].endswith(" 1 missed") for r in rows[:2]] == [False, True]
+    cases = {}
+    for case in model:
+        cases[case] = {"max_abs_difference_deg": float(np.max(diff[case]))}
+        if kind != "cell":
+            def worst(e):
+                e = np.abs(np.where(np.isfinite(e), e, np.inf))
+                return e if e.ndim == 1 else e.max(axis=-1)
+            cases[case]["max_worst_error_difference_deg"] = float(
+                np.max(np.abs(worst(chain[case]) - worst(model[case]))))
+        cases[case]["missed"] = int(np.sum(~np.isfinite(diff[case])))
+    every = "every set-point" if kind == "all_points" else None
+    want = {"draws": 3, "max_abs_difference_deg": np.inf, "cases": cases, "elapsed_s": 1.5}
+    if kind == "cell":
+        want |= {"subbin_steps": [0, 2, -1], "set_point":
+                 "the draw's worst (angular distance) in the fast model"}
+    else:
+        want["set_point"] = every or "the draw's worst in the fast model"
+    assert res.to_dict() == want
+    assert res.max_difference_deg == np.inf

@@ -389,3 +389,54 @@ def test_the_secant_estimate_of_each_branch(lo, hi, logs, slope, want):
     from rtsgeom.analysis.tolerance.search import _secant
     got = _secant(lo, hi, logs, slope)
     assert got == want if want is None else got == pytest.approx(want, rel=1e-12)
+
+
+# -- the module-level searches forward every argument unchanged (a spy in place of the study) --
+
+def _spy(monkeypatch, method):
+    from rtsgeom.analysis.tolerance.search import YieldSearch
+    calls = []
+
+    def spy(self, *args):
+        calls.append((self, args))
+        return {"spied": True}
+    monkeypatch.setattr(YieldSearch, method, spy)
+    return calls
+
+
+def test_max_sigma_for_yield_forwards_every_argument(monkeypatch):
+    from rtsgeom.analysis.tolerance.config import MonteCarlo
+    from rtsgeom.analysis.tolerance.draws import Bounds
+    from rtsgeom.analysis.tolerance.search import YieldSearch, max_sigma_for_yield
+    calls = _spy(monkeypatch, "sigma")
+    model, sigma, mc = object(), (1e-4, 2e-4, 3e-4), MonteCarlo(draws=7, seed=3)
+    held = Bounds((0.0, 0.0, 0.0))
+    got = max_sigma_for_yield(model, sigma, mc, 0.8, 0.25, "uncalibrated", "height",
+                              bounds=held, rel_tol=0.03, cap_m=0.002, slope=2.5)
+    assert got == {"spied": True}
+    (search, args), = calls
+    assert search == YieldSearch(0.8, 0.25, "uncalibrated", 0.03, 0.002, 2.5)
+    assert args[0] is model and args[1] is sigma and args[2] is mc
+    assert args[3] == "height" and args[4] is held and len(args) == 5
+    calls.clear()
+    max_sigma_for_yield(model, sigma, mc, 0.9)  # the defaults
+    (search, args), = calls
+    assert search == YieldSearch(0.9, 0.1, "calibrated", 0.01, 0.01, 1.0)
+    assert args[3:] == ("all", None)
+
+
+def test_max_scale_for_yield_forwards_every_argument(monkeypatch):
+    from rtsgeom.analysis.tolerance.config import MonteCarlo
+    from rtsgeom.analysis.tolerance.search import YieldSearch, max_scale_for_yield
+    calls = _spy(monkeypatch, "scale")
+    model, bounds, mc = object(), (1e-4, 2e-4, 3e-4), MonteCarlo(draws=7, seed=3)
+    got = max_scale_for_yield(model, bounds, mc, 0.8, 0.25, "uncalibrated", rel_tol=0.05,
+                              cap=7.0, slope=0.5)
+    assert got == {"spied": True}
+    (search, args), = calls
+    assert search == YieldSearch(0.8, 0.25, "uncalibrated", 0.05, 7.0, 0.5)
+    assert len(args) == 3 and args[0] is model and args[1] is bounds and args[2] is mc
+    calls.clear()
+    max_scale_for_yield(model, bounds, mc, 0.9)
+    (search, args), = calls
+    assert search == YieldSearch(0.9, 0.1, "calibrated", None, None, 1.0)
