@@ -220,7 +220,11 @@ _MUTMUT = [sys.executable, "-c", "import sys; from mutmut.__main__ import cli; "
 # forked figure or pool): mutmut then stopped with a KeyError in wait_for_result (seeds 41
 # and 107, a geometry-only run). Such strays are reaped here and the wait goes on.
 _REAP_STRAYS = (
-    "import os as _os, datetime as _dt, mutmut.workers.isolation as _iso\n"
+    "import os as _os, datetime as _dt\n"
+    "try:\n"
+    "    import mutmut.workers.isolation as _iso\n"
+    "except Exception:  # no mutmut project here: mutmut itself says why\n"
+    "    _iso = None\n"
     "def _wait(self, timeout=None):\n"
     "    if self._no_tests_results:\n"
     "        return self._no_tests_results.pop(0)\n"
@@ -232,7 +236,8 @@ _REAP_STRAYS = (
     "    return _iso.MutantResult(mutant_name=w.mutant_name,\n"
     "        exit_code=_os.waitstatus_to_exitcode(status),\n"
     "        duration=(_dt.datetime.now() - w.start_time).total_seconds())\n"
-    "_iso.ForkRunner.wait_for_result = _wait\n")
+    "if _iso is not None:\n"
+    "    _iso.ForkRunner.wait_for_result = _wait\n")
 
 _SKIP_CLEAN = ("import mutmut.workers.isolation as iso\n"
                "for c in (iso.ForkServerRunner, iso.ForkRunner):\n"
