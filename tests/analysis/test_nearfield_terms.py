@@ -106,6 +106,16 @@ def test_a_pairs_worst_synthesis_errors_in_full(default_scene, moved):
     assert synthesis_errors(setup, paths, st, 15.0, single, 4) == [got]
 
 
+def _cell_grid(setup, st, n: int):
+    """The front ends' extent in (azimuth, elevation) and the n x n set directions at
+    (k + 1) / (n + 1) of it, as the cell study places them."""
+    ang = st.angles(setup.fe_direction_cosines())
+    lo, hi = ang.min(0), ang.max(0)
+    f = np.arange(1, n + 1) / (n + 1)
+    return lo, hi, [(lo[0] + a * (hi[0] - lo[0]), lo[1] + b * (hi[1] - lo[1]))
+                    for a in f for b in f]
+
+
 @pytest.mark.parametrize("points, n", [(6, 2), (7, 3), (1, 2)])
 def test_a_cells_worst_synthesis_errors_in_full(sphere_scene, points, n):
     """An n x n grid, n = round(sqrt(points)) >= 2, at (k + 1) / (n + 1) of the front ends'
@@ -122,10 +132,7 @@ def test_a_cells_worst_synthesis_errors_in_full(sphere_scene, points, n):
     st = Steering.auto(setup.rut, sphere_scene.radar)
     cell = (0, 1, 2, 3)
     design, actual = _designs(setup, paths, cell, TargetConfig(15.0), st)
-    ang = st.angles(setup.fe_direction_cosines())
-    lo, hi = ang.min(0), ang.max(0)
-    f = np.arange(1, n + 1) / (n + 1)
-    grid = [(lo[0] + a * (hi[0] - lo[0]), lo[1] + b * (hi[1] - lo[1])) for a in f for b in f]
+    lo, hi, grid = _cell_grid(setup, st, n)
     want = {"cell": [0, 1, 2, 3],
             "span_deg": {"azimuth": list(np.degrees([lo[0], hi[0]])),
                          "elevation": list(np.degrees([lo[1], hi[1]]))},
@@ -167,10 +174,7 @@ def test_an_unreachable_set_direction_is_left_out_and_all_unreachable_is_none(
     st = Steering.auto(setup.rut, sphere_scene.radar)
     cell = (0, 1, 2, 3)
     design, actual = _designs(setup, paths, cell, TargetConfig(15.0), st)
-    ang = st.angles(setup.fe_direction_cosines())
-    lo, hi = ang.min(0), ang.max(0)
-    f = np.arange(1, 3) / 3
-    grid = [(lo[0] + a * (hi[0] - lo[0]), lo[1] + b * (hi[1] - lo[1])) for a in f for b in f]
+    lo, hi, grid = _cell_grid(setup, st, 2)
     errs = []
     for a in grid[1:]:  # the first is unreachable in array-factor mode
         u = st.directions(np.array(a))
