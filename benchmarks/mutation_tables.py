@@ -6,6 +6,10 @@ from __future__ import annotations
 
 # mutant name -> why it is equivalent (no observable change); filled in from the survivors
 EQUIVALENT: dict[str, str] = {
+    "rtsgeom.radar.newton.x_newton__mutmut_156":
+        "a non-finite Hessian entry replaced by 1.0 instead of 0.0 before its eigenvalues are "
+        "taken: such a row is not concave whatever they are (the test is ANDed with all "
+        "entries finite), so the same step.",
     "rtsgeom.analysis.kpi.report.x__stack__mutmut_5":
         "FigureCanvasAgg(None) instead of FigureCanvasAgg(page): the page keeps matplotlib's "
         "default canvas, and saving it to PDF or PNG switches to that format's canvas either "
