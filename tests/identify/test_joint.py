@@ -153,3 +153,33 @@ def test_the_radar_fit_refuses_a_gain_beyond_the_scenes_limit():
                                   "dB")
     # a reference keeps the scene's value, unchecked
     check_radar_fit(_radar((lim + 5.0, 0.0, 0.0, lim + 5.0, 0.0)))
+
+
+def _linear_front(q, seed, v):
+    """A front end whose capture is linear in its PARAMS: h = A theta_b + h0 (V,)."""
+    rng = np.random.default_rng(seed)
+    a = rng.normal(size=(v, N)) + 1j * rng.normal(size=(v, N))
+    h0 = rng.normal(size=v) + 1j * rng.normal(size=v)
+    return SimpleNamespace(active=q, jacobian=lambda th, cols: (a @ th + h0, a[:, cols]))
+
+
+@pytest.mark.parametrize("sigma2", [0.3, (0.5, 2.0, 0.05)])
+def test_joint_cramer_rao_is_the_weighted_fisher_inverse(sigma2):
+    """rtsgeom.identify.joint.joint_cramer_rao = sqrt(diag(F^-1)) on the free parameters,
+    F = sum_c 2 Re(J_c^H J_c) / sigma2_c over the captures' rows of the model's Jacobian
+    (a scalar sigma2 for every capture, or one per capture), NaN elsewhere."""
+    from rtsgeom.identify.joint import joint_cramer_rao
+    fronts = (_linear_front(2, 11, VTX.size), _linear_front(5, 12, VTX.size))
+    model = JointModel(fronts + (fronts[0],), np.array([0, 1, 0]), (2, 5), 3, 4, VTX, VRX)
+    theta = np.random.default_rng(3).normal(0, 0.3, model.size)
+    free = list(range(2 * N)) + [model.antenna_index("tx", 2, PARAMS.index("log_gain")),
+                                 model.antenna_index("rx", 1, PARAMS.index("phase"))]
+    _, jac = model.jacobian(theta, free)
+    s2 = np.broadcast_to(np.asarray(sigma2, float), (3,))
+    fim = sum(2 * np.real(j.conj().T @ j) / s for j, s in
+              zip(np.split(jac, 3), s2))
+    want = np.full(model.size, np.nan)
+    want[free] = np.sqrt(np.diag(np.linalg.inv(fim)))
+    got = joint_cramer_rao(model, theta, sigma2, free)
+    np.testing.assert_allclose(got, want, rtol=1e-10, atol=0)
+    assert np.isnan(got).sum() == model.size - len(free)

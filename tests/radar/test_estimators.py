@@ -422,3 +422,25 @@ def test_bad_smoothing_settings_are_refused_word_for_word():
                    "radar.angle_subarray = 3: must be 0 with 2-D (azimuth x elevation) "
                    "processing: spatial smoothing is implemented for the 1-D azimuth row only",
                    SceneError)
+
+
+@pytest.mark.parametrize("n", [2, 3, 4])
+def test_music_leaves_at_least_one_noise_eigenvector(n):
+    """rtsgeom.radar.estimators' MUSIC kernel on R = V diag(lam) V^H with k = 1..n eigenvalues
+    within SIGNAL_EIGEN_DB of the largest (the rest 60 dB below): the projector onto the
+    n - min(k, n - 1) smallest eigenvectors, so a full-rank, well-conditioned R (k = n) still
+    keeps one noise eigenvector (rank 1, trace 1), over a batch of covariances."""
+    rng = np.random.default_rng(n)
+    q, _ = np.linalg.qr(rng.normal(size=(n, n, n)) + 1j * rng.normal(size=(n, n, n)))
+    covs, want = [], []
+    for k in range(1, n + 1):
+        v = q[k - 1]
+        lam = np.r_[np.full(n - k, 1e-6), np.linspace(0.5, 1.0, k)]  # ascending
+        covs.append((v * lam) @ v.conj().T)
+        m = n - min(k, n - 1)
+        want.append(v[:, :m] @ v[:, :m].conj().T)
+    got = est.kernel(np.stack(covs), "music")
+    np.testing.assert_allclose(got, np.stack(want), rtol=0, atol=1e-9)
+    assert np.allclose(np.trace(got, axis1=-2, axis2=-1).real,
+                       [n - min(k, n - 1) for k in range(1, n + 1)], atol=1e-9)
+    assert np.linalg.matrix_rank(got[-1], tol=1e-6) == 1

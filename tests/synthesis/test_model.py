@@ -147,3 +147,27 @@ def test_air_legs_on_a_sphere_are_the_distances_to_the_elevated_front_ends(spher
     r_a, r_b = rev.air_legs(off[::-1])
     np.testing.assert_allclose(r_a, t_a[::-1], rtol=1e-13, atol=0)
     np.testing.assert_allclose(r_b, t_b[::-1], rtol=1e-13, atol=0)
+
+
+def test_direction_cosines_without_a_start_are_the_searched_angles(pair, sphere_model):
+    """``direction_cosines(w)`` (no ``u0``): D = 1, (..., 1) = sin of the searched azimuth;
+    D = 2 (scenes/sphere4.toml), (..., 2) = (sin az cos el, sin el) of the searched
+    (az, el), over a batch of weights."""
+    _, cm = pair
+    w = cm.pair_weights(np.array([[0.5, 1.0, 2.0], [0.8, 1.3, 0.3]]))
+    u = cm.direction_cosines(w)
+    assert cm.dims == 1 and u.shape == (2, 3, 1)
+    np.testing.assert_array_equal(u[..., 0], np.sin(cm.direction(w)))
+    from rtsgeom.radar.steering import Steering
+    setup, flat = sphere_model
+    steer = Steering.auto(setup.rut, setup.scene.radar)
+    sm = ChannelModel.build(setup, exact_paths(setup), flat.channels, TargetConfig(12.0),
+                            steering=steer)
+    rng = np.random.default_rng(5)
+    w2 = sm.weights(rng.uniform(0.3, 1.0, (3, sm.count)))
+    u2 = sm.direction_cosines(w2)
+    assert sm.dims == 2 and u2.shape == (3, 2)
+    az, el = np.moveaxis(sm.direction(w2), -1, 0)
+    np.testing.assert_allclose(u2, np.stack([np.sin(az) * np.cos(el), np.sin(el)], -1),
+                               rtol=0, atol=1e-15)
+    assert np.ptp(u2[:, 1]) > 1e-4  # the batch's elevations differ: not a constant read
