@@ -288,3 +288,34 @@ def test_the_resolution_cell_is_named_per_axis():
     assert _cell(np.array([0.5, 0.2, 0.02, 0.04])) == {
         "range_m": 0.5, "velocity_mps": 0.2, "direction_cosine": 0.02,
         "direction_cosine_elevation": 0.04}
+
+
+def _u_scale(u: float, factor: float) -> float:
+    """A cell ``s`` whose ``s * factor`` is exactly ``u`` in floating point."""
+    s = u / factor
+    for _ in range(64):
+        if s * factor == u:
+            return s
+        s = np.nextafter(s, np.inf if s * factor < u else -np.inf)
+    raise AssertionError("no exact cell")
+
+
+@pytest.mark.parametrize("az_deg", [0.7, 3.1])
+def test_pairs_counts_a_detection_one_cell_away_as_close_with_a_1e9_margin(az_deg):
+    """Each truth detection paired with the RTS's of its cell (-1: none); close where every
+    axis differs by at most one cell times (1 + 1e-9), the bound itself included: 1 + 1e-10
+    cells and exactly (1 + 1e-9) cells away in u are close, 1 + 1e-8 are not (still paired:
+    the gate is on range and Doppler only); a detection beyond one range bin is not paired."""
+    from rtsgeom.analysis.objects import pairs
+    u = float(np.sin(np.radians(az_deg)))
+    truth = np.array([[20.0, 1.0, 0.0, 0.0]])
+    rts = np.array([[20.0, 1.0, az_deg, 0.0]])
+    for factor, close in [(1 + 1e-10, True), (1 + 1e-9, True), (1 + 1e-8, False)]:
+        sc = (0.1, 0.05, _u_scale(u, factor))
+        det, ok = pairs(truth, rts, sc)
+        assert det.tolist() == [0] and ok.tolist() == [close], (factor, ok)
+    far = np.array([[20.0 + 0.1 * (1 + 1e-6), 1.0, 0.0, 0.0], [20.0, 1.0, 0.0, 0.0]])
+    det, ok = pairs(np.array([[20.0, 1.0, 0.0, 0.0]] * 2), far[:1], (0.1, 0.05, 0.01))
+    assert det.tolist() == [-1, -1] and ok.tolist() == [False, False]
+    det, ok = pairs(truth, far, (0.1, 0.05, 0.01))
+    assert det.tolist() == [1] and ok.tolist() == [True]

@@ -103,3 +103,29 @@ def test_run_scene_refuses_a_calibration_that_is_no_dict():
         assert_refused(lambda: run_scene(scene, calibration=bad),
                        f"run_scene: calibration = {type(bad).__name__}: must be a calibration "
                        "file's content (a dict, json.load of calibration.json)")
+
+
+@pytest.mark.parametrize("link", [False, True])
+@pytest.mark.parametrize("kinds", [(0, 0), (0, 2, 1), ()])
+def test_the_budget_estimates_the_sheet_only_for_a_link_without_setup_echoes(monkeypatch, link,
+                                                                             kinds):
+    """With ``[radar.link]`` the physical-optics sheet estimate (``sheet_paths`` then
+    ``setup_echoes``) is formed once where the echoes carry no setup reflection and handed to
+    ``link_budget``; never where they carry one, never without ``[radar.link]``."""
+    from types import SimpleNamespace
+    import rtsgeom.pipeline.run as run
+    from rtsgeom.rts.channels import EchoKind
+    calls = []
+    sp, est, setup = object(), object(), object()
+    monkeypatch.setattr(run, "sheet_paths", lambda s: calls.append(("sheet", s)) or sp)
+    monkeypatch.setattr(run, "setup_echoes",
+                        lambda s, p: calls.append(("echoes", s, p)) or est)
+    monkeypatch.setattr(run, "link_budget", lambda *a: a)
+    scene = SimpleNamespace(radar=SimpleNamespace(link=object() if link else None,
+                                                  snr_db=None))
+    echoes = SimpleNamespace(kind=np.array(kinds, int))
+    program = object()
+    got = run._budget(scene, setup, echoes, program)
+    formed = link and EchoKind.SETUP not in kinds
+    assert calls == ([("sheet", setup), ("echoes", setup, sp)] if formed else [])
+    assert got == (scene, echoes, program, link, None, est if formed else None)
