@@ -6,6 +6,12 @@ from __future__ import annotations
 
 # mutant name -> why it is equivalent (no observable change); filled in from the survivors
 EQUIVALENT: dict[str, str] = {
+    "rtsgeom.calibration.fit.x_fit_centre__mutmut_43":
+        "np.asarray(extra_phase_rad) without float: the callers pass the probes' phases as "
+        "float arrays already; the same array.",
+    "rtsgeom.synthesis.model.xǁChannelModelǁcoherent_phases__mutmut_32":
+        "a zero-magnitude product divided by 2.0 instead of 1.0: it is zero either way, so the "
+        "same sum and angle.",
     "rtsgeom.radar.newton.x_newton__mutmut_156":
         "a non-finite Hessian entry replaced by 1.0 instead of 0.0 before its eigenvalues are "
         "taken: such a row is not concave whatever they are (the test is ANDed with all "
