@@ -335,3 +335,18 @@ def test_a_batch_without_candidates_refines_to_nothing(estimator, subarray):
     u, val = peaks._refine_1d(st, x, cand)
     assert np.isfinite(u[1, 2, 0]) and abs(u[1, 2, 0] - 0.1) < 1e-5
     assert np.isnan(np.delete(val.ravel(), 7)).all()
+
+
+@pytest.mark.parametrize("estimator, subarray", [("bartlett", 0), ("capon", 5)])
+def test_the_1d_refinement_lands_on_a_lone_source_between_its_zoom_steps(estimator, subarray):
+    """One noiseless source at angles off the zoom grids (0.005 deg, then 1e-4 deg around the
+    candidate): the parabola through the finest three points moves the peak towards the source,
+    to within 1e-8 in u (a parabola fitted the wrong way would leave up to 3e-6)."""
+    from rtsgeom.radar import peaks
+    st = dataclasses.replace(_line(8), estimator=estimator, subarray=subarray)
+    true_deg = np.array([-23.45678, -3.21037, 0.00003, 7.00007, 18.76543])
+    u_true = np.sin(np.radians(true_deg))
+    x = np.stack([_snap(st, [u]) for u in u_true])
+    cand = np.radians(true_deg + 0.0231)[:, None]  # a grid candidate 0.0231 deg off
+    u, _ = peaks._refine_1d(st, x, cand)
+    assert np.abs(u[:, 0, 0] - u_true).max() < 1e-8
