@@ -510,7 +510,9 @@ def test_a_signal_deferred_out_of_an_import_is_raised_after_a_fork(capsys):
         with honoured_signals():
             _SignalInFinalizer(signal.SIGTERM)  # deferred: the timer fires 20 ms later
             t = time.monotonic()
-            while time.monotonic() - t < 0.1:  # forks while the timer is due
+            # forks until the timer fires (20 ms; seconds on a loaded machine, where a fixed
+            # 0.1 s of forking ended before it and the test failed now and then)
+            while time.monotonic() - t < 10.0:
                 fork_call(pow, 2, 3).result()
     assert "Exception ignored" not in capsys.readouterr().err
 
