@@ -316,4 +316,10 @@ def staged_dir(path, inputs: Iterable = (), before_swap=None) -> Iterator[Path]:
                 shutil.rmtree(old)
         finally:
             if stage.exists():
-                shutil.rmtree(stage, ignore_errors=True)
+                try:
+                    shutil.rmtree(stage, ignore_errors=True)
+                except BaseException:  # a signal's exception raised mid-removal (the CLI's
+                    # deferred SIGTERM can fire here after the staged run was refused): the
+                    # folder is still removed whole, then the exception goes on
+                    shutil.rmtree(stage, ignore_errors=True)
+                    raise

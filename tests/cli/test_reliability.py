@@ -575,3 +575,27 @@ def test_a_signal_between_the_last_write_and_the_swap_keeps_the_old_folder(tmp_p
             _wait_for_the_signal()  # (not reached where the swap was refused)
     _assert_old(out)
     _no_leftovers(tmp_path)
+
+
+def test_a_signal_raised_while_the_staging_folder_is_removed_still_removes_it(tmp_path,
+                                                                               monkeypatch):
+    """A run cut short: its staging folder is removed; a second exception raised inside that
+    removal (the CLI's deferred SIGTERM firing there) does not leave it half removed, and goes
+    on to the caller."""
+    import rtsgeom._lib.io as io_mod
+    real = io_mod.shutil.rmtree
+    calls = []
+
+    def interrupted_once(path, *a, **k):
+        calls.append(path)
+        if len(calls) == 1:  # the signal fires as the removal starts
+            raise Terminated()
+        return real(path, *a, **k)
+    monkeypatch.setattr(io_mod.shutil, "rmtree", interrupted_once)
+    out = tmp_path / "out"
+    with pytest.raises(Terminated):
+        with staged_dir(out) as stage:
+            (stage / "half.csv").write_text("x")
+            raise KeyboardInterrupt  # the run cut short
+    assert len(calls) == 2 and not list(tmp_path.glob(".out.rtsgeom-staging-*"))
+    assert not out.exists()
