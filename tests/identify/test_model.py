@@ -121,46 +121,37 @@ def _offsets(setup, cap, recorded_delay=False):
     return probe_offset_bins(rd.power, model)
 
 
-@pytest.mark.parametrize("shift", [0.5, -0.4])
-def test_a_sidecar_probe_range_off_by_part_of_a_bin_is_refused_whole(bench, shift):
-    """The sidecar's range ``shift`` bins off the echo: refused with the echo's range (the
-    sidecar's plus the offset it read, which is about -shift) in the whole message; a shift
-    of 0.1 bin (inside ``SUBBIN_LIMIT``) is measured."""
+_RANGE_TAIL = (", or a radial or channel delay offset larger than that moves the echo")
+
+
+@pytest.mark.parametrize("field, axis, shift, inside", [
+    ("range_m", 0, 0.5, 0.1), ("range_m", 0, -0.4, 0.1),
+    ("velocity_mps", 1, 0.3, 0.01), ("velocity_mps", 1, -0.3, 0.01)])
+def test_a_sidecar_probe_off_by_part_of_a_bin_is_refused_whole(bench, field, axis, shift,
+                                                               inside):
+    """The sidecar's probe range (velocity) ``shift`` range (Doppler) bins off the echo:
+    refused with the echo's position (the sidecar's plus the offset it read, which is about
+    -shift) in the whole message (the Doppler's without the range's 'or ...' tail); an
+    offset of ``inside`` bin (inside ``SUBBIN_LIMIT``) is measured."""
     from rtsgeom.identify.model import SUBBIN_LIMIT
     assert SUBBIN_LIMIT == {"range": 0.25, "doppler": 0.05}
     setup, cap, _ = bench
-    r_bin, _ = _bins(setup.scene.radar)
-    measure(setup, dataclasses.replace(cap, range_m=cap.range_m + 0.1 * r_bin))
-    have = cap.range_m + shift * r_bin
+    size = _bins(setup.scene.radar)[axis]
+    base = cap.range_m if axis == 0 else 0.0
+    measure(setup, dataclasses.replace(cap, **{field: base + inside * size}))
+    have = base + shift * size
+    moved = dataclasses.replace(cap, **{field: have})
     with pytest.raises(CaptureError) as exc:
-        measure(setup, dataclasses.replace(cap, range_m=have))
-    msg = str(exc.value)
-    off = _offsets(setup, dataclasses.replace(cap, range_m=have))[0]
+        measure(setup, moved)
+    off = _offsets(setup, moved)[axis]
     assert off == pytest.approx(-shift, abs=0.06)
-    assert msg == (
-        f"capture: probe_range_m = {have:g}: must be where the capture's echo is, "
-        f"{have + off * r_bin:.5g} m ({off:+.2f} bins of {r_bin:.4g} m away, at most 0.25 bin "
-        "on the nominal setup): the sidecar does not describe this capture, or a radial or "
-        "channel delay offset larger than that moves the echo")
-
-
-@pytest.mark.parametrize("shift", [0.3, -0.3])
-def test_a_sidecar_probe_velocity_off_by_part_of_a_bin_is_refused_whole(bench, shift):
-    """The sidecar's velocity ``shift`` Doppler bins off the static echo: refused whole (no
-    'or ...' tail for the Doppler); 0.01 bin off is measured."""
-    setup, cap, _ = bench
-    _, v_bin = _bins(setup.scene.radar)
-    measure(setup, dataclasses.replace(cap, velocity_mps=0.01 * v_bin))
-    have = shift * v_bin
-    with pytest.raises(CaptureError) as exc:
-        measure(setup, dataclasses.replace(cap, velocity_mps=have))
-    msg = str(exc.value)
-    off = _offsets(setup, dataclasses.replace(cap, velocity_mps=have))[1]
-    assert off == pytest.approx(-shift, abs=0.06)
-    assert msg == (
-        f"capture: probe_velocity_mps = {have:g}: must be where the capture's echo is, "
-        f"{have + off * v_bin:.5g} m/s ({off:+.2f} bins of {v_bin:.4g} m/s away, at most "
-        "0.05 bin on the nominal setup): the sidecar does not describe this capture")
+    unit, limit, name = (("m", 0.25, "probe_range_m") if axis == 0 else
+                         ("m/s", 0.05, "probe_velocity_mps"))
+    assert str(exc.value) == (
+        f"capture: {name} = {have:g}: must be where the capture's echo is, "
+        f"{have + off * size:.5g} {unit} ({off:+.2f} bins of {size:.4g} {unit} away, at most "
+        f"{limit:g} bin on the nominal setup): the sidecar does not describe this capture"
+        + (_RANGE_TAIL if axis == 0 else ""))
 
 
 def test_a_recorded_rts_delay_that_the_scene_s_air_path_misses_is_refused_whole(bench):
