@@ -29,8 +29,6 @@ SCENE = ROOT / "scenes" / "diewald2022.toml"
 COMPARED = ("summary.json", "detections.csv", "maps.npz")
 
 
-timed = timed_rtsgeom  # one whole process of rtsgeom, timed (benchmarks._io)
-
 
 def summary(runs: list[dict]) -> dict:
     return {f"median_{k}": statistics.median(r[k] for r in runs)
@@ -53,7 +51,7 @@ def main(argv=None) -> int:
     rows = {t: {c: [] for c in cases} for t in trees}
     with tempfile.TemporaryDirectory() as tmp:
         for tree, root in trees.items():  # the first run: bytecode, caches (not timed)
-            timed(["run", str(SCENE), "--out", str(Path(tmp) / f"{tree}-first"), "--quiet"],
+            timed_rtsgeom(["run", str(SCENE), "--out", str(Path(tmp) / f"{tree}-first"), "--quiet"],
                   root, bytecode=True)
         # every case and tree in turn within each repeat (not case after case): a shared
         # machine's slow minute then falls on all of them alike
@@ -61,7 +59,7 @@ def main(argv=None) -> int:
             for case, (extra, bytecode) in cases.items():
                 for tree, root in trees.items():
                     out = Path(tmp) / f"{tree}-{case.replace(' ', '').replace(',', '')}-{r}"
-                    rows[tree][case].append(timed(["run", str(SCENE), "--out", str(out),
+                    rows[tree][case].append(timed_rtsgeom(["run", str(SCENE), "--out", str(out),
                                                    "--quiet", *extra], root, bytecode))
                     x = rows[tree][case][-1]
                     print(f"{tree} {case}: {x['wall_s']:.2f} s wall, {x['cpu_s']:.2f} s CPU "

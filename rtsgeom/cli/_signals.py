@@ -46,6 +46,7 @@ _CALLBACK_PACKAGES = ("/llvmlite/", "/vtkmodules/")
 #: SIGTERM raised in ``np.unique`` of structured rows (building a setup) came out as
 #: "TypeError: Cannot compare structured arrays", a traceback instead of exit 143
 _CONVERTING_PACKAGES = ("/numpy/",)
+_UNSAFE_PACKAGES = _CALLBACK_PACKAGES + _CONVERTING_PACKAGES  # built once, not per frame
 
 
 def _unsafe(frame) -> bool:
@@ -54,7 +55,7 @@ def _unsafe(frame) -> bool:
         code = frame.f_code
         name = code.co_filename
         if (name.startswith("<frozen importlib") or code.co_name == "__del__"
-                or any(part in name for part in _CALLBACK_PACKAGES + _CONVERTING_PACKAGES)):
+                or any(part in name for part in _UNSAFE_PACKAGES)):
             return True
         frame = frame.f_back
     return False
