@@ -149,8 +149,9 @@ def _points(name: str, values) -> np.ndarray | None:
 def _power_map(ax, fig, x, y, power_db, xlabel: str, ylabel: str, title: str) -> None:
     """Colour map of power in dB over ``DYNAMIC_RANGE_DB`` below its maximum; a long title
     (a lab's scene name, a clipping note) wrapped, the top margin lowered for each extra line
-    (the margins are fixed: nothing else makes room for it)."""
-    lines = textwrap.wrap(title, 60) if title else []
+    (the margins are fixed: nothing else makes room for it; four lines at most, so the axes
+    keep their height)."""
+    lines = textwrap.wrap(title, 60, max_lines=4, placeholder=" ...") if title else []
     fig.subplots_adjust(**{**_MAP_MARGINS,
                            "top": _MAP_MARGINS["top"] - 0.04 * max(len(lines) - 1, 0)})
     finite = power_db[np.isfinite(power_db)]

@@ -219,6 +219,8 @@ def merge_lines(polylines: list[np.ndarray]):
     :func:`polyline` of each, merged; built at once: the 448 paths of a 64-front-end arc
     took 0.3 s as separate meshes)."""
     lines = [np.asarray(p, float).reshape(-1, 3) for p in polylines]
+    if not lines:  # nothing to draw (a sheet without cutouts has no rims)
+        return pv.PolyData()
     start = np.cumsum([0] + [len(p) for p in lines[:-1]])
     seg = np.concatenate([s + np.arange(len(p) - 1) for s, p in zip(start, lines)])
     cells = np.column_stack([np.full(len(seg), 2), seg, seg + 1])

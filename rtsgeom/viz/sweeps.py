@@ -5,6 +5,7 @@ figure per pair made a report of a 64-front-end arc 32 figures long, and cost 0.
 from __future__ import annotations
 
 import math
+import textwrap
 from typing import Mapping, Sequence
 
 import numpy as np
@@ -94,10 +95,14 @@ def calibration_sweeps_figure(sweeps: Sequence[Mapping], title: str = "") -> obj
                       label="chosen offset, its residual")]
     if periods:
         handles.append(Line2D([], [], linestyle=":", color="C2", label="chosen + k periods"))
-    fig.legend(handles=handles, loc="upper center", ncols=len(handles), frameon=False,
-               bbox_to_anchor=(0.5, 1 - 0.32 / height))
-    fig.suptitle(title or "Phase coherency calibration of each pair", fontsize=10,
-                 y=1 - 0.08 / height, va="top").set_parse_math(False)
+    # the legend in one row at 7 pt (at 8 pt four entries ran off a two-panel figure); the
+    # title wrapped to the figure's width (about 14 characters an inch), two lines at most
+    fig.legend(handles=handles, loc="upper center", ncols=len(handles),
+               frameon=False, bbox_to_anchor=(0.5, 1 - 0.32 / height), fontsize=7)
+    text = title or "Phase coherency calibration of each pair"
+    fig.suptitle("\n".join(textwrap.wrap(text, max(30, int(14 * width)), max_lines=2,
+                                          placeholder=" ...")),
+                 fontsize=10, y=1 - 0.02 / height, va="top").set_parse_math(False)
     if worst:
         fig.text(0.5, 0.06 / height, f"red titles: the {len(worst)} largest residuals",
                  ha="center", va="bottom", fontsize=8, color="C3")

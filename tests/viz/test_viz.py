@@ -500,3 +500,39 @@ def test_a_power_maps_long_title_wraps_and_the_axes_make_room_for_it(title, line
     title_box = ax.title.get_window_extent()
     width, height = fig.canvas.get_width_height()
     assert 0 <= title_box.x0 and title_box.x1 <= width and title_box.y1 <= height
+
+
+def test_a_title_of_any_length_keeps_the_maps_axes_and_no_lines_drawn_is_an_empty_mesh():
+    """A scene name of 2000 characters: at most four title lines (the rest elided), the axes
+    keep their place instead of subplots_adjust refusing a top under the bottom; merging no
+    polylines (a sheet without cutouts has no rims) is an empty mesh, not an error."""
+    from rtsgeom.viz.meshes import merge_lines
+    fig = F.range_doppler_figure(np.zeros((8, 6)), np.linspace(0, 50, 8),
+                                 np.linspace(-5, 5, 6), title="lab " * 500)
+    shown = fig.axes[0].get_title()
+    assert shown.count("\n") == 3 and shown.endswith(" ...")
+    assert fig.axes[0].get_position().y1 == pytest.approx(0.93 - 0.04 * 3)
+    assert merge_lines([]).n_points == 0
+
+
+@pytest.mark.parametrize("pairs", [2, 3, 8])
+def test_the_sweeps_legend_and_a_long_title_stay_on_the_figure(pairs):
+    """All four legend entries (periods drawn) in one row inside the figure, and a long title
+    wrapped onto two lines inside it, for two panels (the narrowest figure) and more."""
+    from rtsgeom.viz.sweeps import calibration_sweeps_figure
+    t = np.linspace(-1e-9, 1e-9, 21)
+    sweeps = [{"label": f"{k}-{k + 1}", "delta_tau_s": t, "angle_error_deg": 20 * np.sin(3e9 * t + k),
+               "chosen_delta_tau_s": 0.0, "residual_error_deg": 0.01, "period_s": 0.6e-9}
+              for k in range(pairs)]
+    fig = calibration_sweeps_figure(sweeps, title="a-rather-long-lab-scene-name: phase "
+                                    "coherency calibration of the front-end pairs " * 2)
+    fig.canvas.draw()
+    width, height = fig.canvas.get_width_height()
+    legend = fig.legends[0]
+    assert len(legend.get_texts()) == 4
+    box = legend.get_window_extent()
+    assert 0 <= box.x0 and box.x1 <= width
+    title = fig._suptitle  # noqa: SLF001
+    assert title.get_text().count("\n") == 1
+    tb = title.get_window_extent()
+    assert 0 <= tb.x0 and tb.x1 <= width and tb.y1 <= height
