@@ -95,14 +95,7 @@ def calibration_sweeps_figure(sweeps: Sequence[Mapping], title: str = "") -> obj
                       label="chosen offset, its residual")]
     if periods:
         handles.append(Line2D([], [], linestyle=":", color="C2", label="chosen + k periods"))
-    # the legend in one row at 7 pt (at 8 pt four entries ran off a two-panel figure); the
-    # title wrapped to the figure's width (about 14 characters an inch), two lines at most
-    fig.legend(handles=handles, loc="upper center", ncols=len(handles),
-               frameon=False, bbox_to_anchor=(0.5, 1 - 0.32 / height), fontsize=7)
-    text = title or "Phase coherency calibration of each pair"
-    fig.suptitle("\n".join(textwrap.wrap(text, max(30, int(14 * width)), max_lines=2,
-                                          placeholder=" ...")),
-                 fontsize=10, y=1 - 0.02 / height, va="top").set_parse_math(False)
+    _header(fig, handles, title or "Phase coherency calibration of each pair", width, height)
     if worst:
         fig.text(0.5, 0.06 / height, f"red titles: the {len(worst)} largest residuals",
                  ha="center", va="bottom", fontsize=8, color="C3")
@@ -132,6 +125,16 @@ def _array(s: Mapping, key: str) -> np.ndarray:
     """``s[key]`` as a float array (empty where absent or None)."""
     v = s.get(key)
     return np.asarray([] if v is None else v, float).ravel()
+
+
+def _header(fig, handles, title: str, width: float, height: float) -> None:
+    """The legend in one row at 7 pt (at 8 pt four entries ran off a two-panel figure) and
+    the title wrapped to the figure's width (about 14 characters an inch), two lines at most."""
+    fig.legend(handles=handles, loc="upper center", ncols=len(handles),
+               frameon=False, bbox_to_anchor=(0.5, 1 - 0.32 / height), fontsize=7)
+    fig.suptitle("\n".join(textwrap.wrap(title, max(30, int(14 * width)), max_lines=2,
+                                          placeholder=" ...")),
+                 fontsize=10, y=1 - 0.02 / height, va="top").set_parse_math(False)
 
 
 def _panel(ax, s: Mapping, worst: bool) -> bool:
