@@ -23,7 +23,8 @@ from ..rts.channels import Echoes, apparent_range
 from ..scene import Scene
 
 __all__ = ["association_scale", "direction_columns", "target_points", "detection_points",
-           "associate_targets", "match_targets", "undetected_reason", "truth_twin"]
+           "associate_targets", "match_targets", "undetected_reason", "truth_twin",
+           "in_gate"]
 
 def association_scale(scene: Scene, rd: RangeDoppler, steering=None) -> np.ndarray:
     """The association's resolution cell: range bin, velocity bin and the RuT's two-target
@@ -129,6 +130,16 @@ def match_targets(scene: Scene, det: Detections, rd: RangeDoppler, bins: int = 2
     return out
 
 
+def in_gate(det: Detections, rd, range_m: float, velocity_mps: float,
+            bins: int) -> np.ndarray:
+    """Which detections lie within ``bins`` range and Doppler bins of (``range_m``,
+    ``velocity_mps``) on the map axes ``rd`` (the association's gate, ends included)."""
+    dr = rd.range_m[1] - rd.range_m[0]
+    dv = rd.velocity_mps[1] - rd.velocity_mps[0]
+    return ((np.abs(det.range_m - range_m) <= bins * dr)
+            & (np.abs(det.velocity_mps - velocity_mps) <= bins * dv))
+
+
 def undetected_reason(scene: Scene, det: Detections, rd: RangeDoppler, target,
                       bins: int = 2, owner=None, seen_at: float | None = None) -> dict:
     """Why a target has no detection: the map's strongest cell within one bin of the target's
@@ -144,10 +155,7 @@ def undetected_reason(scene: Scene, det: Detections, rd: RangeDoppler, target,
     noise = float(np.median(rd.power)) * v / float(gammaincinv(v, 0.5))
     thr = float(scene.radar.cfar.threshold_db)
     snr = None if noise <= 0 else float(10 * np.log10(max(float(cell.max()), 1e-300) / noise))
-    dr = rd.range_m[1] - rd.range_m[0]
-    dv = rd.velocity_mps[1] - rd.velocity_mps[0]
-    near = ((np.abs(det.range_m - r_t) <= bins * dr)
-            & (np.abs(det.velocity_mps - target.velocity_mps) <= bins * dv))
+    near = in_gate(det, rd, r_t, target.velocity_mps, bins)
     if np.any(near):
         mine = np.flatnonzero(near)
         others = sorted({int(owner[j]) for j in mine if owner is not None and owner[j] >= 0})

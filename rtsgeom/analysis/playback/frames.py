@@ -23,7 +23,7 @@ from ...pipeline.merge import budget_targets
 from ...pipeline.plan import (FixedCalibration, calibrate_pairs, lead_program,
                               probe_pair, program_frames, target_namer, target_pairs,
                               uses_cells)
-from ...pipeline.matching import match_targets, truth_twin
+from ...pipeline.matching import in_gate, match_targets, truth_twin
 from ...radar.frame import observe
 from ...radar.windowed import cell_centres
 from ...calibration.channels import channel_offsets
@@ -193,12 +193,9 @@ def detect_frame(setup: Setup, paths: Paths, program: RtsProgram, scene_f: Scene
             compare=None if synthesized is None else compare, look=view)
         fallbacks += [] if why is None else [why]
     claimed = {m.get("detection_index") for m in matches}
-    dr = rd.range_m[1] - rd.range_m[0]
-    dv = rd.velocity_mps[1] - rd.velocity_mps[0]
     seen_at = apparent_range(scene_f, [t.range_m for t in compare])  # as the association
     extra = np.zeros(len(matches), int)
     for k, t in enumerate(compare):
-        near = np.flatnonzero((np.abs(det.range_m - seen_at[k]) <= bins * dr)
-                              & (np.abs(det.velocity_mps - t.velocity_mps) <= bins * dv))
+        near = np.flatnonzero(in_gate(det, rd, seen_at[k], t.velocity_mps, bins))
         extra[k] = sum(1 for j in near if j not in claimed)
     return matches, extra, (det, t_det, rd, view.steering), tuple(fallbacks)
